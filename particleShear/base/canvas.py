@@ -1,0 +1,987 @@
+"""Canvases: the ensemble state arrays and the vectorised step (spec §3, §4, §10.6).
+
+Each class of the documented chain adds one capability:
+
+=========================================  ==============================================
+``CanvasPoints``                           state arrays, ``sphereList``, bookkeeping
+``CanvasPointsMass``                       kick, damping, force register, momenta
+``CanvasPointsNeighbors``                  pair table and the O(N) neighbour update
+``CanvasPointsShear``                      Lees-Edwards offset, plates, shear rate
+``CanvasPointsBasicElasticity``            central elastic + viscous pair term
+``CanvasPointsBasicElasticityLeesEdwards`` rate changes, boundary-aware registration
+``CanvasPointsFrictionElasticityLeesEdwards``  tangential term, torques, ξ history
+=========================================  ==============================================
+
+A step never loops over spheres or pairs in Python.  Forces of one force phase
+are collected per active pair and applied with one ``bincount`` per component
+(`_flush_pair_forces`), which also fills the force register.
+"""
+import math
+
+import numpy as np
+
+from .graphics import Graphical_output_configuration
+from .kernels import le_wrap, min_image, pair_geometry, tangential_two_pass
+from .laws import call_law_vectorised
+from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
+from .points import CircleBasicElasticity, _check_finite, _check_positive
+from .register import Force_register, SphereSelection
+from .relations import _BaseRelationView
+
+__all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasPointsShear",
+           "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
+           "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative"]
+
+#: per-sphere arrays and their defaults
+FIELDS = {
+    "x": 0.0, "y": 0.0, "xspeed": 0.0, "yspeed": 0.0, "omega": 0.0, "phi": -math.pi / 2,
+    "r": 1.0, "m": 1.0, "inertia": 0.5, "xforce": 0.0, "yforce": 0.0, "torque": 0.0,
+    "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
+    "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
+}
+_PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
+           "keep_viscosity_coefficients_constant")
+
+
+def check_non_negative(name, value):
+    """Raise ValueError unless ``value`` is a finite number ≥ 0."""
+    _check_finite(name, value)
+    if value < 0:
+        raise ValueError(f"{name} must be >= 0, got {value!r}")
+
+
+class SphereList(list):
+    """The ensemble's spheres in index order; ``append`` moves a sphere's state into the arrays."""
+
+    def __init__(self, canvas):
+        list.__init__(self)
+        self._canvas = canvas
+
+    def append(self, sphere):
+        self._canvas._attach(sphere)
+        list.append(self, sphere)
+
+    def extend(self, spheres):
+        for s in spheres:
+            self.append(s)
+
+    def __iadd__(self, spheres):
+        self.extend(spheres)
+        return self
+
+    def _forbidden(self, *args, **kwargs):
+        raise TypeError("spheres cannot be removed, replaced or reordered once in an ensemble")
+
+    insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
+
+
+class _Geometry:
+    """Per-step arrays over the active pairs (positions at the start of the step)."""
+    __slots__ = ("slots", "ai", "aj", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
+                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt")
+
+
+class CanvasPoints:
+    """Cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form."""
+
+    use_lees_edwards = False
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False):
+        _check_positive("size_x", size_x)
+        _check_positive("size_y", size_y)
+        self.theCanvas = theCanvas
+        self.size_x = size_x
+        self.size_y = size_y
+        self.doDrawing = doDrawing
+        self._cap = 0
+        self._n = 0
+        self._buf = {name: np.zeros(0) for name in FIELDS}
+        self._a = {name: arr[:0] for name, arr in self._buf.items()}
+        self._sphereList = SphereList(self)
+        self._rng = np.random.default_rng()
+        self._renderer = None
+        self._uniform = {}
+        self.graphical_output_configuration = Graphical_output_configuration()
+
+    # -- sphere list and state arrays ----------------------------------------------------------
+    @property
+    def sphereList(self):
+        return self._sphereList
+
+    @sphereList.setter
+    def sphereList(self, spheres):
+        if len(self._sphereList):
+            raise TypeError("sphereList can only be assigned while the ensemble is empty")
+        for s in spheres:
+            self._sphereList.append(s)
+
+    def set_random_generator(self, rng):
+        """Use ``rng`` (a ``numpy.random.Generator``) for every random choice of this ensemble."""
+        self._rng = rng
+
+    def _attach(self, sphere):
+        if sphere.__dict__.get("_ens") is not None:
+            raise ValueError("sphere is already in an ensemble; a sphere can be appended to one ensemble only")
+        for name in ("x", "y", "xspeed", "yspeed"):
+            _check_finite(name, getattr(sphere, name))
+        _check_positive("r", getattr(sphere, "r", 1.0))
+        _check_positive("m", getattr(sphere, "m", 1.0))
+        n = self._n
+        if n == self._cap:
+            cap = max(16, 2 * self._cap)
+            for name, old in self._buf.items():
+                new = np.zeros(cap, dtype=old.dtype)
+                new[:n] = old[:n]
+                self._buf[name] = new
+            self._cap = cap
+        cls = type(sphere)
+        for name, default in FIELDS.items():
+            val = getattr(sphere, name) if hasattr(cls, name) else default
+            self._buf[name][n] = float(val)
+        self._n = n + 1
+        self._a = {name: arr[: self._n] for name, arr in self._buf.items()}
+        d = sphere.__dict__
+        d["_ens"] = self
+        d["_idx"] = n
+        for name in FIELDS:
+            d.pop("_v_" + name, None)
+        self._params_changed()
+        self._spheres_changed()
+
+    def _spheres_changed(self):
+        self._invalidate_neighbours()
+
+    def _invalidate_neighbours(self):
+        pass
+
+    def _params_changed(self):
+        self._uniform = {}
+
+    def _param(self, name):
+        """Scalar value of a per-sphere parameter if all spheres share it, else None."""
+        u = self._uniform
+        if name not in u:
+            arr = self._a[name]
+            u[name] = float(arr[0]) if len(arr) and (arr == arr[0]).all() else None
+        return u[name]
+
+    # -- bookkeeping ----------------------------------------------------------------------------
+    def set_graphical_output_configuration(self, graphical_output_configuration):
+        """Share one drawing configuration with every sphere."""
+        self.graphical_output_configuration = graphical_output_configuration
+        for s in self.sphereList:
+            s.set_graphical_output_configuration(graphical_output_configuration)
+
+    def initiateGraphics(self):
+        if self._renderer is not None:
+            self._renderer.draw(self)
+
+    def correct_linear_drift(self):
+        """Subtract the unweighted mean velocity from all spheres."""
+        a = self._a
+        if self._n:
+            a["xspeed"] -= a["xspeed"].sum() / self._n
+            a["yspeed"] -= a["yspeed"].sum() / self._n
+
+    def particle_info(self):
+        return "Points in a periodic cell"
+
+    def canMove(self, theSphere):
+        return True
+
+    def _mobile_mask(self):
+        """Boolean mask of mobile spheres, or None when every sphere is mobile."""
+        return None
+
+    def movableSphereList(self):
+        mob = self._mobile_mask()
+        if mob is None:
+            return list(self.sphereList)
+        return [self.sphereList[k] for k in np.flatnonzero(mob)]
+
+    def do_linear_acceleration(self, dt):
+        """Kick mobile spheres ``v += F·dt/m`` and reset their force."""
+        a = self._a
+        mob = self._mobile_mask()
+        fx, fy, m = a["xforce"], a["yforce"], a["m"]
+        if mob is None:
+            a["xspeed"] += fx * dt / m
+            a["yspeed"] += fy * dt / m
+            fx[:] = 0.0
+            fy[:] = 0.0
+        else:
+            a["xspeed"][mob] += fx[mob] * dt / m[mob]
+            a["yspeed"][mob] += fy[mob] * dt / m[mob]
+            fx[mob] = 0.0
+            fy[mob] = 0.0
+
+    def _cool_spin(self, f):
+        pass
+
+    def cool(self, f=0.8):
+        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` of all spheres (§4.4)."""
+        a = self._a
+        rate = getattr(self, "shear_rate", 0)
+        if rate:
+            u = rate * (a["y"] - self.size_y / 2)
+            a["xspeed"][:] = u + (a["xspeed"] - u) * f
+        else:
+            a["xspeed"] *= f
+        a["yspeed"] *= f
+        self._cool_spin(f)
+
+    def _drift(self, dt):
+        a = self._a
+        a["x"] += a["xspeed"] * dt
+        a["y"] += a["yspeed"] * dt
+
+    def move(self, dt=1):
+        self._drift(dt)
+
+    def _le_shift(self):
+        return 0.0
+
+    def boundary_conditions(self):
+        """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
+        a = self._a
+        le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
+                getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0)
+
+    def regular_sphere_distribution(self, rand_fraction=0.5):
+        """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing."""
+        n = self._n
+        if n == 0:
+            return
+        cols = int(math.ceil(math.sqrt(n * self.size_x / self.size_y)))
+        rows = int(math.ceil(n / cols))
+        sx, sy = self.size_x / cols, self.size_y / rows
+        k = np.arange(n)
+        jitter = (self._rng.random((2, n)) - 0.5) * rand_fraction
+        a = self._a
+        a["x"][:] = ((k % cols) + 0.5 + jitter[0] * 1.0) * sx % self.size_x
+        a["y"][:] = ((k // cols) + 0.5 + jitter[1] * 1.0) * sy % self.size_y
+        self._invalidate_neighbours()
+
+
+class CanvasPointsMass(CanvasPoints):
+    """Adds the clock ``t`` (s), the force register and momentum bookkeeping."""
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
+        CanvasPoints.__init__(self, size_x, size_y, theCanvas, doDrawing)
+        self.t = 0
+        self.force_register = Force_register()
+        self.m = m
+
+    def reset_force_register(self):
+        self.force_register.reset_force_register()
+
+    # Registration filters (§3.5) for scripts that apply forces sphere by sphere.
+    def _source_is_external(self, target, source):
+        return False
+
+    def record_individual_internal_force(self, target, source, force_vector):
+        if not self.canMove(target):
+            return
+        if not self.canMove(source) or self._source_is_external(target, source):
+            self.force_register.record_external_force(target, force_vector)
+        else:
+            self.force_register.record_individual_internal_force(target, source, force_vector)
+
+    def record_individual_internal_torque(self, target, source, moment):
+        if not self.canMove(target):
+            return
+        if not self.canMove(source) or self._source_is_external(target, source):
+            self.force_register.record_external_torque(target, moment)
+        else:
+            self.force_register.record_individual_internal_torque(target, source, moment)
+
+    def record_total_particle_force(self, target, force_vector):
+        if self.canMove(target):
+            self.force_register.record_total_particle_force(target, force_vector)
+
+    def record_external_force(self, target, force_vector):
+        if self.canMove(target):
+            self.force_register.record_external_force(target, force_vector)
+
+    def record_external_torque(self, target, moment):
+        if self.canMove(target):
+            self.force_register.record_external_torque(target, moment)
+
+    def record_unbalanced_moment(self, target, moment):
+        if self.canMove(target):
+            self.force_register.record_unbalanced_moment(target, moment)
+
+    def _torque_total(self):
+        return None
+
+    def record_total_particle_forces(self):
+        """Store the accumulated force of every mobile sphere (and torques, where spin exists)."""
+        a = self._a
+        self.force_register._set_totals(self, self._mobile_mask(), a["xforce"].copy(),
+                                        a["yforce"].copy(), self._torque_total())
+
+    def particle_info(self):
+        return "Spheres with mass"
+
+    def evaluate_stress_tensors(self, StressTensorEvaluator):
+        """Evaluate every tensor of §7 for the current register, mobile spheres and shear rate."""
+        StressTensorEvaluator.evaluate_stress_tensors(
+            self.force_register, SphereSelection(self, self._mobile_mask()), getattr(self, "shear_rate", 0))
+        return StressTensorEvaluator
+
+    def reset_force(self):
+        self._a["xforce"][:] = 0.0
+        self._a["yforce"][:] = 0.0
+
+    # Momenta (raw coordinates, origin at the cell corner) — conserved in isolated scenes.
+    def total_momentum(self):
+        """Linear momentum ``Σ m v`` (mg·µm/s per m depth)."""
+        a = self._a
+        return np.array([a["m"] @ a["xspeed"], a["m"] @ a["yspeed"]])
+
+    def total_angular_momentum(self):
+        """``Σ m (x v_y − y v_x) + Σ I ω`` about the origin (mg·µm²/s per m depth)."""
+        a = self._a
+        return float(a["m"] @ (a["x"] * a["yspeed"] - a["y"] * a["xspeed"]) + a["inertia"] @ a["omega"])
+
+
+class CanvasPointsNeighbors(CanvasPointsMass):
+    """Adds the pair table and the neighbour update (relations = contacts ∪ permanent links)."""
+
+    #: extra search distance of the candidate list, in units of the largest radius
+    neighbour_skin = 0.5
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
+        CanvasPointsMass.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
+        self._pairs = PairTable()
+        self._nl_valid = False
+        self._g = None
+        self._relation_view_class = _BaseRelationView
+        self._in_force_phase = False
+        self._disp = np.zeros((2, 0))
+
+    def _invalidate_neighbours(self):
+        self._nl_valid = False
+
+    def _links_changed(self):
+        self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
+
+    def _spheres_changed(self):
+        self._nl_valid = False
+        self._disp = np.zeros((2, self._n))
+
+    def _drift(self, dt):
+        a = self._a
+        sx = a["xspeed"] * dt
+        sy = a["yspeed"] * dt
+        a["x"] += sx
+        a["y"] += sy
+        self._disp[0] += sx
+        self._disp[1] += sy
+
+    def _skin(self):
+        return self.neighbour_skin * float(self._a["r"].max()) if self._n else 0.0
+
+    def _needs_rebuild(self):
+        if not self._nl_valid:
+            return True
+        d = self._disp
+        bound = 2 * math.sqrt(float((d[0] * d[0] + d[1] * d[1]).max())) if self._n else 0.0
+        bound += abs(self._le_shift() - self._nl_shift)
+        return bound >= self._nl_skin or (self.size_x, self.size_y) != self._nl_box
+
+    def _rebuild_candidates(self):
+        a = self._a
+        x = a["x"].copy()
+        y = a["y"].copy()
+        shift = self._le_shift()
+        le_wrap(x, y, np.zeros(self._n), self.size_x, self.size_y, shift, 0.0)
+        skin = self._skin()
+        i, j = candidate_pairs(x, y, a["r"], self.size_x, self.size_y, shift, skin)
+        self._pairs.replace(i, j)
+        self._nl_valid = True
+        self._nl_skin = skin
+        self._nl_shift = shift
+        self._nl_box = (self.size_x, self.size_y)
+        self._disp[:] = 0.0
+
+    def _shear_rate_for_images(self):
+        return 0.0
+
+    def test_neighbor_relation(self):
+        """Neighbour update (§4.2): activate touching pairs, drop transient ones that separated.
+
+        Also computes the geometry of the active pairs that every force term of
+        this step uses.
+        """
+        pt = self._pairs
+        if self._needs_rebuild():
+            self._rebuild_candidates()
+        a = self._a
+        x, y, r = a["x"], a["y"], a["r"]
+        i, j = pt.i, pt.j
+        Lx, Ly = self.size_x, self.size_y
+        dx0 = x[j] - x[i]
+        dy0 = y[j] - y[i]
+        dx, dy, dvx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+        d = np.sqrt(dx * dx + dy * dy)
+        d0 = r[i] + r[j]
+        touching = d < d0
+        perm = pt.state == PERMANENT if pt.n_permanent else None
+        new_active = touching if perm is None else (touching | perm)
+        old = pt.active
+        born = new_active & ~old
+        died = old & ~new_active
+        if born.any():
+            pt.state[born] = STICK
+            pt.xi_ij[born] = 0.0
+            pt.xi_ji[born] = 0.0
+            pt.birth[born] = pt.next_births(int(born.sum()))
+        if died.any():
+            pt.state[died] = STICK
+            pt.xi_ij[died] = 0.0
+            pt.xi_ji[died] = 0.0
+        pt.active = new_active
+        sel = np.flatnonzero(new_active)
+        g = _Geometry()
+        g.slots = sel
+        g.ai = i[sel]
+        g.aj = j[sel]
+        g.dx = dx[sel]
+        g.dy = dy[sel]
+        d_raw = np.sqrt(dx0[sel] ** 2 + dy0[sel] ** 2)
+        g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
+        g.dvx = None if dvx is None else dvx[sel]
+        g.d0 = d0[sel]
+        g.P = len(sel)
+        if perm is None:
+            g.perm = None
+            g.trans = None
+        else:
+            g.perm = perm[sel]
+            g.trans = ~g.perm
+            if not g.perm.any():
+                g.perm = g.trans = None
+        shifted = d_raw != g.d
+        mob = self._mobile_mask()
+        if mob is None:
+            g.internal = ~shifted
+            g.ext_i = shifted
+            g.ext_j = shifted
+        else:
+            mi = mob[g.ai]
+            mj = mob[g.aj]
+            g.internal = mi & mj & ~shifted
+            g.ext_i = mi & ~g.internal
+            g.ext_j = mj & ~g.internal
+        g.fn_i = np.zeros(g.P)
+        g.fn_j = None
+        g.ft = None
+        g.vn = None
+        g.vt = None
+        self._g = g
+        return g
+
+    # -- pair-force accumulation -----------------------------------------------------------------
+    def _geometry(self):
+        if self._g is None:
+            self.test_neighbor_relation()
+        return self._g
+
+    def _add_normal(self, f_i, f_j=None):
+        """Add scalar central forces along n_ij: ``f_i`` on i, ``f_j`` (default ``f_i``) on j (reversed)."""
+        g = self._g
+        if f_j is None and g.fn_j is None:
+            g.fn_i += f_i
+            return
+        if g.fn_j is None:
+            g.fn_j = g.fn_i.copy()
+        g.fn_i += f_i
+        g.fn_j += f_i if f_j is None else f_j
+
+    def _flush_pair_forces(self):
+        """Apply the collected pair forces to the spheres and put them into the force register."""
+        g = self._g
+        if g is None:
+            return
+        a = self._a
+        n = self._n
+        fn_i = g.fn_i
+        fn_j = fn_i if g.fn_j is None else g.fn_j
+        fix = fn_i * g.nx
+        fiy = fn_i * g.ny
+        if g.fn_j is None:
+            fjx = -fix
+            fjy = -fiy
+        else:
+            fjx = -fn_j * g.nx
+            fjy = -fn_j * g.ny
+        ti = tj = None
+        if g.ft is not None:
+            tx = -g.ny * g.ft
+            ty = g.nx * g.ft
+            fix = fix + tx
+            fiy = fiy + ty
+            fjx = fjx - tx
+            fjy = fjy - ty
+            df = g.d * g.ft
+            ri = a["r"][g.ai]
+            rj = a["r"][g.aj]
+            rs = ri + rj
+            ti = df * ri / rs
+            tj = df * rj / rs
+        if g.P:
+            idx = np.concatenate((g.ai, g.aj))
+            a["xforce"] += np.bincount(idx, np.concatenate((fix, fjx)), n)
+            a["yforce"] += np.bincount(idx, np.concatenate((fiy, fjy)), n)
+            if ti is not None:
+                a["torque"] += np.bincount(idx, np.concatenate((ti, tj)), n)
+        self.force_register._set_pairs(self, {
+            "i": g.ai, "j": g.aj, "fix": fix, "fiy": fiy, "fjx": fjx, "fjy": fjy, "ti": ti, "tj": tj,
+            "internal": g.internal, "ext_i": g.ext_i, "ext_j": g.ext_j})
+        g.fn_i = np.zeros(g.P)
+        g.fn_j = None
+        g.ft = None
+
+    def _term_done(self):
+        if not self._in_force_phase:
+            self._flush_pair_forces()
+
+    # -- views and scalar helpers for the API ------------------------------------------------------
+    def _relations_of(self, p):
+        pt = self._pairs
+        m = pt.active & ((pt.i == p) | (pt.j == p))
+        slots = np.flatnonzero(m)
+        slots = slots[np.argsort(pt.birth[slots], kind="stable")]
+        partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
+        cls = self._relation_view_class
+        return [cls(self, p, int(q)) for q in partners]
+
+    def _drop_relations_of(self, p):
+        pt = self._pairs
+        m = pt.active & ((pt.i == p) | (pt.j == p)) & (pt.state != PERMANENT)
+        pt.active[m] = False
+        pt.xi_ij[m] = 0.0
+        pt.xi_ji[m] = 0.0
+
+    def _pair_d(self, p, q):
+        a = self._a
+        dx, dy, _ = min_image(np.array([a["x"][q] - a["x"][p]]), np.array([a["y"][q] - a["y"][p]]),
+                              self.size_x, self.size_y, self._le_shift())
+        return float(np.sqrt(dx * dx + dy * dy)[0])
+
+    def _test_pair(self, p, q):
+        """Neighbour test of one pair (the scalar ``test_neighbor_relation(theSphere)`` API)."""
+        a = self._a
+        touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
+        pt = self._pairs
+        s = int(pt.find(p, q))
+        if touching:
+            s = int(pt.ensure(p, q)[0])
+            if not pt.active[s]:
+                pt.active[s] = True
+                pt.state[s] = STICK
+                pt.xi_ij[s] = pt.xi_ji[s] = 0.0
+                pt.birth[s] = pt.next_births(1)[0]
+        elif s >= 0 and pt.active[s] and pt.state[s] != PERMANENT:
+            pt.active[s] = False
+            pt.xi_ij[s] = pt.xi_ji[s] = 0.0
+
+    def contact_pairs(self):
+        """Sphere indices (i, j), i < j, of the current relations (contacts and links)."""
+        pt = self._pairs
+        return pt.i[pt.active].copy(), pt.j[pt.active].copy()
+
+
+class CanvasPointsShear(CanvasPointsNeighbors):
+    """Adds the shear strain ``shear`` (γ), its rate ``shear_rate`` (1/s) and the moving plates."""
+
+    use_lees_edwards = True
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
+        CanvasPointsNeighbors.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
+        self.t = 0
+        self.applyingShear = False
+        self.shear_rate = 0
+        self.shear = 0
+
+    def canMove(self, theSphere):
+        """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (§4.6)."""
+        if not self.applyingShear:
+            return True
+        return theSphere.r < theSphere.y < self.size_y - theSphere.r
+
+    def _mobile_mask(self):
+        if not self.applyingShear:
+            return None
+        a = self._a
+        y, r = a["y"], a["r"]
+        return (r < y) & (y < self.size_y - r)
+
+    def do_linear_acceleration(self, dt):
+        """Kick mobile spheres; immobile ones take the velocity of their plate (§4.1 step 4)."""
+        CanvasPointsNeighbors.do_linear_acceleration(self, dt)
+        mob = self._mobile_mask()
+        if mob is not None and not mob.all():
+            imm = ~mob
+            a = self._a
+            a["yspeed"][imm] = 0.0
+            v = self.shear_rate * self.size_y / 2
+            a["xspeed"][imm] = np.where(a["y"][imm] > self.size_y / 2, v, -v)
+
+    def transmit_lees_edwards_parameters(self, theSphere):
+        theSphere.size_x = self.size_x
+        theSphere.size_y = self.size_y
+        theSphere.shear = self.shear
+        theSphere.shear_rate = self.shear_rate
+        theSphere.use_lees_edwards = self.use_lees_edwards
+
+    def _le_shift(self):
+        return self.size_y * self.shear if self.use_lees_edwards else 0.0
+
+    def _shear_rate_for_images(self):
+        return self.shear_rate if self.use_lees_edwards else 0.0
+
+    def _source_is_external(self, target, source):
+        dx = source.x - target.x
+        dy = source.y - target.y
+        return math.sqrt(dx ** 2 + dy ** 2) != target.d(source)
+
+
+class CanvasPointsBasicElasticity(CanvasPointsShear):
+    """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``."""
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1):
+        CanvasPointsShear.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
+        check_non_negative("k", k)
+        check_non_negative("nu", nu)
+        self.k = k
+        self.nu = nu
+        self.central_repulsion_coefficient = 0
+
+    def set_central_repulsion_coefficient(self, central_repulsion_coefficient=0):
+        """Set the law's repulsion coefficient c ∈ [0, 1] on the ensemble and every sphere."""
+        _check_finite("central_repulsion_coefficient", central_repulsion_coefficient)
+        self.central_repulsion_coefficient = central_repulsion_coefficient
+        self._a["central_repulsion_coefficient"][:] = central_repulsion_coefficient
+        self._params_changed()
+
+    def _pair_param(self, name, g):
+        """(value seen by the visit from i, from j): scalars when all spheres agree."""
+        v = self._param(name)
+        if v is not None:
+            return v, v
+        arr = self._a[name]
+        return arr[g.ai], arr[g.aj]
+
+    def _law(self, d, d0, k, c):
+        return call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, d, d0, k, c)
+
+    def elastic_force_from_neighbors(self):
+        """Central elastic force of every relation (§2.4-2.5)."""
+        self._geometry()
+        self._elastic_terms()
+        self._term_done()
+
+    def _elastic_terms(self):
+        """Transient contacts: ``law(d, r_i + r_j, k, c)`` along n_ij."""
+        g = self._g
+        if g.P:
+            tr = g.trans
+            c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
+            d, d0 = (g.d, g.d0) if tr is None else (g.d[tr], g.d0[tr])
+            if tr is not None and np.ndim(c_i):
+                c_i, c_j = c_i[tr], c_j[tr]
+            touch = d < d0
+            f_i = np.where(touch, self._law(d, d0, self.k, c_i), 0.0)
+            f_j = None if np.ndim(c_i) == 0 else np.where(touch, self._law(d, d0, self.k, c_j), 0.0)
+            if tr is not None:
+                f_i = self._scatter(f_i, tr, g.P)
+                f_j = None if f_j is None else self._scatter(f_j, tr, g.P)
+            self._add_normal(f_i, f_j)
+
+    @staticmethod
+    def _scatter(values, mask, n):
+        out = np.zeros(n)
+        out[mask] = values
+        return out
+
+    def _relative_velocity(self, g):
+        a = self._a
+        vx, vy = a["xspeed"], a["yspeed"]
+        rvx = vx[g.aj] - vx[g.ai]
+        if g.dvx is not None:
+            rvx = rvx + g.dvx
+        return rvx, vy[g.aj] - vy[g.ai]
+
+    def _normal_speed(self, g):
+        if g.vn is None:
+            rvx, rvy = self._relative_velocity(g)
+            g.vn = rvx * g.nx + rvy * g.ny
+        return g.vn
+
+    def _viscous_scale(self, g):
+        """Per-pair factor on ν (1 except for permanent links of the adjustable class)."""
+        return None
+
+    def central_viscous_force_from_neighbors(self):
+        """Central viscous force ``ν v_n`` of every relation (§2.4)."""
+        self._geometry()
+        self._viscous_terms()
+        self._term_done()
+
+    def _viscous_terms(self):
+        g = self._g
+        if g.P and self.nu != 0:
+            f = self.nu * self._normal_speed(g)
+            scale = self._viscous_scale(g)
+            if scale is None:
+                self._add_normal(f)
+            else:
+                self._add_normal(f * scale[0], f * scale[1])
+
+    def elastic_force(self):
+        """All-pairs variant (reference API): a neighbour update, then the elastic term."""
+        self.test_neighbor_relation()
+        self.elastic_force_from_neighbors()
+
+    def central_viscous_force(self):
+        self.test_neighbor_relation()
+        self.central_viscous_force_from_neighbors()
+
+    def _force_terms(self):
+        self._elastic_terms()
+        self._viscous_terms()
+
+    def mechanical_simulation_step_calculate_forces(self, dt=1):
+        """Clear the register, update neighbours, add every pair force (§4.1 step 1)."""
+        self.reset_force_register()
+        self.test_neighbor_relation()
+        self._in_force_phase = True
+        try:
+            self._force_terms()
+        finally:
+            self._in_force_phase = False
+        self._flush_pair_forces()
+
+    def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
+        self.do_linear_acceleration(dt)
+        self.cool(cool_factor)
+
+    def _advance_strain(self, dt):
+        if self.applyingShear:
+            self.shear = self.shear + self.shear_rate * dt
+
+    def mechanical_simulation_step_calculate_movement(self, dt=1):
+        """Drift, strain update, wrap, clock (§4.1 steps 5-6)."""
+        self.move(dt)
+        self._advance_strain(dt)
+        self.boundary_conditions()
+        self.t = self.t + dt
+        self._g = None
+        if self._renderer is not None:
+            self._renderer.update(self)
+
+    def mechanical_simulation_step(self, cool_factor=0.97, dt=1):
+        """One step in reference order: forces → totals → kick + damping → movement."""
+        self.mechanical_simulation_step_calculate_forces()
+        self.record_total_particle_forces()
+        self.mechanical_simulation_step_calculate_acceleration(cool_factor, dt)
+        self.mechanical_simulation_step_calculate_movement(dt)
+
+    def mechanical_relaxation(self, N=1000, cool_factor=0.97, dt=1, theTk=False, StressTensorEvaluator=False):
+        """N steps; optionally a window update and a stress evaluation after each."""
+        for _ in range(int(N)):
+            self.mechanical_simulation_step(cool_factor, dt)
+            if theTk:
+                theTk.update()
+            if StressTensorEvaluator:
+                self.evaluate_stress_tensors(StressTensorEvaluator)
+
+    @property
+    def active_terms(self):
+        """Names of the force terms a step of this ensemble evaluates now."""
+        terms = ["central_elastic"]
+        if self.nu != 0:
+            terms.append("central_viscous")
+        return terms
+
+
+class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
+    """Adds shear-rate changes that keep velocities relative to the flow (§4.5)."""
+
+    def setShear(self, theShear):
+        self.shear = theShear
+        self._g = None
+
+    def setShearInSpheres(self):
+        pass  # spheres read γ from the ensemble
+
+    def setShearRateInSpheres(self):
+        pass  # spheres read γ̇ from the ensemble
+
+    def adjust_sphere_speed_to_shear_rate_change(self, delta_shear_rate):
+        a = self._a
+        a["xspeed"] += (a["y"] - self.size_y / 2) * delta_shear_rate
+        a["omega"] -= delta_shear_rate / 2
+
+    def setShearRate(self, theShearRate):
+        """Change γ̇; every sphere keeps its velocity relative to the local flow."""
+        delta = theShearRate - self.shear_rate
+        if delta != 0:
+            self.adjust_sphere_speed_to_shear_rate_change(delta)
+        self.shear_rate = theShearRate
+
+
+class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesEdwards):
+    """Adds the tangential force (``k_t``, ``nu_t``, Coulomb ``mu``), spin and the ξ history."""
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1, k_t=1,
+                 nu_t=0.01, mu=0.1):
+        CanvasPointsBasicElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
+        check_non_negative("k_t", k_t)
+        check_non_negative("nu_t", nu_t)
+        check_non_negative("mu", mu)
+        self.k_t = k_t
+        self.nu_t = nu_t
+        self.mu = mu
+
+    def _tangential_speed(self, g):
+        if g.vt is None:
+            a = self._a
+            rvx, rvy = self._relative_velocity(g)
+            om, r = a["omega"], a["r"]
+            g.vt = (rvx * -g.ny + rvy * g.nx) - (r[g.ai] * om[g.ai] + r[g.aj] * om[g.aj])
+        return g.vt
+
+    def _add_tangential(self, f_pair):
+        g = self._g
+        g.ft = f_pair if g.ft is None else g.ft + f_pair
+
+    def _tangential_needed(self):
+        return self.mu != 0
+
+    def tangential_force_from_neighbors(self):
+        """Two-visit tangential force of every relation (§2.6-2.8, B.3)."""
+        self._geometry()
+        self._tangential_terms()
+        self._term_done()
+
+    def _tangential_terms(self):
+        """Transient contacts: viscous + spring on ξ, Coulomb-limited, two visits."""
+        g = self._g
+        pt = self._pairs
+        if g.P:
+            sel = g.slots if g.trans is None else g.slots[g.trans]
+            if len(sel):
+                if not self._tangential_needed():
+                    # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
+                    pt.state[sel] = SLIP
+                    pt.xi_ij[sel] = 0.0
+                    pt.xi_ji[sel] = 0.0
+                else:
+                    vt = self._tangential_speed(g)
+                    d, d0 = g.d, g.d0
+                    c_i = self._param("central_repulsion_coefficient")
+                    if g.trans is not None:
+                        vt, d, d0 = vt[g.trans], d[g.trans], d0[g.trans]
+                    if c_i is None:
+                        cc = self._a["central_repulsion_coefficient"][g.ai]
+                        c_i = cc if g.trans is None else cc[g.trans]
+                    fc = np.abs(self.mu * self._law(d, d0, self.k, c_i))
+                    xi_ij = pt.xi_ij[sel]
+                    xi_ji = pt.xi_ji[sel]
+                    touching = d < d0
+                    f1, f2, slip = tangential_two_pass(
+                        vt, touching, np.zeros(len(sel), bool), xi_ij, xi_ji, self.k_t, self.k_t,
+                        self.nu_t, self.nu_t, fc)
+                    pt.xi_ij[sel] = xi_ij
+                    pt.xi_ji[sel] = xi_ji
+                    state = np.where(slip, SLIP, STICK).astype(np.int8)
+                    # a transient relation that no longer touches keeps its state and gets no force
+                    if not touching.all():
+                        state = np.where(touching, state, pt.state[sel])
+                        f1 = np.where(touching, f1, 0.0)
+                        f2 = np.where(touching, f2, 0.0)
+                    pt.state[sel] = state
+                    f_pair = f1 / 2 + f2 / 2
+                    self._add_tangential(f_pair if g.trans is None else self._scatter(f_pair, g.trans, g.P))
+
+    def tangential_force(self):
+        """All-pairs variant (reference API)."""
+        self.test_neighbor_relation()
+        self.tangential_force_from_neighbors()
+
+    def _force_terms(self):
+        CanvasPointsBasicElasticityLeesEdwards._force_terms(self)
+        self._tangential_terms()
+
+    def _torque_total(self):
+        return self._a["torque"].copy()
+
+    def do_rotational_acceleration(self, dt):
+        a = self._a
+        a["omega"] += a["torque"] * dt / a["inertia"]
+        a["torque"][:] = 0.0
+
+    def _cool_spin(self, f):
+        self._a["omega"] *= f
+
+    def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
+        """Linear kick (plates), rotational kick of all spheres, damping (§4.1 step 4)."""
+        self.do_linear_acceleration(dt)
+        self.do_rotational_acceleration(dt)
+        self.cool(cool_factor)
+
+    def _integrate_xi(self, dt):
+        """Sequential ξ rule of the reference, without a Python loop (§2.10, B.2)."""
+        g = self._g
+        if g is None or not g.P:
+            return
+        pt = self._pairs
+        st = pt.state[g.slots]
+        keep = st != SLIP
+        if not keep.any():
+            return
+        a = self._a
+        x, y, vx, vy, om, r = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"], a["r"]
+        allk = keep.all()
+        sl = g.slots if allk else g.slots[keep]
+        ai = g.ai if allk else g.ai[keep]
+        aj = g.aj if allk else g.aj[keep]
+        nx = g.nx if allk else g.nx[keep]
+        ny = g.ny if allk else g.ny[keep]
+        spin = r[ai] * om[ai] + r[aj] * om[aj]
+        # relation i→j: both spheres still at their old positions
+        rvx = vx[aj] - vx[ai]
+        if g.dvx is not None:
+            rvx = rvx + (g.dvx if allk else g.dvx[keep])
+        rvy = vy[aj] - vy[ai]
+        pt.xi_ij[sl] += ((rvx * -ny + rvy * nx) - spin) * dt
+        # relation j→i: i (lower index) has already moved
+        xin = x[ai] + vx[ai] * dt
+        yin = y[ai] + vy[ai] * dt
+        dx, dy, dvx = min_image(xin - x[aj], yin - y[aj], self.size_x, self.size_y, self._le_shift(),
+                                self._shear_rate_for_images())
+        _, mx, my = pair_geometry(dx, dy, self._rng)
+        svx = vx[ai] - vx[aj]
+        if dvx is not None:
+            svx = svx + dvx
+        svy = vy[ai] - vy[aj]
+        pt.xi_ji[sl] += ((svx * -my + svy * mx) - spin) * dt
+
+    def move(self, dt=1):
+        a = self._a
+        a["phi"] += a["omega"] * dt
+        self._integrate_xi(dt)
+        self._drift(dt)
+
+    def _advance_strain(self, dt):
+        self.shear = self.shear + self.shear_rate * dt
+
+    @property
+    def active_terms(self):
+        terms = CanvasPointsBasicElasticityLeesEdwards.active_terms.fget(self)
+        if self._tangential_needed():
+            terms.append("tangential")
+        return terms

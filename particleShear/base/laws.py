@@ -1,0 +1,118 @@
+"""Central force laws (spec §2.3, §2.5, §2.12).
+
+Every law works on Python scalars and on NumPy arrays alike: the engine calls
+them once per step on whole pair arrays, the sphere API calls them on scalars.
+Sign convention: negative = repulsion, positive = attraction.  Distances in µm,
+spring constants in mg·s⁻² per m depth, forces in mg·µm·s⁻² per m depth.
+"""
+import numpy as np
+
+__all__ = [
+    "elastic_force_law", "elastic_force_law_plateau", "distance_transform_plateau",
+    "PlateauConfiguration", "elastic_force_law_tensile",
+    "elastic_force_law_tensile_exponential", "TensileConfiguration",
+    "call_law_vectorised",
+]
+
+
+def _scalar_result(value, *args):
+    """Return a Python float when every argument was a scalar."""
+    if all(np.ndim(a) == 0 for a in args):
+        return float(value)
+    return value
+
+
+def elastic_force_law(d, d0, k, central_repulsion_coefficient):
+    """Blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law; 0 for d > d0.
+
+    The divergent part is capped at ``d0/d = 1000`` (eq. S1-6).
+    """
+    c = central_repulsion_coefficient
+    if np.ndim(d) == 0 and np.ndim(d0) == 0:
+        if d > d0:
+            return 0
+        f_lin = -k * (1 - c) * (d0 - d)
+        f_nl = -k * c * d0 * (d0 / max(d, d0 / 1000) - 1)
+        return _scalar_result(f_lin + f_nl, k, c)
+    d = np.asarray(d, dtype=float)
+    f_lin = -k * (1 - c) * (d0 - d)
+    f_nl = -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)
+    return np.where(d > d0, 0.0, f_lin + f_nl)
+
+
+class PlateauConfiguration:
+    """Static parameters of the plateau law, as fractions of the contact distance."""
+    relative_plateau_begin = 0.3
+    relative_plateau_end = 0.8
+    relative_plateau_slope = 0.1
+
+
+def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_slope):
+    """Continuous distance mapping that flattens the law between begin and end (µm)."""
+    pb, pe, s = plateau_begin, plateau_end, relative_plateau_slope
+    if np.ndim(d) == 0 and np.ndim(pb) == 0 and np.ndim(pe) == 0:
+        if d >= pe:
+            return d
+        if d >= pb:
+            return pe + (d - pe) * s
+        return d * (pe + (pb - pe) * s) / pb
+    d = np.asarray(d, dtype=float)
+    return np.where(d >= pe, d, np.where(d >= pb, pe + (d - pe) * s, d * (pe + (pb - pe) * s) / pb))
+
+
+def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
+    """Law of spongy particles: the default law evaluated on a plateau-transformed distance."""
+    pb = PlateauConfiguration.relative_plateau_begin * d0
+    pe = PlateauConfiguration.relative_plateau_end * d0
+    s = PlateauConfiguration.relative_plateau_slope
+    c = central_repulsion_coefficient
+    if np.ndim(d) == 0 and np.ndim(d0) == 0:
+        if d > d0:
+            return 0
+        dp = distance_transform_plateau(d, pb, pe, s)
+        return _scalar_result(-k * (1 - c) * (d0 - dp) - k * c * d0 * (d0 / max(dp, d0 / 1000) - 1), k, c)
+    d = np.asarray(d, dtype=float)
+    dp = distance_transform_plateau(d, pb, pe, s)
+    val = -k * (1 - c) * (d0 - dp) - k * c * d0 * (d0 / np.maximum(dp, d0 / 1000) - 1)
+    return np.where(d > d0, 0.0, val)
+
+
+def elastic_force_law_tensile(d, d0, k):
+    """Linear tensile law of permanent links: ``-k (d0 - d)`` (attractive for d > d0)."""
+    return -k * (d0 - d)
+
+
+class TensileConfiguration:
+    """Static parameter of the saturating tensile law (relative decay length)."""
+    d_exponential = 0.2
+
+
+def elastic_force_law_tensile_exponential(d, d0, k):
+    """Saturating tensile law: slope k at d0, limit ``k·d0·δ`` (δ = TensileConfiguration.d_exponential)."""
+    delta = TensileConfiguration.d_exponential
+    return k * d0 * delta * (1 - np.exp(-(d - d0) / (d0 * delta)))
+
+
+_NUMPY_AWARE = {elastic_force_law, elastic_force_law_plateau, elastic_force_law_tensile,
+                elastic_force_law_tensile_exponential}
+
+
+def call_law_vectorised(law, *args):
+    """Evaluate a (possibly user-supplied, scalar-only) law on pair arrays.
+
+    Laws of this module accept arrays directly; any other callable is tried on
+    arrays and, if that fails or returns the wrong shape, applied element-wise.
+    """
+    n = np.shape(args[0])
+    if law in _NUMPY_AWARE:
+        return np.asarray(law(*args), dtype=float)
+    if n == () or n[0] == 0:
+        return np.zeros(n)
+    try:
+        out = np.asarray(law(*args), dtype=float)
+        if out.shape == n:
+            return out
+    except Exception:
+        pass
+    bc = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in args])
+    return np.array([float(law(*vals)) for vals in zip(*[b.tolist() for b in bc])], dtype=float)

@@ -1,0 +1,154 @@
+"""Pair table and O(N) neighbour search with Lees-Edwards-shifted cell rows (spec §4.2, B.4).
+
+The pair table holds candidate pairs ``i < j`` (list indices) found within
+``r_i + r_j + skin`` plus every permanent link; a pair is *active* (a relation
+in the reference sense) while it touches or is permanent.  Candidates are
+rebuilt only when spheres or the shear offset have moved by more than the skin
+allows, so the per-step contact set is exactly the all-pairs one.
+"""
+import numpy as np
+
+from .kernels import min_image
+
+__all__ = ["PairTable", "STICK", "SLIP", "PERMANENT", "STATE_NAMES", "candidate_pairs", "all_pairs"]
+
+STICK, SLIP, PERMANENT = 0, 1, 2
+STATE_NAMES = ("stick", "slip", "permanent")
+STATE_CODES = {"stick": STICK, "slip": SLIP, "permanent": PERMANENT}
+
+
+def _key(i, j):
+    return (np.asarray(i, dtype=np.int64) << 32) | np.asarray(j, dtype=np.int64)
+
+
+class PairTable:
+    """Structure of arrays over candidate pairs, sorted by (i, j)."""
+
+    FIELDS = ("i", "j", "state", "xi_ij", "xi_ji", "d_eq", "active", "birth")
+
+    def __init__(self):
+        self.i = np.zeros(0, dtype=np.intp)
+        self.j = np.zeros(0, dtype=np.intp)
+        self.key = np.zeros(0, dtype=np.int64)
+        self.state = np.zeros(0, dtype=np.int8)
+        self.xi_ij = np.zeros(0)
+        self.xi_ji = np.zeros(0)
+        self.d_eq = np.zeros(0)
+        self.active = np.zeros(0, dtype=bool)
+        self.birth = np.zeros(0, dtype=np.int64)
+        self.n_permanent = 0
+        self._births = 0
+
+    def __len__(self):
+        return len(self.i)
+
+    def find(self, i, j):
+        """Slots of pairs (i, j) (any order), -1 where absent."""
+        i = np.asarray(i)
+        j = np.asarray(j)
+        lo, hi = np.minimum(i, j), np.maximum(i, j)
+        k = _key(lo, hi)
+        pos = np.searchsorted(self.key, k)
+        pos_c = np.minimum(pos, max(len(self.key) - 1, 0))
+        found = (pos < len(self.key)) & (self.key[pos_c] == k) if len(self.key) else np.zeros(np.shape(k), bool)
+        return np.where(found, pos_c, -1)
+
+    def next_births(self, n):
+        b = np.arange(self._births, self._births + n, dtype=np.int64)
+        self._births += n
+        return b
+
+    def replace(self, i, j, keep_existing=False):
+        """Make (i, j) the candidate set, keeping the state of pairs present before.
+
+        Permanent and active pairs are always kept; with ``keep_existing`` every
+        existing row is kept and (i, j) are added.
+        """
+        keep = slice(None) if keep_existing else (self.active | (self.state == PERMANENT))
+        lo = np.concatenate([np.minimum(i, j), self.i[keep]])
+        hi = np.concatenate([np.maximum(i, j), self.j[keep]])
+        k = np.unique(_key(lo, hi))
+        old_key = self.key
+        pos = np.searchsorted(old_key, k)
+        pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
+        had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
+        src = pos_c[had]
+        n = len(k)
+        self.i = (k >> 32).astype(np.intp)
+        self.j = (k & 0xFFFFFFFF).astype(np.intp)
+        for name, dtype in (("state", np.int8), ("xi_ij", float), ("xi_ji", float), ("d_eq", float),
+                            ("active", bool), ("birth", np.int64)):
+            arr = np.zeros(n, dtype=dtype)
+            if len(src):
+                arr[had] = getattr(self, name)[src]
+            setattr(self, name, arr)
+        self.key = k
+
+    def ensure(self, i, j):
+        """Slots of pairs (i, j), inserting missing ones (inactive, stick, ξ = 0)."""
+        i = np.atleast_1d(np.asarray(i, dtype=np.intp))
+        j = np.atleast_1d(np.asarray(j, dtype=np.intp))
+        slots = self.find(i, j)
+        miss = slots < 0
+        if miss.any():
+            self.replace(i[miss], j[miss], keep_existing=True)
+            slots = self.find(i, j)
+        return slots
+
+
+def all_pairs(n):
+    """Every pair i < j (test oracle and small systems)."""
+    i, j = np.triu_indices(n, 1)
+    return i.astype(np.intp), j.astype(np.intp)
+
+
+def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
+    """Pairs i < j whose minimum-image distance is below ``r_i + r_j + skin``.
+
+    Cell list with rows above/below the cell searched at the x position moved
+    by the Lees-Edwards offset ``shift = Ly·γ``; all-pairs when the cell grid
+    would be smaller than 3 × 3.  ``x``, ``y`` must lie in the cell.
+    """
+    n = len(x)
+    if n < 2:
+        return np.zeros(0, np.intp), np.zeros(0, np.intp)
+    rc = 2 * float(r.max()) + skin
+    nx = int(Lx // rc) if rc > 0 else 0
+    ny = int(Ly // rc) if rc > 0 else 0
+    if nx < 3 or ny < 3 or n < 64:
+        i, j = all_pairs(n)
+    else:
+        cw = Lx / nx
+        ch = Ly / ny
+        cx = np.minimum((x / cw).astype(np.intp), nx - 1)
+        cy = np.minimum((y / ch).astype(np.intp), ny - 1)
+        cell = cy * nx + cx
+        order = np.argsort(cell, kind="stable")
+        counts = np.bincount(cell, minlength=nx * ny)
+        start = np.concatenate(([0], np.cumsum(counts)[:-1]))
+        cells = np.empty((n, 9), dtype=np.intp)
+        col = 0
+        for drow in (-1, 0, 1):
+            row = cy + drow
+            if drow == 0:
+                c0 = cx
+            else:
+                xs = x - shift if drow == 1 else x + shift
+                xs = np.where(row >= ny, xs, x) if drow == 1 else np.where(row < 0, xs, x)
+                c0 = np.minimum((np.mod(xs, Lx) / cw).astype(np.intp), nx - 1)
+            row = np.mod(row, ny)
+            for dcol in (-1, 0, 1):
+                cells[:, col] = row * nx + np.mod(c0 + dcol, nx)
+                col += 1
+        cnt = counts[cells].ravel()
+        total = int(cnt.sum())
+        owner = np.repeat(np.repeat(np.arange(n, dtype=np.intp), 9), cnt)
+        first = np.repeat(start[cells].ravel(), cnt)
+        offs = np.arange(total, dtype=np.intp) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        other = order[first + offs]
+        sel = owner < other
+        i, j = owner[sel], other[sel]
+    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+    reach = r[i] + r[j] + skin
+    sel = dx * dx + dy * dy < reach * reach
+    return i[sel], j[sel]

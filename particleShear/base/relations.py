@@ -1,0 +1,89 @@
+"""Neighbour relations (spec §10.5): plain objects, and views of an ensemble's pair table."""
+from .neighbours import STATE_CODES, STATE_NAMES
+
+__all__ = ["neighbor_relation", "RelationView"]
+
+
+class neighbor_relation:
+    """Directed relation of a sphere to ``theSphere``: state and tangential history ξ (µm)."""
+
+    def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1):
+        self.myindex = getattr(theSphere, "myindex", 0)
+        self.friction_position = friction_position
+        self.interface_type = interface_type
+        self.theSphere = theSphere
+        self.graphical_line_index = graphical_line_index
+
+
+class RelationView:
+    """Mixin: the relation ``owner → partner`` read from and written to the ensemble's pair table.
+
+    Views are built on demand (``sphere.neighbors``); they look the pair up by
+    its sphere indices at every access, so they stay valid across steps.
+    """
+
+    def _bind(self, ensemble, owner, partner):
+        d = self.__dict__
+        d["_ens"] = ensemble
+        d["_owner"] = owner
+        d["_partner"] = partner
+        d["graphical_line_index"] = -1
+        d["linking_line_index"] = -1
+
+    def _slot(self):
+        ens = self.__dict__["_ens"]
+        s = int(ens._pairs.find(self.__dict__["_owner"], self.__dict__["_partner"]))
+        if s < 0:
+            raise LookupError("this relation no longer exists")
+        return s
+
+    def _side(self):
+        return "xi_ij" if self.__dict__["_owner"] < self.__dict__["_partner"] else "xi_ji"
+
+    @property
+    def theSphere(self):
+        return self.__dict__["_ens"].sphereList[self.__dict__["_partner"]]
+
+    @property
+    def myindex(self):
+        return getattr(self.theSphere, "myindex", 0)
+
+    @property
+    def friction_position(self):
+        return float(getattr(self.__dict__["_ens"]._pairs, self._side())[self._slot()])
+
+    @friction_position.setter
+    def friction_position(self, value):
+        getattr(self.__dict__["_ens"]._pairs, self._side())[self._slot()] = value
+
+    @property
+    def interface_type(self):
+        return STATE_NAMES[int(self.__dict__["_ens"]._pairs.state[self._slot()])]
+
+    @interface_type.setter
+    def interface_type(self, value):
+        pt = self.__dict__["_ens"]._pairs
+        s = self._slot()
+        was_perm = pt.state[s] == 2
+        pt.state[s] = STATE_CODES[value]
+        if was_perm != (value == "permanent"):
+            self.__dict__["_ens"]._links_changed()
+
+    @property
+    def equilibrium_distance(self):
+        return float(self.__dict__["_ens"]._pairs.d_eq[self._slot()])
+
+    @equilibrium_distance.setter
+    def equilibrium_distance(self, value):
+        self.__dict__["_ens"]._pairs.d_eq[self._slot()] = value
+
+    def __repr__(self):
+        return (f"<relation {self.__dict__['_owner']}->{self.__dict__['_partner']} "
+                f"{self.interface_type} xi={self.friction_position}>")
+
+
+class _BaseRelationView(RelationView, neighbor_relation):
+    """View of a relation for non-linkable ensembles."""
+
+    def __init__(self, ensemble, owner, partner):
+        self._bind(ensemble, owner, partner)

@@ -1,0 +1,157 @@
+"""Concrete non-crosslinkable ensembles with random bimodal spheres (spec §6.2, §10.6)."""
+import math
+
+import numpy as np
+
+from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
+                           CanvasPointsFrictionElasticityLeesEdwards, check_non_negative)
+from ..base.points import _check_positive
+from .model import adjust_m, r_estimate
+from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
+
+__all__ = ["Ensemble", "EnsembleFriction", "EnsembleLeesEdwards", "EnsembleFrictionLeesEdwards",
+           "RandomBimodalSpheres"]
+
+
+def _check_count(N):
+    if int(N) != N or N < 0:
+        raise ValueError(f"N must be a non-negative integer, got {N!r}")
+
+
+class RandomBimodalSpheres:
+    """Mixin: N spheres of radius ``r_b/√bf`` or ``r_b·√bf`` (probability 1/2 each) at random integer positions.
+
+    Masses follow ``adjust_m(m, r, r_b)`` (§5.4); every draw comes from the
+    ensemble's ``numpy.random.Generator`` (``set_random_generator``).
+    """
+
+    def _init_bimodal(self, N, packing_fraction, bimodal_factor):
+        _check_count(N)
+        _check_positive("packing_fraction", packing_fraction)
+        _check_positive("bimodal_factor", bimodal_factor)
+        self.bimodal_upper = math.sqrt(bimodal_factor)
+        self.bimodal_lower = math.sqrt(1 / bimodal_factor)
+        self.N = N
+        self.packing_fraction = packing_fraction
+        self.r_max = 0
+
+    def random_radius_bimodal(self, r):
+        """``r·(lower + (upper − lower)·U{0,1})``: small or large radius with equal probability."""
+        return r * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(self._rng.integers(0, 2)))
+
+    def _new_sphere(self, x, y, r, m, index):
+        raise NotImplementedError
+
+    def _create_spheres(self, N, m):
+        """Draw and append N spheres; one block of draws per quantity, in index order."""
+        if N == 0:
+            return
+        r_b = r_estimate(self.size_x, self.size_y, self.packing_fraction, N, self.bimodal_upper,
+                         self.bimodal_lower)
+        rng = self._rng
+        large = rng.integers(0, 2, N)
+        xs = rng.integers(0, int(self.size_x), N) if self.size_x >= 1 else rng.random(N) * self.size_x
+        ys = rng.integers(0, int(self.size_y), N) if self.size_y >= 1 else rng.random(N) * self.size_y
+        for p in range(N):
+            r = r_b * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(large[p]))
+            self.r_max = max(self.r_max, r)
+            s = self._new_sphere(float(xs[p]), float(ys[p]), r, adjust_m(m, r, r_b), p)
+            self.sphereList.append(s)
+
+    def particle_info(self):
+        return ("Spheres with, bimodal distribution, equal probability, \n\tr1="
+                + str(self.r_max / self.bimodal_upper * self.bimodal_lower) + "r2=" + str(self.r_max))
+
+
+class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
+    """Legacy ensemble: plain periodic cell (no shear offset), frictional spheres, central forces only.
+
+    The reference emulates periodicity with boundary replicas; here the minimum
+    image does it, and boundary-crossing pairs are registered as external forces.
+    """
+
+    use_lees_edwards = False
+
+    def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
+                 nu=0.01, m=1, bimodal_factor=1.4):
+        CanvasPointsBasicElasticity.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
+        self._init_bimodal(N, packing_fraction, bimodal_factor)
+        self.record_type = "internal"
+        self.spheres_boundary = []
+        self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereFriction(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
+                              self.theCanvas, self.doDrawing, self)
+
+    def periodic_boundary_extension(self):
+        """No replicas are needed: the minimum image makes the cell periodic."""
+        self.spheres_boundary = []
+
+
+class EnsembleFriction(Ensemble):
+    """Legacy periodic ensemble with tangential forces (no shear offset)."""
+
+    def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
+                 nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
+        Ensemble.__init__(self, size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m,
+                          bimodal_factor)
+        check_non_negative("k_t", k_t)
+        check_non_negative("nu_t", nu_t)
+        check_non_negative("mu", mu)
+        self.k_t = k_t
+        self.nu_t = nu_t
+        self.mu = mu
+
+    # the tangential machinery of the Lees-Edwards friction canvas, with a zero shear offset
+    _tangential_speed = CanvasPointsFrictionElasticityLeesEdwards._tangential_speed
+    _add_tangential = CanvasPointsFrictionElasticityLeesEdwards._add_tangential
+    _tangential_needed = CanvasPointsFrictionElasticityLeesEdwards._tangential_needed
+    tangential_force_from_neighbors = CanvasPointsFrictionElasticityLeesEdwards.tangential_force_from_neighbors
+    _tangential_terms = CanvasPointsFrictionElasticityLeesEdwards._tangential_terms
+    tangential_force = CanvasPointsFrictionElasticityLeesEdwards.tangential_force
+    _torque_total = CanvasPointsFrictionElasticityLeesEdwards._torque_total
+    do_rotational_acceleration = CanvasPointsFrictionElasticityLeesEdwards.do_rotational_acceleration
+    _cool_spin = CanvasPointsFrictionElasticityLeesEdwards._cool_spin
+    mechanical_simulation_step_calculate_acceleration = \
+        CanvasPointsFrictionElasticityLeesEdwards.mechanical_simulation_step_calculate_acceleration
+    _integrate_xi = CanvasPointsFrictionElasticityLeesEdwards._integrate_xi
+    move = CanvasPointsFrictionElasticityLeesEdwards.move
+
+    def _force_terms(self):
+        Ensemble._force_terms(self)
+        self._tangential_terms()
+
+
+class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesEdwards):
+    """Frictionless Lees-Edwards ensemble (buildable here; the reference crashes for N > 0)."""
+
+    def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
+                 nu=0.01, m=1, bimodal_factor=1.4):
+        CanvasPointsBasicElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
+        self._init_bimodal(N, packing_fraction, bimodal_factor)
+        self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereLeesEdwards(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
+                                 self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
+
+
+class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElasticityLeesEdwards):
+    """Frictional spheres under Lees-Edwards boundary conditions."""
+
+    def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
+                 nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
+        CanvasPointsFrictionElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m,
+                                                           k_t, nu_t, mu)
+        self._init_bimodal(N, packing_fraction, bimodal_factor)
+        self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereFrictionLeesEdwards(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r,
+                                         m, index, self.theCanvas, self.doDrawing, self, self.size_x,
+                                         self.size_y)
+
+    def particle_info(self):
+        return "Frictional spheres under Lees-Edwards boundary conditions\n\t" + \
+            RandomBimodalSpheres.particle_info(self)
