@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from .graphics import Graphical_output_configuration
-from .kernels import le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from .laws import call_law_vectorised
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
@@ -78,7 +78,7 @@ class SphereList(list):
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
     __slots__ = ("slots", "ai", "aj", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
-                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt")
+                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv", "ky", "kx")
 
 
 class CanvasPoints:
@@ -101,6 +101,8 @@ class CanvasPoints:
         self._rng = np.random.default_rng()
         self._renderer = None
         self._uniform = {}
+        self._pos_version = 0
+        self._in_cell = False
         self.graphical_output_configuration = Graphical_output_configuration()
 
     # -- sphere list and state arrays ----------------------------------------------------------
@@ -152,7 +154,8 @@ class CanvasPoints:
         self._invalidate_neighbours()
 
     def _invalidate_neighbours(self):
-        pass
+        self._pos_version += 1
+        self._in_cell = False
 
     def _params_changed(self):
         self._uniform = {}
@@ -234,6 +237,7 @@ class CanvasPoints:
         a = self._a
         a["x"] += a["xspeed"] * dt
         a["y"] += a["yspeed"] * dt
+        self._pos_version += 1
 
     def move(self, dt=1):
         self._drift(dt)
@@ -246,6 +250,8 @@ class CanvasPoints:
         a = self._a
         le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
                 getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0)
+        self._pos_version += 1
+        self._in_cell = True
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
         """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing."""
@@ -362,12 +368,20 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     def _invalidate_neighbours(self):
         self._nl_valid = False
+        self._pos_version += 1
+        self._in_cell = False
+
+    def _passes(self):
+        """Fixed minimum-image passes when every position is known to lie in the cell."""
+        return in_cell_passes(self.size_x, self._le_shift()) if self._in_cell else None
 
     def _links_changed(self):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
 
     def _spheres_changed(self):
         self._nl_valid = False
+        self._in_cell = False
+        self._pos_version += 1
         self._disp = np.zeros((2, self._n))
 
     def _drift(self, dt):
@@ -378,6 +392,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         a["y"] += sy
         self._disp[0] += sx
         self._disp[1] += sy
+        self._pos_version += 1
 
     def _skin(self):
         return self.neighbour_skin * float(self._a["r"].max()) if self._n else 0.0
@@ -423,15 +438,17 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         Lx, Ly = self.size_x, self.size_y
         dx0 = x[j] - x[i]
         dy0 = y[j] - y[i]
-        dx, dy, dvx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+        dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
+                                        self._passes(), counts=True)
         d = np.sqrt(dx * dx + dy * dy)
         d0 = r[i] + r[j]
         touching = d < d0
         perm = pt.state == PERMANENT if pt.n_permanent else None
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
-        born = new_active & ~old
-        died = old & ~new_active
+        changed = (new_active != old).any()
+        born = new_active & ~old if changed else old[:0]
+        died = old & ~new_active if changed else old[:0]
         if born.any():
             pt.state[born] = STICK
             pt.xi_ij[born] = 0.0
@@ -449,8 +466,13 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.aj = j[sel]
         g.dx = dx[sel]
         g.dy = dy[sel]
-        d_raw = np.sqrt(dx0[sel] ** 2 + dy0[sel] ** 2)
         g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
+        # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5)
+        shifted = (g.dx != dx0[sel]) | (g.dy != dy0[sel])
+        if shifted.any():
+            w = np.flatnonzero(shifted)
+            rx, ry = dx0[sel][w], dy0[sel][w]
+            shifted[w] = np.sqrt(rx * rx + ry * ry) != g.d[w]
         g.dvx = None if dvx is None else dvx[sel]
         g.d0 = d0[sel]
         g.P = len(sel)
@@ -462,7 +484,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             g.trans = ~g.perm
             if not g.perm.any():
                 g.perm = g.trans = None
-        shifted = d_raw != g.d
         mob = self._mobile_mask()
         if mob is None:
             g.internal = ~shifted
@@ -479,6 +500,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.ft = None
         g.vn = None
         g.vt = None
+        g.fel = None
+        g.rv = None
+        g.ky = None if ky is None else ky[sel]
+        g.kx = None if kx is None else kx[sel]
         self._g = g
         return g
 
@@ -538,7 +563,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
                 a["torque"] += np.bincount(idx, np.concatenate((ti, tj)), n)
         self.force_register._set_pairs(self, {
             "i": g.ai, "j": g.aj, "fix": fix, "fiy": fiy, "fjx": fjx, "fjy": fjy, "ti": ti, "tj": tj,
-            "internal": g.internal, "ext_i": g.ext_i, "ext_j": g.ext_j})
+            "internal": g.internal, "ext_i": g.ext_i, "ext_j": g.ext_j, "antisymmetric": g.fn_j is None})
         g.fn_i = np.zeros(g.P)
         g.fn_j = None
         g.ft = None
@@ -604,6 +629,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.applyingShear = False
         self.shear_rate = 0
         self.shear = 0
+        self._mob_key = None
 
     def canMove(self, theSphere):
         """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (§4.6)."""
@@ -614,20 +640,32 @@ class CanvasPointsShear(CanvasPointsNeighbors):
     def _mobile_mask(self):
         if not self.applyingShear:
             return None
-        a = self._a
-        y, r = a["y"], a["r"]
-        return (r < y) & (y < self.size_y - r)
+        key = (self._pos_version, self.size_y)
+        if self._mob_key != key:
+            a = self._a
+            y, r = a["y"], a["r"]
+            self._mob = (r < y) & (y < self.size_y - r)
+            self._mob_key = key
+        return self._mob
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres; immobile ones take the velocity of their plate (§4.1 step 4)."""
-        CanvasPointsNeighbors.do_linear_acceleration(self, dt)
+        """Kick mobile spheres; immobile ones take the velocity of their plate (§4.1 step 4).
+
+        Every sphere is kicked and the plate velocity then overwrites the
+        immobile ones, which gives the mobile spheres exactly the reference kick.
+        """
+        a = self._a
+        fx, fy, m = a["xforce"], a["yforce"], a["m"]
+        a["xspeed"] += fx * dt / m
+        a["yspeed"] += fy * dt / m
+        fx[:] = 0.0
+        fy[:] = 0.0
         mob = self._mobile_mask()
         if mob is not None and not mob.all():
             imm = ~mob
-            a = self._a
-            a["yspeed"][imm] = 0.0
             v = self.shear_rate * self.size_y / 2
-            a["xspeed"][imm] = np.where(a["y"][imm] > self.size_y / 2, v, -v)
+            np.copyto(a["yspeed"], 0.0, where=imm)
+            np.copyto(a["xspeed"], np.where(a["y"] > self.size_y / 2, v, -v), where=imm)
 
     def transmit_lees_edwards_parameters(self, theSphere):
         theSphere.size_x = self.size_x
@@ -667,7 +705,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._params_changed()
 
     def _pair_param(self, name, g):
-        """(value seen by the visit from i, from j): scalars when all spheres agree."""
+        """(value seen by the visit from i, from j): one Python float when all spheres agree."""
         v = self._param(name)
         if v is not None:
             return v, v
@@ -684,20 +722,22 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._term_done()
 
     def _elastic_terms(self):
-        """Transient contacts: ``law(d, r_i + r_j, k, c)`` along n_ij."""
+        """Transient contacts: ``law(d, r_i + r_j, k, c)`` along n_ij (the law is 0 beyond contact)."""
         g = self._g
         if g.P:
             tr = g.trans
             c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
-            d, d0 = (g.d, g.d0) if tr is None else (g.d[tr], g.d0[tr])
-            if tr is not None and np.ndim(c_i):
-                c_i, c_j = c_i[tr], c_j[tr]
-            touch = d < d0
-            f_i = np.where(touch, self._law(d, d0, self.k, c_i), 0.0)
-            f_j = None if np.ndim(c_i) == 0 else np.where(touch, self._law(d, d0, self.k, c_j), 0.0)
-            if tr is not None:
-                f_i = self._scatter(f_i, tr, g.P)
-                f_j = None if f_j is None else self._scatter(f_j, tr, g.P)
+            if tr is None:
+                f_i = self._law(g.d, g.d0, self.k, c_i)
+                f_j = None if c_j is c_i else self._law(g.d, g.d0, self.k, c_j)
+                g.fel = f_i
+            else:
+                d, d0 = g.d[tr], g.d0[tr]
+                if type(c_i) is not float:
+                    c_i, c_j = c_i[tr], c_j[tr]
+                f_i = self._scatter(self._law(d, d0, self.k, c_i), tr, g.P)
+                f_j = None if c_j is c_i else self._scatter(self._law(d, d0, self.k, c_j), tr, g.P)
+                g.fel = f_i
             self._add_normal(f_i, f_j)
 
     @staticmethod
@@ -707,12 +747,15 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         return out
 
     def _relative_velocity(self, g):
-        a = self._a
-        vx, vy = a["xspeed"], a["yspeed"]
-        rvx = vx[g.aj] - vx[g.ai]
-        if g.dvx is not None:
-            rvx = rvx + g.dvx
-        return rvx, vy[g.aj] - vy[g.ai]
+        """Velocity of j's nearest image relative to i (µm/s), computed once per force phase."""
+        if g.rv is None:
+            a = self._a
+            vx, vy = a["xspeed"], a["yspeed"]
+            rvx = vx.take(g.aj) - vx.take(g.ai)
+            if g.dvx is not None:
+                rvx = rvx + g.dvx
+            g.rv = (rvx, vy.take(g.aj) - vy.take(g.ai))
+        return g.rv
 
     def _normal_speed(self, g):
         if g.vn is None:
@@ -870,42 +913,51 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
     def _tangential_terms(self):
         """Transient contacts: viscous + spring on ξ, Coulomb-limited, two visits."""
         g = self._g
+        if not g.P:
+            return
+        if not self._tangential_needed():
+            # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
+            pt = self._pairs
+            pt.state[g.slots] = SLIP
+            pt.xi_ij[g.slots] = 0.0
+            pt.xi_ji[g.slots] = 0.0
+            return
+        fc = np.abs(self.mu * self._coulomb_law(g))
+        self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
+
+    def _coulomb_law(self, g):
+        """Elastic central law of each transient contact (cached from the elastic term)."""
+        if getattr(g, "fel", None) is None:
+            c_i = self._pair_param("central_repulsion_coefficient", g)[0]
+            return self._law(g.d, g.d0, self.k, c_i)
+        return g.fel
+
+    def _apply_tangential(self, permanent, kt_i, kt_j, nut_i, nut_j, fc):
+        """Run the two-visit kernel on all active pairs and record states, ξ and forces."""
+        g = self._g
         pt = self._pairs
-        if g.P:
-            sel = g.slots if g.trans is None else g.slots[g.trans]
-            if len(sel):
-                if not self._tangential_needed():
-                    # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
-                    pt.state[sel] = SLIP
-                    pt.xi_ij[sel] = 0.0
-                    pt.xi_ji[sel] = 0.0
-                else:
-                    vt = self._tangential_speed(g)
-                    d, d0 = g.d, g.d0
-                    c_i = self._param("central_repulsion_coefficient")
-                    if g.trans is not None:
-                        vt, d, d0 = vt[g.trans], d[g.trans], d0[g.trans]
-                    if c_i is None:
-                        cc = self._a["central_repulsion_coefficient"][g.ai]
-                        c_i = cc if g.trans is None else cc[g.trans]
-                    fc = np.abs(self.mu * self._law(d, d0, self.k, c_i))
-                    xi_ij = pt.xi_ij[sel]
-                    xi_ji = pt.xi_ji[sel]
-                    touching = d < d0
-                    f1, f2, slip = tangential_two_pass(
-                        vt, touching, np.zeros(len(sel), bool), xi_ij, xi_ji, self.k_t, self.k_t,
-                        self.nu_t, self.nu_t, fc)
-                    pt.xi_ij[sel] = xi_ij
-                    pt.xi_ji[sel] = xi_ji
-                    state = np.where(slip, SLIP, STICK).astype(np.int8)
-                    # a transient relation that no longer touches keeps its state and gets no force
-                    if not touching.all():
-                        state = np.where(touching, state, pt.state[sel])
-                        f1 = np.where(touching, f1, 0.0)
-                        f2 = np.where(touching, f2, 0.0)
-                    pt.state[sel] = state
-                    f_pair = f1 / 2 + f2 / 2
-                    self._add_tangential(f_pair if g.trans is None else self._scatter(f_pair, g.trans, g.P))
+        sl = g.slots
+        vt = self._tangential_speed(g)
+        xi_ij = pt.xi_ij[sl]
+        xi_ji = pt.xi_ji[sl]
+        touching = g.d < g.d0
+        f1, f2, slip = tangential_two_pass(vt, touching, permanent, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, fc)
+        state = np.where(slip, SLIP, STICK).astype(np.int8)
+        if permanent is not np.False_:
+            state[permanent] = PERMANENT
+        if not touching.all():
+            # a transient relation that no longer touches keeps its state and gets no force
+            idle = ~touching & ~permanent
+            if idle.any():
+                state[idle] = pt.state[sl][idle]
+                f1 = np.where(idle, 0.0, f1)
+                f2 = np.where(idle, 0.0, f2)
+                xi_ij[idle] = pt.xi_ij[sl][idle]
+                xi_ji[idle] = pt.xi_ji[sl][idle]
+        pt.xi_ij[sl] = xi_ij
+        pt.xi_ji[sl] = xi_ji
+        pt.state[sl] = state
+        self._add_tangential(f1 / 2 + f2 / 2)
 
     def tangential_force(self):
         """All-pairs variant (reference API)."""
@@ -958,11 +1010,26 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             rvx = rvx + (g.dvx if allk else g.dvx[keep])
         rvy = vy[aj] - vy[ai]
         pt.xi_ij[sl] += ((rvx * -ny + rvy * nx) - spin) * dt
-        # relation j→i: i (lower index) has already moved
+        # relation j→i: i (lower index) has already moved; same image as in the force phase
+        # (periods −k, applied one at a time as the reference does), checked against half a cell
         xin = x[ai] + vx[ai] * dt
         yin = y[ai] + vy[ai] * dt
-        dx, dy, dvx = min_image(xin - x[aj], yin - y[aj], self.size_x, self.size_y, self._le_shift(),
-                                self._shear_rate_for_images())
+        rx = xin - x[aj]
+        ry = yin - y[aj]
+        if g.ky is not None:
+            ky = g.ky if allk else g.ky[keep]
+            kx = g.kx if allk else g.kx[keep]
+            Lx, Ly = float(self.size_x), float(self.size_y)
+            dy = ry + Ly * ky
+            dx = (rx + float(self._le_shift()) * ky) + Lx * kx
+            dvx = (Ly * float(self._shear_rate_for_images())) * ky
+            if ((dy >= self.size_y / 2) | (dy < -self.size_y / 2) | (dx >= self.size_x / 2)
+                    | (dx < -self.size_x / 2)).any():
+                dx, dy, dvx = min_image(rx, ry, self.size_x, self.size_y, self._le_shift(),
+                                        self._shear_rate_for_images())
+        else:
+            dx, dy, dvx = min_image(rx, ry, self.size_x, self.size_y, self._le_shift(),
+                                    self._shear_rate_for_images())
         _, mx, my = pair_geometry(dx, dy, self._rng)
         svx = vx[ai] - vx[aj]
         if dvx is not None:

@@ -9,47 +9,70 @@ import numpy as np
 __all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass"]
 
 
-def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0):
+def _wrap_count(v, half):
+    """−1, 0 or +1 per element: one period to subtract (``v ≥ half``) or add (``v < −half``)."""
+    return (v >= half).view(np.int8) - (v < -half).view(np.int8)
+
+
+def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     """Lees-Edwards minimum image of raw differences (§3.1) with the relative-speed correction (§3.2).
 
     The y image is chosen first and moves x by ``shift = Ly·γ``; intervals are
     half-open (``[-L/2, L/2)``) and periods are subtracted one at a time, as the
-    reference does, so the result is bit-identical to it.
+    reference does, so the result is bit-identical to it.  ``passes`` = (ny, nx)
+    fixes the number of one-period passes when the caller knows the range of the
+    differences (positions inside the cell); by default passes repeat until done.
 
     Returns ``(dx, dy, dvx)`` where ``dvx`` is the x velocity correction of the
     image (``-Ly·γ̇`` per image above) — an array, or None when nothing wrapped in y.
+    With ``counts`` also the numbers of y and x periods subtracted (int arrays or None).
     """
-    dx = np.array(dx, dtype=float, copy=True)
-    dy = np.array(dy, dtype=float, copy=True)
+    dx = np.asarray(dx, dtype=float)
+    dy = np.asarray(dy, dtype=float)
+    Lx = float(Lx)
+    Ly = float(Ly)
+    shift = float(shift)
     hy = Ly / 2
     hx = Lx / 2
+    rate_shift = Ly * float(shear_rate)
     dvx = None
-    rate_shift = Ly * shear_rate
-    m = dy >= hy
-    while m.any():
-        dy[m] -= Ly
-        dx[m] -= shift
-        if dvx is None:
-            dvx = np.zeros(dx.shape)
-        dvx[m] -= rate_shift
-        m = dy >= hy
-    m = dy < -hy
-    while m.any():
-        dy[m] += Ly
-        dx[m] += shift
-        if dvx is None:
-            dvx = np.zeros(dx.shape)
-        dvx[m] += rate_shift
-        m = dy < -hy
-    m = dx >= hx
-    while m.any():
-        dx[m] -= Lx
-        m = dx >= hx
-    m = dx < -hx
-    while m.any():
-        dx[m] += Lx
-        m = dx < -hx
+    ky_total = None
+    n_y = passes[0] if passes is not None else None
+    p = 0
+    while True if n_y is None else p < n_y:
+        ky = _wrap_count(dy, hy)
+        if n_y is None and not ky.any():
+            break
+        dy = dy - Ly * ky
+        dx = dx - shift * ky
+        ky_total = ky if ky_total is None else ky_total + ky
+        p += 1
+    if ky_total is not None and rate_shift != 0:
+        dvx = -rate_shift * ky_total
+    n_x = passes[1] if passes is not None else None
+    p = 0
+    kx_total = None
+    while True if n_x is None else p < n_x:
+        kx = _wrap_count(dx, hx)
+        if n_x is None and not kx.any():
+            break
+        dx = dx - Lx * kx
+        kx_total = kx if kx_total is None else kx_total + kx
+        p += 1
+    if counts:
+        if ky_total is not None and kx_total is None:
+            kx_total = np.zeros(dx.shape, np.int8)
+        if kx_total is not None and ky_total is None:
+            ky_total = np.zeros(dx.shape, np.int8)
+        if ky_total is not None and (np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1):
+            ky_total = kx_total = None  # several periods: the movement phase recomputes the image
+        return dx, dy, dvx, ky_total, kx_total
     return dx, dy, dvx
+
+
+def in_cell_passes(Lx, shift, margin=0.01):
+    """(ny, nx) one-period passes that suffice for differences of positions inside the cell."""
+    return 1, int(0.5 + abs(shift) / Lx + margin) + 1
 
 
 def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):

@@ -35,9 +35,13 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
         f_nl = -k * c * d0 * (d0 / max(d, d0 / 1000) - 1)
         return _scalar_result(f_lin + f_nl, k, c)
     d = np.asarray(d, dtype=float)
-    f_lin = -k * (1 - c) * (d0 - d)
-    f_nl = -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)
-    return np.where(d > d0, 0.0, f_lin + f_nl)
+    if np.ndim(c) == 0 and c == 1:
+        f = -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)   # the linear part is ±0 here
+    elif np.ndim(c) == 0 and c == 0:
+        f = -k * (1 - c) * (d0 - d)                                # the divergent part is ±0 here
+    else:
+        f = -k * (1 - c) * (d0 - d) + -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)
+    return np.where(d > d0, 0.0, f)
 
 
 class PlateauConfiguration:

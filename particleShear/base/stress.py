@@ -96,38 +96,47 @@ class StressTensorEvaluation:
             y = ens._a["y"]
             i, j = p["i"], p["j"]
             internal = p["internal"]
-            if internal.any():
-                ii, jj = i[internal], j[internal]
-                ddx = x[ii] - x[jj]
-                ddy = y[ii] - y[jj]
-                for a_, fi, fj in ((0, p["fix"][internal], p["fjx"][internal]),
-                                   (1, p["fiy"][internal], p["fjy"][internal])):
-                    gi = fi * _CF
-                    gj = fj * _CF
-                    for b_, dd in ((0, ddx), (1, ddy)):
-                        lw[a_, b_] += np.sum(gi * dd * _CL / 2) + np.sum(gj * -dd * _CL / 2)
+            fix, fiy, fjx, fjy = p["fix"], p["fiy"], p["fjx"], p["fjy"]
+            if not internal.all():
+                w = np.flatnonzero(internal)
+                i_, j_ = i[w], j[w]
+                fix, fiy, fjx, fjy = fix[w], fiy[w], fjx[w], fjy[w]
+            else:
+                i_, j_ = i, j
+            if len(i_):
+                ddx = x[i_] - x[j_]
+                ddy = y[i_] - y[j_]
+                if p.get("antisymmetric", True):
+                    # F_j = −F_i: the two entries of a pair are equal and their halves add up exactly
+                    lw += (np.array((fix, fiy)) * _CF) @ np.array((ddx, ddy)).T * _CL
+                else:
+                    gx = fix * _CF
+                    gy = fiy * _CF
+                    hx = fjx * _CF
+                    hy = fjy * _CF
+                    for a_, gi, gj in ((0, gx, hx), (1, gy, hy)):
+                        for b_, dd in ((0, ddx), (1, ddy)):
+                            lw[a_, b_] += np.sum(gi * dd * _CL / 2) + np.sum(gj * -dd * _CL / 2)
             for side, idx, fx, fy in (("ext_i", i, p["fix"], p["fiy"]), ("ext_j", j, p["fjx"], p["fjy"])):
                 m = p[side]
                 if m.any():
-                    t = idx[m]
+                    w = np.flatnonzero(m)
+                    t = idx[w]
                     lx = (x[t] - cx) * _CL
                     ly = (y[t] - cy) * _CL
-                    gx = fx[m] * _CF
-                    gy = fy[m] * _CF
+                    gx = fx[w] * _CF
+                    gy = fy[w] * _CF
                     ext -= [[gx @ lx, gx @ ly], [gy @ lx, gy @ ly]]
         if reg._tot is not None:
             mobile, fx, fy = reg._tot
             x = ens._a["x"]
             y = ens._a["y"]
-            if mobile is None:
-                lx, ly, gx, gy = x, y, fx, fy
-            else:
-                lx, ly, gx, gy = x[mobile], y[mobile], fx[mobile], fy[mobile]
-            lx = (lx - cx) * _CL
-            ly = (ly - cy) * _CL
-            gx = gx * _CF
-            gy = gy * _CF
-            unb += [[gx @ lx, gx @ ly], [gy @ lx, gy @ ly]]
+            F = np.array((fx, fy))
+            X = np.array((x - cx, y - cy))
+            if mobile is not None:
+                F = F[:, mobile]
+                X = X[:, mobile]
+            unb += (F * _CF) @ (X * _CL).T
         for t, s, f in reg._m_pair:
             d = ((t.x - s.x) * _CL, (t.y - s.y) * _CL)
             for a in range(2):
@@ -198,10 +207,78 @@ class StressTensorEvaluation:
 
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
         """Every tensor of §7 and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24)."""
+        reg = force_register
+        if (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
+                and len(reg._blocks) == 1 and reg._tot is not None and not reg._m_pair and not reg._m_ext
+                and not reg._m_tot and not reg._m_imom and not reg._m_unb):
+            self._evaluate_arrays(reg, theSphereList.mask, shear_rate)
+            return
         self.evaluate_force_stress_tensors(force_register)
         self.evaluate_rotational_stress_tensors(force_register, theSphereList)
         self.evaluate_peculiar_momentum_transport_for_linear_acceleration_tensor(theSphereList, shear_rate)
         self._t[_ALL] = self._t[_LW] + self._t[_TINT] + self._t[_CEN]
+
+    def _evaluate_arrays(self, reg, mobile, shear_rate):
+        """All tensors of one engine force phase in a few array operations (same formulas as above)."""
+        t = self._t
+        ens = reg._ens
+        a = ens._a
+        x, y = a["x"], a["y"]
+        V = self._volume()
+        cx, cy = self.size_x / 2, self.size_y / 2
+        p = reg._blocks[0]
+        i, j = p["i"], p["j"]
+        internal = p["internal"]
+        n_int = int(np.count_nonzero(internal))
+        F_i = np.array((p["fix"], p["fiy"]))
+        if n_int and p.get("antisymmetric", True):
+            if n_int == len(i):
+                ii, jj, G = i, j, F_i
+            else:
+                w = np.nonzero(internal)[0]
+                ii, jj, G = i.take(w), j.take(w), F_i[:, w]
+            D = np.array((x.take(ii) - x.take(jj), y.take(ii) - y.take(jj)))
+            t[_LW] = (G * _CF) @ D.T * _CL / V
+        elif n_int:
+            self.evaluate_force_stress_tensors(reg)
+        else:
+            t[_LW] = 0.0
+        if n_int != len(i):
+            wi = np.nonzero(p["ext_i"])[0]
+            wj = np.nonzero(p["ext_j"])[0]
+            tg = np.concatenate((i.take(wi), j.take(wj)))
+            G = np.concatenate((F_i[:, wi], np.array((p["fjx"].take(wj), p["fjy"].take(wj)))), axis=1)
+            X = np.array((x.take(tg) - cx, y.take(tg) - cy))
+            t[_EXT] = (0.0 - (G * _CF) @ (X * _CL).T) / V
+        else:
+            t[_EXT] = 0.0
+        _, fx, fy = reg._tot
+        inertia, omega, m, vx, vy = a["inertia"], a["omega"], a["m"], a["xspeed"], a["yspeed"]
+        xm, ym = x, y
+        if mobile is not None:
+            w = np.nonzero(mobile)[0]
+            fx, fy, xm, ym = fx.take(w), fy.take(w), x.take(w), y.take(w)
+            inertia, omega, m, vx, vy = inertia.take(w), omega.take(w), m.take(w), vx.take(w), vy.take(w)
+        t[_UNB] = (np.array((fx, fy)) * _CF) @ (np.array((xm - cx, ym - cy)) * _CL).T / V
+        t[_LIN] = t[_UNB]
+        K = float(((inertia * _CT) * (omega * omega) / 2).sum())
+        cen = t[_CEN]
+        cen[0, 0] = cen[1, 1] = -K / V
+        cen[0, 1] = cen[1, 0] = 0.0
+        mp = m * 1e-12
+        P = np.array((mp * (vx - shear_rate * (ym - self.size_y / 2)), mp * vy))
+        t[_OT] = -((P / (m * 1e-6)) @ P.T) / V
+        total = float(reg._mom.sum()) if reg._mom is not None else 0.0
+        t[_TQ] = self._antisym(total, V)
+        if p.get("ti") is not None and n_int:
+            if n_int == len(i):
+                tint = float(p["ti"].sum() + p["tj"].sum())
+            else:
+                tint = float(internal @ (p["ti"] + p["tj"]))
+        else:
+            tint = 0.0
+        t[_TINT] = self._antisym(tint, V)
+        t[_ALL] = t[_LW] + t[_TINT] + t[_CEN]
 
     def evaluate_quasistatic_shear_stress(self):
         """τ_internal = −σ_xy of the overall tensor (Pa)."""

@@ -14,6 +14,7 @@ from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image, tangential_two_pass
 from ..base.laws import call_law_vectorised
 from ..base.neighbours import PERMANENT, SLIP, STICK
+from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
 
@@ -124,43 +125,57 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self.cutLine((0, self.size_y), math.pi / 2)
 
     # -- bond forces -------------------------------------------------------------------------------
-    def _perm_subset(self, g):
-        perm = g.perm
-        return perm, g.slots[perm]
-
     def _elastic_terms(self):
-        CanvasPointsFrictionElasticityLeesEdwards._elastic_terms(self)
+        """Transient contacts as in the parent; bonds: law below ``d_eq``, tensile law above, × ratio."""
         g = self._g
         if g.perm is None:
+            CanvasPointsFrictionElasticityLeesEdwards._elastic_terms(self)
             return
-        from ..base.points import CircleBasicElasticity
-        perm, slots = self._perm_subset(g)
-        d = g.d[perm]
-        deq = self._pairs.d_eq[slots]
+        perm = g.perm
+        deq = self._pairs.d_eq[g.slots]
+        d0 = np.where(perm, deq, g.d0)
         c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
-        rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
         tensile = SphereLinkable.call_back_elastic_force_law_tensile
-        stretched = d >= deq
-        f_t = call_law_vectorised(tensile, d, deq, self.k)
-        f_i = np.where(stretched, f_t, call_law_vectorised(
-            law, d, deq, self.k, c_i if np.ndim(c_i) == 0 else c_i[perm]))
-        if np.ndim(c_i) == 0:
-            f_j = f_i
+        stretched = perm & (g.d >= deq)
+        f_i = call_law_vectorised(law, g.d, d0, self.k, c_i)
+        g.fel = f_i
+        f_j = f_i if c_j is c_i else call_law_vectorised(law, g.d, d0, self.k, c_j)
+        if stretched.any():
+            f_t = call_law_vectorised(tensile, g.d, deq, self.k)
+            f_i = np.where(stretched, f_t, f_i)
+            f_j = f_i if c_j is c_i else np.where(stretched, f_t, f_j)
+        rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
+        if not (rc_i is rc_j and rc_i == 1.0):
+            f_i = f_i * np.where(perm, rc_i, 1.0)
+            f_j = f_j * np.where(perm, rc_j, 1.0)
+        self._add_normal(f_i, None if f_j is f_i else f_j)
+
+    def _tangential_terms(self):
+        """Transient contacts and bonds in one two-visit pass; bonds have no Coulomb bound."""
+        g = self._g
+        if g.perm is None:
+            CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
+            return
+        perm = g.perm
+        rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
+        nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
+        kt, nut = self.k_t, self.nu_t
+        kt_i = np.where(perm, kt * rt_i, kt)
+        kt_j = kt_i if rt_j is rt_i else np.where(perm, kt * rt_j, kt)
+        if nv_i is nv_j and nv_i == 1.0:
+            nut_i = nut_j = nut
         else:
-            f_j = np.where(stretched, f_t, call_law_vectorised(law, d, deq, self.k, c_j[perm]))
-        f_i = f_i * (rc_i if np.ndim(rc_i) == 0 else rc_i[perm])
-        f_j = f_j * (rc_j if np.ndim(rc_j) == 0 else rc_j[perm])
-        if np.ndim(c_i) == 0 and np.ndim(rc_i) == 0:
-            self._add_normal(self._scatter(f_i, perm, g.P))
-        else:
-            self._add_normal(self._scatter(f_i, perm, g.P), self._scatter(f_j, perm, g.P))
+            nut_i = np.where(perm, nut * nv_i, nut)
+            nut_j = np.where(perm, nut * nv_j, nut)
+        fc = np.abs(self.mu * self._coulomb_law(g))
+        self._apply_tangential(perm, kt_i, kt_j, nut_i, nut_j, fc)
 
     def _visc_ratio(self, g, ratio_name):
         """Per-visit viscosity factors of bonds: the ratio unless viscosities are kept constant."""
         r_i, r_j = self._pair_param(ratio_name, g)
         k_i, k_j = self._pair_param("keep_viscosity_coefficients_constant", g)
-        if np.ndim(r_i) == 0 and np.ndim(k_i) == 0:
+        if type(r_i) is float and type(k_i) is float:
             v = 1.0 if k_i else r_i
             return v, v
         r_i = np.broadcast_to(r_i, (g.P,))
@@ -172,33 +187,11 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         if g.perm is None:
             return None
         v_i, v_j = self._visc_ratio(g, "permanent_ratio_central")
-        if np.ndim(v_i) == 0 and v_i == 1.0:
+        if type(v_i) is float and v_i == 1.0:
             return None
         s_i = np.where(g.perm, v_i, 1.0)
         s_j = np.where(g.perm, v_j, 1.0)
         return s_i, s_j
-
-    def _tangential_terms(self):
-        CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
-        g = self._g
-        if g.perm is None:
-            return
-        pt = self._pairs
-        perm, slots = self._perm_subset(g)
-        vt = self._tangential_speed(g)[perm]
-        touching = g.d[perm] < g.d0[perm]
-        rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
-        nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
-
-        def sub(v):
-            return v if np.ndim(v) == 0 else v[perm]
-
-        xi_ij = pt.xi_ij[slots]
-        xi_ji = pt.xi_ji[slots]
-        f1, f2, _ = tangential_two_pass(vt, touching, np.ones(len(slots), bool), xi_ij, xi_ji,
-                                        self.k_t * sub(rt_i), self.k_t * sub(rt_j),
-                                        self.nu_t * sub(nv_i), self.nu_t * sub(nv_j), 0.0)
-        self._add_tangential(self._scatter(f1 / 2 + f2 / 2, perm, g.P))
 
     @property
     def active_terms(self):
