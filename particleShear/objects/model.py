@@ -14,7 +14,7 @@ def r_estimate(size_x, size_y, packing_fraction, N, bimodal_upper=1.2, bimodal_l
 
 def adjust_m(m, r_actual, r_mean):
     """Mass scaled with the disc area: ``m · r_actual² / r_mean²``."""
-    return m * r_actual ** 2 / r_mean ** 2
+    return m * r_actual * r_actual / r_mean / r_mean  # this order reproduces the reference masses exactly
 
 
 class particle_shear_model_parameters:

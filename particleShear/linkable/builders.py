@@ -1,0 +1,298 @@
+"""Ensemble factories from physical properties (spec §4.7, §5.5, §6.4, §6.11, §10.3).
+
+Both builders validate every input before any work, derive the model constants
+and time steps, relax the random packing, crosslink it, cut it into particles
+and relax again.  ``rng`` (Generator, int seed or None) drives every random
+choice; ``verbose`` prints the reference's console messages.
+"""
+import math
+import numbers
+
+import numpy as np
+
+from ..objects.model import particle_shear_model_parameters
+from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
+
+__all__ = ["EnsembleCompactParticlesFromModelParameters",
+           "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
+           "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
+
+#: attempts at cutting without a height-spanning particle before giving up (the reference loops forever)
+MAX_CUT_ATTEMPTS = 1000
+
+
+# -- input validation -------------------------------------------------------------------------------------
+def _number(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return value
+
+
+def _require(name, value, ok, allowed):
+    _number(name, value)
+    if not ok(value):
+        raise ValueError(f"{name}={value!r} is out of range: allowed {allowed}")
+
+
+def _require_int(name, value, minimum):
+    _number(name, value)
+    if int(value) != value or value < minimum:
+        raise ValueError(f"{name}={value!r} is out of range: allowed integers >= {minimum}")
+
+
+def _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
+                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
+                     relative_transversal_link_strength, avoid_horizontal_angle_degree):
+    pos = (lambda v: v > 0, "> 0")
+    nonneg = (lambda v: v >= 0, ">= 0")
+    _require("size_x", size_x, *pos)
+    _require("size_y", size_y, *pos)
+    _require_int("N", N, 2)
+    _require("packing_fraction", packing_fraction, *pos)
+    _require("mu", mu, *nonneg)
+    _require("Young_modulus_spheres", Young_modulus_spheres, *pos)
+    _require("density", density, *pos)
+    _require("bimodal_factor", bimodal_factor, *pos)
+    _require_int("cut_lines", cut_lines, 0)
+    _require("relative_viscosity", relative_viscosity, *nonneg)
+    _number("central_repulsion_coefficient", central_repulsion_coefficient)
+    _require("anticipated_amplitude", anticipated_amplitude, *pos)
+    _require("relative_transversal_link_strength", relative_transversal_link_strength, *nonneg)
+    _require("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, lambda v: 0 <= v < 90,
+             "0 <= value < 90 (degrees)")
+
+
+# -- time steps -------------------------------------------------------------------------------------------
+def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
+                          anticipated_amplitude, relative_viscosity):
+    """Final step ``dt`` and coarsest relaxation step ``dt_max`` (s) of §4.7, in the reference's order."""
+    tau, bf, rts, A, rv = (time_constant, bimodal_factor, relative_transversal_link_strength,
+                           anticipated_amplitude, relative_viscosity)
+    dt = 0.1 * tau / bf
+    if mu <= 1 or rts < 1:
+        dt = dt / 2
+    if A <= 0.05:
+        dt = dt / 2
+    if mu <= 0.1 or rts < 0.1:
+        dt = dt / 2
+    if A <= 0.005:
+        dt = dt / 2
+    if A >= 0.5:
+        dt = dt / 2
+    dt_max = 0.25 * tau / bf
+    if (rv <= 0.1 and mu < 0.1) or rts < 0.1 or rts > 5:
+        dt_max = 0.125 * tau / bf
+    if (rv < 0.01 and mu < 0.01) or rts < 0.01:
+        dt_max = 0.04 * tau / bf
+    if dt > dt_max:
+        dt = dt_max
+    if rv > 1:
+        dt_max = dt_max / rv
+    return dt, dt_max
+
+
+# -- shared constitution steps ----------------------------------------------------------------------------
+def _avoid_flag(avoid, doCutByTriangulation, cut_lines, verbose):
+    """Step 0 of §6.4: height checks only make sense when cutting can produce separate particles."""
+    if avoid and ((doCutByTriangulation and cut_lines <= 1) or (not doCutByTriangulation and cut_lines <= 0)):
+        if verbose:
+            print("avoid_height_spanning_particles ignored: with cut_lines=" + str(cut_lines)
+                  + " the gel is not cut into separate particles")
+        return False
+    return avoid
+
+
+def _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness):
+    if doCutByTriangulation:
+        ens.cutByTriangulation(cut_lines, edge_fuzziness)
+    else:
+        for _ in range(int(cut_lines)):
+            ens.cutRandomLine()
+
+
+def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose):
+    """Crosslink all contacts, cut into particles, re-cut while a particle spans > 0.9·Ly (§6.5-6.8)."""
+    ens.makeAllLinksPermanent()
+    if cut_top_bottom:
+        ens.cutTopBottomEdge()
+    _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness)
+    if not avoid:
+        return
+    h = ens.maximal_particle_height()
+    attempts = 1
+    while h > 0.9 * ens.size_y:
+        if attempts >= MAX_CUT_ATTEMPTS:
+            raise RuntimeError(f"no cut without a height-spanning particle found in {attempts} attempts "
+                               f"(cut_lines={cut_lines}); use more cuts or avoid_height_spanning_particles=False")
+        if verbose:
+            print("Height spanning particle (height " + str(h) + "), cutting again")
+        ens.particles = []
+        ens.makeAllLinksPermanent()
+        if cut_top_bottom:
+            ens.cutTopBottomEdge()
+        _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness)
+        h = ens.maximal_particle_height()
+        attempts += 1
+
+
+def _free_mu0(ens, n, mu):
+    """``μ=0: free(n)``: run a relaxation block with the ensemble's μ set to 0, then restore it."""
+    ens.mu = 0
+    ens.free_pre_equilibration(n)
+    ens.mu = mu
+
+
+# -- builders ---------------------------------------------------------------------------------------------
+def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
+        size_x=500, size_y=500, N=100, packing_fraction=1, mu=1, Young_modulus_spheres=10000, density=50,
+        bimodal_factor=1.4, cut_lines=5, do_permanent_links=True, theTk=False, do_pre_equilibration=True,
+        relative_viscosity=0.01, central_repulsion_coefficient=0, anticipated_amplitude=0.1,
+        relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
+        avoid_height_spanning_particles=False, interface_reenforcement_central=1,
+        interface_reenforcement_tangential=1, keep_viscosity_coefficients_constant=True, cut_top_bottom=True,
+        doCutByTriangulation=True, remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, do_debug=False,
+        rng=None, verbose=False):
+    """Relaxed, crosslinked and cut ensemble with reinforced transient interfaces (§6.4); the main factory.
+
+    Returns an :class:`EnsembleCompactParticlesAdjustableInterfaceStrength` whose
+    ``dt`` / ``dt_max`` (s) are the steps the experiment should use.
+    """
+    _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
+                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
+                     relative_transversal_link_strength, avoid_horizontal_angle_degree)
+    _require("interface_reenforcement_central", interface_reenforcement_central, lambda v: v > 0, "> 0")
+    _require("interface_reenforcement_tangential", interface_reenforcement_tangential, lambda v: v > 0, "> 0")
+    _require("remove_link_fraction", remove_link_fraction, lambda v: 0 <= v <= 1, "0 <= value <= 1")
+    _require("edge_fuzziness", edge_fuzziness, lambda v: v >= 0, ">= 0")
+
+    N, cut_lines = int(N), int(cut_lines)
+    R = 10 if do_debug else 1
+    irc, irt = interface_reenforcement_central, interface_reenforcement_tangential
+    rv, rts, A, bf = relative_viscosity, relative_transversal_link_strength, anticipated_amplitude, bimodal_factor
+    prc = 1 / irc
+    prt = 1 / irt
+    avoid = _avoid_flag(avoid_height_spanning_particles, doCutByTriangulation, cut_lines, verbose)
+
+    model = particle_shear_model_parameters(size_x, size_y, N, packing_fraction, Young_modulus_spheres, density,
+                                            bimodal_factor=1)
+    tau, k = model.time_constant, model.k
+    dt, dt_max = time_steps_from_model(tau, bf, mu, rts, A, rv)
+    k_ens = k * irc
+    k_t_ens = k * rts * irt
+    nu_ens = rv * k * tau
+    nu_t_ens = rv * k * tau * rts
+    if not keep_viscosity_coefficients_constant:
+        nu_ens = nu_ens * irc
+        nu_t_ens = nu_t_ens * irt
+    ens = EnsembleCompactParticlesAdjustableInterfaceStrength(
+        size_x, size_y, N, packing_fraction, False, doDrawing, k_ens, nu_ens, model.m, bf, k_t_ens, nu_t_ens, mu,
+        dt, dt_max, False, avoid_horizontal_angle_degree, prc, prt, keep_viscosity_coefficients_constant,
+        rng=np.random.default_rng(rng))
+    ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
+    ens.avoid_height_spanning_particles = avoid
+    ens.model = model
+    ens.edge_fuzziness = edge_fuzziness
+
+    if do_pre_equilibration:
+        ens.dt = dt
+        ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
+        if packing_fraction > 2:
+            ens.dt_max = ens.dt_max / 2
+        n1 = int(300 / R) if prc == 1 else int(100 / R)
+        ens.free_pre_equilibration(n1)
+        if A <= 0.01 or rts < 0.1:
+            ens.free_pre_equilibration(n1)
+        ens.dt = dt
+        ens.dt_max = dt_max
+        ens.free_pre_equilibration(int(200 / R) if prc == 1 else int(100 / R))
+        if A <= 0.01 and prc == 1:
+            ens.free_pre_equilibration(int(200 / R))
+        if A <= 0.001 and prc == 1:
+            ens.free_pre_equilibration(int(200 / R))
+
+    if do_permanent_links:
+        _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose)
+        if cut_top_bottom:
+            ens.cut_top_bottom = True
+        if remove_link_fraction > 0:
+            ens.remove_non_essential_links(remove_link_fraction, True)
+            if verbose:
+                print("Actual fraction of removed non-essential links: " + str(ens.removed_fraction))
+        ens.join_isolated_spheres()
+        ens.dt_max = min(2 * ens.dt, ens.dt_max)
+        if rts > 5:
+            ens.dt_max = ens.dt_max / 2
+        ens.free_pre_equilibration(int(300 / R))
+        n = int(150 / R)
+        if A < 0.1:
+            _free_mu0(ens, n, mu)
+            ens.free_pre_equilibration(n)
+        n = int(100 / R)
+        for threshold in (0.01, 0.001, 0.0001):
+            if A <= threshold:
+                ens.free_pre_equilibration(n)
+                _free_mu0(ens, n, mu)
+                ens.free_pre_equilibration(n)
+        if A <= 0.001 and (irt != 1 or irc != 1):
+            ens.dt_max = ens.dt_max / 3
+            n = int(200 / R)
+            ens.free_pre_equilibration(n)
+            _free_mu0(ens, n, mu)
+            ens.free_pre_equilibration(n)
+    return ens
+
+
+def EnsembleCompactParticlesFromModelParameters(
+        size_x=500, size_y=500, N=100, packing_fraction=1, mu=1, Young_modulus_spheres=10000, density=50,
+        bimodal_factor=1.4, cut_lines=5, do_permanent_links=True, theTk=False, do_pre_equilibration=True,
+        relative_viscosity=0.01, central_repulsion_coefficient=0, anticipated_amplitude=0.1,
+        relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
+        avoid_height_spanning_particles=False, doCutByTriangulation=True, doDrawing=True, do_debug=False,
+        rng=None, verbose=False):
+    """Legacy factory (§6.11): no reinforcement, top/bottom always cut, a short final relaxation.
+
+    Returns an :class:`EnsembleCompactParticles`.
+    """
+    _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
+                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
+                     relative_transversal_link_strength, avoid_horizontal_angle_degree)
+    N, cut_lines = int(N), int(cut_lines)
+    R = 10 if do_debug else 1
+    rv, rts, A, bf = relative_viscosity, relative_transversal_link_strength, anticipated_amplitude, bimodal_factor
+    avoid = _avoid_flag(avoid_height_spanning_particles, doCutByTriangulation, cut_lines, verbose)
+
+    model = particle_shear_model_parameters(size_x, size_y, N, packing_fraction, Young_modulus_spheres, density,
+                                            bimodal_factor=1)
+    tau, k = model.time_constant, model.k
+    dt, dt_max = time_steps_from_model(tau, bf, mu, rts, A, rv)
+    ens = EnsembleCompactParticles(size_x, size_y, N, packing_fraction, False, doDrawing, k, rv * k * tau,
+                                   model.m, bf, k * rts, rv * k * tau * rts, mu, dt, dt_max, False,
+                                   avoid_horizontal_angle_degree, rng=np.random.default_rng(rng))
+    ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
+    ens.avoid_height_spanning_particles = avoid
+    ens.model = model
+
+    if do_pre_equilibration:
+        ens.dt = dt
+        ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
+        ens.free_pre_equilibration(int(300 / R))
+        if A <= 0.01 or rts < 0.1:
+            ens.free_pre_equilibration(int(300 / R))
+        ens.dt = dt
+        ens.dt_max = dt_max
+        ens.free_pre_equilibration(int(200 / R))
+        if A <= 0.01:
+            ens.free_pre_equilibration(int(200 / R))
+        if A <= 0.001:
+            ens.free_pre_equilibration(int(200 / R))
+
+    if do_permanent_links:
+        _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, 0, True, avoid, verbose)
+        ens.join_isolated_spheres()
+        ens.dt_max = min(2 * ens.dt, ens.dt_max)
+        if rts > 5:
+            ens.dt_max = ens.dt_max / 2
+        ens.free_pre_equilibration()
+    return ens
