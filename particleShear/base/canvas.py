@@ -414,6 +414,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         skin = self._skin()
         i, j = candidate_pairs(x, y, a["r"], self.size_x, self.size_y, shift, skin)
         self._pairs.replace(i, j)
+        self._nl_rsum_version = -1
         self._nl_valid = True
         self._nl_skin = skin
         self._nl_shift = shift
@@ -441,7 +442,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
                                         self._passes(), counts=True)
         d = np.sqrt(dx * dx + dy * dy)
-        d0 = r[i] + r[j]
+        if self._nl_rsum_version != pt.version:
+            self._nl_rsum = r[i] + r[j]
+            self._nl_rsum_version = pt.version
+        d0 = self._nl_rsum
         touching = d < d0
         perm = pt.state == PERMANENT if pt.n_permanent else None
         new_active = touching if perm is None else (touching | perm)
@@ -466,9 +470,19 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.aj = j[sel]
         g.dx = dx[sel]
         g.dy = dy[sel]
-        g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
+        g.d = d[sel]
+        if (g.d == 0).any():
+            g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
+        else:
+            g.nx = g.dx / g.d
+            g.ny = g.dy / g.d
+        g.ky = None if ky is None else ky[sel]
+        g.kx = None if kx is None else kx[sel]
         # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5)
-        shifted = (g.dx != dx0[sel]) | (g.dy != dy0[sel])
+        if g.ky is None:
+            shifted = (g.dx != dx0[sel]) | (g.dy != dy0[sel])
+        else:
+            shifted = (g.ky != 0) | (g.kx != 0)
         if shifted.any():
             w = np.flatnonzero(shifted)
             rx, ry = dx0[sel][w], dy0[sel][w]
@@ -502,8 +516,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.vt = None
         g.fel = None
         g.rv = None
-        g.ky = None if ky is None else ky[sel]
-        g.kx = None if kx is None else kx[sel]
         self._g = g
         return g
 
@@ -696,6 +708,28 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.k = k
         self.nu = nu
         self.central_repulsion_coefficient = 0
+        self.integrator = "euler"
+        self.stability_guard = None
+        self.phase = ""
+        self.step_count = 0
+        self._half_kick = None
+
+    INTEGRATORS = ("euler", "verlet")
+
+    def set_integrator(self, integrator):
+        """Choose the time integrator.
+
+        ``"euler"`` (default) is the reference's semi-implicit Euler: kick with the
+        forces of the step, damp, drift.  ``"verlet"`` is velocity Verlet with a
+        half-kick predictor (Groot-Warren λ = 1/2): the velocity-dependent forces
+        see the velocity at the force time instead of half a step earlier, which
+        makes the viscous terms second-order accurate.  Positions and the
+        conservative forces are updated identically by both.
+        """
+        if integrator not in self.INTEGRATORS:
+            raise ValueError(f"integrator must be one of {self.INTEGRATORS}, got {integrator!r}")
+        self.integrator = integrator
+        self._half_kick = None
 
     def set_central_repulsion_coefficient(self, central_repulsion_coefficient=0):
         """Set the law's repulsion coefficient c ∈ [0, 1] on the ensemble and every sphere."""
@@ -800,14 +834,56 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         """Clear the register, update neighbours, add every pair force (§4.1 step 1)."""
         self.reset_force_register()
         self.test_neighbor_relation()
+        predicted = self._predict_velocities() if self._half_kick is not None else None
         self._in_force_phase = True
         try:
             self._force_terms()
         finally:
             self._in_force_phase = False
+            if predicted is not None:
+                self._restore_velocities(predicted)
         self._flush_pair_forces()
+        if self.stability_guard is not None:
+            self.stability_guard.check(self, step=self.step_count, phase=self.phase, dt=self._last_dt)
+
+    _last_dt = None
+
+    def _predict_velocities(self):
+        """Velocity Verlet: move velocities half a kick ahead for the velocity-dependent forces."""
+        a = self._a
+        saved = (a["xspeed"].copy(), a["yspeed"].copy(), a["omega"].copy())
+        hx, hy, ht = self._half_kick
+        if len(hx) == self._n:
+            a["xspeed"] += hx
+            a["yspeed"] += hy
+            if ht is not None:
+                a["omega"] += ht
+        if self._g is not None:
+            self._g.rv = None
+            self._g.vn = None
+            self._g.vt = None
+        return saved
+
+    def _restore_velocities(self, saved):
+        a = self._a
+        a["xspeed"][:], a["yspeed"][:], a["omega"][:] = saved
+
+    def _store_half_kick(self, dt):
+        """Remember ``F·dt/(2m)`` of mobile spheres for the next force phase (Verlet only)."""
+        a = self._a
+        mob = self._mobile_mask()
+        hx = a["xforce"] * dt / (2 * a["m"])
+        hy = a["yforce"] * dt / (2 * a["m"])
+        ht = a["torque"] * dt / (2 * a["inertia"]) if self._torque_total() is not None else None
+        if mob is not None:
+            hx = np.where(mob, hx, 0.0)
+            hy = np.where(mob, hy, 0.0)
+        self._half_kick = (hx, hy, ht)
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
+        if self.integrator != "euler":
+            self._store_half_kick(dt)
+        self._last_dt = dt
         self.do_linear_acceleration(dt)
         self.cool(cool_factor)
 
@@ -821,6 +897,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._advance_strain(dt)
         self.boundary_conditions()
         self.t = self.t + dt
+        self.step_count += 1
         self._g = None
         if self._renderer is not None:
             self._renderer.update(self)
@@ -981,6 +1058,9 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
         """Linear kick (plates), rotational kick of all spheres, damping (§4.1 step 4)."""
+        if self.integrator != "euler":
+            self._store_half_kick(dt)
+        self._last_dt = dt
         self.do_linear_acceleration(dt)
         self.do_rotational_acceleration(dt)
         self.cool(cool_factor)

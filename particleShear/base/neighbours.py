@@ -38,6 +38,7 @@ class PairTable:
         self.birth = np.zeros(0, dtype=np.int64)
         self.n_permanent = 0
         self._births = 0
+        self.version = 0
 
     def __len__(self):
         return len(self.i)
@@ -83,6 +84,7 @@ class PairTable:
                 arr[had] = getattr(self, name)[src]
             setattr(self, name, arr)
         self.key = k
+        self.version += 1
 
     def ensure(self, i, j):
         """Slots of pairs (i, j), inserting missing ones (inactive, stick, ξ = 0)."""
