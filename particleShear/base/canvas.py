@@ -50,6 +50,23 @@ def check_non_negative(name, value):
         raise ValueError(f"{name} must be >= 0, got {value!r}")
 
 
+class NonNegative:
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu)."""
+
+    def __set_name__(self, owner, name):
+        self.name = name
+        self.key = "_c_" + name
+
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        return obj.__dict__[self.key]
+
+    def __set__(self, obj, value):
+        check_non_negative(self.name, value)
+        obj.__dict__[self.key] = value
+
+
 class SphereList(list):
     """The ensemble's spheres in index order; ``append`` moves a sphere's state into the arrays."""
 
@@ -701,10 +718,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 class CanvasPointsBasicElasticity(CanvasPointsShear):
     """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``."""
 
+    k = NonNegative()
+    nu = NonNegative()
+
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1):
         CanvasPointsShear.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
-        check_non_negative("k", k)
-        check_non_negative("nu", nu)
         self.k = k
         self.nu = nu
         self.central_repulsion_coefficient = 0
@@ -956,12 +974,13 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
 class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesEdwards):
     """Adds the tangential force (``k_t``, ``nu_t``, Coulomb ``mu``), spin and the ξ history."""
 
+    k_t = NonNegative()
+    nu_t = NonNegative()
+    mu = NonNegative()
+
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1, k_t=1,
                  nu_t=0.01, mu=0.1):
         CanvasPointsBasicElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
-        check_non_negative("k_t", k_t)
-        check_non_negative("nu_t", nu_t)
-        check_non_negative("mu", mu)
         self.k_t = k_t
         self.nu_t = nu_t
         self.mu = mu

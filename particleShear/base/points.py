@@ -28,10 +28,11 @@ def dotProduct2(a, b):
 class ArrayField:
     """Attribute stored locally before the sphere joins an ensemble, in the ensemble's array after."""
 
-    def __init__(self, default=0.0, geometry=False, param=False):
+    def __init__(self, default=0.0, geometry=False, param=False, positive=False):
         self.default = default
         self.geometry = geometry
         self.param = param
+        self.positive = positive
 
     def __set_name__(self, owner, name):
         self.name = name
@@ -46,6 +47,10 @@ class ArrayField:
         return ens._a[self.name][obj.__dict__["_idx"]].item()
 
     def __set__(self, obj, value):
+        if self.positive:
+            _check_positive(self.name, value)
+        else:
+            _check_finite(self.name, value)
         ens = obj.__dict__.get("_ens")
         if ens is None:
             obj.__dict__[self.key] = value
@@ -277,7 +282,7 @@ def _check_positive(name, value):
 class Circle(PointLeesEdwards):
     """Disc of radius ``diameter/2`` (µm); the cross-section of an infinite cylinder."""
 
-    r = ArrayField(1.0, geometry=True)
+    r = ArrayField(1.0, geometry=True, positive=True)
 
     def __init__(self, color, x, y, diameter, theCanvas=False, doDrawing=False, use_lees_edwards=False):
         PointLeesEdwards.__init__(self, x, y, use_lees_edwards=use_lees_edwards)
@@ -322,7 +327,7 @@ class Circle(PointLeesEdwards):
 class CircleMass(Circle):
     """Disc with mass ``m`` (mg per m depth) and a force accumulator (mg·µm·s⁻² per m)."""
 
-    m = ArrayField(1.0)
+    m = ArrayField(1.0, positive=True)
     xforce = ArrayField(0.0)
     yforce = ArrayField(0.0)
 
@@ -482,7 +487,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
     phi = ArrayField(-math.pi / 2)
     omega = ArrayField(0.0)
     torque = ArrayField(0.0)
-    inertia = ArrayField(0.5)
+    inertia = ArrayField(0.5, positive=True)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):

@@ -43,6 +43,9 @@ class StressTensorEvaluation:
     """Evaluates every stress tensor of §7 from a :class:`Force_register` with array operations."""
 
     def __init__(self, size_x, size_y, theCanvas=False):
+        for name, v in (("size_x", size_x), ("size_y", size_y)):
+            if not (isinstance(v, (int, float, np.number)) and np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
         self.size_x = size_x
         self.size_y = size_y
         self.theCanvas = theCanvas

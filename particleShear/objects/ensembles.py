@@ -4,7 +4,7 @@ import math
 import numpy as np
 
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
-                           CanvasPointsFrictionElasticityLeesEdwards, check_non_negative)
+                           CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
 from ..base.points import _check_positive
 from .model import adjust_m, r_estimate
 from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
@@ -92,13 +92,14 @@ class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
 class EnsembleFriction(Ensemble):
     """Legacy periodic ensemble with tangential forces (no shear offset)."""
 
+    k_t = NonNegative()
+    nu_t = NonNegative()
+    mu = NonNegative()
+
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
         Ensemble.__init__(self, size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m,
                           bimodal_factor)
-        check_non_negative("k_t", k_t)
-        check_non_negative("nu_t", nu_t)
-        check_non_negative("mu", mu)
         self.k_t = k_t
         self.nu_t = nu_t
         self.mu = mu

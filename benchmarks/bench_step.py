@@ -1,0 +1,211 @@
+"""Cost of one protocol step of a frictional, crosslinked ensemble under shear (not a test).
+
+One protocol step = setShearRate + forces (neighbour update, central, tangential,
+links) + register totals + every stress tensor + acceleration (kick, damping)
++ movement (ξ, drift, strain, wrap) + reset — the per-step sequence of §8.3.
+
+Scenes: EnsembleLinkable with random bimodal spheres (radius ratio 1.4) at packing
+fraction 1.5 in a cell that grows with N (the sphere size of the default 150-sphere
+500 × 500 µm run), relaxed with damping, then ``makeAllLinksPermanent()`` and a
+few ``cutLine``s; μ = 0.01, c = 1, k = k_t = π/8·8000·1e6, ν = ν_t ≈ 2e3, masses
+~0.1 mg/m, dt ≈ 1.1e-7 s, plates on, sinusoidal shear (A = 0.2, f ≈ 4 kHz).
+
+Baselines measured in the same run: the legacy O(N²) pure-Python neighbour test of
+the reference (§4.2, all ordered pairs, one relation search each) at N = 150, and a
+plain all-pairs NumPy minimum-image distance computation per step at N = 150 and 1,000.
+
+Targets (one core): ≤ 300 µs/step at N = 150, ≤ 1 µs per particle-step at N = 10,000,
+growth ≤ N^1.1 between 1,000 and 10,000.
+
+Usage: python benchmarks/bench_step.py [--quick]
+"""
+import os
+
+for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import statistics  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from particleShear import EnsembleLinkable, SphereLinkable, StressTensorEvaluation  # noqa: E402
+from particleShear.base.kernels import min_image  # noqa: E402
+
+E = 8000.0
+K = math.pi / 8 * E * 1e6          # 3.14e9 mg s^-2 per m depth
+NU = 1981.6636488030053            # relative viscosity 0.1 (spec A.2)
+DT = 1.1263984473304288e-07        # default final dt (spec A.2)
+F_EXC = 3963.327297606011          # excitation frequency (Hz)
+AMPLITUDE = 0.2
+PHI = 1.5
+R_MODEL = 28.209479177387816       # r_model of the default 150-sphere cell (µm)
+M_MODEL = 0.125                    # model mass (mg/m)
+BF = 1.4
+
+
+def build(n, seed=1):
+    """Frictional crosslinked ensemble of n spheres, relaxed, linked and cut, plates on."""
+    L = math.sqrt(n * math.pi * R_MODEL ** 2 / PHI)
+    rng = np.random.default_rng(seed)
+    r_b = math.sqrt(L * L * PHI / (n * math.pi)) / ((math.sqrt(BF) + 1 / math.sqrt(BF)) / 2)
+    ens = EnsembleLinkable(L, L, 0, k=K, nu=NU, k_t=K, nu_t=NU, mu=0.0)
+    ens.set_random_generator(rng)
+    large = rng.integers(0, 2, n)
+    xs = rng.random(n) * L
+    ys = rng.random(n) * L
+    for p in range(n):
+        r = r_b * (math.sqrt(BF) if large[p] else 1 / math.sqrt(BF))
+        s = SphereLinkable("grey", float(xs[p]), float(ys[p]), 2 * r, M_MODEL * r * r / (r_b * r_b), p,
+                           force_register=ens, size_x=L, size_y=L)
+        ens.sphereList.append(s)
+    # frictionless damped relaxation (linear law first: random placement has deep overlaps)
+    ens.set_central_repulsion_coefficient(0)
+    for _ in range(40):
+        ens.mechanical_simulation_step(cool_factor=0.7, dt=4 * DT)
+    ens.set_central_repulsion_coefficient(1)
+    for _ in range(20):
+        ens.mechanical_simulation_step(cool_factor=0.9, dt=2 * DT)
+    ens.mu = 0.01
+    ens.test_neighbor_relation()
+    ens.makeAllLinksPermanent()
+    n_cuts = max(3, int(round(5 * math.sqrt(n / 150))))
+    for _ in range(n_cuts):
+        ens.cutRandomLine()
+    ens.applyingShear = True
+    ens.t = 0
+    return ens
+
+
+def protocol_steps(ens, ev, n_steps, cool=0.99969060716623):
+    """Time n_steps protocol steps; returns the list of per-step wall times (s)."""
+    times = []
+    w = 2 * math.pi * F_EXC
+    for _ in range(n_steps):
+        t0 = time.perf_counter()
+        ens.setShearRate(AMPLITUDE * w * math.cos(w * ens.t))
+        ens.mechanical_simulation_step_calculate_forces()
+        ens.record_total_particle_forces()
+        ens.evaluate_stress_tensors(ev)
+        ev.evaluate_quasistatic_shear_stress()
+        ev.evaluate_externally_applied_shear_stress()
+        ens.mechanical_simulation_step_calculate_acceleration(cool, DT)
+        ens.mechanical_simulation_step_calculate_movement(DT)
+        ens.reset_force()
+        times.append(time.perf_counter() - t0)
+    return times
+
+
+def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
+    """The reference's O(N²) pure-Python neighbour update (§4.2): every ordered pair, LE minimum image,
+    linear search of the relation list by index."""
+    n = len(xs)
+    for i in range(n):
+        rel = relations[i]
+        for j in range(n):
+            if i == j:
+                continue
+            dx = xs[j] - xs[i]
+            dy = ys[j] - ys[i]
+            while dy >= L / 2:
+                dy -= L
+                dx -= L * shear
+            while dy < -L / 2:
+                dy += L
+                dx += L * shear
+            while dx >= L / 2:
+                dx -= L
+            while dx < -L / 2:
+                dx += L
+            touching = math.sqrt(dx * dx + dy * dy) < rs[i] + rs[j]
+            found = -1
+            for q, idx in enumerate(rel):
+                if idx == j:
+                    found = q
+            if not touching and found >= 0:
+                del rel[found]
+            if touching and found < 0:
+                rel.append(j)
+
+
+def numpy_all_pairs_step(x, y, r, L, shift):
+    i, j = np.triu_indices(len(x), 1)
+    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], L, L, shift)
+    d = np.sqrt(dx * dx + dy * dy)
+    return int(np.count_nonzero(d < r[i] + r[j]))
+
+
+def median_us(times):
+    return statistics.median(times) * 1e6
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer steps and sizes 150 / 1,000 / 10,000 still")
+    args = ap.parse_args()
+    quick = args.quick
+    sizes = (150, 1000, 10000)
+    steps = {150: 200 if quick else 1000, 1000: 60 if quick else 300, 10000: 10 if quick else 60}
+    warm = {150: 20, 1000: 10, 10000: 3}
+
+    print(f"particleShear protocol-step benchmark ({'quick' if quick else 'full'}); numpy {np.__version__}, "
+          f"threads pinned to 1")
+    per = {}
+    scenes = {}
+    for n in sizes:
+        t0 = time.perf_counter()
+        ens = build(n)
+        t_build = time.perf_counter() - t0
+        ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+        protocol_steps(ens, ev, warm[n])
+        times = protocol_steps(ens, ev, steps[n])
+        per[n] = median_us(times)
+        scenes[n] = ens
+        links = len(ens.permanent_pairs()[0])
+        contacts = len(ens.contact_pairs()[0])
+        mobile = len(ens.movableSphereList())
+        print(f"N = {n:6d}: {per[n]:10.1f} µs/step (median of {len(times)}), {per[n] / n:7.3f} µs/particle-step"
+              f"  [L = {ens.size_x:.0f} µm, relations {contacts}, links {links}, mobile {mobile}, "
+              f"terms {'+'.join(ens.active_terms)}; build {t_build:.1f} s]")
+    expo = math.log(per[10000] / per[1000]) / math.log(10)
+    print(f"scaling exponent 1,000 → 10,000: N^{expo:.2f}")
+
+    # baselines, same run
+    ens = scenes[150]
+    a_x = np.array([s.x for s in ens.sphereList])
+    a_y = np.array([s.y for s in ens.sphereList])
+    a_r = np.array([s.r for s in ens.sphereList])
+    L = ens.size_x
+    rels = [[] for _ in range(len(a_x))]
+    xs, ys, rs = a_x.tolist(), a_y.tolist(), a_r.tolist()
+    legacy = []
+    for _ in range(2 if quick else 5):
+        t0 = time.perf_counter()
+        legacy_neighbour_loop(xs, ys, rs, L, ens.shear, rels)
+        legacy.append(time.perf_counter() - t0)
+    leg = median_us(legacy)
+    print(f"baseline legacy pure-Python O(N²) neighbour update alone, N = 150: {leg:10.1f} µs/step "
+          f"→ full vectorised step is {leg / per[150]:.1f}× faster")
+    for n in (150, 1000):
+        e = scenes[n]
+        x = np.array([s.x for s in e.sphereList])
+        y = np.array([s.y for s in e.sphereList])
+        r = np.array([s.r for s in e.sphereList])
+        bt = []
+        for _ in range(20 if n == 150 else 5):
+            t0 = time.perf_counter()
+            numpy_all_pairs_step(x, y, r, e.size_x, e.size_y * e.shear)
+            bt.append(time.perf_counter() - t0)
+        b = median_us(bt)
+        print(f"baseline NumPy all-pairs LE distances alone, N = {n:5d}: {b:10.1f} µs/step "
+              f"→ ratio full step / baseline = {per[n] / b:.2f}")
+    ok = (per[150] <= 300, per[10000] / 10000 <= 1.0, expo <= 1.1)
+    print(f"targets: N=150 ≤ 300 µs: {'met' if ok[0] else 'MISSED'}; "
+          f"N=10,000 ≤ 1 µs/particle-step: {'met' if ok[1] else 'MISSED'}; "
+          f"growth ≤ N^1.1: {'met' if ok[2] else 'MISSED'}")
+
+
+if __name__ == "__main__":
+    main()
