@@ -1085,56 +1085,58 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self.cool(cool_factor)
 
     def _integrate_xi(self, dt):
-        """Sequential ξ rule of the reference, without a Python loop (§2.10, B.2)."""
+        """Sequential ξ rule of the reference, without a Python loop (§2.10, B.2).
+
+        Relation i→j (i < j) sees both spheres at their old positions; relation
+        j→i sees i already moved by ``v_i·dt``.  Both use the velocities after
+        the kick and damping, and slip relations are not integrated.
+        """
         g = self._g
         if g is None or not g.P:
             return
         pt = self._pairs
-        st = pt.state[g.slots]
-        keep = st != SLIP
-        if not keep.any():
-            return
+        keep = pt.state.take(g.slots) != SLIP
+        allk = keep.all()
+        if allk:
+            sl, ai, aj, nx, ny, dvx0, ky, kx, d = g.slots, g.ai, g.aj, g.nx, g.ny, g.dvx, g.ky, g.kx, g.d
+        else:
+            w = np.nonzero(keep)[0]
+            if not len(w):
+                return
+            sl, ai, aj, nx, ny, d = (g.slots.take(w), g.ai.take(w), g.aj.take(w), g.nx.take(w), g.ny.take(w),
+                                     g.d.take(w))
+            dvx0 = None if g.dvx is None else g.dvx.take(w)
+            ky = None if g.ky is None else g.ky.take(w)
+            kx = None if g.kx is None else g.kx.take(w)
         a = self._a
         x, y, vx, vy, om, r = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"], a["r"]
-        allk = keep.all()
-        sl = g.slots if allk else g.slots[keep]
-        ai = g.ai if allk else g.ai[keep]
-        aj = g.aj if allk else g.aj[keep]
-        nx = g.nx if allk else g.nx[keep]
-        ny = g.ny if allk else g.ny[keep]
-        spin = r[ai] * om[ai] + r[aj] * om[aj]
-        # relation i→j: both spheres still at their old positions
-        rvx = vx[aj] - vx[ai]
-        if g.dvx is not None:
-            rvx = rvx + (g.dvx if allk else g.dvx[keep])
-        rvy = vy[aj] - vy[ai]
-        pt.xi_ij[sl] += ((rvx * -ny + rvy * nx) - spin) * dt
-        # relation j→i: i (lower index) has already moved; same image as in the force phase
-        # (periods −k, applied one at a time as the reference does), checked against half a cell
-        xin = x[ai] + vx[ai] * dt
-        yin = y[ai] + vy[ai] * dt
-        rx = xin - x[aj]
-        ry = yin - y[aj]
-        if g.ky is not None:
-            ky = g.ky if allk else g.ky[keep]
-            kx = g.kx if allk else g.kx[keep]
-            Lx, Ly = float(self.size_x), float(self.size_y)
+        vxi, vyi = vx.take(ai), vy.take(ai)
+        rvx = vx.take(aj) - vxi
+        rvy = vy.take(aj) - vyi
+        spin = r.take(ai) * om.take(ai) + r.take(aj) * om.take(aj)
+        # relation i→j: both spheres still at their old positions (the force-phase geometry)
+        ux = rvx if dvx0 is None else rvx + dvx0
+        pt.xi_ij[sl] += ((ux * -ny + rvy * nx) - spin) * dt
+        # relation j→i: i has moved; same image as in the force phase (periods −k, one at a time)
+        rx = (x.take(ai) + vxi * dt) - x.take(aj)
+        ry = (y.take(ai) + vyi * dt) - y.take(aj)
+        Lx, Ly = float(self.size_x), float(self.size_y)
+        if ky is not None:
             dy = ry + Ly * ky
             dx = (rx + float(self._le_shift()) * ky) + Lx * kx
             dvx = (Ly * float(self._shear_rate_for_images())) * ky
-            if ((dy >= self.size_y / 2) | (dy < -self.size_y / 2) | (dx >= self.size_x / 2)
-                    | (dx < -self.size_x / 2)).any():
-                dx, dy, dvx = min_image(rx, ry, self.size_x, self.size_y, self._le_shift(),
-                                        self._shear_rate_for_images())
         else:
-            dx, dy, dvx = min_image(rx, ry, self.size_x, self.size_y, self._le_shift(),
-                                    self._shear_rate_for_images())
-        _, mx, my = pair_geometry(dx, dy, self._rng)
-        svx = vx[ai] - vx[aj]
-        if dvx is not None:
-            svx = svx + dvx
-        svy = vy[ai] - vy[aj]
-        pt.xi_ji[sl] += ((svx * -my + svy * mx) - spin) * dt
+            dx, dy, dvx = rx, ry, None
+        if np.abs(dx).max() >= Lx / 2 or np.abs(dy).max() >= Ly / 2:
+            dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+        dm = np.sqrt(dx * dx + dy * dy)
+        if (dm == 0).any():
+            _, mx, my = pair_geometry(dx, dy, self._rng)
+        else:
+            mx = dx / dm
+            my = dy / dm
+        svx = -rvx if dvx is None else -rvx + dvx
+        pt.xi_ji[sl] += ((svx * -my + -rvy * mx) - spin) * dt
 
     def move(self, dt=1):
         a = self._a

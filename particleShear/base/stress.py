@@ -224,8 +224,7 @@ class StressTensorEvaluation:
     def _evaluate_arrays(self, reg, mobile, shear_rate):
         """All tensors of one engine force phase in a few array operations (same formulas as above)."""
         t = self._t
-        ens = reg._ens
-        a = ens._a
+        a = reg._ens._a
         x, y = a["x"], a["y"]
         V = self._volume()
         cx, cy = self.size_x / 2, self.size_y / 2
@@ -233,15 +232,19 @@ class StressTensorEvaluation:
         i, j = p["i"], p["j"]
         internal = p["internal"]
         n_int = int(np.count_nonzero(internal))
-        F_i = np.array((p["fix"], p["fiy"]))
         if n_int and p.get("antisymmetric", True):
-            if n_int == len(i):
-                ii, jj, G = i, j, F_i
-            else:
+            fix, fiy = p["fix"], p["fiy"]
+            if n_int != len(i):
                 w = np.nonzero(internal)[0]
-                ii, jj, G = i.take(w), j.take(w), F_i[:, w]
-            D = np.array((x.take(ii) - x.take(jj), y.take(ii) - y.take(jj)))
-            t[_LW] = (G * _CF) @ D.T * _CL / V
+                i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
+            G = np.array((fix, fiy))
+            G *= _CF
+            D = np.array((x.take(i) - x.take(j), y.take(i) - y.take(j)))
+            lw = np.dot(G, D.T)
+            lw *= _CL
+            lw /= V
+            t[_LW] = lw
+            i, j = p["i"], p["j"]
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
         else:
@@ -250,9 +253,15 @@ class StressTensorEvaluation:
             wi = np.nonzero(p["ext_i"])[0]
             wj = np.nonzero(p["ext_j"])[0]
             tg = np.concatenate((i.take(wi), j.take(wj)))
-            G = np.concatenate((F_i[:, wi], np.array((p["fjx"].take(wj), p["fjy"].take(wj)))), axis=1)
-            X = np.array((x.take(tg) - cx, y.take(tg) - cy))
-            t[_EXT] = (0.0 - (G * _CF) @ (X * _CL).T) / V
+            if len(tg):
+                G = np.array((np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
+                              np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj)))))
+                G *= _CF
+                X = np.array((x.take(tg) - cx, y.take(tg) - cy))
+                X *= _CL
+                t[_EXT] = (0.0 - np.dot(G, X.T)) / V
+            else:
+                t[_EXT] = 0.0
         else:
             t[_EXT] = 0.0
         _, fx, fy = reg._tot
@@ -262,26 +271,44 @@ class StressTensorEvaluation:
             w = np.nonzero(mobile)[0]
             fx, fy, xm, ym = fx.take(w), fy.take(w), x.take(w), y.take(w)
             inertia, omega, m, vx, vy = inertia.take(w), omega.take(w), m.take(w), vx.take(w), vy.take(w)
-        t[_UNB] = (np.array((fx, fy)) * _CF) @ (np.array((xm - cx, ym - cy)) * _CL).T / V
-        t[_LIN] = t[_UNB]
-        K = float(((inertia * _CT) * (omega * omega) / 2).sum())
+        G = np.array((fx, fy))
+        G *= _CF
+        X = np.array((xm - cx, ym - cy))
+        X *= _CL
+        unb = np.dot(G, X.T)
+        unb /= V
+        t[_UNB] = unb
+        t[_LIN] = unb
+        K = float(np.dot(inertia * _CT, omega * omega)) / 2
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K / V
         cen[0, 1] = cen[1, 0] = 0.0
         mp = m * 1e-12
-        P = np.array((mp * (vx - shear_rate * (ym - self.size_y / 2)), mp * vy))
-        t[_OT] = -((P / (m * 1e-6)) @ P.T) / V
+        P = np.array((vx - shear_rate * (ym - self.size_y / 2), vy))
+        P *= mp
+        ot = np.dot(P / (m * 1e-6), P.T)
+        ot /= -V
+        t[_OT] = ot
         total = float(reg._mom.sum()) if reg._mom is not None else 0.0
-        t[_TQ] = self._antisym(total, V)
+        s_ = total * _CT / V
+        tq = t[_TQ]
+        tq[0, 0] = tq[1, 1] = 0.0
+        tq[0, 1] = -s_ / 2
+        tq[1, 0] = s_ / 2
         if p.get("ti") is not None and n_int:
             if n_int == len(i):
                 tint = float(p["ti"].sum() + p["tj"].sum())
             else:
-                tint = float(internal @ (p["ti"] + p["tj"]))
+                tint = float(np.dot(internal, p["ti"] + p["tj"]))
         else:
             tint = 0.0
-        t[_TINT] = self._antisym(tint, V)
-        t[_ALL] = t[_LW] + t[_TINT] + t[_CEN]
+        s_ = tint * _CT / V
+        ti = t[_TINT]
+        ti[0, 0] = ti[1, 1] = 0.0
+        ti[0, 1] = -s_ / 2
+        ti[1, 0] = s_ / 2
+        np.add(t[_LW], t[_TINT], out=t[_ALL])
+        t[_ALL] += t[_CEN]
 
     def evaluate_quasistatic_shear_stress(self):
         """τ_internal = −σ_xy of the overall tensor (Pa)."""
