@@ -95,12 +95,18 @@ class TestDerivedConstants(unittest.TestCase):
         self.assertFalse(ens.cut_top_bottom)
         self.assertTrue(ens.doCutByTriangulation)
         self.assertTrue(ens.avoid_height_spanning_particles)
-        info = ens.particle_info()
+        info = ens.particle_info(reference=True)
         expected = ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
                     "adjustment ofstrength between permament and temporary interfaces\n\tSpheres with, bimodal "
                     "distribution, equal probability, \n\tr1=" + str(ens.r_max * 0.8 / 1.2) + "r2="
                     + str(ens.r_max) + "\n\tidentical mass=" + str(ens.sphereList[0].m) + "mg")
         self.assertEqual(info, expected)
+        # the default text fixes §12 #23: the true small radius and both masses
+        fixed = ens.particle_info()
+        r1 = float(fixed.split("r1=")[1].split()[0])
+        self.assertAlmostEqual(r1, ens.r_max / 1.4, delta=1e-12 * ens.r_max)
+        m = sorted({s.m for s in ens.sphereList})
+        self.assertIn("m1=" + str(m[0]) + "mg m2=" + str(m[-1]) + "mg", fixed)
 
     def test_debug_schedule_lengths(self):
         ens = relaxed(0)

@@ -81,14 +81,22 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return SphereLinkable(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
                               self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
 
-    def particle_info(self):
+    def particle_info(self, reference=False):
+        """Description of the spheres for the output header (``reference=True``: the 1.0.2 text, §12 #23)."""
         return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles\n\t"
-                + self._sphere_info())
+                + self._sphere_info(reference))
 
-    def _sphere_info(self):
-        mass = str(float(self._a["m"][0])) if self._n else "0"
-        return ("Spheres with, bimodal distribution, equal probability, \n\tr1=" + str(self.r_max * 0.8 / 1.2)
-                + "r2=" + str(self.r_max) + "\n\tidentical mass=" + mass + "mg")
+    def _sphere_info(self, reference=False):
+        if reference:
+            mass = str(float(self._a["m"][0])) if self._n else "0"
+            return ("Spheres with, bimodal distribution, equal probability, \n\tr1=" + str(self.r_max * 0.8 / 1.2)
+                    + "r2=" + str(self.r_max) + "\n\tidentical mass=" + mass + "mg")
+        m = self._a["m"]
+        m1 = str(float(m.min())) if self._n else "0"
+        m2 = str(float(m.max())) if self._n else "0"
+        r1 = self.r_max * self.bimodal_lower / self.bimodal_upper
+        return ("Spheres with bimodal distribution, equal probability, \n\tr1=" + str(r1) + " r2="
+                + str(self.r_max) + "\n\tmasses m1=" + m1 + "mg m2=" + m2 + "mg")
 
     # -- relaxation ----------------------------------------------------------------------------------
     def free_pre_equilibration(self, N=25):
@@ -335,9 +343,13 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
             self.doDrawing, self, self.size_x, self.size_y, self.permanent_ratio_central,
             self.permanent_ratio_tangential, self.keep_viscosity_coefficients_constant)
 
-    def particle_info(self):
+    def particle_info(self, reference=False):
+        """Description of the spheres for the output header (``reference=True``: the 1.0.2 text, §12 #23)."""
+        if reference:
+            return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
+                    "adjustment ofstrength between permament and temporary interfaces\n\t" + self._sphere_info(True))
         return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
-                "adjustment ofstrength between permament and temporary interfaces\n\t" + self._sphere_info())
+                "adjustment of strength between permanent and temporary interfaces\n\t" + self._sphere_info())
 
 
 def _check_angle(a):

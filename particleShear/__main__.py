@@ -1,0 +1,7 @@
+"""``python -m particleShear``: run one simulation from the command line (see ``--help``)."""
+import sys
+
+from .run.cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

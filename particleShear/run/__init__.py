@@ -1,0 +1,4 @@
+"""Layer 5: ``doParticleShearSimulation``, ``doParticleShearSimulationSeries`` and the command line."""
+from .api import SimulationResult, doParticleShearSimulation, doParticleShearSimulationSeries
+
+__all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult"]

@@ -1,0 +1,354 @@
+"""The oscillatory shear experiment (spec §8.2–§8.6, §10.9).
+
+``OscillatoryShearExperiment.oscillatory_shear_experiment`` runs the fixed-boundary
+pre-equilibration (§8.4) and the measurement protocol (§8.2) in the reference
+per-step order (§8.3, one visible loop in :meth:`OscillatoryShearExperiment.run_protocol`),
+records every step, demodulates τ_internal and τ_surface (§8.5) and returns
+``[G′_surface, G″_surface]`` (Pa) as the reference does.
+"""
+import math
+import os
+import sys
+import time
+
+
+from ..base.stress import StressTensorEvaluation
+from .evaluation import EvaluationHandlerPlotter, demodulation
+from .output import (NO_TENSOR_DATA_TEXT, experiment_description_text, output_summary_text, table_text)
+
+__all__ = ["OscillatoryShearExperiment", "image_cadence", "protocol_steps"]
+
+
+def protocol_steps(periods, pre, post, f, dt):
+    """Number of protocol steps ``int((periods + pre + post)/f / dt)`` (truncation, §8.2)."""
+    return int((periods + pre + post) / f / dt)
+
+
+def image_cadence(n_steps):
+    """Snapshot interval ``image_N`` of §9.4: ``int(n/200)`` if n > 200 else 1."""
+    return int(n_steps / 200) if n_steps > 200 else 1
+
+
+class OscillatoryShearExperiment:
+    """Pre-equilibration with fixed plates, sinusoidal strain protocol, recording and demodulation.
+
+    Parameters (reference order and defaults)
+    ----------
+    theEnsemble : ensemble
+        A Lees-Edwards ensemble with the step API (``setShearRate``, ``mechanical_simulation_step_*``).
+    dt : float
+        Time step of the protocol (s).
+    f : float
+        Excitation frequency (Hz).
+    amplitude : float
+        Strain amplitude A.
+    output_file : file-like or False
+        Where the experiment description and the results are written (False: nothing written).
+    dt_max : float
+        Coarsest step of the pre-equilibration; ``10·dt`` unless larger than ``dt``.
+    TkSimulation, theTkOutput : optional
+        Live windows (kept for API compatibility; see ``renderer`` and ``stress_window``).
+    force_scale : float
+        Plot scale of the stresses (pixels per Pa).
+    imageOutputFolder, imageBaseFileName, imageFileType :
+        Snapshots (§9.4), saved when a folder and a base name are given and a renderer exists.
+    plotStress : bool
+        Live stress/strain plot (needs a display).
+    saveStressTensorData : bool
+        Write the 42-column table (and keep the per-step tensor history for it).
+
+    Attributes beyond the reference
+    -------------------------------
+    correct_drift_sign : bool
+        False (reference quirk, default) / True: sign of the drift correction of §8.5.
+    reference_header : bool
+        True reproduces the header defects §12 #21–22 ("Post-measurement periods" printing
+        the pre value, "Simulated time" = excitation time only).  Default False.
+    renderer : Renderer or None
+        Drawing backend used for snapshots (and live updates); see :mod:`.drawing`.
+    stress_window : StressPlotWindow or None
+    image_N : int or None
+        Snapshot interval; None = reference rule :func:`image_cadence`.
+    progress : callable or None
+        ``progress(phase, step, total, elapsed_s)`` called about 10 times per second.
+    verbose : bool
+        Print the reference console messages.
+    timings : dict
+        Wall time (s) of "pre_equilibration", "protocol", "demodulation", "output".
+    results : dict
+        After the run: "internal" and "surface" demodulation results ``[SA, SB, G', G'']``.
+    """
+
+    def __init__(self, theEnsemble, dt, f, amplitude, output_file, dt_max=0, TkSimulation=False, force_scale=1,
+                 theTkOutput=False, imageOutputFolder=False, imageBaseFileName=False, imageFileType="jpg",
+                 plotStress=True, saveStressTensorData=True):
+        self.plotStress = plotStress
+        self.theEnsemble = theEnsemble
+        self.amplitude = amplitude
+        self.dt = dt
+        self.f = f
+        self.theTk = theTkOutput
+        self.external_output_Tk = bool(theTkOutput)
+        self.width = 1000
+        self.height = 500
+        self.outputCanvas = False
+        self.output_file = output_file
+        self.dt_max = dt_max if dt_max > dt else 10 * dt
+        self.theTkSimulation = TkSimulation
+        self.plotter = None
+        self.theEvaluator = None
+        self.baseline_pre_periods = 0
+        self.baseline_post_periods = 0
+        self.periods = 2
+        self.force_scale = force_scale
+        self.final_cool_factor = 1
+        self.cool_factor = 1
+        self.do_preequilibration_with_fixed_boundaries = True
+        self.imageOutputFolder = imageOutputFolder
+        self.imageBaseFileName = imageBaseFileName
+        self.imageFileType = imageFileType
+        self.saveStressTensorData = saveStressTensorData
+        # beyond the reference
+        self.correct_drift_sign = False
+        self.reference_header = False
+        self.renderer = None
+        self.stress_window = None
+        self.image_N = None
+        self.progress = None
+        self.verbose = False
+        self.keep_tensor_history = None
+        self.timings = {}
+        self.results = {}
+        self.n_images_saved = 0
+        self.N_steps = 0
+
+    # -- signals ---------------------------------------------------------------------------------
+    def in_phase_signal(self, t):
+        """``sin(2π(t f − pre))``: the strain shape (§8.2)."""
+        return math.sin(2 * math.pi * (t * self.f - self.baseline_pre_periods))
+
+    def out_of_phase_signal(self, t):
+        """``cos(2π(t f − pre))``: the strain-rate shape (§8.2)."""
+        return math.cos(2 * math.pi * (t * self.f - self.baseline_pre_periods))
+
+    def _say(self, *args):
+        if self.verbose:
+            print(*args)
+
+    def _report(self, phase, step, total, t0, state):
+        """Call the progress callback at most ~10 times per second (and at the end)."""
+        if self.progress is None:
+            return
+        now = time.perf_counter()
+        if step == total or now - state[0] >= 0.1:
+            state[0] = now
+            self.progress(phase, step, total, now - t0)
+
+    # -- pre-equilibration -----------------------------------------------------------------------
+    def pre_equilibrate(self, N=25, cool_factor=0.99):
+        """Relax with the plates fixed (§8.4): coarse levels from ``dt_max``, 2N steps at dt, N steps at dt.
+
+        Runs with ``applyingShear = True`` (the plate band is immobile, the plates rest).  The
+        last N steps use ``cool_factor`` and reset γ̇ to 0 by direct assignment before each step.
+        """
+        ens = self.theEnsemble
+        ens.applyingShear = True
+        t0 = time.perf_counter()
+        level_dt = self.dt_max
+        cf = 0.5
+        blocks = []
+        while level_dt > self.dt:
+            blocks.append((int(N / 2), level_dt, cf))
+            level_dt = level_dt / 2
+            cf = (1 + cf) / 2
+        total = sum(b[0] for b in blocks) + 3 * int(N)
+        self._say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt "
+                  + str(self.dt_max) + " final dt " + str(self.dt))
+        state = [0.0]
+        step = 0
+        for n, ldt, c in blocks:
+            self._say("dt= " + str(ldt))
+            for _ in range(n):
+                ens.mechanical_simulation_step(c, ldt)
+                step += 1
+                self._report("pre-equilibration", step, total, t0, state)
+        self._say("  Setting final dt= " + str(self.dt))
+        for _ in range(2 * int(N)):
+            ens.mechanical_simulation_step(0.98, self.dt)
+            step += 1
+            self._report("pre-equilibration", step, total, t0, state)
+        for _ in range(int(N)):
+            ens.shear_rate = 0
+            ens.mechanical_simulation_step(cool_factor, self.dt)
+            ens.reset_force()
+            step += 1
+            self._report("pre-equilibration", step, total, t0, state)
+        self.timings["pre_equilibration"] = time.perf_counter() - t0
+
+    def free_pre_equilibration(self):
+        """Unused by the reference protocol: relaxation without plates (§8.4, last paragraph)."""
+        ens = self.theEnsemble
+        ens.applyingShear = False
+        mu = getattr(ens, "mu", 0)
+        N = int(20 * (2 - math.log10(mu))) if mu > 0 else 10
+        level_dt = self.dt_max
+        cf = 0.5
+        while level_dt > self.dt:
+            ens.mechanical_relaxation(N, cf, level_dt)
+            level_dt = level_dt / 2
+            cf = (1 + cf) / 2
+            ens.correct_linear_drift()
+        ens.mechanical_relaxation(N, 1, self.dt)
+
+    # -- images ----------------------------------------------------------------------------------
+    def image_path(self, index):
+        """``<folder>/<base><index padded to 7 digits>.<ext>`` (§9.4)."""
+        from .drawing import IMAGE_EXTENSIONS
+        ext = IMAGE_EXTENSIONS.get(self.imageFileType, IMAGE_EXTENSIONS["ps"])[0]
+        return os.path.join(str(self.imageOutputFolder), str(self.imageBaseFileName) + f"{index:07d}" + ext)
+
+    def save_canvas_image(self, index):
+        """Save a snapshot of the particle picture for protocol step ``index`` (if a renderer exists)."""
+        if self.renderer is None or not self.imageOutputFolder or not self.imageBaseFileName:
+            return
+        self.renderer.save(self.theEnsemble, self.image_path(index), self.imageFileType)
+        self.n_images_saved += 1
+
+    # -- the protocol ----------------------------------------------------------------------------
+    def _make_plotter(self, T_total):
+        canvas = self.stress_window.canvas if (self.plotStress and self.stress_window is not None) else False
+        plotter = EvaluationHandlerPlotter(self.stress_window.tk if canvas else False, canvas,
+                                           x_scale=self.width / T_total, y_scale_strain=30 / self.amplitude,
+                                           y_scale_force=self.force_scale, r=2, offset_x=0,
+                                           offset_y=self.height / 2, plotStress=bool(canvas))
+        self.outputCanvas = canvas
+        return plotter
+
+    def prepare_recording(self):
+        """Create the evaluator and the plotter and preallocate the recording for the whole protocol."""
+        ens = self.theEnsemble
+        pre, P, post = self.baseline_pre_periods, self.periods, self.baseline_post_periods
+        T_total = (P + pre + post) / self.f
+        N_steps = int(T_total / self.dt)
+        self.theEvaluator = StressTensorEvaluation(ens.size_x, ens.size_y)
+        self.plotter = self._make_plotter(T_total)
+        keep = self.keep_tensor_history
+        if keep is None:
+            keep = bool(self.output_file) and bool(self.saveStressTensorData)
+        self.plotter.allocate(N_steps, keep_tensor_history=keep)
+        return N_steps
+
+    def run_protocol(self, cool_factor, n_steps=None):
+        """The measurement protocol in the reference per-step order (§8.2, §8.3).
+
+        ``n_steps`` stops after that many steps (default: the whole protocol,
+        ``int((P + pre + post)/f/dt)`` steps).  Needs :meth:`prepare_recording` first.
+        """
+        ens = self.theEnsemble
+        dt, f, A = self.dt, self.f, self.amplitude
+        pre, P, post = self.baseline_pre_periods, self.periods, self.baseline_post_periods
+        T_total = (P + pre + post) / f
+        N_steps = int(T_total / dt)
+        lo = pre / (f * dt)
+        hi = (P + pre) / (f * dt)
+        if self.plotter is None:
+            self.prepare_recording()
+        plotter = self.plotter
+        evaluator = self.theEvaluator
+        save_images = self.renderer is not None and bool(self.imageOutputFolder) and bool(self.imageBaseFileName)
+        image_N = self.image_N or image_cadence(N_steps)
+        window = self.stress_window if self.plotStress else None
+        n_run = N_steps if n_steps is None else min(int(n_steps), N_steps)
+        self._say("Start application shear protocol, total N= " + str(N_steps) + " steps")
+        t0 = time.perf_counter()
+        state = [0.0]
+        for i in range(n_run):
+            if lo <= i <= hi:
+                rate = A * math.cos(2 * math.pi * (ens.t * f - pre)) * 2 * math.pi * f
+            else:
+                rate = 0
+            ens.setShearRate(rate)                                    # §4.5 velocity/spin adjustment
+            ens.mechanical_simulation_step_calculate_forces()         # neighbours + pair forces
+            ens.record_total_particle_forces()                        # register totals
+            plotter.record(ens, evaluator)                            # tensors, τ_int, τ_surf, t, γ, γ̇
+            ens.mechanical_simulation_step_calculate_acceleration(cool_factor, dt)  # kick + damping
+            ens.mechanical_simulation_step_calculate_movement(dt)     # ξ, drift, γ, wrap, t += dt
+            ens.reset_force()
+            if window is not None:
+                window.update()
+            if save_images and i % image_N == 0:
+                self.save_canvas_image(i)
+            self._report("protocol", i + 1, n_run, t0, state)
+        self.timings["protocol"] = time.perf_counter() - t0
+        self.N_steps = n_run
+        return n_run
+
+    def oscillatory_shear_experiment(self, cool_factor=1, N_pre_equilibration_fixed_boundaries=25):
+        """Run pre-equilibration and protocol; return ``[G′_surface, G″_surface]`` (Pa).
+
+        ``cool_factor`` is the per-step damping factor (§4.4).  Both demodulations are kept in
+        ``results`` ("internal": overall tensor, "surface": external forces).
+        """
+        ens = self.theEnsemble
+        self.cool_factor = cool_factor
+        if self.output_file:
+            self.write_experiment_description_information_to_file()
+        self.prepare_recording()
+        ens.applyingShear = True
+        if self.do_preequilibration_with_fixed_boundaries:
+            self.pre_equilibrate(N_pre_equilibration_fixed_boundaries, cool_factor)
+        ens.t = 0
+        ens.applyingShear = True
+        self.run_protocol(cool_factor)
+        t0 = time.perf_counter()
+        G_int = self.evaluateStressAndG(useExternalForce=False)
+        G_surf = self.evaluateStressAndG(useExternalForce=True)
+        self.results = {"internal": G_int, "surface": G_surf}
+        self.timings["demodulation"] = time.perf_counter() - t0
+        if self.verbose:
+            p = self.plotter
+            if p.last_tensors is not None:
+                print("Overall stress tensor, last step:", p.last_tensors[-1].tolist())
+                print("Overall stress tensor, first step:", p.first_tensors[-1].tolist())
+            for label, v in (("G'", G_int[2]), ("G''", G_int[3]), ("G'(by surface force)", G_surf[2]),
+                             ("G''(by surface force)", G_surf[3])):
+                print(label)
+                print(v)
+                print("Pa")
+        t0 = time.perf_counter()
+        if self.output_file:
+            self.write_output_information_to_file()
+        self.timings["output"] = time.perf_counter() - t0
+        return [G_surf[2], G_surf[3]]
+
+    # -- evaluation ------------------------------------------------------------------------------
+    def demodulation(self, t, shear_stress):
+        """``[in-phase stress, out-of-phase stress, G′, G″]`` of a series (§8.5), this protocol's settings."""
+        return demodulation(t, shear_stress, self.f, self.amplitude, self.baseline_pre_periods, self.periods,
+                            self.baseline_post_periods, correct_drift_sign=self.correct_drift_sign)
+
+    def evaluateStressAndG(self, useExternalForce=False):
+        """Demodulate τ_surface (``useExternalForce=True``) or τ_internal (False) of the recorded run."""
+        p = self.plotter
+        s = p.force_array if useExternalForce else p.shear_stress_array
+        return self.demodulation(p.t_array, s)
+
+    # -- output ----------------------------------------------------------------------------------
+    def write_experiment_description_information_to_file(self):
+        """Block 2 of the output file (§9.1)."""
+        self.output_file.write(experiment_description_text(self, reference_header=self.reference_header))
+
+    def write_output_information_to_file(self):
+        """Block 3 of the output file: summary and (optionally) the 42-column table (§9.1)."""
+        G_int = self.results.get("internal") or self.evaluateStressAndG(False)
+        G_surf = self.results.get("surface") or self.evaluateStressAndG(True)
+        out = self.output_file
+        out.write(output_summary_text(G_int, G_surf))
+        p = self.plotter
+        if self.saveStressTensorData and p.tensor_history is not None:
+            out.write(table_text(p._scal[: len(p)], p.tensor_history))
+        elif self.saveStressTensorData:
+            print("OscillatoryShearExperiment: tensor history was not kept; writing no table", file=sys.stderr)
+            out.write("\n" + NO_TENSOR_DATA_TEXT)
+        else:
+            out.write("\n" + NO_TENSOR_DATA_TEXT)

@@ -1,0 +1,475 @@
+"""Simulation classes: ensemble construction + experiment + output file (spec §8.1, §9, §10.9).
+
+``runSimulation`` (inherited by every class) validates the output settings before any
+work, builds the ensemble (``initEnsemble``), writes the text file of §9.1 atomically
+(temporary file + ``os.replace``), drives the :class:`OscillatoryShearExperiment` and
+returns ``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings,
+output path, series) is kept in ``self.result_info`` after the run.
+"""
+import math
+import os
+import time
+
+from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
+                                 EnsembleCompactParticlesFromModelParameters)
+from .drawing import make_renderer, open_stress_plot
+from .experiment import OscillatoryShearExperiment
+from .output import reserve_numbered_path
+
+__all__ = ["OscillatorySimulation", "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
+           "Simulation_interlocking_rheology", "check_output_folder"]
+
+
+def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True):
+    """Raise ValueError when output is requested without a usable ``root_folder`` (§12 #26)."""
+    wants = []
+    if saveData:
+        wants.append("saveData=True")
+    if saveOutputImages and doDrawing:
+        wants.append("saveOutputImages=True")
+    if not wants:
+        return
+    if not root_folder or not isinstance(root_folder, (str, os.PathLike)):
+        raise ValueError(f"root_folder={root_folder!r} is invalid: {' and '.join(wants)} needs an existing "
+                         "output folder (a non-empty path)")
+    if not os.path.isdir(root_folder):
+        raise ValueError(f"root_folder={root_folder!r} is invalid: {' and '.join(wants)} needs an existing "
+                         "output folder (no such directory)")
+
+
+class OscillatorySimulation:
+    """Base class: output paths, file header, experiment set-up and the run (§8.1).
+
+    Parameters
+    ----------
+    root_folder : str
+        Folder of the text file and the image folder (needed when saving).
+    amplitude : float
+        Strain amplitude A.
+    relative_y_scale_force : float
+        Plot scaling of the stress window only.
+    relative_frequency : float
+        Excitation frequency in units of 1/τ (f = relative_frequency/τ).
+    doDrawing : bool
+        Particle drawing (live window when a display exists; needed for snapshots).
+    saveData : bool
+        Write the text file of §9.1.
+
+    Attributes beyond the reference: ``rng`` (Generator/seed for the builder), ``verbose``,
+    ``renderer_backend`` ("auto", "tk", "pillow", "none"), ``correct_drift_sign``,
+    ``reference_header`` (see :class:`OscillatoryShearExperiment`), ``progress``
+    (callback), ``timings`` and ``result_info`` (after the run), ``output_path``.
+    """
+
+    def __init__(self, root_folder, amplitude=0.5, relative_y_scale_force=5e-4, relative_frequency=0.05,
+                 doDrawing=True, saveData=False):
+        self.amplitude = amplitude
+        self.doDrawing = doDrawing
+        self.relative_y_scale_force = relative_y_scale_force
+        self.relative_frequency = relative_frequency
+        self.theTkSimulation = False
+        self.f = -1
+        self.root_folder = root_folder
+        self.saveData = saveData
+        self.baseline_pre_periods = 0
+        self.baseline_post_periods = 0
+        self.imageOutputFolder = False
+        self.imageBaseFileName = "image"
+        self.saveOutputImages = False
+        self.imageFileType = "jpg"
+        self.saveStressTensorData = True
+        self.function_call = "OscillatorySimulation(root_folder=" + str(root_folder) + ")"
+        self.theExperiment = None
+        self.theEnsemble = None
+        self.model = False
+        # beyond the reference
+        self.rng = None
+        self.verbose = False
+        self.renderer_backend = "auto"
+        self.renderer = None
+        self.correct_drift_sign = False
+        self.reference_header = False
+        self.progress = None
+        self.timings = {}
+        self.result_info = None
+        self.output_path = None
+
+    # -- ensemble --------------------------------------------------------------------------------
+    def initEnsemble(self):
+        """Base class: nothing to build (subclasses create ``theEnsemble``)."""
+        return None
+
+    def _attach_renderer(self):
+        """Choose the drawing backend now that the ensemble exists (live window or files or nothing)."""
+        ens = self.theEnsemble
+        want_images = bool(self.saveOutputImages) and bool(self.root_folder)
+        title = self._window_title()
+        self.renderer = make_renderer(self.doDrawing, want_images, ens.size_x, ens.size_y, title,
+                                      getattr(ens, "graphical_output_configuration", None),
+                                      backend=self.renderer_backend)
+        if self.renderer is not None and self.renderer.live:
+            ens._renderer = self.renderer
+            self.theTkSimulation = getattr(self.renderer, "root", False)
+            ens.initiateGraphics()
+
+    def _window_title(self):
+        return "particleShear A=" + str(self.amplitude)
+
+    def adjustment_factor_for_bounded_preequilibration_steps(self):
+        return 1
+
+    # -- paths -----------------------------------------------------------------------------------
+    def _file_stem(self):
+        return os.path.join(str(self.root_folder), "oscillatory_simulation_")
+
+    def file_path(self):
+        """``root/<name><k>.txt`` for the smallest k ≥ 1 not yet used (§9.3); False without a root folder."""
+        if not self.root_folder:
+            return False
+        stem = self._file_stem()
+        k = 1
+        while os.path.exists(stem + str(k) + ".txt") or os.path.exists(
+                os.path.join(os.path.dirname(stem), "." + os.path.basename(stem) + str(k) + ".txt.part")):
+            k += 1
+        return stem + str(k) + ".txt"
+
+    def image_folder_path(self, fileName):
+        """``<text file path>_images_folder`` (§9.4)."""
+        return str(fileName) + "_images_folder"
+
+    def createFolder(self, directory):
+        os.makedirs(directory, exist_ok=True)
+
+    def write_information_on_simulation_to_file(self, theFile):
+        theFile.write("Oscillatory simulation\n\n\n\nFunction call : \n" + self.function_call + "\n\n")
+
+    # -- experiment ------------------------------------------------------------------------------
+    def createExperiment(self, output_file=False, periods=2, plotStress=False, imageOutputFolder=False):
+        """Build the experiment exactly as :meth:`runSimulation` does (also used by the stochastic tests)."""
+        ens = self.theEnsemble
+        model = self.model or getattr(ens, "model", False)
+        y_scale_force = self.relative_y_scale_force / model.k / self.amplitude if model else 1
+        self.dt = ens.dt
+        self.f = self.relative_frequency / model.time_constant
+        if self.verbose:
+            print("Setting relative frequency: " + str(self.relative_frequency) + " f= " + str(self.f) + "Hz")
+        exp = OscillatoryShearExperiment(ens, self.dt, self.f, self.amplitude, output_file,
+                                         force_scale=y_scale_force, TkSimulation=self.theTkSimulation,
+                                         dt_max=ens.dt_max, imageOutputFolder=imageOutputFolder,
+                                         imageBaseFileName=self.imageBaseFileName,
+                                         imageFileType=self.imageFileType, plotStress=plotStress,
+                                         saveStressTensorData=self.saveStressTensorData)
+        exp.periods = periods
+        exp.baseline_pre_periods = self.baseline_pre_periods
+        exp.baseline_post_periods = self.baseline_post_periods
+        exp.do_preequilibration_with_fixed_boundaries = True
+        exp.correct_drift_sign = self.correct_drift_sign
+        exp.reference_header = self.reference_header
+        exp.renderer = self.renderer
+        exp.verbose = self.verbose
+        exp.progress = self.progress
+        if self.verbose:
+            print("Creating oscillatory shear experiment, dt = " + str(exp.dt) + " max dt = " + str(exp.dt_max))
+            print("OscillatoryShearExperiment: Plot stress graph: " + str(plotStress))
+        if plotStress and self.doDrawing:
+            exp.stress_window = open_stress_plot(exp.width, exp.height, renderer=self.renderer,
+                                                 backend=self.renderer_backend)
+        self.theExperiment = exp
+        return exp
+
+    def runSimulation(self, cool_factor=1, periods=2, plotStress=True):
+        """Build, equilibrate, shear, write; return ``[G′_surface, G″_surface]`` (Pa) (§8.1).
+
+        ``cool_factor`` is the fraction of peculiar velocity left after one excitation period;
+        the per-step factor is ``cool_factor ** (1/N_per_period)`` (§4.4).
+        """
+        check_output_folder(self.root_folder, self.saveData, self.saveOutputImages, self.doDrawing)
+        if not periods > 0:
+            raise ValueError(f"periods={periods!r} is out of range: allowed > 0")
+        if not 0 < cool_factor <= 1:
+            raise ValueError(f"cool_factor={cool_factor!r} is out of range: allowed 0 < value <= 1")
+        t_start = time.perf_counter()
+        out = None
+        try:
+            if self.progress is not None:
+                self.progress("constitution", 0, 0, 0.0)
+            self.initEnsemble()
+            self.timings["constitution"] = time.perf_counter() - t_start
+            if self.progress is not None:
+                self.progress("constitution", 1, 1, self.timings["constitution"])
+            self._attach_renderer()
+            model = self.model or getattr(self.theEnsemble, "model", False)
+            self.dt = self.theEnsemble.dt
+            self.f = self.relative_frequency / model.time_constant
+            fileName = False
+            if self.saveData or (self.saveOutputImages and self.doDrawing):
+                out = reserve_numbered_path(self._file_stem())
+                fileName = out.path
+                if not self.saveData:  # the name is only needed for the image folder
+                    out.abort()
+                    out = None
+            self.output_path = fileName if self.saveData else None
+            image_folder = False
+            if self.saveOutputImages and self.renderer is not None and fileName:
+                image_folder = self.image_folder_path(fileName)
+                self.createFolder(image_folder)
+            if out is not None:
+                self.write_information_on_simulation_to_file(out)
+            exp = self.createExperiment(out if out is not None else False, periods, plotStress, image_folder)
+            N_pre = 25 * int(self.adjustment_factor_for_bounded_preequilibration_steps())
+            N_per_period = 1 / self.f / self.dt
+            f_step = cool_factor ** (1 / N_per_period)
+            if self.verbose:
+                print("cool factor per dt= " + str(f_step))
+                if out is not None:
+                    print("Writing output to file " + fileName)
+            G = exp.oscillatory_shear_experiment(cool_factor=f_step, N_pre_equilibration_fixed_boundaries=N_pre)
+            if out is not None:
+                t0 = time.perf_counter()
+                out.commit()
+                exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
+            self.timings.update(exp.timings)
+            self.timings["total"] = time.perf_counter() - t_start
+            self.result_info = {
+                "G_surface": (exp.results["surface"][2], exp.results["surface"][3]),
+                "G_internal": (exp.results["internal"][2], exp.results["internal"][3]),
+                "stress_surface": (exp.results["surface"][0], exp.results["surface"][1]),
+                "stress_internal": (exp.results["internal"][0], exp.results["internal"][1]),
+                "dt": self.dt, "f": self.f, "N_steps": exp.N_steps, "N_pre_equilibration": N_pre,
+                "damping_factor": f_step, "output_path": self.output_path,
+                "image_folder": image_folder or None, "n_images": exp.n_images_saved,
+                "timings": dict(self.timings),
+            }
+            return G
+        finally:
+            if out is not None and not out.committed:
+                out.abort()
+            self._close_windows()
+
+    def _close_windows(self):
+        exp = self.theExperiment
+        if exp is not None and exp.stress_window is not None:
+            exp.stress_window.close()
+            exp.stress_window = None
+        if self.renderer is not None:
+            self.renderer.close()
+        if self.theEnsemble is not None:
+            self.theEnsemble._renderer = None
+
+
+class OscillatorySimulationFragmentation(OscillatorySimulation):
+    """Crosslinked ensembles cut into particles ("fragmentation"); naming and header of §9.1/§9.3."""
+
+    def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2, amplitude=0.5,
+                 Young_modulus_spheres=1000, mu=0.1, relative_y_scale_force=5e-4, relative_frequency=0.05,
+                 doDrawing=True, saveData=False):
+        OscillatorySimulation.__init__(self, root_folder, amplitude, relative_y_scale_force, relative_frequency,
+                                       doDrawing, saveData)
+        self.packing_fraction = packing_fraction
+        self.N = N
+        self.do_permanent_links = do_permanent_links
+        self.cut_lines = cut_lines
+        self.Young_modulus_spheres = Young_modulus_spheres
+        self.mu = mu
+        self.theEnsemble = None
+        self.model = False
+        self.function_call = ("OscillatorySimulationFragmentation(root_folder=" + str(root_folder)
+                              + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines)
+                              + ",N=" + str(N) + ",packing_fraction=" + str(packing_fraction)
+                              + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres="
+                              + str(Young_modulus_spheres) + ",mu=" + str(mu) + ",relative_y_scale_force="
+                              + str(relative_y_scale_force) + ",relative_frequency=" + str(relative_frequency)
+                              + ",doDrawing=" + str(doDrawing) + ")")
+
+    def adjustment_factor_for_bounded_preequilibration_steps(self):
+        if 0 < self.mu <= 1:
+            return int(2 - math.log10(self.mu))
+        return 1
+
+    def _window_title(self):
+        return ("Interface: tangential=" + str(getattr(self, "interface_reenforcement_tangential", 1))
+                + " central=" + str(getattr(self, "interface_reenforcement_central", 1))
+                + " A=" + str(self.amplitude) + " mu=" + str(self.mu))
+
+    def initEnsemble(self, do_debug=False):
+        """Legacy builder with this class's parameters (§6.11)."""
+        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(
+            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
+            Young_modulus_spheres=self.Young_modulus_spheres, cut_lines=self.cut_lines,
+            do_permanent_links=self.do_permanent_links, anticipated_amplitude=self.amplitude, doDrawing=False,
+            do_debug=do_debug, rng=self.rng, verbose=self.verbose)
+        self.model = self.theEnsemble.model
+        self.dt = self.theEnsemble.dt
+        self.dt_max = self.theEnsemble.dt_max
+        return self.theEnsemble
+
+    def _file_stem(self):
+        name = "dermal_filler"
+        if self.do_permanent_links:
+            if not self.cut_lines > 0:
+                name += "_bulk"
+        else:
+            name += "_uncrosslinked"
+        f = self.f if self.f != -1 else self._frequency()
+        name += (str(self.mu) + "_f_" + str(round(f * 10000) / 10000) + "_strain_"
+                 + str(round(self.amplitude * 100000) / 100000) + "_nr_")
+        return os.path.join(str(self.root_folder), name)
+
+    def _frequency(self):
+        model = self.model or getattr(self.theEnsemble, "model", False)
+        return self.relative_frequency / model.time_constant if model else -1
+
+    def write_information_on_simulation_to_file(self, theFile):
+        """Block 1 of §9.1."""
+        if self.do_permanent_links:
+            if self.cut_lines > 0:
+                head = ("Dermal filler Ensemble: \n\tCutting lines used to generate the particles"
+                        + str(self.cut_lines) + "\n")
+            else:
+                head = "Dermal filler control ensemble: no cut lines \n"
+        else:
+            head = "Dermal filler control ensemble: No permanent links\n"
+        theFile.write(head
+                      + "\tN=" + str(self.N) + " spheres, nominal packing density = " + str(self.packing_fraction)
+                      + "\n\tYoung modulus of the individual spheres = " + str(self.Young_modulus_spheres) + " Pa \n"
+                      + "\tFriction coefficient = " + str(self.mu) + "\n\n\n\n"
+                      + "Function call : \n" + self.function_call + "\n\n")
+
+
+class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
+    """Fragmentation simulation with full material parameters; legacy builder (§6.11, §10.9)."""
+
+    def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2,
+                 bimodal_factor=1.4, amplitude=0.5, Young_modulus_spheres=1000, density=50, mu=0.1,
+                 relative_viscosity=0.01, relative_y_scale_force=5e-4, relative_frequency=0.05,
+                 relative_transversal_link_strength=1, central_repulsion_coefficient=1,
+                 avoid_horizontal_angle_degree=0, avoid_height_spanning_particles=False, doCutByTriangulation=True,
+                 doDrawing=True, saveData=False):
+        OscillatorySimulationFragmentation.__init__(self, root_folder, do_permanent_links, cut_lines, N,
+                                                    packing_fraction, amplitude, Young_modulus_spheres, mu,
+                                                    relative_y_scale_force, relative_frequency, doDrawing, saveData)
+        self.avoid_horizontal_angle_degree = avoid_horizontal_angle_degree
+        self.avoid_height_spanning_particles = avoid_height_spanning_particles
+        self.doCutByTriangulation = doCutByTriangulation
+        self.bimodal_factor = bimodal_factor
+        self.central_repulsion_coefficient = central_repulsion_coefficient
+        self.density = density
+        self.relative_viscosity = relative_viscosity
+        self.relative_transversal_link_strength = relative_transversal_link_strength
+        self.dt = None
+        self.dt_max = None
+        self.function_call = (
+            "Simulation_dermal_filler_rheology(root_folder=" + str(root_folder)
+            + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines) + ",N=" + str(N)
+            + ",packing_fraction=" + str(packing_fraction) + ",bimodal_factor=" + str(bimodal_factor)
+            + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres=" + str(Young_modulus_spheres)
+            + ",density=" + str(density) + ",mu=" + str(mu) + ",relative_viscosity=" + str(relative_viscosity)
+            + ",relative_y_scale_force=" + str(relative_y_scale_force) + ",relative_frequency="
+            + str(relative_frequency) + ",relative_transversal_link_strength="
+            + str(relative_transversal_link_strength) + ",central_repulsion_coefficient="
+            + str(central_repulsion_coefficient) + ",avoid_horizontal_angle_degree="
+            + str(avoid_horizontal_angle_degree) + ",avoid_height_spanning_particles="
+            + str(avoid_height_spanning_particles) + ",doCutByTriangulation=" + str(doCutByTriangulation)
+            + ",doDrawing=" + str(doDrawing) + ")")
+
+    def adjustment_factor_for_bounded_preequilibration_steps(self):
+        """Longer fixed-boundary relaxation for low friction, amplitude or viscosity (§8.4)."""
+        F = 1
+        mu, A = self.mu, self.amplitude
+        if mu <= 0.1:
+            F *= 1.5
+        if mu <= 0.01:
+            F *= 2
+        if mu <= 0.001:
+            F *= 2
+        if A <= 0.01:
+            F *= 1 - (math.log10(A) + 2)
+        if A <= 0.005:
+            F *= 2
+        if self.relative_viscosity <= 0.1:
+            F *= 2
+        if self.verbose:
+            print("Adjustment factor of pre-equilibration time for low amplitude and friction: " + str(F))
+        return F
+
+    def initEnsemble(self, do_debug=False):
+        """Legacy builder with every material parameter (§6.11)."""
+        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(
+            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
+            Young_modulus_spheres=self.Young_modulus_spheres, density=self.density,
+            bimodal_factor=self.bimodal_factor, cut_lines=self.cut_lines, do_permanent_links=self.do_permanent_links,
+            theTk=False, do_pre_equilibration=True, relative_viscosity=self.relative_viscosity,
+            central_repulsion_coefficient=self.central_repulsion_coefficient, anticipated_amplitude=self.amplitude,
+            relative_transversal_link_strength=self.relative_transversal_link_strength,
+            avoid_horizontal_angle_degree=self.avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles=self.avoid_height_spanning_particles,
+            doCutByTriangulation=self.doCutByTriangulation, doDrawing=False, do_debug=do_debug, rng=self.rng,
+            verbose=self.verbose)
+        self.model = self.theEnsemble.model
+        self.dt = self.theEnsemble.dt
+        self.dt_max = self.theEnsemble.dt_max
+        return self.theEnsemble
+
+
+class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
+    """The simulation created by ``doParticleShearSimulation``: adjustable interfaces, §6.4 builder."""
+
+    def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2,
+                 bimodal_factor=1.4, amplitude=0.5, Young_modulus_spheres=1000, density=50, mu=0.1,
+                 relative_viscosity=0.01, relative_y_scale_force=5e-4, relative_frequency=0.05,
+                 relative_transversal_link_strength=1, avoid_horizontal_angle_degree=15,
+                 avoid_height_spanning_particles=False, interface_reenforcement_central=1,
+                 interface_reenforcement_tangential=1, central_repulsion_coefficient=1,
+                 keep_viscosity_coefficients_constant=True, cut_top_bottom=True, doCutByTriangulation=True,
+                 remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, saveData=False):
+        Simulation_dermal_filler_rheology.__init__(
+            self, root_folder, do_permanent_links, cut_lines, N, packing_fraction, bimodal_factor, amplitude,
+            Young_modulus_spheres, density, mu, relative_viscosity, relative_y_scale_force, relative_frequency,
+            relative_transversal_link_strength, central_repulsion_coefficient, avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles, doCutByTriangulation, doDrawing, saveData)
+        self.interface_reenforcement_central = interface_reenforcement_central
+        self.interface_reenforcement_tangential = interface_reenforcement_tangential
+        self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
+        self.cut_top_bottom = cut_top_bottom
+        self.remove_link_fraction = remove_link_fraction
+        self.edge_fuzziness = edge_fuzziness
+        self.function_call = (
+            "Simulation_interlocking_rheology(root_folder=" + str(root_folder)
+            + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines) + ",N=" + str(N)
+            + ",packing_fraction=" + str(packing_fraction) + ",bimodal_factor=" + str(bimodal_factor)
+            + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres=" + str(Young_modulus_spheres)
+            + ",density=" + str(density) + ",mu=" + str(mu) + ",relative_viscosity=" + str(relative_viscosity)
+            + ",relative_y_scale_force=" + str(relative_y_scale_force) + ",relative_frequency="
+            + str(relative_frequency) + ",relative_transversal_link_strength="
+            + str(relative_transversal_link_strength) + ",central_repulsion_coefficient="
+            + str(central_repulsion_coefficient) + ",avoid_horizontal_angle_degree="
+            + str(avoid_horizontal_angle_degree) + ",avoid_height_spanning_particles="
+            + str(avoid_height_spanning_particles) + ",interface_reenforcement_central="
+            + str(interface_reenforcement_central) + ",interface_reenforcement_tangential="
+            + str(interface_reenforcement_tangential) + ",keep_viscosity_coefficients_constant="
+            + str(keep_viscosity_coefficients_constant) + ",cut_top_bottom=" + str(cut_top_bottom)
+            + ",doCutByTriangulation=" + str(doCutByTriangulation) + ",remove_link_fraction="
+            + str(remove_link_fraction) + ",edge_fuzziness=" + str(edge_fuzziness) + ",doDrawing="
+            + str(doDrawing) + ")")
+
+    def initEnsemble(self, do_debug=False):
+        """Adjustable-interface builder (§6.4) with ``anticipated_amplitude = amplitude``."""
+        self.theEnsemble = EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
+            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
+            Young_modulus_spheres=self.Young_modulus_spheres, density=self.density,
+            bimodal_factor=self.bimodal_factor, cut_lines=self.cut_lines, do_permanent_links=self.do_permanent_links,
+            theTk=False, do_pre_equilibration=True, relative_viscosity=self.relative_viscosity,
+            central_repulsion_coefficient=self.central_repulsion_coefficient, anticipated_amplitude=self.amplitude,
+            relative_transversal_link_strength=self.relative_transversal_link_strength,
+            avoid_horizontal_angle_degree=self.avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles=self.avoid_height_spanning_particles,
+            interface_reenforcement_central=self.interface_reenforcement_central,
+            interface_reenforcement_tangential=self.interface_reenforcement_tangential,
+            keep_viscosity_coefficients_constant=self.keep_viscosity_coefficients_constant,
+            cut_top_bottom=self.cut_top_bottom, doCutByTriangulation=self.doCutByTriangulation,
+            remove_link_fraction=self.remove_link_fraction, edge_fuzziness=self.edge_fuzziness, doDrawing=False,
+            do_debug=do_debug, rng=self.rng, verbose=self.verbose)
+        self.model = self.theEnsemble.model
+        self.dt = self.theEnsemble.dt
+        self.dt_max = self.theEnsemble.dt_max
+        return self.theEnsemble
