@@ -502,6 +502,7 @@ class TestStochasticScenarios(unittest.TestCase):
         return exp, ens
 
     def shear(self, exp):
+        exp.keep_tensor_history = True  # every tensor at every step (runs that keep nothing evaluate only σ_xy)
         exp.prepare_recording()
         n = int((0.15 * exp.periods + exp.baseline_pre_periods) / (exp.f * exp.dt))
         exp.run_protocol(1, n)

@@ -237,13 +237,15 @@ class StressTensorEvaluation:
             if n_int != len(i):
                 w = np.nonzero(internal)[0]
                 i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
-            G = np.array((fix, fiy))
-            G *= _CF
-            D = np.array((x.take(i) - x.take(j), y.take(i) - y.take(j)))
-            lw = np.dot(G, D.T)
-            lw *= _CL
-            lw /= V
-            t[_LW] = lw
+            gx = fix * _CF
+            gy = fiy * _CF
+            ddx = x.take(i) - x.take(j)
+            ddy = y.take(i) - y.take(j)
+            lw = t[_LW]
+            lw[0, 0] = np.dot(gx, ddx) * _CL / V
+            lw[0, 1] = np.dot(gx, ddy) * _CL / V
+            lw[1, 0] = np.dot(gy, ddx) * _CL / V
+            lw[1, 1] = np.dot(gy, ddy) * _CL / V
             i, j = p["i"], p["j"]
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
@@ -254,12 +256,15 @@ class StressTensorEvaluation:
             wj = np.nonzero(p["ext_j"])[0]
             tg = np.concatenate((i.take(wi), j.take(wj)))
             if len(tg):
-                G = np.array((np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
-                              np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj)))))
-                G *= _CF
-                X = np.array((x.take(tg) - cx, y.take(tg) - cy))
-                X *= _CL
-                t[_EXT] = (0.0 - np.dot(G, X.T)) / V
+                gx = np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))) * _CF
+                gy = np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))) * _CF
+                lx = (x.take(tg) - cx) * _CL
+                ly = (y.take(tg) - cy) * _CL
+                ext = t[_EXT]
+                ext[0, 0] = (0.0 - np.dot(gx, lx)) / V
+                ext[0, 1] = (0.0 - np.dot(gx, ly)) / V
+                ext[1, 0] = (0.0 - np.dot(gy, lx)) / V
+                ext[1, 1] = (0.0 - np.dot(gy, ly)) / V
             else:
                 t[_EXT] = 0.0
         else:
@@ -309,6 +314,60 @@ class StressTensorEvaluation:
         ti[1, 0] = s_ / 2
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
+
+    def evaluate_shear_stresses(self, force_register, theSphereList):
+        """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).
+
+        Returns ``(τ_internal, τ_surface)`` computed with exactly the operations of
+        the full evaluation, so G does not depend on whether tensors are kept.
+        The other tensor entries are not updated.
+        """
+        reg = force_register
+        if not (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
+                and len(reg._blocks) == 1 and not reg._m_pair and not reg._m_ext and not reg._m_imom):
+            self.evaluate_stress_tensors(force_register, theSphereList, 0)
+            return self.evaluate_quasistatic_shear_stress(), self.evaluate_externally_applied_shear_stress()
+        t = self._t
+        a = reg._ens._a
+        x, y = a["x"], a["y"]
+        V = self._volume()
+        p = reg._blocks[0]
+        i, j = p["i"], p["j"]
+        internal = p["internal"]
+        n_int = int(np.count_nonzero(internal))
+        lw01 = 0.0
+        if n_int:
+            fix = p["fix"]
+            if not p.get("antisymmetric", True):
+                self.evaluate_force_stress_tensors(reg)
+                lw01 = t[_LW, 0, 1]
+            else:
+                ii, jj = i, j
+                if n_int != len(i):
+                    w = np.nonzero(internal)[0]
+                    ii, jj, fix = i.take(w), j.take(w), fix.take(w)
+                lw01 = np.dot(fix * _CF, y.take(ii) - y.take(jj)) * _CL / V
+        ext01 = 0.0
+        if n_int != len(i):
+            wi = np.nonzero(p["ext_i"])[0]
+            wj = np.nonzero(p["ext_j"])[0]
+            tg = np.concatenate((i.take(wi), j.take(wj)))
+            if len(tg):
+                gx = np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))) * _CF
+                ext01 = (0.0 - np.dot(gx, (y.take(tg) - self.size_y / 2) * _CL)) / V
+        tint = 0.0
+        if p.get("ti") is not None and n_int:
+            if n_int == len(i):
+                tint = float(p["ti"].sum() + p["tj"].sum())
+            else:
+                tint = float(np.dot(internal, p["ti"] + p["tj"]))
+        s_ = tint * _CT / V
+        t[_LW, 0, 1] = lw01
+        t[_EXT, 0, 1] = ext01
+        t[_TINT, 0, 1] = -s_ / 2
+        t[_CEN, 0, 1] = 0.0
+        t[_ALL, 0, 1] = t[_LW, 0, 1] + t[_TINT, 0, 1] + t[_CEN, 0, 1]
+        return -float(t[_ALL, 0, 1]), -float(t[_EXT, 0, 1])
 
     def evaluate_quasistatic_shear_stress(self):
         """τ_internal = −σ_xy of the overall tensor (Pa)."""

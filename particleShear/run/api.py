@@ -9,6 +9,7 @@ every call (per process) or returned directly with ``return_result=True``.
 ``concurrent.futures.Executor`` (a ``ProcessPoolExecutor`` by default) with per-run seeds
 ``numpy.random.SeedSequence(seed).spawn(n)`` and returns the results in iteration order.
 """
+import math
 import concurrent.futures
 import dataclasses
 
@@ -102,7 +103,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               doCutByTriangulation=True, doDrawing=True, saveData=False, saveStressTensorData=True,
                               plotStress=True, relative_y_scale_force=1e8, pre_periods=2, periods=3,
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
-                              progress=None, correct_drift_sign=False, reference_header=False, renderer="auto"):
+                              progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
+                              time_step_factor=1.0, integrator="euler", stability_guard=True):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     Parameters
@@ -130,6 +132,16 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         Reproduce the reference header defects §12 #21–22 in the output file.
     renderer : {"auto", "tk", "pillow", "none"}, keyword-only
         Drawing backend (see :mod:`particleShear.simulation.drawing`).
+    time_step_factor : float, keyword-only
+        Multiplies the time step (and the coarsest step) of the measurement: pre-equilibration
+        with plates and protocol.  1 = the reference rule of §4.7; constitution is unchanged, so
+        one seed gives the same initial packing for every factor (used by the accuracy study).
+    integrator : {"euler", "verlet"}, keyword-only
+        Time integrator of the measurement: the reference semi-implicit Euler (default) or
+        velocity Verlet with a half-kick predictor for the velocity-dependent forces.
+    stability_guard : bool, keyword-only
+        Stop a diverging measurement with :class:`SimulationInstabilityError` (step, phase, worst
+        pair, suggested time step) instead of producing NaN moduli.
 
     Returns
     -------
@@ -160,6 +172,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   relative_y_scale_force=relative_y_scale_force, pre_periods=pre_periods, periods=periods,
                   post_periods=post_periods, cool_factor=cool_factor, seed=seed)
     validate_simulation_parameters(params)
+    if not (isinstance(time_step_factor, (int, float)) and math.isfinite(time_step_factor) and time_step_factor > 0):
+        raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
+    if integrator not in ("euler", "verlet"):
+        raise ValueError(f"integrator={integrator!r} is out of range: allowed 'euler' or 'verlet'")
     ss, rng = _seed_sequence(seed)
 
     theSimulation = Simulation_interlocking_rheology(
@@ -193,6 +209,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.correct_drift_sign = correct_drift_sign
     theSimulation.reference_header = reference_header
     theSimulation.renderer_backend = renderer
+    theSimulation.time_step_factor = float(time_step_factor)
+    theSimulation.integrator = integrator
+    theSimulation.stability_guard = bool(stability_guard)
 
     G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 

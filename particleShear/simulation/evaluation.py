@@ -12,6 +12,7 @@ import sys
 
 import numpy as np
 
+from ..base.register import SphereSelection
 from ..base.stress import StressTensorEvaluation, TENSOR_NAMES
 
 __all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "demodulation", "demodulation_reference_loop"]
@@ -197,6 +198,7 @@ class EvaluationHandler:
     def reset(self):
         """Forget every recorded sample (buffers are released)."""
         self._n = 0
+        self._planned = 0  # samples announced by allocate(); the last one gets all tensors
         self._scal = np.zeros((0, 5))
         self._tens = None
         self.first_tensors = None
@@ -206,6 +208,7 @@ class EvaluationHandler:
         """Preallocate room for ``n_steps`` further samples (and the tensor history if kept)."""
         if keep_tensor_history is not None:
             self.keep_tensor_history = bool(keep_tensor_history)
+        self._planned = self._n + int(n_steps)
         self._grow(self._n + int(n_steps))
 
     def _grow(self, cap):
@@ -342,12 +345,19 @@ class EvaluationHandler:
         if self.check_force_balance and n % self.force_balance_check_interval == 0:
             self._check_balance(theEnsemble.force_register)
         self._record_momenta(theEnsemble)
-        theEnsemble.evaluate_stress_tensors(ev)
-        tens = ev.tensors
         row = self._scal[n]
         row[_T] = theEnsemble.t
         row[_STRAIN] = theEnsemble.shear
         row[_RATE] = theEnsemble.shear_rate
+        full = self.keep_tensor_history or n == 0 or n + 1 >= self._planned
+        if not full and hasattr(ev, "evaluate_shear_stresses"):
+            # tensors nobody keeps are not evaluated: only the two shear stresses G needs
+            row[_SHEAR], row[_FORCE] = ev.evaluate_shear_stresses(
+                theEnsemble.force_register, SphereSelection(theEnsemble, theEnsemble._mobile_mask()))
+            self._n = n + 1
+            return ev
+        theEnsemble.evaluate_stress_tensors(ev)
+        tens = ev.tensors
         row[_FORCE] = ev.evaluate_externally_applied_shear_stress()
         row[_SHEAR] = ev.evaluate_quasistatic_shear_stress()
         if self.keep_tensor_history:

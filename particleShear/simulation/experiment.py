@@ -153,6 +153,7 @@ class OscillatoryShearExperiment:
         """
         ens = self.theEnsemble
         ens.applyingShear = True
+        ens.phase = "pre-equilibration"
         t0 = time.perf_counter()
         level_dt = self.dt_max
         cf = 0.5
@@ -260,6 +261,8 @@ class OscillatoryShearExperiment:
         window = self.stress_window if self.plotStress else None
         n_run = N_steps if n_steps is None else min(int(n_steps), N_steps)
         self._say("Start application shear protocol, total N= " + str(N_steps) + " steps")
+        ens.phase = "protocol"
+        ens.step_count = 0
         t0 = time.perf_counter()
         state = [0.0]
         for i in range(n_run):

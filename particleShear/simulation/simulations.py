@@ -12,6 +12,7 @@ import time
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
                                  EnsembleCompactParticlesFromModelParameters)
+from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
 from .output import reserve_numbered_path
@@ -60,6 +61,13 @@ class OscillatorySimulation:
     ``reference_header`` (see :class:`OscillatoryShearExperiment`), ``progress``
     (callback), ``timings`` and ``result_info`` (after the run), ``output_path``.
     """
+
+    #: multiplies dt and dt_max of the measurement (1 = the reference rule)
+    time_step_factor = 1.0
+    #: "euler" (reference) or "verlet"
+    integrator = "euler"
+    #: stop a diverging measurement with a clear error
+    stability_guard = True
 
     def __init__(self, root_folder, amplitude=0.5, relative_y_scale_force=5e-4, relative_frequency=0.05,
                  doDrawing=True, saveData=False):
@@ -149,13 +157,17 @@ class OscillatorySimulation:
         ens = self.theEnsemble
         model = self.model or getattr(ens, "model", False)
         y_scale_force = self.relative_y_scale_force / model.k / self.amplitude if model else 1
-        self.dt = ens.dt
+        factor = getattr(self, "time_step_factor", 1.0)
+        self.dt = ens.dt * factor
         self.f = self.relative_frequency / model.time_constant
+        ens.set_integrator(getattr(self, "integrator", "euler"))
+        if getattr(self, "stability_guard", True):
+            ens.stability_guard = StabilityGuard()
         if self.verbose:
             print("Setting relative frequency: " + str(self.relative_frequency) + " f= " + str(self.f) + "Hz")
         exp = OscillatoryShearExperiment(ens, self.dt, self.f, self.amplitude, output_file,
                                          force_scale=y_scale_force, TkSimulation=self.theTkSimulation,
-                                         dt_max=ens.dt_max, imageOutputFolder=imageOutputFolder,
+                                         dt_max=ens.dt_max * factor, imageOutputFolder=imageOutputFolder,
                                          imageBaseFileName=self.imageBaseFileName,
                                          imageFileType=self.imageFileType, plotStress=plotStress,
                                          saveStressTensorData=self.saveStressTensorData)
@@ -199,7 +211,7 @@ class OscillatorySimulation:
                 self.progress("constitution", 1, 1, self.timings["constitution"])
             self._attach_renderer()
             model = self.model or getattr(self.theEnsemble, "model", False)
-            self.dt = self.theEnsemble.dt
+            self.dt = self.theEnsemble.dt * getattr(self, "time_step_factor", 1.0)
             self.f = self.relative_frequency / model.time_constant
             fileName = False
             if self.saveData or (self.saveOutputImages and self.doDrawing):
