@@ -79,12 +79,15 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
     """Bring positions back into ``[0, Lx) × [0, Ly)`` in place (§3.3).
 
     Crossing y = Ly moves x by ``-shift`` and vx by ``-Ly·γ̇`` (and the reverse
-    through y = 0).  Returns True if anything was wrapped.
+    through y = 0); periods are applied one at a time, as the reference does.
+    Returns True if anything was wrapped.
     """
+    if not len(y):
+        return False
     wrapped = False
-    m = y >= Ly
-    if m.any():
+    if y.min() < 0 or y.max() >= Ly:
         y0 = y.copy()
+        m = y >= Ly
         while m.any():
             y[m] -= Ly
             x[m] -= shift
@@ -96,25 +99,15 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
             m = y < 0
         vx += (y - y0) * shear_rate
         wrapped = True
-    else:
-        m = y < 0
-        if m.any():
-            y0 = y.copy()
-            while m.any():
-                y[m] += Ly
-                x[m] += shift
-                m = y < 0
-            vx += (y - y0) * shear_rate
-            wrapped = True
-    m = x >= Lx
-    while m.any():
-        x[m] -= Lx
+    if x.min() < 0 or x.max() >= Lx:
         m = x >= Lx
-        wrapped = True
-    m = x < 0
-    while m.any():
-        x[m] += Lx
+        while m.any():
+            x[m] -= Lx
+            m = x >= Lx
         m = x < 0
+        while m.any():
+            x[m] += Lx
+            m = x < 0
         wrapped = True
     return wrapped
 

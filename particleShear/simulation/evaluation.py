@@ -167,7 +167,9 @@ class EvaluationHandler:
     ``overall_stress_tensor2`` (never filled, as in the reference), and the running
     estimates ``Gprime`` (−Σγτ/Σγ², Pa) and ``viscosity`` (−Σγ̇τ/Σγ̇², Pa·s).  After each
     :meth:`record`: ``total_mass`` (mg/m), ``xg`` (mass-weighted centre, µm), ``v_mean``
-    (µm/s) and ``angular_momentum_around_origin`` (mg·µm²/s per m, spin included).
+    (µm/s) and ``angular_momentum_around_origin`` (mg·µm²/s per m, spin included) — on
+    every fully evaluated step (every step unless a protocol runs without tensor history,
+    where only its first and last steps are fully evaluated).
 
     Storage: call :meth:`allocate` with the number of steps to preallocate; otherwise
     buffers grow by doubling.  ``keep_tensor_history`` (default True) controls whether the
@@ -344,7 +346,6 @@ class EvaluationHandler:
             self._grow(max(2 * n, 16))
         if self.check_force_balance and n % self.force_balance_check_interval == 0:
             self._check_balance(theEnsemble.force_register)
-        self._record_momenta(theEnsemble)
         row = self._scal[n]
         row[_T] = theEnsemble.t
         row[_STRAIN] = theEnsemble.shear
@@ -356,6 +357,7 @@ class EvaluationHandler:
                 theEnsemble.force_register, SphereSelection(theEnsemble, theEnsemble._mobile_mask()))
             self._n = n + 1
             return ev
+        self._record_momenta(theEnsemble)
         theEnsemble.evaluate_stress_tensors(ev)
         tens = ev.tensors
         row[_FORCE] = ev.evaluate_externally_applied_shear_stress()
