@@ -28,6 +28,8 @@ from .points import CircleBasicElasticity, _check_finite, _check_positive
 from .register import Force_register, SphereSelection
 from .relations import _BaseRelationView
 
+_nz = np.count_nonzero  # number of True entries; faster than ndarray.any() on small arrays
+
 __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasPointsShear",
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
            "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative"]
@@ -120,6 +122,7 @@ class CanvasPoints:
         self._uniform = {}
         self._pos_version = 0
         self._in_cell = False
+        self._images_valid = False
         self.graphical_output_configuration = Graphical_output_configuration()
 
     # -- sphere list and state arrays ----------------------------------------------------------
@@ -265,8 +268,9 @@ class CanvasPoints:
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
         a = self._a
-        le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
-                getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0)
+        if le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
+                   getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0):
+            self._images_valid = False
         self._pos_version += 1
         self._in_cell = True
 
@@ -387,6 +391,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_valid = False
         self._pos_version += 1
         self._in_cell = False
+        self._images_valid = False
 
     def _passes(self):
         """Fixed minimum-image passes when every position is known to lie in the cell."""
@@ -441,6 +446,26 @@ class CanvasPointsNeighbors(CanvasPointsMass):
     def _shear_rate_for_images(self):
         return 0.0
 
+    def _store_images(self, ky, kx, n):
+        """Keep the period counts of the candidates' minimum images while they stay valid.
+
+        Valid until a sphere wraps, the candidates change or positions are set from
+        outside; only for positions inside the cell, single periods, and cells much
+        larger than the candidate reach (so the nearest image cannot change).
+        """
+        self._images_valid = False
+        if not self._in_cell or not self._nl_valid:
+            return
+        reach = 2 * (2 * float(self._a["r"].max()) + 2 * self._nl_skin)
+        if min(self.size_x, self.size_y) <= reach:
+            return
+        if ky is None:
+            return
+        self._images = (ky, kx, float(self.size_y) * ky, float(self.size_x) * kx)
+        self._images_any_y = bool(_nz(ky))
+        self._images_version = self._pairs.version
+        self._images_valid = True
+
     def test_neighbor_relation(self):
         """Neighbour update (§4.2): activate touching pairs, drop transient ones that separated.
 
@@ -454,10 +479,21 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         x, y, r = a["x"], a["y"], a["r"]
         i, j = pt.i, pt.j
         Lx, Ly = self.size_x, self.size_y
-        dx0 = x[j] - x[i]
-        dy0 = y[j] - y[i]
-        dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
-                                        self._passes(), counts=True)
+        dx0 = x.take(j) - x.take(i)
+        dy0 = y.take(j) - y.take(i)
+        if self._images_valid and self._images_version == pt.version:
+            # no sphere wrapped since the images were found: reuse their period counts (§3.1,
+            # one period at a time, so bit-identical to a fresh minimum image)
+            ky, kx, Lky, Lkx = self._images
+            shift = float(self._le_shift())
+            dy = dy0 - Lky
+            dx = (dx0 - shift * ky) - Lkx
+            rate = float(self._shear_rate_for_images())
+            dvx = -(float(Ly) * rate) * ky if rate and self._images_any_y else None
+        else:
+            dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
+                                            self._passes(), counts=True)
+            self._store_images(ky, kx, len(i))
         d = np.sqrt(dx * dx + dy * dy)
         if self._nl_rsum_version != pt.version:
             self._nl_rsum = r[i] + r[j]
@@ -467,15 +503,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         perm = pt.state == PERMANENT if pt.n_permanent else None
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
-        changed = (new_active != old).any()
+        changed = _nz(new_active != old)
         born = new_active & ~old if changed else old[:0]
         died = old & ~new_active if changed else old[:0]
-        if born.any():
+        if _nz(born):
             pt.state[born] = STICK
             pt.xi_ij[born] = 0.0
             pt.xi_ji[born] = 0.0
             pt.birth[born] = pt.next_births(int(born.sum()))
-        if died.any():
+        if _nz(died):
             pt.state[died] = STICK
             pt.xi_ij[died] = 0.0
             pt.xi_ji[died] = 0.0
@@ -488,7 +524,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.dx = dx[sel]
         g.dy = dy[sel]
         g.d = d[sel]
-        if (g.d == 0).any():
+        if _nz(g.d == 0):
             g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
         else:
             g.nx = g.dx / g.d
@@ -500,7 +536,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             shifted = (g.dx != dx0[sel]) | (g.dy != dy0[sel])
         else:
             shifted = (g.ky != 0) | (g.kx != 0)
-        if shifted.any():
+        if _nz(shifted):
             w = np.flatnonzero(shifted)
             rx, ry = dx0[sel][w], dy0[sel][w]
             shifted[w] = np.sqrt(rx * rx + ry * ry) != g.d[w]
@@ -513,7 +549,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         else:
             g.perm = perm[sel]
             g.trans = ~g.perm
-            if not g.perm.any():
+            if not _nz(g.perm):
                 g.perm = g.trans = None
         mob = self._mobile_mask()
         if mob is None:
@@ -690,7 +726,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         fx[:] = 0.0
         fy[:] = 0.0
         mob = self._mobile_mask()
-        if mob is not None and not mob.all():
+        if mob is not None and _nz(mob) != len(mob):
             imm = ~mob
             v = self.shear_rate * self.size_y / 2
             np.copyto(a["yspeed"], 0.0, where=imm)
@@ -1041,10 +1077,10 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         state = np.where(slip, SLIP, STICK).astype(np.int8)
         if permanent is not np.False_:
             state[permanent] = PERMANENT
-        if not touching.all():
+        if _nz(touching) != len(touching):
             # a transient relation that no longer touches keeps its state and gets no force
             idle = ~touching & ~permanent
-            if idle.any():
+            if _nz(idle):
                 state[idle] = pt.state[sl][idle]
                 f1 = np.where(idle, 0.0, f1)
                 f2 = np.where(idle, 0.0, f2)
@@ -1096,7 +1132,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             return
         pt = self._pairs
         keep = pt.state.take(g.slots) != SLIP
-        allk = keep.all()
+        allk = _nz(keep) == len(keep)
         if allk:
             sl, ai, aj, nx, ny, dvx0, ky, kx, d = g.slots, g.ai, g.aj, g.nx, g.ny, g.dvx, g.ky, g.kx, g.d
         else:
@@ -1130,7 +1166,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if np.abs(dx).max() >= Lx / 2 or np.abs(dy).max() >= Ly / 2:
             dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
         dm = np.sqrt(dx * dx + dy * dy)
-        if (dm == 0).any():
+        if _nz(dm == 0):
             _, mx, my = pair_geometry(dx, dy, self._rng)
         else:
             mx = dx / dm

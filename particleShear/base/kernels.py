@@ -6,6 +6,8 @@ Lengths in µm, velocities in µm/s, forces in mg·µm·s⁻² per m depth.
 """
 import numpy as np
 
+_nz = np.count_nonzero  # number of True entries; faster than ndarray.any() on small arrays
+
 __all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass"]
 
 
@@ -41,7 +43,7 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     p = 0
     while True if n_y is None else p < n_y:
         ky = _wrap_count(dy, hy)
-        if n_y is None and not ky.any():
+        if n_y is None and not _nz(ky):
             break
         dy = dy - Ly * ky
         dx = dx - shift * ky
@@ -54,18 +56,20 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     kx_total = None
     while True if n_x is None else p < n_x:
         kx = _wrap_count(dx, hx)
-        if n_x is None and not kx.any():
+        if n_x is None and not _nz(kx):
             break
         dx = dx - Lx * kx
         kx_total = kx if kx_total is None else kx_total + kx
         p += 1
     if counts:
-        if ky_total is not None and kx_total is None:
-            kx_total = np.zeros(dx.shape, np.int8)
-        if kx_total is not None and ky_total is None:
+        # period counts per pair (zeros where nothing wrapped); None when some pair needed
+        # several periods, whose repeated subtraction a count cannot reproduce bit for bit
+        if ky_total is None:
             ky_total = np.zeros(dx.shape, np.int8)
-        if ky_total is not None and (np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1):
-            ky_total = kx_total = None  # several periods: the movement phase recomputes the image
+        if kx_total is None:
+            kx_total = np.zeros(dx.shape, np.int8)
+        if np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1:
+            ky_total = kx_total = None
         return dx, dy, dvx, ky_total, kx_total
     return dx, dy, dvx
 
@@ -88,12 +92,12 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
     if y.min() < 0 or y.max() >= Ly:
         y0 = y.copy()
         m = y >= Ly
-        while m.any():
+        while _nz(m):
             y[m] -= Ly
             x[m] -= shift
             m = y >= Ly
         m = y < 0
-        while m.any():
+        while _nz(m):
             y[m] += Ly
             x[m] += shift
             m = y < 0
@@ -101,11 +105,11 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
         wrapped = True
     if x.min() < 0 or x.max() >= Lx:
         m = x >= Lx
-        while m.any():
+        while _nz(m):
             x[m] -= Lx
             m = x >= Lx
         m = x < 0
-        while m.any():
+        while _nz(m):
             x[m] += Lx
             m = x < 0
         wrapped = True
@@ -116,7 +120,7 @@ def pair_geometry(dx, dy, rng=None):
     """Distance and unit normal of min-image separations; a random normal where d == 0 (§2.1)."""
     d = np.sqrt(dx * dx + dy * dy)
     zero = d == 0
-    if zero.any():
+    if _nz(zero):
         d_safe = np.where(zero, 1.0, d)
         nx = dx / d_safe
         ny = dy / d_safe
@@ -141,21 +145,21 @@ def tangential_two_pass(vt, touching, permanent, xi_ij, xi_ji, kt_i, kt_j, nut_i
     transient = ~permanent
     ftv_i = nut_i * vt
     ftv_j = nut_j * vt
-    if not touching.all():
+    if _nz(touching) != len(touching):
         ftv_i = np.where(touching, ftv_i, 0.0)
         ftv_j = np.where(touching, ftv_j, 0.0)
     ft1 = ftv_i + kt_i * xi_ij
     a1 = np.abs(ft1)
     slip1 = transient & (a1 > f_coulomb)
     f1 = np.where(transient, np.copysign(np.minimum(a1, f_coulomb), ft1), ft1)
-    if slip1.any():
+    if _nz(slip1):
         xi_ij[slip1] = 0.0
         xi_ji[slip1] = 0.0
     ft2 = ftv_j + kt_j * xi_ji
     a2 = np.abs(ft2)
     slip2 = transient & (a2 > f_coulomb)
     f2 = np.where(transient, np.copysign(np.minimum(a2, f_coulomb), ft2), ft2)
-    if slip2.any():
+    if _nz(slip2):
         xi_ij[slip2] = 0.0
         xi_ji[slip2] = 0.0
     return f1, f2, slip2

@@ -29,6 +29,15 @@ _CL = 1e-6
 _CT = 1e-18
 
 
+def _pair_moment(fx, fy, lx, ly):
+    """``Σ F ⊗ l`` in SI units (N·m per m depth) for forces (internal units) and lever arms (µm)."""
+    G = np.array((fx, fy))
+    G *= _CF
+    L = np.array((lx, ly))
+    L *= _CL
+    return np.dot(G, L.T)
+
+
 def _tensor_property(k):
     def fget(self):
         return self._t[k].tolist()
@@ -237,15 +246,9 @@ class StressTensorEvaluation:
             if n_int != len(i):
                 w = np.nonzero(internal)[0]
                 i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
-            gx = fix * _CF
-            gy = fiy * _CF
-            ddx = x.take(i) - x.take(j)
-            ddy = y.take(i) - y.take(j)
-            lw = t[_LW]
-            lw[0, 0] = np.dot(gx, ddx) * _CL / V
-            lw[0, 1] = np.dot(gx, ddy) * _CL / V
-            lw[1, 0] = np.dot(gy, ddx) * _CL / V
-            lw[1, 1] = np.dot(gy, ddy) * _CL / V
+            lw = _pair_moment(fix, fiy, x.take(i) - x.take(j), y.take(i) - y.take(j))
+            lw /= V
+            t[_LW] = lw
             i, j = p["i"], p["j"]
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
@@ -256,15 +259,10 @@ class StressTensorEvaluation:
             wj = np.nonzero(p["ext_j"])[0]
             tg = np.concatenate((i.take(wi), j.take(wj)))
             if len(tg):
-                gx = np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))) * _CF
-                gy = np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))) * _CF
-                lx = (x.take(tg) - cx) * _CL
-                ly = (y.take(tg) - cy) * _CL
-                ext = t[_EXT]
-                ext[0, 0] = (0.0 - np.dot(gx, lx)) / V
-                ext[0, 1] = (0.0 - np.dot(gx, ly)) / V
-                ext[1, 0] = (0.0 - np.dot(gy, lx)) / V
-                ext[1, 1] = (0.0 - np.dot(gy, ly)) / V
+                m_ = _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
+                                  np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
+                                  x.take(tg) - cx, y.take(tg) - cy)
+                t[_EXT] = (0.0 - m_) / V
             else:
                 t[_EXT] = 0.0
         else:
@@ -346,15 +344,18 @@ class StressTensorEvaluation:
                 if n_int != len(i):
                     w = np.nonzero(internal)[0]
                     ii, jj, fix = i.take(w), j.take(w), fix.take(w)
-                lw01 = np.dot(fix * _CF, y.take(ii) - y.take(jj)) * _CL / V
+                fiy = p["fiy"] if n_int == len(i) else p["fiy"].take(w)
+                lw01 = (_pair_moment(fix, fiy, x.take(ii) - x.take(jj), y.take(ii) - y.take(jj)) / V)[0, 1]
         ext01 = 0.0
         if n_int != len(i):
             wi = np.nonzero(p["ext_i"])[0]
             wj = np.nonzero(p["ext_j"])[0]
             tg = np.concatenate((i.take(wi), j.take(wj)))
             if len(tg):
-                gx = np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))) * _CF
-                ext01 = (0.0 - np.dot(gx, (y.take(tg) - self.size_y / 2) * _CL)) / V
+                m_ = _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
+                                  np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
+                                  x.take(tg) - self.size_x / 2, y.take(tg) - self.size_y / 2)
+                ext01 = ((0.0 - m_) / V)[0, 1]
         tint = 0.0
         if p.get("ti") is not None and n_int:
             if n_int == len(i):

@@ -1,0 +1,758 @@
+"""Accuracy against run time: what a time step, a sphere count, a number of periods buys (not a test).
+
+Four studies, all through the public entry point ``doParticleShearSimulation`` (so the numbers
+are those a user gets), run on a ``ProcessPoolExecutor`` (default 2 workers):
+
+1. **Time-step convergence** of G′, G″ (both estimators: ``G_internal`` from the overall stress
+   tensor, ``G_surface`` from the external forces) and of the peak overlap
+   ``max(1 − d/(r_i + r_j))`` over transient contacts during the protocol, for
+   ``time_step_factor`` = 8 … 1/8 (dt of the measurement relative to the §4.7 rule; one seed gives
+   the same initial packing for every factor), for the default crosslinked scene and for frictional
+   spheres without links, with both integrators ("euler" = reference, "verlet").  Error against the
+   finest run and against a Richardson extrapolation; observed order of convergence.  A coarse
+   factor that trips the stability guard is recorded as "unstable".
+   Along the way: the largest relative asymmetry ``|σ01 − σ10| / (|σ00| + |σ11|)`` of the overall
+   stress tensor over all recorded steps, and the peculiar momentum of the mobile spheres
+   ``|Σ m (v − γ̇ (y − Ly/2) e_x)|`` relative to the plate momentum scale ``Σ m · A·2πf·Ly/2``.
+2. **Statistics**: mean and standard deviation over seeds of G′, G″ for N = 45 … 2,400 (cell
+   500 × 500 µm, packing fraction 1.5, so radii shrink as 1/√N and dt with them) and for
+   3 vs 6 excitation periods, with run times.
+3. **Largest stable time step** per regime: bisection on ``time_step_factor`` (log scale) with the
+   stability guard (:class:`particleShear.base.stability.SimulationInstabilityError`) as oracle,
+   short runs (0.5 + 1 + 0.25 periods) from one cached packing per regime.
+4. Tables (Markdown), JSON, CSV and a log-log plot drawn with Pillow.
+
+Peak overlap, momentum and the tensor history are read through a read-only hook: the study
+runs ``doParticleShearSimulation`` with the simulation class replaced by a subclass whose
+``createExperiment`` keeps the tensor history and wraps the installed stability guard in a
+recorder (the guard is called by the ensemble after every force phase, with the pair
+geometry ``ens._g`` of that step).  The recorder reads, never writes, so G is bit-identical
+to a plain call (checked at start-up, see ``_self_check``).
+
+Usage::
+
+    python benchmarks/accuracy_study.py [--quick] [--out DIR] [--workers 2]
+
+``--quick`` (< 3 min on 2 cores) uses N = 45 scenes, five factors and fewer seeds; the full
+study (~15–25 min on 2 cores) is what ``docs/accuracy.md`` reports.  Output in ``DIR``
+(default ``docs/accuracy_data``): ``accuracy_results.json``, ``convergence.csv``,
+``statistics.csv``, ``stability.csv``, ``accuracy_tables.md`` and ``accuracy.png``.
+"""
+import os
+
+for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import argparse  # noqa: E402
+import concurrent.futures  # noqa: E402
+import copy  # noqa: E402
+import csv  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import platform  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import particleShear.run.api as api  # noqa: E402
+from particleShear.base.stability import SimulationInstabilityError  # noqa: E402
+from particleShear.simulation.simulations import Simulation_interlocking_rheology  # noqa: E402
+
+#: quiet, no drawing, full result — common to every run
+BASE = dict(doDrawing=False, plotStress=False, verbose=False, return_result=True)
+#: the two scenes of the convergence study (everything else: doParticleShearSimulation defaults)
+SCENES = {
+    "crosslinked": dict(),
+    "frictional": dict(do_permanent_links=False, cut_lines=0),
+}
+#: regimes of the stable-time-step map (crosslinked default scene unless stated)
+REGIMES = {
+    "default crosslinked": dict(),
+    "frictional spheres": dict(do_permanent_links=False, cut_lines=0),
+    "amplitude 2.0": dict(theAmplitude=2.0),
+    "packing fraction 2.5": dict(packing_fraction=2.5),
+    "stiff E = 1e7 Pa": dict(Young_modulus_spheres=1e7),
+    "mu = 1": dict(theMu=1.0),
+    "low viscosity rv = 0.01": dict(relative_viscosity=0.01),
+}
+
+
+# ---------------------------------------------------------------------------------------------
+# read-only recording hook
+# ---------------------------------------------------------------------------------------------
+class RunRecorder:
+    """Wraps the stability guard; records peak overlap and peculiar momentum of the protocol.
+
+    ``check(ens, step, phase, dt)`` is called by the ensemble after every force phase.  It first
+    delegates to the wrapped guard (so a diverging run still raises), then, during the
+    protocol only, reads the pair geometry of the step.
+    """
+
+    def __init__(self, inner):
+        self.inner = inner
+        self.min_ratio = math.inf      # smallest d/(r_i+r_j) of a transient contact
+        self.p_max = 0.0               # largest |peculiar momentum| (mg·µm/s per m)
+        self.p_first = None
+        self.p_last = None
+        self.n = 0
+        self.mass = None               # total sphere mass (mg per m depth)
+
+    def check(self, ens, step=None, phase=None, dt=None):
+        if self.mass is None:
+            self.mass = float(ens._a["m"].sum())
+        if self.inner is not None:
+            self.inner.check(ens, step=step, phase=phase, dt=dt)
+        if phase != "protocol":
+            return
+        g = ens._g
+        if g is not None and g.P:
+            r = g.d / g.d0
+            if g.trans is not None:
+                r = r[g.trans]
+            if r.size:
+                self.min_ratio = min(self.min_ratio, float(r.min()))
+        a = ens._a
+        mob = ens._mobile_mask()
+        m = a["m"] if mob is None else np.where(mob, a["m"], 0.0)
+        rate = ens.shear_rate or 0.0
+        px = float(m @ (a["xspeed"] - rate * (a["y"] - ens.size_y / 2)))
+        py = float(m @ a["yspeed"])
+        p = math.hypot(px, py)
+        self.p_max = max(self.p_max, p)
+        if self.p_first is None:
+            self.p_first = (px, py)
+        self.p_last = (px, py)
+        self.n += 1
+
+
+class _Hooks:
+    recorder = None
+    keep_tensors = False
+    cache = {}          # constitution cache for the bisection: key -> ensemble (deep copy)
+    use_cache = False
+    key = None
+
+
+class RecordingSimulation(Simulation_interlocking_rheology):
+    """The simulation of ``doParticleShearSimulation`` plus the read-only hooks above."""
+
+    def initEnsemble(self, do_debug=False):
+        if not _Hooks.use_cache:
+            return Simulation_interlocking_rheology.initEnsemble(self, do_debug)
+        if _Hooks.key not in _Hooks.cache:
+            Simulation_interlocking_rheology.initEnsemble(self, do_debug)
+            _Hooks.cache[_Hooks.key] = copy.deepcopy(self.theEnsemble)
+        self.theEnsemble = copy.deepcopy(_Hooks.cache[_Hooks.key])
+        self.model = self.theEnsemble.model
+        self.dt = self.theEnsemble.dt
+        self.dt_max = self.theEnsemble.dt_max
+        return self.theEnsemble
+
+    def createExperiment(self, *args, **kwargs):
+        exp = Simulation_interlocking_rheology.createExperiment(self, *args, **kwargs)
+        if _Hooks.keep_tensors:
+            exp.keep_tensor_history = True
+        ens = self.theEnsemble
+        _Hooks.recorder = RunRecorder(ens.stability_guard)
+        ens.stability_guard = _Hooks.recorder
+        return exp
+
+
+api.Simulation_interlocking_rheology = RecordingSimulation
+
+
+# ---------------------------------------------------------------------------------------------
+# one run
+# ---------------------------------------------------------------------------------------------
+def run_case(job):
+    """Run one job dict (``params`` for doParticleShearSimulation + bookkeeping); return a result dict."""
+    params = dict(BASE, **job["params"])
+    _Hooks.keep_tensors = bool(job.get("tensors", False))
+    _Hooks.use_cache = bool(job.get("cache", False))
+    _Hooks.key = json.dumps(job.get("cache_key"), sort_keys=True, default=str)
+    out = dict(job)
+    t0 = time.perf_counter()
+    try:
+        r = api.doParticleShearSimulation(**params)
+    except SimulationInstabilityError as e:
+        out.update(status="unstable", wall=time.perf_counter() - t0, step=e.step, phase=e.phase,
+                   suggested_dt=e.suggested_dt, reason=e.reason)
+        return out
+    rec = _Hooks.recorder
+    out.update(status="ok", wall=time.perf_counter() - t0, wall_measurement=r.timings.get("protocol", 0.0)
+               + r.timings.get("pre_equilibration", 0.0), wall_constitution=r.timings.get("constitution", 0.0),
+               dt=r.dt, f=r.f, N_steps=r.N_steps,
+               Gp_int=r.G_internal[0], Gpp_int=r.G_internal[1], Gp_surf=r.G_surface[0], Gpp_surf=r.G_surface[1],
+               peak_overlap=(1 - rec.min_ratio) if math.isfinite(rec.min_ratio) else 0.0)
+    A = params.get("theAmplitude", 0.2)
+    if rec is not None and rec.n:
+        # momentum scale: total mass × peak plate speed A·2πf·Ly/2 (Ly = 500 µm)
+        scale = rec.mass * A * 2 * math.pi * r.f * 250.0
+        out["momentum_max_rel"] = rec.p_max / scale
+        out["momentum_drift_rel"] = math.hypot(rec.p_last[0] - rec.p_first[0], rec.p_last[1] - rec.p_first[1]) / scale
+    T = r.series.get("tensors")
+    if T is not None and len(T):
+        al = T[:, 8]
+        asym = np.abs(al[:, 0, 1] - al[:, 1, 0]) / (np.abs(al[:, 0, 0]) + np.abs(al[:, 1, 1]))
+        out["symmetry_max"] = float(asym.max())
+        out["symmetry_median"] = float(np.median(asym))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# bisection of the largest stable factor
+# ---------------------------------------------------------------------------------------------
+def stable_factor(job):
+    """Bisection (log₂) of the largest stable ``time_step_factor`` for one regime and integrator.
+
+    Short runs (pre 0.5, 1 period, post 0.25) from the same cached packing (seed); the oracle is
+    the stability guard.  Returns the bracket [stable, unstable] and every probe.
+    """
+    params = dict(job["params"], pre_periods=0.5, periods=1, post_periods=0.25)
+    key = dict(job["params"], seed=params.get("seed"))
+    probes = []
+
+    def probe(factor):
+        res = run_case(dict(params=dict(params, time_step_factor=factor), cache=True, cache_key=key))
+        probes.append(dict(factor=factor, status=res["status"], phase=res.get("phase"), step=res.get("step"),
+                           peak_overlap=res.get("peak_overlap"), wall=res["wall"],
+                           dt0=res["dt"] / factor if res["status"] == "ok" else None))
+        return res["status"] == "ok"
+
+    lo, hi = None, None
+    f = 1.0
+    if probe(f):
+        lo = f
+        while hi is None and f < job.get("f_max", 256):
+            f *= 4
+            if probe(f):
+                lo = f
+            else:
+                hi = f
+    else:
+        hi = f
+        while lo is None and f > 1 / 64:
+            f /= 4
+            if probe(f):
+                lo = f
+            else:
+                hi = f
+    if lo is not None and hi is not None:
+        for _ in range(job.get("bisections", 5)):
+            mid = math.sqrt(lo * hi)
+            if probe(mid):
+                lo = mid
+            else:
+                hi = mid
+    return dict(job, stable=lo, unstable=hi, probes=probes)
+
+
+# ---------------------------------------------------------------------------------------------
+# analysis
+# ---------------------------------------------------------------------------------------------
+QUANTITIES = ("Gp_int", "Gpp_int", "Gp_surf", "Gpp_surf", "peak_overlap")
+
+
+def convergence_analysis(rows):
+    """Per (scene, integrator, quantity): reference values, errors, observed order."""
+    out = {}
+    for (scene, integ) in sorted({(r["scene"], r["integrator"]) for r in rows}):
+        sel = sorted([r for r in rows if r["scene"] == scene and r["integrator"] == integ and r["status"] == "ok"],
+                     key=lambda r: r["factor"])
+        if len(sel) < 3:
+            continue
+        fine = sel[0]
+        res = {}
+        for q in QUANTITIES:
+            v = {r["factor"]: r[q] for r in sel}
+            fs = sorted(v)
+            h1, h2, h3 = fs[0], fs[1], fs[2]
+            d12 = v[h2] - v[h1]
+            d23 = v[h3] - v[h2]
+            p3 = math.log(abs(d23 / d12)) / math.log(h2 / h1) if d12 and d23 else float("nan")
+            if math.isfinite(p3) and 0.3 < p3 < 4:
+                rich = v[h1] - d12 / ((h2 / h1) ** p3 - 1)
+            else:
+                rich = float("nan")
+            errs = {f: abs(v[f] - v[h1]) / abs(v[h1]) if v[h1] else float("nan") for f in fs}
+            pts = [(math.log(f), math.log(errs[f])) for f in fs[1:] if errs[f] > 0]
+            slope = float("nan")
+            if len(pts) >= 2:
+                xs, ys = zip(*pts)
+                slope = float(np.polyfit(xs, ys, 1)[0])
+            res[q] = dict(values=v, finest=v[h1], richardson=rich, order_three_finest=p3, order_fit=slope,
+                          rel_error_vs_finest=errs)
+        out[f"{scene}/{integ}"] = dict(scene=scene, integrator=integ, finest_factor=fine["factor"], q=res)
+    return out
+
+
+def statistics_analysis(rows):
+    groups = {}
+    for r in rows:
+        if r["status"] != "ok":
+            continue
+        groups.setdefault((r["scene"], r["N"], r["periods"]), []).append(r)
+    out = []
+    for (scene, N, P), rs in sorted(groups.items()):
+        row = dict(scene=scene, N=N, periods=P, seeds=len(rs), wall_mean=float(np.mean([r["wall"] for r in rs])),
+                   dt=rs[0]["dt"], N_steps=rs[0]["N_steps"])
+        for q in ("Gp_int", "Gpp_int", "Gp_surf", "Gpp_surf"):
+            x = np.array([r[q] for r in rs])
+            row[q + "_mean"] = float(x.mean())
+            row[q + "_std"] = float(x.std(ddof=1)) if len(x) > 1 else float("nan")
+        out.append(row)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# plot (Pillow, log-log)
+# ---------------------------------------------------------------------------------------------
+def _font(size):
+    from PIL import ImageFont
+    for name in ("DejaVuSans.ttf", "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"):
+        try:
+            return ImageFont.truetype(name, size)
+        except OSError:
+            pass
+    try:
+        return ImageFont.load_default(size)
+    except TypeError:  # Pillow < 10.1
+        return ImageFont.load_default()
+
+
+class LogPanel:
+    """A log-log axes box on a Pillow image: decade ticks, grid, labels, polylines and markers."""
+
+    def __init__(self, draw, box, xlim, ylim, xlabel, ylabel, title):
+        self.d, self.box = draw, box
+        self.lx = (math.log10(xlim[0]), math.log10(xlim[1]))
+        self.ly = (math.log10(ylim[0]), math.log10(ylim[1]))
+        f, fs = _font(15), _font(13)
+        x0, y0, x1, y1 = box
+        draw.rectangle(box, outline="black", width=2)
+        for e in range(math.floor(self.lx[0]), math.ceil(self.lx[1]) + 1):
+            for m in range(1, 10):
+                v = e + math.log10(m)
+                if self.lx[0] <= v <= self.lx[1]:
+                    X = self._X(10 ** v)
+                    draw.line([(X, y0), (X, y1)], fill=(225, 225, 225) if m > 1 else (190, 190, 190))
+                    draw.line([(X, y1), (X, y1 - (8 if m == 1 else 4))], fill="black")
+                    if m == 1:
+                        draw.text((X, y1 + 6), _dec(e), fill="black", font=fs, anchor="ma")
+        for e in range(math.floor(self.ly[0]), math.ceil(self.ly[1]) + 1):
+            for m in range(1, 10):
+                v = e + math.log10(m)
+                if self.ly[0] <= v <= self.ly[1]:
+                    Y = self._Y(10 ** v)
+                    draw.line([(x0, Y), (x1, Y)], fill=(225, 225, 225) if m > 1 else (190, 190, 190))
+                    draw.line([(x0, Y), (x0 + (8 if m == 1 else 4), Y)], fill="black")
+                    if m == 1:
+                        draw.text((x0 - 6, Y), _dec(e), fill="black", font=fs, anchor="rm")
+        draw.rectangle(box, outline="black", width=2)
+        draw.text(((x0 + x1) / 2, y1 + 28), xlabel, fill="black", font=f, anchor="ma")
+        draw.text(((x0 + x1) / 2, y0 - 10), title, fill="black", font=_font(16), anchor="md")
+        self.ylabel = (x0 - 52, (y0 + y1) / 2, ylabel)
+
+    def _X(self, x):
+        x0, _, x1, _ = self.box
+        return x0 + (math.log10(x) - self.lx[0]) / (self.lx[1] - self.lx[0]) * (x1 - x0)
+
+    def _Y(self, y):
+        _, y0, _, y1 = self.box
+        return y1 - (math.log10(y) - self.ly[0]) / (self.ly[1] - self.ly[0]) * (y1 - y0)
+
+    def inside(self, x, y):
+        return (x > 0 and y > 0 and self.lx[0] <= math.log10(x) <= self.lx[1]
+                and self.ly[0] <= math.log10(y) <= self.ly[1])
+
+    def line(self, pts, color, marker="o", width=2, dash=False):
+        pts = [(x, y) for x, y in pts if self.inside(x, y)]
+        P = [(self._X(x), self._Y(y)) for x, y in pts]
+        if len(P) > 1:
+            if dash:
+                for a, b in zip(P[:-1], P[1:]):
+                    _dashed(self.d, a, b, color, width)
+            else:
+                self.d.line(P, fill=color, width=width)
+        for X, Y in P:
+            _marker(self.d, X, Y, marker, color)
+
+    def hline(self, y, color, label=None):
+        if not self.inside(10 ** self.lx[0] * 1.0001, y):
+            return
+        x0, _, x1, _ = self.box
+        Y = self._Y(y)
+        _dashed(self.d, (x0, Y), (x1, Y), color, 2)
+        if label:
+            self.d.text((x1 - 6, Y - 3), label, fill=color, font=_font(12), anchor="rd")
+
+
+def _dec(e):
+    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return "10" + str(e).translate(sup)
+
+
+def _dashed(d, a, b, color, width, on=8, off=6):
+    L = math.hypot(b[0] - a[0], b[1] - a[1])
+    if L == 0:
+        return
+    ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
+    s = 0.0
+    while s < L:
+        e = min(s + on, L)
+        d.line([(a[0] + ux * s, a[1] + uy * s), (a[0] + ux * e, a[1] + uy * e)], fill=color, width=width)
+        s = e + off
+
+
+def _marker(d, X, Y, kind, color, s=5):
+    if kind == "o":
+        d.ellipse([X - s, Y - s, X + s, Y + s], outline=color, fill=color)
+    elif kind == "s":
+        d.rectangle([X - s, Y - s, X + s, Y + s], outline=color, width=2)
+    elif kind == "^":
+        d.polygon([(X, Y - s - 1), (X - s, Y + s), (X + s, Y + s)], outline=color)
+    elif kind == "x":
+        d.line([(X - s, Y - s), (X + s, Y + s)], fill=color, width=2)
+        d.line([(X - s, Y + s), (X + s, Y - s)], fill=color, width=2)
+
+
+def _vertical_text(img, xy, text, size=15):
+    from PIL import Image, ImageDraw
+    f = _font(size)
+    w = int(f.getlength(text)) + 4
+    tmp = Image.new("RGBA", (w, size + 6), (255, 255, 255, 0))
+    ImageDraw.Draw(tmp).text((2, 1), text, fill="black", font=f)
+    tmp = tmp.rotate(90, expand=True)
+    img.paste(tmp, (int(xy[0] - tmp.width / 2), int(xy[1] - tmp.height / 2)), tmp)
+
+
+COLORS = {("crosslinked", "euler"): (200, 30, 30), ("crosslinked", "verlet"): (240, 140, 20),
+          ("frictional", "euler"): (30, 60, 200), ("frictional", "verlet"): (20, 170, 200)}
+
+
+def draw_plot(results, path):
+    """Two log-log panels: |error of G′| vs wall time, and vs time-step factor (with seed spread)."""
+    from PIL import Image, ImageDraw
+    W, H = 1500, 700
+    img = Image.new("RGB", (W, H), "white")
+    d = ImageDraw.Draw(img)
+    conv = results["convergence_rows"]
+    ana = results["convergence"]
+    stats = {(s["scene"], s["N"], s["periods"]): s for s in results["statistics"]}
+    N0 = results["config"]["N_conv"]
+    errs, walls = [], []
+    for key, a in ana.items():
+        for q in ("Gp_int", "Gp_surf"):
+            for f, e in a["q"][q]["rel_error_vs_finest"].items():
+                if e > 0:
+                    errs.append(e)
+    for r in conv:
+        if r["status"] == "ok":
+            walls.append(r["wall"])
+    if not errs:
+        errs = [1e-3, 1]
+    ylim = (10 ** math.floor(math.log10(min(errs + [1e-3]))), 10 ** math.ceil(math.log10(max(errs + [1.0]))))
+    xlim_t = (10 ** math.floor(math.log10(min(walls))), 10 ** math.ceil(math.log10(max(walls))))
+    fs = sorted({r["factor"] for r in conv})
+    xlim_f = (10 ** math.floor(math.log10(min(fs))), 10 ** math.ceil(math.log10(max(fs))))
+    p1 = LogPanel(d, (110, 60, 700, 560), xlim_t, ylim, "wall time of the run (s, one core)",
+                  "relative error of G′ vs finest dt", "Error of G′ against run time")
+    p2 = LogPanel(d, (880, 60, 1470, 560), xlim_f, ylim, "time_step_factor (dt / default rule)",
+                  "relative error of G′ vs finest dt", "Error of G′ against time step")
+    for p in (p1, p2):
+        _vertical_text(img, p.ylabel[:2], p.ylabel[2])
+    legend = []
+    for key, a in sorted(ana.items()):
+        scene, integ = a["scene"], a["integrator"]
+        col = COLORS.get((scene, integ), (0, 0, 0))
+        for q, mk, dash in (("Gp_int", "o", False), ("Gp_surf", "s", True)):
+            e = a["q"][q]["rel_error_vs_finest"]
+            rows = {r["factor"]: r for r in conv if r["scene"] == scene and r["integrator"] == integ
+                    and r["status"] == "ok"}
+            pts_t = sorted((rows[f]["wall"], e[f]) for f in e if e[f] > 0)
+            pts_f = sorted((f, e[f]) for f in e if e[f] > 0)
+            p1.line(pts_t, col, mk, dash=dash)
+            p2.line(pts_f, col, mk, dash=dash)
+            legend.append((col, mk, dash, f"{scene}, {integ}, {'G′ internal' if q == 'Gp_int' else 'G′ surface'}"))
+        # unstable factors: crosses on the top edge of panel 2
+        for r in conv:
+            if r["scene"] == scene and r["integrator"] == integ and r["status"] != "ok":
+                _marker(d, p2._X(r["factor"]), p2._Y(ylim[1]) + 8, "x", col)
+    # seed-to-seed spread at the convergence N (relative std of G′ internal) as horizontal lines
+    for scene in SCENES:
+        s = stats.get((scene, N0, 3))
+        if s and s["Gp_int_mean"] and math.isfinite(s["Gp_int_std"]):
+            rel = s["Gp_int_std"] / abs(s["Gp_int_mean"])
+            col = COLORS[(scene, "euler")]
+            for p in (p1, p2):
+                p.hline(rel, col, f"{scene}: seed spread (std/mean, N={N0})")
+    # order guides on panel 2
+    f_lo, f_hi = xlim_f
+    for order, lab in ((1, "slope 1"), (2, "slope 2")):
+        y_at_1 = 10 ** (math.log10(ylim[0]) + 0.6 * (math.log10(ylim[1]) - math.log10(ylim[0])))
+        pts = [(f, y_at_1 * f ** order) for f in (f_lo, 1, f_hi)]
+        p2.line(pts, (120, 120, 120), marker="", width=1, dash=True)
+        X, Y = p2._X(1), p2._Y(y_at_1)
+        d.text((X + 4, Y + (4 if order == 1 else -18)), lab, fill=(100, 100, 100), font=_font(12))
+    ly = 600
+    for k, (col, mk, dash, text) in enumerate(legend):
+        X = 110 + (k % 3) * 460
+        Y = ly + (k // 3) * 24
+        if dash:
+            _dashed(d, (X, Y), (X + 40, Y), col, 2)
+        else:
+            d.line([(X, Y), (X + 40, Y)], fill=col, width=2)
+        _marker(d, X + 20, Y, mk, col)
+        d.text((X + 50, Y), text, fill="black", font=_font(13), anchor="lm")
+    d.text((W - 10, H - 8), "× at the top: run stopped by the stability guard (unstable)", fill="black",
+           font=_font(12), anchor="rd")
+    img.save(path)
+
+
+# ---------------------------------------------------------------------------------------------
+# tables
+# ---------------------------------------------------------------------------------------------
+def _g(x, fmt="{:.4g}"):
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "–"
+    return fmt.format(x)
+
+
+def tables(results):
+    cfg = results["config"]
+    L = []
+    L.append(f"Command: `{cfg['command']}`  \nMachine: {cfg['machine']}; {cfg['workers']} worker processes; "
+             f"total wall time {cfg['wall_total']:.0f} s.\n")
+    L.append("### Time-step convergence (seed %d, N = %d)\n" % (cfg["seed"], cfg["N_conv"]))
+    L.append("Wall time = whole call (constitution included, identical for every factor) with two runs in "
+             "parallel. Peak overlap = max over the protocol of 1 − d/(r_i+r_j) over transient contacts. "
+             "Asym. = max over all steps of |σ01−σ10|/(|σ00|+|σ11|) of the overall tensor. p_max = largest "
+             "peculiar momentum of the mobile spheres / (Σm·A·2πf·Ly/2).\n")
+    L.append("| scene | integrator | factor | dt (s) | steps | wall (s) | G′ int (Pa) | G″ int (Pa) | G′ surf (Pa) "
+             "| G″ surf (Pa) | peak overlap | asym. | p_max |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in sorted(results["convergence_rows"], key=lambda r: (r["scene"], r["integrator"], -r["factor"])):
+        if r["status"] != "ok":
+            L.append(f"| {r['scene']} | {r['integrator']} | {r['factor']:g} | – | – | {r['wall']:.1f} | unstable: "
+                     f"{r.get('phase')} step {r.get('step')} | | | | | | |")
+            continue
+        L.append(f"| {r['scene']} | {r['integrator']} | {r['factor']:g} | {r['dt']:.3g} | {r['N_steps']} | "
+                 f"{r['wall']:.1f} | {r['Gp_int']:.2f} | {r['Gpp_int']:.2f} | {r['Gp_surf']:.2f} | "
+                 f"{r['Gpp_surf']:.2f} | {r['peak_overlap']:.4f} | {_g(r.get('symmetry_max'), '{:.1e}')} | "
+                 f"{_g(r.get('momentum_max_rel'), '{:.1e}')} |")
+    L.append("")
+    L.append("### Errors and observed order\n")
+    L.append("Relative error against the finest factor; Richardson value from the three finest factors "
+             "(only when their observed order lies in 0.3…4); p₃ = log₂ of the ratio of successive "
+             "differences of the three finest; p_fit = least-squares slope of log error vs log factor.\n")
+    fs = sorted({r["factor"] for r in results["convergence_rows"]}, reverse=True)
+    head = "| scene / integrator | quantity | finest | Richardson | p₃ | p_fit | " + " | ".join(
+        f"err @{f:g}" for f in fs) + " |"
+    L.append(head)
+    L.append("|" + "---|" * (6 + len(fs)))
+    for key, a in sorted(results["convergence"].items()):
+        for q in QUANTITIES:
+            c = a["q"][q]
+            e = c["rel_error_vs_finest"]
+            cells = []
+            for f in fs:
+                fk = f if f in e else str(f)
+                v = e.get(fk)
+                cells.append("unstable" if v is None else (f"{v:.1e}" if v > 0 else "ref"))
+            L.append(f"| {key} | {q} | {c['finest']:.4g} | {_g(c['richardson'])} | {_g(c['order_three_finest'], '{:.2f}')}"
+                     f" | {_g(c['order_fit'], '{:.2f}')} | " + " | ".join(cells) + " |")
+    L.append("")
+    L.append("### Sample-to-sample spread (std over seeds)\n")
+    L.append("| scene | N | periods | seeds | dt (s) | steps | wall/run (s) | G′ int mean ± std (Pa) | "
+             "G″ int mean ± std | G′ surf mean ± std | G″ surf mean ± std | std/mean G′ int | std of mean G′ int |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for s in results["statistics"]:
+        rel = s["Gp_int_std"] / abs(s["Gp_int_mean"]) if s["Gp_int_mean"] else float("nan")
+        L.append(f"| {s['scene']} | {s['N']} | {s['periods']} | {s['seeds']} | {s['dt']:.3g} | {s['N_steps']} | "
+                 f"{s['wall_mean']:.1f} | {s['Gp_int_mean']:.1f} ± {s['Gp_int_std']:.1f} | "
+                 f"{s['Gpp_int_mean']:.1f} ± {s['Gpp_int_std']:.1f} | {s['Gp_surf_mean']:.1f} ± {s['Gp_surf_std']:.1f} | "
+                 f"{s['Gpp_surf_mean']:.1f} ± {s['Gpp_surf_std']:.1f} | {rel:.1%} | "
+                 f"{rel / math.sqrt(s['seeds']):.1%} |")
+    L.append("")
+    L.append("### Largest stable time step (bisection on time_step_factor, guard as oracle)\n")
+    L.append("| regime | integrator | default dt (s) | largest stable factor | first unstable factor | "
+             "margin (× default dt) | probes | failing phase |")
+    L.append("|---|---|---|---|---|---|---|---|")
+    for b in results["stability"]:
+        bad = [p for p in b["probes"] if p["status"] != "ok"]
+        phases = sorted({str(p["phase"]) for p in bad})
+        L.append(f"| {b['regime']} | {b['integrator']} | {_g(b.get('dt0'), '{:.3g}')} | {_g(b['stable'], '{:.3g}')} | "
+                 f"{_g(b['unstable'], '{:.3g}')} | {_g(b['stable'], '{:.2g}')} | {len(b['probes'])} | "
+                 f"{', '.join(phases) or '–'} |")
+    L.append("")
+    return "\n".join(L)
+
+
+# ---------------------------------------------------------------------------------------------
+# main
+# ---------------------------------------------------------------------------------------------
+def build_jobs(quick, seed):
+    if quick:
+        N_conv, factors = 45, (4, 2, 1, 0.5, 0.25)
+        stat_plan = [(45, 3, (1, 2, 3)), (150, 3, (1, 2)), (45, 6, (1, 2, 3))]
+        regimes = ["default crosslinked"]
+        integrators_bisect = ("euler",)
+        bis = 3
+    else:
+        N_conv, factors = 150, (8, 4, 2, 1, 0.5, 0.25, 0.125)
+        stat_plan = [(45, 3, tuple(range(1, 11))), (150, 3, tuple(range(1, 9))), (600, 3, tuple(range(1, 5))),
+                     (2400, 3, (1, 2, 3)), (150, 6, tuple(range(1, 9)))]
+        regimes = list(REGIMES)
+        integrators_bisect = ("euler", "verlet")
+        bis = 5
+    jobs = []
+    for scene, sp in SCENES.items():
+        for integ in ("euler", "verlet"):
+            for f in factors:
+                cost = (N_conv / 150) / f
+                jobs.append(dict(kind="conv", scene=scene, integrator=integ, factor=f, tensors=True, cost=cost,
+                                 params=dict(sp, N=N_conv, seed=seed, time_step_factor=f, integrator=integ)))
+    for N, P, seeds in stat_plan:
+        for scene, sp in SCENES.items():
+            if N == 2400 and scene == "frictional":
+                continue   # the N dependence is shown on the crosslinked default scene
+            if P == 6 and scene == "frictional" and not quick:
+                pass
+            for s in seeds:
+                cost = (N / 150) ** 1.5 * (P + 3) / 6
+                jobs.append(dict(kind="stat", scene=scene, N=N, periods=P, seed=s, cost=cost,
+                                 params=dict(sp, N=N, periods=P, seed=s)))
+    for name in regimes:
+        for integ in integrators_bisect:
+            jobs.append(dict(kind="bisect", regime=name, integrator=integ, cost=1.5, bisections=bis,
+                             params=dict(REGIMES[name], seed=seed, integrator=integ,
+                                         N=45 if quick else 150)))
+    return jobs, N_conv
+
+
+def _dispatch(job):
+    if job["kind"] == "bisect":
+        return stable_factor(job)
+    return run_case(job)
+
+
+def _self_check():
+    """The hooks must not change the physics: a hooked run equals a plain one bit for bit."""
+    kw = dict(BASE, N=20, do_permanent_links=False, cut_lines=0, relative_frequency=0.2, pre_periods=0.5,
+              periods=1, post_periods=0.5, seed=7)
+    hooked = run_case(dict(params=kw, tensors=True))
+    api.Simulation_interlocking_rheology = Simulation_interlocking_rheology
+    try:
+        plain = api.doParticleShearSimulation(**kw)
+    finally:
+        api.Simulation_interlocking_rheology = RecordingSimulation
+    assert (hooked["Gp_int"], hooked["Gpp_int"]) == tuple(plain.G_internal), "recording hook changed the run"
+    assert (hooked["Gp_surf"], hooked["Gpp_surf"]) == tuple(plain.G_surface), "recording hook changed the run"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small scenes, < 3 min on 2 cores")
+    ap.add_argument("--out", default=os.path.join("docs", "accuracy_data"), help="output folder")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=1, help="seed of the convergence and bisection runs")
+    args = ap.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    t_start = time.perf_counter()
+    _self_check()
+    jobs, N_conv = build_jobs(args.quick, args.seed)
+    jobs.sort(key=lambda j: -j["cost"])
+    rows = []
+    with concurrent.futures.ProcessPoolExecutor(args.workers) as ex:
+        futs = {ex.submit(_dispatch, j): j for j in jobs}
+        for k, fut in enumerate(concurrent.futures.as_completed(futs), 1):
+            r = fut.result()
+            rows.append(r)
+            tag = r.get("scene") or r.get("regime")
+            extra = (f"stable={r['stable']} unstable={r['unstable']}" if r["kind"] == "bisect"
+                     else f"{r['status']} G'int={r.get('Gp_int', float('nan')):.2f} wall={r['wall']:.1f}s")
+            print(f"[{k}/{len(jobs)} {time.perf_counter() - t_start:6.0f}s] {r['kind']} {tag} "
+                  f"{r.get('integrator', '')} f={r.get('factor', '')} N={r.get('N', '')} "
+                  f"P={r.get('periods', '')} seed={r.get('seed', '')}: {extra}", flush=True)
+    conv_rows = [r for r in rows if r["kind"] == "conv"]
+    stat_rows = [r for r in rows if r["kind"] == "stat"]
+    # the convergence runs at factor 1 are seed-`seed` members of the N_conv, 3-period statistics
+    stab = [r for r in rows if r["kind"] == "bisect"]
+    for b in stab:
+        b["probes"].sort(key=lambda p: p["factor"])
+        b["dt0"] = next((p["dt0"] for p in b["probes"] if p["dt0"]), None)
+    results = dict(
+        config=dict(command="python benchmarks/accuracy_study.py" + (" --quick" if args.quick else "")
+                    + (f" --out {args.out}" if args.out != os.path.join("docs", "accuracy_data") else ""),
+                    quick=args.quick, seed=args.seed, N_conv=N_conv, workers=args.workers,
+                    machine=f"{platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}, "
+                            f"NumPy {np.__version__}",
+                    wall_total=time.perf_counter() - t_start),
+        convergence_rows=conv_rows, convergence=convergence_analysis(conv_rows),
+        statistics=statistics_analysis(stat_rows), statistics_rows=stat_rows, stability=stab)
+    results["cheapest"] = cheapest_within(results, 0.01)
+    with open(os.path.join(args.out, "accuracy_results.json"), "w") as fh:
+        json.dump(results, fh, indent=1, default=float)
+    _csv(os.path.join(args.out, "convergence.csv"), conv_rows,
+         ("scene", "integrator", "factor", "status", "dt", "N_steps", "wall", "wall_measurement", "Gp_int", "Gpp_int",
+          "Gp_surf", "Gpp_surf", "peak_overlap", "symmetry_max", "momentum_max_rel", "momentum_drift_rel", "phase",
+          "step"))
+    _csv(os.path.join(args.out, "statistics.csv"), stat_rows,
+         ("scene", "N", "periods", "seed", "status", "dt", "N_steps", "wall", "Gp_int", "Gpp_int", "Gp_surf",
+          "Gpp_surf", "peak_overlap", "momentum_max_rel"))
+    _csv(os.path.join(args.out, "stability.csv"),
+         [dict(regime=b["regime"], integrator=b["integrator"], **p) for b in stab for p in b["probes"]],
+         ("regime", "integrator", "factor", "status", "phase", "step", "peak_overlap", "wall"))
+    md = tables(results) + "\n" + cheapest_text(results["cheapest"])
+    with open(os.path.join(args.out, "accuracy_tables.md"), "w") as fh:
+        fh.write(md)
+    draw_plot(results, os.path.join(args.out, "accuracy.png"))
+    print(md)
+    print(f"done in {time.perf_counter() - t_start:.0f} s; results in {args.out}")
+
+
+def cheapest_within(results, tol):
+    """Cheapest (scene, integrator, factor) whose G′ (both estimators) lies within ``tol`` of the converged value.
+
+    Converged value = Richardson extrapolation when available, otherwise the finest run.
+    """
+    out = {}
+    for key, a in results["convergence"].items():
+        rows = {r["factor"]: r for r in results["convergence_rows"] if r["scene"] == a["scene"]
+                and r["integrator"] == a["integrator"] and r["status"] == "ok"}
+        best = None
+        for f, r in rows.items():
+            ok = True
+            for q in ("Gp_int", "Gp_surf"):
+                c = a["q"][q]
+                ref = c["richardson"] if math.isfinite(c["richardson"]) else c["finest"]
+                if abs(r[q] - ref) > tol * abs(ref):
+                    ok = False
+            if ok and (best is None or r["wall"] < best["wall"]):
+                best = dict(factor=f, wall=r["wall"], dt=r["dt"])
+        out[key] = best
+    return out
+
+
+def cheapest_text(ch):
+    L = ["### Cheapest setting within 1 % of the converged G′ (both estimators, seed and N fixed)\n",
+         "| scene / integrator | time_step_factor | dt (s) | wall (s) |", "|---|---|---|---|"]
+    for key, b in sorted(ch.items()):
+        if b is None:
+            L.append(f"| {key} | none within 1 % | | |")
+        else:
+            L.append(f"| {key} | {b['factor']:g} | {b['dt']:.3g} | {b['wall']:.1f} |")
+    return "\n".join(L) + "\n"
+
+
+def _csv(path, rows, cols):
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in rows:
+            w.writerow([r.get(c, "") for c in cols])
+
+
+if __name__ == "__main__":
+    sys.exit(main())
