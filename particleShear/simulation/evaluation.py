@@ -15,7 +15,7 @@ import numpy as np
 from ..base.register import SphereSelection
 from ..base.stress import StressTensorEvaluation, TENSOR_NAMES
 
-__all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "demodulation", "demodulation_reference_loop"]
+__all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "demodulation"]
 
 # scalar columns of the buffer
 _T, _STRAIN, _RATE, _FORCE, _SHEAR = range(5)
@@ -94,51 +94,6 @@ def demodulation(t, shear_stress, f, amplitude, baseline_pre_periods=0, periods=
     SA = float(sc @ a) / saa if saa else math.nan
     SB = float(sc @ b) / sbb if sbb else math.nan
     return [SA, SB, SA / amplitude, SB / amplitude]
-
-
-def demodulation_reference_loop(t, shear_stress, f, amplitude, baseline_pre_periods=0, periods=2,
-                                baseline_post_periods=0):
-    """Plain-Python transcription of the reference formula (§8.5, drift-sign quirk included).
-
-    Slow (one Python loop over the samples); kept as an executable statement of the
-    reference rule for tests and for readers.  Returns the same list as :func:`demodulation`.
-    """
-    pre, P, post = baseline_pre_periods, periods, baseline_post_periods
-    e = 1 if P >= 2 else 0
-    if pre > 0:
-        n1 = S1 = T1 = 0.0
-        for ti, si in zip(t, shear_stress):
-            if 2 * pre / (3 * f) <= ti < pre / f:
-                S1 += si
-                T1 += ti
-                n1 += 1
-        S1, T1 = S1 / n1, T1 / n1
-    else:
-        S1, T1 = shear_stress[0], t[0]
-    if post > 0:
-        n2 = S2 = T2 = 0.0
-        for ti, si in zip(t, shear_stress):
-            if (pre + P) / f < ti <= (pre + P + post / 3) / f:
-                S2 += si
-                T2 += ti
-                n2 += 1
-        S2, T2 = S2 / n2, T2 / n2
-    else:
-        S2, T2 = shear_stress[-1], t[-1]
-    D = (S2 - S1) / (T1 - T2)
-    sa = saa = sb = sbb = 0.0
-    for ti, si in zip(t, shear_stress):
-        if (pre + e) / f <= ti <= (pre + P) / f:
-            a = math.sin(2 * math.pi * (f * ti - pre))
-            b = math.cos(2 * math.pi * (f * ti - pre))
-        else:
-            a = b = 0.0
-        sc = si - (ti - pre / f) * D
-        sa += sc * a
-        saa += a * a
-        sb += sc * b
-        sbb += b * b
-    return [sa / saa, sb / sbb, sa / saa / amplitude, sb / sbb / amplitude]
 
 
 def _list_property(col, doc):

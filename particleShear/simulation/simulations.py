@@ -38,6 +38,11 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
                          "output folder (no such directory)")
 
 
+def call_string(name, **arguments):
+    """``name(k1=v1,k2=v2,...)`` with ``str()`` values and no spaces: the header's function-call line (§9.1)."""
+    return name + "(" + ",".join(k + "=" + str(v) for k, v in arguments.items()) + ")"
+
+
 class OscillatorySimulation:
     """Base class: output paths, file header, experiment set-up and the run (§8.1).
 
@@ -285,13 +290,11 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         self.mu = mu
         self.theEnsemble = None
         self.model = False
-        self.function_call = ("OscillatorySimulationFragmentation(root_folder=" + str(root_folder)
-                              + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines)
-                              + ",N=" + str(N) + ",packing_fraction=" + str(packing_fraction)
-                              + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres="
-                              + str(Young_modulus_spheres) + ",mu=" + str(mu) + ",relative_y_scale_force="
-                              + str(relative_y_scale_force) + ",relative_frequency=" + str(relative_frequency)
-                              + ",doDrawing=" + str(doDrawing) + ")")
+        self.function_call = call_string("OscillatorySimulationFragmentation", root_folder=root_folder,
+            do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N, packing_fraction=packing_fraction,
+            amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres, mu=mu,
+            relative_y_scale_force=relative_y_scale_force, relative_frequency=relative_frequency,
+            doDrawing=doDrawing)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
         if 0 < self.mu <= 1:
@@ -370,19 +373,16 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
         self.relative_transversal_link_strength = relative_transversal_link_strength
         self.dt = None
         self.dt_max = None
-        self.function_call = (
-            "Simulation_dermal_filler_rheology(root_folder=" + str(root_folder)
-            + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines) + ",N=" + str(N)
-            + ",packing_fraction=" + str(packing_fraction) + ",bimodal_factor=" + str(bimodal_factor)
-            + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres=" + str(Young_modulus_spheres)
-            + ",density=" + str(density) + ",mu=" + str(mu) + ",relative_viscosity=" + str(relative_viscosity)
-            + ",relative_y_scale_force=" + str(relative_y_scale_force) + ",relative_frequency="
-            + str(relative_frequency) + ",relative_transversal_link_strength="
-            + str(relative_transversal_link_strength) + ",central_repulsion_coefficient="
-            + str(central_repulsion_coefficient) + ",avoid_horizontal_angle_degree="
-            + str(avoid_horizontal_angle_degree) + ",avoid_height_spanning_particles="
-            + str(avoid_height_spanning_particles) + ",doCutByTriangulation=" + str(doCutByTriangulation)
-            + ",doDrawing=" + str(doDrawing) + ")")
+        self.function_call = call_string("Simulation_dermal_filler_rheology", root_folder=root_folder,
+            do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N, packing_fraction=packing_fraction,
+            bimodal_factor=bimodal_factor, amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres,
+            density=density, mu=mu, relative_viscosity=relative_viscosity,
+            relative_y_scale_force=relative_y_scale_force, relative_frequency=relative_frequency,
+            relative_transversal_link_strength=relative_transversal_link_strength,
+            central_repulsion_coefficient=central_repulsion_coefficient,
+            avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles=avoid_height_spanning_particles,
+            doCutByTriangulation=doCutByTriangulation, doDrawing=doDrawing)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
         """Longer fixed-boundary relaxation for low friction, amplitude or viscosity (§8.4)."""
@@ -445,24 +445,20 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         self.cut_top_bottom = cut_top_bottom
         self.remove_link_fraction = remove_link_fraction
         self.edge_fuzziness = edge_fuzziness
-        self.function_call = (
-            "Simulation_interlocking_rheology(root_folder=" + str(root_folder)
-            + ",do_permanent_links=" + str(do_permanent_links) + ",cut_lines=" + str(cut_lines) + ",N=" + str(N)
-            + ",packing_fraction=" + str(packing_fraction) + ",bimodal_factor=" + str(bimodal_factor)
-            + ",amplitude=" + str(amplitude) + ",Young_modulus_spheres=" + str(Young_modulus_spheres)
-            + ",density=" + str(density) + ",mu=" + str(mu) + ",relative_viscosity=" + str(relative_viscosity)
-            + ",relative_y_scale_force=" + str(relative_y_scale_force) + ",relative_frequency="
-            + str(relative_frequency) + ",relative_transversal_link_strength="
-            + str(relative_transversal_link_strength) + ",central_repulsion_coefficient="
-            + str(central_repulsion_coefficient) + ",avoid_horizontal_angle_degree="
-            + str(avoid_horizontal_angle_degree) + ",avoid_height_spanning_particles="
-            + str(avoid_height_spanning_particles) + ",interface_reenforcement_central="
-            + str(interface_reenforcement_central) + ",interface_reenforcement_tangential="
-            + str(interface_reenforcement_tangential) + ",keep_viscosity_coefficients_constant="
-            + str(keep_viscosity_coefficients_constant) + ",cut_top_bottom=" + str(cut_top_bottom)
-            + ",doCutByTriangulation=" + str(doCutByTriangulation) + ",remove_link_fraction="
-            + str(remove_link_fraction) + ",edge_fuzziness=" + str(edge_fuzziness) + ",doDrawing="
-            + str(doDrawing) + ")")
+        self.function_call = call_string("Simulation_interlocking_rheology", root_folder=root_folder,
+            do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N, packing_fraction=packing_fraction,
+            bimodal_factor=bimodal_factor, amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres,
+            density=density, mu=mu, relative_viscosity=relative_viscosity,
+            relative_y_scale_force=relative_y_scale_force, relative_frequency=relative_frequency,
+            relative_transversal_link_strength=relative_transversal_link_strength,
+            central_repulsion_coefficient=central_repulsion_coefficient,
+            avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles=avoid_height_spanning_particles,
+            interface_reenforcement_central=interface_reenforcement_central,
+            interface_reenforcement_tangential=interface_reenforcement_tangential,
+            keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
+            cut_top_bottom=cut_top_bottom, doCutByTriangulation=doCutByTriangulation,
+            remove_link_fraction=remove_link_fraction, edge_fuzziness=edge_fuzziness, doDrawing=doDrawing)
 
     def initEnsemble(self, do_debug=False):
         """Adjustable-interface builder (§6.4) with ``anticipated_amplitude = amplitude``."""
