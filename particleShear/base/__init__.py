@@ -8,6 +8,7 @@ from .relations import neighbor_relation
 from .register import Force_register, SphereSelection
 from .stress import StressTensorEvaluation
 from .graphics import Graphical_output_configuration
+from .stability import SimulationInstabilityError, StabilityGuard
 from .canvas import (CanvasPoints, CanvasPointsMass, CanvasPointsNeighbors, CanvasPointsShear,
                      CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                      CanvasPointsFrictionElasticityLeesEdwards)
@@ -20,5 +21,5 @@ __all__ = [
     "neighbor_relation", "Force_register", "StressTensorEvaluation",
     "Graphical_output_configuration", "CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors",
     "CanvasPointsShear", "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
-    "CanvasPointsFrictionElasticityLeesEdwards",
+    "CanvasPointsFrictionElasticityLeesEdwards", "SimulationInstabilityError", "StabilityGuard",
 ]
