@@ -169,6 +169,39 @@ class CanvasPoints:
             d.pop("_v_" + name, None)
         self._params_changed()
         self._spheres_changed()
+        self._adopt_relations(sphere)
+
+    def _adopt_relations(self, sphere):
+        """Move relations made before appending (e.g. links) into the pair table.
+
+        A relation is adopted once both of its spheres are in this ensemble; the
+        partner's own relation back supplies the second history.
+        """
+        own = sphere.__dict__.get("_own_neighbors")
+        if not own or not hasattr(self, "_pairs"):
+            return
+        from .neighbours import STATE_CODES
+        p = sphere.__dict__["_idx"]
+        pending = []
+        for rel in own:
+            partner = rel.theSphere
+            if partner.__dict__.get("_ens") is not self:
+                pending.append(rel)  # adopted when the partner joins
+                continue
+            q = partner.__dict__["_idx"]
+            pt = self._pairs
+            slot = int(pt.ensure(p, q)[0])
+            if not pt.active[slot]:
+                pt.active[slot] = True
+                pt.birth[slot] = pt.next_births(1)[0]
+            pt.state[slot] = STATE_CODES[rel.interface_type]
+            pt.d_eq[slot] = getattr(rel, "equilibrium_distance", 0)
+            (pt.xi_ij if p < q else pt.xi_ji)[slot] = rel.friction_position
+            back = [b for b in partner.__dict__.get("_own_neighbors", []) if b.theSphere is sphere]
+            if back:
+                (pt.xi_ji if p < q else pt.xi_ij)[slot] = back[-1].friction_position
+        sphere.__dict__["_own_neighbors"] = pending
+        self._links_changed()
 
     def _spheres_changed(self):
         self._invalidate_neighbours()
