@@ -197,7 +197,7 @@ def stable_factor(job):
     def probe(factor):
         res = run_case(dict(params=dict(params, time_step_factor=factor), ))
         probes.append(dict(factor=factor, status=res["status"], phase=res.get("phase"), step=res.get("step"),
-                           peak_overlap=res.get("peak_overlap"), wall=res["wall"],
+                           peak_overlap=res.get("peak_overlap"), wall=res["wall"], reason=res.get("reason"),
                            dt0=res["dt"] / factor if res["status"] == "ok" else None))
         return res["status"] == "ok"
 
@@ -359,14 +359,15 @@ class LogPanel:
         for X, Y in P:
             _marker(self.d, X, Y, marker, color)
 
-    def hline(self, y, color, label=None):
+    def hline(self, y, color, label=None, below=False):
         if not self.inside(10 ** self.lx[0] * 1.0001, y):
             return
         x0, _, x1, _ = self.box
         Y = self._Y(y)
         _dashed(self.d, (x0, Y), (x1, Y), color, 2)
         if label:
-            self.d.text((x1 - 6, Y - 3), label, fill=color, font=_font(12), anchor="rd")
+            self.d.text((x1 - 6, Y + 4 if below else Y - 3), label, fill=color, font=_font(12),
+                        anchor="ra" if below else "rd")
 
 
 def _dec(e):
@@ -415,7 +416,7 @@ COLORS = {("crosslinked", "euler"): (200, 30, 30), ("crosslinked", "verlet"): (2
 def draw_plot(results, path):
     """Two log-log panels: |error of G′| vs wall time, and vs time-step factor (with seed spread)."""
     from PIL import Image, ImageDraw
-    W, H = 1500, 700
+    W, H = 1500, 760
     img = Image.new("RGB", (W, H), "white")
     d = ImageDraw.Draw(img)
     conv = results["convergence_rows"]
@@ -437,7 +438,7 @@ def draw_plot(results, path):
     xlim_t = (10 ** math.floor(math.log10(min(walls))), 10 ** math.ceil(math.log10(max(walls))))
     fs = sorted({r["factor"] for r in conv})
     xlim_f = (10 ** math.floor(math.log10(min(fs))), 10 ** math.ceil(math.log10(max(fs))))
-    p1 = LogPanel(d, (110, 60, 700, 560), xlim_t, ylim, "wall time of the run (s, one core)",
+    p1 = LogPanel(d, (110, 60, 700, 560), xlim_t, ylim, "wall time of the run (s)",
                   "relative error of G′ vs finest dt", "Error of G′ against run time")
     p2 = LogPanel(d, (880, 60, 1470, 560), xlim_f, ylim, "time_step_factor (dt / default rule)",
                   "relative error of G′ vs finest dt", "Error of G′ against time step")
@@ -448,8 +449,8 @@ def draw_plot(results, path):
         scene, integ = a["scene"], a["integrator"]
         col = COLORS.get((scene, integ), (0, 0, 0))
         for q, mk, dash in (("Gp_int", "o", False), ("Gp_surf", "s", True)):
-            e = a["q"][q]["rel_error_vs_finest"]
-            rows = {r["factor"]: r for r in conv if r["scene"] == scene and r["integrator"] == integ
+            e = {float(k): v for k, v in a["q"][q]["rel_error_vs_finest"].items()}
+            rows = {float(r["factor"]): r for r in conv if r["scene"] == scene and r["integrator"] == integ
                     and r["status"] == "ok"}
             pts_t = sorted((rows[f]["wall"], e[f]) for f in e if e[f] > 0)
             pts_f = sorted((f, e[f]) for f in e if e[f] > 0)
@@ -461,13 +462,13 @@ def draw_plot(results, path):
             if r["scene"] == scene and r["integrator"] == integ and r["status"] != "ok":
                 _marker(d, p2._X(r["factor"]), p2._Y(ylim[1]) + 8, "x", col)
     # seed-to-seed spread at the convergence N (relative std of G′ internal) as horizontal lines
-    for scene in SCENES:
+    for k_scene, scene in enumerate(SCENES):
         s = stats.get((scene, N0, 3))
         if s and s["Gp_int_mean"] and math.isfinite(s["Gp_int_std"]):
             rel = s["Gp_int_std"] / abs(s["Gp_int_mean"])
             col = COLORS[(scene, "euler")]
             for p in (p1, p2):
-                p.hline(rel, col, f"{scene}: seed spread (std/mean, N={N0})")
+                p.hline(rel, col, f"{scene}: seed spread (std/mean, N={N0})", below=k_scene == 0)
     # order guides on panel 2
     f_lo, f_hi = xlim_f
     for order, lab in ((1, "slope 1"), (2, "slope 2")):
@@ -476,7 +477,7 @@ def draw_plot(results, path):
         p2.line(pts, (120, 120, 120), marker="", width=1, dash=True)
         X, Y = p2._X(1), p2._Y(y_at_1)
         d.text((X + 4, Y + (4 if order == 1 else -18)), lab, fill=(100, 100, 100), font=_font(12))
-    ly = 600
+    ly = 650
     for k, (col, mk, dash, text) in enumerate(legend):
         X = 110 + (k % 3) * 460
         Y = ly + (k // 3) * 24
@@ -558,11 +559,11 @@ def tables(results):
     L.append("")
     L.append("### Largest stable time step (bisection on time_step_factor, guard as oracle)\n")
     L.append("| regime | integrator | default dt (s) | largest stable factor | first unstable factor | "
-             "margin (× default dt) | probes | failing phase |")
+             "margin (× default dt) | probes | failing phase: reason |")
     L.append("|---|---|---|---|---|---|---|---|")
     for b in results["stability"]:
         bad = [p for p in b["probes"] if p["status"] != "ok"]
-        phases = sorted({str(p["phase"]) for p in bad})
+        phases = sorted({f"{p['phase']}: {str(p.get('reason') or '')[:40]}" for p in bad})
         L.append(f"| {b['regime']} | {b['integrator']} | {_g(b.get('dt0'), '{:.3g}')} | {_g(b['stable'], '{:.3g}')} | "
                  f"{_g(b['unstable'], '{:.3g}')} | {_g(b['stable'], '{:.2g}')} | {len(b['probes'])} | "
                  f"{', '.join(phases) or '–'} |")
@@ -594,6 +595,13 @@ def build_jobs(quick, seed):
                 cost = (N_conv / 150) / f
                 jobs.append(dict(kind="conv", scene=scene, integrator=integ, factor=f, tensors=True, cost=cost,
                                  params=dict(sp, N=N_conv, seed=seed, time_step_factor=f, integrator=integ)))
+    if not quick:
+        # a single frictional packing is chaotic in dt; its seed mean is what converges
+        for f in (8, 4, 2, 1, 0.5):
+            for s2 in (seed + 1, seed + 2):
+                jobs.append(dict(kind="convseed", scene="frictional", integrator="euler", factor=f, seed=s2,
+                                 cost=1 / f, params=dict(SCENES["frictional"], N=N_conv, seed=s2,
+                                                         time_step_factor=f, integrator="euler")))
     for N, P, seeds in stat_plan:
         for scene, sp in SCENES.items():
             if N == 2400 and scene == "frictional":
@@ -658,6 +666,8 @@ def main(argv=None):
                   f"P={r.get('periods', '')} seed={r.get('seed', '')}: {extra}", flush=True)
     conv_rows = [r for r in rows if r["kind"] == "conv"]
     stat_rows = [r for r in rows if r["kind"] == "stat"]
+    seed_rows = [r for r in rows if r["kind"] == "convseed"] + [
+        dict(r, seed=args.seed) for r in conv_rows if r["scene"] == "frictional" and r["integrator"] == "euler"]
     # the convergence runs at factor 1 are seed-`seed` members of the N_conv, 3-period statistics
     stab = [r for r in rows if r["kind"] == "bisect"]
     for b in stab:
@@ -671,7 +681,8 @@ def main(argv=None):
                             f"NumPy {np.__version__}",
                     wall_total=time.perf_counter() - t_start),
         convergence_rows=conv_rows, convergence=convergence_analysis(conv_rows),
-        statistics=statistics_analysis(stat_rows), statistics_rows=stat_rows, stability=stab)
+        statistics=statistics_analysis(stat_rows), statistics_rows=stat_rows, stability=stab,
+        seed_mean_convergence=seed_mean_analysis(seed_rows))
     results["cheapest"] = cheapest_within(results, 0.01)
     with open(os.path.join(args.out, "accuracy_results.json"), "w") as fh:
         json.dump(results, fh, indent=1, default=float)
@@ -684,8 +695,9 @@ def main(argv=None):
           "Gpp_surf", "peak_overlap", "momentum_max_rel"))
     _csv(os.path.join(args.out, "stability.csv"),
          [dict(regime=b["regime"], integrator=b["integrator"], **p) for b in stab for p in b["probes"]],
-         ("regime", "integrator", "factor", "status", "phase", "step", "peak_overlap", "wall"))
-    md = tables(results) + "\n" + cheapest_text(results["cheapest"])
+         ("regime", "integrator", "factor", "status", "phase", "step", "reason", "peak_overlap", "wall"))
+    md = tables(results) + "\n" + seed_mean_text(results["seed_mean_convergence"]) + "\n" + cheapest_text(
+        results["cheapest"])
     with open(os.path.join(args.out, "accuracy_tables.md"), "w") as fh:
         fh.write(md)
     draw_plot(results, os.path.join(args.out, "accuracy.png"))
@@ -694,26 +706,56 @@ def main(argv=None):
 
 
 def cheapest_within(results, tol):
-    """Cheapest (scene, integrator, factor) whose G′ (both estimators) lies within ``tol`` of the converged value.
-
-    Converged value = Richardson extrapolation when available, otherwise the finest run.
+    """Coarsest factor (cheapest run) such that it and every finer factor give G′ (both estimators)
+    within ``tol`` of the converged value (Richardson extrapolation when available, else the finest run);
+    None when even the second-finest factor is outside the band.
     """
     out = {}
     for key, a in results["convergence"].items():
         rows = {r["factor"]: r for r in results["convergence_rows"] if r["scene"] == a["scene"]
                 and r["integrator"] == a["integrator"] and r["status"] == "ok"}
         best = None
-        for f, r in rows.items():
+        for f in sorted(rows):      # from fine to coarse: stop at the first factor outside the band
+            r = rows[f]
             ok = True
             for q in ("Gp_int", "Gp_surf"):
                 c = a["q"][q]
                 ref = c["richardson"] if math.isfinite(c["richardson"]) else c["finest"]
                 if abs(r[q] - ref) > tol * abs(ref):
                     ok = False
-            if ok and (best is None or r["wall"] < best["wall"]):
+            if not ok:
+                break
+            if f > a["finest_factor"]:
                 best = dict(factor=f, wall=r["wall"], dt=r["dt"])
         out[key] = best
     return out
+
+
+def seed_mean_analysis(rows):
+    """Mean ± std over seeds of G′/G″ per factor (frictional scene, euler), for factors run with > 1 seed."""
+    out = []
+    for f in sorted({r["factor"] for r in rows}, reverse=True):
+        rs = [r for r in rows if r["factor"] == f and r["status"] == "ok"]
+        if len(rs) < 2:
+            continue
+        row = dict(factor=f, seeds=sorted(r["seed"] for r in rs), wall=float(np.mean([r["wall"] for r in rs])))
+        for q in ("Gp_int", "Gpp_int", "Gp_surf", "Gpp_surf"):
+            x = np.array([r[q] for r in rs])
+            row[q] = (float(x.mean()), float(x.std(ddof=1)))
+        out.append(row)
+    return out
+
+
+def seed_mean_text(rows):
+    if not rows:
+        return ""
+    L = ["### Frictional spheres: seed mean against the time step (euler, same seeds at every factor)\n",
+         "| factor | seeds | wall/run (s) | G′ int | G″ int | G′ surf | G″ surf |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        L.append(f"| {r['factor']:g} | {','.join(map(str, r['seeds']))} | {r['wall']:.1f} | "
+                 + " | ".join(f"{r[q][0]:.1f} ± {r[q][1]:.1f}" for q in ("Gp_int", "Gpp_int", "Gp_surf", "Gpp_surf"))
+                 + " |")
+    return "\n".join(L) + "\n"
 
 
 def cheapest_text(ch):
