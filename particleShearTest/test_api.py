@@ -163,5 +163,23 @@ class TestEvaluationModes(unittest.TestCase):
         self.assertTrue(math.isfinite(tau_int) and tau_int != 0)
 
 
+
+class TestAllocatorTuning(unittest.TestCase):
+    def test_opt_out_leaves_the_allocator_alone(self):
+        import os
+        import subprocess
+        import sys
+        code = ("import particleShear.base.memory as m; from particleShear import EnsembleLinkable; "
+                "EnsembleLinkable(500, 500, 0); print(m._done)")
+        env = dict(os.environ, PARTICLESHEAR_NO_MALLOPT="1")
+        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+        self.assertEqual(out.stdout.strip(), "False")
+        env.pop("PARTICLESHEAR_NO_MALLOPT")
+        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+        import platform
+        glibc = sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc"
+        self.assertEqual(out.stdout.strip(), "True" if glibc else "False")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -23,6 +23,7 @@ import numpy as np
 from .graphics import Graphical_output_configuration
 from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from .laws import call_law_vectorised
+from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
 from .register import Force_register, SphereSelection
@@ -108,6 +109,7 @@ class CanvasPoints:
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False):
         _check_positive("size_x", size_x)
         _check_positive("size_y", size_y)
+        tune_allocator()
         self.theCanvas = theCanvas
         self.size_x = size_x
         self.size_y = size_y
