@@ -164,6 +164,22 @@ class TestEvaluationModes(unittest.TestCase):
 
 
 
+class TestLegacyEnsembles(unittest.TestCase):
+    def test_periodic_friction_ensemble_conserves_momentum(self):
+        # plain periodic cell, no plates, no damping: pair forces cancel, Σ m v stays put
+        from particleShear import EnsembleFriction
+        ens = EnsembleFriction(500, 500, 60, packing_fraction=1.2, k=1, nu=0.5, k_t=1, nu_t=0.5, mu=0.3)
+        ens.set_random_generator(np.random.default_rng(3))
+        ens._a["xspeed"][:] = np.random.default_rng(1).normal(0, 1, 60)
+        p0 = ens.total_momentum()
+        for _ in range(100):
+            ens.mechanical_simulation_step(1, 0.05)
+        scale = float(ens._a["m"] @ np.abs(ens._a["xspeed"]))
+        self.assertLess(np.abs(ens.total_momentum() - p0).max(), 1e-12 * scale)
+        self.assertIn("tangential", ens.active_terms)
+        self.assertTrue(np.any(ens._a["omega"] != 0))  # friction spins the spheres
+
+
 class TestAllocatorTuning(unittest.TestCase):
     def test_opt_out_leaves_the_allocator_alone(self):
         import os

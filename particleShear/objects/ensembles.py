@@ -104,24 +104,17 @@ class EnsembleFriction(Ensemble):
         self.nu_t = nu_t
         self.mu = mu
 
-    # the tangential machinery of the Lees-Edwards friction canvas, with a zero shear offset
-    _tangential_speed = CanvasPointsFrictionElasticityLeesEdwards._tangential_speed
-    _add_tangential = CanvasPointsFrictionElasticityLeesEdwards._add_tangential
-    _tangential_needed = CanvasPointsFrictionElasticityLeesEdwards._tangential_needed
-    tangential_force_from_neighbors = CanvasPointsFrictionElasticityLeesEdwards.tangential_force_from_neighbors
-    _tangential_terms = CanvasPointsFrictionElasticityLeesEdwards._tangential_terms
-    tangential_force = CanvasPointsFrictionElasticityLeesEdwards.tangential_force
-    _torque_total = CanvasPointsFrictionElasticityLeesEdwards._torque_total
-    do_rotational_acceleration = CanvasPointsFrictionElasticityLeesEdwards.do_rotational_acceleration
-    _cool_spin = CanvasPointsFrictionElasticityLeesEdwards._cool_spin
-    mechanical_simulation_step_calculate_acceleration = \
-        CanvasPointsFrictionElasticityLeesEdwards.mechanical_simulation_step_calculate_acceleration
-    _integrate_xi = CanvasPointsFrictionElasticityLeesEdwards._integrate_xi
-    move = CanvasPointsFrictionElasticityLeesEdwards.move
-
     def _force_terms(self):
         Ensemble._force_terms(self)
         self._tangential_terms()
+
+
+# EnsembleFriction takes the tangential machinery of the friction canvas (it is not on that branch
+# of the documented chain); its strain still advances only while shearing, as in its base class.
+for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
+    if not _name.startswith("__") and _name not in ("_advance_strain", "k_t", "nu_t", "mu", "_force_terms"):
+        setattr(EnsembleFriction, _name, _value)
+del _name, _value
 
 
 class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesEdwards):
