@@ -95,10 +95,17 @@ class SphereList(list):
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
 
 
+class _Structure:
+    """Arrays over the active pairs that stay valid while the set of relations does."""
+    __slots__ = ("token", "slots", "ai", "aj", "d0", "ri", "rj", "idx2", "ky", "kx", "perm", "trans", "shifted",
+                 "mob", "internal", "ext_i", "ext_j")
+
+
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
     __slots__ = ("slots", "ai", "aj", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
-                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv", "ky", "kx")
+                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv", "ky", "kx",
+                 "ri", "rj", "idx2")
 
 
 class CanvasPoints:
@@ -421,6 +428,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._relation_view_class = _BaseRelationView
         self._in_force_phase = False
         self._disp = np.zeros((2, 0))
+        self._struct = None
+        self._links_version = 0
+        self._images_token = 0
+        self._cand_key = None
 
     def _invalidate_neighbours(self):
         self._nl_valid = False
@@ -434,6 +445,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     def _links_changed(self):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
+        self._links_version += 1
 
     def _spheres_changed(self):
         self._nl_valid = False
@@ -471,7 +483,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         skin = self._skin()
         i, j = candidate_pairs(x, y, a["r"], self.size_x, self.size_y, shift, skin)
         self._pairs.replace(i, j)
-        self._nl_rsum_version = -1
         self._nl_valid = True
         self._nl_skin = skin
         self._nl_shift = shift
@@ -505,7 +516,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         """Neighbour update (§4.2): activate touching pairs, drop transient ones that separated.
 
         Also computes the geometry of the active pairs that every force term of
-        this step uses.
+        this step uses.  What depends only on *which* pairs are active (indices,
+        contact distances, bond flags, image periods, internal/external flags) is
+        kept from the previous step while that set, the bonds and the images stay
+        the same — most steps.
         """
         pt = self._pairs
         if self._needs_rebuild():
@@ -516,7 +530,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         Lx, Ly = self.size_x, self.size_y
         dx0 = x.take(j) - x.take(i)
         dy0 = y.take(j) - y.take(i)
-        if self._images_valid and self._images_version == pt.version:
+        cached_images = self._images_valid and self._images_version == pt.version
+        if cached_images:
             # no sphere wrapped since the images were found: reuse their period counts (§3.1,
             # one period at a time, so bit-identical to a fresh minimum image)
             ky, kx, Lky, Lkx = self._images
@@ -529,74 +544,78 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
                                             self._passes(), counts=True)
             self._store_images(ky, kx, len(i))
+            self._images_token += 1
         d = np.sqrt(dx * dx + dy * dy)
-        if self._nl_rsum_version != pt.version:
+        key = (pt.version, self._links_version)
+        if self._cand_key != key:
             self._nl_rsum = r[i] + r[j]
-            self._nl_rsum_version = pt.version
+            self._cand_perm = pt.state == PERMANENT if pt.n_permanent else None
+            self._cand_key = key
         d0 = self._nl_rsum
         touching = d < d0
-        perm = pt.state == PERMANENT if pt.n_permanent else None
+        perm = self._cand_perm
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
         changed = _nz(new_active != old)
-        born = new_active & ~old if changed else old[:0]
-        died = old & ~new_active if changed else old[:0]
-        if _nz(born):
-            pt.state[born] = STICK
-            pt.xi_ij[born] = 0.0
-            pt.xi_ji[born] = 0.0
-            pt.birth[born] = pt.next_births(int(born.sum()))
-        if _nz(died):
-            pt.state[died] = STICK
-            pt.xi_ij[died] = 0.0
-            pt.xi_ji[died] = 0.0
-        pt.active = new_active
-        sel = np.flatnonzero(new_active)
+        if changed:
+            born = new_active & ~old
+            died = old & ~new_active
+            if _nz(born):
+                pt.state[born] = STICK
+                pt.xi_ij[born] = 0.0
+                pt.xi_ji[born] = 0.0
+                pt.birth[born] = pt.next_births(int(born.sum()))
+            if _nz(died):
+                pt.state[died] = STICK
+                pt.xi_ij[died] = 0.0
+                pt.xi_ji[died] = 0.0
+            pt.active = new_active
+        S = self._struct
+        token = (key, self._images_token)
+        if changed or S is None or S.token != token:
+            S = self._active_structure(new_active, d0, perm, ky, kx, dx0, dy0, dx, dy, d, cached_images)
+            S.token = token
+            self._struct = S
         g = _Geometry()
+        sel = S.slots
         g.slots = sel
-        g.ai = i[sel]
-        g.aj = j[sel]
-        g.dx = dx[sel]
-        g.dy = dy[sel]
-        g.d = d[sel]
+        g.ai = S.ai
+        g.aj = S.aj
+        g.dx = dx.take(sel)
+        g.dy = dy.take(sel)
+        g.d = d.take(sel)
         if _nz(g.d == 0):
             g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
         else:
             g.nx = g.dx / g.d
             g.ny = g.dy / g.d
-        g.ky = None if ky is None else ky[sel]
-        g.kx = None if kx is None else kx[sel]
-        # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5)
-        if g.ky is None:
-            shifted = (g.dx != dx0[sel]) | (g.dy != dy0[sel])
-        else:
-            shifted = (g.ky != 0) | (g.kx != 0)
-        if _nz(shifted):
-            w = np.flatnonzero(shifted)
-            rx, ry = dx0[sel][w], dy0[sel][w]
-            shifted[w] = np.sqrt(rx * rx + ry * ry) != g.d[w]
-        g.dvx = None if dvx is None else dvx[sel]
-        g.d0 = d0[sel]
+        g.ky = S.ky
+        g.kx = S.kx
+        g.dvx = None if dvx is None else dvx.take(sel)
+        g.d0 = S.d0
         g.P = len(sel)
-        if perm is None:
-            g.perm = None
-            g.trans = None
-        else:
-            g.perm = perm[sel]
-            g.trans = ~g.perm
-            if not _nz(g.perm):
-                g.perm = g.trans = None
+        g.perm = S.perm
+        g.trans = S.trans
         mob = self._mobile_mask()
-        if mob is None:
-            g.internal = ~shifted
-            g.ext_i = shifted
-            g.ext_j = shifted
-        else:
-            mi = mob[g.ai]
-            mj = mob[g.aj]
-            g.internal = mi & mj & ~shifted
-            g.ext_i = mi & ~g.internal
-            g.ext_j = mj & ~g.internal
+        if S.mob is not mob and not (mob is not None and S.mob is not None and np.array_equal(mob, S.mob)):
+            shifted = S.shifted
+            if mob is None:
+                S.internal = ~shifted
+                S.ext_i = shifted
+                S.ext_j = shifted
+            else:
+                mi = mob.take(S.ai)
+                mj = mob.take(S.aj)
+                S.internal = mi & mj & ~shifted
+                S.ext_i = mi & ~S.internal
+                S.ext_j = mj & ~S.internal
+            S.mob = mob
+        g.internal = S.internal
+        g.ext_i = S.ext_i
+        g.ext_j = S.ext_j
+        g.ri = S.ri
+        g.rj = S.rj
+        g.idx2 = S.idx2
         g.fn_i = np.zeros(g.P)
         g.fn_j = None
         g.ft = None
@@ -606,6 +625,42 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.rv = None
         self._g = g
         return g
+
+    def _active_structure(self, active, d0, perm, ky, kx, dx0, dy0, dx, dy, d, cached_images):
+        """Per-active-pair data that change only when the set of relations, bonds or images change."""
+        pt = self._pairs
+        r = self._a["r"]
+        S = _Structure()
+        sel = np.nonzero(active)[0]
+        S.slots = sel
+        S.ai = pt.i.take(sel)
+        S.aj = pt.j.take(sel)
+        S.d0 = d0.take(sel)
+        S.ri = r.take(S.ai)
+        S.rj = r.take(S.aj)
+        S.idx2 = np.concatenate((S.ai, S.aj))
+        S.ky = None if ky is None else ky.take(sel)
+        S.kx = None if kx is None else kx.take(sel)
+        if perm is None:
+            S.perm = S.trans = None
+        else:
+            S.perm = perm.take(sel)
+            S.trans = ~S.perm
+            if not _nz(S.perm):
+                S.perm = S.trans = None
+        # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5);
+        # with cached images the cell is much larger than a contact, so any period applied means that
+        if S.ky is None:
+            shifted = (dx.take(sel) != dx0.take(sel)) | (dy.take(sel) != dy0.take(sel))
+        else:
+            shifted = (S.ky != 0) | (S.kx != 0)
+        if not cached_images and _nz(shifted):
+            w = sel[np.nonzero(shifted)[0]]
+            rx, ry = dx0.take(w), dy0.take(w)
+            shifted[np.nonzero(shifted)[0]] = np.sqrt(rx * rx + ry * ry) != d.take(w)
+        S.shifted = shifted
+        S.mob = False  # internal/external flags not computed yet
+        return S
 
     # -- pair-force accumulation -----------------------------------------------------------------
     def _geometry(self):
@@ -650,13 +705,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             fjx = fjx - tx
             fjy = fjy - ty
             df = g.d * g.ft
-            ri = a["r"][g.ai]
-            rj = a["r"][g.aj]
-            rs = ri + rj
+            ri, rj = g.ri, g.rj
+            rs = g.d0
             ti = df * ri / rs
             tj = df * rj / rs
         if g.P:
-            idx = np.concatenate((g.ai, g.aj))
+            idx = g.idx2
             a["xforce"] += np.bincount(idx, np.concatenate((fix, fjx)), n)
             a["yforce"] += np.bincount(idx, np.concatenate((fiy, fjy)), n)
             if ti is not None:
@@ -683,6 +737,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         return [cls(self, p, int(q)) for q in partners]
 
     def _drop_relations_of(self, p):
+        self._struct = None
         pt = self._pairs
         m = pt.active & ((pt.i == p) | (pt.j == p)) & (pt.state != PERMANENT)
         pt.active[m] = False
@@ -697,6 +752,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     def _test_pair(self, p, q):
         """Neighbour test of one pair (the scalar ``test_neighbor_relation(theSphere)`` API)."""
+        self._struct = None
         a = self._a
         touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
         pt = self._pairs
@@ -1184,7 +1240,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         vxi, vyi = vx.take(ai), vy.take(ai)
         rvx = vx.take(aj) - vxi
         rvy = vy.take(aj) - vyi
-        spin = r.take(ai) * om.take(ai) + r.take(aj) * om.take(aj)
+        ri, rj = (g.ri, g.rj) if allk else (g.ri.take(w), g.rj.take(w))
+        spin = ri * om.take(ai) + rj * om.take(aj)
         # relation i→j: both spheres still at their old positions (the force-phase geometry)
         ux = rvx if dvx0 is None else rvx + dvx0
         pt.xi_ij[sl] += ((ux * -ny + rvy * nx) - spin) * dt
