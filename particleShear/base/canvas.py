@@ -1216,55 +1216,54 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
         Relation i→j (i < j) sees both spheres at their old positions; relation
         j→i sees i already moved by ``v_i·dt``.  Both use the velocities after
-        the kick and damping, and slip relations are not integrated.
+        the kick and damping; slip relations are not integrated (their increment
+        is multiplied by 0, which leaves their ξ = 0 exactly).
         """
         g = self._g
         if g is None or not g.P:
             return
         pt = self._pairs
-        keep = pt.state.take(g.slots) != SLIP
-        allk = _nz(keep) == len(keep)
-        if allk:
-            sl, ai, aj, nx, ny, dvx0, ky, kx, d = g.slots, g.ai, g.aj, g.nx, g.ny, g.dvx, g.ky, g.kx, g.d
-        else:
-            w = np.nonzero(keep)[0]
-            if not len(w):
-                return
-            sl, ai, aj, nx, ny, d = (g.slots.take(w), g.ai.take(w), g.aj.take(w), g.nx.take(w), g.ny.take(w),
-                                     g.d.take(w))
-            dvx0 = None if g.dvx is None else g.dvx.take(w)
-            ky = None if g.ky is None else g.ky.take(w)
-            kx = None if g.kx is None else g.kx.take(w)
+        sl, ai, aj, nx, ny = g.slots, g.ai, g.aj, g.nx, g.ny
+        keep = pt.state.take(sl) != SLIP
+        n_keep = _nz(keep)
+        if not n_keep:
+            return
         a = self._a
-        x, y, vx, vy, om, r = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"], a["r"]
+        x, y, vx, vy, om = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]
         vxi, vyi = vx.take(ai), vy.take(ai)
         rvx = vx.take(aj) - vxi
         rvy = vy.take(aj) - vyi
-        ri, rj = (g.ri, g.rj) if allk else (g.ri.take(w), g.rj.take(w))
-        spin = ri * om.take(ai) + rj * om.take(aj)
+        spin = g.ri * om.take(ai) + g.rj * om.take(aj)
         # relation i→j: both spheres still at their old positions (the force-phase geometry)
-        ux = rvx if dvx0 is None else rvx + dvx0
-        pt.xi_ij[sl] += ((ux * -ny + rvy * nx) - spin) * dt
+        ux = rvx if g.dvx is None else rvx + g.dvx
+        inc = ((ux * -ny + rvy * nx) - spin) * dt
+        if n_keep != len(keep):
+            inc *= keep
+        pt.xi_ij[sl] += inc
         # relation j→i: i has moved; same image as in the force phase (periods −k, one at a time)
         rx = (x.take(ai) + vxi * dt) - x.take(aj)
         ry = (y.take(ai) + vyi * dt) - y.take(aj)
         Lx, Ly = float(self.size_x), float(self.size_y)
-        if ky is not None:
-            dy = ry + Ly * ky
-            dx = (rx + float(self._le_shift()) * ky) + Lx * kx
-            dvx = (Ly * float(self._shear_rate_for_images())) * ky
+        if g.ky is not None:
+            dy = ry + Ly * g.ky
+            dx = (rx + float(self._le_shift()) * g.ky) + Lx * g.kx
+            dvx = (Ly * float(self._shear_rate_for_images())) * g.ky
         else:
             dx, dy, dvx = rx, ry, None
-        if np.abs(dx).max() >= Lx / 2 or np.abs(dy).max() >= Ly / 2:
-            dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
         dm = np.sqrt(dx * dx + dy * dy)
+        if dm.max() >= 0.5 * min(Lx, Ly) and (np.abs(dx).max() >= Lx / 2 or np.abs(dy).max() >= Ly / 2):
+            dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+            dm = np.sqrt(dx * dx + dy * dy)
         if _nz(dm == 0):
             _, mx, my = pair_geometry(dx, dy, self._rng)
         else:
             mx = dx / dm
             my = dy / dm
         svx = -rvx if dvx is None else -rvx + dvx
-        pt.xi_ji[sl] += ((svx * -my + -rvy * mx) - spin) * dt
+        inc = ((svx * -my + -rvy * mx) - spin) * dt
+        if n_keep != len(keep):
+            inc *= keep
+        pt.xi_ji[sl] += inc
 
     def move(self, dt=1):
         a = self._a
