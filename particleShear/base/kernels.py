@@ -144,10 +144,11 @@ def tangential_two_pass(vt, touching, permanent, xi_ij, xi_ji, kt_i, kt_j, nut_i
     """
     transient = ~permanent
     ftv_i = nut_i * vt
-    ftv_j = nut_j * vt
     if _nz(touching) != len(touching):
         ftv_i = np.where(touching, ftv_i, 0.0)
-        ftv_j = np.where(touching, ftv_j, 0.0)
+        ftv_j = ftv_i if nut_j is nut_i else np.where(touching, nut_j * vt, 0.0)
+    else:
+        ftv_j = ftv_i if nut_j is nut_i else nut_j * vt
     ft1 = ftv_i + kt_i * xi_ij
     a1 = np.abs(ft1)
     slip1 = transient & (a1 > f_coulomb)
