@@ -33,6 +33,7 @@ import numpy as np  # noqa: E402
 
 from particleShear import EnsembleLinkable, SphereLinkable, StressTensorEvaluation  # noqa: E402
 from particleShear.base.kernels import min_image  # noqa: E402
+from particleShear.base.points import _le_closest  # noqa: E402
 
 E = 8000.0
 K = math.pi / 8 * E * 1e6          # 3.14e9 mg s^-2 per m depth
@@ -107,18 +108,7 @@ def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
         for j in range(n):
             if i == j:
                 continue
-            dx = xs[j] - xs[i]
-            dy = ys[j] - ys[i]
-            while dy >= L / 2:
-                dy -= L
-                dx -= L * shear
-            while dy < -L / 2:
-                dy += L
-                dx += L * shear
-            while dx >= L / 2:
-                dx -= L
-            while dx < -L / 2:
-                dx += L
+            dx, dy = _le_closest(xs[j] - xs[i], ys[j] - ys[i], L, L, shear)  # scalar §3.1, as the reference
             touching = math.sqrt(dx * dx + dy * dy) < rs[i] + rs[j]
             found = -1
             for q, idx in enumerate(rel):

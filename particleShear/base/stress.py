@@ -38,6 +38,27 @@ def _pair_moment(fx, fy, lx, ly):
     return np.dot(G, L.T)
 
 
+def _internal_moment(p, x, y, n_int):
+    """``Σ F_i ⊗ (x_i − x_j)`` (SI) over the internal pairs of a register block with F_j = −F_i."""
+    i, j, fix, fiy = p["i"], p["j"], p["fix"], p["fiy"]
+    if n_int != len(i):
+        w = np.nonzero(p["internal"])[0]
+        i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
+    return _pair_moment(fix, fiy, x.take(i) - x.take(j), y.take(i) - y.take(j))
+
+
+def _external_moment(p, x, y, cx, cy):
+    """``Σ F ⊗ (x_target − c)`` (SI) over the external entries of a register block, or None if there are none."""
+    wi = np.nonzero(p["ext_i"])[0]
+    wj = np.nonzero(p["ext_j"])[0]
+    tg = np.concatenate((p["i"].take(wi), p["j"].take(wj)))
+    if not len(tg):
+        return None
+    return _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
+                        np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
+                        x.take(tg) - cx, y.take(tg) - cy)
+
+
 def _tensor_property(k):
     def fget(self):
         return self._t[k].tolist()
@@ -242,31 +263,13 @@ class StressTensorEvaluation:
         internal = p["internal"]
         n_int = int(np.count_nonzero(internal))
         if n_int and p.get("antisymmetric", True):
-            fix, fiy = p["fix"], p["fiy"]
-            if n_int != len(i):
-                w = np.nonzero(internal)[0]
-                i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
-            lw = _pair_moment(fix, fiy, x.take(i) - x.take(j), y.take(i) - y.take(j))
-            lw /= V
-            t[_LW] = lw
-            i, j = p["i"], p["j"]
+            t[_LW] = _internal_moment(p, x, y, n_int) / V
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
         else:
             t[_LW] = 0.0
-        if n_int != len(i):
-            wi = np.nonzero(p["ext_i"])[0]
-            wj = np.nonzero(p["ext_j"])[0]
-            tg = np.concatenate((i.take(wi), j.take(wj)))
-            if len(tg):
-                m_ = _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
-                                  np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
-                                  x.take(tg) - cx, y.take(tg) - cy)
-                t[_EXT] = (0.0 - m_) / V
-            else:
-                t[_EXT] = 0.0
-        else:
-            t[_EXT] = 0.0
+        m_ = _external_moment(p, x, y, cx, cy) if n_int != len(i) else None
+        t[_EXT] = 0.0 if m_ is None else (0.0 - m_) / V
         _, fx, fy = reg._tot
         inertia, omega, m, vx, vy = a["inertia"], a["omega"], a["m"], a["xspeed"], a["yspeed"]
         xm, ym = x, y
@@ -335,26 +338,15 @@ class StressTensorEvaluation:
         n_int = int(np.count_nonzero(internal))
         lw01 = 0.0
         if n_int:
-            fix = p["fix"]
             if not p.get("antisymmetric", True):
                 self.evaluate_force_stress_tensors(reg)
                 lw01 = t[_LW, 0, 1]
             else:
-                ii, jj = i, j
-                if n_int != len(i):
-                    w = np.nonzero(internal)[0]
-                    ii, jj, fix = i.take(w), j.take(w), fix.take(w)
-                fiy = p["fiy"] if n_int == len(i) else p["fiy"].take(w)
-                lw01 = (_pair_moment(fix, fiy, x.take(ii) - x.take(jj), y.take(ii) - y.take(jj)) / V)[0, 1]
+                lw01 = (_internal_moment(p, x, y, n_int) / V)[0, 1]
         ext01 = 0.0
         if n_int != len(i):
-            wi = np.nonzero(p["ext_i"])[0]
-            wj = np.nonzero(p["ext_j"])[0]
-            tg = np.concatenate((i.take(wi), j.take(wj)))
-            if len(tg):
-                m_ = _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
-                                  np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
-                                  x.take(tg) - self.size_x / 2, y.take(tg) - self.size_y / 2)
+            m_ = _external_moment(p, x, y, self.size_x / 2, self.size_y / 2)
+            if m_ is not None:
                 ext01 = ((0.0 - m_) / V)[0, 1]
         tint = 0.0
         if p.get("ti") is not None and n_int:

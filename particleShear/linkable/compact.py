@@ -248,11 +248,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     def join_isolated_spheres(self, physical_neighbors_only=True):
         """Bond each sphere without a (physical) link to a random partner among its non-permanent relations (§6.10)."""
         pt = self._pairs
-        perm = pt.state == PERMANENT
-        i, j = pt.i[perm], pt.j[perm]
-        if physical_neighbors_only:
-            keep = self._physical(i, j)
-            i, j = i[keep], j[keep]
+        i, j = self.permanent_pairs(physical_neighbors_only)
         bonded = np.zeros(self._n, bool)
         bonded[i] = True
         bonded[j] = True
