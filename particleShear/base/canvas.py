@@ -42,6 +42,8 @@ FIELDS = {
     "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
     "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
 }
+#: row of each field in the state block ``CanvasPoints._st`` (fields × spheres)
+_ROW = {name: k for k, name in enumerate(FIELDS)}
 _PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
            "keep_viscosity_coefficients_constant")
 
@@ -95,17 +97,26 @@ class SphereList(list):
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
 
 
+_UNSET = object()
+
+
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "slots", "ai", "aj", "d0", "ri", "rj", "idx2", "ky", "kx", "perm", "trans", "shifted",
-                 "mob", "internal", "ext_i", "ext_j")
+    __slots__ = ("token", "slots", "slots2", "ai", "aj", "d0", "ri", "rj", "wi", "wj", "idx2", "idx6", "ky", "kx", "any_y",
+                 "LK", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
+
+
+class _Flags:
+    """What the stress tensors need of the internal/external flags of one mobility mask (§7.2):
+    number and float weights (None: all) of internal pairs; slots, targets and signs of external forces."""
+    __slots__ = ("P", "n_int", "w_int", "ext_wi", "ext_wj", "ext_slots", "ext_targets", "ext_sign")
 
 
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
-    __slots__ = ("slots", "ai", "aj", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
-                 "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv", "ky", "kx",
-                 "ri", "rj", "idx2")
+    __slots__ = ("S", "slots", "ai", "aj", "D", "n", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
+                 "touching", "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv",
+                 "ky", "kx", "ri", "rj", "idx2", "state", "Vi", "Vj")
 
 
 class CanvasPoints:
@@ -123,8 +134,7 @@ class CanvasPoints:
         self.doDrawing = doDrawing
         self._cap = 0
         self._n = 0
-        self._buf = {name: np.zeros(0) for name in FIELDS}
-        self._a = {name: arr[:0] for name, arr in self._buf.items()}
+        self._set_capacity(0)
         self._sphereList = SphereList(self)
         self._rng = np.random.default_rng()
         self._renderer = None
@@ -150,6 +160,26 @@ class CanvasPoints:
         """Use ``rng`` (a ``numpy.random.Generator``) for every random choice of this ensemble."""
         self._rng = rng
 
+    def _set_capacity(self, cap):
+        """(Re)allocate the state block: one row per field of FIELDS, one column per sphere slot."""
+        block = np.zeros((len(FIELDS), cap))
+        old = getattr(self, "_block", None)
+        if old is not None:
+            block[:, :self._n] = old[:, :self._n]
+        self._block = block
+        self._cap = cap
+        self._views()
+
+    def _views(self):
+        """Per-field views ``_a[name]`` and the grouped rows the kernels gather in one call:
+        ``_pos`` (x, y), ``_vel`` (xspeed, yspeed, omega), ``_frc`` (xforce, yforce, torque)."""
+        st = self._block[:, :self._n]
+        self._st = st
+        self._a = {name: st[k] for k, name in enumerate(FIELDS)}
+        self._pos = st[0:2]
+        self._vel = st[2:5]
+        self._frc = st[9:12]
+
     def _attach(self, sphere):
         if sphere.__dict__.get("_ens") is not None:
             raise ValueError("sphere is already in an ensemble; a sphere can be appended to one ensemble only")
@@ -159,18 +189,13 @@ class CanvasPoints:
         _check_positive("m", getattr(sphere, "m", 1.0))
         n = self._n
         if n == self._cap:
-            cap = max(16, 2 * self._cap)
-            for name, old in self._buf.items():
-                new = np.zeros(cap, dtype=old.dtype)
-                new[:n] = old[:n]
-                self._buf[name] = new
-            self._cap = cap
+            self._set_capacity(max(16, 2 * self._cap))
         cls = type(sphere)
+        col = self._block[:, n]
         for name, default in FIELDS.items():
-            val = getattr(sphere, name) if hasattr(cls, name) else default
-            self._buf[name][n] = float(val)
+            col[_ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
         self._n = n + 1
-        self._a = {name: arr[: self._n] for name, arr in self._buf.items()}
+        self._views()
         d = sphere.__dict__
         d["_ens"] = self
         d["_idx"] = n
@@ -385,9 +410,9 @@ class CanvasPointsMass(CanvasPoints):
 
     def record_total_particle_forces(self):
         """Store the accumulated force of every mobile sphere (and torques, where spin exists)."""
-        a = self._a
-        self.force_register._set_totals(self, self._mobile_mask(), a["xforce"].copy(),
-                                        a["yforce"].copy(), self._torque_total())
+        tot = self._frc.copy()
+        self.force_register._set_totals(self, self._mobile_mask(), tot[0], tot[1],
+                                        tot[2] if self._torque_total() is not None else None)
 
     def particle_info(self):
         return "Spheres with mass"
@@ -428,6 +453,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._relation_view_class = _BaseRelationView
         self._in_force_phase = False
         self._disp = np.zeros((2, 0))
+        self._nl_strain = 0.0
+        self._nl_abs_strain = 0.0
         self._struct = None
         self._links_version = 0
         self._images_token = 0
@@ -454,13 +481,22 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._disp = np.zeros((2, self._n))
 
     def _drift(self, dt):
-        a = self._a
-        sx = a["xspeed"] * dt
-        sy = a["yspeed"] * dt
-        a["x"] += sx
-        a["y"] += sy
-        self._disp[0] += sx
-        self._disp[1] += sy
+        """Move every sphere by ``v·dt`` and accumulate its displacement relative to the affine flow.
+
+        The Verlet criterion works with displacements *relative to the shear flow*
+        ``γ̇ (y − Ly/2)``: under Lees-Edwards the flow carries neighbours along with
+        each other, so only peculiar motion (plus the small affine stretch of a
+        pair, bounded through the accumulated strain) can bring a far pair into contact.
+        """
+        step = self._vel[:2] * dt
+        rate = float(self._shear_rate_for_images())
+        if rate:
+            dg = rate * dt
+            self._disp[0] -= (self._pos[1] - self.size_y / 2) * dg
+            self._nl_strain += dg
+            self._nl_abs_strain += abs(dg)
+        self._pos += step
+        self._disp += step
         self._pos_version += 1
 
     def _skin(self):
@@ -469,9 +505,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
     def _needs_rebuild(self):
         if not self._nl_valid:
             return True
-        d = self._disp
-        bound = 2 * math.sqrt(float((d[0] * d[0] + d[1] * d[1]).max())) if self._n else 0.0
-        bound += abs(self._le_shift() - self._nl_shift)
+        # relative displacement of any pair since the rebuild: peculiar part ≤ 2U, affine stretch of a
+        # pair at distance r ≤ A·r (A = accumulated |strain|, Gronwall: factor A·e^A), and any strain
+        # change not carried by the flow (e.g. γ set directly) moves boundary images by Ly·Δγ
+        d2 = self._disp * self._disp
+        U = math.sqrt(float((d2[0] + d2[1]).max())) if self._n else 0.0
+        A = self._nl_abs_strain
+        gA = A * math.exp(A) if A else 0.0
+        bound = 2 * U * (1 + gA) + gA * self._nl_reach
+        bound += abs(self._le_shift() - self._nl_shift - float(self.size_y) * self._nl_strain)
         return bound >= self._nl_skin or (self.size_x, self.size_y) != self._nl_box
 
     def _rebuild_candidates(self):
@@ -487,6 +529,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_skin = skin
         self._nl_shift = shift
         self._nl_box = (self.size_x, self.size_y)
+        self._nl_reach = 2 * float(a["r"].max()) + skin if self._n else 0.0
+        self._nl_strain = 0.0
+        self._nl_abs_strain = 0.0
         self._disp[:] = 0.0
 
     def _shear_rate_for_images(self):
@@ -507,7 +552,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             return
         if ky is None:
             return
-        self._images = (ky, kx, float(self.size_y) * ky, float(self.size_x) * kx)
+        self._images = (ky, kx, np.array((float(self.size_x) * kx, float(self.size_y) * ky)))
         self._images_any_y = bool(_nz(ky))
         self._images_version = self._pairs.version
         self._images_valid = True
@@ -524,33 +569,38 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         pt = self._pairs
         if self._needs_rebuild():
             self._rebuild_candidates()
-        a = self._a
-        x, y, r = a["x"], a["y"], a["r"]
-        i, j = pt.i, pt.j
+        pos = self._pos
+        C = len(pt.i)
         Lx, Ly = self.size_x, self.size_y
-        dx0 = x.take(j) - x.take(i)
-        dy0 = y.take(j) - y.take(i)
+        key = (pt.version, self._links_version)
+        if self._cand_key != key:
+            r = self._a["r"]
+            self._nl_rsum = r[pt.i] + r[pt.j]
+            self._cand_perm = pt.state == PERMANENT if pt.n_permanent else None
+            self._cand_ji = np.concatenate((pt.j, pt.i))
+            self._cand_key = key
+        T = pos.take(self._cand_ji, axis=1)
+        D0 = T[:, :C] - T[:, C:]   # raw differences (x_j − x_i, y_j − y_i)
         cached_images = self._images_valid and self._images_version == pt.version
+        dvx_rate = 0.0
         if cached_images:
             # no sphere wrapped since the images were found: reuse their period counts (§3.1,
             # one period at a time, so bit-identical to a fresh minimum image)
-            ky, kx, Lky, Lkx = self._images
-            shift = float(self._le_shift())
-            dy = dy0 - Lky
-            dx = (dx0 - shift * ky) - Lkx
-            rate = float(self._shear_rate_for_images())
-            dvx = -(float(Ly) * rate) * ky if rate and self._images_any_y else None
+            ky, kx, LK = self._images
+            D = D0   # fresh array; the raw differences are not needed again on this path
+            if self._images_any_y:
+                D[0] -= float(self._le_shift()) * ky
+                dvx_rate = float(self._shear_rate_for_images())
+            D -= LK
+            dvx = None
         else:
-            dx, dy, dvx, ky, kx = min_image(dx0, dy0, Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
+            dx, dy, dvx, ky, kx = min_image(D0[0], D0[1], Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
                                             self._passes(), counts=True)
-            self._store_images(ky, kx, len(i))
+            D = np.array((dx, dy))
+            self._store_images(ky, kx, C)
             self._images_token += 1
-        d = np.sqrt(dx * dx + dy * dy)
-        key = (pt.version, self._links_version)
-        if self._cand_key != key:
-            self._nl_rsum = r[i] + r[j]
-            self._cand_perm = pt.state == PERMANENT if pt.n_permanent else None
-            self._cand_key = key
+        DD = D * D
+        d = np.sqrt(DD[0] + DD[1])
         d0 = self._nl_rsum
         touching = d < d0
         perm = self._cand_perm
@@ -562,85 +612,118 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             died = old & ~new_active
             if _nz(born):
                 pt.state[born] = STICK
-                pt.xi_ij[born] = 0.0
-                pt.xi_ji[born] = 0.0
+                pt.xi[:, born] = 0.0
                 pt.birth[born] = pt.next_births(int(born.sum()))
             if _nz(died):
                 pt.state[died] = STICK
-                pt.xi_ij[died] = 0.0
-                pt.xi_ji[died] = 0.0
+                pt.xi[:, died] = 0.0
             pt.active = new_active
         S = self._struct
         token = (key, self._images_token)
         if changed or S is None or S.token != token:
-            S = self._active_structure(new_active, d0, perm, ky, kx, dx0, dy0, dx, dy, d, cached_images)
+            S = self._active_structure(new_active, d0, perm, ky, kx, D0, D, d, cached_images)
             S.token = token
             self._struct = S
-        g = _Geometry()
         sel = S.slots
+        g = _Geometry()
+        g.S = S
         g.slots = sel
         g.ai = S.ai
         g.aj = S.aj
-        g.dx = dx.take(sel)
-        g.dy = dy.take(sel)
-        g.d = d.take(sel)
-        if _nz(g.d == 0):
-            g.d, g.nx, g.ny = pair_geometry(g.dx, g.dy, self._rng)
+        g.P = P = len(sel)
+        gD = D.take(sel, axis=1)
+        gd = d.take(sel)
+        if _nz(gd) != P:
+            gd, nx, ny = pair_geometry(gD[0], gD[1], self._rng)
+            g.n = np.array((nx, ny))
         else:
-            g.nx = g.dx / g.d
-            g.ny = g.dy / g.d
+            g.n = gD / gd
+        g.D = gD
+        g.d = gd
+        g.dx, g.dy = gD
+        g.nx, g.ny = g.n
         g.ky = S.ky
         g.kx = S.kx
-        g.dvx = None if dvx is None else dvx.take(sel)
+        if dvx is not None:
+            g.dvx = dvx.take(sel)
+        elif dvx_rate and S.any_y:
+            g.dvx = -(float(Ly) * dvx_rate) * S.ky
+        else:
+            g.dvx = None
         g.d0 = S.d0
-        g.P = len(sel)
         g.perm = S.perm
         g.trans = S.trans
+        g.touching = touching.take(sel) if perm is not None else None
         mob = self._mobile_mask()
-        if S.mob is not mob and not (mob is not None and S.mob is not None and np.array_equal(mob, S.mob)):
-            shifted = S.shifted
-            if mob is None:
-                S.internal = ~shifted
-                S.ext_i = shifted
-                S.ext_j = shifted
+        if S.mob is not mob:
+            if S.mob is _UNSET or mob is None or S.mob is None or _nz(mob != S.mob):
+                self._set_internal_flags(S, mob)
             else:
-                mi = mob.take(S.ai)
-                mj = mob.take(S.aj)
-                S.internal = mi & mj & ~shifted
-                S.ext_i = mi & ~S.internal
-                S.ext_j = mj & ~S.internal
-            S.mob = mob
+                S.mob = mob   # same mask, new array
         g.internal = S.internal
         g.ext_i = S.ext_i
         g.ext_j = S.ext_j
         g.ri = S.ri
         g.rj = S.rj
         g.idx2 = S.idx2
-        g.fn_i = np.zeros(g.P)
+        g.fn_i = None
         g.fn_j = None
         g.ft = None
         g.vn = None
         g.vt = None
         g.fel = None
         g.rv = None
+        g.state = None
         self._g = g
         return g
 
-    def _active_structure(self, active, d0, perm, ky, kx, dx0, dy0, dx, dy, d, cached_images):
+    def _set_internal_flags(self, S, mob):
+        """Internal/external flags of the active pairs for mobility mask ``mob`` (§7.2), and what the
+        stress evaluation needs of them: float weights of internal pairs, slots and targets of external forces."""
+        shifted = S.shifted
+        if mob is None:
+            S.internal = ~shifted
+            S.ext_i = shifted
+            S.ext_j = shifted
+        else:
+            mi = mob.take(S.ai)
+            mj = mob.take(S.aj)
+            S.internal = mi & mj & ~shifted
+            S.ext_i = mi & ~S.internal
+            S.ext_j = mj & ~S.internal
+        S.mob = mob
+        S.flags = F = _Flags()
+        F.P = len(S.ai)
+        F.n_int = n_int = _nz(S.internal)
+        F.w_int = None if n_int == F.P else S.internal.astype(float)
+        F.ext_wi = wi = np.flatnonzero(S.ext_i)
+        F.ext_wj = wj = np.flatnonzero(S.ext_j)
+        F.ext_slots = np.concatenate((wi, wj))
+        F.ext_targets = np.concatenate((S.ai.take(wi), S.aj.take(wj)))
+        F.ext_sign = np.concatenate((np.ones(len(wi)), -np.ones(len(wj))))
+
+    def _active_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
         """Per-active-pair data that change only when the set of relations, bonds or images change."""
         pt = self._pairs
         r = self._a["r"]
+        n = self._n
         S = _Structure()
         sel = np.nonzero(active)[0]
         S.slots = sel
+        S.slots2 = np.concatenate((sel, sel + len(pt.i)))   # flat slots of (ξ_ij, ξ_ji) in the (2, C) table
         S.ai = pt.i.take(sel)
         S.aj = pt.j.take(sel)
         S.d0 = d0.take(sel)
         S.ri = r.take(S.ai)
         S.rj = r.take(S.aj)
+        S.wi = S.ri / S.d0   # torque lever fractions r_i/(r_i + r_j), r_j/(r_i + r_j) of eq. S1-3
+        S.wj = S.rj / S.d0
         S.idx2 = np.concatenate((S.ai, S.aj))
+        # flat bincount index of (x, y, torque) rows: one call accumulates every pair force on the spheres
+        S.idx6 = np.concatenate((S.idx2, S.idx2 + n, S.idx2 + 2 * n))
         S.ky = None if ky is None else ky.take(sel)
         S.kx = None if kx is None else kx.take(sel)
+        S.any_y = S.ky is not None and bool(_nz(S.ky))
         if perm is None:
             S.perm = S.trans = None
         else:
@@ -651,15 +734,18 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5);
         # with cached images the cell is much larger than a contact, so any period applied means that
         if S.ky is None:
-            shifted = (dx.take(sel) != dx0.take(sel)) | (dy.take(sel) != dy0.take(sel))
+            shifted = (D.take(sel, axis=1) != D0.take(sel, axis=1)).any(axis=0)
         else:
             shifted = (S.ky != 0) | (S.kx != 0)
         if not cached_images and _nz(shifted):
             w = sel[np.nonzero(shifted)[0]]
-            rx, ry = dx0.take(w), dy0.take(w)
+            rx, ry = D0[0].take(w), D0[1].take(w)
             shifted[np.nonzero(shifted)[0]] = np.sqrt(rx * rx + ry * ry) != d.take(w)
         S.shifted = shifted
-        S.mob = False  # internal/external flags not computed yet
+        S.mob = _UNSET  # internal/external flags not computed yet
+        S.bond = None  # bond constants, filled by the linkable canvas
+        if S.ky is not None:
+            S.LK = np.array((float(self.size_x) * S.kx, float(self.size_y) * S.ky))
         return S
 
     # -- pair-force accumulation -----------------------------------------------------------------
@@ -669,56 +755,67 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         return self._g
 
     def _add_normal(self, f_i, f_j=None):
-        """Add scalar central forces along n_ij: ``f_i`` on i, ``f_j`` (default ``f_i``) on j (reversed)."""
+        """Add scalar central forces along n_ij: ``f_i`` on i, ``f_j`` (default ``f_i``) on j (reversed).
+
+        The first term is kept by reference (terms never modify their results afterwards)."""
         g = self._g
         if f_j is None and g.fn_j is None:
-            g.fn_i += f_i
+            g.fn_i = f_i if g.fn_i is None else g.fn_i + f_i
             return
+        if g.fn_i is None:
+            g.fn_i = np.zeros(g.P)
         if g.fn_j is None:
-            g.fn_j = g.fn_i.copy()
-        g.fn_i += f_i
-        g.fn_j += f_i if f_j is None else f_j
+            g.fn_j = g.fn_i
+        g.fn_i = g.fn_i + f_i
+        g.fn_j = g.fn_j + (f_i if f_j is None else f_j)
 
     def _flush_pair_forces(self):
-        """Apply the collected pair forces to the spheres and put them into the force register."""
+        """Apply the collected pair forces to the spheres and put them into the force register.
+
+        Forces on i and j and the tangential torques go into one (3, 2P) array that a single
+        ``bincount`` adds to the (xforce, yforce, torque) rows of the state block.
+        """
         g = self._g
         if g is None:
             return
-        a = self._a
         n = self._n
-        fn_i = g.fn_i
-        fn_j = fn_i if g.fn_j is None else g.fn_j
-        fix = fn_i * g.nx
-        fiy = fn_i * g.ny
-        if g.fn_j is None:
-            fjx = -fix
-            fjy = -fiy
+        P = g.P
+        S = g.S
+        spin = g.ft is not None
+        W = np.empty((3 if spin else 2, 2 * P))
+        Fi = W[:2, :P]
+        Fj = W[:2, P:]
+        antisymmetric = g.fn_j is None
+        if g.fn_i is None:
+            Fi[...] = 0.0
         else:
-            fjx = -fn_j * g.nx
-            fjy = -fn_j * g.ny
+            np.multiply(g.n, g.fn_i, out=Fi)
+        if spin:
+            # tangential force along t_ij = (−n_y, n_x): F_i += f_t t, F_j −= f_t t
+            Tf = g.n[::-1] * g.ft
+            Tf[0] *= -1.0
+            Fi += Tf
+        if antisymmetric:
+            np.negative(Fi, out=Fj)
+        else:
+            np.multiply(g.n, -g.fn_j, out=Fj)
+            if spin:
+                Fj -= Tf
         ti = tj = None
-        if g.ft is not None:
-            tx = -g.ny * g.ft
-            ty = g.nx * g.ft
-            fix = fix + tx
-            fiy = fiy + ty
-            fjx = fjx - tx
-            fjy = fjy - ty
+        if spin:
             df = g.d * g.ft
-            ri, rj = g.ri, g.rj
-            rs = g.d0
-            ti = df * ri / rs
-            tj = df * rj / rs
-        if g.P:
-            idx = g.idx2
-            a["xforce"] += np.bincount(idx, np.concatenate((fix, fjx)), n)
-            a["yforce"] += np.bincount(idx, np.concatenate((fiy, fjy)), n)
-            if ti is not None:
-                a["torque"] += np.bincount(idx, np.concatenate((ti, tj)), n)
+            ti = np.multiply(df, S.wi, out=W[2, :P])
+            tj = np.multiply(df, S.wj, out=W[2, P:])
+        if P:
+            k = W.shape[0]
+            idx = S.idx6 if k == 3 else S.idx6[:4 * P]
+            self._frc[:k] += np.bincount(idx, W.ravel(), k * n).reshape(k, n)
         self.force_register._set_pairs(self, {
-            "i": g.ai, "j": g.aj, "fix": fix, "fiy": fiy, "fjx": fjx, "fjy": fjy, "ti": ti, "tj": tj,
-            "internal": g.internal, "ext_i": g.ext_i, "ext_j": g.ext_j, "antisymmetric": g.fn_j is None})
-        g.fn_i = np.zeros(g.P)
+            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "fix": Fi[0], "fiy": Fi[1], "fjx": Fj[0], "fjy": Fj[1],
+            "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
+            "ext_j": g.ext_j, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
+            "pos_version": self._pos_version})
+        g.fn_i = None
         g.fn_j = None
         g.ft = None
 
@@ -811,11 +908,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         immobile ones, which gives the mobile spheres exactly the reference kick.
         """
         a = self._a
-        fx, fy, m = a["xforce"], a["yforce"], a["m"]
-        a["xspeed"] += fx * dt / m
-        a["yspeed"] += fy * dt / m
-        fx[:] = 0.0
-        fy[:] = 0.0
+        F = self._frc[:2]
+        kick = F * dt
+        kick /= a["m"]
+        self._vel[:2] += kick
+        F[...] = 0.0
         mob = self._mobile_mask()
         if mob is not None and _nz(mob) != len(mob):
             imm = ~mob
@@ -926,20 +1023,23 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         return out
 
     def _relative_velocity(self, g):
-        """Velocity of j's nearest image relative to i (µm/s), computed once per force phase."""
+        """Velocity of j's nearest image relative to i (µm/s), shape (2, P), computed once per force phase.
+
+        Also keeps the gathered (xspeed, yspeed, omega) of both spheres for the tangential term."""
         if g.rv is None:
-            a = self._a
-            vx, vy = a["xspeed"], a["yspeed"]
-            rvx = vx.take(g.aj) - vx.take(g.ai)
+            vel = self._vel
+            g.Vi = Vi = vel.take(g.ai, axis=1)
+            g.Vj = Vj = vel.take(g.aj, axis=1)
+            rv = Vj[:2] - Vi[:2]
             if g.dvx is not None:
-                rvx = rvx + g.dvx
-            g.rv = (rvx, vy.take(g.aj) - vy.take(g.ai))
+                rv[0] += g.dvx
+            g.rv = rv
         return g.rv
 
     def _normal_speed(self, g):
         if g.vn is None:
-            rvx, rvy = self._relative_velocity(g)
-            g.vn = rvx * g.nx + rvy * g.ny
+            rv = self._relative_velocity(g) * g.n
+            g.vn = rv[0] + rv[1]
         return g.vn
 
     def _viscous_scale(self, g):
@@ -1114,10 +1214,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def _tangential_speed(self, g):
         if g.vt is None:
-            a = self._a
             rvx, rvy = self._relative_velocity(g)
-            om, r = a["omega"], a["r"]
-            g.vt = (rvx * -g.ny + rvy * g.nx) - (r[g.ai] * om[g.ai] + r[g.aj] * om[g.aj])
+            g.vt = (rvx * -g.ny + rvy * g.nx) - (g.ri * g.Vi[2] + g.rj * g.Vj[2])
         return g.vt
 
     def _add_tangential(self, f_pair):
@@ -1142,8 +1240,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
             pt = self._pairs
             pt.state[g.slots] = SLIP
-            pt.xi_ij[g.slots] = 0.0
-            pt.xi_ji[g.slots] = 0.0
+            pt.xi[:, g.slots] = 0.0
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1156,31 +1253,38 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         return g.fel
 
     def _apply_tangential(self, permanent, kt_i, kt_j, nut_i, nut_j, fc):
-        """Run the two-visit kernel on all active pairs and record states, ξ and forces."""
+        """Run the two-visit kernel on all active pairs and record states, ξ and forces.
+
+        ``permanent`` is the bond mask of the active pairs or ``np.False_``; ``fc`` the
+        Coulomb bound of each pair (bonds: ``inf``, i.e. no bound).
+        """
         g = self._g
         pt = self._pairs
         sl = g.slots
         vt = self._tangential_speed(g)
-        xi_ij = pt.xi_ij[sl]
-        xi_ji = pt.xi_ji[sl]
-        touching = g.d < g.d0
-        f1, f2, slip = tangential_two_pass(vt, touching, permanent, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, fc)
-        state = np.where(slip, SLIP, STICK).astype(np.int8)
+        xi = pt.xi.take(sl, axis=1)
+        touching = g.touching
+        if touching is None:
+            touching = g.d < g.d0
+        f1, f2, slip = tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
+        state = slip.view(np.int8)   # SLIP = 1, STICK = 0
         if permanent is not np.False_:
-            state[permanent] = PERMANENT
-        if _nz(touching) != len(touching):
+            state = state + g.S.bond.perm_code
+        n_touch = _nz(touching)
+        if n_touch != len(touching):
             # a transient relation that no longer touches keeps its state and gets no force
-            idle = ~touching & ~permanent
+            idle = ~touching if permanent is np.False_ else ~touching & ~permanent
             if _nz(idle):
-                state[idle] = pt.state[sl][idle]
+                state = np.where(idle, pt.state.take(sl), state).astype(np.int8)
                 f1 = np.where(idle, 0.0, f1)
                 f2 = np.where(idle, 0.0, f2)
-                xi_ij[idle] = pt.xi_ij[sl][idle]
-                xi_ji[idle] = pt.xi_ji[sl][idle]
-        pt.xi_ij[sl] = xi_ij
-        pt.xi_ji[sl] = xi_ji
+                xi = np.where(idle, pt.xi.take(sl, axis=1), xi)
+        pt.xi.reshape(-1)[g.S.slots2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sl]
         pt.state[sl] = state
-        self._add_tangential(f1 / 2 + f2 / 2)
+        g.state = state
+        f = f1 + f2
+        f *= 0.5     # = f1/2 + f2/2 exactly (halving is exact in binary floating point)
+        self._add_tangential(f)
 
     def tangential_force(self):
         """All-pairs variant (reference API)."""
@@ -1192,7 +1296,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self._tangential_terms()
 
     def _torque_total(self):
-        return self._a["torque"].copy()
+        return self._a["torque"]
 
     def do_rotational_acceleration(self, dt):
         a = self._a
@@ -1228,42 +1332,60 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         n_keep = _nz(keep)
         if not n_keep:
             return
-        a = self._a
-        x, y, vx, vy, om = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]
-        vxi, vyi = vx.take(ai), vy.take(ai)
-        rvx = vx.take(aj) - vxi
-        rvy = vy.take(aj) - vyi
-        spin = g.ri * om.take(ai) + g.rj * om.take(aj)
+        P = g.P
+        vel, pos = self._vel, self._pos
+        Vi = vel.take(ai, axis=1)
+        Vj = vel.take(aj, axis=1)
+        rv = Vj[:2] - Vi[:2]
+        rvx, rvy = rv
+        spin = g.ri * Vi[2]
+        spin += g.rj * Vj[2]
+        inc = np.empty((2, P))
         # relation i→j: both spheres still at their old positions (the force-phase geometry)
         ux = rvx if g.dvx is None else rvx + g.dvx
-        inc = ((ux * -ny + rvy * nx) - spin) * dt
-        if n_keep != len(keep):
-            inc *= keep
-        pt.xi_ij[sl] += inc
+        a_ = ux * -ny
+        a_ += rvy * nx
+        np.subtract(a_, spin, out=a_)
+        np.multiply(a_, dt, out=inc[0])
         # relation j→i: i has moved; same image as in the force phase (periods −k, one at a time)
-        rx = (x.take(ai) + vxi * dt) - x.take(aj)
-        ry = (y.take(ai) + vyi * dt) - y.take(aj)
+        R = Vi[:2] * dt
+        R += pos.take(ai, axis=1)
+        R -= pos.take(aj, axis=1)
         Lx, Ly = float(self.size_x), float(self.size_y)
+        dvx = None
         if g.ky is not None:
-            dy = ry + Ly * g.ky
-            dx = (rx + float(self._le_shift()) * g.ky) + Lx * g.kx
-            dvx = (Ly * float(self._shear_rate_for_images())) * g.ky
-        else:
-            dx, dy, dvx = rx, ry, None
-        dm = np.sqrt(dx * dx + dy * dy)
-        if dm.max() >= 0.5 * min(Lx, Ly) and (np.abs(dx).max() >= Lx / 2 or np.abs(dy).max() >= Ly / 2):
+            S = g.S
+            if S.any_y:
+                R[0] += float(self._le_shift()) * g.ky
+                rate = float(self._shear_rate_for_images())
+                if rate:
+                    dvx = (Ly * rate) * g.ky
+            R += S.LK
+        RR = R * R
+        dm = np.sqrt(RR[0] + RR[1])
+        if dm.max() >= 0.5 * min(Lx, Ly) and (np.abs(R[0]).max() >= Lx / 2 or np.abs(R[1]).max() >= Ly / 2):
+            rx = (pos[0].take(ai) + Vi[0] * dt) - pos[0].take(aj)
+            ry = (pos[1].take(ai) + Vi[1] * dt) - pos[1].take(aj)
             dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
-            dm = np.sqrt(dx * dx + dy * dy)
-        if _nz(dm == 0):
-            _, mx, my = pair_geometry(dx, dy, self._rng)
+            R = np.array((dx, dy))
+            RR = R * R
+            dm = np.sqrt(RR[0] + RR[1])
+        if _nz(dm) != P:
+            _, mx, my = pair_geometry(R[0], R[1], self._rng)
         else:
-            mx = dx / dm
-            my = dy / dm
-        svx = -rvx if dvx is None else -rvx + dvx
-        inc = ((svx * -my + -rvy * mx) - spin) * dt
+            mx, my = R / dm
+        # ((−rv_x + dvx)·(−m_y) + (−rv_y)·m_x − spin)·dt, rearranged with exact sign flips only
+        svx = rvx if dvx is None else rvx - dvx
+        b_ = svx * my
+        b_ -= rvy * mx
+        np.subtract(b_, spin, out=inc[1])
+        inc[1] *= dt
         if n_keep != len(keep):
             inc *= keep
-        pt.xi_ji[sl] += inc
+        flat = pt.xi.reshape(-1)
+        s2 = g.S.slots2
+        inc += flat.take(s2).reshape(2, P)
+        flat[s2] = inc.reshape(-1)
 
     def move(self, dt=1):
         a = self._a

@@ -133,34 +133,34 @@ def pair_geometry(dx, dy, rng=None):
     return d, nx, ny
 
 
-def tangential_two_pass(vt, touching, permanent, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, f_coulomb):
-    """Two-visit tangential force of each pair (§2.6-2.7, Appendix B.3).
+def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
+    """Two-visit tangential force of each pair (§2.6-2.8, B.3), transient contacts and bonds alike.
 
-    ``vt`` is the slip velocity, ``kt_*``/``nut_*`` the effective constants of
-    each visit, ``f_coulomb`` the Coulomb bound (ignored for permanent pairs).
-    Updates ``xi_ij``/``xi_ji`` in place (reset on slip) and returns
-    ``(F1, F2, slip2)``: the scalar force of the visit from i and from j (both
-    along t_ij as seen from i) and the final slip flag of transient pairs.
+    ``vt`` is the slip velocity, ``xi`` the (2, P) array of ξ_ij, ξ_ji, ``kt_*``/``nut_*``
+    the effective constants of each visit, ``f_coulomb`` the Coulomb bound (``inf``
+    for permanent pairs, which never slip).  The viscous part acts only on touching
+    pairs.  Updates ``xi`` in place (both histories reset on slip) and returns
+    ``(F1, F2, slip2)``: the scalar force of the visit from i and from j (both along
+    t_ij as seen from i) and the final slip flag.
     """
-    transient = ~permanent
     ftv_i = nut_i * vt
     if _nz(touching) != len(touching):
         ftv_i = np.where(touching, ftv_i, 0.0)
         ftv_j = ftv_i if nut_j is nut_i else np.where(touching, nut_j * vt, 0.0)
     else:
         ftv_j = ftv_i if nut_j is nut_i else nut_j * vt
-    ft1 = ftv_i + kt_i * xi_ij
+    ft1 = kt_i * xi[0]
+    ft1 += ftv_i
     a1 = np.abs(ft1)
-    slip1 = transient & (a1 > f_coulomb)
-    f1 = np.where(transient, np.copysign(np.minimum(a1, f_coulomb), ft1), ft1)
+    slip1 = a1 > f_coulomb
+    f1 = np.copysign(np.minimum(a1, f_coulomb, out=a1), ft1, out=a1)
     if _nz(slip1):
-        xi_ij[slip1] = 0.0
-        xi_ji[slip1] = 0.0
-    ft2 = ftv_j + kt_j * xi_ji
+        np.copyto(xi, 0.0, where=slip1)
+    ft2 = kt_j * xi[1]
+    ft2 += ftv_j
     a2 = np.abs(ft2)
-    slip2 = transient & (a2 > f_coulomb)
-    f2 = np.where(transient, np.copysign(np.minimum(a2, f_coulomb), ft2), ft2)
+    slip2 = a2 > f_coulomb
+    f2 = np.copysign(np.minimum(a2, f_coulomb, out=a2), ft2, out=a2)
     if _nz(slip2):
-        xi_ij[slip2] = 0.0
-        xi_ji[slip2] = 0.0
+        np.copyto(xi, 0.0, where=slip2)
     return f1, f2, slip2

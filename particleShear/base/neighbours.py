@@ -31,8 +31,7 @@ class PairTable:
         self.j = np.zeros(0, dtype=np.intp)
         self.key = np.zeros(0, dtype=np.int64)
         self.state = np.zeros(0, dtype=np.int8)
-        self.xi_ij = np.zeros(0)
-        self.xi_ji = np.zeros(0)
+        self.xi = np.zeros((2, 0))
         self.d_eq = np.zeros(0)
         self.active = np.zeros(0, dtype=bool)
         self.birth = np.zeros(0, dtype=np.int64)
@@ -42,6 +41,16 @@ class PairTable:
 
     def __len__(self):
         return len(self.i)
+
+    @property
+    def xi_ij(self):
+        """ξ of relation i→j (µm), a row view of ``xi`` (both directions gathered in one call)."""
+        return self.xi[0]
+
+    @property
+    def xi_ji(self):
+        """ξ of relation j→i (µm), a row view of ``xi``."""
+        return self.xi[1]
 
     def find(self, i, j):
         """Slots of pairs (i, j) (any order), -1 where absent."""
@@ -77,12 +86,15 @@ class PairTable:
         n = len(k)
         self.i = (k >> 32).astype(np.intp)
         self.j = (k & 0xFFFFFFFF).astype(np.intp)
-        for name, dtype in (("state", np.int8), ("xi_ij", float), ("xi_ji", float), ("d_eq", float),
-                            ("active", bool), ("birth", np.int64)):
+        for name, dtype in (("state", np.int8), ("d_eq", float), ("active", bool), ("birth", np.int64)):
             arr = np.zeros(n, dtype=dtype)
             if len(src):
                 arr[had] = getattr(self, name)[src]
             setattr(self, name, arr)
+        xi = np.zeros((2, n))
+        if len(src):
+            xi[:, had] = self.xi[:, src]
+        self.xi = xi
         self.key = k
         self.version += 1
 

@@ -75,7 +75,9 @@ class RelationView:
 
     @equilibrium_distance.setter
     def equilibrium_distance(self, value):
-        self.__dict__["_ens"]._pairs.d_eq[self._slot()] = value
+        ens = self.__dict__["_ens"]
+        ens._pairs.d_eq[self._slot()] = value
+        ens._links_changed()   # cached bond constants depend on d_eq
 
     def __repr__(self):
         return (f"<relation {self.__dict__['_owner']}->{self.__dict__['_partner']} "

@@ -38,25 +38,43 @@ def _pair_moment(fx, fy, lx, ly):
     return np.dot(G, L.T)
 
 
-def _internal_moment(p, x, y, n_int):
-    """``Σ F_i ⊗ (x_i − x_j)`` (SI) over the internal pairs of a register block with F_j = −F_i."""
-    i, j, fix, fiy = p["i"], p["j"], p["fix"], p["fiy"]
-    if n_int != len(i):
-        w = np.nonzero(p["internal"])[0]
-        i, j, fix, fiy = i.take(w), j.take(w), fix.take(w), fiy.take(w)
-    return _pair_moment(fix, fiy, x.take(i) - x.take(j), y.take(i) - y.take(j))
+def _internal_moment(p, pos, pos_version):
+    """``Σ F_i ⊗ (x_i − x_j)`` (SI) over the internal pairs of an engine register block with F_j = −F_i.
+
+    Internal pairs never act through the boundary, so ``x_i − x_j`` is minus the pair vector of
+    the force phase while no sphere has moved since; otherwise positions are gathered anew.
+    """
+    S = p["S"]
+    F = p["Fi"]
+    if S.w_int is not None:
+        F = F * S.w_int
+    if p["pos_version"] == pos_version:
+        L = p["D"]
+        m = np.dot(F, L.T)
+        m *= -(_CF * _CL)
+    else:
+        L = pos.take(p["i"], axis=1)
+        L -= pos.take(p["j"], axis=1)
+        m = np.dot(F, L.T)
+        m *= _CF * _CL
+    return m
 
 
-def _external_moment(p, x, y, cx, cy):
-    """``Σ F ⊗ (x_target − c)`` (SI) over the external entries of a register block, or None if there are none."""
-    wi = np.nonzero(p["ext_i"])[0]
-    wj = np.nonzero(p["ext_j"])[0]
-    tg = np.concatenate((p["i"].take(wi), p["j"].take(wj)))
-    if not len(tg):
+def _external_moment(p, pos, c):
+    """``Σ F ⊗ (x_target − c)`` (SI) over the external entries of an engine register block, or None."""
+    S = p["S"]
+    if not len(S.ext_slots):
         return None
-    return _pair_moment(np.concatenate((p["fix"].take(wi), p["fjx"].take(wj))),
-                        np.concatenate((p["fiy"].take(wi), p["fjy"].take(wj))),
-                        x.take(tg) - cx, y.take(tg) - cy)
+    if p["antisymmetric"]:
+        F = p["Fi"].take(S.ext_slots, axis=1)
+        F *= S.ext_sign
+    else:
+        F = np.concatenate((p["Fi"].take(S.ext_wi, axis=1), p["Fj"].take(S.ext_wj, axis=1)), axis=1)
+    X = pos.take(S.ext_targets, axis=1)
+    X -= c
+    m = np.dot(F, X.T)
+    m *= _CF * _CL
+    return m
 
 
 def _tensor_property(k):
@@ -242,7 +260,7 @@ class StressTensorEvaluation:
         """Every tensor of §7 and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24)."""
         reg = force_register
         if (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
-                and len(reg._blocks) == 1 and reg._tot is not None and not reg._m_pair and not reg._m_ext
+                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and reg._tot is not None and not reg._m_pair and not reg._m_ext
                 and not reg._m_tot and not reg._m_imom and not reg._m_unb):
             self._evaluate_arrays(reg, theSphereList.mask, shear_rate)
             return
@@ -252,48 +270,56 @@ class StressTensorEvaluation:
         self._t[_ALL] = self._t[_LW] + self._t[_TINT] + self._t[_CEN]
 
     def _evaluate_arrays(self, reg, mobile, shear_rate):
-        """All tensors of one engine force phase in a few array operations (same formulas as above)."""
+        """All tensors of one engine force phase in a few array operations (same formulas as above).
+
+        Sums over mobile spheres are dot products with the mobility mask as weights."""
         t = self._t
-        a = reg._ens._a
-        x, y = a["x"], a["y"]
+        ens = reg._ens
+        a = ens._a
+        pos = ens._pos
         V = self._volume()
-        cx, cy = self.size_x / 2, self.size_y / 2
+        c = np.array(((self.size_x / 2,), (self.size_y / 2,)))
         p = reg._blocks[0]
-        i, j = p["i"], p["j"]
-        internal = p["internal"]
-        n_int = int(np.count_nonzero(internal))
-        if n_int and p.get("antisymmetric", True):
-            t[_LW] = _internal_moment(p, x, y, n_int) / V
+        S = p["S"]
+        n_int = S.n_int
+        if n_int and p["antisymmetric"]:
+            m_ = _internal_moment(p, pos, ens._pos_version)
+            m_ /= V
+            t[_LW] = m_
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
         else:
             t[_LW] = 0.0
-        m_ = _external_moment(p, x, y, cx, cy) if n_int != len(i) else None
-        t[_EXT] = 0.0 if m_ is None else (0.0 - m_) / V
+        m_ = _external_moment(p, pos, c) if n_int != S.P else None
+        if m_ is None:
+            t[_EXT] = 0.0
+        else:
+            m_ /= -V
+            t[_EXT] = m_
         _, fx, fy = reg._tot
-        inertia, omega, m, vx, vy = a["inertia"], a["omega"], a["m"], a["xspeed"], a["yspeed"]
-        xm, ym = x, y
+        F = np.array((fx, fy))
+        X = pos - c
+        wm = a["m"]
+        wI = a["inertia"]
         if mobile is not None:
-            w = np.nonzero(mobile)[0]
-            fx, fy, xm, ym = fx.take(w), fy.take(w), x.take(w), y.take(w)
-            inertia, omega, m, vx, vy = inertia.take(w), omega.take(w), m.take(w), vx.take(w), vy.take(w)
-        G = np.array((fx, fy))
-        G *= _CF
-        X = np.array((xm - cx, ym - cy))
-        X *= _CL
-        unb = np.dot(G, X.T)
-        unb /= V
+            F *= mobile
+            wm = wm * mobile
+            wI = wI * mobile
+        unb = np.dot(F, X.T)
+        unb *= _CF * _CL / V
         t[_UNB] = unb
         t[_LIN] = unb
-        K = float(np.dot(inertia * _CT, omega * omega)) / 2
+        om = a["omega"]
+        K = float(np.dot(wI, om * om)) * (_CT / 2)
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K / V
         cen[0, 1] = cen[1, 0] = 0.0
-        mp = m * 1e-12
-        P = np.array((vx - shear_rate * (ym - self.size_y / 2), vy))
-        P *= mp
-        ot = np.dot(P / (m * 1e-6), P.T)
-        ot /= -V
+        # Otsuki term: −(1/V) Σ m u ⊗ u with u the velocity relative to the affine flow (SI: m·1e-6 kg/m, u·1e-6 m/s)
+        U = ens._vel[:2].copy()
+        if shear_rate:
+            U[0] -= shear_rate * X[1]
+        ot = np.dot(U * wm, U.T)
+        ot *= -1e-18 / V
         t[_OT] = ot
         total = float(reg._mom.sum()) if reg._mom is not None else 0.0
         s_ = total * _CT / V
@@ -301,13 +327,7 @@ class StressTensorEvaluation:
         tq[0, 0] = tq[1, 1] = 0.0
         tq[0, 1] = -s_ / 2
         tq[1, 0] = s_ / 2
-        if p.get("ti") is not None and n_int:
-            if n_int == len(i):
-                tint = float(p["ti"].sum() + p["tj"].sum())
-            else:
-                tint = float(np.dot(internal, p["ti"] + p["tj"]))
-        else:
-            tint = 0.0
+        tint = self._internal_torque(p) if n_int else 0.0
         s_ = tint * _CT / V
         ti = t[_TINT]
         ti[0, 0] = ti[1, 1] = 0.0
@@ -315,6 +335,17 @@ class StressTensorEvaluation:
         ti[1, 0] = s_ / 2
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
+
+    @staticmethod
+    def _internal_torque(p):
+        """Σ (t_i + t_j) over the internal pairs of an engine register block (internal units)."""
+        T = p.get("T")
+        if T is None:
+            return 0.0
+        S = p["S"]
+        if S.w_int is None:
+            return float(T.sum())
+        return float(np.dot(S.w_int, p["ti"]) + np.dot(S.w_int, p["tj"]))
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
         """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).
@@ -325,35 +356,33 @@ class StressTensorEvaluation:
         """
         reg = force_register
         if not (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
-                and len(reg._blocks) == 1 and not reg._m_pair and not reg._m_ext and not reg._m_imom):
+                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and not reg._m_pair and not reg._m_ext
+                and not reg._m_imom):
             self.evaluate_stress_tensors(force_register, theSphereList, 0)
             return self.evaluate_quasistatic_shear_stress(), self.evaluate_externally_applied_shear_stress()
         t = self._t
-        a = reg._ens._a
-        x, y = a["x"], a["y"]
+        ens = reg._ens
+        pos = ens._pos
         V = self._volume()
         p = reg._blocks[0]
-        i, j = p["i"], p["j"]
-        internal = p["internal"]
-        n_int = int(np.count_nonzero(internal))
+        S = p["S"]
+        n_int = S.n_int
         lw01 = 0.0
         if n_int:
-            if not p.get("antisymmetric", True):
+            if not p["antisymmetric"]:
                 self.evaluate_force_stress_tensors(reg)
                 lw01 = t[_LW, 0, 1]
             else:
-                lw01 = (_internal_moment(p, x, y, n_int) / V)[0, 1]
+                m_ = _internal_moment(p, pos, ens._pos_version)
+                m_ /= V
+                lw01 = m_[0, 1]
         ext01 = 0.0
-        if n_int != len(i):
-            m_ = _external_moment(p, x, y, self.size_x / 2, self.size_y / 2)
+        if n_int != S.P:
+            m_ = _external_moment(p, pos, np.array(((self.size_x / 2,), (self.size_y / 2,))))
             if m_ is not None:
-                ext01 = ((0.0 - m_) / V)[0, 1]
-        tint = 0.0
-        if p.get("ti") is not None and n_int:
-            if n_int == len(i):
-                tint = float(p["ti"].sum() + p["tj"].sum())
-            else:
-                tint = float(np.dot(internal, p["ti"] + p["tj"]))
+                m_ /= -V
+                ext01 = m_[0, 1]
+        tint = self._internal_torque(p) if n_int else 0.0
         s_ = tint * _CT / V
         t[_LW, 0, 1] = lw01
         t[_EXT, 0, 1] = ext01

@@ -23,6 +23,11 @@ _nz = np.count_nonzero  # number of True entries; faster than ndarray.any() on s
 __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 
+class _BondStructure:
+    """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf")
+
+
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
     """Friction canvas whose relations can be made permanent (crosslinks)."""
 
@@ -127,24 +132,37 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self.cutLine((0, self.size_y), math.pi / 2)
 
     # -- bond forces -------------------------------------------------------------------------------
+    def _bond_structure(self, g):
+        """Per-active-pair bond constants, kept while the relations and bonds stay the same."""
+        S = g.S
+        B = S.bond
+        if B is None:
+            B = S.bond = _BondStructure()
+            perm = S.perm
+            B.deq = deq = self._pairs.d_eq.take(S.slots)
+            B.d0 = np.where(perm, deq, S.d0)               # contact distance of the central law
+            B.deq_stretch = np.where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
+            B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
+            B.fc_inf = np.where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
+        return B
+
     def _elastic_terms(self):
         """Transient contacts as in the parent; bonds: law below ``d_eq``, tensile law above, × ratio."""
         g = self._g
         if g.perm is None:
             CanvasPointsFrictionElasticityLeesEdwards._elastic_terms(self)
             return
+        B = self._bond_structure(g)
         perm = g.perm
-        deq = self._pairs.d_eq[g.slots]
-        d0 = np.where(perm, deq, g.d0)
         c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
-        tensile = SphereLinkable.call_back_elastic_force_law_tensile
-        stretched = perm & (g.d >= deq)
-        f_i = call_law_vectorised(law, g.d, d0, self.k, c_i)
+        f_i = call_law_vectorised(law, g.d, B.d0, self.k, c_i)
         g.fel = f_i
-        f_j = f_i if c_j is c_i else call_law_vectorised(law, g.d, d0, self.k, c_j)
+        f_j = f_i if c_j is c_i else call_law_vectorised(law, g.d, B.d0, self.k, c_j)
+        stretched = g.d >= B.deq_stretch
         if _nz(stretched):
-            f_t = call_law_vectorised(tensile, g.d, deq, self.k)
+            tensile = SphereLinkable.call_back_elastic_force_law_tensile
+            f_t = call_law_vectorised(tensile, g.d, B.deq, self.k)
             f_i = np.where(stretched, f_t, f_i)
             f_j = f_i if c_j is c_i else np.where(stretched, f_t, f_j)
         rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
@@ -159,18 +177,23 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         if g.perm is None:
             CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
             return
+        B = self._bond_structure(g)
         perm = g.perm
         rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
         nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
         kt, nut = self.k_t, self.nu_t
-        kt_i = np.where(perm, kt * rt_i, kt)
-        kt_j = kt_i if rt_j is rt_i else np.where(perm, kt * rt_j, kt)
+        if rt_i is rt_j and type(rt_i) is float and kt * rt_i == kt:
+            kt_i = kt_j = kt
+        else:
+            kt_i = np.where(perm, kt * rt_i, kt)
+            kt_j = kt_i if rt_j is rt_i else np.where(perm, kt * rt_j, kt)
         if nv_i is nv_j and nv_i == 1.0:
             nut_i = nut_j = nut
         else:
             nut_i = np.where(perm, nut * nv_i, nut)
             nut_j = np.where(perm, nut * nv_j, nut)
         fc = np.abs(self.mu * self._coulomb_law(g))
+        fc += B.fc_inf
         self._apply_tangential(perm, kt_i, kt_j, nut_i, nut_j, fc)
 
     def _visc_ratio(self, g, ratio_name):
