@@ -22,6 +22,7 @@ import numpy as np
 
 from .graphics import Graphical_output_configuration
 from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
@@ -98,11 +99,14 @@ class SphereList(list):
 
 
 _UNSET = object()
+_ROT = np.array(((-1.0,), (1.0,)))
+#: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
+_ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "slots", "slots2", "ai", "aj", "d0", "ri", "rj", "wi", "wj", "idx2", "idx6", "ky", "kx", "any_y",
+    __slots__ = ("token", "safe_images", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
                  "LK", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
@@ -114,7 +118,7 @@ class _Flags:
 
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
-    __slots__ = ("S", "slots", "ai", "aj", "D", "n", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
+    __slots__ = ("S", "slots", "active", "ai", "aj", "D", "n", "t", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
                  "touching", "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv",
                  "ky", "kx", "ri", "rj", "idx2", "state", "Vi", "Vj")
 
@@ -620,32 +624,34 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             pt.active = new_active
         S = self._struct
         token = (key, self._images_token)
-        if changed or S is None or S.token != token:
-            S = self._active_structure(new_active, d0, perm, ky, kx, D0, D, d, cached_images)
+        if S is None or S.token != token:
+            S = self._pair_structure(d0, perm, ky, kx, D0, D, d, cached_images)
             S.token = token
             self._struct = S
-        sel = S.slots
+        # every force term runs over all candidate pairs: inactive ones get exactly zero force
+        # (ξ = 0, law = 0 beyond contact, viscous terms masked), so nothing is gathered per step
         g = _Geometry()
         g.S = S
-        g.slots = sel
+        g.slots = slice(None)
         g.ai = S.ai
         g.aj = S.aj
-        g.P = P = len(sel)
-        gD = D.take(sel, axis=1)
-        gd = d.take(sel)
-        if _nz(gd) != P:
-            gd, nx, ny = pair_geometry(gD[0], gD[1], self._rng)
+        g.P = C
+        g.active = new_active
+        g.touching = touching
+        if _nz(d) != C:
+            d, nx, ny = pair_geometry(D[0], D[1], self._rng)
             g.n = np.array((nx, ny))
         else:
-            g.n = gD / gd
-        g.D = gD
-        g.d = gd
-        g.dx, g.dy = gD
+            g.n = D / d
+        g.t = g.n[::-1] * _ROT   # t_ij = (−n_y, n_x)
+        g.D = D
+        g.d = d
+        g.dx, g.dy = D
         g.nx, g.ny = g.n
         g.ky = S.ky
         g.kx = S.kx
         if dvx is not None:
-            g.dvx = dvx.take(sel)
+            g.dvx = dvx
         elif dvx_rate and S.any_y:
             g.dvx = -(float(Ly) * dvx_rate) * S.ky
         else:
@@ -653,7 +659,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.d0 = S.d0
         g.perm = S.perm
         g.trans = S.trans
-        g.touching = touching.take(sel) if perm is not None else None
         mob = self._mobile_mask()
         if S.mob is not mob:
             if S.mob is _UNSET or mob is None or S.mob is None or _nz(mob != S.mob):
@@ -702,50 +707,46 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.ext_targets = np.concatenate((S.ai.take(wi), S.aj.take(wj)))
         F.ext_sign = np.concatenate((np.ones(len(wi)), -np.ones(len(wj))))
 
-    def _active_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
-        """Per-active-pair data that change only when the set of relations, bonds or images change."""
+    def _pair_structure(self, d0, perm, ky, kx, D0, D, d, cached_images):
+        """Per-candidate-pair data that change only when the candidates, bonds or images change."""
         pt = self._pairs
         r = self._a["r"]
         n = self._n
         S = _Structure()
-        sel = np.nonzero(active)[0]
-        S.slots = sel
-        S.slots2 = np.concatenate((sel, sel + len(pt.i)))   # flat slots of (ξ_ij, ξ_ji) in the (2, C) table
-        S.ai = pt.i.take(sel)
-        S.aj = pt.j.take(sel)
-        S.d0 = d0.take(sel)
+        S.ai = pt.i
+        S.aj = pt.j
+        S.d0 = d0
         S.ri = r.take(S.ai)
         S.rj = r.take(S.aj)
-        S.wi = S.ri / S.d0   # torque lever fractions r_i/(r_i + r_j), r_j/(r_i + r_j) of eq. S1-3
-        S.wj = S.rj / S.d0
+        S.w2 = np.array((S.ri, S.rj)) / S.d0   # torque lever fractions r_i/(r_i + r_j), r_j/(r_i + r_j) (S1-3)
         S.idx2 = np.concatenate((S.ai, S.aj))
         # flat bincount index of (x, y, torque) rows: one call accumulates every pair force on the spheres
         S.idx6 = np.concatenate((S.idx2, S.idx2 + n, S.idx2 + 2 * n))
-        S.ky = None if ky is None else ky.take(sel)
-        S.kx = None if kx is None else kx.take(sel)
-        S.any_y = S.ky is not None and bool(_nz(S.ky))
-        if perm is None:
+        S.ky = ky
+        S.kx = kx
+        S.any_y = ky is not None and bool(_nz(ky))
+        if perm is None or not _nz(perm):
             S.perm = S.trans = None
         else:
-            S.perm = perm.take(sel)
-            S.trans = ~S.perm
-            if not _nz(S.perm):
-                S.perm = S.trans = None
+            S.perm = perm
+            S.trans = ~perm
         # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5);
         # with cached images the cell is much larger than a contact, so any period applied means that
-        if S.ky is None:
-            shifted = (D.take(sel, axis=1) != D0.take(sel, axis=1)).any(axis=0)
+        if ky is None:
+            shifted = (D != D0).any(axis=0)
         else:
-            shifted = (S.ky != 0) | (S.kx != 0)
+            shifted = (ky != 0) | (kx != 0)
         if not cached_images and _nz(shifted):
-            w = sel[np.nonzero(shifted)[0]]
+            w = np.nonzero(shifted)[0]
             rx, ry = D0[0].take(w), D0[1].take(w)
-            shifted[np.nonzero(shifted)[0]] = np.sqrt(rx * rx + ry * ry) != d.take(w)
+            shifted[w] = np.sqrt(rx * rx + ry * ry) != d.take(w)
         S.shifted = shifted
         S.mob = _UNSET  # internal/external flags not computed yet
         S.bond = None  # bond constants, filled by the linkable canvas
-        if S.ky is not None:
-            S.LK = np.array((float(self.size_x) * S.kx, float(self.size_y) * S.ky))
+        if ky is not None:
+            S.LK = np.array((float(self.size_x) * kx, float(self.size_y) * ky))
+        # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
+        S.safe_images = bool(self._images_valid)
         return S
 
     # -- pair-force accumulation -----------------------------------------------------------------
@@ -792,8 +793,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             np.multiply(g.n, g.fn_i, out=Fi)
         if spin:
             # tangential force along t_ij = (−n_y, n_x): F_i += f_t t, F_j −= f_t t
-            Tf = g.n[::-1] * g.ft
-            Tf[0] *= -1.0
+            Tf = g.t * g.ft
             Fi += Tf
         if antisymmetric:
             np.negative(Fi, out=Fj)
@@ -804,8 +804,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         ti = tj = None
         if spin:
             df = g.d * g.ft
-            ti = np.multiply(df, S.wi, out=W[2, :P])
-            tj = np.multiply(df, S.wj, out=W[2, P:])
+            Wt = W[2].reshape(2, P)
+            np.multiply(df, S.w2, out=Wt)
+            ti, tj = Wt
         if P:
             k = W.shape[0]
             idx = S.idx6 if k == 3 else S.idx6[:4 * P]
@@ -813,7 +814,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self.force_register._set_pairs(self, {
             "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "fix": Fi[0], "fiy": Fi[1], "fjx": Fj[0], "fjy": Fj[1],
             "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
-            "ext_j": g.ext_j, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
+            "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
             "pos_version": self._pos_version})
         g.fn_i = None
         g.fn_j = None
@@ -991,6 +992,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _law(self, d, d0, k, c):
         return call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, d, d0, k, c)
 
+    def _mask_law(self, f):
+        """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
+        if CircleBasicElasticity.call_back_elastic_force_law in _ZERO_BEYOND_CONTACT:
+            return f
+        return f * self._g.active
+
     def elastic_force_from_neighbors(self):
         """Central elastic force of every relation (§2.4-2.5)."""
         self._geometry()
@@ -1004,15 +1011,15 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             tr = g.trans
             c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
             if tr is None:
-                f_i = self._law(g.d, g.d0, self.k, c_i)
-                f_j = None if c_j is c_i else self._law(g.d, g.d0, self.k, c_j)
+                f_i = self._mask_law(self._law(g.d, g.d0, self.k, c_i))
+                f_j = None if c_j is c_i else self._mask_law(self._law(g.d, g.d0, self.k, c_j))
                 g.fel = f_i
             else:
                 d, d0 = g.d[tr], g.d0[tr]
                 if type(c_i) is not float:
                     c_i, c_j = c_i[tr], c_j[tr]
-                f_i = self._scatter(self._law(d, d0, self.k, c_i), tr, g.P)
-                f_j = None if c_j is c_i else self._scatter(self._law(d, d0, self.k, c_j), tr, g.P)
+                f_i = self._mask_law(self._scatter(self._law(d, d0, self.k, c_i), tr, g.P))
+                f_j = None if c_j is c_i else self._mask_law(self._scatter(self._law(d, d0, self.k, c_j), tr, g.P))
                 g.fel = f_i
             self._add_normal(f_i, f_j)
 
@@ -1056,6 +1063,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         g = self._g
         if g.P and self.nu != 0:
             f = self.nu * self._normal_speed(g)
+            f *= g.active   # relations only (×1.0 is exact)
             scale = self._viscous_scale(g)
             if scale is None:
                 self._add_normal(f)
@@ -1214,8 +1222,12 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def _tangential_speed(self, g):
         if g.vt is None:
-            rvx, rvy = self._relative_velocity(g)
-            g.vt = (rvx * -g.ny + rvy * g.nx) - (g.ri * g.Vi[2] + g.rj * g.Vj[2])
+            w = self._relative_velocity(g) * g.t
+            spin = g.ri * g.Vi[2]
+            spin += g.rj * g.Vj[2]
+            vt = w[0] + w[1]
+            vt -= spin
+            g.vt = vt
         return g.vt
 
     def _add_tangential(self, f_pair):
@@ -1239,8 +1251,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if not self._tangential_needed():
             # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
             pt = self._pairs
-            pt.state[g.slots] = SLIP
-            pt.xi[:, g.slots] = 0.0
+            pt.state[g.active] = SLIP
+            pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1249,41 +1261,26 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         """Elastic central law of each transient contact (cached from the elastic term)."""
         if getattr(g, "fel", None) is None:
             c_i = self._pair_param("central_repulsion_coefficient", g)[0]
-            return self._law(g.d, g.d0, self.k, c_i)
+            return self._mask_law(self._law(g.d, g.d0, self.k, c_i))
         return g.fel
 
     def _apply_tangential(self, permanent, kt_i, kt_j, nut_i, nut_j, fc):
-        """Run the two-visit kernel on all active pairs and record states, ξ and forces.
+        """Run the two-visit kernel on all candidate pairs and record states, ξ and forces.
 
-        ``permanent`` is the bond mask of the active pairs or ``np.False_``; ``fc`` the
-        Coulomb bound of each pair (bonds: ``inf``, i.e. no bound).
+        ``permanent`` is the bond mask or ``np.False_``; ``fc`` the Coulomb bound of each
+        pair (bonds: ``inf``, i.e. no bound).  Inactive candidates have ξ = 0, no viscous
+        part and a zero bound, so they get exactly zero force and stay in the stick state.
         """
         g = self._g
         pt = self._pairs
-        sl = g.slots
         vt = self._tangential_speed(g)
-        xi = pt.xi.take(sl, axis=1)
-        touching = g.touching
-        if touching is None:
-            touching = g.d < g.d0
-        f1, f2, slip = tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
+        F, slip = tangential_two_pass(vt, g.touching, pt.xi, kt_i, kt_j, nut_i, nut_j, fc)
         state = slip.view(np.int8)   # SLIP = 1, STICK = 0
         if permanent is not np.False_:
             state = state + g.S.bond.perm_code
-        n_touch = _nz(touching)
-        if n_touch != len(touching):
-            # a transient relation that no longer touches keeps its state and gets no force
-            idle = ~touching if permanent is np.False_ else ~touching & ~permanent
-            if _nz(idle):
-                state = np.where(idle, pt.state.take(sl), state).astype(np.int8)
-                f1 = np.where(idle, 0.0, f1)
-                f2 = np.where(idle, 0.0, f2)
-                xi = np.where(idle, pt.xi.take(sl, axis=1), xi)
-        pt.xi.reshape(-1)[g.S.slots2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sl]
-        pt.state[sl] = state
-        g.state = state
-        f = f1 + f2
-        f *= 0.5     # = f1/2 + f2/2 exactly (halving is exact in binary floating point)
+        pt.state[...] = state
+        f = F[0] + F[1]
+        f *= 0.5     # = F1/2 + F2/2 exactly (halving is exact in binary floating point)
         self._add_tangential(f)
 
     def tangential_force(self):
@@ -1327,65 +1324,57 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if g is None or not g.P:
             return
         pt = self._pairs
-        sl, ai, aj, nx, ny = g.slots, g.ai, g.aj, g.nx, g.ny
-        keep = pt.state.take(sl) != SLIP
+        keep = pt.state != SLIP
+        keep &= g.active
         n_keep = _nz(keep)
         if not n_keep:
             return
         P = g.P
-        vel, pos = self._vel, self._pos
-        Vi = vel.take(ai, axis=1)
-        Vj = vel.take(aj, axis=1)
+        vel = self._vel
+        Vi = vel.take(g.ai, axis=1)
+        Vj = vel.take(g.aj, axis=1)
         rv = Vj[:2] - Vi[:2]
-        rvx, rvy = rv
         spin = g.ri * Vi[2]
         spin += g.rj * Vj[2]
         inc = np.empty((2, P))
-        # relation i→j: both spheres still at their old positions (the force-phase geometry)
-        ux = rvx if g.dvx is None else rvx + g.dvx
-        a_ = ux * -ny
-        a_ += rvy * nx
-        np.subtract(a_, spin, out=a_)
-        np.multiply(a_, dt, out=inc[0])
-        # relation j→i: i has moved; same image as in the force phase (periods −k, one at a time)
+        # relation i→j: both spheres still at their old positions (the force-phase geometry);
+        # relation j→i sees the image from the other side, i.e. the velocity −(rv_x + dvx, rv_y)
+        if g.dvx is not None:
+            rv[0] += g.dvx
+        svx = rv[0]
+        w = rv * g.t
+        np.add(w[0], w[1], out=inc[0])
+        # relation j→i: i has moved by v_i·dt; the pair vector is −(x_j − x_i) of the force phase
+        # plus that move (same image, the cell being much larger than any candidate pair)
         R = Vi[:2] * dt
-        R += pos.take(ai, axis=1)
-        R -= pos.take(aj, axis=1)
-        Lx, Ly = float(self.size_x), float(self.size_y)
-        dvx = None
-        if g.ky is not None:
-            S = g.S
-            if S.any_y:
-                R[0] += float(self._le_shift()) * g.ky
-                rate = float(self._shear_rate_for_images())
-                if rate:
-                    dvx = (Ly * rate) * g.ky
-            R += S.LK
+        R -= g.D
         RR = R * R
         dm = np.sqrt(RR[0] + RR[1])
-        if dm.max() >= 0.5 * min(Lx, Ly) and (np.abs(R[0]).max() >= Lx / 2 or np.abs(R[1]).max() >= Ly / 2):
-            rx = (pos[0].take(ai) + Vi[0] * dt) - pos[0].take(aj)
-            ry = (pos[1].take(ai) + Vi[1] * dt) - pos[1].take(aj)
-            dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
-            R = np.array((dx, dy))
-            RR = R * R
-            dm = np.sqrt(RR[0] + RR[1])
+        if not g.S.safe_images:
+            Lx, Ly = float(self.size_x), float(self.size_y)
+            if np.abs(R[0]).max() >= Lx / 2 or np.abs(R[1]).max() >= Ly / 2:
+                rx = (self._pos[0].take(g.ai) + Vi[0] * dt) - self._pos[0].take(g.aj)
+                ry = (self._pos[1].take(g.ai) + Vi[1] * dt) - self._pos[1].take(g.aj)
+                dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+                R = np.array((dx, dy))
+                svx = Vj[0] - Vi[0]
+                if dvx is not None:
+                    svx = svx - dvx
+                RR = R * R
+                dm = np.sqrt(RR[0] + RR[1])
         if _nz(dm) != P:
             _, mx, my = pair_geometry(R[0], R[1], self._rng)
         else:
             mx, my = R / dm
-        # ((−rv_x + dvx)·(−m_y) + (−rv_y)·m_x − spin)·dt, rearranged with exact sign flips only
-        svx = rvx if dvx is None else rvx - dvx
+        # ((−svx)·(−m_y) + (−rv_y)·m_x − spin) = (svx·m_y − rv_y·m_x) − spin, exact sign flips only
         b_ = svx * my
-        b_ -= rvy * mx
-        np.subtract(b_, spin, out=inc[1])
-        inc[1] *= dt
+        b_ -= rv[1] * mx
+        inc[1] = b_
+        inc -= spin
+        inc *= dt
         if n_keep != len(keep):
             inc *= keep
-        flat = pt.xi.reshape(-1)
-        s2 = g.S.slots2
-        inc += flat.take(s2).reshape(2, P)
-        flat[s2] = inc.reshape(-1)
+        pt.xi += inc
 
     def move(self, dt=1):
         a = self._a

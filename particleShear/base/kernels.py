@@ -139,28 +139,42 @@ def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
     ``vt`` is the slip velocity, ``xi`` the (2, P) array of ξ_ij, ξ_ji, ``kt_*``/``nut_*``
     the effective constants of each visit, ``f_coulomb`` the Coulomb bound (``inf``
     for permanent pairs, which never slip).  The viscous part acts only on touching
-    pairs.  Updates ``xi`` in place (both histories reset on slip) and returns
-    ``(F1, F2, slip2)``: the scalar force of the visit from i and from j (both along
+    pairs.  Visit 1 (from i) sees ξ_ij; visit 2 (from j) sees ξ_ji, reset to 0 if
+    visit 1 slipped; a slip in either visit resets both histories.  Both visits are
+    evaluated as the two rows of one (2, P) array.  Updates ``xi`` in place and
+    returns ``(F, slip2)``: the scalar forces of the two visits (rows, both along
     t_ij as seen from i) and the final slip flag.
     """
     ftv_i = nut_i * vt
-    if _nz(touching) != len(touching):
+    all_touch = _nz(touching) == len(touching)
+    if not all_touch:
         ftv_i = np.where(touching, ftv_i, 0.0)
-        ftv_j = ftv_i if nut_j is nut_i else np.where(touching, nut_j * vt, 0.0)
+    if nut_j is nut_i:
+        ftv_j = ftv_i
     else:
-        ftv_j = ftv_i if nut_j is nut_i else nut_j * vt
-    ft1 = kt_i * xi[0]
-    ft1 += ftv_i
-    a1 = np.abs(ft1)
-    slip1 = a1 > f_coulomb
-    f1 = np.copysign(np.minimum(a1, f_coulomb, out=a1), ft1, out=a1)
+        ftv_j = nut_j * vt if all_touch else np.where(touching, nut_j * vt, 0.0)
+    if kt_j is kt_i:
+        ft = kt_i * xi
+    else:
+        ft = np.empty_like(xi)
+        np.multiply(kt_i, xi[0], out=ft[0])
+        np.multiply(kt_j, xi[1], out=ft[1])
+    if ftv_j is ftv_i:
+        ft += ftv_i
+    else:
+        ft[0] += ftv_i
+        ft[1] += ftv_j
+    a = np.abs(ft)
+    slip1 = a[0] > f_coulomb
     if _nz(slip1):
-        np.copyto(xi, 0.0, where=slip1)
-    ft2 = kt_j * xi[1]
-    ft2 += ftv_j
-    a2 = np.abs(ft2)
-    slip2 = a2 > f_coulomb
-    f2 = np.copysign(np.minimum(a2, f_coulomb, out=a2), ft2, out=a2)
-    if _nz(slip2):
+        # visit 2 sees ξ_ji = 0 after a slip in visit 1
+        np.copyto(ft[1], ftv_j, where=slip1)
+        np.abs(ft[1], out=a[1])
+    slip2 = a[1] > f_coulomb
+    F = np.copysign(np.minimum(a, f_coulomb, out=a), ft, out=a)
+    if _nz(slip1):
+        slip2_or_1 = slip1 | slip2
+        np.copyto(xi, 0.0, where=slip2_or_1)
+    elif _nz(slip2):
         np.copyto(xi, 0.0, where=slip2)
-    return f1, f2, slip2
+    return F, slip2

@@ -11,6 +11,13 @@ import numpy as np
 __all__ = ["Force_register", "SphereSelection"]
 
 
+def _live(p, flag):
+    """Entries of a register block with ``flag`` set that are relations (engine blocks span all candidates)."""
+    m = p[flag]
+    active = p.get("active")
+    return m if active is None else m & active
+
+
 class SphereSelection:
     """A list-like selection of an ensemble's spheres by boolean mask (no Python loop to build)."""
 
@@ -93,7 +100,7 @@ class Force_register:
         out = []
         for p in self._blocks:
             sl = self._spheres()
-            for k in np.flatnonzero(p["internal"]):
+            for k in np.flatnonzero(_live(p, "internal")):
                 i, j = int(p["i"][k]), int(p["j"][k])
                 out.append([sl[i], sl[j], [float(p["fix"][k]), float(p["fiy"][k])]])
                 out.append([sl[j], sl[i], [float(p["fjx"][k]), float(p["fjy"][k])]])
@@ -104,7 +111,7 @@ class Force_register:
         out = []
         for p in self._blocks:
             sl = self._spheres()
-            for k in np.flatnonzero(p["ext_i"] | p["ext_j"]):
+            for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
                 i, j = int(p["i"][k]), int(p["j"][k])
                 if p["ext_i"][k]:
                     out.append([sl[i], [float(p["fix"][k]), float(p["fiy"][k])]])
@@ -119,12 +126,12 @@ class Force_register:
                 continue
             sl = self._spheres()
             if which == "internal":
-                for k in np.flatnonzero(p["internal"]):
+                for k in np.flatnonzero(_live(p, "internal")):
                     i, j = int(p["i"][k]), int(p["j"][k])
                     out.append([sl[i], sl[j], float(p["ti"][k])])
                     out.append([sl[j], sl[i], float(p["tj"][k])])
             else:
-                for k in np.flatnonzero(p["ext_i"] | p["ext_j"]):
+                for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
                     i, j = int(p["i"][k]), int(p["j"][k])
                     if p["ext_i"][k]:
                         out.append([sl[i], float(p["ti"][k])])

@@ -139,7 +139,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         if B is None:
             B = S.bond = _BondStructure()
             perm = S.perm
-            B.deq = deq = self._pairs.d_eq.take(S.slots)
+            B.deq = deq = self._pairs.d_eq.copy()
             B.d0 = np.where(perm, deq, S.d0)               # contact distance of the central law
             B.deq_stretch = np.where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
@@ -156,9 +156,9 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         perm = g.perm
         c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
-        f_i = call_law_vectorised(law, g.d, B.d0, self.k, c_i)
+        f_i = self._mask_law(call_law_vectorised(law, g.d, B.d0, self.k, c_i))
         g.fel = f_i
-        f_j = f_i if c_j is c_i else call_law_vectorised(law, g.d, B.d0, self.k, c_j)
+        f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, self.k, c_j))
         stretched = g.d >= B.deq_stretch
         if _nz(stretched):
             tensile = SphereLinkable.call_back_elastic_force_law_tensile
