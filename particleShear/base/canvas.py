@@ -99,6 +99,8 @@ class SphereList(list):
 
 
 _UNSET = object()
+#: rows of the state block dividing (xforce, yforce, torque) in the kick: m, m, inertia
+_KICK_ROWS = np.array((_ROW["m"], _ROW["m"], _ROW["inertia"]))
 _ROT = np.array(((-1.0,), (1.0,)))
 #: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
 _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
@@ -339,8 +341,14 @@ class CanvasPoints:
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
         a = self._a
-        if le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
-                   getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0):
+        if self._n:
+            lo = self._pos.min(axis=1)
+            hi = self._pos.max(axis=1)
+            inside = lo[0] >= 0 and lo[1] >= 0 and hi[0] < self.size_x and hi[1] < self.size_y
+        else:
+            inside = True
+        if not inside and le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
+                                  getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0):
             self._images_valid = False
         self._pos_version += 1
         self._in_cell = True
@@ -416,7 +424,7 @@ class CanvasPointsMass(CanvasPoints):
         """Store the accumulated force of every mobile sphere (and torques, where spin exists)."""
         tot = self._frc.copy()
         self.force_register._set_totals(self, self._mobile_mask(), tot[0], tot[1],
-                                        tot[2] if self._torque_total() is not None else None)
+                                        tot[2] if self._torque_total() is not None else None, tot)
 
     def particle_info(self):
         return "Spheres with mass"
@@ -914,6 +922,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         kick /= a["m"]
         self._vel[:2] += kick
         F[...] = 0.0
+        self._plates_follow()
+
+    def _plates_follow(self):
+        """Immobile (plate) spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity (§4.6)."""
+        a = self._a
         mob = self._mobile_mask()
         if mob is not None and _nz(mob) != len(mob):
             imm = ~mob
@@ -1308,9 +1321,33 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if self.integrator != "euler":
             self._store_half_kick(dt)
         self._last_dt = dt
-        self.do_linear_acceleration(dt)
-        self.do_rotational_acceleration(dt)
+        cls = type(self)
+        if (cls.do_linear_acceleration is CanvasPointsShear.do_linear_acceleration
+                and cls.do_rotational_acceleration is CanvasPointsFrictionElasticityLeesEdwards.do_rotational_acceleration):
+            # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
+            kick = self._frc * dt
+            kick /= self._st.take(_KICK_ROWS, axis=0)
+            self._vel += kick
+            self._frc[...] = 0.0
+            self._plates_follow()
+        else:
+            self.do_linear_acceleration(dt)
+            self.do_rotational_acceleration(dt)
         self.cool(cool_factor)
+
+    def cool(self, f=0.8):
+        """Damp velocity relative to the affine flow and spin by ``f`` (§4.4), all three rows at once."""
+        if type(self)._cool_spin is not CanvasPointsFrictionElasticityLeesEdwards._cool_spin:
+            return CanvasPointsBasicElasticityLeesEdwards.cool(self, f)
+        V = self._vel
+        rate = getattr(self, "shear_rate", 0)
+        if rate:
+            u = (self._pos[1] - self.size_y / 2) * rate
+            V[0] -= u
+            V *= f
+            V[0] += u       # u + (v_x − u)·f
+        else:
+            V *= f
 
     def _integrate_xi(self, dt):
         """Sequential ξ rule of the reference, without a Python loop (§2.10, B.2).

@@ -53,6 +53,7 @@ class Force_register:
         self._ens = None
         self._blocks = []
         self._tot = None
+        self._tot_block = None
         self._mom = None
         self._m_pair = []
         self._m_ext = []
@@ -67,9 +68,10 @@ class Force_register:
         self._ens = ensemble
         self._blocks.append(pair)
 
-    def _set_totals(self, ensemble, mobile, fx, fy, torque):
+    def _set_totals(self, ensemble, mobile, fx, fy, torque, block=None):
         self._ens = ensemble
         self._tot = (mobile, fx, fy)
+        self._tot_block = np.array((fx, fy)) if block is None else block
         self._mom = torque
 
     # -- manual API (reference signatures) ----------------------------------------------------

@@ -24,6 +24,9 @@ TENSOR_NAMES = (
 )
 (_LW, _OT, _EXT, _LIN, _UNB, _TQ, _TINT, _CEN, _ALL) = range(9)
 
+#: rows (m, m, inertia) of the ensemble state block: weights of (u_x, u_y, ω) in the kinetic tensors
+_MMI_ROWS = np.array((7, 7, 8))
+
 _CF = 1e-12
 _CL = 1e-6
 _CT = 1e-18
@@ -272,10 +275,11 @@ class StressTensorEvaluation:
     def _evaluate_arrays(self, reg, mobile, shear_rate):
         """All tensors of one engine force phase in a few array operations (same formulas as above).
 
-        Sums over mobile spheres are dot products with the mobility mask as weights."""
+        Sums over mobile spheres are dot products with the mobility mask as weights; the
+        Otsuki and spin terms come from one 3×3 product over (u_x, u_y, ω)."""
         t = self._t
         ens = reg._ens
-        a = ens._a
+        st = ens._st
         pos = ens._pos
         V = self._volume()
         c = np.array(((self.size_x / 2,), (self.size_y / 2,)))
@@ -283,56 +287,49 @@ class StressTensorEvaluation:
         S = p["S"]
         n_int = S.n_int
         if n_int and p["antisymmetric"]:
-            m_ = _internal_moment(p, pos, ens._pos_version)
-            m_ /= V
-            t[_LW] = m_
+            t[_LW] = _internal_moment(p, pos, ens._pos_version)
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
+            t[_LW] *= V
         else:
             t[_LW] = 0.0
         m_ = _external_moment(p, pos, c) if n_int != S.P else None
-        if m_ is None:
-            t[_EXT] = 0.0
-        else:
-            m_ /= -V
-            t[_EXT] = m_
-        _, fx, fy = reg._tot
-        F = np.array((fx, fy))
+        t[_EXT] = 0.0 if m_ is None else np.negative(m_)
         X = pos - c
-        wm = a["m"]
-        wI = a["inertia"]
-        if mobile is not None:
-            F *= mobile
-            wm = wm * mobile
-            wI = wI * mobile
-        unb = np.dot(F, X.T)
-        unb *= _CF * _CL / V
+        Xm = X if mobile is None else X * mobile
+        unb = np.dot(reg._tot_block[:2], Xm.T)
+        unb *= _CF * _CL
         t[_UNB] = unb
-        t[_LIN] = unb
-        om = a["omega"]
-        K = float(np.dot(wI, om * om)) * (_CT / 2)
-        cen = t[_CEN]
-        cen[0, 0] = cen[1, 1] = -K / V
-        cen[0, 1] = cen[1, 0] = 0.0
-        # Otsuki term: −(1/V) Σ m u ⊗ u with u the velocity relative to the affine flow (SI: m·1e-6 kg/m, u·1e-6 m/s)
-        U = ens._vel[:2].copy()
+        # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
+        U = ens._vel.copy()
         if shear_rate:
             U[0] -= shear_rate * X[1]
-        ot = np.dot(U * wm, U.T)
-        ot *= -1e-18 / V
-        t[_OT] = ot
+        Wt = st.take(_MMI_ROWS, axis=0)
+        if mobile is not None:
+            Wt *= mobile
+        Wt *= U
+        M = np.dot(Wt, U.T)
+        ot = t[_OT]
+        ot[...] = M[:2, :2]
+        ot *= -1e-18          # Σ m u⊗u in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
+        K = float(M[2, 2]) * (_CT / 2)
+        cen = t[_CEN]
+        cen[0, 0] = cen[1, 1] = -K
+        cen[0, 1] = cen[1, 0] = 0.0
         total = float(reg._mom.sum()) if reg._mom is not None else 0.0
-        s_ = total * _CT / V
+        s_ = total * _CT
         tq = t[_TQ]
         tq[0, 0] = tq[1, 1] = 0.0
         tq[0, 1] = -s_ / 2
         tq[1, 0] = s_ / 2
         tint = self._internal_torque(p) if n_int else 0.0
-        s_ = tint * _CT / V
+        s_ = tint * _CT
         ti = t[_TINT]
         ti[0, 0] = ti[1, 1] = 0.0
         ti[0, 1] = -s_ / 2
         ti[1, 0] = s_ / 2
+        t[:_ALL] /= V
+        t[_LIN] = t[_UNB]
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
 
