@@ -108,7 +108,7 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "safe_images", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
+    __slots__ = ("token", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
                  "LK", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
@@ -456,6 +456,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     #: extra search distance of the candidate list, in units of the largest radius
     neighbour_skin = 0.5
+    #: candidate tables at least this long are compacted to the active pairs each time relations change;
+    #: shorter ones run every term over all candidates (per-call overhead dominates there)
+    compact_pairs_from = 20000
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsMass.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
@@ -630,22 +633,34 @@ class CanvasPointsNeighbors(CanvasPointsMass):
                 pt.state[died] = STICK
                 pt.xi[:, died] = 0.0
             pt.active = new_active
+        # Small tables (overhead-bound): every force term runs over all candidate pairs, inactive ones
+        # getting exactly zero force (ξ = 0, law = 0 beyond contact, viscous terms masked), so nothing
+        # is gathered per step.  Large tables (throughput-bound): the terms run over the active pairs only.
+        compact = C >= self.compact_pairs_from
         S = self._struct
         token = (key, self._images_token)
-        if S is None or S.token != token:
-            S = self._pair_structure(d0, perm, ky, kx, D0, D, d, cached_images)
+        if S is None or S.token != token or (S.sel is None) == compact or (compact and changed):
+            S = self._pair_structure(new_active if compact else None, d0, perm, ky, kx, D0, D, d, cached_images)
             S.token = token
             self._struct = S
-        # every force term runs over all candidate pairs: inactive ones get exactly zero force
-        # (ξ = 0, law = 0 beyond contact, viscous terms masked), so nothing is gathered per step
         g = _Geometry()
         g.S = S
-        g.slots = slice(None)
         g.ai = S.ai
         g.aj = S.aj
-        g.P = C
-        g.active = new_active
-        g.touching = touching
+        sel = S.sel
+        if sel is None:
+            g.slots = slice(None)
+            g.active = new_active
+            g.touching = touching
+        else:
+            g.slots = sel
+            g.active = None            # every pair of the step is a relation
+            D = D.take(sel, axis=1)
+            d = d.take(sel)
+            g.touching = touching.take(sel)
+            if dvx is not None:
+                dvx = dvx.take(sel)
+        g.P = C = len(d)
         if _nz(d) != C:
             d, nx, ny = pair_geometry(D[0], D[1], self._rng)
             g.n = np.array((nx, ny))
@@ -715,14 +730,31 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.ext_targets = np.concatenate((S.ai.take(wi), S.aj.take(wj)))
         F.ext_sign = np.concatenate((np.ones(len(wi)), -np.ones(len(wj))))
 
-    def _pair_structure(self, d0, perm, ky, kx, D0, D, d, cached_images):
-        """Per-candidate-pair data that change only when the candidates, bonds or images change."""
+    def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
+        """Per-pair data that change only when the candidates, bonds or images change — or, for a
+        table compacted to its ``active`` pairs, when the set of relations changes."""
         pt = self._pairs
         r = self._a["r"]
         n = self._n
         S = _Structure()
-        S.ai = pt.i
-        S.aj = pt.j
+        if active is None:
+            S.sel = S.sel2 = None
+            S.ai = pt.i
+            S.aj = pt.j
+        else:
+            S.sel = sel = np.flatnonzero(active)
+            S.sel2 = np.concatenate((sel, sel + len(pt.i)))   # flat slots of (ξ_ij, ξ_ji) in the (2, C) table
+            S.ai = pt.i.take(sel)
+            S.aj = pt.j.take(sel)
+            d0 = d0.take(sel)
+            D0 = D0.take(sel, axis=1)
+            D = D.take(sel, axis=1)
+            d = d.take(sel)
+            if ky is not None:
+                ky = ky.take(sel)
+                kx = kx.take(sel)
+            if perm is not None:
+                perm = perm.take(sel)
         S.d0 = d0
         S.ri = r.take(S.ai)
         S.rj = r.take(S.aj)
@@ -1007,7 +1039,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
-        if CircleBasicElasticity.call_back_elastic_force_law in _ZERO_BEYOND_CONTACT:
+        if self._g.active is None or CircleBasicElasticity.call_back_elastic_force_law in _ZERO_BEYOND_CONTACT:
             return f
         return f * self._g.active
 
@@ -1076,7 +1108,8 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         g = self._g
         if g.P and self.nu != 0:
             f = self.nu * self._normal_speed(g)
-            f *= g.active   # relations only (×1.0 is exact)
+            if g.active is not None:
+                f *= g.active   # relations only (×1.0 is exact)
             scale = self._viscous_scale(g)
             if scale is None:
                 self._add_normal(f)
@@ -1264,8 +1297,12 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if not self._tangential_needed():
             # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
             pt = self._pairs
-            pt.state[g.active] = SLIP
-            pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
+            if g.active is None:
+                pt.state[g.slots] = SLIP
+                pt.xi[:, g.slots] = 0.0
+            else:
+                pt.state[g.active] = SLIP
+                pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1287,11 +1324,17 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         g = self._g
         pt = self._pairs
         vt = self._tangential_speed(g)
-        F, slip = tangential_two_pass(vt, g.touching, pt.xi, kt_i, kt_j, nut_i, nut_j, fc)
+        sel = g.S.sel
+        xi = pt.xi if sel is None else pt.xi.take(sel, axis=1)
+        F, slip = tangential_two_pass(vt, g.touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
         state = slip.view(np.int8)   # SLIP = 1, STICK = 0
         if permanent is not np.False_:
             state = state + g.S.bond.perm_code
-        pt.state[...] = state
+        if sel is None:
+            pt.state[...] = state
+        else:
+            pt.state[sel] = state
+            pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
         f = F[0] + F[1]
         f *= 0.5     # = F1/2 + F2/2 exactly (halving is exact in binary floating point)
         self._add_tangential(f)
@@ -1361,8 +1404,12 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if g is None or not g.P:
             return
         pt = self._pairs
-        keep = pt.state != SLIP
-        keep &= g.active
+        sel = g.S.sel
+        if sel is None:
+            keep = pt.state != SLIP
+            keep &= g.active
+        else:
+            keep = pt.state.take(sel) != SLIP
         n_keep = _nz(keep)
         if not n_keep:
             return
@@ -1411,7 +1458,12 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         inc *= dt
         if n_keep != len(keep):
             inc *= keep
-        pt.xi += inc
+        if sel is None:
+            pt.xi += inc
+        else:
+            flat = pt.xi.reshape(-1)
+            inc += flat.take(g.S.sel2).reshape(2, P)
+            flat[g.S.sel2] = inc.reshape(-1)
 
     def move(self, dt=1):
         a = self._a

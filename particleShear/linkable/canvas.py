@@ -139,7 +139,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         if B is None:
             B = S.bond = _BondStructure()
             perm = S.perm
-            B.deq = deq = self._pairs.d_eq.copy()
+            B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
             B.d0 = np.where(perm, deq, S.d0)               # contact distance of the central law
             B.deq_stretch = np.where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
