@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from .graphics import Graphical_output_configuration
-from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import _nz, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
@@ -30,7 +30,6 @@ from .points import CircleBasicElasticity, _check_finite, _check_positive
 from .register import Force_register, SphereSelection
 from .relations import _BaseRelationView
 
-_nz = np.count_nonzero  # number of True entries; faster than ndarray.any() on small arrays
 
 __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasPointsShear",
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",

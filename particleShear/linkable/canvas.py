@@ -11,14 +11,13 @@ import math
 import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
-from ..base.kernels import min_image, tangential_two_pass
+from ..base.kernels import _nz, min_image, tangential_two_pass
 from ..base.laws import call_law_vectorised
 from ..base.neighbours import PERMANENT, SLIP, STICK
 from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
 
-_nz = np.count_nonzero  # number of True entries; faster than ndarray.any() on small arrays
 
 __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
