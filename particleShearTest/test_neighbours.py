@@ -198,6 +198,48 @@ if __name__ == "__main__":
     unittest.main()
 
 
+class TestVerletCriterionUnderAffineFlow(unittest.TestCase):
+    """Spheres carried exactly by the shear flow have no peculiar displacement, yet pairs stretch
+    (A·r) and boundary images shift; and a strain set directly moves images without any motion.
+    Both must trigger a rebuild before a contact is missed."""
+
+    def test_affine_motion_and_strain_jump(self):
+        rng = np.random.default_rng(5)
+        Lx = Ly = 500.0
+        n = 260
+        x, y, r = random_configuration(rng, n, Lx, Ly, packing_fraction=0.8)
+        ens = EnsembleLinkable(Lx, Ly, 0, k=0.0, nu=0.0, k_t=0.0, nu_t=0.0, mu=0.0)  # no forces: pure flow
+        for p in range(n):
+            ens.sphereList.append(SphereLinkable("grey", float(x[p]), float(y[p]), 2 * float(r[p]), 1.0, p + 1,
+                                                 force_register=ens, size_x=Lx, size_y=Ly))
+        ens.setShearRate(0.5)   # velocities follow the flow γ̇ (y − Ly/2) exactly
+        dt = 0.01               # 0.005 strain per step
+        missed = []
+
+        def check(tag):
+            ens.test_neighbor_relation()
+            xs, ys, rs = ens._a["x"], ens._a["y"], ens._a["r"]
+            want = oracle_pairs(xs, ys, rs, Lx, Ly, ens.shear)
+            got = set(zip(*map(np.ndarray.tolist, ens.contact_pairs())))
+            if got != want:
+                missed.append((tag, len(want - got), len(got - want)))
+
+        changes = 0
+        for step in range(120):   # strain 0.6 in total
+            before = set(zip(*map(np.ndarray.tolist, ens.contact_pairs())))
+            check(step)
+            changes += len(before ^ set(zip(*map(np.ndarray.tolist, ens.contact_pairs()))))
+            ens.mechanical_simulation_step_calculate_forces()
+            ens.mechanical_simulation_step_calculate_acceleration(1.0, dt)
+            ens.mechanical_simulation_step_calculate_movement(dt)
+        self.assertGreater(changes, 50)   # the flow really makes and breaks contacts
+        ens.setShearRate(0.0)
+        for jump in (0.3, -0.45, 0.05):
+            ens.shear = ens.shear + jump   # images move, spheres do not
+            check(f"jump {jump}")
+        self.assertEqual(missed, [])
+
+
 class TestCompactedAndFullPairTables(unittest.TestCase):
     """Terms over all candidate pairs (small tables) and over the active pairs only (large tables)
     are the same arithmetic per pair: a sheared, frictional, crosslinked scene evolves identically."""
