@@ -435,8 +435,7 @@ class CanvasPointsMass(CanvasPoints):
         return StressTensorEvaluator
 
     def reset_force(self):
-        self._a["xforce"][:] = 0.0
-        self._a["yforce"][:] = 0.0
+        self._frc[:2] = 0.0
 
     # Momenta (raw coordinates, origin at the cell corner) — conserved in isolated scenes.
     def total_momentum(self):

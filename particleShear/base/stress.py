@@ -41,7 +41,7 @@ def _pair_moment(fx, fy, lx, ly):
     return np.dot(G, L.T)
 
 
-def _internal_moment(p, pos, pos_version):
+def _internal_moment(p, pos, pos_version, scale=_CF * _CL):
     """``Σ F_i ⊗ (x_i − x_j)`` (SI) over the internal pairs of an engine register block with F_j = −F_i.
 
     Internal pairs never act through the boundary, so ``x_i − x_j`` is minus the pair vector of
@@ -54,16 +54,16 @@ def _internal_moment(p, pos, pos_version):
     if p["pos_version"] == pos_version:
         L = p["D"]
         m = np.dot(F, L.T)
-        m *= -(_CF * _CL)
+        m *= -scale
     else:
         L = pos.take(p["i"], axis=1)
         L -= pos.take(p["j"], axis=1)
         m = np.dot(F, L.T)
-        m *= _CF * _CL
+        m *= scale
     return m
 
 
-def _external_moment(p, pos, c):
+def _external_moment(p, pos, c, scale=_CF * _CL):
     """``Σ F ⊗ (x_target − c)`` (SI) over the external entries of an engine register block, or None."""
     S = p["S"]
     if not len(S.ext_slots):
@@ -76,7 +76,7 @@ def _external_moment(p, pos, c):
     X = pos.take(S.ext_targets, axis=1)
     X -= c
     m = np.dot(F, X.T)
-    m *= _CF * _CL
+    m *= scale
     return m
 
 
@@ -282,24 +282,25 @@ class StressTensorEvaluation:
         st = ens._st
         pos = ens._pos
         V = self._volume()
-        c = np.array(((self.size_x / 2,), (self.size_y / 2,)))
+        c = self._centre()
         p = reg._blocks[0]
         S = p["S"]
         n_int = S.n_int
+        sv = _CF * _CL / V   # forces × lever arms in SI, per volume
         if n_int and p["antisymmetric"]:
-            t[_LW] = _internal_moment(p, pos, ens._pos_version)
+            t[_LW] = _internal_moment(p, pos, ens._pos_version, sv)
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
-            t[_LW] *= V
         else:
             t[_LW] = 0.0
-        m_ = _external_moment(p, pos, c) if n_int != S.P else None
-        t[_EXT] = 0.0 if m_ is None else np.negative(m_)
+        m_ = _external_moment(p, pos, c, -sv) if n_int != S.P else None
+        t[_EXT] = 0.0 if m_ is None else m_
         X = pos - c
         Xm = X if mobile is None else X * mobile
         unb = np.dot(reg._tot_block[:2], Xm.T)
-        unb *= _CF * _CL
+        unb *= sv
         t[_UNB] = unb
+        t[_LIN] = unb
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
         if shear_rate:
@@ -311,27 +312,33 @@ class StressTensorEvaluation:
         M = np.dot(Wt, U.T)
         ot = t[_OT]
         ot[...] = M[:2, :2]
-        ot *= -1e-18          # Σ m u⊗u in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
-        K = float(M[2, 2]) * (_CT / 2)
+        ot *= -1e-18 / V      # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
+        K = float(M[2, 2]) * (_CT / 2) / V
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K
         cen[0, 1] = cen[1, 0] = 0.0
         total = float(reg._mom.sum()) if reg._mom is not None else 0.0
-        s_ = total * _CT
+        s_ = total * _CT / V
         tq = t[_TQ]
         tq[0, 0] = tq[1, 1] = 0.0
         tq[0, 1] = -s_ / 2
         tq[1, 0] = s_ / 2
         tint = self._internal_torque(p) if n_int else 0.0
-        s_ = tint * _CT
+        s_ = tint * _CT / V
         ti = t[_TINT]
         ti[0, 0] = ti[1, 1] = 0.0
         ti[0, 1] = -s_ / 2
         ti[1, 0] = s_ / 2
-        t[:_ALL] /= V
-        t[_LIN] = t[_UNB]
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
+
+    def _centre(self):
+        """Cell centre as a (2, 1) column (µm), cached per cell size."""
+        key = (self.size_x, self.size_y)
+        if getattr(self, "_c_key", None) != key:
+            self._c = np.array(((self.size_x / 2,), (self.size_y / 2,)))
+            self._c_key = key
+        return self._c
 
     @staticmethod
     def _internal_torque(p):
