@@ -145,6 +145,7 @@ class CanvasPoints:
         self._renderer = None
         self._uniform = {}
         self._pos_version = 0
+        self._yc_key = None
         self._in_cell = False
         self._images_valid = False
         self.graphical_output_configuration = Graphical_output_configuration()
@@ -318,7 +319,7 @@ class CanvasPoints:
         a = self._a
         rate = getattr(self, "shear_rate", 0)
         if rate:
-            u = rate * (a["y"] - self.size_y / 2)
+            u = self._y_centred() * rate
             a["xspeed"][:] = u + (a["xspeed"] - u) * f
         else:
             a["xspeed"] *= f
@@ -336,6 +337,15 @@ class CanvasPoints:
 
     def _le_shift(self):
         return 0.0
+
+    def _y_centred(self):
+        """``y − Ly/2`` of every sphere (µm), computed once per position update: the affine flow,
+        the damping, the shear-rate change and the drift bookkeeping all need it."""
+        key = (self._pos_version, self.size_y)
+        if self._yc_key != key:
+            self._yc = self._pos[1] - self.size_y / 2
+            self._yc_key = key
+        return self._yc
 
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
@@ -505,7 +515,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         rate = float(self._shear_rate_for_images())
         if rate:
             dg = rate * dt
-            self._disp[0] -= (self._pos[1] - self.size_y / 2) * dg
+            self._disp[0] -= self._y_centred() * dg
             self._nl_strain += dg
             self._nl_abs_strain += abs(dg)
         self._pos += step
@@ -922,6 +932,8 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.shear_rate = 0
         self.shear = 0
         self._mob_key = None
+        self._mob = None
+        self._plates = None
 
     def canMove(self, theSphere):
         """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (§4.6)."""
@@ -936,7 +948,10 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         if self._mob_key != key:
             a = self._a
             y, r = a["y"], a["r"]
-            self._mob = (r < y) & (y < self.size_y - r)
+            mob = (r < y) & (y < self.size_y - r)
+            # keep the same object while nothing changed: users of the mask compare by identity
+            if self._mob is None or len(mob) != len(self._mob) or _nz(mob != self._mob):
+                self._mob = mob
             self._mob_key = key
         return self._mob
 
@@ -958,11 +973,17 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         """Immobile (plate) spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity (§4.6)."""
         a = self._a
         mob = self._mobile_mask()
-        if mob is not None and _nz(mob) != len(mob):
+        if mob is None:
+            return
+        pl = self._plates
+        if pl is None or pl[0] is not mob:
             imm = ~mob
+            # immobile spheres do not move in y, so their plate (top or bottom) stays with the mask
+            pl = self._plates = (mob, _nz(imm), imm, np.where(self._y_centred() > 0, 1.0, -1.0))
+        if pl[1]:
             v = self.shear_rate * self.size_y / 2
-            np.copyto(a["yspeed"], 0.0, where=imm)
-            np.copyto(a["xspeed"], np.where(a["y"] > self.size_y / 2, v, -v), where=imm)
+            np.copyto(a["yspeed"], 0.0, where=pl[2])
+            np.copyto(a["xspeed"], pl[3] * v, where=pl[2])
 
     def transmit_lees_edwards_parameters(self, theSphere):
         theSphere.size_x = self.size_x
@@ -1239,7 +1260,7 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
 
     def adjust_sphere_speed_to_shear_rate_change(self, delta_shear_rate):
         a = self._a
-        a["xspeed"] += (a["y"] - self.size_y / 2) * delta_shear_rate
+        a["xspeed"] += self._y_centred() * delta_shear_rate
         a["omega"] -= delta_shear_rate / 2
 
     def setShearRate(self, theShearRate):
@@ -1383,7 +1404,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         V = self._vel
         rate = getattr(self, "shear_rate", 0)
         if rate:
-            u = (self._pos[1] - self.size_y / 2) * rate
+            u = self._y_centred() * rate
             V[0] -= u
             V *= f
             V[0] += u       # u + (v_x − u)·f
