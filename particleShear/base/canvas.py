@@ -107,7 +107,7 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
+    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
                  "LK", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
@@ -791,6 +791,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.shifted = shifted
         S.mob = _UNSET  # internal/external flags not computed yet
         S.bond = None  # bond constants, filled by the linkable canvas
+        S.law = None   # constants of the built-in central law
         if ky is not None:
             S.LK = np.array((float(self.size_x) * kx, float(self.size_y) * ky))
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
@@ -1056,6 +1057,28 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _law(self, d, d0, k, c):
         return call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, d, d0, k, c)
 
+    def _central_law(self, d, d0, k, c, holder):
+        """Central elastic law of every pair of the step (already masked to relations).
+
+        The built-in law (§2.3) with one repulsion coefficient is evaluated with its
+        per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder`` (the pair or bond
+        structure), in exactly the operations of :func:`~particleShear.base.laws.elastic_force_law`.
+        """
+        law = CircleBasicElasticity.call_back_elastic_force_law
+        if law is not laws.elastic_force_law or type(c) is not float or holder is None:
+            return self._mask_law(call_law_vectorised(law, d, d0, k, c))
+        lc = holder.law
+        if lc is None or lc[0] != (k, c):
+            lc = holder.law = ((k, c), d0 / 1000, -k * c * d0, -k * (1 - c))
+        _, d0_cap, a_div, a_lin = lc
+        if c == 1:
+            f = a_div * (d0 / np.maximum(d, d0_cap) - 1)   # the linear part is ±0 here
+        elif c == 0:
+            f = a_lin * (d0 - d)                           # the divergent part is ±0 here
+        else:
+            f = a_lin * (d0 - d) + a_div * (d0 / np.maximum(d, d0_cap) - 1)
+        return np.where(d > d0, 0.0, f)
+
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
         if self._g.active is None or CircleBasicElasticity.call_back_elastic_force_law in _ZERO_BEYOND_CONTACT:
@@ -1075,7 +1098,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             tr = g.trans
             c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
             if tr is None:
-                f_i = self._mask_law(self._law(g.d, g.d0, self.k, c_i))
+                f_i = self._central_law(g.d, g.d0, self.k, c_i, g.S)
                 f_j = None if c_j is c_i else self._mask_law(self._law(g.d, g.d0, self.k, c_j))
                 g.fel = f_i
             else:

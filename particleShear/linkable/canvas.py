@@ -12,7 +12,7 @@ import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import _nz, min_image, tangential_two_pass
-from ..base.laws import call_law_vectorised
+from ..base.laws import call_law_vectorised, elastic_force_law_tensile
 from ..base.neighbours import PERMANENT, SLIP, STICK
 from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
@@ -24,7 +24,7 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 class _BondStructure:
     """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf")
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law")
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
@@ -143,6 +143,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B.deq_stretch = np.where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
             B.fc_inf = np.where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
+            B.law = None
         return B
 
     def _elastic_terms(self):
@@ -155,13 +156,16 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         perm = g.perm
         c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
-        f_i = self._mask_law(call_law_vectorised(law, g.d, B.d0, self.k, c_i))
+        f_i = self._central_law(g.d, B.d0, self.k, c_i, B)
         g.fel = f_i
         f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, self.k, c_j))
         stretched = g.d >= B.deq_stretch
         if _nz(stretched):
             tensile = SphereLinkable.call_back_elastic_force_law_tensile
-            f_t = call_law_vectorised(tensile, g.d, B.deq, self.k)
+            if tensile is elastic_force_law_tensile:
+                f_t = -self.k * (B.deq - g.d)    # the built-in linear tensile law, inline
+            else:
+                f_t = call_law_vectorised(tensile, g.d, B.deq, self.k)
             f_i = np.where(stretched, f_t, f_i)
             f_j = f_i if c_j is c_i else np.where(stretched, f_t, f_j)
         rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
