@@ -98,6 +98,9 @@ class SphereList(list):
 
 
 _UNSET = object()
+# ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
+_max_reduce = np.maximum.reduce
+_min_reduce = np.minimum.reduce
 #: rows of the state block dividing (xforce, yforce, torque) in the kick: m, m, inertia
 _KICK_ROWS = np.array((_ROW["m"], _ROW["m"], _ROW["inertia"]))
 _ROT = np.array(((-1.0,), (1.0,)))
@@ -119,9 +122,15 @@ class _Flags:
 
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
-    __slots__ = ("S", "slots", "active", "ai", "aj", "D", "n", "t", "dx", "dy", "d", "nx", "ny", "dvx", "d0", "perm", "trans",
+    __slots__ = ("S", "slots", "active", "ai", "aj", "D", "n", "t", "d", "dvx", "d0", "perm", "trans",
                  "touching", "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv",
                  "ky", "kx", "ri", "rj", "idx2", "state", "Vi", "Vj")
+
+    # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
+    dx = property(lambda self: self.D[0])
+    dy = property(lambda self: self.D[1])
+    nx = property(lambda self: self.n[0])
+    ny = property(lambda self: self.n[1])
 
 
 class CanvasPoints:
@@ -351,8 +360,8 @@ class CanvasPoints:
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
         a = self._a
         if self._n:
-            lo = self._pos.min(axis=1)
-            hi = self._pos.max(axis=1)
+            lo = _min_reduce(self._pos, axis=1)
+            hi = _max_reduce(self._pos, axis=1)
             inside = lo[0] >= 0 and lo[1] >= 0 and hi[0] < self.size_x and hi[1] < self.size_y
         else:
             inside = True
@@ -532,7 +541,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         # pair at distance r ≤ A·r (A = accumulated |strain|, Gronwall: factor A·e^A), and any strain
         # change not carried by the flow (e.g. γ set directly) moves boundary images by Ly·Δγ
         d2 = self._disp * self._disp
-        U = math.sqrt(float((d2[0] + d2[1]).max())) if self._n else 0.0
+        U = math.sqrt(float(_max_reduce(d2[0] + d2[1]))) if self._n else 0.0
         A = self._nl_abs_strain
         gA = A * math.exp(A) if A else 0.0
         bound = 2 * U * (1 + gA) + gA * self._nl_reach
@@ -677,8 +686,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.t = g.n[::-1] * _ROT   # t_ij = (−n_y, n_x)
         g.D = D
         g.d = d
-        g.dx, g.dy = D
-        g.nx, g.ny = g.n
         g.ky = S.ky
         g.kx = S.kx
         if dvx is not None:
@@ -1493,9 +1500,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         else:
             mx, my = R / dm
         # ((−svx)·(−m_y) + (−rv_y)·m_x − spin) = (svx·m_y − rv_y·m_x) − spin, exact sign flips only
-        b_ = svx * my
+        b_ = np.multiply(svx, my, out=inc[1])
         b_ -= rv[1] * mx
-        inc[1] = b_
         inc -= spin
         inc *= dt
         if n_keep != len(keep):

@@ -317,7 +317,7 @@ class StressTensorEvaluation:
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K
         cen[0, 1] = cen[1, 0] = 0.0
-        total = float(reg._mom.sum()) if reg._mom is not None else 0.0
+        total = float(np.add.reduce(reg._mom)) if reg._mom is not None else 0.0
         s_ = total * _CT / V
         tq = t[_TQ]
         tq[0, 0] = tq[1, 1] = 0.0
@@ -348,7 +348,7 @@ class StressTensorEvaluation:
             return 0.0
         S = p["S"]
         if S.w_int is None:
-            return float(T.sum())
+            return float(np.add.reduce(T))
         return float(np.dot(S.w_int, p["ti"]) + np.dot(S.w_int, p["tj"]))
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
