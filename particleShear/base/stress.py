@@ -41,8 +41,8 @@ def _pair_moment(fx, fy, lx, ly):
     return np.dot(G, L.T)
 
 
-def _internal_moment(p, pos, pos_version, scale=_CF * _CL):
-    """``Σ F_i ⊗ (x_i − x_j)`` (SI) over the internal pairs of an engine register block with F_j = −F_i.
+def _internal_moment(p, pos, pos_version, scale=_CF * _CL, out=None):
+    """``scale · Σ F_i ⊗ (x_i − x_j)`` over the internal pairs of an engine register block with F_j = −F_i.
 
     Internal pairs never act through the boundary, so ``x_i − x_j`` is minus the pair vector of
     the force phase while no sphere has moved since; otherwise positions are gathered anew.
@@ -52,19 +52,16 @@ def _internal_moment(p, pos, pos_version, scale=_CF * _CL):
     if S.w_int is not None:
         F = F * S.w_int
     if p["pos_version"] == pos_version:
-        L = p["D"]
-        m = np.dot(F, L.T)
-        m *= -scale
-    else:
-        L = pos.take(p["i"], axis=1)
-        L -= pos.take(p["j"], axis=1)
-        m = np.dot(F, L.T)
-        m *= scale
-    return m
+        return np.multiply(np.dot(F, p["D"].T), -scale, out=out)
+    L = pos.take(p["i"], axis=1)
+    L -= pos.take(p["j"], axis=1)
+    return np.multiply(np.dot(F, L.T), scale, out=out)
 
 
-def _external_moment(p, pos, c, scale=_CF * _CL):
-    """``Σ F ⊗ (x_target − c)`` (SI) over the external entries of an engine register block, or None."""
+def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
+    """``scale · Σ F ⊗ (x_target − c)`` over the external entries of an engine register block, or None.
+
+    ``X`` may give ``pos − c`` already computed."""
     S = p["S"]
     if not len(S.ext_slots):
         return None
@@ -73,11 +70,12 @@ def _external_moment(p, pos, c, scale=_CF * _CL):
         F *= S.ext_sign
     else:
         F = np.concatenate((p["Fi"].take(S.ext_wi, axis=1), p["Fj"].take(S.ext_wj, axis=1)), axis=1)
-    X = pos.take(S.ext_targets, axis=1)
-    X -= c
-    m = np.dot(F, X.T)
-    m *= scale
-    return m
+    if X is None:
+        Xt = pos.take(S.ext_targets, axis=1)
+        Xt -= c
+    else:
+        Xt = X.take(S.ext_targets, axis=1)
+    return np.multiply(np.dot(F, Xt.T), scale, out=out)
 
 
 def _tensor_property(k):
@@ -287,20 +285,18 @@ class StressTensorEvaluation:
         S = p["S"]
         n_int = S.n_int
         sv = _CF * _CL / V   # forces × lever arms in SI, per volume
+        X = pos - c
         if n_int and p["antisymmetric"]:
-            t[_LW] = _internal_moment(p, pos, ens._pos_version, sv)
+            _internal_moment(p, pos, ens._pos_version, sv, out=t[_LW])
         elif n_int:
             self.evaluate_force_stress_tensors(reg)
         else:
             t[_LW] = 0.0
-        m_ = _external_moment(p, pos, c, -sv) if n_int != S.P else None
-        t[_EXT] = 0.0 if m_ is None else m_
-        X = pos - c
+        if n_int == S.P or _external_moment(p, pos, c, -sv, out=t[_EXT], X=X) is None:
+            t[_EXT] = 0.0
         Xm = X if mobile is None else X * mobile
-        unb = np.dot(reg._tot_block[:2], Xm.T)
-        unb *= sv
-        t[_UNB] = unb
-        t[_LIN] = unb
+        np.multiply(np.dot(reg._tot_block[:2], Xm.T), sv, out=t[_UNB])
+        t[_LIN] = t[_UNB]
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
         if shear_rate:
@@ -310,9 +306,7 @@ class StressTensorEvaluation:
             Wt *= mobile
         Wt *= U
         M = np.dot(Wt, U.T)
-        ot = t[_OT]
-        ot[...] = M[:2, :2]
-        ot *= -1e-18 / V      # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
+        np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
         K = float(M[2, 2]) * (_CT / 2) / V
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K
@@ -377,14 +371,11 @@ class StressTensorEvaluation:
                 self.evaluate_force_stress_tensors(reg)
                 lw01 = t[_LW, 0, 1]
             else:
-                m_ = _internal_moment(p, pos, ens._pos_version)
-                m_ /= V
-                lw01 = m_[0, 1]
+                lw01 = _internal_moment(p, pos, ens._pos_version, _CF * _CL / V)[0, 1]
         ext01 = 0.0
         if n_int != S.P:
-            m_ = _external_moment(p, pos, np.array(((self.size_x / 2,), (self.size_y / 2,))))
+            m_ = _external_moment(p, pos, self._centre(), -(_CF * _CL / V))
             if m_ is not None:
-                m_ /= -V
                 ext01 = m_[0, 1]
         tint = self._internal_torque(p) if n_int else 0.0
         s_ = tint * _CT / V
