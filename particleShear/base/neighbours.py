@@ -8,13 +8,16 @@ allows, so the per-step contact set is exactly the all-pairs one.
 """
 import numpy as np
 
-from .kernels import min_image
+from .kernels import _nz, in_cell_passes, min_image
 
 __all__ = ["PairTable", "STICK", "SLIP", "PERMANENT", "STATE_NAMES", "candidate_pairs", "all_pairs"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 STATE_NAMES = ("stick", "slip", "permanent")
 STATE_CODES = {"stick": STICK, "slip": SLIP, "permanent": PERMANENT}
+
+
+_OFFSETS = np.array((-1, 0, 1), dtype=np.intp)
 
 
 def _key(i, j):
@@ -74,11 +77,18 @@ class PairTable:
         Permanent and active pairs are always kept; with ``keep_existing`` every
         existing row is kept and (i, j) are added.
         """
-        keep = slice(None) if keep_existing else (self.active | (self.state == PERMANENT))
-        lo = np.concatenate([np.minimum(i, j), self.i[keep]])
-        hi = np.concatenate([np.maximum(i, j), self.j[keep]])
-        k = np.unique(_key(lo, hi))
         old_key = self.key
+        k = np.sort(_key(np.minimum(i, j), np.maximum(i, j)))
+        if len(k) > 1 and _nz(k[1:] == k[:-1]):
+            k = np.unique(k)
+        # rows to keep that the new candidates miss (e.g. bonds stretched beyond the search reach)
+        kept = old_key if keep_existing else old_key[self.active | (self.state == PERMANENT)]
+        if len(kept):
+            at = np.searchsorted(k, kept)
+            found = at < len(k)
+            found[found] = k[at[found]] == kept[found]
+            if not found.all():
+                k = np.union1d(k, kept[~found])
         pos = np.searchsorted(old_key, k)
         pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
         had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
@@ -93,7 +103,9 @@ class PairTable:
             setattr(self, name, arr)
         xi = np.zeros((2, n))
         if len(src):
-            xi[:, had] = self.xi[:, src]
+            dst = np.flatnonzero(had)
+            xi[0, dst] = self.xi[0, src]
+            xi[1, dst] = self.xi[1, src]
         self.xi = xi
         self.key = k
         self.version += 1
@@ -140,20 +152,14 @@ def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
         order = np.argsort(cell, kind="stable")
         counts = np.bincount(cell, minlength=nx * ny)
         start = np.concatenate(([0], np.cumsum(counts)[:-1]))
-        cells = np.empty((n, 9), dtype=np.intp)
-        col = 0
-        for drow in (-1, 0, 1):
-            row = cy + drow
-            if drow == 0:
-                c0 = cx
-            else:
-                xs = x - shift if drow == 1 else x + shift
-                xs = np.where(row >= ny, xs, x) if drow == 1 else np.where(row < 0, xs, x)
-                c0 = np.minimum((np.mod(xs, Lx) / cw).astype(np.intp), nx - 1)
-            row = np.mod(row, ny)
-            for dcol in (-1, 0, 1):
-                cells[:, col] = row * nx + np.mod(c0 + dcol, nx)
-                col += 1
+        # the 3 × 3 cells around each sphere; through y = 0 / Ly the row is searched at x ∓ shift
+        xs = np.empty((n, 3))
+        xs[:, 0] = np.where(cy - 1 < 0, x + shift, x)
+        xs[:, 1] = x
+        xs[:, 2] = np.where(cy + 1 >= ny, x - shift, x)
+        c0 = np.minimum((np.mod(xs, Lx) / cw).astype(np.intp), nx - 1)
+        rows = np.mod(cy[:, None] + _OFFSETS, ny)
+        cells = (rows[:, :, None] * nx + np.mod(c0[:, :, None] + _OFFSETS, nx)).reshape(n, 9)
         cnt = counts[cells].ravel()
         total = int(cnt.sum())
         owner = np.repeat(np.repeat(np.arange(n, dtype=np.intp), 9), cnt)
@@ -162,7 +168,7 @@ def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
         other = order[first + offs]
         sel = owner < other
         i, j = owner[sel], other[sel]
-    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift, passes=in_cell_passes(Lx, shift))
     reach = r[i] + r[j] + skin
     sel = dx * dx + dy * dy < reach * reach
     return i[sel], j[sel]
