@@ -1377,11 +1377,14 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         xi = pt.xi if sel is None else pt.xi.take(sel, axis=1)
         F, slip = tangential_two_pass(vt, g.touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
         state = slip.view(np.int8)   # SLIP = 1, STICK = 0
-        if permanent is not np.False_:
-            state = state + g.S.bond.perm_code
         if sel is None:
-            pt.state[...] = state
+            if permanent is not np.False_:
+                state = np.add(state, g.S.bond.perm_code, out=pt.state)
+            else:
+                pt.state[...] = state
         else:
+            if permanent is not np.False_:
+                state = state + g.S.bond.perm_code
             pt.state[sel] = state
             pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
         f = F[0] + F[1]
