@@ -27,7 +27,7 @@ from .laws import call_law_vectorised
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
-from .register import Force_register, SphereSelection
+from .register import Force_register, PairBlock, SphereSelection
 from .relations import _BaseRelationView
 
 
@@ -862,16 +862,17 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             df = g.d * g.ft
             Wt = W[2].reshape(2, P)
             np.multiply(df, S.w2, out=Wt)
-            ti, tj = Wt
+            ti = Wt[0]   # indexing, not tuple unpacking (iterating an array is slow)
+            tj = Wt[1]
         if P:
             k = W.shape[0]
             idx = S.idx6 if k == 3 else S.idx6[:4 * P]
             self._frc[:k] += np.bincount(idx, W.ravel(), k * n).reshape(k, n)
-        self.force_register._set_pairs(self, {
-            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "fix": Fi[0], "fiy": Fi[1], "fjx": Fj[0], "fjy": Fj[1],
+        self.force_register._set_pairs(self, PairBlock({
+            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj,
             "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
-            "pos_version": self._pos_version})
+            "pos_version": self._pos_version}))
         g.fn_i = None
         g.fn_j = None
         g.ft = None
@@ -1501,7 +1502,9 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if _nz(dm) != P:
             _, mx, my = pair_geometry(R[0], R[1], self._rng)
         else:
-            mx, my = R / dm
+            M = R / dm
+            mx = M[0]
+            my = M[1]
         # ((−svx)·(−m_y) + (−rv_y)·m_x − spin) = (svx·m_y − rv_y·m_x) − spin, exact sign flips only
         b_ = np.multiply(svx, my, out=inc[1])
         b_ -= rv[1] * mx

@@ -18,6 +18,21 @@ def _live(p, flag):
     return m if active is None else m & active
 
 
+class PairBlock(dict):
+    """Register block of the engine: per-pair arrays; ``fix``, ``fiy``, ``fjx``, ``fjy`` are the rows
+    of the (2, P) force arrays ``Fi``, ``Fj``, made on first use."""
+
+    _ROWS = {"fix": ("Fi", 0), "fiy": ("Fi", 1), "fjx": ("Fj", 0), "fjy": ("Fj", 1)}
+
+    def __missing__(self, key):
+        if key in self._ROWS:
+            name, row = self._ROWS[key]
+            value = self[name][row]
+            self[key] = value
+            return value
+        raise KeyError(key)
+
+
 class SphereSelection:
     """A list-like selection of an ensemble's spheres by boolean mask (no Python loop to build)."""
 
