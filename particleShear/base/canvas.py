@@ -154,6 +154,7 @@ class CanvasPoints:
         self._renderer = None
         self._uniform = {}
         self._pos_version = 0
+        self._params_version = 0
         self._yc_key = None
         self._in_cell = False
         self._images_valid = False
@@ -261,6 +262,7 @@ class CanvasPoints:
 
     def _params_changed(self):
         self._uniform = {}
+        self._params_version += 1
 
     def _param(self, name):
         """Scalar value of a per-sphere parameter if all spheres share it, else None."""

@@ -24,7 +24,7 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 class _BondStructure:
     """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law")
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "tangential", "viscous")
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
@@ -144,6 +144,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
             B.fc_inf = np.where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
             B.law = None
+            B.tangential = None
+            B.viscous = None
         return B
 
     def _elastic_terms(self):
@@ -181,10 +183,20 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
             return
         B = self._bond_structure(g)
+        kt, nut = self.k_t, self.nu_t
+        key = (self._params_version, kt, nut)
+        if B.tangential is None or B.tangential[0] != key:
+            B.tangential = (key,) + self._tangential_constants(g, kt, nut)
+        _, kt_i, kt_j, nut_i, nut_j = B.tangential
+        fc = np.abs(self.mu * self._coulomb_law(g))
+        fc += B.fc_inf
+        self._apply_tangential(g.perm, kt_i, kt_j, nut_i, nut_j, fc)
+
+    def _tangential_constants(self, g, kt, nut):
+        """(k_t, ν_t) seen by each visit: scaled by the sphere's ratios on bonds (kept per bond structure)."""
         perm = g.perm
         rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
         nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
-        kt, nut = self.k_t, self.nu_t
         if rt_i is rt_j and type(rt_i) is float and kt * rt_i == kt:
             kt_i = kt_j = kt
         else:
@@ -195,9 +207,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         else:
             nut_i = np.where(perm, nut * nv_i, nut)
             nut_j = np.where(perm, nut * nv_j, nut)
-        fc = np.abs(self.mu * self._coulomb_law(g))
-        fc += B.fc_inf
-        self._apply_tangential(perm, kt_i, kt_j, nut_i, nut_j, fc)
+        return kt_i, kt_j, nut_i, nut_j
 
     def _visc_ratio(self, g, ratio_name):
         """Per-visit viscosity factors of bonds: the ratio unless viscosities are kept constant."""
@@ -214,6 +224,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
     def _viscous_scale(self, g):
         if g.perm is None:
             return None
+        B = self._bond_structure(g)
+        if B.viscous is None or B.viscous[0] != self._params_version:
+            B.viscous = (self._params_version, self._viscous_scale_of(g))
+        return B.viscous[1]
+
+    def _viscous_scale_of(self, g):
         v_i, v_j = self._visc_ratio(g, "permanent_ratio_central")
         if type(v_i) is float and v_i == 1.0:
             return None
