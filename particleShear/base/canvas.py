@@ -117,7 +117,7 @@ class _Structure:
 class _Flags:
     """What the stress tensors need of the internal/external flags of one mobility mask (§7.2):
     number and float weights (None: all) of internal pairs; slots, targets and signs of external forces."""
-    __slots__ = ("P", "n_int", "w_int", "ext_wi", "ext_wj", "ext_slots", "ext_targets", "ext_sign")
+    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_wi", "ext_wj", "ext_slots", "ext_targets", "ext_sign")
 
 
 class _Geometry:
@@ -741,6 +741,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.P = len(S.ai)
         F.n_int = n_int = _nz(S.internal)
         F.w_int = None if n_int == F.P else S.internal.astype(float)
+        F.w_int2 = None if F.w_int is None else np.concatenate((F.w_int, F.w_int))
         F.ext_wi = wi = np.flatnonzero(S.ext_i)
         F.ext_wj = wj = np.flatnonzero(S.ext_j)
         F.ext_slots = np.concatenate((wi, wj))

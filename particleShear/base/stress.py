@@ -343,7 +343,7 @@ class StressTensorEvaluation:
         S = p["S"]
         if S.w_int is None:
             return float(np.add.reduce(T))
-        return float(np.dot(S.w_int, p["ti"]) + np.dot(S.w_int, p["tj"]))
+        return float(np.dot(S.w_int2, T))   # T = (t_i of every pair, t_j of every pair)
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
         """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).
