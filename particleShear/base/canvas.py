@@ -1512,9 +1512,10 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         b_ = np.multiply(svx, my, out=inc[1])
         b_ -= rv[1] * mx
         inc -= spin
-        inc *= dt
         if n_keep != len(keep):
-            inc *= keep
+            inc *= keep * dt   # ×dt then ×0/1, in one pass: (x·dt)·1 = x·(dt·1), x·(dt·0) = ±0
+        else:
+            inc *= dt
         if sel is None:
             pt.xi += inc
         else:
