@@ -110,8 +110,8 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6", "ky", "kx", "any_y",
-                 "LK", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
+    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6",
+                 "ky", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
 class _Flags:
@@ -124,7 +124,7 @@ class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step)."""
     __slots__ = ("S", "slots", "active", "ai", "aj", "D", "n", "t", "d", "dvx", "d0", "perm", "trans",
                  "touching", "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv",
-                 "ky", "kx", "ri", "rj", "idx2", "state", "Vi", "Vj")
+                 "ri", "rj", "Vi", "Vj")
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
     dx = property(lambda self: self.D[0])
@@ -688,8 +688,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.t = g.n[::-1] * _ROT   # t_ij = (−n_y, n_x)
         g.D = D
         g.d = d
-        g.ky = S.ky
-        g.kx = S.kx
         if dvx is not None:
             g.dvx = dvx
         elif dvx_rate and S.any_y:
@@ -710,7 +708,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.ext_j = S.ext_j
         g.ri = S.ri
         g.rj = S.rj
-        g.idx2 = S.idx2
         g.fn_i = None
         g.fn_j = None
         g.ft = None
@@ -718,7 +715,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.vt = None
         g.fel = None
         g.rv = None
-        g.state = None
         self._g = g
         return g
 
@@ -802,8 +798,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.mob = _UNSET  # internal/external flags not computed yet
         S.bond = None  # bond constants, filled by the linkable canvas
         S.law = None   # constants of the built-in central law
-        if ky is not None:
-            S.LK = np.array((float(self.size_x) * kx, float(self.size_y) * ky))
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
         S.safe_images = bool(self._images_valid)
         return S

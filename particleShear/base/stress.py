@@ -32,15 +32,6 @@ _CL = 1e-6
 _CT = 1e-18
 
 
-def _pair_moment(fx, fy, lx, ly):
-    """``Σ F ⊗ l`` in SI units (N·m per m depth) for forces (internal units) and lever arms (µm)."""
-    G = np.array((fx, fy))
-    G *= _CF
-    L = np.array((lx, ly))
-    L *= _CL
-    return np.dot(G, L.T)
-
-
 def _internal_moment(p, pos, pos_version, scale=_CF * _CL, out=None):
     """``scale · Σ F_i ⊗ (x_i − x_j)`` over the internal pairs of an engine register block with F_j = −F_i.
 
