@@ -85,7 +85,8 @@ class TestShearedCrosslinkedEnsemble(unittest.TestCase):
                 ref.evaluate_force_stress_tensors(ens.force_register)
                 ref.evaluate_rotational_stress_tensors(ens.force_register, mobile)
                 ref.evaluate_peculiar_momentum_transport_for_linear_acceleration_tensor(mobile, ens.shear_rate)
-                ref.overall_stress_tensor = (np.array(ref.stress_tensor_LW) + np.array(ref.stress_tensor_internal_torque)
+                ref.overall_stress_tensor = (np.array(ref.stress_tensor_LW)
+                                             + np.array(ref.stress_tensor_internal_torque)
                                              + np.array(ref.stress_tensor_spin_kinetic_energy))
                 cls.generic.append((tensors(ev), tensors(ref)))
             for s in ens.sphereList[:40]:

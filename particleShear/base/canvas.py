@@ -1415,8 +1415,9 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             self._store_half_kick(dt)
         self._last_dt = dt
         cls = type(self)
+        friction = CanvasPointsFrictionElasticityLeesEdwards
         if (cls.do_linear_acceleration is CanvasPointsShear.do_linear_acceleration
-                and cls.do_rotational_acceleration is CanvasPointsFrictionElasticityLeesEdwards.do_rotational_acceleration):
+                and cls.do_rotational_acceleration is friction.do_rotational_acceleration):
             # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
             kick = self._frc * dt
             kick /= self._st.take(_KICK_ROWS, axis=0)

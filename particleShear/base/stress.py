@@ -252,7 +252,8 @@ class StressTensorEvaluation:
         """Every tensor of §7 and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24)."""
         reg = force_register
         if (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
-                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and reg._tot is not None and not reg._m_pair and not reg._m_ext
+                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and reg._tot is not None
+                and not reg._m_pair and not reg._m_ext
                 and not reg._m_tot and not reg._m_imom and not reg._m_unb):
             self._evaluate_arrays(reg, theSphereList.mask, shear_rate)
             return
