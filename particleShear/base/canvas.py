@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from .graphics import Graphical_output_configuration
-from .kernels import _nz, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import _bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
@@ -56,20 +56,19 @@ def check_non_negative(name, value):
 
 
 class NonNegative:
-    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu)."""
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu).
+
+    Only assignment is intercepted (and validated); the value lives in the instance
+    ``__dict__`` under its own name, so reading it is a plain attribute lookup
+    (a descriptor without ``__get__`` yields to the instance dictionary).
+    """
 
     def __set_name__(self, owner, name):
         self.name = name
-        self.key = "_c_" + name
-
-    def __get__(self, obj, objtype=None):
-        if obj is None:
-            return self
-        return obj.__dict__[self.key]
 
     def __set__(self, obj, value):
         check_non_negative(self.name, value)
-        obj.__dict__[self.key] = value
+        obj.__dict__[self.name] = value
 
 
 class SphereList(list):
@@ -611,7 +610,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             r = self._a["r"]
             self._nl_rsum = r[pt.i] + r[pt.j]
             self._cand_perm = pt.state == PERMANENT if pt.n_permanent else None
-            self._cand_ji = np.concatenate((pt.j, pt.i))
+            self._cand_ji = _concat((pt.j, pt.i))
             self._cand_key = key
         T = pos.take(self._cand_ji, axis=1)
         D0 = T[:, :C] - T[:, C:]   # raw differences (x_j − x_i, y_j − y_i)
@@ -737,12 +736,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.P = len(S.ai)
         F.n_int = n_int = _nz(S.internal)
         F.w_int = None if n_int == F.P else S.internal.astype(float)
-        F.w_int2 = None if F.w_int is None else np.concatenate((F.w_int, F.w_int))
+        F.w_int2 = None if F.w_int is None else _concat((F.w_int, F.w_int))
         F.ext_wi = wi = np.flatnonzero(S.ext_i)
         F.ext_wj = wj = np.flatnonzero(S.ext_j)
-        F.ext_slots = np.concatenate((wi, wj))
-        F.ext_targets = np.concatenate((S.ai.take(wi), S.aj.take(wj)))
-        F.ext_sign = np.concatenate((np.ones(len(wi)), -np.ones(len(wj))))
+        F.ext_slots = _concat((wi, wj))
+        F.ext_targets = _concat((S.ai.take(wi), S.aj.take(wj)))
+        F.ext_sign = _concat((np.ones(len(wi)), -np.ones(len(wj))))
 
     def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
         """Per-pair data that change only when the candidates, bonds or images change — or, for a
@@ -757,7 +756,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             S.aj = pt.j
         else:
             S.sel = sel = np.flatnonzero(active)
-            S.sel2 = np.concatenate((sel, sel + len(pt.i)))   # flat slots of (ξ_ij, ξ_ji) in the (2, C) table
+            S.sel2 = _concat((sel, sel + len(pt.i)))   # flat slots of (ξ_ij, ξ_ji) in the (2, C) table
             S.ai = pt.i.take(sel)
             S.aj = pt.j.take(sel)
             d0 = d0.take(sel)
@@ -773,9 +772,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.ri = r.take(S.ai)
         S.rj = r.take(S.aj)
         S.w2 = np.array((S.ri, S.rj)) / S.d0   # torque lever fractions r_i/(r_i + r_j), r_j/(r_i + r_j) (S1-3)
-        S.idx2 = np.concatenate((S.ai, S.aj))
+        S.idx2 = _concat((S.ai, S.aj))
         # flat bincount index of (x, y, torque) rows: one call accumulates every pair force on the spheres
-        S.idx6 = np.concatenate((S.idx2, S.idx2 + n, S.idx2 + 2 * n))
+        S.idx6 = _concat((S.idx2, S.idx2 + n, S.idx2 + 2 * n))
         S.ky = ky
         S.kx = kx
         S.any_y = ky is not None and bool(_nz(ky))
@@ -864,7 +863,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         if P:
             k = W.shape[0]
             idx = S.idx6 if k == 3 else S.idx6[:4 * P]
-            self._frc[:k] += np.bincount(idx, W.ravel(), k * n).reshape(k, n)
+            self._frc[:k] += _bincount(idx, W.ravel(), k * n).reshape(k, n)
         self.force_register._set_pairs(self, PairBlock({
             "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj,
             "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
@@ -884,7 +883,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         m = pt.active & ((pt.i == p) | (pt.j == p))
         slots = np.flatnonzero(m)
         slots = slots[np.argsort(pt.birth[slots], kind="stable")]
-        partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
+        partners = _where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
         cls = self._relation_view_class
         return [cls(self, p, int(q)) for q in partners]
 
@@ -985,11 +984,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         if pl is None or pl[0] is not mob:
             imm = ~mob
             # immobile spheres do not move in y, so their plate (top or bottom) stays with the mask
-            pl = self._plates = (mob, _nz(imm), imm, np.where(self._y_centred() > 0, 1.0, -1.0))
+            pl = self._plates = (mob, _nz(imm), imm, _where(self._y_centred() > 0, 1.0, -1.0))
         if pl[1]:
             v = self.shear_rate * self.size_y / 2
-            np.copyto(a["yspeed"], 0.0, where=pl[2])
-            np.copyto(a["xspeed"], pl[3] * v, where=pl[2])
+            _copyto(a["yspeed"], 0.0, where=pl[2])
+            _copyto(a["xspeed"], pl[3] * v, where=pl[2])
 
     def transmit_lees_edwards_parameters(self, theSphere):
         theSphere.size_x = self.size_x
@@ -1082,7 +1081,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             f = a_lin * (d0 - d)                           # the divergent part is ±0 here
         else:
             f = a_lin * (d0 - d) + a_div * (d0 / np.maximum(d, d0_cap) - 1)
-        return np.where(d > d0, 0.0, f)
+        return _where(d > d0, 0.0, f)
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
@@ -1222,8 +1221,8 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         hy = a["yforce"] * dt / (2 * a["m"])
         ht = a["torque"] * dt / (2 * a["inertia"]) if self._torque_total() is not None else None
         if mob is not None:
-            hx = np.where(mob, hx, 0.0)
-            hy = np.where(mob, hy, 0.0)
+            hx = _where(mob, hx, 0.0)
+            hy = _where(mob, hy, 0.0)
         self._half_kick = (hx, hy, ht)
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):

@@ -6,6 +6,7 @@ forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
 import numpy as np
 
+from .kernels import _concat, _dot
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
@@ -43,10 +44,10 @@ def _internal_moment(p, pos, pos_version, scale=_CF * _CL, out=None):
     if S.w_int is not None:
         F = F * S.w_int
     if p["pos_version"] == pos_version:
-        return np.multiply(np.dot(F, p["D"].T), -scale, out=out)
+        return np.multiply(_dot(F, p["D"].T), -scale, out=out)
     L = pos.take(p["i"], axis=1)
     L -= pos.take(p["j"], axis=1)
-    return np.multiply(np.dot(F, L.T), scale, out=out)
+    return np.multiply(_dot(F, L.T), scale, out=out)
 
 
 def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
@@ -60,13 +61,13 @@ def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
         F = p["Fi"].take(S.ext_slots, axis=1)
         F *= S.ext_sign
     else:
-        F = np.concatenate((p["Fi"].take(S.ext_wi, axis=1), p["Fj"].take(S.ext_wj, axis=1)), axis=1)
+        F = _concat((p["Fi"].take(S.ext_wi, axis=1), p["Fj"].take(S.ext_wj, axis=1)), axis=1)
     if X is None:
         Xt = pos.take(S.ext_targets, axis=1)
         Xt -= c
     else:
         Xt = X.take(S.ext_targets, axis=1)
-    return np.multiply(np.dot(F, Xt.T), scale, out=out)
+    return np.multiply(_dot(F, Xt.T), scale, out=out)
 
 
 def _tensor_property(k):
@@ -287,7 +288,7 @@ class StressTensorEvaluation:
         if n_int == S.P or _external_moment(p, pos, c, -sv, out=t[_EXT], X=X) is None:
             t[_EXT] = 0.0
         Xm = X if mobile is None else X * mobile
-        np.multiply(np.dot(reg._tot_block[:2], Xm.T), sv, out=t[_UNB])
+        np.multiply(_dot(reg._tot_block[:2], Xm.T), sv, out=t[_UNB])
         t[_LIN] = t[_UNB]
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
@@ -297,7 +298,7 @@ class StressTensorEvaluation:
         if mobile is not None:
             Wt *= mobile
         Wt *= U
-        M = np.dot(Wt, U.T)
+        M = _dot(Wt, U.T)
         np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
         K = float(M[2, 2]) * (_CT / 2) / V
         cen = t[_CEN]
@@ -335,7 +336,7 @@ class StressTensorEvaluation:
         S = p["S"]
         if S.w_int is None:
             return float(np.add.reduce(T))
-        return float(np.dot(S.w_int2, T))   # T = (t_i of every pair, t_j of every pair)
+        return float(_dot(S.w_int2, T))   # T = (t_i of every pair, t_j of every pair)
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
         """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).

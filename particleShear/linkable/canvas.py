@@ -11,9 +11,9 @@ import math
 import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
-from ..base.kernels import _nz, min_image, tangential_two_pass
+from ..base.kernels import _nz, _where, min_image
 from ..base.laws import call_law_vectorised, elastic_force_law_tensile
-from ..base.neighbours import PERMANENT, SLIP, STICK
+from ..base.neighbours import PERMANENT, SLIP
 from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
@@ -139,10 +139,10 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B = S.bond = _BondStructure()
             perm = S.perm
             B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
-            B.d0 = np.where(perm, deq, S.d0)               # contact distance of the central law
-            B.deq_stretch = np.where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
+            B.d0 = _where(perm, deq, S.d0)               # contact distance of the central law
+            B.deq_stretch = _where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
-            B.fc_inf = np.where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
+            B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
             B.law = None
             B.tangential = None
             B.viscous = None
@@ -168,12 +168,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                 f_t = -self.k * (B.deq - g.d)    # the built-in linear tensile law, inline
             else:
                 f_t = call_law_vectorised(tensile, g.d, B.deq, self.k)
-            f_i = np.where(stretched, f_t, f_i)
-            f_j = f_i if c_j is c_i else np.where(stretched, f_t, f_j)
+            f_i = _where(stretched, f_t, f_i)
+            f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
         rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
         if not (rc_i is rc_j and rc_i == 1.0):
-            f_i = f_i * np.where(perm, rc_i, 1.0)
-            f_j = f_j * np.where(perm, rc_j, 1.0)
+            f_i = f_i * _where(perm, rc_i, 1.0)
+            f_j = f_j * _where(perm, rc_j, 1.0)
         self._add_normal(f_i, None if f_j is f_i else f_j)
 
     def _tangential_terms(self):
@@ -200,13 +200,13 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         if rt_i is rt_j and type(rt_i) is float and kt * rt_i == kt:
             kt_i = kt_j = kt
         else:
-            kt_i = np.where(perm, kt * rt_i, kt)
-            kt_j = kt_i if rt_j is rt_i else np.where(perm, kt * rt_j, kt)
+            kt_i = _where(perm, kt * rt_i, kt)
+            kt_j = kt_i if rt_j is rt_i else _where(perm, kt * rt_j, kt)
         if nv_i is nv_j and nv_i == 1.0:
             nut_i = nut_j = nut
         else:
-            nut_i = np.where(perm, nut * nv_i, nut)
-            nut_j = np.where(perm, nut * nv_j, nut)
+            nut_i = _where(perm, nut * nv_i, nut)
+            nut_j = _where(perm, nut * nv_j, nut)
         return kt_i, kt_j, nut_i, nut_j
 
     def _visc_ratio(self, g, ratio_name):
@@ -218,8 +218,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             return v, v
         r_i = np.broadcast_to(r_i, (g.P,))
         r_j = np.broadcast_to(r_j, (g.P,))
-        return (np.where(np.broadcast_to(k_i, (g.P,)) != 0, 1.0, r_i),
-                np.where(np.broadcast_to(k_j, (g.P,)) != 0, 1.0, r_j))
+        return (_where(np.broadcast_to(k_i, (g.P,)) != 0, 1.0, r_i),
+                _where(np.broadcast_to(k_j, (g.P,)) != 0, 1.0, r_j))
 
     def _viscous_scale(self, g):
         if g.perm is None:
@@ -233,8 +233,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         v_i, v_j = self._visc_ratio(g, "permanent_ratio_central")
         if type(v_i) is float and v_i == 1.0:
             return None
-        s_i = np.where(g.perm, v_i, 1.0)
-        s_j = np.where(g.perm, v_j, 1.0)
+        s_i = _where(g.perm, v_i, 1.0)
+        s_j = _where(g.perm, v_j, 1.0)
         return s_i, s_j
 
     @property
