@@ -1419,7 +1419,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 and cls.do_rotational_acceleration is friction.do_rotational_acceleration):
             # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
             kick = self._frc * dt
-            kick /= self._st.take(_KICK_ROWS, axis=0)
+            kick /= self._kick_weights()
             self._vel += kick
             self._frc[...] = 0.0
             self._plates_follow()
@@ -1427,6 +1427,13 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             self.do_linear_acceleration(dt)
             self.do_rotational_acceleration(dt)
         self.cool(cool_factor)
+
+    def _kick_weights(self):
+        """(m, m, I) of every sphere as a (3, N) array, kept while masses and inertias stay the same."""
+        kw = self.__dict__.get("_kw")
+        if kw is None or kw[0] != self._params_version:
+            kw = self._kw = (self._params_version, self._st.take(_KICK_ROWS, axis=0))
+        return kw[1]
 
     def cool(self, f=0.8):
         """Damp velocity relative to the affine flow and spin by ``f`` (§4.4), all three rows at once."""

@@ -327,7 +327,7 @@ class Circle(PointLeesEdwards):
 class CircleMass(Circle):
     """Disc with mass ``m`` (mg per m depth) and a force accumulator (mg·µm·s⁻² per m)."""
 
-    m = ArrayField(1.0, positive=True)
+    m = ArrayField(1.0, positive=True, param=True)
     xforce = ArrayField(0.0)
     yforce = ArrayField(0.0)
 
@@ -487,7 +487,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
     phi = ArrayField(-math.pi / 2)
     omega = ArrayField(0.0)
     torque = ArrayField(0.0)
-    inertia = ArrayField(0.5, positive=True)
+    inertia = ArrayField(0.5, positive=True, param=True)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):

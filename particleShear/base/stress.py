@@ -93,6 +93,7 @@ class StressTensorEvaluation:
         self.graphical_output_configuration = None
         self.toDeleteList = []
         self._t = np.zeros((9, 2, 2))
+        self._w_cache = None
 
     for _k, _name in enumerate(TENSOR_NAMES):
         locals()[_name] = _tensor_property(_k)
@@ -270,7 +271,6 @@ class StressTensorEvaluation:
         Otsuki and spin terms come from one 3×3 product over (u_x, u_y, ω)."""
         t = self._t
         ens = reg._ens
-        st = ens._st
         pos = ens._pos
         V = self._volume()
         c = self._centre()
@@ -294,10 +294,7 @@ class StressTensorEvaluation:
         U = ens._vel.copy()
         if shear_rate:
             U[0] -= shear_rate * X[1]
-        Wt = st.take(_MMI_ROWS, axis=0)
-        if mobile is not None:
-            Wt *= mobile
-        Wt *= U
+        Wt = self._mobile_weights(ens, mobile) * U
         M = _dot(Wt, U.T)
         np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
         K = float(M[2, 2]) * (_CT / 2) / V
@@ -318,6 +315,18 @@ class StressTensorEvaluation:
         ti[1, 0] = s_ / 2
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
+
+    def _mobile_weights(self, ens, mobile):
+        """(m, m, I) of the mobile spheres (0 for the others), shape (3, N); kept while the
+        ensemble's masses and the mobility mask (same object while unchanged) stay the same."""
+        key = (ens, ens._params_version, mobile)
+        w = getattr(self, "_w_cache", None)
+        if w is None or w[0][0] is not ens or w[0][1] != key[1] or w[0][2] is not mobile:
+            Wt = ens._st.take(_MMI_ROWS, axis=0)
+            if mobile is not None:
+                Wt *= mobile
+            w = self._w_cache = (key, Wt)
+        return w[1]
 
     def _centre(self):
         """Cell centre as a (2, 1) column (µm), cached per cell size."""
