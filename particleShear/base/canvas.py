@@ -1071,17 +1071,22 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         law = CircleBasicElasticity.call_back_elastic_force_law
         if law is not laws.elastic_force_law or type(c) is not float or holder is None:
             return self._mask_law(call_law_vectorised(law, d, d0, k, c))
+        return _where(d > d0, 0.0, self._builtin_law_inside(d, d0, k, c, holder))
+
+    @staticmethod
+    def _builtin_law_inside(d, d0, k, c, holder):
+        """The built-in law (§2.3) as if every pair were in contact (no cut-off at ``d0``), with its
+        per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder``; same operations as
+        :func:`~particleShear.base.laws.elastic_force_law`."""
         lc = holder.law
         if lc is None or lc[0] != (k, c):
             lc = holder.law = ((k, c), d0 / 1000, -k * c * d0, -k * (1 - c))
         _, d0_cap, a_div, a_lin = lc
         if c == 1:
-            f = a_div * (d0 / np.maximum(d, d0_cap) - 1)   # the linear part is ±0 here
-        elif c == 0:
-            f = a_lin * (d0 - d)                           # the divergent part is ±0 here
-        else:
-            f = a_lin * (d0 - d) + a_div * (d0 / np.maximum(d, d0_cap) - 1)
-        return _where(d > d0, 0.0, f)
+            return a_div * (d0 / np.maximum(d, d0_cap) - 1)   # the linear part is ±0 here
+        if c == 0:
+            return a_lin * (d0 - d)                           # the divergent part is ±0 here
+        return a_lin * (d0 - d) + a_div * (d0 / np.maximum(d, d0_cap) - 1)
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""

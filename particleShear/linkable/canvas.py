@@ -12,7 +12,7 @@ import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import _nz, _where, min_image
-from ..base.laws import call_law_vectorised, elastic_force_law_tensile
+from ..base.laws import call_law_vectorised, elastic_force_law, elastic_force_law_tensile
 from ..base.neighbours import PERMANENT, SLIP
 from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
@@ -24,7 +24,8 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 class _BondStructure:
     """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "tangential", "viscous")
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "tensile", "perm", "tangential",
+                 "viscous")
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
@@ -144,6 +145,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
             B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
             B.law = None
+            B.tensile = None
+            B.perm = perm
             B.tangential = None
             B.viscous = None
         return B
@@ -158,23 +161,43 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         perm = g.perm
         c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
-        f_i = self._central_law(g.d, B.d0, self.k, c_i, B)
-        g.fel = f_i
-        f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, self.k, c_j))
-        stretched = g.d >= B.deq_stretch
-        if _nz(stretched):
-            tensile = SphereLinkable.call_back_elastic_force_law_tensile
-            if tensile is elastic_force_law_tensile:
-                f_t = -self.k * (B.deq - g.d)    # the built-in linear tensile law, inline
-            else:
-                f_t = call_law_vectorised(tensile, g.d, B.deq, self.k)
-            f_i = _where(stretched, f_t, f_i)
-            f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
+        k = self.k
+        if (c_j is c_i and type(c_i) is float and law is elastic_force_law
+                and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile):
+            # built-in laws: beyond d0 (= d_eq for bonds) a bond pulls with k·(d − d_eq) and a contact
+            # has no force (k·(d − 0)·0 = +0); up to d0 both follow the compressive law
+            f_i = f_j = _where(g.d > B.d0, self._tensile_inline(g.d, k, B),
+                               self._builtin_law_inside(g.d, B.d0, k, c_i, B))
+            g.fel = f_i
+        else:
+            f_i = self._central_law(g.d, B.d0, k, c_i, B)
+            g.fel = f_i
+            f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, k, c_j))
+            stretched = g.d >= B.deq_stretch
+            if _nz(stretched):
+                tensile = SphereLinkable.call_back_elastic_force_law_tensile
+                if tensile is elastic_force_law_tensile:
+                    f_t = -k * (B.deq - g.d)    # the built-in linear tensile law, inline
+                else:
+                    f_t = call_law_vectorised(tensile, g.d, B.deq, k)
+                f_i = _where(stretched, f_t, f_i)
+                f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
         rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
         if not (rc_i is rc_j and rc_i == 1.0):
             f_i = f_i * _where(perm, rc_i, 1.0)
             f_j = f_j * _where(perm, rc_j, 1.0)
         self._add_normal(f_i, None if f_j is f_i else f_j)
+
+    @staticmethod
+    def _tensile_inline(d, k, B):
+        """Built-in tensile law ``−k (d_eq − d)``, computed as ``k (d − d_eq)`` (the same number) on
+        bonds and as ``(d − 0)·0 = +0`` on contacts; the factors are kept on the bond structure."""
+        kd = B.tensile
+        if kd is None or kd[0] != k:
+            kd = B.tensile = (k, _where(B.perm, k, 0.0), _where(B.perm, B.deq, 0.0))
+        f = d - kd[2]
+        f *= kd[1]
+        return f
 
     def _tangential_terms(self):
         """Transient contacts and bonds in one two-visit pass; bonds have no Coulomb bound."""
