@@ -489,6 +489,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_strain = 0.0
         self._nl_abs_strain = 0.0
         self._struct = None
+        self._active_epoch = 0    # changes whenever the set of relations may have changed
         self._links_version = 0
         self._images_token = 0
         self._cand_key = None
@@ -651,6 +652,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
                 pt.state[died] = STICK
                 pt.xi[:, died] = 0.0
             pt.active = new_active
+            self._active_epoch += 1
         # Small tables (overhead-bound): every force term runs over all candidate pairs, inactive ones
         # getting exactly zero force (ξ = 0, law = 0 beyond contact, viscous terms masked), so nothing
         # is gathered per step.  Large tables (throughput-bound): the terms run over the active pairs only.
@@ -661,6 +663,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             S = self._pair_structure(new_active if compact else None, d0, perm, ky, kx, D0, D, d, cached_images)
             S.token = token
             self._struct = S
+            self._active_epoch += 1   # relations may have been changed in place by the API
         g = _Geometry()
         g.S = S
         g.ai = S.ai
@@ -1025,6 +1028,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.phase = ""
         self.step_count = 0
         self._half_kick = None
+        self._nu_active = None
 
     INTEGRATORS = ("euler", "verlet")
 
@@ -1157,10 +1161,16 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
     def _viscous_terms(self):
         g = self._g
-        if g.P and self.nu != 0:
-            f = self.nu * self._normal_speed(g)
-            if g.active is not None:
-                f *= g.active   # relations only (×1.0 is exact)
+        nu = self.nu
+        if g.P and nu != 0:
+            if g.active is None:
+                f = nu * self._normal_speed(g)
+            else:
+                # relations only: ν·1 = ν exactly, ν·0 = 0; kept while the relations stay the same
+                na = self._nu_active
+                if na is None or na[0] != self._active_epoch or na[1] != nu:
+                    na = self._nu_active = (self._active_epoch, nu, nu * g.active)
+                f = na[2] * self._normal_speed(g)
             scale = self._viscous_scale(g)
             if scale is None:
                 self._add_normal(f)

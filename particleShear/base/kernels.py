@@ -157,14 +157,15 @@ def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
     returns ``(F, slip2)``: the scalar forces of the two visits (rows, both along
     t_ij as seen from i) and the final slip flag.
     """
+    # viscous part on touching pairs only: ×1 is exact; ×0 gives a zero whose sign may differ from
+    # +0, which changes nothing downstream (added to k_t·ξ, and ξ is never −0)
     ftv_i = nut_i * vt
-    all_touch = _nz(touching) == len(touching)
-    if not all_touch:
-        ftv_i = _where(touching, ftv_i, 0.0)
+    ftv_i *= touching
     if nut_j is nut_i:
         ftv_j = ftv_i
     else:
-        ftv_j = nut_j * vt if all_touch else _where(touching, nut_j * vt, 0.0)
+        ftv_j = nut_j * vt
+        ftv_j *= touching
     if kt_j is kt_i:
         ft = kt_i * xi
     else:
