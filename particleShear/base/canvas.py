@@ -116,7 +116,8 @@ class _Structure:
 class _Flags:
     """What the stress tensors need of the internal/external flags of one mobility mask (§7.2):
     number and float weights (None: all) of internal pairs; slots, targets and signs of external forces."""
-    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_wi", "ext_wj", "ext_slots", "ext_targets", "ext_sign")
+    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_wi", "ext_wj", "ext_slots", "ext_slots2", "ext_targets",
+                 "ext_sign")
 
 
 class _Geometry:
@@ -155,6 +156,7 @@ class CanvasPoints:
         self._pos_version = 0
         self._params_version = 0
         self._yc_key = None
+        self._u_key = None
         self._in_cell = False
         self._images_valid = False
         self.graphical_output_configuration = Graphical_output_configuration()
@@ -356,6 +358,15 @@ class CanvasPoints:
             self._yc = self._pos[1] - self.size_y / 2
             self._yc_key = key
         return self._yc
+
+    def _affine_vx(self, rate):
+        """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s), computed once per
+        position update and rate: the damping and the kinetic stress tensors both need it."""
+        key = (self._pos_version, self.size_y, rate)
+        if self._u_key != key:
+            self._u = self._y_centred() * rate
+            self._u_key = key
+        return self._u
 
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
@@ -743,6 +754,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.ext_wi = wi = np.flatnonzero(S.ext_i)
         F.ext_wj = wj = np.flatnonzero(S.ext_j)
         F.ext_slots = _concat((wi, wj))
+        F.ext_slots2 = _concat((wi, wj + F.P))   # the same entries in the (2, 2P) array (F_i | F_j)
         F.ext_targets = _concat((S.ai.take(wi), S.aj.take(wj)))
         F.ext_sign = _concat((np.ones(len(wi)), -np.ones(len(wj))))
 
@@ -868,7 +880,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             idx = S.idx6 if k == 3 else S.idx6[:4 * P]
             self._frc[:k] += _bincount(idx, W.ravel(), k * n).reshape(k, n)
         self.force_register._set_pairs(self, PairBlock({
-            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj,
+            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "F2": W[:2],
             "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
             "pos_version": self._pos_version}))
@@ -941,6 +953,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.shear = 0
         self._mob_key = None
         self._mob = None
+        self._mob_limits = None
         self._plates = None
 
     def canMove(self, theSphere):
@@ -954,11 +967,16 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             return None
         key = (self._pos_version, self.size_y)
         if self._mob_key != key:
-            a = self._a
-            y, r = a["y"], a["r"]
-            mob = (r < y) & (y < self.size_y - r)
+            y = self._pos[1]
+            lim = self._mob_limits
+            if lim is None or lim[0] != (self.size_y, self._params_version):
+                r = self._a["r"]
+                lim = self._mob_limits = ((self.size_y, self._params_version), r.copy(), self.size_y - r)
+            mob = lim[1] < y
+            mob &= y < lim[2]
             # keep the same object while nothing changed: users of the mask compare by identity
-            if self._mob is None or len(mob) != len(self._mob) or _nz(mob != self._mob):
+            old = self._mob
+            if old is None or len(mob) != len(old) or mob.tobytes() != old.tobytes():
                 self._mob = mob
             self._mob_key = key
         return self._mob
@@ -1457,7 +1475,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         V = self._vel
         rate = getattr(self, "shear_rate", 0)
         if rate:
-            u = self._y_centred() * rate
+            u = self._affine_vx(rate)
             V[0] -= u
             V *= f
             V[0] += u       # u + (v_x − u)·f

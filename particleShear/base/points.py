@@ -282,7 +282,7 @@ def _check_positive(name, value):
 class Circle(PointLeesEdwards):
     """Disc of radius ``diameter/2`` (µm); the cross-section of an infinite cylinder."""
 
-    r = ArrayField(1.0, geometry=True, positive=True)
+    r = ArrayField(1.0, geometry=True, positive=True, param=True)
 
     def __init__(self, color, x, y, diameter, theCanvas=False, doDrawing=False, use_lees_edwards=False):
         PointLeesEdwards.__init__(self, x, y, use_lees_edwards=use_lees_edwards)

@@ -57,7 +57,10 @@ def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
     S = p["S"]
     if not len(S.ext_slots):
         return None
-    if p["antisymmetric"]:
+    F2 = p.get("F2")
+    if F2 is not None:   # forces on i, then on j, side by side: one gather, no sign to apply
+        F = F2.take(S.ext_slots2, axis=1)
+    elif p["antisymmetric"]:
         F = p["Fi"].take(S.ext_slots, axis=1)
         F *= S.ext_sign
     else:
@@ -293,7 +296,7 @@ class StressTensorEvaluation:
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
         if shear_rate:
-            U[0] -= shear_rate * X[1]
+            U[0] -= ens._affine_vx(shear_rate)   # = shear_rate · X[1], shared with the damping
         Wt = self._mobile_weights(ens, mobile) * U
         M = _dot(Wt, U.T)
         np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
