@@ -1047,6 +1047,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.step_count = 0
         self._half_kick = None
         self._nu_active = None
+        self._dt_active = None
 
     INTEGRATORS = ("euler", "verlet")
 
@@ -1495,14 +1496,11 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             return
         pt = self._pairs
         sel = g.S.sel
+        # the factor dt on relations that did not slip, 0 on slipped ones and on inactive candidates
         if sel is None:
-            keep = pt.state != SLIP
-            keep &= g.active
+            kd = _where(pt.state == SLIP, 0.0, self._dt_on_relations(dt, g))
         else:
-            keep = pt.state.take(sel) != SLIP
-        n_keep = _nz(keep)
-        if not n_keep:
-            return
+            kd = _where(pt.state.take(sel) == SLIP, 0.0, dt)
         P = g.P
         vel = self._vel
         Vi = vel.take(g.ai, axis=1)
@@ -1546,16 +1544,20 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         b_ = np.multiply(svx, my, out=inc[1])
         b_ -= rv[1] * mx
         inc -= spin
-        if n_keep != len(keep):
-            inc *= keep * dt   # ×dt then ×0/1, in one pass: (x·dt)·1 = x·(dt·1), x·(dt·0) = ±0
-        else:
-            inc *= dt
+        inc *= kd   # ×dt on kept relations, ×0 (±0) on the others
         if sel is None:
             pt.xi += inc
         else:
             flat = pt.xi.reshape(-1)
             inc += flat.take(g.S.sel2).reshape(2, P)
             flat[g.S.sel2] = inc.reshape(-1)
+
+    def _dt_on_relations(self, dt, g):
+        """``dt`` on the relations among all candidate pairs, 0 elsewhere; kept while relations stay."""
+        c = self._dt_active
+        if c is None or c[0] != self._active_epoch or c[1] != dt:
+            c = self._dt_active = (self._active_epoch, dt, dt * g.active)
+        return c[2]
 
     def move(self, dt=1):
         a = self._a
