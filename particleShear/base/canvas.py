@@ -109,15 +109,15 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx2", "idx6",
+    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
                  "ky", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
 class _Flags:
     """What the stress tensors need of the internal/external flags of one mobility mask (§7.2):
-    number and float weights (None: all) of internal pairs; slots, targets and signs of external forces."""
-    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_wi", "ext_wj", "ext_slots", "ext_slots2", "ext_targets",
-                 "ext_sign")
+    number and float weights (None: all) of internal pairs; positions in the flush's flat force array
+    and target spheres of the external forces."""
+    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_flat", "ext_targets")
 
 
 class _Geometry:
@@ -751,12 +751,11 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         F.n_int = n_int = _nz(S.internal)
         F.w_int = None if n_int == F.P else S.internal.astype(float)
         F.w_int2 = None if F.w_int is None else _concat((F.w_int, F.w_int))
-        F.ext_wi = wi = np.flatnonzero(S.ext_i)
-        F.ext_wj = wj = np.flatnonzero(S.ext_j)
-        F.ext_slots = _concat((wi, wj))
-        F.ext_slots2 = _concat((wi, wj + F.P))   # the same entries in the (2, 2P) array (F_i | F_j)
+        wi = np.flatnonzero(S.ext_i)
+        wj = np.flatnonzero(S.ext_j)
+        P = F.P   # the same entries in the flat (F_i, F_j, …) array of the flush, x row then y row
+        F.ext_flat = np.array((_concat((wi, wj + 2 * P)), _concat((wi + P, wj + 3 * P))))
         F.ext_targets = _concat((S.ai.take(wi), S.aj.take(wj)))
-        F.ext_sign = _concat((np.ones(len(wi)), -np.ones(len(wj))))
 
     def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
         """Per-pair data that change only when the candidates, bonds or images change — or, for a
@@ -787,9 +786,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.ri = r.take(S.ai)
         S.rj = r.take(S.aj)
         S.w2 = np.array((S.ri, S.rj)) / S.d0   # torque lever fractions r_i/(r_i + r_j), r_j/(r_i + r_j) (S1-3)
-        S.idx2 = _concat((S.ai, S.aj))
         # flat bincount index of (x, y, torque) rows: one call accumulates every pair force on the spheres
-        S.idx6 = _concat((S.idx2, S.idx2 + n, S.idx2 + 2 * n))
+        S.idx6 = _concat((S.ai, S.ai + n, S.aj, S.aj + n, S.ai + 2 * n, S.aj + 2 * n))
         S.ky = ky
         S.kx = kx
         S.any_y = ky is not None and bool(_nz(ky))
@@ -840,8 +838,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
     def _flush_pair_forces(self):
         """Apply the collected pair forces to the spheres and put them into the force register.
 
-        Forces on i and j and the tangential torques go into one (3, 2P) array that a single
-        ``bincount`` adds to the (xforce, yforce, torque) rows of the state block.
+        Forces on i and j and the tangential torques go into one flat array, in contiguous (2, P)
+        blocks F_i, F_j, (t_i, t_j), that a single ``bincount`` adds to the (xforce, yforce, torque)
+        rows of the state block.
         """
         g = self._g
         if g is None:
@@ -850,9 +849,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         P = g.P
         S = g.S
         spin = g.ft is not None
-        W = np.empty((3 if spin else 2, 2 * P))
-        Fi = W[:2, :P]
-        Fj = W[:2, P:]
+        W = np.empty((6 if spin else 4) * P)
+        Fi = W[:2 * P].reshape(2, P)
+        Fj = W[2 * P:4 * P].reshape(2, P)
         antisymmetric = g.fn_j is None
         if g.fn_i is None:
             Fi[...] = 0.0
@@ -868,20 +867,21 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             np.multiply(g.n, -g.fn_j, out=Fj)
             if spin:
                 Fj -= Tf
-        ti = tj = None
+        ti = tj = T = None
         if spin:
             df = g.d * g.ft
-            Wt = W[2].reshape(2, P)
+            T = W[4 * P:]
+            Wt = T.reshape(2, P)
             np.multiply(df, S.w2, out=Wt)
             ti = Wt[0]   # indexing, not tuple unpacking (iterating an array is slow)
             tj = Wt[1]
         if P:
-            k = W.shape[0]
-            idx = S.idx6 if k == 3 else S.idx6[:4 * P]
-            self._frc[:k] += _bincount(idx, W.ravel(), k * n).reshape(k, n)
+            k = 3 if spin else 2
+            idx = S.idx6 if spin else S.idx6[:4 * P]
+            self._frc[:k] += _bincount(idx, W, k * n).reshape(k, n)
         self.force_register._set_pairs(self, PairBlock({
-            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "F2": W[:2],
-            "ti": ti, "tj": tj, "T": W[2] if spin else None, "internal": g.internal, "ext_i": g.ext_i,
+            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "W": W,
+            "ti": ti, "tj": tj, "T": T, "internal": g.internal, "ext_i": g.ext_i,
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
             "pos_version": self._pos_version}))
         g.fn_i = None

@@ -6,7 +6,7 @@ forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
 import numpy as np
 
-from .kernels import _concat, _dot
+from .kernels import _dot
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
@@ -55,16 +55,9 @@ def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
 
     ``X`` may give ``pos − c`` already computed."""
     S = p["S"]
-    if not len(S.ext_slots):
+    if not len(S.ext_targets):
         return None
-    F2 = p.get("F2")
-    if F2 is not None:   # forces on i, then on j, side by side: one gather, no sign to apply
-        F = F2.take(S.ext_slots2, axis=1)
-    elif p["antisymmetric"]:
-        F = p["Fi"].take(S.ext_slots, axis=1)
-        F *= S.ext_sign
-    else:
-        F = _concat((p["Fi"].take(S.ext_wi, axis=1), p["Fj"].take(S.ext_wj, axis=1)), axis=1)
+    F = p["W"].take(S.ext_flat)   # from the flat (F_i, F_j, …) array of the flush: one gather, no signs
     if X is None:
         Xt = pos.take(S.ext_targets, axis=1)
         Xt -= c
