@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from .graphics import Graphical_output_configuration
-from .kernels import _bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import _bincount, _concat, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
@@ -102,7 +102,6 @@ _max_reduce = np.maximum.reduce
 _min_reduce = np.minimum.reduce
 #: rows of the state block dividing (xforce, yforce, torque) in the kick: m, m, inertia
 _KICK_ROWS = np.array((_ROW["m"], _ROW["m"], _ROW["inertia"]))
-_ROT = np.array(((-1.0,), (1.0,)))
 #: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
 _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
@@ -110,7 +109,7 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
     __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
 
 
 class _Flags:
@@ -372,9 +371,15 @@ class CanvasPoints:
         """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
         a = self._a
         if self._n:
-            lo = _min_reduce(self._pos, axis=1)
-            hi = _max_reduce(self._pos, axis=1)
-            inside = lo[0] >= 0 and lo[1] >= 0 and hi[0] < self.size_x and hi[1] < self.size_y
+            pos = self._pos
+            Lx, Ly = self.size_x, self.size_y
+            if _min_reduce(pos, axis=None) < 0:
+                inside = False
+            elif Lx == Ly:
+                inside = _max_reduce(pos, axis=None) < Lx
+            else:
+                hi = _max_reduce(pos, axis=1)
+                inside = hi[0] < Lx and hi[1] < Ly
         else:
             inside = True
         if not inside and le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
@@ -597,7 +602,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             return
         if ky is None:
             return
-        self._images = (ky, kx, np.array((float(self.size_x) * kx, float(self.size_y) * ky)))
+        # period counts as floats too: a float times a float array avoids a per-call cast
+        self._images = (ky, ky.astype(float), kx, np.array((float(self.size_x) * kx, float(self.size_y) * ky)))
         self._images_any_y = bool(_nz(ky))
         self._images_version = self._pairs.version
         self._images_valid = True
@@ -631,10 +637,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         if cached_images:
             # no sphere wrapped since the images were found: reuse their period counts (§3.1,
             # one period at a time, so bit-identical to a fresh minimum image)
-            ky, kx, LK = self._images
+            ky, kyf, kx, LK = self._images
             D = D0   # fresh array; the raw differences are not needed again on this path
             if self._images_any_y:
-                D[0] -= float(self._le_shift()) * ky
+                D[0] -= float(self._le_shift()) * kyf
                 dvx_rate = float(self._shear_rate_for_images())
             D -= LK
             dvx = None
@@ -698,13 +704,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             g.n = np.array((nx, ny))
         else:
             g.n = D / d
-        g.t = g.n[::-1] * _ROT   # t_ij = (−n_y, n_x)
+        g.t = t = np.empty((2, C))   # t_ij = (−n_y, n_x)
+        np.negative(g.n[1], out=t[0])
+        t[1] = g.n[0]
         g.D = D
         g.d = d
         if dvx is not None:
             g.dvx = dvx
         elif dvx_rate and S.any_y:
-            g.dvx = -(float(Ly) * dvx_rate) * S.ky
+            g.dvx = -(float(Ly) * dvx_rate) * S.kyf
         else:
             g.dvx = None
         g.d0 = S.d0
@@ -789,6 +797,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         # flat bincount index of (x, y, torque) rows: one call accumulates every pair force on the spheres
         S.idx6 = _concat((S.ai, S.ai + n, S.aj, S.aj + n, S.ai + 2 * n, S.aj + 2 * n))
         S.ky = ky
+        S.kyf = None if ky is None else ky.astype(float)
         S.kx = kx
         S.any_y = ky is not None and bool(_nz(ky))
         if perm is None or not _nz(perm):
@@ -1003,13 +1012,14 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             return
         pl = self._plates
         if pl is None or pl[0] is not mob:
-            imm = ~mob
+            imm = np.flatnonzero(~mob)
             # immobile spheres do not move in y, so their plate (top or bottom) stays with the mask
-            pl = self._plates = (mob, _nz(imm), imm, _where(self._y_centred() > 0, 1.0, -1.0))
-        if pl[1]:
+            pl = self._plates = (mob, imm, _where(self._y_centred().take(imm) > 0, 1.0, -1.0))
+        imm = pl[1]
+        if len(imm):
             v = self.shear_rate * self.size_y / 2
-            _copyto(a["yspeed"], 0.0, where=pl[2])
-            _copyto(a["xspeed"], pl[3] * v, where=pl[2])
+            a["yspeed"][imm] = 0.0
+            a["xspeed"][imm] = pl[2] * v
 
     def transmit_lees_edwards_parameters(self, theSphere):
         theSphere.size_x = self.size_x

@@ -283,14 +283,15 @@ class StressTensorEvaluation:
             t[_LW] = 0.0
         if n_int == S.P or _external_moment(p, pos, c, -sv, out=t[_EXT], X=X) is None:
             t[_EXT] = 0.0
-        Xm = X if mobile is None else X * mobile
+        Wm, mobf = self._mobile_weights(ens, mobile)
+        Xm = X if mobile is None else X * mobf
         np.multiply(_dot(reg._tot_block[:2], Xm.T), sv, out=t[_UNB])
         t[_LIN] = t[_UNB]
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
         if shear_rate:
             U[0] -= ens._affine_vx(shear_rate)   # = shear_rate · X[1], shared with the damping
-        Wt = self._mobile_weights(ens, mobile) * U
+        Wt = Wm * U
         M = _dot(Wt, U.T)
         np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
         K = float(M[2, 2]) * (_CT / 2) / V
@@ -313,16 +314,18 @@ class StressTensorEvaluation:
         t[_ALL] += t[_CEN]
 
     def _mobile_weights(self, ens, mobile):
-        """(m, m, I) of the mobile spheres (0 for the others), shape (3, N); kept while the
-        ensemble's masses and the mobility mask (same object while unchanged) stay the same."""
+        """(m, m, I) of the mobile spheres (0 for the others), shape (3, N), and the mobility mask
+        as floats; kept while the ensemble's masses and the mask (same object while unchanged) stay."""
         key = (ens, ens._params_version, mobile)
         w = getattr(self, "_w_cache", None)
         if w is None or w[0][0] is not ens or w[0][1] != key[1] or w[0][2] is not mobile:
             Wt = ens._st.take(_MMI_ROWS, axis=0)
+            mobf = None
             if mobile is not None:
-                Wt *= mobile
-            w = self._w_cache = (key, Wt)
-        return w[1]
+                mobf = mobile.astype(float)
+                Wt *= mobf
+            w = self._w_cache = (key, Wt, mobf)
+        return w[1], w[2]
 
     def _centre(self):
         """Cell centre as a (2, 1) column (µm), cached per cell size."""
