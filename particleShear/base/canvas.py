@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
 from .kernels import _bincount, _concat, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from . import laws
@@ -35,15 +36,7 @@ __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasP
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
            "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative"]
 
-#: per-sphere arrays and their defaults
-FIELDS = {
-    "x": 0.0, "y": 0.0, "xspeed": 0.0, "yspeed": 0.0, "omega": 0.0, "phi": -math.pi / 2,
-    "r": 1.0, "m": 1.0, "inertia": 0.5, "xforce": 0.0, "yforce": 0.0, "torque": 0.0,
-    "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
-    "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
-}
-#: row of each field in the state block ``CanvasPoints._st`` (fields × spheres)
-_ROW = {name: k for k, name in enumerate(FIELDS)}
+_ROW = ROW
 _PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
            "keep_viscosity_coefficients_constant")
 
@@ -188,12 +181,14 @@ class CanvasPoints:
 
     def _views(self):
         """Per-field views ``_a[name]`` and the grouped rows the kernels gather in one call:
-        ``_pos`` (x, y), ``_vel`` (xspeed, yspeed, omega), ``_frc`` (xforce, yforce, torque)."""
+        ``_pos`` (x, y), ``_coord`` (x, y, phi), ``_vel`` (xspeed, yspeed, omega), ``_frc`` (xforce,
+        yforce, torque)."""
         st = self._block[:, :self._n]
         self._st = st
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
         self._pos = st[0:2]
-        self._vel = st[2:5]
+        self._coord = st[0:3]   # x, y, phi: advanced by (xspeed, yspeed, omega)·dt in one pass
+        self._vel = st[3:6]
         self._frc = st[9:12]
 
     def _attach(self, sphere):
@@ -530,23 +525,29 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._pos_version += 1
         self._disp = np.zeros((2, self._n))
 
-    def _drift(self, dt):
-        """Move every sphere by ``v·dt`` and accumulate its displacement relative to the affine flow.
+    def _drift(self, dt, spin=False):
+        """Move every sphere by ``v·dt`` (and turn it by ``ω·dt`` with ``spin``) and accumulate its
+        displacement relative to the affine flow.
 
         The Verlet criterion works with displacements *relative to the shear flow*
         ``γ̇ (y − Ly/2)``: under Lees-Edwards the flow carries neighbours along with
         each other, so only peculiar motion (plus the small affine stretch of a
         pair, bounded through the accumulated strain) can bring a far pair into contact.
         """
-        step = self._vel[:2] * dt
         rate = float(self._shear_rate_for_images())
         if rate:
             dg = rate * dt
             self._disp[0] -= self._y_centred() * dg
             self._nl_strain += dg
             self._nl_abs_strain += abs(dg)
-        self._pos += step
-        self._disp += step
+        if spin:
+            step = self._vel * dt
+            self._coord += step
+            self._disp += step[:2]
+        else:
+            step = self._vel[:2] * dt
+            self._pos += step
+            self._disp += step
         self._pos_version += 1
 
     def _skin(self):
@@ -1570,10 +1571,9 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         return c[2]
 
     def move(self, dt=1):
-        a = self._a
-        a["phi"] += a["omega"] * dt
+        """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule)."""
         self._integrate_xi(dt)
-        self._drift(dt)
+        self._drift(dt, spin=True)
 
     def _advance_strain(self, dt):
         self.shear = self.shear + self.shear_rate * dt

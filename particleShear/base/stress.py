@@ -6,6 +6,7 @@ forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
 import numpy as np
 
+from .fields import ROW
 from .kernels import _dot
 from .register import SphereSelection
 
@@ -26,7 +27,7 @@ TENSOR_NAMES = (
 (_LW, _OT, _EXT, _LIN, _UNB, _TQ, _TINT, _CEN, _ALL) = range(9)
 
 #: rows (m, m, inertia) of the ensemble state block: weights of (u_x, u_y, ω) in the kinetic tensors
-_MMI_ROWS = np.array((7, 7, 8))
+_MMI_ROWS = np.array((ROW["m"], ROW["m"], ROW["inertia"]))
 
 _CF = 1e-12
 _CL = 1e-6
