@@ -102,7 +102,8 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
     __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond")
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond",
+                 "view")
 
 
 class _Flags:
@@ -113,10 +114,12 @@ class _Flags:
 
 
 class _Geometry:
-    """Per-step arrays over the active pairs (positions at the start of the step)."""
-    __slots__ = ("S", "slots", "active", "ai", "aj", "D", "n", "t", "d", "dvx", "d0", "perm", "trans",
-                 "touching", "internal", "ext_i", "ext_j", "fn_i", "fn_j", "ft", "P", "vn", "vt", "fel", "rv",
-                 "ri", "rj", "Vi", "Vj")
+    """Per-step arrays over the active pairs (positions at the start of the step).
+
+    The per-structure arrays (``S``, ``ai``, ``aj``, ``d0``, ``perm``, ``trans``, ``ri``, ``rj``,
+    ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
+    what the force terms compute on first use starts as the class default None."""
+    fn_i = fn_j = ft = vn = vt = fel = rv = None
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
     dx = property(lambda self: self.D[0])
@@ -682,10 +685,14 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             S.token = token
             self._struct = S
             self._active_epoch += 1   # relations may have been changed in place by the API
+        mob = self._mobile_mask()
+        if S.mob is not mob:
+            if S.mob is _UNSET or mob is None or S.mob is None or _nz(mob != S.mob):
+                self._set_internal_flags(S, mob)
+            else:
+                S.mob = mob   # same mask, new array
         g = _Geometry()
-        g.S = S
-        g.ai = S.ai
-        g.aj = S.aj
+        g.__dict__.update(S.view)
         sel = S.sel
         if sel is None:
             g.slots = slice(None)
@@ -716,27 +723,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             g.dvx = -(float(Ly) * dvx_rate) * S.kyf
         else:
             g.dvx = None
-        g.d0 = S.d0
-        g.perm = S.perm
-        g.trans = S.trans
-        mob = self._mobile_mask()
-        if S.mob is not mob:
-            if S.mob is _UNSET or mob is None or S.mob is None or _nz(mob != S.mob):
-                self._set_internal_flags(S, mob)
-            else:
-                S.mob = mob   # same mask, new array
-        g.internal = S.internal
-        g.ext_i = S.ext_i
-        g.ext_j = S.ext_j
-        g.ri = S.ri
-        g.rj = S.rj
-        g.fn_i = None
-        g.fn_j = None
-        g.ft = None
-        g.vn = None
-        g.vt = None
-        g.fel = None
-        g.rv = None
         self._g = g
         return g
 
@@ -755,6 +741,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             S.ext_i = mi & ~S.internal
             S.ext_j = mj & ~S.internal
         S.mob = mob
+        S.view.update(internal=S.internal, ext_i=S.ext_i, ext_j=S.ext_j)
         S.flags = F = _Flags()
         F.P = len(S.ai)
         F.n_int = n_int = _nz(S.internal)
@@ -818,6 +805,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             shifted[w] = np.sqrt(rx * rx + ry * ry) != d.take(w)
         S.shifted = shifted
         S.mob = _UNSET  # internal/external flags not computed yet
+        # what every step's geometry takes over from the structure
+        S.view = {"S": S, "ai": S.ai, "aj": S.aj, "d0": S.d0, "perm": S.perm, "trans": S.trans,
+                  "ri": S.ri, "rj": S.rj}
         S.bond = None  # bond constants, filled by the linkable canvas
         S.law = None   # constants of the built-in central law
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
