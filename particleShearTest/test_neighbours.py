@@ -283,3 +283,40 @@ class TestCompactedAndFullPairTables(unittest.TestCase):
         np.testing.assert_array_equal(full[2], compact[2])
         np.testing.assert_array_equal(full[3], compact[3])
         np.testing.assert_allclose(full[1], compact[1], rtol=1e-12, atol=1e-12 * np.abs(full[1]).max())
+
+
+class TestStepLeavesNoCyclicGarbage(unittest.TestCase):
+    """A protocol step frees its per-step arrays by reference counting alone.
+
+    Per-step objects that refer to themselves (e.g. a pair structure holding a dictionary that holds
+    the structure) wait for Python's cyclic collector; at N ≳ 10⁴ the memory they pin comes back in
+    large batches that the allocator returns to the system and page-faults in again (measured: 6 →
+    26 ms per step at N = 10,000).  Both pair-table modes, with relations changing every step."""
+
+    def test_no_cycles_per_step(self):
+        import gc
+        from particleShearTest.test_invariants import random_ensemble
+        for compact_from in (10 ** 9, 0):
+            with self.subTest(compact_pairs_from=compact_from):
+                ens = random_ensemble(60, 300.0, seed=11)
+                ens.compact_pairs_from = compact_from
+                ens.makeAllLinksPermanent()
+                ens.cutLine((150.0, 150.0), 0.3)
+                ens.applyingShear = True
+                ev = StressTensorEvaluation(300.0, 300.0)
+                for _ in range(3):
+                    ens.mechanical_simulation_step(cool_factor=0.9, dt=1e-7)
+                gc.collect()
+                gc.disable()
+                try:
+                    for k in range(20):
+                        ens.setShearRate(3000 * math.cos(0.3 * k))
+                        ens.mechanical_simulation_step_calculate_forces()
+                        ens.record_total_particle_forces()
+                        ens.evaluate_stress_tensors(ev)
+                        ens.mechanical_simulation_step_calculate_acceleration(0.9997, 1e-7)
+                        ens.mechanical_simulation_step_calculate_movement(1e-7)
+                        ens.reset_force()
+                    self.assertEqual(gc.collect(), 0)
+                finally:
+                    gc.enable()

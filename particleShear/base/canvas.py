@@ -116,7 +116,7 @@ class _Flags:
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step).
 
-    The per-structure arrays (``S``, ``ai``, ``aj``, ``d0``, ``perm``, ``trans``, ``ri``, ``rj``,
+    The per-structure arrays (``ai``, ``aj``, ``d0``, ``perm``, ``trans``, ``ri``, ``rj``,
     ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
@@ -692,6 +692,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             else:
                 S.mob = mob   # same mask, new array
         g = _Geometry()
+        g.S = S
         g.__dict__.update(S.view)
         sel = S.sel
         if sel is None:
@@ -806,7 +807,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.shifted = shifted
         S.mob = _UNSET  # internal/external flags not computed yet
         # what every step's geometry takes over from the structure
-        S.view = {"S": S, "ai": S.ai, "aj": S.aj, "d0": S.d0, "perm": S.perm, "trans": S.trans,
+        # (not S itself: a structure referring to itself would wait for the cyclic collector)
+        S.view = {"ai": S.ai, "aj": S.aj, "d0": S.d0, "perm": S.perm, "trans": S.trans,
                   "ri": S.ri, "rj": S.rj}
         S.bond = None  # bond constants, filled by the linkable canvas
         S.law = None   # constants of the built-in central law
