@@ -70,6 +70,12 @@ class Force_register:
         self._tot = None
         self._tot_block = None
         self._mom = None
+        if getattr(self, "_manual", True):
+            self._clear_manual()
+
+    def _clear_manual(self):
+        """Empty the lists that the manual ``record_*`` calls fill (only when something was recorded)."""
+        self._manual = False
         self._m_pair = []
         self._m_ext = []
         self._m_imom = []
@@ -91,21 +97,27 @@ class Force_register:
 
     # -- manual API (reference signatures) ----------------------------------------------------
     def record_individual_internal_force(self, target, source, force_vector):
+        self._manual = True
         self._m_pair.append([target, source, list(force_vector)])
 
     def record_total_particle_force(self, target, force_vector):
+        self._manual = True
         self._m_tot[id(target)] = [target, list(force_vector)]
 
     def record_external_force(self, target, force_vector):
+        self._manual = True
         self._m_ext.append([target, list(force_vector)])
 
     def record_external_torque(self, target, moment):
+        self._manual = True
         self._m_emom.append([target, moment])
 
     def record_individual_internal_torque(self, target, source, moment):
+        self._manual = True
         self._m_imom.append([target, source, moment])
 
     def record_unbalanced_moment(self, target, moment):
+        self._manual = True
         self._m_unb[id(target)] = [target, moment]
 
     # -- reference lists, built on demand ---------------------------------------------------------

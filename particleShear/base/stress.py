@@ -104,6 +104,15 @@ class StressTensorEvaluation:
     def _volume(self):
         return (self.size_x * _CL) * (self.size_y * _CL)
 
+    def _cell(self):
+        """(V, centre as a (2, 1) column, 1e-18/V) of the cell, kept per cell size."""
+        key = (self.size_x, self.size_y)
+        c = getattr(self, "_cell_cache", None)
+        if c is None or c[0] != key:
+            V = self._volume()
+            c = self._cell_cache = (key, V, np.array(((self.size_x / 2,), (self.size_y / 2,))), _CF * _CL / V)
+        return c
+
     # -- sphere lists -----------------------------------------------------------------------
     @staticmethod
     def _sphere_values(theSphereList):
@@ -252,8 +261,7 @@ class StressTensorEvaluation:
         reg = force_register
         if (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
                 and len(reg._blocks) == 1 and "S" in reg._blocks[0] and reg._tot is not None
-                and not reg._m_pair and not reg._m_ext
-                and not reg._m_tot and not reg._m_imom and not reg._m_unb):
+                and not reg._manual):
             self._evaluate_arrays(reg, theSphereList.mask, shear_rate)
             return
         self.evaluate_force_stress_tensors(force_register)
@@ -269,12 +277,10 @@ class StressTensorEvaluation:
         t = self._t
         ens = reg._ens
         pos = ens._pos
-        V = self._volume()
-        c = self._centre()
+        _, V, c, sv = self._cell()   # sv: forces × lever arms in SI, per volume
         p = reg._blocks[0]
         S = p["S"]
         n_int = S.n_int
-        sv = _CF * _CL / V   # forces × lever arms in SI, per volume
         X = pos - c
         if n_int and p["antisymmetric"]:
             _internal_moment(p, pos, ens._pos_version, sv, out=t[_LW])

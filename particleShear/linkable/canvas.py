@@ -24,7 +24,7 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 class _BondStructure:
     """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "tensile", "perm", "tangential",
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "params", "tensile", "perm", "tangential",
                  "viscous")
 
 
@@ -145,6 +145,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
             B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
             B.law = None
+            B.params = None
             B.tensile = None
             B.perm = perm
             B.tangential = None
@@ -159,7 +160,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             return
         B = self._bond_structure(g)
         perm = g.perm
-        c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
+        pp = B.params
+        if pp is None or pp[0] != self._params_version:
+            pp = B.params = ((self._params_version,) + self._pair_param("central_repulsion_coefficient", g)
+                             + self._pair_param("permanent_ratio_central", g))
+        c_i = pp[1]
+        c_j = pp[2]
         law = CircleBasicElasticity.call_back_elastic_force_law
         k = self.k
         if (c_j is c_i and type(c_i) is float and law is elastic_force_law
@@ -182,7 +188,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                     f_t = call_law_vectorised(tensile, g.d, B.deq, k)
                 f_i = _where(stretched, f_t, f_i)
                 f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
-        rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
+        rc_i = pp[3]
+        rc_j = pp[4]
         if not (rc_i is rc_j and rc_i == 1.0):
             f_i = f_i * _where(perm, rc_i, 1.0)
             f_j = f_j * _where(perm, rc_j, 1.0)
