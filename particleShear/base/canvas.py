@@ -22,7 +22,7 @@ import numpy as np
 
 from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import _bincount, _concat, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import _bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
@@ -661,17 +661,16 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         perm = self._cand_perm
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
-        changed = _nz(new_active != old)
+        flip = new_active != old
+        changed = _nz(flip)
         if changed:
-            born = new_active & ~old
-            died = old & ~new_active
-            if _nz(born):
-                pt.state[born] = STICK
-                pt.xi[:, born] = 0.0
-                pt.birth[born] = pt.next_births(int(born.sum()))
-            if _nz(died):
-                pt.state[died] = STICK
-                pt.xi[:, died] = 0.0
+            # relations born or ended: stick state, no history; the born ones get the next birth numbers
+            pt.state[flip] = STICK
+            _copyto(pt.xi, 0.0, where=flip)
+            born = new_active & flip
+            n_born = _nz(born)
+            if n_born:
+                pt.birth[born] = pt.next_births(n_born)
             pt.active = new_active
             self._active_epoch += 1
         # Small tables (overhead-bound): every force term runs over all candidate pairs, inactive ones
