@@ -34,27 +34,28 @@ _CL = 1e-6
 _CT = 1e-18
 
 
-def _internal_moment(p, pos, pos_version, scale=_CF * _CL, out=None):
-    """``scale · Σ F_i ⊗ (x_i − x_j)`` over the internal pairs of an engine register block with F_j = −F_i.
+def _internal_moment(p, pos, pos_version, out):
+    """``Σ F_i ⊗ (x_j − x_i)`` (unscaled, into the (2, 2) ``out``) over the internal pairs of an engine
+    register block with F_j = −F_i; the caller multiplies by −scale.
 
-    Internal pairs never act through the boundary, so ``x_i − x_j`` is minus the pair vector of
-    the force phase while no sphere has moved since; otherwise positions are gathered anew.
+    Internal pairs never act through the boundary, so ``x_j − x_i`` is the pair vector of the force
+    phase while no sphere has moved since; otherwise positions are gathered anew.
     """
     S = p["S"]
     F = p["Fi"]
     if S.w_int is not None:
         F = F * S.w_int
     if p["pos_version"] == pos_version:
-        return np.multiply(_dot(F, p["D"].T), -scale, out=out)
+        return _dot(F, p["D"].T, out)
     L = pos.take(p["i"], axis=1)
     L -= pos.take(p["j"], axis=1)
-    return np.multiply(_dot(F, L.T), scale, out=out)
+    return np.negative(_dot(F, L.T), out=out)   # −(Σ F ⊗ (x_i − x_j)); × −scale is exact
 
 
 def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
     """``scale · Σ F ⊗ (x_target − c)`` over the external entries of an engine register block, or None.
 
-    ``X`` may give ``pos − c`` already computed."""
+    ``X`` may give ``pos − c`` already computed; ``scale=None`` leaves the sum unscaled (into ``out``)."""
     S = p["S"]
     if not len(S.ext_targets):
         return None
@@ -64,6 +65,8 @@ def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
         Xt -= c
     else:
         Xt = X.take(S.ext_targets, axis=1)
+    if scale is None:
+        return _dot(F, Xt.T, out)
     return np.multiply(_dot(F, Xt.T), scale, out=out)
 
 
@@ -90,6 +93,7 @@ class StressTensorEvaluation:
         self.graphical_output_configuration = None
         self.toDeleteList = []
         self._t = np.zeros((9, 2, 2))
+        self._raw = np.zeros((5, 2, 2))
         self._w_cache = None
 
     for _k, _name in enumerate(TENSOR_NAMES):
@@ -110,7 +114,9 @@ class StressTensorEvaluation:
         c = getattr(self, "_cell_cache", None)
         if c is None or c[0] != key:
             V = self._volume()
-            c = self._cell_cache = (key, V, np.array(((self.size_x / 2,), (self.size_y / 2,))), _CF * _CL / V)
+            sv = _CF * _CL / V
+            scale5 = np.array((-sv, -1e-18 / V, -sv, sv, sv)).reshape(5, 1, 1)
+            c = self._cell_cache = (key, V, np.array(((self.size_x / 2,), (self.size_y / 2,))), sv, scale5)
         return c
 
     # -- sphere lists -----------------------------------------------------------------------
@@ -277,30 +283,37 @@ class StressTensorEvaluation:
         t = self._t
         ens = reg._ens
         pos = ens._pos
-        _, V, c, sv = self._cell()   # sv: forces × lever arms in SI, per volume
+        _, V, c, sv, _ = self._cell()   # sv: forces × lever arms in SI, per volume
         p = reg._blocks[0]
         S = p["S"]
         n_int = S.n_int
         X = pos - c
-        if n_int and p["antisymmetric"]:
-            _internal_moment(p, pos, ens._pos_version, sv, out=t[_LW])
-        elif n_int:
-            self.evaluate_force_stress_tensors(reg)
-        else:
-            t[_LW] = 0.0
-        if n_int == S.P or _external_moment(p, pos, c, -sv, out=t[_EXT], X=X) is None:
-            t[_EXT] = 0.0
+        # unscaled sums of the first five tensors (LW, Otsuki, external, linear acceleration, unbalanced),
+        # scaled by one multiply: −sv, −1e-18/V, −sv, sv, sv
+        raw = self._raw
+        lw_pairs = n_int and p["antisymmetric"]
+        if lw_pairs:
+            _internal_moment(p, pos, ens._pos_version, raw[_LW])
+        ext = n_int != S.P and _external_moment(p, pos, c, None, out=raw[_EXT], X=X) is not None
         Wm, mobf = self._mobile_weights(ens, mobile)
         Xm = X if mobile is None else X * mobf
-        np.multiply(_dot(reg._tot_block[:2], Xm.T), sv, out=t[_UNB])
-        t[_LIN] = t[_UNB]
+        _dot(reg._tot_block[:2], Xm.T, raw[_UNB])
+        raw[_LIN] = raw[_UNB]
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
         U = ens._vel.copy()
         if shear_rate:
             U[0] -= ens._affine_vx(shear_rate)   # = shear_rate · X[1], shared with the damping
         Wt = Wm * U
         M = _dot(Wt, U.T)
-        np.multiply(M[:2, :2], -1e-18 / V, out=t[_OT])   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
+        raw[_OT] = M[:2, :2]   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
+        np.multiply(raw, self._cell()[4], out=t[:5])
+        if not lw_pairs:
+            if n_int:
+                self.evaluate_force_stress_tensors(reg)
+            else:
+                t[_LW] = 0.0
+        if not ext:
+            t[_EXT] = 0.0
         K = float(M[2, 2]) * (_CT / 2) / V
         cen = t[_CEN]
         cen[0, 0] = cen[1, 1] = -K
@@ -379,7 +392,7 @@ class StressTensorEvaluation:
                 self.evaluate_force_stress_tensors(reg)
                 lw01 = t[_LW, 0, 1]
             else:
-                lw01 = _internal_moment(p, pos, ens._pos_version, _CF * _CL / V)[0, 1]
+                lw01 = _internal_moment(p, pos, ens._pos_version, np.empty((2, 2)))[0, 1] * -(_CF * _CL / V)
         ext01 = 0.0
         if n_int != S.P:
             m_ = _external_moment(p, pos, self._centre(), -(_CF * _CL / V))
