@@ -179,13 +179,14 @@ def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
         ft[1] += ftv_j
     a = np.abs(ft)
     slip1 = a[0] > f_coulomb
-    if _nz(slip1):
+    any_slip1 = _nz(slip1)
+    if any_slip1:
         # visit 2 sees ξ_ji = 0 after a slip in visit 1
         _copyto(ft[1], ftv_j, where=slip1)
         np.abs(ft[1], out=a[1])
     slip2 = a[1] > f_coulomb
     F = np.copysign(np.minimum(a, f_coulomb, out=a), ft, out=a)
-    if _nz(slip1):
+    if any_slip1:
         slip2_or_1 = slip1 | slip2
         _copyto(xi, 0.0, where=slip2_or_1)
     elif _nz(slip2):
