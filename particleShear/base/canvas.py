@@ -136,6 +136,7 @@ class _Geometry:
     ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
+    all_slip = False   # set when the μ = 0 tangential path made every relation slip (no ξ to integrate)
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
     dx = property(lambda self: self.D[0])
@@ -921,6 +922,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     def _drop_relations_of(self, p):
         self._struct = None
+        if self._g is not None:
+            self._g.all_slip = False
         pt = self._pairs
         m = pt.active & ((pt.i == p) | (pt.j == p)) & (pt.state != PERMANENT)
         pt.active[m] = False
@@ -936,6 +939,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
     def _test_pair(self, p, q):
         """Neighbour test of one pair (the scalar ``test_neighbor_relation(theSphere)`` API)."""
         self._struct = None
+        if self._g is not None:
+            self._g.all_slip = False
         a = self._a
         touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
         pt = self._pairs
@@ -1401,6 +1406,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             else:
                 pt.state[g.active] = SLIP
                 pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
+            g.all_slip = True
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1510,7 +1516,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         is multiplied by 0, which leaves their ξ = 0 exactly).
         """
         g = self._g
-        if g is None or not g.P:
+        if g is None or not g.P or g.all_slip:
             return
         pt = self._pairs
         sel = g.S.sel
