@@ -44,7 +44,7 @@ def _internal_moment(p, pos, pos_version, out):
     S = p["S"]
     F = p["Fi"]
     if S.w_int is not None:
-        F = F * S.w_int
+        F = F * S.w_int2.reshape(2, -1)   # weights on both rows: a same-shape product, no broadcasting
     if p["pos_version"] == pos_version:
         return _dot(F, p["D"].T, out)
     L = pos.take(p["i"], axis=1)
@@ -335,7 +335,8 @@ class StressTensorEvaluation:
 
     def _mobile_weights(self, ens, mobile):
         """(m, m, I) of the mobile spheres (0 for the others), shape (3, N), and the mobility mask
-        as floats; kept while the ensemble's masses and the mask (same object while unchanged) stay."""
+        as floats on two rows; kept while the ensemble's masses and the mask (same object while
+        unchanged) stay."""
         key = (ens, ens._params_version, mobile)
         w = getattr(self, "_w_cache", None)
         if w is None or w[0][0] is not ens or w[0][1] != key[1] or w[0][2] is not mobile:
@@ -344,6 +345,7 @@ class StressTensorEvaluation:
             if mobile is not None:
                 mobf = mobile.astype(float)
                 Wt *= mobf
+                mobf = np.array((mobf, mobf))   # for the (2, N) lever arms: same shape, no broadcasting
             w = self._w_cache = (key, Wt, mobf)
         return w[1], w[2]
 
