@@ -481,8 +481,11 @@ class CanvasPointsMass(CanvasPoints):
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):
         """Evaluate every tensor of §7 for the current register, mobile spheres and shear rate."""
-        StressTensorEvaluator.evaluate_stress_tensors(
-            self.force_register, SphereSelection(self, self._mobile_mask()), getattr(self, "shear_rate", 0))
+        mob = self._mobile_mask()
+        sel = self.__dict__.get("_selection")
+        if sel is None or sel.mask is not mob:
+            sel = self._selection = SphereSelection(self, mob)   # kept while the mask is the same object
+        StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
         return StressTensorEvaluator
 
     def reset_force(self):
