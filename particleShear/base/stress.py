@@ -25,6 +25,10 @@ TENSOR_NAMES = (
     "overall_stress_tensor",
 )
 (_LW, _OT, _EXT, _LIN, _UNB, _TQ, _TINT, _CEN, _ALL) = range(9)
+# flat positions of the entries [k, a, b] (4k + 2a + b) written as scalars
+_TQ00, _TQ01, _TQ10, _TQ11 = range(4 * _TQ, 4 * _TQ + 4)
+_TI00, _TI01, _TI10, _TI11 = range(4 * _TINT, 4 * _TINT + 4)
+_CE00, _CE01, _CE10, _CE11 = range(4 * _CEN, 4 * _CEN + 4)
 
 #: rows (m, m, inertia) of the ensemble state block: weights of (u_x, u_y, ω) in the kinetic tensors
 _MMI_ROWS = np.array((ROW["m"], ROW["m"], ROW["inertia"]))
@@ -93,6 +97,7 @@ class StressTensorEvaluation:
         self.graphical_output_configuration = None
         self.toDeleteList = []
         self._t = np.zeros((9, 2, 2))
+        self._tflat = self._t.reshape(-1)
         self._raw = np.zeros((5, 2, 2))
         self._w_cache = None
 
@@ -283,7 +288,7 @@ class StressTensorEvaluation:
         t = self._t
         ens = reg._ens
         pos = ens._pos
-        _, V, c, sv, _ = self._cell()   # sv: forces × lever arms in SI, per volume
+        _, V, c, sv, scale5 = self._cell()   # sv: forces × lever arms in SI, per volume
         p = reg._blocks[0]
         S = p["S"]
         n_int = S.n_int
@@ -306,7 +311,7 @@ class StressTensorEvaluation:
         Wt = Wm * U
         M = _dot(Wt, U.T)
         raw[_OT] = M[:2, :2]   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
-        np.multiply(raw, self._cell()[4], out=t[:5])
+        np.multiply(raw, scale5, out=t[:5])
         if not lw_pairs:
             if n_int:
                 self.evaluate_force_stress_tensors(reg)
@@ -315,21 +320,20 @@ class StressTensorEvaluation:
         if not ext:
             t[_EXT] = 0.0
         K = float(M[2, 2]) * (_CT / 2) / V
-        cen = t[_CEN]
-        cen[0, 0] = cen[1, 1] = -K
-        cen[0, 1] = cen[1, 0] = 0.0
         total = float(np.add.reduce(reg._mom)) if reg._mom is not None else 0.0
         s_ = total * _CT / V
-        tq = t[_TQ]
-        tq[0, 0] = tq[1, 1] = 0.0
-        tq[0, 1] = -s_ / 2
-        tq[1, 0] = s_ / 2
         tint = self._internal_torque(p) if n_int else 0.0
-        s_ = tint * _CT / V
-        ti = t[_TINT]
-        ti[0, 0] = ti[1, 1] = 0.0
-        ti[0, 1] = -s_ / 2
-        ti[1, 0] = s_ / 2
+        s2 = tint * _CT / V
+        # the scalar entries of the torque, internal-torque and spin tensors, through the flat view
+        tf = self._tflat
+        tf[_TQ00] = tf[_TQ11] = 0.0
+        tf[_TQ01] = -s_ / 2
+        tf[_TQ10] = s_ / 2
+        tf[_TI00] = tf[_TI11] = 0.0
+        tf[_TI01] = -s2 / 2
+        tf[_TI10] = s2 / 2
+        tf[_CE00] = tf[_CE11] = -K
+        tf[_CE01] = tf[_CE10] = 0.0
         np.add(t[_LW], t[_TINT], out=t[_ALL])
         t[_ALL] += t[_CEN]
 
