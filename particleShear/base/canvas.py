@@ -681,9 +681,10 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         perm = self._cand_perm
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
-        flip = new_active != old
-        changed = _nz(flip)
+        # most steps keep every relation: a byte comparison of the masks is cheaper than != and a count
+        changed = new_active.tobytes() != old.tobytes()
         if changed:
+            flip = new_active != old
             # relations born or ended: stick state, no history; the born ones get the next birth numbers
             pt.state[flip] = STICK
             _copyto(pt.xi, 0.0, where=flip)
