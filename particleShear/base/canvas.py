@@ -119,7 +119,7 @@ class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
     __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
                  "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond",
-                 "view")
+                 "view", "flush")
 
 
 class _Flags:
@@ -826,6 +826,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             shifted[w] = np.sqrt(rx * rx + ry * ry) != d.take(w)
         S.shifted = shifted
         S.mob = _UNSET  # internal/external flags not computed yet
+        S.flush = None  # the force array of the flush, reused from step to step
         # what every step's geometry takes over from the structure
         # (not S itself: a structure referring to itself would wait for the cyclic collector)
         S.view = {"ai": S.ai, "aj": S.aj, "d0": S.d0, "perm": S.perm, "trans": S.trans,
@@ -857,12 +858,21 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.fn_i = g.fn_i + f_i
         g.fn_j = g.fn_j + (f_i if f_j is None else f_j)
 
-    def _flush_pair_forces(self):
+    @staticmethod
+    def _flush_arrays(P, spin):
+        """The flat force array of a flush and its views: F_i, F_j (2, P), torques (2P,) and (2, P)."""
+        W = np.empty((6 if spin else 4) * P)
+        T = W[4 * P:] if spin else None
+        return (W, W[:2 * P].reshape(2, P), W[2 * P:4 * P].reshape(2, P), T,
+                None if T is None else T.reshape(2, P))
+
+    def _flush_pair_forces(self, reuse=False):
         """Apply the collected pair forces to the spheres and put them into the force register.
 
         Forces on i and j and the tangential torques go into one flat array, in contiguous (2, P)
         blocks F_i, F_j, (t_i, t_j), that a single ``bincount`` adds to the (xforce, yforce, torque)
-        rows of the state block.
+        rows of the state block.  With ``reuse`` (one flush per force phase, the register cleared
+        before it) that array is kept with the pair structure from step to step.
         """
         g = self._g
         if g is None:
@@ -871,9 +881,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         P = g.P
         S = g.S
         spin = g.ft is not None
-        W = np.empty((6 if spin else 4) * P)
-        Fi = W[:2 * P].reshape(2, P)
-        Fj = W[2 * P:4 * P].reshape(2, P)
+        if reuse:
+            fa = S.flush
+            if fa is None or (fa[3] is None) == spin:
+                fa = S.flush = self._flush_arrays(P, spin)
+        else:
+            fa = self._flush_arrays(P, spin)
+        W = fa[0]
+        Fi = fa[1]
+        Fj = fa[2]
         antisymmetric = g.fn_j is None
         if g.fn_i is None:
             Fi[...] = 0.0
@@ -889,11 +905,11 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             np.multiply(g.n, -g.fn_j, out=Fj)
             if spin:
                 Fj -= Tf
-        ti = tj = T = None
+        ti = tj = None
+        T = fa[3]
         if spin:
             df = g.d * g.ft
-            T = W[4 * P:]
-            Wt = T.reshape(2, P)
+            Wt = fa[4]
             np.multiply(df, S.w2, out=Wt)
             ti = Wt[0]   # indexing, not tuple unpacking (iterating an array is slow)
             tj = Wt[1]
@@ -1248,7 +1264,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             self._in_force_phase = False
             if predicted is not None:
                 self._restore_velocities(predicted)
-        self._flush_pair_forces()
+        self._flush_pair_forces(reuse=True)
         if self.stability_guard is not None:
             self.stability_guard.check(self, step=self.step_count, phase=self.phase, dt=self._last_dt)
 
