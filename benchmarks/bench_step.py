@@ -16,7 +16,7 @@ particles after pre-equilibration), which is calmer than the relaxed-random scen
 Baselines measured in the same run: the legacy O(N²) pure-Python neighbour test of
 the reference (§4.2, all ordered pairs, one relation search each) at N = 150, a
 plain all-pairs NumPy minimum-image distance computation per step at N = 150 and 1,000,
-and the same protocol step on a 40-sphere scene (the fixed cost of the ~180 NumPy calls
+and the same protocol step on a 40-sphere scene (the fixed cost of the ~145 NumPy calls
 and the Python around them, which no vectorisation removes).
 
 Targets (one core): ≤ 300 µs/step at N = 150, ≤ 1 µs per particle-step at N = 10,000,
