@@ -20,9 +20,10 @@ import math
 
 import numpy as np
 
-from .fields import FIELDS, ROW
+from .fields import FIELDS, MASS_ROWS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import _bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import (_bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry,
+                      tangential_two_pass)
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator
@@ -36,7 +37,6 @@ __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasP
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
            "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative"]
 
-_ROW = ROW
 _PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
            "keep_viscosity_coefficients_constant")
 
@@ -109,8 +109,7 @@ def _zeros(n):
 # ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
 _max_reduce = np.maximum.reduce
 _min_reduce = np.minimum.reduce
-#: rows of the state block dividing (xforce, yforce, torque) in the kick: m, m, inertia
-_KICK_ROWS = np.array((_ROW["m"], _ROW["m"], _ROW["inertia"]))
+_MASS_ROWS = np.array(MASS_ROWS)
 #: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
 _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
@@ -118,8 +117,8 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
     __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j", "flags", "bond",
-                 "view", "flush")
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j",
+                 "flags", "bond", "view", "flush")
 
 
 class _Flags:
@@ -206,10 +205,11 @@ class CanvasPoints:
         st = self._block[:, :self._n]
         self._st = st
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
-        self._pos = st[0:2]
-        self._coord = st[0:3]   # x, y, phi: advanced by (xspeed, yspeed, omega)·dt in one pass
-        self._vel = st[3:6]
-        self._frc = st[9:12]
+        x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
+        self._pos = st[x:x + 2]
+        self._coord = st[x:x + 3]   # x, y, phi: advanced by (xspeed, yspeed, omega)·dt in one pass
+        self._vel = st[vx:vx + 3]
+        self._frc = st[fx:fx + 3]
 
     def _attach(self, sphere):
         if sphere.__dict__.get("_ens") is not None:
@@ -224,7 +224,7 @@ class CanvasPoints:
         cls = type(sphere)
         col = self._block[:, n]
         for name, default in FIELDS.items():
-            col[_ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
+            col[ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
         self._n = n + 1
         self._views()
         d = sphere.__dict__
@@ -345,7 +345,7 @@ class CanvasPoints:
         a = self._a
         rate = getattr(self, "shear_rate", 0)
         if rate:
-            u = self._y_centred() * rate
+            u = self._affine_vx(rate)
             a["xspeed"][:] = u + (a["xspeed"] - u) * f
         else:
             a["xspeed"] *= f
@@ -524,6 +524,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_abs_strain = 0.0
         self._struct = None
         self._active_epoch = 0    # changes whenever the set of relations may have changed
+        self._rel_factors = (None, {})
         self._links_version = 0
         self._images_token = 0
         self._cand_key = None
@@ -746,6 +747,18 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             g.dvx = None
         self._g = g
         return g
+
+    def _on_relations(self, value, g):
+        """``value`` on the relations among all candidate pairs and 0 elsewhere (``value · active``),
+        kept while the relations stay the same (ν of the viscous term, dt of the ξ rule)."""
+        epoch, kept = self._rel_factors
+        if epoch != self._active_epoch or len(kept) > 8:
+            kept = {}
+            self._rel_factors = (self._active_epoch, kept)
+        f = kept.get(value)
+        if f is None:
+            f = kept[value] = value * g.active
+        return f
 
     def _set_internal_flags(self, S, mob):
         """Internal/external flags of the active pairs for mobility mask ``mob`` (§7.2), and what the
@@ -1089,8 +1102,6 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.phase = ""
         self.step_count = 0
         self._half_kick = None
-        self._nu_active = None
-        self._dt_active = None
 
     INTEGRATORS = ("euler", "verlet")
 
@@ -1228,11 +1239,8 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             if g.active is None:
                 f = nu * self._normal_speed(g)
             else:
-                # relations only: ν·1 = ν exactly, ν·0 = 0; kept while the relations stay the same
-                na = self._nu_active
-                if na is None or na[0] != self._active_epoch or na[1] != nu:
-                    na = self._nu_active = (self._active_epoch, nu, nu * g.active)
-                f = na[2] * self._normal_speed(g)
+                # relations only: ν·1 = ν exactly, ν·0 = 0
+                f = self._on_relations(nu, g) * self._normal_speed(g)
             scale = self._viscous_scale(g)
             if scale is None:
                 self._add_normal(f)
@@ -1510,7 +1518,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         """(m, m, I) of every sphere as a (3, N) array, kept while masses and inertias stay the same."""
         kw = self.__dict__.get("_kw")
         if kw is None or kw[0] != self._params_version:
-            kw = self._kw = (self._params_version, self._st.take(_KICK_ROWS, axis=0))
+            kw = self._kw = (self._params_version, self._st.take(_MASS_ROWS, axis=0))
         return kw[1]
 
     def cool(self, f=0.8):
@@ -1543,7 +1551,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         P = g.P
         # the factor dt on relations that did not slip, 0 on slipped ones and on inactive candidates
         if sel is None:
-            kd = _where(pt.state == _SLIP8, _zeros(P), self._dt_on_relations(dt, g))
+            kd = _where(pt.state == _SLIP8, _zeros(P), self._on_relations(dt, g))
         else:
             kd = _where(pt.state.take(sel) == _SLIP8, 0.0, dt)
         vel = self._vel
@@ -1595,13 +1603,6 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             flat = pt.xi.reshape(-1)
             inc += flat.take(g.S.sel2).reshape(2, P)
             flat[g.S.sel2] = inc.reshape(-1)
-
-    def _dt_on_relations(self, dt, g):
-        """``dt`` on the relations among all candidate pairs, 0 elsewhere; kept while relations stay."""
-        c = self._dt_active
-        if c is None or c[0] != self._active_epoch or c[1] != dt:
-            c = self._dt_active = (self._active_epoch, dt, dt * g.active)
-        return c[2]
 
     def move(self, dt=1):
         """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule)."""

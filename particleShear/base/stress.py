@@ -6,7 +6,7 @@ forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
 import numpy as np
 
-from .fields import ROW
+from .fields import MASS_ROWS
 from .kernels import _dot
 from .register import SphereSelection
 
@@ -31,7 +31,7 @@ _TI00, _TI01, _TI10, _TI11 = range(4 * _TINT, 4 * _TINT + 4)
 _CE00, _CE01, _CE10, _CE11 = range(4 * _CEN, 4 * _CEN + 4)
 
 #: rows (m, m, inertia) of the ensemble state block: weights of (u_x, u_y, ω) in the kinetic tensors
-_MMI_ROWS = np.array((ROW["m"], ROW["m"], ROW["inertia"]))
+_MASS_ROWS = np.array(MASS_ROWS)
 
 _CF = 1e-12
 _CL = 1e-6
@@ -114,7 +114,8 @@ class StressTensorEvaluation:
         return (self.size_x * _CL) * (self.size_y * _CL)
 
     def _cell(self):
-        """(V, centre as a (2, 1) column, 1e-18/V) of the cell, kept per cell size."""
+        """(key, V, centre as a (2, 1) column, sv = 1e-18/V, scales of the first five tensors) of the
+        cell, kept per cell size."""
         key = (self.size_x, self.size_y)
         c = getattr(self, "_cell_cache", None)
         if c is None or c[0] != key:
@@ -344,7 +345,7 @@ class StressTensorEvaluation:
         key = (ens, ens._params_version, mobile)
         w = getattr(self, "_w_cache", None)
         if w is None or w[0][0] is not ens or w[0][1] != key[1] or w[0][2] is not mobile:
-            Wt = ens._st.take(_MMI_ROWS, axis=0)
+            Wt = ens._st.take(_MASS_ROWS, axis=0)
             mobf = None
             if mobile is not None:
                 mobf = mobile.astype(float)
@@ -354,12 +355,8 @@ class StressTensorEvaluation:
         return w[1], w[2]
 
     def _centre(self):
-        """Cell centre as a (2, 1) column (µm), cached per cell size."""
-        key = (self.size_x, self.size_y)
-        if getattr(self, "_c_key", None) != key:
-            self._c = np.array(((self.size_x / 2,), (self.size_y / 2,)))
-            self._c_key = key
-        return self._c
+        """Cell centre as a (2, 1) column (µm)."""
+        return self._cell()[2]
 
     @staticmethod
     def _internal_torque(p):

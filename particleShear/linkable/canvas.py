@@ -24,7 +24,7 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 class _BondStructure:
     """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "params", "tensile", "perm", "tangential",
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "params", "tensile", "tangential",
                  "viscous")
 
 
@@ -147,7 +147,6 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             B.law = None
             B.params = None
             B.tensile = None
-            B.perm = perm
             B.tangential = None
             B.viscous = None
         return B
@@ -172,7 +171,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                 and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile):
             # built-in laws: beyond d0 (= d_eq for bonds) a bond pulls with k·(d − d_eq) and a contact
             # has no force (k·(d − 0)·0 = +0); up to d0 both follow the compressive law
-            f_i = f_j = _where(g.d > B.d0, self._tensile_inline(g.d, k, B),
+            f_i = f_j = _where(g.d > B.d0, self._tensile_inline(g.d, k, B, perm),
                                self._builtin_law_inside(g.d, B.d0, k, c_i, B))
             g.fel = f_i
         else:
@@ -196,12 +195,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._add_normal(f_i, None if f_j is f_i else f_j)
 
     @staticmethod
-    def _tensile_inline(d, k, B):
+    def _tensile_inline(d, k, B, perm):
         """Built-in tensile law ``−k (d_eq − d)``, computed as ``k (d − d_eq)`` (the same number) on
         bonds and as ``(d − 0)·0 = +0`` on contacts; the factors are kept on the bond structure."""
         kd = B.tensile
         if kd is None or kd[0] != k:
-            kd = B.tensile = (k, _where(B.perm, k, 0.0), _where(B.perm, B.deq, 0.0))
+            kd = B.tensile = (k, _where(perm, k, 0.0), _where(perm, B.deq, 0.0))
         f = d - kd[2]
         f *= kd[1]
         return f

@@ -373,7 +373,8 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
         self.relative_transversal_link_strength = relative_transversal_link_strength
         self.dt = None
         self.dt_max = None
-        self.function_call = call_string("Simulation_dermal_filler_rheology", root_folder=root_folder,
+        # the leading arguments of the header's function-call line, shared with the subclass
+        self._call_arguments = dict(root_folder=root_folder,
             do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N, packing_fraction=packing_fraction,
             bimodal_factor=bimodal_factor, amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres,
             density=density, mu=mu, relative_viscosity=relative_viscosity,
@@ -381,8 +382,9 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             relative_transversal_link_strength=relative_transversal_link_strength,
             central_repulsion_coefficient=central_repulsion_coefficient,
             avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-            avoid_height_spanning_particles=avoid_height_spanning_particles,
-            doCutByTriangulation=doCutByTriangulation, doDrawing=doDrawing)
+            avoid_height_spanning_particles=avoid_height_spanning_particles)
+        self.function_call = call_string("Simulation_dermal_filler_rheology", **self._call_arguments,
+                                         doCutByTriangulation=doCutByTriangulation, doDrawing=doDrawing)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
         """Longer fixed-boundary relaxation for low friction, amplitude or viscosity (§8.4)."""
@@ -404,9 +406,9 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             print("Adjustment factor of pre-equilibration time for low amplitude and friction: " + str(F))
         return F
 
-    def initEnsemble(self, do_debug=False):
-        """Legacy builder with every material parameter (§6.11)."""
-        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(
+    def _builder_arguments(self, do_debug):
+        """Keyword arguments the builders of this class and its subclass share."""
+        return dict(
             size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
             Young_modulus_spheres=self.Young_modulus_spheres, density=self.density,
             bimodal_factor=self.bimodal_factor, cut_lines=self.cut_lines, do_permanent_links=self.do_permanent_links,
@@ -417,6 +419,10 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             avoid_height_spanning_particles=self.avoid_height_spanning_particles,
             doCutByTriangulation=self.doCutByTriangulation, doDrawing=False, do_debug=do_debug, rng=self.rng,
             verbose=self.verbose)
+
+    def initEnsemble(self, do_debug=False):
+        """Legacy builder with every material parameter (§6.11)."""
+        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(**self._builder_arguments(do_debug))
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max
@@ -445,15 +451,7 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         self.cut_top_bottom = cut_top_bottom
         self.remove_link_fraction = remove_link_fraction
         self.edge_fuzziness = edge_fuzziness
-        self.function_call = call_string("Simulation_interlocking_rheology", root_folder=root_folder,
-            do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N, packing_fraction=packing_fraction,
-            bimodal_factor=bimodal_factor, amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres,
-            density=density, mu=mu, relative_viscosity=relative_viscosity,
-            relative_y_scale_force=relative_y_scale_force, relative_frequency=relative_frequency,
-            relative_transversal_link_strength=relative_transversal_link_strength,
-            central_repulsion_coefficient=central_repulsion_coefficient,
-            avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-            avoid_height_spanning_particles=avoid_height_spanning_particles,
+        self.function_call = call_string("Simulation_interlocking_rheology", **self._call_arguments,
             interface_reenforcement_central=interface_reenforcement_central,
             interface_reenforcement_tangential=interface_reenforcement_tangential,
             keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
@@ -463,20 +461,12 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     def initEnsemble(self, do_debug=False):
         """Adjustable-interface builder (§6.4) with ``anticipated_amplitude = amplitude``."""
         self.theEnsemble = EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
-            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
-            Young_modulus_spheres=self.Young_modulus_spheres, density=self.density,
-            bimodal_factor=self.bimodal_factor, cut_lines=self.cut_lines, do_permanent_links=self.do_permanent_links,
-            theTk=False, do_pre_equilibration=True, relative_viscosity=self.relative_viscosity,
-            central_repulsion_coefficient=self.central_repulsion_coefficient, anticipated_amplitude=self.amplitude,
-            relative_transversal_link_strength=self.relative_transversal_link_strength,
-            avoid_horizontal_angle_degree=self.avoid_horizontal_angle_degree,
-            avoid_height_spanning_particles=self.avoid_height_spanning_particles,
+            **self._builder_arguments(do_debug),
             interface_reenforcement_central=self.interface_reenforcement_central,
             interface_reenforcement_tangential=self.interface_reenforcement_tangential,
             keep_viscosity_coefficients_constant=self.keep_viscosity_coefficients_constant,
-            cut_top_bottom=self.cut_top_bottom, doCutByTriangulation=self.doCutByTriangulation,
-            remove_link_fraction=self.remove_link_fraction, edge_fuzziness=self.edge_fuzziness, doDrawing=False,
-            do_debug=do_debug, rng=self.rng, verbose=self.verbose)
+            cut_top_bottom=self.cut_top_bottom, remove_link_fraction=self.remove_link_fraction,
+            edge_fuzziness=self.edge_fuzziness)
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max
