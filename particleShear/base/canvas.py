@@ -135,6 +135,8 @@ class _Geometry:
     ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
+    parts = None       # [(term, f_i, f_j)] of the central terms, for the register's per-visit lists
+    ft_visits = None   # (2, P) scalar forces of the two tangential visits, or 0.0 when every contact slipped at μ = 0
     all_slip = False   # set when the μ = 0 tangential path made every relation slip (no ξ to integrate)
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
@@ -856,11 +858,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             self.test_neighbor_relation()
         return self._g
 
-    def _add_normal(self, f_i, f_j=None):
+    def _add_normal(self, f_i, f_j=None, term="elastic"):
         """Add scalar central forces along n_ij: ``f_i`` on i, ``f_j`` (default ``f_i``) on j (reversed).
 
-        The first term is kept by reference (terms never modify their results afterwards)."""
+        The first term is kept by reference (terms never modify their results afterwards); each term is
+        also noted by name for the register's per-visit lists (built only when read)."""
         g = self._g
+        if g.parts is None:
+            g.parts = []
+        g.parts.append((term, f_i, f_j))
         if f_j is None and g.fn_j is None:
             g.fn_i = f_i if g.fn_i is None else g.fn_i + f_i
             return
@@ -934,10 +940,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "W": W,
             "ti": ti, "tj": tj, "T": T, "internal": g.internal, "ext_i": g.ext_i,
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
-            "pos_version": self._pos_version}))
+            "pos_version": self._pos_version,
+            # per-visit terms for the reference lists of the register (read only when asked for)
+            "parts": g.parts, "ft_visits": g.ft_visits, "n": g.n, "t": g.t, "d": g.d, "w2": S.w2,
+            "touching": g.touching, "perm": g.perm, "birth": self._pairs.birth, "slots": g.slots}))
         g.fn_i = None
         g.fn_j = None
         g.ft = None
+        g.parts = None
+        g.ft_visits = None
 
     def _term_done(self):
         if not self._in_force_phase:
@@ -1235,6 +1246,9 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _viscous_terms(self):
         g = self._g
         nu = self.nu
+        if g.P and nu == 0:
+            # no force, but the reference still registers ν·v_n = 0 per visit (noted for the register only)
+            g.parts = (g.parts or []) + [("viscous", None, None)]
         if g.P and nu != 0:
             if g.active is None:
                 f = nu * self._normal_speed(g)
@@ -1243,9 +1257,9 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
                 f = self._on_relations(nu, g) * self._normal_speed(g)
             scale = self._viscous_scale(g)
             if scale is None:
-                self._add_normal(f)
+                self._add_normal(f, None, "viscous")
             else:
-                self._add_normal(f * scale[0], f * scale[1])
+                self._add_normal(f * scale[0], f * scale[1], "viscous")
 
     def elastic_force(self):
         """All-pairs variant (reference API): a neighbour update, then the elastic term."""
@@ -1435,6 +1449,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 pt.state[g.active] = SLIP
                 pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
             g.all_slip = True
+            g.ft_visits = 0.0   # every visit applies a zero force (Coulomb bound 0)
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1470,6 +1485,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 state = state + g.S.bond.perm_code
             pt.state[sel] = state
             pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
+        g.ft_visits = F
         f = F[0] + F[1]
         f *= 0.5     # = F1/2 + F2/2 exactly (halving is exact in binary floating point)
         self._add_tangential(f)

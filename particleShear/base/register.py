@@ -70,6 +70,7 @@ class Force_register:
         self._tot = None
         self._tot_block = None
         self._mom = None
+        self._lists = None
         if getattr(self, "_manual", True):
             self._clear_manual()
 
@@ -124,72 +125,154 @@ class Force_register:
     def _spheres(self):
         return self._ens.sphereList
 
-    @property
-    def pair_register(self):
-        out = []
+    def _engine_lists(self):
+        """The engine part of the six reference lists, built once per force phase when first read."""
+        cache = self.__dict__.get("_lists")
+        if cache is not None and cache[0] is self._blocks and cache[1] == len(self._blocks):
+            return cache[2]
+        out = {"pair": [], "ext": [], "imom": [], "emom": []}
         for p in self._blocks:
-            sl = self._spheres()
-            for k in np.flatnonzero(_live(p, "internal")):
-                i, j = int(p["i"][k]), int(p["j"][k])
-                out.append([sl[i], sl[j], [float(p["fix"][k]), float(p["fiy"][k])]])
-                out.append([sl[j], sl[i], [float(p["fjx"][k]), float(p["fjy"][k])]])
-        return out + self._m_pair
-
-    @property
-    def external_force_register(self):
-        out = []
-        for p in self._blocks:
-            sl = self._spheres()
-            for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
-                i, j = int(p["i"][k]), int(p["j"][k])
-                if p["ext_i"][k]:
-                    out.append([sl[i], [float(p["fix"][k]), float(p["fiy"][k])]])
-                if p["ext_j"][k]:
-                    out.append([sl[j], [float(p["fjx"][k]), float(p["fjy"][k])]])
-        return out + self._m_ext
-
-    def _moments(self, which):
-        out = []
-        for p in self._blocks:
-            if p.get("ti") is None:
-                continue
-            sl = self._spheres()
-            if which == "internal":
-                for k in np.flatnonzero(_live(p, "internal")):
-                    i, j = int(p["i"][k]), int(p["j"][k])
-                    out.append([sl[i], sl[j], float(p["ti"][k])])
-                    out.append([sl[j], sl[i], float(p["tj"][k])])
-            else:
-                for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
-                    i, j = int(p["i"][k]), int(p["j"][k])
-                    if p["ext_i"][k]:
-                        out.append([sl[i], float(p["ti"][k])])
-                    if p["ext_j"][k]:
-                        out.append([sl[j], float(p["tj"][k])])
+            _visit_entries(p, self._spheres(), out)
+        self._lists = (self._blocks, len(self._blocks), out)
         return out
 
     @property
+    def pair_register(self):
+        """``[target, source, [F_x, F_y]]`` per internal pair-force entry, in the reference's order (§7.1):
+        every central elastic visit, then every central viscous visit, then two entries per tangential
+        visit (visiting sphere, then its neighbour); visits by sphere in ``sphereList`` order and, per
+        sphere, by relation in ``neighbors`` order."""
+        return self._engine_lists()["pair"] + self._m_pair
+
+    @property
+    def external_force_register(self):
+        """``[target, [F_x, F_y]]`` per force from an immobile sphere or through the periodic boundary,
+        at the place of its visit in the order of :attr:`pair_register`."""
+        return self._engine_lists()["ext"] + self._m_ext
+
+    @property
     def internal_moment_register(self):
-        return self._moments("internal") + self._m_imom
+        """``[target, source, M]`` per internal tangential torque, two per tangential visit."""
+        return self._engine_lists()["imom"] + self._m_imom
 
     @property
     def external_moment_register(self):
-        return self._moments("external") + self._m_emom
+        """``[target, M]`` per external tangential torque (stored, never used by a tensor)."""
+        return self._engine_lists()["emom"] + self._m_emom
 
     @property
     def total_particle_force_register(self):
+        """``[sphere, [F_x, F_y]]``: the total force of every mobile sphere, in ``sphereList`` order."""
         out = []
         if self._tot is not None:
             mobile, fx, fy = self._tot
             sl = self._spheres()
-            for k in np.flatnonzero(mobile):
-                out.append([sl[k], [float(fx[k]), float(fy[k])]])
+            idx = range(len(fx)) if mobile is None else np.flatnonzero(mobile).tolist()
+            fx, fy = fx.tolist(), fy.tolist()
+            out = [[sl[k], [fx[k], fy[k]]] for k in idx]
         return out + list(self._m_tot.values())
 
     @property
     def unbalanced_moment_register(self):
+        """``[sphere, T]``: the net torque of every sphere, immobile ones included (reference quirk)."""
         out = []
         if self._mom is not None:
             sl = self._spheres()
-            out = [[sl[k], float(t)] for k, t in enumerate(self._mom)]
+            out = [[sl[k], t] for k, t in enumerate(self._mom.tolist())]
         return out + list(self._m_unb.values())
+
+
+def _visit_entries(p, sl, out):
+    """Append the reference entries of one engine register block to the lists in ``out`` (§7.1, §2.7-2.8).
+
+    Each relation (pair k, i < j) is visited twice: from i (side 0) and from j (side 1).  Visits are
+    ordered by visiting sphere, then by the visitor's relation order (birth of the relation, then
+    partner index).  A central term gives one entry per visit, on the visiting sphere; a tangential
+    visit with scalar force F gives ``±F/2·t`` on the visitor and its neighbour (eq. S1-3 torques
+    ``d·F/2·r/(r_i + r_j)`` likewise).  Each entry goes to the internal list, the external list or
+    nowhere according to the pair's flags for its target (target immobile: dropped; source immobile
+    or the pair acting through the boundary: external).
+    """
+    i_all, j_all = p["i"], p["j"]
+    if not len(i_all):
+        return
+    active = p.get("active")
+    ks = np.arange(len(i_all)) if active is None else np.flatnonzero(active)
+    if not len(ks):
+        return
+    birth = p["birth"]
+    slots = p.get("slots", slice(None))
+    b = (birth[slots] if isinstance(slots, slice) else birth.take(slots))[ks]
+    i, j = i_all[ks], j_all[ks]
+    visitor = np.concatenate((i, j))
+    partner = np.concatenate((j, i))
+    side = np.repeat((0, 1), len(ks))
+    order = np.lexsort((partner, np.concatenate((b, b)), visitor))
+    vk = np.concatenate((ks, ks))[order]      # pair of each visit, in visit order
+    vs = side[order]                          # 0: visit from i, 1: visit from j
+    n, t = p["n"], p["t"]
+    internal, ext_i, ext_j = p["internal"], p["ext_i"], p["ext_j"]
+    touching, perm = p["touching"], p["perm"]
+    interacting = touching if perm is None else (touching | perm)   # elastic and tangential visits happen
+
+    # per (pair, side-of-target): where an entry on that target goes (1 internal, 2 external, 0 dropped)
+    dest = np.zeros((2, len(i_all)), dtype=np.int8)
+    dest[0][ext_i] = 2
+    dest[1][ext_j] = 2
+    dest[0][internal] = 1
+    dest[1][internal] = 1
+
+    def emit(kind, k, s_target, target, source, value):
+        dd = dest[s_target, k]
+        if dd == 1:
+            out["pair" if kind == "F" else "imom"].append([sl[target], sl[source], value])
+        elif dd == 2:
+            out["ext" if kind == "F" else "emom"].append([sl[target], value])
+
+    nx, ny, tx, ty = n[0].tolist(), n[1].tolist(), t[0].tolist(), t[1].tolist()
+    ii, jj = i_all.tolist(), j_all.tolist()
+    visits = list(zip(vk.tolist(), vs.tolist()))
+    inter = interacting.tolist()
+    for term, f_i, f_j in (p.get("parts") or ()):
+        scal_i = _as_list(f_i, len(i_all))
+        scal_j = scal_i if f_j is None else _as_list(f_j, len(i_all))
+        for k, s in visits:
+            if term == "elastic" and not inter[k]:
+                continue   # transient relation beyond contact: no elastic force applied, nothing registered
+            if s == 0:
+                f = scal_i[k]
+                emit("F", k, 0, ii[k], jj[k], [nx[k] * f, ny[k] * f])
+            else:
+                f = scal_j[k]
+                emit("F", k, 1, jj[k], ii[k], [-nx[k] * f, -ny[k] * f])
+    F = p.get("ft_visits")
+    if F is None:
+        return
+    F = np.broadcast_to(F, (2, len(i_all))).tolist()
+    d = p["d"].tolist()
+    wi, wj = p["w2"][0].tolist(), p["w2"][1].tolist()
+    for k, s in visits:
+        if not inter[k]:
+            continue   # transient relation beyond contact: no tangential force (§2.6)
+        h = F[s][k] * 0.5
+        fi = [tx[k] * h, ty[k] * h]        # +F/2·t_ij on i
+        fj = [-tx[k] * h, -ty[k] * h]      # −F/2·t_ij on j
+        mi = d[k] * h * wi[k]
+        mj = d[k] * h * wj[k]
+        if s == 0:   # visit from i: the entry on i, then on its neighbour j
+            emit("F", k, 0, ii[k], jj[k], fi)
+            emit("F", k, 1, jj[k], ii[k], fj)
+            emit("M", k, 0, ii[k], jj[k], mi)
+            emit("M", k, 1, jj[k], ii[k], mj)
+        else:        # visit from j (force along t_ji = −t_ij on j): j first, then i
+            emit("F", k, 1, jj[k], ii[k], fj)
+            emit("F", k, 0, ii[k], jj[k], fi)
+            emit("M", k, 1, jj[k], ii[k], mj)
+            emit("M", k, 0, ii[k], jj[k], mi)
+
+
+def _as_list(f, P):
+    """Per-pair scalars of a term as a Python list (zeros for a term noted without force)."""
+    if f is None:
+        return [0.0] * P
+    return np.broadcast_to(np.asarray(f, dtype=float), (P,)).tolist()
