@@ -163,6 +163,7 @@ class CanvasPoints:
         self._n = 0
         self._set_capacity(0)
         self._sphereList = SphereList(self)
+        self._m_given = []   # masses as the spheres were given them (int stays int): sums of §10.8
         self._rng = np.random.default_rng()
         self._renderer = None
         self._uniform = {}
@@ -224,6 +225,7 @@ class CanvasPoints:
         if n == self._cap:
             self._set_capacity(max(16, 2 * self._cap))
         cls = type(sphere)
+        self._m_given.append(getattr(sphere, "m", 1.0))
         col = self._block[:, n]
         for name, default in FIELDS.items():
             col[ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
@@ -318,10 +320,18 @@ class CanvasPoints:
         return None
 
     def movableSphereList(self):
+        """The mobile spheres, in index order, as a list (a :class:`SphereSelection`: new on each call,
+        and recognised by the stress evaluation, which then sums over the ensemble's arrays)."""
+        sel = self._mobile_selection()
+        return SphereSelection(self, sel.mask, sel)
+
+    def _mobile_selection(self):
+        """The ensemble's own selection of its mobile spheres, kept while the mask is the same object."""
         mob = self._mobile_mask()
-        if mob is None:
-            return list(self.sphereList)
-        return [self.sphereList[k] for k in np.flatnonzero(mob)]
+        sel = self.__dict__.get("_selection")
+        if sel is None or sel.mask is not mob or not sel.is_current():
+            sel = self._selection = SphereSelection(self, mob)
+        return sel
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres ``v += F·dt/m`` and reset their force."""
@@ -483,10 +493,7 @@ class CanvasPointsMass(CanvasPoints):
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):
         """Evaluate every tensor of §7 for the current register, mobile spheres and shear rate."""
-        mob = self._mobile_mask()
-        sel = self.__dict__.get("_selection")
-        if sel is None or sel.mask is not mob:
-            sel = self._selection = SphereSelection(self, mob)   # kept while the mask is the same object
+        sel = self._mobile_selection()
         StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
         return StressTensorEvaluator
 

@@ -33,28 +33,58 @@ class PairBlock(dict):
         raise KeyError(key)
 
 
-class SphereSelection:
-    """A list-like selection of an ensemble's spheres by boolean mask (no Python loop to build)."""
+def _invalidating(name):
+    method = getattr(list, name)
 
-    def __init__(self, ensemble, mask=None):
+    def changed(self, *args, **kwargs):
+        self._valid = False   # contents no longer follow the mask: evaluated sphere by sphere
+        return method(self, *args, **kwargs)
+
+    changed.__name__ = name
+    return changed
+
+
+class SphereSelection(list):
+    """The spheres of an ensemble picked by a boolean ``mask`` (None: all), as a list.
+
+    It is what ``movableSphereList()`` returns: a plain ``list`` of the spheres in index
+    order for every use a script makes of it, which also tells the stress evaluation
+    which rows of the ensemble's arrays it holds, so the tensors are summed with array
+    operations.  Changing it (``append``, ``remove``, ``sel[k] = …`` …) keeps it a list
+    and drops that link.
+    """
+
+    def __init__(self, ensemble, mask=None, spheres=None):
+        if spheres is None:
+            sl = ensemble.sphereList
+            spheres = sl if mask is None else [sl[k] for k in np.flatnonzero(mask).tolist()]
+        list.__init__(self, spheres)
         self.ensemble = ensemble
         self.mask = mask
+        self._valid = True
 
-    def indices(self):
+    def is_current(self):
+        """True while the selection holds exactly the spheres of ``mask`` in the ensemble as it is now."""
+        if not self._valid:
+            return False
         n = len(self.ensemble.sphereList)
         if self.mask is None:
-            return np.arange(n)
+            return len(self) == n
+        return len(self.mask) == n
+
+    def indices(self):
+        """Indices of the selected spheres in ``sphereList``."""
+        if self.mask is None:
+            return np.arange(len(self))
         return np.flatnonzero(self.mask)
 
-    def __iter__(self):
-        sl = self.ensemble.sphereList
-        return (sl[k] for k in self.indices())
+    def copy(self):
+        return SphereSelection(self.ensemble, self.mask, self) if self._valid else list(self)
 
-    def __len__(self):
-        return len(self.indices())
-
-    def __getitem__(self, k):
-        return self.ensemble.sphereList[self.indices()[k]]
+    for _name in ("append", "extend", "insert", "remove", "pop", "clear", "sort", "reverse", "__setitem__",
+                  "__delitem__", "__iadd__", "__imul__"):
+        locals()[_name] = _invalidating(_name)
+    del _name
 
 
 class Force_register:
