@@ -949,8 +949,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
             "pos_version": self._pos_version,
             # per-visit terms for the reference lists of the register (read only when asked for)
-            "parts": g.parts, "ft_visits": g.ft_visits, "n": g.n, "t": g.t, "d": g.d, "w2": S.w2,
-            "touching": g.touching, "perm": g.perm, "birth": self._pairs.birth, "slots": g.slots}))
+            "visits": (g.parts, g.ft_visits, g.n, g.t, g.d, S.w2, g.touching, g.perm, self._pairs.birth,
+                       g.slots)}))
         g.fn_i = None
         g.fn_j = None
         g.ft = None

@@ -213,7 +213,7 @@ class Force_register:
 
 
 def _visit_entries(p, sl, out):
-    """Append the reference entries of one engine register block to the lists in ``out`` (§7.1, §2.7-2.8).
+    """Append the reference entries of one engine register block to the lists in ``out`` (docs/design.md).
 
     Each relation (pair k, i < j) is visited twice: from i (side 0) and from j (side 1).  Visits are
     ordered by visiting sphere, then by the visitor's relation order (birth of the relation, then
@@ -224,14 +224,13 @@ def _visit_entries(p, sl, out):
     or the pair acting through the boundary: external).
     """
     i_all, j_all = p["i"], p["j"]
-    if not len(i_all):
+    if not len(i_all) or "visits" not in p:
         return
+    parts, F, n, t, d, w2, touching, perm, birth, slots = p["visits"]
     active = p.get("active")
     ks = np.arange(len(i_all)) if active is None else np.flatnonzero(active)
     if not len(ks):
         return
-    birth = p["birth"]
-    slots = p.get("slots", slice(None))
     b = (birth[slots] if isinstance(slots, slice) else birth.take(slots))[ks]
     i, j = i_all[ks], j_all[ks]
     visitor = np.concatenate((i, j))
@@ -240,9 +239,7 @@ def _visit_entries(p, sl, out):
     order = np.lexsort((partner, np.concatenate((b, b)), visitor))
     vk = np.concatenate((ks, ks))[order]      # pair of each visit, in visit order
     vs = side[order]                          # 0: visit from i, 1: visit from j
-    n, t = p["n"], p["t"]
     internal, ext_i, ext_j = p["internal"], p["ext_i"], p["ext_j"]
-    touching, perm = p["touching"], p["perm"]
     interacting = touching if perm is None else (touching | perm)   # elastic and tangential visits happen
 
     # per (pair, side-of-target): where an entry on that target goes (1 internal, 2 external, 0 dropped)
@@ -251,9 +248,10 @@ def _visit_entries(p, sl, out):
     dest[1][ext_j] = 2
     dest[0][internal] = 1
     dest[1][internal] = 1
+    dest = dest.tolist()
 
     def emit(kind, k, s_target, target, source, value):
-        dd = dest[s_target, k]
+        dd = dest[s_target][k]
         if dd == 1:
             out["pair" if kind == "F" else "imom"].append([sl[target], sl[source], value])
         elif dd == 2:
@@ -263,7 +261,7 @@ def _visit_entries(p, sl, out):
     ii, jj = i_all.tolist(), j_all.tolist()
     visits = list(zip(vk.tolist(), vs.tolist()))
     inter = interacting.tolist()
-    for term, f_i, f_j in (p.get("parts") or ()):
+    for term, f_i, f_j in (parts or ()):
         scal_i = _as_list(f_i, len(i_all))
         scal_j = scal_i if f_j is None else _as_list(f_j, len(i_all))
         for k, s in visits:
@@ -275,12 +273,11 @@ def _visit_entries(p, sl, out):
             else:
                 f = scal_j[k]
                 emit("F", k, 1, jj[k], ii[k], [-nx[k] * f, -ny[k] * f])
-    F = p.get("ft_visits")
     if F is None:
         return
     F = np.broadcast_to(F, (2, len(i_all))).tolist()
-    d = p["d"].tolist()
-    wi, wj = p["w2"][0].tolist(), p["w2"][1].tolist()
+    d = d.tolist()
+    wi, wj = w2[0].tolist(), w2[1].tolist()
     for k, s in visits:
         if not inter[k]:
             continue   # transient relation beyond contact: no tangential force (§2.6)
