@@ -264,7 +264,7 @@ class ForceRegisterOrderTest(unittest.TestCase):
 
 
 class EvaluationHandlerValuesTest(unittest.TestCase):
-    """Momenta of the handler are Python values summed over the spheres as given (§10.8 of the manual's
+    """Momenta of the handler are Python values summed over the spheres as given (the manual's
     API: ``total_mass = Σ m``, ``xg = Σ m x / Σ m``, ``v_mean = Σ m v / Σ m``, ``Σ (m x v_y − m y v_x + ω I)``)."""
 
     def _scene(self, masses):

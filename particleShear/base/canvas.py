@@ -136,7 +136,7 @@ class _Geometry:
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
     parts = None       # [(term, f_i, f_j)] of the central terms, for the register's per-visit lists
-    ft_visits = None   # (2, P) scalar forces of the two tangential visits, or 0.0 when every contact slipped at μ = 0
+    ft_visits = None   # (2, P) scalar forces of the two tangential visits (0.0: all slipped at μ = 0)
     all_slip = False   # set when the μ = 0 tangential path made every relation slip (no ξ to integrate)
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
@@ -163,7 +163,7 @@ class CanvasPoints:
         self._n = 0
         self._set_capacity(0)
         self._sphereList = SphereList(self)
-        self._m_given = []   # masses as the spheres were given them (int stays int): sums of §10.8
+        self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
         self._renderer = None
         self._uniform = {}

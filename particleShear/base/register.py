@@ -168,7 +168,7 @@ class Force_register:
 
     @property
     def pair_register(self):
-        """``[target, source, [F_x, F_y]]`` per internal pair-force entry, in the reference's order (§7.1):
+        """``[target, source, [F_x, F_y]]`` per internal pair-force entry, in the reference's order (docs/design.md):
         every central elastic visit, then every central viscous visit, then two entries per tangential
         visit (visiting sphere, then its neighbour); visits by sphere in ``sphereList`` order and, per
         sphere, by relation in ``neighbors`` order."""
@@ -280,7 +280,7 @@ def _visit_entries(p, sl, out):
     wi, wj = w2[0].tolist(), w2[1].tolist()
     for k, s in visits:
         if not inter[k]:
-            continue   # transient relation beyond contact: no tangential force (§2.6)
+            continue   # transient relation beyond contact: no tangential force
         h = F[s][k] * 0.5
         fi = [tx[k] * h, ty[k] * h]        # +F/2·t_ij on i
         fj = [-tx[k] * h, -ty[k] * h]      # −F/2·t_ij on j
