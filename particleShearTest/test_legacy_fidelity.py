@@ -264,8 +264,8 @@ class ForceRegisterOrderTest(unittest.TestCase):
 
 
 class EvaluationHandlerValuesTest(unittest.TestCase):
-    """Momenta of the handler are Python values summed over the spheres as given (the manual's
-    API: ``total_mass = Σ m``, ``xg = Σ m x / Σ m``, ``v_mean = Σ m v / Σ m``, ``Σ (m x v_y − m y v_x + ω I)``)."""
+    """Momenta of the handler are Python values summed over the spheres as given (the manual's API:
+    ``total_mass = Σ m``, ``xg = Σ m x / Σ m``, ``v_mean = Σ m v / Σ m``, ``Σ (m x v_y − m y v_x + ω I)``)."""
 
     def _scene(self, masses):
         ens = EnsembleLinkable(L, L, 0, k=1, nu=0.01, k_t=1, nu_t=0.01, mu=0.1)

@@ -310,7 +310,8 @@ class EvaluationHandler:
 
         return property(fget, fset, doc=doc)
 
-    total_mass = _momentum_property("total_mass", "Σ m over all spheres (mg/m); an int if the masses were given as ints.")
+    total_mass = _momentum_property("total_mass",
+                                    "Σ m over all spheres (mg/m); an int if the masses were given as ints.")
     xg = _momentum_property("xg", "Mass-weighted centre ``[Σ m x / Σ m, Σ m y / Σ m]`` (µm), raw coordinates.")
     v_mean = _momentum_property("v_mean", "Mass-weighted mean velocity ``[Σ m v_x / Σ m, Σ m v_y / Σ m]`` (µm/s).")
     angular_momentum_around_origin = _momentum_property(
