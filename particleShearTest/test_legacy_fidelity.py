@@ -24,18 +24,22 @@ L = 500.0
 
 # -- an independent, sphere-by-sphere evaluation of one force phase ------------------------------------
 def _min_image(dx, dy, shift):
-    """Lees-Edwards minimum image of a separation, one period at a time (half-open convention)."""
+    """Lees-Edwards minimum image of a separation, one period at a time (half-open convention), and the
+    number of periods taken off in y (the image's velocity differs by −that·Ly·γ̇)."""
+    ky = 0
     while dy >= L / 2:
         dy -= L
         dx -= shift
+        ky += 1
     while dy < -L / 2:
         dy += L
         dx += shift
+        ky -= 1
     while dx >= L / 2:
         dx -= L
     while dx < -L / 2:
         dx += L
-    return dx, dy
+    return dx, dy, ky
 
 
 def _law(d, d0, k, c):
@@ -74,16 +78,17 @@ def reference_force_phase(ens):
         order.append(partners)
     k, nu, kt, nut, mu, c = ens.k, ens.nu, ens.k_t, ens.nu_t, ens.mu, ens.central_repulsion_coefficient
     shift = L * ens.shear
+    rate = ens.shear_rate
 
     def geometry(a, b):
         pa, pb = S[a], S[b]
         rx, ry = pb["x"] - pa["x"], pb["y"] - pa["y"]
-        dx, dy = _min_image(rx, ry, shift)
+        dx, dy, ky = _min_image(rx, ry, shift)
         d = math.sqrt(dx * dx + dy * dy)
         n = (dx / d, dy / d)
         t = (-n[1], n[0])
         crossing = math.sqrt(rx * rx + ry * ry) != d
-        vrx = pb["vx"] - pa["vx"]   # shear rate 0 in these scenes: no boundary velocity jump
+        vrx = pb["vx"] - pa["vx"] - ky * L * rate   # across the y boundary the image moves with ±Ly·γ̇
         vry = pb["vy"] - pa["vy"]
         vn = vrx * n[0] + vry * n[1]
         vt = vrx * t[0] + vry * t[1] - (pa["r"] * pa["w"] + pb["r"] * pb["w"])
@@ -157,15 +162,19 @@ def reference_force_phase(ens):
 
 
 # -- scenes -------------------------------------------------------------------------------------------
-def two_sphere_scene(positions, velocities, xi=None, link=False, shear_plates=False, c=0.0, extra=()):
-    """Frictional linkable spheres of diameter 120 µm in a 500 µm cell; ``xi`` sets ξ of the relations."""
-    ens = EnsembleLinkable(L, L, 0, k=1, nu=0.01, k_t=1, nu_t=0.01, mu=0.1)
+def two_sphere_scene(positions, velocities, xi=None, link=False, shear_plates=False, c=0.0, extra=(), nu=0.01,
+                     mu=0.1, shear=None):
+    """Linkable spheres of diameter 120 µm in a 500 µm cell (frictional unless ``mu=0``); ``xi`` sets ξ."""
+    ens = EnsembleLinkable(L, L, 0, k=1, nu=nu, k_t=1, nu_t=0.01, mu=mu)
     for q, ((x, y), (vx, vy, w)) in enumerate(zip(list(positions) + [e[0] for e in extra],
                                                   list(velocities) + [e[1] for e in extra])):
         s = SphereLinkable("grey", x, y, 120, 1, q, force_register=ens, size_x=L, size_y=L)
         ens.sphereList.append(s)
         s.xspeed, s.yspeed, s.omega = vx, vy, w
     ens.set_central_repulsion_coefficient(c)
+    if shear is not None:   # (γ, γ̇): Lees-Edwards offset and rate before the relations are made
+        ens.setShear(shear[0])
+        ens.setShearRate(shear[1])
     a, b = ens.sphereList[0], ens.sphereList[1]
     if link:
         a.establish_permanent_link(b)
@@ -185,10 +194,16 @@ SCENES = {
                                    velocities=[(1.0, 0.4, -0.05), (-0.5, 0.2, 0.3)], xi=(0.3, 0.2), c=1.0),
     "through_the_boundary": dict(positions=[(30.0, 250.0), (480.0, 262.0)],
                                  velocities=[(-1.0, 2.0, 0.1), (1.5, -0.5, 0.0)], xi=(0.5, -0.4)),
+    "through_the_sheared_boundary": dict(positions=[(250.0, 20.0), (300.0, 470.0)],
+                                         velocities=[(1.0, 0.5, 0.1), (-0.5, -1.0, 0.2)], xi=(0.1, -0.2),
+                                         shear=(0.1, 40.0)),
     "against_a_plate": dict(positions=[(250.0, 50.0), (260.0, 150.0)],
                             velocities=[(0.5, 0.0, 0.3), (-1.0, -2.0, 0.1)], xi=(0.2, 0.1), shear_plates=True),
     "stretched_link": dict(positions=[(200.0, 250.0), (300.0, 250.0)],
                            velocities=[(-1.0, 0.3, 0.2), (1.0, -0.2, 0.1)], xi=(0.7, 0.4), link=True),
+    # ν = 0 and μ = 0: the viscous and tangential visits still register their zero forces
+    "inviscid_frictionless": dict(positions=[(200.0, 250.0), (300.0, 262.0)],
+                                  velocities=[(3.0, -1.0, 0.2), (-2.0, 0.5, -0.1)], nu=0.0, mu=0.0),
     "three_spheres": dict(positions=[(200.0, 250.0), (300.0, 262.0)],
                           velocities=[(3.0, -1.0, 0.2), (-2.0, 0.5, -0.1)], xi=(0.05, -0.02),
                           extra=[((210.0, 355.0), (0.2, -1.5, 0.4))]),
