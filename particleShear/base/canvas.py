@@ -135,6 +135,8 @@ class _Geometry:
     ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
+    parts = None       # [(term, f_i, f_j)] of the central terms, for the register's per-visit lists
+    ft_visits = None   # (2, P) scalar forces of the two tangential visits (0.0: all slipped at μ = 0)
     all_slip = False   # set when the μ = 0 tangential path made every relation slip (no ξ to integrate)
 
     # components of the pair vector and normal, for inspection (the kernels use the (2, P) arrays)
@@ -161,6 +163,7 @@ class CanvasPoints:
         self._n = 0
         self._set_capacity(0)
         self._sphereList = SphereList(self)
+        self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
         self._renderer = None
         self._uniform = {}
@@ -222,6 +225,7 @@ class CanvasPoints:
         if n == self._cap:
             self._set_capacity(max(16, 2 * self._cap))
         cls = type(sphere)
+        self._m_given.append(getattr(sphere, "m", 1.0))
         col = self._block[:, n]
         for name, default in FIELDS.items():
             col[ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
@@ -316,10 +320,18 @@ class CanvasPoints:
         return None
 
     def movableSphereList(self):
+        """The mobile spheres, in index order, as a list (a :class:`SphereSelection`: new on each call,
+        and recognised by the stress evaluation, which then sums over the ensemble's arrays)."""
+        sel = self._mobile_selection()
+        return SphereSelection(self, sel.mask, sel)
+
+    def _mobile_selection(self):
+        """The ensemble's own selection of its mobile spheres, kept while the mask is the same object."""
         mob = self._mobile_mask()
-        if mob is None:
-            return list(self.sphereList)
-        return [self.sphereList[k] for k in np.flatnonzero(mob)]
+        sel = self.__dict__.get("_selection")
+        if sel is None or sel.mask is not mob or not sel.is_current():
+            sel = self._selection = SphereSelection(self, mob)
+        return sel
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres ``v += F·dt/m`` and reset their force."""
@@ -481,10 +493,7 @@ class CanvasPointsMass(CanvasPoints):
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):
         """Evaluate every tensor of §7 for the current register, mobile spheres and shear rate."""
-        mob = self._mobile_mask()
-        sel = self.__dict__.get("_selection")
-        if sel is None or sel.mask is not mob:
-            sel = self._selection = SphereSelection(self, mob)   # kept while the mask is the same object
+        sel = self._mobile_selection()
         StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
         return StressTensorEvaluator
 
@@ -856,11 +865,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             self.test_neighbor_relation()
         return self._g
 
-    def _add_normal(self, f_i, f_j=None):
+    def _add_normal(self, f_i, f_j=None, term="elastic"):
         """Add scalar central forces along n_ij: ``f_i`` on i, ``f_j`` (default ``f_i``) on j (reversed).
 
-        The first term is kept by reference (terms never modify their results afterwards)."""
+        The first term is kept by reference (terms never modify their results afterwards); each term is
+        also noted by name for the register's per-visit lists (built only when read)."""
         g = self._g
+        if g.parts is None:
+            g.parts = []
+        g.parts.append((term, f_i, f_j))
         if f_j is None and g.fn_j is None:
             g.fn_i = f_i if g.fn_i is None else g.fn_i + f_i
             return
@@ -934,10 +947,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "W": W,
             "ti": ti, "tj": tj, "T": T, "internal": g.internal, "ext_i": g.ext_i,
             "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
-            "pos_version": self._pos_version}))
+            "pos_version": self._pos_version,
+            # per-visit terms for the reference lists of the register (read only when asked for)
+            "visits": (g.parts, g.ft_visits, g.n, g.t, g.d, S.w2, g.touching, g.perm, self._pairs.birth,
+                       g.slots)}))
         g.fn_i = None
         g.fn_j = None
         g.ft = None
+        g.parts = None
+        g.ft_visits = None
 
     def _term_done(self):
         if not self._in_force_phase:
@@ -1235,6 +1253,9 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _viscous_terms(self):
         g = self._g
         nu = self.nu
+        if g.P and nu == 0:
+            # no force, but the reference still registers ν·v_n = 0 per visit (noted for the register only)
+            g.parts = (g.parts or []) + [("viscous", None, None)]
         if g.P and nu != 0:
             if g.active is None:
                 f = nu * self._normal_speed(g)
@@ -1243,9 +1264,9 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
                 f = self._on_relations(nu, g) * self._normal_speed(g)
             scale = self._viscous_scale(g)
             if scale is None:
-                self._add_normal(f)
+                self._add_normal(f, None, "viscous")
             else:
-                self._add_normal(f * scale[0], f * scale[1])
+                self._add_normal(f * scale[0], f * scale[1], "viscous")
 
     def elastic_force(self):
         """All-pairs variant (reference API): a neighbour update, then the elastic term."""
@@ -1435,6 +1456,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 pt.state[g.active] = SLIP
                 pt.xi[...] = 0.0   # inactive candidates hold ξ = 0 already
             g.all_slip = True
+            g.ft_visits = 0.0   # every visit applies a zero force (Coulomb bound 0)
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
         self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
@@ -1470,6 +1492,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 state = state + g.S.bond.perm_code
             pt.state[sel] = state
             pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
+        g.ft_visits = F
         f = F[0] + F[1]
         f *= 0.5     # = F1/2 + F2/2 exactly (halving is exact in binary floating point)
         self._add_tangential(f)

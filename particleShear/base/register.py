@@ -33,28 +33,58 @@ class PairBlock(dict):
         raise KeyError(key)
 
 
-class SphereSelection:
-    """A list-like selection of an ensemble's spheres by boolean mask (no Python loop to build)."""
+def _invalidating(name):
+    method = getattr(list, name)
 
-    def __init__(self, ensemble, mask=None):
+    def changed(self, *args, **kwargs):
+        self._valid = False   # contents no longer follow the mask: evaluated sphere by sphere
+        return method(self, *args, **kwargs)
+
+    changed.__name__ = name
+    return changed
+
+
+class SphereSelection(list):
+    """The spheres of an ensemble picked by a boolean ``mask`` (None: all), as a list.
+
+    It is what ``movableSphereList()`` returns: a plain ``list`` of the spheres in index
+    order for every use a script makes of it, which also tells the stress evaluation
+    which rows of the ensemble's arrays it holds, so the tensors are summed with array
+    operations.  Changing it (``append``, ``remove``, ``sel[k] = …`` …) keeps it a list
+    and drops that link.
+    """
+
+    def __init__(self, ensemble, mask=None, spheres=None):
+        if spheres is None:
+            sl = ensemble.sphereList
+            spheres = sl if mask is None else [sl[k] for k in np.flatnonzero(mask).tolist()]
+        list.__init__(self, spheres)
         self.ensemble = ensemble
         self.mask = mask
+        self._valid = True
 
-    def indices(self):
+    def is_current(self):
+        """True while the selection holds exactly the spheres of ``mask`` in the ensemble as it is now."""
+        if not self._valid:
+            return False
         n = len(self.ensemble.sphereList)
         if self.mask is None:
-            return np.arange(n)
+            return len(self) == n
+        return len(self.mask) == n
+
+    def indices(self):
+        """Indices of the selected spheres in ``sphereList``."""
+        if self.mask is None:
+            return np.arange(len(self))
         return np.flatnonzero(self.mask)
 
-    def __iter__(self):
-        sl = self.ensemble.sphereList
-        return (sl[k] for k in self.indices())
+    def copy(self):
+        return SphereSelection(self.ensemble, self.mask, self) if self._valid else list(self)
 
-    def __len__(self):
-        return len(self.indices())
-
-    def __getitem__(self, k):
-        return self.ensemble.sphereList[self.indices()[k]]
+    for _name in ("append", "extend", "insert", "remove", "pop", "clear", "sort", "reverse", "__setitem__",
+                  "__delitem__", "__iadd__", "__imul__"):
+        locals()[_name] = _invalidating(_name)
+    del _name
 
 
 class Force_register:
@@ -70,6 +100,7 @@ class Force_register:
         self._tot = None
         self._tot_block = None
         self._mom = None
+        self._lists = None
         if getattr(self, "_manual", True):
             self._clear_manual()
 
@@ -124,72 +155,151 @@ class Force_register:
     def _spheres(self):
         return self._ens.sphereList
 
-    @property
-    def pair_register(self):
-        out = []
+    def _engine_lists(self):
+        """The engine part of the six reference lists, built once per force phase when first read."""
+        cache = self.__dict__.get("_lists")
+        if cache is not None and cache[0] is self._blocks and cache[1] == len(self._blocks):
+            return cache[2]
+        out = {"pair": [], "ext": [], "imom": [], "emom": []}
         for p in self._blocks:
-            sl = self._spheres()
-            for k in np.flatnonzero(_live(p, "internal")):
-                i, j = int(p["i"][k]), int(p["j"][k])
-                out.append([sl[i], sl[j], [float(p["fix"][k]), float(p["fiy"][k])]])
-                out.append([sl[j], sl[i], [float(p["fjx"][k]), float(p["fjy"][k])]])
-        return out + self._m_pair
-
-    @property
-    def external_force_register(self):
-        out = []
-        for p in self._blocks:
-            sl = self._spheres()
-            for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
-                i, j = int(p["i"][k]), int(p["j"][k])
-                if p["ext_i"][k]:
-                    out.append([sl[i], [float(p["fix"][k]), float(p["fiy"][k])]])
-                if p["ext_j"][k]:
-                    out.append([sl[j], [float(p["fjx"][k]), float(p["fjy"][k])]])
-        return out + self._m_ext
-
-    def _moments(self, which):
-        out = []
-        for p in self._blocks:
-            if p.get("ti") is None:
-                continue
-            sl = self._spheres()
-            if which == "internal":
-                for k in np.flatnonzero(_live(p, "internal")):
-                    i, j = int(p["i"][k]), int(p["j"][k])
-                    out.append([sl[i], sl[j], float(p["ti"][k])])
-                    out.append([sl[j], sl[i], float(p["tj"][k])])
-            else:
-                for k in np.flatnonzero(_live(p, "ext_i") | _live(p, "ext_j")):
-                    i, j = int(p["i"][k]), int(p["j"][k])
-                    if p["ext_i"][k]:
-                        out.append([sl[i], float(p["ti"][k])])
-                    if p["ext_j"][k]:
-                        out.append([sl[j], float(p["tj"][k])])
+            _visit_entries(p, self._spheres(), out)
+        self._lists = (self._blocks, len(self._blocks), out)
         return out
 
     @property
+    def pair_register(self):
+        """``[target, source, [F_x, F_y]]`` per internal pair-force entry, in the reference's order (docs/design.md):
+        every central elastic visit, then every central viscous visit, then two entries per tangential
+        visit (visiting sphere, then its neighbour); visits by sphere in ``sphereList`` order and, per
+        sphere, by relation in ``neighbors`` order."""
+        return self._engine_lists()["pair"] + self._m_pair
+
+    @property
+    def external_force_register(self):
+        """``[target, [F_x, F_y]]`` per force from an immobile sphere or through the periodic boundary,
+        at the place of its visit in the order of :attr:`pair_register`."""
+        return self._engine_lists()["ext"] + self._m_ext
+
+    @property
     def internal_moment_register(self):
-        return self._moments("internal") + self._m_imom
+        """``[target, source, M]`` per internal tangential torque, two per tangential visit."""
+        return self._engine_lists()["imom"] + self._m_imom
 
     @property
     def external_moment_register(self):
-        return self._moments("external") + self._m_emom
+        """``[target, M]`` per external tangential torque (stored, never used by a tensor)."""
+        return self._engine_lists()["emom"] + self._m_emom
 
     @property
     def total_particle_force_register(self):
+        """``[sphere, [F_x, F_y]]``: the total force of every mobile sphere, in ``sphereList`` order."""
         out = []
         if self._tot is not None:
             mobile, fx, fy = self._tot
             sl = self._spheres()
-            for k in np.flatnonzero(mobile):
-                out.append([sl[k], [float(fx[k]), float(fy[k])]])
+            idx = range(len(fx)) if mobile is None else np.flatnonzero(mobile).tolist()
+            fx, fy = fx.tolist(), fy.tolist()
+            out = [[sl[k], [fx[k], fy[k]]] for k in idx]
         return out + list(self._m_tot.values())
 
     @property
     def unbalanced_moment_register(self):
+        """``[sphere, T]``: the net torque of every sphere, immobile ones included (reference quirk)."""
         out = []
         if self._mom is not None:
             sl = self._spheres()
-            out = [[sl[k], float(t)] for k, t in enumerate(self._mom)]
+            out = [[sl[k], t] for k, t in enumerate(self._mom.tolist())]
         return out + list(self._m_unb.values())
+
+
+def _visit_entries(p, sl, out):
+    """Append the reference entries of one engine register block to the lists in ``out`` (docs/design.md).
+
+    Each relation (pair k, i < j) is visited twice: from i (side 0) and from j (side 1).  Visits are
+    ordered by visiting sphere, then by the visitor's relation order (birth of the relation, then
+    partner index).  A central term gives one entry per visit, on the visiting sphere; a tangential
+    visit with scalar force F gives ``±F/2·t`` on the visitor and its neighbour (eq. S1-3 torques
+    ``d·F/2·r/(r_i + r_j)`` likewise).  Each entry goes to the internal list, the external list or
+    nowhere according to the pair's flags for its target (target immobile: dropped; source immobile
+    or the pair acting through the boundary: external).
+    """
+    i_all, j_all = p["i"], p["j"]
+    if not len(i_all) or "visits" not in p:
+        return
+    parts, F, n, t, d, w2, touching, perm, birth, slots = p["visits"]
+    active = p.get("active")
+    ks = np.arange(len(i_all)) if active is None else np.flatnonzero(active)
+    if not len(ks):
+        return
+    b = (birth[slots] if isinstance(slots, slice) else birth.take(slots))[ks]
+    i, j = i_all[ks], j_all[ks]
+    visitor = np.concatenate((i, j))
+    partner = np.concatenate((j, i))
+    side = np.repeat((0, 1), len(ks))
+    order = np.lexsort((partner, np.concatenate((b, b)), visitor))
+    vk = np.concatenate((ks, ks))[order]      # pair of each visit, in visit order
+    vs = side[order]                          # 0: visit from i, 1: visit from j
+    internal, ext_i, ext_j = p["internal"], p["ext_i"], p["ext_j"]
+    interacting = touching if perm is None else (touching | perm)   # elastic and tangential visits happen
+
+    # per (pair, side-of-target): where an entry on that target goes (1 internal, 2 external, 0 dropped)
+    dest = np.zeros((2, len(i_all)), dtype=np.int8)
+    dest[0][ext_i] = 2
+    dest[1][ext_j] = 2
+    dest[0][internal] = 1
+    dest[1][internal] = 1
+    dest = dest.tolist()
+
+    def emit(kind, k, s_target, target, source, value):
+        dd = dest[s_target][k]
+        if dd == 1:
+            out["pair" if kind == "F" else "imom"].append([sl[target], sl[source], value])
+        elif dd == 2:
+            out["ext" if kind == "F" else "emom"].append([sl[target], value])
+
+    nx, ny, tx, ty = n[0].tolist(), n[1].tolist(), t[0].tolist(), t[1].tolist()
+    ii, jj = i_all.tolist(), j_all.tolist()
+    visits = list(zip(vk.tolist(), vs.tolist()))
+    inter = interacting.tolist()
+    for term, f_i, f_j in (parts or ()):
+        scal_i = _as_list(f_i, len(i_all))
+        scal_j = scal_i if f_j is None else _as_list(f_j, len(i_all))
+        for k, s in visits:
+            if term == "elastic" and not inter[k]:
+                continue   # transient relation beyond contact: no elastic force applied, nothing registered
+            if s == 0:
+                f = scal_i[k]
+                emit("F", k, 0, ii[k], jj[k], [nx[k] * f, ny[k] * f])
+            else:
+                f = scal_j[k]
+                emit("F", k, 1, jj[k], ii[k], [-nx[k] * f, -ny[k] * f])
+    if F is None:
+        return
+    F = np.broadcast_to(F, (2, len(i_all))).tolist()
+    d = d.tolist()
+    wi, wj = w2[0].tolist(), w2[1].tolist()
+    for k, s in visits:
+        if not inter[k]:
+            continue   # transient relation beyond contact: no tangential force
+        h = F[s][k] * 0.5
+        fi = [tx[k] * h, ty[k] * h]        # +F/2·t_ij on i
+        fj = [-tx[k] * h, -ty[k] * h]      # −F/2·t_ij on j
+        mi = d[k] * h * wi[k]
+        mj = d[k] * h * wj[k]
+        if s == 0:   # visit from i: the entry on i, then on its neighbour j
+            emit("F", k, 0, ii[k], jj[k], fi)
+            emit("F", k, 1, jj[k], ii[k], fj)
+            emit("M", k, 0, ii[k], jj[k], mi)
+            emit("M", k, 1, jj[k], ii[k], mj)
+        else:        # visit from j (force along t_ji = −t_ij on j): j first, then i
+            emit("F", k, 1, jj[k], ii[k], fj)
+            emit("F", k, 0, ii[k], jj[k], fi)
+            emit("M", k, 1, jj[k], ii[k], mj)
+            emit("M", k, 0, ii[k], jj[k], mi)
+
+
+def _as_list(f, P):
+    """Per-pair scalars of a term as a Python list (zeros for a term noted without force)."""
+    if f is None:
+        return [0.0] * P
+    return np.broadcast_to(np.asarray(f, dtype=float), (P,)).tolist()

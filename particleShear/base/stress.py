@@ -4,6 +4,8 @@ All tensors are 2×2 in Pa, index ``[a][b]`` = (force component, lever-arm
 component), compression positive.  Internal units are converted here only:
 forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
+from operator import attrgetter
+
 import numpy as np
 
 from .fields import MASS_ROWS
@@ -34,6 +36,9 @@ _CE00, _CE01, _CE10, _CE11 = range(4 * _CEN, 4 * _CEN + 4)
 _MASS_ROWS = np.array(MASS_ROWS)
 
 _CF = 1e-12
+_ENS_OF = attrgetter("_ens")
+_IDX_OF = attrgetter("_idx")
+_NOT_ROWS = (False, None)
 _CL = 1e-6
 _CT = 1e-18
 
@@ -127,13 +132,52 @@ class StressTensorEvaluation:
 
     # -- sphere lists -----------------------------------------------------------------------
     @staticmethod
-    def _sphere_values(theSphereList):
+    def _rows_of(ens, spheres):
+        """``(True, mask)`` when ``spheres`` are rows of ``ens``'s arrays in index order, each once
+        (``mask`` None: all of them), else ``(False, None)``: the list is then read sphere by sphere.
+
+        ``sphereList`` and the selections of ``movableSphereList()`` are recognised at once; another
+        list or tuple by one pass over its spheres' ensemble and index.
+        """
+        if ens is None:
+            return _NOT_ROWS
+        if isinstance(spheres, SphereSelection) and spheres.ensemble is ens and spheres.is_current():
+            return True, spheres.mask
+        sl = ens.sphereList
+        if spheres is sl:
+            return True, None
+        if not isinstance(spheres, (list, tuple)):
+            return _NOT_ROWS
+        m = len(spheres)
+        n = len(sl)
+        if not m or m > n:
+            return _NOT_ROWS
+        try:
+            owners = set(map(_ENS_OF, spheres))
+            idx = np.array(list(map(_IDX_OF, spheres)))
+        except AttributeError:
+            return _NOT_ROWS
+        if len(owners) != 1 or ens not in owners:
+            return _NOT_ROWS
+        if m > 1 and not (idx[1:] > idx[:-1]).all():
+            return _NOT_ROWS   # repeated or reordered spheres: summed one by one, as given
+        if m == n:
+            return True, None
+        mask = np.zeros(n, dtype=bool)
+        mask[idx] = True
+        return True, mask
+
+    def _sphere_values(self, theSphereList, ens=None):
         """(I, omega, m, vx, vy, y) arrays of the spheres in a list or selection."""
-        if isinstance(theSphereList, SphereSelection):
-            a = theSphereList.ensemble._a
-            if theSphereList.mask is None:
+        if ens is None:
+            ens = getattr(theSphereList, "ensemble", None)
+            if ens is None and isinstance(theSphereList, (list, tuple)) and len(theSphereList):
+                ens = getattr(theSphereList[0], "_ens", None)
+        ok, mk = self._rows_of(ens, theSphereList)
+        if ok:
+            a = ens._a
+            if mk is None:
                 return a["inertia"], a["omega"], a["m"], a["xspeed"], a["yspeed"], a["y"]
-            mk = theSphereList.mask
             return (a["inertia"][mk], a["omega"][mk], a["m"][mk], a["xspeed"][mk],
                     a["yspeed"][mk], a["y"][mk])
         sl = list(theSphereList)
@@ -271,11 +315,11 @@ class StressTensorEvaluation:
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
         """Every tensor of §7 and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24)."""
         reg = force_register
-        if (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
-                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and reg._tot is not None
-                and not reg._manual):
-            self._evaluate_arrays(reg, theSphereList.mask, shear_rate)
-            return
+        if len(reg._blocks) == 1 and reg._tot is not None and not reg._manual and "S" in reg._blocks[0]:
+            ok, mask = self._rows_of(reg._ens, theSphereList)
+            if ok:
+                self._evaluate_arrays(reg, mask, shear_rate)
+                return
         self.evaluate_force_stress_tensors(force_register)
         self.evaluate_rotational_stress_tensors(force_register, theSphereList)
         self.evaluate_peculiar_momentum_transport_for_linear_acceleration_tensor(theSphereList, shear_rate)
@@ -284,8 +328,10 @@ class StressTensorEvaluation:
     def _evaluate_arrays(self, reg, mobile, shear_rate):
         """All tensors of one engine force phase in a few array operations (same formulas as above).
 
-        Sums over mobile spheres are dot products with the mobility mask as weights; the
-        Otsuki and spin terms come from one 3×3 product over (u_x, u_y, ω)."""
+        ``mobile`` is the mask of the spheres passed by the caller (None: all), the spheres of the
+        spin and Otsuki sums; the unbalanced-force tensor sums over the register's mobile spheres.
+        Sums over spheres are dot products with the masks as weights; the Otsuki and spin terms
+        come from one 3×3 product over (u_x, u_y, ω)."""
         t = self._t
         ens = reg._ens
         pos = ens._pos
@@ -302,7 +348,11 @@ class StressTensorEvaluation:
             _internal_moment(p, pos, ens._pos_version, raw[_LW])
         ext = n_int != S.P and _external_moment(p, pos, c, None, out=raw[_EXT], X=X) is not None
         Wm, mobf = self._mobile_weights(ens, mobile)
-        Xm = X if mobile is None else X * mobf
+        reg_mobile = reg._tot[0]   # the spheres of total_particle_force_register
+        if reg_mobile is mobile:
+            Xm = X if mobile is None else X * mobf
+        else:
+            Xm = X if reg_mobile is None else X * reg_mobile
         _dot(reg._tot_block[:2], Xm.T, raw[_UNB])
         raw[_LIN] = raw[_UNB]
         # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
@@ -377,9 +427,8 @@ class StressTensorEvaluation:
         The other tensor entries are not updated.
         """
         reg = force_register
-        if not (isinstance(theSphereList, SphereSelection) and reg._ens is theSphereList.ensemble
-                and len(reg._blocks) == 1 and "S" in reg._blocks[0] and not reg._m_pair and not reg._m_ext
-                and not reg._m_imom):
+        if not (len(reg._blocks) == 1 and "S" in reg._blocks[0] and not reg._m_pair and not reg._m_ext
+                and not reg._m_imom and self._rows_of(reg._ens, theSphereList)[0]):
             self.evaluate_stress_tensors(force_register, theSphereList, 0)
             return self.evaluate_quasistatic_shear_stress(), self.evaluate_externally_applied_shear_stress()
         t = self._t

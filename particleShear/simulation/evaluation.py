@@ -12,7 +12,6 @@ import sys
 
 import numpy as np
 
-from ..base.register import SphereSelection
 from ..base.stress import StressTensorEvaluation, TENSOR_NAMES
 
 __all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "demodulation"]
@@ -142,10 +141,9 @@ class EvaluationHandler:
         self.keep_tensor_history = True
         self.check_force_balance = True
         self.n_force_balance_warnings = 0
-        self.total_mass = 0.0
-        self.xg = [0.0, 0.0]
-        self.v_mean = [0.0, 0.0]
-        self.angular_momentum_around_origin = 0.0
+        self._momenta = None
+        self._momenta_values = {"total_mass": 0.0, "xg": [0.0, 0.0], "v_mean": [0.0, 0.0],
+                                "angular_momentum_around_origin": 0.0}
         self.overall_stress_tensor2 = []
         self.first_tensors = None
         self.last_tensors = None
@@ -272,14 +270,54 @@ class EvaluationHandler:
                       "n_force_balance_warnings)", file=sys.stderr)
 
     def _record_momenta(self, ens):
+        """Keep what the momenta of this step are made of; they are summed when first read."""
         a = ens._a
-        m = a["m"]
-        M = float(m.sum())
-        self.total_mass = M
-        if M:
-            self.xg = [float(m @ a["x"]) / M, float(m @ a["y"]) / M]
-            self.v_mean = [float(m @ a["xspeed"]) / M, float(m @ a["yspeed"]) / M]
-        self.angular_momentum_around_origin = float(ens.total_angular_momentum())
+        self._momenta = (ens.__dict__.get("_m_given"),
+                         np.array((a["m"], a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"], a["inertia"])))
+        self._momenta_values = None
+
+    def _momentum_values(self):
+        """``total_mass``, ``xg``, ``v_mean``, ``angular_momentum_around_origin`` of the last fully evaluated
+        step as the reference computes them (docs/design.md): plain Python numbers, summed sphere by sphere
+        in list order, with the masses as given (``int`` masses give an ``int`` total mass)."""
+        v = self._momenta_values
+        if v is None:
+            given, rows = self._momenta
+            m, x, y, vx, vy, w, inertia = rows.tolist()
+            if given is not None and len(given) == len(m) and np.array_equal(np.asarray(given, dtype=float),
+                                                                               rows[0]):
+                m = list(given)   # unchanged since they were given: use them as given
+            M = 0
+            sx = sy = su = sv = ang = 0.0
+            for mk, xk, yk, uk, vk, wk, ik in zip(m, x, y, vx, vy, w, inertia):
+                M += mk
+                sx += mk * xk
+                sy += mk * yk
+                su += mk * uk
+                sv += mk * vk
+                ang += mk * xk * vk - mk * yk * uk + wk * ik
+            v = {"total_mass": M, "xg": [sx / M, sy / M] if M else [0.0, 0.0],
+                 "v_mean": [su / M, sv / M] if M else [0.0, 0.0], "angular_momentum_around_origin": ang}
+            self._momenta_values = v
+        return v
+
+    def _momentum_property(name, doc):
+        def fget(self):
+            return self._momentum_values()[name]
+
+        def fset(self, value):
+            self._momentum_values()[name] = value
+
+        return property(fget, fset, doc=doc)
+
+    total_mass = _momentum_property("total_mass",
+                                    "Σ m over all spheres (mg/m); an int if the masses were given as ints.")
+    xg = _momentum_property("xg", "Mass-weighted centre ``[Σ m x / Σ m, Σ m y / Σ m]`` (µm), raw coordinates.")
+    v_mean = _momentum_property("v_mean", "Mass-weighted mean velocity ``[Σ m v_x / Σ m, Σ m v_y / Σ m]`` (µm/s).")
+    angular_momentum_around_origin = _momentum_property(
+        "angular_momentum_around_origin",
+        "``Σ (m x v_y − m y v_x + ω I)`` about the cell corner (mg·µm²/s per m depth), spin included.")
+    del _momentum_property
 
     def record(self, theEnsemble, theEvaluator=False):
         """Evaluate the stress tensors of the current step and append one sample (§10.8).
@@ -309,7 +347,7 @@ class EvaluationHandler:
         if not full and hasattr(ev, "evaluate_shear_stresses"):
             # tensors nobody keeps are not evaluated: only the two shear stresses G needs
             row[_SHEAR], row[_FORCE] = ev.evaluate_shear_stresses(
-                theEnsemble.force_register, SphereSelection(theEnsemble, theEnsemble._mobile_mask()))
+                theEnsemble.force_register, theEnsemble._mobile_selection())
             self._n = n + 1
             return ev
         self._record_momenta(theEnsemble)

@@ -338,11 +338,16 @@ class OscillatoryShearExperiment:
 
     # -- output ----------------------------------------------------------------------------------
     def write_experiment_description_information_to_file(self):
-        """Block 2 of the output file (§9.1)."""
+        """Block 2 of the output file (docs/output.md); nothing without an output file (``False``/None)."""
+        if not self.output_file:
+            return
         self.output_file.write(experiment_description_text(self, reference_header=self.reference_header))
 
     def write_output_information_to_file(self):
-        """Block 3 of the output file: summary and (optionally) the 42-column table (§9.1)."""
+        """Block 3 of the output file (docs/output.md): summary and (optionally) the 42-column table; nothing without
+        an output file (``False``/None)."""
+        if not self.output_file:
+            return
         G_int = self.results.get("internal") or self.evaluateStressAndG(False)
         G_surf = self.results.get("surface") or self.evaluateStressAndG(True)
         out = self.output_file

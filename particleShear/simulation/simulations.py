@@ -38,6 +38,12 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
                          "output folder (no such directory)")
 
 
+def _writes(simulation, theFile):
+    """Whether ``write_information_on_simulation_to_file`` writes: a file is given (``False``/None mean
+    none, as in the reference) and the simulation saves data (1.0.2 writes nothing with ``saveData=False``)."""
+    return theFile is not False and theFile is not None and bool(simulation.saveData)
+
+
 def call_string(name, **arguments):
     """``name(k1=v1,k2=v2,...)`` with ``str()`` values and no spaces: the header's function-call line (§9.1)."""
     return name + "(" + ",".join(k + "=" + str(v) for k, v in arguments.items()) + ")"
@@ -151,9 +157,15 @@ class OscillatorySimulation:
         return str(fileName) + "_images_folder"
 
     def createFolder(self, directory):
+        """Create ``directory`` (and its parents); ``False``/None (no folder, as in the reference) does nothing."""
+        if directory is False or directory is None:
+            return
         os.makedirs(directory, exist_ok=True)
 
     def write_information_on_simulation_to_file(self, theFile):
+        """Block 1 of the text file (docs/output.md); nothing for ``theFile`` False/None or ``saveData`` False."""
+        if not _writes(self, theFile):
+            return
         theFile.write("Oscillatory simulation\n\n\n\nFunction call : \n" + self.function_call + "\n\n")
 
     # -- experiment ------------------------------------------------------------------------------
@@ -335,7 +347,9 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         return self.relative_frequency / model.time_constant if model else -1
 
     def write_information_on_simulation_to_file(self, theFile):
-        """Block 1 of §9.1."""
+        """Block 1 of the text file (docs/output.md); nothing for ``theFile`` False/None or ``saveData`` False."""
+        if not _writes(self, theFile):
+            return
         if self.do_permanent_links:
             if self.cut_lines > 0:
                 head = ("Dermal filler Ensemble: \n\tCutting lines used to generate the particles"
