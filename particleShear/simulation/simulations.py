@@ -26,7 +26,7 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
     wants = []
     if saveData:
         wants.append("saveData=True")
-    if saveOutputImages and doDrawing:
+    if saveOutputImages:  # snapshots are rendered off-screen, with or without doDrawing
         wants.append("saveOutputImages=True")
     if not wants:
         return
@@ -183,6 +183,7 @@ class OscillatorySimulation:
         exp.correct_drift_sign = self.correct_drift_sign
         exp.reference_header = self.reference_header
         exp.renderer = self.renderer
+        exp.save_movie = bool(getattr(self, "saveOutputMovie", False))
         exp.verbose = self.verbose
         exp.progress = self.progress
         if self.verbose:
@@ -219,7 +220,7 @@ class OscillatorySimulation:
             self.dt = self.theEnsemble.dt * getattr(self, "time_step_factor", 1.0)
             self.f = self.relative_frequency / model.time_constant
             fileName = False
-            if self.saveData or (self.saveOutputImages and self.doDrawing):
+            if self.saveData or self.saveOutputImages:
                 out = reserve_numbered_path(self._file_stem())
                 fileName = out.path
                 if not self.saveData:  # the name is only needed for the image folder
