@@ -253,9 +253,11 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None):
     groups = sweep_groups(rows, estimator)
     if not groups:
         raise ValueError(f"folder_or_csv={folder_or_csv!r} has no rows with status 'ok' and finite moduli")
+    import numpy as np
     fig = _figure(6.4, 4.4)
     ax = fig.subplots()
     for k, ((group, mu), d) in enumerate(groups.items()):
+        d = {key: np.asarray(v, dtype=float) for key, v in d.items()}
         colour = f"C{k % 10}"
         name = f"{group}, μ={mu:g}"
         ax.errorbar(d["A"], d["Gp"], yerr=d["Gp_err"], color=colour, marker="o", ls="-", capsize=3,
