@@ -91,6 +91,20 @@ class TestCaption(unittest.TestCase):
         self.assertEqual(img.getpixel((185, 230)), (0, 0, 255))
 
 
+class TestStressWindowTicks(unittest.TestCase):
+    def test_nice_ticks_are_round_and_cover_the_range(self):
+        from particleShear.simulation.drawing import nice_ticks
+        ticks = nice_ticks(0, 0.00113, 8)   # a protocol of 1.13 ms
+        self.assertEqual(ticks[0], 0)
+        steps = np.diff(ticks)
+        np.testing.assert_allclose(steps, steps[0])
+        self.assertAlmostEqual(steps[0], 2e-4)          # 1, 2 or 5 × 10^k
+        self.assertLessEqual(ticks[-1], 0.00113)
+        self.assertGreater(ticks[-1] + steps[0], 0.00113)
+        self.assertEqual(nice_ticks(-250, 250, 5), [-200, -100, 0, 100, 200])
+        self.assertEqual(nice_ticks(1, 1), [])
+
+
 class TestFiles(unittest.TestCase):
     def test_eps_and_svg_are_vector(self):
         ens = two_bonded_spheres()

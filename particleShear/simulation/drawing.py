@@ -30,7 +30,7 @@ from ..base.kernels import min_image
 from ..base.neighbours import PERMANENT, SLIP
 
 __all__ = ["Renderer", "PillowRenderer", "TkRenderer", "StressPlotWindow", "display_available",
-           "make_renderer", "open_stress_plot", "scene_geometry", "scene_primitives", "periodic_offsets",
+           "make_renderer", "open_stress_plot", "nice_ticks", "scene_geometry", "scene_primitives", "periodic_offsets",
            "IMAGE_EXTENSIONS", "CAPTION_HEIGHT"]
 
 #: imageFileType → (file extension, Pillow format)
@@ -570,17 +570,72 @@ class TkRenderer(Renderer):
                 pass
 
 
+def nice_ticks(lo, hi, n=5):
+    """Round tick values (1, 2 or 5 × 10^k steps) covering [lo, hi] with about ``n`` ticks."""
+    span = float(hi) - float(lo)
+    if not math.isfinite(span) or span <= 0:
+        return []
+    raw = span / max(int(n), 1)
+    k = math.floor(math.log10(raw))
+    step = next(m * 10 ** k for m in (1, 2, 5, 10) if m * 10 ** k >= raw)
+    first = math.ceil(lo / step)
+    return [i * step for i in range(first, int(math.floor(hi / step)) + 1)][:50]
+
+
 class StressPlotWindow:
-    """Tk window with a ``width × height`` canvas for the stress/strain plot (§9.5)."""
+    """Tk window with a ``width × height`` canvas for the live stress/strain plot.
+
+    :meth:`draw_axes` adds the time axis (s), the stress axis (Pa, left), strain marks (right),
+    the excitation window and a legend; the dots are drawn by
+    :class:`~particleShear.simulation.evaluation.EvaluationHandlerPlotter`.  At the end of a run
+    :meth:`finish` keeps the window open until the user closes it (only in the main process and
+    when :attr:`keep_open` is True; set ``StressPlotWindow.keep_open = False`` for scripted loops).
+    """
+
+    #: wait for the user to close the window at the end of a run
+    keep_open = True
 
     def __init__(self, width=1000, height=500, title="Stress and strain", master=None):
         import tkinter
         self._tkinter = tkinter
         self.tk = tkinter.Toplevel(master) if master is not None else tkinter.Tk()
         self.tk.title(title)
+        self.width, self.height = width, height
         self.canvas = tkinter.Canvas(self.tk, width=width, height=height, bg="white")
         self.canvas.pack()
         self._last = 0.0
+
+    def draw_axes(self, T_total, x_scale, y_scale_force, y_scale_strain, amplitude, t_on=None, t_off=None):
+        """Axes, ticks, units and legend matching the plotter's mapping ``y = height/2 − value·scale``."""
+        c = self.canvas
+        if not hasattr(c, "create_text"):  # minimal canvases (tests) draw dots only
+            return
+        W, H, y0 = self.width, self.height, self.height / 2
+        c.create_line(0, y0, W, y0, fill="black")
+        for t in nice_ticks(0, T_total, 8):
+            x = t * x_scale
+            c.create_line(x, y0 - 4, x, y0 + 4, fill="black")
+            c.create_text(x + 2, y0 + 6, text=f"{t:.3g}", anchor="nw", font=("TkDefaultFont", 8))
+        c.create_text(W - 4, y0 + 20, text="time t (s)", anchor="ne")
+        if y_scale_force:
+            half = y0 / abs(y_scale_force)
+            for v in nice_ticks(-half, half, 8):
+                y = y0 - v * y_scale_force
+                c.create_line(0, y, 6, y, fill="black")
+                c.create_text(8, y, text=f"{v:.3g}", anchor="w", font=("TkDefaultFont", 8))
+            c.create_text(8, 4, text="stress − stress(0) (Pa)", anchor="nw")
+        for v in (-amplitude, amplitude):
+            y = y0 - v * y_scale_strain
+            c.create_line(W - 6, y, W, y, fill="green")
+            c.create_text(W - 8, y, text=f"\u03b3 = {v:+.3g}", anchor="e", fill="green", font=("TkDefaultFont", 8))
+        for t in (t_on, t_off):
+            if t is not None:
+                c.create_line(t * x_scale, 0, t * x_scale, H, fill="grey", dash=(2, 4))
+        for k, (col, label) in enumerate((("red", "\u03c4 internal (stress tensor)"),
+                                          ("blue", "\u03c4 surface (plate forces)"), ("green", "strain \u03b3"))):
+            y = 24 + 16 * k
+            c.create_line(200, y, 220, y, fill=col, width=3)
+            c.create_text(226, y, text=label, anchor="w")
 
     def update(self, min_interval=0.03):
         if time.monotonic() - self._last >= min_interval:
@@ -589,6 +644,19 @@ class StressPlotWindow:
             except self._tkinter.TclError:
                 pass
             self._last = time.monotonic()
+
+    def finish(self, wait=True):
+        """End of the run: with ``wait``, wait until the user closes the window (see :attr:`keep_open`), then close."""
+        import multiprocessing
+        loop = getattr(self.tk, "mainloop", None)
+        if wait and self.keep_open and loop is not None and multiprocessing.parent_process() is None:
+            try:
+                self.tk.title("Stress and strain (run finished: close this window to continue)")
+                self.tk.protocol("WM_DELETE_WINDOW", self.tk.quit)  # closing ends the wait
+                loop()
+            except self._tkinter.TclError:
+                pass
+        self.close()
 
     def close(self):
         try:

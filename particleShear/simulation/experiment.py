@@ -223,6 +223,10 @@ class OscillatoryShearExperiment:
                                            y_scale_force=self.force_scale, r=2, offset_x=0,
                                            offset_y=self.height / 2, plotStress=bool(canvas))
         self.outputCanvas = canvas
+        if canvas:
+            self.stress_window.draw_axes(T_total, plotter.x_scale, plotter.y_scale_force, plotter.y_scale_strain,
+                                         self.amplitude, self.baseline_pre_periods / self.f,
+                                         (self.baseline_pre_periods + self.periods) / self.f)
         return plotter
 
     def prepare_recording(self):

@@ -8,6 +8,7 @@ output path, series) is kept in ``self.result_info`` after the run.
 """
 import math
 import os
+import sys
 import time
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
@@ -267,7 +268,8 @@ class OscillatorySimulation:
     def _close_windows(self):
         exp = self.theExperiment
         if exp is not None and exp.stress_window is not None:
-            exp.stress_window.close()
+            # after a successful run the window stays open until closed (main process), then closes
+            exp.stress_window.finish(wait=sys.exc_info()[0] is None)
             exp.stress_window = None
         if self.renderer is not None:
             self.renderer.close()
