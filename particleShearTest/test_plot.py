@@ -96,6 +96,15 @@ class TestResultPlot(unittest.TestCase):
         area = 0.5 * abs(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
         self.assertAlmostEqual(area / (math.pi * 60.0 * 0.2 ** 2), 1.0, delta=2e-3)  # 400 points per period
 
+    def test_headless_run_saves_the_stress_window_as_png(self):
+        from particleShear import doParticleShearSimulation
+        with tempfile.TemporaryDirectory() as d, mock.patch.dict(os.environ, {"DISPLAY": "", "WAYLAND_DISPLAY": ""}):
+            res = doParticleShearSimulation(d, N=12, cut_lines=2, pre_periods=0.25, periods=0.5, post_periods=0.25,
+                                            saveData=True, saveStressTensorData=False, seed=2, verbose=False,
+                                            return_result=True)
+            with open(res.output_path + "_stress.png", "rb") as fh:
+                self.assertEqual(fh.read(4), b"\x89PNG")
+
     def test_missing_matplotlib_names_the_extra(self):
         from particleShear.plot import plot_result
         with mock.patch.dict(sys.modules, {"matplotlib.figure": None}):

@@ -244,6 +244,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         n_images=info["n_images"], dt=info["dt"], f=info["f"], N_steps=info["N_steps"],
         damping_factor=info["damping_factor"],
         removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series)
+    if plotStress and doDrawing and result.output_path:
+        _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
     if return_result:
         return result
@@ -251,6 +253,18 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
 
 
 doParticleShearSimulation.last_result = None
+
+
+def _save_headless_stress_plot(result, renderer):
+    """Without a display the live stress window cannot open: save its content instead, as
+    ``<output file>_stress.png`` (trace and Lissajous loop, needs matplotlib; skipped without it)."""
+    import importlib.util
+    from ..simulation.drawing import _backend_choice, display_available
+    if _backend_choice(renderer) in ("auto", "tk") and display_available()[0]:
+        return  # the live window was shown
+    if importlib.util.find_spec("matplotlib") is None:
+        return
+    result.plot(str(result.output_path) + "_stress.png")
 
 
 def series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_control, do_non_frictional_control,
