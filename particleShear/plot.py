@@ -266,6 +266,11 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None):
                     capsize=3, label="G″ " + name)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    amplitudes = sorted({a for d in groups.values() for a in d["A"]})
+    if len(amplitudes) <= 12:  # label the measured amplitudes themselves, no crowded minor labels
+        from matplotlib.ticker import NullFormatter
+        ax.set_xticks(amplitudes, [f"{a:g}" for a in amplitudes])
+        ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("strain amplitude A (–)")
     ax.set_ylabel(f"G′, G″ (Pa), {estimator} estimator")
     n_seeds = sorted({n for d in groups.values() for n in d["n"]})
