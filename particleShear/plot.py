@@ -229,8 +229,9 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None):
     Reads ``DIR/results.csv`` (columns run_id, status, error, Gp_surface, Gpp_surface,
     Gp_internal, Gpp_internal, then the parameters: theAmplitude, theMu, do_permanent_links,
     cut_lines, ...).  Only ``status == "ok"`` rows are used; each point is the mean over seeds
-    with an error bar of one standard error.  Both axes are logarithmic; G′ is drawn with
-    solid lines and filled circles, G″ with dashed lines and open squares, same colour per group.
+    with an error bar of one standard error.  Both axes are logarithmic, so a non-positive mean
+    (e.g. a negative G′ of a fluid-like group) is not shown; G′ is drawn with solid lines and filled
+    circles, G″ with dashed lines and open squares, same colour per group.
 
     Parameters
     ----------
