@@ -359,7 +359,10 @@ def draw_plot(results, path):
     p1.set_title("Error of G′ against run time")
     p2.set_title("Error of G′ against time step")
     p1.plot([], [], ls="none", marker="x", color="0.3", label="× on the top edge: stopped by the stability guard")
-    fig.legend(*p1.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize="small")
+    try:
+        fig.legend(*p1.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize="small")
+    except ValueError:  # matplotlib < 3.7: no "outside" locations
+        fig.legend(*p1.get_legend_handles_labels(), loc="lower center", ncol=3, fontsize="small")
     save_figure(fig, path)
     return fig
 

@@ -105,6 +105,35 @@ class TestStressWindowTicks(unittest.TestCase):
         self.assertEqual(nice_ticks(1, 1), [])
 
 
+    def test_axes_of_the_live_window_match_the_plotter_mapping(self):
+        """draw_axes on a recording canvas (no Tk): ticks where the plotter puts those values."""
+        from particleShear.simulation.drawing import StressPlotWindow
+
+        class Canvas:
+            def __init__(self):
+                self.texts, self.lines = [], []
+
+            def create_text(self, x, y, text="", **k):
+                self.texts.append((x, y, text))
+
+            def create_line(self, *xy, **k):
+                self.lines.append(xy)
+
+        w = StressPlotWindow.__new__(StressPlotWindow)   # no Tk window
+        w.width, w.height, w.canvas = 1000, 500, Canvas()
+        T, A, fs = 0.004, 0.2, 2.0                        # 4 ms protocol, 2 px per Pa
+        w.draw_axes(T, 1000 / T, fs, 30 / A, A, t_on=0.001, t_off=0.003)
+        texts = {t: (x, y) for x, y, t in w.canvas.texts}
+        self.assertIn("time t (s)", texts)
+        self.assertIn("stress − stress(0) (Pa)", texts)
+        self.assertAlmostEqual(texts["0.002"][0], 500 + 2)          # t = 2 ms at x = t·x_scale (+2 px offset)
+        self.assertAlmostEqual(texts["100"][1], 250 - 100 * fs)     # 100 Pa at y = H/2 − τ·scale
+        self.assertAlmostEqual(texts["\u03b3 = +0.2"][1], 250 - 30)  # strain A drawn 30 px above the axis
+        self.assertIn((250.0, 0, 250.0, 500), w.canvas.lines)        # excitation start t_on = 1 ms
+        for label in ("\u03c4 internal (stress tensor)", "\u03c4 surface (plate forces)", "strain \u03b3"):
+            self.assertIn(label, texts)
+
+
 class TestFiles(unittest.TestCase):
     def test_eps_and_svg_are_vector(self):
         ens = two_bonded_spheres()
