@@ -363,7 +363,7 @@ def draw_plot(results, path):
         fig.legend(*p1.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize="small")
     except ValueError:  # matplotlib < 3.7: no "outside" locations
         fig.legend(*p1.get_legend_handles_labels(), loc="lower center", ncol=3, fontsize="small")
-    save_figure(fig, path)
+    save_figure(fig, path, dpi=110)
     return fig
 
 
