@@ -20,7 +20,7 @@ are those a user gets), run on a ``ProcessPoolExecutor`` (default 2 workers):
 3. **Largest stable time step** per regime: bisection on ``time_step_factor`` (log scale) with the
    stability guard (:class:`particleShear.base.stability.SimulationInstabilityError`) as oracle,
    short runs (0.5 + 1 + 0.25 periods), each rebuilt from the same seed (same packing).
-4. Tables (Markdown), JSON, CSV and a log-log plot drawn with Pillow.
+4. Tables (Markdown), JSON, CSV and a log-log plot drawn with matplotlib (extra ``[plot]``).
 
 Peak overlap, momentum and the tensor history are read through a read-only hook: the study
 runs ``doParticleShearSimulation`` with the simulation class replaced by a subclass whose
@@ -32,6 +32,7 @@ to a plain call (checked at start-up, see ``_self_check``).
 Usage::
 
     python benchmarks/accuracy_study.py [--quick] [--out DIR] [--workers 2]
+    python benchmarks/accuracy_study.py --replot      # redraw accuracy.png from the saved JSON
 
 ``--quick`` (< 3 min on 2 cores) uses N = 45 scenes, four factors and fewer seeds; the full
 study (~15–25 min on 2 cores) is what ``docs/accuracy.md`` reports.  Output in ``DIR``
@@ -287,209 +288,92 @@ def statistics_analysis(rows):
 
 
 # ---------------------------------------------------------------------------------------------
-# plot (Pillow, log-log)
+# plot (matplotlib, log-log; extra [plot])
 # ---------------------------------------------------------------------------------------------
-def _font(size):
-    from PIL import ImageFont
-    for name in ("DejaVuSans.ttf", "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"):
-        try:
-            return ImageFont.truetype(name, size)
-        except OSError:
-            pass
-    try:
-        return ImageFont.load_default(size)
-    except TypeError:  # Pillow < 10.1
-        return ImageFont.load_default()
-
-
-class LogPanel:
-    """A log-log axes box on a Pillow image: decade ticks, grid, labels, polylines and markers."""
-
-    def __init__(self, draw, box, xlim, ylim, xlabel, ylabel, title):
-        self.d, self.box = draw, box
-        self.lx = (math.log10(xlim[0]), math.log10(xlim[1]))
-        self.ly = (math.log10(ylim[0]), math.log10(ylim[1]))
-        f, fs = _font(15), _font(13)
-        x0, y0, x1, y1 = box
-        draw.rectangle(box, outline="black", width=2)
-        for e in range(math.floor(self.lx[0]), math.ceil(self.lx[1]) + 1):
-            for m in range(1, 10):
-                v = e + math.log10(m)
-                if self.lx[0] <= v <= self.lx[1]:
-                    X = self._X(10 ** v)
-                    draw.line([(X, y0), (X, y1)], fill=(225, 225, 225) if m > 1 else (190, 190, 190))
-                    draw.line([(X, y1), (X, y1 - (8 if m == 1 else 4))], fill="black")
-                    if m == 1:
-                        draw.text((X, y1 + 6), _dec(e), fill="black", font=fs, anchor="ma")
-        for e in range(math.floor(self.ly[0]), math.ceil(self.ly[1]) + 1):
-            for m in range(1, 10):
-                v = e + math.log10(m)
-                if self.ly[0] <= v <= self.ly[1]:
-                    Y = self._Y(10 ** v)
-                    draw.line([(x0, Y), (x1, Y)], fill=(225, 225, 225) if m > 1 else (190, 190, 190))
-                    draw.line([(x0, Y), (x0 + (8 if m == 1 else 4), Y)], fill="black")
-                    if m == 1:
-                        draw.text((x0 - 6, Y), _dec(e), fill="black", font=fs, anchor="rm")
-        draw.rectangle(box, outline="black", width=2)
-        draw.text(((x0 + x1) / 2, y1 + 28), xlabel, fill="black", font=f, anchor="ma")
-        draw.text(((x0 + x1) / 2, y0 - 10), title, fill="black", font=_font(16), anchor="md")
-        self.ylabel = (x0 - 52, (y0 + y1) / 2, ylabel)
-
-    def _X(self, x):
-        x0, _, x1, _ = self.box
-        return x0 + (math.log10(x) - self.lx[0]) / (self.lx[1] - self.lx[0]) * (x1 - x0)
-
-    def _Y(self, y):
-        _, y0, _, y1 = self.box
-        return y1 - (math.log10(y) - self.ly[0]) / (self.ly[1] - self.ly[0]) * (y1 - y0)
-
-    def inside(self, x, y):
-        return (x > 0 and y > 0 and self.lx[0] <= math.log10(x) <= self.lx[1]
-                and self.ly[0] <= math.log10(y) <= self.ly[1])
-
-    def line(self, pts, color, marker="o", width=2, dash=False):
-        pts = [(x, y) for x, y in pts if self.inside(x, y)]
-        P = [(self._X(x), self._Y(y)) for x, y in pts]
-        if len(P) > 1:
-            if dash:
-                for a, b in zip(P[:-1], P[1:]):
-                    _dashed(self.d, a, b, color, width)
-            else:
-                self.d.line(P, fill=color, width=width)
-        for X, Y in P:
-            _marker(self.d, X, Y, marker, color)
-
-    def hline(self, y, color, label=None, below=False):
-        if not self.inside(10 ** self.lx[0] * 1.0001, y):
-            return
-        x0, _, x1, _ = self.box
-        Y = self._Y(y)
-        _dashed(self.d, (x0, Y), (x1, Y), color, 2)
-        if label:
-            self.d.text((x1 - 6, Y + 4 if below else Y - 3), label, fill=color, font=_font(12),
-                        anchor="ra" if below else "rd")
-
-
-def _dec(e):
-    sup = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-    return "10" + str(e).translate(sup)
-
-
-def _dashed(d, a, b, color, width, on=8, off=6):
-    L = math.hypot(b[0] - a[0], b[1] - a[1])
-    if L == 0:
-        return
-    ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
-    s = 0.0
-    while s < L:
-        e = min(s + on, L)
-        d.line([(a[0] + ux * s, a[1] + uy * s), (a[0] + ux * e, a[1] + uy * e)], fill=color, width=width)
-        s = e + off
-
-
-def _marker(d, X, Y, kind, color, s=5):
-    if kind == "o":
-        d.ellipse([X - s, Y - s, X + s, Y + s], outline=color, fill=color)
-    elif kind == "s":
-        d.rectangle([X - s, Y - s, X + s, Y + s], outline=color, width=2)
-    elif kind == "^":
-        d.polygon([(X, Y - s - 1), (X - s, Y + s), (X + s, Y + s)], outline=color)
-    elif kind == "x":
-        d.line([(X - s, Y - s), (X + s, Y + s)], fill=color, width=2)
-        d.line([(X - s, Y + s), (X + s, Y - s)], fill=color, width=2)
-
-
-def _vertical_text(img, xy, text, size=15):
-    from PIL import Image, ImageDraw
-    f = _font(size)
-    w = int(f.getlength(text)) + 4
-    tmp = Image.new("RGBA", (w, size + 6), (255, 255, 255, 0))
-    ImageDraw.Draw(tmp).text((2, 1), text, fill="black", font=f)
-    tmp = tmp.rotate(90, expand=True)
-    img.paste(tmp, (int(xy[0] - tmp.width / 2), int(xy[1] - tmp.height / 2)), tmp)
-
-
-COLORS = {("crosslinked", "euler"): (200, 30, 30), ("crosslinked", "verlet"): (240, 140, 20),
-          ("frictional", "euler"): (30, 60, 200), ("frictional", "verlet"): (20, 170, 200)}
+COLORS = {("crosslinked", "euler"): "#c81e1e", ("crosslinked", "verlet"): "#f08c14",
+          ("frictional", "euler"): "#1e3cc8", ("frictional", "verlet"): "#14aac8"}
 
 
 def draw_plot(results, path):
-    """Two log-log panels: |error of G′| vs wall time, and vs time-step factor (with seed spread)."""
-    from PIL import Image, ImageDraw
-    W, H = 1500, 760
-    img = Image.new("RGB", (W, H), "white")
-    d = ImageDraw.Draw(img)
+    """Two log-log panels: relative error of G′ against wall time and against the time-step factor.
+
+    Errors are relative to the finest time step of the same scene and integrator (both
+    estimators: internal = solid line and circles, surface = dashed line and squares); crosses on
+    the top edge mark factors stopped by the stability guard; the horizontal dotted lines are the
+    seed-to-seed spread (std/mean of G′ internal at the convergence N); grey guides have slopes 1
+    and 2.  Drawn with matplotlib on an Agg canvas (:func:`particleShear.plot.save_figure`).
+    """
+    from particleShear.plot import _figure, save_figure
     conv = results["convergence_rows"]
     ana = results["convergence"]
     stats = {(s["scene"], s["N"], s["periods"]): s for s in results["statistics"]}
     N0 = results["config"]["N_conv"]
-    errs, walls = [], []
-    for key, a in ana.items():
-        for q in ("Gp_int", "Gp_surf"):
-            for f, e in a["q"][q]["rel_error_vs_finest"].items():
-                if e > 0:
-                    errs.append(e)
-    for r in conv:
-        if r["status"] == "ok":
-            walls.append(r["wall"])
-    if not errs:
-        errs = [1e-3, 1]
-    ylim = (10 ** math.floor(math.log10(min(errs + [1e-3]))), 10 ** math.ceil(math.log10(max(errs + [1.0]))))
-    xlim_t = (10 ** math.floor(math.log10(min(walls))), 10 ** math.ceil(math.log10(max(walls))))
-    fs = sorted({r["factor"] for r in conv})
-    xlim_f = (10 ** math.floor(math.log10(min(fs))), 10 ** math.ceil(math.log10(max(fs))))
-    p1 = LogPanel(d, (110, 60, 700, 560), xlim_t, ylim, "wall time of the run (s)",
-                  "relative error of G′ vs finest dt", "Error of G′ against run time")
-    p2 = LogPanel(d, (880, 60, 1470, 560), xlim_f, ylim, "time_step_factor (dt / default rule)",
-                  "relative error of G′ vs finest dt", "Error of G′ against time step")
-    for p in (p1, p2):
-        _vertical_text(img, p.ylabel[:2], p.ylabel[2])
-    legend = []
+    fig = _figure(12, 5.2)
+    p1, p2 = fig.subplots(1, 2, sharey=True)
     for key, a in sorted(ana.items()):
         scene, integ = a["scene"], a["integrator"]
-        col = COLORS.get((scene, integ), (0, 0, 0))
-        for q, mk, dash in (("Gp_int", "o", False), ("Gp_surf", "s", True)):
-            e = {float(k): v for k, v in a["q"][q]["rel_error_vs_finest"].items()}
-            rows = {float(r["factor"]): r for r in conv if r["scene"] == scene and r["integrator"] == integ
-                    and r["status"] == "ok"}
-            pts_t = sorted((rows[f]["wall"], e[f]) for f in e if e[f] > 0)
-            pts_f = sorted((f, e[f]) for f in e if e[f] > 0)
-            p1.line(pts_t, col, mk, dash=dash)
-            p2.line(pts_f, col, mk, dash=dash)
-            legend.append((col, mk, dash, f"{scene}, {integ}, {'G′ internal' if q == 'Gp_int' else 'G′ surface'}"))
-        # unstable factors: crosses on the top edge of panel 2
-        for r in conv:
-            if r["scene"] == scene and r["integrator"] == integ and r["status"] != "ok":
-                _marker(d, p2._X(r["factor"]), p2._Y(ylim[1]) + 8, "x", col)
-    # seed-to-seed spread at the convergence N (relative std of G′ internal) as horizontal lines
-    for k_scene, scene in enumerate(SCENES):
+        col = COLORS.get((scene, integ), "black")
+        rows = {float(r["factor"]): r for r in conv if r["scene"] == scene and r["integrator"] == integ
+                and r["status"] == "ok"}
+        for q, mk, ls, name in (("Gp_int", "o", "-", "G′ internal"), ("Gp_surf", "s", "--", "G′ surface")):
+            e = {float(k): v for k, v in a["q"][q]["rel_error_vs_finest"].items() if v > 0}
+            pts_f = sorted(e.items())
+            pts_t = sorted((rows[f]["wall"], v) for f, v in e.items() if f in rows)
+            label = f"{scene}, {integ}, {name}"
+            if pts_t:
+                p1.plot(*zip(*pts_t), color=col, marker=mk, ls=ls, mfc="white" if mk == "s" else col, label=label)
+            if pts_f:
+                p2.plot(*zip(*pts_f), color=col, marker=mk, ls=ls, mfc="white" if mk == "s" else col)
+        bad = [float(r["factor"]) for r in conv if r["scene"] == scene and r["integrator"] == integ
+               and r["status"] != "ok"]
+        if bad:
+            p2.plot(bad, [1.0] * len(bad), ls="none", marker="x", color=col, ms=8,
+                    transform=p2.get_xaxis_transform(), clip_on=False)
+    for scene in SCENES:
         s = stats.get((scene, N0, 3))
         if s and s["Gp_int_mean"] and math.isfinite(s["Gp_int_std"]):
             rel = s["Gp_int_std"] / abs(s["Gp_int_mean"])
-            col = COLORS[(scene, "euler")]
             for p in (p1, p2):
-                p.hline(rel, col, f"{scene}: seed spread (std/mean, N={N0})", below=k_scene == 0)
-    # order guides on panel 2
-    f_lo, f_hi = xlim_f
-    for order, lab in ((1, "slope 1"), (2, "slope 2")):
-        y_at_1 = 10 ** (math.log10(ylim[0]) + 0.6 * (math.log10(ylim[1]) - math.log10(ylim[0])))
-        pts = [(f, y_at_1 * f ** order) for f in (f_lo, 1, f_hi)]
-        p2.line(pts, (120, 120, 120), marker="", width=1, dash=True)
-        X, Y = p2._X(1), p2._Y(y_at_1)
-        d.text((X + 4, Y + (4 if order == 1 else -18)), lab, fill=(100, 100, 100), font=_font(12))
-    ly = 650
-    for k, (col, mk, dash, text) in enumerate(legend):
-        X = 110 + (k % 3) * 460
-        Y = ly + (k // 3) * 24
-        if dash:
-            _dashed(d, (X, Y), (X + 40, Y), col, 2)
-        else:
-            d.line([(X, Y), (X + 40, Y)], fill=col, width=2)
-        _marker(d, X + 20, Y, mk, col)
-        d.text((X + 50, Y), text, fill="black", font=_font(13), anchor="lm")
-    d.text((W - 10, H - 8), "× at the top: run stopped by the stability guard (unstable)", fill="black",
-           font=_font(12), anchor="rd")
-    img.save(path)
+                p.axhline(rel, color=COLORS[(scene, "euler")], ls=":", lw=1.5,
+                          label=f"{scene}: seed spread (std/mean, N={N0})" if p is p1 else None)
+    fs = np.array(sorted({float(r["factor"]) for r in conv}))
+    errs = [v for a in ana.values() for q in ("Gp_int", "Gp_surf") for v in a["q"][q]["rel_error_vs_finest"].values()
+            if v > 0]
+    y1 = math.sqrt(min(errs) * max(errs)) if errs else 1e-2  # guides through the middle of the data (at f = 1)
+    for order in (1, 2):
+        p2.plot(fs, y1 * fs ** order, color="0.55", lw=1, ls=(0, (4, 4)))
+        p2.annotate(f"slope {order}", (fs[-1], y1 * fs[-1] ** order), fontsize="small", color="0.4",
+                    xytext=(-40, 0), textcoords="offset points")
+    from matplotlib.ticker import NullFormatter
+    walls = [r["wall"] for r in conv if r["status"] == "ok"]
+    for p, ticks in ((p1, [v for v in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+                           if walls and min(walls) / 1.5 <= v <= max(walls) * 1.5]), (p2, list(fs))):
+        p.set_xscale("log")
+        p.set_yscale("log")
+        p.set_xticks(ticks, [f"{v:g}" for v in ticks])
+        p.xaxis.set_minor_formatter(NullFormatter())
+        p.grid(True, which="both", color="0.9", lw=0.6)
+    p1.set_xlabel("wall time of the run (s)")
+    p2.set_xlabel("time_step_factor (dt / default rule)")
+    p1.set_ylabel("relative error of G′ against the finest dt (–)")
+    p1.set_title("Error of G′ against run time")
+    p2.set_title("Error of G′ against time step")
+    p1.plot([], [], ls="none", marker="x", color="0.3", label="× on the top edge: stopped by the stability guard")
+    try:
+        fig.legend(*p1.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize="small")
+    except ValueError:  # matplotlib < 3.7: no "outside" locations
+        fig.legend(*p1.get_legend_handles_labels(), loc="lower center", ncol=3, fontsize="small")
+    save_figure(fig, path, dpi=110)
+    return fig
+
+
+def replot(folder):
+    """Redraw ``accuracy.png`` in ``folder`` from its ``accuracy_results.json`` (no simulation)."""
+    with open(os.path.join(folder, "accuracy_results.json")) as fh:
+        results = json.load(fh)
+    path = os.path.join(folder, "accuracy.png")
+    draw_plot(results, path)
+    return path
 
 
 # ---------------------------------------------------------------------------------------------
@@ -646,7 +530,12 @@ def main(argv=None):
     ap.add_argument("--out", default=os.path.join("docs", "accuracy_data"), help="output folder")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1, help="seed of the convergence and bisection runs")
+    ap.add_argument("--replot", action="store_true",
+                    help="only redraw accuracy.png from OUT/accuracy_results.json (no simulation)")
     args = ap.parse_args(argv)
+    if args.replot:
+        print("wrote " + replot(args.out))
+        return
     os.makedirs(args.out, exist_ok=True)
     t_start = time.perf_counter()
     _self_check()

@@ -393,7 +393,7 @@ class TestRunLayer(unittest.TestCase):
             self.assertEqual(r.output_path, None)  # saveData=False: no text file, only images
             from PIL import Image
             with Image.open(os.path.join(r.image_folder, files[-1])) as im:
-                self.assertEqual(im.size, (500, 500))
+                self.assertEqual(im.size, (500, 500 + 44))  # cell (1 px = 1 µm) + caption strip
 
     def test_tk_backend_with_fake_tkinter(self):
         """Exercise the live drawing code paths (particle window, stress plot) without a display."""

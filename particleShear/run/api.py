@@ -81,6 +81,15 @@ class SimulationResult:
         """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns."""
         return [self.G_surface[0], self.G_surface[1]]
 
+    def plot(self, path=None):
+        """Strain and stress traces against time plus the Lissajous loop (needs ``particleShear[plot]``).
+
+        See :func:`particleShear.plot.plot_result`; ``path`` (optional) writes PNG, PDF, SVG or EPS
+        by extension.  Returns the :class:`matplotlib.figure.Figure`.
+        """
+        from ..plot import plot_result
+        return plot_result(self, path)
+
 
 def _seed_sequence(seed):
     """(SeedSequence or None, Generator) for ``seed`` = None, int, SeedSequence, Generator or BitGenerator."""
@@ -104,7 +113,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               plotStress=True, relative_y_scale_force=1e8, pre_periods=2, periods=3,
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
-                              time_step_factor=1.0, integrator="euler", stability_guard=True):
+                              time_step_factor=1.0, integrator="euler", stability_guard=True,
+                              saveOutputMovie=False):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     Parameters
@@ -142,6 +152,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     stability_guard : bool, keyword-only
         Stop a diverging measurement with :class:`SimulationInstabilityError` (step, phase, worst
         pair, suggested time step) instead of producing NaN moduli.
+    saveOutputMovie : bool, keyword-only
+        Also write the snapshots as an animated GIF ``movie.gif`` in the image folder (needs
+        ``saveOutputImages=True``; frames are kept at most 500 px wide, at most 200 of them).
 
     Returns
     -------
@@ -176,6 +189,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
     if integrator not in ("euler", "verlet"):
         raise ValueError(f"integrator={integrator!r} is out of range: allowed 'euler' or 'verlet'")
+    if not isinstance(saveOutputMovie, (bool, np.bool_)):
+        raise TypeError(f"saveOutputMovie={saveOutputMovie!r} is invalid: allowed True or False")
+    if saveOutputMovie and not saveOutputImages:
+        raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
+                         "the snapshots (set saveOutputImages=True and a root_folder)")
     ss, rng = _seed_sequence(seed)
 
     theSimulation = Simulation_interlocking_rheology(
@@ -212,6 +230,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.time_step_factor = float(time_step_factor)
     theSimulation.integrator = integrator
     theSimulation.stability_guard = bool(stability_guard)
+    theSimulation.saveOutputMovie = bool(saveOutputMovie)
 
     G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
@@ -225,6 +244,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         n_images=info["n_images"], dt=info["dt"], f=info["f"], N_steps=info["N_steps"],
         damping_factor=info["damping_factor"],
         removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series)
+    if plotStress and doDrawing and result.output_path:
+        _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
     if return_result:
         return result
@@ -232,6 +253,18 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
 
 
 doParticleShearSimulation.last_result = None
+
+
+def _save_headless_stress_plot(result, renderer):
+    """Without a display the live stress window cannot open: save its content instead, as
+    ``<output file>_stress.png`` (trace and Lissajous loop, needs matplotlib; skipped without it)."""
+    import importlib.util
+    from ..simulation.drawing import _backend_choice, display_available
+    if _backend_choice(renderer) in ("auto", "tk") and display_available()[0]:
+        return  # the live window was shown
+    if importlib.util.find_spec("matplotlib") is None:
+        return
+    result.plot(str(result.output_path) + "_stress.png")
 
 
 def series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_control, do_non_frictional_control,

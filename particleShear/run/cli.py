@@ -85,13 +85,23 @@ def build_parser():
     a("--draw", action="store_true", help="show the live particle and stress windows (needs a display)")
     a("--correct-drift-sign", action="store_true", help="use the correct drift sign in the demodulation")
     a("--reference-header", action="store_true", help="reproduce the reference header defects #21-22")
+    a("--movie", action="store_true", help="with --images: also write the snapshots as movie.gif")
+    a("--plot", metavar="FILE", default=None,
+      help="write the strain/stress trace and Lissajous loop to FILE (.png/.pdf/.svg; needs particleShear[plot])")
     a("--quiet", action="store_true", help="no progress line")
     a("--verbose", action="store_true", help="print the reference console messages")
     return p
 
 
 def main(argv=None):
-    """Entry point; returns the process exit status (0 ok, 2 invalid parameters)."""
+    """Entry point; returns the process exit status (0 ok, 2 invalid parameters).
+
+    ``particleShear plot DIR ...`` dispatches to :func:`particleShear.plot.cli_main`.
+    """
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] == "plot":
+        from ..plot import cli_main
+        return cli_main(argv[1:])
     args = build_parser().parse_args(argv)
     from .api import doParticleShearSimulation
     progress = None if args.quiet else ProgressLine()
@@ -113,7 +123,8 @@ def main(argv=None):
             periods=args.periods, post_periods=args.post_periods, cool_factor=args.cool_factor, seed=args.seed,
             return_result=True, verbose=args.verbose, progress=progress,
             correct_drift_sign=args.correct_drift_sign, reference_header=args.reference_header,
-            renderer="auto" if args.draw else ("pillow" if args.images else "none"))
+            renderer="auto" if args.draw else ("pillow" if args.images else "none"),
+            saveOutputMovie=bool(args.movie and args.images))
     except (ValueError, TypeError) as exc:
         if progress is not None:
             progress.finish()
@@ -130,6 +141,13 @@ def main(argv=None):
         print("output file: " + res.output_path)
     if res.image_folder:
         print(f"images: {res.n_images} in {res.image_folder}")
+    if args.plot:
+        try:
+            res.plot(args.plot)
+        except (ImportError, ValueError) as exc:
+            print(f"particleShear: --plot: {exc}", file=sys.stderr)
+            return 1
+        print("plot: " + args.plot)
     return 0
 
 

@@ -30,10 +30,12 @@ from ..base.kernels import min_image
 from ..base.neighbours import PERMANENT, SLIP
 
 __all__ = ["Renderer", "PillowRenderer", "TkRenderer", "StressPlotWindow", "display_available",
-           "make_renderer", "open_stress_plot", "scene_geometry", "IMAGE_EXTENSIONS"]
+           "make_renderer", "open_stress_plot", "nice_ticks", "scene_geometry", "scene_primitives", "periodic_offsets",
+           "IMAGE_EXTENSIONS", "CAPTION_HEIGHT"]
 
 #: imageFileType → (file extension, Pillow format)
-IMAGE_EXTENSIONS = {"jpg": (".jpg", "JPEG"), "png": (".png", "PNG"), "ps": (".ps", "EPS"), "eps": (".eps", "EPS")}
+IMAGE_EXTENSIONS = {"jpg": (".jpg", "JPEG"), "png": (".png", "PNG"), "ps": (".ps", "EPS"), "eps": (".eps", "EPS"),
+                    "svg": (".svg", "SVG")}
 
 _headless_message_printed = False
 
@@ -117,70 +119,374 @@ class Renderer:
     def update(self, ens):
         pass
 
-    def save(self, ens, path, file_type="jpg"):
+    def save(self, ens, path, file_type="jpg", step=None):
         raise NotImplementedError
 
     def close(self):
         pass
 
 
+#: height (pixels) of the caption strip under the particle picture of a snapshot
+CAPTION_HEIGHT = 44
+
+#: colours of the drawn interfaces (legend entries), defaults of Graphical_output_configuration
+_LEGEND = (("color_interface_locked", "red", "sticking contact"), ("color_interface_slip", "green", "slipping"),
+           (None, "blue", "bond"))
+
+
+def periodic_offsets(size_x, size_y, shift):
+    """(dx, dy) of the 3 × 4 Lees-Edwards images of the cell that can overlap it (µm).
+
+    The image above (``y + Ly``) is moved by ``+shift = Ly·γ`` in x, the one below by ``−shift``
+    (the convention of :func:`particleShear.base.kernels.min_image`).  Drawing every disc and
+    segment at these offsets (clipped to the cell) shows a disc crossing an edge on both sides.
+    """
+    out = []
+    for ky in (-1, 0, 1):
+        base = math.fmod(ky * shift, size_x)
+        if base < 0:
+            base += size_x
+        for kx in (-2, -1, 0, 1):
+            out.append((base + kx * size_x, ky * size_y))
+    return out
+
+
+def scene_primitives(ens, cfg=None):
+    """What a snapshot shows, in cell coordinates (µm, y downwards as on the Tk canvas).
+
+    Returns ``(discs, segments)``: ``discs`` = list of (x, y, r, fill) and ``segments`` = list of
+    (x1, y1, x2, y2, colour, width_µm), periodic images included (only those that reach into the
+    cell ``[0, Lx] × [0, Ly]``).
+    """
+    opt = (lambda name, d: getattr(cfg, name, d)) if cfg is not None else (lambda name, d: d)
+    g = scene_geometry(ens)
+    Lx, Ly = float(ens.size_x), float(ens.size_y)
+    offsets = periodic_offsets(Lx, Ly, ens._le_shift() if hasattr(ens, "_le_shift") else 0.0)
+    discs, segs = [], []
+    how = opt("draw_spheres_as", "spheres")
+    fill = opt("color_spheres_volume", "grey")
+    if how != "none":
+        for xx, yy, rr in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist()):
+            rad = rr if how == "spheres" else 2.0
+            for ox, oy in offsets:
+                X, Y = xx + ox, yy + oy
+                if X + rad >= 0 and X - rad <= Lx and Y + rad >= 0 and Y - rad <= Ly:
+                    discs.append((X, Y, rad, fill))
+    plain = []
+    if opt("draw_rotation_line", False):
+        col = opt("color_rotation_line", "black")
+        for xx, yy, rr, ph in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist(), g["phi"].tolist()):
+            plain.append((xx, yy, xx + rr * math.cos(ph), yy + rr * math.sin(ph), col, 1.0))
+    if opt("draw_active_interface", True):
+        locked = opt("color_interface_locked", "red")
+        slip = opt("color_interface_slip", "green")
+        for seg, st in zip(g["chords"].tolist(), g["chord_state"].tolist()):
+            plain.append((*seg, slip if st == SLIP else locked, 3.0))
+    if opt("draw_permanent_interfaces", False):
+        for seg in g["perm_chords"].tolist():
+            plain.append((*seg, "darkorange", 3.0))
+    for seg in g["links"].tolist():
+        plain.append((*seg, "blue", 3.0))
+    for x1, y1, x2, y2, col, w in plain:
+        for ox, oy in offsets:
+            a, b, c, d = x1 + ox, y1 + oy, x2 + ox, y2 + oy
+            if max(a, c) >= 0 and min(a, c) <= Lx and max(b, d) >= 0 and min(b, d) <= Ly:
+                segs.append((a, b, c, d, col, w))
+    return discs, segs
+
+
+def snapshot_caption(ens, step=None):
+    """Text of the caption: time (s), strain γ and protocol step."""
+    t = float(getattr(ens, "t", 0.0))
+    gamma = float(getattr(ens, "shear", 0.0))
+    text = f"t = {t:.4g} s   strain \u03b3 = {gamma:+.4f}"
+    if step is not None:
+        text += f"   step {int(step)}"
+    return text
+
+
+def scale_bar_length(size_x):
+    """A round scale-bar length (µm): 1, 2 or 5 × 10^k, about a fifth of the cell width."""
+    target = size_x / 5.0
+    k = math.floor(math.log10(target))
+    for m in (5, 2, 1):
+        if m * 10 ** k <= target:
+            return m * 10 ** k
+    return 10 ** k
+
+
+_FONTS = {}
+
+
+def _font(size):
+    """``(font, unicode_ok)``: DejaVu Sans (system, or matplotlib's copy, found without importing it),
+    else Pillow's default font (ASCII only on old Pillow, no µ/γ glyphs in Pillow's own font)."""
+    if size in _FONTS:
+        return _FONTS[size]
+    from PIL import ImageFont
+    import importlib.util
+    candidates = ["DejaVuSans.ttf"]
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is not None and spec.submodule_search_locations:
+        for loc in spec.submodule_search_locations:
+            candidates.append(os.path.join(loc, "mpl-data", "fonts", "ttf", "DejaVuSans.ttf"))
+    found = None
+    for c in candidates:
+        try:
+            found = (ImageFont.truetype(c, size), True)
+            break
+        except OSError:
+            continue
+    if found is None:
+        try:
+            found = (ImageFont.load_default(size=size), False)
+        except TypeError:  # Pillow < 10.1: bitmap font
+            found = (ImageFont.load_default(), False)
+    _FONTS[size] = found
+    return found
+
+
+def _ascii(text):
+    return text.replace("\u03b3", "gamma").replace("\u00b5", "u")
+
+
+def _text_width(text, size):
+    """Width in pixels of ``text`` in the caption font (estimate 0.6·size per character without one)."""
+    try:
+        font, ok = _font(size)
+        return font.getlength(text if ok else _ascii(text))
+    except Exception:
+        return 0.6 * size * len(text)
+
+
+def _legend_entries(cfg):
+    out = []
+    for name, default, label in _LEGEND:
+        out.append((getattr(cfg, name, default) if (cfg is not None and name) else default, label))
+    return out
+
+
+def caption_items(ens, cfg, width_px, scale, step=None):
+    """Caption layout in pixels below the picture (origin at the top left of the strip).
+
+    Returns a list of ("text", x, y, string, size) / ("line", x1, y1, x2, y2, colour, width) items
+    shared by the raster and the vector writers: time/strain/step on the first row; scale bar
+    and colour legend on the second.
+    """
+    items = [("text", 6, 4, snapshot_caption(ens, step), 13)]
+    L = scale_bar_length(ens.size_x)
+    y = 30
+    items.append(("line", 6, y, 6 + L * scale, y, "black", 4))
+    items.append(("text", 12 + L * scale, y - 8, f"{L:g} \u00b5m", 12))
+    x = 24 + L * scale + _text_width(f"{L:g} \u00b5m", 12)
+    for col, label in _legend_entries(cfg):
+        items.append(("line", x, y, x + 16, y, col, 4))
+        items.append(("text", x + 20, y - 8, label, 12))
+        x += 32 + _text_width(label, 12)
+    return items
+
+
 class PillowRenderer(Renderer):
-    """Off-screen rendering of the particle picture with Pillow (imported on first use)."""
+    """Off-screen snapshots with Pillow (imported on first use): particle picture plus a caption.
+
+    The picture is the cell at ``scale`` pixels per µm (1 canvas pixel = 1 µm at scale 1),
+    discs crossing a periodic edge drawn on both sides (Lees-Edwards images); below it a
+    strip of :data:`CAPTION_HEIGHT` pixels with time, strain and step, a scale bar in µm and
+    the legend of the interface colours.  ``"ps"``/``"eps"`` snapshots are vector EPS and
+    ``"svg"`` vector SVG (same content); ``"jpg"``/``"png"`` are raster.
+
+    Attributes
+    ----------
+    collect_movie : bool
+        Keep a reduced copy (at most ``movie_width`` pixels wide) of every saved frame for
+        :meth:`write_movie`.  At most ``movie_max_frames`` are kept: when full, every second
+        frame is dropped and only every second later frame is kept (bounded memory).
+    """
 
     def __init__(self, graphical_output_configuration=None, scale=1.0, background="white"):
         self.cfg = graphical_output_configuration
         self.scale = float(scale)
         self.background = background
+        self.collect_movie = False
+        self.movie_width = 320
+        self.movie_max_frames = 400
+        self.movie_frames = []
+        self._movie_stride = 1
+        self._movie_seen = 0
 
     def _opt(self, name, default):
         return getattr(self.cfg, name, default) if self.cfg is not None else default
 
-    def render(self, ens):
+    def _config(self, ens):
+        if self.cfg is None:
+            self.cfg = getattr(ens, "graphical_output_configuration", None)
+        return self.cfg
+
+    def render(self, ens, step=None, caption=True):
         """Return a ``PIL.Image`` of the current state (y drawn downwards, as on the Tk canvas)."""
         from PIL import Image, ImageDraw
-        cfg = self.cfg if self.cfg is not None else getattr(ens, "graphical_output_configuration", None)
-        self.cfg = cfg
+        cfg = self._config(ens)
         s = self.scale
-        W, H = int(round(ens.size_x * s)), int(round(ens.size_y * s))
-        img = Image.new("RGB", (max(W, 1), max(H, 1)), self.background)
+        W, H = max(int(round(ens.size_x * s)), 1), max(int(round(ens.size_y * s)), 1)
+        img = Image.new("RGB", (W, H + (CAPTION_HEIGHT if caption else 0)), self.background)
         dr = ImageDraw.Draw(img)
-        g = scene_geometry(ens)
-        how = self._opt("draw_spheres_as", "spheres")
-        fill = self._opt("color_spheres_volume", "grey")
-        if how != "none":
-            for xx, yy, rr in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist()):
-                rad = rr if how == "spheres" else 2.0 / s
-                dr.ellipse([(xx - rad) * s, (yy - rad) * s, (xx + rad) * s, (yy + rad) * s], fill=fill,
-                           outline="black")
-        if self._opt("draw_rotation_line", False):
-            col = self._opt("color_rotation_line", "black")
-            for xx, yy, rr, ph in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist(), g["phi"].tolist()):
-                dr.line([xx * s, yy * s, (xx + rr * math.cos(ph)) * s, (yy + rr * math.sin(ph)) * s], fill=col)
-        w = max(1, int(round(3 * s)))
-        if self._opt("draw_active_interface", True):
-            locked = self._opt("color_interface_locked", "red")
-            slip = self._opt("color_interface_slip", "green")
-            for seg, st in zip(g["chords"].tolist(), g["chord_state"].tolist()):
-                dr.line([v * s for v in seg], fill=slip if st == SLIP else locked, width=w)
-        if self._opt("draw_permanent_interfaces", False):
-            for seg in g["perm_chords"].tolist():
-                dr.line([v * s for v in seg], fill="darkorange", width=w)
-        for seg in g["links"].tolist():
-            dr.line([v * s for v in seg], fill="blue", width=w)
+        discs, segs = scene_primitives(ens, cfg)
+        for x, y, r, fill in discs:
+            dr.ellipse([(x - r) * s, (y - r) * s, (x + r) * s, (y + r) * s], fill=fill, outline="black")
+        for x1, y1, x2, y2, col, w in segs:
+            dr.line([x1 * s, y1 * s, x2 * s, y2 * s], fill=col, width=max(1, int(round(w * s))))
+        if caption:
+            dr.rectangle([0, H, W, H + CAPTION_HEIGHT], fill="white")
+            dr.line([0, H, W, H], fill="black")
+            for item in caption_items(ens, cfg, W, s, step):
+                if item[0] == "text":
+                    _, x, y, text, size = item
+                    font, unicode_ok = _font(size)
+                    if not unicode_ok:
+                        text = _ascii(text)
+                    dr.text((x, H + y), text, fill="black", font=font)
+                else:
+                    _, x1, y1, x2, y2, col, w = item
+                    dr.line([x1, H + y1, x2, H + y2], fill=col, width=w)
         return img
 
-    def save(self, ens, path, file_type="jpg"):
-        """Write a snapshot atomically (temporary file in the same folder, then ``os.replace``)."""
+    # -- vector output ------------------------------------------------------------------------
+    def vector(self, ens, fmt, step=None):
+        """EPS (``fmt="eps"``) or SVG (``"svg"``) text of the snapshot: same content as :meth:`render`."""
+        from PIL import ImageColor
+        cfg = self._config(ens)
+        s = self.scale
+        W, H = ens.size_x * s, ens.size_y * s
+        Ht = H + CAPTION_HEIGHT
+        discs, segs = scene_primitives(ens, cfg)
+        items = caption_items(ens, cfg, W, s, step)
+        rgb = {}
+
+        def colour(c):
+            if c not in rgb:
+                rgb[c] = ImageColor.getrgb(c)[:3]
+            return rgb[c]
+
+        if fmt == "svg":
+            out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:g}" height="{Ht:g}" '
+                   f'viewBox="0 0 {W:g} {Ht:g}">',
+                   f'<rect width="{W:g}" height="{Ht:g}" fill="white"/>',
+                   f'<clipPath id="cell"><rect width="{W:g}" height="{H:g}"/></clipPath><g clip-path="url(#cell)">']
+            for x, y, r, fill in discs:
+                out.append(f'<circle cx="{x * s:.2f}" cy="{y * s:.2f}" r="{r * s:.2f}" fill="rgb{colour(fill)}" '
+                           'stroke="black" stroke-width="0.5"/>')
+            for x1, y1, x2, y2, col, w in segs:
+                out.append(f'<line x1="{x1 * s:.2f}" y1="{y1 * s:.2f}" x2="{x2 * s:.2f}" y2="{y2 * s:.2f}" '
+                           f'stroke="rgb{colour(col)}" stroke-width="{w * s:.2f}"/>')
+            out.append(f'</g><line x1="0" y1="{H:g}" x2="{W:g}" y2="{H:g}" stroke="black"/>')
+            for item in items:
+                if item[0] == "text":
+                    _, x, y, text, size = item
+                    text = text.replace("&", "&amp;").replace("<", "&lt;")
+                    out.append(f'<text x="{x:g}" y="{H + y + size:g}" font-family="Helvetica, Arial, sans-serif" '
+                               f'font-size="{size}">{text}</text>')
+                else:
+                    _, x1, y1, x2, y2, col, w = item
+                    out.append(f'<line x1="{x1:g}" y1="{H + y1:g}" x2="{x2:g}" y2="{H + y2:g}" '
+                               f'stroke="rgb{colour(col)}" stroke-width="{w}"/>')
+            out.append("</svg>\n")
+            return "\n".join(out)
+
+        def ps_col(c):
+            r, g, b = colour(c)
+            return f"{r / 255:.3f} {g / 255:.3f} {b / 255:.3f} setrgbcolor"
+
+        def ps_text(text):
+            text = _ascii(text)  # the standard PostScript fonts: ASCII here
+            return "(" + text.replace("\\", "\\\\").replace("(", "\\(").replace(")", "\\)") + ")"
+
+        # PostScript has y upwards: flip once, so all coordinates stay those of the picture
+        out = ["%!PS-Adobe-3.0 EPSF-3.0", f"%%BoundingBox: 0 0 {math.ceil(W)} {math.ceil(Ht)}",
+               "%%Creator: particleShear", "%%EndComments",
+               "/D { 0 360 arc closepath gsave fill grestore 0 setgray stroke } bind def",
+               "/L { moveto lineto stroke } bind def", "1 1 1 setrgbcolor "
+               f"0 0 {W:g} {Ht:g} rectfill", f"0 {Ht:g} translate 1 -1 scale",
+               f"gsave 0 0 {W:g} {H:g} rectclip 0.5 setlinewidth"]
+        last = None
+        for x, y, r, fill in discs:
+            if fill != last:
+                out.append(f"/F {{ {ps_col(fill)} }} def")
+                last = fill
+            out.append(f"newpath F {x * s:.2f} {y * s:.2f} {r * s:.2f} D")
+        for x1, y1, x2, y2, col, w in segs:
+            out.append(f"{ps_col(col)} {w * s:.2f} setlinewidth {x2 * s:.2f} {y2 * s:.2f} {x1 * s:.2f} {y1 * s:.2f} L")
+        out.append("grestore")
+        out.append(f"0 setgray 1 setlinewidth 0 {H:g} {W:g} {H:g} L")
+        for item in items:
+            if item[0] == "text":
+                _, x, y, text, size = item
+                out.append(f"gsave /Helvetica findfont {size} scalefont setfont {x:g} {H + y + size:g} moveto "
+                           f"1 -1 scale {ps_text(text)} show grestore")
+            else:
+                _, x1, y1, x2, y2, col, w = item
+                out.append(f"{ps_col(col)} {w} setlinewidth {x2:g} {H + y2:g} {x1:g} {H + y1:g} L")
+        out.append("showpage\n%%EOF\n")
+        return "\n".join(out)
+
+    # -- files ---------------------------------------------------------------------------------
+    def save(self, ens, path, file_type="jpg", step=None):
+        """Write a snapshot atomically (temporary file in the same folder, then ``os.replace``).
+
+        ``file_type``: "jpg", "png" (raster), "ps"/"eps" (vector EPS) or "svg" (vector SVG);
+        ``step`` is the protocol step shown in the caption.
+        """
         ext, fmt = IMAGE_EXTENSIONS.get(file_type, IMAGE_EXTENSIONS["ps"])
-        img = self.render(ens)
+        img = None
+        if fmt in ("EPS", "SVG"):
+            data = self.vector(ens, fmt.lower(), step).encode("utf-8")
+        else:
+            img = self.render(ens, step)
+            data = None
         tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
         try:
-            options = {"PNG": {"compress_level": 1}, "JPEG": {"quality": 90}}.get(fmt, {})
-            img.save(tmp, format=fmt, **options)
+            if data is not None:
+                with open(tmp, "wb") as fh:
+                    fh.write(data)
+            else:
+                options = {"PNG": {"compress_level": 1}, "JPEG": {"quality": 90}}.get(fmt, {})
+                img.save(tmp, format=fmt, **options)
             os.replace(tmp, path)
         finally:
             if os.path.exists(tmp):
                 os.remove(tmp)
+        if self.collect_movie:
+            self._keep_movie_frame(img if img is not None else self.render(ens, step))
+
+    # -- movie ---------------------------------------------------------------------------------
+    def _keep_movie_frame(self, img):
+        self._movie_seen += 1
+        if (self._movie_seen - 1) % self._movie_stride:
+            return
+        if img.width > self.movie_width:
+            h = max(1, round(img.height * self.movie_width / img.width))
+            img = img.resize((self.movie_width, h))
+        self.movie_frames.append(img.convert("P", palette=1, colors=64))  # 1 = Image.Palette.ADAPTIVE
+        if len(self.movie_frames) >= self.movie_max_frames:
+            self.movie_frames = self.movie_frames[::2]
+            self._movie_stride *= 2
+
+    def write_movie(self, path, frame_duration_ms=80):
+        """Write the kept frames as an animated GIF (Pillow ``save_all``), atomically; return the count.
+
+        Writes nothing and returns 0 when no frame was kept.
+        """
+        frames = self.movie_frames
+        if not frames:
+            return 0
+        tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
+        try:
+            frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:],
+                           duration=int(frame_duration_ms), loop=0, optimize=False, disposal=1)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+        return len(frames)
 
 
 class TkRenderer(Renderer):
@@ -239,9 +545,21 @@ class TkRenderer(Renderer):
             return
         self.draw(ens)
 
-    def save(self, ens, path, file_type="jpg"):
+    def save(self, ens, path, file_type="jpg", step=None):
         self._pillow.cfg = self.cfg if self.cfg is not None else getattr(ens, "graphical_output_configuration", None)
-        self._pillow.save(ens, path, file_type)
+        self._pillow.save(ens, path, file_type, step)
+
+    @property
+    def collect_movie(self):
+        return self._pillow.collect_movie
+
+    @collect_movie.setter
+    def collect_movie(self, value):
+        self._pillow.collect_movie = value
+
+    def write_movie(self, path, frame_duration_ms=80):
+        """See :meth:`PillowRenderer.write_movie`."""
+        return self._pillow.write_movie(path, frame_duration_ms)
 
     def close(self):
         if not self.closed:
@@ -252,17 +570,72 @@ class TkRenderer(Renderer):
                 pass
 
 
+def nice_ticks(lo, hi, n=5):
+    """Round tick values (1, 2 or 5 × 10^k steps) covering [lo, hi] with about ``n`` ticks."""
+    span = float(hi) - float(lo)
+    if not math.isfinite(span) or span <= 0:
+        return []
+    raw = span / max(int(n), 1)
+    k = math.floor(math.log10(raw))
+    step = next(m * 10 ** k for m in (1, 2, 5, 10) if m * 10 ** k >= raw)
+    first = math.ceil(lo / step)
+    return [i * step for i in range(first, int(math.floor(hi / step)) + 1)][:50]
+
+
 class StressPlotWindow:
-    """Tk window with a ``width × height`` canvas for the stress/strain plot (§9.5)."""
+    """Tk window with a ``width × height`` canvas for the live stress/strain plot.
+
+    :meth:`draw_axes` adds the time axis (s), the stress axis (Pa, left), strain marks (right),
+    the excitation window and a legend; the dots are drawn by
+    :class:`~particleShear.simulation.evaluation.EvaluationHandlerPlotter`.  At the end of a run
+    :meth:`finish` keeps the window open until the user closes it (only in the main process and
+    when :attr:`keep_open` is True; set ``StressPlotWindow.keep_open = False`` for scripted loops).
+    """
+
+    #: wait for the user to close the window at the end of a run
+    keep_open = True
 
     def __init__(self, width=1000, height=500, title="Stress and strain", master=None):
         import tkinter
         self._tkinter = tkinter
         self.tk = tkinter.Toplevel(master) if master is not None else tkinter.Tk()
         self.tk.title(title)
+        self.width, self.height = width, height
         self.canvas = tkinter.Canvas(self.tk, width=width, height=height, bg="white")
         self.canvas.pack()
         self._last = 0.0
+
+    def draw_axes(self, T_total, x_scale, y_scale_force, y_scale_strain, amplitude, t_on=None, t_off=None):
+        """Axes, ticks, units and legend matching the plotter's mapping ``y = height/2 − value·scale``."""
+        c = self.canvas
+        if not hasattr(c, "create_text"):  # minimal canvases (tests) draw dots only
+            return
+        W, H, y0 = self.width, self.height, self.height / 2
+        c.create_line(0, y0, W, y0, fill="black")
+        for t in nice_ticks(0, T_total, 8):
+            x = t * x_scale
+            c.create_line(x, y0 - 4, x, y0 + 4, fill="black")
+            c.create_text(x + 2, y0 + 6, text=f"{t:.3g}", anchor="nw", font=("TkDefaultFont", 8))
+        c.create_text(W - 4, y0 + 20, text="time t (s)", anchor="ne")
+        if y_scale_force:
+            half = y0 / abs(y_scale_force)
+            for v in nice_ticks(-half, half, 8):
+                y = y0 - v * y_scale_force
+                c.create_line(0, y, 6, y, fill="black")
+                c.create_text(8, y, text=f"{v:.3g}", anchor="w", font=("TkDefaultFont", 8))
+            c.create_text(8, 4, text="stress − stress(0) (Pa)", anchor="nw")
+        for v in (-amplitude, amplitude):
+            y = y0 - v * y_scale_strain
+            c.create_line(W - 6, y, W, y, fill="green")
+            c.create_text(W - 8, y, text=f"\u03b3 = {v:+.3g}", anchor="e", fill="green", font=("TkDefaultFont", 8))
+        for t in (t_on, t_off):
+            if t is not None:
+                c.create_line(t * x_scale, 0, t * x_scale, H, fill="grey", dash=(2, 4))
+        for k, (col, label) in enumerate((("red", "\u03c4 internal (stress tensor)"),
+                                          ("blue", "\u03c4 surface (plate forces)"), ("green", "strain \u03b3"))):
+            y = 24 + 16 * k
+            c.create_line(200, y, 220, y, fill=col, width=3)
+            c.create_text(226, y, text=label, anchor="w")
 
     def update(self, min_interval=0.03):
         if time.monotonic() - self._last >= min_interval:
@@ -271,6 +644,19 @@ class StressPlotWindow:
             except self._tkinter.TclError:
                 pass
             self._last = time.monotonic()
+
+    def finish(self, wait=True):
+        """End of the run: with ``wait``, wait until the user closes the window (see :attr:`keep_open`), then close."""
+        import multiprocessing
+        loop = getattr(self.tk, "mainloop", None)
+        if wait and self.keep_open and loop is not None and multiprocessing.parent_process() is None:
+            try:
+                self.tk.title("Stress and strain (run finished: close this window to continue)")
+                self.tk.protocol("WM_DELETE_WINDOW", self.tk.quit)  # closing ends the wait
+                loop()
+            except self._tkinter.TclError:
+                pass
+        self.close()
 
     def close(self):
         try:
@@ -295,7 +681,8 @@ def make_renderer(doDrawing, save_images, size_x=500, size_y=500, title="particl
     Parameters
     ----------
     doDrawing : bool
-        Draw at all (live window when possible).  False → None (and no snapshots, as in the reference).
+        Show the live window when possible.  False: no window; a Pillow renderer is still
+        returned when ``save_images`` (snapshots do not need a display).
     save_images : bool
         Snapshots will be saved (needs a renderer even without a display).
     backend : {"auto", "tk", "pillow", "none"}
@@ -306,8 +693,10 @@ def make_renderer(doDrawing, save_images, size_x=500, size_y=500, title="particl
     Renderer or None
     """
     backend = _backend_choice(backend)
-    if not doDrawing or backend == "none":
+    if backend == "none":
         return None
+    if not doDrawing:
+        return PillowRenderer(graphical_output_configuration) if save_images else None
     if backend == "pillow":
         return PillowRenderer(graphical_output_configuration) if save_images else None
     ok, reason = display_available()

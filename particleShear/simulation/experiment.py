@@ -212,7 +212,7 @@ class OscillatoryShearExperiment:
         """Save a snapshot of the particle picture for protocol step ``index`` (if a renderer exists)."""
         if self.renderer is None or not self.imageOutputFolder or not self.imageBaseFileName:
             return
-        self.renderer.save(self.theEnsemble, self.image_path(index), self.imageFileType)
+        self.renderer.save(self.theEnsemble, self.image_path(index), self.imageFileType, step=index)
         self.n_images_saved += 1
 
     # -- the protocol ----------------------------------------------------------------------------
@@ -223,6 +223,10 @@ class OscillatoryShearExperiment:
                                            y_scale_force=self.force_scale, r=2, offset_x=0,
                                            offset_y=self.height / 2, plotStress=bool(canvas))
         self.outputCanvas = canvas
+        if canvas:
+            self.stress_window.draw_axes(T_total, plotter.x_scale, plotter.y_scale_force, plotter.y_scale_strain,
+                                         self.amplitude, self.baseline_pre_periods / self.f,
+                                         (self.baseline_pre_periods + self.periods) / self.f)
         return plotter
 
     def prepare_recording(self):
@@ -257,6 +261,9 @@ class OscillatoryShearExperiment:
         plotter = self.plotter
         evaluator = self.theEvaluator
         save_images = self.renderer is not None and bool(self.imageOutputFolder) and bool(self.imageBaseFileName)
+        movie = save_images and getattr(self, "save_movie", False)
+        if movie:
+            self.renderer.collect_movie = True
         image_N = self.image_N or image_cadence(N_steps)
         window = self.stress_window if self.plotStress else None
         n_run = N_steps if n_steps is None else min(int(n_steps), N_steps)
@@ -282,6 +289,8 @@ class OscillatoryShearExperiment:
             if save_images and i % image_N == 0:
                 self.save_canvas_image(i)
             self._report("protocol", i + 1, n_run, t0, state)
+        if movie:  # the snapshots as an animated GIF beside the frames
+            self.renderer.write_movie(os.path.join(str(self.imageOutputFolder), "movie.gif"))
         self.timings["protocol"] = time.perf_counter() - t0
         self.N_steps = n_run
         return n_run

@@ -8,6 +8,7 @@ output path, series) is kept in ``self.result_info`` after the run.
 """
 import math
 import os
+import sys
 import time
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
@@ -26,7 +27,7 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
     wants = []
     if saveData:
         wants.append("saveData=True")
-    if saveOutputImages and doDrawing:
+    if saveOutputImages:  # snapshots are rendered off-screen, with or without doDrawing
         wants.append("saveOutputImages=True")
     if not wants:
         return
@@ -195,6 +196,7 @@ class OscillatorySimulation:
         exp.correct_drift_sign = self.correct_drift_sign
         exp.reference_header = self.reference_header
         exp.renderer = self.renderer
+        exp.save_movie = bool(getattr(self, "saveOutputMovie", False))
         exp.verbose = self.verbose
         exp.progress = self.progress
         if self.verbose:
@@ -231,7 +233,7 @@ class OscillatorySimulation:
             self.dt = self.theEnsemble.dt * getattr(self, "time_step_factor", 1.0)
             self.f = self.relative_frequency / model.time_constant
             fileName = False
-            if self.saveData or (self.saveOutputImages and self.doDrawing):
+            if self.saveData or self.saveOutputImages:
                 out = reserve_numbered_path(self._file_stem())
                 fileName = out.path
                 if not self.saveData:  # the name is only needed for the image folder
@@ -278,7 +280,8 @@ class OscillatorySimulation:
     def _close_windows(self):
         exp = self.theExperiment
         if exp is not None and exp.stress_window is not None:
-            exp.stress_window.close()
+            # after a successful run the window stays open until closed (main process), then closes
+            exp.stress_window.finish(wait=sys.exc_info()[0] is None)
             exp.stress_window = None
         if self.renderer is not None:
             self.renderer.close()
