@@ -81,6 +81,27 @@ class SimulationResult:
         """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns."""
         return [self.G_surface[0], self.G_surface[1]]
 
+    def to_dict(self):
+        """The row of this run in a sweep's results table (docs/sweeps.md), as a dict.
+
+        Keys in table order: ``run_id`` (hash of the complete parameter set and seed),
+        ``status`` ("ok"), ``error`` (""), ``Gp_surface, Gpp_surface, Gp_internal,
+        Gpp_internal`` (Pa), every parameter (defaults filled in for those not recorded),
+        ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.
+        """
+        from .. import __version__
+        from ..sweep.spec import sweep_parameter_defaults
+        from ..sweep.identity import run_identity
+        params = sweep_parameter_defaults()
+        params.update({k: v for k, v in self.parameters.items() if k in params})
+        row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
+               "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),
+               "Gp_internal": float(self.G_internal[0]), "Gpp_internal": float(self.G_internal[1])}
+        row.update(params)
+        row.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
+                   wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")
+        return row
+
 
 def _seed_sequence(seed):
     """(SeedSequence or None, Generator) for ``seed`` = None, int, SeedSequence, Generator or BitGenerator."""
