@@ -92,6 +92,10 @@ def build_parser():
 
 def main(argv=None):
     """Entry point; returns the process exit status (0 ok, 2 invalid parameters)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["sweep"]:  # python -m particleShear sweep SPEC --out DIR (particleShear.sweep.cli)
+        from ..sweep.cli import main as sweep_main
+        return sweep_main(argv[1:])
     args = build_parser().parse_args(argv)
     from .api import doParticleShearSimulation
     progress = None if args.quiet else ProgressLine()

@@ -61,9 +61,12 @@ def _publish(run_dir, out_dir, produced, run_id):
     the file itself last.  Returns the new path of ``produced``.
     """
     base = os.path.basename(produced)
-    head = base.split(".", 1)[0]
-    m = re.match(r"^(.*_)(\d+)$", head)
-    new_head = (m.group(1) if m else head + "_") + run_id
+    m = re.match(r"^(.*_)(\d+)(\.[A-Za-z][A-Za-z0-9.]*)$", base)   # <stem><k><.ext>; μ may hold dots
+    if m:
+        head, new_head = m.group(1) + m.group(2), m.group(1) + run_id
+    else:
+        head = os.path.splitext(base)[0]
+        new_head = head + "_" + run_id
     entries = sorted(e for e in os.listdir(run_dir) if e.startswith(head) and not e.endswith(".part"))
     entries.sort(key=lambda e: e == base)          # the text file last
     final = None
