@@ -317,6 +317,15 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     list of SimulationResult
         In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
+
+    Notes
+    -----
+    Runs on the sweep machinery (docs/sweeps.md).  With a ``root_folder`` the series is a
+    resumable sweep into that folder: files are named ``<reference stem><run id>.txt``, one row
+    per run goes to ``root_folder/results.csv``, and calling again with the same arguments and
+    ``seed`` runs only the runs that have not finished; those are returned as results rebuilt
+    from their rows (moduli, parameters, seed, output path; no per-step series).  A failing run
+    raises ``RuntimeError`` once the other runs have finished.
     """
     if isinstance(N_repetitions, bool) or int(N_repetitions) != N_repetitions or N_repetitions < 0:
         raise ValueError(f"N_repetitions={N_repetitions!r} is out of range: allowed integers >= 0")
@@ -351,12 +360,5 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         all_kwargs.append(kw)
     if not all_kwargs:
         return []
-    own = executor is None
-    if own:
-        executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
-    try:
-        futures = [executor.submit(_series_worker, kw) for kw in all_kwargs]
-        return [fut.result() for fut in futures]
-    finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+    from ..sweep.runner import run_series
+    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)

@@ -97,13 +97,13 @@ def execute_run(task):
     """
     from ..run.api import doParticleShearSimulation
     p = task["parameters"]
-    run_dir = os.path.join(task["out_dir"], "runs", task["run_id"])
+    writes = bool(task["out_dir"]) and bool(p.get("saveData") or p.get("saveOutputImages"))
+    run_dir = os.path.join(task["out_dir"], "runs", task["run_id"]) if writes else ""
     t0 = time.perf_counter()
     result = None
     try:
-        shutil.rmtree(run_dir, ignore_errors=True)          # leftovers of a killed attempt
-        writes = bool(p.get("saveData") or p.get("saveOutputImages"))
         if writes:
+            shutil.rmtree(run_dir, ignore_errors=True)      # leftovers of a killed attempt
             os.makedirs(run_dir)
         ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
         result = doParticleShearSimulation(**dict(p, root_folder=run_dir if writes else "", seed=ss,
@@ -124,7 +124,8 @@ def execute_run(task):
     except Exception as exc:  # a failed run is a row, never the end of the sweep
         row, result = _failed_row(task, exc, time.perf_counter() - t0), None
     finally:
-        shutil.rmtree(run_dir, ignore_errors=True)
+        if run_dir:
+            shutil.rmtree(run_dir, ignore_errors=True)
     return row, result
 
 
@@ -383,3 +384,78 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
     return Sweep(spec, out_dir, task_index=task_index, task_count=task_count).run(
         executor=executor, workers=workers, keep_series=keep_series, retry_failed=retry_failed,
         progress=progress, stream=stream)
+
+
+def _from_runs(runs, out_dir):
+    """A :class:`Sweep` over an explicit list of SweepRun (used by the series)."""
+    sweep = Sweep.__new__(Sweep)
+    sweep.spec = None
+    sweep.out_dir = os.path.abspath(os.fspath(out_dir))
+    sweep.task_index = sweep.task_count = None
+    sweep.runs = list(runs)
+    sweep.columns = table_columns(list(sweep.runs[0].parameters) if sweep.runs else None)
+    sweep.table_path = os.path.join(sweep.out_dir, TABLE_NAME)
+    return sweep
+
+
+def _result_from_row(row, run):
+    """A light SimulationResult of a run finished in an earlier call (moduli, parameters, seed, path)."""
+    from ..run.api import SimulationResult
+    g = tuple(float(row[c]) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
+    return SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
+                            parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
+                            timings={"total": float(row["wall_time_s"])}, output_path=row["output_path"] or None)
+
+
+def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
+    """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
+
+    ``all_kwargs[k]`` holds every argument of run k, its ``seed`` a SeedSequence.  With a
+    ``root_folder`` the runs form a resumable sweep into it (see :class:`Sweep`).
+    """
+    from .identity import run_identity
+    from .spec import SweepRun, sweep_parameter_defaults
+    defaults = sweep_parameter_defaults()
+    runs = []
+    for k, kw in enumerate(all_kwargs):
+        ss = kw["seed"]
+        params = dict(defaults, **{n: v for n, v in kw.items() if n not in ("root_folder", "seed", "verbose")})
+        runs.append(SweepRun(index=k, point=k, repetition=0, parameters=params, seed_entropy=ss.entropy,
+                             spawn_key=tuple(ss.spawn_key), run_id=run_identity(params, ss.entropy, ss.spawn_key)))
+    results = [None] * len(runs)
+    failures = []
+    if root_folder:
+        sweep = _from_runs(runs, root_folder)
+        done = sweep.finished_rows()
+        pos = {r.run_id: i for i, r in enumerate(runs)}
+        for i, r in enumerate(runs):
+            if r.run_id in done and done[r.run_id]["status"] == "ok":
+                results[i] = _result_from_row(done[r.run_id], r)
+        for outcome in sweep.as_completed(executor=executor, workers=max_workers, keep_series=True,
+                                          retry_failed=True, progress=False):
+            if outcome.ok:
+                results[pos[outcome.run.run_id]] = outcome.result
+            else:
+                failures.append(outcome.row)
+    else:
+        own = executor is None
+        if own:
+            executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
+        try:
+            futures = [executor.submit(execute_run, {"run_id": r.run_id, "index": r.index,
+                                                     "parameters": r.parameters, "seed_entropy": r.seed_entropy,
+                                                     "spawn_key": r.spawn_key, "out_dir": "",
+                                                     "keep_series": True}) for r in runs]
+            for i, fut in enumerate(futures):
+                row, results[i] = fut.result()
+                if row["status"] != "ok":
+                    failures.append(row)
+        finally:
+            if own:
+                executor.shutdown(wait=True, cancel_futures=True)
+    if failures:
+        first = failures[0]
+        raise RuntimeError(f"{len(failures)} of {len(runs)} runs of the series failed; first: run "
+                           f"{first['run_id']} (theAmplitude={first['theAmplitude']}, theMu={first['theMu']}): "
+                           f"{first['error']}")
+    return results
