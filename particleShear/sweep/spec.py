@@ -21,6 +21,7 @@ Points enumerate the grid keys in file order, then each ``[[zip]]`` group, the l
 fastest.  Every run is validated before any starts (docs/sweeps.md).
 """
 import dataclasses
+import functools
 import inspect
 import itertools
 import json
@@ -38,12 +39,17 @@ _SEED_KEYS = ("root", "repetitions")
 _RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
 
 
-def sweep_parameter_defaults():
-    """Every parameter a SPEC may set, with the default of ``doParticleShearSimulation`` (dict, signature order)."""
+@functools.lru_cache(maxsize=1)
+def _defaults():
     from ..run.api import doParticleShearSimulation
     sig = inspect.signature(doParticleShearSimulation)
-    return {name: p.default for name, p in sig.parameters.items()
-            if name not in _RESERVED and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    return tuple((name, p.default) for name, p in sig.parameters.items()
+                 if name not in _RESERVED and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
+
+
+def sweep_parameter_defaults():
+    """Every parameter a SPEC may set, with the default of ``doParticleShearSimulation`` (dict, signature order)."""
+    return dict(_defaults())
 
 
 @dataclasses.dataclass(frozen=True)
