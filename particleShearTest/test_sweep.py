@@ -60,6 +60,11 @@ def _stable(rows):
     return [{k: v for k, v in r.items() if k not in VOLATILE} for r in rows]
 
 
+def _lines(path):
+    with open(path) as fh:
+        return fh.read().splitlines()
+
+
 def _txt(folder):
     return sorted(e for e in os.listdir(folder) if e.endswith(".txt"))
 
@@ -205,23 +210,22 @@ class TestSweep(unittest.TestCase):
         try:
             deadline = time.monotonic() + 60
             while time.monotonic() < deadline and proc.poll() is None:   # kill after the first row
-                if os.path.exists(table) and len(open(table).read().splitlines()) >= 2:
+                if os.path.exists(table) and len(_lines(table)) >= 2:
                     break
                 time.sleep(0.01)
         finally:
             os.killpg(proc.pid, signal.SIGKILL)   # the whole job, as a scheduler kills it
             proc.wait(timeout=30)
-        n_before = len(open(table).read().splitlines()) - 1
+        n_before = len(_lines(table)) - 1
         self.assertLess(n_before, 4, "the sweep finished before it was killed: nothing to resume")
         rows = run_sweep(spec_path, out, workers=1, progress=False)
         self.assertEqual(_stable(rows), _stable(self.rows))
         self.assertEqual(_txt(out), _txt(self.ref))
-        self.assertEqual(len(open(table).read().splitlines()), 5)        # no duplicate row
+        self.assertEqual(len(_lines(table)), 5)        # no duplicate row
         self.assertEqual(_leftovers(out), [])
         for name in _txt(out):                                          # same numbers in every file
-            a = open(os.path.join(out, name)).read().split("\n\n")[-1]
-            b = open(os.path.join(self.ref, name)).read().split("\n\n")[-1]
-            self.assertEqual(a, b)
+            a, b = _lines(os.path.join(out, name)), _lines(os.path.join(self.ref, name))
+            self.assertEqual(a[-100:], b[-100:])
 
     def test_failed_run_is_a_row(self):
         from particleShear.run import api
@@ -246,7 +250,7 @@ class TestSweep(unittest.TestCase):
         self.assertEqual(Sweep(SPEC, out).pending(), [])
         rows = run_sweep(SPEC, out, workers=1, retry_failed=True, progress=False)
         self.assertEqual(_stable(rows), _stable(self.rows))
-        self.assertEqual(len(open(os.path.join(out, "results.csv")).read().splitlines()), 5)
+        self.assertEqual(len(_lines(os.path.join(out, "results.csv"))), 5)
 
     def test_dask_local_cluster_equals_local(self):
         from dask.distributed import Client, LocalCluster

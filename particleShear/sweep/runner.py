@@ -168,20 +168,35 @@ class SweepProgress:
             self._bar.close()
 
 
+#: seconds to wait for the table lock (a killed sweep's worker may still be exiting)
+LOCK_WAIT_S = 15.0
+
+
 @contextlib.contextmanager
-def _table_lock(path):
-    """Exclusive advisory lock on ``path + '.lock'`` (released by the OS if the process dies)."""
+def _table_lock(path, wait_s=None):
+    """Exclusive advisory lock on ``path + '.lock'``, released by the OS when its holders die.
+
+    Forked workers inherit it, so a worker of a killed sweep keeps it until it has exited;
+    we wait up to ``LOCK_WAIT_S`` for it, then refuse (another sweep writes this table).
+    """
     try:
         import fcntl
     except ImportError:  # pragma: no cover - Windows: no lock
         yield
         return
+    wait_s = LOCK_WAIT_S if wait_s is None else wait_s
     fd = os.open(path + ".lock", os.O_WRONLY | os.O_CREAT, 0o644)
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise RuntimeError(f"another sweep is writing {path!r}; wait for it or use another --out DIR") from None
+        deadline = time.monotonic() + wait_s
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError:
+                if time.monotonic() >= deadline:
+                    raise RuntimeError(f"another sweep is writing {path!r}; wait for it or use another "
+                                       "--out DIR") from None
+                time.sleep(0.05)
         yield
     finally:
         os.close(fd)
