@@ -129,6 +129,12 @@ def execute_run(task):
     return row, result
 
 
+def _ignore_sigint():
+    """Worker initializer: Ctrl-C reaches only the driving process, which then stops cleanly."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 class SweepProgress:
     """One line per finished run: done/failed/total, rate, ETA (a tqdm bar on a terminal when installed)."""
 
@@ -327,18 +333,32 @@ class Sweep:
                 return
             own = executor is None
             if own:
-                executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
-            futures = {}
+                executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+            futures, recorded = {}, set()
             try:
                 by_id = {r.run_id: r for r in todo}
                 futures = {executor.submit(execute_run, self._task(r, keep_series)): r.run_id for r in todo}
+                recorded = set()
                 for fut in concurrent.futures.as_completed(futures):
                     row, result = fut.result()
                     append_row(self.table_path, row, self.columns)
+                    recorded.add(fut)
                     outcome = SweepOutcome(by_id[futures[fut]], row, result)
                     if show is not None:
                         show(outcome)
                     yield outcome
+            except KeyboardInterrupt:
+                for fut in futures:
+                    fut.cancel()
+                if own:                 # our workers ignore SIGINT: let the running runs finish
+                    stream.write("[sweep] interrupted: waiting for the running runs to finish "
+                                 "(Ctrl-C again to stop at once)\n")
+                    stream.flush()
+                    executor.shutdown(wait=True, cancel_futures=True)
+                for fut in futures:     # runs that finished meanwhile: keep their rows (their files exist)
+                    if fut not in recorded and fut.done() and not fut.cancelled() and fut.exception() is None:
+                        append_row(self.table_path, fut.result()[0], self.columns)
+                raise
             except BaseException:
                 for fut in futures:
                     fut.cancel()
