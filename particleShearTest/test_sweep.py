@@ -172,6 +172,14 @@ class TestSweep(unittest.TestCase):
                 "dermal_filler_uncrosslinked0.01_f_" if r["do_permanent_links"] == "False" else "dermal_filler0.01_f_"))
         self.assertEqual(_leftovers(self.ref), [])
         self.assertFalse(os.path.exists(os.path.join(self.ref, "runs")))
+        try:
+            import pyarrow.parquet as pq
+        except ImportError:  # pragma: no cover - optional extra
+            return
+        pt = pq.read_table(os.path.join(self.ref, "results.parquet")).to_pydict()
+        self.assertEqual(pt["run_id"], [r["run_id"] for r in self.rows])
+        self.assertEqual(pt["Gp_surface"], [float(r["Gp_surface"]) for r in self.rows])   # repr round-trips
+        self.assertEqual(pt["do_permanent_links"], [True, False, True, False])
 
     def test_row_is_the_run(self):
         """A row holds the moduli of the same run done directly with the same seed, and equals to_dict()."""
@@ -260,6 +268,8 @@ class TestSweep(unittest.TestCase):
             rows = run_sweep(SPEC, out, executor=client.get_executor(), progress=False)
         self.assertEqual(_stable(rows), _stable(self.rows))
         self.assertEqual(_txt(out), _txt(self.ref))
+        for name in _txt(out):                                          # every per-step value
+            self.assertEqual(_lines(os.path.join(out, name))[-100:], _lines(os.path.join(self.ref, name))[-100:])
 
     def test_task_array_and_merge(self):
         out = os.path.join(self.tmp, "array")
