@@ -21,6 +21,7 @@ def build_parser():
     a("--task-count", type=int, default=None, metavar="K", help="number of job-array tasks sharing the sweep")
     a("--merge", action="store_true", help="merge the per-task tables into DIR/results.csv and exit")
     a("--dry-run", action="store_true", help="print the size and projected cost, run nothing")
+    a("--calibrate", action="store_true", help="with --dry-run: time one shortened run here and scale the projection")
     a("--retry-failed", action="store_true", help="run again the runs whose row says failed")
     a("--keep-going", action="store_true", help="exit 0 even when runs failed (default: exit 1)")
     a("--quiet", action="store_true", help="no progress lines")
@@ -53,8 +54,16 @@ def main(argv=None):
         return 0 if missing == 0 else 1
     if args.dry_run:
         print(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
-        print("all runs:   " + format_cost(sweep.cost(workers)))
-        print("still to run: " + format_cost(sweep.cost(workers, pending_only=True)))
+        all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
+        if args.calibrate:
+            from .cost import calibrate
+            factor = calibrate(sweep.runs[0].parameters)
+            print(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
+            for c in (all_c, todo_c):
+                c["cpu_s"] *= factor
+                c["wall_s"] *= factor
+        print("all runs:   " + format_cost(all_c))
+        print("still to run: " + format_cost(todo_c))
         return 0
     failed = 0
     with contextlib.ExitStack() as stack:

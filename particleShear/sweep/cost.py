@@ -80,3 +80,20 @@ def format_cost(c):
     return (f"{c['runs']} runs, {c['steps']:,} protocol steps, disk ~{_human_bytes(c['bytes'])}, "
             f"projected ~{_human_s(c['cpu_s'])} CPU = ~{_human_s(c['wall_s'])} on {c['workers']} worker(s) "
             f"(~{c['cpu_s'] / 3600:.3g} CPU-hours)")
+
+
+def calibrate(p, target_steps=2000):
+    """Measured / projected wall time of a shortened run of ``p`` on this machine (a factor for the projection).
+
+    Runs ``p`` once without output, its protocol cut to about ``target_steps`` steps (one
+    excitation period at most, no baseline periods), and compares the measured wall time
+    with :func:`run_seconds` of that shortened run.
+    """
+    import time
+    from ..run.api import doParticleShearSimulation
+    per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
+    short = dict(p, pre_periods=0, post_periods=0, periods=min(1.0, target_steps / per_period), saveData=False,
+                 saveOutputImages=False, doDrawing=False, plotStress=False)
+    t0 = time.perf_counter()
+    doParticleShearSimulation(**short, seed=0, verbose=False)
+    return (time.perf_counter() - t0) / run_seconds(short)
