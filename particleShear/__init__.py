@@ -20,5 +20,7 @@ try:
     from .run import *  # noqa: F401,F403
     from .run import __all__ as _run_all
     __all__ += list(_run_all)
+    from .sweep import Sweep, run_sweep  # noqa: F401
+    __all__ += ["Sweep", "run_sweep"]
 except ImportError:  # pragma: no cover - during development only
     pass

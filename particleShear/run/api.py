@@ -89,6 +89,26 @@ class SimulationResult:
         """
         from ..plot import plot_result
         return plot_result(self, path)
+    def to_dict(self):
+        """The row of this run in a sweep's results table (docs/sweeps.md), as a dict.
+
+        Keys in table order: ``run_id`` (hash of the complete parameter set and seed),
+        ``status`` ("ok"), ``error`` (""), ``Gp_surface, Gpp_surface, Gp_internal,
+        Gpp_internal`` (Pa), every parameter (defaults filled in for those not recorded),
+        ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.
+        """
+        from .. import __version__
+        from ..sweep.spec import sweep_parameter_defaults
+        from ..sweep.identity import run_identity
+        params = sweep_parameter_defaults()
+        params.update({k: v for k, v in self.parameters.items() if k in params})
+        row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
+               "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),
+               "Gp_internal": float(self.G_internal[0]), "Gpp_internal": float(self.G_internal[1])}
+        row.update(params)
+        row.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
+                   wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")
+        return row
 
 
 def _seed_sequence(seed):
@@ -329,6 +349,15 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     list of SimulationResult
         In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
+
+    Notes
+    -----
+    Runs on the sweep machinery (docs/sweeps.md).  With a ``root_folder`` the series is a
+    resumable sweep into that folder: files are named ``<reference stem><run id>.txt``, one row
+    per run goes to ``root_folder/results.csv``, and calling again with the same arguments and
+    ``seed`` runs only the runs that have not finished; those are returned as results rebuilt
+    from their rows (moduli, parameters, seed, output path; no per-step series).  A failing run
+    raises ``RuntimeError`` once the other runs have finished.
     """
     if isinstance(N_repetitions, bool) or int(N_repetitions) != N_repetitions or N_repetitions < 0:
         raise ValueError(f"N_repetitions={N_repetitions!r} is out of range: allowed integers >= 0")
@@ -363,12 +392,5 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         all_kwargs.append(kw)
     if not all_kwargs:
         return []
-    own = executor is None
-    if own:
-        executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
-    try:
-        futures = [executor.submit(_series_worker, kw) for kw in all_kwargs]
-        return [fut.result() for fut in futures]
-    finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+    from ..sweep.runner import run_series
+    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)

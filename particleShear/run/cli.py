@@ -96,12 +96,16 @@ def build_parser():
 def main(argv=None):
     """Entry point; returns the process exit status (0 ok, 2 invalid parameters).
 
-    ``particleShear plot DIR ...`` dispatches to :func:`particleShear.plot.cli_main`.
+    ``particleShear plot DIR ...`` dispatches to :func:`particleShear.plot.cli_main`,
+    ``particleShear sweep SPEC --out DIR ...`` to :func:`particleShear.sweep.cli.main`.
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv and argv[0] == "plot":
         from ..plot import cli_main
         return cli_main(argv[1:])
+    if argv[:1] == ["sweep"]:  # python -m particleShear sweep SPEC --out DIR (particleShear.sweep.cli)
+        from ..sweep.cli import main as sweep_main
+        return sweep_main(argv[1:])
     args = build_parser().parse_args(argv)
     from .api import doParticleShearSimulation
     progress = None if args.quiet else ProgressLine()

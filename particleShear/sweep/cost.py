@@ -1,0 +1,99 @@
+"""Projected size and cost of a sweep, from the time-step rule and documented per-step costs.
+
+The number of protocol steps of a run is exact (the rule of ``time_steps_from_model`` and
+``protocol_steps``: ``τ`` cancels, so no ensemble is built).  Wall times use the per-step costs
+measured on the project's 2-core CI-class machine (docs/performance.md): 285 µs per step at
+N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extrapolated with the
+nearest slope), plus constitution 0.53 s · (N/150)^0.7.  Disk: the text format writes about
+723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md).
+"""
+import math
+
+from ..linkable.builders import time_steps_from_model
+from ..simulation.experiment import protocol_steps
+
+__all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "format_cost"]
+
+_STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step), docs/performance.md
+_CONSTITUTION_S = 0.53                                            # s at N = 150
+_BYTES_PER_STEP = 723
+_HEADER_BYTES = 4000
+
+
+def run_steps(p):
+    """Protocol steps (pre + excitation + post periods) of a run with parameters ``p``."""
+    dt, _ = time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"],
+                                  p["theAmplitude"], p["relative_viscosity"])
+    dt *= float(p.get("time_step_factor", 1.0))
+    return protocol_steps(p["periods"], p["pre_periods"], p["post_periods"], p["relative_frequency"], dt)
+
+
+def _step_seconds(N):
+    pts = _STEP_COST
+    if N <= pts[1][0]:
+        (n0, t0), (n1, t1) = pts[0], pts[1]
+    else:
+        (n0, t0), (n1, t1) = pts[1], pts[2]
+    slope = math.log(t1 / t0) / math.log(n1 / n0)
+    return t0 * (N / n0) ** slope
+
+
+def run_seconds(p):
+    """Projected single-core wall time (s) of one run."""
+    N = float(p["N"])
+    return _CONSTITUTION_S * (N / 150) ** 0.7 + run_steps(p) * _step_seconds(N)
+
+
+def run_bytes(p):
+    """Projected bytes written by one run (text format; 0 without ``saveData``)."""
+    if not p.get("saveData"):
+        return 0
+    return _HEADER_BYTES + (_BYTES_PER_STEP * run_steps(p) if p.get("saveStressTensorData", True) else 0)
+
+
+def estimate_cost(runs, workers=1):
+    """Totals over ``runs`` (SweepRun or parameter dicts): runs, steps, bytes, CPU seconds, wall seconds."""
+    params = [getattr(r, "parameters", r) for r in runs]
+    cpu = sum(run_seconds(p) for p in params)
+    return {"runs": len(params), "steps": sum(run_steps(p) for p in params),
+            "bytes": sum(run_bytes(p) for p in params), "cpu_s": cpu,
+            "wall_s": cpu / max(1, int(workers or 1)), "workers": max(1, int(workers or 1))}
+
+
+def _human_bytes(b):
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if b < 1000 or unit == "TB":
+            return f"{b:.3g} {unit}"
+        b /= 1000
+
+
+def _human_s(s):
+    if s < 120:
+        return f"{s:.1f} s"
+    if s < 7200:
+        return f"{s / 60:.1f} min"
+    return f"{s / 3600:.1f} h"
+
+
+def format_cost(c):
+    """One line: ``runs, steps, disk, CPU time, wall time on the given workers``."""
+    return (f"{c['runs']} runs, {c['steps']:,} protocol steps, disk ~{_human_bytes(c['bytes'])}, "
+            f"projected ~{_human_s(c['cpu_s'])} CPU = ~{_human_s(c['wall_s'])} on {c['workers']} worker(s) "
+            f"(~{c['cpu_s'] / 3600:.3g} CPU-hours)")
+
+
+def calibrate(p, target_steps=2000):
+    """Measured / projected wall time of a shortened run of ``p`` on this machine (a factor for the projection).
+
+    Runs ``p`` once without output, its protocol cut to about ``target_steps`` steps (one
+    excitation period at most, no baseline periods), and compares the measured wall time
+    with :func:`run_seconds` of that shortened run.
+    """
+    import time
+    from ..run.api import doParticleShearSimulation
+    per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
+    short = dict(p, pre_periods=0, post_periods=0, periods=min(1.0, target_steps / per_period), saveData=False,
+                 saveOutputImages=False, doDrawing=False, plotStress=False)
+    t0 = time.perf_counter()
+    doParticleShearSimulation(**short, seed=0, verbose=False)
+    return (time.perf_counter() - t0) / run_seconds(short)

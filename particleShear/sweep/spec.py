@@ -1,0 +1,290 @@
+"""Sweep specification: a TOML (or JSON) file with the tables [parameters], [grid], [seeds], [[zip]].
+
+::
+
+    [parameters]        # fixed values: any parameter of doParticleShearSimulation
+    N = 150
+    saveData = true
+    [grid]              # lists: every combination is a point
+    theAmplitude = [0.05, 0.1, 0.2, 0.5]
+    theMu = [0.01, 0.1]
+    [[zip]]             # lists of equal length that vary together (one more grid dimension)
+    do_permanent_links = [true, true, false]
+    cut_lines = [5, 0, 0]
+    [seeds]             # repetitions per point, seeds spawned from one root
+    root = 2021
+    repetitions = 6
+
+Run ``k = repetition · n_points + point`` gets ``numpy.random.SeedSequence(root, spawn_key=(k,))``,
+i.e. ``SeedSequence(root).spawn(n)[k]``: adding repetitions keeps the ids of the earlier ones.
+Points enumerate the grid keys in file order, then each ``[[zip]]`` group, the last varying
+fastest.  Every run is validated before any starts (docs/sweeps.md).
+"""
+import dataclasses
+import functools
+import inspect
+import itertools
+import json
+import math
+import numbers
+import os
+
+__all__ = ["SweepSpec", "SweepRun", "load_spec", "parse_spec", "expand_runs", "sweep_parameter_defaults",
+           "SPEC_TABLES"]
+
+#: the tables a SPEC may hold
+SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
+_SEED_KEYS = ("root", "repetitions")
+#: arguments a SPEC may not set: the sweep chooses them
+_RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
+
+
+@functools.lru_cache(maxsize=1)
+def _defaults():
+    from ..run.api import doParticleShearSimulation
+    sig = inspect.signature(doParticleShearSimulation)
+    return tuple((name, p.default) for name, p in sig.parameters.items()
+                 if name not in _RESERVED and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
+
+
+def sweep_parameter_defaults():
+    """Every parameter a SPEC may set, with the default of ``doParticleShearSimulation`` (dict, signature order)."""
+    return dict(_defaults())
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepRun:
+    """One run of a sweep.
+
+    Attributes
+    ----------
+    index : int
+        Position in the sweep (``repetition · n_points + point``); also the spawn key.
+    point, repetition : int
+    parameters : dict
+        The complete parameter set (every SPEC-settable argument, defaults filled in).
+    seed_entropy : int
+    spawn_key : tuple of int
+    run_id : str
+        :func:`particleShear.sweep.identity.run_identity` of the above.
+    """
+
+    index: int
+    point: int
+    repetition: int
+    parameters: dict
+    seed_entropy: int
+    spawn_key: tuple
+    run_id: str
+
+
+@dataclasses.dataclass
+class SweepSpec:
+    """A parsed, checked SPEC (see the module docstring)."""
+
+    parameters: dict
+    grid: dict
+    zips: list
+    root: int
+    repetitions: int
+    source: str = ""
+
+    @property
+    def n_points(self):
+        n = 1
+        for values in self.grid.values():
+            n *= len(values)
+        for group in self.zips:
+            n *= len(next(iter(group.values())))
+        return n
+
+    @property
+    def n_runs(self):
+        return self.n_points * self.repetitions
+
+
+def _read_toml(path):
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python < 3.11
+        try:
+            import tomli as tomllib
+        except ModuleNotFoundError:
+            raise ValueError(f"SPEC={path!r}: reading TOML needs Python >= 3.11 or the package 'tomli'; "
+                             "install tomli or write the SPEC as JSON (same tables)") from None
+    with open(path, "rb") as fh:
+        try:
+            return tomllib.load(fh)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"SPEC={path!r} is not valid TOML: {exc}") from None
+
+
+def load_spec(path):
+    """Read and check a SPEC file (``.toml`` or ``.json``); return a :class:`SweepSpec`.
+
+    Raises
+    ------
+    ValueError
+        Unknown table or key, a value out of range (the message names the key), or an unreadable file.
+    """
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise ValueError(f"SPEC={path!r} is invalid: no such file")
+    if path.endswith(".toml"):
+        doc = _read_toml(path)
+    elif path.endswith(".json"):
+        with open(path, encoding="utf-8") as fh:
+            try:
+                doc = json.load(fh)
+            except json.JSONDecodeError as exc:
+                raise ValueError(f"SPEC={path!r} is not valid JSON: {exc}") from None
+    else:
+        raise ValueError(f"SPEC={path!r} is invalid: allowed a .toml or .json file")
+    return parse_spec(doc, source=path)
+
+
+def _scalar(where, v):
+    ok = isinstance(v, (bool, str)) or (isinstance(v, numbers.Real) and math.isfinite(v))
+    if not ok:
+        raise ValueError(f"{where}={v!r} is invalid: allowed a bool, a finite number or a string")
+    return v
+
+
+def _known(where, name, known):
+    if name not in known:
+        hint = " (set by the sweep itself)" if name in _RESERVED else ""
+        raise ValueError(f"{where}.{name} is not a parameter of doParticleShearSimulation{hint}")
+
+
+def _values(where, v):
+    if not isinstance(v, list) or not v:
+        raise ValueError(f"{where}={v!r} is invalid: allowed a non-empty list of values")
+    return [_scalar(f"{where}[{i}]", x) for i, x in enumerate(v)]
+
+
+def parse_spec(doc, source=""):
+    """Check a SPEC given as a dict (parsed TOML/JSON) and return a :class:`SweepSpec`."""
+    if not isinstance(doc, dict):
+        raise ValueError(f"SPEC {source!r} is invalid: allowed a table of the tables {SPEC_TABLES}")
+    for table in doc:
+        if table not in SPEC_TABLES:
+            raise ValueError(f"SPEC table [{table}] is unknown: allowed {', '.join(SPEC_TABLES)}")
+    known = sweep_parameter_defaults()
+    seen = {}
+
+    def claim(name, where):
+        _known(where, name, known)
+        if name in seen:
+            raise ValueError(f"{where}.{name} is set twice: also in {seen[name]}")
+        seen[name] = where
+
+    parameters = doc.get("parameters", {})
+    if not isinstance(parameters, dict):
+        raise ValueError("[parameters] is invalid: allowed a table of fixed values")
+    for name, v in parameters.items():
+        claim(name, "parameters")
+        _scalar(f"parameters.{name}", v)
+
+    grid = doc.get("grid", {})
+    if not isinstance(grid, dict):
+        raise ValueError("[grid] is invalid: allowed a table of lists")
+    grid = {name: _values(f"grid.{name}", v) for name, v in grid.items()}
+    for name in grid:
+        claim(name, "grid")
+
+    zips = doc.get("zip", [])
+    if isinstance(zips, dict):
+        zips = [zips]
+    if not isinstance(zips, list):
+        raise ValueError("[[zip]] is invalid: allowed an array of tables of equal-length lists")
+    checked = []
+    for i, group in enumerate(zips):
+        where = f"zip[{i}]"
+        if not isinstance(group, dict) or not group:
+            raise ValueError(f"{where} is invalid: allowed a non-empty table of equal-length lists")
+        group = {name: _values(f"{where}.{name}", v) for name, v in group.items()}
+        lengths = {name: len(v) for name, v in group.items()}
+        if len(set(lengths.values())) != 1:
+            raise ValueError(f"{where} is invalid: its lists must have equal lengths, got {lengths}")
+        for name in group:
+            claim(name, where)
+        checked.append(group)
+
+    if "seeds" not in doc:
+        raise ValueError("[seeds] is missing: allowed root = <integer >= 0> and repetitions = <integer >= 1>")
+    seeds = doc["seeds"]
+    if not isinstance(seeds, dict):
+        raise ValueError("[seeds] is invalid: allowed a table with root and repetitions")
+    for key in seeds:
+        if key not in _SEED_KEYS:
+            raise ValueError(f"seeds.{key} is unknown: allowed {', '.join(_SEED_KEYS)}")
+    root = seeds.get("root")
+    if isinstance(root, bool) or not isinstance(root, numbers.Integral) or root < 0:
+        raise ValueError(f"seeds.root={root!r} is invalid: allowed an integer >= 0")
+    reps = seeds.get("repetitions", 1)
+    if isinstance(reps, bool) or not isinstance(reps, numbers.Integral) or reps < 1:
+        raise ValueError(f"seeds.repetitions={reps!r} is invalid: allowed an integer >= 1")
+    return SweepSpec(parameters=dict(parameters), grid=grid, zips=checked, root=int(root), repetitions=int(reps),
+                     source=str(source))
+
+
+def _points(spec):
+    dims = [[{name: v} for v in values] for name, values in spec.grid.items()]
+    for group in spec.zips:
+        n = len(next(iter(group.values())))
+        dims.append([{name: values[i] for name, values in group.items()} for i in range(n)])
+    for combo in itertools.product(*dims):
+        point = {}
+        for part in combo:
+            point.update(part)
+        yield point
+
+
+def _check_options(p, where):
+    """The keyword-only options that ``validate_simulation_parameters`` does not cover."""
+    tsf = p.get("time_step_factor", 1.0)
+    if isinstance(tsf, bool) or not isinstance(tsf, numbers.Real) or not math.isfinite(tsf) or tsf <= 0:
+        raise ValueError(f"{where}: time_step_factor={tsf!r} is out of range: allowed finite > 0")
+    if p.get("integrator", "euler") not in ("euler", "verlet"):
+        raise ValueError(f"{where}: integrator={p['integrator']!r} is out of range: allowed 'euler' or 'verlet'")
+    if p.get("renderer", "auto") not in ("auto", "tk", "pillow", "none"):
+        raise ValueError(f"{where}: renderer={p['renderer']!r} is invalid: allowed auto, tk, pillow, none")
+    for name in ("correct_drift_sign", "reference_header", "stability_guard"):
+        if name in p and not isinstance(p[name], bool):
+            raise ValueError(f"{where}: {name}={p[name]!r} is invalid: allowed true or false")
+
+
+def expand_runs(spec):
+    """Every run of ``spec`` in sweep order, each validated before any is returned.
+
+    Returns
+    -------
+    list of SweepRun
+
+    Raises
+    ------
+    ValueError, TypeError
+        The first invalid run, naming the parameter (and the run's point) — before any work.
+    """
+    from ..run.validation import validate_simulation_parameters
+    from .identity import run_identity
+    defaults = sweep_parameter_defaults()
+    points = []
+    for p_index, point in enumerate(_points(spec)):
+        params = dict(defaults, **spec.parameters, **point)
+        where = f"point {p_index} ({', '.join(f'{k}={v!r}' for k, v in point.items()) or 'fixed parameters'})"
+        try:
+            validate_simulation_parameters(dict(params, root_folder=os.curdir))
+            _check_options(params, where)
+        except (ValueError, TypeError) as exc:
+            raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
+        points.append(params)
+    runs = []
+    for rep in range(spec.repetitions):
+        for p_index, params in enumerate(points):
+            k = rep * len(points) + p_index
+            key = (k,)
+            runs.append(SweepRun(index=k, point=p_index, repetition=rep, parameters=params,
+                                 seed_entropy=spec.root, spawn_key=key,
+                                 run_id=run_identity(params, spec.root, key)))
+    return runs
