@@ -16,7 +16,7 @@ import dataclasses
 import numpy as np
 
 from ..simulation.simulations import Simulation_interlocking_rheology
-from .validation import validate_simulation_parameters
+from .validation import validate_options, validate_series, validate_simulation_parameters
 
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
 
@@ -171,11 +171,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   saveStressTensorData=saveStressTensorData, plotStress=plotStress,
                   relative_y_scale_force=relative_y_scale_force, pre_periods=pre_periods, periods=periods,
                   post_periods=post_periods, cool_factor=cool_factor, seed=seed)
-    validate_simulation_parameters(params)
-    if not (isinstance(time_step_factor, (int, float)) and math.isfinite(time_step_factor) and time_step_factor > 0):
-        raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
-    if integrator not in ("euler", "verlet"):
-        raise ValueError(f"integrator={integrator!r} is out of range: allowed 'euler' or 'verlet'")
+    # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
+    # run are checked before any work (limits in docs/parameters.md)
+    validate_simulation_parameters(dict(
+        params, return_result=return_result, verbose=verbose, progress=progress,
+        correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
+        time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard))
     ss, rng = _seed_sequence(seed)
 
     theSimulation = Simulation_interlocking_rheology(
@@ -297,12 +298,13 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
     """
-    if isinstance(N_repetitions, bool) or int(N_repetitions) != N_repetitions or N_repetitions < 0:
-        raise ValueError(f"N_repetitions={N_repetitions!r} is out of range: allowed integers >= 0")
-    amplitudes = list(amplitudes)
-    mu = list(mu)
-    if not amplitudes or not mu:
-        raise ValueError(f"amplitudes={amplitudes!r} and mu={mu!r} must be non-empty lists")
+    # the grid (repetitions × amplitudes × μ × controls) is checked before any job is built
+    amplitudes, mu = validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
+                                     do_non_frictional_control)
+    validate_options(verbose=verbose, **options)
+    if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, int)
+                                    or max_workers < 1):
+        raise ValueError(f"max_workers={max_workers!r} is out of range: allowed None or an integer >= 1")
     common = dict(root_folder=root_folder, Young_modulus_spheres=Young_modulus_spheres, N=N,
                   packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor,
                   relative_viscosity=relative_viscosity,
