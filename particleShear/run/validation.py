@@ -144,8 +144,8 @@ def check_folder_writable(name, folder):
     try:
         fd, path = tempfile.mkstemp(prefix=".particleShear-write-test-", dir=folder)
     except OSError as exc:
-        raise ValueError(f"{name}={str(folder)!r} is invalid: the folder is not writable "
-                         f"({exc.strerror or exc})") from None
+        raise ValueError(f"{name}={str(folder)!r} is invalid: the folder is not writable (creating a file "
+                         f"there failed: {exc.strerror or exc})") from None
     os.close(fd)
     os.remove(path)
 
@@ -231,9 +231,23 @@ def estimate_run_cost(p):
             "total_steps": protocol + pre + constitution, "memory": memory}
 
 
-def _largest_period_parameter(p):
-    """The one of pre_periods / periods / post_periods that contributes most to the protocol length."""
-    return max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
+def _protocol_culprit(p, cost, steps_ok):
+    """(name, allowed) of the parameter that makes the protocol longer than ``steps_ok`` steps.
+
+    ``time_step_factor`` when the run would fit at factor 1, ``relative_frequency`` when it would fit
+    at the default 0.025, else the largest of pre_periods / periods / post_periods.
+    """
+    factor = float(p.get("time_step_factor", 1.0))
+    spp = cost["steps_per_period"]
+    n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
+    if factor < 1 and n_periods * spp <= steps_ok:
+        return "time_step_factor", f"time_step_factor >= {n_periods * spp / steps_ok:.4g}"
+    rf = float(p["relative_frequency"])
+    if rf < 0.025 and n_periods * spp * rf / 0.025 / factor <= steps_ok:
+        return "relative_frequency", f"relative_frequency >= {n_periods * spp * rf / factor / steps_ok:.4g}"
+    name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
+    room = max(0.0, steps_ok * factor / spp - (n_periods - float(p[name])))
+    return name, f"{name} <= {room:.4g}"
 
 
 def _check_constitution(p):
@@ -284,15 +298,12 @@ def _check_cost(p):
             f"per excitation period, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed time_step_factor <= "
             f"{spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} at relative_frequency={p['relative_frequency']!r}")
     if cost["total_steps"] > MAX_TOTAL_STEPS:
-        name = _largest_period_parameter(p)
         other = cost["total_steps"] - cost["protocol_steps"]
-        per_period = spp / factor
-        room = max(0.0, (MAX_TOTAL_STEPS - other) / per_period
-                   - (float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"]) - float(p[name])))
+        name, allowed = _protocol_culprit(p, cost, MAX_TOTAL_STEPS - other)
         raise ValueError(
             f"{name}={p[name]!r} is out of range: the run would take {cost['total_steps']:.3g} steps, more than "
-            f"the limit of {MAX_TOTAL_STEPS:.0e} ({per_period:.4g} steps per period at "
-            f"relative_frequency={p['relative_frequency']!r}); allowed {name} <= {room:.4g}")
+            f"the limit of {MAX_TOTAL_STEPS:.0e} ({spp / factor:.4g} steps per excitation period); "
+            f"allowed {allowed}")
     avail = available_memory()
     if avail is None:
         return cost
@@ -300,26 +311,24 @@ def _check_cost(p):
     budget = MEMORY_FRACTION * avail
     if mem["total"] <= budget:
         return cost
-    item = max(("ensemble", "recording", "cutting", "output_text"), key=lambda k: mem[k])
-    need = f"the run needs ~{_bytes(mem['total'])}, more than {MEMORY_FRACTION:.0%} of the {_bytes(avail)} " \
-           "of memory available"
+    parts = {"ensemble": mem["ensemble"], "cutting": mem["cutting"],
+             "recording": mem["recording"] + mem["output_text"]}
+    item = max(parts, key=parts.get)
+    need = (f"needs ~{_bytes(parts[item])} ({_bytes(mem['total'])} for the whole run), more than "
+            f"{MEMORY_FRACTION:.0%} of the {_bytes(avail)} of memory available")
     if item == "ensemble":
         allowed = int(budget / BYTES_PER_SPHERE)
-        raise ValueError(f"N={p['N']!r} is out of range: {need} ({_bytes(BYTES_PER_SPHERE)} per sphere); "
-                         f"allowed N <= {allowed:,} on this machine")
+        raise ValueError(f"N={p['N']!r} is out of range: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per "
+                         f"sphere); allowed N <= {allowed:,} on this machine")
     if item == "cutting":
         allowed = int(budget / (int(p["N"]) * CUT_BYTES_PER_SPHERE_AND_SEED))
-        raise ValueError(f"cut_lines={p['cut_lines']!r} is out of range: {need} for the Voronoi cut; allowed "
+        raise ValueError(f"cut_lines={p['cut_lines']!r} is out of range: the Voronoi cut {need}; allowed "
                          f"cut_lines <= {allowed:,} for N={p['N']!r} on this machine")
-    name = _largest_period_parameter(p)
     per_step = (mem["recording"] + mem["output_text"]) / max(cost["protocol_steps"], 1.0)
-    steps_ok = max(0.0, (budget - mem["ensemble"] - mem["cutting"]) / per_step)
-    per_period = spp / factor
-    room = max(0.0, steps_ok / per_period
-               - (float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"]) - float(p[name])))
+    name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - mem["ensemble"] - mem["cutting"]) / per_step))
     hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
-    raise ValueError(f"{name}={p[name]!r} is out of range: {need} to record {cost['protocol_steps']:.3g} "
-                     f"protocol steps; allowed {name} <= {room:.4g} on this machine{hint}")
+    raise ValueError(f"{name}={p[name]!r} is out of range: recording {cost['protocol_steps']:.3g} protocol steps "
+                     f"{need}; allowed {allowed} on this machine{hint}")
 
 
 # -- the whole call --------------------------------------------------------------------------------
