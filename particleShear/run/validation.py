@@ -208,9 +208,10 @@ def estimate_run_cost(p):
     n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
     protocol = n_periods * steps_per_period / factor
     # fixed-plate pre-equilibration: N/2 steps per halving level from dt_max down to dt, then 3N steps,
-    # N = 25·F with the adjustment factor F ≤ 1.5·2·2·(1 − log10 A + 2)·2·2 of the simulation
+    # N = 25·F with the adjustment factor of the simulation, bounded here by its largest value:
+    # F ≤ 1.5·2·2 (μ) · 2 (rv) = 24, times (1 − (log10 A + 2))·2 at small amplitudes
     levels = max(0, math.ceil(math.log2(max(dt_max * factor, 1e-300) / dt))) if dt_max * factor > dt else 0
-    F = 48.0 * max(1.0, 1 - (math.log10(A) + 2)) if A <= 0.01 else 12.0
+    F = 48.0 * max(1.0, 1 - (math.log10(A) + 2)) if A <= 0.01 else 24.0
     n_pre = 25 * F
     pre = (levels * n_pre / 2 + 3 * n_pre)
     # constitution: at most ~3,600 block steps, each block running (levels + 2) times
