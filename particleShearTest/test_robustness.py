@@ -41,7 +41,7 @@ QUIET = dict(doDrawing=False, plotStress=False, verbose=False)
 
 
 def reference_le_wrap(x, y, vx, Lx, Ly, shift, rate):
-    """The reference wrap (§3.3): one period per pass until every coordinate is inside the cell."""
+    """The reference wrap: one period per pass until every coordinate is inside the cell."""
     y0 = y.copy()
     while (y >= Ly).any():
         m = y >= Ly
@@ -59,7 +59,7 @@ def reference_le_wrap(x, y, vx, Lx, Ly, shift, rate):
 
 
 def reference_min_image(dx, dy, Lx, Ly, shift):
-    """The reference minimum image (§3.1): y image first (moving x by the shift), half-open intervals."""
+    """The reference minimum image: y image first (moving x by the shift), half-open intervals."""
     dx, dy = dx.copy(), dy.copy()
     while ((dy >= Ly / 2) | (dy < -Ly / 2)).any():
         k = (dy >= Ly / 2).astype(float) - (dy < -Ly / 2)
@@ -104,7 +104,7 @@ class TestWrapIsConstantTime(unittest.TestCase):
 
     def test_closed_form_is_exact_where_it_can_be(self):
         # 2·10⁶ periods above the cell in y and 2·10⁶ to the right in x, all exactly representable:
-        # y → 7, x → 10 − 2e6·shift + 2e6·L ≡ 10 (mod L), vx → vx − 2e6·Ly·γ̇ (§3.3)
+        # y → 7, x → 10 − 2e6·shift + 2e6·L ≡ 10 (mod L), vx → vx − 2e6·Ly·γ̇ (Lees-Edwards crossing)
         n = 2_000_000
         x, y, vx = np.array([10.0 + n * L]), np.array([7.0 + n * L]), np.array([1.0])
         le_wrap(x, y, vx, L, L, 100.0, 0.25)

@@ -427,6 +427,9 @@ class CanvasPoints:
         :data:`MAX_CELLS_OUTSIDE` cell lengths outside the cell (step, sphere and value in the message)."""
         x, y = self._pos[0], self._pos[1]
         Lx, Ly = self.size_x, self.size_y
+        far = MAX_CELLS_OUTSIDE * min(Lx, Ly)
+        if _min_reduce(self._pos, axis=None) >= -far and _max_reduce(self._pos, axis=None) < max(Lx, Ly) + far:
+            return  # two reductions (False for NaN) clear the ordinary case
         with np.errstate(invalid="ignore"):
             bad = ~((np.abs(x - Lx / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Lx)
                     & (np.abs(y - Ly / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Ly))
