@@ -13,6 +13,7 @@ their limits, in ``docs/parameters.md``):
   cutting, output text) stay within documented limits and the memory available
   on this machine, read when the run is checked (:func:`available_memory`).
 """
+import itertools
 import math
 import numbers
 import os
@@ -186,13 +187,26 @@ _OPTION_NAMES = ("return_result", "verbose", "progress", "correct_drift_sign", "
 
 # -- cost ------------------------------------------------------------------------------------------
 def estimate_run_cost(p):
-    """Steps and memory (bytes) a run with the parameter dict ``p`` will need, without building anything.
+    """Steps and memory a run will need, computed from its parameters without building anything.
 
     Uses the model constants (eq. S1-8), the time-step rule and the constitution schedule of
     the builder, the protocol length ``(pre + periods + post)/f/dt`` and what is kept or saved.
-    Returns a dict with ``dt`` (s), ``f`` (Hz), ``steps_per_period`` (reference time step),
-    ``protocol_steps``, ``pre_equilibration_steps``, ``constitution_steps``, ``total_steps`` and
-    ``memory`` (a dict of bytes per item: ensemble, recording, cutting, output_text, total).
+    The protocol step count is the run's own (``int`` of ``protocol_steps``); pre-equilibration
+    and constitution counts are upper bounds.
+
+    Parameters
+    ----------
+    p : dict
+        Every argument of ``doParticleShearSimulation`` by name (already range-checked), optionally
+        with ``time_step_factor``.
+
+    Returns
+    -------
+    dict
+        ``dt`` (s, protocol time step), ``f`` (Hz), ``steps_per_period`` (at the reference time
+        step), ``protocol_steps``, ``pre_equilibration_steps``, ``constitution_steps``,
+        ``total_steps`` and ``memory``: bytes per item ("ensemble", "recording", "cutting",
+        "output_text") and their "total".
     """
     N = int(p["N"])
     bf, A, mu = float(p["bimodal_factor"]), float(p["theAmplitude"]), float(p["theMu"])
@@ -334,10 +348,30 @@ def _check_cost(p):
 
 # -- the whole call --------------------------------------------------------------------------------
 def validate_simulation_parameters(p):
-    """Check the dict ``p`` of ``doParticleShearSimulation`` arguments; raise on the first bad value.
+    """Check every argument of a ``doParticleShearSimulation`` call before any work.
 
-    Keyword-only options present in ``p`` (``verbose``, ``renderer``, ``time_step_factor``, …) are
-    checked too.  Returns the cost estimate of :func:`estimate_run_cost`.
+    Single values first (type, range), then the constitution (minimum image, spheres per
+    particle), the resolution, the step count and the memory of the run, and last the
+    writability of the output folder.  Limits: ``docs/parameters.md``.
+
+    Parameters
+    ----------
+    p : dict
+        The arguments by name; keyword-only options present in ``p`` (``verbose``, ``renderer``,
+        ``time_step_factor``, …) are checked too.
+
+    Returns
+    -------
+    dict
+        The cost estimate of :func:`estimate_run_cost`.
+
+    Raises
+    ------
+    TypeError
+        A value of the wrong type (a boolean that is not a bool, a non-callable ``progress``, …).
+    ValueError
+        A value out of range or a run beyond a limit; the message names the parameter, its value
+        and what would be allowed.
     """
     options = {k: p[k] for k in _OPTION_NAMES if k in p}
     validate_options(**options)
@@ -404,11 +438,13 @@ def validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrossli
     n_rep = _int("N_repetitions", N_repetitions, 0, MAX_SERIES_RUNS)
     lists = []
     for name, v in (("amplitudes", amplitudes), ("mu", mu)):
-        if isinstance(v, (str, bytes)) or not hasattr(v, "__len__"):
+        if isinstance(v, (str, bytes)) or not hasattr(v, "__iter__"):
             raise TypeError(f"{name}={v!r} is invalid: allowed a non-empty list of numbers")
-        if not 1 <= len(v) <= MAX_SERIES_RUNS:
-            raise ValueError(f"{name} has {len(v):,} values: allowed 1 <= len({name}) <= {MAX_SERIES_RUNS:,}")
-        lists.append(list(v))
+        values = list(itertools.islice(v, MAX_SERIES_RUNS + 1))  # bounded, even for an endless iterator
+        if not 1 <= len(values) <= MAX_SERIES_RUNS:
+            raise ValueError(f"{name} has {len(values):,}{'+' if len(values) > MAX_SERIES_RUNS else ''} values: "
+                             f"allowed 1 <= len({name}) <= {MAX_SERIES_RUNS:,}")
+        lists.append(values)
     per_point = 1 + sum(bool(c) for c in (do_bulk_control, do_uncrosslinked_control, do_non_frictional_control))
     runs = n_rep * len(lists[0]) * len(lists[1]) * per_point
     if runs > MAX_SERIES_RUNS:
