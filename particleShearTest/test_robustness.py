@@ -29,7 +29,7 @@ import numpy as np
 
 from particleShear import EnsembleLinkable, SphereLinkable, doParticleShearSimulation
 from particleShear.base.kernels import le_wrap, min_image
-from particleShear.base.stability import SimulationInstabilityError
+from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
 from particleShear.linkable.builders import EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
 from particleShear.run import validation
 from particleShear.run.api import doParticleShearSimulationSeries
@@ -212,6 +212,16 @@ class TestLowLevelStep(unittest.TestCase):
                 ens.mechanical_simulation_step(1.0, 1e300)
         self.assertLess(time.perf_counter() - t, 1.0)
         self.assertIn("not finite", str(cm.exception))
+
+    def test_guard_names_the_non_finite_value(self):
+        ens = two_spheres()
+        ens.stability_guard = StabilityGuard(interval=1)
+        ens._a["yspeed"][1] = np.nan  # past the setter's check, as a diverging force would leave it
+        with self.assertRaises(SimulationInstabilityError) as cm:
+            ens.mechanical_simulation_step(1.0, 0.01)
+        self.assertEqual(cm.exception.pair, (1,))
+        for text in ("step 0", "sphere 1", "nan"):
+            self.assertIn(text, str(cm.exception))
 
     def test_link_across_ensembles_refused(self):
         e1, e2 = two_spheres(), two_spheres()

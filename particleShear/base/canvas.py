@@ -630,7 +630,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         d2 = self._disp * self._disp
         U = math.sqrt(float(_max_reduce(d2[0] + d2[1]))) if self._n else 0.0
         A = self._nl_abs_strain
-        gA = A * math.exp(A) if A else 0.0
+        gA = (A * math.exp(A) if A < 700 else math.inf) if A else 0.0  # e^A overflows beyond ~709
         bound = 2 * U * (1 + gA) + gA * self._nl_reach
         bound += abs(self._le_shift() - self._nl_shift - float(self.size_y) * self._nl_strain)
         return bound >= self._nl_skin or (self.size_x, self.size_y) != self._nl_box
