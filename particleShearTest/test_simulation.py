@@ -470,7 +470,7 @@ class TestRunLayer(unittest.TestCase):
         with mock.patch.object(sys, "stderr", err):
             rc = cli_main(["--amplitude", "-1", "--quiet"])
         self.assertEqual(rc, 2)
-        self.assertIn("theAmplitude", err.getvalue())
+        self.assertIn("--amplitude", err.getvalue())  # the flag the user typed (issue 10)
 
 
 class TestStochasticScenarios(unittest.TestCase):

@@ -31,14 +31,31 @@ from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
 from .register import Force_register, PairBlock, SphereSelection
 from .relations import _BaseRelationView
+from .stability import StabilityGuard
 
 
 __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasPointsShear",
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
-           "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative"]
+           "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative", "check_time_step"]
 
 _PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
            "keep_viscosity_coefficients_constant")
+
+
+#: a sphere found farther than this many cell lengths outside the cell after a step has diverged
+#: (or was placed there by mistake): no physical step moves a sphere across a thousand cells
+MAX_CELLS_OUTSIDE = 1000
+
+
+def check_time_step(dt, step=None):
+    """Raise ValueError unless the time step ``dt`` (s) is a finite real number > 0.
+
+    A zero, negative, infinite or NaN step would freeze, reverse or destroy the state
+    (NaN or infinite positions) without any error; refusing it costs one comparison.
+    """
+    if isinstance(dt, bool) or not 0.0 < dt < math.inf:
+        where = "" if step is None else f" at step {step}"
+        raise ValueError(f"dt={dt!r} is out of range{where}: allowed a finite time step > 0 (s)")
 
 
 def check_non_negative(name, value):
@@ -409,11 +426,38 @@ class CanvasPoints:
                 inside = hi[0] < Lx and hi[1] < Ly
         else:
             inside = True
+        if not inside:
+            self._check_positions()
         if not inside and le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
                                   getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0):
             self._images_valid = False
         self._pos_version += 1
         self._in_cell = True
+
+    def _check_positions(self):
+        """Raise :class:`SimulationInstabilityError` for a non-finite position or one more than
+        :data:`MAX_CELLS_OUTSIDE` cell lengths outside the cell (step, sphere and value in the message)."""
+        x, y = self._pos[0], self._pos[1]
+        Lx, Ly = self.size_x, self.size_y
+        far = MAX_CELLS_OUTSIDE * min(Lx, Ly)
+        if _min_reduce(self._pos, axis=None) >= -far and _max_reduce(self._pos, axis=None) < max(Lx, Ly) + far:
+            return  # two reductions (False for NaN) clear the ordinary case
+        with np.errstate(invalid="ignore"):
+            bad = ~((np.abs(x - Lx / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Lx)
+                    & (np.abs(y - Ly / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Ly))
+        if not _nz(bad):
+            return
+        k = int(np.flatnonzero(bad)[0])
+        step = getattr(self, "step_count", None)
+        phase = getattr(self, "phase", "")
+        what = ("is not finite" if not (math.isfinite(x[k]) and math.isfinite(y[k]))
+                else f"is more than {MAX_CELLS_OUTSIDE} cell lengths outside the {Lx:g} x {Ly:g} µm cell")
+        a = self._a
+        reason = (f"position (x, y) = ({float(x[k])!r}, {float(y[k])!r}) µm of sphere {k} {what} (velocity "
+                  f"({float(a['xspeed'][k])!r}, {float(a['yspeed'][k])!r}) µm/s): a diverging step or a sphere "
+                  "placed outside the cell")
+        guard = getattr(self, "stability_guard", None) or StabilityGuard()
+        guard._fail(self, step, phase, getattr(self, "_last_dt", None), reason, pair=(k,))
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
         """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing."""
@@ -595,7 +639,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         d2 = self._disp * self._disp
         U = math.sqrt(float(_max_reduce(d2[0] + d2[1]))) if self._n else 0.0
         A = self._nl_abs_strain
-        gA = A * math.exp(A) if A else 0.0
+        gA = (A * math.exp(A) if A < 700 else math.inf) if A else 0.0  # e^A overflows beyond ~709
         bound = 2 * U * (1 + gA) + gA * self._nl_reach
         bound += abs(self._le_shift() - self._nl_shift - float(self.size_y) * self._nl_strain)
         return bound >= self._nl_skin or (self.size_x, self.size_y) != self._nl_box
@@ -1332,6 +1376,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._half_kick = (hx, hy, ht)
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
+        check_time_step(dt, self.step_count)
         if self.integrator != "euler":
             self._store_half_kick(dt)
         self._last_dt = dt
@@ -1344,6 +1389,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
     def mechanical_simulation_step_calculate_movement(self, dt=1):
         """Drift, strain update, wrap, clock (§4.1 steps 5-6)."""
+        check_time_step(dt, self.step_count)
         self.move(dt)
         self._advance_strain(dt)
         self.boundary_conditions()
@@ -1355,6 +1401,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
     def mechanical_simulation_step(self, cool_factor=0.97, dt=1):
         """One step in reference order: forces → totals → kick + damping → movement."""
+        check_time_step(dt, self.step_count)  # before the force phase: a refused step does no work
         self.mechanical_simulation_step_calculate_forces()
         self.record_total_particle_forces()
         self.mechanical_simulation_step_calculate_acceleration(cool_factor, dt)
@@ -1519,6 +1566,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
         """Linear kick (plates), rotational kick of all spheres, damping (§4.1 step 4)."""
+        check_time_step(dt, self.step_count)
         if self.integrator != "euler":
             self._store_half_kick(dt)
         self._last_dt = dt

@@ -20,12 +20,41 @@ try:  # the C functions behind np.dot, np.where, …, without their __array_func
 except (ImportError, AttributeError):  # pragma: no cover - other NumPy layouts
     _dot, _where, _copyto, _bincount, _concat = np.dot, np.where, np.copyto, np.bincount, np.concatenate
 
-__all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass"]
+__all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass", "MAX_LOOP_PASSES"]
+
+
+#: one-period passes applied one at a time, as the reference does, before the closed form takes over;
+#: ordinary coordinates (within a couple of periods of the cell) never reach it, so their results stay
+#: bit-identical to the reference loop, while a huge coordinate costs O(1) instead of O(|x| / L) passes
+MAX_LOOP_PASSES = 4
 
 
 def _wrap_count(v, half):
     """−1, 0 or +1 per element: one period to subtract (``v ≥ half``) or add (``v < −half``)."""
     return (v >= half).view(np.int8) - (v < -half).view(np.int8)
+
+
+def _periods_to_subtract(v, L, lo):
+    """Whole periods ``k`` (float array) that bring ``v − k·L`` into ``[lo, lo + L)``; 0 where already there.
+
+    The closed form for coordinates that one-period passes would need many iterations for;
+    non-finite entries give NaN (``inf − inf``), which the stability guard and the step report.
+    """
+    with np.errstate(invalid="ignore", over="ignore"):
+        k = np.floor((v - lo) / L)
+    return np.where((v >= lo) & (v < lo + L), 0.0, k)
+
+
+def _fold(v, L, lo):
+    """``v`` brought into ``[lo, lo + L)`` with the closed form; returns (folded v, periods subtracted)."""
+    k = _periods_to_subtract(v, L, lo)
+    with np.errstate(invalid="ignore"):
+        w = v - k * L
+        # rounding of v − k·L can land one period off; a huge |v| can leave an ulp-sized excess
+        w = np.where(w >= lo + L, w - L, w)
+        w = np.where(w < lo, w + L, w)
+        w = np.where(np.isfinite(w), np.clip(w, lo, np.nextafter(lo + L, lo)), w)
+    return w, k
 
 
 def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
@@ -36,6 +65,9 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     reference does, so the result is bit-identical to it.  ``passes`` = (ny, nx)
     fixes the number of one-period passes when the caller knows the range of the
     differences (positions inside the cell); by default passes repeat until done.
+    At most :data:`MAX_LOOP_PASSES` passes run per axis; what is still outside then
+    (a difference of many periods, or a large shift) is folded in closed form, so the
+    cost never depends on the size of a coordinate.
 
     Returns ``(dx, dy, dvx)`` where ``dvx`` is the x velocity correction of the
     image (``-Ly·γ̇`` per image above) — an array, or None when nothing wrapped in y.
@@ -53,7 +85,8 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     ky_total = None
     n_y = passes[0] if passes is not None else None
     p = 0
-    while True if n_y is None else p < n_y:
+    many = False  # some difference needed more passes than the loop runs
+    while p < (MAX_LOOP_PASSES if n_y is None else min(n_y, MAX_LOOP_PASSES)):
         ky = _wrap_count(dy, hy)
         if n_y is None and not _nz(ky):
             break
@@ -61,18 +94,31 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
         dx = dx - shift * ky
         ky_total = ky if ky_total is None else ky_total + ky
         p += 1
+    else:
+        if n_y is None or n_y > MAX_LOOP_PASSES:
+            dy, k = _fold(dy, Ly, -hy)
+            if _nz(k):
+                many = True
+                dx = dx - shift * k
+                ky_total = k if ky_total is None else ky_total + k
     if ky_total is not None and rate_shift != 0:
         dvx = -rate_shift * ky_total
     n_x = passes[1] if passes is not None else None
     p = 0
     kx_total = None
-    while True if n_x is None else p < n_x:
+    while p < (MAX_LOOP_PASSES if n_x is None else min(n_x, MAX_LOOP_PASSES)):
         kx = _wrap_count(dx, hx)
         if n_x is None and not _nz(kx):
             break
         dx = dx - Lx * kx
         kx_total = kx if kx_total is None else kx_total + kx
         p += 1
+    else:
+        if n_x is None or n_x > MAX_LOOP_PASSES:
+            dx, k = _fold(dx, Lx, -hx)
+            if _nz(k):
+                many = True
+                kx_total = k if kx_total is None else kx_total + k
     if counts:
         # period counts per pair (zeros where nothing wrapped); None when some pair needed
         # several periods, whose repeated subtraction a count cannot reproduce bit for bit
@@ -80,7 +126,7 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
             ky_total = np.zeros(dx.shape, np.int8)
         if kx_total is None:
             kx_total = np.zeros(dx.shape, np.int8)
-        if np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1:
+        if many or np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1:
             ky_total = kx_total = None
         return dx, dy, dvx, ky_total, kx_total
     return dx, dy, dvx
@@ -91,39 +137,52 @@ def in_cell_passes(Lx, shift, margin=0.01):
     return 1, int(0.5 + abs(shift) / Lx + margin) + 1
 
 
+def _wrap_axis(v, L, carry=None, carry_step=0.0):
+    """Bring ``v`` into ``[0, L)`` in place, one period at a time for at most :data:`MAX_LOOP_PASSES` passes,
+    then in closed form; ``carry`` (if given) moves by ``−carry_step`` per period subtracted."""
+    for _ in range(MAX_LOOP_PASSES):
+        m = v >= L
+        if not _nz(m):
+            break
+        v[m] -= L
+        if carry is not None:
+            carry[m] -= carry_step
+    for _ in range(MAX_LOOP_PASSES):
+        m = v < 0
+        if not _nz(m):
+            break
+        v[m] += L
+        if carry is not None:
+            carry[m] += carry_step
+    out = ~((v >= 0) & (v < L))  # NaN counts as outside
+    if _nz(out):
+        w, k = _fold(v[out], L, 0.0)
+        v[out] = w
+        if carry is not None:
+            with np.errstate(invalid="ignore"):
+                carry[out] -= carry_step * k
+
+
 def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
     """Bring positions back into ``[0, Lx) × [0, Ly)`` in place (§3.3).
 
     Crossing y = Ly moves x by ``-shift`` and vx by ``-Ly·γ̇`` (and the reverse
-    through y = 0); periods are applied one at a time, as the reference does.
+    through y = 0); periods are applied one at a time, as the reference does, for
+    a few passes, and in closed form (floor) beyond, so the cost is O(1) in the
+    size of a coordinate.  Non-finite coordinates come out NaN.
     Returns True if anything was wrapped.
     """
     if not len(y):
         return False
     wrapped = False
-    if y.min() < 0 or y.max() >= Ly:
+    if not (y.min() >= 0 and y.max() < Ly):
         y0 = y.copy()
-        m = y >= Ly
-        while _nz(m):
-            y[m] -= Ly
-            x[m] -= shift
-            m = y >= Ly
-        m = y < 0
-        while _nz(m):
-            y[m] += Ly
-            x[m] += shift
-            m = y < 0
-        vx += (y - y0) * shear_rate
+        _wrap_axis(y, Ly, x, shift)
+        with np.errstate(invalid="ignore"):
+            vx += (y - y0) * shear_rate
         wrapped = True
-    if x.min() < 0 or x.max() >= Lx:
-        m = x >= Lx
-        while _nz(m):
-            x[m] -= Lx
-            m = x >= Lx
-        m = x < 0
-        while _nz(m):
-            x[m] += Lx
-            m = x < 0
+    if not (x.min() >= 0 and x.max() < Lx):
+        _wrap_axis(x, Lx)
         wrapped = True
     return wrapped
 

@@ -66,7 +66,13 @@ class StabilityGuard:
         if not math.isfinite(total):
             bad = np.flatnonzero(~(np.isfinite(x) & np.isfinite(y) & np.isfinite(vx) & np.isfinite(vy)
                                    & np.isfinite(om)))
-            self._fail(ens, step, phase, dt, "non-finite state", pair=(int(bad[0]),) if len(bad) else None)
+            if len(bad):
+                k = int(bad[0])
+                state = (f" of sphere {k}: (x, y) = ({float(x[k])!r}, {float(y[k])!r}) µm, (vx, vy) = "
+                         f"({float(vx[k])!r}, {float(vy[k])!r}) µm/s, ω = {float(om[k])!r} rad/s")
+            else:  # the sum overflowed although every value is finite
+                k, state = int(np.argmax(np.abs(vx) + np.abs(vy))), " (sums overflow)"
+            self._fail(ens, step, phase, dt, "non-finite state" + state, pair=(k,))
         rate = getattr(ens, "shear_rate", 0) or 0
         self._rate_max = max(self._rate_max, abs(rate))
         u = vx - rate * (y - ens.size_y / 2) if rate else vx

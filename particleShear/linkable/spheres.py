@@ -25,8 +25,13 @@ class LinkableRelationView(RelationView, neighbor_relation_linkable):
 
 
 def _same_ensemble(a, b):
+    """The ensemble holding both spheres, None if neither is in one; ValueError if they are in two different ones."""
     ens = a.__dict__.get("_ens")
-    return ens if ens is not None and b.__dict__.get("_ens") is ens else None
+    other = b.__dict__.get("_ens")
+    if ens is not None and other is not None and other is not ens:
+        raise ValueError(f"cannot link sphere {a.__dict__.get('_idx')} of one ensemble to sphere "
+                         f"{b.__dict__.get('_idx')} of another: a bond joins spheres of the same ensemble")
+    return ens if ens is not None and other is ens else None
 
 
 class SphereLinkable(SphereFrictionLeesEdwards):

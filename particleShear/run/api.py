@@ -9,14 +9,13 @@ every call (per process) or returned directly with ``return_result=True``.
 ``concurrent.futures.Executor`` (a ``ProcessPoolExecutor`` by default) with per-run seeds
 ``numpy.random.SeedSequence(seed).spawn(n)`` and returns the results in iteration order.
 """
-import math
 import concurrent.futures
 import dataclasses
 
 import numpy as np
 
 from ..simulation.simulations import Simulation_interlocking_rheology
-from .validation import validate_simulation_parameters
+from .validation import validate_options, validate_series, validate_simulation_parameters
 
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
 
@@ -204,11 +203,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   saveStressTensorData=saveStressTensorData, plotStress=plotStress,
                   relative_y_scale_force=relative_y_scale_force, pre_periods=pre_periods, periods=periods,
                   post_periods=post_periods, cool_factor=cool_factor, seed=seed)
-    validate_simulation_parameters(params)
-    if not (isinstance(time_step_factor, (int, float)) and math.isfinite(time_step_factor) and time_step_factor > 0):
-        raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
-    if integrator not in ("euler", "verlet"):
-        raise ValueError(f"integrator={integrator!r} is out of range: allowed 'euler' or 'verlet'")
+    # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
+    # run are checked before any work (limits in docs/parameters.md)
+    validate_simulation_parameters(dict(
+        params, return_result=return_result, verbose=verbose, progress=progress,
+        correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
+        time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard))
     if not isinstance(saveOutputMovie, (bool, np.bool_)):
         raise TypeError(f"saveOutputMovie={saveOutputMovie!r} is invalid: allowed True or False")
     if saveOutputMovie and not saveOutputImages:
@@ -359,12 +359,13 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     from their rows (moduli, parameters, seed, output path; no per-step series).  A failing run
     raises ``RuntimeError`` once the other runs have finished.
     """
-    if isinstance(N_repetitions, bool) or int(N_repetitions) != N_repetitions or N_repetitions < 0:
-        raise ValueError(f"N_repetitions={N_repetitions!r} is out of range: allowed integers >= 0")
-    amplitudes = list(amplitudes)
-    mu = list(mu)
-    if not amplitudes or not mu:
-        raise ValueError(f"amplitudes={amplitudes!r} and mu={mu!r} must be non-empty lists")
+    # the grid (repetitions × amplitudes × μ × controls) is checked before any job is built
+    amplitudes, mu = validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
+                                     do_non_frictional_control)
+    validate_options(verbose=verbose, **options)
+    if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, int)
+                                    or max_workers < 1):
+        raise ValueError(f"max_workers={max_workers!r} is out of range: allowed None or an integer >= 1")
     common = dict(root_folder=root_folder, Young_modulus_spheres=Young_modulus_spheres, N=N,
                   packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor,
                   relative_viscosity=relative_viscosity,

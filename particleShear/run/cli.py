@@ -5,10 +5,51 @@ progress line on stderr (phase, step, elapsed, estimated remaining) and prints G
 G″ from both estimators (overall stress tensor and surface forces) on stdout.
 """
 import argparse
+import re
 import sys
 import time
 
-__all__ = ["main", "build_parser", "ProgressLine"]
+__all__ = ["main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message"]
+
+#: the ``doParticleShearSimulation`` parameter behind each flag, so that errors name what the user typed
+PARAMETER_FLAGS = {
+    "theAmplitude": "--amplitude", "theMu": "--mu", "N": "--N", "cut_lines": "--cut-lines",
+    "Young_modulus_spheres": "--young-modulus", "packing_fraction": "--packing-fraction", "density": "--density",
+    "bimodal_factor": "--bimodal-factor", "relative_viscosity": "--relative-viscosity",
+    "relative_transversal_link_strength": "--relative-transversal-link-strength",
+    "relative_frequency": "--relative-frequency", "remove_link_fraction": "--remove-link-fraction",
+    "edge_fuzziness": "--edge-fuzziness", "pre_periods": "--pre-periods", "periods": "--periods",
+    "post_periods": "--post-periods", "cool_factor": "--cool-factor", "seed": "--seed", "root_folder": "--save",
+    "imageFileType": "--images",
+}
+#: parameter settings that a flag switches
+_SETTING_FLAGS = {"saveStressTensorData=False": "--no-tensor-data", "doCutByTriangulation=False": "--line-cuts",
+                  "do_permanent_links=False": "--no-permanent-links", "saveData=True": "--save DIR",
+                  "saveOutputImages=True": "--images"}
+
+
+def cli_message(text):
+    """``text`` of an API error on one line, with parameter names replaced by the CLI flags.
+
+    A name is replaced where it is unambiguous: followed by ``=`` or a comparison, or spelled
+    like an identifier (an underscore or a capital letter inside it).
+    """
+    text = " ".join(str(text).split())
+    for setting, flag in _SETTING_FLAGS.items():
+        text = text.replace(setting, flag)
+    for name, flag in sorted(PARAMETER_FLAGS.items(), key=lambda kv: -len(kv[0])):
+        identifier = "_" in name or any(c.isupper() for c in name[1:])
+        pattern = rf"(?<![\w-])({re.escape(name)})(?![\w-])" if identifier else \
+            rf"(?<![\w-])({re.escape(name)})(?=\s*(?:=|<=|>=|<|>))"
+        text = re.sub(pattern, flag, text)
+    return text
+
+
+class _Parser(argparse.ArgumentParser):
+    """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: invalid parameter: {' '.join(message.split())}\n")
 
 
 class ProgressLine:
@@ -54,7 +95,7 @@ class ProgressLine:
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="particleShear",
+    p = _Parser(prog="particleShear",
                                 description="2D soft-particle oscillatory shear rheology: G' and G'' of one run "
                                             "(defaults = doParticleShearSimulation defaults).")
     a = p.add_argument
@@ -108,6 +149,7 @@ def main(argv=None):
         return sweep_main(argv[1:])
     args = build_parser().parse_args(argv)
     from .api import doParticleShearSimulation
+    from ..base.stability import SimulationInstabilityError
     progress = None if args.quiet else ProgressLine()
     if args.images and not args.save:
         print("particleShear: --images needs --save DIR", file=sys.stderr)
@@ -132,8 +174,13 @@ def main(argv=None):
     except (ValueError, TypeError) as exc:
         if progress is not None:
             progress.finish()
-        print(f"particleShear: invalid parameter: {exc}", file=sys.stderr)
+        print(f"particleShear: invalid parameter: {cli_message(exc)}", file=sys.stderr)
         return 2
+    except SimulationInstabilityError as exc:
+        if progress is not None:
+            progress.finish()
+        print(f"particleShear: {cli_message(exc)}", file=sys.stderr)
+        return 1
     if progress is not None:
         progress.finish()
     print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")

@@ -1,20 +1,83 @@
-"""Validation of every ``doParticleShearSimulation`` parameter before any work (spec §10.1).
+"""Validation of every ``doParticleShearSimulation`` parameter and option before any work (spec §10.1).
 
 Each failure raises ``ValueError`` (``TypeError`` for a wrong type) naming the
-parameter, its value and the allowed range.
+parameter, its value and the allowed range.  Beyond the range of each value on
+its own, three checks of the whole run come before any work (documented, with
+their limits, in ``docs/parameters.md``):
+
+* **resolution** — the protocol resolves the excitation (at least
+  :data:`MIN_STEPS_PER_PERIOD` steps per period at the reference time step);
+* **constitution** — the ensemble is large enough for its cell (minimum image)
+  and for the requested number of particles;
+* **cost** — the number of steps and the memory of the run (ensemble, recording,
+  cutting, output text) stay within documented limits and the memory available
+  on this machine, read when the run is checked (:func:`available_memory`).
 """
+import itertools
 import math
 import numbers
 import os
+import tempfile
 
 import numpy as np
 
-__all__ = ["validate_simulation_parameters", "IMAGE_FILE_TYPES"]
+from ..linkable.builders import time_steps_from_model
+from ..objects.model import particle_shear_model_parameters, r_estimate
+
+__all__ = ["validate_simulation_parameters", "validate_options", "validate_series", "estimate_run_cost",
+           "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS", "INTEGRATORS",
+           "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS", "MAX_SERIES_RUNS"]
 
 #: accepted ``imageFileType`` values (the reference silently wrote PostScript for anything else)
 IMAGE_FILE_TYPES = ("jpg", "png", "ps")
+#: accepted ``renderer`` values (None = "auto")
+RENDERERS = ("auto", "tk", "pillow", "none")
+#: accepted ``integrator`` values
+INTEGRATORS = ("euler", "verlet")
+
+#: cell of every run (µm)
+CELL = 500.0
+#: fewest protocol steps per excitation period at the reference time step: the demodulation
+#: integrates one sine period with the rectangle rule, whose error on G′, G″ is O(1/n²)
+#: (~1e-4 relative at n = 100), and the explicit step stays far below the period
+MIN_STEPS_PER_PERIOD = 100
+#: fewest protocol steps per period that a coarsened time step (``time_step_factor`` > 1) may
+#: leave: below 2 samples a period the excitation cannot be represented at all (Nyquist)
+MIN_STEPS_PER_PERIOD_COARSENED = 2
+#: fewest spheres per particle of a cut gel (mean): fewer than three bonded discs have no area
+#: and no shear rigidity of their own
+MIN_SPHERES_PER_PARTICLE = 3
+#: most spheres of one run (constitution cost grows faster than N; ~10 kB each)
+MAX_N = 1_000_000
+#: most integration steps of one run (constitution + pre-equilibration + protocol)
+MAX_TOTAL_STEPS = 10 ** 9
+#: most runs of one series
+MAX_SERIES_RUNS = 100_000
+
+#: upper limits (and lower limits > 0) of single physical parameters: far beyond any material, yet
+#: small enough that products of them (k·τ, m·v², …) stay finite double-precision numbers
+UPPER = {"theAmplitude": 100.0, "theMu": 1e6, "Young_modulus_spheres": 1e12, "packing_fraction": 10.0,
+         "density": 1e6, "bimodal_factor": 100.0, "relative_viscosity": 1e6,
+         "relative_transversal_link_strength": 1e6, "interface_reenforcement_central": 1e6,
+         "interface_reenforcement_tangential": 1e6, "edge_fuzziness": 1e3, "relative_y_scale_force": 1e300}
+LOWER = {"Young_modulus_spheres": 1e-6, "density": 1e-6, "bimodal_factor": 1e-2,
+         "interface_reenforcement_central": 1e-6, "interface_reenforcement_tangential": 1e-6}
+
+#: memory of one sphere in a running ensemble, bytes (state rows, pair table, relations; measured
+#: 6–9 kB peak per sphere at N = 2,000–20,000 with tracemalloc, rounded up)
+BYTES_PER_SPHERE = 10_000
+#: recording per protocol step: 5 scalars, and the (9, 2, 2) tensor history when it is kept
+RECORD_BYTES_PER_STEP = 5 * 8
+TENSOR_BYTES_PER_STEP = 9 * 2 * 2 * 8
+#: the text of one table row of the output file while it is built (42 columns ≈ 3.4 kB)
+OUTPUT_TEXT_BYTES_PER_STEP = 3_500
+#: the Voronoi cut holds ~8 float arrays of shape (N, cut_lines)
+CUT_BYTES_PER_SPHERE_AND_SEED = 8 * 8
+#: fraction of the available memory a run may plan to use
+MEMORY_FRACTION = 0.8
 
 
+# -- single values ---------------------------------------------------------------------------------
 def _real(name, v):
     if isinstance(v, bool) or not isinstance(v, numbers.Real):
         raise TypeError(f"{name}={v!r} is invalid: allowed a real number")
@@ -25,18 +88,25 @@ def _real(name, v):
 
 def _range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
     x = _real(name, v)
+    if hi is None and name in UPPER:
+        hi = UPPER[name]
+    if name in LOWER and (lo is None or LOWER[name] > lo):
+        lo, lo_open = LOWER[name], False
     bad = ((lo is not None and (x <= lo if lo_open else x < lo))
            or (hi is not None and (x >= hi if hi_open else x > hi)))
     if bad:
-        left = "" if lo is None else (f"{lo} < " if lo_open else f"{lo} <= ")
-        right = "" if hi is None else (f" < {hi}" if hi_open else f" <= {hi}")
+        left = "" if lo is None else (f"{lo:g} < " if lo_open else f"{lo:g} <= ")
+        right = "" if hi is None else (f" < {hi:g}" if hi_open else f" <= {hi:g}")
         raise ValueError(f"{name}={v!r} is out of range: allowed {left}value{right}")
+    return x
 
 
-def _int(name, v, lo):
+def _int(name, v, lo, hi=None):
     x = _real(name, v)
-    if int(x) != x or x < lo:
-        raise ValueError(f"{name}={v!r} is out of range: allowed integers >= {lo}")
+    if int(x) != x or x < lo or (hi is not None and x > hi):
+        allowed = f"integers >= {lo}" if hi is None else f"integers {lo} <= value <= {hi:,}"
+        raise ValueError(f"{name}={v!r} is out of range: allowed {allowed}")
+    return int(x)
 
 
 def _bool(name, v):
@@ -44,8 +114,267 @@ def _bool(name, v):
         raise TypeError(f"{name}={v!r} is invalid: allowed True or False")
 
 
+# -- machine ---------------------------------------------------------------------------------------
+def available_memory():
+    """Memory (bytes) a new allocation can get now, or None when it cannot be read.
+
+    ``MemAvailable`` of ``/proc/meminfo`` (Linux: free memory plus reclaimable caches), else the
+    free physical pages of ``os.sysconf``; read at every call, so the check follows the machine.
+    """
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_folder_writable(name, folder):
+    """Raise ValueError unless ``folder`` is an existing directory in which a file can be created.
+
+    Creates and removes one empty temporary file (``os.access`` is not enough: it says yes to root
+    for read-only file systems such as ``/proc``).
+    """
+    if not os.path.isdir(folder):
+        raise ValueError(f"{name}={str(folder)!r} is invalid: needs an existing output folder (no such directory)")
+    try:
+        fd, path = tempfile.mkstemp(prefix=".particleShear-write-test-", dir=folder)
+    except OSError as exc:
+        raise ValueError(f"{name}={str(folder)!r} is invalid: the folder is not writable (creating a file "
+                         f"there failed: {exc.strerror or exc})") from None
+    os.close(fd)
+    os.remove(path)
+
+
+def _bytes(n):
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if abs(n) < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}" if unit != "B" else f"{int(n)} B"
+        n /= 1024
+    return f"{n:.3g} PiB"  # pragma: no cover
+
+
+# -- keyword-only options --------------------------------------------------------------------------
+def validate_options(return_result=False, verbose=True, progress=None, correct_drift_sign=False,
+                     reference_header=False, renderer="auto", time_step_factor=1.0, integrator="euler",
+                     stability_guard=True):
+    """Check the keyword-only options of ``doParticleShearSimulation``; raise on the first bad value."""
+    for name, v in (("return_result", return_result), ("verbose", verbose),
+                    ("correct_drift_sign", correct_drift_sign), ("reference_header", reference_header),
+                    ("stability_guard", stability_guard)):
+        _bool(name, v)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress={progress!r} is invalid: allowed None or a callable "
+                        "progress(phase, step, total, elapsed_s)")
+    if renderer is not None and (not isinstance(renderer, str) or renderer.lower() not in RENDERERS):
+        raise ValueError(f"renderer={renderer!r} is invalid: allowed one of {RENDERERS} or None")
+    if isinstance(time_step_factor, (bool, np.bool_)) or not isinstance(time_step_factor, numbers.Real):
+        raise TypeError(f"time_step_factor={time_step_factor!r} is invalid: allowed a real number")
+    if not (math.isfinite(time_step_factor) and time_step_factor > 0):
+        raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed a finite value > 0")
+    if not isinstance(integrator, str) or integrator not in INTEGRATORS:
+        raise ValueError(f"integrator={integrator!r} is out of range: allowed one of {INTEGRATORS}")
+
+
+_OPTION_NAMES = ("return_result", "verbose", "progress", "correct_drift_sign", "reference_header", "renderer",
+                 "time_step_factor", "integrator", "stability_guard")
+
+
+# -- cost ------------------------------------------------------------------------------------------
+def estimate_run_cost(p):
+    """Steps and memory a run will need, computed from its parameters without building anything.
+
+    Uses the model constants (eq. S1-8), the time-step rule and the constitution schedule of
+    the builder, the protocol length ``(pre + periods + post)/f/dt`` and what is kept or saved.
+    The protocol step count is the run's own (``int`` of ``protocol_steps``); pre-equilibration
+    and constitution counts are upper bounds.
+
+    Parameters
+    ----------
+    p : dict
+        Every argument of ``doParticleShearSimulation`` by name (already range-checked), optionally
+        with ``time_step_factor``.
+
+    Returns
+    -------
+    dict
+        ``dt`` (s, protocol time step), ``f`` (Hz), ``steps_per_period`` (at the reference time
+        step), ``protocol_steps``, ``pre_equilibration_steps``, ``constitution_steps``,
+        ``total_steps`` and ``memory``: bytes per item ("ensemble", "recording", "cutting",
+        "output_text") and their "total".
+    """
+    N = int(p["N"])
+    bf, A, mu = float(p["bimodal_factor"]), float(p["theAmplitude"]), float(p["theMu"])
+    rv, rts = float(p["relative_viscosity"]), float(p["relative_transversal_link_strength"])
+    factor = float(p.get("time_step_factor", 1.0))
+    model = particle_shear_model_parameters(CELL, CELL, N, p["packing_fraction"], p["Young_modulus_spheres"],
+                                            p["density"], bimodal_factor=1)
+    tau = model.time_constant
+    dt_ref, dt_max = time_steps_from_model(tau, bf, mu, rts, A, rv)
+    f = float(p["relative_frequency"]) / tau
+    steps_per_period = 1.0 / (f * dt_ref)  # = τ/(f·τ·dt): independent of N, E and density
+    dt = dt_ref * factor
+    n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
+    protocol = n_periods * steps_per_period / factor
+    # fixed-plate pre-equilibration: N/2 steps per halving level from dt_max down to dt, then 3N steps,
+    # N = 25·F with the adjustment factor of the simulation, bounded here by its largest value:
+    # F ≤ 1.5·2·2 (μ) · 2 (rv) = 24, times (1 − (log10 A + 2))·2 at small amplitudes
+    levels = max(0, math.ceil(math.log2(max(dt_max * factor, 1e-300) / dt))) if dt_max * factor > dt else 0
+    F = 48.0 * max(1.0, 1 - (math.log10(A) + 2)) if A <= 0.01 else 24.0
+    n_pre = 25 * F
+    pre = (levels * n_pre / 2 + 3 * n_pre)
+    # constitution: at most ~3,600 block steps, each block running (levels + 2) times
+    levels_c = max(0, math.ceil(math.log2(0.25 * tau / bf / dt_ref))) if 0.25 * tau / bf > dt_ref else 0
+    constitution = 3600 * (levels_c + 2)
+    saving = bool(p.get("saveData"))
+    tensors = saving and bool(p.get("saveStressTensorData", True))
+    cut = int(p["cut_lines"]) if (p.get("do_permanent_links", True) and p.get("doCutByTriangulation", True)) else 0
+    memory = {
+        "ensemble": N * BYTES_PER_SPHERE,
+        "recording": protocol * (RECORD_BYTES_PER_STEP + (TENSOR_BYTES_PER_STEP if tensors else 0)),
+        "cutting": float(N) * cut * CUT_BYTES_PER_SPHERE_AND_SEED,
+        "output_text": protocol * OUTPUT_TEXT_BYTES_PER_STEP if tensors else 0.0,
+    }
+    memory["total"] = sum(memory.values())
+    return {"dt": dt, "f": f, "steps_per_period": steps_per_period, "protocol_steps": protocol,
+            "pre_equilibration_steps": pre, "constitution_steps": constitution,
+            "total_steps": protocol + pre + constitution, "memory": memory}
+
+
+def _protocol_culprit(p, cost, steps_ok):
+    """(name, allowed) of the parameter that makes the protocol longer than ``steps_ok`` steps.
+
+    ``time_step_factor`` when the run would fit at factor 1, ``relative_frequency`` when it would fit
+    at the default 0.025, else the largest of pre_periods / periods / post_periods.
+    """
+    factor = float(p.get("time_step_factor", 1.0))
+    spp = cost["steps_per_period"]
+    n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
+    if factor < 1 and n_periods * spp <= steps_ok:
+        return "time_step_factor", f"time_step_factor >= {n_periods * spp / steps_ok:.4g}"
+    rf = float(p["relative_frequency"])
+    if rf < 0.025 and n_periods * spp * rf / 0.025 / factor <= steps_ok:
+        return "relative_frequency", f"relative_frequency >= {n_periods * spp * rf / factor / steps_ok:.4g}"
+    name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
+    room = max(0.0, steps_ok * factor / spp - (n_periods - float(p[name])))
+    return name, f"{name} <= {room:.4g}"
+
+
+def _check_constitution(p):
+    """Ensemble large enough for the cell (minimum image) and for the number of particles."""
+    N, phi, bf = int(p["N"]), float(p["packing_fraction"]), float(p["bimodal_factor"])
+    up, low = math.sqrt(bf), math.sqrt(1 / bf)
+    r_large = r_estimate(CELL, CELL, phi, N, up, low) * max(up, low)
+    if 2 * r_large >= CELL / 2:
+        # r_large² = L²·φ·2·max(bf, 1/bf) / (N π (bf + 1/bf)) < L²/16
+        n_min = math.floor(32 * phi * max(bf, 1 / bf) / (math.pi * (bf + 1 / bf))) + 1
+        raise ValueError(
+            f"N={p['N']!r} is too small for packing_fraction={p['packing_fraction']!r} and "
+            f"bimodal_factor={p['bimodal_factor']!r}: the largest spheres (radius {r_large:.3g} µm) must be "
+            f"smaller than a quarter of the {CELL:g} µm cell for each pair to interact through one image "
+            f"only; allowed N >= {n_min} (or a smaller packing_fraction)")
+    cut = int(p["cut_lines"])
+    if not p["do_permanent_links"] or cut <= 1:
+        return
+    if p["doCutByTriangulation"]:
+        pieces, kind = cut, "particles (Voronoi cells)"
+        cut_max = N // MIN_SPHERES_PER_PARTICLE
+    else:
+        # an arrangement of L lines cuts the plane into at most 1 + L(L+1)/2 pieces
+        pieces, kind = 1 + cut * (cut + 1) // 2, "pieces of the straight cuts (at most 1 + L(L+1)/2)"
+        cut_max = int((math.sqrt(1 + 8 * (N / MIN_SPHERES_PER_PARTICLE - 1)) - 1) / 2) if N >= 6 else 0
+    if N < MIN_SPHERES_PER_PARTICLE * pieces:
+        raise ValueError(
+            f"cut_lines={p['cut_lines']!r} is too many for N={p['N']!r}: {pieces} {kind} would hold fewer than "
+            f"{MIN_SPHERES_PER_PARTICLE} spheres each; allowed cut_lines <= {cut_max} for N={p['N']!r}, "
+            f"or N >= {MIN_SPHERES_PER_PARTICLE * pieces} for cut_lines={p['cut_lines']!r}, "
+            "or cut_lines=0 (bulk gel)")
+
+
+def _check_cost(p):
+    """Resolution, step count and memory of the whole run, before any work."""
+    cost = estimate_run_cost(p)
+    factor = float(p.get("time_step_factor", 1.0))
+    spp = cost["steps_per_period"]
+    rf = float(p["relative_frequency"])
+    if spp < MIN_STEPS_PER_PERIOD:
+        raise ValueError(
+            f"relative_frequency={p['relative_frequency']!r} is out of range: the protocol would resolve an "
+            f"excitation period with {spp:.3g} steps, fewer than {MIN_STEPS_PER_PERIOD}; allowed "
+            f"relative_frequency <= {rf * spp / MIN_STEPS_PER_PERIOD:.3g} for these parameters")
+    if spp / factor < MIN_STEPS_PER_PERIOD_COARSENED:
+        raise ValueError(
+            f"time_step_factor={p.get('time_step_factor')!r} is out of range: it leaves {spp / factor:.3g} steps "
+            f"per excitation period, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed time_step_factor <= "
+            f"{spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} at relative_frequency={p['relative_frequency']!r}")
+    if cost["total_steps"] > MAX_TOTAL_STEPS:
+        other = cost["total_steps"] - cost["protocol_steps"]
+        name, allowed = _protocol_culprit(p, cost, MAX_TOTAL_STEPS - other)
+        raise ValueError(
+            f"{name}={p[name]!r} is out of range: the run would take {cost['total_steps']:.3g} steps, more than "
+            f"the limit of {MAX_TOTAL_STEPS:.0e} ({spp / factor:.4g} steps per excitation period); "
+            f"allowed {allowed}")
+    avail = available_memory()
+    if avail is None:
+        return cost
+    mem = cost["memory"]
+    budget = MEMORY_FRACTION * avail
+    if mem["total"] <= budget:
+        return cost
+    parts = {"ensemble": mem["ensemble"], "cutting": mem["cutting"],
+             "recording": mem["recording"] + mem["output_text"]}
+    item = max(parts, key=parts.get)
+    need = (f"needs ~{_bytes(parts[item])} ({_bytes(mem['total'])} for the whole run), more than "
+            f"{MEMORY_FRACTION:.0%} of the {_bytes(avail)} of memory available")
+    if item == "ensemble":
+        allowed = int(budget / BYTES_PER_SPHERE)
+        raise ValueError(f"N={p['N']!r} is out of range: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per "
+                         f"sphere); allowed N <= {allowed:,} on this machine")
+    if item == "cutting":
+        allowed = int(budget / (int(p["N"]) * CUT_BYTES_PER_SPHERE_AND_SEED))
+        raise ValueError(f"cut_lines={p['cut_lines']!r} is out of range: the Voronoi cut {need}; allowed "
+                         f"cut_lines <= {allowed:,} for N={p['N']!r} on this machine")
+    per_step = (mem["recording"] + mem["output_text"]) / max(cost["protocol_steps"], 1.0)
+    name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - mem["ensemble"] - mem["cutting"]) / per_step))
+    hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
+    raise ValueError(f"{name}={p[name]!r} is out of range: recording {cost['protocol_steps']:.3g} protocol steps "
+                     f"{need}; allowed {allowed} on this machine{hint}")
+
+
+# -- the whole call --------------------------------------------------------------------------------
 def validate_simulation_parameters(p):
-    """Check the dict ``p`` of ``doParticleShearSimulation`` arguments; raise on the first bad value."""
+    """Check every argument of a ``doParticleShearSimulation`` call before any work.
+
+    Single values first (type, range), then the constitution (minimum image, spheres per
+    particle), the resolution, the step count and the memory of the run, and last the
+    writability of the output folder.  Limits: ``docs/parameters.md``.
+
+    Parameters
+    ----------
+    p : dict
+        The arguments by name; keyword-only options present in ``p`` (``verbose``, ``renderer``,
+        ``time_step_factor``, …) are checked too.
+
+    Returns
+    -------
+    dict
+        The cost estimate of :func:`estimate_run_cost`.
+
+    Raises
+    ------
+    TypeError
+        A value of the wrong type (a boolean that is not a bool, a non-callable ``progress``, …).
+    ValueError
+        A value out of range or a run beyond a limit; the message names the parameter, its value
+        and what would be allowed.
+    """
+    options = {k: p[k] for k in _OPTION_NAMES if k in p}
+    validate_options(**options)
     for name in ("do_permanent_links", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",
                  "cut_top_bottom", "saveOutputImages", "doCutByTriangulation", "doDrawing", "saveData",
                  "saveStressTensorData", "plotStress"):
@@ -54,7 +383,7 @@ def validate_simulation_parameters(p):
     _range("theMu", p["theMu"], 0)
     _int("cut_lines", p["cut_lines"], 0)
     _range("Young_modulus_spheres", p["Young_modulus_spheres"], 0, lo_open=True)
-    _int("N", p["N"], 2)
+    _int("N", p["N"], 2, MAX_N)
     _range("packing_fraction", p["packing_fraction"], 0, lo_open=True)
     _range("density", p["density"], 0, lo_open=True)
     _range("bimodal_factor", p["bimodal_factor"], 0, lo_open=True)
@@ -69,7 +398,7 @@ def validate_simulation_parameters(p):
     _range("remove_link_fraction", p["remove_link_fraction"], 0, 1)
     _range("edge_fuzziness", p["edge_fuzziness"], 0)
     _range("central_repulsion_coefficient", p["central_repulsion_coefficient"], 0, 1)
-    _real("relative_y_scale_force", p.get("relative_y_scale_force", 1e8))
+    _range("relative_y_scale_force", p.get("relative_y_scale_force", 1e8), -UPPER["relative_y_scale_force"])
     _range("pre_periods", p["pre_periods"], 0)
     _range("periods", p["periods"], 0, lo_open=True)
     _range("post_periods", p["post_periods"], 0)
@@ -89,3 +418,38 @@ def validate_simulation_parameters(p):
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
             raise ValueError(f"seed={seed!r} is invalid: allowed None, an integer >= 0, a numpy SeedSequence "
                              "or Generator")
+    _check_constitution(p)
+    cost = _check_cost(p)
+    if wants:
+        check_folder_writable("root_folder", root)
+    return cost
+
+
+def validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
+                    do_non_frictional_control):
+    """Check the grid of a series before any job is built; returns (amplitudes, mu) as lists.
+
+    The series has ``N_repetitions · len(amplitudes) · len(mu) · (1 + controls)`` runs, at most
+    :data:`MAX_SERIES_RUNS`.
+    """
+    for name, v in (("do_bulk_control", do_bulk_control), ("do_uncrosslinked_control", do_uncrosslinked_control),
+                    ("do_non_frictional_control", do_non_frictional_control)):
+        _bool(name, v)
+    n_rep = _int("N_repetitions", N_repetitions, 0, MAX_SERIES_RUNS)
+    lists = []
+    for name, v in (("amplitudes", amplitudes), ("mu", mu)):
+        if isinstance(v, (str, bytes)) or not hasattr(v, "__iter__"):
+            raise TypeError(f"{name}={v!r} is invalid: allowed a non-empty list of numbers")
+        values = list(itertools.islice(v, MAX_SERIES_RUNS + 1))  # bounded, even for an endless iterator
+        if not 1 <= len(values) <= MAX_SERIES_RUNS:
+            raise ValueError(f"{name} has {len(values):,}{'+' if len(values) > MAX_SERIES_RUNS else ''} values: "
+                             f"allowed 1 <= len({name}) <= {MAX_SERIES_RUNS:,}")
+        lists.append(values)
+    per_point = 1 + sum(bool(c) for c in (do_bulk_control, do_uncrosslinked_control, do_non_frictional_control))
+    runs = n_rep * len(lists[0]) * len(lists[1]) * per_point
+    if runs > MAX_SERIES_RUNS:
+        raise ValueError(f"N_repetitions={N_repetitions!r} with {len(lists[0])} amplitudes, {len(lists[1])} mu values "
+                         f"and {per_point} runs per point is a series of {runs:,} runs: allowed at most "
+                         f"{MAX_SERIES_RUNS:,} runs (N_repetitions <= "
+                         f"{MAX_SERIES_RUNS // (len(lists[0]) * len(lists[1]) * per_point)})")
+    return lists[0], lists[1]
