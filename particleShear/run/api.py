@@ -15,6 +15,8 @@ import dataclasses
 
 import numpy as np
 
+from ..simulation.formats import check_output_format
+from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_simulation_parameters
 
@@ -56,6 +58,10 @@ class SimulationResult:
     series : dict of numpy.ndarray
         t (s), strain, strain_rate (1/s), stress_surface, stress_internal (Pa), and "tensors"
         (n, 9, 2, 2) when the tensor history was kept (``saveData`` with ``saveStressTensorData``).
+    run_id : str
+        12 hex digits identifying parameters + seed (:func:`~particleShear.simulation.provenance.run_identity`).
+    write_error : Exception or None
+        Why writing the output failed after the run (the moduli are valid); None when written.
     """
 
     G_surface: tuple
@@ -75,6 +81,8 @@ class SimulationResult:
     damping_factor: float = 1.0
     removed_fraction: float = 0.0
     series: dict = dataclasses.field(default_factory=dict, repr=False)
+    run_id: str = ""
+    write_error: object = None
 
     @property
     def G(self):
@@ -104,7 +112,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               plotStress=True, relative_y_scale_force=1e8, pre_periods=2, periods=3,
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
-                              time_step_factor=1.0, integrator="euler", stability_guard=True):
+                              time_step_factor=1.0, integrator="euler", stability_guard=True,
+                              output_format="text", strict_io=False):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     Parameters
@@ -142,6 +151,13 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     stability_guard : bool, keyword-only
         Stop a diverging measurement with :class:`SimulationInstabilityError` (step, phase, worst
         pair, suggested time step) instead of producing NaN moduli.
+    output_format : {"text", "text.gz", "npz", "parquet"}, keyword-only
+        File format of ``saveData`` (see ``docs/output.md``): the reference text (default), the
+        same gzip-compressed, NumPy ``.npz`` or Parquet (needs the extra ``particleShear[parquet]``).
+        Read any of them with :func:`particleShear.read_run`.
+    strict_io : bool, keyword-only
+        Raise the ``OSError`` of a failed write after the run (default False: the result is
+        returned with ``write_error`` set, and ``last_result`` holds it either way).
 
     Returns
     -------
@@ -176,7 +192,18 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
     if integrator not in ("euler", "verlet"):
         raise ValueError(f"integrator={integrator!r} is out of range: allowed 'euler' or 'verlet'")
+    check_output_format(output_format)
+    if not isinstance(strict_io, bool):
+        raise TypeError(f"strict_io={strict_io!r} is invalid: allowed True or False")
     ss, rng = _seed_sequence(seed)
+    # every input, the keyword-only options included
+    params.update(return_result=return_result, verbose=verbose, progress=progress,
+                  correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
+                  time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
+                  output_format=output_format, strict_io=strict_io)
+    seed_entropy = None if ss is None else ss.entropy
+    spawn_key = () if ss is None else tuple(ss.spawn_key)
+    run_id = run_identity(params, seed_entropy, spawn_key)
 
     theSimulation = Simulation_interlocking_rheology(
         root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
@@ -212,6 +239,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.time_step_factor = float(time_step_factor)
     theSimulation.integrator = integrator
     theSimulation.stability_guard = bool(stability_guard)
+    theSimulation.output_format = output_format
+    theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
+    theSimulation.parameters = params
 
     G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
@@ -224,8 +254,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         timings=info["timings"], output_path=info["output_path"], image_folder=info["image_folder"],
         n_images=info["n_images"], dt=info["dt"], f=info["f"], N_steps=info["N_steps"],
         damping_factor=info["damping_factor"],
-        removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series)
+        removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series,
+        run_id=run_id, write_error=info.get("write_error"))
     doParticleShearSimulation.last_result = result
+    if strict_io and result.write_error is not None:
+        raise result.write_error
     if return_result:
         return result
     return G
