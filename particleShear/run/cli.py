@@ -80,6 +80,8 @@ def build_parser():
     a("--seed", type=int, default=None, help="random seed (same seed = identical run)")
     a("--save", metavar="DIR", default=None, help="write the text output file into DIR (must exist)")
     a("--no-tensor-data", action="store_true", help="with --save: omit the 42-column per-step table")
+    a("--output-format", default="text", choices=("text", "text.gz", "npz", "parquet"),
+      help="with --save: file format (default text, the reference format; see docs/output.md)")
     a("--images", nargs="?", const="jpg", default=None, choices=("jpg", "png", "ps"),
       help="with --save: save ~200 snapshots (default type jpg)")
     a("--draw", action="store_true", help="show the live particle and stress windows (needs a display)")
@@ -91,7 +93,8 @@ def build_parser():
 
 
 def main(argv=None):
-    """Entry point; returns the process exit status (0 ok, 2 invalid parameters)."""
+    """Entry point; returns the process exit status (0 ok, 1 output not written, 2 invalid parameters,
+    130 interrupted)."""
     args = build_parser().parse_args(argv)
     from .api import doParticleShearSimulation
     progress = None if args.quiet else ProgressLine()
@@ -113,7 +116,17 @@ def main(argv=None):
             periods=args.periods, post_periods=args.post_periods, cool_factor=args.cool_factor, seed=args.seed,
             return_result=True, verbose=args.verbose, progress=progress,
             correct_drift_sign=args.correct_drift_sign, reference_header=args.reference_header,
-            renderer="auto" if args.draw else ("pillow" if args.images else "none"))
+            renderer="auto" if args.draw else ("pillow" if args.images else "none"),
+            output_format=args.output_format)
+    except KeyboardInterrupt as exc:  # one line, no traceback; the run removed its temporary files
+        if progress is not None:
+            progress.finish()
+        phase, step, total = getattr(exc, "position", ("set-up", 0, 0))
+        print(f"particleShear: interrupted at step {step} of {total} ({phase})", file=sys.stderr)
+        return 130
+    except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
+        print(f"particleShear: {exc}", file=sys.stderr)
+        return 2
     except (ValueError, TypeError) as exc:
         if progress is not None:
             progress.finish()
@@ -130,6 +143,9 @@ def main(argv=None):
         print("output file: " + res.output_path)
     if res.image_folder:
         print(f"images: {res.n_images} in {res.image_folder}")
+    if res.write_error is not None:
+        print(f"particleShear: writing the output failed, nothing was saved: {res.write_error}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -399,8 +399,8 @@ def output_summary_text(G_internal, G_surface, reference_header=False):
     return "\n".join(L)
 
 
-#: rows formatted and written at a time by the streaming writers (about 1.5 MB of text)
-CHUNK_ROWS = 2048
+#: rows formatted and written at a time by the streaming writers (about 0.8 MB of text)
+CHUNK_ROWS = 1024
 
 
 def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
