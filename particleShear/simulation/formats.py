@@ -19,6 +19,7 @@ import io
 import json
 import os
 import re
+import zipfile
 
 import numpy as np
 
@@ -37,6 +38,8 @@ _SERIES_COLUMNS = (("t", "t"), ("strain", "strain"), ("strain_rate", "strain_rat
                    ("stress_internal", "shear_stress_internal_stress-tensor"))
 _PARQUET_HINT = ("output_format='parquet' needs pyarrow, which is not installed: "
                  "pip install 'particleShear[parquet]' (or pip install pyarrow)")
+#: rows per Parquet row group (about 5 MB of columns)
+_PARQUET_ROWS = 16384
 _DETAILED = re.compile(r"Detailed[a-zA-Z0-9\s].*data")
 
 
@@ -111,16 +114,20 @@ def write_run(fh, output_format, header_text, scalars, tensors, metadata):
     cols = series_columns(series)
     meta = json.dumps({"header": header_text, "metadata": metadata})
     if output_format == "npz":
-        np.savez(fh, header=np.array(meta), **{name: np.ascontiguousarray(v) for name, v in cols.items()})
+        # what numpy.savez writes, one column at a time (one column copy in memory, not the table)
+        with zipfile.ZipFile(fh, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
+            for name, v in [("header", np.array(meta))] + list(cols.items()):
+                with zf.open(name + ".npy", "w", force_zip64=True) as member:
+                    np.lib.format.write_array(member, np.ascontiguousarray(v), allow_pickle=False)
         return
     if output_format == "parquet":
         pa, pq = _pyarrow()
         schema = pa.schema([(name, pa.int64() if name == "index" else pa.float64()) for name in cols],
                            metadata={b"particleShear": meta.encode("utf-8")})
         n = len(cols["index"])
-        with pq.ParquetWriter(fh, schema) as writer:
-            for a in range(0, max(n, 1), 65536):  # row groups: bounded extra memory
-                b = min(n, a + 65536)
+        with pq.ParquetWriter(fh, schema, use_dictionary=False) as writer:
+            for a in range(0, max(n, 1), _PARQUET_ROWS):  # row groups: bounded extra memory
+                b = min(n, a + _PARQUET_ROWS)
                 writer.write_table(pa.table({name: np.ascontiguousarray(v[a:b]) for name, v in cols.items()},
                                             schema=schema))
         return
