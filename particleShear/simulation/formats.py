@@ -116,9 +116,11 @@ def write_run(fh, output_format, header_text, scalars, tensors, metadata):
     if output_format == "npz":
         # what numpy.savez writes, one column at a time (one column copy in memory, not the table)
         with zipfile.ZipFile(fh, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as zf:
-            for name, v in [("header", np.array(meta))] + list(cols.items()):
+            arrays = [("header", np.array(meta))] + list(cols.items())
+            for name, v in arrays:  # a strided column is copied when written, one at a time
+                v = v if v.ndim == 0 else np.ascontiguousarray(v)
                 with zf.open(name + ".npy", "w", force_zip64=True) as member:
-                    np.lib.format.write_array(member, np.ascontiguousarray(v), allow_pickle=False)
+                    np.lib.format.write_array(member, v, allow_pickle=False)
         return
     if output_format == "parquet":
         pa, pq = _pyarrow()
