@@ -272,6 +272,16 @@ class TestStreaming(unittest.TestCase):
         self.assertGreater(sink.n, 20e6)
         # one chunk of rows at a time: a few MB, far below the text size (the old writer built it all)
         self.assertLess(peak, 8e6, f"peak {peak / 1e6:.1f} MB for {sink.n / 1e6:.1f} MB of text")
+        # npz: one column copy at a time (a column is 0.24 MB here, the table 10 MB)
+        with tempfile.TemporaryFile() as fh:
+            tracemalloc.start()
+            try:
+                formats.write_run(fh, "npz", "header", scalars, tensors, {})
+                _, peak = tracemalloc.get_traced_memory()
+            finally:
+                tracemalloc.stop()
+            self.assertGreater(fh.tell(), 10e6)
+        self.assertLess(peak, 2e6, f"npz writer peak {peak / 1e6:.1f} MB")
 
 
 def _wait_for(predicate, timeout_s):
