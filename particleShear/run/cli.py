@@ -122,7 +122,8 @@ def main(argv=None):
         if progress is not None:
             progress.finish()
         phase, step, total = getattr(exc, "position", ("set-up", 0, 0))
-        print(f"particleShear: interrupted at step {step} of {total} ({phase})", file=sys.stderr)
+        where = f"at step {step} of {total} ({phase})" if total else f"during {phase}"
+        print(f"particleShear: interrupted {where}; no file written", file=sys.stderr)
         return 130
     except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
         print(f"particleShear: {exc}", file=sys.stderr)
