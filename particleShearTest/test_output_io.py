@@ -432,7 +432,8 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
             self.assertNotIn("Traceback", err)
             lines = [line for line in err.splitlines() if line.strip()]
             self.assertEqual(len(lines), 1, err)
-            self.assertRegex(lines[0], r"^particleShear: interrupted at step \d+ of \d+ \((pre-equilibration|protocol)\); no file written$")
+            self.assertRegex(lines[0], r"^particleShear: interrupted at step \d+ of \d+ "
+                                       r"\((pre-equilibration|protocol)\); no file written$")
             self.assertEqual(os.listdir(d), [])
 
 

@@ -1,8 +1,11 @@
 """The reference text output (spec §9.1, §9.3): header blocks, summary, 42-column table, atomic files.
 
-Values are formatted with ``str()`` exactly as the reference does.  Files are
-written to a temporary file in the target folder and renamed into place with
-``os.replace`` when complete, so an interrupted run never leaves a truncated file.
+Values are formatted with ``str()`` as the reference does, except that numbers ``str()`` writes in
+exponent notation are written positionally unless ``reference_header`` (the downstream R patterns
+read digits only; see :mod:`.provenance`).  Files are reserved by a locked temporary file in the
+target folder, streamed and renamed into place with ``os.replace`` when complete, so an
+interrupted run never leaves a truncated file and the temporary files of killed runs are
+recognised and removed by the next run (``docs/output.md``, "Files are complete or absent").
 """
 import math
 import os
@@ -28,7 +31,8 @@ IMAGE_FOLDER_SUFFIX = "_images_folder"
 #: ending of the private name a temporary file has before it is locked and linked to its ``.part`` name
 _PRIVATE_SUFFIX = ".new"
 
-__all__ = ["TABLE_COLUMNS", "AtomicOutputFile", "reserve_numbered_path", "experiment_description_text",
+__all__ = ["TABLE_COLUMNS", "AtomicOutputFile", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
+           "probe_writable", "iter_table_text", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
 #: output-table column name stems of the nine tensors, in the order of TENSOR_NAMES
@@ -280,10 +284,6 @@ def probe_writable(folder):
         os.remove(probe)
 
 
-def _s(v):
-    return str(v)
-
-
 def _particle_info(ens, reference):
     """The ensemble's description; the 1.0.2 text (with its §12 #23 defects) when ``reference``."""
     try:
@@ -299,7 +299,7 @@ def experiment_description_text(exp, reference_header=False):
     time" = excitation time only (§12 #22) and "Post-measurement periods" printing the
     pre value (§12 #21).  By default both are correct (whole protocol time; post value).
     """
-    _s = str if reference_header else header_number  # noqa: F841 - positional numbers for the R patterns
+    _s = str if reference_header else header_number  # positional numbers for the R patterns
     ens = exp.theEnsemble
     L = ["Oscillatory shear experiment", ""]
     model = getattr(ens, "model", False)
