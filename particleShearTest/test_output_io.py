@@ -244,44 +244,33 @@ class TestFormats(unittest.TestCase):
             read_run(os.path.join(self.dir.name, "x.csv"))
 
 
-class _Discard:
-    """A binary sink that keeps only the byte count."""
-
-    def __init__(self):
-        self.n = 0
-
-    def write(self, b):
-        self.n += len(b)
-        return len(b)
-
-
 class TestStreaming(unittest.TestCase):
-    def test_writer_memory_is_bounded(self):
-        # a synthetic 30,000-step table (~25 MB of text) with full-precision values
-        n = 30_000
+    @staticmethod
+    def peak_while_writing(fmt, n):
+        """(peak traced bytes, bytes written) for writing a synthetic n-step table in ``fmt``."""
         rng = np.random.default_rng(0)
-        scalars = rng.standard_normal((n, 5))
+        scalars = rng.standard_normal((n, 5))  # full-precision values: ~800 bytes of text per row
         tensors = rng.standard_normal((n, 9, 2, 2))
-        sink = _Discard()
-        tracemalloc.start()
-        try:
-            formats.write_run(sink, "text", "header", scalars, tensors, {})
-            _, peak = tracemalloc.get_traced_memory()
-        finally:
-            tracemalloc.stop()
-        self.assertGreater(sink.n, 20e6)
-        # one chunk of rows at a time: a few MB, far below the text size (the old writer built it all)
-        self.assertLess(peak, 8e6, f"peak {peak / 1e6:.1f} MB for {sink.n / 1e6:.1f} MB of text")
-        # npz: one column copy at a time (a column is 0.24 MB here, the table 10 MB)
         with tempfile.TemporaryFile() as fh:
             tracemalloc.start()
             try:
-                formats.write_run(fh, "npz", "header", scalars, tensors, {})
+                formats.write_run(fh, fmt, "header", scalars, tensors, {})
                 _, peak = tracemalloc.get_traced_memory()
             finally:
                 tracemalloc.stop()
-            self.assertGreater(fh.tell(), 10e6)
-        self.assertLess(peak, 2e6, f"npz writer peak {peak / 1e6:.1f} MB")
+            return peak, fh.tell()
+
+    def test_writer_memory_is_bounded(self):
+        # the writers hold one chunk of rows (text) or one column (npz) at a time: the peak does not
+        # grow with the table and stays far below its size (the old writer built the whole text)
+        small, _ = self.peak_while_writing("text", 3 * output.CHUNK_ROWS)
+        big, size = self.peak_while_writing("text", 12 * output.CHUNK_ROWS)
+        self.assertGreater(size, 9e6)
+        self.assertLess(big, 1.3 * small + 0.5e6, f"text writer peak {small / 1e6:.1f} → {big / 1e6:.1f} MB")
+        self.assertLess(big, size / 2)
+        peak, size = self.peak_while_writing("npz", 30_000)
+        self.assertGreater(size, 10e6)
+        self.assertLess(peak, 2e6, f"npz writer peak {peak / 1e6:.1f} MB")  # one column is 0.24 MB
 
 
 def _wait_for(predicate, timeout_s):

@@ -26,7 +26,7 @@ from .provenance import header_number
 
 #: suffix of a run's temporary output file (``.<name>.part``)
 PART_SUFFIX = ".part"
-#: suffix of a run's snapshot folder after the text file name (§9.4)
+#: suffix of a run's snapshot folder after the text file name (docs/output.md, "Snapshots")
 IMAGE_FOLDER_SUFFIX = "_images_folder"
 #: ending of the private name a temporary file has before it is locked and linked to its ``.part`` name
 _PRIVATE_SUFFIX = ".new"
@@ -64,7 +64,7 @@ class AtomicOutputFile:
     The temporary file ``.<name>.part`` (same folder) is created under a private name, locked
     (``fcntl.flock``, held until :meth:`commit` or :meth:`abort`) and only then linked to its
     public name, which fails if that name exists.  So the public ``.part`` name reserves
-    ``path`` against concurrent runs choosing the same number (§9.3), and a ``.part`` whose
+    ``path`` against concurrent runs choosing the same number, and a ``.part`` whose
     lock can be taken belongs to a process that died (SIGKILL, power loss): the next run in
     the folder removes it (:func:`remove_stale_parts`).
 
