@@ -10,6 +10,7 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -353,6 +354,21 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
                     run(d, strict_io=True, **QUICK)
             self.assertIs(doParticleShearSimulation.last_result.write_error, full)
             self.assertEqual(os.listdir(d), [])
+
+    def test_folder_removed_during_the_run(self):
+        # a real failure, no mock: the output folder disappears while the run computes
+        with tempfile.TemporaryDirectory() as top:
+            d = os.path.join(top, "out")
+            os.mkdir(d)
+
+            def progress(phase, step, total, elapsed):
+                if phase == "protocol" and os.path.isdir(d):
+                    shutil.rmtree(d)
+            r = run(d, progress=progress, **QUICK)
+            self.assertIsInstance(r.write_error, OSError)
+            self.assertTrue(all(math.isfinite(g) for g in r.G_surface + r.G_internal))
+            self.assertEqual(len(r.series["t"]), r.N_steps)
+            self.assertEqual(os.listdir(top), [])
 
     def test_failed_write_in_a_binary_format(self):
         with tempfile.TemporaryDirectory() as d:
