@@ -1,10 +1,11 @@
 """Simulation classes: ensemble construction + experiment + output file (spec §8.1, §9, §10.9).
 
-``runSimulation`` (inherited by every class) validates the output settings before any
-work, builds the ensemble (``initEnsemble``), writes the text file of §9.1 atomically
-(temporary file + ``os.replace``), drives the :class:`OscillatoryShearExperiment` and
-returns ``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings,
-output path, series) is kept in ``self.result_info`` after the run.
+``runSimulation`` (inherited by every class) validates the output settings (and probes the
+folder) before any work, builds the ensemble (``initEnsemble``), reserves the file number,
+drives the :class:`OscillatoryShearExperiment`, then streams the file (format
+``output_format``) and its JSON sidecar to disk and renames them into place; it returns
+``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings, output path,
+write error) is kept in ``self.result_info`` after the run.  See ``docs/output.md``.
 """
 import gzip
 import io
