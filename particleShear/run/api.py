@@ -119,7 +119,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     Parameters
     ----------
     root_folder : str
-        Output folder (must exist when ``saveData`` or ``saveOutputImages``).
+        Output folder (must exist and be writable when ``saveData`` or ``saveOutputImages``; probed
+        before any work).
     theAmplitude : float
         Strain amplitude A (> 0; 0.2 = 20 %).
     theMu : float
