@@ -216,7 +216,8 @@ class TestOutputFile(unittest.TestCase):
         f = self.res.f
         expected = ("dermal_filler0.01_f_" + str(round(f * 10000) / 10000) + "_strain_0.2_nr_1.txt")
         self.assertEqual(name, expected)
-        self.assertEqual(sorted(os.listdir(self.dir.name)), [expected])  # no temporary file left
+        # the file and its JSON sidecar, no temporary file left
+        self.assertEqual(sorted(os.listdir(self.dir.name)), [expected, expected + ".json"])
         self.assertFalse(self.text.endswith("\n"))
 
     def test_header_regexes(self):

@@ -14,6 +14,8 @@ import dataclasses
 
 import numpy as np
 
+from ..simulation.formats import check_output_format
+from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_options, validate_series, validate_simulation_parameters
 
@@ -55,6 +57,10 @@ class SimulationResult:
     series : dict of numpy.ndarray
         t (s), strain, strain_rate (1/s), stress_surface, stress_internal (Pa), and "tensors"
         (n, 9, 2, 2) when the tensor history was kept (``saveData`` with ``saveStressTensorData``).
+    run_id : str
+        12 hex digits identifying parameters + seed (:func:`~particleShear.simulation.provenance.run_identity`).
+    write_error : Exception or None
+        Why writing the output failed after the run (the moduli are valid); None when written.
     """
 
     G_surface: tuple
@@ -74,6 +80,8 @@ class SimulationResult:
     damping_factor: float = 1.0
     removed_fraction: float = 0.0
     series: dict = dataclasses.field(default_factory=dict, repr=False)
+    run_id: str = ""
+    write_error: object = None
 
     @property
     def G(self):
@@ -133,13 +141,14 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
-                              saveOutputMovie=False):
+                              saveOutputMovie=False, output_format="text", strict_io=False):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     Parameters
     ----------
     root_folder : str
-        Output folder (must exist when ``saveData`` or ``saveOutputImages``).
+        Output folder (must exist and be writable when ``saveData`` or ``saveOutputImages``; probed
+        before any work).
     theAmplitude : float
         Strain amplitude A (> 0; 0.2 = 20 %).
     theMu : float
@@ -174,6 +183,13 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     saveOutputMovie : bool, keyword-only
         Also write the snapshots as an animated GIF ``movie.gif`` in the image folder (needs
         ``saveOutputImages=True``; frames are kept at most 500 px wide, at most 200 of them).
+    output_format : {"text", "text.gz", "npz", "parquet"}, keyword-only
+        File format of ``saveData`` (see ``docs/output.md``): the reference text (default), the
+        same gzip-compressed, NumPy ``.npz`` or Parquet (needs the extra ``particleShear[parquet]``).
+        Read any of them with :func:`particleShear.read_run`.
+    strict_io : bool, keyword-only
+        Raise the ``OSError`` of a failed write after the run (default False: the result is
+        returned with ``write_error`` set, and ``last_result`` holds it either way).
 
     Returns
     -------
@@ -214,7 +230,19 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     if saveOutputMovie and not saveOutputImages:
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
+    check_output_format(output_format)
+    if not isinstance(strict_io, bool):
+        raise TypeError(f"strict_io={strict_io!r} is invalid: allowed True or False")
     ss, rng = _seed_sequence(seed)
+    # every input, the keyword-only options included
+    params.update(return_result=return_result, verbose=verbose, progress=progress,
+                  correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
+                  time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
+                  output_format=output_format, strict_io=strict_io,
+                  saveOutputMovie=saveOutputMovie)
+    seed_entropy = None if ss is None else ss.entropy
+    spawn_key = () if ss is None else tuple(ss.spawn_key)
+    run_id = run_identity(params, seed_entropy, spawn_key)
 
     theSimulation = Simulation_interlocking_rheology(
         root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
@@ -251,6 +279,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.integrator = integrator
     theSimulation.stability_guard = bool(stability_guard)
     theSimulation.saveOutputMovie = bool(saveOutputMovie)
+    theSimulation.output_format = output_format
+    theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
+    theSimulation.parameters = params
 
     G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
@@ -263,10 +294,13 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         timings=info["timings"], output_path=info["output_path"], image_folder=info["image_folder"],
         n_images=info["n_images"], dt=info["dt"], f=info["f"], N_steps=info["N_steps"],
         damping_factor=info["damping_factor"],
-        removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series)
+        removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series,
+        run_id=run_id, write_error=info.get("write_error"))
     if plotStress and doDrawing and result.output_path:
         _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
+    if strict_io and result.write_error is not None:
+        raise result.write_error
     if return_result:
         return result
     return G

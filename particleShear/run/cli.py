@@ -121,6 +121,8 @@ def build_parser():
     a("--seed", type=int, default=None, help="random seed (same seed = identical run)")
     a("--save", metavar="DIR", default=None, help="write the text output file into DIR (must exist)")
     a("--no-tensor-data", action="store_true", help="with --save: omit the 42-column per-step table")
+    a("--output-format", default="text", choices=("text", "text.gz", "npz", "parquet"),
+      help="with --save: file format (default text, the reference format; see docs/output.md)")
     a("--images", nargs="?", const="jpg", default=None, choices=("jpg", "png", "ps"),
       help="with --save: save ~200 snapshots (default type jpg)")
     a("--draw", action="store_true", help="show the live particle and stress windows (needs a display)")
@@ -135,7 +137,8 @@ def build_parser():
 
 
 def main(argv=None):
-    """Entry point; returns the process exit status (0 ok, 2 invalid parameters).
+    """Entry point; returns the process exit status (0 ok, 1 output not written or run unstable,
+    2 invalid parameters, 130 interrupted).
 
     ``particleShear plot DIR ...`` dispatches to :func:`particleShear.plot.cli_main`,
     ``particleShear sweep SPEC --out DIR ...`` to :func:`particleShear.sweep.cli.main`.
@@ -170,7 +173,19 @@ def main(argv=None):
             return_result=True, verbose=args.verbose, progress=progress,
             correct_drift_sign=args.correct_drift_sign, reference_header=args.reference_header,
             renderer="auto" if args.draw else ("pillow" if args.images else "none"),
-            saveOutputMovie=bool(args.movie and args.images))
+            saveOutputMovie=bool(args.movie and args.images),
+            output_format=args.output_format)
+
+    except KeyboardInterrupt as exc:  # one line, no traceback; the run removed its temporary files
+        if progress is not None:
+            progress.finish()
+        phase, step, total = getattr(exc, "position", ("set-up", 0, 0))
+        where = f"at step {step} of {total} ({phase})" if total else f"during {phase}"
+        print(f"particleShear: interrupted {where}; no file written", file=sys.stderr)
+        return 130
+    except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
+        print(f"particleShear: {exc}", file=sys.stderr)
+        return 2
     except (ValueError, TypeError) as exc:
         if progress is not None:
             progress.finish()
@@ -192,6 +207,9 @@ def main(argv=None):
         print("output file: " + res.output_path)
     if res.image_folder:
         print(f"images: {res.n_images} in {res.image_folder}")
+    if res.write_error is not None:
+        print(f"particleShear: writing the output failed, nothing was saved: {res.write_error}", file=sys.stderr)
+        return 1
     if args.plot:
         try:
             res.plot(args.plot)

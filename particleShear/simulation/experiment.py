@@ -14,7 +14,7 @@ import time
 
 from ..base.stress import StressTensorEvaluation
 from .evaluation import EvaluationHandlerPlotter, demodulation
-from .output import (NO_TENSOR_DATA_TEXT, experiment_description_text, output_summary_text, table_text)
+from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 
 __all__ = ["OscillatoryShearExperiment", "image_cadence", "protocol_steps"]
 
@@ -121,6 +121,10 @@ class OscillatoryShearExperiment:
         self.results = {}
         self.n_images_saved = 0
         self.N_steps = 0
+        #: block 2 of the header as it was at the start of the run (kept for writers after the run)
+        self.description_text = None
+        #: (phase, step, total) of the running loop: where an interrupt stopped the run
+        self.position = ("set-up", 0, 0)
 
     # -- signals ---------------------------------------------------------------------------------
     def in_phase_signal(self, t):
@@ -172,17 +176,20 @@ class OscillatoryShearExperiment:
             for _ in range(n):
                 ens.mechanical_simulation_step(c, ldt)
                 step += 1
+                self.position = ("pre-equilibration", step, total)
                 self._report("pre-equilibration", step, total, t0, state)
         self._say("  Setting final dt= " + str(self.dt))
         for _ in range(2 * int(N)):
             ens.mechanical_simulation_step(0.98, self.dt)
             step += 1
+            self.position = ("pre-equilibration", step, total)
             self._report("pre-equilibration", step, total, t0, state)
         for _ in range(int(N)):
             ens.shear_rate = 0
             ens.mechanical_simulation_step(cool_factor, self.dt)
             ens.reset_force()
             step += 1
+            self.position = ("pre-equilibration", step, total)
             self._report("pre-equilibration", step, total, t0, state)
         self.timings["pre_equilibration"] = time.perf_counter() - t0
 
@@ -288,6 +295,7 @@ class OscillatoryShearExperiment:
                 window.update()
             if save_images and i % image_N == 0:
                 self.save_canvas_image(i)
+            self.position = ("protocol", i + 1, n_run)
             self._report("protocol", i + 1, n_run, t0, state)
         if movie:  # the snapshots as an animated GIF beside the frames
             self.renderer.write_movie(os.path.join(str(self.imageOutputFolder), "movie.gif"))
@@ -303,6 +311,7 @@ class OscillatoryShearExperiment:
         """
         ens = self.theEnsemble
         self.cool_factor = cool_factor
+        self.description_text = experiment_description_text(self, reference_header=self.reference_header)
         if self.output_file:
             self.write_experiment_description_information_to_file()
         self.prepare_recording()
@@ -350,7 +359,8 @@ class OscillatoryShearExperiment:
         """Block 2 of the output file (docs/output.md); nothing without an output file (``False``/None)."""
         if not self.output_file:
             return
-        self.output_file.write(experiment_description_text(self, reference_header=self.reference_header))
+        text = self.description_text or experiment_description_text(self, reference_header=self.reference_header)
+        self.output_file.write(text)
 
     def write_output_information_to_file(self):
         """Block 3 of the output file (docs/output.md): summary and (optionally) the 42-column table; nothing without
@@ -360,10 +370,11 @@ class OscillatoryShearExperiment:
         G_int = self.results.get("internal") or self.evaluateStressAndG(False)
         G_surf = self.results.get("surface") or self.evaluateStressAndG(True)
         out = self.output_file
-        out.write(output_summary_text(G_int, G_surf))
+        out.write(output_summary_text(G_int, G_surf, reference_header=self.reference_header))
         p = self.plotter
         if self.saveStressTensorData and p.tensor_history is not None:
-            out.write(table_text(p._scal[: len(p)], p.tensor_history))
+            for piece in iter_table_text(p._scal[: len(p)], p.tensor_history):  # streamed: bounded memory
+                out.write(piece)
         elif self.saveStressTensorData:
             print("OscillatoryShearExperiment: tensor history was not kept; writing no table", file=sys.stderr)
             out.write("\n" + NO_TENSOR_DATA_TEXT)

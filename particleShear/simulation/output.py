@@ -1,15 +1,38 @@
 """The reference text output (spec §9.1, §9.3): header blocks, summary, 42-column table, atomic files.
 
-Values are formatted with ``str()`` exactly as the reference does.  Files are
-written to a temporary file in the target folder and renamed into place with
-``os.replace`` when complete, so an interrupted run never leaves a truncated file.
+Values are formatted with ``str()`` as the reference does, except that numbers ``str()`` writes in
+exponent notation are written positionally unless ``reference_header`` (the downstream R patterns
+read digits only; see :mod:`.provenance`).  Files are reserved by a locked temporary file in the
+target folder, streamed and renamed into place with ``os.replace`` when complete, so an
+interrupted run never leaves a truncated file and the temporary files of killed runs are
+recognised and removed by the next run (``docs/output.md``, "Files are complete or absent").
 """
 import math
 import os
+import shutil
+import secrets
+import tempfile
+import time
+
+try:
+    import fcntl
+    _HAVE_FLOCK = True
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None
+    _HAVE_FLOCK = False
 
 from ..base.stress import TENSOR_NAMES
+from .provenance import header_number
 
-__all__ = ["TABLE_COLUMNS", "AtomicOutputFile", "reserve_numbered_path", "experiment_description_text",
+#: suffix of a run's temporary output file (``.<name>.part``)
+PART_SUFFIX = ".part"
+#: suffix of a run's snapshot folder after the text file name (docs/output.md, "Snapshots")
+IMAGE_FOLDER_SUFFIX = "_images_folder"
+#: ending of the private name a temporary file has before it is locked and linked to its ``.part`` name
+_PRIVATE_SUFFIX = ".new"
+
+__all__ = ["TABLE_COLUMNS", "AtomicOutputFile", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
+           "probe_writable", "iter_table_text", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
 #: output-table column name stems of the nine tensors, in the order of TENSOR_NAMES
@@ -36,47 +59,74 @@ NO_TENSOR_DATA_TEXT = ("\tNot saving detailed stress tensor data. If you wish to
 
 
 class AtomicOutputFile:
-    """Text file written under a temporary name and moved to ``path`` by :meth:`commit`.
+    """Binary file written under a temporary name and moved to ``path`` by :meth:`commit`.
+
+    The temporary file ``.<name>.part`` (same folder) is created under a private name, locked
+    (``fcntl.flock``, held until :meth:`commit` or :meth:`abort`) and only then linked to its
+    public name, which fails if that name exists.  So the public ``.part`` name reserves
+    ``path`` against concurrent runs choosing the same number, and a ``.part`` whose
+    lock can be taken belongs to a process that died (SIGKILL, power loss): the next run in
+    the folder removes it (:func:`remove_stale_parts`).
 
     ``abort()`` (or leaving a ``with`` block by an exception) removes the temporary file.
-    The temporary name ``.<name>.part`` in the same folder is created exclusively, which
-    also reserves ``path`` against concurrent runs choosing the same number (§9.3).
+    Dependent temporary entries of the same run use the names :meth:`dependent` gives
+    (``.<name>.part.<role>``) and are removed with a stale owner.
     """
 
     def __init__(self, path, exclusive=True):
-        self.path = path
-        folder, name = os.path.split(path)
-        self.tmp_path = os.path.join(folder, "." + name + ".part")
-        flags = os.O_WRONLY | os.O_CREAT | (os.O_EXCL if exclusive else os.O_TRUNC)
-        fd = os.open(self.tmp_path, flags, 0o644)
-        self._f = os.fdopen(fd, "w", encoding="utf-8", newline="")
+        self.path = str(path)
+        folder, name = os.path.split(self.path)
+        self.folder = folder or "."
+        self.tmp_path = os.path.join(folder, "." + name + PART_SUFFIX)
+        self._fh = _create_locked(self.tmp_path, exclusive)
         self.committed = False
+        self.aborted = False
+
+    @property
+    def binary(self):
+        """The open binary file object (writers stream into it)."""
+        return self._fh
 
     def write(self, text):
-        return self._f.write(text)
+        """Write ``text`` (str, UTF-8) or bytes."""
+        return self._fh.write(text.encode("utf-8") if isinstance(text, str) else text)
 
     def flush(self):
-        self._f.flush()
+        self._fh.flush()
+
+    def dependent(self, role):
+        """Temporary path ``.<name>.part.<role>`` for a companion entry (sidecar, image folder)."""
+        return self.tmp_path + "." + role
 
     def commit(self):
-        """Close and move the complete file into place (``os.replace``)."""
+        """Move the complete file into place (``os.replace``) and release the reservation."""
         if self.committed:
             return self.path
-        self._f.close()
-        os.replace(self.tmp_path, self.path)
+        self._fh.flush()
+        if _HAVE_FLOCK:  # rename while still locked: the .part is never seen unlocked by another run
+            os.replace(self.tmp_path, self.path)
+            self._fh.close()
+        else:
+            self._fh.close()
+            os.replace(self.tmp_path, self.path)
         self.committed = True
         return self.path
 
     def abort(self):
-        """Close and delete the temporary file (nothing appears under ``path``)."""
-        if not self._f.closed:
-            self._f.close()
-        if not self.committed and os.path.exists(self.tmp_path):
-            os.remove(self.tmp_path)
+        """Delete the temporary file and release the reservation (nothing appears under ``path``)."""
+        if self.committed or self.aborted:
+            return
+        try:
+            if os.path.exists(self.tmp_path):
+                os.remove(self.tmp_path)
+        finally:
+            if not self._fh.closed:
+                self._fh.close()
+            self.aborted = True
 
     @property
     def closed(self):
-        return self._f.closed
+        return self._fh.closed
 
     def __enter__(self):
         return self
@@ -89,25 +139,149 @@ class AtomicOutputFile:
         return False
 
 
-def reserve_numbered_path(stem, suffix=".txt"):
+def _create_locked(tmp_path, exclusive):
+    """Open ``tmp_path`` for binary writing, locked before it is visible under that name."""
+    folder, name = os.path.split(tmp_path)
+    if not _HAVE_FLOCK:
+        flags = os.O_WRONLY | os.O_CREAT | (os.O_EXCL if exclusive else os.O_TRUNC)
+        return os.fdopen(os.open(tmp_path, flags, 0o644), "wb")
+    private = os.path.join(folder, name + ".%d.%s%s" % (os.getpid(), secrets.token_hex(4), _PRIVATE_SUFFIX))
+    fd = os.open(private, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        try:
+            os.link(private, tmp_path)  # atomic: fails when the name exists
+        except FileExistsError:
+            if exclusive:
+                raise
+            os.replace(private, tmp_path)
+    except BaseException:
+        os.close(fd)
+        if os.path.exists(private):
+            os.remove(private)
+        raise
+    os.remove(private)
+    return os.fdopen(fd, "wb")
+
+
+def _is_live(part_path):
+    """True when the temporary file ``part_path`` is locked by a running process (or cannot be checked).
+
+    Without ``fcntl`` (Windows) nothing can be proved stale, so every ``.part`` counts as live.
+    """
+    if not _HAVE_FLOCK:
+        return True
+    try:
+        fd = os.open(part_path, os.O_RDONLY)
+    except FileNotFoundError:
+        return False
+    except OSError:
+        return True
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return True
+        return False  # our lock is released on close below
+    finally:
+        os.close(fd)
+
+
+def _age_s(path):
+    try:
+        return time.time() - os.stat(path).st_mtime
+    except OSError:
+        return 0.0
+
+
+def _remove_entry(path):
+    if os.path.isdir(path) and not os.path.islink(path):
+        shutil.rmtree(path, ignore_errors=True)
+    elif os.path.lexists(path):
+        try:
+            os.remove(path)
+        except FileNotFoundError:
+            pass
+
+
+def remove_stale_parts(folder):
+    """Remove the temporary entries of killed runs in ``folder``; return the names removed.
+
+    An owner ``.<name>.part`` is stale when no process holds its lock; its companions
+    ``.<name>.part.<role>`` (sidecar, image folder) are stale with it or when the owner is gone.
+    Entries of live runs (lock held) are left alone, so this is safe while other runs write
+    into the same folder.
+    """
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    removed = []
+    owners = [n for n in names if n.startswith(".") and n.endswith(PART_SUFFIX)]
+    live = set()
+    for n in owners:
+        p = os.path.join(folder, n)
+        if _is_live(p):
+            live.add(n)
+        else:
+            _remove_entry(p)
+            removed.append(n)
+    for n in names:
+        if not n.startswith(".") or PART_SUFFIX + "." not in n:
+            continue
+        owner = n[: n.index(PART_SUFFIX + ".") + len(PART_SUFFIX)]
+        if owner in live:
+            continue
+        p = os.path.join(folder, n)
+        if n.endswith(_PRIVATE_SUFFIX) and (_is_live(p) or _age_s(p) < 60):
+            continue  # a run between creating its private file and linking it (microseconds)
+        if not _HAVE_FLOCK and os.path.exists(os.path.join(folder, owner)):
+            continue
+        _remove_entry(os.path.join(folder, n))
+        removed.append(n)
+    return removed
+
+
+def number_is_free(path):
+    """True when neither ``path``, its image folder nor a live reservation of it exists."""
+    folder, name = os.path.split(str(path))
+    part = os.path.join(folder, "." + name + PART_SUFFIX)
+    if os.path.lexists(path) or os.path.lexists(str(path) + IMAGE_FOLDER_SUFFIX):
+        return False
+    return not os.path.lexists(part) or not _is_live(part)
+
+
+def reserve_numbered_path(stem, suffix=".txt", max_number=1_000_000):
     """Open an :class:`AtomicOutputFile` at ``stem + str(k) + suffix`` for the smallest k ≥ 1 free.
 
-    A number is free when neither the file nor its temporary twin exists; the temporary file
-    is created exclusively, so concurrent processes never pick the same number.
+    Stale temporary files of killed runs in the folder are removed first, so they never take a
+    number.  A number is free when neither the file, its image folder nor a live reservation
+    exists; the reservation is atomic, so concurrent processes never pick the same number.
+    Raises ``OSError`` when more than ``max_number`` numbers are taken (the loop is bounded).
     """
-    k = 1
-    while True:
+    folder = os.path.dirname(stem) or "."
+    remove_stale_parts(folder)
+    for k in range(1, max_number + 1):
         path = stem + str(k) + suffix
-        if not os.path.exists(path):
+        if number_is_free(path):
             try:
                 return AtomicOutputFile(path, exclusive=True)
             except FileExistsError:
-                pass
-        k += 1
+                continue
+    raise OSError(f"no free file number below {max_number} for {stem}<k>{suffix}")
 
 
-def _s(v):
-    return str(v)
+def probe_writable(folder):
+    """Raise ``OSError`` unless a file can be created, written and removed in ``folder``.
+
+    A real probe (``os.access`` says yes to root on a read-only mount or a full disk).
+    """
+    fd, probe = tempfile.mkstemp(prefix=".particleShear-probe-", dir=folder)
+    try:
+        os.write(fd, b"probe")
+    finally:
+        os.close(fd)
+        os.remove(probe)
 
 
 def _particle_info(ens, reference):
@@ -125,6 +299,7 @@ def experiment_description_text(exp, reference_header=False):
     time" = excitation time only (§12 #22) and "Post-measurement periods" printing the
     pre value (§12 #21).  By default both are correct (whole protocol time; post value).
     """
+    _s = str if reference_header else header_number  # positional numbers for the R patterns
     ens = exp.theEnsemble
     L = ["Oscillatory shear experiment", ""]
     model = getattr(ens, "model", False)
@@ -202,11 +377,14 @@ def experiment_description_text(exp, reference_header=False):
     return "\n".join(L) + "\n"
 
 
-def output_summary_text(G_internal, G_surface):
+def output_summary_text(G_internal, G_surface, reference_header=False):
     """Block 3 up to and including the line "Detailed stress tensor data" (no newline at the end).
 
-    ``G_internal`` / ``G_surface`` are the demodulation results ``[SA, SB, G', G'']``.
+    ``G_internal`` / ``G_surface`` are the demodulation results ``[SA, SB, G', G'']``.  Numbers
+    in exponent notation are written positionally unless ``reference_header`` (the R patterns
+    read G values as plain decimals).
     """
+    _s = str if reference_header else header_number
     SA, SB, Gp, Gpp = G_internal
     L = ["", "", "Output data", "Summary data",
          "In phase stress = " + _s(SA) + "Pa",
@@ -221,17 +399,32 @@ def output_summary_text(G_internal, G_surface):
     return "\n".join(L)
 
 
+#: rows formatted and written at a time by the streaming writers (about 0.8 MB of text)
+CHUNK_ROWS = 1024
+
+
+def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
+    """The text of :func:`table_text` in pieces of ``chunk_rows`` lines (bounded memory).
+
+    Only one chunk of rows is converted to Python floats and formatted at a time, so writing
+    a 231k-step table needs a few MB instead of the whole table as one string.
+    """
+    n = len(scalars)
+    yield "\n" + "\t".join(TABLE_COLUMNS)
+    flat = tensors.reshape(n, 36)
+    for a in range(0, n, chunk_rows):
+        b = min(n, a + chunk_rows)
+        sc = scalars[a:b].tolist()
+        tt = flat[a:b].tolist()
+        yield "".join("\n" + str(a + k) + "\t" + "\t".join(map(str, sc[k])) + "\t" + "\t".join(map(str, tt[k]))
+                      for k in range(b - a))
+
+
 def table_text(scalars, tensors):
     """The header line and the data lines of the 42-column table, each data line preceded by "\\n".
 
     ``scalars`` (n, 5) = t, strain, strain_rate, τ_surface, τ_internal; ``tensors`` (n, 9, 2, 2).
     Returns the text starting with a newline (after "Detailed stress tensor data") and without a
-    trailing newline.
+    trailing newline.  Writers use :func:`iter_table_text` instead (bounded memory).
     """
-    n = len(scalars)
-    parts = ["\n", "\t".join(TABLE_COLUMNS)]
-    sc = scalars.tolist()
-    tt = tensors.reshape(n, 36).tolist()
-    for k in range(n):
-        parts.append("\n" + str(k) + "\t" + "\t".join(map(str, sc[k])) + "\t" + "\t".join(map(str, tt[k])))
-    return "".join(parts)
+    return "".join(iter_table_text(scalars, tensors))

@@ -1,13 +1,18 @@
 """Simulation classes: ensemble construction + experiment + output file (spec §8.1, §9, §10.9).
 
-``runSimulation`` (inherited by every class) validates the output settings before any
-work, builds the ensemble (``initEnsemble``), writes the text file of §9.1 atomically
-(temporary file + ``os.replace``), drives the :class:`OscillatoryShearExperiment` and
-returns ``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings,
-output path, series) is kept in ``self.result_info`` after the run.
+``runSimulation`` (inherited by every class) validates the output settings (and probes the
+folder) before any work, builds the ensemble (``initEnsemble``), reserves the file number,
+drives the :class:`OscillatoryShearExperiment`, then streams the file (format
+``output_format``) and its JSON sidecar to disk and renames them into place; it returns
+``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings, output path,
+write error) is kept in ``self.result_info`` after the run.  See ``docs/output.md``.
 """
+import gzip
+import io
+import json
 import math
 import os
+import shutil
 import sys
 import time
 
@@ -16,7 +21,10 @@ from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStre
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
-from .output import reserve_numbered_path
+from .formats import FORMAT_SUFFIXES, check_output_format, write_run
+from .output import (IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text, probe_writable,
+                     reserve_numbered_path)
+from .provenance import header_number, json_safe, package_version, positional_numbers_in_call, provenance_lines
 
 __all__ = ["OscillatorySimulation", "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
            "Simulation_interlocking_rheology", "check_output_folder"]
@@ -37,6 +45,21 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
     if not os.path.isdir(root_folder):
         raise ValueError(f"root_folder={root_folder!r} is invalid: {' and '.join(wants)} needs an existing "
                          "output folder (no such directory)")
+    try:
+        probe_writable(root_folder)
+    except OSError as exc:
+        raise ValueError(f"root_folder={root_folder!r} is invalid: {' and '.join(wants)} needs a writable "
+                         f"output folder ({exc.strerror or exc})") from exc
+
+
+class _TextSink:
+    """Text writes encoded as UTF-8 into a binary file (plain or gzip)."""
+
+    def __init__(self, binary):
+        self._b = binary
+
+    def write(self, text):
+        self._b.write(text.encode("utf-8"))
 
 
 def _writes(simulation, theFile):
@@ -80,6 +103,15 @@ class OscillatorySimulation:
     integrator = "euler"
     #: stop a diverging measurement with a clear error
     stability_guard = True
+    #: file format of ``saveData``: "text" (reference), "text.gz", "npz" or "parquet" (see .formats)
+    output_format = "text"
+    #: provenance written into the header and the sidecar (set by doParticleShearSimulation)
+    run_id = None
+    seed_entropy = None
+    spawn_key = ()
+    parameters = None
+    #: the exception of a failed write after the run (None when the output was written)
+    write_error = None
 
     def __init__(self, root_folder, amplitude=0.5, relative_y_scale_force=5e-4, relative_frequency=0.05,
                  doDrawing=True, saveData=False):
@@ -147,15 +179,15 @@ class OscillatorySimulation:
         if not self.root_folder:
             return False
         stem = self._file_stem()
-        k = 1
-        while os.path.exists(stem + str(k) + ".txt") or os.path.exists(
-                os.path.join(os.path.dirname(stem), "." + os.path.basename(stem) + str(k) + ".txt.part")):
-            k += 1
-        return stem + str(k) + ".txt"
+        suffix = FORMAT_SUFFIXES.get(getattr(self, "output_format", "text"), ".txt")
+        for k in range(1, 1_000_001):  # bounded, as reserve_numbered_path
+            if number_is_free(stem + str(k) + suffix):
+                return stem + str(k) + suffix
+        raise OSError("no free file number for " + stem + "<k>" + suffix)
 
     def image_folder_path(self, fileName):
         """``<text file path>_images_folder`` (§9.4)."""
-        return str(fileName) + "_images_folder"
+        return str(fileName) + IMAGE_FOLDER_SUFFIX
 
     def createFolder(self, directory):
         """Create ``directory`` (and its parents); ``False``/None (no folder, as in the reference) does nothing."""
@@ -213,14 +245,28 @@ class OscillatorySimulation:
 
         ``cool_factor`` is the fraction of peculiar velocity left after one excitation period;
         the per-step factor is ``cool_factor ** (1/N_per_period)`` (§4.4).
+
+        Output (see ``docs/output.md``): the folder is probed for writability before any work;
+        the file number is reserved (a locked ``.part`` file) when the ensemble exists, snapshots
+        go to a temporary folder renamed when the protocol is complete, and the file (format
+        ``self.output_format``) and its JSON sidecar are streamed to disk after the run and
+        renamed into place.  A failure while writing after the run does not lose the result:
+        it is kept in ``self.write_error`` (and ``result_info["write_error"]``) and nothing
+        partial is left.  An interrupt (``KeyboardInterrupt``) removes every temporary entry
+        and is re-raised with ``position = (phase, step, total)`` attached.
         """
         check_output_folder(self.root_folder, self.saveData, self.saveOutputImages, self.doDrawing)
         if not periods > 0:
             raise ValueError(f"periods={periods!r} is out of range: allowed > 0")
         if not 0 < cool_factor <= 1:
             raise ValueError(f"cool_factor={cool_factor!r} is out of range: allowed 0 < value <= 1")
+        output_format = getattr(self, "output_format", "text")
+        check_output_format(output_format)
         t_start = time.perf_counter()
         out = None
+        image_tmp = None
+        self.write_error = None
+        self.theExperiment = None
         try:
             if self.progress is not None:
                 self.progress("constitution", 0, 0, 0.0)
@@ -234,31 +280,46 @@ class OscillatorySimulation:
             self.f = self.relative_frequency / model.time_constant
             fileName = False
             if self.saveData or self.saveOutputImages:
-                out = reserve_numbered_path(self._file_stem())
+                # the reservation (a locked .part file) is held for the whole run, also when only
+                # the image folder needs the name
+                out = reserve_numbered_path(self._file_stem(), FORMAT_SUFFIXES[output_format])
                 fileName = out.path
-                if not self.saveData:  # the name is only needed for the image folder
-                    out.abort()
-                    out = None
             self.output_path = fileName if self.saveData else None
             image_folder = False
             if self.saveOutputImages and self.renderer is not None and fileName:
+                image_tmp = out.dependent("images")
+                os.makedirs(image_tmp)
                 image_folder = self.image_folder_path(fileName)
-                self.createFolder(image_folder)
-            if out is not None:
-                self.write_information_on_simulation_to_file(out)
-            exp = self.createExperiment(out if out is not None else False, periods, plotStress, image_folder)
+            header = None
+            if self.saveData:
+                block1 = io.StringIO()
+                self.write_information_on_simulation_to_file(block1)
+                header = block1.getvalue()
+            exp = self.createExperiment(False, periods, plotStress, image_tmp or False)
+            exp.keep_tensor_history = bool(self.saveData and self.saveStressTensorData)
             N_pre = 25 * int(self.adjustment_factor_for_bounded_preequilibration_steps())
             N_per_period = 1 / self.f / self.dt
             f_step = cool_factor ** (1 / N_per_period)
             if self.verbose:
                 print("cool factor per dt= " + str(f_step))
-                if out is not None:
+                if self.saveData:
                     print("Writing output to file " + fileName)
             G = exp.oscillatory_shear_experiment(cool_factor=f_step, N_pre_equilibration_fixed_boundaries=N_pre)
-            if out is not None:
-                t0 = time.perf_counter()
-                out.commit()
-                exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
+            t0 = time.perf_counter()
+            try:
+                if image_tmp is not None:
+                    os.rename(image_tmp, image_folder)  # complete: the folder appears under its name
+                    image_tmp = None
+                if self.saveData:
+                    self._write_output(out, header, exp, output_format)
+            except Exception as exc:  # noqa: BLE001 - any write failure: keep the computed result
+                self.write_error = exc
+                self.output_path = None
+                if self.verbose:
+                    print("Writing the output failed: " + repr(exc))
+            if out is not None and not out.committed:
+                out.abort()  # images only (or a failed write): release the reservation
+            exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
             self.timings.update(exp.timings)
             self.timings["total"] = time.perf_counter() - t_start
             self.result_info = {
@@ -268,14 +329,67 @@ class OscillatorySimulation:
                 "stress_internal": (exp.results["internal"][0], exp.results["internal"][1]),
                 "dt": self.dt, "f": self.f, "N_steps": exp.N_steps, "N_pre_equilibration": N_pre,
                 "damping_factor": f_step, "output_path": self.output_path,
-                "image_folder": image_folder or None, "n_images": exp.n_images_saved,
-                "timings": dict(self.timings),
+                "image_folder": (image_folder if image_tmp is None else None) or None,
+                "n_images": exp.n_images_saved, "timings": dict(self.timings), "write_error": self.write_error,
             }
             return G
+        except KeyboardInterrupt as exc:
+            exp = self.theExperiment
+            exc.position = exp.position if exp is not None else ("constitution", 0, 0)
+            raise
         finally:
             if out is not None and not out.committed:
                 out.abort()
+            if image_tmp is not None and os.path.isdir(image_tmp):
+                shutil.rmtree(image_tmp, ignore_errors=True)
             self._close_windows()
+
+    def run_metadata(self, output_format, path):
+        """JSON-safe description of the run: parameters and provenance (the sidecar's content)."""
+        return {
+            "file": os.path.basename(path) if path else None, "output_format": output_format,
+            "package_version": package_version(), "run_id": getattr(self, "run_id", None),
+            "seed_entropy": json_safe(getattr(self, "seed_entropy", None)),
+            "spawn_key": json_safe(list(getattr(self, "spawn_key", ()))),
+            "parameters": json_safe(getattr(self, "parameters", None)),
+            "time_step_factor": float(getattr(self, "time_step_factor", 1.0)),
+            "integrator": getattr(self, "integrator", "euler"), "correct_drift_sign": bool(self.correct_drift_sign),
+            "reference_header": bool(self.reference_header), "function_call": self.function_call,
+        }
+
+    def _write_output(self, out, header, exp, output_format):
+        """Stream the run into the reserved ``out`` in ``output_format``, write the sidecar, commit both.
+
+        Text formats are written by the experiment's own block-3 writer (summary, then the table
+        in chunks); npz and parquet by :func:`~.formats.write_run`.  The sidecar
+        ``<file>.json`` is moved into place just before the file itself.
+        """
+        metadata = self.run_metadata(output_format, out.path)
+        if output_format in ("text", "text.gz"):
+            gz = gzip.GzipFile(fileobj=out.binary, mode="wb", compresslevel=6, mtime=0) \
+                if output_format == "text.gz" else None
+            sink = _TextSink(gz if gz is not None else out.binary)
+            sink.write(header)
+            sink.write(exp.description_text)
+            exp.output_file = sink
+            try:
+                exp.write_output_information_to_file()
+            finally:
+                exp.output_file = False
+            if gz is not None:
+                gz.close()
+        else:
+            p = exp.plotter
+            G_int, G_surf = exp.results["internal"], exp.results["surface"]
+            text = (header + exp.description_text
+                    + output_summary_text(G_int, G_surf, reference_header=self.reference_header))
+            tensors = p.tensor_history if self.saveStressTensorData else None
+            write_run(out.binary, output_format, text, p._scal[: len(p)], tensors, metadata)
+        tmp_json = out.dependent("json")
+        with open(tmp_json, "w", encoding="utf-8") as fh:
+            json.dump(metadata, fh, indent=1)
+        os.replace(tmp_json, out.path + ".json")
+        out.commit()
 
     def _close_windows(self):
         exp = self.theExperiment
@@ -350,7 +464,8 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         return self.relative_frequency / model.time_constant if model else -1
 
     def write_information_on_simulation_to_file(self, theFile):
-        """Block 1 of the text file (docs/output.md); nothing for ``theFile`` False/None or ``saveData`` False."""
+        """Block 1 of the text file (docs/output.md; and, unless ``reference_header``, the provenance lines
+        after μ); nothing for ``theFile`` False/None or ``saveData`` False."""
         if not _writes(self, theFile):
             return
         if self.do_permanent_links:
@@ -361,11 +476,18 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
                 head = "Dermal filler control ensemble: no cut lines \n"
         else:
             head = "Dermal filler control ensemble: No permanent links\n"
+        if self.reference_header:  # the reference text exactly
+            num, call, extra = str, self.function_call, ""
+        else:  # positional numbers for the R patterns, and the provenance lines
+            num, call = header_number, positional_numbers_in_call(self.function_call)
+            extra = provenance_lines(self.run_id, self.seed_entropy, self.spawn_key,
+                                     getattr(self, "time_step_factor", 1.0), getattr(self, "integrator", "euler"),
+                                     self.correct_drift_sign) + "\n"
         theFile.write(head
-                      + "\tN=" + str(self.N) + " spheres, nominal packing density = " + str(self.packing_fraction)
-                      + "\n\tYoung modulus of the individual spheres = " + str(self.Young_modulus_spheres) + " Pa \n"
-                      + "\tFriction coefficient = " + str(self.mu) + "\n\n\n\n"
-                      + "Function call : \n" + self.function_call + "\n\n")
+                      + "\tN=" + num(self.N) + " spheres, nominal packing density = " + num(self.packing_fraction)
+                      + "\n\tYoung modulus of the individual spheres = " + num(self.Young_modulus_spheres) + " Pa \n"
+                      + "\tFriction coefficient = " + num(self.mu) + "\n" + extra + "\n\n\n"
+                      + "Function call : \n" + call + "\n\n")
 
 
 class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):

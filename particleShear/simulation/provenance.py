@@ -1,0 +1,125 @@
+"""Provenance of a run: its identity (a hash of every input and the seed) and header formatting.
+
+Two runs with the same parameters and the same seed are the same run; :func:`run_identity`
+gives them the same short id whatever the process, machine or order of the parameters.  The
+id is written in the header of the text file, in the JSON sidecar and in
+``SimulationResult.run_id`` (see ``docs/output.md``).
+
+Header numbers are written with :func:`header_number`: Python's ``str()`` unless that uses
+exponent notation, which the regular expressions of the downstream R package
+(particleShearEvaluation) read as digits only (``1e-05`` would be read as 1).  Such numbers are
+written positionally instead (``0.00001``), which reads back as the same float.
+"""
+import hashlib
+import json
+import math
+import re
+
+import numpy as np
+
+__all__ = ["run_identity", "header_number", "positional_numbers_in_call", "json_safe", "provenance_lines",
+           "IDENTITY_EXCLUDED", "package_version"]
+
+#: inputs that change neither the physics nor what is written: left out of the run identity
+IDENTITY_EXCLUDED = frozenset({"seed", "root_folder", "return_result", "verbose", "progress", "strict_io",
+                               "renderer", "plotStress", "doDrawing"})
+
+
+def package_version():
+    """The installed particleShear version (``particleShear.__version__``)."""
+    from .. import __version__
+    return __version__
+
+
+def json_safe(value):
+    """``value`` as plain JSON data: numbers, strings, booleans, None, lists and dicts.
+
+    NumPy scalars become Python numbers, tuples lists, SeedSequences ``{"entropy", "spawn_key"}``,
+    callables and other objects their qualified name (they cannot be stored, but their
+    presence is recorded).
+    """
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else repr(v)
+    if isinstance(value, np.random.SeedSequence):
+        return {"entropy": json_safe(value.entropy), "spawn_key": [int(k) for k in value.spawn_key]}
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [json_safe(v) for v in value]
+    if hasattr(value, "__fspath__"):
+        return str(value.__fspath__())
+    name = getattr(value, "__qualname__", None) or type(value).__qualname__
+    return "<" + str(name) + ">"
+
+
+def run_identity(parameters, seed_entropy, spawn_key):
+    """Short deterministic id of a run: 12 hex digits of SHA-256 over its inputs and seed.
+
+    Parameters
+    ----------
+    parameters : dict
+        Inputs of :func:`doParticleShearSimulation` (any superset is fine); keys in
+        :data:`IDENTITY_EXCLUDED` (where the files go, console and drawing options, the seed
+        object itself) are ignored, as is the order of the keys.
+    seed_entropy : int or None
+        ``SeedSequence.entropy`` of the run (None when a Generator was passed).
+    spawn_key : sequence of int
+        ``SeedSequence.spawn_key`` (empty for a single run, ``(k,)`` for run k of a series).
+
+    Returns
+    -------
+    str
+        12 lower-case hexadecimal digits (48 bits: collisions are negligible for campaigns of
+        millions of runs).
+    """
+    kept = {k: json_safe(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
+    payload = {"parameters": kept, "seed_entropy": json_safe(seed_entropy),
+               "spawn_key": [int(k) for k in (spawn_key or ())]}
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]
+
+
+def header_number(value):
+    """``str(value)``, except that a float in exponent notation is written positionally.
+
+    ``header_number(1e-05) == "0.00001"``, ``header_number(0.1) == "0.1"``,
+    ``header_number(8000) == "8000"``; ``float(header_number(x)) == x`` for every finite float.
+    Non-numbers (booleans, strings) are returned as ``str(value)``.
+    """
+    text = str(value)
+    if isinstance(value, (float, np.floating)) and math.isfinite(value) and ("e" in text or "E" in text):
+        return np.format_float_positional(float(value), trim="-")
+    return text
+
+
+# a number in exponent notation right after "=" (optionally one space) and before , ) or the line end;
+# the value of root_folder (a path) is never touched
+_CALL_EXPONENT = re.compile(r"(?<!root_folder=)(?<==)( ?)(-?\d+(?:\.\d*)?[eE][+-]?\d+)(?=[,)\n]|$)")
+
+
+def positional_numbers_in_call(text):
+    """The function-call lines of the header with every exponent-notation number written positionally."""
+    return _CALL_EXPONENT.sub(lambda m: m.group(1) + header_number(float(m.group(2))), text)
+
+
+def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrator, correct_drift_sign):
+    """The provenance lines of the header's first block (each TAB-indented, joined by newlines).
+
+    The labels use ``:`` instead of ``=`` and none contains a label that the downstream R
+    patterns search for, so they change nothing that particleShearEvaluation reads.
+    """
+    key = ",".join(str(int(k)) for k in (spawn_key or ()))
+    return "\n".join([
+        "\tparticleShear version: " + package_version(),
+        "\tRun id: " + str(run_id),
+        "\tSeed entropy: " + str(seed_entropy),
+        "\tSeed spawn key: [" + key + "]",
+        "\tTime step factor: " + header_number(time_step_factor),
+        "\tIntegrator: " + str(integrator),
+        "\tCorrect drift sign: " + str(bool(correct_drift_sign)),
+    ])
