@@ -11,6 +11,7 @@ import functools
 import io
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -182,6 +183,14 @@ class TestSweep(unittest.TestCase):
                          {r["run_id"]: float(r["Gp_surface"]) for r in self.rows})
         self.assertEqual(dict(zip(pt["run_id"], pt["do_permanent_links"])),
                          {r["run_id"]: r["do_permanent_links"] == "True" for r in self.rows})
+
+    def test_file_header_names_the_row_id(self):
+        """The run id in a file's provenance header is the id of its row and of its file name."""
+        for r in self.rows:
+            with open(r["output_path"], encoding="utf-8") as fh:
+                head = fh.read(20000)
+            ids = re.findall(r"^\tRun id: (\S+)$", head, flags=re.M)
+            self.assertEqual(ids, [r["run_id"]])
 
     def test_row_is_the_run(self):
         """A row holds the moduli of the same run done directly with the same seed, and equals to_dict()."""

@@ -106,7 +106,7 @@ class SimulationResult:
         """
         from .. import __version__
         from ..sweep.spec import sweep_parameter_defaults
-        from ..sweep.identity import run_identity
+        from ..simulation.provenance import run_identity
         params = sweep_parameter_defaults()
         params.update({k: v for k, v in self.parameters.items() if k in params})
         row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",

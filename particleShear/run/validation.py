@@ -69,8 +69,9 @@ BYTES_PER_SPHERE = 10_000
 #: recording per protocol step: 5 scalars, and the (9, 2, 2) tensor history when it is kept
 RECORD_BYTES_PER_STEP = 5 * 8
 TENSOR_BYTES_PER_STEP = 9 * 2 * 2 * 8
-#: the text of one table row of the output file while it is built (42 columns ≈ 3.4 kB)
-OUTPUT_TEXT_BYTES_PER_STEP = 3_500
+#: the output table is streamed in blocks of 1,024 rows (42 columns ≈ 3.4 kB of text a row), so
+#: writing needs a bounded ~3.5 MB buffer whatever the length of the run
+OUTPUT_TEXT_BUFFER_BYTES = 1_024 * 3_500
 #: the Voronoi cut holds ~8 float arrays of shape (N, cut_lines)
 CUT_BYTES_PER_SPHERE_AND_SEED = 8 * 8
 #: fraction of the available memory a run may plan to use
@@ -238,7 +239,7 @@ def estimate_run_cost(p):
         "ensemble": N * BYTES_PER_SPHERE,
         "recording": protocol * (RECORD_BYTES_PER_STEP + (TENSOR_BYTES_PER_STEP if tensors else 0)),
         "cutting": float(N) * cut * CUT_BYTES_PER_SPHERE_AND_SEED,
-        "output_text": protocol * OUTPUT_TEXT_BYTES_PER_STEP if tensors else 0.0,
+        "output_text": OUTPUT_TEXT_BUFFER_BYTES if tensors else 0.0,
     }
     memory["total"] = sum(memory.values())
     return {"dt": dt, "f": f, "steps_per_period": steps_per_period, "protocol_steps": protocol,
@@ -339,8 +340,9 @@ def _check_cost(p):
         allowed = int(budget / (int(p["N"]) * CUT_BYTES_PER_SPHERE_AND_SEED))
         raise ValueError(f"cut_lines={p['cut_lines']!r} is out of range: the Voronoi cut {need}; allowed "
                          f"cut_lines <= {allowed:,} for N={p['N']!r} on this machine")
-    per_step = (mem["recording"] + mem["output_text"]) / max(cost["protocol_steps"], 1.0)
-    name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - mem["ensemble"] - mem["cutting"]) / per_step))
+    per_step = mem["recording"] / max(cost["protocol_steps"], 1.0)
+    fixed = mem["ensemble"] + mem["cutting"] + mem["output_text"]  # the streamed output's buffer does not grow
+    name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - fixed) / per_step))
     hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
     raise ValueError(f"{name}={p[name]!r} is out of range: recording {cost['protocol_steps']:.3g} protocol steps "
                      f"{need}; allowed {allowed} on this machine{hint}")

@@ -13,6 +13,7 @@ written positionally instead (``0.00001``), which reads back as the same float.
 import hashlib
 import json
 import math
+import numbers
 import re
 
 import numpy as np
@@ -57,6 +58,18 @@ def json_safe(value):
     return "<" + str(name) + ">"
 
 
+def _identity_value(value):
+    """JSON form of one input for the run identity: every real number as a float, bools as bools.
+
+    ``N = 30`` and ``N = 30.0`` describe the same run and hash alike; ``True`` and ``1`` stay apart.
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, numbers.Real):
+        return json_safe(float(value))
+    return json_safe(value)
+
+
 def run_identity(parameters, seed_entropy, spawn_key):
     """Short deterministic id of a run: 12 hex digits of SHA-256 over its inputs and seed.
 
@@ -77,7 +90,7 @@ def run_identity(parameters, seed_entropy, spawn_key):
         12 lower-case hexadecimal digits (48 bits: collisions are negligible for campaigns of
         millions of runs).
     """
-    kept = {k: json_safe(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
+    kept = {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
     payload = {"parameters": kept, "seed_entropy": json_safe(seed_entropy),
                "spawn_key": [int(k) for k in (spawn_key or ())]}
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"))

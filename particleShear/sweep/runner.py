@@ -448,7 +448,7 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
     ``all_kwargs[k]`` holds every argument of run k, its ``seed`` a SeedSequence.  With a
     ``root_folder`` the runs form a resumable sweep into it (see :class:`Sweep`).
     """
-    from .identity import run_identity
+    from ..simulation.provenance import run_identity
     from .spec import SweepRun, sweep_parameter_defaults
     defaults = sweep_parameter_defaults()
     runs = []

@@ -66,7 +66,7 @@ class SweepRun:
     seed_entropy : int
     spawn_key : tuple of int
     run_id : str
-        :func:`particleShear.sweep.identity.run_identity` of the above.
+        :func:`particleShear.simulation.provenance.run_identity` of the above.
     """
 
     index: int
@@ -267,7 +267,7 @@ def expand_runs(spec):
         The first invalid run, naming the parameter (and the run's point) — before any work.
     """
     from ..run.validation import validate_simulation_parameters
-    from .identity import run_identity
+    from ..simulation.provenance import run_identity
     defaults = sweep_parameter_defaults()
     points = []
     for p_index, point in enumerate(_points(spec)):
