@@ -21,6 +21,7 @@ The estimators are defined in ``docs/output.md``: "surface" = shear stress from 
 the plate bands (the value :func:`doParticleShearSimulation` returns), "internal" = xy component
 of the overall stress tensor (eq. S1-24).
 """
+__docformat__ = "numpy"
 import argparse
 import csv
 import math

@@ -13,6 +13,7 @@ their limits, in ``docs/parameters.md``):
   cutting, output text) stay within documented limits and the memory available
   on this machine, read when the run is checked (:func:`available_memory`).
 """
+__docformat__ = "numpy"
 import itertools
 import math
 import numbers

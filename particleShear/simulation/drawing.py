@@ -19,6 +19,7 @@ environment variable ``PARTICLESHEAR_RENDERER``) uses Tk when a display is avail
 and falls back to Pillow (only if snapshots are requested) otherwise, printing one
 message per process.
 """
+__docformat__ = "numpy"
 import math
 import os
 import sys

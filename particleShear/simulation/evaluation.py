@@ -7,6 +7,7 @@ the number of steps is not known in advance); the reference list attributes
 (``t``, ``strain``, ``stress_tensor_LW`` …) are built lazily when read, and the
 running estimates ``Gprime`` / ``viscosity`` are computed on demand.
 """
+__docformat__ = "numpy"
 import math
 import sys
 

@@ -6,6 +6,7 @@ per-step order (§8.3, one visible loop in :meth:`OscillatoryShearExperiment.run
 records every step, demodulates τ_internal and τ_surface (§8.5) and returns
 ``[G′_surface, G″_surface]`` (Pa) as the reference does.
 """
+__docformat__ = "numpy"
 import math
 import os
 import sys

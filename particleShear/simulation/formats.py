@@ -14,6 +14,7 @@ Every writer streams into an open binary file (bounded memory) and is used by
 ``runSimulation`` on an :class:`~particleShear.simulation.output.AtomicOutputFile`, so a file
 is complete or absent.  See ``docs/output.md`` for sizes and load times.
 """
+__docformat__ = "numpy"
 import gzip
 import io
 import json

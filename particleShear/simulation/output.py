@@ -7,6 +7,7 @@ target folder, streamed and renamed into place with ``os.replace`` when complete
 interrupted run never leaves a truncated file and the temporary files of killed runs are
 recognised and removed by the next run (``docs/output.md``, "Files are complete or absent").
 """
+__docformat__ = "numpy"
 import math
 import os
 import shutil

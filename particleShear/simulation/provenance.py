@@ -10,6 +10,7 @@ exponent notation, which the regular expressions of the downstream R package
 (particleShearEvaluation) read as digits only (``1e-05`` would be read as 1).  Such numbers are
 written positionally instead (``0.00001``), which reads back as the same float.
 """
+__docformat__ = "numpy"
 import hashlib
 import json
 import math

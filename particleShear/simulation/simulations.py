@@ -7,6 +7,7 @@ drives the :class:`OscillatoryShearExperiment`, then streams the file (format
 ``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings, output path,
 write error) is kept in ``self.result_info`` after the run.  See ``docs/output.md``.
 """
+__docformat__ = "numpy"
 import gzip
 import io
 import json

@@ -1,4 +1,5 @@
 """``python -m particleShear sweep SPEC --out DIR``: run, resume, dry-run or merge a sweep (docs/sweeps.md)."""
+__docformat__ = "numpy"
 import argparse
 import contextlib
 import os

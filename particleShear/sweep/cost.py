@@ -7,6 +7,7 @@ N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extr
 nearest slope), plus constitution 0.53 s · (N/150)^0.7.  Disk: the text format writes about
 723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md).
 """
+__docformat__ = "numpy"
 import math
 
 from ..linkable.builders import time_steps_from_model

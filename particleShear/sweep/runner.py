@@ -14,6 +14,7 @@ moment leaves, at worst, a scratch folder (cleared when the run starts again) an
 that was being published, a file without row: the rerun writes the same file under the same name,
 so ``DIR`` never holds two ``.txt`` files of one run.
 """
+__docformat__ = "numpy"
 import concurrent.futures
 import contextlib
 import dataclasses

@@ -20,6 +20,7 @@ i.e. ``SeedSequence(root).spawn(n)[k]``: adding repetitions keeps the ids of the
 Points enumerate the grid keys in file order, then each ``[[zip]]`` group, the last varying
 fastest.  Every run is validated before any starts (docs/sweeps.md).
 """
+__docformat__ = "numpy"
 import dataclasses
 import functools
 import inspect

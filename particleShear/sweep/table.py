@@ -9,6 +9,7 @@ Rows are appended by one writer (the sweep's driving process) with a single ``os
 complete line on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
 most one torn last line, which :func:`read_rows` drops and :func:`repair_table` cuts off.
 """
+__docformat__ = "numpy"
 import csv
 import io
 import json
