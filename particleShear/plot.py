@@ -381,7 +381,6 @@ def cli_main(argv=None):
     int
         Exit status: 0 written, 1 matplotlib missing, 2 invalid input (message on stderr).
     """
-
     args = build_parser().parse_args(argv)
     try:
         plot_sweep(args.folder, estimator=args.estimator, path=args.output)

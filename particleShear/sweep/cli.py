@@ -57,7 +57,6 @@ def main(argv=None):
         Exit status: 0 ok, 1 some runs failed (or unfinished after ``--merge``), 2 invalid
         input (message naming the flag on stderr), 130 interrupted.
     """
-
     args = build_parser().parse_args(argv)
     from .cost import format_cost
     from .runner import Sweep

@@ -164,7 +164,6 @@ def calibrate(p, target_steps=2000):
     float
         Measured wall time divided by the projected one (1 = the documented costs hold here).
     """
-
     import time
     from ..run.api import doParticleShearSimulation
     per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
