@@ -50,14 +50,19 @@ DOCUMENTED_MODULES = [
     "particleShear.run.validation",
 ]
 
-#: Modules of DOCUMENTED_MODULES still being completed on another branch: their checks are
-#: expected failures until that branch is merged (the lead removes a name here once it passes).
-#: run.api: doParticleShearSimulation's docstring and the "§" references of api.py are written
-#: by the helper of the API docstring (issue 13 item 3), not on this branch.
-#: run.cli: rewritten by the helper of the generated command line (issue 13 item 5).
-PENDING_MODULES = {
+#: Modules of DOCUMENTED_MODULES still being completed on another branch: their docstring
+#: check is an expected failure until that branch is merged (the lead removes a name here once
+#: it passes).  run.api: doParticleShearSimulation's docstring is written by the helper of the
+#: API docstring (issue 13 item 3), not on this branch; run.cli: rewritten by the helper of the
+#: generated command line (issue 13 item 5).
+PENDING_DOCSTRINGS = {
     "particleShear.run.api",
     "particleShear.run.cli",
+}
+
+#: Modules whose "§" references are replaced on another branch (run.api, see above).
+PENDING_SECTION_SIGNS = {
+    "particleShear.run.api",
 }
 
 #: The engine layers (being rewritten; documented after the engine merge).  Checked as a whole,
@@ -411,8 +416,9 @@ def _make_tests(module_name):
         hits = section_sign_lines(module_name)
         self.assertEqual(hits, [], "\"§\" points to a document users do not have:\n" + "\n".join(hits))
 
-    if module_name in PENDING_MODULES:
+    if module_name in PENDING_DOCSTRINGS:
         test_documented = unittest.expectedFailure(test_documented)
+    if module_name in PENDING_SECTION_SIGNS:
         test_no_section_sign = unittest.expectedFailure(test_no_section_sign)
     return test_documented, test_no_section_sign
 
