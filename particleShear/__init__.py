@@ -3,6 +3,7 @@
 ``from particleShear import *`` exposes the documented classes and functions of
 every layer (base → objects → linkable → simulation → run).
 """
+__docformat__ = "numpy"
 from .base import *  # noqa: F401,F403
 from .base import __all__ as _base_all
 from .objects import *  # noqa: F401,F403

@@ -21,6 +21,7 @@ The estimators are defined in ``docs/output.md``: "surface" = shear stress from 
 the plate bands (the value :func:`doParticleShearSimulation` returns), "internal" = xy component
 of the overall stress tensor (eq. S1-24).
 """
+__docformat__ = "numpy"
 import argparse
 import csv
 import math
@@ -54,6 +55,25 @@ def save_figure(fig, path, dpi=150):
 
     The figure is written to a temporary file in the same folder and renamed, so the file is
     complete or absent.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure to write.
+    path : str or os.PathLike
+        Destination file; its extension (.png, .pdf, .svg or .eps) chooses the format.
+    dpi : float, optional
+        Resolution of raster output in dots per inch (default 150; PDF/SVG/EPS are vector).
+
+    Returns
+    -------
+    str or os.PathLike
+        ``path``, as given.
+
+    Raises
+    ------
+    ValueError
+        If the extension of ``path`` is none of .png, .pdf, .svg, .eps.
     """
     ext = os.path.splitext(str(path))[1].lower()
     if ext not in FIGURE_FORMATS:
@@ -159,7 +179,20 @@ def _float(v):
 def read_sweep_table(folder_or_csv):
     """Rows of a sweep's ``results.csv`` as dicts of strings (csv module; no pandas needed).
 
-    ``folder_or_csv`` is the sweep folder (its ``results.csv`` is read) or the CSV file itself.
+    Parameters
+    ----------
+    folder_or_csv : str or os.PathLike
+        The sweep folder (its ``results.csv`` is read) or the CSV file itself.
+
+    Returns
+    -------
+    list of dict
+        One ``{column: text}`` dict per row, in file order.
+
+    Raises
+    ------
+    ValueError
+        If there is no such CSV file.
     """
     path = str(folder_or_csv)
     if os.path.isdir(path):
@@ -175,6 +208,17 @@ def group_of(row):
 
     crosslinked = ``do_permanent_links`` and ``cut_lines > 0``; uncrosslinked = not
     ``do_permanent_links``; bulk control = ``do_permanent_links`` and ``cut_lines == 0``.
+
+    Parameters
+    ----------
+    row : dict
+        A row of ``results.csv`` (values as text or numbers); a missing ``do_permanent_links``
+        counts as True, a missing ``cut_lines`` as 0.
+
+    Returns
+    -------
+    str
+        The group name.
     """
     if not _truth(row.get("do_permanent_links", True)):
         return "uncrosslinked"
@@ -187,11 +231,24 @@ def sweep_groups(rows, estimator="surface"):
     Only rows with ``status == "ok"`` and finite moduli count.  The standard error is
     ``s/√n`` with the sample standard deviation ``s`` (ddof = 1); 0 for a single seed.
 
+    Parameters
+    ----------
+    rows : iterable of dict
+        Rows of ``results.csv`` (as :func:`read_sweep_table` returns them).
+    estimator : {"surface", "internal"}, optional
+        Which moduli to average: ``Gp_surface``/``Gpp_surface`` (plate forces, default) or
+        ``Gp_internal``/``Gpp_internal`` (overall stress tensor, eq. S1-24).
+
     Returns
     -------
     dict
         ``{(group, mu): {"A": [...], "Gp": [...], "Gp_err": [...], "Gpp": [...], "Gpp_err": [...],
-        "n": [...]}}`` with amplitudes ascending.
+        "n": [...]}}`` with amplitudes ascending; moduli in Pa.
+
+    Raises
+    ------
+    ValueError
+        If ``estimator`` is not "surface" or "internal".
     """
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS}")
@@ -293,7 +350,13 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None):
 # command line
 # ---------------------------------------------------------------------------------------------
 def build_parser():
-    """Parser of ``python -m particleShear plot``."""
+    """Parser of ``python -m particleShear plot``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Positional ``DIR``, options ``--estimator {surface,internal}`` and ``--output FILE``.
+    """
     p = argparse.ArgumentParser(prog="particleShear plot",
                                 description="Plot G' and G'' against strain amplitude of a sweep folder "
                                             "(reads DIR/results.csv, writes DIR/G_vs_amplitude.png and .pdf).")
@@ -306,7 +369,18 @@ def build_parser():
 
 
 def cli_main(argv=None):
-    """``python -m particleShear plot DIR [--estimator internal] [--output FILE]``; returns the exit status."""
+    """``python -m particleShear plot DIR [--estimator internal] [--output FILE]``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``plot`` (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0 written, 1 matplotlib missing, 2 invalid input (message on stderr).
+    """
     args = build_parser().parse_args(argv)
     try:
         plot_sweep(args.folder, estimator=args.estimator, path=args.output)

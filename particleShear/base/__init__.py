@@ -1,4 +1,5 @@
 """Layer 1: points, circles, pair physics, Lees-Edwards geometry, force register, stress tensors."""
+__docformat__ = "numpy"
 from .laws import (elastic_force_law, elastic_force_law_plateau, distance_transform_plateau,
                    PlateauConfiguration, elastic_force_law_tensile,
                    elastic_force_law_tensile_exponential, TensileConfiguration)

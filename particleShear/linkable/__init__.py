@@ -1,4 +1,5 @@
 """Layer 3: permanent links, compact particles, cutting, builders."""
+__docformat__ = "numpy"
 from .spheres import neighbor_relation_linkable, SphereLinkable, SphereLinkableAdjustableInterfaceStrength
 from .canvas import CanvasPointsLinkable, EnsembleLinkable
 

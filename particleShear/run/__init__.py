@@ -1,4 +1,5 @@
 """Layer 5: ``doParticleShearSimulation``, ``doParticleShearSimulationSeries`` and the command line."""
+__docformat__ = "numpy"
 from .api import SimulationResult, doParticleShearSimulation, doParticleShearSimulationSeries
 
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult"]

@@ -1,4 +1,4 @@
-"""Validation of every ``doParticleShearSimulation`` parameter and option before any work (spec §10.1).
+"""Validation of every ``doParticleShearSimulation`` parameter and option before any work (docs/parameters.md).
 
 Each failure raises ``ValueError`` (``TypeError`` for a wrong type) naming the
 parameter, its value and the allowed range.  Beyond the range of each value on
@@ -13,6 +13,7 @@ their limits, in ``docs/parameters.md``):
   cutting, output text) stay within documented limits and the memory available
   on this machine, read when the run is checked (:func:`available_memory`).
 """
+__docformat__ = "numpy"
 import itertools
 import math
 import numbers
@@ -140,6 +141,18 @@ def check_folder_writable(name, folder):
 
     Creates and removes one empty temporary file (``os.access`` is not enough: it says yes to root
     for read-only file systems such as ``/proc``).
+
+    Parameters
+    ----------
+    name : str
+        The parameter name used in the message (e.g. ``"root_folder"``).
+    folder : str or os.PathLike
+        The folder to probe.
+
+    Raises
+    ------
+    ValueError
+        If ``folder`` is not an existing directory or a file cannot be created there.
     """
     if not os.path.isdir(folder):
         raise ValueError(f"{name}={str(folder)!r} is invalid: needs an existing output folder (no such directory)")
@@ -164,7 +177,42 @@ def _bytes(n):
 def validate_options(return_result=False, verbose=True, progress=None, correct_drift_sign=False,
                      reference_header=False, renderer="auto", time_step_factor=1.0, integrator="euler",
                      stability_guard=True):
-    """Check the keyword-only options of ``doParticleShearSimulation``; raise on the first bad value."""
+    """Check the keyword-only options of ``doParticleShearSimulation``; raise on the first bad value.
+
+    Parameters
+    ----------
+    return_result : bool, optional
+        Return the ``SimulationResult`` instead of ``[G′_surface, G″_surface]`` (default False).
+    verbose : bool, optional
+        Print the reference console messages (default True).
+    progress : callable or None, optional
+        ``progress(phase, step, total, elapsed_s)``; phases "constitution",
+        "pre-equilibration", "protocol" (default None).
+    correct_drift_sign : bool, optional
+        Demodulation with the correct drift sign (default False: the reference's sign,
+        docs/output.md).
+    reference_header : bool, optional
+        Write the reference's header defects #21–22 (default False, docs/output.md).
+    renderer : {"auto", "tk", "pillow", "none"} or None, optional
+        Drawing backend (default "auto": Tk when a display exists, else Pillow for snapshots).
+    time_step_factor : float, optional
+        Multiplier of the measurement's time step, finite and > 0, not a bool (default 1.0;
+        docs/accuracy.md).
+    integrator : {"euler", "verlet"}, optional
+        "euler" (default): the reference's semi-implicit Euler; "verlet": velocity Verlet with a
+        half-kick predictor.
+    stability_guard : bool, optional
+        Stop with ``SimulationInstabilityError`` on non-finite values, runaway kinetic energy or
+        near-total interpenetration (default True).
+
+    Raises
+    ------
+    TypeError
+        A boolean option that is not ``True``/``False``, a ``progress`` that is not callable, a
+        ``time_step_factor`` that is not a real number.
+    ValueError
+        An unknown ``renderer`` or ``integrator``, a ``time_step_factor`` that is not finite and > 0.
+    """
     for name, v in (("return_result", return_result), ("verbose", verbose),
                     ("correct_drift_sign", correct_drift_sign), ("reference_header", reference_header),
                     ("stability_guard", stability_guard)):
@@ -433,6 +481,32 @@ def validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrossli
 
     The series has ``N_repetitions · len(amplitudes) · len(mu) · (1 + controls)`` runs, at most
     :data:`MAX_SERIES_RUNS`.
+
+    Parameters
+    ----------
+    N_repetitions : int
+        Repetitions of each (amplitude, μ) point, 0 … :data:`MAX_SERIES_RUNS`.
+    amplitudes : iterable of float
+        Strain amplitudes, 1 … :data:`MAX_SERIES_RUNS` values (read at most that many + 1).
+    mu : iterable of float
+        Friction coefficients, 1 … :data:`MAX_SERIES_RUNS` values.
+    do_bulk_control : bool
+        Add a crosslinked run without cuts (bulk) per point.
+    do_uncrosslinked_control : bool
+        Add a run without permanent links per point.
+    do_non_frictional_control : bool
+        Add a run with μ = 0 per point.
+
+    Returns
+    -------
+    tuple of list
+        ``(amplitudes, mu)`` as lists.
+
+    Raises
+    ------
+    TypeError, ValueError
+        A control flag that is not a bool, ``amplitudes``/``mu`` not a non-empty list, or more
+        than :data:`MAX_SERIES_RUNS` runs in all (the message names the parameter).
     """
     for name, v in (("do_bulk_control", do_bulk_control), ("do_uncrosslinked_control", do_uncrosslinked_control),
                     ("do_non_frictional_control", do_non_frictional_control)):

@@ -3,6 +3,7 @@
 Importing this package imports neither Pillow nor tkinter; they are loaded only when
 something is drawn or saved (see :mod:`particleShear.simulation.drawing`).
 """
+__docformat__ = "numpy"
 from .evaluation import EvaluationHandler, EvaluationHandlerPlotter, demodulation  # noqa: F401
 from .experiment import OscillatoryShearExperiment
 from .formats import OUTPUT_FORMATS, RunData, read_run

@@ -1,4 +1,4 @@
-"""Drawing: one renderer interface, a Pillow backend (files) and a Tk backend (live windows) (spec §9.4, §9.5).
+"""Drawing: one renderer interface, a Pillow backend (files) and a Tk backend (live windows) (docs/output.md).
 
 Drawing never influences the physics.  Neither Pillow nor tkinter is imported
 unless something is actually drawn or saved: a headless run that saves no
@@ -19,6 +19,7 @@ environment variable ``PARTICLESHEAR_RENDERER``) uses Tk when a display is avail
 and falls back to Pillow (only if snapshots are requested) otherwise, printing one
 message per process.
 """
+__docformat__ = "numpy"
 import math
 import os
 import sys
@@ -64,10 +65,18 @@ def display_available():
 def scene_geometry(ens):
     """Arrays describing what to draw for the current state of ``ens``.
 
-    Returns a dict with ``x, y, r, phi`` (per sphere), ``chords`` (k, 4) = x1, y1, x2, y2 and
-    ``chord_state`` (k,) for touching transient contacts (state codes of
-    :mod:`particleShear.base.neighbours`), ``links`` (m, 4) centre-to-centre segments of
-    permanent links (through the periodic image), and ``perm_chords`` (m', 4).
+    Parameters
+    ----------
+    ens : ensemble
+        An ensemble of this package (its state arrays and pair table are read, not changed).
+
+    Returns
+    -------
+    dict
+        ``x, y, r, phi`` (per sphere; µm, rad), ``chords`` (k, 4) = x1, y1, x2, y2 and
+        ``chord_state`` (k,) for touching transient contacts (state codes of
+        :mod:`particleShear.base.neighbours`), ``links`` (m, 4) centre-to-centre segments of
+        permanent links (through the periodic image), and ``perm_chords`` (m', 4).
     """
     a = ens._a
     x, y, r = a["x"].copy(), a["y"].copy(), a["r"].copy()
@@ -114,15 +123,48 @@ class Renderer:
     live = False
 
     def draw(self, ens):
+        """Draw the initial picture of ``ens`` (nothing in this base class).
+
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        """
         pass
 
     def update(self, ens):
+        """Redraw after a movement of ``ens`` (live backends; nothing in this base class).
+
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        """
         pass
 
     def save(self, ens, path, file_type="jpg", step=None):
+        """Write a snapshot of ``ens`` to ``path``.
+
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        path : str
+            Destination file.
+        file_type : str, optional
+            "jpg" (default), "png" (raster), "ps"/"eps" (vector EPS) or "svg" (vector SVG).
+        step : int, optional
+            Protocol step shown in the caption.
+
+        Raises
+        ------
+        NotImplementedError
+            In this base class.
+        """
         raise NotImplementedError
 
     def close(self):
+        """Release windows and resources (nothing in this base class)."""
         pass
 
 
@@ -140,6 +182,18 @@ def periodic_offsets(size_x, size_y, shift):
     The image above (``y + Ly``) is moved by ``+shift = Ly·γ`` in x, the one below by ``−shift``
     (the convention of :func:`particleShear.base.kernels.min_image`).  Drawing every disc and
     segment at these offsets (clipped to the cell) shows a disc crossing an edge on both sides.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell width L_x and height L_y (µm).
+    shift : float
+        Lees-Edwards offset ``L_y·γ`` (µm).
+
+    Returns
+    -------
+    list of tuple
+        The (dx, dy) offsets (µm), (0, 0) included.
     """
     out = []
     for ky in (-1, 0, 1):
@@ -154,9 +208,19 @@ def periodic_offsets(size_x, size_y, shift):
 def scene_primitives(ens, cfg=None):
     """What a snapshot shows, in cell coordinates (µm, y downwards as on the Tk canvas).
 
-    Returns ``(discs, segments)``: ``discs`` = list of (x, y, r, fill) and ``segments`` = list of
-    (x1, y1, x2, y2, colour, width_µm), periodic images included (only those that reach into the
-    cell ``[0, Lx] × [0, Ly]``).
+    Parameters
+    ----------
+    ens : ensemble
+        The ensemble to draw.
+    cfg : Graphical_output_configuration, optional
+        Colours and drawing options (default: the built-in colours).
+
+    Returns
+    -------
+    tuple of list
+        ``(discs, segments)``: ``discs`` = list of (x, y, r, fill) and ``segments`` = list of
+        (x1, y1, x2, y2, colour, width_µm), periodic images included (only those that reach into
+        the cell ``[0, Lx] × [0, Ly]``).
     """
     opt = (lambda name, d: getattr(cfg, name, d)) if cfg is not None else (lambda name, d: d)
     g = scene_geometry(ens)
@@ -196,7 +260,19 @@ def scene_primitives(ens, cfg=None):
 
 
 def snapshot_caption(ens, step=None):
-    """Text of the caption: time (s), strain γ and protocol step."""
+    """Text of the caption: time (s), strain γ and protocol step.
+
+    Parameters
+    ----------
+    ens : ensemble
+        Its clock ``t`` (s) and strain ``shear`` are shown.
+    step : int, optional
+        Protocol step (omitted when None).
+
+    Returns
+    -------
+    str
+    """
     t = float(getattr(ens, "t", 0.0))
     gamma = float(getattr(ens, "shear", 0.0))
     text = f"t = {t:.4g} s   strain \u03b3 = {gamma:+.4f}"
@@ -206,7 +282,17 @@ def snapshot_caption(ens, step=None):
 
 
 def scale_bar_length(size_x):
-    """A round scale-bar length (µm): 1, 2 or 5 × 10^k, about a fifth of the cell width."""
+    """A round scale-bar length (µm): 1, 2 or 5 × 10^k, about a fifth of the cell width.
+
+    Parameters
+    ----------
+    size_x : float
+        Cell width (µm), > 0.
+
+    Returns
+    -------
+    float
+    """
     target = size_x / 5.0
     k = math.floor(math.log10(target))
     for m in (5, 2, 1):
@@ -269,9 +355,26 @@ def _legend_entries(cfg):
 def caption_items(ens, cfg, width_px, scale, step=None):
     """Caption layout in pixels below the picture (origin at the top left of the strip).
 
-    Returns a list of ("text", x, y, string, size) / ("line", x1, y1, x2, y2, colour, width) items
-    shared by the raster and the vector writers: time/strain/step on the first row; scale bar
-    and colour legend on the second.
+    Time/strain/step on the first row; scale bar and colour legend on the second.
+
+    Parameters
+    ----------
+    ens : ensemble
+        The ensemble shown (clock, strain, cell width).
+    cfg : Graphical_output_configuration or None
+        Colours of the legend (None: the built-in colours).
+    width_px : float
+        Width of the picture (pixels).
+    scale : float
+        Pixels per µm.
+    step : int, optional
+        Protocol step shown (omitted when None).
+
+    Returns
+    -------
+    list of tuple
+        ("text", x, y, string, size) / ("line", x1, y1, x2, y2, colour, width) items shared by
+        the raster and the vector writers.
     """
     items = [("text", 6, 4, snapshot_caption(ens, step), 13)]
     L = scale_bar_length(ens.size_x)
@@ -294,6 +397,15 @@ class PillowRenderer(Renderer):
     strip of :data:`CAPTION_HEIGHT` pixels with time, strain and step, a scale bar in µm and
     the legend of the interface colours.  ``"ps"``/``"eps"`` snapshots are vector EPS and
     ``"svg"`` vector SVG (same content); ``"jpg"``/``"png"`` are raster.
+
+    Parameters
+    ----------
+    graphical_output_configuration : Graphical_output_configuration, optional
+        Colours and drawing options (default: the ensemble's, else the built-in colours).
+    scale : float, optional
+        Pixels per µm (default 1).
+    background : str, optional
+        Background colour of the cell (default "white").
 
     Attributes
     ----------
@@ -323,7 +435,21 @@ class PillowRenderer(Renderer):
         return self.cfg
 
     def render(self, ens, step=None, caption=True):
-        """Return a ``PIL.Image`` of the current state (y drawn downwards, as on the Tk canvas)."""
+        """Return a ``PIL.Image`` of the current state (y drawn downwards, as on the Tk canvas).
+
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        step : int, optional
+            Protocol step shown in the caption.
+        caption : bool, optional
+            Add the caption strip below the picture (default True).
+
+        Returns
+        -------
+        PIL.Image.Image
+        """
         from PIL import Image, ImageDraw
         cfg = self._config(ens)
         s = self.scale
@@ -352,7 +478,21 @@ class PillowRenderer(Renderer):
 
     # -- vector output ------------------------------------------------------------------------
     def vector(self, ens, fmt, step=None):
-        """EPS (``fmt="eps"``) or SVG (``"svg"``) text of the snapshot: same content as :meth:`render`."""
+        """EPS (``fmt="eps"``) or SVG (``"svg"``) text of the snapshot: same content as :meth:`render`.
+
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        fmt : {"eps", "svg"}
+            The vector format.
+        step : int, optional
+            Protocol step shown in the caption.
+
+        Returns
+        -------
+        str
+        """
         from PIL import ImageColor
         cfg = self._config(ens)
         s = self.scale
@@ -432,8 +572,16 @@ class PillowRenderer(Renderer):
     def save(self, ens, path, file_type="jpg", step=None):
         """Write a snapshot atomically (temporary file in the same folder, then ``os.replace``).
 
-        ``file_type``: "jpg", "png" (raster), "ps"/"eps" (vector EPS) or "svg" (vector SVG);
-        ``step`` is the protocol step shown in the caption.
+        Parameters
+        ----------
+        ens : ensemble
+            The ensemble to draw.
+        path : str
+            Destination file.
+        file_type : str, optional
+            "jpg" (default), "png" (raster), "ps"/"eps" (vector EPS) or "svg" (vector SVG).
+        step : int, optional
+            Protocol step shown in the caption.
         """
         ext, fmt = IMAGE_EXTENSIONS.get(file_type, IMAGE_EXTENSIONS["ps"])
         img = None
@@ -474,6 +622,18 @@ class PillowRenderer(Renderer):
         """Write the kept frames as an animated GIF (Pillow ``save_all``), atomically; return the count.
 
         Writes nothing and returns 0 when no frame was kept.
+
+        Parameters
+        ----------
+        path : str
+            The GIF file.
+        frame_duration_ms : int, optional
+            Display time of each frame (ms, default 80).
+
+        Returns
+        -------
+        int
+            Frames written.
         """
         frames = self.movie_frames
         if not frames:
@@ -490,7 +650,23 @@ class PillowRenderer(Renderer):
 
 
 class TkRenderer(Renderer):
-    """Live particle window (``size_x × size_y`` pixels).  Redraws at most every ``min_interval`` s."""
+    """Live particle window (``size_x × size_y`` pixels).  Redraws at most every ``min_interval`` s.
+
+    Snapshots are written by an internal :class:`PillowRenderer` (same picture as headless).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Canvas size (pixels; 1 pixel = 1 µm).
+    title : str, optional
+        Window title.
+    graphical_output_configuration : Graphical_output_configuration, optional
+        Colours and drawing options (default: the ensemble's).
+    min_interval : float, optional
+        Shortest time between two redraws (s, default 0.03: about 30 per second).
+    root : tkinter.Tk, optional
+        An existing Tk root to draw into (default: a new one).
+    """
 
     live = True
 
@@ -551,6 +727,7 @@ class TkRenderer(Renderer):
 
     @property
     def collect_movie(self):
+        """Keep reduced frames for :meth:`write_movie` (see :class:`PillowRenderer`)."""
         return self._pillow.collect_movie
 
     @collect_movie.setter
@@ -558,7 +735,20 @@ class TkRenderer(Renderer):
         self._pillow.collect_movie = value
 
     def write_movie(self, path, frame_duration_ms=80):
-        """See :meth:`PillowRenderer.write_movie`."""
+        """Write the kept frames as an animated GIF; see :meth:`PillowRenderer.write_movie`.
+
+        Parameters
+        ----------
+        path : str
+            The GIF file.
+        frame_duration_ms : int, optional
+            Display time of each frame (ms, default 80).
+
+        Returns
+        -------
+        int
+            Frames written.
+        """
         return self._pillow.write_movie(path, frame_duration_ms)
 
     def close(self):
@@ -571,7 +761,19 @@ class TkRenderer(Renderer):
 
 
 def nice_ticks(lo, hi, n=5):
-    """Round tick values (1, 2 or 5 × 10^k steps) covering [lo, hi] with about ``n`` ticks."""
+    """Round tick values (1, 2 or 5 × 10^k steps) covering [lo, hi] with about ``n`` ticks.
+
+    Parameters
+    ----------
+    lo, hi : float
+        The range.
+    n : int, optional
+        About how many ticks (default 5).
+
+    Returns
+    -------
+    list of float
+    """
     span = float(hi) - float(lo)
     if not math.isfinite(span) or span <= 0:
         return []
@@ -590,6 +792,15 @@ class StressPlotWindow:
     :class:`~particleShear.simulation.evaluation.EvaluationHandlerPlotter`.  At the end of a run
     :meth:`finish` keeps the window open until the user closes it (only in the main process and
     when :attr:`keep_open` is True; set ``StressPlotWindow.keep_open = False`` for scripted loops).
+
+    Parameters
+    ----------
+    width, height : int, optional
+        Canvas size (pixels, default 1000 × 500).
+    title : str, optional
+        Window title.
+    master : tkinter widget, optional
+        Open as a ``Toplevel`` of this window (e.g. the particle window's root); default a new Tk.
     """
 
     #: wait for the user to close the window at the end of a run
@@ -606,7 +817,23 @@ class StressPlotWindow:
         self._last = 0.0
 
     def draw_axes(self, T_total, x_scale, y_scale_force, y_scale_strain, amplitude, t_on=None, t_off=None):
-        """Axes, ticks, units and legend matching the plotter's mapping ``y = height/2 − value·scale``."""
+        """Axes, ticks, units and legend matching the plotter's mapping ``y = height/2 − value·scale``.
+
+        Parameters
+        ----------
+        T_total : float
+            Duration of the protocol (s): range of the time axis.
+        x_scale : float
+            Pixels per second.
+        y_scale_force : float
+            Pixels per Pa of the stresses (0: no stress ticks).
+        y_scale_strain : float
+            Pixels per unit strain.
+        amplitude : float
+            Strain amplitude A (marks at ±A).
+        t_on, t_off : float, optional
+            Start and end of the excitation (s), drawn as dashed lines.
+        """
         c = self.canvas
         if not hasattr(c, "create_text"):  # minimal canvases (tests) draw dots only
             return
@@ -638,6 +865,13 @@ class StressPlotWindow:
             c.create_text(226, y, text=label, anchor="w")
 
     def update(self, min_interval=0.03):
+        """Process window events, at most every ``min_interval`` s.
+
+        Parameters
+        ----------
+        min_interval : float, optional
+            Shortest time between two updates (s, default 0.03).
+        """
         if time.monotonic() - self._last >= min_interval:
             try:
                 self.tk.update()
@@ -646,7 +880,13 @@ class StressPlotWindow:
             self._last = time.monotonic()
 
     def finish(self, wait=True):
-        """End of the run: with ``wait``, wait until the user closes the window (see :attr:`keep_open`), then close."""
+        """End of the run: with ``wait``, wait until the user closes the window (see :attr:`keep_open`), then close.
+
+        Parameters
+        ----------
+        wait : bool, optional
+            Wait for the user (default True; only in the main process and with ``keep_open``).
+        """
         import multiprocessing
         loop = getattr(self.tk, "mainloop", None)
         if wait and self.keep_open and loop is not None and multiprocessing.parent_process() is None:
@@ -659,6 +899,7 @@ class StressPlotWindow:
         self.close()
 
     def close(self):
+        """Destroy the window (errors of an already closed window are ignored)."""
         try:
             self.tk.destroy()
         except Exception:
@@ -687,10 +928,23 @@ def make_renderer(doDrawing, save_images, size_x=500, size_y=500, title="particl
         Snapshots will be saved (needs a renderer even without a display).
     backend : {"auto", "tk", "pillow", "none"}
         "auto" = Tk if a display is available, else Pillow for snapshots or nothing.
+    size_x, size_y : float, optional
+        Size of the live window (pixels = µm, default 500 × 500).
+    title : str, optional
+        Title of the live window.
+    graphical_output_configuration : Graphical_output_configuration, optional
+        Colours and drawing options.
 
     Returns
     -------
     Renderer or None
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``backend``.
+    RuntimeError
+        For ``backend="tk"`` without a display.
     """
     backend = _backend_choice(backend)
     if backend == "none":
@@ -714,7 +968,28 @@ def make_renderer(doDrawing, save_images, size_x=500, size_y=500, title="particl
 
 
 def open_stress_plot(width=1000, height=500, title="Stress and strain", renderer=None, backend="auto"):
-    """Open the live stress/strain window, or return None (headless, or backend not Tk)."""
+    """Open the live stress/strain window, or return None (headless, or backend not Tk).
+
+    Parameters
+    ----------
+    width, height : int, optional
+        Canvas size (pixels, default 1000 × 500).
+    title : str, optional
+        Window title.
+    renderer : Renderer, optional
+        A live :class:`TkRenderer`: the window opens as its ``Toplevel``.
+    backend : {"auto", "tk", "pillow", "none"}, optional
+        "none"/"pillow" return None.
+
+    Returns
+    -------
+    StressPlotWindow or None
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``backend``.
+    """
     backend = _backend_choice(backend)
     if backend in ("none", "pillow"):
         return None

@@ -1,12 +1,14 @@
-"""Per-step recording of the oscillatory experiment and the demodulation of G′, G″ (spec §8.3, §8.5, §10.8).
+"""Per-step recording of the oscillatory experiment and the demodulation of G′, G″.
 
 The reference keeps Python lists that grow by one entry per step and recomputes
-running estimates over the whole history at every step (O(n²) per run, §12 #43).
+running estimates over the whole history at every step (O(n²) per run; reference defect
+#43 in docs/output.md).
 Here every series lives in a preallocated NumPy buffer (grown by doubling when
 the number of steps is not known in advance); the reference list attributes
 (``t``, ``strain``, ``stress_tensor_LW`` …) are built lazily when read, and the
 running estimates ``Gprime`` / ``viscosity`` are computed on demand.
 """
+__docformat__ = "numpy"
 import math
 import sys
 
@@ -22,7 +24,11 @@ _T, _STRAIN, _RATE, _FORCE, _SHEAR = range(5)
 
 def demodulation(t, shear_stress, f, amplitude, baseline_pre_periods=0, periods=2, baseline_post_periods=0,
                  correct_drift_sign=False):
-    """Project a shear-stress series on the strain (sine) and strain-rate (cosine) signals (spec §8.5).
+    """Project a shear-stress series on the strain (sine) and strain-rate (cosine) signals.
+
+    G′ is the least-squares amplitude of the component in phase with the strain
+    ``A·sin(2π(f t − pre))``, G″ that of the component in phase with the strain rate (cosine),
+    both divided by A, after a linear drift estimate from the baselines.
 
     Parameters
     ----------
@@ -37,7 +43,7 @@ def demodulation(t, shear_stress, f, amplitude, baseline_pre_periods=0, periods=
     baseline_pre_periods, periods, baseline_post_periods : float
         Protocol: ``pre`` baseline periods, ``periods`` excitation periods, ``post`` recovery periods.
     correct_drift_sign : bool, optional
-        False (default) reproduces the reference quirk (§12 #1): the drift estimate
+        False (default) reproduces the reference quirk (defect #1 in docs/output.md): the drift estimate
         ``D = (S2 − S1)/(T1 − T2)`` is *minus* the baseline slope and is subtracted,
         so a linear drift is doubled instead of removed.  True uses
         ``D = (S2 − S1)/(T2 − T1)``, which removes a linear drift exactly.
@@ -160,7 +166,16 @@ class EvaluationHandler:
         self.last_tensors = None
 
     def allocate(self, n_steps, keep_tensor_history=None):
-        """Preallocate room for ``n_steps`` further samples (and the tensor history if kept)."""
+        """Preallocate room for ``n_steps`` further samples (and the tensor history if kept).
+
+        Parameters
+        ----------
+        n_steps : int
+            Samples still to come (the last of them is always fully evaluated).
+        keep_tensor_history : bool, optional
+            Store the 36 tensor numbers of every step (True) or only the first and last
+            tensors (False); None (default) keeps the current setting.
+        """
         if keep_tensor_history is not None:
             self.keep_tensor_history = bool(keep_tensor_history)
         self._planned = self._n + int(n_steps)
@@ -208,14 +223,17 @@ class EvaluationHandler:
 
     @property
     def t_array(self):
+        """Sample times t (s), a view of the buffer."""
         return self._scal[: self._n, _T]
 
     @property
     def strain_array(self):
+        """Strain γ samples (–), a view of the buffer."""
         return self._scal[: self._n, _STRAIN]
 
     @property
     def strain_rate_array(self):
+        """Strain-rate γ̇ samples (1/s), a view of the buffer."""
         return self._scal[: self._n, _RATE]
 
     @property
@@ -233,7 +251,7 @@ class EvaluationHandler:
         """Array (n, 9, 2, 2) of the recorded tensors in output-column order, or None if not kept."""
         return None if self._tens is None else self._tens[: self._n]
 
-    # running estimates (computed on demand, §12 #43)
+    # running estimates (computed on demand; reference defect #43 in docs/output.md)
     @property
     def Gprime(self):
         """Running elastic estimate ``−Σ γ·τ_int / Σ γ²`` over all samples (Pa); 0 without strain."""
@@ -320,7 +338,7 @@ class EvaluationHandler:
     del _momentum_property
 
     def record(self, theEnsemble, theEvaluator=False):
-        """Evaluate the stress tensors of the current step and append one sample (§10.8).
+        """Evaluate the stress tensors of the current step and append one sample.
 
         Parameters
         ----------
@@ -328,7 +346,12 @@ class EvaluationHandler:
             After its force phase and ``record_total_particle_forces()``.
         theEvaluator : StressTensorEvaluation, optional
             Evaluator to use; by default the handler's ``theEvaluator`` (created on first use —
-            the reference crashed without one, §12 #34).
+            the reference crashed without one, defect #34 in docs/output.md).
+
+        Returns
+        -------
+        StressTensorEvaluation
+            The evaluator used (its ``tensors`` hold this step's tensors when fully evaluated).
         """
         ev = theEvaluator or self.theEvaluator
         if not ev:
@@ -367,12 +390,31 @@ class EvaluationHandler:
 
 
 class EvaluationHandlerPlotter(EvaluationHandler):
-    """:class:`EvaluationHandler` that also plots each sample into a stress window (§9.5).
+    """:class:`EvaluationHandler` that also plots each sample into a stress window (docs/output.md).
 
     ``theCanvas`` is a Tk canvas (or any object with ``create_oval``); with ``False``/None or
     ``plotStress=False`` nothing is drawn.  Three dots per sample at ``x = t·x_scale + offset_x``:
     red τ_internal − τ_internal(0), blue τ_surface − τ_surface(0) (scaled by ``y_scale_force``),
     green strain (scaled by ``y_scale_strain``), at ``y = offset_y − value·scale``.
+
+    Parameters
+    ----------
+    theTk : tkinter.Tk or None
+        The window's Tk root (kept for the reference API; not used for drawing).
+    theCanvas : tkinter.Canvas or None
+        Where the dots are drawn; False/None draws nothing.
+    x_scale : float, optional
+        Pixels per second of simulated time (default 1).
+    y_scale_strain : float, optional
+        Pixels per unit strain (default 1).
+    y_scale_force : float, optional
+        Pixels per Pa of both shear stresses (default 1).
+    r : float, optional
+        Dot radius in pixels (default 10).
+    offset_x, offset_y : float, optional
+        Pixel position of t = 0 and of the zero line (default 0).
+    plotStress : bool, optional
+        False: record only, draw nothing (default True).
     """
 
     def __init__(self, theTk, theCanvas, x_scale=1, y_scale_strain=1, y_scale_force=1, r=10, offset_x=0,
@@ -389,7 +431,19 @@ class EvaluationHandlerPlotter(EvaluationHandler):
         self.plotStress = plotStress
 
     def plot(self, t, strain, force, shear_stress):
-        """Draw one sample (stresses already relative to the first sample)."""
+        """Draw one sample (stresses already relative to the first sample).
+
+        Parameters
+        ----------
+        t : float
+            Time of the sample (s).
+        strain : float
+            Strain γ (–).
+        force : float
+            τ_surface − τ_surface(0) (Pa).
+        shear_stress : float
+            τ_internal − τ_internal(0) (Pa).
+        """
         c = self.theCanvas
         if not (self.plotStress and c):
             return

@@ -1,11 +1,13 @@
-"""The oscillatory shear experiment (spec §8.2–§8.6, §10.9).
+"""The oscillatory shear experiment: pre-equilibration, sinusoidal strain protocol, G′ and G″.
 
 ``OscillatoryShearExperiment.oscillatory_shear_experiment`` runs the fixed-boundary
-pre-equilibration (§8.4) and the measurement protocol (§8.2) in the reference
-per-step order (§8.3, one visible loop in :meth:`OscillatoryShearExperiment.run_protocol`),
-records every step, demodulates τ_internal and τ_surface (§8.5) and returns
-``[G′_surface, G″_surface]`` (Pa) as the reference does.
+pre-equilibration and the measurement protocol (strain ``A·sin(2π(f t − pre))`` during the
+excitation periods, at rest during the baselines) in the reference per-step order (one
+visible loop in :meth:`OscillatoryShearExperiment.run_protocol`; docs/design.md, "One step"),
+records every step, demodulates τ_internal and τ_surface (:func:`~.evaluation.demodulation`)
+and returns ``[G′_surface, G″_surface]`` (Pa) as the reference does.
 """
+__docformat__ = "numpy"
 import math
 import os
 import sys
@@ -20,19 +22,48 @@ __all__ = ["OscillatoryShearExperiment", "image_cadence", "protocol_steps"]
 
 
 def protocol_steps(periods, pre, post, f, dt):
-    """Number of protocol steps ``int((periods + pre + post)/f / dt)`` (truncation, §8.2)."""
+    """Number of protocol steps ``int((periods + pre + post)/f / dt)`` (truncated, as the reference).
+
+    Parameters
+    ----------
+    periods : float
+        Excitation periods.
+    pre : float
+        Baseline periods before the excitation.
+    post : float
+        Baseline (recovery) periods after it.
+    f : float
+        Excitation frequency (Hz).
+    dt : float
+        Time step (s).
+
+    Returns
+    -------
+    int
+    """
     return int((periods + pre + post) / f / dt)
 
 
 def image_cadence(n_steps):
-    """Snapshot interval ``image_N`` of §9.4: ``int(n/200)`` if n > 200 else 1."""
+    """Snapshot interval ``image_N``: ``int(n/200)`` if n > 200 else 1 (docs/output.md, "Snapshots").
+
+    Parameters
+    ----------
+    n_steps : int
+        Protocol steps of the run.
+
+    Returns
+    -------
+    int
+        Steps between two snapshots (the first is taken at step 0).
+    """
     return int(n_steps / 200) if n_steps > 200 else 1
 
 
 class OscillatoryShearExperiment:
     """Pre-equilibration with fixed plates, sinusoidal strain protocol, recording and demodulation.
 
-    Parameters (reference order and defaults)
+    Parameters
     ----------
     theEnsemble : ensemble
         A Lees-Edwards ensemble with the step API (``setShearRate``, ``mechanical_simulation_step_*``).
@@ -50,20 +81,26 @@ class OscillatoryShearExperiment:
         Live windows (kept for API compatibility; see ``renderer`` and ``stress_window``).
     force_scale : float
         Plot scale of the stresses (pixels per Pa).
-    imageOutputFolder, imageBaseFileName, imageFileType :
-        Snapshots (§9.4), saved when a folder and a base name are given and a renderer exists.
+    imageOutputFolder : str or False
+        Folder of the snapshots (docs/output.md, "Snapshots"); False: none.
+    imageBaseFileName : str or False
+        File name before the 7-digit step index (``"image"`` in the simulations); False: none.
+    imageFileType : str
+        ``"jpg"`` (default), ``"png"`` or ``"ps"``; snapshots are saved when a folder and a
+        base name are given and a renderer exists.
     plotStress : bool
         Live stress/strain plot (needs a display).
     saveStressTensorData : bool
         Write the 42-column table (and keep the per-step tensor history for it).
 
-    Attributes beyond the reference
-    -------------------------------
+    Attributes
+    ----------
     correct_drift_sign : bool
-        False (reference quirk, default) / True: sign of the drift correction of §8.5.
+        Beyond the reference, as the attributes below.  False (reference quirk, default) /
+        True: sign of the drift correction of the demodulation (defect #1 in docs/output.md).
     reference_header : bool
-        True reproduces the header defects §12 #21–22 ("Post-measurement periods" printing
-        the pre value, "Simulated time" = excitation time only).  Default False.
+        True reproduces the header defects #21–22 of docs/output.md ("Post-measurement periods"
+        printing the pre value, "Simulated time" = excitation time only).  Default False.
     renderer : Renderer or None
         Drawing backend used for snapshots (and live updates); see :mod:`.drawing`.
     stress_window : StressPlotWindow or None
@@ -128,11 +165,31 @@ class OscillatoryShearExperiment:
 
     # -- signals ---------------------------------------------------------------------------------
     def in_phase_signal(self, t):
-        """``sin(2π(t f − pre))``: the strain shape (§8.2)."""
+        """``sin(2π(t f − pre))``: the strain shape (the strain is A times it during the excitation).
+
+        Parameters
+        ----------
+        t : float
+            Time since the start of the protocol (s).
+
+        Returns
+        -------
+        float
+        """
         return math.sin(2 * math.pi * (t * self.f - self.baseline_pre_periods))
 
     def out_of_phase_signal(self, t):
-        """``cos(2π(t f − pre))``: the strain-rate shape (§8.2)."""
+        """``cos(2π(t f − pre))``: the strain-rate shape (the rate is 2πf·A times it).
+
+        Parameters
+        ----------
+        t : float
+            Time since the start of the protocol (s).
+
+        Returns
+        -------
+        float
+        """
         return math.cos(2 * math.pi * (t * self.f - self.baseline_pre_periods))
 
     def _say(self, *args):
@@ -150,10 +207,20 @@ class OscillatoryShearExperiment:
 
     # -- pre-equilibration -----------------------------------------------------------------------
     def pre_equilibrate(self, N=25, cool_factor=0.99):
-        """Relax with the plates fixed (§8.4): coarse levels from ``dt_max``, 2N steps at dt, N steps at dt.
+        """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at dt, N steps at dt.
 
-        Runs with ``applyingShear = True`` (the plate band is immobile, the plates rest).  The
+        Runs with ``applyingShear = True`` (the plate band is immobile, the plates rest).  Each
+        coarse level (step halved from ``dt_max`` down to ``dt``) takes ``int(N/2)`` steps with a
+        damping factor rising from 0.5 towards 1; then 2N steps at dt with damping 0.98.  The
         last N steps use ``cool_factor`` and reset γ̇ to 0 by direct assignment before each step.
+
+        Parameters
+        ----------
+        N : int, optional
+            Step count unit (default 25; the simulations use ``25 · adjustment factor``).
+        cool_factor : float, optional
+            Per-step damping factor of the last N steps: fraction of the peculiar velocity kept
+            per step (default 0.99).
         """
         ens = self.theEnsemble
         ens.applyingShear = True
@@ -194,7 +261,7 @@ class OscillatoryShearExperiment:
         self.timings["pre_equilibration"] = time.perf_counter() - t0
 
     def free_pre_equilibration(self):
-        """Unused by the reference protocol: relaxation without plates (§8.4, last paragraph)."""
+        """Unused by the reference protocol: relaxation without plates (kept for the reference API)."""
         ens = self.theEnsemble
         ens.applyingShear = False
         mu = getattr(ens, "mu", 0)
@@ -210,13 +277,29 @@ class OscillatoryShearExperiment:
 
     # -- images ----------------------------------------------------------------------------------
     def image_path(self, index):
-        """``<folder>/<base><index padded to 7 digits>.<ext>`` (§9.4)."""
+        """``<folder>/<base><index padded to 7 digits>.<ext>`` (docs/output.md, "Snapshots").
+
+        Parameters
+        ----------
+        index : int
+            Protocol step of the snapshot.
+
+        Returns
+        -------
+        str
+        """
         from .drawing import IMAGE_EXTENSIONS
         ext = IMAGE_EXTENSIONS.get(self.imageFileType, IMAGE_EXTENSIONS["ps"])[0]
         return os.path.join(str(self.imageOutputFolder), str(self.imageBaseFileName) + f"{index:07d}" + ext)
 
     def save_canvas_image(self, index):
-        """Save a snapshot of the particle picture for protocol step ``index`` (if a renderer exists)."""
+        """Save a snapshot of the particle picture for protocol step ``index`` (if a renderer exists).
+
+        Parameters
+        ----------
+        index : int
+            Protocol step, used in the file name (:meth:`image_path`).
+        """
         if self.renderer is None or not self.imageOutputFolder or not self.imageBaseFileName:
             return
         self.renderer.save(self.theEnsemble, self.image_path(index), self.imageFileType, step=index)
@@ -251,10 +334,24 @@ class OscillatoryShearExperiment:
         return N_steps
 
     def run_protocol(self, cool_factor, n_steps=None):
-        """The measurement protocol in the reference per-step order (§8.2, §8.3).
+        """The measurement protocol in the reference per-step order (docs/design.md, "One step").
 
-        ``n_steps`` stops after that many steps (default: the whole protocol,
-        ``int((P + pre + post)/f/dt)`` steps).  Needs :meth:`prepare_recording` first.
+        Needs :meth:`prepare_recording` first.  Each step: set the shear rate
+        (``A·2πf·cos(2π(f t − pre))`` during the excitation, else 0), forces, recording,
+        acceleration with damping, movement, snapshot every ``image_N`` steps.
+
+        Parameters
+        ----------
+        cool_factor : float
+            Per-step damping factor of the peculiar velocity (fraction kept per step).
+        n_steps : int, optional
+            Stop after that many steps (default: the whole protocol,
+            ``int((P + pre + post)/f/dt)`` steps).
+
+        Returns
+        -------
+        int
+            Steps run.
         """
         ens = self.theEnsemble
         dt, f, A = self.dt, self.f, self.amplitude
@@ -284,7 +381,7 @@ class OscillatoryShearExperiment:
                 rate = A * math.cos(2 * math.pi * (ens.t * f - pre)) * 2 * math.pi * f
             else:
                 rate = 0
-            ens.setShearRate(rate)                                    # §4.5 velocity/spin adjustment
+            ens.setShearRate(rate)                                    # velocity/spin adjustment to the new rate
             ens.mechanical_simulation_step_calculate_forces()         # neighbours + pair forces
             ens.record_total_particle_forces()                        # register totals
             plotter.record(ens, evaluator)                            # tensors, τ_int, τ_surf, t, γ, γ̇
@@ -306,8 +403,23 @@ class OscillatoryShearExperiment:
     def oscillatory_shear_experiment(self, cool_factor=1, N_pre_equilibration_fixed_boundaries=25):
         """Run pre-equilibration and protocol; return ``[G′_surface, G″_surface]`` (Pa).
 
-        ``cool_factor`` is the per-step damping factor (§4.4).  Both demodulations are kept in
-        ``results`` ("internal": overall tensor, "surface": external forces).
+        Both demodulations are kept in ``results`` ("internal": overall tensor, eq. S1-24;
+        "surface": external forces on the plates).
+
+        Parameters
+        ----------
+        cool_factor : float, optional
+            Per-step damping factor (default 1: none): the peculiar velocity ``v − γ̇ (y − Ly/2)``
+            and the spin are multiplied by it every step.  The simulations pass
+            ``cool_factor_per_period ** (f·dt)``.
+        N_pre_equilibration_fixed_boundaries : int, optional
+            ``N`` of :meth:`pre_equilibrate` (default 25); the pre-equilibration is skipped
+            when ``do_preequilibration_with_fixed_boundaries`` is False.
+
+        Returns
+        -------
+        list of float
+            ``[G′_surface, G″_surface]`` in Pa.
         """
         ens = self.theEnsemble
         self.cool_factor = cool_factor
@@ -344,12 +456,37 @@ class OscillatoryShearExperiment:
 
     # -- evaluation ------------------------------------------------------------------------------
     def demodulation(self, t, shear_stress):
-        """``[in-phase stress, out-of-phase stress, G′, G″]`` of a series (§8.5), this protocol's settings."""
+        """``[in-phase stress, out-of-phase stress, G′, G″]`` of a series, with this protocol's settings.
+
+        Parameters
+        ----------
+        t : array_like
+            Sample times since the start of the protocol (s).
+        shear_stress : array_like
+            Shear stress samples (Pa).
+
+        Returns
+        -------
+        list of float
+            See :func:`~.evaluation.demodulation` (Pa).
+        """
         return demodulation(t, shear_stress, self.f, self.amplitude, self.baseline_pre_periods, self.periods,
                             self.baseline_post_periods, correct_drift_sign=self.correct_drift_sign)
 
     def evaluateStressAndG(self, useExternalForce=False):
-        """Demodulate τ_surface (``useExternalForce=True``) or τ_internal (False) of the recorded run."""
+        """Demodulate τ_surface (``useExternalForce=True``) or τ_internal (False) of the recorded run.
+
+        Parameters
+        ----------
+        useExternalForce : bool, optional
+            True: the stress from the external (plate) forces; False (default): the xy
+            component of the overall stress tensor (eq. S1-24).
+
+        Returns
+        -------
+        list of float
+            ``[SA, SB, G′, G″]`` in Pa.
+        """
         p = self.plotter
         s = p.force_array if useExternalForce else p.shear_stress_array
         return self.demodulation(p.t_array, s)

@@ -14,6 +14,7 @@ Every writer streams into an open binary file (bounded memory) and is used by
 ``runSimulation`` on an :class:`~particleShear.simulation.output.AtomicOutputFile`, so a file
 is complete or absent.  See ``docs/output.md`` for sizes and load times.
 """
+__docformat__ = "numpy"
 import gzip
 import io
 import json
@@ -53,7 +54,21 @@ def _pyarrow():
 
 
 def check_output_format(output_format):
-    """Raise ``ValueError`` for an unknown format and ``ImportError`` for parquet without pyarrow."""
+    """Check an output format before any work.
+
+    Parameters
+    ----------
+    output_format : str
+        One of :data:`OUTPUT_FORMATS` (``"text"``, ``"text.gz"``, ``"npz"``, ``"parquet"``;
+        CLI ``--output-format``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown format (the message lists the allowed ones).
+    ImportError
+        For ``"parquet"`` without pyarrow (the message names the extra to install).
+    """
     if not isinstance(output_format, str) or output_format not in FORMAT_SUFFIXES:
         raise ValueError(f"output_format={output_format!r} is invalid: allowed "
                          + ", ".join(repr(k) for k in OUTPUT_FORMATS) + " (CLI --output-format)")
@@ -65,6 +80,18 @@ def series_columns(series):
     """``{column name: 1-D array}`` of the table from a ``SimulationResult.series``-like dict.
 
     ``index`` and the five base series always; the 36 tensor columns when ``"tensors"`` is present.
+
+    Parameters
+    ----------
+    series : dict
+        ``t`` (s), ``strain`` (–), ``strain_rate`` (1/s), ``stress_surface`` and
+        ``stress_internal`` (Pa) as 1-D sequences of equal length; optionally ``tensors``,
+        shape (n, 9, 2, 2) in Pa.
+
+    Returns
+    -------
+    dict
+        Column name → 1-D ``numpy.ndarray``, in the order of the text table (docs/output.md).
     """
     n = len(series["t"])
     cols = {"index": np.arange(n, dtype=np.int64)}
@@ -144,15 +171,21 @@ class RunData(dict):
     ``stress_tensor_*`` columns when saved); empty for a text file written with
     ``saveStressTensorData=False`` (the reference writes no table then).
 
-    Attributes
+    Made by :func:`read_run`; the parameters are also its attributes.
+
+    Parameters
     ----------
+    columns : dict
+        Column name → 1-D array (the dict's items).
     header : str
         The text header, blocks 1–3, up to and including "Detailed stress tensor data".
     metadata : dict
         Parameters and provenance (run id, seed, version): stored in npz/parquet, read from the
         ``<file>.json`` sidecar for text files (empty when there is none).
     path : str
+        The file read.
     output_format : str
+        Its format, one of :data:`OUTPUT_FORMATS`.
     """
 
     def __init__(self, columns, header, metadata, path, output_format):

@@ -1,4 +1,4 @@
-"""The reference text output (spec §9.1, §9.3): header blocks, summary, 42-column table, atomic files.
+"""The reference text output (docs/output.md): header blocks, summary, 42-column table, atomic files.
 
 Values are formatted with ``str()`` as the reference does, except that numbers ``str()`` writes in
 exponent notation are written positionally unless ``reference_header`` (the downstream R patterns
@@ -7,6 +7,7 @@ target folder, streamed and renamed into place with ``os.replace`` when complete
 interrupted run never leaves a truncated file and the temporary files of killed runs are
 recognised and removed by the next run (``docs/output.md``, "Files are complete or absent").
 """
+__docformat__ = "numpy"
 import math
 import os
 import shutil
@@ -49,7 +50,7 @@ _TENSOR_COLUMN_STEMS = (
 )
 assert len(_TENSOR_COLUMN_STEMS) == len(TENSOR_NAMES)
 
-#: the 42 column names of the detailed stress tensor table (§9.1)
+#: the 42 column names of the detailed stress tensor table (docs/output.md, "Table columns")
 TABLE_COLUMNS = (["index", "t", "strain", "strain_rate", "stress_measured_at_surface",
                   "shear_stress_internal_stress-tensor"]
                  + [stem + "_" + ab for stem in _TENSOR_COLUMN_STEMS for ab in ("00", "01", "10", "11")])
@@ -71,6 +72,14 @@ class AtomicOutputFile:
     ``abort()`` (or leaving a ``with`` block by an exception) removes the temporary file.
     Dependent temporary entries of the same run use the names :meth:`dependent` gives
     (``.<name>.part.<role>``) and are removed with a stale owner.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The final file name.
+    exclusive : bool, optional
+        True (default): fail with ``FileExistsError`` when ``.<name>.part`` exists already
+        (the reservation of ``path`` by another run).
     """
 
     def __init__(self, path, exclusive=True):
@@ -88,14 +97,36 @@ class AtomicOutputFile:
         return self._fh
 
     def write(self, text):
-        """Write ``text`` (str, UTF-8) or bytes."""
+        """Write ``text`` into the temporary file.
+
+        Parameters
+        ----------
+        text : str or bytes
+            A str is encoded as UTF-8.
+
+        Returns
+        -------
+        int
+            Bytes written.
+        """
         return self._fh.write(text.encode("utf-8") if isinstance(text, str) else text)
 
     def flush(self):
+        """Flush Python's buffer of the temporary file to the operating system."""
         self._fh.flush()
 
     def dependent(self, role):
-        """Temporary path ``.<name>.part.<role>`` for a companion entry (sidecar, image folder)."""
+        """Temporary path ``.<name>.part.<role>`` for a companion entry (sidecar, image folder).
+
+        Parameters
+        ----------
+        role : str
+            Suffix naming the companion (e.g. ``"json"``, ``"images"``).
+
+        Returns
+        -------
+        str
+        """
         return self.tmp_path + "." + role
 
     def commit(self):
@@ -126,6 +157,7 @@ class AtomicOutputFile:
 
     @property
     def closed(self):
+        """True once the temporary file is closed (after :meth:`commit` or :meth:`abort`)."""
         return self._fh.closed
 
     def __enter__(self):
@@ -211,6 +243,16 @@ def remove_stale_parts(folder):
     ``.<name>.part.<role>`` (sidecar, image folder) are stale with it or when the owner is gone.
     Entries of live runs (lock held) are left alone, so this is safe while other runs write
     into the same folder.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder (an unreadable folder removes nothing).
+
+    Returns
+    -------
+    list of str
+        The names removed.
     """
     try:
         names = os.listdir(folder)
@@ -243,7 +285,17 @@ def remove_stale_parts(folder):
 
 
 def number_is_free(path):
-    """True when neither ``path``, its image folder nor a live reservation of it exists."""
+    """True when neither ``path``, its image folder nor a live reservation of it exists.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A candidate output file name.
+
+    Returns
+    -------
+    bool
+    """
     folder, name = os.path.split(str(path))
     part = os.path.join(folder, "." + name + PART_SUFFIX)
     if os.path.lexists(path) or os.path.lexists(str(path) + IMAGE_FOLDER_SUFFIX):
@@ -257,7 +309,24 @@ def reserve_numbered_path(stem, suffix=".txt", max_number=1_000_000):
     Stale temporary files of killed runs in the folder are removed first, so they never take a
     number.  A number is free when neither the file, its image folder nor a live reservation
     exists; the reservation is atomic, so concurrent processes never pick the same number.
-    Raises ``OSError`` when more than ``max_number`` numbers are taken (the loop is bounded).
+    Parameters
+    ----------
+    stem : str
+        Path up to the number (``root/<name>_nr_``).
+    suffix : str, optional
+        What follows the number (default ``".txt"``).
+    max_number : int, optional
+        Largest number tried (default 1,000,000; the loop is bounded).
+
+    Returns
+    -------
+    AtomicOutputFile
+        The reserved, open file.
+
+    Raises
+    ------
+    OSError
+        When all numbers up to ``max_number`` are taken.
     """
     folder = os.path.dirname(stem) or "."
     remove_stale_parts(folder)
@@ -275,6 +344,16 @@ def probe_writable(folder):
     """Raise ``OSError`` unless a file can be created, written and removed in ``folder``.
 
     A real probe (``os.access`` says yes to root on a read-only mount or a full disk).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The folder to probe.
+
+    Raises
+    ------
+    OSError
+        If creating, writing or removing the probe file fails.
     """
     fd, probe = tempfile.mkstemp(prefix=".particleShear-probe-", dir=folder)
     try:
@@ -285,7 +364,7 @@ def probe_writable(folder):
 
 
 def _particle_info(ens, reference):
-    """The ensemble's description; the 1.0.2 text (with its §12 #23 defects) when ``reference``."""
+    """The ensemble's description; the 1.0.2 text (with its reference defect #23 of docs/output.md) when ``reference``."""
     try:
         return ens.particle_info(reference=reference)
     except TypeError:
@@ -293,11 +372,22 @@ def _particle_info(ens, reference):
 
 
 def experiment_description_text(exp, reference_header=False):
-    """Block 2 of §9.1 for an :class:`OscillatoryShearExperiment` ``exp`` (ends with a newline).
+    """Block 2 of the text file (docs/output.md, "Blocks"): the experiment's description.
 
-    ``reference_header=True`` reproduces the reference's bookkeeping defects: "Simulated
-    time" = excitation time only (§12 #22) and "Post-measurement periods" printing the
-    pre value (§12 #21).  By default both are correct (whole protocol time; post value).
+    Parameters
+    ----------
+    exp : OscillatoryShearExperiment
+        The experiment (its ensemble, dt, frequency, amplitude and periods are written).
+    reference_header : bool, optional
+        True reproduces the reference's bookkeeping defects #21 and #22 of docs/output.md:
+        "Simulated time" = excitation time only and "Post-measurement periods" printing the
+        pre value; also numbers with plain ``str()``.  False (default): both are correct
+        (whole protocol time; post value).
+
+    Returns
+    -------
+    str
+        The block, ending with a newline.
     """
     _s = str if reference_header else header_number  # positional numbers for the R patterns
     ens = exp.theEnsemble
@@ -380,9 +470,21 @@ def experiment_description_text(exp, reference_header=False):
 def output_summary_text(G_internal, G_surface, reference_header=False):
     """Block 3 up to and including the line "Detailed stress tensor data" (no newline at the end).
 
-    ``G_internal`` / ``G_surface`` are the demodulation results ``[SA, SB, G', G'']``.  Numbers
-    in exponent notation are written positionally unless ``reference_header`` (the R patterns
-    read G values as plain decimals).
+    Numbers in exponent notation are written positionally unless ``reference_header`` (the R
+    patterns read G values as plain decimals).
+
+    Parameters
+    ----------
+    G_internal : sequence of float
+        Demodulation ``[SA, SB, G′, G″]`` (Pa) of τ_internal (overall stress tensor, eq. S1-24).
+    G_surface : sequence of float
+        Demodulation ``[SA, SB, G′, G″]`` (Pa) of τ_surface (plate forces).
+    reference_header : bool, optional
+        True: numbers written with ``str()`` exactly as the reference (default False).
+
+    Returns
+    -------
+    str
     """
     _s = str if reference_header else header_number
     SA, SB, Gp, Gpp = G_internal
@@ -408,6 +510,20 @@ def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
 
     Only one chunk of rows is converted to Python floats and formatted at a time, so writing
     a 231k-step table needs a few MB instead of the whole table as one string.
+
+    Parameters
+    ----------
+    scalars : numpy.ndarray
+        Shape (n, 5): t (s), strain (–), strain rate (1/s), τ_surface and τ_internal (Pa).
+    tensors : numpy.ndarray
+        Shape (n, 9, 2, 2): the nine stress tensors of each step (Pa).
+    chunk_rows : int, optional
+        Rows per piece (default :data:`CHUNK_ROWS`).
+
+    Yields
+    ------
+    str
+        The header line (preceded by a newline), then the data lines in chunks.
     """
     n = len(scalars)
     yield "\n" + "\t".join(TABLE_COLUMNS)
@@ -423,8 +539,19 @@ def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
 def table_text(scalars, tensors):
     """The header line and the data lines of the 42-column table, each data line preceded by "\\n".
 
-    ``scalars`` (n, 5) = t, strain, strain_rate, τ_surface, τ_internal; ``tensors`` (n, 9, 2, 2).
-    Returns the text starting with a newline (after "Detailed stress tensor data") and without a
-    trailing newline.  Writers use :func:`iter_table_text` instead (bounded memory).
+    Writers use :func:`iter_table_text` instead (bounded memory).
+
+    Parameters
+    ----------
+    scalars : numpy.ndarray
+        Shape (n, 5): t (s), strain (–), strain rate (1/s), τ_surface and τ_internal (Pa).
+    tensors : numpy.ndarray
+        Shape (n, 9, 2, 2): the nine stress tensors of each step (Pa).
+
+    Returns
+    -------
+    str
+        The text starting with a newline (after "Detailed stress tensor data") and without a
+        trailing newline.
     """
     return "".join(iter_table_text(scalars, tensors))

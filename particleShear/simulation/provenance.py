@@ -10,6 +10,7 @@ exponent notation, which the regular expressions of the downstream R package
 (particleShearEvaluation) read as digits only (``1e-05`` would be read as 1).  Such numbers are
 written positionally instead (``0.00001``), which reads back as the same float.
 """
+__docformat__ = "numpy"
 import hashlib
 import json
 import math
@@ -38,6 +39,16 @@ def json_safe(value):
     NumPy scalars become Python numbers, tuples lists, SeedSequences ``{"entropy", "spawn_key"}``,
     callables and other objects their qualified name (they cannot be stored, but their
     presence is recorded).
+
+    Parameters
+    ----------
+    value : object
+        Any value (nested lists, tuples and dicts are converted recursively).
+
+    Returns
+    -------
+    object
+        JSON-serialisable data.
     """
     if value is None or isinstance(value, (bool, str)):
         return value
@@ -103,6 +114,15 @@ def header_number(value):
     ``header_number(1e-05) == "0.00001"``, ``header_number(0.1) == "0.1"``,
     ``header_number(8000) == "8000"``; ``float(header_number(x)) == x`` for every finite float.
     Non-numbers (booleans, strings) are returned as ``str(value)``.
+
+    Parameters
+    ----------
+    value : object
+        A header value (float, int, bool, str, ...).
+
+    Returns
+    -------
+    str
     """
     text = str(value)
     if isinstance(value, (float, np.floating)) and math.isfinite(value) and ("e" in text or "E" in text):
@@ -116,7 +136,18 @@ _CALL_EXPONENT = re.compile(r"(?<!root_folder=)(?<==)( ?)(-?\d+(?:\.\d*)?[eE][+-
 
 
 def positional_numbers_in_call(text):
-    """The function-call lines of the header with every exponent-notation number written positionally."""
+    """The function-call lines of the header with every exponent-notation number written positionally.
+
+    Parameters
+    ----------
+    text : str
+        Header text with ``name=value`` arguments; a number in exponent notation after ``=``
+        (not the ``root_folder`` path) is rewritten with :func:`header_number`.
+
+    Returns
+    -------
+    str
+    """
     return _CALL_EXPONENT.sub(lambda m: m.group(1) + header_number(float(m.group(2))), text)
 
 
@@ -125,6 +156,26 @@ def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrat
 
     The labels use ``:`` instead of ``=`` and none contains a label that the downstream R
     patterns search for, so they change nothing that particleShearEvaluation reads.
+
+    Parameters
+    ----------
+    run_id : str
+        :func:`run_identity` of the run.
+    seed_entropy : int
+        Entropy of the run's ``numpy.random.SeedSequence``.
+    spawn_key : tuple of int
+        Its spawn key (empty for a root sequence).
+    time_step_factor : float
+        Multiplier of the model's time step (``time_step_factor`` of ``doParticleShearSimulation``).
+    integrator : str
+        ``"euler"`` or ``"verlet"``.
+    correct_drift_sign : bool
+        Whether the demodulation's drift correction had the correct sign (docs/output.md).
+
+    Returns
+    -------
+    str
+        The lines, without a final newline.
     """
     key = ",".join(str(int(k)) for k in (spawn_key or ()))
     return "\n".join([

@@ -1,4 +1,4 @@
-"""Simulation classes: ensemble construction + experiment + output file (spec §8.1, §9, §10.9).
+"""Simulation classes: ensemble construction + experiment + output file (docs/output.md).
 
 ``runSimulation`` (inherited by every class) validates the output settings (and probes the
 folder) before any work, builds the ensemble (``initEnsemble``), reserves the file number,
@@ -7,6 +7,7 @@ drives the :class:`OscillatoryShearExperiment`, then streams the file (format
 ``[G′_surface, G″_surface]`` (Pa).  The full outcome (both moduli pairs, timings, output path,
 write error) is kept in ``self.result_info`` after the run.  See ``docs/output.md``.
 """
+__docformat__ = "numpy"
 import gzip
 import io
 import json
@@ -31,7 +32,27 @@ __all__ = ["OscillatorySimulation", "OscillatorySimulationFragmentation", "Simul
 
 
 def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True):
-    """Raise ValueError when output is requested without a usable ``root_folder`` (§12 #26)."""
+    """Raise ValueError when output is requested without a usable ``root_folder``.
+
+    The reference crashed or wrote to file descriptor 0 here (defect #26 in docs/output.md).
+
+    Parameters
+    ----------
+    root_folder : str or os.PathLike
+        The output folder; must exist and be writable (probed) when anything is saved.
+    saveData : bool
+        Whether the text file is written.
+    saveOutputImages : bool
+        Whether snapshots are saved (rendered off-screen, with or without ``doDrawing``).
+    doDrawing : bool, optional
+        Accepted for the reference signature; snapshots do not depend on it (default True).
+
+    Raises
+    ------
+    ValueError
+        Naming ``root_folder`` when output is requested and the folder is empty, missing or
+        not writable.
+    """
     wants = []
     if saveData:
         wants.append("saveData=True")
@@ -69,12 +90,24 @@ def _writes(simulation, theFile):
 
 
 def call_string(name, **arguments):
-    """``name(k1=v1,k2=v2,...)`` with ``str()`` values and no spaces: the header's function-call line (§9.1)."""
+    """``name(k1=v1,k2=v2,...)`` with ``str()`` values and no spaces: the header's function-call line.
+
+    Parameters
+    ----------
+    name : str
+        The function or class name.
+    **arguments
+        The arguments, in order.
+
+    Returns
+    -------
+    str
+    """
     return name + "(" + ",".join(k + "=" + str(v) for k, v in arguments.items()) + ")"
 
 
 class OscillatorySimulation:
-    """Base class: output paths, file header, experiment set-up and the run (§8.1).
+    """Base class: output paths, file header, experiment set-up and the run.
 
     Parameters
     ----------
@@ -89,7 +122,7 @@ class OscillatorySimulation:
     doDrawing : bool
         Particle drawing (live window when a display exists; needed for snapshots).
     saveData : bool
-        Write the text file of §9.1.
+        Write the text file (docs/output.md).
 
     Attributes beyond the reference: ``rng`` (Generator/seed for the builder), ``verbose``,
     ``renderer_backend`` ("auto", "tk", "pillow", "none"), ``correct_drift_sign``,
@@ -168,6 +201,7 @@ class OscillatorySimulation:
         return "particleShear A=" + str(self.amplitude)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
+        """Multiplier of the fixed-boundary pre-equilibration length (``N = 25 · int(factor)``); 1 here."""
         return 1
 
     # -- paths -----------------------------------------------------------------------------------
@@ -175,7 +209,7 @@ class OscillatorySimulation:
         return os.path.join(str(self.root_folder), "oscillatory_simulation_")
 
     def file_path(self):
-        """``root/<name><k>.txt`` for the smallest k ≥ 1 not yet used (§9.3); False without a root folder."""
+        """``root/<name><k>.txt`` for the smallest k ≥ 1 not yet used (docs/output.md, "Name"); False without a root folder."""
         if not self.root_folder:
             return False
         stem = self._file_stem()
@@ -186,24 +220,63 @@ class OscillatorySimulation:
         raise OSError("no free file number for " + stem + "<k>" + suffix)
 
     def image_folder_path(self, fileName):
-        """``<text file path>_images_folder`` (§9.4)."""
+        """``<text file path>_images_folder`` (docs/output.md, "Snapshots").
+
+        Parameters
+        ----------
+        fileName : str or os.PathLike
+            The text file's path.
+
+        Returns
+        -------
+        str
+        """
         return str(fileName) + IMAGE_FOLDER_SUFFIX
 
     def createFolder(self, directory):
-        """Create ``directory`` (and its parents); ``False``/None (no folder, as in the reference) does nothing."""
+        """Create ``directory`` (and its parents); ``False``/None (no folder, as in the reference) does nothing.
+
+        Parameters
+        ----------
+        directory : str, os.PathLike, False or None
+            The folder.
+        """
         if directory is False or directory is None:
             return
         os.makedirs(directory, exist_ok=True)
 
     def write_information_on_simulation_to_file(self, theFile):
-        """Block 1 of the text file (docs/output.md); nothing for ``theFile`` False/None or ``saveData`` False."""
+        """Block 1 of the text file (docs/output.md); nothing for ``theFile`` False/None or ``saveData`` False.
+
+        Parameters
+        ----------
+        theFile : file-like, False or None
+            An open text file (or any object with ``write``).
+        """
         if not _writes(self, theFile):
             return
         theFile.write("Oscillatory simulation\n\n\n\nFunction call : \n" + self.function_call + "\n\n")
 
     # -- experiment ------------------------------------------------------------------------------
     def createExperiment(self, output_file=False, periods=2, plotStress=False, imageOutputFolder=False):
-        """Build the experiment exactly as :meth:`runSimulation` does (also used by the stochastic tests)."""
+        """Build the experiment exactly as :meth:`runSimulation` does (also used by the stochastic tests).
+
+        Parameters
+        ----------
+        output_file : file-like or False, optional
+            Where the experiment writes its description and results (default False: nothing).
+        periods : float, optional
+            Excitation periods (default 2).
+        plotStress : bool, optional
+            Live stress/strain window (default False).
+        imageOutputFolder : str or False, optional
+            Snapshot folder (default False: none).
+
+        Returns
+        -------
+        OscillatoryShearExperiment
+            Also kept as ``self.theExperiment``.
+        """
         ens = self.theEnsemble
         model = self.model or getattr(ens, "model", False)
         y_scale_force = self.relative_y_scale_force / model.k / self.amplitude if model else 1
@@ -241,10 +314,7 @@ class OscillatorySimulation:
         return exp
 
     def runSimulation(self, cool_factor=1, periods=2, plotStress=True):
-        """Build, equilibrate, shear, write; return ``[G′_surface, G″_surface]`` (Pa) (§8.1).
-
-        ``cool_factor`` is the fraction of peculiar velocity left after one excitation period;
-        the per-step factor is ``cool_factor ** (1/N_per_period)`` (§4.4).
+        """Build, equilibrate, shear, write; return ``[G′_surface, G″_surface]`` (Pa).
 
         Output (see ``docs/output.md``): the folder is probed for writability before any work;
         the file number is reserved (a locked ``.part`` file) when the ensemble exists, snapshots
@@ -254,6 +324,28 @@ class OscillatorySimulation:
         it is kept in ``self.write_error`` (and ``result_info["write_error"]``) and nothing
         partial is left.  An interrupt (``KeyboardInterrupt``) removes every temporary entry
         and is re-raised with ``position = (phase, step, total)`` attached.
+
+        Parameters
+        ----------
+        cool_factor : float, optional
+            Fraction of the peculiar velocity left after one excitation period, 0 < c ≤ 1
+            (default 1: no damping); the per-step factor is ``cool_factor ** (1/N_per_period)``
+            with ``N_per_period = 1/(f·dt)``.
+        periods : float, optional
+            Excitation periods, > 0 (default 2).
+        plotStress : bool, optional
+            Live stress/strain window (needs a display; default True).
+
+        Returns
+        -------
+        list of float
+            ``[G′_surface, G″_surface]`` in Pa (moduli from the plate forces).
+
+        Raises
+        ------
+        ValueError
+            For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
+            unknown output format — before any work.
         """
         check_output_folder(self.root_folder, self.saveData, self.saveOutputImages, self.doDrawing)
         if not periods > 0:
@@ -345,7 +437,19 @@ class OscillatorySimulation:
             self._close_windows()
 
     def run_metadata(self, output_format, path):
-        """JSON-safe description of the run: parameters and provenance (the sidecar's content)."""
+        """JSON-safe description of the run: parameters and provenance (the sidecar's content).
+
+        Parameters
+        ----------
+        output_format : str
+            The format of the output file (one of ``OUTPUT_FORMATS``).
+        path : str or None
+            The output file (its base name is recorded).
+
+        Returns
+        -------
+        dict
+        """
         return {
             "file": os.path.basename(path) if path else None, "output_format": output_format,
             "package_version": package_version(), "run_id": getattr(self, "run_id", None),
@@ -404,7 +508,38 @@ class OscillatorySimulation:
 
 
 class OscillatorySimulationFragmentation(OscillatorySimulation):
-    """Crosslinked ensembles cut into particles ("fragmentation"); naming and header of §9.1/§9.3."""
+    """Crosslinked ensembles cut into particles ("fragmentation"); file naming and header of docs/output.md.
+
+    Builds the ensemble with the legacy builder ``EnsembleCompactParticlesFromModelParameters``
+    (fixed material constants apart from those given here).
+
+    Parameters
+    ----------
+    root_folder : str
+        Folder of the text file and the image folder (must exist and be writable when saving).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after relaxation (False: frictional spheres only).
+    cut_lines : int, optional
+        Number of particles the crosslinked gel is cut into (Voronoi seeds); ≤ 1 / 0 = bulk gel.
+    N : int, optional
+        Number of spheres.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ defining the radii (eq. S1-14).
+    amplitude : float, optional
+        Strain amplitude A (0.5 = 50 %).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa); spring constant k = π E/8 (eq. S1-8).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts.
+    relative_y_scale_force : float, optional
+        Plot scaling of the stress window only.
+    relative_frequency : float, optional
+        Excitation frequency in units of the characteristic frequency 1/τ (f = relative_frequency/τ).
+    doDrawing : bool, optional
+        Live particle window when a display exists (snapshots do not need it).
+    saveData : bool, optional
+        Write the text file (docs/output.md).
+    """
 
     def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2, amplitude=0.5,
                  Young_modulus_spheres=1000, mu=0.1, relative_y_scale_force=5e-4, relative_frequency=0.05,
@@ -426,6 +561,7 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
             doDrawing=doDrawing)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
+        """Multiplier of the pre-equilibration length: ``int(2 − log10 μ)`` for 0 < μ ≤ 1, else 1."""
         if 0 < self.mu <= 1:
             return int(2 - math.log10(self.mu))
         return 1
@@ -436,7 +572,18 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
                 + " A=" + str(self.amplitude) + " mu=" + str(self.mu))
 
     def initEnsemble(self, do_debug=False):
-        """Legacy builder with this class's parameters (§6.11)."""
+        """Build ``theEnsemble`` with the legacy builder and this class's parameters.
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Returns
+        -------
+        EnsembleCompactParticlesFromModelParameters
+            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
+        """
         self.theEnsemble = EnsembleCompactParticlesFromModelParameters(
             size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
             Young_modulus_spheres=self.Young_modulus_spheres, cut_lines=self.cut_lines,
@@ -465,7 +612,13 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
 
     def write_information_on_simulation_to_file(self, theFile):
         """Block 1 of the text file (docs/output.md; and, unless ``reference_header``, the provenance lines
-        after μ); nothing for ``theFile`` False/None or ``saveData`` False."""
+        after μ); nothing for ``theFile`` False/None or ``saveData`` False.
+
+        Parameters
+        ----------
+        theFile : file-like, False or None
+            An open text file (or any object with ``write``).
+        """
         if not _writes(self, theFile):
             return
         if self.do_permanent_links:
@@ -491,7 +644,52 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
 
 
 class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
-    """Fragmentation simulation with full material parameters; legacy builder (§6.11, §10.9)."""
+    """Fragmentation simulation with full material parameters; legacy builder.
+
+    Parameters
+    ----------
+    root_folder : str
+        Folder of the text file and the image folder (must exist and be writable when saving).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after relaxation (False: frictional spheres only).
+    cut_lines : int, optional
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        ≤ 1 / 0 = bulk gel.
+    N : int, optional
+        Number of spheres.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ defining the radii (eq. S1-14).
+    bimodal_factor : float, optional
+        Large/small radius ratio (50/50 random).
+    amplitude : float, optional
+        Strain amplitude A (0.5 = 50 %).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa); spring constant k = π E/8 (eq. S1-8).
+    density : float, optional
+        Material density (kg/m³).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts (permanent links are not limited).
+    relative_viscosity : float, optional
+        rv in the contact viscosity ν = rv·√(m k) (eq. S1-9).
+    relative_y_scale_force : float, optional
+        Plot scaling of the stress window only.
+    relative_frequency : float, optional
+        f·τ: excitation frequency in units of the characteristic frequency 1/τ.
+    relative_transversal_link_strength : float, optional
+        k_t/k and ν_t/ν: tangential relative to central stiffness and viscosity.
+    central_repulsion_coefficient : float, optional
+        c of the central force law, 0 … 1 (1 = divergent law eq. S1-5b, 0 = linear eq. S1-5a).
+    avoid_horizontal_angle_degree : float, optional
+        Line-cut mode only: forbidden band (degrees) around horizontal cut lines.
+    avoid_height_spanning_particles : bool, optional
+        Re-cut while a particle is taller than 0.9·L_y.
+    doCutByTriangulation : bool, optional
+        Particles by periodic Voronoi cells (False: random straight lines).
+    doDrawing : bool, optional
+        Live particle window when a display exists (snapshots do not need it).
+    saveData : bool, optional
+        Write the text file (docs/output.md).
+    """
 
     def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2,
                  bimodal_factor=1.4, amplitude=0.5, Young_modulus_spheres=1000, density=50, mu=0.1,
@@ -526,7 +724,15 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
                                          doCutByTriangulation=doCutByTriangulation, doDrawing=doDrawing)
 
     def adjustment_factor_for_bounded_preequilibration_steps(self):
-        """Longer fixed-boundary relaxation for low friction, amplitude or viscosity (§8.4)."""
+        """Longer fixed-boundary relaxation for low friction, amplitude or viscosity.
+
+        ``F = 1``, times 1.5 if μ ≤ 0.1, 2 if μ ≤ 0.01, 2 if μ ≤ 0.001, ``1 − (log10 A + 2)``
+        if A ≤ 0.01, 2 if A ≤ 0.005 and 2 if rv ≤ 0.1 (default run: 6, so N = 150 steps).
+
+        Returns
+        -------
+        float
+        """
         F = 1
         mu, A = self.mu, self.amplitude
         if mu <= 0.1:
@@ -560,7 +766,18 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             verbose=self.verbose)
 
     def initEnsemble(self, do_debug=False):
-        """Legacy builder with every material parameter (§6.11)."""
+        """Build ``theEnsemble`` with the legacy builder and every material parameter.
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Returns
+        -------
+        EnsembleCompactParticlesFromModelParameters
+            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
+        """
         self.theEnsemble = EnsembleCompactParticlesFromModelParameters(**self._builder_arguments(do_debug))
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
@@ -569,7 +786,69 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
 
 
 class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
-    """The simulation created by ``doParticleShearSimulation``: adjustable interfaces, §6.4 builder."""
+    """The simulation created by ``doParticleShearSimulation``: adjustable interface strength.
+
+    Builds the ensemble with ``EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters``.
+    The class defaults are the reference's and differ from those of ``doParticleShearSimulation``
+    (docs/parameters.md), which passes every argument.
+
+    Parameters
+    ----------
+    root_folder : str
+        Folder of the text file and the image folder (must exist and be writable when saving).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after relaxation (False: frictional spheres only).
+    cut_lines : int, optional
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        ≤ 1 / 0 = bulk gel.
+    N : int, optional
+        Number of spheres.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ defining the radii (eq. S1-14).
+    bimodal_factor : float, optional
+        Large/small radius ratio (50/50 random).
+    amplitude : float, optional
+        Strain amplitude A (0.5 = 50 %); also the builder's anticipated amplitude (time step,
+        relaxation length).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa); spring constant k = π E/8 (eq. S1-8).
+    density : float, optional
+        Material density (kg/m³).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts (permanent links are not limited).
+    relative_viscosity : float, optional
+        rv in the contact viscosity ν = rv·√(m k) (eq. S1-9).
+    relative_y_scale_force : float, optional
+        Plot scaling of the stress window only.
+    relative_frequency : float, optional
+        f·τ: excitation frequency in units of the characteristic frequency 1/τ.
+    relative_transversal_link_strength : float, optional
+        k_t/k and ν_t/ν: tangential relative to central stiffness and viscosity.
+    avoid_horizontal_angle_degree : float, optional
+        Line-cut mode only: forbidden band (degrees) around horizontal cut lines.
+    avoid_height_spanning_particles : bool, optional
+        Re-cut while a particle is taller than 0.9·L_y.
+    interface_reenforcement_central : float, optional
+        Factor on k of transient contacts relative to permanent links.
+    interface_reenforcement_tangential : float, optional
+        The same for the tangential stiffness k_t.
+    central_repulsion_coefficient : float, optional
+        c of the central force law, 0 … 1 (1 = divergent law eq. S1-5b, 0 = linear eq. S1-5a).
+    keep_viscosity_coefficients_constant : bool, optional
+        False: the viscosities follow the reinforcement factors.
+    cut_top_bottom : bool, optional
+        Cut every link through the y-periodic boundary (wall-slip emulation).
+    doCutByTriangulation : bool, optional
+        Particles by periodic Voronoi cells (False: random straight lines).
+    remove_link_fraction : float, optional
+        Target fraction (0 … 1) of non-essential links to remove.
+    edge_fuzziness : float, optional
+        Random roughening of the Voronoi borders, in units of the largest radius r_max.
+    doDrawing : bool, optional
+        Live particle window when a display exists (snapshots do not need it).
+    saveData : bool, optional
+        Write the text file (docs/output.md).
+    """
 
     def __init__(self, root_folder, do_permanent_links=True, cut_lines=5, N=150, packing_fraction=2,
                  bimodal_factor=1.4, amplitude=0.5, Young_modulus_spheres=1000, density=50, mu=0.1,
@@ -598,7 +877,18 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
             remove_link_fraction=remove_link_fraction, edge_fuzziness=edge_fuzziness, doDrawing=doDrawing)
 
     def initEnsemble(self, do_debug=False):
-        """Adjustable-interface builder (§6.4) with ``anticipated_amplitude = amplitude``."""
+        """Build ``theEnsemble`` with the adjustable-interface builder (``anticipated_amplitude = amplitude``).
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Returns
+        -------
+        EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
+            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
+        """
         self.theEnsemble = EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
             **self._builder_arguments(do_debug),
             interface_reenforcement_central=self.interface_reenforcement_central,

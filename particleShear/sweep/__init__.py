@@ -4,6 +4,7 @@
 combination of a SPEC's [grid] and [[zip]] lists × [seeds] repetitions, one results row per
 run in ``DIR/results.csv``, resumable after any interruption.
 """
+__docformat__ = "numpy"
 from ..simulation.provenance import run_identity
 from .spec import SweepRun, SweepSpec, expand_runs, load_spec, parse_spec
 from .runner import Sweep, SweepOutcome, run_sweep

@@ -1,4 +1,5 @@
 """``python -m particleShear sweep SPEC --out DIR``: run, resume, dry-run or merge a sweep (docs/sweeps.md)."""
+__docformat__ = "numpy"
 import argparse
 import contextlib
 import os
@@ -8,6 +9,15 @@ __all__ = ["main", "build_parser"]
 
 
 def build_parser():
+    """Parser of ``python -m particleShear sweep`` (flags described in docs/sweeps.md).
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Positional ``SPEC``; ``--out DIR`` (required), ``--workers``, ``--dask``, ``--scheduler``,
+        ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``,
+        ``--retry-failed``, ``--keep-going``, ``--quiet``.
+    """
     p = argparse.ArgumentParser(prog="particleShear sweep",
                                 description="Run (or resume) every run of a sweep SPEC (.toml or .json) into DIR; "
                                             "one row per run in DIR/results.csv.")
@@ -34,7 +44,19 @@ def _positive(name, flag, v):
 
 
 def main(argv=None):
-    """Entry point; returns the exit status (0 ok, 1 some runs failed, 2 invalid input, 130 interrupted)."""
+    """Entry point of ``python -m particleShear sweep``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``sweep`` (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0 ok, 1 some runs failed (or unfinished after ``--merge``), 2 invalid
+        input (message naming the flag on stderr), 130 interrupted.
+    """
     args = build_parser().parse_args(argv)
     from .cost import format_cost
     from .runner import Sweep

@@ -7,6 +7,7 @@ N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extr
 nearest slope), plus constitution 0.53 s · (N/150)^0.7.  Disk: the text format writes about
 723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md).
 """
+__docformat__ = "numpy"
 import math
 
 from ..linkable.builders import time_steps_from_model
@@ -21,7 +22,21 @@ _HEADER_BYTES = 4000
 
 
 def run_steps(p):
-    """Protocol steps (pre + excitation + post periods) of a run with parameters ``p``."""
+    """Protocol steps (pre + excitation + post periods) of a run with parameters ``p``.
+
+    Parameters
+    ----------
+    p : dict
+        Complete parameters of ``doParticleShearSimulation`` (``bimodal_factor``, ``theMu``,
+        ``relative_transversal_link_strength``, ``theAmplitude``, ``relative_viscosity``,
+        ``periods``, ``pre_periods``, ``post_periods``, ``relative_frequency``; optional
+        ``time_step_factor``, default 1).
+
+    Returns
+    -------
+    int
+        ``int((periods + pre + post)/f / dt)`` with the time step of the model's rule.
+    """
     dt, _ = time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"],
                                   p["theAmplitude"], p["relative_viscosity"])
     dt *= float(p.get("time_step_factor", 1.0))
@@ -39,20 +54,57 @@ def _step_seconds(N):
 
 
 def run_seconds(p):
-    """Projected single-core wall time (s) of one run."""
+    """Projected single-core wall time (s) of one run: constitution plus protocol steps.
+
+    Parameters
+    ----------
+    p : dict
+        Complete parameters of ``doParticleShearSimulation`` (as for :func:`run_steps`, plus
+        ``N``, the number of spheres).
+
+    Returns
+    -------
+    float
+        Seconds on the reference machine of docs/performance.md.
+    """
     N = float(p["N"])
     return _CONSTITUTION_S * (N / 150) ** 0.7 + run_steps(p) * _step_seconds(N)
 
 
 def run_bytes(p):
-    """Projected bytes written by one run (text format; 0 without ``saveData``)."""
+    """Projected bytes written by one run (text format; 0 without ``saveData``).
+
+    Parameters
+    ----------
+    p : dict
+        Complete parameters of ``doParticleShearSimulation`` (as for :func:`run_steps`;
+        ``saveData`` and ``saveStressTensorData`` decide what is written).
+
+    Returns
+    -------
+    int
+        ≈ 4 kB header plus 723 bytes per protocol step with the tensor table.
+    """
     if not p.get("saveData"):
         return 0
     return _HEADER_BYTES + (_BYTES_PER_STEP * run_steps(p) if p.get("saveStressTensorData", True) else 0)
 
 
 def estimate_cost(runs, workers=1):
-    """Totals over ``runs`` (SweepRun or parameter dicts): runs, steps, bytes, CPU seconds, wall seconds."""
+    """Totals over ``runs``: runs, steps, bytes, CPU seconds, wall seconds.
+
+    Parameters
+    ----------
+    runs : iterable of SweepRun or dict
+        The runs (their ``parameters``) or complete parameter dicts.
+    workers : int, optional
+        Number of parallel workers the wall time is divided by (default 1; values < 1 count as 1).
+
+    Returns
+    -------
+    dict
+        ``{"runs", "steps", "bytes", "cpu_s", "wall_s", "workers"}`` (seconds in s).
+    """
     params = [getattr(r, "parameters", r) for r in runs]
     cpu = sum(run_seconds(p) for p in params)
     return {"runs": len(params), "steps": sum(run_steps(p) for p in params),
@@ -76,7 +128,18 @@ def _human_s(s):
 
 
 def format_cost(c):
-    """One line: ``runs, steps, disk, CPU time, wall time on the given workers``."""
+    """One line: ``runs, steps, disk, CPU time, wall time on the given workers``.
+
+    Parameters
+    ----------
+    c : dict
+        Totals as :func:`estimate_cost` returns them.
+
+    Returns
+    -------
+    str
+        The line, with human units (kB/MB/GB; s/min/h).
+    """
     return (f"{c['runs']} runs, {c['steps']:,} protocol steps, disk ~{_human_bytes(c['bytes'])}, "
             f"projected ~{_human_s(c['cpu_s'])} CPU = ~{_human_s(c['wall_s'])} on {c['workers']} worker(s) "
             f"(~{c['cpu_s'] / 3600:.3g} CPU-hours)")
@@ -88,6 +151,18 @@ def calibrate(p, target_steps=2000):
     Runs ``p`` once without output, its protocol cut to about ``target_steps`` steps (one
     excitation period at most, no baseline periods), and compares the measured wall time
     with :func:`run_seconds` of that shortened run.
+
+    Parameters
+    ----------
+    p : dict
+        Complete parameters of ``doParticleShearSimulation`` of a representative run.
+    target_steps : int, optional
+        About how many protocol steps the shortened run takes (default 2000).
+
+    Returns
+    -------
+    float
+        Measured wall time divided by the projected one (1 = the documented costs hold here).
     """
     import time
     from ..run.api import doParticleShearSimulation

@@ -14,6 +14,7 @@ moment leaves, at worst, a scratch folder (cleared when the run starts again) an
 that was being published, a file without row: the rerun writes the same file under the same name,
 so ``DIR`` never holds two ``.txt`` files of one run.
 """
+__docformat__ = "numpy"
 import concurrent.futures
 import contextlib
 import dataclasses
@@ -40,8 +41,15 @@ _TABLE_GLOB = re.compile(r"^results(\.task-\d+-of-\d+)?\.csv$")
 class SweepOutcome:
     """A finished run: its :class:`~particleShear.sweep.spec.SweepRun`, its table row, and its result.
 
-    ``result`` is the :class:`~particleShear.run.api.SimulationResult` (None for a failed run);
-    its per-step ``series`` are kept only with ``keep_series=True``.
+    Parameters
+    ----------
+    run : SweepRun
+        The run (parameters, seed, run id).
+    row : dict
+        Its row of ``results.csv`` (status ``ok`` or ``failed``, moduli in Pa, parameters, ...).
+    result : SimulationResult or None, optional
+        The :class:`~particleShear.run.api.SimulationResult` (None for a failed run);
+        its per-step ``series`` are kept only with ``keep_series=True``.
     """
 
     run: object
@@ -50,6 +58,7 @@ class SweepOutcome:
 
     @property
     def ok(self):
+        """True when the run succeeded (``row["status"] == "ok"``)."""
         return self.row["status"] == "ok"
 
 
@@ -94,6 +103,19 @@ def execute_run(task):
     """Run one sweep task (a picklable dict) in the calling process; return ``(row, result or None)``.
 
     Never raises for a failing simulation: the exception becomes a ``failed`` row.
+
+    Parameters
+    ----------
+    task : dict
+        ``run_id``, ``index``, ``parameters`` (complete, of ``doParticleShearSimulation``),
+        ``seed_entropy``, ``spawn_key``, ``out_dir`` (sweep folder; "" writes nothing) and
+        ``keep_series`` (bool: keep the per-step series in the result).
+
+    Returns
+    -------
+    tuple
+        ``(row, result)``: the results-table row (dict) and the SimulationResult, or None
+        when the run failed.
     """
     from ..run.api import doParticleShearSimulation
     p = task["parameters"]
@@ -136,7 +158,19 @@ def _ignore_sigint():
 
 
 class SweepProgress:
-    """One line per finished run: done/failed/total, rate, ETA (a tqdm bar on a terminal when installed)."""
+    """One line per finished run: done/failed/total, rate, ETA (a tqdm bar on a terminal when installed).
+
+    Call it with each :class:`SweepOutcome`; :meth:`close` at the end.
+
+    Parameters
+    ----------
+    total : int
+        Number of runs of the sweep (or of this task's share).
+    already : int, optional
+        Runs finished before this call (resumed sweep), counted as done (default 0).
+    stream : file-like, optional
+        Where the lines go (default ``sys.stderr``); a terminal gets a tqdm bar when installed.
+    """
 
     def __init__(self, total, already=0, stream=None):
         self.total, self.done, self.failed = total, already, 0
@@ -170,6 +204,7 @@ class SweepProgress:
         self.stream.flush()
 
     def close(self):
+        """Close the tqdm bar, if one is shown (lines need no closing)."""
         if self._bar is not None:
             self._bar.close()
 
@@ -265,7 +300,17 @@ class Sweep:
                                or os.path.exists(os.path.join(self.out_dir, os.path.basename(path))))
 
     def finished_rows(self, retry_failed=False):
-        """``{run_id: row}`` of this sweep's finished runs, over all tables of ``out_dir``."""
+        """``{run_id: row}`` of this sweep's finished runs, over all tables of ``out_dir``.
+
+        Parameters
+        ----------
+        retry_failed : bool, optional
+            True: rows with status ``failed`` do not count as finished (default False).
+
+        Returns
+        -------
+        dict
+        """
         ids = {r.run_id for r in self.runs}
         done = {}
         for path in self._tables():
@@ -282,12 +327,35 @@ class Sweep:
         return done
 
     def pending(self, retry_failed=False):
-        """This process's runs that have not finished, in sweep order."""
+        """This process's runs that have not finished, in sweep order.
+
+        Parameters
+        ----------
+        retry_failed : bool, optional
+            True: failed runs count as pending (default False).
+
+        Returns
+        -------
+        list of SweepRun
+        """
         done = self.finished_rows(retry_failed)
         return [r for r in self.my_runs() if r.run_id not in done]
 
     def cost(self, workers=1, pending_only=False):
-        """:func:`~particleShear.sweep.cost.estimate_cost` of the (pending) runs."""
+        """:func:`~particleShear.sweep.cost.estimate_cost` of the (pending) runs.
+
+        Parameters
+        ----------
+        workers : int, optional
+            Parallel workers for the wall-time projection (default 1).
+        pending_only : bool, optional
+            True: only the runs not yet finished (default False: this process's whole share).
+
+        Returns
+        -------
+        dict
+            As :func:`~particleShear.sweep.cost.estimate_cost`.
+        """
         return estimate_cost(self.pending() if pending_only else self.my_runs(), workers)
 
     # -- running -------------------------------------------------------------------------------
@@ -300,11 +368,36 @@ class Sweep:
                      stream=None):
         """Run the pending runs; yield a :class:`SweepOutcome` per run as it finishes (completion order).
 
-        Each row is appended to the table (fsynced) before it is yielded.  ``executor``: any
-        ``concurrent.futures.Executor`` (not shut down here); default a ``ProcessPoolExecutor(workers)``.
-        ``progress``: True (lines on ``stream``, default stderr), False, or a callable(outcome).
+        Each row is appended to the table (fsynced) before it is yielded.
         On KeyboardInterrupt the queued runs are cancelled and the interrupt propagates; the
         rows written so far are kept and a rerun resumes.
+
+        Parameters
+        ----------
+        executor : concurrent.futures.Executor, optional
+            Where the runs execute (not shut down here; e.g. a Dask client's executor);
+            default a ``ProcessPoolExecutor(workers)`` owned by this call.
+        workers : int, optional
+            Processes of the default executor (≥ 1, ``--workers``; default: all cores).
+        keep_series : bool, optional
+            Keep the per-step series in each outcome's result (default False: moduli only).
+        retry_failed : bool, optional
+            Run again the runs whose row says ``failed`` (default False).
+        progress : bool or callable, optional
+            True (default): one line per run on ``stream``; False: silent; a callable is
+            called with each :class:`SweepOutcome`.
+        stream : file-like, optional
+            Where progress lines go (default ``sys.stderr``).
+
+        Yields
+        ------
+        SweepOutcome
+            One per finished run, in completion order.
+
+        Raises
+        ------
+        ValueError
+            If ``workers`` is not an integer ≥ 1 (before any run starts).
         """
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
             raise ValueError(f"workers={workers!r} (--workers) is invalid: allowed an integer >= 1")
@@ -378,7 +471,19 @@ class Sweep:
             write_parquet(self.table_path)
 
     def run(self, **kwargs):
-        """Run the pending runs (see :meth:`as_completed`); return every finished row in sweep order."""
+        """Run the pending runs; return every finished row in sweep order.
+
+        Parameters
+        ----------
+        **kwargs
+            The options of :meth:`as_completed` (``executor``, ``workers``, ``keep_series``,
+            ``retry_failed``, ``progress``, ``stream``).
+
+        Returns
+        -------
+        list of dict
+            As :meth:`rows`.
+        """
         for _ in self.as_completed(**kwargs):
             pass
         return self.rows()
@@ -392,7 +497,12 @@ class Sweep:
         """Merge every table of ``out_dir`` into ``results.csv`` (one row per run, sweep order).
 
         Rows of other sweeps in ``results.csv`` are kept; the task tables are removed after the
-        merged table has been written.  Returns ``(n_rows, n_missing)``.
+        merged table has been written.
+
+        Returns
+        -------
+        tuple of int
+            ``(n_rows, n_missing)``: rows of this sweep written, runs not finished yet.
         """
         path = os.path.join(self.out_dir, TABLE_NAME)
         with _table_lock(path):
@@ -414,7 +524,39 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
               retry_failed=False, progress=True, stream=None):
     """Run (or resume) the sweep ``spec`` into ``out_dir``; return its finished rows in sweep order.
 
-    See :class:`Sweep` and :meth:`Sweep.as_completed` for the parameters; docs/sweeps.md for the layout.
+    The layout of ``out_dir`` and of the table is described in docs/sweeps.md.
+
+    Parameters
+    ----------
+    spec : str, os.PathLike, dict or SweepSpec
+        A SPEC file (.toml/.json), its parsed dict, or a :class:`SweepSpec`.
+    out_dir : str or os.PathLike
+        Output folder (created when missing); the same folder resumes the sweep.
+    executor : concurrent.futures.Executor, optional
+        Where the runs execute (not shut down here); default a process pool of ``workers``.
+    workers : int, optional
+        Processes of the default executor (≥ 1; default: all cores).
+    task_index, task_count : int, optional
+        Job-array share: this process runs the runs with ``index % task_count == task_index``
+        into its own table (merge with :meth:`Sweep.merge` / ``--merge``).
+    keep_series : bool, optional
+        Keep the per-step series of each run in memory (default False).
+    retry_failed : bool, optional
+        Run again the runs whose row says ``failed`` (default False).
+    progress : bool or callable, optional
+        True (default): one line per run on ``stream``; False: silent; or a callable(outcome).
+    stream : file-like, optional
+        Where progress lines go (default ``sys.stderr``).
+
+    Returns
+    -------
+    list of dict
+        The finished rows in sweep order (dicts of strings).
+
+    Raises
+    ------
+    ValueError
+        An invalid SPEC or run (naming the parameter), before any run starts.
     """
     return Sweep(spec, out_dir, task_index=task_index, task_count=task_count).run(
         executor=executor, workers=workers, keep_series=keep_series, retry_failed=retry_failed,
@@ -445,8 +587,27 @@ def _result_from_row(row, run):
 def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
     """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
 
-    ``all_kwargs[k]`` holds every argument of run k, its ``seed`` a SeedSequence.  With a
-    ``root_folder`` the runs form a resumable sweep into it (see :class:`Sweep`).
+    Parameters
+    ----------
+    all_kwargs : list of dict
+        ``all_kwargs[k]`` holds every argument of run k, its ``seed`` a ``numpy.random.SeedSequence``.
+    root_folder : str, optional
+        With a folder the runs form a resumable sweep into it (see :class:`Sweep`); "" (default)
+        writes nothing.
+    executor : concurrent.futures.Executor, optional
+        Where the runs execute (not shut down here); default a process pool owned by this call.
+    max_workers : int, optional
+        Processes of the default pool (default: all cores).
+
+    Returns
+    -------
+    list of SimulationResult
+        In the order of ``all_kwargs``.
+
+    Raises
+    ------
+    RuntimeError
+        If any run failed (after all have finished), naming the first failed run.
     """
     from ..simulation.provenance import run_identity
     from .spec import SweepRun, sweep_parameter_defaults

@@ -20,6 +20,7 @@ i.e. ``SeedSequence(root).spawn(n)[k]``: adding repetitions keeps the ids of the
 Points enumerate the grid keys in file order, then each ``[[zip]]`` group, the last varying
 fastest.  Every run is validated before any starts (docs/sweeps.md).
 """
+__docformat__ = "numpy"
 import dataclasses
 import functools
 import inspect
@@ -54,17 +55,23 @@ def sweep_parameter_defaults():
 
 @dataclasses.dataclass(frozen=True)
 class SweepRun:
-    """One run of a sweep.
+    """One run of a sweep (made by :func:`expand_runs`; frozen).
 
-    Attributes
+    Parameters
     ----------
     index : int
         Position in the sweep (``repetition · n_points + point``); also the spawn key.
-    point, repetition : int
+    point : int
+        Index of the parameter point (the combination of [grid] and [[zip]] values), 0-based.
+    repetition : int
+        Index of the repetition of that point (0 … ``repetitions`` − 1).
     parameters : dict
         The complete parameter set (every SPEC-settable argument, defaults filled in).
     seed_entropy : int
+        The SPEC's ``[seeds] root``: entropy of the run's ``numpy.random.SeedSequence``.
     spawn_key : tuple of int
+        ``(index,)``: the run's child of the root seed sequence, so every run has its own,
+        reproducible random stream.
     run_id : str
         :func:`particleShear.simulation.provenance.run_identity` of the above.
     """
@@ -80,8 +87,23 @@ class SweepRun:
 
 @dataclasses.dataclass
 class SweepSpec:
-    """A parsed, checked SPEC (see the module docstring)."""
+    """A parsed, checked SPEC (see the module docstring and docs/sweeps.md).
 
+    Parameters
+    ----------
+    parameters : dict
+        The [parameters] table: values fixed for every run.
+    grid : dict
+        The [grid] table: ``{name: [values]}``, every combination is run.
+    zips : list of dict
+        The [[zip]] tables: each ``{name: [values]}`` with lists of equal length, varied together.
+    root : int
+        ``[seeds] root``: the root entropy of every run's seed.
+    repetitions : int
+        ``[seeds] repetitions``: runs per parameter point (≥ 1).
+    source : str, optional
+        Where the SPEC came from (file path), for messages.
+    """
     parameters: dict
     grid: dict
     zips: list
@@ -91,6 +113,7 @@ class SweepSpec:
 
     @property
     def n_points(self):
+        """Number of parameter points: product of the [grid] list lengths and the [[zip]] lengths."""
         n = 1
         for values in self.grid.values():
             n *= len(values)
@@ -100,6 +123,7 @@ class SweepSpec:
 
     @property
     def n_runs(self):
+        """Number of runs: ``n_points · repetitions``."""
         return self.n_points * self.repetitions
 
 
@@ -121,6 +145,16 @@ def _read_toml(path):
 
 def load_spec(path):
     """Read and check a SPEC file (``.toml`` or ``.json``); return a :class:`SweepSpec`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The SPEC file: ``.toml`` (needs Python ≥ 3.11 or tomli) or ``.json``, same tables.
+
+
+    Returns
+    -------
+    SweepSpec
 
     Raises
     ------
@@ -163,7 +197,26 @@ def _values(where, v):
 
 
 def parse_spec(doc, source=""):
-    """Check a SPEC given as a dict (parsed TOML/JSON) and return a :class:`SweepSpec`."""
+    """Check a SPEC given as a dict (parsed TOML/JSON) and return a :class:`SweepSpec`.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed SPEC: tables ``parameters``, ``grid``, ``zip`` (list) and ``seeds``
+        (``root`` required, ``repetitions`` default 1).
+    source : str, optional
+        Where the SPEC came from, kept in :attr:`SweepSpec.source` for messages.
+
+    Returns
+    -------
+    SweepSpec
+
+    Raises
+    ------
+    ValueError
+        Unknown table or parameter, a parameter set twice, zip lists of unequal length, a
+        missing or invalid seed (the message names the key).
+    """
     if not isinstance(doc, dict):
         raise ValueError(f"SPEC {source!r} is invalid: allowed a table of the tables {SPEC_TABLES}")
     for table in doc:
@@ -256,6 +309,11 @@ def _check_options(p, where):
 
 def expand_runs(spec):
     """Every run of ``spec`` in sweep order, each validated before any is returned.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        A parsed SPEC (:func:`load_spec`, :func:`parse_spec`).
 
     Returns
     -------

@@ -9,6 +9,7 @@ Rows are appended by one writer (the sweep's driving process) with a single ``os
 complete line on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
 most one torn last line, which :func:`read_rows` drops and :func:`repair_table` cuts off.
 """
+__docformat__ = "numpy"
 import csv
 import io
 import json
@@ -24,12 +25,36 @@ TABLE_NAME = "results.csv"
 
 
 def task_table_name(task_index, task_count):
-    """Per-task table of a job-array task, merged by ``--merge``: ``results.task-0003-of-0010.csv``."""
+    """Per-task table of a job-array task, merged by ``--merge``: ``results.task-0003-of-0010.csv``.
+
+    Parameters
+    ----------
+    task_index : int
+        The task's index, 0-based (``--task-index``).
+    task_count : int
+        Number of tasks sharing the sweep (``--task-count``).
+
+    Returns
+    -------
+    str
+        The file name (no folder).
+    """
     return f"results.task-{task_index:04d}-of-{task_count:04d}.csv"
 
 
 def table_columns(parameter_names=None):
-    """All columns, given the parameter names (default: every SPEC-settable parameter)."""
+    """All columns, given the parameter names (order of the module docstring).
+
+    Parameters
+    ----------
+    parameter_names : iterable of str, optional
+        The parameter columns, in order (default: every SPEC-settable parameter, signature
+        order of ``doParticleShearSimulation``).
+
+    Returns
+    -------
+    list of str
+    """
     if parameter_names is None:
         from .spec import sweep_parameter_defaults
         parameter_names = list(sweep_parameter_defaults())
@@ -47,14 +72,37 @@ def _cell(v):
 
 
 def row_line(row, columns):
-    """One CSV line (with newline) of ``row`` in ``columns`` order; a missing value is empty."""
+    """One CSV line (with newline) of ``row`` in ``columns`` order; a missing value is empty.
+
+    Parameters
+    ----------
+    row : dict
+        Column name → value; lists and tuples are written as JSON, floats with ``repr``.
+    columns : sequence of str
+        The table's columns.
+
+    Returns
+    -------
+    str
+    """
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow([_cell(row.get(c)) for c in columns])
     return buf.getvalue()
 
 
 def repair_table(path):
-    """Cut a torn last line (no trailing newline) left by a killed writer; True when the file was cut."""
+    """Cut a torn last line (no trailing newline) left by a killed writer.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table; nothing happens when it does not exist.
+
+    Returns
+    -------
+    bool
+        True when the file was cut.
+    """
     if not os.path.exists(path):
         return False
     with open(path, "rb+") as fh:
@@ -69,6 +117,15 @@ def repair_table(path):
 
 def append_row(path, row, columns):
     """Append ``row`` to the table at ``path`` (header first when new); flushed and fsynced.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table (created when absent); a torn last line is cut first (:func:`repair_table`).
+    row : dict
+        Column name → value (see :func:`row_line`).
+    columns : sequence of str
+        The table's columns; must equal the existing header.
 
     Raises
     ------
@@ -95,7 +152,17 @@ def append_row(path, row, columns):
 
 
 def read_rows(path):
-    """Rows of a table as a list of dicts of strings (a torn last line is ignored); [] when absent."""
+    """Rows of a table as a list of dicts of strings (a torn last line is ignored); [] when absent.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table.
+
+    Returns
+    -------
+    list of dict
+    """
     if not os.path.exists(path):
         return []
     with open(path, newline="", encoding="utf-8") as fh:
@@ -106,7 +173,17 @@ def read_rows(path):
 
 
 def write_table(path, rows, columns):
-    """Write a complete table atomically (temporary file in the same folder, fsync, rename)."""
+    """Write a complete table atomically (temporary file in the same folder, fsync, rename).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table; replaced as a whole.
+    rows : iterable of dict
+        The rows (see :func:`row_line`).
+    columns : sequence of str
+        The header and column order.
+    """
     tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
     with open(tmp, "w", newline="", encoding="utf-8") as fh:
         fh.write(row_line({c: c for c in columns}, columns))
@@ -121,6 +198,16 @@ def write_parquet(csv_path):
     """Write ``results.parquet`` next to ``csv_path`` when pyarrow is installed; its path, or None.
 
     Numeric columns are typed by pyarrow's CSV reader; ``error`` and ``output_path`` stay strings.
+
+    Parameters
+    ----------
+    csv_path : str or os.PathLike
+        The results table; ``results.parquet`` is written beside it (atomically).
+
+    Returns
+    -------
+    str or None
+        The Parquet file's path; None without pyarrow or without the CSV file.
     """
     try:
         import pyarrow.csv as pacsv
