@@ -14,6 +14,7 @@ import dataclasses
 
 import numpy as np
 
+from ..messages import console_messages
 from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
@@ -283,7 +284,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
     theSimulation.parameters = params
 
-    G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
+    with console_messages(verbose):  # verbose: this call's INFO messages on stdout, the reference's text
+        G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
     info = theSimulation.result_info
     series = theSimulation.theExperiment.plotter.arrays()
