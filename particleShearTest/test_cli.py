@@ -155,6 +155,35 @@ class TestFlagsFromTheSignature(unittest.TestCase):
                     self.assertNotIn(python_name, err)
 
 
+class TestApiDocstrings(unittest.TestCase):
+    """The docstrings of the run API document every parameter (the CLI help is made of them)."""
+
+    def test_every_parameter_is_documented(self):
+        import dataclasses
+        from particleShear import SimulationResult, doParticleShearSimulationSeries
+        for func in (doParticleShearSimulation, doParticleShearSimulationSeries):
+            docs = parameter_docs(func)
+            for name in inspect.signature(func).parameters:
+                with self.subTest(func=func.__name__, name=name):
+                    self.assertIn(name.lstrip("*"), {n.lstrip("*") for n in docs})
+                    self.assertTrue(docs.get(name, docs.get("**" + name, ("", "")))[1])   # a description
+        docs = parameter_docs(SimulationResult)
+        for field in dataclasses.fields(SimulationResult):
+            with self.subTest(field=field.name):
+                self.assertTrue(docs[field.name][1])
+
+    def test_types_units_and_defaults(self):
+        docs = parameter_docs()
+        for name, par in inspect.signature(doParticleShearSimulation).parameters.items():
+            with self.subTest(name=name):
+                type_text, text = docs[name]
+                self.assertIn("default", type_text)               # "float, default 0.2"
+                self.assertNotIn("\u00a7", text)                   # no reference to the unpublished spec
+        self.assertIn("Pa", docs["Young_modulus_spheres"][1])
+        self.assertIn("kg/m³", docs["density"][1])
+        self.assertIn("eq. S1-8", docs["Young_modulus_spheres"][1])
+
+
 class TestRunAndJson(unittest.TestCase):
     @classmethod
     def setUpClass(cls):

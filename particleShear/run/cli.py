@@ -219,6 +219,9 @@ def _flags_for_messages():
     PARAMETER_FLAGS["root_folder"] = "--save"
 
 
+_flags_for_messages()
+
+
 class _Parser(argparse.ArgumentParser):
     """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block."""
 
