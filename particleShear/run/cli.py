@@ -297,7 +297,8 @@ def build_parser():
                 group.add_argument(_NEGATIVE_ALIASES[name], dest=name, action=_StoreConst, const=False,
                                    default=None, help=f"same as {_negative(name)}")
         else:
-            metavar = None if choices else {int: "INT", float: "FLOAT"}.get(cli_type, "STR")
+            metavar = None if choices else ("DIR" if name == "root_folder" else
+                                            {int: "INT", float: "FLOAT"}.get(cli_type, "STR"))
             group.add_argument(*strings, dest=name, action=_Store, type=cli_type, choices=choices, default=None,
                                metavar=metavar, help=help_text)
     c = p.add_argument_group("command line")
