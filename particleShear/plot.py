@@ -24,9 +24,12 @@ of the overall stress tensor (eq. S1-24).
 __docformat__ = "numpy"
 import argparse
 import csv
+import logging
 import math
 import os
 import sys
+
+from .messages import console_messages
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "sweep_groups", "cli_main", "save_figure"]
 
@@ -392,6 +395,7 @@ def cli_main(argv=None):
         return 2
     folder = args.folder if os.path.isdir(args.folder) else os.path.dirname(os.path.abspath(args.folder))
     written = [args.output] if args.output else [os.path.join(folder, "G_vs_amplitude" + e) for e in (".png", ".pdf")]
-    for w in written:
-        print("wrote " + w)
+    with console_messages(stream=sys.stdout):
+        for w in written:
+            logging.getLogger(__name__).info("wrote %s", w)
     return 0

@@ -44,6 +44,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.spec",
     "particleShear.sweep.table",
     "particleShear.plot",
+    "particleShear.messages",
     "particleShear.run",
     "particleShear.run.api",
     "particleShear.run.cli",
@@ -55,15 +56,10 @@ DOCUMENTED_MODULES = [
 #: it passes).  run.api: doParticleShearSimulation's docstring is written by the helper of the
 #: API docstring (issue 13 item 3), not on this branch; run.cli: rewritten by the helper of the
 #: generated command line (issue 13 item 5).
-PENDING_DOCSTRINGS = {
-    "particleShear.run.api",
-    "particleShear.run.cli",
-}
+PENDING_DOCSTRINGS = set()
 
 #: Modules whose "§" references are replaced on another branch (run.api, see above).
-PENDING_SECTION_SIGNS = {
-    "particleShear.run.api",
-}
+PENDING_SECTION_SIGNS = set()
 
 #: The engine layers (being rewritten; documented after the engine merge).  Checked as a whole,
 #: as an expected failure for now: the lead turns it into a plain test after the engine merge.

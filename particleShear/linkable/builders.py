@@ -5,6 +5,7 @@ and time steps, relax the random packing, crosslink it, cut it into particles
 and relax again.  ``rng`` (Generator, int seed or None) drives every random
 choice; ``verbose`` prints the reference's console messages.
 """
+import logging
 import math
 import numbers
 
@@ -98,7 +99,7 @@ def _avoid_flag(avoid, doCutByTriangulation, cut_lines, verbose):
     """Step 0 of §6.4: height checks only make sense when cutting can produce separate particles."""
     if avoid and ((doCutByTriangulation and cut_lines <= 1) or (not doCutByTriangulation and cut_lines <= 0)):
         if verbose:
-            print("avoid_height_spanning_particles ignored: with cut_lines=" + str(cut_lines)
+            logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines=" + str(cut_lines)
                   + " the gel is not cut into separate particles")
         return False
     return avoid
@@ -127,7 +128,7 @@ def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut
             raise RuntimeError(f"no cut without a height-spanning particle found in {attempts} attempts "
                                f"(cut_lines={cut_lines}); use more cuts or avoid_height_spanning_particles=False")
         if verbose:
-            print("Height spanning particle (height " + str(h) + "), cutting again")
+            logging.getLogger(__name__).info("Height spanning particle (height " + str(h) + "), cutting again")
         ens.particles = []
         ens.makeAllLinksPermanent()
         if cut_top_bottom:
@@ -219,7 +220,7 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         if remove_link_fraction > 0:
             ens.remove_non_essential_links(remove_link_fraction, True)
             if verbose:
-                print("Actual fraction of removed non-essential links: " + str(ens.removed_fraction))
+                logging.getLogger(__name__).info("Actual fraction of removed non-essential links: " + str(ens.removed_fraction))
         ens.join_isolated_spheres()
         ens.dt_max = min(2 * ens.dt, ens.dt_max)
         if rts > 5:

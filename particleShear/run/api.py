@@ -1,4 +1,4 @@
-"""High-level entry points (spec §10.1, §10.2): one simulation, and series on any executor.
+"""High-level entry points: one simulation, and series on any executor.
 
 ``doParticleShearSimulation(...)`` keeps the reference signature (plus a trailing ``seed``)
 and return value ``[G′_surface, G″_surface]``; the complete outcome is a
@@ -14,11 +14,13 @@ import dataclasses
 
 import numpy as np
 
+from ..messages import console_messages
 from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_options, validate_series, validate_simulation_parameters
 
+__docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
 
 
@@ -26,41 +28,56 @@ __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "Simu
 class SimulationResult:
     """Everything a run of :func:`doParticleShearSimulation` produced.
 
-    Attributes
+    Parameters
     ----------
     G_surface : tuple of float
-        (G′, G″) in Pa from the external (surface) forces — the reference's return value.
+        (G′, G″) in Pa from the external (surface) forces on the plate bands — the
+        reference's return value.
     G_internal : tuple of float
-        (G′, G″) in Pa from the overall stress tensor — the values the header lists first.
+        (G′, G″) in Pa from the overall stress tensor (eq. S1-24) — the values the output
+        header lists first.
     stress_surface, stress_internal : tuple of float
-        (in-phase, out-of-phase) stress amplitudes in Pa of the two estimators.
+        (in-phase, out-of-phase) shear stress amplitudes in Pa of the two estimators.
     parameters : dict
-        Every argument of the call (reference names).
-    seed : int or None
-        Entropy of the ``numpy.random.SeedSequence`` that drove the run (None if a Generator was given).
-    spawn_key : tuple
-        Spawn key of that SeedSequence (non-empty for runs of a series).
-    timings : dict
-        Wall time in s: "constitution", "pre_equilibration", "protocol", "demodulation", "output", "total".
-    output_path : str or None
-        The text file (when ``saveData``).
-    image_folder : str or None
-    n_images : int
-    dt, f : float
-        Protocol time step (s) and excitation frequency (Hz).
-    N_steps : int
-        Protocol steps.
-    damping_factor : float
-        Per-step damping factor.
-    removed_fraction : float
-        Actual fraction of removed non-essential bonds.
+        Every argument of the call (reference names), keyword-only options included.
+    seed : int or None, default None
+        Entropy of the ``numpy.random.SeedSequence`` that drove the run (None if a Generator
+        was given).
+    spawn_key : tuple of int, default ()
+        Spawn key of that SeedSequence (non-empty for the runs of a series).
+    timings : dict of float
+        Wall time in s of "constitution", "pre_equilibration", "protocol", "demodulation",
+        "output" and "total".
+    output_path : str or None, default None
+        The output file (when ``saveData``).
+    image_folder : str or None, default None
+        The folder of the snapshots (when ``saveOutputImages``).
+    n_images : int, default 0
+        Number of snapshots written.
+    dt : float, default 0.0
+        Protocol time step in s.
+    f : float, default 0.0
+        Excitation frequency in Hz.
+    N_steps : int, default 0
+        Number of protocol steps.
+    damping_factor : float, default 1.0
+        Per-step velocity damping factor (``cool_factor`` per step), dimensionless.
+    removed_fraction : float, default 0.0
+        Actual fraction of removed non-essential bonds (``remove_link_fraction``).
     series : dict of numpy.ndarray
-        t (s), strain, strain_rate (1/s), stress_surface, stress_internal (Pa), and "tensors"
-        (n, 9, 2, 2) when the tensor history was kept (``saveData`` with ``saveStressTensorData``).
-    run_id : str
-        12 hex digits identifying parameters + seed (:func:`~particleShear.simulation.provenance.run_identity`).
-    write_error : Exception or None
+        Per protocol step: "t" (s), "strain", "strain_rate" (1/s), "stress_surface" and
+        "stress_internal" (Pa), and "tensors" (n, 9, 2, 2) in Pa when the tensor history was kept
+        (``saveData`` with ``saveStressTensorData``).
+    run_id : str, default ""
+        12 hex digits identifying parameters + seed
+        (:func:`~particleShear.simulation.provenance.run_identity`).
+    write_error : Exception or None, default None
         Why writing the output failed after the run (the moduli are valid); None when written.
+
+    Attributes
+    ----------
+    G : list of float
+        ``[G′_surface, G″_surface]`` in Pa — what :func:`doParticleShearSimulation` returns.
     """
 
     G_surface: tuple
@@ -91,11 +108,20 @@ class SimulationResult:
     def plot(self, path=None):
         """Strain and stress traces against time plus the Lissajous loop (needs ``particleShear[plot]``).
 
-        See :func:`particleShear.plot.plot_result`; ``path`` (optional) writes PNG, PDF, SVG or EPS
-        by extension.  Returns the :class:`matplotlib.figure.Figure`.
+        See :func:`particleShear.plot.plot_result`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike, optional
+            File to write (PNG, PDF, SVG or EPS, chosen by the extension); None writes nothing.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
         """
         from ..plot import plot_result
         return plot_result(self, path)
+
     def to_dict(self):
         """The row of this run in a sweep's results table (docs/sweeps.md), as a dict.
 
@@ -144,63 +170,171 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               saveOutputMovie=False, output_format="text", strict_io=False):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
+    The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
+    500 × 500 µm Lees-Edwards cell, crosslinked, cut into particles, pre-equilibrated and sheared
+    with the strain γ(t) = A sin(2π f t); G′ and G″ are demodulated from the shear stress of the
+    plate forces ("surface") and of the overall stress tensor ("internal", eq. S1-24); see
+    docs/output.md.  Internal units: lengths in µm, time in s, masses in mg and forces in
+    mg·µm·s⁻² per metre of cylinder depth; stresses and moduli in Pa.  Every parameter is checked
+    before any work (limits of resolution, steps and memory: docs/parameters.md).
+
     Parameters
     ----------
-    root_folder : str
-        Output folder (must exist and be writable when ``saveData`` or ``saveOutputImages``; probed
-        before any work).
-    theAmplitude : float
-        Strain amplitude A (> 0; 0.2 = 20 %).
-    theMu : float
-        Friction coefficient of transient contacts (>= 0).
-    do_permanent_links, cut_lines, ... cool_factor :
-        As in the reference; see ``docs/parameters.md`` for units, defaults and meaning.
-    seed : None, int, numpy.random.SeedSequence or numpy.random.Generator
-        Drives every random choice; one seed gives a bit-identical run.  None draws fresh
-        entropy (recorded in the result).
-    return_result : bool, keyword-only
-        Return the :class:`SimulationResult` instead of ``[G′_surface, G″_surface]``.
-    verbose : bool, keyword-only
-        Print the reference console messages (§8.6).
-    progress : callable, keyword-only
-        ``progress(phase, step, total, elapsed_s)`` for phases "constitution", "pre-equilibration", "protocol".
-    correct_drift_sign : bool, keyword-only
-        Use the mathematically correct drift correction in the demodulation (default: reference quirk).
-    reference_header : bool, keyword-only
-        Reproduce the reference header defects §12 #21–22 in the output file.
-    renderer : {"auto", "tk", "pillow", "none"}, keyword-only
-        Drawing backend (see :mod:`particleShear.simulation.drawing`).
-    time_step_factor : float, keyword-only
-        Multiplies the time step (and the coarsest step) of the measurement: pre-equilibration
-        with plates and protocol.  1 = the reference rule of §4.7; constitution is unchanged, so
-        one seed gives the same initial packing for every factor (used by the accuracy study).
-    integrator : {"euler", "verlet"}, keyword-only
-        Time integrator of the measurement: the reference semi-implicit Euler (default) or
-        velocity Verlet with a half-kick predictor for the velocity-dependent forces.
-    stability_guard : bool, keyword-only
-        Stop a diverging measurement with :class:`SimulationInstabilityError` (step, phase, worst
-        pair, suggested time step) instead of producing NaN moduli.
-    saveOutputMovie : bool, keyword-only
-        Also write the snapshots as an animated GIF ``movie.gif`` in the image folder (needs
-        ``saveOutputImages=True``; frames are kept at most 500 px wide, at most 200 of them).
-    output_format : {"text", "text.gz", "npz", "parquet"}, keyword-only
-        File format of ``saveData`` (see ``docs/output.md``): the reference text (default), the
-        same gzip-compressed, NumPy ``.npz`` or Parquet (needs the extra ``particleShear[parquet]``).
-        Read any of them with :func:`particleShear.read_run`.
-    strict_io : bool, keyword-only
-        Raise the ``OSError`` of a failed write after the run (default False: the result is
-        returned with ``write_error`` set, and ``last_result`` holds it either way).
+    root_folder : str, default ""
+        Output folder (path) of the text file and of the image folder.  Allowed: any string;
+        it must be an existing, writable folder when ``saveData`` or ``saveOutputImages`` is
+        True (probed with an empty temporary file before any work).
+    theAmplitude : float, default 0.2
+        Strain amplitude A, dimensionless (0.2 = 20 %); allowed 0 < A <= 100.  Also the
+        builder's anticipated amplitude (time step, relaxation length).
+    theMu : float, default 0.01
+        Coulomb friction coefficient μ of transient contacts, dimensionless; allowed
+        0 <= μ <= 1e6 (permanent links are not limited by friction).
+    do_permanent_links : bool, default True
+        Crosslink all contacts after relaxation; False: frictional spheres only.
+    cut_lines : int, default 5
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer >= 0 that
+        leaves >= 3 spheres per particle on average (triangulation: cut_lines <= N/3).
+    Young_modulus_spheres : float, default 8000
+        Young modulus E of the sphere material in Pa; allowed 1e-6 ... 1e12.  Contact stiffness
+        k = π E/8 (eq. S1-8).
+    N : int, default 150
+        Number of spheres; allowed an integer from N_min (11 at the default packing fraction and
+        bimodal factor: the largest sphere must be smaller than a quarter of the cell) to 1e6.
+    packing_fraction : float, default 1.5
+        Nominal (uncompressed) area fraction φ that defines the radii (eq. S1-14), dimensionless;
+        allowed 0 < φ <= 10.
+    density : float, default 50
+        Material density in kg/m³; allowed 1e-6 ... 1e6 (the manual's table says 1000, the
+        reference code default is 50).
+    bimodal_factor : float, default 1.4
+        Ratio of large to small radius (50/50 random), dimensionless; allowed 0.01 ... 100.
+    relative_viscosity : float, default 0.1
+        rv in the contact damping ν = rv·√(m k) (eq. S1-9), dimensionless; allowed 0 ... 1e6.
+    relative_transversal_link_strength : float, default 1
+        k_t/k and ν_t/ν, dimensionless; allowed 0 ... 1e6.
+    relative_frequency : float, default 0.025
+        f·τ: excitation frequency in units of the characteristic frequency 1/τ, dimensionless;
+        allowed > 0 with >= 100 steps per excitation period (<= 0.56 at the defaults).
+    avoid_horizontal_angle_degree : float, default 15
+        Line-cut mode only: half-width in degrees of the forbidden band around horizontal cut
+        lines; allowed 0 <= a < 90.
+    interface_reenforcement_central : float, default 1
+        Factor on k of transient contacts relative to permanent links, dimensionless; allowed
+        1e-6 ... 1e6.
+    interface_reenforcement_tangential : float, default 1
+        The same factor for k_t, dimensionless; allowed 1e-6 ... 1e6.
+    keep_viscosity_coefficients_constant : bool, default False
+        False: the contact viscosities follow the reinforcement factors; True: they stay.
+    avoid_height_spanning_particles : bool, default True
+        Cut again while a particle is taller than 0.9 of the cell height.
+    cut_top_bottom : bool, default False
+        Cut every link through the y-periodic boundary (emulates wall slip).
+    saveOutputImages : bool, default False
+        Save about 200 captioned snapshots of the protocol into an image folder beside the
+        output file (needs ``root_folder``; works with or without ``doDrawing``).
+    imageFileType : {"jpg", "png", "ps"}, default "jpg"
+        Snapshot format; "ps" is vector Encapsulated PostScript (extension .ps).
+    remove_link_fraction : float, default 0
+        Target fraction of non-essential permanent links removed at random; allowed 0 ... 1.
+    edge_fuzziness : float, default 0
+        Random roughening of the Voronoi borders in units of the largest radius; allowed
+        0 ... 1000.
+    central_repulsion_coefficient : float, default 1
+        c of the central force law, dimensionless (1 = divergent repulsion eq. S1-5b, 0 =
+        linear eq. S1-5a); allowed 0 ... 1.
+    doCutByTriangulation : bool, default True
+        Cut into particles by periodic Voronoi cells; False: by random straight lines.
+    doDrawing : bool, default True
+        Draw: the live particle window when a display exists (snapshots do not need it).
+    saveData : bool, default False
+        Write the output file of the run (format ``output_format``; docs/output.md).
+    saveStressTensorData : bool, default True
+        With ``saveData``: also write the 42-column per-step table of the stress tensors.
+    plotStress : bool, default True
+        Live stress/strain window (needs a display and ``doDrawing``); without a display, and
+        with ``saveData``, it is saved as ``<output file>_stress.png`` (needs particleShear[plot]).
+    relative_y_scale_force : float, default 1e8
+        Vertical scale of the live stress window only, dimensionless; allowed |value| <= 1e300.
+    pre_periods : float, default 2
+        Baseline before the excitation, in excitation periods (drift reference); allowed >= 0
+        within the step and memory limits.
+    periods : float, default 3
+        Excitation periods (the first is skipped in the demodulation when >= 2); allowed > 0
+        within the step and memory limits.
+    post_periods : float, default 1
+        Recovery after the excitation, in excitation periods; allowed >= 0 within the step and
+        memory limits.
+    cool_factor : float, default 0.5
+        Fraction of the peculiar velocity left after one excitation period (damping),
+        dimensionless; allowed 0 < c <= 1.
+    seed : None, int, numpy.random.SeedSequence or numpy.random.Generator, default None
+        Drives every random choice; one seed gives a bit-identical run.  Allowed None (fresh
+        entropy, recorded in the result), an integer >= 0, a SeedSequence or a Generator.
+    return_result : bool, default False
+        Keyword-only.  Return the :class:`SimulationResult` instead of ``[G′_surface, G″_surface]``.
+    verbose : bool, default True
+        Keyword-only.  Show the reference's console messages: INFO messages of the logger
+        "particleShear" on stdout during the call (see :mod:`particleShear.messages`).
+    progress : callable or None, default None
+        Keyword-only.  ``progress(phase, step, total, elapsed_s)``, called at most ~10 times
+        per second, for the phases "constitution", "pre-equilibration" and "protocol".
+    correct_drift_sign : bool, default False
+        Keyword-only.  Demodulate with the mathematically correct drift correction (default:
+        the reference's sign; docs/output.md).
+    reference_header : bool, default False
+        Keyword-only.  Reproduce the two defects of the reference's output header
+        (docs/output.md).
+    renderer : {"auto", "tk", "pillow", "none"}, default "auto"
+        Keyword-only.  Drawing backend: "auto" (Tk when a display exists, else Pillow for the
+        snapshots), "tk", "pillow" or "none"; also set by the environment variable
+        PARTICLESHEAR_RENDERER.
+    time_step_factor : float, default 1.0
+        Keyword-only.  Multiplies the time step (and the coarsest relaxation step) of the
+        measurement: plate pre-equilibration and protocol (1 = the reference rule).  The
+        constitution is unchanged, so one seed gives the same packing for every factor
+        (docs/accuracy.md).  Allowed > 0, leaving >= 2 steps per excitation period.
+    integrator : {"euler", "verlet"}, default "euler"
+        Keyword-only.  Time integrator of the measurement: the reference's semi-implicit Euler,
+        or velocity Verlet with a half-kick predictor for the velocity-dependent forces.
+    stability_guard : bool, default True
+        Keyword-only.  Stop a diverging measurement with ``SimulationInstabilityError`` (step,
+        phase, worst pair, suggested time step) instead of returning NaN moduli.
+    saveOutputMovie : bool, default False
+        Keyword-only.  Also write the snapshots as the animated GIF ``movie.gif`` in the image
+        folder (needs ``saveOutputImages``; at most 200 frames, at most 500 px wide).
+    output_format : {"text", "text.gz", "npz", "parquet"}, default "text"
+        Keyword-only.  File format of ``saveData``: the reference text, the same gzip-compressed,
+        NumPy .npz, or Parquet (needs particleShear[parquet]); read any with
+        :func:`particleShear.read_run` (docs/output.md).
+    strict_io : bool, default False
+        Keyword-only.  Raise the ``OSError`` of a failed write after the run; False: return the
+        result with ``write_error`` set (``last_result`` holds it either way).
 
     Returns
     -------
-    list of float
-        ``[G′_surface, G″_surface]`` in Pa (moduli from the surface forces, as the reference returns);
-        the full :class:`SimulationResult` is stored in ``doParticleShearSimulation.last_result``.
+    list of float or SimulationResult
+        ``[G′_surface, G″_surface]`` in Pa (the moduli from the surface forces, as the reference
+        returns), or the :class:`SimulationResult` with ``return_result=True``; the full result
+        of the last call is ``doParticleShearSimulation.last_result`` either way.
 
     Raises
     ------
     ValueError, TypeError
-        For any invalid parameter, before any simulation work.
+        For any invalid parameter, naming it, its value and the allowed range, before any work.
+    SimulationInstabilityError
+        When the measurement diverges (``stability_guard``).
+
+    See Also
+    --------
+    doParticleShearSimulationSeries : many runs on an executor.
+    particleShear.Sweep : resumable parameter sweeps (docs/sweeps.md).
+
+    Examples
+    --------
+    >>> G_storage, G_loss = doParticleShearSimulation(N=20, cut_lines=0, relative_frequency=0.2,
+    ...     pre_periods=0.2, periods=1, post_periods=0, seed=1, doDrawing=False, verbose=False)
     """
     params = dict(root_folder=root_folder, theAmplitude=theAmplitude, theMu=theMu,
                   do_permanent_links=do_permanent_links, cut_lines=cut_lines,
@@ -283,7 +417,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
     theSimulation.parameters = params
 
-    G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
+    with console_messages(verbose):  # verbose: this call's INFO messages on stdout, the reference's text
+        G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
     info = theSimulation.result_info
     series = theSimulation.theExperiment.plotter.arrays()
@@ -323,7 +458,25 @@ def _save_headless_stress_plot(result, renderer):
 
 def series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_control, do_non_frictional_control,
                 N_repetitions):
-    """The reference iteration order of §10.2 as a list of (A, μ, do_permanent_links, cut_lines)."""
+    """The reference iteration order of a series (docs/parameters.md) as a list of (A, μ, do_permanent_links, cut_lines).
+
+    Parameters
+    ----------
+    amplitudes, mu : sequence of float
+        Strain amplitudes A (1) and friction coefficients μ (1), iterated A outer, μ inner.
+    cut_lines : int
+        Particles (cut lines) of the material runs.
+    do_bulk_control, do_uncrosslinked_control, do_non_frictional_control : bool
+        Add, per (A, μ), a bulk control (links, no cut) before the material run, an uncrosslinked
+        control (no links) and a non-frictional control (μ = 0) after it.
+    N_repetitions : int
+        Repetitions of the whole grid (outermost loop).
+
+    Returns
+    -------
+    list of tuple
+        ``(A, μ, do_permanent_links, cut_lines)`` per run, in the reference order.
+    """
     jobs = []
     for _ in range(int(N_repetitions)):
         for A in amplitudes:
@@ -358,25 +511,65 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
                                     max_workers=None, verbose=False, **options):
     """Run the reference series (repetitions × amplitudes × μ × controls) on an executor.
 
+    Every run is a :func:`doParticleShearSimulation`; the parameters shared with it have its
+    meaning, units, defaults and allowed ranges (see there), except where said below.
+
     Parameters
     ----------
-    root_folder ... cool_factor :
-        As in §10.2 (the lists ``amplitudes`` and ``mu`` are iterated; every other value is
-        forwarded unchanged to :func:`doParticleShearSimulation`).
+    root_folder : str, default ""
+        Output folder.  Empty: nothing is written.  Otherwise the series is a resumable sweep
+        into this folder (see Notes); it must exist and be writable.
+    amplitudes : list of float, default [0.2]
+        Strain amplitudes A (dimensionless), each as ``theAmplitude``; 1 ... 1e5 values.
+    mu : list of float, default [0.01]
+        Friction coefficients μ (dimensionless), each as ``theMu``; 1 ... 1e5 values.
+    cut_lines : int, default 5
+        ``cut_lines`` of the material runs (the controls use 0).
+    Young_modulus_spheres : float, default 8000
+        Young modulus E in Pa, as in :func:`doParticleShearSimulation`.
+    do_bulk_control : bool, default False
+        Also run, per point, the uncut crosslinked gel (``cut_lines=0``).
+    do_uncrosslinked_control : bool, default False
+        Also run, per point, frictional spheres without links (``do_permanent_links=False``).
+    do_non_frictional_control : bool, default False
+        Also run, per point, the material without friction (``theMu=0``).
+    N_repetitions : int, default 6
+        Repetitions of the whole grid (different seeds); allowed 0 ... 1e5, at most 1e5 runs
+        in all.
+    N, packing_fraction, density, bimodal_factor, relative_viscosity : as in :func:`doParticleShearSimulation`
+        Number of spheres; area fraction φ; density in kg/m³; radius ratio; rv (eq. S1-9).
+    relative_transversal_link_strength, relative_frequency : float
+        k_t/k; f·τ (as in :func:`doParticleShearSimulation`).
+    avoid_horizontal_angle_degree : float, default 15
+        Degrees, line-cut mode only (as in :func:`doParticleShearSimulation`).
+    interface_reenforcement_central, interface_reenforcement_tangential : float, default 1
+        Factors on k and k_t of transient contacts (as in :func:`doParticleShearSimulation`).
+    keep_viscosity_coefficients_constant, avoid_height_spanning_particles, cut_top_bottom : bool
+        As in :func:`doParticleShearSimulation` (defaults False, True, False).
+    doCutByTriangulation, saveOutputImages, doDrawing, saveData, saveStressTensorData, plotStress : bool
+        As in :func:`doParticleShearSimulation` (defaults True, False, True, False, True, True).
+    imageFileType : {"jpg", "png", "ps"}, default "jpg"
+        Snapshot format (as in :func:`doParticleShearSimulation`).
+    remove_link_fraction, edge_fuzziness, central_repulsion_coefficient : float
+        As in :func:`doParticleShearSimulation` (defaults 0, 0, 1).
+    pre_periods, periods, post_periods : float, default 2, 3, 1
+        Baseline, excitation and recovery in excitation periods.
+    cool_factor : float, default 0.5
+        Velocity fraction left after one period (as in :func:`doParticleShearSimulation`).
     executor : concurrent.futures.Executor, optional
         Where the runs execute (e.g. a ``ProcessPoolExecutor``, Dask's ``Client.get_executor()``,
         ``mpi4py.futures.MPIPoolExecutor``).  Default: a ``ProcessPoolExecutor(max_workers)``
         created and shut down here.  A given executor is not shut down.
-    seed : None, int or numpy.random.SeedSequence
+    seed : None, int or numpy.random.SeedSequence, default None
         Root seed; run k gets ``SeedSequence(seed).spawn(n)[k]``, so the series is reproducible
         whatever the executor or the completion order.
-    max_workers : int, keyword-only
-        Size of the default process pool.
-    verbose : bool, keyword-only
-        Forwarded to each run (default False: quiet workers).
-    **options :
+    max_workers : int or None, default None
+        Keyword-only.  Size of the default process pool (>= 1; None: all cores).
+    verbose : bool, default False
+        Keyword-only.  Forwarded to each run (default False: quiet workers).
+    **options
         Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
-        ``reference_header``, ``renderer``, ...).
+        ``reference_header``, ``renderer``, ``time_step_factor``, ...).
 
     Returns
     -------
@@ -384,14 +577,20 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
 
+    Raises
+    ------
+    ValueError, TypeError
+        For an invalid grid or parameter of any run, before any run starts.
+    RuntimeError
+        When a run failed (raised once the other runs have finished).
+
     Notes
     -----
     Runs on the sweep machinery (docs/sweeps.md).  With a ``root_folder`` the series is a
     resumable sweep into that folder: files are named ``<reference stem><run id>.txt``, one row
     per run goes to ``root_folder/results.csv``, and calling again with the same arguments and
     ``seed`` runs only the runs that have not finished; those are returned as results rebuilt
-    from their rows (moduli, parameters, seed, output path; no per-step series).  A failing run
-    raises ``RuntimeError`` once the other runs have finished.
+    from their rows (moduli, parameters, seed, output path; no per-step series).
     """
     # the grid (repetitions × amplitudes × μ × controls) is checked before any job is built
     amplitudes, mu = validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,

@@ -1,48 +1,255 @@
 """Command line: ``python -m particleShear`` / ``particleShear`` (console script).
 
-Runs one ``doParticleShearSimulation`` headless by default (no windows), shows a
-progress line on stderr (phase, step, elapsed, estimated remaining) and prints G′ and
-G″ from both estimators (overall stress tensor and surface forces) on stdout.
+``particleShear [run] [FLAGS]`` runs one :func:`~particleShear.doParticleShearSimulation`,
+headless by default (no windows unless ``--draw``), with a progress line on stderr, and prints G′
+and G″ from both estimators (overall stress tensor and surface forces) on stdout, or with
+``--json`` the result row (:meth:`~particleShear.SimulationResult.to_dict`) as JSON and nothing
+else.  ``particleShear sweep SPEC --out DIR`` runs a sweep (docs/sweeps.md), ``particleShear plot
+DIR`` plots one.
+
+The flags of ``run`` are generated from the signature of ``doParticleShearSimulation``: every
+parameter has the flag of its name in kebab case (``time_step_factor`` → ``--time-step-factor``,
+``saveOutputImages`` → ``--save-output-images``; booleans as ``--flag``/``--no-flag``), with the
+help text, type, unit and allowed range taken from its numpydoc docstring; the short names of
+earlier versions (``--amplitude``, ``--mu``, ``--young-modulus``, ``--no-permanent-links``,
+``--line-cuts``, ``--no-tensor-data``, ``--save DIR``, ``--images [TYPE]``, ``--draw``, ``--movie``,
+``--quiet``) stay as aliases.  Exit status: 0 ok, 1 output not written or run unstable, 2 invalid
+parameters, 130 interrupted.
 """
+__docformat__ = "numpy"
 import argparse
+import contextlib
+import inspect
+import json
+import math
 import re
 import sys
 import time
 
-__all__ = ["main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message"]
+__all__ = ["main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
+           "flag_name", "api_kwargs", "NOT_FLAGS"]
 
-#: the ``doParticleShearSimulation`` parameter behind each flag, so that errors name what the user typed
-PARAMETER_FLAGS = {
-    "theAmplitude": "--amplitude", "theMu": "--mu", "N": "--N", "cut_lines": "--cut-lines",
-    "Young_modulus_spheres": "--young-modulus", "packing_fraction": "--packing-fraction", "density": "--density",
-    "bimodal_factor": "--bimodal-factor", "relative_viscosity": "--relative-viscosity",
-    "relative_transversal_link_strength": "--relative-transversal-link-strength",
-    "relative_frequency": "--relative-frequency", "remove_link_fraction": "--remove-link-fraction",
-    "edge_fuzziness": "--edge-fuzziness", "pre_periods": "--pre-periods", "periods": "--periods",
-    "post_periods": "--post-periods", "cool_factor": "--cool-factor", "seed": "--seed", "root_folder": "--save",
-    "imageFileType": "--images",
+#: today's (short) flag names of the parameters, kept as the first option string of each
+_ALIASES = {"theAmplitude": "--amplitude", "theMu": "--mu", "Young_modulus_spheres": "--young-modulus",
+            "saveOutputMovie": "--movie"}
+#: earlier flags that switch a boolean parameter off
+_NEGATIVE_ALIASES = {"do_permanent_links": "--no-permanent-links", "doCutByTriangulation": "--line-cuts",
+                     "saveStressTensorData": "--no-tensor-data"}
+#: parameters without a flag, and why
+NOT_FLAGS = {"return_result": "the command line always takes the whole result; --json prints it"}
+#: parameters whose command-line default differs from the API's (headless, quiet, progress line)
+_CLI_DEFAULTS = {
+    "doDrawing": "off unless --draw or --images",
+    "plotStress": "off unless --draw",
+    "renderer": '"none"; "auto" with --draw, "pillow" with --images',
+    "verbose": "off",
+    "progress": "on (--quiet: off)",
+    "saveData": "off; on with --save DIR",
+    "root_folder": '""; DIR of --save DIR',
+    "saveOutputImages": "off; on with --images",
 }
-#: parameter settings that a flag switches
-_SETTING_FLAGS = {"saveStressTensorData=False": "--no-tensor-data", "doCutByTriangulation=False": "--line-cuts",
-                  "do_permanent_links=False": "--no-permanent-links", "saveData=True": "--save DIR",
-                  "saveOutputImages=True": "--images"}
+#: help of parameters whose command-line meaning differs from the API's
+_CLI_HELP = {"progress": "Show a progress line on stderr (phase, step, elapsed, estimated remaining time), "
+                         "the progress callback of the API."}
+#: the command-line type of parameters whose Python type is wider
+_CLI_TYPES = {"seed": int, "progress": bool}
 
 
-def cli_message(text):
+def flag_name(name):
+    """The flag of a parameter: its name in kebab case (``theMu`` → ``--the-mu``; ``N`` stays ``--N``).
+
+    Parameters
+    ----------
+    name : str
+        Parameter name of :func:`~particleShear.doParticleShearSimulation`.
+
+    Returns
+    -------
+    str
+    """
+    if len(name) == 1:
+        return "--" + name
+    kebab = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "-", name).replace("_", "-").lower()
+    return "--" + kebab
+
+
+def parameter_docs(func=None):
+    """``{name: (type text, description)}`` of the numpydoc Parameters section of ``func``.
+
+    The description is one line (whitespace joined); a leading "Keyword-only." is dropped.
+
+    Parameters
+    ----------
+    func : callable, optional
+        Function with a numpydoc docstring (default :func:`~particleShear.doParticleShearSimulation`).
+
+    Returns
+    -------
+    dict
+    """
+    if func is None:
+        from .api import doParticleShearSimulation as func
+    lines = inspect.cleandoc(func.__doc__ or "").splitlines()
+    try:
+        i = next(k for k in range(len(lines) - 1) if lines[k].strip() == "Parameters"
+                 and set(lines[k + 1].strip()) == {"-"}) + 2
+    except StopIteration:
+        return {}
+    docs, current = {}, None
+    for k in range(i, len(lines)):
+        line = lines[k]
+        if k + 1 < len(lines) and line.strip() and set(lines[k + 1].strip()) == {"-"} and not line.startswith(" "):
+            break  # the next section
+        if line and not line.startswith(" "):
+            names, _, type_text = line.partition(" : ")
+            current = [n.strip() for n in names.split(",")]
+            for n in current:
+                docs[n] = [type_text.strip(), ""]
+        elif current and line.strip():
+            for n in current:
+                docs[n][1] = (docs[n][1] + " " + line.strip()).strip()
+    out = {}
+    for n, (t, d) in docs.items():
+        d = re.sub(r"^Keyword-only\.\s*", "", d)
+        out[n] = (t, d)
+    return out
+
+
+def _choices(type_text):
+    if not type_text.startswith("{"):
+        return None
+    return tuple(re.findall(r'"([^"]*)"', type_text[:type_text.index("}")]))
+
+
+def _cli_type(name, type_text, default):
+    if name in _CLI_TYPES:
+        return _CLI_TYPES[name]
+    first = re.split(r"[ ,]", type_text, maxsplit=1)[0]
+    return {"bool": bool, "int": int, "float": float, "str": str}.get(first, type(default))
+
+
+def _default_text(value):
+    if isinstance(value, float):
+        return f"{value:g}"
+    return '""' if value == "" else (json.dumps(value) if isinstance(value, str) else str(value))
+
+
+def _help(text):
+    """Help text for argparse: plain reST markup dropped, ``%`` escaped."""
+    text = re.sub(r":\w+:`~?([^`]*)`", r"\1", text).replace("``", "")
+    return text.replace("%", "%%")
+
+
+def _record(namespace, dest, option_string):
+    typed = getattr(namespace, "_typed", None)
+    if typed is None:
+        typed = {}
+        setattr(namespace, "_typed", typed)
+    typed[dest] = option_string
+
+
+class _Store(argparse._StoreAction):
+    """``store``, remembering the option string the user typed (for error messages)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        _record(namespace, self.dest, option_string)
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _StoreConst(argparse._StoreConstAction):
+    def __call__(self, parser, namespace, values, option_string=None):
+        _record(namespace, self.dest, option_string)
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _Bool(argparse.BooleanOptionalAction):
+    """``--flag``/``--no-flag``, remembering which was typed."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        _record(namespace, self.dest, option_string)
+        super().__call__(parser, namespace, values, option_string)
+
+
+def _flags():
+    """``{parameter: (option strings, kind, choices, CLI type, default)}`` in signature order."""
+    from .api import doParticleShearSimulation
+    sig = inspect.signature(doParticleShearSimulation)
+    docs = parameter_docs(doParticleShearSimulation)
+    out = {}
+    for name, par in sig.parameters.items():
+        if name in NOT_FLAGS:
+            continue
+        type_text = docs.get(name, ("", ""))[0]
+        derived = flag_name(name)
+        strings = [_ALIASES[name], derived] if name in _ALIASES and _ALIASES[name] != derived else [derived]
+        out[name] = (strings, _cli_type(name, type_text, par.default), _choices(type_text), par.default)
+    return out
+
+
+def _primary(name):
+    return _ALIASES.get(name) or flag_name(name)
+
+
+def _negative(name):
+    return "--no-" + _primary(name)[2:]
+
+
+#: the flag named in messages for each ``doParticleShearSimulation`` parameter
+PARAMETER_FLAGS = {}
+
+
+def cli_message(text, typed=None):
     """``text`` of an API error on one line, with parameter names replaced by the CLI flags.
 
+    ``typed`` maps parameters to the flag the user typed (preferred over the documented one).
     A name is replaced where it is unambiguous: followed by ``=`` or a comparison, or spelled
-    like an identifier (an underscore or a capital letter inside it).
+    like an identifier (an underscore or a capital letter inside it); ``name=True`` and
+    ``name=False`` of a boolean become its flag and its ``--no-`` flag.
+
+    Parameters
+    ----------
+    text : str or Exception
+        The message.
+    typed : dict, optional
+        ``{parameter: flag the user typed}``.
+
+    Returns
+    -------
+    str
     """
+    if not PARAMETER_FLAGS:
+        _flags_for_messages()
+    typed = typed or {}
     text = " ".join(str(text).split())
-    for setting, flag in _SETTING_FLAGS.items():
-        text = text.replace(setting, flag)
-    for name, flag in sorted(PARAMETER_FLAGS.items(), key=lambda kv: -len(kv[0])):
+    for name in sorted(PARAMETER_FLAGS, key=len, reverse=True):
+        for value in ("True", "False"):
+            setting = f"{name}={value}"
+            if not re.search(rf"(?<![\w-]){re.escape(setting)}(?!\w)", text):
+                continue
+            t = typed.get(name)
+            if value == "True":
+                flag = t if t and not t.startswith("--no-") and t not in _NEGATIVE_ALIASES.values() else \
+                    ("--save DIR" if name == "saveData" else _primary(name))
+            else:
+                flag = t if t and (t.startswith("--no-") or t in _NEGATIVE_ALIASES.values()) else \
+                    _NEGATIVE_ALIASES.get(name, _negative(name))
+            text = re.sub(rf"(?<![\w-]){re.escape(setting)}(?!\w)", flag, text)
+    for name in sorted(PARAMETER_FLAGS, key=len, reverse=True):
+        flag = typed.get(name) or PARAMETER_FLAGS[name]
         identifier = "_" in name or any(c.isupper() for c in name[1:])
         pattern = rf"(?<![\w-])({re.escape(name)})(?![\w-])" if identifier else \
             rf"(?<![\w-])({re.escape(name)})(?=\s*(?:=|<=|>=|<|>))"
-        text = re.sub(pattern, flag, text)
+        text = re.sub(pattern, flag.replace("\\", "\\\\"), text)
     return text
+
+
+def _flags_for_messages():
+    for name in _flags():
+        PARAMETER_FLAGS[name] = _primary(name)
+    PARAMETER_FLAGS["root_folder"] = "--save"
+
+
+_flags_for_messages()
 
 
 class _Parser(argparse.ArgumentParser):
@@ -56,6 +263,12 @@ class ProgressLine:
     """Progress callback writing one self-overwriting line to a stream (default stderr).
 
     The estimate of the remaining time of a phase is ``elapsed · (total − step)/step``.
+
+    Parameters
+    ----------
+    stream : file-like, optional
+        Where the line goes (default ``sys.stderr``); without a terminal, one line per phase
+        boundary and at most one every ``log_interval`` s, without carriage returns.
     """
 
     def __init__(self, stream=None):
@@ -89,93 +302,173 @@ class ProgressLine:
         self.stream.flush()
 
     def finish(self):
+        """End the self-overwriting line (a newline on a terminal)."""
         if self._tty and self._width:
             self.stream.write("\n")
             self.stream.flush()
 
 
 def build_parser():
+    """The parser of ``particleShear [run]``: one flag per parameter of ``doParticleShearSimulation``."""
+    from .. import __version__
+    from .api import doParticleShearSimulation
+    docs = parameter_docs(doParticleShearSimulation)
     p = _Parser(prog="particleShear",
-                                description="2D soft-particle oscillatory shear rheology: G' and G'' of one run "
-                                            "(defaults = doParticleShearSimulation defaults).")
-    a = p.add_argument
-    a("--amplitude", type=float, default=0.2, help="strain amplitude A (0.2 = 20%%)")
-    a("--mu", type=float, default=0.01, help="friction coefficient of transient contacts")
-    a("--N", type=int, default=150, help="number of spheres")
-    a("--cut-lines", type=int, default=5, help="number of particles (triangulation) / cut lines; 0 = bulk gel")
-    a("--no-permanent-links", action="store_true", help="frictional spheres only (no crosslinks)")
-    a("--young-modulus", type=float, default=8000, help="Young modulus of the sphere material (Pa)")
-    a("--packing-fraction", type=float, default=1.5, help="nominal packing fraction")
-    a("--density", type=float, default=50, help="density (kg/m^3)")
-    a("--bimodal-factor", type=float, default=1.4, help="large/small radius ratio")
-    a("--relative-viscosity", type=float, default=0.1, help="rv in nu = rv*sqrt(m k)")
-    a("--relative-transversal-link-strength", type=float, default=1, help="k_t/k")
-    a("--relative-frequency", type=float, default=0.025, help="f * tau")
-    a("--remove-link-fraction", type=float, default=0, help="fraction of non-essential bonds to remove")
-    a("--edge-fuzziness", type=float, default=0, help="roughening of particle borders (units of r_max)")
-    a("--line-cuts", action="store_true", help="cut with random straight lines instead of triangulation")
-    a("--pre-periods", type=float, default=2, help="baseline periods before the excitation")
-    a("--periods", type=float, default=3, help="excitation periods")
-    a("--post-periods", type=float, default=1, help="recovery periods after the excitation")
-    a("--cool-factor", type=float, default=0.5, help="peculiar velocity left after one period")
-    a("--seed", type=int, default=None, help="random seed (same seed = identical run)")
-    a("--save", metavar="DIR", default=None, help="write the text output file into DIR (must exist)")
-    a("--no-tensor-data", action="store_true", help="with --save: omit the 42-column per-step table")
-    a("--output-format", default="text", choices=("text", "text.gz", "npz", "parquet"),
-      help="with --save: file format (default text, the reference format; see docs/output.md)")
-    a("--images", nargs="?", const="jpg", default=None, choices=("jpg", "png", "ps"),
-      help="with --save: save ~200 snapshots (default type jpg)")
-    a("--draw", action="store_true", help="show the live particle and stress windows (needs a display)")
-    a("--correct-drift-sign", action="store_true", help="use the correct drift sign in the demodulation")
-    a("--reference-header", action="store_true", help="reproduce the reference header defects #21-22")
-    a("--movie", action="store_true", help="with --images: also write the snapshots as movie.gif")
-    a("--plot", metavar="FILE", default=None,
-      help="write the strain/stress trace and Lissajous loop to FILE (.png/.pdf/.svg; needs particleShear[plot])")
-    a("--quiet", action="store_true", help="no progress line")
-    a("--verbose", action="store_true", help="print the reference console messages")
+                description="2D soft-particle oscillatory shear rheology: G' and G'' of one run. Commands: "
+                            "run (default; the flags below), sweep SPEC --out DIR (particleShear sweep --help), "
+                            "plot DIR (particleShear plot --help). Flags follow the parameters of "
+                            "doParticleShearSimulation (its docstring and docs/parameters.md); headless by default.")
+    p.add_argument("--version", action="version", version=f"particleShear {__version__}")
+    groups = {True: p.add_argument_group("parameters of doParticleShearSimulation (reference order)"),
+              False: p.add_argument_group("keyword-only options of doParticleShearSimulation")}
+    from inspect import Parameter, signature
+    kinds = {n: par.kind for n, par in signature(doParticleShearSimulation).parameters.items()}
+    for name, (strings, cli_type, choices, default) in _flags().items():
+        group = groups[kinds[name] != Parameter.KEYWORD_ONLY]
+        desc = _CLI_HELP.get(name) or docs.get(name, ("", ""))[1]
+        shown = _CLI_DEFAULTS.get(name, _default_text(default))
+        help_text = _help(cli_message(desc)) + f" [default: {shown}]"
+        if cli_type is bool:
+            group.add_argument(*strings, dest=name, action=_Bool, default=None, help=help_text)
+            if name in _NEGATIVE_ALIASES:
+                group.add_argument(_NEGATIVE_ALIASES[name], dest=name, action=_StoreConst, const=False,
+                                   default=None, help=f"same as {_negative(name)}")
+        else:
+            metavar = None if choices else ("DIR" if name == "root_folder" else
+                                            {int: "INT", float: "FLOAT"}.get(cli_type, "STR"))
+            group.add_argument(*strings, dest=name, action=_Store, type=cli_type, choices=choices, default=None,
+                               metavar=metavar, help=help_text)
+    c = p.add_argument_group("command line")
+    c.add_argument("--save", metavar="DIR", default=None, action=_Store,
+                   help="write the output file into DIR (must exist): --root-folder DIR --save-data")
+    c.add_argument("--images", nargs="?", const="jpg", default=None, choices=("jpg", "png", "ps"), action=_Store,
+                   help="with --save: save ~200 snapshots of type jpg (default), png or ps: "
+                        "--save-output-images --image-file-type TYPE")
+    c.add_argument("--draw", action="store_true",
+                   help="show the live particle and stress windows (needs a display): "
+                        "--do-drawing --plot-stress --renderer auto")
+    c.add_argument("--plot", metavar="FILE", default=None,
+                   help="write the strain/stress trace and Lissajous loop to FILE (.png/.pdf/.svg/.eps; "
+                        "needs particleShear[plot])")
+    c.add_argument("--json", action="store_true",
+                   help="print the result row (SimulationResult.to_dict(), the row of a sweep's results.csv) "
+                        "as one JSON object on stdout, and nothing else there")
+    c.add_argument("--quiet", dest="progress", action=_StoreConst, const=False, default=None,
+                   help="no progress line (same as --no-progress)")
     return p
+
+
+def api_kwargs(args):
+    """The keyword arguments of ``doParticleShearSimulation`` for parsed ``args`` (command-line defaults applied).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed by :func:`build_parser`.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ValueError
+        Naming the flags, for combinations the API cannot express.
+    """
+    from .api import doParticleShearSimulation
+    kw = {}
+    for name, par in inspect.signature(doParticleShearSimulation).parameters.items():
+        if name in NOT_FLAGS:
+            continue
+        value = getattr(args, name, None)
+        kw[name] = par.default if value is None else value
+    given = {n for n in kw if getattr(args, n, None) is not None}
+    images = getattr(args, "images", None)
+    save = getattr(args, "save", None)
+    draw = bool(getattr(args, "draw", False))
+    if "root_folder" not in given:
+        kw["root_folder"] = save or ""
+    if "saveData" not in given:
+        kw["saveData"] = bool(save)
+    if "saveOutputImages" not in given:
+        kw["saveOutputImages"] = bool(images)
+    if "imageFileType" not in given and images:
+        kw["imageFileType"] = images
+    if "doDrawing" not in given:
+        kw["doDrawing"] = bool(draw or images)
+    if "plotStress" not in given:
+        kw["plotStress"] = draw
+    if "renderer" not in given:
+        kw["renderer"] = "auto" if draw else ("pillow" if kw["saveOutputImages"] else "none")
+    if "verbose" not in given:
+        kw["verbose"] = False
+    kw["progress"] = ProgressLine() if getattr(args, "progress", None) in (None, True) else None
+    if images and not kw["root_folder"]:
+        raise ValueError("--images needs --save DIR")
+    return kw
+
+
+def _json_row(res):
+    """The result row with non-finite numbers as null (strict JSON)."""
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        return v
+    return json.dumps({k: clean(v) for k, v in res.to_dict().items()}, default=str)
 
 
 def main(argv=None):
     """Entry point; returns the process exit status (0 ok, 1 output not written or run unstable,
     2 invalid parameters, 130 interrupted).
 
-    ``particleShear plot DIR ...`` dispatches to :func:`particleShear.plot.cli_main`,
-    ``particleShear sweep SPEC --out DIR ...`` to :func:`particleShear.sweep.cli.main`.
+    ``particleShear run ...`` (or flags only) runs one simulation, ``particleShear plot DIR ...``
+    dispatches to :func:`particleShear.plot.cli_main`, ``particleShear sweep SPEC --out DIR ...`` to
+    :func:`particleShear.sweep.cli.main`.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
     """
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv and argv[0] == "plot":
+    if argv[:1] == ["plot"]:
         from ..plot import cli_main
         return cli_main(argv[1:])
     if argv[:1] == ["sweep"]:  # python -m particleShear sweep SPEC --out DIR (particleShear.sweep.cli)
         from ..sweep.cli import main as sweep_main
         return sweep_main(argv[1:])
+    if argv[:1] == ["run"]:
+        argv = argv[1:]
+    elif argv and not argv[0].startswith("-"):
+        print(f"particleShear: invalid parameter: unknown command {argv[0]!r}: allowed run (default), sweep, plot",
+              file=sys.stderr)
+        return 2
     args = build_parser().parse_args(argv)
+    typed = getattr(args, "_typed", {})
+    if "save" in typed:
+        typed.setdefault("root_folder", "--save")
+        typed.setdefault("saveData", "--save")
+    if "images" in typed:
+        typed.setdefault("saveOutputImages", "--images")
     from .api import doParticleShearSimulation
     from ..base.stability import SimulationInstabilityError
-    progress = None if args.quiet else ProgressLine()
-    if args.images and not args.save:
-        print("particleShear: --images needs --save DIR", file=sys.stderr)
-        return 2
     try:
-        res = doParticleShearSimulation(
-            root_folder=args.save or "", theAmplitude=args.amplitude, theMu=args.mu,
-            do_permanent_links=not args.no_permanent_links, cut_lines=args.cut_lines,
-            Young_modulus_spheres=args.young_modulus, N=args.N, packing_fraction=args.packing_fraction,
-            density=args.density, bimodal_factor=args.bimodal_factor, relative_viscosity=args.relative_viscosity,
-            relative_transversal_link_strength=args.relative_transversal_link_strength,
-            relative_frequency=args.relative_frequency, saveOutputImages=bool(args.images),
-            imageFileType=args.images or "jpg", remove_link_fraction=args.remove_link_fraction,
-            edge_fuzziness=args.edge_fuzziness, doCutByTriangulation=not args.line_cuts,
-            doDrawing=bool(args.draw or args.images), saveData=bool(args.save),
-            saveStressTensorData=not args.no_tensor_data, plotStress=bool(args.draw), pre_periods=args.pre_periods,
-            periods=args.periods, post_periods=args.post_periods, cool_factor=args.cool_factor, seed=args.seed,
-            return_result=True, verbose=args.verbose, progress=progress,
-            correct_drift_sign=args.correct_drift_sign, reference_header=args.reference_header,
-            renderer="auto" if args.draw else ("pillow" if args.images else "none"),
-            saveOutputMovie=bool(args.movie and args.images),
-            output_format=args.output_format)
-
+        kw = api_kwargs(args)
+    except ValueError as exc:
+        print(f"particleShear: {exc}", file=sys.stderr)
+        return 2
+    progress = kw["progress"]
+    # with --json, stdout holds the JSON only: the run's console messages go to stderr
+    quiet_stdout = contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext()
+    try:
+        with quiet_stdout:
+            res = doParticleShearSimulation(**kw, return_result=True)
     except KeyboardInterrupt as exc:  # one line, no traceback; the run removed its temporary files
         if progress is not None:
             progress.finish()
@@ -189,24 +482,29 @@ def main(argv=None):
     except (ValueError, TypeError) as exc:
         if progress is not None:
             progress.finish()
-        print(f"particleShear: invalid parameter: {cli_message(exc)}", file=sys.stderr)
+        print(f"particleShear: invalid parameter: {cli_message(exc, typed)}", file=sys.stderr)
         return 2
     except SimulationInstabilityError as exc:
         if progress is not None:
             progress.finish()
-        print(f"particleShear: {cli_message(exc)}", file=sys.stderr)
+        print(f"particleShear: {cli_message(exc, typed)}", file=sys.stderr)
         return 1
     if progress is not None:
         progress.finish()
-    print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
-    print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
-    t = res.timings
-    print("seed entropy = " + str(res.seed) + "; wall time " + ", ".join(
-        f"{k} {t[k]:.2f} s" for k in ("constitution", "pre_equilibration", "protocol", "output", "total") if k in t))
-    if res.output_path:
-        print("output file: " + res.output_path)
-    if res.image_folder:
-        print(f"images: {res.n_images} in {res.image_folder}")
+    info = sys.stderr if args.json else sys.stdout
+    if args.json:
+        print(_json_row(res))
+    else:
+        print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
+        print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
+        t = res.timings
+        print("seed entropy = " + str(res.seed) + "; wall time " + ", ".join(
+            f"{k} {t[k]:.2f} s" for k in ("constitution", "pre_equilibration", "protocol", "output", "total")
+            if k in t))
+        if res.output_path:
+            print("output file: " + res.output_path)
+        if res.image_folder:
+            print(f"images: {res.n_images} in {res.image_folder}")
     if res.write_error is not None:
         print(f"particleShear: writing the output failed, nothing was saved: {res.write_error}", file=sys.stderr)
         return 1
@@ -216,7 +514,7 @@ def main(argv=None):
         except (ImportError, ValueError) as exc:
             print(f"particleShear: --plot: {exc}", file=sys.stderr)
             return 1
-        print("plot: " + args.plot)
+        print("plot: " + args.plot, file=info)
     return 0
 
 

@@ -24,6 +24,7 @@ import math
 import os
 import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -47,8 +48,8 @@ def _headless_message(reason, files):
         return
     _headless_message_printed = True
     extra = " Snapshots are rendered off-screen with Pillow." if files else ""
-    print(f"particleShear: no display available ({reason}); running headless without live windows.{extra}",
-          file=sys.stderr)
+    message = f"particleShear: no display available ({reason}); running headless without live windows.{extra}"
+    warnings.warn(message, UserWarning, stacklevel=3)
 
 
 def display_available():

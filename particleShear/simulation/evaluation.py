@@ -10,7 +10,7 @@ running estimates ``Gprime`` / ``viscosity`` are computed on demand.
 """
 __docformat__ = "numpy"
 import math
-import sys
+import warnings
 
 import numpy as np
 
@@ -283,9 +283,9 @@ class EvaluationHandler:
         if den and (abs(sx) / den >= self.force_balance_tolerance or abs(sy) / den >= self.force_balance_tolerance):
             self.n_force_balance_warnings += 1
             if self.n_force_balance_warnings == 1:
-                print(f"EvaluationHandler: internal pair forces do not balance: |ΣFx|/Σ|F| = {abs(sx) / den}, "
+                warnings.warn(f"EvaluationHandler: internal pair forces do not balance: |ΣFx|/Σ|F| = {abs(sx) / den}, "
                       f"|ΣFy|/Σ|F| = {abs(sy) / den} (further warnings are counted in "
-                      "n_force_balance_warnings)", file=sys.stderr)
+                      "n_force_balance_warnings)", RuntimeWarning, stacklevel=2)
 
     def _record_momenta(self, ens):
         """Keep what the momenta of this step are made of; they are summed when first read."""

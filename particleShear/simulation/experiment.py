@@ -8,15 +8,18 @@ records every step, demodulates τ_internal and τ_surface (:func:`~.evaluation.
 and returns ``[G′_surface, G″_surface]`` (Pa) as the reference does.
 """
 __docformat__ = "numpy"
+import logging
 import math
 import os
-import sys
 import time
+import warnings
 
 
 from ..base.stress import StressTensorEvaluation
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
+
+_log = logging.getLogger(__name__)
 
 __all__ = ["OscillatoryShearExperiment", "image_cadence", "protocol_steps"]
 
@@ -194,7 +197,7 @@ class OscillatoryShearExperiment:
 
     def _say(self, *args):
         if self.verbose:
-            print(*args)
+            _log.info(" ".join(str(a) for a in args))
 
     def _report(self, phase, step, total, t0, state):
         """Call the progress callback at most ~10 times per second (and at the end)."""
@@ -441,13 +444,13 @@ class OscillatoryShearExperiment:
         if self.verbose:
             p = self.plotter
             if p.last_tensors is not None:
-                print("Overall stress tensor, last step:", p.last_tensors[-1].tolist())
-                print("Overall stress tensor, first step:", p.first_tensors[-1].tolist())
+                _log.info("Overall stress tensor, last step: %s", p.last_tensors[-1].tolist())
+                _log.info("Overall stress tensor, first step: %s", p.first_tensors[-1].tolist())
             for label, v in (("G'", G_int[2]), ("G''", G_int[3]), ("G'(by surface force)", G_surf[2]),
                              ("G''(by surface force)", G_surf[3])):
-                print(label)
-                print(v)
-                print("Pa")
+                _log.info("%s", label)
+                _log.info("%s", v)
+                _log.info("Pa")
         t0 = time.perf_counter()
         if self.output_file:
             self.write_output_information_to_file()
@@ -513,7 +516,7 @@ class OscillatoryShearExperiment:
             for piece in iter_table_text(p._scal[: len(p)], p.tensor_history):  # streamed: bounded memory
                 out.write(piece)
         elif self.saveStressTensorData:
-            print("OscillatoryShearExperiment: tensor history was not kept; writing no table", file=sys.stderr)
+            warnings.warn("OscillatoryShearExperiment: tensor history was not kept; writing no table", RuntimeWarning)
             out.write("\n" + NO_TENSOR_DATA_TEXT)
         else:
             out.write("\n" + NO_TENSOR_DATA_TEXT)

@@ -11,6 +11,7 @@ __docformat__ = "numpy"
 import gzip
 import io
 import json
+import logging
 import math
 import os
 import shutil
@@ -26,6 +27,8 @@ from .formats import FORMAT_SUFFIXES, check_output_format, write_run
 from .output import (IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text, probe_writable,
                      reserve_numbered_path)
 from .provenance import header_number, json_safe, package_version, positional_numbers_in_call, provenance_lines
+
+_log = logging.getLogger(__name__)
 
 __all__ = ["OscillatorySimulation", "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
            "Simulation_interlocking_rheology", "check_output_folder"]
@@ -287,7 +290,7 @@ class OscillatorySimulation:
         if getattr(self, "stability_guard", True):
             ens.stability_guard = StabilityGuard()
         if self.verbose:
-            print("Setting relative frequency: " + str(self.relative_frequency) + " f= " + str(self.f) + "Hz")
+            _log.info("Setting relative frequency: " + str(self.relative_frequency) + " f= " + str(self.f) + "Hz")
         exp = OscillatoryShearExperiment(ens, self.dt, self.f, self.amplitude, output_file,
                                          force_scale=y_scale_force, TkSimulation=self.theTkSimulation,
                                          dt_max=ens.dt_max * factor, imageOutputFolder=imageOutputFolder,
@@ -305,8 +308,8 @@ class OscillatorySimulation:
         exp.verbose = self.verbose
         exp.progress = self.progress
         if self.verbose:
-            print("Creating oscillatory shear experiment, dt = " + str(exp.dt) + " max dt = " + str(exp.dt_max))
-            print("OscillatoryShearExperiment: Plot stress graph: " + str(plotStress))
+            _log.info("Creating oscillatory shear experiment, dt = " + str(exp.dt) + " max dt = " + str(exp.dt_max))
+            _log.info("OscillatoryShearExperiment: Plot stress graph: " + str(plotStress))
         if plotStress and self.doDrawing:
             exp.stress_window = open_stress_plot(exp.width, exp.height, renderer=self.renderer,
                                                  backend=self.renderer_backend)
@@ -393,9 +396,9 @@ class OscillatorySimulation:
             N_per_period = 1 / self.f / self.dt
             f_step = cool_factor ** (1 / N_per_period)
             if self.verbose:
-                print("cool factor per dt= " + str(f_step))
+                _log.info("cool factor per dt= " + str(f_step))
                 if self.saveData:
-                    print("Writing output to file " + fileName)
+                    _log.info("Writing output to file " + fileName)
             G = exp.oscillatory_shear_experiment(cool_factor=f_step, N_pre_equilibration_fixed_boundaries=N_pre)
             t0 = time.perf_counter()
             try:
@@ -408,7 +411,7 @@ class OscillatorySimulation:
                 self.write_error = exc
                 self.output_path = None
                 if self.verbose:
-                    print("Writing the output failed: " + repr(exc))
+                    _log.warning("Writing the output failed: " + repr(exc))
             if out is not None and not out.committed:
                 out.abort()  # images only (or a failed write): release the reservation
             exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
@@ -748,7 +751,7 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
         if self.relative_viscosity <= 0.1:
             F *= 2
         if self.verbose:
-            print("Adjustment factor of pre-equilibration time for low amplitude and friction: " + str(F))
+            _log.info("Adjustment factor of pre-equilibration time for low amplitude and friction: " + str(F))
         return F
 
     def _builder_arguments(self, do_debug):

@@ -2,8 +2,13 @@
 __docformat__ = "numpy"
 import argparse
 import contextlib
+import logging
 import os
 import sys
+
+from ..messages import console_messages
+
+_log = logging.getLogger(__name__)
 
 __all__ = ["main", "build_parser"]
 
@@ -46,6 +51,8 @@ def _positive(name, flag, v):
 def main(argv=None):
     """Entry point of ``python -m particleShear sweep``.
 
+    Status lines are INFO messages of the logger ``particleShear.sweep.cli``, shown on stdout.
+
     Parameters
     ----------
     argv : list of str, optional
@@ -58,6 +65,11 @@ def main(argv=None):
         input (message naming the flag on stderr), 130 interrupted.
     """
     args = build_parser().parse_args(argv)
+    with console_messages(stream=sys.stdout):
+        return _main(args)
+
+
+def _main(args):
     from .cost import format_cost
     from .runner import Sweep
     try:
@@ -72,20 +84,20 @@ def main(argv=None):
     workers = args.workers or os.cpu_count() or 1
     if args.merge:
         n, missing = sweep.merge()
-        print(f"merged {n} rows into {os.path.join(sweep.out_dir, 'results.csv')}; {missing} runs not finished")
+        _log.info(f"merged {n} rows into {os.path.join(sweep.out_dir, 'results.csv')}; {missing} runs not finished")
         return 0 if missing == 0 else 1
     if args.dry_run:
-        print(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
+        _log.info(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
         all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
         if args.calibrate:
             from .cost import calibrate
             factor = calibrate(sweep.runs[0].parameters)
-            print(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
+            _log.info(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
             for c in (all_c, todo_c):
                 c["cpu_s"] *= factor
                 c["wall_s"] *= factor
-        print("all runs:   " + format_cost(all_c))
-        print("still to run: " + format_cost(todo_c))
+        _log.info("all runs:   " + format_cost(all_c))
+        _log.info("still to run: " + format_cost(todo_c))
         return 0
     failed = 0
     with contextlib.ExitStack() as stack:
@@ -118,5 +130,5 @@ def main(argv=None):
             return 2
     rows = sweep.rows()
     n_failed = sum(r["status"] == "failed" for r in rows)
-    print(f"{len(rows)} of {len(sweep.my_runs())} runs finished ({n_failed} failed); table: {sweep.table_path}")
+    _log.info(f"{len(rows)} of {len(sweep.my_runs())} runs finished ({n_failed} failed); table: {sweep.table_path}")
     return 1 if (n_failed and not args.keep_going) else 0
