@@ -26,7 +26,7 @@ import re
 import sys
 import time
 
-__all__ = ["main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
+__all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
 
 #: today's (short) flag names of the parameters, kept as the first option string of each
@@ -520,3 +520,22 @@ def main(argv=None):
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def console_main():
+    """Console-script entry (``particleShear`` / ``python -m particleShear``): :func:`main` with a closed pipe ended quietly.
+
+    A reader that stops early (``particleShear --json | head -c 100``) closes stdout; that ends
+    the command with status 141 (as a shell pipeline reports SIGPIPE) instead of a traceback.
+
+    Returns
+    -------
+    int
+    """
+    import os
+    try:
+        return main()
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # no second error when Python flushes stdout at exit
+        return 141
