@@ -1,4 +1,5 @@
 """Layer 5: ``doParticleShearSimulation``, ``doParticleShearSimulationSeries`` and the command line."""
 from .api import SimulationResult, doParticleShearSimulation, doParticleShearSimulationSeries
+from .batch import run_batch
 
-__all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult"]
+__all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "run_batch"]

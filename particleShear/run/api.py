@@ -17,6 +17,7 @@ import numpy as np
 
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_simulation_parameters
+from .batch import batches, check_backend, check_batch_size, run_batch
 
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
 
@@ -104,7 +105,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               plotStress=True, relative_y_scale_force=1e8, pre_periods=2, periods=3,
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
-                              time_step_factor=1.0, integrator="euler", stability_guard=True):
+                              time_step_factor=1.0, integrator="euler", stability_guard=True, backend="numpy"):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     Parameters
@@ -142,6 +143,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     stability_guard : bool, keyword-only
         Stop a diverging measurement with :class:`SimulationInstabilityError` (step, phase, worst
         pair, suggested time step) instead of producing NaN moduli.
+    backend : {"numpy"}, keyword-only
+        Array backend (see :mod:`particleShear.run.batch`; only NumPy in this version).
 
     Returns
     -------
@@ -172,6 +175,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   relative_y_scale_force=relative_y_scale_force, pre_periods=pre_periods, periods=periods,
                   post_periods=post_periods, cool_factor=cool_factor, seed=seed)
     validate_simulation_parameters(params)
+    check_backend(backend)
     if not (isinstance(time_step_factor, (int, float)) and math.isfinite(time_step_factor) and time_step_factor > 0):
         raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed finite > 0")
     if integrator not in ("euler", "verlet"):
@@ -268,7 +272,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
                                     central_repulsion_coefficient=1, doDrawing=True, saveData=False,
                                     saveStressTensorData=True, plotStress=True, pre_periods=2, periods=3,
                                     post_periods=1, cool_factor=0.5, executor=None, seed=None, *,
-                                    max_workers=None, verbose=False, **options):
+                                    max_workers=None, verbose=False, batch_size=None, backend="numpy",
+                                    **options):
     """Run the reference series (repetitions × amplitudes × μ × controls) on an executor.
 
     Parameters
@@ -287,6 +292,14 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Size of the default process pool.
     verbose : bool, keyword-only
         Forwarded to each run (default False: quiet workers).
+    batch_size : int, keyword-only
+        When given, runs that share a step schedule (same N, time-step rule and protocol; see
+        :func:`particleShear.run.batch.schedule_key`) are grouped into batches of up to
+        ``batch_size`` runs, and each batch is one task of the executor
+        (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
+        unbatched series, in the same order.  Default None: one task per run.
+    backend : {"numpy"}, keyword-only
+        Array backend of every run.
     **options :
         Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
         ``reference_header``, ``renderer``, ...).
@@ -297,6 +310,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
     """
+    check_batch_size(batch_size)
+    check_backend(backend)
     if isinstance(N_repetitions, bool) or int(N_repetitions) != N_repetitions or N_repetitions < 0:
         raise ValueError(f"N_repetitions={N_repetitions!r} is out of range: allowed integers >= 0")
     amplitudes = list(amplitudes)
@@ -334,8 +349,16 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     if own:
         executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
     try:
-        futures = [executor.submit(_series_worker, kw) for kw in all_kwargs]
-        return [fut.result() for fut in futures]
+        if batch_size is None:
+            futures = [executor.submit(_series_worker, kw) for kw in all_kwargs]
+            return [fut.result() for fut in futures]
+        groups = batches(all_kwargs, batch_size)
+        futures = [executor.submit(run_batch, [all_kwargs[p] for p in g], backend) for g in groups]
+        results = [None] * len(all_kwargs)
+        for g, fut in zip(groups, futures):
+            for p, res in zip(g, fut.result()):
+                results[p] = res
+        return results
     finally:
         if own:
             executor.shutdown(wait=True, cancel_futures=True)
