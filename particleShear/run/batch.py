@@ -11,14 +11,24 @@ per replica, in the given order; :func:`batches` splits a list of runs into batc
 ``batch_size`` runs that share a schedule.  ``doParticleShearSimulationSeries(..., batch_size=B)``
 submits every batch as one task of its executor.
 
-A replica's result does not depend on the other replicas of its batch: its trajectory, tensors
-and G′/G″ are bit-identical to its single run (tested).  In this version the replicas of a batch
-are advanced one after the other, each through the same code path as a single run; see
-``docs/design.md`` (section "Batches of replicas") for what a vectorised replica axis will change.
+A replica's result does not depend on the other replicas of its batch: its recorded series and
+G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
+no drawing, no files, no progress or console output, the Euler integrator, the built-in force laws,
+N ≤ :data:`ENGINE_MAX_N`) — single runs included — measure through :mod:`particleShear.engine`, all
+replicas of a batch in one set of arrays; other runs go through the documented classes one after
+the other.  See ``docs/design.md`` (section "Batches of replicas").
 """
+import time
+
+import numpy as np
+
 from ..linkable.builders import time_steps_from_model
 
-__all__ = ["run_batch", "batches", "schedule_key", "PER_REPLICA_PARAMETERS", "BACKENDS"]
+__all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
+           "ENGINE_MAX_N"]
+
+#: largest N measured by the engine (its candidate search is all-pairs per replica at each rebuild)
+ENGINE_MAX_N = 2000
 
 #: parameters a replica may choose on its own (everything else must agree within a batch)
 PER_REPLICA_PARAMETERS = frozenset((
@@ -67,15 +77,17 @@ def schedule_key(kwargs):
     """Hashable key of the step schedule of one run (runs with equal keys may share a batch).
 
     The key holds the values of :data:`SCHEDULE_PARAMETERS` (defaults filled in) and the
-    branches of the time-step rule (``time_steps_from_model`` with τ = 1, docs/parameters.md),
-    which also depend on the replica's μ, amplitude and link strength: two runs with equal keys
-    have the same ``dt``, ``dt_max``, damping factor and number of steps in every phase.
+    protocol time step ``dt`` of the time-step rule (``time_steps_from_model`` with τ = 1,
+    docs/parameters.md), which also depends on the replica's μ, amplitude and link strength: two
+    runs with equal keys have the same ``dt``, damping factor and protocol steps.  Their
+    pre-equilibration may differ (``dt_max`` depends on the links); the batch then
+    pre-equilibrates each group of equal ``dt_max`` on its own and shears them together.
     """
     full = dict(_signature_defaults(), **kwargs)
     shared = tuple((name, repr(full[name])) for name in SCHEDULE_PARAMETERS)
     steps = time_steps_from_model(1.0, full["bimodal_factor"], full["theMu"],
                                   full["relative_transversal_link_strength"], full["theAmplitude"],
-                                  full["relative_viscosity"])
+                                  full["relative_viscosity"])[0]
     other = tuple(sorted((k, repr(v)) for k, v in kwargs.items()
                          if k not in PER_REPLICA_PARAMETERS and k not in SCHEDULE_PARAMETERS))
     return shared + (("steps", steps),) + other
@@ -155,4 +167,138 @@ def run_batch(list_of_kwargs, backend="numpy"):
             raise ValueError(f"list_of_kwargs[{n}] has unknown parameters {unknown}: allowed the keywords of "
                              "doParticleShearSimulation")
         validate_simulation_parameters(dict(defaults, **kw))
-    return [doParticleShearSimulation(**kw, return_result=True) for kw in runs]
+    full = [dict(defaults, **kw) for kw in runs]
+    if not all(engine_supports(kw) for kw in full):
+        return [doParticleShearSimulation(**kw, return_result=True) for kw in runs]
+    results = measure_batch(full)
+    doParticleShearSimulation.last_result = results[-1]
+    return results
+
+
+def engine_supports(kw):
+    """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
+
+    It does when nothing is drawn, plotted, saved or printed, no progress callback is given,
+    the integrator is "euler", the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.
+    """
+    from ..base.laws import elastic_force_law, elastic_force_law_tensile
+    from ..base.points import CircleBasicElasticity
+    from ..linkable.spheres import SphereLinkable
+    return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveData"] and not kw["saveOutputImages"]
+            and not kw["verbose"] and kw["progress"] is None and kw["integrator"] == "euler"
+            and int(kw["N"]) <= ENGINE_MAX_N
+            and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
+            and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
+
+
+def measure_batch(runs):
+    """Constitute every replica with the documented builder, then measure all of them in one engine.
+
+    ``runs``: complete, validated keyword dicts sharing one schedule.  Returns the
+    :class:`~particleShear.run.api.SimulationResult` of each run, in order.
+    """
+    from ..engine.state import BatchState
+    from ..engine.step import BatchEngine, pre_equilibrate, protocol
+    from ..simulation.evaluation import demodulation
+    from .api import SimulationResult, _build_simulation, _seed_sequence
+
+    sims, seeds, constitution = [], [], []
+    for kw in runs:
+        if not kw["periods"] > 0:
+            raise ValueError(f"periods={kw['periods']!r} is out of range: allowed > 0")
+        if not 0 < kw["cool_factor"] <= 1:
+            raise ValueError(f"cool_factor={kw['cool_factor']!r} is out of range: allowed 0 < value <= 1")
+    for kw in runs:
+        ss, rng = _seed_sequence(kw["seed"])
+        params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
+        t0 = time.perf_counter()
+        sim = _build_simulation(params, rng, verbose=False, progress=None,
+                                correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
+                                renderer="none", time_step_factor=kw["time_step_factor"], integrator="euler",
+                                stability_guard=kw["stability_guard"])
+        sim.initEnsemble()
+        constitution.append(time.perf_counter() - t0)
+        sims.append(sim)
+        seeds.append((ss, params))
+    # the schedule of each replica; replicas sharing the protocol schedule are measured in one engine,
+    # after pre-equilibrating (in one engine per pre-equilibration schedule)
+    sched = []
+    for kw, sim in zip(runs, sims):
+        e = sim.theEnsemble
+        factor = float(kw["time_step_factor"])
+        model = sim.model or getattr(e, "model", False)
+        dt = e.dt * factor
+        f = sim.relative_frequency / model.time_constant
+        proto = (dt, f, kw["cool_factor"] ** (1 / (1 / f / dt)), kw["pre_periods"], kw["periods"], kw["post_periods"])
+        pre = (e.dt_max * factor, 25 * int(sim.adjustment_factor_for_bounded_preequilibration_steps()))
+        sched.append((proto, pre))
+    rec = [None] * len(runs)
+    protocol_time = {}
+    pre_time = {}
+    for proto in dict.fromkeys(p for p, _ in sched):
+        members = [b for b, (p, _) in enumerate(sched) if p == proto]
+        dt, f, cool, pre_p, periods, post = proto
+        states = []
+        order = []
+        for pre in dict.fromkeys(sched[b][1] for b in members):
+            group = [b for b in members if sched[b][1] == pre]
+            t0 = time.perf_counter()
+            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
+            _guarded(pre_equilibrate, BatchEngine(st), pre[1], dt, pre[0], cool, dt=dt)
+            for b in group:
+                pre_time[b] = (time.perf_counter() - t0) / len(group)
+            states.append(st)
+            order += group
+        t0 = time.perf_counter()
+        engine = BatchEngine(BatchState.concat(states))
+        out = _guarded(protocol, engine, dt, f, [runs[b]["theAmplitude"] for b in order], cool, pre_p, periods, post,
+                       dt=dt)
+        for col, b in enumerate(order):
+            rec[b] = {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()}
+            protocol_time[b] = (time.perf_counter() - t0) / len(order)
+    results = []
+    for b, (kw, sim, (ss, params)) in enumerate(zip(runs, sims, seeds)):
+        t0 = time.perf_counter()
+        dt, f, cool, pre, periods, post = sched[b][0]
+        series = {key: rec[b][key] for key in ("t", "strain", "strain_rate", "stress_surface", "stress_internal")}
+        A = kw["theAmplitude"]
+        G_int = demodulation(series["t"], series["stress_internal"], f, A, pre, periods, post,
+                             correct_drift_sign=kw["correct_drift_sign"])
+        G_surf = demodulation(series["t"], series["stress_surface"], f, A, pre, periods, post,
+                              correct_drift_sign=kw["correct_drift_sign"])
+        t_demod = time.perf_counter() - t0
+        tim = {"constitution": constitution[b], "pre_equilibration": pre_time[b], "protocol": protocol_time[b],
+               "demodulation": t_demod, "output": 0.0}
+        tim["total"] = sum(tim.values())
+        results.append(SimulationResult(
+            G_surface=(G_surf[2], G_surf[3]), G_internal=(G_int[2], G_int[3]),
+            stress_surface=(G_surf[0], G_surf[1]), stress_internal=(G_int[0], G_int[1]), parameters=params,
+            seed=None if ss is None else ss.entropy, spawn_key=() if ss is None else tuple(ss.spawn_key),
+            timings=tim, output_path=None, image_folder=None, n_images=0, dt=dt, f=f,
+            N_steps=len(series["t"]), damping_factor=cool,
+            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0), series=series))
+    return results
+
+
+def _guarded(phase, engine, *args, dt):
+    """Run an engine phase; a diverging replica raises SimulationInstabilityError (step, phase, suggested dt)."""
+    from ..base.stability import SimulationInstabilityError
+    from ..engine.step import EngineInstability
+    try:
+        return phase(engine, *args)
+    except EngineInstability as e:
+        raise SimulationInstabilityError(
+            f"run {e.replica} of the batch diverged at step {e.step} of phase {e.phase!r} (time step {dt:.3g} s, "
+            f"try dt <= {dt / 2:.3g} s)", step=e.step, phase=e.phase, pair=None, suggested_dt=dt / 2,
+            reason="non-finite state") from e
+
+
+#: the arguments a SimulationResult lists in ``parameters`` (the reference's, in its order)
+_REFERENCE_ARGUMENTS = (
+    "root_folder", "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "Young_modulus_spheres", "N",
+    "packing_fraction", "density", "bimodal_factor", "relative_viscosity", "relative_transversal_link_strength",
+    "relative_frequency", "avoid_horizontal_angle_degree", "interface_reenforcement_central",
+    "interface_reenforcement_tangential", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",
+    "cut_top_bottom", "saveOutputImages", "imageFileType", "remove_link_fraction", "edge_fuzziness",
+    "central_repulsion_coefficient", "doCutByTriangulation", "doDrawing", "saveData", "saveStressTensorData",
+    "plotStress", "relative_y_scale_force", "pre_periods", "periods", "post_periods", "cool_factor", "seed")

@@ -1,0 +1,298 @@
+"""One step of a batch of replicas, top to bottom in the reference order, and the measurement.
+
+:meth:`BatchEngine.step` reads like the reference's step (reference §4.1, §8.3): shear rate →
+neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
+:func:`pre_equilibrate` (plates fixed: coarse levels from ``dt_max``, then 2N and N steps at
+``dt``) and :func:`protocol` (recording t, γ, γ̇, τ_internal and τ_surface of every replica and
+step) are the measurement of the oscillatory experiment on a batch.
+
+The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
+place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
+"""
+import math
+
+import numpy as np
+
+from .box import min_image, wrap
+from .forces import PairConstants, central_term, normals, scatter, shear_stresses, tangential_term
+from .neighbours import build_candidates, displacement_bound
+from .state import SLIP, STICK, ReplicaPairs
+
+__all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
+
+
+class EngineInstability(RuntimeError):
+    """A replica's state became non-finite (``replica``, ``step``, ``phase`` say where)."""
+
+    def __init__(self, message, replica=None, step=None, phase=None):
+        RuntimeError.__init__(self, message)
+        self.replica = replica
+        self.step = step
+        self.phase = phase
+
+
+class BatchEngine:
+    """Advances a :class:`~particleShear.engine.state.BatchState` step by step.
+
+    Parameters
+    ----------
+    state : BatchState
+    skin_factor : float
+        Verlet skin in units of each replica's largest radius (> 0).
+    check_interval : int
+        Steps between the finiteness checks of the state (the stability guard of the engine).
+    """
+
+    def __init__(self, state, skin_factor=0.5, check_interval=4):
+        if not skin_factor > 0:
+            raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
+        s = self.s = state
+        B, N = s.B, s.N
+        self.skin = skin_factor * s.r.reshape(B, N).max(axis=1)
+        self.bound = np.full(B, np.inf)        # first step builds every list
+        self.C = None
+        self.Lx_s = s.Lx[s.rep]
+        self.Ly_s = s.Ly[s.rep]
+        self.hy_s = self.Ly_s / 2
+        self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
+        self.check_interval = int(check_interval)
+        self.step_count = 0
+        self.phase = "pre-equilibration"
+        self.rebuilds = np.zeros(B, dtype=np.int64)
+
+    # -- the one cache ---------------------------------------------------------------------------
+    def _sync_down(self):
+        """Write the flat pair history back into the per-replica lists."""
+        C = self.C
+        for b, p in enumerate(self.s.pairs):
+            lo, hi = C.offsets[b], C.offsets[b + 1]
+            p.state = self.state_p[lo:hi].copy()
+            p.xi = self.xi[:, lo:hi].copy()
+            p.active = self.active[lo:hi].copy()
+
+    def neighbours(self):
+        """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
+        per-candidate constants with them (the one invalidation point)."""
+        need = self.bound >= self.skin
+        if not need.any():
+            return
+        s = self.s
+        if self.C is not None:
+            self._sync_down()
+        for b in np.flatnonzero(need):
+            rows = s.replica(b)
+            s.pairs[b] = build_candidates(s.x[rows], s.y[rows], s.r[rows], s.Lx[b], s.Ly[b], s.Ly[b] * s.gamma[b],
+                                          self.skin[b], s.pairs[b])
+            self.bound[b] = 0.0
+            self.rebuilds[b] += 1
+        offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
+        C = self.C = PairConstants(s, offsets)
+        self.state_p = np.concatenate([p.state for p in s.pairs])
+        self.xi = np.concatenate([p.xi for p in s.pairs], axis=1)
+        self.active = np.concatenate([p.active for p in s.pairs])
+        C.set_bonds(s, self.state_p, np.concatenate([p.d_eq for p in s.pairs]))
+
+    def flush(self):
+        """Write the flat pair history back into ``state.pairs`` (after a phase)."""
+        if self.C is not None:
+            self._sync_down()
+
+    def pairs_of(self, b):
+        """Current candidate list of replica ``b`` (a copy, with the flat history written in)."""
+        if self.C is not None:
+            self._sync_down()
+        p = self.s.pairs[b]
+        return ReplicaPairs(p.i, p.j, p.state, p.xi, p.d_eq, p.active)
+
+    def mobile(self):
+        """Mobility mask: with the plates on, spheres overlapping ``y = 0`` or ``y = Ly`` are immobile."""
+        s = self.s
+        if not s.applying_shear:
+            return np.ones(len(s.y), bool)
+        return (s.r < s.y) & (s.y < self.Ly_s - s.r)
+
+    # -- the step --------------------------------------------------------------------------------
+    def set_rate(self, rate):
+        """Change γ̇ per replica; each sphere keeps its velocity relative to the local flow (§4.5)."""
+        s = self.s
+        delta = rate - s.rate
+        d_s = delta[s.rep]
+        s.vx += (s.y - self.hy_s) * d_s
+        s.omega -= d_s / 2
+        s.rate = np.array(rate, dtype=float)
+
+    def step(self, cool, dt, sample=False):
+        """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when sampled."""
+        s = self.s
+        x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
+        # neighbours (positions at the start of the step)
+        self.neighbours()
+        C = self.C
+        ai, aj = C.ai, C.aj
+        # geometry and relations
+        dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, (s.Ly * s.gamma)[C.rep])
+        d = np.sqrt(dx * dx + dy * dy)
+        nx, ny = normals(dx, dy, d, C.rep, s.rng)
+        touching = d < C.d0
+        active = C.perm | touching
+        newly = active & ~self.active
+        if newly.any():
+            self.state_p[newly] = STICK
+        self.xi = xi = np.where(active, self.xi, 0.0)   # an opened contact loses its history
+        self.active = active
+        # relative velocities (image velocity −Ly·γ̇ per period above)
+        dvx = -(C.Ly * s.rate[C.rep]) * ky
+        rvx = vx[aj] - vx[ai] + dvx
+        rvy = vy[aj] - vy[ai]
+        vn = rvx * nx + rvy * ny
+        spin = C.ri * om[ai] + C.rj * om[aj]
+        vt = rvx * -ny + rvy * nx - spin
+        # forces: central (elastic + viscous), tangential (two visits), scatter
+        fn, law = central_term(C, d, vn, active)
+        F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
+        self.state_p = slip.view(np.int8) + C.perm_code
+        f_t = (F[0] + F[1]) * 0.5
+        fx_i = fn * nx - f_t * ny
+        fy_i = fn * ny + f_t * nx
+        dF = d * f_t
+        s.fx, s.fy, s.torque = scatter(C, len(x), fx_i, fy_i, dF * C.w_i, dF * C.w_j)
+        mob = self.mobile()
+        out = None
+        if sample:
+            shifted = (ky != 0) | (kx != 0)
+            out = shear_stresses(C, s.B, y, mob, active, shifted, dy, fx_i, dF, self.V)
+        self._check("force phase")
+        # kick (plates follow), rotational kick, damping
+        rate_s = s.rate[s.rep]
+        vx += s.fx * dt / s.m
+        vy += s.fy * dt / s.m
+        om += s.torque * dt / s.inertia
+        s.fx[:] = 0.0
+        s.fy[:] = 0.0
+        s.torque[:] = 0.0
+        imm = ~mob
+        if imm.any():
+            plate = np.where(y - self.hy_s > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
+            vy[imm] = 0.0
+            vx[imm] = plate[imm]
+        u = (y - self.hy_s) * rate_s
+        vx -= u
+        vx *= cool
+        vx += u
+        vy *= cool
+        om *= cool
+        # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
+        kd = np.where(active & (self.state_p != SLIP), dt, 0.0)
+        rvx = vx[aj] - vx[ai] + dvx
+        rvy = vy[aj] - vy[ai]
+        spin = C.ri * om[ai] + C.rj * om[aj]
+        inc_ij = rvx * -ny + rvy * nx - spin
+        Rx = vx[ai] * dt - dx
+        Ry = vy[ai] * dt - dy
+        mx, my = normals(Rx, Ry, np.sqrt(Rx * Rx + Ry * Ry), C.rep, s.rng)
+        inc_ji = rvx * my - rvy * mx - spin
+        xi[0] += inc_ij * kd
+        xi[1] += inc_ji * kd
+        # drift, strain, wrap, clock
+        speed = np.sqrt(vx * vx + vy * vy).reshape(s.B, s.N).max(axis=1)
+        self.bound += displacement_bound(speed, s.Ly, s.rate, dt)
+        x += vx * dt
+        y += vy * dt
+        s.phi += om * dt
+        s.gamma = s.gamma + s.rate * dt
+        wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
+        s.t = s.t + dt
+        self.step_count += 1
+        return out
+
+    def _check(self, where):
+        if self.step_count % self.check_interval:
+            return
+        s = self.s
+        total = (s.x + s.y + s.vx + s.vy + s.omega + s.fx + s.fy).reshape(s.B, s.N).sum(axis=1)
+        bad = np.flatnonzero(~np.isfinite(total))
+        if len(bad):
+            b = int(bad[0])
+            raise EngineInstability(f"replica {b}: non-finite state at step {self.step_count} of phase "
+                                    f"{self.phase!r} ({where})", replica=b, step=self.step_count, phase=self.phase)
+
+
+def pre_equilibration_blocks(N, dt, dt_max):
+    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``."""
+    blocks = []
+    level_dt, cf = dt_max, 0.5
+    while level_dt > dt:
+        blocks.append((int(N / 2), level_dt, cf))
+        level_dt = level_dt / 2
+        cf = (1 + cf) / 2
+    return blocks
+
+
+def pre_equilibrate(engine, N, dt, dt_max, cool):
+    """Relax with the plates fixed (reference §8.4): coarse levels from ``dt_max``, 2N steps at
+    ``dt`` (damping 0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment."""
+    s = engine.s
+    s.applying_shear = True
+    engine.phase = "pre-equilibration"
+    engine.step_count = 0
+    for n, level_dt, cf in pre_equilibration_blocks(N, dt, dt_max):
+        for _ in range(n):
+            engine.step(cf, level_dt)
+    for _ in range(2 * int(N)):
+        engine.step(0.98, dt)
+    for _ in range(int(N)):
+        s.rate = np.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
+        engine.step(cool, dt)
+    engine.flush()
+
+
+def protocol(engine, dt, f, amplitudes, cool, pre, periods, post):
+    """The oscillatory protocol of every replica (reference §8.2-8.3), clock reset to 0.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+    dt : float
+        Time step (s), shared by the replicas.
+    f : float
+        Excitation frequency (Hz).
+    amplitudes : array_like (B,)
+        Strain amplitude of each replica.
+    cool : float
+        Damping factor per step.
+    pre, periods, post : float
+        Baseline periods before, shear periods, baseline periods after.
+
+    Returns
+    -------
+    dict of ndarray (n_steps, B)
+        "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step.
+    """
+    s = engine.s
+    s.applying_shear = True
+    s.t = np.zeros(s.B)
+    T_total = (periods + pre + post) / f
+    n_steps = int(T_total / dt)
+    lo = pre / (f * dt)
+    hi = (periods + pre) / (f * dt)
+    A = np.asarray(amplitudes, dtype=float)
+    rec = {name: np.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
+                                                         "stress_surface")}
+    engine.phase = "protocol"
+    engine.step_count = 0
+    zero = np.zeros(s.B)
+    for i in range(n_steps):
+        t = float(s.t[0])      # every replica has the same clock (same dt, same schedule)
+        if lo <= i <= hi:
+            rate = A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
+        else:
+            rate = zero
+        engine.set_rate(rate)
+        rec["t"][i] = s.t
+        rec["strain"][i] = s.gamma
+        rec["strain_rate"][i] = s.rate
+        tau_int, tau_surf = engine.step(cool, dt, sample=True)
+        rec["stress_internal"][i] = tau_int
+        rec["stress_surface"][i] = tau_surf
+    engine.flush()
+    return rec
