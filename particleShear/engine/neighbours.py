@@ -2,9 +2,9 @@
 
 A candidate is a pair whose Lees-Edwards minimum-image distance is below
 ``r_i + r_j + skin``, or a bond.  The list stays valid while no pair can have come into
-contact: :func:`displacement_bound` accumulates per replica an upper bound of how much any
-pair separation can have shrunk since the list was built, and the list is rebuilt when the
-bound reaches the skin.  The contacts of every step are therefore exactly those of an
+contact: :func:`verlet_bound` is, per replica, an upper bound of how much any pair separation
+can have shrunk since the list was built (from the peculiar displacements and the accumulated
+strain), and the list is rebuilt when the bound reaches the skin.  The contacts of every step are therefore exactly those of an
 all-pairs search (tested), and a replica's list depends only on its own history.
 """
 import numpy as np
@@ -12,7 +12,7 @@ import numpy as np
 from .box import min_image
 from .state import PERMANENT, ReplicaPairs
 
-__all__ = ["all_pairs", "build_candidates", "displacement_bound"]
+__all__ = ["all_pairs", "build_candidates", "verlet_bound"]
 
 _TRIU = {}
 
@@ -76,10 +76,15 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     return ReplicaPairs(i[sel], j[sel], state, xi, d_eq, active)
 
 
-def displacement_bound(speed_max, Ly, rate, dt):
-    """Growth of the Verlet bound in one step (µm): ``(2·max|v| + Ly·|γ̇|)·dt``.
+def verlet_bound(u_max, strain, r_max):
+    """Upper bound (µm) of how much any pair separation can have shrunk since the list was built.
 
-    A pair separation (through any image) changes by at most the two spheres' displacements
-    plus, for a pair across the sheared boundary, the change ``Ly·|γ̇|·dt`` of the offset.
+    Under Lees-Edwards shear a pair vector (through a fixed image) evolves as
+    ``dΔ = γ̇ Δ_y dt + (peculiar displacements)``, the peculiar velocity being ``v − γ̇ (y − Ly/2)``
+    (invariant under the wrap).  With ``u_max`` the largest peculiar displacement of any sphere
+    since the build (running maximum) and ``strain`` the accumulated ``Σ |γ̇| dt``, a pair that
+    touches now (``|Δ| < r_i + r_j ≤ 2 r_max``) was at most
+    ``2 u_max (1 + 2·strain) + 2·strain·r_max`` farther apart at the build.  The list is valid
+    while this stays below the skin.
     """
-    return (2 * speed_max + Ly * np.abs(rate)) * dt
+    return 2 * u_max * (1 + 2 * strain) + 2 * strain * r_max

@@ -15,7 +15,7 @@ import numpy as np
 
 from .box import min_image, wrap
 from .forces import PairConstants, central_term, normals, scatter, shear_stresses, tangential_term
-from .neighbours import build_candidates, displacement_bound
+from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
@@ -48,8 +48,12 @@ class BatchEngine:
             raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
         s = self.s = state
         B, N = s.B, s.N
-        self.skin = skin_factor * s.r.reshape(B, N).max(axis=1)
+        self.r_max = s.r.reshape(B, N).max(axis=1)
+        self.skin = skin_factor * self.r_max
         self.bound = np.full(B, np.inf)        # first step builds every list
+        self.u = np.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
+        self.u_max = np.zeros(B)               # running maximum of |u| per replica
+        self.strain = np.zeros(B)              # Σ |γ̇| dt per replica since its list was built
         self.C = None
         self.Lx_s = s.Lx[s.rep]
         self.Ly_s = s.Ly[s.rep]
@@ -84,6 +88,9 @@ class BatchEngine:
             s.pairs[b] = build_candidates(s.x[rows], s.y[rows], s.r[rows], s.Lx[b], s.Ly[b], s.Ly[b] * s.gamma[b],
                                           self.skin[b], s.pairs[b])
             self.bound[b] = 0.0
+            self.u[:, rows] = 0.0
+            self.u_max[b] = 0.0
+            self.strain[b] = 0.0
             self.rebuilds[b] += 1
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
         C = self.C = PairConstants(s, offsets)
@@ -194,8 +201,12 @@ class BatchEngine:
         xi[0] += inc_ij * kd
         xi[1] += inc_ji * kd
         # drift, strain, wrap, clock
-        speed = np.sqrt(vx * vx + vy * vy).reshape(s.B, s.N).max(axis=1)
-        self.bound += displacement_bound(speed, s.Ly, s.rate, dt)
+        u = self.u
+        u[0] += (vx - (y - self.hy_s) * rate_s) * dt
+        u[1] += vy * dt
+        self.u_max = np.maximum(self.u_max, np.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
+        self.strain += np.abs(s.rate) * dt
+        self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         x += vx * dt
         y += vy * dt
         s.phi += om * dt
