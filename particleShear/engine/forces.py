@@ -44,6 +44,7 @@ class PairConstants:
         self.Lx = s.Lx[g]
         self.Ly = s.Ly[g]
         self.hy = self.Ly / 2
+        self.hx = self.Lx / 2
         self.sphere_idx = np.concatenate((self.ai, self.aj))
 
     def set_bonds(self, s, state, d_eq):
@@ -130,25 +131,26 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     return fx, fy, tq
 
 
-def shear_stresses(C, B, y, mob, active, shifted, dy, fx_i, dF, V):
+def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     """τ_internal = −σ_xy of the overall tensor and τ_surface = −σ_xy of the external-force tensor (Pa).
 
     ``σ_LW,xy = (1/V) Σ_internal F_x,i (y_i − y_j)`` (eq. S1-19) with ``y_i − y_j = −D_y`` for
     an unshifted pair; ``σ_Tint,xy = −(1/V) Σ_internal d·F_T/2`` (eq. S1-22, ``dF = d·F_T``);
     the centrifugal term has no xy part.  ``σ_ext,xy = −(1/V) Σ_external F_x (y_target − Ly/2)``
     (eq. S1-16): a pair is internal when both spheres are mobile and no image shift was used,
-    otherwise each mobile sphere receives an external entry.  Sums per replica over its own
-    pairs in list order (``bincount`` over the replica index).
+    otherwise each mobile sphere receives an external entry.  ``yc`` is ``y − Ly/2`` per sphere,
+    ``flags`` = (mobile i, mobile j, not both mobile) per candidate.  Sums per replica over its
+    own pairs in list order (``bincount`` over the replica index).
     """
-    mi, mj = mob[C.ai], mob[C.aj]
-    internal = mi & mj & ~shifted & active
-    lw = np.bincount(C.rep, np.where(internal, fx_i * -dy, 0.0), B)
-    tint = np.bincount(C.rep, np.where(internal, dF, 0.0), B)
-    ext_i = mi & (~mj | shifted) & active
-    ext_j = mj & (~mi | shifted) & active
-    yc_i = y[C.ai] - C.hy
-    yc_j = y[C.aj] - C.hy
-    surf = np.bincount(C.rep, np.where(ext_i, fx_i * yc_i, 0.0) - np.where(ext_j, fx_i * yc_j, 0.0), B)
-    sigma_all = lw * (CF_CL / V) - tint * (CT / V) / 2
+    mi, mj, not_both = flags
+    ext = not_both | shifted
+    ext &= active
+    internal = active & ~ext
+    lw = np.bincount(C.rep, fx_i * dy * internal, B)          # Σ F_x,i·D_y = −Σ F_x,i (y_i − y_j)
+    tint = np.bincount(C.rep, dF * internal, B)
+    lever = yc[C.ai] * (ext & mi)
+    lever -= yc[C.aj] * (ext & mj)
+    surf = np.bincount(C.rep, fx_i * lever, B)
+    sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)
     return -sigma_all, -sigma_ext

@@ -43,7 +43,8 @@ class BatchState:
     B, N : int
         Replicas and spheres per replica.
     x, y, vx, vy, omega, phi, r, m, inertia : ndarray (B·N,)
-        Sphere state (µm, µm/s, 1/s, rad, µm, mg/m, mg·µm²/m).
+        Sphere state (µm, µm/s, 1/s, rad, µm, mg/m, mg·µm²/m); ``x, y`` are the rows of ``pos``
+        (2, B·N) and ``vx, vy, omega`` those of ``vel`` (3, B·N).
     Lx, Ly, gamma, rate, t : ndarray (B,)
         Box (µm), strain γ, strain rate γ̇ (1/s) and clock (s) of each replica.
     k, nu, k_t, nu_t, mu, c, prc, prt, keep : ndarray (B,)
@@ -60,7 +61,12 @@ class BatchState:
         self.B = int(B)
         self.N = int(N)
         n = self.B * self.N
-        for name in ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia"):
+        # positions and velocities as row views of two blocks: one gather fetches all rows of a pair side
+        self.pos = np.zeros((2, n))
+        self.x, self.y = self.pos
+        self.vel = np.zeros((3, n))
+        self.vx, self.vy, self.omega = self.vel
+        for name in ("phi", "r", "m", "inertia"):
             setattr(self, name, np.zeros(n))
         for name in ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
             setattr(self, name, np.zeros(self.B))
@@ -122,7 +128,7 @@ class BatchState:
         out = cls(sum(st.B for st in states), Ns.pop())
         for name in ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia", "fx", "fy", "torque", "Lx", "Ly",
                      "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
-            setattr(out, name, np.concatenate([getattr(st, name) for st in states]))
+            getattr(out, name)[...] = np.concatenate([getattr(st, name) for st in states])
         out.pairs = [p for st in states for p in st.pairs]
         out.rng = [g for st in states for g in st.rng]
         out.applying_shear = all(st.applying_shear for st in states)

@@ -63,6 +63,8 @@ class BatchEngine:
         self.step_count = 0
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
+        self._img = None          # period counts of the candidates' images (with the C they belong to)
+        self._mob_flags = None    # mobility flags of the candidates (with the C and mask they belong to)
 
     # -- the one cache ---------------------------------------------------------------------------
     def _sync_down(self):
@@ -98,6 +100,32 @@ class BatchEngine:
         self.xi = np.concatenate([p.xi for p in s.pairs], axis=1)
         self.active = np.concatenate([p.active for p in s.pairs])
         C.set_bonds(s, self.state_p, np.concatenate([p.d_eq for p in s.pairs]))
+
+    def _images(self, raw_x, raw_y, shift_p):
+        """Minimum image of the candidates, reusing the period counts of the last step while they
+        still give separations inside the half-open intervals (one period at most, so the result is
+        the same number as a fresh :func:`~particleShear.engine.box.min_image`)."""
+        C = self.C
+        img = self._img
+        if img is not None and img[0] is C:
+            _, Lyky, ky, Lxkx, kx = img
+            dy = raw_y - Lyky
+            dx = raw_x - shift_p * ky
+            dx -= Lxkx
+            if (np.abs(dy) < C.hy).all() and (np.abs(dx) < C.hx).all():
+                return dx, dy, ky, kx
+        dx, dy, ky, kx = min_image(raw_x, raw_y, C.Lx, C.Ly, shift_p)
+        one = (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all()
+        self._img = (C, C.Ly * ky, ky, C.Lx * kx, kx) if one else None
+        return dx, dy, ky, kx
+
+    def _mobility_flags(self, mob):
+        """(mob_i, mob_j, not both mobile) of the candidates, kept while the mask and the lists stay."""
+        fl = self._mob_flags
+        if fl is None or fl[0] is not self.C or not np.array_equal(fl[1], mob):
+            mi, mj = mob[self.C.ai], mob[self.C.aj]
+            fl = self._mob_flags = (self.C, mob, mi, mj, ~(mi & mj))
+        return fl[2:]
 
     def flush(self):
         """Write the flat pair history back into ``state.pairs`` (after a phase)."""
@@ -137,7 +165,10 @@ class BatchEngine:
         C = self.C
         ai, aj = C.ai, C.aj
         # geometry and relations
-        dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, (s.Ly * s.gamma)[C.rep])
+        yc = y - self.hy_s                              # height above the cell's centre line
+        raw = s.pos.take(aj, axis=1)
+        raw -= s.pos.take(ai, axis=1)
+        dx, dy, ky, kx = self._images(raw[0], raw[1], (s.Ly * s.gamma)[C.rep])
         d = np.sqrt(dx * dx + dy * dy)
         nx, ny = normals(dx, dy, d, C.rep, s.rng)
         touching = d < C.d0
@@ -149,10 +180,12 @@ class BatchEngine:
         self.active = active
         # relative velocities (image velocity −Ly·γ̇ per period above)
         dvx = -(C.Ly * s.rate[C.rep]) * ky
-        rvx = vx[aj] - vx[ai] + dvx
-        rvy = vy[aj] - vy[ai]
+        Vi = s.vel.take(ai, axis=1)
+        Vj = s.vel.take(aj, axis=1)
+        rvx = Vj[0] - Vi[0] + dvx
+        rvy = Vj[1] - Vi[1]
         vn = rvx * nx + rvy * ny
-        spin = C.ri * om[ai] + C.rj * om[aj]
+        spin = C.ri * Vi[2] + C.rj * Vj[2]
         vt = rvx * -ny + rvy * nx - spin
         # forces: central (elastic + viscous), tangential (two visits), scatter
         fn, law = central_term(C, d, vn, active)
@@ -167,7 +200,7 @@ class BatchEngine:
         out = None
         if sample:
             shifted = (ky != 0) | (kx != 0)
-            out = shear_stresses(C, s.B, y, mob, active, shifted, dy, fx_i, dF, self.V)
+            out = shear_stresses(C, s.B, yc, self._mobility_flags(mob), active, shifted, dy, fx_i, dF, self.V)
         self._check("force phase")
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
@@ -179,36 +212,37 @@ class BatchEngine:
         s.torque[:] = 0.0
         imm = ~mob
         if imm.any():
-            plate = np.where(y - self.hy_s > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
+            plate = np.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
             vy[imm] = 0.0
             vx[imm] = plate[imm]
-        u = (y - self.hy_s) * rate_s
-        vx -= u
+        flow = yc * rate_s
+        vx -= flow
         vx *= cool
-        vx += u
+        vx += flow
         vy *= cool
         om *= cool
         # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
         kd = np.where(active & (self.state_p != SLIP), dt, 0.0)
-        rvx = vx[aj] - vx[ai] + dvx
-        rvy = vy[aj] - vy[ai]
-        spin = C.ri * om[ai] + C.rj * om[aj]
+        Vi = s.vel.take(ai, axis=1)
+        Vj = s.vel.take(aj, axis=1)
+        rvx = Vj[0] - Vi[0] + dvx
+        rvy = Vj[1] - Vi[1]
+        spin = C.ri * Vi[2] + C.rj * Vj[2]
         inc_ij = rvx * -ny + rvy * nx - spin
-        Rx = vx[ai] * dt - dx
-        Ry = vy[ai] * dt - dy
+        Rx = Vi[0] * dt - dx
+        Ry = Vi[1] * dt - dy
         mx, my = normals(Rx, Ry, np.sqrt(Rx * Rx + Ry * Ry), C.rep, s.rng)
         inc_ji = rvx * my - rvy * mx - spin
         xi[0] += inc_ij * kd
         xi[1] += inc_ji * kd
         # drift, strain, wrap, clock
         u = self.u
-        u[0] += (vx - (y - self.hy_s) * rate_s) * dt
+        u[0] += (vx - flow) * dt
         u[1] += vy * dt
         self.u_max = np.maximum(self.u_max, np.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
         self.strain += np.abs(s.rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
-        x += vx * dt
-        y += vy * dt
+        s.pos += s.vel[:2] * dt
         s.phi += om * dt
         s.gamma = s.gamma + s.rate * dt
         wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
