@@ -7,7 +7,8 @@ over a replica is a ``bincount`` over its own rows, so a replica's numbers do no
 other replicas of its batch.
 
 Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central laws),
+:mod:`.tangential` (the two-visit tangential rule, shared with the canvas classes),
 :mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica),
-:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, and
-the measurement protocol).
+:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, the
+pre-equilibration and the protocol).  NumPy only in this version.
 """

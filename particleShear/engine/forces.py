@@ -59,7 +59,7 @@ class PairConstants:
         self.d_cap = self.d_law / 1000
         self.a_lin = -k * (1 - c)
         self.a_div = -k * c * self.d_law
-        self.d_eq = np.where(perm, d_eq, 0.0)               # tensile law k·(d − d_eq) on bonds, (d − 0)·0 on contacts
+        self.d_eq = np.where(perm, d_eq, 0.0)   # tensile law k·(d − d_eq) on bonds, (d − 0)·0 on contacts
         self.k_tens = np.where(perm, k, 0.0)
         self.ratio_c = np.where(perm, s.prc[g], 1.0)
         keep = s.keep[g] != 0

@@ -4,8 +4,9 @@ A candidate is a pair whose Lees-Edwards minimum-image distance is below
 ``r_i + r_j + skin``, or a bond.  The list stays valid while no pair can have come into
 contact: :func:`verlet_bound` is, per replica, an upper bound of how much any pair separation
 can have shrunk since the list was built (from the peculiar displacements and the accumulated
-strain), and the list is rebuilt when the bound reaches the skin.  The contacts of every step are therefore exactly those of an
-all-pairs search (tested), and a replica's list depends only on its own history.
+strain), and the list is rebuilt when the bound reaches the skin.  The contacts of every step
+are therefore exactly those of an all-pairs search (tested), and a replica's list depends only
+on its own history.
 """
 import numpy as np
 
