@@ -116,6 +116,23 @@ class TestBatchGrouping(unittest.TestCase):
         self.assertEqual(schedule_key(dict(theAmplitude=0.2, seed=1)), schedule_key(dict(theAmplitude=0.3)))
 
 
+class TestBatchStability(unittest.TestCase):
+    def test_diverging_replica_stops_the_batch_with_a_clear_error(self):
+        # 40× the time step rule: the explicit step is far beyond its stability limit and blows up
+        from particleShear import SimulationInstabilityError
+        coarse = dict(QUICK, N=20, do_permanent_links=False, cut_lines=0, seed=1, time_step_factor=40)
+        doParticleShearSimulation.last_result = None
+        with self.assertRaises(SimulationInstabilityError) as cm:
+            doParticleShearSimulation(**coarse, return_result=True)
+        e = cm.exception
+        self.assertIn(e.phase, ("pre-equilibration", "protocol"))
+        self.assertIsInstance(e.step, int)
+        self.assertLess(e.suggested_dt, 40 * doParticleShearSimulation(**dict(coarse, time_step_factor=1),
+                                                                       return_result=True).dt)
+        with self.assertRaises(SimulationInstabilityError):
+            run_batch([dict(coarse, seed=2), coarse])
+
+
 class TestBatchBadInput(unittest.TestCase):
     def test_batch_size(self):
         for bad in (0, -1, 1.5, True, "2"):

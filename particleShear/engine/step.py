@@ -40,10 +40,15 @@ class BatchEngine:
     skin_factor : float
         Verlet skin in units of each replica's largest radius (> 0).
     check_interval : int
-        Steps between the finiteness checks of the state (the stability guard of the engine).
+        Steps between the checks of the stability guard.
+    guard : bool
+        Check every ``check_interval`` steps, per replica, what
+        :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
+        energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
+        contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
     """
 
-    def __init__(self, state, skin_factor=0.5, check_interval=4):
+    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True):
         if not skin_factor > 0:
             raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
         s = self.s = state
@@ -60,6 +65,9 @@ class BatchEngine:
         self.hy_s = self.Ly_s / 2
         self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
         self.check_interval = int(check_interval)
+        self.guard = bool(guard)
+        self.rate_max = np.zeros(B)
+        self.min_distance_ratio = 0.05
         self.step_count = 0
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
@@ -201,7 +209,8 @@ class BatchEngine:
         if sample:
             shifted = (ky != 0) | (kx != 0)
             out = shear_stresses(C, s.B, yc, self._mobility_flags(mob), active, shifted, dy, fx_i, dF, self.V)
-        self._check("force phase")
+        if self.guard and not self.step_count % self.check_interval:
+            self._check(d, active)
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
         vx += s.fx * dt / s.m
@@ -250,16 +259,33 @@ class BatchEngine:
         self.step_count += 1
         return out
 
-    def _check(self, where):
-        if self.step_count % self.check_interval:
-            return
+    def _check(self, d, active):
+        """The stability guard (see the class docstring); raises :class:`EngineInstability`."""
         s = self.s
-        total = (s.x + s.y + s.vx + s.vy + s.omega + s.fx + s.fy).reshape(s.B, s.N).sum(axis=1)
-        bad = np.flatnonzero(~np.isfinite(total))
-        if len(bad):
-            b = int(bad[0])
-            raise EngineInstability(f"replica {b}: non-finite state at step {self.step_count} of phase "
-                                    f"{self.phase!r} ({where})", replica=b, step=self.step_count, phase=self.phase)
+        B, N = s.B, s.N
+        self.rate_max = np.maximum(self.rate_max, np.abs(s.rate))
+        state = np.stack((s.x, s.y, s.vx, s.vy, s.omega)).reshape(5, B, N)
+        finite = np.isfinite(state).all(axis=(0, 2))
+        u = s.vx - (s.y - self.hy_s) * s.rate[s.rep]
+        ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
+        plate = self.rate_max * s.Ly / 2
+        bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
+        C = self.C
+        ratio = np.where(active & C.trans, d / C.d0, np.inf)
+        lo, hi = C.offsets[:-1], C.offsets[1:]
+        closest = np.minimum.reduceat(np.append(ratio, np.inf), lo)     # pairs of a replica are contiguous
+        closest[hi == lo] = np.inf
+        for b in range(B):
+            if not finite[b]:
+                reason = "non-finite state"
+            elif ke[b] > bound[b]:
+                reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
+            elif closest[b] < self.min_distance_ratio:
+                reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
+            else:
+                continue
+            raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
+                                    replica=b, step=self.step_count, phase=self.phase)
 
 
 def pre_equilibration_blocks(N, dt, dt_max):

@@ -244,13 +244,14 @@ def measure_batch(runs):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
-            _guarded(pre_equilibrate, BatchEngine(st), pre[1], dt, pre[0], cool, dt=dt)
+            guard = all(runs[b]["stability_guard"] for b in group)
+            _guarded(pre_equilibrate, BatchEngine(st, guard=guard), pre[1], dt, pre[0], cool, dt=dt)
             for b in group:
                 pre_time[b] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states))
+        engine = BatchEngine(BatchState.concat(states), guard=all(runs[b]["stability_guard"] for b in order))
         out = _guarded(protocol, engine, dt, f, [runs[b]["theAmplitude"] for b in order], cool, pre_p, periods, post,
                        dt=dt)
         for col, b in enumerate(order):
@@ -288,9 +289,8 @@ def _guarded(phase, engine, *args, dt):
         return phase(engine, *args)
     except EngineInstability as e:
         raise SimulationInstabilityError(
-            f"run {e.replica} of the batch diverged at step {e.step} of phase {e.phase!r} (time step {dt:.3g} s, "
-            f"try dt <= {dt / 2:.3g} s)", step=e.step, phase=e.phase, pair=None, suggested_dt=dt / 2,
-            reason="non-finite state") from e
+            f"{e} (time step {dt:.3g} s, try dt <= {dt / 2:.3g} s)", step=e.step, phase=e.phase,
+            pair=(e.replica,), suggested_dt=dt / 2, reason=str(e)) from e
 
 
 #: the arguments a SimulationResult lists in ``parameters`` (the reference's, in its order)
