@@ -173,6 +173,50 @@ class TestEngineAgainstClasses(unittest.TestCase):
                 self.assertGreater(np.max(np.abs(ref["stress_surface"])), 0.0)
 
 
+class TestStressRegistry(unittest.TestCase):
+    """Every engine tensor against the documented classes' StressTensorEvaluation along a protocol
+    (same states to ≈ 1e-15, see above; tolerance 1e-12 of the pressure scale, or of the tensor's own
+    scale for the small kinetic terms), and the registry's names and output columns."""
+
+    def test_tensors_along_a_protocol(self):
+        from particleShear.base.stress import TENSOR_NAMES
+        from particleShear.engine.stress import TENSORS
+        _, ens_c, sc = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
+        _, ens_e, _ = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
+        exp = OscillatoryShearExperiment(ens_c, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+        exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+        exp.keep_tensor_history = True
+        ens_c.applyingShear = True
+        exp.prepare_recording()
+        exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+        ens_c.t = 0
+        exp.run_protocol(sc["cool"])
+        ref = exp.plotter.arrays()["tensors"]
+        eng = BatchEngine(BatchState.from_ensembles([ens_e]))
+        pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+        got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5, keep_tensors=True)
+        self.assertEqual([t.name for t in TENSORS], list(TENSOR_NAMES))
+        tens = got["tensors"][:, 0]
+        self.assertEqual(tens.shape, ref.shape)
+        p = np.max(np.abs(ref[:, 0, 0, 0])) + np.max(np.abs(ref[:, 0, 1, 1]))
+        for k, t in enumerate(TENSORS):
+            with self.subTest(tensor=t.name):
+                scale = p if t.name not in ("stress_tensor_spin_kinetic_energy",
+                                            "stress_tensor_linear_acceleration_otsuki") \
+                    else np.max(np.abs(ref[:, k])) + 1e-300
+                self.assertGreater(np.max(np.abs(ref[:, k])), 0.0)
+                self.assertLessEqual(np.max(np.abs(tens[:, k] - ref[:, k])), 1e-12 * scale)
+        # the fast shear stresses G uses are the xy entries of the overall and external tensors
+        np.testing.assert_allclose(got["stress_internal"][:, 0], -tens[:, 8, 0, 1], rtol=0, atol=1e-13 * p)
+        np.testing.assert_allclose(got["stress_surface"][:, 0], -tens[:, 2, 0, 1], rtol=0, atol=1e-13 * p)
+
+    def test_registry_matches_output_columns(self):
+        from particleShear.engine.stress import TENSORS
+        from particleShear.simulation.output import TABLE_COLUMNS
+        stems = [c[:-3] for c in TABLE_COLUMNS if c.endswith("_00")]
+        self.assertEqual([t.stem for t in TENSORS], stems)
+
+
 class TestVerletListKeepsEveryContact(unittest.TestCase):
     def test_contacts_equal_all_pairs_during_shear(self):
         _, ens, sc = constituted(11, theMu=0.05, do_permanent_links=False, cut_lines=0, theAmplitude=0.5)

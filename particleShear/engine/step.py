@@ -17,6 +17,7 @@ from .box import min_image, wrap
 from .forces import PairConstants, central_term, normals, scatter, shear_stresses, tangential_term
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
+from .stress import StressInputs, evaluate_all
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
@@ -165,7 +166,9 @@ class BatchEngine:
         s.rate = np.array(rate, dtype=float)
 
     def step(self, cool, dt, sample=False):
-        """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when sampled."""
+        """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when
+        ``sample``, and also every tensor of :data:`~particleShear.engine.stress.TENSORS` as a
+        (B, 9, 2, 2) array when ``sample == "tensors"``."""
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         # neighbours (positions at the start of the step)
@@ -209,6 +212,11 @@ class BatchEngine:
         if sample:
             shifted = (ky != 0) | (kx != 0)
             out = shear_stresses(C, s.B, yc, self._mobility_flags(mob), active, shifted, dy, fx_i, dF, self.V)
+            if sample == "tensors":
+                q = StressInputs(C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia,
+                                 Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
+                                 dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
+                out = out + (evaluate_all(q),)
         if self.guard and not self.step_count % self.check_interval:
             self._check(d, active)
         # kick (plates follow), rotational kick, damping
@@ -317,7 +325,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool):
     engine.flush()
 
 
-def protocol(engine, dt, f, amplitudes, cool, pre, periods, post):
+def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False):
     """The oscillatory protocol of every replica (reference §8.2-8.3), clock reset to 0.
 
     Parameters
@@ -334,6 +342,9 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post):
     pre, periods, post : float
         Baseline periods before, shear periods, baseline periods after.
 
+    keep_tensors : bool
+        Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
+
     Returns
     -------
     dict of ndarray (n_steps, B)
@@ -349,6 +360,9 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post):
     A = np.asarray(amplitudes, dtype=float)
     rec = {name: np.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
                                                          "stress_surface")}
+    if keep_tensors:
+        rec["tensors"] = np.empty((n_steps, s.B, 9, 2, 2))
+    sample = "tensors" if keep_tensors else True
     engine.phase = "protocol"
     engine.step_count = 0
     zero = np.zeros(s.B)
@@ -362,8 +376,10 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post):
         rec["t"][i] = s.t
         rec["strain"][i] = s.gamma
         rec["strain_rate"][i] = s.rate
-        tau_int, tau_surf = engine.step(cool, dt, sample=True)
-        rec["stress_internal"][i] = tau_int
-        rec["stress_surface"][i] = tau_surf
+        out = engine.step(cool, dt, sample=sample)
+        rec["stress_internal"][i] = out[0]
+        rec["stress_surface"][i] = out[1]
+        if keep_tensors:
+            rec["tensors"][i] = out[2]
     engine.flush()
     return rec
