@@ -45,7 +45,10 @@ class PairConstants:
         self.Ly = s.Ly[g]
         self.hy = self.Ly / 2
         self.hx = self.Lx / 2
-        self.sphere_idx = np.concatenate((self.ai, self.aj))
+        self.rep3 = np.concatenate((self.rep, self.rep + s.B, self.rep + 2 * s.B))
+        nb = s.B * N
+        self.scatter_idx = np.concatenate((self.ai, self.aj, self.ai + nb, self.aj + nb, self.ai + 2 * nb,
+                                           self.aj + 2 * nb))
 
     def set_bonds(self, s, state, d_eq):
         """Bond-dependent constants (bonds never change during the measurement)."""
@@ -121,14 +124,12 @@ def tangential_term(C, vt, touching, xi, law):
 def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     """Pair forces to per-sphere totals: ``+F`` on i, ``−F`` on j, torques on both (eq. S1-3).
 
-    One ``bincount`` per component over ``(ai, aj)``: each sphere's sum runs over its own
-    replica's pairs in list order, whatever else the batch holds.
+    One ``bincount`` over ``(ai, aj)`` of each component (offset by ``k·n_spheres``): each sphere's
+    sum runs over its own replica's pairs in list order, whatever else the batch holds.  Returns
+    the (3, n_spheres) block (F_x, F_y, torque).
     """
-    idx = C.sphere_idx
-    fx = np.bincount(idx, np.concatenate((fx_i, -fx_i)), n_spheres)
-    fy = np.bincount(idx, np.concatenate((fy_i, -fy_i)), n_spheres)
-    tq = np.bincount(idx, np.concatenate((tq_i, tq_j)), n_spheres)
-    return fx, fy, tq
+    w = np.concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
+    return np.bincount(C.scatter_idx, w, 3 * n_spheres).reshape(3, n_spheres)
 
 
 def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
@@ -146,11 +147,11 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     ext = not_both | shifted
     ext &= active
     internal = active & ~ext
-    lw = np.bincount(C.rep, fx_i * dy * internal, B)          # Σ F_x,i·D_y = −Σ F_x,i (y_i − y_j)
-    tint = np.bincount(C.rep, dF * internal, B)
     lever = yc[C.ai] * (ext & mi)
     lever -= yc[C.aj] * (ext & mj)
-    surf = np.bincount(C.rep, fx_i * lever, B)
+    # three per-replica sums in one bincount: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
+    w = np.concatenate((fx_i * dy * internal, dF * internal, fx_i * lever))
+    lw, tint, surf = np.bincount(C.rep3, w, 3 * B).reshape(3, B)
     sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)
     return -sigma_all, -sigma_ext

@@ -74,9 +74,8 @@ class BatchState:
         self.pairs = [None] * self.B
         self.rng = [None] * self.B
         self.applying_shear = True
-        self.fx = np.zeros(n)
-        self.fy = np.zeros(n)
-        self.torque = np.zeros(n)
+        self.frc = np.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
+        self.fx, self.fy, self.torque = self.frc
 
     @classmethod
     def from_ensembles(cls, ensembles):

@@ -65,6 +65,7 @@ class BatchEngine:
         self.Ly_s = s.Ly[s.rep]
         self.hy_s = self.Ly_s / 2
         self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
+        self.mmi = np.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
         self.check_interval = int(check_interval)
         self.guard = bool(guard)
         self.rate_max = np.zeros(B)
@@ -206,7 +207,7 @@ class BatchEngine:
         fx_i = fn * nx - f_t * ny
         fy_i = fn * ny + f_t * nx
         dF = d * f_t
-        s.fx, s.fy, s.torque = scatter(C, len(x), fx_i, fy_i, dF * C.w_i, dF * C.w_j)
+        s.frc[...] = scatter(C, len(x), fx_i, fy_i, dF * C.w_i, dF * C.w_j)
         mob = self.mobile()
         out = None
         if sample:
@@ -221,12 +222,10 @@ class BatchEngine:
             self._check(d, active)
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
-        vx += s.fx * dt / s.m
-        vy += s.fy * dt / s.m
-        om += s.torque * dt / s.inertia
-        s.fx[:] = 0.0
-        s.fy[:] = 0.0
-        s.torque[:] = 0.0
+        kick = s.frc * dt
+        kick /= self.mmi                                    # (F_x/m, F_y/m, T/I)·dt
+        s.vel += kick
+        s.frc[...] = 0.0
         imm = ~mob
         if imm.any():
             plate = np.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
