@@ -116,6 +116,34 @@ class TestBatchGrouping(unittest.TestCase):
         self.assertEqual(schedule_key(dict(theAmplitude=0.2, seed=1)), schedule_key(dict(theAmplitude=0.3)))
 
 
+class TestConsoleAndProgress(unittest.TestCase):
+    def test_engine_path_prints_and_reports_as_the_classes(self):
+        # verbose messages line by line and progress calls, engine path (doDrawing=False) against the
+        # documented classes (doDrawing=True with no renderer); numbers agree to rounding (≈ 1e-15 over
+        # this short protocol), compared to 9 significant digits
+        import contextlib
+        import io
+        import re
+
+        def run(**extra):
+            out, prog = io.StringIO(), []
+            kw = dict(QUICK, seed=1, do_permanent_links=True, cut_lines=2, verbose=True,
+                      progress=lambda *a: prog.append(a[:3]), **extra)
+            with contextlib.redirect_stdout(out):
+                doParticleShearSimulation(**kw)
+            num = re.compile(r"-?\d+\.\d+(?:e[-+]?\d+)?")
+            return [num.sub(lambda m: f"{float(m.group()):.9g}", line) for line in out.getvalue().splitlines()], prog
+
+        engine, classes = run(doDrawing=False), run(doDrawing=True, renderer="none")
+        self.assertGreater(len(engine[0]), 15)
+        self.assertEqual(engine[0], classes[0])
+        # progress is throttled in time (~10 calls/s): compare the first and the last call of every phase
+        ends = [[c for c in prog if c[1] <= 1 or c[1] == c[2]] for prog in (engine[1], classes[1])]
+        self.assertEqual(ends[0], ends[1])
+        self.assertEqual([c[0] for c in ends[0]], ["constitution", "constitution", "pre-equilibration",
+                                                   "pre-equilibration", "protocol", "protocol"])
+
+
 class TestBatchStability(unittest.TestCase):
     def test_diverging_replica_stops_the_batch_with_a_clear_error(self):
         # 40× the time step rule: the explicit step is far beyond its stability limit and blows up

@@ -42,8 +42,8 @@ class BatchEngine:
         Verlet skin in units of each replica's largest radius (> 0).
     check_interval : int
         Steps between the checks of the stability guard.
-    guard : bool
-        Check every ``check_interval`` steps, per replica, what
+    guard : bool or array of bool (B,)
+        Check every ``check_interval`` steps, for each replica where it is true, what
         :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
         energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
         contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
@@ -67,7 +67,7 @@ class BatchEngine:
         self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
         self.mmi = np.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
         self.check_interval = int(check_interval)
-        self.guard = bool(guard)
+        self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica
         self.rate_max = np.zeros(B)
         self.min_distance_ratio = 0.05
         self.step_count = 0
@@ -218,7 +218,7 @@ class BatchEngine:
                                  Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
                                  dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
                 out = out + (evaluate_all(q),)
-        if self.guard and not self.step_count % self.check_interval:
+        if not self.step_count % self.check_interval and self.guard.any():
             self._check(d, active)
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
@@ -283,6 +283,8 @@ class BatchEngine:
         closest = np.minimum.reduceat(np.append(ratio, np.inf), lo)     # pairs of a replica are contiguous
         closest[hi == lo] = np.inf
         for b in range(B):
+            if not self.guard[b]:
+                continue
             if not finite[b]:
                 reason = "non-finite state"
             elif ke[b] > bound[b]:
@@ -306,25 +308,45 @@ def pre_equilibration_blocks(N, dt, dt_max):
     return blocks
 
 
-def pre_equilibrate(engine, N, dt, dt_max, cool):
+def _quiet(*args):
+    pass
+
+
+def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
     """Relax with the plates fixed (reference §8.4): coarse levels from ``dt_max``, 2N steps at
-    ``dt`` (damping 0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment."""
+    ``dt`` (damping 0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment.
+
+    ``say(message)`` receives the reference's console messages, ``report(step, total)`` is
+    called after every step (progress)."""
     s = engine.s
     s.applying_shear = True
     engine.phase = "pre-equilibration"
     engine.step_count = 0
-    for n, level_dt, cf in pre_equilibration_blocks(N, dt, dt_max):
+    blocks = pre_equilibration_blocks(N, dt, dt_max)
+    total = sum(b[0] for b in blocks) + 3 * int(N)
+    say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt " + str(dt_max)
+        + " final dt " + str(dt))
+    step = 0
+    for n, level_dt, cf in blocks:
+        say("dt= " + str(level_dt))
         for _ in range(n):
             engine.step(cf, level_dt)
+            step += 1
+            report(step, total)
+    say("  Setting final dt= " + str(dt))
     for _ in range(2 * int(N)):
         engine.step(0.98, dt)
+        step += 1
+        report(step, total)
     for _ in range(int(N)):
         s.rate = np.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
         engine.step(cool, dt)
+        step += 1
+        report(step, total)
     engine.flush()
 
 
-def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False):
+def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet):
     """The oscillatory protocol of every replica (reference §8.2-8.3), clock reset to 0.
 
     Parameters
@@ -343,11 +365,14 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
 
     keep_tensors : bool
         Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
+    say, report : callable
+        Receive the reference's console message and ``(step, total)`` after every step.
 
     Returns
     -------
     dict of ndarray (n_steps, B)
-        "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step.
+        "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step, and
+        "first_tensors", "last_tensors" (B, 9, 2, 2): every tensor at the first and last step.
     """
     s = engine.s
     s.applying_shear = True
@@ -361,7 +386,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
                                                          "stress_surface")}
     if keep_tensors:
         rec["tensors"] = np.empty((n_steps, s.B, 9, 2, 2))
-    sample = "tensors" if keep_tensors else True
+    say("Start application shear protocol, total N= " + str(n_steps) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
     zero = np.zeros(s.B)
@@ -375,10 +400,16 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
         rec["t"][i] = s.t
         rec["strain"][i] = s.gamma
         rec["strain_rate"][i] = s.rate
-        out = engine.step(cool, dt, sample=sample)
+        ends = i == 0 or i == n_steps - 1
+        out = engine.step(cool, dt, sample="tensors" if keep_tensors or ends else True)
         rec["stress_internal"][i] = out[0]
         rec["stress_surface"][i] = out[1]
         if keep_tensors:
             rec["tensors"][i] = out[2]
+        if i == 0:
+            rec["first_tensors"] = out[2]
+        if i == n_steps - 1:
+            rec["last_tensors"] = out[2]
+        report(i + 1, n_steps)
     engine.flush()
     return rec

@@ -13,8 +13,8 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, no files, no progress or console output, the Euler integrator, the built-in force laws,
-N ≤ :data:`ENGINE_MAX_N`) — single runs included — measure through :mod:`particleShear.engine`, all
+no drawing, no files, the Euler integrator, the built-in force laws, N ≤ :data:`ENGINE_MAX_N`) —
+single runs included — measure through :mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
 """
@@ -178,14 +178,15 @@ def run_batch(list_of_kwargs, backend="numpy"):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted, saved or printed, no progress callback is given,
-    the integrator is "euler", the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.
+    It does when nothing is drawn, plotted or saved, the integrator is "euler", the force laws
+    are the built-in ones and N ≤ :data:`ENGINE_MAX_N` (console messages and progress callbacks
+    work as in the documented classes).
     """
     from ..base.laws import elastic_force_law, elastic_force_law_tensile
     from ..base.points import CircleBasicElasticity
     from ..linkable.spheres import SphereLinkable
     return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveData"] and not kw["saveOutputImages"]
-            and not kw["verbose"] and kw["progress"] is None and kw["integrator"] == "euler"
+            and kw["integrator"] == "euler"
             and int(kw["N"]) <= ENGINE_MAX_N
             and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
             and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
@@ -208,30 +209,40 @@ def measure_batch(runs):
             raise ValueError(f"periods={kw['periods']!r} is out of range: allowed > 0")
         if not 0 < kw["cool_factor"] <= 1:
             raise ValueError(f"cool_factor={kw['cool_factor']!r} is out of range: allowed 0 < value <= 1")
+    sched = []
     for kw in runs:
         ss, rng = _seed_sequence(kw["seed"])
         params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
         t0 = time.perf_counter()
-        sim = _build_simulation(params, rng, verbose=False, progress=None,
+        sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
                                 correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
                                 renderer="none", time_step_factor=kw["time_step_factor"], integrator="euler",
                                 stability_guard=kw["stability_guard"])
+        if sim.progress is not None:
+            sim.progress("constitution", 0, 0, 0.0)
         sim.initEnsemble()
         constitution.append(time.perf_counter() - t0)
+        if sim.progress is not None:
+            sim.progress("constitution", 1, 1, constitution[-1])
         sims.append(sim)
         seeds.append((ss, params))
-    # the schedule of each replica; replicas sharing the protocol schedule are measured in one engine,
-    # after pre-equilibrating (in one engine per pre-equilibration schedule)
-    sched = []
-    for kw, sim in zip(runs, sims):
+        # the schedule of the replica (with the console messages of the reference's set-up, in its order)
         e = sim.theEnsemble
         factor = float(kw["time_step_factor"])
         model = sim.model or getattr(e, "model", False)
         dt = e.dt * factor
         f = sim.relative_frequency / model.time_constant
-        proto = (dt, f, kw["cool_factor"] ** (1 / (1 / f / dt)), kw["pre_periods"], kw["periods"], kw["post_periods"])
-        pre = (e.dt_max * factor, 25 * int(sim.adjustment_factor_for_bounded_preequilibration_steps()))
-        sched.append((proto, pre))
+        if sim.verbose:
+            print("Setting relative frequency: " + str(sim.relative_frequency) + " f= " + str(f) + "Hz")
+            print("Creating oscillatory shear experiment, dt = " + str(dt) + " max dt = " + str(e.dt_max * factor))
+            print("OscillatoryShearExperiment: Plot stress graph: " + str(kw["plotStress"]))
+        N_pre = 25 * int(sim.adjustment_factor_for_bounded_preequilibration_steps())
+        cool = kw["cool_factor"] ** (1 / (1 / f / dt))
+        if sim.verbose:
+            print("cool factor per dt= " + str(cool))
+        sched.append(((dt, f, cool, kw["pre_periods"], kw["periods"], kw["post_periods"]), (e.dt_max * factor, N_pre)))
+    # replicas sharing the protocol schedule are measured in one engine, after pre-equilibrating
+    # (in one engine per pre-equilibration schedule)
     rec = [None] * len(runs)
     protocol_time = {}
     pre_time = {}
@@ -244,18 +255,21 @@ def measure_batch(runs):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
-            guard = all(runs[b]["stability_guard"] for b in group)
-            _guarded(pre_equilibrate, BatchEngine(st, guard=guard), pre[1], dt, pre[0], cool, dt=dt)
+            guard = [bool(runs[b]["stability_guard"]) for b in group]
+            say, report = _console(sims, group, "pre-equilibration")
+            _guarded(pre_equilibrate, BatchEngine(st, guard=guard), pre[1], dt, pre[0], cool, say, report, dt=dt)
             for b in group:
                 pre_time[b] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states), guard=all(runs[b]["stability_guard"] for b in order))
+        engine = BatchEngine(BatchState.concat(states), guard=[bool(runs[b]["stability_guard"]) for b in order])
+        say, report = _console(sims, order, "protocol")
         out = _guarded(protocol, engine, dt, f, [runs[b]["theAmplitude"] for b in order], cool, pre_p, periods, post,
-                       dt=dt)
+                       False, say, report, dt=dt)
         for col, b in enumerate(order):
-            rec[b] = {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()}
+            rec[b] = {key: (np.ascontiguousarray(v[col]) if key.endswith("_tensors") else
+                            np.ascontiguousarray(v[:, col])) for key, v in out.items()}
             protocol_time[b] = (time.perf_counter() - t0) / len(order)
     results = []
     for b, (kw, sim, (ss, params)) in enumerate(zip(runs, sims, seeds)):
@@ -268,6 +282,15 @@ def measure_batch(runs):
         G_surf = demodulation(series["t"], series["stress_surface"], f, A, pre, periods, post,
                               correct_drift_sign=kw["correct_drift_sign"])
         t_demod = time.perf_counter() - t0
+        if sim.verbose:
+            if "last_tensors" in rec[b]:
+                print("Overall stress tensor, last step:", rec[b]["last_tensors"][-1].tolist())
+                print("Overall stress tensor, first step:", rec[b]["first_tensors"][-1].tolist())
+            for label, v in (("G'", G_int[2]), ("G''", G_int[3]), ("G'(by surface force)", G_surf[2]),
+                             ("G''(by surface force)", G_surf[3])):
+                print(label)
+                print(v)
+                print("Pa")
         tim = {"constitution": constitution[b], "pre_equilibration": pre_time[b], "protocol": protocol_time[b],
                "demodulation": t_demod, "output": 0.0}
         tim["total"] = sum(tim.values())
@@ -279,6 +302,26 @@ def measure_batch(runs):
             N_steps=len(series["t"]), damping_factor=cool,
             removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0), series=series))
     return results
+
+
+def _console(sims, members, phase):
+    """``say`` and ``report`` callbacks of a batch phase: the reference's messages when any member is
+    verbose, each member's progress callback at most ~10 times per second (and at the end)."""
+    verbose = any(sims[b].verbose for b in members)
+    callbacks = [sims[b].progress for b in members if sims[b].progress is not None]
+    say = print if verbose else (lambda *a: None)
+    if not callbacks:
+        return say, lambda step, total: None
+    t0 = time.perf_counter()
+    last = [0.0]
+
+    def report(step, total):
+        now = time.perf_counter()
+        if step == total or now - last[0] >= 0.1:
+            last[0] = now
+            for cb in callbacks:
+                cb(phase, step, total, now - t0)
+    return say, report
 
 
 def _guarded(phase, engine, *args, dt):
