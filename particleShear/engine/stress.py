@@ -94,7 +94,8 @@ def spin_kinetic_energy(q):
 
 
 def peculiar_acceleration_otsuki(q):
-    """σ_ot = −(1/V) Σ_mobile P ⊗ P / m, P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa; comparison only)."""
+    """σ_ot = −(1/V) Σ_mobile P ⊗ P / m with P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa; for
+    comparison only)."""
     px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * (q.y - (q.Ly / 2)[q.rep]))
     py = q.m * 1e-12 * q.vy
     w = q.mob / (q.m * 1e-6)
