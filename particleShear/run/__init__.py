@@ -1,5 +1,6 @@
 """Layer 5: ``doParticleShearSimulation``, ``doParticleShearSimulationSeries`` and the command line."""
 __docformat__ = "numpy"
 from .api import SimulationResult, doParticleShearSimulation, doParticleShearSimulationSeries
+from .batch import run_batch
 
-__all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult"]
+__all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "run_batch"]

@@ -19,6 +19,7 @@ from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_options, validate_series, validate_simulation_parameters
+from .batch import batches, check_backend, check_batch_size, engine_supports, measure_batch, run_batch
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -154,6 +155,67 @@ def _seed_sequence(seed):
     return ss, np.random.default_rng(ss)
 
 
+def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, reference_header, renderer,
+                      time_step_factor, integrator, stability_guard):
+    """The :class:`Simulation_interlocking_rheology` of one run, configured but not run (``params``: the
+    validated reference arguments of :func:`doParticleShearSimulation`; ``rng`` its Generator)."""
+    p = params
+    root_folder, do_permanent_links, cut_lines, N = p["root_folder"], p["do_permanent_links"], p["cut_lines"], p["N"]
+    (packing_fraction, density, bimodal_factor, theAmplitude) = (p["packing_fraction"], p["density"],
+                                                                 p["bimodal_factor"], p["theAmplitude"])
+    Young_modulus_spheres, theMu, relative_y_scale_force = p["Young_modulus_spheres"], p["theMu"], p[
+        "relative_y_scale_force"]
+    relative_frequency, relative_viscosity = p["relative_frequency"], p["relative_viscosity"]
+    relative_transversal_link_strength = p["relative_transversal_link_strength"]
+    central_repulsion_coefficient = p["central_repulsion_coefficient"]
+    avoid_horizontal_angle_degree = p["avoid_horizontal_angle_degree"]
+    interface_reenforcement_central = p["interface_reenforcement_central"]
+    interface_reenforcement_tangential = p["interface_reenforcement_tangential"]
+    keep_viscosity_coefficients_constant = p["keep_viscosity_coefficients_constant"]
+    avoid_height_spanning_particles, cut_top_bottom = p["avoid_height_spanning_particles"], p["cut_top_bottom"]
+    doCutByTriangulation, remove_link_fraction = p["doCutByTriangulation"], p["remove_link_fraction"]
+    edge_fuzziness, doDrawing, saveData = p["edge_fuzziness"], p["doDrawing"], p["saveData"]
+    pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
+    saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
+    saveStressTensorData = p["saveStressTensorData"]
+    theSimulation = Simulation_interlocking_rheology(
+        root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
+        packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor, amplitude=theAmplitude,
+        Young_modulus_spheres=Young_modulus_spheres, mu=theMu, relative_y_scale_force=relative_y_scale_force,
+        relative_frequency=relative_frequency, relative_viscosity=relative_viscosity,
+        relative_transversal_link_strength=relative_transversal_link_strength,
+        central_repulsion_coefficient=central_repulsion_coefficient,
+        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+        interface_reenforcement_central=interface_reenforcement_central,
+        interface_reenforcement_tangential=interface_reenforcement_tangential,
+        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
+        avoid_height_spanning_particles=avoid_height_spanning_particles, cut_top_bottom=cut_top_bottom,
+        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
+        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, saveData=saveData)
+    theSimulation.function_call += (
+        "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
+        + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
+        + "\n\ttheSimulation.saveOutputImages = " + str(saveOutputImages)
+        + "\n\ttheSimulation.imageFileType = " + str(imageFileType)
+        + "\n\ttheSimulation.runSimulation(periods=" + str(periods) + ", cool_factor=" + str(cool_factor) + ")")
+    theSimulation.baseline_pre_periods = pre_periods
+    theSimulation.baseline_post_periods = post_periods
+    theSimulation.saveOutputImages = saveOutputImages
+    theSimulation.imageFileType = imageFileType
+    theSimulation.saveStressTensorData = saveStressTensorData
+    theSimulation.rng = rng
+    theSimulation.verbose = verbose
+    theSimulation.progress = progress
+    theSimulation.correct_drift_sign = correct_drift_sign
+    theSimulation.reference_header = reference_header
+    theSimulation.renderer_backend = renderer
+    theSimulation.time_step_factor = float(time_step_factor)
+    theSimulation.integrator = integrator
+    theSimulation.stability_guard = bool(stability_guard)
+
+    return theSimulation
+
+
 def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=5,
                               Young_modulus_spheres=8000, N=150, packing_fraction=1.5, density=50,
                               bimodal_factor=1.4, relative_viscosity=0.1, relative_transversal_link_strength=1,
@@ -167,7 +229,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
-                              saveOutputMovie=False, output_format="text", strict_io=False):
+                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy"):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -311,6 +373,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     strict_io : bool, default False
         Keyword-only.  Raise the ``OSError`` of a failed write after the run; False: return the
         result with ``write_error`` set (``last_result`` holds it either way).
+    backend : {"numpy"}, default "numpy"
+        Keyword-only.  Array library of the measurement (only NumPy in this version; see
+        :mod:`particleShear.run.batch`).  Runs without drawing, snapshots or files measure through
+        the engine (:mod:`particleShear.engine`) as a batch of one, so that a run in a batched
+        series (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it.
 
     Returns
     -------
@@ -365,6 +432,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_output_format(output_format)
+    check_backend(backend)
     if not isinstance(strict_io, bool):
         raise TypeError(f"strict_io={strict_io!r} is invalid: allowed True or False")
     ss, rng = _seed_sequence(seed)
@@ -373,45 +441,22 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
                   time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
                   output_format=output_format, strict_io=strict_io,
-                  saveOutputMovie=saveOutputMovie)
+                  saveOutputMovie=saveOutputMovie, backend=backend)
     seed_entropy = None if ss is None else ss.entropy
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
 
-    theSimulation = Simulation_interlocking_rheology(
-        root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
-        packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor, amplitude=theAmplitude,
-        Young_modulus_spheres=Young_modulus_spheres, mu=theMu, relative_y_scale_force=relative_y_scale_force,
-        relative_frequency=relative_frequency, relative_viscosity=relative_viscosity,
-        relative_transversal_link_strength=relative_transversal_link_strength,
-        central_repulsion_coefficient=central_repulsion_coefficient,
-        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-        interface_reenforcement_central=interface_reenforcement_central,
-        interface_reenforcement_tangential=interface_reenforcement_tangential,
-        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
-        avoid_height_spanning_particles=avoid_height_spanning_particles, cut_top_bottom=cut_top_bottom,
-        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
-        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, saveData=saveData)
-    theSimulation.function_call += (
-        "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
-        + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
-        + "\n\ttheSimulation.saveOutputImages = " + str(saveOutputImages)
-        + "\n\ttheSimulation.imageFileType = " + str(imageFileType)
-        + "\n\ttheSimulation.runSimulation(periods=" + str(periods) + ", cool_factor=" + str(cool_factor) + ")")
-    theSimulation.baseline_pre_periods = pre_periods
-    theSimulation.baseline_post_periods = post_periods
-    theSimulation.saveOutputImages = saveOutputImages
-    theSimulation.imageFileType = imageFileType
-    theSimulation.saveStressTensorData = saveStressTensorData
-    theSimulation.rng = rng
-    theSimulation.verbose = verbose
-    theSimulation.progress = progress
-    theSimulation.correct_drift_sign = correct_drift_sign
-    theSimulation.reference_header = reference_header
-    theSimulation.renderer_backend = renderer
-    theSimulation.time_step_factor = float(time_step_factor)
-    theSimulation.integrator = integrator
-    theSimulation.stability_guard = bool(stability_guard)
+    if engine_supports(params):  # measured by the engine: a batch of one (particleShear.run.batch)
+        with console_messages(verbose):
+            result = measure_batch([params])[0]
+        result.parameters, result.run_id = params, run_id
+        doParticleShearSimulation.last_result = result
+        return result if return_result else result.G
+
+    theSimulation = _build_simulation(params, rng, verbose=verbose, progress=progress,
+                                      correct_drift_sign=correct_drift_sign, reference_header=reference_header,
+                                      renderer=renderer, time_step_factor=time_step_factor, integrator=integrator,
+                                      stability_guard=stability_guard)
     theSimulation.saveOutputMovie = bool(saveOutputMovie)
     theSimulation.output_format = output_format
     theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
@@ -508,7 +553,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
                                     central_repulsion_coefficient=1, doDrawing=True, saveData=False,
                                     saveStressTensorData=True, plotStress=True, pre_periods=2, periods=3,
                                     post_periods=1, cool_factor=0.5, executor=None, seed=None, *,
-                                    max_workers=None, verbose=False, **options):
+                                    max_workers=None, verbose=False, batch_size=None, backend="numpy",
+                                    **options):
     """Run the reference series (repetitions × amplitudes × μ × controls) on an executor.
 
     Every run is a :func:`doParticleShearSimulation`; the parameters shared with it have its
@@ -568,6 +614,14 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     verbose : bool, default False
         Keyword-only.  Forwarded to each run (default False: quiet workers).
     **options
+    batch_size : int, keyword-only
+        When given, runs that share a step schedule (same N, time-step rule and protocol; see
+        :func:`particleShear.run.batch.schedule_key`) are grouped into batches of up to
+        ``batch_size`` runs, and each batch is one task of the executor
+        (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
+        unbatched series, in the same order.  Default None: one task per run.
+    backend : {"numpy"}, keyword-only
+        Array backend of every run.
         Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
         ``reference_header``, ``renderer``, ``time_step_factor``, ...).
 
@@ -592,6 +646,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     ``seed`` runs only the runs that have not finished; those are returned as results rebuilt
     from their rows (moduli, parameters, seed, output path; no per-step series).
     """
+    check_batch_size(batch_size)
+    check_backend(backend)
     # the grid (repetitions × amplitudes × μ × controls) is checked before any job is built
     amplitudes, mu = validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
                                      do_non_frictional_control)
@@ -621,10 +677,26 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     all_kwargs = []
     for (A, m, links, cl), child in zip(jobs, children):
         kw = dict(common, theAmplitude=A, theMu=m, do_permanent_links=links, cut_lines=cl, seed=child,
-                  verbose=verbose, **options)
+                  verbose=verbose, backend=backend, **options)
         validate_simulation_parameters({**kw})  # every run is checked before any work starts
         all_kwargs.append(kw)
     if not all_kwargs:
         return []
-    from ..sweep.runner import run_series
-    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)
+    if batch_size is None:
+        from ..sweep.runner import run_series
+        return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)
+    # batches of runs that share a schedule, one executor task each (results in the series order)
+    own = executor is None
+    if own:
+        executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
+    try:
+        groups = batches(all_kwargs, batch_size)
+        futures = [executor.submit(run_batch, [all_kwargs[p] for p in g], backend) for g in groups]
+        results = [None] * len(all_kwargs)
+        for g, fut in zip(groups, futures):
+            for p, res in zip(g, fut.result()):
+                results[p] = res
+        return results
+    finally:
+        if own:
+            executor.shutdown(wait=True, cancel_futures=True)

@@ -1,0 +1,14 @@
+"""Layer 0: pure array kernels with a leading replica axis (see ``docs/design.md``).
+
+The engine advances B independent replicas of the measurement (pre-equilibration with plates,
+then the oscillatory protocol) in one set of flat arrays: spheres of replica b occupy rows
+``b·N … b·N + N − 1``, pairs are kept per replica in canonical ``(i, j)`` order, and every sum
+over a replica is a ``bincount`` over its own rows, so a replica's numbers do not depend on the
+other replicas of its batch.
+
+Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central laws),
+:mod:`.tangential` (the two-visit tangential rule, shared with the canvas classes),
+:mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica),
+:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, the
+pre-equilibration and the protocol).  NumPy only in this version.
+"""

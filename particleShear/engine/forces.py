@@ -1,0 +1,157 @@
+"""Pair terms over the flat candidate arrays of a batch, the scatter and the shear stresses.
+
+Each function is a pure function of arrays: the geometry of the candidates, the central term
+(elastic law of :mod:`.laws` and viscous term, transient contacts and bonds), the tangential
+two-visit rule (:func:`.tangential.tangential_two_pass`), the scatter of pair
+forces to spheres and the two shear stresses G′/G″ need.  Equations: reference manual eq.
+S1-3 (torque split), S1-5/S1-6 (laws), S1-16 (external-force tensor), S1-19 (Love-Weber),
+S1-22/S1-24 (torque terms, overall tensor); details in ``docs/design.md``.
+"""
+import numpy as np
+
+from .tangential import tangential_two_pass
+from .box import min_image
+
+__all__ = ["PairConstants", "geometry", "central_term", "tangential_term", "scatter", "shear_stresses"]
+
+#: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
+CF_CL = 1e-18
+CT = 1e-18
+
+
+class PairConstants:
+    """Per-candidate constants of a batch, valid until the candidate lists change.
+
+    Built from the per-replica lists and the per-replica constants of the state; ``rep`` is
+    each pair's replica, ``ai``/``aj`` the global sphere rows.
+    """
+
+    def __init__(self, s, offsets):
+        pairs = s.pairs
+        N = s.N
+        self.offsets = offsets
+        self.rep = np.repeat(np.arange(s.B), [len(p.i) for p in pairs])
+        base = self.rep * N
+        self.ai = np.concatenate([p.i for p in pairs]) + base
+        self.aj = np.concatenate([p.j for p in pairs]) + base
+        self.P = len(self.ai)
+        g = self.rep
+        self.ri = s.r[self.ai]
+        self.rj = s.r[self.aj]
+        self.d0 = self.ri + self.rj
+        self.w_i = self.ri / self.d0
+        self.w_j = self.rj / self.d0
+        self.Lx = s.Lx[g]
+        self.Ly = s.Ly[g]
+        self.hy = self.Ly / 2
+        self.hx = self.Lx / 2
+        self.rep3 = np.concatenate((self.rep, self.rep + s.B, self.rep + 2 * s.B))
+        nb = s.B * N
+        self.scatter_idx = np.concatenate((self.ai, self.aj, self.ai + nb, self.aj + nb, self.ai + 2 * nb,
+                                           self.aj + 2 * nb))
+
+    def set_bonds(self, s, state, d_eq):
+        """Bond-dependent constants (bonds never change during the measurement)."""
+        g = self.rep
+        perm = state == 2
+        self.perm = perm
+        self.trans = ~perm
+        k, c = s.k[g], s.c[g]
+        self.k = k
+        self.d_law = np.where(perm, d_eq, self.d0)         # contact distance of the compressive law
+        self.d_cap = self.d_law / 1000
+        self.a_lin = -k * (1 - c)
+        self.a_div = -k * c * self.d_law
+        self.d_eq = np.where(perm, d_eq, 0.0)   # tensile law k·(d − d_eq) on bonds, (d − 0)·0 on contacts
+        self.k_tens = np.where(perm, k, 0.0)
+        self.ratio_c = np.where(perm, s.prc[g], 1.0)
+        keep = s.keep[g] != 0
+        self.nu = s.nu[g] * np.where(perm & ~keep, s.prc[g], 1.0)
+        self.k_t = s.k_t[g] * np.where(perm, s.prt[g], 1.0)
+        self.nu_t = s.nu_t[g] * np.where(perm & ~keep, s.prt[g], 1.0)
+        self.mu = s.mu[g]
+        self.fc_inf = np.where(perm, np.inf, 0.0)
+        self.perm_code = perm.view(np.int8) * np.int8(2)
+
+
+def geometry(C, x, y, shift_p):
+    """Minimum-image pair vectors ``D = x_j − x_i`` (2, P), distances, unit normals, image counts."""
+    ai, aj = C.ai, C.aj
+    dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, shift_p)
+    d = np.sqrt(dx * dx + dy * dy)
+    return dx, dy, d, ky, kx
+
+
+def normals(dx, dy, d, rep, rng):
+    """Unit normals ``n = D/d``; at ``d = 0`` a random direction from the replica's own generator."""
+    zero = d == 0
+    if not zero.any():
+        return dx / d, dy / d
+    safe = np.where(zero, 1.0, d)
+    nx, ny = dx / safe, dy / safe
+    for p in np.flatnonzero(zero):
+        theta = 2 * np.pi * rng[int(rep[p])].random()
+        nx[p], ny[p] = np.cos(theta), np.sin(theta)
+    return nx, ny
+
+
+def central_term(C, d, vn, active):
+    """Elastic + viscous central scalar of each candidate (along ``n_ij`` on i; −n on j) and the
+    unscaled elastic law (for the Coulomb bound).
+
+    Transient contacts: ``law(d, r_i + r_j, k, c)`` (0 beyond contact) and ``ν·v_n``; bonds:
+    ``k (d − d_eq)`` when stretched, the compressive law below, both × ``permanent_ratio_central``,
+    viscous × the ratio unless viscosities are kept constant.  Inactive candidates give 0.
+    """
+    inside = C.a_lin * (C.d_law - d) + C.a_div * (C.d_law / np.maximum(d, C.d_cap) - 1)
+    law = np.where(d > C.d_law, (d - C.d_eq) * C.k_tens, inside)   # contacts beyond d0: (d − 0)·0 = 0
+    f = law * C.ratio_c
+    f += np.where(active, C.nu, 0.0) * vn
+    return f, law
+
+
+def tangential_term(C, vt, touching, xi, law):
+    """Two-visit tangential rule (reference §2.6-2.7): forces of both visits and the final slip flag.
+
+    Bonds have no Coulomb bound; a transient contact is bounded by ``|μ·law|``.  Updates ``xi``
+    in place (reset on slip); inactive candidates (ξ = 0, no viscous part, bound 0) get ±0.
+    """
+    fc = np.abs(C.mu * law)
+    fc += C.fc_inf
+    return tangential_two_pass(vt, touching, xi, C.k_t, C.k_t, C.nu_t, C.nu_t, fc)
+
+
+def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
+    """Pair forces to per-sphere totals: ``+F`` on i, ``−F`` on j, torques on both (eq. S1-3).
+
+    One ``bincount`` over ``(ai, aj)`` of each component (offset by ``k·n_spheres``): each sphere's
+    sum runs over its own replica's pairs in list order, whatever else the batch holds.  Returns
+    the (3, n_spheres) block (F_x, F_y, torque).
+    """
+    w = np.concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
+    return np.bincount(C.scatter_idx, w, 3 * n_spheres).reshape(3, n_spheres)
+
+
+def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
+    """τ_internal = −σ_xy of the overall tensor and τ_surface = −σ_xy of the external-force tensor (Pa).
+
+    ``σ_LW,xy = (1/V) Σ_internal F_x,i (y_i − y_j)`` (eq. S1-19) with ``y_i − y_j = −D_y`` for
+    an unshifted pair; ``σ_Tint,xy = −(1/V) Σ_internal d·F_T/2`` (eq. S1-22, ``dF = d·F_T``);
+    the centrifugal term has no xy part.  ``σ_ext,xy = −(1/V) Σ_external F_x (y_target − Ly/2)``
+    (eq. S1-16): a pair is internal when both spheres are mobile and no image shift was used,
+    otherwise each mobile sphere receives an external entry.  ``yc`` is ``y − Ly/2`` per sphere,
+    ``flags`` = (mobile i, mobile j, not both mobile) per candidate.  Sums per replica over its
+    own pairs in list order (``bincount`` over the replica index).
+    """
+    mi, mj, not_both = flags
+    ext = not_both | shifted
+    ext &= active
+    internal = active & ~ext
+    lever = yc[C.ai] * (ext & mi)
+    lever -= yc[C.aj] * (ext & mj)
+    # three per-replica sums in one bincount: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
+    w = np.concatenate((fx_i * dy * internal, dF * internal, fx_i * lever))
+    lw, tint, surf = np.bincount(C.rep3, w, 3 * B).reshape(3, B)
+    sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
+    sigma_ext = -surf * (CF_CL / V)
+    return -sigma_all, -sigma_ext

@@ -1,0 +1,138 @@
+"""The state of a batch of replicas as explicit arrays (docs/design.md, "Batches of replicas").
+
+Spheres of replica b occupy rows ``b·N … b·N + N − 1`` of every per-sphere array; per-replica
+values (box, strain, rate, model constants) are arrays of length B and are gathered to spheres
+or pairs where a kernel needs them.  Pairs are kept per replica (:class:`ReplicaPairs`, sorted by
+``(i, j)``) and concatenated in replica order into the flat arrays a step works on.
+
+Units: µm, s, mg per m depth (reference units, docs/parameters.md).
+"""
+import numpy as np
+
+__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM"]
+
+STICK, SLIP, PERMANENT = 0, 1, 2
+
+#: per-sphere model parameters that must be uniform within a replica for the engine
+PER_SPHERE_UNIFORM = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
+                      "keep_viscosity_coefficients_constant")
+
+
+class ReplicaPairs:
+    """Candidate pairs of one replica: local indices ``i < j`` in canonical order and their history.
+
+    ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds)
+    and ``active`` (a relation of the reference: touching at the last neighbour update, or a bond).
+    """
+    __slots__ = ("i", "j", "state", "xi", "d_eq", "active")
+
+    def __init__(self, i, j, state, xi, d_eq, active):
+        self.i = np.asarray(i, dtype=np.intp)
+        self.j = np.asarray(j, dtype=np.intp)
+        self.state = np.asarray(state, dtype=np.int8)
+        self.xi = np.asarray(xi, dtype=float).reshape(2, -1)
+        self.d_eq = np.asarray(d_eq, dtype=float)
+        self.active = np.asarray(active, dtype=bool)
+
+
+class BatchState:
+    """Arrays of B replicas of N spheres each (see the module docstring).
+
+    Attributes
+    ----------
+    B, N : int
+        Replicas and spheres per replica.
+    x, y, vx, vy, omega, phi, r, m, inertia : ndarray (B·N,)
+        Sphere state (µm, µm/s, 1/s, rad, µm, mg/m, mg·µm²/m); ``x, y`` are the rows of ``pos``
+        (2, B·N) and ``vx, vy, omega`` those of ``vel`` (3, B·N).
+    Lx, Ly, gamma, rate, t : ndarray (B,)
+        Box (µm), strain γ, strain rate γ̇ (1/s) and clock (s) of each replica.
+    k, nu, k_t, nu_t, mu, c, prc, prt, keep : ndarray (B,)
+        Ensemble constants of each replica (the values a step of its ensemble uses).
+    pairs : list of ReplicaPairs
+        Candidate pairs of each replica.
+    rng : list of numpy.random.Generator
+        Each replica's own generator (random normals at ``d = 0``).
+    applying_shear : bool
+        Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
+    """
+
+    def __init__(self, B, N):
+        self.B = int(B)
+        self.N = int(N)
+        n = self.B * self.N
+        # positions and velocities as row views of two blocks: one gather fetches all rows of a pair side
+        self.pos = np.zeros((2, n))
+        self.x, self.y = self.pos
+        self.vel = np.zeros((3, n))
+        self.vx, self.vy, self.omega = self.vel
+        for name in ("phi", "r", "m", "inertia"):
+            setattr(self, name, np.zeros(n))
+        for name in ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
+            setattr(self, name, np.zeros(self.B))
+        self.rep = np.repeat(np.arange(self.B), self.N)
+        self.pairs = [None] * self.B
+        self.rng = [None] * self.B
+        self.applying_shear = True
+        self.frc = np.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
+        self.fx, self.fy, self.torque = self.frc
+
+    @classmethod
+    def from_ensembles(cls, ensembles):
+        """Copy B ensembles of equal N (after constitution) into one batch state.
+
+        Raises
+        ------
+        ValueError
+            If the ensembles differ in N, or a per-sphere parameter of :data:`PER_SPHERE_UNIFORM`
+            differs within an ensemble.
+        """
+        Ns = {len(e.sphereList) for e in ensembles}
+        if len(Ns) != 1:
+            raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
+        B, N = len(ensembles), Ns.pop()
+        s = cls(B, N)
+        for b, e in enumerate(ensembles):
+            a = e._a
+            rows = slice(b * N, (b + 1) * N)
+            for name, src in (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"),
+                              ("phi", "phi"), ("r", "r"), ("m", "m"), ("inertia", "inertia"),
+                              ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
+                getattr(s, name)[rows] = a[src][:N]
+            for name in PER_SPHERE_UNIFORM:
+                v = np.asarray(a[name][:N], dtype=float)
+                if N and not np.all(v == v[0]):
+                    raise ValueError(f"ensemble {b}: {name} differs between spheres (the engine needs one value)")
+            s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
+            s.gamma[b], s.rate[b], s.t[b] = float(e.shear), float(e.shear_rate), float(e.t)
+            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(e.k), float(e.nu), float(e.k_t), float(e.nu_t),
+                                                             float(e.mu))
+            s.c[b] = float(a["central_repulsion_coefficient"][0]) if N else 0.0
+            s.prc[b] = float(a["permanent_ratio_central"][0]) if N else 1.0
+            s.prt[b] = float(a["permanent_ratio_tangential"][0]) if N else 1.0
+            s.keep[b] = float(a["keep_viscosity_coefficients_constant"][0]) if N else 1.0
+            pt = e._pairs
+            keep = pt.active | (pt.state == PERMANENT)
+            s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
+                                      pt.active[keep])
+            s.rng[b] = e._rng
+        return s
+
+    @classmethod
+    def concat(cls, states):
+        """One state holding the replicas of ``states`` in order (equal N)."""
+        Ns = {st.N for st in states}
+        if len(Ns) != 1:
+            raise ValueError(f"states have N = {sorted(Ns)}: a batch needs one N")
+        out = cls(sum(st.B for st in states), Ns.pop())
+        for name in ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia", "fx", "fy", "torque", "Lx", "Ly",
+                     "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
+            getattr(out, name)[...] = np.concatenate([getattr(st, name) for st in states])
+        out.pairs = [p for st in states for p in st.pairs]
+        out.rng = [g for st in states for g in st.rng]
+        out.applying_shear = all(st.applying_shear for st in states)
+        return out
+
+    def replica(self, b):
+        """Row slice of replica ``b`` in the per-sphere arrays."""
+        return slice(b * self.N, (b + 1) * self.N)

@@ -1,0 +1,415 @@
+"""One step of a batch of replicas, top to bottom in the reference order, and the measurement.
+
+:meth:`BatchEngine.step` reads like the reference's step (reference §4.1, §8.3): shear rate →
+neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
+:func:`pre_equilibrate` (plates fixed: coarse levels from ``dt_max``, then 2N and N steps at
+``dt``) and :func:`protocol` (recording t, γ, γ̇, τ_internal and τ_surface of every replica and
+step) are the measurement of the oscillatory experiment on a batch.
+
+The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
+place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
+"""
+import math
+
+import numpy as np
+
+from .box import min_image, wrap
+from .forces import PairConstants, central_term, normals, scatter, shear_stresses, tangential_term
+from .neighbours import build_candidates, verlet_bound
+from .state import SLIP, STICK, ReplicaPairs
+from .stress import StressInputs, evaluate_all
+
+__all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
+
+
+class EngineInstability(RuntimeError):
+    """A replica's state became non-finite (``replica``, ``step``, ``phase`` say where)."""
+
+    def __init__(self, message, replica=None, step=None, phase=None):
+        RuntimeError.__init__(self, message)
+        self.replica = replica
+        self.step = step
+        self.phase = phase
+
+
+class BatchEngine:
+    """Advances a :class:`~particleShear.engine.state.BatchState` step by step.
+
+    Parameters
+    ----------
+    state : BatchState
+    skin_factor : float
+        Verlet skin in units of each replica's largest radius (> 0).
+    check_interval : int
+        Steps between the checks of the stability guard.
+    guard : bool or array of bool (B,)
+        Check every ``check_interval`` steps, for each replica where it is true, what
+        :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
+        energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
+        contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
+    """
+
+    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True):
+        if not skin_factor > 0:
+            raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
+        s = self.s = state
+        B, N = s.B, s.N
+        self.r_max = s.r.reshape(B, N).max(axis=1)
+        self.skin = skin_factor * self.r_max
+        self.bound = np.full(B, np.inf)        # first step builds every list
+        self.u = np.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
+        self.u_max = np.zeros(B)               # running maximum of |u| per replica
+        self.strain = np.zeros(B)              # Σ |γ̇| dt per replica since its list was built
+        self.C = None
+        self.Lx_s = s.Lx[s.rep]
+        self.Ly_s = s.Ly[s.rep]
+        self.hy_s = self.Ly_s / 2
+        self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
+        self.mmi = np.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
+        self.check_interval = int(check_interval)
+        self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica
+        self.rate_max = np.zeros(B)
+        self.min_distance_ratio = 0.05
+        self.step_count = 0
+        self.phase = "pre-equilibration"
+        self.rebuilds = np.zeros(B, dtype=np.int64)
+        self._img = None          # period counts of the candidates' images (with the C they belong to)
+        self._mob_flags = None    # mobility flags of the candidates (with the C and mask they belong to)
+
+    # -- the one cache ---------------------------------------------------------------------------
+    def _sync_down(self):
+        """Write the flat pair history back into the per-replica lists."""
+        C = self.C
+        for b, p in enumerate(self.s.pairs):
+            lo, hi = C.offsets[b], C.offsets[b + 1]
+            p.state = self.state_p[lo:hi].copy()
+            p.xi = self.xi[:, lo:hi].copy()
+            p.active = self.active[lo:hi].copy()
+
+    def neighbours(self):
+        """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
+        per-candidate constants with them (the one invalidation point)."""
+        need = self.bound >= self.skin
+        if not need.any():
+            return
+        s = self.s
+        if self.C is not None:
+            self._sync_down()
+        for b in np.flatnonzero(need):
+            rows = s.replica(b)
+            s.pairs[b] = build_candidates(s.x[rows], s.y[rows], s.r[rows], s.Lx[b], s.Ly[b], s.Ly[b] * s.gamma[b],
+                                          self.skin[b], s.pairs[b])
+            self.bound[b] = 0.0
+            self.u[:, rows] = 0.0
+            self.u_max[b] = 0.0
+            self.strain[b] = 0.0
+            self.rebuilds[b] += 1
+        offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
+        C = self.C = PairConstants(s, offsets)
+        self.state_p = np.concatenate([p.state for p in s.pairs])
+        self.xi = np.concatenate([p.xi for p in s.pairs], axis=1)
+        self.active = np.concatenate([p.active for p in s.pairs])
+        C.set_bonds(s, self.state_p, np.concatenate([p.d_eq for p in s.pairs]))
+
+    def _images(self, raw_x, raw_y, shift_p):
+        """Minimum image of the candidates, reusing the period counts of the last step while they
+        still give separations inside the half-open intervals (one period at most, so the result is
+        the same number as a fresh :func:`~particleShear.engine.box.min_image`)."""
+        C = self.C
+        img = self._img
+        if img is not None and img[0] is C:
+            _, Lyky, ky, Lxkx, kx = img
+            dy = raw_y - Lyky
+            dx = raw_x - shift_p * ky
+            dx -= Lxkx
+            if (np.abs(dy) < C.hy).all() and (np.abs(dx) < C.hx).all():
+                return dx, dy, ky, kx
+        dx, dy, ky, kx = min_image(raw_x, raw_y, C.Lx, C.Ly, shift_p)
+        one = (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all()
+        self._img = (C, C.Ly * ky, ky, C.Lx * kx, kx) if one else None
+        return dx, dy, ky, kx
+
+    def _mobility_flags(self, mob):
+        """(mob_i, mob_j, not both mobile) of the candidates, kept while the mask and the lists stay."""
+        fl = self._mob_flags
+        if fl is None or fl[0] is not self.C or not np.array_equal(fl[1], mob):
+            mi, mj = mob[self.C.ai], mob[self.C.aj]
+            fl = self._mob_flags = (self.C, mob, mi, mj, ~(mi & mj))
+        return fl[2:]
+
+    def flush(self):
+        """Write the flat pair history back into ``state.pairs`` (after a phase)."""
+        if self.C is not None:
+            self._sync_down()
+
+    def pairs_of(self, b):
+        """Current candidate list of replica ``b`` (a copy, with the flat history written in)."""
+        if self.C is not None:
+            self._sync_down()
+        p = self.s.pairs[b]
+        return ReplicaPairs(p.i, p.j, p.state, p.xi, p.d_eq, p.active)
+
+    def mobile(self):
+        """Mobility mask: with the plates on, spheres overlapping ``y = 0`` or ``y = Ly`` are immobile."""
+        s = self.s
+        if not s.applying_shear:
+            return np.ones(len(s.y), bool)
+        return (s.r < s.y) & (s.y < self.Ly_s - s.r)
+
+    # -- the step --------------------------------------------------------------------------------
+    def set_rate(self, rate):
+        """Change γ̇ per replica; each sphere keeps its velocity relative to the local flow (§4.5)."""
+        s = self.s
+        delta = rate - s.rate
+        d_s = delta[s.rep]
+        s.vx += (s.y - self.hy_s) * d_s
+        s.omega -= d_s / 2
+        s.rate = np.array(rate, dtype=float)
+
+    def step(self, cool, dt, sample=False):
+        """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when
+        ``sample``, and also every tensor of :data:`~particleShear.engine.stress.TENSORS` as a
+        (B, 9, 2, 2) array when ``sample == "tensors"``."""
+        s = self.s
+        x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
+        # neighbours (positions at the start of the step)
+        self.neighbours()
+        C = self.C
+        ai, aj = C.ai, C.aj
+        # geometry and relations
+        yc = y - self.hy_s                              # height above the cell's centre line
+        raw = s.pos.take(aj, axis=1)
+        raw -= s.pos.take(ai, axis=1)
+        dx, dy, ky, kx = self._images(raw[0], raw[1], (s.Ly * s.gamma)[C.rep])
+        d = np.sqrt(dx * dx + dy * dy)
+        nx, ny = normals(dx, dy, d, C.rep, s.rng)
+        touching = d < C.d0
+        active = C.perm | touching
+        newly = active & ~self.active
+        if newly.any():
+            self.state_p[newly] = STICK
+        self.xi = xi = np.where(active, self.xi, 0.0)   # an opened contact loses its history
+        self.active = active
+        # relative velocities (image velocity −Ly·γ̇ per period above)
+        dvx = -(C.Ly * s.rate[C.rep]) * ky
+        Vi = s.vel.take(ai, axis=1)
+        Vj = s.vel.take(aj, axis=1)
+        rvx = Vj[0] - Vi[0] + dvx
+        rvy = Vj[1] - Vi[1]
+        vn = rvx * nx + rvy * ny
+        spin = C.ri * Vi[2] + C.rj * Vj[2]
+        vt = rvx * -ny + rvy * nx - spin
+        # forces: central (elastic + viscous), tangential (two visits), scatter
+        fn, law = central_term(C, d, vn, active)
+        F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
+        self.state_p = slip.view(np.int8) + C.perm_code
+        f_t = (F[0] + F[1]) * 0.5
+        fx_i = fn * nx - f_t * ny
+        fy_i = fn * ny + f_t * nx
+        dF = d * f_t
+        s.frc[...] = scatter(C, len(x), fx_i, fy_i, dF * C.w_i, dF * C.w_j)
+        mob = self.mobile()
+        out = None
+        if sample:
+            shifted = (ky != 0) | (kx != 0)
+            out = shear_stresses(C, s.B, yc, self._mobility_flags(mob), active, shifted, dy, fx_i, dF, self.V)
+            if sample == "tensors":
+                q = StressInputs(C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia,
+                                 Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
+                                 dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
+                out = out + (evaluate_all(q),)
+        if not self.step_count % self.check_interval and self.guard.any():
+            self._check(d, active)
+        # kick (plates follow), rotational kick, damping
+        rate_s = s.rate[s.rep]
+        kick = s.frc * dt
+        kick /= self.mmi                                    # (F_x/m, F_y/m, T/I)·dt
+        s.vel += kick
+        s.frc[...] = 0.0
+        imm = ~mob
+        if imm.any():
+            plate = np.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
+            vy[imm] = 0.0
+            vx[imm] = plate[imm]
+        flow = yc * rate_s
+        vx -= flow
+        vx *= cool
+        vx += flow
+        vy *= cool
+        om *= cool
+        # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
+        kd = np.where(active & (self.state_p != SLIP), dt, 0.0)
+        Vi = s.vel.take(ai, axis=1)
+        Vj = s.vel.take(aj, axis=1)
+        rvx = Vj[0] - Vi[0] + dvx
+        rvy = Vj[1] - Vi[1]
+        spin = C.ri * Vi[2] + C.rj * Vj[2]
+        inc_ij = rvx * -ny + rvy * nx - spin
+        Rx = Vi[0] * dt - dx
+        Ry = Vi[1] * dt - dy
+        mx, my = normals(Rx, Ry, np.sqrt(Rx * Rx + Ry * Ry), C.rep, s.rng)
+        inc_ji = rvx * my - rvy * mx - spin
+        xi[0] += inc_ij * kd
+        xi[1] += inc_ji * kd
+        # drift, strain, wrap, clock
+        u = self.u
+        u[0] += (vx - flow) * dt
+        u[1] += vy * dt
+        self.u_max = np.maximum(self.u_max, np.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
+        self.strain += np.abs(s.rate) * dt
+        self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
+        s.pos += s.vel[:2] * dt
+        s.phi += om * dt
+        s.gamma = s.gamma + s.rate * dt
+        wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
+        s.t = s.t + dt
+        self.step_count += 1
+        return out
+
+    def _check(self, d, active):
+        """The stability guard (see the class docstring); raises :class:`EngineInstability`."""
+        s = self.s
+        B, N = s.B, s.N
+        self.rate_max = np.maximum(self.rate_max, np.abs(s.rate))
+        state = np.stack((s.x, s.y, s.vx, s.vy, s.omega)).reshape(5, B, N)
+        finite = np.isfinite(state).all(axis=(0, 2))
+        u = s.vx - (s.y - self.hy_s) * s.rate[s.rep]
+        ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
+        plate = self.rate_max * s.Ly / 2
+        bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
+        C = self.C
+        ratio = np.where(active & C.trans, d / C.d0, np.inf)
+        lo, hi = C.offsets[:-1], C.offsets[1:]
+        closest = np.minimum.reduceat(np.append(ratio, np.inf), lo)     # pairs of a replica are contiguous
+        closest[hi == lo] = np.inf
+        for b in range(B):
+            if not self.guard[b]:
+                continue
+            if not finite[b]:
+                reason = "non-finite state"
+            elif ke[b] > bound[b]:
+                reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
+            elif closest[b] < self.min_distance_ratio:
+                reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
+            else:
+                continue
+            raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
+                                    replica=b, step=self.step_count, phase=self.phase)
+
+
+def pre_equilibration_blocks(N, dt, dt_max):
+    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``."""
+    blocks = []
+    level_dt, cf = dt_max, 0.5
+    while level_dt > dt:
+        blocks.append((int(N / 2), level_dt, cf))
+        level_dt = level_dt / 2
+        cf = (1 + cf) / 2
+    return blocks
+
+
+def _quiet(*args):
+    pass
+
+
+def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
+    """Relax with the plates fixed (reference §8.4): coarse levels from ``dt_max``, 2N steps at
+    ``dt`` (damping 0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment.
+
+    ``say(message)`` receives the reference's console messages, ``report(step, total)`` is
+    called after every step (progress)."""
+    s = engine.s
+    s.applying_shear = True
+    engine.phase = "pre-equilibration"
+    engine.step_count = 0
+    blocks = pre_equilibration_blocks(N, dt, dt_max)
+    total = sum(b[0] for b in blocks) + 3 * int(N)
+    say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt " + str(dt_max)
+        + " final dt " + str(dt))
+    step = 0
+    for n, level_dt, cf in blocks:
+        say("dt= " + str(level_dt))
+        for _ in range(n):
+            engine.step(cf, level_dt)
+            step += 1
+            report(step, total)
+    say("  Setting final dt= " + str(dt))
+    for _ in range(2 * int(N)):
+        engine.step(0.98, dt)
+        step += 1
+        report(step, total)
+    for _ in range(int(N)):
+        s.rate = np.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
+        engine.step(cool, dt)
+        step += 1
+        report(step, total)
+    engine.flush()
+
+
+def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet):
+    """The oscillatory protocol of every replica (reference §8.2-8.3), clock reset to 0.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+    dt : float
+        Time step (s), shared by the replicas.
+    f : float
+        Excitation frequency (Hz).
+    amplitudes : array_like (B,)
+        Strain amplitude of each replica.
+    cool : float
+        Damping factor per step.
+    pre, periods, post : float
+        Baseline periods before, shear periods, baseline periods after.
+
+    keep_tensors : bool
+        Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
+    say, report : callable
+        Receive the reference's console message and ``(step, total)`` after every step.
+
+    Returns
+    -------
+    dict of ndarray (n_steps, B)
+        "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step, and
+        "first_tensors", "last_tensors" (B, 9, 2, 2): every tensor at the first and last step.
+    """
+    s = engine.s
+    s.applying_shear = True
+    s.t = np.zeros(s.B)
+    T_total = (periods + pre + post) / f
+    n_steps = int(T_total / dt)
+    lo = pre / (f * dt)
+    hi = (periods + pre) / (f * dt)
+    A = np.asarray(amplitudes, dtype=float)
+    rec = {name: np.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
+                                                         "stress_surface")}
+    if keep_tensors:
+        rec["tensors"] = np.empty((n_steps, s.B, 9, 2, 2))
+    say("Start application shear protocol, total N= " + str(n_steps) + " steps")
+    engine.phase = "protocol"
+    engine.step_count = 0
+    zero = np.zeros(s.B)
+    for i in range(n_steps):
+        t = float(s.t[0])      # every replica has the same clock (same dt, same schedule)
+        if lo <= i <= hi:
+            rate = A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
+        else:
+            rate = zero
+        engine.set_rate(rate)
+        rec["t"][i] = s.t
+        rec["strain"][i] = s.gamma
+        rec["strain_rate"][i] = s.rate
+        ends = i == 0 or i == n_steps - 1
+        out = engine.step(cool, dt, sample="tensors" if keep_tensors or ends else True)
+        rec["stress_internal"][i] = out[0]
+        rec["stress_surface"][i] = out[1]
+        if keep_tensors:
+            rec["tensors"][i] = out[2]
+        if i == 0:
+            rec["first_tensors"] = out[2]
+        if i == n_steps - 1:
+            rec["last_tensors"] = out[2]
+        report(i + 1, n_steps)
+    engine.flush()
+    return rec

@@ -1,0 +1,129 @@
+"""Every stress tensor as one function, with its name and output-column stem in one registry.
+
+Each function takes the :class:`StressInputs` of one force phase of a batch and returns a
+``(B, 2, 2)`` array (Pa; index ``[b, a, c]``: replica, force component, position component).
+Sums run per replica over its own rows (``bincount`` over the replica index), so a replica's
+tensors do not depend on its batch.  Units as in the reference: forces ×1e-12 (N per m depth),
+lengths ×1e-6 (m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from
+the cell centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
+"""
+import collections
+
+import numpy as np
+
+__all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
+
+_ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
+
+
+class StressInputs:
+    """What the tensors read from one force phase of a batch (all arrays of the step, not copies).
+
+    ``C`` the candidate constants, ``B`` replicas, ``rep`` sphere → replica, ``x, y, vx, vy,
+    omega, m, inertia`` sphere state, ``Lx, Ly, rate, V`` per replica, ``mob`` mobility mask,
+    ``active``/``shifted`` per candidate, ``dx, dy`` minimum-image pair vectors, ``fx_i, fy_i``
+    pair force on i, ``dF`` = d·F_T (internal torque of a pair), ``fx, fy, torque`` sphere totals.
+    """
+
+    def __init__(self, **arrays):
+        self.__dict__.update(arrays)
+
+    def per_replica(self, weights, by_pair=True):
+        """Σ of ``weights`` per replica (pairs or spheres), in row order."""
+        return np.bincount(self.C.rep if by_pair else self.rep, weights, self.B)
+
+    def outer(self, u, w, by_pair=True):
+        """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows)."""
+        out = np.empty((self.B, 2, 2))
+        for a in range(2):
+            for c in range(2):
+                out[:, a, c] = self.per_replica(u[a] * w[c], by_pair)
+        return out
+
+    @property
+    def internal(self):
+        """Pairs counted as internal: both spheres mobile, no image shift, a relation (eq. S1-19)."""
+        C = self.C
+        return self.active & self.mob[C.ai] & self.mob[C.aj] & ~self.shifted
+
+
+def love_weber(q):
+    """σ_LW = (1/V) Σ_internal F_i ⊗ (x_i − x_j) (eq. S1-19); ``x_i − x_j = −D`` for an unshifted pair."""
+    w = q.internal
+    return q.outer((q.fx_i * w, q.fy_i * w), (-q.dx, -q.dy)) * (1e-18 / q.V)[:, None, None]
+
+
+def external_forces(q):
+    """σ_ext = −(1/V) Σ_external F ⊗ (x_target − c) (eq. S1-16): a mobile sphere of a pair through
+    the boundary or with an immobile partner receives the pair force at its own centre."""
+    C = q.C
+    ext = q.active & ~q.internal
+    ei, ej = ext & q.mob[C.ai], ext & q.mob[C.aj]
+    cx, cy = (q.Lx / 2)[C.rep], (q.Ly / 2)[C.rep]
+    lever_x = (q.x[C.ai] - cx) * ei - (q.x[C.aj] - cx) * ej     # F on j is −F on i
+    lever_y = (q.y[C.ai] - cy) * ei - (q.y[C.aj] - cy) * ej
+    return -q.outer((q.fx_i, q.fy_i), (lever_x, lever_y)) * (1e-18 / q.V)[:, None, None]
+
+
+def unbalanced_forces(q):
+    """σ_unb = (1/V) Σ_mobile F_total ⊗ (x − c) (eq. S1-17)."""
+    w = q.mob
+    cx, cy = (q.Lx / 2)[q.rep], (q.Ly / 2)[q.rep]
+    return q.outer((q.fx * w, q.fy * w), (q.x - cx, q.y - cy), by_pair=False) * (1e-18 / q.V)[:, None, None]
+
+
+def linear_acceleration(q):
+    """σ_linacc = σ_unb (m·a = F_total; gravity neglected, eq. S1-17)."""
+    return unbalanced_forces(q)
+
+
+def unbalanced_torque(q):
+    """σ_T = (1/V) Σ_all spheres T·[[0, −½], [½, 0]] (eq. S1-22; immobile spheres included, reference quirk)."""
+    return q.per_replica(q.torque, by_pair=False)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
+
+
+def internal_torque(q):
+    """σ_Tint = (1/V) Σ_internal d·F_T·[[0, −½], [½, 0]] (eq. S1-22): the pair's two torques sum to d·F_T."""
+    return q.per_replica(q.dF * q.internal)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
+
+
+def spin_kinetic_energy(q):
+    """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21)."""
+    k = q.per_replica(q.inertia * q.omega * q.omega * q.mob, by_pair=False) * 1e-18 / 2
+    return -(k / q.V)[:, None, None] * np.eye(2)
+
+
+def peculiar_acceleration_otsuki(q):
+    """σ_ot = −(1/V) Σ_mobile P ⊗ P / m with P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa; for
+    comparison only)."""
+    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * (q.y - (q.Ly / 2)[q.rep]))
+    py = q.m * 1e-12 * q.vy
+    w = q.mob / (q.m * 1e-6)
+    return -q.outer((px * w, py * w), (px, py), by_pair=False) / q.V[:, None, None]
+
+
+def overall(q):
+    """σ = σ_LW + σ_Tint + σ_cen (eq. S1-24)."""
+    return love_weber(q) + internal_torque(q) + spin_kinetic_energy(q)
+
+
+#: one registry entry per tensor: name (StressTensorEvaluation attribute), output-column stem, equation
+Tensor = collections.namedtuple("Tensor", "name stem equation function")
+TENSORS = (
+    Tensor("stress_tensor_LW", "stress_tensor_Love_Weber", "S1-19", love_weber),
+    Tensor("stress_tensor_linear_acceleration_otsuki", "stress_tensor_peculiar_acceleration_otsuki", "Otsuki",
+           peculiar_acceleration_otsuki),
+    Tensor("stress_tensor_with_external_forces", "stress_tensor_from_external_forces", "S1-16", external_forces),
+    Tensor("stress_tensor_linear_acceleration", "stress_tensor_linear_acceleration", "S1-17", linear_acceleration),
+    Tensor("stress_tensor_unbalanced_forces", "stress_tensor_unbalanced_linear_forces", "S1-17",
+           unbalanced_forces),
+    Tensor("stress_tensor_unbalanced_torque", "stress_tensor_tangential_torque", "S1-22", unbalanced_torque),
+    Tensor("stress_tensor_internal_torque", "stress_tensor_internal_tangential_torque", "S1-22", internal_torque),
+    Tensor("stress_tensor_spin_kinetic_energy", "stress_tensor_centrifugal", "S1-21", spin_kinetic_energy),
+    Tensor("overall_stress_tensor", "stress_tensor_overall", "S1-24", overall),
+)
+
+
+def evaluate_all(q):
+    """(B, 9, 2, 2) array of every tensor of :data:`TENSORS`, in registry order."""
+    return np.stack([t.function(q) for t in TENSORS], axis=1)

@@ -1,0 +1,189 @@
+"""Batches of replicas (particleShear.run.batch): a replica's run does not depend on its batch.
+
+A replica of a batch must give exactly — bit for bit — the trajectory record, tensors and
+G′/G″ of its single run, whatever the other replicas of the batch are (frictional or not,
+crosslinked or not, other μ and amplitude), and a batched series must return exactly the
+unbatched series in the same order.  Small N and short protocols keep the runs cheap; the
+comparison is exact, so there is no tolerance to justify.
+"""
+import concurrent.futures
+import unittest
+
+import numpy as np
+
+from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
+from particleShear.run.batch import batches, run_batch, schedule_key
+
+#: ~300 protocol steps of 20 spheres (the quick scene of test_simulation.py)
+QUICK = dict(N=20, relative_frequency=0.2, pre_periods=0.5, periods=1, post_periods=0.5, doDrawing=False,
+             plotStress=False, verbose=False)
+
+#: four mixed replicas sharing one schedule: frictional only; crosslinked and cut with stronger
+#: friction and a larger amplitude; crosslinked without friction; crosslinked, uncut
+MIXED = [dict(QUICK, seed=1, theAmplitude=0.2, theMu=0.01, do_permanent_links=False, cut_lines=0),
+         dict(QUICK, seed=2, theAmplitude=0.3, theMu=0.05, do_permanent_links=True, cut_lines=2),
+         dict(QUICK, seed=3, theAmplitude=0.1, theMu=0.0, do_permanent_links=True, cut_lines=2),
+         dict(QUICK, seed=4, theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=0)]
+
+
+class InlineExecutor(concurrent.futures.Executor):
+    """Runs each task at submission (an executor without workers, for deterministic tests)."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        fut = concurrent.futures.Future()
+        fut.set_result(fn(*args, **kwargs))
+        return fut
+
+
+def assert_same_result(test, a, b):
+    """Every number of two SimulationResults equal bit for bit (timings excluded: wall clock)."""
+    for name in ("G_surface", "G_internal", "stress_surface", "stress_internal", "seed", "spawn_key", "dt", "f",
+                 "N_steps", "damping_factor", "removed_fraction", "n_images", "output_path"):
+        test.assertEqual(getattr(a, name), getattr(b, name), name)
+    test.assertEqual(sorted(a.series), sorted(b.series))
+    for key in a.series:
+        x, y = np.asarray(a.series[key]), np.asarray(b.series[key])
+        test.assertEqual(x.shape, y.shape, key)
+        test.assertTrue(np.array_equal(x, y), key)
+        test.assertEqual(x.tobytes(), y.tobytes(), key)  # also the sign of zeros
+    pa = {k: v for k, v in a.parameters.items() if k != "seed"}
+    pb = {k: v for k, v in b.parameters.items() if k != "seed"}
+    test.assertEqual(pa, pb)
+
+
+class TestBatchOfMixedReplicas(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.batch = run_batch(MIXED)
+        cls.single = [doParticleShearSimulation(**kw, return_result=True) for kw in MIXED]
+        cls.pair = run_batch([MIXED[2], MIXED[0]])  # other companions, other order
+
+    def test_scene_is_mixed(self):
+        # the replicas really differ: links where asked, different moduli, one schedule
+        self.assertEqual(len({schedule_key(kw) for kw in MIXED}), 1)
+        self.assertEqual(len({r.G_surface for r in self.single}), 4)
+        self.assertEqual(len({r.N_steps for r in self.single}), 1)
+        self.assertGreater(self.single[0].N_steps, 100)
+
+    def test_each_replica_equals_its_single_run(self):
+        self.assertEqual(len(self.batch), 4)
+        for n, (b, s) in enumerate(zip(self.batch, self.single)):
+            with self.subTest(replica=n):
+                assert_same_result(self, b, s)
+
+    def test_replica_independent_of_its_companions(self):
+        assert_same_result(self, self.pair[0], self.single[2])
+        assert_same_result(self, self.pair[1], self.single[0])
+
+    def test_whole_protocol_recorded(self):
+        for r in self.batch:
+            self.assertEqual(len(r.series["t"]), r.N_steps)
+            self.assertTrue(np.all(np.isfinite(r.series["stress_surface"])))
+
+
+class TestBatchedSeries(unittest.TestCase):
+    KW = dict(amplitudes=[0.1, 0.3], mu=[0.01], cut_lines=2, do_uncrosslinked_control=True, N_repetitions=1,
+              seed=5, **QUICK)
+
+    def test_batched_series_equals_unbatched(self):
+        # four runs in batches of three: one full and one partial batch
+        plain = doParticleShearSimulationSeries(executor=InlineExecutor(), **self.KW)
+        batched = doParticleShearSimulationSeries(executor=InlineExecutor(), batch_size=3, **self.KW)
+        self.assertEqual(len(plain), 4)
+        self.assertEqual(len(batched), len(plain))
+        for a, b in zip(batched, plain):
+            assert_same_result(self, a, b)
+
+    def test_batched_series_on_a_process_pool(self):
+        kw = dict(self.KW, amplitudes=[0.2], cut_lines=0, do_uncrosslinked_control=False, N_repetitions=2)
+        plain = doParticleShearSimulationSeries(executor=InlineExecutor(), **kw)
+        with concurrent.futures.ProcessPoolExecutor(max_workers=1) as pool:
+            batched = doParticleShearSimulationSeries(executor=pool, batch_size=2, **kw)
+        for a, b in zip(batched, plain):
+            assert_same_result(self, a, b)
+
+
+class TestBatchGrouping(unittest.TestCase):
+    def test_batches_keep_order_and_split_schedules(self):
+        runs = [dict(N=20), dict(N=30), dict(N=20, theMu=0.05), dict(N=20), dict(N=30, seed=3)]
+        self.assertEqual(batches(runs, 2), [[0, 2], [1, 4], [3]])
+        self.assertEqual(batches(runs, 1), [[0], [1], [2], [3], [4]])
+
+    def test_time_step_rule_separates_batches(self):
+        # μ > 1 halves dt less often (docs/parameters.md): another schedule
+        self.assertNotEqual(schedule_key(dict(theMu=0.01)), schedule_key(dict(theMu=2.0)))
+        self.assertNotEqual(schedule_key(dict(theAmplitude=0.2)), schedule_key(dict(theAmplitude=0.6)))
+        self.assertEqual(schedule_key(dict(theAmplitude=0.2, seed=1)), schedule_key(dict(theAmplitude=0.3)))
+
+
+class TestConsoleAndProgress(unittest.TestCase):
+    def test_engine_path_prints_and_reports_as_the_classes(self):
+        # verbose messages line by line and progress calls, engine path (doDrawing=False) against the
+        # documented classes (doDrawing=True with no renderer); numbers agree to rounding (≈ 1e-15 over
+        # this short protocol), compared to 9 significant digits
+        import contextlib
+        import io
+        import re
+
+        def run(**extra):
+            out, prog = io.StringIO(), []
+            kw = dict(QUICK, seed=1, do_permanent_links=True, cut_lines=2, verbose=True,
+                      progress=lambda *a: prog.append(a[:3]), **extra)
+            with contextlib.redirect_stdout(out):
+                doParticleShearSimulation(**kw)
+            num = re.compile(r"-?\d+\.\d+(?:e[-+]?\d+)?")
+            return [num.sub(lambda m: f"{float(m.group()):.9g}", line) for line in out.getvalue().splitlines()], prog
+
+        engine, classes = run(doDrawing=False), run(doDrawing=True, renderer="none")
+        self.assertGreater(len(engine[0]), 15)
+        self.assertEqual(engine[0], classes[0])
+        # progress is throttled in time (~10 calls/s): compare the first and the last call of every phase
+        ends = [[c for c in prog if c[1] <= 1 or c[1] == c[2]] for prog in (engine[1], classes[1])]
+        self.assertEqual(ends[0], ends[1])
+        self.assertEqual([c[0] for c in ends[0]], ["constitution", "constitution", "pre-equilibration",
+                                                   "pre-equilibration", "protocol", "protocol"])
+
+
+class TestBatchStability(unittest.TestCase):
+    def test_diverging_replica_stops_the_batch_with_a_clear_error(self):
+        # 40× the time step rule: the explicit step is far beyond its stability limit and blows up
+        from particleShear import SimulationInstabilityError
+        coarse = dict(QUICK, N=20, do_permanent_links=False, cut_lines=0, seed=1, time_step_factor=40)
+        doParticleShearSimulation.last_result = None
+        with self.assertRaises(SimulationInstabilityError) as cm:
+            doParticleShearSimulation(**coarse, return_result=True)
+        e = cm.exception
+        self.assertIn(e.phase, ("pre-equilibration", "protocol"))
+        self.assertIsInstance(e.step, int)
+        self.assertLess(e.suggested_dt, 40 * doParticleShearSimulation(**dict(coarse, time_step_factor=1),
+                                                                       return_result=True).dt)
+        with self.assertRaises(SimulationInstabilityError):
+            run_batch([dict(coarse, seed=2), coarse])
+
+
+class TestBatchBadInput(unittest.TestCase):
+    def test_batch_size(self):
+        for bad in (0, -1, 1.5, True, "2"):
+            with self.subTest(batch_size=bad):
+                with self.assertRaisesRegex(ValueError, "batch_size"):
+                    doParticleShearSimulationSeries(executor=InlineExecutor(), batch_size=bad, **QUICK)
+
+    def test_backend(self):
+        with self.assertRaisesRegex(ValueError, "backend='nonsense'"):
+            run_batch([MIXED[0]], backend="nonsense")
+        with self.assertRaisesRegex(ValueError, "backend"):
+            doParticleShearSimulationSeries(executor=InlineExecutor(), backend="nonsense", **QUICK)
+
+    def test_empty_mixed_or_unknown(self):
+        with self.assertRaisesRegex(ValueError, "at least one run"):
+            run_batch([])
+        with self.assertRaisesRegex(ValueError, r"list_of_kwargs\[1\].*\bN\b"):
+            run_batch([dict(QUICK), dict(QUICK, N=30)])
+        with self.assertRaisesRegex(ValueError, "unknown parameters"):
+            run_batch([dict(QUICK, nonsense=1)])
+        with self.assertRaisesRegex(ValueError, "theMu"):
+            run_batch([dict(QUICK), dict(QUICK, theMu=-1)])
+
+
+if __name__ == "__main__":
+    unittest.main()
