@@ -9,15 +9,16 @@ class Graphical_output_configuration:
 
     Colours are Tk/Pillow colour names (e.g. ``"grey"``, ``"darkorchid"``).  Some options
     (``color_spheres_boundary``, ``draw_permanent_connections``, ``color_permanent_connections``,
-    the volume forces and the speeds) are stored for compatibility with particleShear 1.0.2
-    but the drawing does not use them.
+    the volume and boundary forces, ``force_scale`` and the speeds) are stored for
+    compatibility with particleShear 1.0.2 but the drawing does not use them: permanent links
+    are always drawn as blue centre-to-centre lines (see docs/output.md).
 
     Parameters
     ----------
     draw_spheres_as : {"spheres", "dots", "none"}
         How a sphere is drawn: its disc outline, a dot of radius 2 pixels, or not at all.
     color_spheres_volume : str
-        Colour of the sphere outlines.
+        Colour of the sphere discs.
     color_spheres_boundary : str
         Colour of spheres touching the boundary (stored, not used).
     draw_rotation_line : bool
@@ -25,7 +26,7 @@ class Graphical_output_configuration:
     color_rotation_line : str
         Colour of the rotation line.
     draw_active_interface : bool
-        Draw a line between the centres of every touching (transient) pair.
+        Draw the contact chord of every touching pair (locked or slip colour by its state).
     color_interface_locked : str
         Colour of a sticking contact.
     color_interface_slip : str
@@ -35,17 +36,17 @@ class Graphical_output_configuration:
     color_permanent_connections : str
         Colour of permanent links (stored; links are drawn in blue).
     draw_permanent_interfaces : bool
-        Draw the interface line of permanent links.
+        Draw the contact chord of permanent links (in dark orange).
     draw_volume_forces : bool
         Draw the volume forces (stored, not used).
     color_volume_forces : str
         Colour of the volume forces (stored, not used).
     draw_boundary_forces : bool
-        Draw the forces on the plate spheres.
+        Draw the forces on the plate spheres (stored, not used).
     color_boundary_forces : str
-        Colour of the boundary forces.
+        Colour of the boundary forces (stored, not used).
     force_scale : float
-        Force (mg·µm·s⁻² per m depth) drawn as one pixel of arrow length.
+        Scale of drawn force arrows (stored, not used).
     draw_speeds : bool
         Draw the velocities (stored, not used).
     color_speeds : str
