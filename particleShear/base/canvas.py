@@ -1,4 +1,4 @@
-"""Canvases: the ensemble state arrays and the vectorised step (spec §3, §4, §10.6).
+"""Canvases: the ensemble state arrays and the vectorised step (see docs/design.md).
 
 Each class of the documented chain adds one capability:
 
@@ -16,6 +16,8 @@ A step never loops over spheres or pairs in Python.  Forces of one force phase
 are collected per active pair and applied with one ``bincount`` per component
 (`_flush_pair_forces`), which also fills the force register.
 """
+__docformat__ = "numpy"
+
 import math
 
 import numpy as np
@@ -52,6 +54,18 @@ def check_time_step(dt, step=None):
 
     A zero, negative, infinite or NaN step would freeze, reverse or destroy the state
     (NaN or infinite positions) without any error; refusing it costs one comparison.
+
+    Parameters
+    ----------
+    dt : float
+        Time step (s).
+    step : int or None
+        Current step, named in the message when given.
+
+    Raises
+    ------
+    ValueError
+        If ``dt`` is not a finite number > 0 (a bool is refused too).
     """
     if isinstance(dt, bool) or not 0.0 < dt < math.inf:
         where = "" if step is None else f" at step {step}"
@@ -59,7 +73,22 @@ def check_time_step(dt, step=None):
 
 
 def check_non_negative(name, value):
-    """Raise ValueError unless ``value`` is a finite number ≥ 0."""
+    """Raise ValueError unless ``value`` is a finite number ≥ 0.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name used in the message.
+    value : float
+        The value to check.
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not a real number.
+    ValueError
+        If ``value`` is not finite or is negative.
+    """
     _check_finite(name, value)
     if value < 0:
         raise ValueError(f"{name} must be >= 0, got {value!r}")
@@ -82,17 +111,44 @@ class NonNegative:
 
 
 class SphereList(list):
-    """The ensemble's spheres in index order; ``append`` moves a sphere's state into the arrays."""
+    """The ensemble's spheres in index order; ``append`` moves a sphere's state into the arrays.
+
+    Spheres can only be added: removing, replacing or reordering raises ``TypeError``.
+
+    Parameters
+    ----------
+    canvas : CanvasPoints
+        The ensemble that owns the list.
+    """
 
     def __init__(self, canvas):
         list.__init__(self)
         self._canvas = canvas
 
     def append(self, sphere):
+        """Add a sphere: its state moves into the ensemble's arrays and its relations into the pair table.
+
+        Parameters
+        ----------
+        sphere : object
+            A sphere (e.g. :class:`~particleShear.base.points.CircleFrictionElasticity`) not yet in an ensemble.
+
+        Raises
+        ------
+        ValueError
+            If the sphere is already in an ensemble, or its position, radius or mass is invalid.
+        """
         self._canvas._attach(sphere)
         list.append(self, sphere)
 
     def extend(self, spheres):
+        """Append every sphere of ``spheres`` in order (see :meth:`append`).
+
+        Parameters
+        ----------
+        spheres : iterable
+            The spheres.
+        """
         for s in spheres:
             self.append(s)
 
@@ -101,6 +157,20 @@ class SphereList(list):
         return self
 
     def _forbidden(self, *args, **kwargs):
+        """Refused: spheres cannot be removed, replaced or reordered once in an ensemble.
+
+        Parameters
+        ----------
+        *args
+            Ignored.
+        **kwargs
+            Ignored.
+
+        Raises
+        ------
+        TypeError
+            Always: spheres cannot be removed, replaced or reordered once in an ensemble.
+        """
         raise TypeError("spheres cannot be removed, replaced or reordered once in an ensemble")
 
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
@@ -139,7 +209,7 @@ class _Structure:
 
 
 class _Flags:
-    """What the stress tensors need of the internal/external flags of one mobility mask (§7.2):
+    """What the stress tensors need of the internal/external flags of one mobility mask (docs/design.md):
     number and float weights (None: all) of internal pairs; positions in the flush's flat force array
     and target spheres of the external forces."""
     __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_flat", "ext_targets")
@@ -164,7 +234,24 @@ class _Geometry:
 
 
 class CanvasPoints:
-    """Cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form."""
+    """Cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form.
+
+    Random choices use the generator set by :meth:`set_random_generator` (seeded by the run).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    """
 
     use_lees_edwards = False
 
@@ -195,17 +282,25 @@ class CanvasPoints:
     # -- sphere list and state arrays ----------------------------------------------------------
     @property
     def sphereList(self):
+        """The spheres in index order (a :class:`SphereList`); assignable only while the ensemble is empty."""
         return self._sphereList
 
     @sphereList.setter
     def sphereList(self, spheres):
+        """The spheres in index order (a :class:`SphereList`); assignable only while the ensemble is empty."""
         if len(self._sphereList):
             raise TypeError("sphereList can only be assigned while the ensemble is empty")
         for s in spheres:
             self._sphereList.append(s)
 
     def set_random_generator(self, rng):
-        """Use ``rng`` (a ``numpy.random.Generator``) for every random choice of this ensemble."""
+        """Use ``rng`` (a ``numpy.random.Generator``) for every random choice of this ensemble.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The generator (e.g. ``numpy.random.default_rng(seed)``).
+        """
         self._rng = rng
 
     def _set_capacity(self, cap):
@@ -310,12 +405,19 @@ class CanvasPoints:
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def set_graphical_output_configuration(self, graphical_output_configuration):
-        """Share one drawing configuration with every sphere."""
+        """Share one drawing configuration with every sphere.
+
+        Parameters
+        ----------
+        graphical_output_configuration : Graphical_output_configuration
+            The drawing options.
+        """
         self.graphical_output_configuration = graphical_output_configuration
         for s in self.sphereList:
             s.set_graphical_output_configuration(graphical_output_configuration)
 
     def initiateGraphics(self):
+        """Draw the ensemble in its live window, if a renderer is attached (else nothing)."""
         if self._renderer is not None:
             self._renderer.draw(self)
 
@@ -327,9 +429,28 @@ class CanvasPoints:
             a["yspeed"] -= a["yspeed"].sum() / self._n
 
     def particle_info(self):
+        """Short description of the ensemble for the output header.
+
+        Returns
+        -------
+        str
+            The description.
+        """
         return "Points in a periodic cell"
 
     def canMove(self, theSphere):
+        """Whether the sphere is mobile (always True here; plates are added by :class:`CanvasPointsShear`).
+
+        Parameters
+        ----------
+        theSphere : object
+            A sphere of this ensemble.
+
+        Returns
+        -------
+        bool
+            True.
+        """
         return True
 
     def _mobile_mask(self):
@@ -351,7 +472,13 @@ class CanvasPoints:
         return sel
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres ``v += F·dt/m`` and reset their force."""
+        """Kick mobile spheres ``v += F·dt/m`` and reset their force.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), finite and > 0.
+        """
         a = self._a
         mob = self._mobile_mask()
         fx, fy, m = a["xforce"], a["yforce"], a["m"]
@@ -370,7 +497,13 @@ class CanvasPoints:
         pass
 
     def cool(self, f=0.8):
-        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` of all spheres (§4.4)."""
+        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` of all spheres (SLLOD-like; docs/design.md).
+
+        Parameters
+        ----------
+        f : float
+            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
+        """
         a = self._a
         rate = getattr(self, "shear_rate", 0)
         if rate:
@@ -388,6 +521,13 @@ class CanvasPoints:
         self._pos_version += 1
 
     def move(self, dt=1):
+        """Drift: advance every position by velocity × ``dt``.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
         self._drift(dt)
 
     def _le_shift(self):
@@ -412,7 +552,13 @@ class CanvasPoints:
         return self._u
 
     def boundary_conditions(self):
-        """Wrap every sphere into the cell (Lees-Edwards shifted where active, §3.3)."""
+        """Wrap every sphere into the cell (Lees-Edwards shifted where active; docs/design.md).
+
+        Raises
+        ------
+        SimulationInstabilityError
+            If a position is not finite or lies more than :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
+        """
         a = self._a
         if self._n:
             pos = self._pos
@@ -460,7 +606,13 @@ class CanvasPoints:
         guard._fail(self, step, phase, getattr(self, "_last_dt", None), reason, pair=(k,))
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
-        """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing."""
+        """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing.
+
+        Parameters
+        ----------
+        rand_fraction : float
+            Jitter amplitude as a fraction of the grid spacing (0 = exact grid).
+        """
         n = self._n
         if n == 0:
             return
@@ -476,7 +628,24 @@ class CanvasPoints:
 
 
 class CanvasPointsMass(CanvasPoints):
-    """Adds the clock ``t`` (s), the force register and momentum bookkeeping."""
+    """Adds the clock ``t`` (s), the force register and momentum bookkeeping.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    """
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPoints.__init__(self, size_x, size_y, theCanvas, doDrawing)
@@ -485,13 +654,26 @@ class CanvasPointsMass(CanvasPoints):
         self.m = m
 
     def reset_force_register(self):
+        """Clear the force register (start of a force phase)."""
         self.force_register.reset_force_register()
 
-    # Registration filters (§3.5) for scripts that apply forces sphere by sphere.
+    # Registration filters (boundary-crossing forces are external) for scripts that apply forces sphere by sphere.
     def _source_is_external(self, target, source):
         return False
 
     def record_individual_internal_force(self, target, source, force_vector):
+        """Record a pair force sphere by sphere: dropped for an immobile target, external when the source is
+        immobile or acts through the periodic boundary, internal otherwise.
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        source : object
+            The sphere exerting it.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         if not self.canMove(target):
             return
         if not self.canMove(source) or self._source_is_external(target, source):
@@ -500,6 +682,17 @@ class CanvasPointsMass(CanvasPoints):
             self.force_register.record_individual_internal_force(target, source, force_vector)
 
     def record_individual_internal_torque(self, target, source, moment):
+        """Record a pair torque with the same filters as :meth:`record_individual_internal_force`.
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        source : object
+            The sphere exerting it.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         if not self.canMove(target):
             return
         if not self.canMove(source) or self._source_is_external(target, source):
@@ -508,18 +701,54 @@ class CanvasPointsMass(CanvasPoints):
             self.force_register.record_individual_internal_torque(target, source, moment)
 
     def record_total_particle_force(self, target, force_vector):
+        """Record the total force of a mobile sphere (dropped for an immobile one).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         if self.canMove(target):
             self.force_register.record_total_particle_force(target, force_vector)
 
     def record_external_force(self, target, force_vector):
+        """Record an external force on a mobile sphere (dropped for an immobile one).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         if self.canMove(target):
             self.force_register.record_external_force(target, force_vector)
 
     def record_external_torque(self, target, moment):
+        """Record an external torque on a mobile sphere (dropped for an immobile one).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         if self.canMove(target):
             self.force_register.record_external_torque(target, moment)
 
     def record_unbalanced_moment(self, target, moment):
+        """Record the net torque of a mobile sphere (dropped for an immobile one).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         if self.canMove(target):
             self.force_register.record_unbalanced_moment(target, moment)
 
@@ -533,15 +762,34 @@ class CanvasPointsMass(CanvasPoints):
                                         tot[2] if self._torque_total() is not None else None, tot)
 
     def particle_info(self):
+        """Short description of the ensemble for the output header.
+
+        Returns
+        -------
+        str
+            The description.
+        """
         return "Spheres with mass"
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):
-        """Evaluate every tensor of §7 for the current register, mobile spheres and shear rate."""
+        """Evaluate every tensor (eqs. S1-16 to S1-24) for the current register, mobile spheres and shear rate.
+
+        Parameters
+        ----------
+        StressTensorEvaluator : StressTensorEvaluation
+            The evaluator whose tensors are updated.
+
+        Returns
+        -------
+        StressTensorEvaluation
+            The same evaluator.
+        """
         sel = self._mobile_selection()
         StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
         return StressTensorEvaluator
 
     def reset_force(self):
+        """Set the force of every sphere to zero."""
         self._frc[:2] = 0.0
 
     # Momenta (raw coordinates, origin at the cell corner) — conserved in isolated scenes.
@@ -557,7 +805,24 @@ class CanvasPointsMass(CanvasPoints):
 
 
 class CanvasPointsNeighbors(CanvasPointsMass):
-    """Adds the pair table and the neighbour update (relations = contacts ∪ permanent links)."""
+    """Adds the pair table and the neighbour update (relations = contacts ∪ permanent links).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    """
 
     #: extra search distance of the candidate list, in units of the largest radius
     neighbour_skin = 0.5
@@ -687,7 +952,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._images_valid = True
 
     def test_neighbor_relation(self):
-        """Neighbour update (§4.2): activate touching pairs, drop transient ones that separated.
+        """Neighbour update (docs/design.md): activate touching pairs, drop transient ones that separated.
 
         Also computes the geometry of the active pairs that every force term of
         this step uses.  What depends only on *which* pairs are active (indices,
@@ -713,7 +978,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         cached_images = self._images_valid and self._images_version == pt.version
         dvx_rate = 0.0
         if cached_images:
-            # no sphere wrapped since the images were found: reuse their period counts (§3.1,
+            # no sphere wrapped since the images were found: reuse their period counts (minimum image,
             # one period at a time, so bit-identical to a fresh minimum image)
             ky, kyf, kx, LK = self._images
             D = D0   # fresh array; the raw differences are not needed again on this path
@@ -814,7 +1079,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         return f
 
     def _set_internal_flags(self, S, mob):
-        """Internal/external flags of the active pairs for mobility mask ``mob`` (§7.2), and what the
+        """Internal/external flags of the active pairs for mobility mask ``mob`` (docs/design.md), and what the
         stress evaluation needs of them: float weights of internal pairs, slots and targets of external forces."""
         shifted = S.shifted
         if mob is None:
@@ -880,7 +1145,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         else:
             S.perm = perm
             S.trans = ~perm
-        # a pair interacts through the boundary iff its raw and minimum-image distances differ (§3.5);
+        # a pair interacts through the boundary iff its raw and minimum-image distances differ;
         # with cached images the cell is much larger than a contact, so any period applied means that
         if ky is None:
             shifted = (D != D0).any(axis=0)
@@ -1058,7 +1323,24 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
 
 class CanvasPointsShear(CanvasPointsNeighbors):
-    """Adds the shear strain ``shear`` (γ), its rate ``shear_rate`` (1/s) and the moving plates."""
+    """Adds the shear strain ``shear`` (γ), its rate ``shear_rate`` (1/s) and the moving plates.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    """
 
     use_lees_edwards = True
 
@@ -1074,7 +1356,18 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self._plates = None
 
     def canMove(self, theSphere):
-        """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (§4.6)."""
+        """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (docs/design.md).
+
+        Parameters
+        ----------
+        theSphere : object
+            A sphere of this ensemble.
+
+        Returns
+        -------
+        bool
+            True if the sphere moves freely.
+        """
         if not self.applyingShear:
             return True
         return theSphere.r < theSphere.y < self.size_y - theSphere.r
@@ -1099,10 +1392,15 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         return self._mob
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres; immobile ones take the velocity of their plate (§4.1 step 4).
+        """Kick mobile spheres; immobile ones take the velocity of their plate.
 
         Every sphere is kicked and the plate velocity then overwrites the
         immobile ones, which gives the mobile spheres exactly the reference kick.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), finite and > 0.
         """
         a = self._a
         F = self._frc[:2]
@@ -1113,7 +1411,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self._plates_follow()
 
     def _plates_follow(self):
-        """Immobile (plate) spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity (§4.6)."""
+        """Immobile (plate) spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity (docs/design.md)."""
         a = self._a
         mob = self._mobile_mask()
         if mob is None:
@@ -1130,6 +1428,13 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             a["xspeed"][imm] = pl[2] * v
 
     def transmit_lees_edwards_parameters(self, theSphere):
+        """Copy the cell size, strain, rate and Lees-Edwards flag to a sphere.
+
+        Parameters
+        ----------
+        theSphere : object
+            The sphere that receives them.
+        """
         theSphere.size_x = self.size_x
         theSphere.size_y = self.size_y
         theSphere.shear = self.shear
@@ -1149,7 +1454,28 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 
 
 class CanvasPointsBasicElasticity(CanvasPointsShear):
-    """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``."""
+    """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    k : float
+        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
+    nu : float
+        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``/``nu`` is not a finite number ≥ 0.
+    """
 
     k = NonNegative()
     nu = NonNegative()
@@ -1176,6 +1502,16 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         see the velocity at the force time instead of half a step earlier, which
         makes the viscous terms second-order accurate.  Positions and the
         conservative forces are updated identically by both.
+
+        Parameters
+        ----------
+        integrator : str
+            One of :attr:`INTEGRATORS` (``"euler"`` or ``"verlet"``).
+
+        Raises
+        ------
+        ValueError
+            If ``integrator`` is not one of them.
         """
         if integrator not in self.INTEGRATORS:
             raise ValueError(f"integrator must be one of {self.INTEGRATORS}, got {integrator!r}")
@@ -1183,7 +1519,18 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._half_kick = None
 
     def set_central_repulsion_coefficient(self, central_repulsion_coefficient=0):
-        """Set the law's repulsion coefficient c ∈ [0, 1] on the ensemble and every sphere."""
+        """Set the law's repulsion coefficient c ∈ [0, 1] on the ensemble and every sphere.
+
+        Parameters
+        ----------
+        central_repulsion_coefficient : float
+            c of the force law: 0 = linear (eq. S1-5a), 1 = divergent (eq. S1-5b).
+
+        Raises
+        ------
+        ValueError
+            If the value is not finite.
+        """
         _check_finite("central_repulsion_coefficient", central_repulsion_coefficient)
         self.central_repulsion_coefficient = central_repulsion_coefficient
         self._a["central_repulsion_coefficient"][:] = central_repulsion_coefficient
@@ -1203,7 +1550,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _central_law(self, d, d0, k, c, holder):
         """Central elastic law of every pair of the step (already masked to relations).
 
-        The built-in law (§2.3) with one repulsion coefficient is evaluated with its
+        The built-in law (eqs. S1-5a, S1-5b) with one repulsion coefficient is evaluated with its
         per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder`` (the pair or bond
         structure), in exactly the operations of :func:`~particleShear.base.laws.elastic_force_law`.
         """
@@ -1214,7 +1561,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
     @staticmethod
     def _builtin_law_inside(d, d0, k, c, holder):
-        """The built-in law (§2.3) as if every pair were in contact (no cut-off at ``d0``), with its
+        """The built-in law (eqs. S1-5a, S1-5b) as if every pair were in contact (no cut-off at ``d0``), with its
         per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder``; same operations as
         :func:`~particleShear.base.laws.elastic_force_law`."""
         lc = holder.law
@@ -1234,7 +1581,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         return f * self._g.active
 
     def elastic_force_from_neighbors(self):
-        """Central elastic force of every relation (§2.4-2.5)."""
+        """Central elastic force of every relation (eqs. S1-5a, S1-5b; links in tension: docs/design.md)."""
         self._geometry()
         self._elastic_terms()
         self._term_done()
@@ -1289,7 +1636,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         return None
 
     def central_viscous_force_from_neighbors(self):
-        """Central viscous force ``ν v_n`` of every relation (§2.4)."""
+        """Central viscous force ``ν v_n`` of every relation (eq. S1-9)."""
         self._geometry()
         self._viscous_terms()
         self._term_done()
@@ -1318,6 +1665,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.elastic_force_from_neighbors()
 
     def central_viscous_force(self):
+        """All-pairs variant (reference API): a neighbour update, then the central viscous term."""
         self.test_neighbor_relation()
         self.central_viscous_force_from_neighbors()
 
@@ -1326,7 +1674,15 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._viscous_terms()
 
     def mechanical_simulation_step_calculate_forces(self, dt=1):
-        """Clear the register, update neighbours, add every pair force (§4.1 step 1)."""
+        """Clear the register, update neighbours, add every pair force (first phase of a step).
+
+        ``dt`` is accepted for the 1.0.2 signature.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s); not used by the force phase.
+        """
         self.reset_force_register()
         self.test_neighbor_relation()
         predicted = self._predict_velocities() if self._half_kick is not None else None
@@ -1376,6 +1732,20 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._half_kick = (hx, hy, ht)
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
+        """Kick the velocities with the forces of the step, then damp them (third phase of a step).
+
+        Parameters
+        ----------
+        cool_factor : float
+            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
+        dt : float
+            Time step (s), finite and > 0.
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not a finite number > 0 (before any work).
+        """
         check_time_step(dt, self.step_count)
         if self.integrator != "euler":
             self._store_half_kick(dt)
@@ -1388,7 +1758,18 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             self.shear = self.shear + self.shear_rate * dt
 
     def mechanical_simulation_step_calculate_movement(self, dt=1):
-        """Drift, strain update, wrap, clock (§4.1 steps 5-6)."""
+        """Drift, strain update (while shearing), wrap, clock (last phase of a step).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s), finite and > 0.
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not a finite number > 0 (before any work).
+        """
         check_time_step(dt, self.step_count)
         self.move(dt)
         self._advance_strain(dt)
@@ -1400,7 +1781,20 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             self._renderer.update(self)
 
     def mechanical_simulation_step(self, cool_factor=0.97, dt=1):
-        """One step in reference order: forces → totals → kick + damping → movement."""
+        """One step in reference order: forces → totals → kick + damping → movement.
+
+        Parameters
+        ----------
+        cool_factor : float
+            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
+        dt : float
+            Time step (s), finite and > 0.
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not a finite number > 0 (before any work).
+        """
         check_time_step(dt, self.step_count)  # before the force phase: a refused step does no work
         self.mechanical_simulation_step_calculate_forces()
         self.record_total_particle_forces()
@@ -1408,7 +1802,26 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.mechanical_simulation_step_calculate_movement(dt)
 
     def mechanical_relaxation(self, N=1000, cool_factor=0.97, dt=1, theTk=False, StressTensorEvaluator=False):
-        """N steps; optionally a window update and a stress evaluation after each."""
+        """N steps; optionally a window update and a stress evaluation after each.
+
+        Parameters
+        ----------
+        N : int
+            Number of steps.
+        cool_factor : float
+            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
+        dt : float
+            Time step (s), finite and > 0.
+        theTk : object or bool
+            Tk root window updated after each step (False: none).
+        StressTensorEvaluator : StressTensorEvaluation or bool
+            Evaluator updated after each step (False: none).
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not a finite number > 0 (before any work).
+        """
         for _ in range(int(N)):
             self.mechanical_simulation_step(cool_factor, dt)
             if theTk:
@@ -1426,25 +1839,68 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
 
 class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
-    """Adds shear-rate changes that keep velocities relative to the flow (§4.5)."""
+    """Adds shear-rate changes that keep velocities relative to the flow (docs/design.md).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    k : float
+        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
+    nu : float
+        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``/``nu`` is not a finite number ≥ 0.
+    """
 
     def setShear(self, theShear):
+        """Set the shear strain γ (the Lees-Edwards offset is ``Ly·γ``).
+
+        Parameters
+        ----------
+        theShear : float
+            Strain (dimensionless).
+        """
         self.shear = theShear
         self._g = None
 
     def setShearInSpheres(self):
+        """Kept for the 1.0.2 API: spheres read γ from the ensemble (does nothing)."""
         pass  # spheres read γ from the ensemble
 
     def setShearRateInSpheres(self):
+        """Kept for the 1.0.2 API: spheres read γ̇ from the ensemble (does nothing)."""
         pass  # spheres read γ̇ from the ensemble
 
     def adjust_sphere_speed_to_shear_rate_change(self, delta_shear_rate):
+        """Add the change of the affine flow to every velocity (and −Δγ̇/2 to every spin).
+
+        Parameters
+        ----------
+        delta_shear_rate : float
+            Change Δγ̇ of the shear rate (1/s).
+        """
         a = self._a
         a["xspeed"] += self._y_centred() * delta_shear_rate
         a["omega"] -= delta_shear_rate / 2
 
     def setShearRate(self, theShearRate):
-        """Change γ̇; every sphere keeps its velocity relative to the local flow."""
+        """Change γ̇; every sphere keeps its velocity relative to the local flow.
+
+        Parameters
+        ----------
+        theShearRate : float
+            New shear rate γ̇ (1/s).
+        """
         delta = theShearRate - self.shear_rate
         if delta != 0:
             self.adjust_sphere_speed_to_shear_rate_change(delta)
@@ -1452,7 +1908,34 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
 
 
 class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesEdwards):
-    """Adds the tangential force (``k_t``, ``nu_t``, Coulomb ``mu``), spin and the ξ history."""
+    """Adds the tangential force (``k_t``, ``nu_t``, Coulomb ``mu``), spin and the ξ history.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    k : float
+        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
+    nu : float
+        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
+    m : float
+        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
+    k_t : float
+        Tangential spring constant (mg·s⁻² per m depth), ≥ 0.
+    nu_t : float
+        Tangential viscosity constant (mg·s⁻¹ per m depth), ≥ 0.
+    mu : float
+        Coulomb friction coefficient μ (dimensionless), ≥ 0.
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``, ``nu``, ``k_t``, ``nu_t`` or ``mu`` is not a finite number ≥ 0.
+    """
 
     k_t = NonNegative()
     nu_t = NonNegative()
@@ -1483,7 +1966,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         return self.mu != 0
 
     def tangential_force_from_neighbors(self):
-        """Two-visit tangential force of every relation (§2.6-2.8, B.3)."""
+        """Two-visit tangential force of every relation (torque split eq. S1-3; visit order: docs/design.md)."""
         self._geometry()
         self._tangential_terms()
         self._term_done()
@@ -1557,6 +2040,13 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         return self._a["torque"]
 
     def do_rotational_acceleration(self, dt):
+        """Kick every spin ``ω += T dt / I`` and reset the torques.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
         a = self._a
         a["omega"] += a["torque"] * dt / a["inertia"]
         a["torque"][:] = 0.0
@@ -1565,7 +2055,20 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self._a["omega"] *= f
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
-        """Linear kick (plates), rotational kick of all spheres, damping (§4.1 step 4)."""
+        """Linear kick (plates), rotational kick of all spheres, damping (third phase of a step).
+
+        Parameters
+        ----------
+        cool_factor : float
+            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
+        dt : float
+            Time step (s), finite and > 0.
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not a finite number > 0 (before any work).
+        """
         check_time_step(dt, self.step_count)
         if self.integrator != "euler":
             self._store_half_kick(dt)
@@ -1593,7 +2096,13 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         return kw[1]
 
     def cool(self, f=0.8):
-        """Damp velocity relative to the affine flow and spin by ``f`` (§4.4), all three rows at once."""
+        """Damp velocity relative to the affine flow and spin by ``f`` (docs/design.md), all three rows at once.
+
+        Parameters
+        ----------
+        f : float
+            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
+        """
         if type(self)._cool_spin is not CanvasPointsFrictionElasticityLeesEdwards._cool_spin:
             return CanvasPointsBasicElasticityLeesEdwards.cool(self, f)
         V = self._vel
@@ -1607,7 +2116,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             V *= f
 
     def _integrate_xi(self, dt):
-        """Sequential ξ rule of the reference, without a Python loop (§2.10, B.2).
+        """Sequential ξ rule of the reference, without a Python loop (docs/design.md).
 
         Relation i→j (i < j) sees both spheres at their old positions; relation
         j→i sees i already moved by ``v_i·dt``.  Both use the velocities after
@@ -1676,7 +2185,13 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             flat[g.S.sel2] = inc.reshape(-1)
 
     def move(self, dt=1):
-        """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule)."""
+        """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
         self._integrate_xi(dt)
         self._drift(dt, spin=True)
 

@@ -3,6 +3,8 @@
 Rows that are advanced or gathered together sit next to each other: (x, y, phi) are moved by
 (xspeed, yspeed, omega)·dt in one pass, and (xforce, yforce, torque) are kicked in one pass.
 """
+__docformat__ = "numpy"
+
 import math
 
 #: per-sphere arrays and their defaults

@@ -1,10 +1,12 @@
-"""Central force laws (spec §2.3, §2.5, §2.12).
+"""Central force laws (eqs. S1-5a, S1-5b, S1-6; the plateau and tensile variants are described in docs/design.md).
 
 Every law works on Python scalars and on NumPy arrays alike: the engine calls
 them once per step on whole pair arrays, the sphere API calls them on scalars.
 Sign convention: negative = repulsion, positive = attraction.  Distances in µm,
 spring constants in mg·s⁻² per m depth, forces in mg·µm·s⁻² per m depth.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 __all__ = [
@@ -25,7 +27,24 @@ def _scalar_result(value, *args):
 def elastic_force_law(d, d0, k, central_repulsion_coefficient):
     """Blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law; 0 for d > d0.
 
-    The divergent part is capped at ``d0/d = 1000`` (eq. S1-6).
+    The force is ``-k (1 - c)(d0 - d) - k c d0 (d0/d - 1)``; the divergent part is capped at
+    ``d0/d = 1000`` (eq. S1-6).
+
+    Parameters
+    ----------
+    d : float or numpy.ndarray
+        Centre distance of the pair (µm).
+    d0 : float or numpy.ndarray
+        Contact distance ``r_i + r_j`` (µm).
+    k : float or numpy.ndarray
+        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+    central_repulsion_coefficient : float or numpy.ndarray
+        Blend ``c`` between the linear law (0, eq. S1-5a) and the divergent law (1, eq. S1-5b).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Central force (mg·µm·s⁻² per m depth); negative = repulsion; a float for scalar input.
     """
     c = central_repulsion_coefficient
     if np.ndim(d) == 0 and np.ndim(d0) == 0:
@@ -52,7 +71,27 @@ class PlateauConfiguration:
 
 
 def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_slope):
-    """Continuous distance mapping that flattens the law between begin and end (µm)."""
+    """Continuous distance mapping that flattens the law between begin and end.
+
+    Distances above ``plateau_end`` are unchanged; between begin and end they are compressed
+    by ``relative_plateau_slope``; below ``plateau_begin`` they are scaled linearly to 0.
+
+    Parameters
+    ----------
+    d : float or numpy.ndarray
+        Centre distance (µm).
+    plateau_begin : float or numpy.ndarray
+        Distance where the plateau begins (µm), smaller than ``plateau_end``.
+    plateau_end : float or numpy.ndarray
+        Distance where the plateau ends (µm).
+    relative_plateau_slope : float
+        Slope of the mapping on the plateau (dimensionless, 0 = flat).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Transformed distance (µm).
+    """
     pb, pe, s = plateau_begin, plateau_end, relative_plateau_slope
     if np.ndim(d) == 0 and np.ndim(pb) == 0 and np.ndim(pe) == 0:
         if d >= pe:
@@ -65,7 +104,27 @@ def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_s
 
 
 def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
-    """Law of spongy particles: the default law evaluated on a plateau-transformed distance."""
+    """Law of spongy particles: the default law evaluated on a plateau-transformed distance.
+
+    The plateau lies between ``PlateauConfiguration.relative_plateau_begin·d0`` and
+    ``relative_plateau_end·d0`` (see :func:`distance_transform_plateau`); 0 for ``d > d0``.
+
+    Parameters
+    ----------
+    d : float or numpy.ndarray
+        Centre distance of the pair (µm).
+    d0 : float or numpy.ndarray
+        Contact distance ``r_i + r_j`` (µm).
+    k : float or numpy.ndarray
+        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+    central_repulsion_coefficient : float or numpy.ndarray
+        Blend ``c`` between the linear law (0, eq. S1-5a) and the divergent law (1, eq. S1-5b).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Central force (mg·µm·s⁻² per m depth); negative = repulsion; a float for scalar input.
+    """
     pb = PlateauConfiguration.relative_plateau_begin * d0
     pe = PlateauConfiguration.relative_plateau_end * d0
     s = PlateauConfiguration.relative_plateau_slope
@@ -82,7 +141,22 @@ def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
 
 
 def elastic_force_law_tensile(d, d0, k):
-    """Linear tensile law of permanent links: ``-k (d0 - d)`` (attractive for d > d0)."""
+    """Linear tensile law of permanent links: ``-k (d0 - d)`` (eq. S1-5a in tension).
+
+    Parameters
+    ----------
+    d : float or numpy.ndarray
+        Centre distance of the linked pair (µm).
+    d0 : float or numpy.ndarray
+        Equilibrium distance of the link (µm).
+    k : float or numpy.ndarray
+        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Central force (mg·µm·s⁻² per m depth); positive (attractive) for ``d > d0``.
+    """
     return -k * (d0 - d)
 
 
@@ -92,7 +166,25 @@ class TensileConfiguration:
 
 
 def elastic_force_law_tensile_exponential(d, d0, k):
-    """Saturating tensile law: slope k at d0, limit ``k·d0·δ`` (δ = TensileConfiguration.d_exponential)."""
+    """Saturating tensile law: slope k at d0, limit ``k·d0·δ`` (δ = TensileConfiguration.d_exponential).
+
+    The force is ``k d0 δ (1 - exp(-(d - d0)/(d0 δ)))``: a bond that weakens smoothly instead
+    of growing without bound.
+
+    Parameters
+    ----------
+    d : float or numpy.ndarray
+        Centre distance of the linked pair (µm).
+    d0 : float or numpy.ndarray
+        Equilibrium distance of the link (µm).
+    k : float or numpy.ndarray
+        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Central force (mg·µm·s⁻² per m depth); positive (attractive) for ``d > d0``.
+    """
     delta = TensileConfiguration.d_exponential
     return k * d0 * delta * (1 - np.exp(-(d - d0) / (d0 * delta)))
 
@@ -106,6 +198,18 @@ def call_law_vectorised(law, *args):
 
     Laws of this module accept arrays directly; any other callable is tried on
     arrays and, if that fails or returns the wrong shape, applied element-wise.
+
+    Parameters
+    ----------
+    law : callable
+        Force law ``law(d, d0, k[, c])`` returning the central force (negative = repulsion).
+    *args : float or numpy.ndarray
+        Its arguments, arrays of one length (the pairs) or scalars; the first sets the length.
+
+    Returns
+    -------
+    numpy.ndarray
+        Force of every pair (mg·µm·s⁻² per m depth), float array of the first argument's shape.
     """
     n = np.shape(args[0])
     if law in _NUMPY_AWARE:

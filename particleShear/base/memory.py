@@ -7,6 +7,8 @@ N ≳ 1,000 (measured: 9.8 → 4.9 ms per step at N = 10,000).  Raising the mmap
 trim thresholds once keeps that memory mapped.  Only glibc on Linux is tuned;
 set ``PARTICLESHEAR_NO_MALLOPT=1`` to leave the allocator alone.
 """
+__docformat__ = "numpy"
+
 import ctypes
 import os
 import sys
@@ -19,7 +21,24 @@ _done = None
 
 
 def tune_allocator(mmap_threshold=16 * 2 ** 20, trim_threshold=128 * 2 ** 20):
-    """Raise glibc's mmap/trim thresholds (bytes) once per process; True if applied."""
+    """Raise glibc's mmap and trim thresholds once per process, so step temporaries stay mapped.
+
+    Only the first call acts; later calls return its result.  Nothing is done off
+    Linux/glibc or when the environment variable ``PARTICLESHEAR_NO_MALLOPT`` is set.
+
+    Parameters
+    ----------
+    mmap_threshold : int
+        Size (bytes) from which a block is allocated with ``mmap`` (default 16 MiB).
+    trim_threshold : int
+        Free memory (bytes) at the top of the heap above which it is returned to the
+        system (default 128 MiB).
+
+    Returns
+    -------
+    bool
+        True if both thresholds were set, False otherwise (not glibc, disabled, or refused).
+    """
     global _done
     if _done is not None:
         return _done

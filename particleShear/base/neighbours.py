@@ -1,4 +1,4 @@
-"""Pair table and O(N) neighbour search with Lees-Edwards-shifted cell rows (spec §4.2, B.4).
+"""Pair table and O(N) neighbour search with Lees-Edwards-shifted cell rows (see docs/design.md).
 
 The pair table holds candidate pairs ``i < j`` (list indices) found within
 ``r_i + r_j + skin`` plus every permanent link; a pair is *active* (a relation
@@ -6,6 +6,8 @@ in the reference sense) while it touches or is permanent.  Candidates are
 rebuilt only when spheres or the shear offset have moved by more than the skin
 allows, so the per-step contact set is exactly the all-pairs one.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 from .kernels import _nz, in_cell_passes, min_image
@@ -56,7 +58,18 @@ class PairTable:
         return self.xi[1]
 
     def find(self, i, j):
-        """Slots of pairs (i, j) (any order), -1 where absent."""
+        """Slots of pairs (i, j) (any order), -1 where absent.
+
+        Parameters
+        ----------
+        i, j : int or array_like of int
+            Sphere indices (``sphereList`` order) of the pairs, in either order.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Row of each pair in the table, -1 where the pair is not a candidate.
+        """
         i = np.asarray(i)
         j = np.asarray(j)
         lo, hi = np.minimum(i, j), np.maximum(i, j)
@@ -67,6 +80,18 @@ class PairTable:
         return np.where(found, pos_c, -1)
 
     def next_births(self, n):
+        """Reserve ``n`` consecutive birth numbers (the order in which relations were created).
+
+        Parameters
+        ----------
+        n : int
+            How many numbers to reserve (≥ 0).
+
+        Returns
+        -------
+        numpy.ndarray of int64
+            The reserved numbers, increasing.
+        """
         b = np.arange(self._births, self._births + n, dtype=np.int64)
         self._births += n
         return b
@@ -76,6 +101,13 @@ class PairTable:
 
         Permanent and active pairs are always kept; with ``keep_existing`` every
         existing row is kept and (i, j) are added.
+
+        Parameters
+        ----------
+        i, j : array_like of int
+            Sphere indices of the new candidate pairs, in either order (duplicates allowed).
+        keep_existing : bool
+            Keep every existing row instead of only the active and permanent ones.
         """
         old_key = self.key
         k = np.sort(_key(np.minimum(i, j), np.maximum(i, j)))
@@ -111,7 +143,18 @@ class PairTable:
         self.version += 1
 
     def ensure(self, i, j):
-        """Slots of pairs (i, j), inserting missing ones (inactive, stick, ξ = 0)."""
+        """Slots of pairs (i, j), inserting missing ones (inactive, stick, ξ = 0).
+
+        Parameters
+        ----------
+        i, j : int or array_like of int
+            Sphere indices (``sphereList`` order) of the pairs, in either order.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Row of each pair in the table (at least one-dimensional).
+        """
         i = np.atleast_1d(np.asarray(i, dtype=np.intp))
         j = np.atleast_1d(np.asarray(j, dtype=np.intp))
         slots = self.find(i, j)
@@ -123,7 +166,18 @@ class PairTable:
 
 
 def all_pairs(n):
-    """Every pair i < j (test oracle and small systems)."""
+    """Every pair i < j (test oracle and small systems).
+
+    Parameters
+    ----------
+    n : int
+        Number of spheres.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(i, j)``, index arrays of the ``n (n - 1) / 2`` pairs.
+    """
     i, j = np.triu_indices(n, 1)
     return i.astype(np.intp), j.astype(np.intp)
 
@@ -134,6 +188,24 @@ def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
     Cell list with rows above/below the cell searched at the x position moved
     by the Lees-Edwards offset ``shift = Ly·γ``; all-pairs when the cell grid
     would be smaller than 3 × 3.  ``x``, ``y`` must lie in the cell.
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray
+        Sphere positions (µm), inside ``[0, Lx) × [0, Ly)``.
+    r : numpy.ndarray
+        Sphere radii (µm).
+    Lx, Ly : float
+        Cell size (µm).
+    shift : float
+        Lees-Edwards offset ``Ly·γ`` of the image rows (µm).
+    skin : float
+        Extra search distance (µm) so the candidates stay valid while spheres move.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(i, j)`` with ``i < j``, the candidate pairs.
     """
     n = len(x)
     if n < 2:

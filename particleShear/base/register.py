@@ -1,4 +1,4 @@
-"""Force register: what the stress tensors are made of (spec §7.1, B.5).
+"""Force register: what the stress tensors are made of (eqs. S1-16 to S1-24; see docs/design.md).
 
 The engine fills it with arrays once per force phase (per active pair: the
 force on each sphere, the tangential torques and the internal/external flags;
@@ -6,6 +6,8 @@ per sphere: totals).  The six reference lists (``pair_register`` …) are built
 on demand as ``[target, source, F]`` entries for the API; manual ``record_*``
 calls (scripts without an ensemble) append to them directly.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 __all__ = ["Force_register", "SphereSelection"]
@@ -37,6 +39,20 @@ def _invalidating(name):
     method = getattr(list, name)
 
     def changed(self, *args, **kwargs):
+        """The ``list`` method of this name; afterwards the selection no longer follows its mask.
+
+        Parameters
+        ----------
+        *args
+            Positional arguments of the ``list`` method.
+        **kwargs
+            Keyword arguments of the ``list`` method.
+
+        Returns
+        -------
+        object
+            What the ``list`` method returns.
+        """
         self._valid = False   # contents no longer follow the mask: evaluated sphere by sphere
         return method(self, *args, **kwargs)
 
@@ -52,6 +68,16 @@ class SphereSelection(list):
     which rows of the ensemble's arrays it holds, so the tensors are summed with array
     operations.  Changing it (``append``, ``remove``, ``sel[k] = …`` …) keeps it a list
     and drops that link.
+
+    Parameters
+    ----------
+    ensemble : object
+        The ensemble (a canvas of :mod:`particleShear.base.canvas`) whose ``sphereList`` is selected.
+    mask : numpy.ndarray of bool or None
+        Which spheres (one flag per sphere of ``sphereList``); None selects all.
+    spheres : list or None
+        The spheres themselves when already known (must match ``mask``); None takes them from
+        ``ensemble.sphereList``.
     """
 
     def __init__(self, ensemble, mask=None, spheres=None):
@@ -79,6 +105,7 @@ class SphereSelection(list):
         return np.flatnonzero(self.mask)
 
     def copy(self):
+        """A shallow copy: a selection with the same mask while still current, else a plain list."""
         return SphereSelection(self.ensemble, self.mask, self) if self._valid else list(self)
 
     for _name in ("append", "extend", "insert", "remove", "pop", "clear", "sort", "reverse", "__setitem__",
@@ -128,26 +155,84 @@ class Force_register:
 
     # -- manual API (reference signatures) ----------------------------------------------------
     def record_individual_internal_force(self, target, source, force_vector):
+        """Append an internal pair force ``[target, source, F]`` to :attr:`pair_register` (Love-Weber, eq. S1-19).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        source : object
+            The sphere exerting it.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         self._manual = True
         self._m_pair.append([target, source, list(force_vector)])
 
     def record_total_particle_force(self, target, force_vector):
+        """Set (update or append) the total force of ``target`` in :attr:`total_particle_force_register` (eq. S1-17).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         self._manual = True
         self._m_tot[id(target)] = [target, list(force_vector)]
 
     def record_external_force(self, target, force_vector):
+        """Append a force from a plate sphere or through the boundary to :attr:`external_force_register` (eq. S1-16).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the force acts on.
+        force_vector : sequence of float
+            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
+        """
         self._manual = True
         self._m_ext.append([target, list(force_vector)])
 
     def record_external_torque(self, target, moment):
+        """Append an external tangential torque to :attr:`external_moment_register` (stored, unused by the tensors).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         self._manual = True
         self._m_emom.append([target, moment])
 
     def record_individual_internal_torque(self, target, source, moment):
+        """Append an internal tangential torque ``[target, source, M]`` to :attr:`internal_moment_register` (eq. S1-22).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        source : object
+            The sphere exerting it.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         self._manual = True
         self._m_imom.append([target, source, moment])
 
     def record_unbalanced_moment(self, target, moment):
+        """Set (update or append) the net torque of ``target`` in :attr:`unbalanced_moment_register` (eq. S1-22).
+
+        Parameters
+        ----------
+        target : object
+            The sphere the torque acts on.
+        moment : float
+            Torque (mg·µm²·s⁻² per m depth).
+        """
         self._manual = True
         self._m_unb[id(target)] = [target, moment]
 

@@ -1,11 +1,26 @@
-"""Neighbour relations (spec §10.5): plain objects, and views of an ensemble's pair table."""
+"""Neighbour relations: plain objects, and views of an ensemble's pair table (see docs/design.md)."""
+__docformat__ = "numpy"
+
 from .neighbours import STATE_CODES, STATE_NAMES
 
 __all__ = ["neighbor_relation", "RelationView"]
 
 
 class neighbor_relation:
-    """Directed relation of a sphere to ``theSphere``: state and tangential history ξ (µm)."""
+    """Directed relation of a sphere to ``theSphere``: state and tangential history ξ (µm).
+
+    Parameters
+    ----------
+    friction_position : float
+        Tangential displacement history ξ of the contact (µm): the spring extension of the
+        tangential force.
+    interface_type : {"stick", "slip", "permanent"}
+        State of the relation: a sticking or slipping transient contact, or a permanent link.
+    theSphere : object
+        The partner sphere; its ``myindex`` (0 if it has none) is copied to ``myindex``.
+    graphical_line_index : int
+        Canvas item of the drawn interface line, -1 when not drawn.
+    """
 
     def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1):
         self.myindex = getattr(theSphere, "myindex", 0)
@@ -42,14 +57,17 @@ class RelationView:
 
     @property
     def theSphere(self):
+        """The partner sphere (an element of the ensemble's ``sphereList``)."""
         return self.__dict__["_ens"].sphereList[self.__dict__["_partner"]]
 
     @property
     def myindex(self):
+        """Index ``myindex`` of the partner sphere (0 if it has none)."""
         return getattr(self.theSphere, "myindex", 0)
 
     @property
     def friction_position(self):
+        """Tangential displacement history ξ of this direction of the pair (µm); settable."""
         return float(getattr(self.__dict__["_ens"]._pairs, self._side())[self._slot()])
 
     @friction_position.setter
@@ -58,6 +76,8 @@ class RelationView:
 
     @property
     def interface_type(self):
+        """State ``"stick"``, ``"slip"`` or ``"permanent"``; setting it updates the pair table
+        (and the cached bond constants when the link becomes or stops being permanent)."""
         return STATE_NAMES[int(self.__dict__["_ens"]._pairs.state[self._slot()])]
 
     @interface_type.setter
@@ -71,6 +91,7 @@ class RelationView:
 
     @property
     def equilibrium_distance(self):
+        """Equilibrium distance of a permanent link (µm), ``r_i + r_j`` when made; settable."""
         return float(self.__dict__["_ens"]._pairs.d_eq[self._slot()])
 
     @equilibrium_distance.setter

@@ -3,6 +3,8 @@
 The guard is cheap (a few reductions over arrays the step already has) and is
 run by the experiment after every force phase.  It never changes the physics.
 """
+__docformat__ = "numpy"
+
 import math
 
 import numpy as np
@@ -11,7 +13,25 @@ __all__ = ["SimulationInstabilityError", "StabilityGuard"]
 
 
 class SimulationInstabilityError(RuntimeError):
-    """The integration diverged; ``step``, ``phase``, ``pair`` and ``suggested_dt`` say where and what to try."""
+    """The integration diverged; ``step``, ``phase``, ``pair`` and ``suggested_dt`` say where and what to try.
+
+    Every argument is stored under its own name.
+
+    Parameters
+    ----------
+    message : str
+        The full explanation (also the exception's text).
+    step : int or None
+        Step of the phase at which the divergence was detected.
+    phase : str or None
+        Name of the phase (e.g. pre-equilibration or shear).
+    pair : tuple of int or None
+        The worst sphere ``(k,)`` or pair ``(i, j)`` (indices in ``sphereList``).
+    suggested_dt : float or None
+        A time step (s) that is likely to be stable.
+    reason : str or None
+        The short cause (non-finite state, kinetic energy bound, interpenetration).
+    """
 
     def __init__(self, message, step=None, phase=None, pair=None, suggested_dt=None, reason=None):
         RuntimeError.__init__(self, message)
@@ -48,14 +68,49 @@ class StabilityGuard:
         self._rate_max = 0.0
 
     def suggested_dt(self, ens, dt):
-        """Half the current step, and at most 5 % of the smallest contact period sqrt(m_min / k)."""
+        """Time step to suggest after a failure: half the current one, at most 5 % of ``sqrt(m_min/k)``.
+
+    Parameters
+    ----------
+    ens : object
+        The ensemble (a canvas of :mod:`particleShear.base.canvas`); its masses and ``k``,
+        ``k_t`` are read.
+    dt : float or None
+        The current time step (s); None or 0 when unknown.
+
+    Returns
+    -------
+    float
+        Suggested time step (s).
+    """
         a = ens._a
         k = max(float(getattr(ens, "k", 0) or 0), float(getattr(ens, "k_t", 0) or 0), 1e-300)
         m_min = float(a["m"].min()) if len(a["m"]) else 1.0
         return min(dt / 2, 0.05 * math.sqrt(m_min / k)) if dt else 0.05 * math.sqrt(m_min / k)
 
     def check(self, ens, step=None, phase=None, dt=None):
-        """Raise :class:`SimulationInstabilityError` if the state of ``ens`` has diverged."""
+        """Raise :class:`SimulationInstabilityError` if the state of ``ens`` has diverged.
+
+    Checked, every ``interval``-th step: finite positions and velocities, kinetic energy
+    relative to the affine flow below ``max_kinetic_energy``, and no transient contact
+    closer than ``min_distance_ratio·(r_i + r_j)``.
+
+    Parameters
+    ----------
+    ens : object
+        The ensemble (a canvas of :mod:`particleShear.base.canvas`).
+    step : int or None
+        Current step; None checks unconditionally.
+    phase : str or None
+        Name of the phase, for the message.
+    dt : float or None
+        Current time step (s), for the message and the suggestion.
+
+    Raises
+    ------
+    SimulationInstabilityError
+        If the state has diverged.
+    """
         if step is not None and step % self.interval:
             return
         a = ens._a

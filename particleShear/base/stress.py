@@ -1,9 +1,11 @@
-"""Stress tensors from the force register (spec §7; Nicot et al. with the factor 3/2).
+"""Stress tensors from the force register (eqs. S1-16 to S1-25; Nicot et al. with the factor 3/2).
 
 All tensors are 2×2 in Pa, index ``[a][b]`` = (force component, lever-arm
 component), compression positive.  Internal units are converted here only:
 forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
 """
+__docformat__ = "numpy"
+
 from operator import attrgetter
 
 import numpy as np
@@ -14,7 +16,7 @@ from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
 
-#: tensor attribute names in the column order of the output table (§9.1)
+#: tensor attribute names in the column order of the output table (docs/output.md, "Table columns")
 TENSOR_NAMES = (
     "stress_tensor_LW",
     "stress_tensor_linear_acceleration_otsuki",
@@ -86,11 +88,30 @@ def _tensor_property(k):
     def fset(self, value):
         self._t[k] = np.asarray(value, dtype=float)
 
-    return property(fget, fset, doc="2×2 tensor (Pa), nested lists; see spec §7.")
+    return property(fget, fset, doc="2×2 tensor (Pa), nested lists; see docs/output.md (eqs. S1-16 to S1-24).")
 
 
 class StressTensorEvaluation:
-    """Evaluates every stress tensor of §7 from a :class:`Force_register` with array operations."""
+    """Evaluates every stress tensor (eqs. S1-16 to S1-24) from a :class:`Force_register` with array operations.
+
+    The tensors are attributes (``overall_stress_tensor``, ``stress_tensor_LW`` …; see
+    :data:`TENSOR_NAMES`), 2×2 nested lists in Pa, recomputed by each ``evaluate_*`` call.
+    The cell volume is ``V = (size_x·1e-6)·(size_y·1e-6)`` m² per m depth.
+
+    Parameters
+    ----------
+    size_x : float
+        Width Lx of the periodic cell (µm), finite and > 0.
+    size_y : float
+        Height Ly of the cell (µm), finite and > 0.
+    theCanvas : object or bool
+        Tk canvas for drawing (stored for compatibility; False when none).
+
+    Raises
+    ------
+    ValueError
+        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    """
 
     def __init__(self, size_x, size_y, theCanvas=False):
         for name, v in (("size_x", size_x), ("size_y", size_y)):
@@ -188,7 +209,13 @@ class StressTensorEvaluation:
 
     # -- force tensors ----------------------------------------------------------------------
     def evaluate_force_stress_tensors(self, force_register):
-        """Love-Weber, unbalanced-force, linear-acceleration and external-force tensors (§7.3-7.5)."""
+        """Love-Weber, unbalanced-force, linear-acceleration and external-force tensors (eqs. S1-19, S1-17, S1-16).
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        """
         V = self._volume()
         cx, cy = self.size_x / 2, self.size_y / 2
         lw = np.zeros((2, 2))
@@ -266,7 +293,13 @@ class StressTensorEvaluation:
 
     # -- rotational tensors -------------------------------------------------------------------
     def evaluate_spin_kinetic_energy_stress_tensor(self, theSphereList):
-        """Centrifugal tensor ``-(1/V) Σ I ω²/2 · 1`` over the given spheres (§7.6)."""
+        """Centrifugal tensor ``-(1/V) Σ I ω²/2 · 1`` over the given spheres (eq. S1-21).
+
+        Parameters
+        ----------
+        theSphereList : list
+            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+        """
         inertia, omega = self._sphere_values(theSphereList)[:2]
         K = float(np.sum((inertia * _CT) * omega ** 2 / 2))
         v = -K / self._volume()
@@ -278,7 +311,13 @@ class StressTensorEvaluation:
         return [[0.0, -s / 2], [s / 2, 0.0]]
 
     def evaluate_unbalanced_torque_stress_tensor(self, force_register):
-        """Antisymmetric tensor of all net torques, immobile spheres included (§7.7)."""
+        """Antisymmetric tensor of all net torques, immobile spheres included (eq. S1-22).
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        """
         total = 0.0
         if force_register._mom is not None:
             total += float(np.sum(force_register._mom))
@@ -286,7 +325,13 @@ class StressTensorEvaluation:
         self._t[_TQ] = self._antisym(total, self._volume())
 
     def evaluate_internal_torque_stress_tensor(self, force_register):
-        """Antisymmetric tensor of the internal pair torques (§7.7); symmetrises Love-Weber."""
+        """Antisymmetric tensor of the internal pair torques (eq. S1-22); symmetrises Love-Weber (eq. S1-24).
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        """
         total = 0.0
         for p in force_register._blocks:
             if p.get("ti") is not None:
@@ -296,12 +341,29 @@ class StressTensorEvaluation:
         self._t[_TINT] = self._antisym(total, self._volume())
 
     def evaluate_rotational_stress_tensors(self, force_register, theSphereList):
+        """Centrifugal, unbalanced-torque and internal-torque tensors (eqs. S1-21, S1-22).
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        theSphereList : list
+            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+        """
         self.evaluate_spin_kinetic_energy_stress_tensor(theSphereList)
         self.evaluate_unbalanced_torque_stress_tensor(force_register)
         self.evaluate_internal_torque_stress_tensor(force_register)
 
     def evaluate_peculiar_momentum_transport_for_linear_acceleration_tensor(self, theSphereList, shear_rate):
-        """Otsuki peculiar-momentum term (§7.10), for comparison only (never enters G)."""
+        """Otsuki peculiar-momentum term ``-(1/V) Σ P ⊗ P / m``, for comparison only (never enters G).
+
+        Parameters
+        ----------
+        theSphereList : list
+            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+        shear_rate : float
+            Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
+        """
         _, _, m, vx, vy, y = self._sphere_values(theSphereList)
         px = m * 1e-12 * (vx - shear_rate * (y - self.size_y / 2))
         py = m * 1e-12 * vy
@@ -313,7 +375,17 @@ class StressTensorEvaluation:
         self._t[_OT] = [[xx / V, xy / V], [xy / V, yy / V]]
 
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
-        """Every tensor of §7 and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24)."""
+        """Every tensor and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24).
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        theSphereList : list
+            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+        shear_rate : float
+            Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
+        """
         reg = force_register
         if len(reg._blocks) == 1 and reg._tot is not None and not reg._manual and "S" in reg._blocks[0]:
             ok, mask = self._rows_of(reg._ens, theSphereList)
@@ -425,6 +497,18 @@ class StressTensorEvaluation:
         Returns ``(τ_internal, τ_surface)`` computed with exactly the operations of
         the full evaluation, so G does not depend on whether tensors are kept.
         The other tensor entries are not updated.
+
+        Parameters
+        ----------
+        force_register : Force_register
+            The forces and torques of the current force phase.
+        theSphereList : list
+            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+
+        Returns
+        -------
+        tuple of float
+            ``(τ_internal, τ_surface)`` (Pa), eq. S1-25.
         """
         reg = force_register
         if not (len(reg._blocks) == 1 and "S" in reg._blocks[0] and not reg._m_pair and not reg._m_ext
@@ -460,9 +544,21 @@ class StressTensorEvaluation:
         return -float(t[_ALL, 0, 1]), -float(t[_EXT, 0, 1])
 
     def evaluate_quasistatic_shear_stress(self):
-        """τ_internal = −σ_xy of the overall tensor (Pa)."""
+        """τ_internal = −σ_xy of the overall tensor (eq. S1-25).
+
+        Returns
+        -------
+        float
+            Shear stress (Pa) of the last evaluation.
+        """
         return -float(self._t[_ALL, 0, 1])
 
     def evaluate_externally_applied_shear_stress(self):
-        """τ_surface = −σ_xy of the external-force tensor (Pa)."""
+        """τ_surface = −σ_xy of the external-force tensor (eq. S1-25).
+
+        Returns
+        -------
+        float
+            Shear stress (Pa) measured from the forces on the boundary, of the last evaluation.
+        """
         return -float(self._t[_EXT, 0, 1])
