@@ -377,7 +377,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return float(len(self.permanent_pairs(physical_neighbors_only)[0]))
 
     def remove_non_essential_links(self, max_fraction_to_remove, physical_neighbors_only=True, max_trials=1000):
-        """Cut random links whose spheres stay connected otherwise,, up to a fraction of the links.
+        """Cut random links whose spheres stay connected otherwise, up to a fraction of the links.
 
         A link is non-essential when its two spheres stay in the same particle without it, so
         removing it never splits a particle.  Sampling is sphere-first (a uniform random sphere,
