@@ -1,10 +1,14 @@
-"""Ensemble factories from physical properties (spec §4.7, §5.5, §6.4, §6.11, §10.3).
+"""Ensemble factories from physical properties: the constitution of a crosslinked, cut gel.
 
 Both builders validate every input before any work, derive the model constants
 and time steps, relax the random packing, crosslink it, cut it into particles
 and relax again.  ``rng`` (Generator, int seed or None) drives every random
-choice; ``verbose`` prints the reference's console messages.
+choice; ``verbose`` logs the console messages of particleShear 1.0.2 (INFO, logger
+``particleShear.linkable.builders``).  The constants follow eq. S1-8 (spring constant),
+eq. S1-9 (viscosity) and eq. S1-14 (radii) of the manual; docs/parameters.md describes every
+parameter and docs/accuracy.md the choice of the time step.
 """
+__docformat__ = "numpy"
 import logging
 import math
 import numbers
@@ -68,7 +72,34 @@ def _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_sphe
 # -- time steps -------------------------------------------------------------------------------------------
 def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
                           anticipated_amplitude, relative_viscosity):
-    """Final step ``dt`` and coarsest relaxation step ``dt_max`` (s) of §4.7, in the reference's order."""
+    """Final step ``dt`` and coarsest relaxation step ``dt_max`` of the builders, in the order of particleShear 1.0.2.
+
+    ``dt = 0.1·τ/bf``, halved when ``mu <= 1 or rts < 1``, when ``A <= 0.05``, when
+    ``mu <= 0.1 or rts < 0.1``, when ``A <= 0.005`` and when ``A >= 0.5``;
+    ``dt_max = 0.25·τ/bf``, or ``0.125·τ/bf`` when ``(rv <= 0.1 and mu < 0.1) or rts < 0.1 or
+    rts > 5``, or ``0.04·τ/bf`` when ``(rv < 0.01 and mu < 0.01) or rts < 0.01``; then ``dt`` is
+    capped at ``dt_max`` and, for ``rv > 1``, ``dt_max`` is divided by ``rv``.
+
+    Parameters
+    ----------
+    time_constant : float
+        Model time constant τ = sqrt(m/k) (s).
+    bimodal_factor : float
+        Ratio bf of the large to the small radius.
+    mu : float
+        Coulomb friction coefficient μ.
+    relative_transversal_link_strength : float
+        rts = k_t/k.
+    anticipated_amplitude : float
+        Strain amplitude A the ensemble is built for.
+    relative_viscosity : float
+        rv in ν = rv·√(m k) (eq. S1-9).
+
+    Returns
+    -------
+    tuple of float
+        ``(dt, dt_max)`` in s.
+    """
     tau, bf, rts, A, rv = (time_constant, bimodal_factor, relative_transversal_link_strength,
                            anticipated_amplitude, relative_viscosity)
     dt = 0.1 * tau / bf
@@ -96,7 +127,7 @@ def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversa
 
 # -- shared constitution steps ----------------------------------------------------------------------------
 def _avoid_flag(avoid, doCutByTriangulation, cut_lines, verbose):
-    """Step 0 of §6.4: height checks only make sense when cutting can produce separate particles."""
+    """Height checks only make sense when cutting can produce separate particles (first step of the builders)."""
     if avoid and ((doCutByTriangulation and cut_lines <= 1) or (not doCutByTriangulation and cut_lines <= 0)):
         if verbose:
             logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines=" + str(cut_lines)
@@ -114,7 +145,7 @@ def _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness):
 
 
 def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose):
-    """Crosslink all contacts, cut into particles, re-cut while a particle spans > 0.9·Ly (§6.5-6.8)."""
+    """Crosslink all contacts, cut into particles, re-cut while a particle spans > 0.9·Ly (at most MAX_CUT_ATTEMPTS)."""
     ens.makeAllLinksPermanent()
     if cut_top_bottom:
         ens.cutTopBottomEdge()
@@ -155,10 +186,96 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         interface_reenforcement_tangential=1, keep_viscosity_coefficients_constant=True, cut_top_bottom=True,
         doCutByTriangulation=True, remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, do_debug=False,
         rng=None, verbose=False):
-    """Relaxed, crosslinked and cut ensemble with reinforced transient interfaces (§6.4); the main factory.
+    """Relaxed, crosslinked and cut ensemble with reinforced transient interfaces; the main factory.
 
-    Returns an :class:`EnsembleCompactParticlesAdjustableInterfaceStrength` whose
-    ``dt`` / ``dt_max`` (s) are the steps the experiment should use.
+    The factory of ``doParticleShearSimulation``: it validates every input, derives the model
+    constants (:class:`~particleShear.objects.model.particle_shear_model_parameters` with
+    ``bimodal_factor=1``) and the time steps (:func:`time_steps_from_model`), sets
+    ``k = k_model·irc``, ``k_t = k_model·rts·irt``, ``ν = rv·k_model·τ`` and ``ν_t = ν·rts``
+    (times ``irc`` / ``irt`` unless ``keep_viscosity_coefficients_constant``), with bonds scaled
+    back by ``1/irc`` and ``1/irt``; then it relaxes the random packing, crosslinks it, cuts it
+    into particles, removes links, joins isolated spheres and relaxes again (docs/design.md).
+
+    Parameters
+    ----------
+    size_x, size_y : float, optional
+        Width and height of the periodic cell (µm), > 0.
+    N : int, optional
+        Number of spheres, >= 2.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
+    density : float, optional
+        Density of the sphere material (kg/m³), > 0.
+    bimodal_factor : float, optional
+        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
+    cut_lines : int, optional
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after the relaxation and cut the gel into particles (False:
+        frictional spheres only).
+    theTk : object, optional
+        Accepted for compatibility with particleShear 1.0.2; not used.
+    do_pre_equilibration : bool, optional
+        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
+    relative_viscosity : float, optional
+        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
+    central_repulsion_coefficient : float, optional
+        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
+    anticipated_amplitude : float, optional
+        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
+        length of the relaxation.
+    relative_transversal_link_strength : float, optional
+        rts = k_t/k = ν_t/ν, >= 0.
+    avoid_horizontal_angle_degree : float, optional
+        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
+        lines that are redrawn.
+    avoid_height_spanning_particles : bool, optional
+        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
+        ignored when the cut cannot produce separate particles.
+    interface_reenforcement_central : float, optional
+        irc, factor on k (and ν) of transient contacts relative to bonds, > 0.
+    interface_reenforcement_tangential : float, optional
+        irt, the same for k_t (and ν_t), > 0.
+    keep_viscosity_coefficients_constant : bool, optional
+        True: the viscosities are not scaled by the reinforcement factors.
+    cut_top_bottom : bool, optional
+        Cut every bond through the y-periodic boundary (wall-slip emulation).
+    doCutByTriangulation : bool, optional
+        Particles by periodic Voronoi cells (False: random straight lines).
+    remove_link_fraction : float, optional
+        Target fraction (0 … 1) of non-essential links to remove after cutting.
+    edge_fuzziness : float, optional
+        Random roughening of the Voronoi borders in units of the largest radius, >= 0.
+    doDrawing : bool, optional
+        Whether the ensemble draws its spheres (no window is opened here).
+    do_debug : bool, optional
+        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
+    rng : numpy.random.Generator, int or None, optional
+        Random generator or seed driving every random choice (placement, cutting, link removal);
+        None draws fresh entropy.
+    verbose : bool, optional
+        Log the progress messages (INFO) of particleShear 1.0.2.
+
+    Returns
+    -------
+    EnsembleCompactParticlesAdjustableInterfaceStrength
+        The ensemble; its ``dt`` / ``dt_max`` (s) are the steps the experiment should use and its
+        ``model`` holds the model constants.
+
+    Raises
+    ------
+    TypeError
+        If a numeric parameter is not a real number.
+    ValueError
+        If a parameter is out of its range (the message names it, its value and the allowed range),
+        before any work.
+    RuntimeError
+        If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
     """
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
@@ -252,9 +369,81 @@ def EnsembleCompactParticlesFromModelParameters(
         relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
         avoid_height_spanning_particles=False, doCutByTriangulation=True, doDrawing=True, do_debug=False,
         rng=None, verbose=False):
-    """Legacy factory (§6.11): no reinforcement, top/bottom always cut, a short final relaxation.
+    """Legacy factory: no reinforcement, top/bottom always cut, a short final relaxation.
 
-    Returns an :class:`EnsembleCompactParticles`.
+    The factory of ``Simulation_dermal_filler_rheology``: the same time steps and constants as
+    :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters` with
+    ``irc = irt = 1``, bonds through the y-periodic boundary always cut, no edge fuzziness, no
+    link removal and a final relaxation of 25 steps per level.
+
+    Parameters
+    ----------
+    size_x, size_y : float, optional
+        Width and height of the periodic cell (µm), > 0.
+    N : int, optional
+        Number of spheres, >= 2.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
+    density : float, optional
+        Density of the sphere material (kg/m³), > 0.
+    bimodal_factor : float, optional
+        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
+    cut_lines : int, optional
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after the relaxation and cut the gel into particles (False:
+        frictional spheres only).
+    theTk : object, optional
+        Accepted for compatibility with particleShear 1.0.2; not used.
+    do_pre_equilibration : bool, optional
+        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
+    relative_viscosity : float, optional
+        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
+    central_repulsion_coefficient : float, optional
+        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
+    anticipated_amplitude : float, optional
+        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
+        length of the relaxation.
+    relative_transversal_link_strength : float, optional
+        rts = k_t/k = ν_t/ν, >= 0.
+    avoid_horizontal_angle_degree : float, optional
+        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
+        lines that are redrawn.
+    avoid_height_spanning_particles : bool, optional
+        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
+        ignored when the cut cannot produce separate particles.
+    doCutByTriangulation : bool, optional
+        Particles by periodic Voronoi cells (False: random straight lines).
+    doDrawing : bool, optional
+        Whether the ensemble draws its spheres (no window is opened here).
+    do_debug : bool, optional
+        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
+    rng : numpy.random.Generator, int or None, optional
+        Random generator or seed driving every random choice (placement, cutting, link removal);
+        None draws fresh entropy.
+    verbose : bool, optional
+        Log the progress messages (INFO) of particleShear 1.0.2.
+
+    Returns
+    -------
+    EnsembleCompactParticles
+        The ensemble; its ``dt`` / ``dt_max`` (s) are the steps the experiment should use and its
+        ``model`` holds the model constants.
+
+    Raises
+    ------
+    TypeError
+        If a numeric parameter is not a real number.
+    ValueError
+        If a parameter is out of its range (the message names it, its value and the allowed range),
+        before any work.
+    RuntimeError
+        If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
     """
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,

@@ -1,11 +1,13 @@
-"""Ensembles with permanent links (spec §2.5, §2.9, §6.5, §6.7, §10.6).
+"""Ensembles with permanent links (crosslinks): bonds, cutting along lines, bond forces.
 
 ``CanvasPointsLinkable`` adds the bond term to the friction canvas: bonds use
 the compressive law below ``d_eq`` and the tensile law above it, never break,
 carry an unbounded tangential spring and are scaled by the per-sphere
 ``permanent_ratio_*`` of the adjustable sphere class.  The bond kernel runs only
-while bonds exist.
+while bonds exist.  The force laws are eq. S1-5a/b of the manual; the constants are those
+of docs/parameters.md; how bonds are made and cut is described in docs/design.md.
 """
+__docformat__ = "numpy"
 import math
 
 import numpy as np
@@ -29,7 +31,37 @@ class _BondStructure:
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
-    """Friction canvas whose relations can be made permanent (crosslinks)."""
+    """Friction canvas whose relations can be made permanent (crosslinks).
+
+    Bonds are made by :meth:`makeAllLinksPermanent` and cut by :meth:`cutLine` and its variants;
+    the bond forces are added to the contact forces of the friction canvas in every step.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic Lees-Edwards cell (µm), > 0.
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Nominal sphere mass stored on the ensemble (mg per metre of depth).
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1, k_t=1, nu_t=0.01,
                  mu=0.1):
@@ -77,7 +109,19 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._cut_slots(slots[slots >= 0])
 
     def permanent_pairs(self, physical_neighbors_only=False):
-        """Sphere indices (i, j), i < j, of the bonds; optionally only those that do not wrap."""
+        """Sphere indices (i, j), i < j, of the bonds.
+
+        Parameters
+        ----------
+        physical_neighbors_only : bool, optional
+            Only bonds that do not wrap through the periodic boundary (raw coordinate differences
+            below half the cell size in x and in y).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``(i, j)``, two integer arrays of equal length (copies).
+        """
         pt = self._pairs
         m = pt.state == PERMANENT
         i, j = pt.i[m], pt.j[m]
@@ -93,7 +137,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                 & (np.abs(a["y"][i] - a["y"][j]) < self.size_y / 2))
 
     def makeAllLinksPermanent(self):
-        """Bond every current relation (the contacts of the last neighbour update) (§6.5)."""
+        """Bond every current relation (the contacts of the last neighbour update).
+
+        Each bond gets ``d_eq = r_i + r_j`` (not the current, compressed distance) and ξ = 0; bonds
+        through the periodic boundary are made like any other (docs/design.md).  Runs a
+        neighbour update first if no relation exists yet.
+        """
         pt = self._pairs
         if self._g is None and not _nz(pt.active):
             self.test_neighbor_relation()
@@ -101,7 +150,20 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._link_pairs(pt.i[m], pt.j[m])
 
     def cutLine(self, point, angle):
-        """Cut every bond crossed by the infinite line through ``point`` with normal angle ``angle`` (rad)."""
+        """Cut every bond crossed by an infinite, non-periodic line.
+
+        With the normal ``n = (cos angle, sin angle)`` and ``b = n·point``, the bond i–j is cut
+        when ``(n·x_i − b)·(n·(x_i + Δ_ij) − b) <= 0`` (from either end), ``Δ_ij`` being the
+        Lees-Edwards minimum-image separation.  Cut bonds become slipping contacts (ξ = 0,
+        ``d_eq`` = 0).
+
+        Parameters
+        ----------
+        point : sequence of float
+            A point ``(x, y)`` of the line (µm).
+        angle : float
+            Angle of the line's normal to the x axis (rad).
+        """
         pt = self._pairs
         slots = np.flatnonzero(pt.state == PERMANENT)
         if not len(slots):
@@ -121,13 +183,19 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._cut_slots(slots[cut])
 
     def cutRandomLine(self):
-        """Cut along a line through a random point with a random direction."""
+        """Cut along a line through a random integer point of the cell with a uniform random normal angle.
+
+        Draws from the ensemble's random generator (x, y, then the angle).
+        """
         rng = self._rng
         point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
         self.cutLine(point, 2 * math.pi * rng.random())
 
     def cutTopBottomEdge(self):
-        """Cut every bond crossing y = 0 or y = Ly through the periodic image (wall slip)."""
+        """Cut every bond crossing y = 0 or y = size_y through the periodic image.
+
+        This emulates wall slip at the plates (``cut_top_bottom`` of the builders).
+        """
         self.cutLine((0, 0), math.pi / 2)
         self.cutLine((0, self.size_y), math.pi / 2)
 
@@ -268,6 +336,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
     @property
     def active_terms(self):
+        """Names of the force terms of a step, ``"permanent_links"`` included while bonds exist (list of str)."""
         terms = CanvasPointsFrictionElasticityLeesEdwards.active_terms.fget(self)
         if self._pairs.n_permanent:
             terms.append("permanent_links")
@@ -275,7 +344,42 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
 
 class EnsembleLinkable(RandomBimodalSpheres, CanvasPointsLinkable):
-    """N random linkable spheres (``N = 0`` for hand-built scenes, as in the unit tests)."""
+    """N random bimodal linkable spheres (``N = 0`` for hand-built scenes, as in the unit tests).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):

@@ -1,11 +1,14 @@
-"""Ensembles of compact particles: crosslinked spheres cut into particles (spec §6.3, §6.5-6.10, §10.6).
+"""Ensembles of compact particles: crosslinked spheres cut into particles.
 
 A *particle* is a connected component of the graph of permanent links (by
 default only *physical* links, i.e. links that do not wrap through the
 periodic boundary).  Components are found with array operations (min-label
 propagation with pointer jumping over the bond arrays); ``particles`` is kept,
-as in the reference, as a list of lists of sphere objects.
+as in particleShear 1.0.2, as a list of lists of sphere objects.  The constitution
+protocol that uses these methods (relax, crosslink, cut, remove links, join isolated
+spheres, relax again) is described in docs/design.md and docs/parameters.md.
 """
+__docformat__ = "numpy"
 import math
 
 import numpy as np
@@ -22,7 +25,20 @@ __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterf
 
 
 def component_labels(n, i, j):
-    """Connected components of the graph (n nodes, edges i–j): label = smallest node index of the component."""
+    """Connected components of an undirected graph, by min-label propagation with pointer jumping.
+
+    Parameters
+    ----------
+    n : int
+        Number of nodes (0 … n−1).
+    i, j : array_like of int
+        End nodes of the edges (equal lengths; an edge may be listed twice or in either order).
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Per node, the label of its component: the smallest node index of the component.
+    """
     lab = np.arange(n, dtype=np.intp)
     i = np.asarray(i, dtype=np.intp)
     j = np.asarray(j, dtype=np.intp)
@@ -51,8 +67,55 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     """Random bimodal linkable spheres that are crosslinked and cut into compact particles.
 
     ``dt`` / ``dt_max`` (s) are the final and the coarsest step of the multi-level
-    relaxation :meth:`free_pre_equilibration`.  ``rng`` (extension: Generator, seed
-    or None) is set before the spheres are drawn so that whole builds are reproducible.
+    relaxation :meth:`free_pre_equilibration`.  ``rng`` (an addition to 1.0.2) is set before
+    the spheres are drawn so that whole builds are reproducible.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+    dt : float, optional
+        Final (finest) time step of :meth:`free_pre_equilibration` (s), > 0 when relaxing.
+    dt_max : float, optional
+        Coarsest time step of the multi-level relaxation (s).
+    theTkSimulation : object or False, optional
+        Tk window of the live drawing, False for none (stored only).
+    avoid_horizontal_angle_degree : float, optional
+        Half-width (degrees, 0 <= value < 90) of the band of near-horizontal line directions that
+        :meth:`cutRandomLine` redraws; 0 accepts every direction.
+    rng : numpy.random.Generator, int or None, optional
+        Random generator or seed for every random choice of the ensemble (sphere placement,
+        cutting, link removal), set before the spheres are drawn; None keeps the ensemble's own
+        unseeded generator.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
@@ -82,7 +145,19 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                               self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
 
     def particle_info(self, reference=False):
-        """Description of the spheres for the output header (``reference=True``: the 1.0.2 text, §12 #23)."""
+        """Description of the spheres for the header of the output file (radii in µm, masses in mg).
+
+        Parameters
+        ----------
+        reference : bool, optional
+            True: the text of particleShear 1.0.2 exactly (its typos and its radius ratio of
+            0.8/1.2 included); False: the corrected text with the actual radii and masses.
+
+        Returns
+        -------
+        str
+            The description.
+        """
         return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles\n\t"
                 + self._sphere_info(reference))
 
@@ -100,7 +175,24 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
 
     # -- relaxation ----------------------------------------------------------------------------------
     def free_pre_equilibration(self, N=25):
-        """Frictionless damped multi-level relaxation, then N frictionless and N frictional steps at ``dt`` (§6.3)."""
+        """Frictionless damped multi-level relaxation, then N frictionless and N frictional steps at ``dt``.
+
+        Starting at ``dt_max`` with damping factor 0.5, N frictionless steps are run per level
+        while the level step exceeds ``dt``; each level halves the step, moves the damping factor
+        half-way to 1 and removes the mean velocity.  Then N steps at ``dt`` without friction
+        and N steps with friction follow, both undamped.  Shear is off throughout; the
+        ensemble's ``mu`` is restored afterwards.
+
+        Parameters
+        ----------
+        N : int, optional
+            Number of steps per level and per final block, >= 0.
+
+        Raises
+        ------
+        ValueError
+            If the ensemble's ``dt`` is not > 0.
+        """
         N = int(N)
         if not self.dt > 0:
             raise ValueError(f"dt must be > 0 for free_pre_equilibration, got {self.dt!r}")
@@ -138,7 +230,18 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return [[sl[k] for k in grp] for grp in np.split(order, cuts)] if self._n else []
 
     def identify_particles(self, physical_neighbors_only=True):
-        """Set and return ``particles``: connected components of the (physical) permanent-link graph."""
+        """Set and return ``particles``: the connected components of the permanent-link graph.
+
+        Parameters
+        ----------
+        physical_neighbors_only : bool, optional
+            Count only bonds that do not wrap through the periodic boundary.
+
+        Returns
+        -------
+        list of list of SphereLinkable
+            One list per particle, ordered by the lowest sphere index (spheres in index order).
+        """
         self.particles = self._particles_from_labels(self._labels(physical_neighbors_only))
         return self.particles
 
@@ -152,7 +255,16 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return top[roots] - bottom[roots]
 
     def maximal_particle_height(self):
-        """Largest ``max(y + r) − min(y − r)`` over the particles (raw coordinates, µm); sets ``particles``."""
+        """Height of the tallest particle: the largest ``max(y + r) − min(y − r)`` (raw coordinates).
+
+        Particles are the components of the physical bonds; ``particles`` is set as by
+        :meth:`identify_particles`.
+
+        Returns
+        -------
+        float
+            The height (µm); 0 for an empty ensemble.
+        """
         lab = self._labels(True)
         self.particles = self._particles_from_labels(lab)
         if not self._n:
@@ -166,7 +278,18 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return d["_idx"]
 
     def findParticle(self, theSphere):
-        """The particle (list of spheres) in ``particles`` that contains ``theSphere``, or False."""
+        """The particle of ``particles`` that contains ``theSphere``.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The sphere looked for.
+
+        Returns
+        -------
+        list of SphereLinkable or False
+            The particle, or False if no particle of ``particles`` contains the sphere.
+        """
         for particle in self.particles:
             for s in particle:
                 if s is theSphere:
@@ -176,8 +299,25 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     def addParticleFromSphere(self, theSphere, physical_neighbors_only=True):
         """Grow the particle of ``theSphere`` breadth-first, append it to ``particles`` and return it.
 
-        Every generation uses ``physical_neighbors_only`` (the reference ignores it
-        beyond the first, §12 #32).
+        Every generation uses ``physical_neighbors_only`` (particleShear 1.0.2 ignores it
+        beyond the first generation).
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            A sphere of this ensemble.
+        physical_neighbors_only : bool, optional
+            Follow only bonds that do not wrap through the periodic boundary.
+
+        Returns
+        -------
+        list of SphereLinkable
+            The particle, in breadth-first order from ``theSphere``.
+
+        Raises
+        ------
+        ValueError
+            If ``theSphere`` is not a sphere of this ensemble.
         """
         p = self._index_of(theSphere)
         if p is None:
@@ -196,7 +336,21 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return particle
 
     def permanentConnectionBetweenSpheres(self, theSphere1, theSphere2, physical_neighbors_only=True):
-        """"direct" (bonded), "indirect" (same particle), "no_connection", or False for foreign/identical spheres."""
+        """How two spheres are connected by bonds.
+
+        Parameters
+        ----------
+        theSphere1, theSphere2 : SphereLinkable
+            The two spheres.
+        physical_neighbors_only : bool, optional
+            Count only bonds that do not wrap through the periodic boundary.
+
+        Returns
+        -------
+        str or False
+            ``"direct"`` (bonded to each other), ``"indirect"`` (same particle),
+            ``"no_connection"``, or False if the spheres are identical or not both of this ensemble.
+        """
         p, q = self._index_of(theSphere1), self._index_of(theSphere2)
         if p is None or q is None or p == q:
             return False
@@ -208,14 +362,48 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return "indirect" if lab[p] == lab[q] else "no_connection"
 
     def n_permanent_connections(self, physical_neighbors_only=True):
-        """Number of permanent links (each pair once), as a float like the reference."""
+        """Number of bonds, each pair counted once.
+
+        Parameters
+        ----------
+        physical_neighbors_only : bool, optional
+            Count only bonds that do not wrap through the periodic boundary.
+
+        Returns
+        -------
+        float
+            The number (a float, as in particleShear 1.0.2).
+        """
         return float(len(self.permanent_pairs(physical_neighbors_only)[0]))
 
     def remove_non_essential_links(self, max_fraction_to_remove, physical_neighbors_only=True, max_trials=1000):
-        """Cut random links whose spheres stay connected otherwise, up to a fraction of the links (§6.9).
+        """Cut random links whose spheres stay connected otherwise, up to a fraction of the links.
 
-        Sphere-first sampling as in the reference; stops after ``max_trials``
-        consecutive failures.  Sets and returns ``removed_fraction`` (0 without links).
+        A link is non-essential when its two spheres stay in the same particle without it, so
+        removing it never splits a particle.  Sampling is sphere-first (a uniform random sphere,
+        then a uniform random bonded partner), as in particleShear 1.0.2, so links are not
+        sampled uniformly; a trial whose link is essential re-establishes it.  Stops after
+        ``max_trials`` consecutive failures.  Sets and returns ``removed_fraction`` (0 without
+        links).
+
+        Parameters
+        ----------
+        max_fraction_to_remove : float
+            Target fraction of the links to remove, >= 0.
+        physical_neighbors_only : bool, optional
+            Count and remove only bonds that do not wrap through the periodic boundary.
+        max_trials : int, optional
+            Consecutive unsuccessful trials after which the removal stops.
+
+        Returns
+        -------
+        float
+            The fraction of the links removed.
+
+        Raises
+        ------
+        ValueError
+            If ``max_fraction_to_remove`` is negative.
         """
         check_non_negative("max_fraction_to_remove", max_fraction_to_remove)
         i, j = self.permanent_pairs(physical_neighbors_only)
@@ -246,7 +434,17 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return self.removed_fraction
 
     def join_isolated_spheres(self, physical_neighbors_only=True):
-        """Bond each sphere without a (physical) link to a random partner among its non-permanent relations (§6.10)."""
+        """Bond each sphere without a bond to a random partner among its non-permanent relations.
+
+        Spheres are visited in index order; a sphere without any relation stays free.  This avoids
+        free single spheres inside the gel (the bond may cross a cut).
+
+        Parameters
+        ----------
+        physical_neighbors_only : bool, optional
+            A sphere counts as bonded only through bonds that do not wrap through the periodic
+            boundary.
+        """
         pt = self._pairs
         i, j = self.permanent_pairs(physical_neighbors_only)
         bonded = np.zeros(self._n, bool)
@@ -269,9 +467,23 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
 
     # -- cutting ---------------------------------------------------------------------------------------
     def cutByTriangulationPoints(self, triangulation_points, edge_fuzziness=0):
-        """Cut every link between spheres whose nearest seed (LE distance + fuzz) differs (§6.6).
+        """Cut every bond between spheres whose nearest seed point differs (a periodic Voronoi cut).
 
-        Fuzz = ``edge_fuzziness · U · r_max`` per (sphere, seed); ties go to the lower seed index.
+        The distance of a sphere to a seed is the Lees-Edwards minimum-image distance plus
+        ``edge_fuzziness · U · r_max`` (U uniform, drawn per (sphere, seed) even when the fuzziness
+        is 0); ties go to the lower seed index.  Sets ``doCutByTriangulation`` and ``sphere_seed``.
+
+        Parameters
+        ----------
+        triangulation_points : array_like of float
+            Seed points, shape (n, 2), in µm.
+        edge_fuzziness : float, optional
+            Roughness of the particle edges in units of the largest sphere radius, >= 0.
+
+        Raises
+        ------
+        ValueError
+            If ``edge_fuzziness`` is negative.
         """
         check_non_negative("edge_fuzziness", edge_fuzziness)
         pts = np.asarray(triangulation_points, dtype=float).reshape(-1, 2)
@@ -290,14 +502,42 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.sphere_seed = seed
 
     def cutByTriangulation(self, n_points=5, edge_fuzziness=0):
-        """Periodic Voronoi cut into ``n_points`` particles around uniform random seeds (§6.6)."""
+        """Periodic Voronoi cut into ``n_points`` particles around uniform random seed points.
+
+        The seeds are drawn from the ensemble's random generator and kept in
+        ``triangulation_points``; ``n_points <= 1`` cuts nothing (a bulk gel).
+
+        Parameters
+        ----------
+        n_points : int, optional
+            Number of seed points, i.e. of particles (``cut_lines`` of the builders).
+        edge_fuzziness : float, optional
+            Roughness of the particle edges in units of the largest sphere radius, >= 0.
+
+        Raises
+        ------
+        ValueError
+            If ``edge_fuzziness`` is negative.
+        """
         n_points = int(n_points)
         pts = self._rng.random((max(n_points, 0), 2)) * np.array([self.size_x, self.size_y])
         self.triangulation_points = pts
         self.cutByTriangulationPoints(pts, edge_fuzziness)
 
     def angle_OK(self, angle):
-        """False for a near-horizontal line: normal angle (rad) within the avoided band around ±y."""
+        """Whether a cut line with this normal angle is accepted (not near-horizontal).
+
+        Parameters
+        ----------
+        angle : float
+            Angle of the line's normal to the x axis (rad), in [0, 2π).
+
+        Returns
+        -------
+        bool
+            False if the normal lies within ``avoid_horizontal_angle_degree`` of ±y, True otherwise
+            (always True when ``avoid_horizontal_angle_degree`` is 0).
+        """
         a = self.avoid_horizontal_angle_degree
         if not a > 0:
             return True
@@ -306,7 +546,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                     or (3 * math.pi / 2 - w <= angle <= 3 * math.pi / 2 + w))
 
     def cutRandomLine(self):
-        """Cut along an infinite line through a random integer point; near-horizontal lines are redrawn (§6.7)."""
+        """Cut along an infinite line through a random integer point; near-horizontal lines are redrawn.
+
+        The angle is redrawn while :meth:`angle_OK` rejects it (bounded: the avoided band is
+        narrower than all directions, ``avoid_horizontal_angle_degree < 90``).
+        """
         rng = self._rng
         point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
         angle = 2 * math.pi * rng.random()
@@ -316,7 +560,66 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
 
 
 class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticles):
-    """Compact-particle ensemble whose bonds are scaled by ``permanent_ratio_*`` relative to transient contacts."""
+    """Compact-particle ensemble whose bonds are scaled by ``permanent_ratio_*`` relative to transient contacts.
+
+    The spheres are :class:`~particleShear.linkable.spheres.SphereLinkableAdjustableInterfaceStrength`;
+    the builders pass ``1/interface_reenforcement_*`` as the ratios.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+    dt : float, optional
+        Final (finest) time step of :meth:`free_pre_equilibration` (s), > 0 when relaxing.
+    dt_max : float, optional
+        Coarsest time step of the multi-level relaxation (s).
+    theTkSimulation : object or False, optional
+        Tk window of the live drawing, False for none (stored only).
+    avoid_horizontal_angle_degree : float, optional
+        Half-width (degrees, 0 <= value < 90) of the band of near-horizontal line directions that
+        :meth:`cutRandomLine` redraws; 0 accepts every direction.
+    permanent_ratio_central : float, optional
+        Factor of the central elastic force of bonds (and of their viscous force unless
+        ``keep_viscosity_coefficients_constant``), >= 0.
+    permanent_ratio_tangential : float, optional
+        Factor of the tangential spring of bonds (and of their tangential viscosity unless
+        ``keep_viscosity_coefficients_constant``), >= 0.
+    keep_viscosity_coefficients_constant : bool, optional
+        True: the viscous forces of bonds are not scaled by the ratios.
+    rng : numpy.random.Generator, int or None, optional
+        Random generator or seed for every random choice of the ensemble (sphere placement,
+        cutting, link removal), set before the spheres are drawn; None keeps the ensemble's own
+        unseeded generator.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1, dt=1, dt_max=10, theTkSimulation=False,
@@ -340,7 +643,19 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
             self.permanent_ratio_tangential, self.keep_viscosity_coefficients_constant)
 
     def particle_info(self, reference=False):
-        """Description of the spheres for the output header (``reference=True``: the 1.0.2 text, §12 #23)."""
+        """Description of the spheres for the header of the output file (radii in µm, masses in mg).
+
+        Parameters
+        ----------
+        reference : bool, optional
+            True: the text of particleShear 1.0.2 exactly (its typos and its radius ratio of
+            0.8/1.2 included); False: the corrected text with the actual radii and masses.
+
+        Returns
+        -------
+        str
+            The description.
+        """
         if reference:
             return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
                     "adjustment ofstrength between permament and temporary interfaces\n\t" + self._sphere_info(True))

@@ -1,4 +1,14 @@
-"""Crosslinkable spheres and their relations (spec §2.5, §10.4-10.5)."""
+"""Crosslinkable spheres and their relations.
+
+A permanent link ("bond") between two spheres stores ``d_eq = r_i + r_j`` at the time it is made;
+below ``d_eq`` it pushes with the compressive contact law (eq. S1-5b, or eq. S1-5a for a linear
+law), above it pulls with the tensile law (linear by default, eq. S1-5a), it never breaks and its
+tangential spring has no Coulomb bound.  In the adjustable sphere class bonds are scaled by
+``permanent_ratio_central`` / ``permanent_ratio_tangential`` relative to transient contacts
+(see docs/parameters.md, ``interface_reenforcement_*``).  Lengths in µm, forces in mg·µm·s⁻² per
+metre of depth (docs/design.md).
+"""
+__docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
 from ..base.points import ArrayField, CircleBasicElasticity, _check_finite
 from ..base.relations import RelationView, neighbor_relation
@@ -8,7 +18,23 @@ __all__ = ["neighbor_relation_linkable", "SphereLinkable", "SphereLinkableAdjust
 
 
 class neighbor_relation_linkable(neighbor_relation):
-    """Relation that can be made permanent; ``equilibrium_distance`` is ``r_i + r_j`` at linking (µm)."""
+    """Directed relation to ``theSphere`` that can be made permanent (a bond).
+
+    ``equilibrium_distance`` is ``r_i + r_j`` at the time of linking (µm), 0 while not linked.
+
+    Parameters
+    ----------
+    friction_position : float
+        Stored tangential displacement ξ of the pair (µm).
+    interface_type : str
+        State of the relation: ``"stick"``, ``"slip"`` or ``"permanent"``.
+    theSphere : Sphere
+        The partner sphere.
+    graphical_line_index : int, optional
+        Canvas item of the drawn contact line, -1 for none.
+    linking_line_index : int, optional
+        Canvas item of the drawn bond line, -1 for none.
+    """
 
     def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1,
                  linking_line_index=-1):
@@ -18,7 +44,18 @@ class neighbor_relation_linkable(neighbor_relation):
 
 
 class LinkableRelationView(RelationView, neighbor_relation_linkable):
-    """View of a relation of a linkable ensemble."""
+    """View of the relation ``owner → partner`` of a linkable ensemble, read from its pair table.
+
+    Built on demand by ``sphere.neighbors``; it looks the pair up at every access, so it stays
+    valid across steps.
+
+    Parameters
+    ----------
+    ensemble : CanvasPointsLinkable
+        The ensemble holding the pair table.
+    owner, partner : int
+        Indices of the two spheres in the ensemble.
+    """
 
     def __init__(self, ensemble, owner, partner):
         self._bind(ensemble, owner, partner)
@@ -47,7 +84,23 @@ class SphereLinkable(SphereFrictionLeesEdwards):
 
     # -- links ------------------------------------------------------------------------------------
     def establish_permanent_link(self, theSphere, do_backlink=True):
-        """Bond to ``theSphere``: state permanent, ``d_eq = r_i + r_j``, ξ = 0 (both directions)."""
+        """Bond to ``theSphere``: state permanent, ``d_eq = r_i + r_j``, ξ = 0.
+
+        Creates the relation if missing.  Inside an ensemble the pair table is updated for both
+        directions at once.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The partner, not this sphere and not a sphere of another ensemble.
+        do_backlink : bool, optional
+            Also make the reverse relation permanent (spheres outside an ensemble).
+
+        Raises
+        ------
+        ValueError
+            If ``theSphere`` is this sphere or belongs to another ensemble.
+        """
         if theSphere is self:
             raise ValueError("cannot link a sphere to itself")
         ens = _same_ensemble(self, theSphere)
@@ -65,7 +118,23 @@ class SphereLinkable(SphereFrictionLeesEdwards):
             theSphere.establish_permanent_link(self, do_backlink=False)
 
     def cut_permanent_link(self, theSphere, do_backlink=True):
-        """Turn a bond into a slipping contact: state slip, ξ = 0, ``d_eq`` = 0 (both directions)."""
+        """Turn a bond into a slipping contact: state slip, ξ = 0, ``d_eq`` = 0.
+
+        The relation stays and acts as a frictional contact while the spheres touch.  Nothing
+        happens if the pair is not bonded.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The partner.
+        do_backlink : bool, optional
+            Also cut the reverse relation (spheres outside an ensemble).
+
+        Raises
+        ------
+        ValueError
+            If ``theSphere`` belongs to another ensemble.
+        """
         ens = _same_ensemble(self, theSphere)
         if ens is not None:
             ens._cut_pairs([self.__dict__["_idx"]], [theSphere.__dict__["_idx"]])
@@ -82,7 +151,19 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return (abs(self.x - theSphere.x) < self.size_x / 2) and (abs(self.y - theSphere.y) < self.size_y / 2)
 
     def permanentlyConnectedSpheres(self, physical_neighbors_only=True):
-        """Partners bonded to this sphere; with ``physical_neighbors_only`` only bonds that do not wrap."""
+        """Partners bonded to this sphere.
+
+        Parameters
+        ----------
+        physical_neighbors_only : bool, optional
+            Only bonds that do not wrap through the periodic boundary (raw coordinate differences
+            below half the cell size).
+
+        Returns
+        -------
+        list of SphereLinkable
+            The partners, in relation-list order.
+        """
         out = []
         for rel in self.neighbors:
             if rel.interface_type == "permanent":
@@ -96,6 +177,24 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return self.permanent_ratio_central
 
     def get_elastic_force_permanent(self, theSphere, k=1):
+        """Scalar central elastic force of the bond to ``theSphere`` (negative = repulsion).
+
+        Tensile law ``call_back_elastic_force_law_tensile(d, d_eq, k)`` for ``d >= d_eq``, the
+        compressive contact law (eq. S1-5b with the sphere's ``central_repulsion_coefficient``)
+        below it, times ``permanent_ratio_central``.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            A bonded partner.
+        k : float, optional
+            Central spring constant (mg·s⁻² per metre of depth).
+
+        Returns
+        -------
+        float
+            The force along the unit vector towards the partner (mg·µm·s⁻² per metre of depth).
+        """
         rel = self._relation(theSphere)
         d = self.d(theSphere)
         d_eq = rel.equilibrium_distance
@@ -106,12 +205,46 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return f * self.permanent_ratio_central
 
     def elastic_force(self, theSphere, k):
+        """Apply the central elastic force of the pair to this sphere and register it.
+
+        A bond uses :meth:`get_elastic_force_permanent` at any distance; a transient contact the
+        contact law of the parent class (only while overlapping).
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The partner.
+        k : float
+            Central spring constant (mg·s⁻² per metre of depth).
+
+        Returns
+        -------
+        list of float
+            The force vector ``[fx, fy]`` applied to this sphere (mg·µm·s⁻² per metre of depth).
+        """
         rel = self._relation(theSphere)
         if rel is None or rel.interface_type != "permanent":
             return SphereFrictionLeesEdwards.elastic_force(self, theSphere, k)
         return self._apply_along_n(theSphere, self.get_elastic_force_permanent(theSphere, k))
 
     def get_central_viscous_force(self, theSphere, nu):
+        """Scalar central viscous force ``ν·v_n`` of the pair.
+
+        On a bond it is multiplied by ``permanent_ratio_central`` unless
+        ``keep_viscosity_coefficients_constant``.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The partner.
+        nu : float
+            Central viscosity constant ν (mg·s⁻¹ per metre of depth).
+
+        Returns
+        -------
+        float
+            The force along the unit vector towards the partner (mg·µm·s⁻² per metre of depth).
+        """
         f = SphereFrictionLeesEdwards.get_central_viscous_force(self, theSphere, nu)
         rel = self._relation(theSphere)
         if rel is not None and rel.interface_type == "permanent" and not self.keep_viscosity_coefficients_constant:
@@ -119,16 +252,70 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return f
 
     def tangential_force_viscous_permanent(self, theSphere, nu):
+        """Tangential viscous force ``ν_t·v_t`` of a bond (non-zero only while the spheres overlap).
+
+        Multiplied by ``permanent_ratio_tangential`` unless ``keep_viscosity_coefficients_constant``.
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            A bonded partner.
+        nu : float
+            Tangential viscosity constant ν_t (mg·s⁻¹ per metre of depth).
+
+        Returns
+        -------
+        float
+            The scalar tangential force (mg·µm·s⁻² per metre of depth).
+        """
         f = self.tangential_force_viscous(theSphere, nu)
         if not self.keep_viscosity_coefficients_constant:
             f = f * self.permanent_ratio_tangential
         return f
 
     def tangential_force_elastic_permanent(self, theSphere, k_t):
+        """Tangential elastic force ``k_t·ξ·permanent_ratio_tangential`` of a bond (no Coulomb bound).
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            A bonded partner.
+        k_t : float
+            Tangential spring constant (mg·s⁻² per metre of depth).
+
+        Returns
+        -------
+        float
+            The scalar tangential force (mg·µm·s⁻² per metre of depth).
+        """
         return k_t * self._relation(theSphere).friction_position * self.permanent_ratio_tangential
 
     def tangential_force(self, theSphere, nu, mu, k, k_t):
-        """One visit of the tangential routine, bonds included (§2.6)."""
+        """One visit of the tangential routine, bonds included.
+
+        A transient contact is handled by the parent class (Coulomb bound ``μ·|F_n|``, slip resets
+        ξ); a bond adds its viscous and elastic tangential forces without bound.  Half of the
+        force is applied per visit, with the torques split in proportion to the radii (eq. S1-3).
+
+        Parameters
+        ----------
+        theSphere : SphereLinkable
+            The partner.
+        nu : float
+            Tangential viscosity constant ν_t (mg·s⁻¹ per metre of depth).
+        mu : float
+            Coulomb friction coefficient μ of transient contacts.
+        k : float
+            Central spring constant (mg·s⁻² per metre of depth), for the Coulomb bound.
+        k_t : float
+            Tangential spring constant (mg·s⁻² per metre of depth).
+
+        Returns
+        -------
+        float
+            The scalar tangential force of this visit (mg·µm·s⁻² per metre of depth); 0 without
+            a relation.
+        """
         rel = self._relation(theSphere)
         if rel is None:
             return 0
@@ -140,6 +327,18 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return f
 
     def contactLineColor(self, interface_type):
+        """Colour of the line drawn for a relation: locked for stick contacts and bonds, else slip.
+
+        Parameters
+        ----------
+        interface_type : str
+            State of the relation: ``"stick"``, ``"slip"`` or ``"permanent"``.
+
+        Returns
+        -------
+        str
+            A colour name of the graphical output configuration.
+        """
         cfg = self.graphical_output_configuration
         if interface_type in ("stick", "permanent"):
             return cfg.color_interface_locked
@@ -147,7 +346,45 @@ class SphereLinkable(SphereFrictionLeesEdwards):
 
 
 class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
-    """Linkable sphere whose bonds are weaker or stronger than transient contacts by fixed ratios."""
+    """Linkable sphere whose bonds are weaker or stronger than transient contacts by fixed ratios.
+
+    The builders set the ratios to ``1/interface_reenforcement_*``, so that bonds keep the base
+    constants while transient contacts are reinforced.
+
+    Parameters
+    ----------
+    color : str
+        Fill colour of the disc in drawings.
+    x, y : float
+        Initial position of the centre (µm).
+    diameter : float
+        Diameter of the disc (µm), > 0.
+    m : float, optional
+        Mass (mg per metre of depth).
+    my_index : int, optional
+        Index of the sphere in its ensemble.
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the sphere draws itself on ``theCanvas``.
+    force_register : object or None, optional
+        Receiver of the recorded forces (the ensemble); None creates a private one.
+    size_x, size_y : float, optional
+        Width and height of the Lees-Edwards cell (µm).
+    permanent_ratio_central : float, optional
+        Factor of the central elastic force of bonds (and of their viscous force unless
+        ``keep_viscosity_coefficients_constant``), >= 0.
+    permanent_ratio_tangential : float, optional
+        Factor of the tangential spring of bonds (and of their tangential viscosity unless
+        ``keep_viscosity_coefficients_constant``), >= 0.
+    keep_viscosity_coefficients_constant : bool, optional
+        True: the viscous forces of bonds are not scaled by the ratios.
+
+    Raises
+    ------
+    ValueError
+        If a ratio is negative or not finite.
+    """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
                  force_register=None, size_x=500, size_y=500, permanent_ratio_central=1,
@@ -164,6 +401,18 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
 
     def contactLineColor(self, interface_type):
+        """Colour of the line drawn for a relation: locked (stick), dark orange (bond) or slip.
+
+        Parameters
+        ----------
+        interface_type : str
+            State of the relation: ``"stick"``, ``"slip"`` or ``"permanent"``.
+
+        Returns
+        -------
+        str
+            A colour name.
+        """
         cfg = self.graphical_output_configuration
         if interface_type == "stick":
             return cfg.color_interface_locked

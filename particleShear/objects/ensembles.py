@@ -1,4 +1,12 @@
-"""Concrete non-crosslinkable ensembles with random bimodal spheres (spec §6.2, §10.6)."""
+"""Concrete non-crosslinkable ensembles with random bimodal spheres.
+
+The spheres are placed at random integer positions (µm) without an overlap check; the heavy
+initial overlaps are relaxed by the frictionless pre-equilibration of the experiment or the
+builders.  Radii follow eq. S1-14, masses scale with the disc area.  Every random draw comes from
+the ensemble's ``numpy.random.Generator`` (``set_random_generator``), so one seed fixes the
+ensemble.  Units: docs/design.md.
+"""
+__docformat__ = "numpy"
 import math
 
 import numpy as np
@@ -21,8 +29,9 @@ def _check_count(N):
 class RandomBimodalSpheres:
     """Mixin: N spheres of radius ``r_b/√bf`` or ``r_b·√bf`` (probability 1/2 each) at random integer positions.
 
-    Masses follow ``adjust_m(m, r, r_b)`` (§5.4); every draw comes from the
-    ensemble's ``numpy.random.Generator`` (``set_random_generator``).
+    ``r_b`` is :func:`~particleShear.objects.model.r_estimate` with the bimodal factors (eq. S1-14);
+    masses follow ``adjust_m(m, r, r_b)`` (mass proportional to the disc area); every draw comes
+    from the ensemble's ``numpy.random.Generator`` (``set_random_generator``).
     """
 
     def _init_bimodal(self, N, packing_fraction, bimodal_factor):
@@ -36,7 +45,20 @@ class RandomBimodalSpheres:
         self.r_max = 0
 
     def random_radius_bimodal(self, r):
-        """``r·(lower + (upper − lower)·U{0,1})``: small or large radius with equal probability."""
+        """Small or large radius with equal probability: ``r·(lower + (upper − lower)·U{0,1})``.
+
+        Draws one integer from the ensemble's random generator.
+
+        Parameters
+        ----------
+        r : float
+            Bimodal mean radius ``r_b`` (µm).
+
+        Returns
+        -------
+        float
+            ``r/√bf`` or ``r·√bf`` (µm).
+        """
         return r * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(self._rng.integers(0, 2)))
 
     def _new_sphere(self, x, y, r, m, index):
@@ -59,6 +81,13 @@ class RandomBimodalSpheres:
             self.sphereList.append(s)
 
     def particle_info(self):
+        """Description of the spheres for the header of the output file (radii in µm).
+
+        Returns
+        -------
+        str
+            The text, with the small radius ``r1`` and the large radius ``r2``.
+        """
         return ("Spheres with, bimodal distribution, equal probability, \n\tr1="
                 + str(self.r_max / self.bimodal_upper * self.bimodal_lower) + "r2=" + str(self.r_max))
 
@@ -66,8 +95,36 @@ class RandomBimodalSpheres:
 class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
     """Legacy ensemble: plain periodic cell (no shear offset), frictional spheres, central forces only.
 
-    The reference emulates periodicity with boundary replicas; here the minimum
+    particleShear 1.0.2 emulates periodicity with boundary replicas; here the minimum
     image does it, and boundary-crossing pairs are registered as external forces.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
     """
 
     use_lees_edwards = False
@@ -90,7 +147,42 @@ class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
 
 
 class EnsembleFriction(Ensemble):
-    """Legacy periodic ensemble with tangential forces (no shear offset)."""
+    """Legacy periodic ensemble with tangential forces (no shear offset).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     k_t = NonNegative()
     nu_t = NonNegative()
@@ -118,7 +210,36 @@ del _name, _value
 
 
 class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesEdwards):
-    """Frictionless Lees-Edwards ensemble (buildable here; the reference crashes for N > 0)."""
+    """Frictionless Lees-Edwards ensemble (buildable here; particleShear 1.0.2 crashes for N > 0).
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4):
@@ -132,7 +253,42 @@ class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesE
 
 
 class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElasticityLeesEdwards):
-    """Frictional spheres under Lees-Edwards boundary conditions."""
+    """Frictional spheres under Lees-Edwards boundary conditions.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Width and height of the periodic cell (µm), > 0.
+    N : int
+        Number of spheres, >= 0 (0 for hand-built scenes).
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    theCanvas : tkinter.Canvas or False, optional
+        Canvas of the live drawing, False for none.
+    doDrawing : bool, optional
+        Whether the spheres are drawn on ``theCanvas``.
+    k : float, optional
+        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
+    nu : float, optional
+        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    m : float, optional
+        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
+        scales with its area.
+    bimodal_factor : float, optional
+        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
+        probability 1/2 each.
+    k_t : float, optional
+        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
+    nu_t : float, optional
+        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
+
+    Raises
+    ------
+    ValueError
+        If a parameter is out of its range (the message names it and its value).
+    """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
@@ -147,5 +303,12 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
                                          self.size_y)
 
     def particle_info(self):
+        """Description of the spheres for the header of the output file (radii in µm).
+
+        Returns
+        -------
+        str
+            The text, with the small radius ``r1`` and the large radius ``r2``.
+        """
         return "Frictional spheres under Lees-Edwards boundary conditions\n\t" + \
             RandomBimodalSpheres.particle_info(self)
