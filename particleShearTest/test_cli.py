@@ -42,7 +42,7 @@ def run_main(argv):
 def sample_value(name, cli_type, choices, default):
     """(command-line text, expected Python value) of a legal value different from the default."""
     if choices:
-        value = next(c for c in choices if c != default)
+        value = next((c for c in choices if c != default), default)  # a single choice: the default itself
         return value, value
     if cli_type is int:
         return "7", 7

@@ -157,6 +157,44 @@ class TestWrapIsConstantTime(unittest.TestCase):
         self.assertEqual((gx[0], gy[0]), (3.0, 240.0))
 
 
+class TestEngineBoxIsConstantTime(unittest.TestCase):
+    """The engine's wrap and minimum image (particleShear.engine.box) end at once for any coordinate."""
+
+    def test_huge_and_infinite_coordinates(self):
+        from particleShear.engine.box import min_image as engine_min_image, wrap as engine_wrap
+        Ls = np.full(3, L)
+
+        def wrap():
+            x, y, vx = np.array([1e300, 10.0, np.inf]), np.array([20.0, -1e300, 3.0]), np.zeros(3)
+            engine_wrap(x, y, vx, Ls, Ls, np.full(3, 100.0), np.full(3, 0.2))
+            return x, y
+        self.assertLess(best_time(wrap), 1e-3)
+        x, y = wrap()
+        self.assertTrue(np.all((x[:2] >= 0) & (x[:2] < L)) and np.all((y[:2] >= 0) & (y[:2] < L)), (x, y))
+        self.assertTrue(np.isnan(x[2]))  # infinite: NaN, which the stability guard reports
+        big = np.array([1e300, 3.0])
+        self.assertLess(best_time(lambda: engine_min_image(big, big, L, L, 5e8)), 1e-3)
+        gx, gy, _, _ = engine_min_image(big, np.array([-1e300, -260.0]), L, L, 5e8)
+        self.assertTrue(np.all((gx >= -L / 2) & (gx < L / 2)) and np.all((gy >= -L / 2) & (gy < L / 2)))
+
+    def test_ordinary_coordinates_match_the_classes_kernel(self):
+        from particleShear.engine.box import wrap as engine_wrap
+        rng = np.random.default_rng(7)
+        for shift, rate in ((0.0, 0.0), (100.0, 0.3), (-730.0, -1.0)):
+            with self.subTest(shift=shift):
+                x = rng.uniform(-1.5 * L, 2.5 * L, 300)
+                y = rng.uniform(-1.5 * L, 2.5 * L, 300)
+                vx = rng.normal(size=300)
+                ref = [a.copy() for a in (x, y, vx)]
+                reference_le_wrap(*ref, L, L, shift, rate)
+                n = len(x)
+                engine_wrap(x, y, vx, np.full(n, L), np.full(n, L), np.full(n, shift), np.full(n, rate))
+                np.testing.assert_array_equal(x, ref[0])
+                np.testing.assert_array_equal(y, ref[1])
+                # vx: −Ly·γ̇ per crossing here, (y − y0)·γ̇ in the reference loop: equal to rounding
+                np.testing.assert_allclose(vx, ref[2], rtol=0, atol=4 * np.finfo(float).eps * L * max(abs(rate), 1))
+
+
 def two_spheres(x=150.0, xspeed=10.0):
     ens = EnsembleLinkable(L, L, 0, k=1, nu=1, k_t=1, nu_t=1, mu=0.01)
     a = SphereLinkable("grey", x, 200, 120, 1, 1, force_register=ens)

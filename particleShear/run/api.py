@@ -613,15 +613,16 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Keyword-only.  Size of the default process pool (>= 1; None: all cores).
     verbose : bool, default False
         Keyword-only.  Forwarded to each run (default False: quiet workers).
-    **options
-    batch_size : int, keyword-only
-        When given, runs that share a step schedule (same N, time-step rule and protocol; see
-        :func:`particleShear.run.batch.schedule_key`) are grouped into batches of up to
-        ``batch_size`` runs, and each batch is one task of the executor
+    batch_size : int or None, default None
+        Keyword-only.  When given, runs that share a step schedule (same N, time-step rule and
+        protocol; see :func:`particleShear.run.batch.schedule_key`) are grouped into batches of up
+        to ``batch_size`` runs, and each batch is one task of the executor
         (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
-        unbatched series, in the same order.  Default None: one task per run.
-    backend : {"numpy"}, keyword-only
-        Array backend of every run.
+        unbatched series, in the same order (a batched series does not resume).  Default None:
+        one task per run.
+    backend : {"numpy"}, default "numpy"
+        Keyword-only.  Array backend of every run.
+    **options
         Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
         ``reference_header``, ``renderer``, ``time_step_factor``, ...).
 
@@ -686,6 +687,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         from ..sweep.runner import run_series
         return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)
     # batches of runs that share a schedule, one executor task each (results in the series order)
+    from ..sweep.runner import series_parameters
     own = executor is None
     if own:
         executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
@@ -695,6 +697,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         results = [None] * len(all_kwargs)
         for g, fut in zip(groups, futures):
             for p, res in zip(g, fut.result()):
+                res.parameters = series_parameters(all_kwargs[p])  # as the unbatched series records them
                 results[p] = res
         return results
     finally:

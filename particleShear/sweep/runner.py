@@ -584,6 +584,26 @@ def _result_from_row(row, run):
                             timings={"total": float(row["wall_time_s"])}, output_path=row["output_path"] or None)
 
 
+def series_parameters(kwargs):
+    """The complete parameter set a series records for one run (``SimulationResult.parameters``).
+
+    Every parameter a SPEC may set, defaults filled in, from the run's keyword arguments; the
+    folder, seed and console choice of the series are not part of it.
+
+    Parameters
+    ----------
+    kwargs : dict
+        Keyword arguments of :func:`~particleShear.doParticleShearSimulation` for the run.
+
+    Returns
+    -------
+    dict
+    """
+    from .spec import sweep_parameter_defaults
+    return dict(sweep_parameter_defaults(),
+                **{n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")})
+
+
 def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
     """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
 
@@ -610,12 +630,11 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
         If any run failed (after all have finished), naming the first failed run.
     """
     from ..simulation.provenance import run_identity
-    from .spec import SweepRun, sweep_parameter_defaults
-    defaults = sweep_parameter_defaults()
+    from .spec import SweepRun
     runs = []
     for k, kw in enumerate(all_kwargs):
         ss = kw["seed"]
-        params = dict(defaults, **{n: v for n, v in kw.items() if n not in ("root_folder", "seed", "verbose")})
+        params = series_parameters(kw)
         runs.append(SweepRun(index=k, point=k, repetition=0, parameters=params, seed_entropy=ss.entropy,
                              spawn_key=tuple(ss.spawn_key), run_id=run_identity(params, ss.entropy, ss.spawn_key)))
     results = [None] * len(runs)
