@@ -282,6 +282,19 @@ class TestSweep(unittest.TestCase):
         for name in _txt(out):                                          # every per-step value
             self.assertEqual(_lines(os.path.join(out, name))[-100:], _lines(os.path.join(self.ref, name))[-100:])
 
+    def test_batched_sweep_equals_unbatched(self):
+        """--batch-size: the runs of one schedule measured as replicas of one batch give the same rows and files."""
+        out = os.path.join(self.tmp, "batched")
+        rows = run_sweep(SPEC, out, workers=1, progress=False, batch_size=4)
+        self.assertEqual(_stable(rows), _stable(self.rows))
+        self.assertEqual(_txt(out), _txt(self.ref))
+        for name in _txt(out):
+            self.assertEqual(_lines(os.path.join(out, name))[-100:], _lines(os.path.join(self.ref, name))[-100:])
+        self.assertEqual(_leftovers(out), [])
+        self.assertEqual(run_sweep(SPEC, out, workers=1, progress=False, batch_size=4), rows)   # resumes: nothing to run
+        with self.assertRaisesRegex(ValueError, "--batch-size"):
+            run_sweep(SPEC, out, progress=False, batch_size=0)
+
     def test_task_array_and_merge(self):
         out = os.path.join(self.tmp, "array")
         shares = []

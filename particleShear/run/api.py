@@ -9,7 +9,6 @@ every call (per process) or returned directly with ``return_result=True``.
 ``concurrent.futures.Executor`` (a ``ProcessPoolExecutor`` by default) with per-run seeds
 ``numpy.random.SeedSequence(seed).spawn(n)`` and returns the results in iteration order.
 """
-import concurrent.futures
 import dataclasses
 
 import numpy as np
@@ -19,7 +18,7 @@ from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_options, validate_series, validate_simulation_parameters
-from .batch import batches, check_backend, check_batch_size, engine_supports, measure_batch, run_batch
+from .batch import check_backend, check_batch_size, engine_supports, measure_batch
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -618,8 +617,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         protocol; see :func:`particleShear.run.batch.schedule_key`) are grouped into batches of up
         to ``batch_size`` runs, and each batch is one task of the executor
         (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
-        unbatched series, in the same order (a batched series does not resume).  Default None:
-        one task per run.
+        unbatched series, in the same order (and resumes like it with a ``root_folder``).
+        Default None: one task per run.
     backend : {"numpy"}, default "numpy"
         Keyword-only.  Array backend of every run.
     **options
@@ -683,23 +682,5 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         all_kwargs.append(kw)
     if not all_kwargs:
         return []
-    if batch_size is None:
-        from ..sweep.runner import run_series
-        return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers)
-    # batches of runs that share a schedule, one executor task each (results in the series order)
-    from ..sweep.runner import series_parameters
-    own = executor is None
-    if own:
-        executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
-    try:
-        groups = batches(all_kwargs, batch_size)
-        futures = [executor.submit(run_batch, [all_kwargs[p] for p in g], backend) for g in groups]
-        results = [None] * len(all_kwargs)
-        for g, fut in zip(groups, futures):
-            for p, res in zip(g, fut.result()):
-                res.parameters = series_parameters(all_kwargs[p])  # as the unbatched series records them
-                results[p] = res
-        return results
-    finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+    from ..sweep.runner import run_series
+    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size)

@@ -30,6 +30,9 @@ def build_parser():
     a("spec", metavar="SPEC", help="sweep specification: tables [parameters], [grid], [[zip]], [seeds]")
     a("--out", metavar="DIR", required=True, help="output folder (created; the same DIR resumes)")
     a("--workers", type=int, default=None, help="local worker processes (default: all cores)")
+    a("--batch-size", type=int, default=None, metavar="B",
+      help="measure runs of one step schedule (same N, time-step rule, protocol) in batches of up to B "
+           "replicas, one task each; rows identical to unbatched runs (default: one task per run)")
     a("--dask", action="store_true", help="run on a dask.distributed LocalCluster of --workers processes")
     a("--scheduler", metavar="ADDRESS", default=None, help="run on an existing Dask cluster (e.g. tcp://host:8786)")
     a("--task-index", type=int, default=None, metavar="I", help="job-array task I (0-based) of --task-count K")
@@ -74,6 +77,7 @@ def _main(args):
     from .runner import Sweep
     try:
         _positive("workers", "--workers", args.workers)
+        _positive("batch_size", "--batch-size", args.batch_size)
         if args.dask and args.scheduler:
             raise ValueError("--dask and --scheduler exclude each other: --dask starts a cluster, "
                              "--scheduler joins one")
@@ -118,7 +122,8 @@ def _main(args):
             executor = client.get_executor()
         try:
             for outcome in sweep.as_completed(executor=executor, workers=None if executor else workers,
-                                              retry_failed=args.retry_failed, progress=not args.quiet):
+                                              retry_failed=args.retry_failed, progress=not args.quiet,
+                                              batch_size=args.batch_size):
                 failed += not outcome.ok
         except KeyboardInterrupt:
             done = len(sweep.finished_rows())

@@ -18,7 +18,6 @@ __docformat__ = "numpy"
 import concurrent.futures
 import contextlib
 import dataclasses
-import json
 import os
 import re
 import shutil
@@ -118,37 +117,85 @@ def execute_run(task):
         when the run failed.
     """
     from ..run.api import doParticleShearSimulation
-    p = task["parameters"]
-    writes = bool(task["out_dir"]) and bool(p.get("saveData") or p.get("saveOutputImages"))
-    run_dir = os.path.join(task["out_dir"], "runs", task["run_id"]) if writes else ""
     t0 = time.perf_counter()
-    result = None
+    run_dir, kwargs = None, None
     try:
-        if writes:
-            shutil.rmtree(run_dir, ignore_errors=True)      # leftovers of a killed attempt
-            os.makedirs(run_dir)
-        ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
-        result = doParticleShearSimulation(**dict(p, root_folder=run_dir if writes else "", seed=ss,
-                                                  return_result=True, verbose=False))
-        result.parameters = dict(p)
-        if result.output_path:
-            image_folder = result.image_folder
-            result.output_path = _publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
-            if image_folder:
-                result.image_folder = result.output_path + "_images_folder"
-        row = result.to_dict()
-        if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
-            raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
-        row["output_path"] = os.path.abspath(result.output_path) if result.output_path else ""
-        row["wall_time_s"] = time.perf_counter() - t0
-        if not task.get("keep_series"):
-            result.series = {}
+        run_dir, kwargs = _prepare(task)
+        result = doParticleShearSimulation(**kwargs)
+        return _finish_run(task, result, time.perf_counter() - t0)
     except Exception as exc:  # a failed run is a row, never the end of the sweep
-        row, result = _failed_row(task, exc, time.perf_counter() - t0), None
+        return _failed_row(task, exc, time.perf_counter() - t0), None
     finally:
         if run_dir:
             shutil.rmtree(run_dir, ignore_errors=True)
+
+
+def _prepare(task):
+    """``(run_dir, kwargs)`` of a task: its empty scratch folder ("" when it writes nothing) and its call."""
+    p = task["parameters"]
+    writes = bool(task["out_dir"]) and bool(p.get("saveData") or p.get("saveOutputImages"))
+    run_dir = os.path.join(task["out_dir"], "runs", task["run_id"]) if writes else ""
+    if writes:
+        shutil.rmtree(run_dir, ignore_errors=True)      # leftovers of a killed attempt
+        os.makedirs(run_dir)
+    ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
+    return run_dir, dict(p, root_folder=run_dir, seed=ss, return_result=True, verbose=False)
+
+
+def _finish_run(task, result, wall_time_s):
+    """Publish a finished run's files under its run id; return ``(row, result)``."""
+    result.parameters = dict(task["parameters"])
+    if result.output_path:
+        run_dir = os.path.dirname(result.output_path)
+        image_folder = result.image_folder
+        result.output_path = _publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
+        if image_folder:
+            result.image_folder = result.output_path + "_images_folder"
+    row = result.to_dict()
+    if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
+        raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
+    row["output_path"] = os.path.abspath(result.output_path) if result.output_path else ""
+    row["wall_time_s"] = wall_time_s
+    if not task.get("keep_series"):
+        result.series = {}
     return row, result
+
+
+def execute_batch(tasks):
+    """Run sweep tasks that share a step schedule as one batch of replicas; ``[(row, result), ...]`` in order.
+
+    The replicas are measured together (:func:`particleShear.run.batch.run_batch`), each
+    bit-identical to its single run, so the rows equal those of :func:`execute_run`.  If the
+    batch fails (one replica diverging stops the batch), every task runs again on its own, so
+    that only the failing run becomes a ``failed`` row.
+
+    Parameters
+    ----------
+    tasks : list of dict
+        As for :func:`execute_run`.
+
+    Returns
+    -------
+    list of tuple
+        ``(row, result or None)`` per task, in the given order.
+    """
+    from ..run.batch import run_batch
+    t0 = time.perf_counter()
+    prepared = []
+    try:
+        prepared = [_prepare(task) for task in tasks]
+        results = run_batch([kw for _, kw in prepared])
+        wall = (time.perf_counter() - t0) / len(tasks)
+        return [_finish_run(task, result, wall) for task, result in zip(tasks, results)]
+    except Exception:  # noqa: BLE001 - one bad replica: run them one by one (failed rows where they fail)
+        for run_dir, _ in prepared:
+            if run_dir:
+                shutil.rmtree(run_dir, ignore_errors=True)
+        return [execute_run(task) for task in tasks]
+    finally:
+        for run_dir, _ in prepared:
+            if run_dir:
+                shutil.rmtree(run_dir, ignore_errors=True)
 
 
 def _ignore_sigint():
@@ -365,7 +412,7 @@ class Sweep:
                 "keep_series": bool(keep_series)}
 
     def as_completed(self, executor=None, workers=None, keep_series=False, retry_failed=False, progress=True,
-                     stream=None):
+                     stream=None, batch_size=None):
         """Run the pending runs; yield a :class:`SweepOutcome` per run as it finishes (completion order).
 
         Each row is appended to the table (fsynced) before it is yielded.
@@ -388,6 +435,10 @@ class Sweep:
             called with each :class:`SweepOutcome`.
         stream : file-like, optional
             Where progress lines go (default ``sys.stderr``).
+        batch_size : int, optional
+            Group pending runs that share a step schedule (``particleShear.run.batch.schedule_key``)
+            into batches of up to ``batch_size`` runs, one task each (``--batch-size``); the rows
+            are those of unbatched runs, bit for bit.  Default None: one task per run.
 
         Yields
         ------
@@ -401,6 +452,9 @@ class Sweep:
         """
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
             raise ValueError(f"workers={workers!r} (--workers) is invalid: allowed an integer >= 1")
+        if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int)
+                                       or batch_size < 1):
+            raise ValueError(f"batch_size={batch_size!r} (--batch-size) is invalid: allowed an integer >= 1")
         stream = stream if stream is not None else sys.stderr
         os.makedirs(self.out_dir, exist_ok=True)
         with _table_lock(self.table_path):
@@ -430,16 +484,23 @@ class Sweep:
             futures, recorded = {}, set()
             try:
                 by_id = {r.run_id: r for r in todo}
-                futures = {executor.submit(execute_run, self._task(r, keep_series)): r.run_id for r in todo}
+                if batch_size is None:
+                    futures = {executor.submit(execute_run, self._task(r, keep_series)): [r.run_id] for r in todo}
+                else:
+                    from ..run.batch import batches
+                    groups = batches([r.parameters for r in todo], batch_size)
+                    futures = {executor.submit(execute_batch, [self._task(todo[i], keep_series) for i in g]):
+                               [todo[i].run_id for i in g] for g in groups}
                 recorded = set()
                 for fut in concurrent.futures.as_completed(futures):
-                    row, result = fut.result()
-                    append_row(self.table_path, row, self.columns)
+                    done = fut.result()
+                    for run_id, (row, result) in zip(futures[fut], [done] if batch_size is None else done):
+                        append_row(self.table_path, row, self.columns)
+                        outcome = SweepOutcome(by_id[run_id], row, result)
+                        if show is not None:
+                            show(outcome)
+                        yield outcome
                     recorded.add(fut)
-                    outcome = SweepOutcome(by_id[futures[fut]], row, result)
-                    if show is not None:
-                        show(outcome)
-                    yield outcome
             except KeyboardInterrupt:
                 for fut in futures:
                     fut.cancel()
@@ -450,7 +511,8 @@ class Sweep:
                     executor.shutdown(wait=True, cancel_futures=True)
                 for fut in futures:     # runs that finished meanwhile: keep their rows (their files exist)
                     if fut not in recorded and fut.done() and not fut.cancelled() and fut.exception() is None:
-                        append_row(self.table_path, fut.result()[0], self.columns)
+                        for row, _ in ([fut.result()] if batch_size is None else fut.result()):
+                            append_row(self.table_path, row, self.columns)
                 raise
             except BaseException:
                 for fut in futures:
@@ -521,7 +583,7 @@ class Sweep:
 
 
 def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, task_count=None, keep_series=False,
-              retry_failed=False, progress=True, stream=None):
+              retry_failed=False, progress=True, stream=None, batch_size=None):
     """Run (or resume) the sweep ``spec`` into ``out_dir``; return its finished rows in sweep order.
 
     The layout of ``out_dir`` and of the table is described in docs/sweeps.md.
@@ -547,6 +609,9 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
         True (default): one line per run on ``stream``; False: silent; or a callable(outcome).
     stream : file-like, optional
         Where progress lines go (default ``sys.stderr``).
+    batch_size : int, optional
+        Measure runs that share a step schedule in batches of up to ``batch_size`` replicas, one
+        task each (``--batch-size``; rows identical to unbatched runs).  Default None.
 
     Returns
     -------
@@ -560,7 +625,7 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
     """
     return Sweep(spec, out_dir, task_index=task_index, task_count=task_count).run(
         executor=executor, workers=workers, keep_series=keep_series, retry_failed=retry_failed,
-        progress=progress, stream=stream)
+        progress=progress, stream=stream, batch_size=batch_size)
 
 
 def _from_runs(runs, out_dir):
@@ -604,7 +669,7 @@ def series_parameters(kwargs):
                 **{n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")})
 
 
-def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
+def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None):
     """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
 
     Parameters
@@ -618,6 +683,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
         Where the runs execute (not shut down here); default a process pool owned by this call.
     max_workers : int, optional
         Processes of the default pool (default: all cores).
+    batch_size : int, optional
+        Runs sharing a step schedule measured in batches of up to ``batch_size`` (one task each).
 
     Returns
     -------
@@ -647,7 +714,7 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
             if r.run_id in done and done[r.run_id]["status"] == "ok":
                 results[i] = _result_from_row(done[r.run_id], r)
         for outcome in sweep.as_completed(executor=executor, workers=max_workers, keep_series=True,
-                                          retry_failed=True, progress=False):
+                                          retry_failed=True, progress=False, batch_size=batch_size):
             if outcome.ok:
                 results[pos[outcome.run.run_id]] = outcome.result
             else:
@@ -657,14 +724,21 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None):
         if own:
             executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
         try:
-            futures = [executor.submit(execute_run, {"run_id": r.run_id, "index": r.index,
-                                                     "parameters": r.parameters, "seed_entropy": r.seed_entropy,
-                                                     "spawn_key": r.spawn_key, "out_dir": "",
-                                                     "keep_series": True}) for r in runs]
-            for i, fut in enumerate(futures):
-                row, results[i] = fut.result()
-                if row["status"] != "ok":
-                    failures.append(row)
+            tasks = [{"run_id": r.run_id, "index": r.index, "parameters": r.parameters,
+                      "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "",
+                      "keep_series": True} for r in runs]
+            if batch_size is None:
+                groups = [[i] for i in range(len(tasks))]
+                futures = [executor.submit(execute_run, tasks[i]) for i in range(len(tasks))]
+            else:
+                from ..run.batch import batches
+                groups = batches([r.parameters for r in runs], batch_size)
+                futures = [executor.submit(execute_batch, [tasks[i] for i in g]) for g in groups]
+            for g, fut in zip(groups, futures):
+                for i, (row, result) in zip(g, [fut.result()] if batch_size is None else fut.result()):
+                    results[i] = result
+                    if row["status"] != "ok":
+                        failures.append(row)
         finally:
             if own:
                 executor.shutdown(wait=True, cancel_futures=True)
