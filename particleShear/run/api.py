@@ -451,6 +451,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
             result = measure_batch([params])[0]
         result.parameters, result.run_id = params, run_id
         doParticleShearSimulation.last_result = result
+        if strict_io and result.write_error is not None:
+            raise result.write_error
         return result if return_result else result.G
 
     theSimulation = _build_simulation(params, rng, verbose=verbose, progress=progress,
