@@ -13,8 +13,9 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, no files, the Euler integrator, the built-in force laws, N ≤ :data:`ENGINE_MAX_N`) —
-single runs included — measure through :mod:`particleShear.engine`, all
+no drawing, plotting or snapshots, the Euler integrator, the built-in force laws,
+N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — measure through
+:mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
 """
@@ -181,9 +182,10 @@ def run_batch(list_of_kwargs, backend="numpy"):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted or saved, the integrator is "euler", the force laws
-    are the built-in ones and N ≤ :data:`ENGINE_MAX_N` (console messages and progress callbacks
-    work as in the documented classes).
+    It does when nothing is drawn, plotted or rendered into snapshots, the integrator is "euler",
+    the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
+    qualify: their files are written as ``runSimulation`` writes them (console messages and
+    progress callbacks work as in the documented classes).
     """
     from ..base.laws import elastic_force_law, elastic_force_law_tensile
     from ..base.points import CircleBasicElasticity
