@@ -46,8 +46,11 @@ def assert_same_result(test, a, b):
         test.assertEqual(x.shape, y.shape, key)
         test.assertTrue(np.array_equal(x, y), key)
         test.assertEqual(x.tobytes(), y.tobytes(), key)  # also the sign of zeros
-    pa = {k: v for k, v in a.parameters.items() if k != "seed"}
-    pb = {k: v for k, v in b.parameters.items() if k != "seed"}
+    # the physical parameters agree; the run-control inputs (output folder, seed object, console,
+    # callbacks) are not recorded by the sweep runner behind an unbatched series
+    control = {"seed", "root_folder", "verbose", "progress", "return_result"}
+    pa = {k: v for k, v in a.parameters.items() if k not in control}
+    pb = {k: v for k, v in b.parameters.items() if k not in control}
     test.assertEqual(pa, pb)
 
 
@@ -187,3 +190,106 @@ class TestBatchBadInput(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+SERIES = ("t", "strain", "strain_rate", "stress_surface", "stress_internal")
+
+
+def assert_same_numbers(test, a, b):
+    """G′/G″, stresses, schedule and the five recorded series of two results equal bit for bit."""
+    for name in ("G_surface", "G_internal", "stress_surface", "stress_internal", "seed", "spawn_key", "dt", "f",
+                 "N_steps", "damping_factor", "removed_fraction"):
+        test.assertEqual(getattr(a, name), getattr(b, name), name)
+    for key in SERIES:
+        test.assertEqual(np.asarray(a.series[key]).tobytes(), np.asarray(b.series[key]).tobytes(), key)
+
+
+class TestSavedRunsMeasureThroughTheEngine(unittest.TestCase):
+    """One seed, one set of numbers: a run that saves its data (text or npz, with or without the
+    tensor table) gives bit for bit the G′/G″ and series of the same run without files, and the file
+    holds exactly the returned series (text writes str() of each float, which reads back exactly)."""
+
+    KW = dict(QUICK, seed=11, theAmplitude=0.2, theMu=0.05, do_permanent_links=True, cut_lines=2)
+
+    @classmethod
+    def setUpClass(cls):
+        import tempfile
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.plain = doParticleShearSimulation(**cls.KW, return_result=True)
+        cls.saved = {}
+        for fmt, tensors in (("text", True), ("npz", True), ("text", False)):
+            cls.saved[fmt, tensors] = doParticleShearSimulation(
+                **cls.KW, root_folder=cls.tmp.name, saveData=True, output_format=fmt,
+                saveStressTensorData=tensors, return_result=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_saved_equals_unsaved(self):
+        self.assertGreater(self.plain.N_steps, 100)
+        self.assertNotEqual(self.plain.G_surface[0], 0.0)
+        for (fmt, tensors), res in self.saved.items():
+            with self.subTest(output_format=fmt, saveStressTensorData=tensors):
+                self.assertIsNone(res.write_error)
+                assert_same_numbers(self, res, self.plain)
+
+    def test_file_holds_the_returned_series(self):
+        from particleShear import read_run
+        for (fmt, tensors), res in self.saved.items():
+            if not tensors:
+                continue  # the text file has no table without the tensor data
+            with self.subTest(output_format=fmt):
+                data = read_run(res.output_path).series
+                for key in SERIES:
+                    self.assertEqual(data[key].tobytes(), np.asarray(res.series[key]).tobytes(), key)
+                # the tensor table: the overall tensor's xy entry is minus τ_internal to rounding
+                # (the engine sums τ for G in another order): 1e-12 of the largest entry
+                overall = data["tensors"][:, 8]
+                scale = np.abs(overall).max()
+                np.testing.assert_allclose(-overall[:, 0, 1], data["stress_internal"], rtol=0, atol=1e-12 * scale)
+
+    def test_header_and_sidecar(self):
+        import json
+        import os
+        res = self.saved["text", True]
+        with open(res.output_path, encoding="utf-8") as fh:
+            text = fh.read()
+        self.assertTrue(text.startswith("Dermal filler Ensemble"))
+        self.assertIn("Function call : \n", text)
+        self.assertIn("Detailed stress tensor data", text)
+        with open(res.output_path + ".json", encoding="utf-8") as fh:
+            meta = json.load(fh)
+        self.assertEqual(meta["run_id"], res.run_id)
+        self.assertEqual(os.path.basename(res.output_path), meta["file"])
+        self.assertEqual([n for n in os.listdir(self.tmp.name) if n.endswith(".part")], [])
+
+
+class TestBatchedSeriesWithFiles(unittest.TestCase):
+    """A batched series that saves its files into a root folder equals the unbatched one bit for bit
+    and writes one complete file per run."""
+
+    KW = dict(amplitudes=[0.1, 0.3], mu=[0.01], cut_lines=2, do_uncrosslinked_control=True, N_repetitions=1,
+              seed=5, saveData=True, **QUICK)
+
+    def test_batched_series_with_files(self):
+        import os
+        import tempfile
+        from particleShear import read_run
+        with tempfile.TemporaryDirectory() as d1, tempfile.TemporaryDirectory() as d2:
+            plain = doParticleShearSimulationSeries(root_folder=d1, executor=InlineExecutor(), **self.KW)
+            batched = doParticleShearSimulationSeries(root_folder=d2, executor=InlineExecutor(), batch_size=3,
+                                                      **self.KW)
+            self.assertEqual(len(plain), 4)
+            self.assertEqual(len(batched), 4)
+            unsaved = doParticleShearSimulationSeries(executor=InlineExecutor(), batch_size=3,
+                                                      **dict(self.KW, saveData=False))
+            for a, b, c in zip(batched, plain, unsaved):
+                assert_same_numbers(self, a, b)
+                assert_same_numbers(self, a, c)
+                self.assertTrue(os.path.dirname(a.output_path) == d2)
+                data = read_run(a.output_path).series
+                for key in SERIES:
+                    self.assertEqual(data[key].tobytes(), np.asarray(a.series[key]).tobytes(), key)
+            self.assertEqual(len({a.output_path for a in batched}), 4)
+            self.assertEqual([n for n in os.listdir(d2) if n.endswith(".part")], [])

@@ -374,7 +374,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         result with ``write_error`` set (``last_result`` holds it either way).
     backend : {"numpy"}, default "numpy"
         Keyword-only.  Array library of the measurement (only NumPy in this version; see
-        :mod:`particleShear.run.batch`).  Runs without drawing, snapshots or files measure through
+        :mod:`particleShear.run.batch`).  Runs without drawing or snapshots (files or not) measure through
         the engine (:mod:`particleShear.engine`) as a batch of one, so that a run in a batched
         series (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it.
 
@@ -450,6 +450,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
             result = measure_batch([params])[0]
         result.parameters, result.run_id = params, run_id
         doParticleShearSimulation.last_result = result
+        if strict_io and result.write_error is not None:
+            raise result.write_error
         return result if return_result else result.G
 
     theSimulation = _build_simulation(params, rng, verbose=verbose, progress=progress,

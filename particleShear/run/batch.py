@@ -13,8 +13,9 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, no files, the Euler integrator, the built-in force laws, N ≤ :data:`ENGINE_MAX_N`) —
-single runs included — measure through :mod:`particleShear.engine`, all
+no drawing, plotting or snapshots, the Euler integrator, the built-in force laws,
+N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — measure through
+:mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
 """
@@ -181,14 +182,15 @@ def run_batch(list_of_kwargs, backend="numpy"):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted or saved, the integrator is "euler", the force laws
-    are the built-in ones and N ≤ :data:`ENGINE_MAX_N` (console messages and progress callbacks
-    work as in the documented classes).
+    It does when nothing is drawn, plotted or rendered into snapshots, the integrator is "euler",
+    the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
+    qualify: their files are written as ``runSimulation`` writes them (console messages and
+    progress callbacks work as in the documented classes).
     """
     from ..base.laws import elastic_force_law, elastic_force_law_tensile
     from ..base.points import CircleBasicElasticity
     from ..linkable.spheres import SphereLinkable
-    return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveData"] and not kw["saveOutputImages"]
+    return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveOutputImages"]
             and kw["integrator"] == "euler"
             and int(kw["N"]) <= ENGINE_MAX_N
             and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
@@ -198,58 +200,81 @@ def engine_supports(kw):
 def measure_batch(runs):
     """Constitute every replica with the documented builder, then measure all of them in one engine.
 
-    ``runs``: complete, validated keyword dicts sharing one schedule.  Returns the
-    :class:`~particleShear.run.api.SimulationResult` of each run, in order.
+    ``runs``: complete, validated keyword dicts sharing one schedule.  Each replica runs through
+    the phases of ``runSimulation`` (:class:`~particleShear.simulation.simulations.RunSession`:
+    validation, constitution, reservation of its output file, experiment set-up, schedule) except
+    the measurement, which the engine does for all replicas at once; each experiment then adopts
+    its replica's record and the session writes the output file as ``runSimulation`` does.
+    Returns the :class:`~particleShear.run.api.SimulationResult` of each run, in order.  An
+    interrupt (``KeyboardInterrupt``) removes every reservation and is re-raised with
+    ``position = (phase, step, total)``.
     """
-    from ..engine.state import BatchState
-    from ..engine.step import BatchEngine, pre_equilibrate, protocol
-    from ..simulation.evaluation import demodulation
     from ..simulation.provenance import run_identity
+    from ..simulation.simulations import RunSession
     from .api import SimulationResult, _build_simulation, _seed_sequence
 
-    sims, seeds, constitution = [], [], []
-    for kw in runs:
-        if not kw["periods"] > 0:
-            raise ValueError(f"periods={kw['periods']!r} is out of range: allowed > 0")
-        if not 0 < kw["cool_factor"] <= 1:
-            raise ValueError(f"cool_factor={kw['cool_factor']!r} is out of range: allowed 0 < value <= 1")
-    sched = []
-    for kw in runs:
+    sims, seeds, sessions = [], [], []
+    for kw in runs:  # every replica's settings are checked before any work
         ss, rng = _seed_sequence(kw["seed"])
+        seed_entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
         params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
-        t0 = time.perf_counter()
         sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
                                 correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
                                 renderer="none", time_step_factor=kw["time_step_factor"], integrator="euler",
                                 stability_guard=kw["stability_guard"])
-        if sim.progress is not None:
-            sim.progress("constitution", 0, 0, 0.0)
-        sim.initEnsemble()
-        constitution.append(time.perf_counter() - t0)
-        if sim.progress is not None:
-            sim.progress("constitution", 1, 1, constitution[-1])
+        sim.output_format = kw.get("output_format", "text")
+        sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
+        sim.parameters = kw
+        sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
-        seeds.append((ss, params))
-        # the schedule of the replica (with the console messages of the reference's set-up, in its order)
-        e = sim.theEnsemble
-        factor = float(kw["time_step_factor"])
-        model = sim.model or getattr(e, "model", False)
-        dt = e.dt * factor
-        f = sim.relative_frequency / model.time_constant
-        if sim.verbose:
-            _log.info("Setting relative frequency: " + str(sim.relative_frequency) + " f= " + str(f) + "Hz")
-            _log.info("Creating oscillatory shear experiment, dt = " + str(dt) + " max dt = " + str(e.dt_max * factor))
-            _log.info("OscillatoryShearExperiment: Plot stress graph: " + str(kw["plotStress"]))
-        N_pre = 25 * int(sim.adjustment_factor_for_bounded_preequilibration_steps())
-        cool = kw["cool_factor"] ** (1 / (1 / f / dt))
-        if sim.verbose:
-            _log.info("cool factor per dt= " + str(cool))
-        sched.append(((dt, f, cool, kw["pre_periods"], kw["periods"], kw["post_periods"]), (e.dt_max * factor, N_pre)))
-    # replicas sharing the protocol schedule are measured in one engine, after pre-equilibrating
-    # (in one engine per pre-equilibration schedule)
-    rec = [None] * len(runs)
-    protocol_time = {}
-    pre_time = {}
+        seeds.append((seed_entropy, spawn_key, params))
+    where = ["constitution", 0, 0]
+    try:
+        sched = []
+        for run in sessions:
+            run.constitute()
+            run.prepare()
+            # the schedule of the replica: the one function runSimulation uses
+            sc = run.schedule
+            sched.append(((sc.dt, sc.f, sc.cool, run.exp.baseline_pre_periods, run.exp.periods,
+                           run.exp.baseline_post_periods), (sc.dt_max, sc.N_pre)))
+        rec, timings = _measure(sessions, sched, where)
+        results = []
+        for b, (kw, sim, run, (seed_entropy, spawn_key, params)) in enumerate(zip(runs, sims, sessions, seeds)):
+            run.exp.adopt_measurement(sched[b][0][2], rec[b], timings[b])
+            rec[b] = None  # the experiment's recording holds it now
+            run.finish()
+            info = sim.result_info
+            results.append(SimulationResult(
+                G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
+                stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
+                spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
+                image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
+                N_steps=info["N_steps"], damping_factor=info["damping_factor"],
+                removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
+                series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
+            results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
+        return results
+    except KeyboardInterrupt as exc:
+        exc.position = tuple(where)
+        raise
+    finally:
+        for run in sessions:
+            run.close()
+
+
+def _measure(sessions, sched, where):
+    """The engine measurement of the replicas: one engine per protocol schedule, after
+    pre-equilibrating in one engine per pre-equilibration schedule.  Returns each replica's
+    record of :func:`~particleShear.engine.step.protocol` and its timings; ``where`` follows
+    ``(phase, step, total)``."""
+    from ..engine.state import BatchState
+    from ..engine.step import BatchEngine, pre_equilibrate, protocol
+
+    sims = [run.sim for run in sessions]
+    guard_of = [bool(run.sim.stability_guard) for run in sessions]
+    rec = [None] * len(sessions)
+    timings = [dict() for _ in sessions]
     for proto in dict.fromkeys(p for p, _ in sched):
         members = [b for b, (p, _) in enumerate(sched) if p == proto]
         dt, f, cool, pre_p, periods, post = proto
@@ -259,69 +284,42 @@ def measure_batch(runs):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
-            guard = [bool(runs[b]["stability_guard"]) for b in group]
-            say, report = _console(sims, group, "pre-equilibration")
-            _guarded(pre_equilibrate, BatchEngine(st, guard=guard), pre[1], dt, pre[0], cool, say, report, dt=dt)
+            say, report = _console(sims, group, "pre-equilibration", where)
+            _guarded(pre_equilibrate, BatchEngine(st, guard=[guard_of[b] for b in group]), pre[1], dt, pre[0],
+                     cool, say, report, dt=dt)
             for b in group:
-                pre_time[b] = (time.perf_counter() - t0) / len(group)
+                timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states), guard=[bool(runs[b]["stability_guard"]) for b in order])
-        say, report = _console(sims, order, "protocol")
-        out = _guarded(protocol, engine, dt, f, [runs[b]["theAmplitude"] for b in order], cool, pre_p, periods, post,
-                       False, say, report, dt=dt)
+        engine = BatchEngine(BatchState.concat(states), guard=[guard_of[b] for b in order])
+        say, report = _console(sims, order, "protocol", where)
+        keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
+        out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
+                       post, any(keep), say, report, dt=dt)
         for col, b in enumerate(order):
             rec[b] = {key: (np.ascontiguousarray(v[col]) if key.endswith("_tensors") else
-                            np.ascontiguousarray(v[:, col])) for key, v in out.items()}
-            protocol_time[b] = (time.perf_counter() - t0) / len(order)
-    results = []
-    for b, (kw, sim, (ss, params)) in enumerate(zip(runs, sims, seeds)):
-        t0 = time.perf_counter()
-        dt, f, cool, pre, periods, post = sched[b][0]
-        series = {key: rec[b][key] for key in ("t", "strain", "strain_rate", "stress_surface", "stress_internal")}
-        A = kw["theAmplitude"]
-        G_int = demodulation(series["t"], series["stress_internal"], f, A, pre, periods, post,
-                             correct_drift_sign=kw["correct_drift_sign"])
-        G_surf = demodulation(series["t"], series["stress_surface"], f, A, pre, periods, post,
-                              correct_drift_sign=kw["correct_drift_sign"])
-        t_demod = time.perf_counter() - t0
-        if sim.verbose:
-            if "last_tensors" in rec[b]:
-                _log.info("Overall stress tensor, last step: %s", rec[b]["last_tensors"][-1].tolist())
-                _log.info("Overall stress tensor, first step: %s", rec[b]["first_tensors"][-1].tolist())
-            for label, v in (("G'", G_int[2]), ("G''", G_int[3]), ("G'(by surface force)", G_surf[2]),
-                             ("G''(by surface force)", G_surf[3])):
-                _log.info("%s", label)
-                _log.info("%s", v)
-                _log.info("Pa")
-        tim = {"constitution": constitution[b], "pre_equilibration": pre_time[b], "protocol": protocol_time[b],
-               "demodulation": t_demod, "output": 0.0}
-        tim["total"] = sum(tim.values())
-        results.append(SimulationResult(
-            G_surface=(G_surf[2], G_surf[3]), G_internal=(G_int[2], G_int[3]),
-            stress_surface=(G_surf[0], G_surf[1]), stress_internal=(G_int[0], G_int[1]), parameters=params,
-            seed=None if ss is None else ss.entropy, spawn_key=() if ss is None else tuple(ss.spawn_key),
-            timings=tim, output_path=None, image_folder=None, n_images=0, dt=dt, f=f,
-            N_steps=len(series["t"]), damping_factor=cool,
-            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0), series=series,
-            run_id=run_identity(kw, None if ss is None else ss.entropy, () if ss is None else tuple(ss.spawn_key))))
-        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
-    return results
+                            np.ascontiguousarray(v[:, col])) for key, v in out.items()
+                      if key != "tensors" or keep[col]}
+            timings[b]["protocol"] = (time.perf_counter() - t0) / len(order)
+        del out
+    return rec, timings
 
 
-def _console(sims, members, phase):
+def _console(sims, members, phase, where):
     """``say`` and ``report`` callbacks of a batch phase: the reference's messages when any member is
-    verbose, each member's progress callback at most ~10 times per second (and at the end)."""
+    verbose, each member's progress callback at most ~10 times per second (and at the end);
+    ``where`` follows ``[phase, step, total]``."""
     verbose = any(sims[b].verbose for b in members)
     callbacks = [sims[b].progress for b in members if sims[b].progress is not None]
     say = (lambda *a: _log.info(" ".join(str(x) for x in a))) if verbose else (lambda *a: None)
-    if not callbacks:
-        return say, lambda step, total: None
     t0 = time.perf_counter()
     last = [0.0]
 
     def report(step, total):
+        where[:] = [phase, step, total]
+        if not callbacks:
+            return
         now = time.perf_counter()
         if step == total or now - last[0] >= 0.1:
             last[0] = now

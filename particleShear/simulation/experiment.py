@@ -14,6 +14,7 @@ import os
 import time
 import warnings
 
+import numpy as np
 
 from ..base.stress import StressTensorEvaluation
 from .evaluation import EvaluationHandlerPlotter, demodulation
@@ -439,6 +440,10 @@ class OscillatoryShearExperiment:
         t0 = time.perf_counter()
         G_int = self.evaluateStressAndG(useExternalForce=False)
         G_surf = self.evaluateStressAndG(useExternalForce=True)
+        return self._conclude(G_int, G_surf, t0)
+
+    def _conclude(self, G_int, G_surf, t0):
+        """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""
         self.results = {"internal": G_int, "surface": G_surf}
         self.timings["demodulation"] = time.perf_counter() - t0
         if self.verbose:
@@ -456,6 +461,56 @@ class OscillatoryShearExperiment:
             self.write_output_information_to_file()
         self.timings["output"] = time.perf_counter() - t0
         return [G_surf[2], G_surf[3]]
+
+    def adopt_measurement(self, cool_factor, record, timings=None):
+        """Take the measurement of this experiment from the engine's record instead of running it.
+
+        The engine (:mod:`particleShear.engine`, used by :func:`particleShear.run.batch.measure_batch`)
+        pre-equilibrates and shears the same ensemble with the same schedule; this fills the
+        recording (:attr:`plotter`: series, tensor history when kept, first and last tensors),
+        demodulates the recorded series exactly as :meth:`oscillatory_shear_experiment` does and
+        keeps block 2 of the header, so the output writers see the same thing either way.
+
+        Parameters
+        ----------
+        cool_factor : float
+            The per-step damping factor the engine used.
+        record : dict of ndarray
+            One replica's record of :func:`particleShear.engine.step.protocol`: "t", "strain",
+            "strain_rate", "stress_surface", "stress_internal" (n,), "first_tensors",
+            "last_tensors" (9, 2, 2) and, when kept, "tensors" (n, 9, 2, 2).
+        timings : dict, optional
+            Wall times of "pre_equilibration" and "protocol" (s).
+
+        Returns
+        -------
+        list of float
+            ``[G′_surface, G″_surface]`` in Pa.
+        """
+        from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
+        self.cool_factor = cool_factor
+        self.description_text = experiment_description_text(self, reference_header=self.reference_header)
+        n = len(record["t"])
+        T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
+        self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
+        p = self.plotter = self._make_plotter(T_total)
+        keep = bool(self.keep_tensor_history) and "tensors" in record
+        p.keep_tensor_history = keep
+        scal = np.empty((n, 5))
+        for col, key in ((_T, "t"), (_STRAIN, "strain"), (_RATE, "strain_rate"), (_FORCE, "stress_surface"),
+                         (_SHEAR, "stress_internal")):
+            scal[:, col] = record[key]
+        p._scal, p._tens, p._n, p._planned = scal, (record["tensors"] if keep else None), n, n
+        p.first_tensors = np.array(record["first_tensors"])
+        p.last_tensors = np.array(record["last_tensors"])
+        self.timings.update(timings or {})
+        self.N_steps = n
+        self.position = ("protocol", n, n)
+        t0 = time.perf_counter()
+        # the contiguous series of the record, demodulated as measure_batch always did
+        G_int = self.demodulation(record["t"], record["stress_internal"])
+        G_surf = self.demodulation(record["t"], record["stress_surface"])
+        return self._conclude(G_int, G_surf, t0)
 
     # -- evaluation ------------------------------------------------------------------------------
     def demodulation(self, t, shear_stress):

@@ -17,6 +17,7 @@ import os
 import shutil
 import sys
 import time
+from collections import namedtuple
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
                                  EnsembleCompactParticlesFromModelParameters)
@@ -30,7 +31,7 @@ from .provenance import header_number, json_safe, package_version, positional_nu
 
 _log = logging.getLogger(__name__)
 
-__all__ = ["OscillatorySimulation", "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
+__all__ = ["MeasurementSchedule", "RunSession", "OscillatorySimulation", "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
            "Simulation_interlocking_rheology", "check_output_folder"]
 
 
@@ -74,6 +75,150 @@ def check_output_folder(root_folder, saveData, saveOutputImages, doDrawing=True)
     except OSError as exc:
         raise ValueError(f"root_folder={root_folder!r} is invalid: {' and '.join(wants)} needs a writable "
                          f"output folder ({exc.strerror or exc})") from exc
+
+
+#: the step schedule of one measurement (see OscillatorySimulation.measurement_schedule)
+MeasurementSchedule = namedtuple("MeasurementSchedule", "dt f cool N_pre dt_max")
+MeasurementSchedule.__doc__ = """``(dt, f, cool, N_pre, dt_max)``: protocol step (s), excitation frequency (Hz),
+damping factor per step, pre-equilibration step unit and coarsest pre-equilibration step (s)."""
+
+
+class RunSession:
+    """One run of :meth:`OscillatorySimulation.runSimulation`, in its phases.
+
+    The phases are shared by the documented classes (``runSimulation``: the experiment measures)
+    and the engine path (:func:`particleShear.run.batch.measure_batch`: the engine measures and
+    the experiment adopts its record), so both build, reserve, write and clean up in one way
+    (docs/output.md, docs/design.md "Batches of replicas").
+
+    Parameters
+    ----------
+    simulation : OscillatorySimulation
+        The configured simulation (not yet constituted).
+    cool_factor : float
+        Fraction of the peculiar velocity left after one excitation period, 0 < c ≤ 1.
+    periods : float
+        Excitation periods, > 0.
+    plotStress : bool
+        Live stress/strain window.
+
+    Raises
+    ------
+    ValueError
+        For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
+        unknown output format — before any work.
+    """
+
+    def __init__(self, simulation, cool_factor, periods, plotStress):
+        sim = simulation
+        check_output_folder(sim.root_folder, sim.saveData, sim.saveOutputImages, sim.doDrawing)
+        if not periods > 0:
+            raise ValueError(f"periods={periods!r} is out of range: allowed > 0")
+        if not 0 < cool_factor <= 1:
+            raise ValueError(f"cool_factor={cool_factor!r} is out of range: allowed 0 < value <= 1")
+        self.output_format = getattr(sim, "output_format", "text")
+        check_output_format(self.output_format)
+        self.sim, self.cool_factor, self.periods, self.plotStress = sim, cool_factor, periods, plotStress
+        self.out = None          # the reservation of the output file (a locked .part file)
+        self.image_tmp = None    # the temporary snapshot folder
+        self.image_folder = False
+        self.header = None       # block 1 of the file
+        self.exp = None
+        self.schedule = None
+        self.t_start = time.perf_counter()
+
+    def constitute(self):
+        """Build the ensemble (``initEnsemble``), with the progress calls of the constitution."""
+        sim = self.sim
+        sim.write_error = None
+        sim.theExperiment = None
+        if sim.progress is not None:
+            sim.progress("constitution", 0, 0, 0.0)
+        sim.initEnsemble()
+        sim.timings["constitution"] = time.perf_counter() - self.t_start
+        if sim.progress is not None:
+            sim.progress("constitution", 1, 1, sim.timings["constitution"])
+
+    def prepare(self):
+        """Renderer, reservation of the file number, block 1, the experiment and the schedule."""
+        sim = self.sim
+        sim._attach_renderer()
+        sim.dt, sim.f, _ = sim.time_steps()
+        fileName = False
+        if sim.saveData or sim.saveOutputImages:
+            # the reservation (a locked .part file) is held for the whole run, also when only
+            # the image folder needs the name
+            self.out = reserve_numbered_path(sim._file_stem(), FORMAT_SUFFIXES[self.output_format])
+            fileName = self.out.path
+        sim.output_path = fileName if sim.saveData else None
+        if sim.saveOutputImages and sim.renderer is not None and fileName:
+            self.image_tmp = self.out.dependent("images")
+            os.makedirs(self.image_tmp)
+            self.image_folder = sim.image_folder_path(fileName)
+        if sim.saveData:
+            block1 = io.StringIO()
+            sim.write_information_on_simulation_to_file(block1)
+            self.header = block1.getvalue()
+        exp = self.exp = sim.createExperiment(False, self.periods, self.plotStress, self.image_tmp or False)
+        exp.keep_tensor_history = bool(sim.saveData and sim.saveStressTensorData)
+        self.schedule = sim.measurement_schedule(self.cool_factor)
+        if sim.verbose:
+            _log.info("cool factor per dt= " + str(self.schedule.cool))
+            if sim.saveData:
+                _log.info("Writing output to file " + fileName)
+        return exp
+
+    def finish(self):
+        """After the measurement: snapshot folder and output file into place, ``result_info``; G.
+
+        A failure while writing does not lose the result: it is kept in ``write_error``.
+
+        Returns
+        -------
+        list of float
+            ``[G′_surface, G″_surface]`` (Pa).
+        """
+        sim, exp, out = self.sim, self.exp, self.out
+        t0 = time.perf_counter()
+        try:
+            if self.image_tmp is not None:
+                os.rename(self.image_tmp, self.image_folder)  # complete: the folder appears under its name
+                self.image_tmp = None
+            if sim.saveData:
+                sim._write_output(out, self.header, exp, self.output_format)
+        except Exception as exc:  # noqa: BLE001 - any write failure: keep the computed result
+            sim.write_error = exc
+            sim.output_path = None
+            if sim.verbose:
+                _log.warning("Writing the output failed: " + repr(exc))
+        if out is not None and not out.committed:
+            out.abort()  # images only (or a failed write): release the reservation
+        exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
+        sim.timings.update(exp.timings)
+        sim.timings["total"] = time.perf_counter() - self.t_start
+        surf, internal = exp.results["surface"], exp.results["internal"]
+        sim.result_info = {
+            "G_surface": (surf[2], surf[3]), "G_internal": (internal[2], internal[3]),
+            "stress_surface": (surf[0], surf[1]), "stress_internal": (internal[0], internal[1]),
+            "dt": sim.dt, "f": sim.f, "N_steps": exp.N_steps, "N_pre_equilibration": self.schedule.N_pre,
+            "damping_factor": self.schedule.cool, "output_path": sim.output_path,
+            "image_folder": (self.image_folder if self.image_tmp is None else None) or None,
+            "n_images": exp.n_images_saved, "timings": dict(sim.timings), "write_error": sim.write_error,
+        }
+        return [surf[2], surf[3]]
+
+    def position(self):
+        """``(phase, step, total)`` where the run is (where an interrupt stopped it)."""
+        exp = self.sim.theExperiment
+        return exp.position if exp is not None else ("constitution", 0, 0)
+
+    def close(self):
+        """Remove every temporary entry (an uncommitted reservation, the snapshot folder), close windows."""
+        if self.out is not None and not self.out.committed:
+            self.out.abort()
+        if self.image_tmp is not None and os.path.isdir(self.image_tmp):
+            shutil.rmtree(self.image_tmp, ignore_errors=True)
+        self.sim._close_windows()
 
 
 class _TextSink:
@@ -283,9 +428,7 @@ class OscillatorySimulation:
         ens = self.theEnsemble
         model = self.model or getattr(ens, "model", False)
         y_scale_force = self.relative_y_scale_force / model.k / self.amplitude if model else 1
-        factor = getattr(self, "time_step_factor", 1.0)
-        self.dt = ens.dt * factor
-        self.f = self.relative_frequency / model.time_constant
+        self.dt, self.f, dt_max = self.time_steps()
         ens.set_integrator(getattr(self, "integrator", "euler"))
         if getattr(self, "stability_guard", True):
             ens.stability_guard = StabilityGuard()
@@ -293,7 +436,7 @@ class OscillatorySimulation:
             _log.info("Setting relative frequency: " + str(self.relative_frequency) + " f= " + str(self.f) + "Hz")
         exp = OscillatoryShearExperiment(ens, self.dt, self.f, self.amplitude, output_file,
                                          force_scale=y_scale_force, TkSimulation=self.theTkSimulation,
-                                         dt_max=ens.dt_max * factor, imageOutputFolder=imageOutputFolder,
+                                         dt_max=dt_max, imageOutputFolder=imageOutputFolder,
                                          imageBaseFileName=self.imageBaseFileName,
                                          imageFileType=self.imageFileType, plotStress=plotStress,
                                          saveStressTensorData=self.saveStressTensorData)
@@ -350,94 +493,47 @@ class OscillatorySimulation:
             For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
             unknown output format — before any work.
         """
-        check_output_folder(self.root_folder, self.saveData, self.saveOutputImages, self.doDrawing)
-        if not periods > 0:
-            raise ValueError(f"periods={periods!r} is out of range: allowed > 0")
-        if not 0 < cool_factor <= 1:
-            raise ValueError(f"cool_factor={cool_factor!r} is out of range: allowed 0 < value <= 1")
-        output_format = getattr(self, "output_format", "text")
-        check_output_format(output_format)
-        t_start = time.perf_counter()
-        out = None
-        image_tmp = None
-        self.write_error = None
-        self.theExperiment = None
+        run = RunSession(self, cool_factor, periods, plotStress)
         try:
-            if self.progress is not None:
-                self.progress("constitution", 0, 0, 0.0)
-            self.initEnsemble()
-            self.timings["constitution"] = time.perf_counter() - t_start
-            if self.progress is not None:
-                self.progress("constitution", 1, 1, self.timings["constitution"])
-            self._attach_renderer()
-            model = self.model or getattr(self.theEnsemble, "model", False)
-            self.dt = self.theEnsemble.dt * getattr(self, "time_step_factor", 1.0)
-            self.f = self.relative_frequency / model.time_constant
-            fileName = False
-            if self.saveData or self.saveOutputImages:
-                # the reservation (a locked .part file) is held for the whole run, also when only
-                # the image folder needs the name
-                out = reserve_numbered_path(self._file_stem(), FORMAT_SUFFIXES[output_format])
-                fileName = out.path
-            self.output_path = fileName if self.saveData else None
-            image_folder = False
-            if self.saveOutputImages and self.renderer is not None and fileName:
-                image_tmp = out.dependent("images")
-                os.makedirs(image_tmp)
-                image_folder = self.image_folder_path(fileName)
-            header = None
-            if self.saveData:
-                block1 = io.StringIO()
-                self.write_information_on_simulation_to_file(block1)
-                header = block1.getvalue()
-            exp = self.createExperiment(False, periods, plotStress, image_tmp or False)
-            exp.keep_tensor_history = bool(self.saveData and self.saveStressTensorData)
-            N_pre = 25 * int(self.adjustment_factor_for_bounded_preequilibration_steps())
-            N_per_period = 1 / self.f / self.dt
-            f_step = cool_factor ** (1 / N_per_period)
-            if self.verbose:
-                _log.info("cool factor per dt= " + str(f_step))
-                if self.saveData:
-                    _log.info("Writing output to file " + fileName)
-            G = exp.oscillatory_shear_experiment(cool_factor=f_step, N_pre_equilibration_fixed_boundaries=N_pre)
-            t0 = time.perf_counter()
-            try:
-                if image_tmp is not None:
-                    os.rename(image_tmp, image_folder)  # complete: the folder appears under its name
-                    image_tmp = None
-                if self.saveData:
-                    self._write_output(out, header, exp, output_format)
-            except Exception as exc:  # noqa: BLE001 - any write failure: keep the computed result
-                self.write_error = exc
-                self.output_path = None
-                if self.verbose:
-                    _log.warning("Writing the output failed: " + repr(exc))
-            if out is not None and not out.committed:
-                out.abort()  # images only (or a failed write): release the reservation
-            exp.timings["output"] = exp.timings.get("output", 0.0) + time.perf_counter() - t0
-            self.timings.update(exp.timings)
-            self.timings["total"] = time.perf_counter() - t_start
-            self.result_info = {
-                "G_surface": (exp.results["surface"][2], exp.results["surface"][3]),
-                "G_internal": (exp.results["internal"][2], exp.results["internal"][3]),
-                "stress_surface": (exp.results["surface"][0], exp.results["surface"][1]),
-                "stress_internal": (exp.results["internal"][0], exp.results["internal"][1]),
-                "dt": self.dt, "f": self.f, "N_steps": exp.N_steps, "N_pre_equilibration": N_pre,
-                "damping_factor": f_step, "output_path": self.output_path,
-                "image_folder": (image_folder if image_tmp is None else None) or None,
-                "n_images": exp.n_images_saved, "timings": dict(self.timings), "write_error": self.write_error,
-            }
-            return G
+            run.constitute()
+            run.prepare()
+            run.exp.oscillatory_shear_experiment(cool_factor=run.schedule.cool,
+                                                 N_pre_equilibration_fixed_boundaries=run.schedule.N_pre)
+            return run.finish()
         except KeyboardInterrupt as exc:
-            exp = self.theExperiment
-            exc.position = exp.position if exp is not None else ("constitution", 0, 0)
+            exc.position = run.position()
             raise
         finally:
-            if out is not None and not out.committed:
-                out.abort()
-            if image_tmp is not None and os.path.isdir(image_tmp):
-                shutil.rmtree(image_tmp, ignore_errors=True)
-            self._close_windows()
+            run.close()
+
+    def time_steps(self):
+        """``(dt, f, dt_max)`` of the measurement: the ensemble's steps times ``time_step_factor`` and
+        ``f = relative_frequency / τ`` (docs/parameters.md, "Time step").  Needs the ensemble."""
+        ens = self.theEnsemble
+        model = self.model or getattr(ens, "model", False)
+        factor = getattr(self, "time_step_factor", 1.0)
+        return ens.dt * factor, self.relative_frequency / model.time_constant, ens.dt_max * factor
+
+    def measurement_schedule(self, cool_factor=1):
+        """The step schedule of the measurement, for the classes and the engine alike.
+
+        Parameters
+        ----------
+        cool_factor : float, optional
+            Fraction of the peculiar velocity left after one excitation period (default 1).
+
+        Returns
+        -------
+        MeasurementSchedule
+            ``dt`` and ``f`` (:meth:`time_steps`), the per-step damping factor
+            ``cool = cool_factor ** (f·dt)`` (written ``cool_factor ** (1/N_per_period)``,
+            ``N_per_period = 1/(f·dt)``), the pre-equilibration unit
+            ``N_pre = 25 · int(adjustment factor)`` and the coarsest pre-equilibration step ``dt_max``.
+        """
+        dt, f, dt_max = self.time_steps()
+        N_pre = 25 * int(self.adjustment_factor_for_bounded_preequilibration_steps())
+        N_per_period = 1 / f / dt
+        return MeasurementSchedule(dt, f, cool_factor ** (1 / N_per_period), N_pre, dt_max)
 
     def run_metadata(self, output_format, path):
         """JSON-safe description of the run: parameters and provenance (the sidecar's content).
