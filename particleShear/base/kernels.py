@@ -1,9 +1,11 @@
-"""Small pure functions over arrays: Lees-Edwards geometry and pair terms (spec §2, §3).
+"""Small pure functions over arrays: Lees-Edwards geometry and pair terms (docs/design.md).
 
 Every function takes and returns NumPy arrays (or scalars) and never touches an
 ensemble; they are the hot path of a step and reusable by other back-ends.
 Lengths in µm, velocities in µm/s, forces in mg·µm·s⁻² per m depth.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 try:  # the C function behind np.count_nonzero, without its Python wrapper (a third of the call cost)
@@ -58,7 +60,7 @@ def _fold(v, L, lo):
 
 
 def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
-    """Lees-Edwards minimum image of raw differences (§3.1) with the relative-speed correction (§3.2).
+    """Lees-Edwards minimum image of raw differences with the relative-speed correction of the image.
 
     The y image is chosen first and moves x by ``shift = Ly·γ``; intervals are
     half-open (``[-L/2, L/2)``) and periods are subtracted one at a time, as the
@@ -72,6 +74,32 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     Returns ``(dx, dy, dvx)`` where ``dvx`` is the x velocity correction of the
     image (``-Ly·γ̇`` per image above) — an array, or None when nothing wrapped in y.
     With ``counts`` also the numbers of y and x periods subtracted (int arrays or None).
+
+    Parameters
+    ----------
+    dx, dy : array_like (P,)
+        Raw differences ``x_j − x_i``, ``y_j − y_i`` of the pairs' positions (µm).
+    Lx, Ly : float
+        Box lengths (µm, > 0).
+    shift : float
+        Lees-Edwards offset ``Ly·γ`` (µm).
+    shear_rate : float
+        Shear rate γ̇ (1/s), for the image velocity correction ``dvx``.
+    passes : tuple of two int, optional
+        ``(ny, nx)`` one-period passes per axis (see :func:`in_cell_passes`); None: until done.
+    counts : bool
+        Also return the period counts.
+
+    Returns
+    -------
+    dx, dy : ndarray (P,)
+        Minimum-image separation (µm), each in ``[−L/2, L/2)``.
+    dvx : ndarray (P,) or None
+        x velocity of j's image relative to j (µm/s); None when no y pass was applied
+        (nothing wrapped) or γ̇ = 0.
+    ky, kx : ndarray (P,) or None
+        Only with ``counts``: y and x periods subtracted per pair; both None when some pair
+        needed more than one period (a count could not reproduce the result bit for bit).
     """
     dx = np.asarray(dx, dtype=float)
     dy = np.asarray(dy, dtype=float)
@@ -133,7 +161,25 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
 
 
 def in_cell_passes(Lx, shift, margin=0.01):
-    """(ny, nx) one-period passes that suffice for differences of positions inside the cell."""
+    """(ny, nx) one-period passes that suffice for differences of positions inside the cell.
+
+    With both positions in ``[0, Lx) × [0, Ly)`` one y pass suffices; the y image moves x by
+    up to ``|shift|``, so x needs ``|shift|/Lx`` more passes (rounded, plus one).
+
+    Parameters
+    ----------
+    Lx : float
+        Box width (µm, > 0).
+    shift : float
+        Lees-Edwards offset ``Ly·γ`` (µm).
+    margin : float
+        Fraction of a period added before rounding, a safety against rounding of ``shift/Lx``.
+
+    Returns
+    -------
+    tuple of two int
+        ``(ny, nx)``, to pass as :func:`min_image`'s ``passes``.
+    """
     return 1, int(0.5 + abs(shift) / Lx + margin) + 1
 
 
@@ -164,13 +210,29 @@ def _wrap_axis(v, L, carry=None, carry_step=0.0):
 
 
 def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
-    """Bring positions back into ``[0, Lx) × [0, Ly)`` in place (§3.3).
+    """Bring positions back into ``[0, Lx) × [0, Ly)`` in place (Lees-Edwards wrap).
 
     Crossing y = Ly moves x by ``-shift`` and vx by ``-Ly·γ̇`` (and the reverse
     through y = 0); periods are applied one at a time, as the reference does, for
     a few passes, and in closed form (floor) beyond, so the cost is O(1) in the
     size of a coordinate.  Non-finite coordinates come out NaN.
     Returns True if anything was wrapped.
+
+    Parameters
+    ----------
+    x, y, vx : ndarray (N,)
+        Positions (µm) and x velocities (µm/s) of the spheres, modified in place.
+    Lx, Ly : float
+        Box lengths (µm, > 0).
+    shift : float
+        Lees-Edwards offset ``Ly·γ`` (µm).
+    shear_rate : float
+        Shear rate γ̇ (1/s): a sphere crossing ``y = Ly`` changes vx by ``−Ly·γ̇``.
+
+    Returns
+    -------
+    bool
+        True if any coordinate was wrapped.
     """
     if not len(y):
         return False
@@ -188,7 +250,23 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
 
 
 def pair_geometry(dx, dy, rng=None):
-    """Distance and unit normal of min-image separations; a random normal where d == 0 (§2.1)."""
+    """Distance and unit normal of min-image separations; a random normal where d == 0.
+
+    Parameters
+    ----------
+    dx, dy : ndarray (P,)
+        Minimum-image pair vectors ``x_j − x_i`` (µm).
+    rng : numpy.random.Generator, optional
+        Source of the random directions at ``d = 0`` (the ensemble's generator, so a run
+        follows its seed); None uses NumPy's global generator.
+
+    Returns
+    -------
+    d : ndarray (P,)
+        Centre distances (µm).
+    nx, ny : ndarray (P,)
+        Unit normal from i towards j.
+    """
     d = np.sqrt(dx * dx + dy * dy)
     zero = d == 0
     if _nz(zero):

@@ -12,3 +12,4 @@ Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central l
 :mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, the
 pre-equilibration and the protocol).  NumPy only in this version.
 """
+__docformat__ = "numpy"

@@ -5,6 +5,8 @@ serves pairs or spheres of many replicas with different boxes and strains.  Leng
 velocities in µm/s.  Periods are removed one at a time (as the reference does) in a bounded
 number of passes.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 __all__ = ["min_image", "wrap", "flow_velocity", "MAX_PASSES"]
@@ -21,11 +23,29 @@ def _count(v, half):
 
 
 def min_image(dx, dy, Lx, Ly, shift):
-    """Lees-Edwards minimum image of raw differences ``x_j − x_i`` (eq. of docs/design.md, reference §3.1).
+    """Lees-Edwards minimum image of raw differences ``x_j − x_i`` (docs/design.md, "State").
 
-    The y image is chosen first and moves x by ``shift = Ly·γ``; intervals are half-open,
-    ``[−L/2, L/2)``.  Returns ``(dx, dy, ky, kx)``: the image separation and the numbers of
-    y and x periods removed (floats; ``ky`` gives the velocity correction ``−Ly·γ̇·ky``).
+    The pair vector of a step is the separation to the nearest periodic image of j.  The y
+    image is chosen first and moves x by ``shift = Ly·γ`` (the offset of the image rows
+    above and below); intervals are half-open, ``[−L/2, L/2)``.  All arguments broadcast
+    against each other, so one call serves the pairs of many replicas.
+
+    Parameters
+    ----------
+    dx, dy : ndarray or float
+        Raw differences ``x_j − x_i``, ``y_j − y_i`` of the pairs' positions (µm).
+    Lx, Ly : ndarray or float
+        Box lengths of each pair's replica (µm, > 0), per element or shared.
+    shift : ndarray or float
+        Lees-Edwards offset ``Ly·γ`` of each pair's replica (µm).
+
+    Returns
+    -------
+    dx, dy : ndarray
+        The minimum-image separation (µm), each in ``[−L/2, L/2)``.
+    ky, kx : ndarray of float
+        Numbers of y and x periods removed (``ky`` gives the image velocity correction
+        ``−Ly·γ̇·ky`` in µm/s).
 
     At most :data:`MAX_PASSES` one-period passes, then the rest is folded in closed form, so
     the cost does not grow with the size of a separation.
@@ -58,11 +78,34 @@ def min_image(dx, dy, Lx, Ly, shift):
 
 
 def wrap(x, y, vx, Lx, Ly, shift, rate):
-    """Bring positions into ``[0, Lx) × [0, Ly)`` in place (reference §3.3).
+    """Bring positions into ``[0, Lx) × [0, Ly)`` in place (Lees-Edwards wrap, docs/design.md).
 
-    Crossing ``y = Ly`` moves x by ``−shift`` (``shift = Ly·γ`` after the strain update) and
-    vx by ``−Ly·γ̇``; crossing ``y = 0`` the reverse.  ``Lx``, ``Ly``, ``shift`` and ``rate``
-    are per-sphere arrays.  Returns True if anything moved.
+    A sphere leaving through the top re-enters at the bottom in the image frame that moves
+    with the flow: crossing ``y = Ly`` moves x by ``−shift`` (``shift = Ly·γ`` after the strain
+    update) and vx by ``−Ly·γ̇``; crossing ``y = 0`` the reverse.  Then x is wrapped into
+    ``[0, Lx)``.
+
+    Parameters
+    ----------
+    x, y, vx : ndarray (B·N,)
+        Positions (µm) and x velocities (µm/s) of the spheres, modified in place.
+    Lx, Ly : ndarray (B·N,) or float
+        Box lengths of each sphere's replica (µm).
+    shift : ndarray (B·N,) or float
+        Lees-Edwards offset ``Ly·γ`` of each sphere's replica (µm).
+    rate : ndarray (B·N,) or float
+        Shear rate γ̇ of each sphere's replica (1/s).
+
+    Returns
+    -------
+    bool
+        True if any sphere was moved by a period.
+
+    Raises
+    ------
+    RuntimeError
+        If more than :data:`MAX_PASSES` periods would be needed on an axis (a non-finite or
+        absurd state).
     """
     moved = False
     for _ in range(MAX_PASSES):
@@ -90,5 +133,23 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
 
 
 def flow_velocity(y, Ly, rate):
-    """x velocity ``γ̇ (y − Ly/2)`` of the affine shear flow at height y (µm/s, reference §4.4)."""
+    """x velocity ``γ̇ (y − Ly/2)`` of the affine shear flow at height y.
+
+    The imposed flow field: the centre line of the cell is at rest, the top moves with
+    ``+γ̇·Ly/2``.  Damping acts on the velocity relative to it (docs/design.md).
+
+    Parameters
+    ----------
+    y : ndarray or float
+        Heights (µm).
+    Ly : ndarray or float
+        Box height of each element's replica (µm).
+    rate : ndarray or float
+        Shear rate γ̇ (1/s).
+
+    Returns
+    -------
+    ndarray or float
+        The flow's x velocity (µm/s).
+    """
     return (y - Ly / 2) * rate

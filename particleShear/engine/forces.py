@@ -6,7 +6,13 @@ two-visit rule (:func:`.tangential.tangential_two_pass`), the scatter of pair
 forces to spheres and the two shear stresses G′/G″ need.  Equations: reference manual eq.
 S1-3 (torque split), S1-5/S1-6 (laws), S1-16 (external-force tensor), S1-19 (Love-Weber),
 S1-22/S1-24 (torque terms, overall tensor); details in ``docs/design.md``.
+
+Shapes: P candidate pairs of the whole batch (the replicas' lists concatenated in replica
+order), B replicas, B·N spheres.  Units: µm, µm/s, forces in mg·µm·s⁻² per m depth, torques
+in mg·µm²·s⁻² per m depth (docs/parameters.md).
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 from .tangential import tangential_two_pass
@@ -23,7 +29,17 @@ class PairConstants:
     """Per-candidate constants of a batch, valid until the candidate lists change.
 
     Built from the per-replica lists and the per-replica constants of the state; ``rep`` is
-    each pair's replica, ``ai``/``aj`` the global sphere rows.
+    each pair's replica, ``ai``/``aj`` the global sphere rows.  The bond-dependent constants are
+    added by :meth:`set_bonds`.
+
+    Parameters
+    ----------
+    s : BatchState
+        The batch; its ``pairs`` (one :class:`~particleShear.engine.state.ReplicaPairs` per
+        replica), radii, boxes and constants are read.
+    offsets : ndarray of int (B + 1,)
+        Start of each replica's candidates in the flat arrays (``offsets[b] … offsets[b+1] − 1``),
+        ``offsets[0] = 0`` and ``offsets[B] = P``.
     """
 
     def __init__(self, s, offsets):
@@ -51,7 +67,23 @@ class PairConstants:
                                            self.aj + 2 * nb))
 
     def set_bonds(self, s, state, d_eq):
-        """Bond-dependent constants (bonds never change during the measurement)."""
+        """Bond-dependent constants (bonds never change during the measurement).
+
+        Sets the per-candidate constants of the central law (contact distance, cap, linear and
+        divergent coefficients, eq. S1-5a/b, S1-6), of the tensile law of bonds, the permanent
+        ratios and the viscosities, the tangential constants and the Coulomb bound offset
+        (``inf`` for bonds).
+
+        Parameters
+        ----------
+        s : BatchState
+            The batch whose per-replica constants (``k, nu, k_t, nu_t, mu, c, prc, prt, keep``)
+            are gathered to the candidates.
+        state : ndarray of int8 (P,)
+            State of each candidate; 2 (:data:`~particleShear.engine.state.PERMANENT`) marks a bond.
+        d_eq : ndarray (P,)
+            Equilibrium distance of each candidate (µm; used for bonds only).
+        """
         g = self.rep
         perm = state == 2
         self.perm = perm
@@ -75,7 +107,26 @@ class PairConstants:
 
 
 def geometry(C, x, y, shift_p):
-    """Minimum-image pair vectors ``D = x_j − x_i`` (2, P), distances, unit normals, image counts."""
+    """Minimum-image pair vectors ``D = x_j − x_i``, distances and image counts of the candidates.
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (sphere rows ``ai``, ``aj`` and box of each).
+    x, y : ndarray (B·N,)
+        Sphere positions (µm).
+    shift_p : ndarray (P,) or float
+        Lees-Edwards offset ``Ly·γ`` of each candidate's replica (µm).
+
+    Returns
+    -------
+    dx, dy : ndarray (P,)
+        Minimum-image separation (µm).
+    d : ndarray (P,)
+        Centre distance (µm).
+    ky, kx : ndarray (P,)
+        Numbers of y and x periods removed (see :func:`~particleShear.engine.box.min_image`).
+    """
     ai, aj = C.ai, C.aj
     dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, shift_p)
     d = np.sqrt(dx * dx + dy * dy)
@@ -83,7 +134,27 @@ def geometry(C, x, y, shift_p):
 
 
 def normals(dx, dy, d, rep, rng):
-    """Unit normals ``n = D/d``; at ``d = 0`` a random direction from the replica's own generator."""
+    """Unit normals ``n = D/d``; at ``d = 0`` a random direction from the replica's own generator.
+
+    Drawing from the generator of the pair's own replica keeps a replica's trajectory
+    independent of its batch (one seed per replica).
+
+    Parameters
+    ----------
+    dx, dy : ndarray (P,)
+        Pair vectors (µm).
+    d : ndarray (P,)
+        Their lengths (µm, ≥ 0).
+    rep : ndarray of int (P,)
+        Replica of each pair (index into ``rng``).
+    rng : sequence of numpy.random.Generator
+        One generator per replica; one uniform number is drawn per pair at ``d = 0``.
+
+    Returns
+    -------
+    nx, ny : ndarray (P,)
+        Components of the unit normal from i towards j.
+    """
     zero = d == 0
     if not zero.any():
         return dx / d, dy / d
@@ -102,6 +173,24 @@ def central_term(C, d, vn, active):
     Transient contacts: ``law(d, r_i + r_j, k, c)`` (0 beyond contact) and ``ν·v_n``; bonds:
     ``k (d − d_eq)`` when stretched, the compressive law below, both × ``permanent_ratio_central``,
     viscous × the ratio unless viscosities are kept constant.  Inactive candidates give 0.
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates, with the constants of :meth:`PairConstants.set_bonds`.
+    d : ndarray (P,)
+        Centre distances (µm).
+    vn : ndarray (P,)
+        Normal relative velocity ``(v_j − v_i)·n_ij`` (µm/s; positive when separating).
+    active : ndarray of bool (P,)
+        Relations (touching, or a bond); only they get the viscous term.
+
+    Returns
+    -------
+    f : ndarray (P,)
+        Central scalar force on i along ``n_ij`` (mg·µm·s⁻² per m depth; negative repels).
+    law : ndarray (P,)
+        The elastic law before the permanent ratio (same unit), the base of the Coulomb bound.
     """
     inside = C.a_lin * (C.d_law - d) + C.a_div * (C.d_law / np.maximum(d, C.d_cap) - 1)
     law = np.where(d > C.d_law, (d - C.d_eq) * C.k_tens, inside)   # contacts beyond d0: (d − 0)·0 = 0
@@ -111,10 +200,31 @@ def central_term(C, d, vn, active):
 
 
 def tangential_term(C, vt, touching, xi, law):
-    """Two-visit tangential rule (reference §2.6-2.7): forces of both visits and the final slip flag.
+    """Two-visit tangential rule (docs/design.md): forces of both visits and the final slip flag.
 
     Bonds have no Coulomb bound; a transient contact is bounded by ``|μ·law|``.  Updates ``xi``
     in place (reset on slip); inactive candidates (ξ = 0, no viscous part, bound 0) get ±0.
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (``k_t``, ``nu_t``, ``mu`` and the bonds' infinite bound).
+    vt : ndarray (P,)
+        Tangential slip velocity along ``t_ij`` seen from i (µm/s).
+    touching : ndarray (P,) of float
+        1 where the pair overlaps (``d < r_i + r_j``), else 0.
+    xi : ndarray (2, P)
+        Histories ξ_ij, ξ_ji (µm), updated in place.
+    law : ndarray (P,)
+        Unscaled elastic central law of each pair (mg·µm·s⁻² per m depth), from :func:`central_term`.
+
+    Returns
+    -------
+    F : ndarray (2, P)
+        Tangential forces of the two visits (mg·µm·s⁻² per m depth), see
+        :func:`~particleShear.engine.tangential.tangential_two_pass`.
+    slip : ndarray of bool (P,)
+        The final slip flag.
     """
     fc = np.abs(C.mu * law)
     fc += C.fc_inf
@@ -127,6 +237,23 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     One ``bincount`` over ``(ai, aj)`` of each component (offset by ``k·n_spheres``): each sphere's
     sum runs over its own replica's pairs in list order, whatever else the batch holds.  Returns
     the (3, n_spheres) block (F_x, F_y, torque).
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (``scatter_idx`` built from ``ai``, ``aj``).
+    n_spheres : int
+        Number of sphere rows, B·N.
+    fx_i, fy_i : ndarray (P,)
+        Pair force on sphere i (mg·µm·s⁻² per m depth); j receives its negative.
+    tq_i, tq_j : ndarray (P,)
+        Torques on i and on j (mg·µm²·s⁻² per m depth): ``d·F_T`` split in proportion to the
+        radii (eq. S1-3).
+
+    Returns
+    -------
+    ndarray (3, n_spheres)
+        Per-sphere totals F_x, F_y (mg·µm·s⁻² per m depth) and torque (mg·µm²·s⁻² per m depth).
     """
     w = np.concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
     return np.bincount(C.scatter_idx, w, 3 * n_spheres).reshape(3, n_spheres)
@@ -142,6 +269,34 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     otherwise each mobile sphere receives an external entry.  ``yc`` is ``y − Ly/2`` per sphere,
     ``flags`` = (mobile i, mobile j, not both mobile) per candidate.  Sums per replica over its
     own pairs in list order (``bincount`` over the replica index).
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates.
+    B : int
+        Number of replicas.
+    yc : ndarray (B·N,)
+        Height of each sphere above its cell's centre line, ``y − Ly/2`` (µm).
+    flags : tuple of three ndarray of bool (P,)
+        (i mobile, j mobile, not both mobile) of each candidate.
+    active : ndarray of bool (P,)
+        Relations (touching, or a bond): only they carry forces.
+    shifted : ndarray of bool (P,)
+        The minimum image removed a period (the pair acts through the boundary).
+    dy : ndarray (P,)
+        y component of the minimum-image pair vector ``D`` (µm).
+    fx_i : ndarray (P,)
+        x component of the pair force on i (mg·µm·s⁻² per m depth).
+    dF : ndarray (P,)
+        ``d·F_T``, the internal torque of each pair (mg·µm²·s⁻² per m depth).
+    V : ndarray (B,)
+        Cell area of each replica, ``Lx·Ly·1e-12`` (m², i.e. m³ per m depth).
+
+    Returns
+    -------
+    tau_internal, tau_surface : ndarray (B,)
+        Shear stresses ``−σ_xy`` of the overall and of the external-force tensor (Pa, eq. S1-25).
     """
     mi, mj, not_both = flags
     ext = not_both | shifted

@@ -8,6 +8,8 @@ strain), and the list is rebuilt when the bound reaches the skin.  The contacts 
 are therefore exactly those of an all-pairs search (tested), and a replica's list depends only
 on its own history.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 from .box import min_image
@@ -19,7 +21,22 @@ _TRIU = {}
 
 
 def all_pairs(N):
-    """``(i, j)`` of every pair ``i < j`` of N spheres, in canonical order (kept per N)."""
+    """``(i, j)`` of every pair ``i < j`` of N spheres, in canonical order (kept per N).
+
+    The all-pairs search that :func:`build_candidates` filters; cached for the last few N
+    so a rebuild does not allocate the index arrays again.
+
+    Parameters
+    ----------
+    N : int
+        Number of spheres of one replica (≥ 0).
+
+    Returns
+    -------
+    i, j : ndarray of int (N·(N−1)/2,)
+        Local sphere indices of every pair, sorted by ``(i, j)`` (shared cached arrays: do
+        not modify).
+    """
     ij = _TRIU.get(N)
     if ij is None:
         if len(_TRIU) > 16:
@@ -45,6 +62,8 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     Returns
     -------
     ReplicaPairs
+        The candidates in canonical ``(i, j)`` order; a pair of ``old`` that is still a
+        candidate keeps its state, ξ, ``d_eq`` and relation, a new one starts at rest.
     """
     N = len(x)
     i, j = all_pairs(N)
@@ -87,5 +106,19 @@ def verlet_bound(u_max, strain, r_max):
     touches now (``|Δ| < r_i + r_j ≤ 2 r_max``) was at most
     ``2 u_max (1 + 2·strain) + 2·strain·r_max`` farther apart at the build.  The list is valid
     while this stays below the skin.
+
+    Parameters
+    ----------
+    u_max : ndarray (B,) or float
+        Largest peculiar displacement of any sphere of each replica since its build (µm).
+    strain : ndarray (B,) or float
+        Accumulated ``Σ |γ̇| dt`` of each replica since its build (dimensionless).
+    r_max : ndarray (B,) or float
+        Largest radius of each replica (µm).
+
+    Returns
+    -------
+    ndarray (B,) or float
+        The bound (µm); the list is rebuilt when it reaches the skin.
     """
     return 2 * u_max * (1 + 2 * strain) + 2 * strain * r_max

@@ -7,6 +7,8 @@ or pairs where a kernel needs them.  Pairs are kept per replica (:class:`Replica
 
 Units: µm, s, mg per m depth (reference units, docs/parameters.md).
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 __all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM"]
@@ -23,6 +25,20 @@ class ReplicaPairs:
 
     ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds)
     and ``active`` (a relation of the reference: touching at the last neighbour update, or a bond).
+    The arguments are converted (not validated) to the dtypes below.
+
+    Parameters
+    ----------
+    i, j : array_like of int (C,)
+        Local sphere indices (0 … N−1) of each candidate, ``i < j``, sorted by ``(i, j)``.
+    state : array_like of int (C,)
+        :data:`STICK`, :data:`SLIP` or :data:`PERMANENT` per candidate.
+    xi : array_like (2, C) or (2·C,)
+        Tangential displacement histories ξ_ij (row 0) and ξ_ji (row 1), µm.
+    d_eq : array_like (C,)
+        Equilibrium distance of each bond (µm; unused for transient contacts).
+    active : array_like of bool (C,)
+        The candidate is a relation (touching at the last update, or a bond).
     """
     __slots__ = ("i", "j", "state", "xi", "d_eq", "active")
 
@@ -55,6 +71,13 @@ class BatchState:
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
+
+    Parameters
+    ----------
+    B : int
+        Number of replicas (≥ 0).
+    N : int
+        Spheres per replica (≥ 0).  Every array starts at zero; :meth:`from_ensembles` fills them.
     """
 
     def __init__(self, B, N):
@@ -80,6 +103,21 @@ class BatchState:
     @classmethod
     def from_ensembles(cls, ensembles):
         """Copy B ensembles of equal N (after constitution) into one batch state.
+
+        The ensembles are not modified; each replica keeps a reference to its ensemble's
+        random generator, so the random normals of ``d = 0`` continue its stream.
+
+        Parameters
+        ----------
+        ensembles : sequence of ensemble
+            Constituted ensembles (``particleShear.objects`` or ``particleShear.linkable``
+            ensembles), all with the same number of spheres.
+
+        Returns
+        -------
+        BatchState
+            Replica b holds ``ensembles[b]``: spheres, box, strain, rate, clock, constants and
+            the relations and bonds of its pair table.
 
         Raises
         ------
@@ -120,7 +158,24 @@ class BatchState:
 
     @classmethod
     def concat(cls, states):
-        """One state holding the replicas of ``states`` in order (equal N)."""
+        """One state holding the replicas of ``states`` in order (equal N).
+
+        Parameters
+        ----------
+        states : sequence of BatchState
+            States with the same N; their arrays are copied, their pair lists and generators
+            shared.
+
+        Returns
+        -------
+        BatchState
+            ``sum(st.B)`` replicas; plates active only if they are in every state.
+
+        Raises
+        ------
+        ValueError
+            If the states differ in N.
+        """
         Ns = {st.N for st in states}
         if len(Ns) != 1:
             raise ValueError(f"states have N = {sorted(Ns)}: a batch needs one N")
@@ -134,5 +189,16 @@ class BatchState:
         return out
 
     def replica(self, b):
-        """Row slice of replica ``b`` in the per-sphere arrays."""
+        """Row slice of replica ``b`` in the per-sphere arrays.
+
+        Parameters
+        ----------
+        b : int
+            Replica index (0 … B−1; not checked).
+
+        Returns
+        -------
+        slice
+            Rows ``b·N … b·N + N − 1``.
+        """
         return slice(b * self.N, (b + 1) * self.N)

@@ -1,6 +1,6 @@
 """One step of a batch of replicas, top to bottom in the reference order, and the measurement.
 
-:meth:`BatchEngine.step` reads like the reference's step (reference §4.1, §8.3): shear rate →
+:meth:`BatchEngine.step` reads like the reference's step (docs/design.md, "One step"): shear rate →
 neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
 :func:`pre_equilibrate` (plates fixed: coarse levels from ``dt_max``, then 2N and N steps at
 ``dt``) and :func:`protocol` (recording t, γ, γ̇, τ_internal and τ_surface of every replica and
@@ -8,7 +8,12 @@ step) are the measurement of the oscillatory experiment on a batch.
 
 The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
 place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
+
+Shapes: B replicas, B·N sphere rows, P candidate pairs; units µm, s, mg per m depth, stresses
+in Pa (docs/parameters.md, docs/output.md).
 """
+__docformat__ = "numpy"
+
 import math
 
 import numpy as np
@@ -23,7 +28,21 @@ __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "p
 
 
 class EngineInstability(RuntimeError):
-    """A replica's state became non-finite (``replica``, ``step``, ``phase`` say where)."""
+    """A replica's state became non-finite or unstable (``replica``, ``step``, ``phase`` say where).
+
+    Raised by the stability guard of :class:`BatchEngine` (see its ``guard``).
+
+    Parameters
+    ----------
+    message : str
+        What happened, for people.
+    replica : int, optional
+        Index of the replica in its batch (0 … B−1).
+    step : int, optional
+        Step count within the phase when the guard fired.
+    phase : str, optional
+        ``"pre-equilibration"`` or ``"protocol"``.
+    """
 
     def __init__(self, message, replica=None, step=None, phase=None):
         RuntimeError.__init__(self, message)
@@ -38,6 +57,7 @@ class BatchEngine:
     Parameters
     ----------
     state : BatchState
+        The batch to advance (modified in place).
     skin_factor : float
         Verlet skin in units of each replica's largest radius (> 0).
     check_interval : int
@@ -47,6 +67,11 @@ class BatchEngine:
         :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
         energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
         contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
+
+    Raises
+    ------
+    ValueError
+        If ``skin_factor`` is not > 0.
     """
 
     def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True):
@@ -143,14 +168,31 @@ class BatchEngine:
             self._sync_down()
 
     def pairs_of(self, b):
-        """Current candidate list of replica ``b`` (a copy, with the flat history written in)."""
+        """Current candidate list of replica ``b`` (a copy, with the flat history written in).
+
+        Parameters
+        ----------
+        b : int
+            Replica index (0 … B−1).
+
+        Returns
+        -------
+        ReplicaPairs
+            The candidates of replica b with their current state, ξ, ``d_eq`` and relations.
+        """
         if self.C is not None:
             self._sync_down()
         p = self.s.pairs[b]
         return ReplicaPairs(p.i, p.j, p.state, p.xi, p.d_eq, p.active)
 
     def mobile(self):
-        """Mobility mask: with the plates on, spheres overlapping ``y = 0`` or ``y = Ly`` are immobile."""
+        """Mobility mask: with the plates on, spheres overlapping ``y = 0`` or ``y = Ly`` are immobile.
+
+        Returns
+        -------
+        ndarray of bool (B·N,)
+            True for the spheres that move freely.
+        """
         s = self.s
         if not s.applying_shear:
             return np.ones(len(s.y), bool)
@@ -158,7 +200,16 @@ class BatchEngine:
 
     # -- the step --------------------------------------------------------------------------------
     def set_rate(self, rate):
-        """Change γ̇ per replica; each sphere keeps its velocity relative to the local flow (§4.5)."""
+        """Change γ̇ per replica; each sphere keeps its velocity relative to the local flow.
+
+        ``vx += (y − Ly/2)·Δγ̇`` and ``ω −= Δγ̇/2`` (the flow's rotation rate), so a change of
+        rate gives no velocity shock (docs/design.md).
+
+        Parameters
+        ----------
+        rate : array_like (B,)
+            New shear rate γ̇ of each replica (1/s).
+        """
         s = self.s
         delta = rate - s.rate
         d_s = delta[s.rep]
@@ -169,7 +220,34 @@ class BatchEngine:
     def step(self, cool, dt, sample=False):
         """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when
         ``sample``, and also every tensor of :data:`~particleShear.engine.stress.TENSORS` as a
-        (B, 9, 2, 2) array when ``sample == "tensors"``."""
+        (B, 9, 2, 2) array when ``sample == "tensors"``.
+
+        Parameters
+        ----------
+        cool : float
+            Damping factor of this step, applied to the velocity relative to the flow and to ω
+            (1 = no damping).
+        dt : float
+            Time step (s), shared by the replicas.
+        sample : bool or str
+            False: no stresses; True: the two shear stresses; ``"tensors"``: also every tensor.
+
+        Returns
+        -------
+        None or tuple
+            None unless ``sample``; else ``(tau_internal, tau_surface)`` (ndarray (B,), Pa) and,
+            for ``"tensors"``, a third item, the (B, 9, 2, 2) tensors (Pa), all evaluated from
+            the forces of the positions at the start of the step.
+
+        Raises
+        ------
+        EngineInstability
+            If the stability guard finds a guarded replica unstable (checked every
+            ``check_interval`` steps).
+        RuntimeError
+            If the Lees-Edwards geometry needs more than
+            :data:`~particleShear.engine.box.MAX_PASSES` periods (a non-finite state).
+        """
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         # neighbours (positions at the start of the step)
@@ -298,7 +376,25 @@ class BatchEngine:
 
 
 def pre_equilibration_blocks(N, dt, dt_max):
-    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``."""
+    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``.
+
+    Each level runs ``int(N/2)`` steps; its damping factor starts at 0.5 and moves halfway
+    to 1 at every halving.
+
+    Parameters
+    ----------
+    N : int
+        Steps per level scale of the pre-equilibration (the reference's ``N``).
+    dt : float
+        Final time step (s, > 0); levels stop once halving reaches it.
+    dt_max : float
+        Largest time step (s), the first level.
+
+    Returns
+    -------
+    list of tuple
+        ``(steps, level_dt, cool)`` per level; empty when ``dt_max ≤ dt``.
+    """
     blocks = []
     level_dt, cf = dt_max, 0.5
     while level_dt > dt:
@@ -313,11 +409,31 @@ def _quiet(*args):
 
 
 def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
-    """Relax with the plates fixed (reference §8.4): coarse levels from ``dt_max``, 2N steps at
-    ``dt`` (damping 0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment.
+    """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at ``dt`` (damping
+    0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment (docs/design.md).
 
-    ``say(message)`` receives the reference's console messages, ``report(step, total)`` is
-    called after every step (progress)."""
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine of the batch; its state is relaxed in place (plates on, step count reset).
+    N : int
+        Steps per level scale (the reference's pre-equilibration ``N``).
+    dt : float
+        Final time step (s).
+    dt_max : float
+        Time step of the first coarse level (s), see :func:`pre_equilibration_blocks`.
+    cool : float
+        Damping factor per step of the last N steps.
+    say : callable
+        ``say(message)`` receives the reference's console messages.
+    report : callable
+        ``report(step, total)`` is called after every step (progress).
+
+    Raises
+    ------
+    EngineInstability
+        If a guarded replica becomes unstable.
+    """
     s = engine.s
     s.applying_shear = True
     engine.phase = "pre-equilibration"
@@ -347,11 +463,15 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
 
 
 def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet):
-    """The oscillatory protocol of every replica (reference §8.2-8.3), clock reset to 0.
+    """The oscillatory protocol of every replica, clock reset to 0 (docs/design.md).
+
+    Every step first sets γ̇ = ``A·2πf·cos(2π(f t − pre))`` during the shear periods (0 in the
+    baselines), so the strain follows ``A·sin(2π(f t − pre))``, then records and steps.
 
     Parameters
     ----------
     engine : BatchEngine
+        The engine of the batch, after :func:`pre_equilibrate`; advanced in place.
     dt : float
         Time step (s), shared by the replicas.
     f : float
@@ -362,7 +482,6 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
         Damping factor per step.
     pre, periods, post : float
         Baseline periods before, shear periods, baseline periods after.
-
     keep_tensors : bool
         Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
     say, report : callable
@@ -373,6 +492,12 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
     dict of ndarray (n_steps, B)
         "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step, and
         "first_tensors", "last_tensors" (B, 9, 2, 2): every tensor at the first and last step.
+        Times in s, strain dimensionless, strain rate in 1/s, stresses and tensors in Pa.
+
+    Raises
+    ------
+    EngineInstability
+        If a guarded replica becomes unstable.
     """
     s = engine.s
     s.applying_shear = True

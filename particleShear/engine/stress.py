@@ -7,6 +7,8 @@ tensors do not depend on its batch.  Units as in the reference: forces ×1e-12 (
 lengths ×1e-6 (m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from
 the cell centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
 """
+__docformat__ = "numpy"
+
 import collections
 
 import numpy as np
@@ -23,17 +25,57 @@ class StressInputs:
     omega, m, inertia`` sphere state, ``Lx, Ly, rate, V`` per replica, ``mob`` mobility mask,
     ``active``/``shifted`` per candidate, ``dx, dy`` minimum-image pair vectors, ``fx_i, fy_i``
     pair force on i, ``dF`` = d·F_T (internal torque of a pair), ``fx, fy, torque`` sphere totals.
+    The arrays are kept as given (views of the step's arrays); nothing is checked or copied.
+
+    Parameters
+    ----------
+    **arrays
+        The inputs by name, stored as attributes: ``C`` (:class:`~particleShear.engine.forces.PairConstants`),
+        ``B`` (int, replicas), ``rep`` (B·N,) replica of each sphere; per sphere (B·N,): ``x, y``
+        (µm), ``vx, vy`` (µm/s), ``omega`` (rad/s), ``m`` (mg per m depth), ``inertia``
+        (mg·µm² per m depth), ``mob`` (bool), ``fx, fy`` (mg·µm·s⁻² per m depth) and ``torque``
+        (mg·µm²·s⁻² per m depth); per replica (B,): ``Lx, Ly`` (µm), ``rate`` (1/s), ``V``
+        (m², ``Lx·Ly·1e-12``); per candidate (P,): ``active``, ``shifted`` (bool), ``dx, dy``
+        (µm), ``fx_i, fy_i`` (mg·µm·s⁻² per m depth) and ``dF`` (mg·µm²·s⁻² per m depth).
     """
 
     def __init__(self, **arrays):
         self.__dict__.update(arrays)
 
     def per_replica(self, weights, by_pair=True):
-        """Σ of ``weights`` per replica (pairs or spheres), in row order."""
+        """Σ of ``weights`` per replica (pairs or spheres), in row order.
+
+        Parameters
+        ----------
+        weights : ndarray (P,) or (B·N,)
+            One value per candidate pair (``by_pair``) or per sphere.
+        by_pair : bool
+            True: sum over each replica's candidates (``C.rep``); False: over its spheres.
+
+        Returns
+        -------
+        ndarray (B,)
+            The sums, in the unit of ``weights``.
+        """
         return np.bincount(self.C.rep if by_pair else self.rep, weights, self.B)
 
     def outer(self, u, w, by_pair=True):
-        """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows)."""
+        """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows).
+
+        Parameters
+        ----------
+        u : tuple of two ndarray
+            x and y components of the first factor (force components; per pair or per sphere).
+        w : tuple of two ndarray
+            x and y components of the second factor (lever arms), same length as ``u``.
+        by_pair : bool
+            True: the rows are candidate pairs; False: spheres.
+
+        Returns
+        -------
+        ndarray (B, 2, 2)
+            ``out[b, a, c] = Σ_rows of b  u_a · w_c`` (unscaled).
+        """
         out = np.empty((self.B, 2, 2))
         for a in range(2):
             for c in range(2):
@@ -48,14 +90,36 @@ class StressInputs:
 
 
 def love_weber(q):
-    """σ_LW = (1/V) Σ_internal F_i ⊗ (x_i − x_j) (eq. S1-19); ``x_i − x_j = −D`` for an unshifted pair."""
+    """σ_LW = (1/V) Σ_internal F_i ⊗ (x_i − x_j) (eq. S1-19); ``x_i − x_j = −D`` for an unshifted pair.
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     w = q.internal
     return q.outer((q.fx_i * w, q.fy_i * w), (-q.dx, -q.dy)) * (1e-18 / q.V)[:, None, None]
 
 
 def external_forces(q):
     """σ_ext = −(1/V) Σ_external F ⊗ (x_target − c) (eq. S1-16): a mobile sphere of a pair through
-    the boundary or with an immobile partner receives the pair force at its own centre."""
+    the boundary or with an immobile partner receives the pair force at its own centre.
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     C = q.C
     ext = q.active & ~q.internal
     ei, ej = ext & q.mob[C.ai], ext & q.mob[C.aj]
@@ -66,36 +130,102 @@ def external_forces(q):
 
 
 def unbalanced_forces(q):
-    """σ_unb = (1/V) Σ_mobile F_total ⊗ (x − c) (eq. S1-17)."""
+    """σ_unb = (1/V) Σ_mobile F_total ⊗ (x − c) (eq. S1-17).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     w = q.mob
     cx, cy = (q.Lx / 2)[q.rep], (q.Ly / 2)[q.rep]
     return q.outer((q.fx * w, q.fy * w), (q.x - cx, q.y - cy), by_pair=False) * (1e-18 / q.V)[:, None, None]
 
 
 def linear_acceleration(q):
-    """σ_linacc = σ_unb (m·a = F_total; gravity neglected, eq. S1-17)."""
+    """σ_linacc = σ_unb (m·a = F_total; gravity neglected, eq. S1-17).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     return unbalanced_forces(q)
 
 
 def unbalanced_torque(q):
-    """σ_T = (1/V) Σ_all spheres T·[[0, −½], [½, 0]] (eq. S1-22; immobile spheres included, reference quirk)."""
+    """σ_T = (1/V) Σ_all spheres T·[[0, −½], [½, 0]] (eq. S1-22; immobile spheres included, reference quirk).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     return q.per_replica(q.torque, by_pair=False)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
 
 
 def internal_torque(q):
-    """σ_Tint = (1/V) Σ_internal d·F_T·[[0, −½], [½, 0]] (eq. S1-22): the pair's two torques sum to d·F_T."""
+    """σ_Tint = (1/V) Σ_internal d·F_T·[[0, −½], [½, 0]] (eq. S1-22): the pair's two torques sum to d·F_T.
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     return q.per_replica(q.dF * q.internal)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
 
 
 def spin_kinetic_energy(q):
-    """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21)."""
+    """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     k = q.per_replica(q.inertia * q.omega * q.omega * q.mob, by_pair=False) * 1e-18 / 2
     return -(k / q.V)[:, None, None] * np.eye(2)
 
 
 def peculiar_acceleration_otsuki(q):
     """σ_ot = −(1/V) Σ_mobile P ⊗ P / m with P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa; for
-    comparison only)."""
+    comparison only).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * (q.y - (q.Ly / 2)[q.rep]))
     py = q.m * 1e-12 * q.vy
     w = q.mob / (q.m * 1e-6)
@@ -103,7 +233,18 @@ def peculiar_acceleration_otsuki(q):
 
 
 def overall(q):
-    """σ = σ_LW + σ_Tint + σ_cen (eq. S1-24)."""
+    """σ = σ_LW + σ_Tint + σ_cen (eq. S1-24).
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 2, 2)
+        The tensor of each replica (Pa; ``[b, force component, position component]``).
+    """
     return love_weber(q) + internal_torque(q) + spin_kinetic_energy(q)
 
 
@@ -125,5 +266,16 @@ TENSORS = (
 
 
 def evaluate_all(q):
-    """(B, 9, 2, 2) array of every tensor of :data:`TENSORS`, in registry order."""
+    """(B, 9, 2, 2) array of every tensor of :data:`TENSORS`, in registry order.
+
+    Parameters
+    ----------
+    q : StressInputs
+        The force phase of the batch.
+
+    Returns
+    -------
+    ndarray (B, 9, 2, 2)
+        ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
+    """
     return np.stack([t.function(q) for t in TENSORS], axis=1)

@@ -1,24 +1,50 @@
-"""Tangential two-visit rule over arrays (reference §2.6-2.8, Appendix B.3), written once.
+"""Tangential two-visit rule over arrays (docs/design.md, "One step"), written once.
 
 Used by the engine's step and by the documented canvas classes alike.  Forces in
 mg·µm·s⁻² per m depth, ξ in µm, velocities in µm/s.
 """
+__docformat__ = "numpy"
+
 import numpy as np
 
 __all__ = ["tangential_two_pass"]
 
 
 def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
-    """Two-visit tangential force of each pair (§2.6-2.8, B.3), transient contacts and bonds alike.
+    """Two-visit tangential force of each pair, transient contacts and bonds alike (docs/design.md).
 
-    ``vt`` is the slip velocity, ``xi`` the (2, P) array of ξ_ij, ξ_ji, ``kt_*``/``nut_*``
-    the effective constants of each visit, ``f_coulomb`` the Coulomb bound (``inf``
-    for permanent pairs, which never slip).  The viscous part acts only on touching
-    pairs.  Visit 1 (from i) sees ξ_ij; visit 2 (from j) sees ξ_ji, reset to 0 if
-    visit 1 slipped; a slip in either visit resets both histories.  Both visits are
-    evaluated as the two rows of one (2, P) array.  Updates ``xi`` in place and
-    returns ``(F, slip2)``: the scalar forces of the two visits (rows, both along
-    t_ij as seen from i) and the final slip flag.
+    The reference visits each pair twice per step, once from each sphere, and each visit
+    applies half of its force; this function evaluates both visits at once as the two rows of
+    one (2, P) array.  Each visit's force is ``k_t·ξ + ν_t·v_t``, clipped to ``f_coulomb``.
+    The viscous part acts only on touching pairs.  Visit 1 (from i) sees ξ_ij; visit 2
+    (from j) sees ξ_ji, reset to 0 if visit 1 slipped; a slip in either visit resets both
+    histories.  The torque split of the resulting force is eq. S1-3 (done by the caller).
+
+    Parameters
+    ----------
+    vt : ndarray (P,)
+        Tangential slip velocity of each pair along ``t_ij`` seen from i (µm/s).
+    touching : ndarray (P,) of float or bool
+        1 where the pair overlaps geometrically (``d < r_i + r_j``), else 0.
+    xi : ndarray (2, P)
+        Tangential displacement histories ξ_ij, ξ_ji (µm); reset to 0 in place on slip.
+    kt_i, kt_j : ndarray (P,) or float
+        Effective tangential spring constants of visits 1 and 2 (mg·s⁻² per m depth); pass
+        the same object twice when they are equal (one multiplication then).
+    nut_i, nut_j : ndarray (P,) or float
+        Effective tangential viscosities of visits 1 and 2 (mg·s⁻¹ per m depth); the same
+        object twice when equal.
+    f_coulomb : ndarray (P,) or float
+        Coulomb bound ``|μ·F_elastic|`` of each pair (mg·µm·s⁻² per m depth, ≥ 0; ``inf``
+        for permanent pairs, which never slip).
+
+    Returns
+    -------
+    F : ndarray (2, P)
+        Scalar tangential forces of the two visits (rows, both along ``t_ij`` as seen from i;
+        mg·µm·s⁻² per m depth).
+    slip2 : ndarray of bool (P,)
+        The final slip flag (visit 2 exceeded the bound).
     """
     # viscous part on touching pairs only: ×1 is exact; ×0 gives a zero whose sign may differ from
     # +0, which changes nothing downstream (added to k_t·ξ, and ξ is never −0)
