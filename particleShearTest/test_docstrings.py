@@ -413,8 +413,6 @@ class TestDocstrings(unittest.TestCase):
         hits = [h for name in ENGINE_MODULES for h in section_sign_lines(name)]
         self.assertEqual(hits, [], "\n".join(hits))
 
-    test_engine_modules_documented = unittest.expectedFailure(test_engine_modules_documented)
-    test_engine_modules_without_section_signs = unittest.expectedFailure(test_engine_modules_without_section_signs)
 
 
 def _make_tests(module_name):

@@ -47,6 +47,8 @@ def min_image(dx, dy, Lx, Ly, shift):
         Numbers of y and x periods removed (``ky`` gives the image velocity correction
         ``−Ly·γ̇·ky`` in µm/s).
 
+    Notes
+    -----
     At most :data:`MAX_PASSES` one-period passes, then the rest is folded in closed form, so
     the cost does not grow with the size of a separation.
     """
@@ -101,11 +103,8 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     bool
         True if any sphere was moved by a period.
 
-    Raises
-    ------
-    RuntimeError
-        If more than :data:`MAX_PASSES` periods would be needed on an axis (a non-finite or
-        absurd state).
+    At most :data:`MAX_PASSES` one-period passes per axis, then the rest is folded in closed
+    form (an infinite coordinate becomes NaN, which the stability guard reports).
     """
     moved = False
     for _ in range(MAX_PASSES):
@@ -117,10 +116,11 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
         x -= shift * up
         vx -= (Ly * rate) * up
     else:  # absurd coordinate: fold the rest at once (non-finite values become NaN for the guard)
-        up = np.floor(y / Ly)
-        y -= Ly * up
-        x -= shift * up
-        vx -= (Ly * rate) * up
+        with np.errstate(invalid="ignore"):
+            up = np.floor(y / Ly)
+            y -= Ly * up
+            x -= shift * up
+            vx -= (Ly * rate) * up
     for _ in range(MAX_PASSES):
         right = (x >= Lx).astype(float) - (x < 0)
         if not right.any():
@@ -128,7 +128,8 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
         moved = True
         x -= Lx * right
     else:
-        x -= Lx * np.floor(x / Lx)
+        with np.errstate(invalid="ignore"):  # inf - inf: NaN, reported by the guard
+            x -= Lx * np.floor(x / Lx)
     return moved
 
 

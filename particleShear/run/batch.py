@@ -19,6 +19,7 @@ N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — me
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
 """
+__docformat__ = "numpy"
 import logging
 import time
 
@@ -63,14 +64,26 @@ def _signature_defaults():
 
 
 def check_backend(backend):
-    """Raise ValueError unless ``backend`` is one of :data:`BACKENDS`."""
+    """Raise ValueError unless ``backend`` is one of :data:`BACKENDS`.
+
+    Parameters
+    ----------
+    backend : str
+        Name of the array library of a measurement.
+    """
     if backend not in BACKENDS:
         raise ValueError(f"backend={backend!r} is out of range: allowed {', '.join(map(repr, BACKENDS))} "
                          "(the CuPy backend needs the array-namespace engine, not in this version)")
 
 
 def check_batch_size(batch_size):
-    """Raise ValueError unless ``batch_size`` is None or an integer >= 1."""
+    """Raise ValueError unless ``batch_size`` is None or an integer >= 1.
+
+    Parameters
+    ----------
+    batch_size : int or None
+        Largest number of replicas per batch.
+    """
     if batch_size is None:
         return
     if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
@@ -86,6 +99,16 @@ def schedule_key(kwargs):
     runs with equal keys have the same ``dt``, damping factor and protocol steps.  Their
     pre-equilibration may differ (``dt_max`` depends on the links); the batch then
     pre-equilibrates each group of equal ``dt_max`` on its own and shears them together.
+
+    Parameters
+    ----------
+    kwargs : dict
+        Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` (missing
+        ones take their defaults).
+
+    Returns
+    -------
+    tuple
     """
     full = dict(_signature_defaults(), **kwargs)
     shared = tuple((name, repr(full[name])) for name in SCHEDULE_PARAMETERS)
@@ -186,6 +209,15 @@ def engine_supports(kw):
     the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
     qualify: their files are written as ``runSimulation`` writes them (console messages and
     progress callbacks work as in the documented classes).
+
+    Parameters
+    ----------
+    kw : dict
+        Every keyword of :func:`~particleShear.run.api.doParticleShearSimulation`.
+
+    Returns
+    -------
+    bool
     """
     from ..base.laws import elastic_force_law, elastic_force_law_tensile
     from ..base.points import CircleBasicElasticity
@@ -208,6 +240,15 @@ def measure_batch(runs):
     Returns the :class:`~particleShear.run.api.SimulationResult` of each run, in order.  An
     interrupt (``KeyboardInterrupt``) removes every reservation and is re-raised with
     ``position = (phase, step, total)``.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Complete, validated keyword dicts of the replicas (one schedule).
+
+    Returns
+    -------
+    list of SimulationResult
     """
     from ..simulation.provenance import run_identity
     from ..simulation.simulations import RunSession
