@@ -6,7 +6,7 @@ are those a user gets), run on a ``ProcessPoolExecutor`` (default 2 workers):
 1. **Time-step convergence** of G′, G″ (both estimators: ``G_internal`` from the overall stress
    tensor, ``G_surface`` from the external forces) and of the peak overlap
    ``max(1 − d/(r_i + r_j))`` over transient contacts during the protocol, for
-   ``time_step_factor`` = 8 … 1/8 (dt of the measurement relative to the §4.7 rule; one seed gives
+   ``time_step_factor`` = 8 … 1/8 (dt of the measurement relative to the reference time-step rule, docs/parameters.md; one seed gives
    the same initial packing for every factor), for the default crosslinked scene and for frictional
    spheres without links, with both integrators ("euler" = reference, "verlet").  Error against the
    finest run and against a Richardson extrapolation; observed order of convergence.  A coarse

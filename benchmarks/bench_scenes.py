@@ -1,13 +1,13 @@
 """What leaving out unneeded work buys: per-step cost and memory by scene and recording (not a test).
 
-Scenes (builder of §6.4, N = 150, 500 × 500 µm, packing fraction 1.5, E = 8000 Pa, the
+Scenes (the default builder EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters, N = 150, 500 × 500 µm, packing fraction 1.5, E = 8000 Pa, the
 ``doParticleShearSimulation`` defaults otherwise, seed 1, plates on, sinusoidal shear A = 0.2):
 
 * frictionless spheres: μ = 0, no permanent links (no tangential term at all);
 * frictional spheres: μ = 0.01, no links;
 * crosslinked particles: μ = 0.01, links, 5 cut lines (the default scene);
 
-each run twice through the experiment's protocol loop (§8.3): recording nothing but the
+each run twice through the experiment's protocol loop (OscillatoryShearExperiment.run_protocol): recording nothing but the
 scalar series (``keep_tensor_history=False``: only σ_xy of the overall tensor and the surface
 stress are evaluated per step) and keeping every tensor of every step (``True``, what
 ``saveData`` with ``saveStressTensorData`` needs).

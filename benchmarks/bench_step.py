@@ -2,7 +2,7 @@
 
 One protocol step = setShearRate + forces (neighbour update, central, tangential,
 links) + register totals + every stress tensor + acceleration (kick, damping)
-+ movement (ξ, drift, strain, wrap) + reset — the per-step sequence of §8.3.
++ movement (ξ, drift, strain, wrap) + reset — the per-step sequence of the protocol (docs/design.md).
 
 Scenes: EnsembleLinkable with random bimodal spheres (radius ratio 1.4) at packing
 fraction 1.5 in a cell that grows with N (the sphere size of the default 150-sphere
@@ -14,7 +14,7 @@ The N = 150 step is also timed on the scene a default run measures (the builder'
 particles after pre-equilibration), which is calmer than the relaxed-random scene above.
 
 Baselines measured in the same run: the legacy O(N²) pure-Python neighbour test of
-the reference (§4.2, all ordered pairs, one relation search each) at N = 150, a
+the reference (all ordered pairs, one relation search each) at N = 150, a
 plain all-pairs NumPy minimum-image distance computation per step at N = 150 and 1,000,
 and the same protocol step on a 40-sphere scene (the fixed cost of the ~145 NumPy calls
 and the Python around them, which no vectorisation removes).
@@ -139,7 +139,7 @@ def documented_vs_protocol(n_blocks, block=50):
 
 
 def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
-    """The reference's O(N²) pure-Python neighbour update (§4.2): every ordered pair, LE minimum image,
+    """The reference's O(N²) pure-Python neighbour update: every ordered pair, LE minimum image,
     linear search of the relation list by index."""
     n = len(xs)
     for i in range(n):
@@ -147,7 +147,7 @@ def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
         for j in range(n):
             if i == j:
                 continue
-            dx, dy = _le_closest(xs[j] - xs[i], ys[j] - ys[i], L, L, shear)  # scalar §3.1, as the reference
+            dx, dy = _le_closest(xs[j] - xs[i], ys[j] - ys[i], L, L, shear)  # scalar minimum image, as the reference
             touching = math.sqrt(dx * dx + dy * dy) < rs[i] + rs[j]
             found = -1
             for q, idx in enumerate(rel):
@@ -230,7 +230,7 @@ def main():
         b = median_us(bt)
         print(f"baseline NumPy all-pairs LE distances alone, N = {n:5d}: {b:10.1f} µs/step "
               f"→ ratio full step / baseline = {per[n] / b:.2f}")
-    # the same step on the scene a default run measures: builder of §6.4 (crosslinked particles, 5 cut
+    # the same step on the scene a default run measures: the default builder (crosslinked particles, 5 cut
     # lines), pre-equilibrated with plates; relaxed, so the Verlet list and the images rarely change
     from bench_scenes import build as build_default_scene
     _, real, _ = build_default_scene(150, 1, 0.01, True, 5)

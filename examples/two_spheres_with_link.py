@@ -1,6 +1,6 @@
 """A particleShear 1.0.2-style script: two bonded spheres, stress tensors step by step.
 
-Builds the scene sphere by sphere (spec §11.5: general collision with a permanent link), runs 50
+Builds the scene sphere by sphere (the manual's unit-test scene "general collision with a permanent link"), runs 50
 evaluated steps and prints the overall stress tensor, its symmetry error and the conserved
 momenta — the checks of the manual's Part 4, on the same API as the old package.
 

@@ -72,6 +72,7 @@ ENGINE_MODULES = [
     "particleShear.base.kernels",
     "particleShear.base.laws",
     "particleShear.base.memory",
+    "particleShear.base.namespace",
     "particleShear.base.neighbours",
     "particleShear.base.points",
     "particleShear.base.register",

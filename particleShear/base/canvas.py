@@ -24,8 +24,9 @@ import numpy as np
 
 from .fields import FIELDS, MASS_ROWS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import (_bincount, _concat, _copyto, _nz, _where, in_cell_passes, le_wrap, min_image, pair_geometry,
-                      tangential_two_pass)
+from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .namespace import (bincount as _bincount, concatenate as _concat, copyto as _copyto,
+                        count_nonzero as _nz, where as _where)
 from . import laws
 from .laws import call_law_vectorised
 from .memory import tune_allocator

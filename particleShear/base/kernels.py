@@ -8,19 +8,8 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-try:  # the C function behind np.count_nonzero, without its Python wrapper (a third of the call cost)
-    from numpy._core.multiarray import count_nonzero as _nz
-except ImportError:  # pragma: no cover - NumPy 1.x
-    _nz = np.count_nonzero
-# _nz(a): number of nonzero (True) entries; cheaper than ndarray.any() on small arrays
-
-try:  # the C functions behind np.dot, np.where, …, without their __array_function__ dispatch (~0.3 µs a call);
-    # the engine passes only ndarrays, for which dispatch changes nothing
-    from numpy._core import _multiarray_umath as _mu
-    _dot, _where, _copyto = _mu.dot, _mu.where, _mu.copyto
-    _bincount, _concat = _mu.bincount, _mu.concatenate
-except (ImportError, AttributeError):  # pragma: no cover - other NumPy layouts
-    _dot, _where, _copyto, _bincount, _concat = np.dot, np.where, np.copyto, np.bincount, np.concatenate
+# NumPy-only speed shims live in the namespace module (no private NumPy import here)
+from .namespace import count_nonzero as _nz, where as _where
 
 __all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass", "MAX_LOOP_PASSES"]
 

@@ -10,7 +10,8 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from .kernels import _nz, in_cell_passes, min_image
+from .kernels import in_cell_passes, min_image
+from .namespace import count_nonzero as _nz
 
 __all__ = ["PairTable", "STICK", "SLIP", "PERMANENT", "STATE_NAMES", "candidate_pairs", "all_pairs"]
 

@@ -11,7 +11,7 @@ from operator import attrgetter
 import numpy as np
 
 from .fields import MASS_ROWS
-from .kernels import _dot
+from .namespace import dot as _dot
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]

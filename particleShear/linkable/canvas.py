@@ -13,7 +13,8 @@ import math
 import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
-from ..base.kernels import _nz, _where, min_image
+from ..base.kernels import min_image
+from ..base.namespace import count_nonzero as _nz, where as _where
 from ..base.laws import call_law_vectorised, elastic_force_law, elastic_force_law_tensile
 from ..base.neighbours import PERMANENT, SLIP
 from ..base.points import CircleBasicElasticity
