@@ -132,6 +132,7 @@ class RunSession:
         sim = self.sim
         sim.write_error = None
         sim.theExperiment = None
+        self.t_start = time.perf_counter()  # the run's clock starts with its own constitution
         if sim.progress is not None:
             sim.progress("constitution", 0, 0, 0.0)
         sim.initEnsemble()
