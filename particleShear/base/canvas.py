@@ -763,13 +763,6 @@ class CanvasPointsMass(CanvasPoints):
                                         tot[2] if self._torque_total() is not None else None, tot)
 
     def particle_info(self):
-        """Short description of the ensemble for the output header.
-
-        Returns
-        -------
-        str
-            The description.
-        """
         return "Spheres with mass"
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):

@@ -643,19 +643,6 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
             self.permanent_ratio_tangential, self.keep_viscosity_coefficients_constant)
 
     def particle_info(self, reference=False):
-        """Description of the spheres for the header of the output file (radii in µm, masses in mg).
-
-        Parameters
-        ----------
-        reference : bool, optional
-            True: the text of particleShear 1.0.2 exactly (its typos and its radius ratio of
-            0.8/1.2 included); False: the corrected text with the actual radii and masses.
-
-        Returns
-        -------
-        str
-            The description.
-        """
         if reference:
             return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
                     "adjustment ofstrength between permament and temporary interfaces\n\t" + self._sphere_info(True))

@@ -303,12 +303,5 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
                                          self.size_y)
 
     def particle_info(self):
-        """Description of the spheres for the header of the output file (radii in µm).
-
-        Returns
-        -------
-        str
-            The text, with the small radius ``r1`` and the large radius ``r2``.
-        """
         return "Frictional spheres under Lees-Edwards boundary conditions\n\t" + \
             RandomBimodalSpheres.particle_info(self)
