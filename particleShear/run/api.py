@@ -295,8 +295,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     saveOutputImages : bool, default False
         Save about 200 captioned snapshots of the protocol into an image folder beside the
         output file (needs ``root_folder``; works with or without ``doDrawing``).
-    imageFileType : {"jpg", "png", "ps"}, default "jpg"
-        Snapshot format; "ps" is vector Encapsulated PostScript (extension .ps).
+    imageFileType : {"jpg", "png", "ps", "svg"}, default "jpg"
+        Snapshot format; "ps" is vector Encapsulated PostScript (extension .ps), "svg" vector SVG.
     remove_link_fraction : float, default 0
         Target fraction of non-essential permanent links removed at random; allowed 0 ... 1.
     edge_fuzziness : float, default 0
@@ -595,7 +595,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         As in :func:`doParticleShearSimulation` (defaults False, True, False).
     doCutByTriangulation, saveOutputImages, doDrawing, saveData, saveStressTensorData, plotStress : bool
         As in :func:`doParticleShearSimulation` (defaults True, False, True, False, True, True).
-    imageFileType : {"jpg", "png", "ps"}, default "jpg"
+    imageFileType : {"jpg", "png", "ps", "svg"}, default "jpg"
         Snapshot format (as in :func:`doParticleShearSimulation`).
     remove_link_fraction, edge_fuzziness, central_repulsion_coefficient : float
         As in :func:`doParticleShearSimulation` (defaults 0, 0, 1).

@@ -30,7 +30,7 @@ __all__ = ["validate_simulation_parameters", "validate_options", "validate_serie
            "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS", "MAX_SERIES_RUNS"]
 
 #: accepted ``imageFileType`` values (the reference silently wrote PostScript for anything else)
-IMAGE_FILE_TYPES = ("jpg", "png", "ps")
+IMAGE_FILE_TYPES = ("jpg", "png", "ps", "svg")
 #: accepted ``renderer`` values (None = "auto")
 RENDERERS = ("auto", "tk", "pillow", "none")
 #: accepted ``integrator`` values
