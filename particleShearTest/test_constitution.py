@@ -1,4 +1,4 @@
-"""Ensemble constitution: derived constants (spec A.2), builders (§6.4, §6.11), cutting and particles (§6.5-6.10)."""
+"""Ensemble constitution: derived constants (spec A.2), builders (docs/design.md, docs/design.md), cutting and particles (docs/design.md-6.10)."""
 import math
 import unittest
 from unittest import mock
@@ -101,7 +101,7 @@ class TestDerivedConstants(unittest.TestCase):
                     "distribution, equal probability, \n\tr1=" + str(ens.r_max * 0.8 / 1.2) + "r2="
                     + str(ens.r_max) + "\n\tidentical mass=" + str(ens.sphereList[0].m) + "mg")
         self.assertEqual(info, expected)
-        # the default text fixes §12 #23: the true small radius and both masses
+        # the default text fixes the reference defects listed in docs/output.md #23: the true small radius and both masses
         fixed = ens.particle_info()
         r1 = float(fixed.split("r1=")[1].split()[0])
         self.assertAlmostEqual(r1, ens.r_max / 1.4, delta=1e-12 * ens.r_max)
@@ -111,7 +111,7 @@ class TestDerivedConstants(unittest.TestCase):
     def test_debug_schedule_lengths(self):
         ens = relaxed(0)
         self.assertEqual(ens.n_constitution_steps, 150 + 100)  # (3·30 + 60) + (3·20 + 40)
-        # A = 0.001, irc = irt = 2 (prc = 0.5): dt = 0.00625, dt_max = 0.125 (units τ/bf), §6.4 with R = 10
+        # A = 0.001, irc = irt = 2 (prc = 0.5): dt = 0.00625, dt_max = 0.125 (units τ/bf), docs/design.md with R = 10
         low = Build(**dict(RUN, N=40, anticipated_amplitude=0.001, interface_reenforcement_central=2,
                            interface_reenforcement_tangential=2, do_debug=True, rng=0))
         pre = 3 * (5 * 10 + 2 * 10)            # free(10) at dt_max 0.2, its repeat, free(10) at dt_max 0.125
@@ -323,7 +323,7 @@ class TestParticles(unittest.TestCase):
         self.assertIs(ens.permanentConnectionBetweenSpheres(A, A), False)
         ens.identify_particles()
         self.assertEqual(ens.findParticle(D), [B, D])
-        # §12 #32 fixed: the physical restriction holds in every generation of the growth
+        # the reference defects listed in docs/output.md #32 fixed: the physical restriction holds in every generation of the growth
         ens.particles = []
         self.assertEqual(ens.addParticleFromSphere(A), [A, C])
         self.assertEqual(ens.addParticleFromSphere(A, False), [A, C, B, D])

@@ -344,6 +344,19 @@ def all_package_modules():
     return names
 
 
+
+class TestNoSectionSignInTheSuite(unittest.TestCase):
+    """The test suite ships with the package: its comments and docstrings cite no unpublished document either."""
+
+    def test_no_section_sign_in_test_files(self):
+        folder = os.path.dirname(os.path.abspath(__file__))
+        hits = []
+        for name in sorted(os.listdir(folder)):
+            if name.endswith(".py") and name != os.path.basename(__file__):
+                with open(os.path.join(folder, name), encoding="utf-8") as fh:
+                    hits += [f"{name}:{k}" for k, line in enumerate(fh, 1) if "\u00a7" in line]
+        self.assertEqual(hits, [])
+
 class TestCheckedModules(unittest.TestCase):
     """The lists above cover the whole package, so a new module cannot escape the checks."""
 

@@ -1,4 +1,4 @@
-"""Central force laws (spec §2.3, §2.5, §2.11, §2.12; reference numbers of Appendix A.1).
+"""Central force laws (docs/design.md, docs/design.md, docs/design.md, docs/design.md; reference numbers of Appendix A.1).
 
 Sign convention: negative = repulsion.  The reference numbers are compared to
 1e-12 relative (an exact 0 where the reference prints 0).
@@ -73,7 +73,7 @@ class TestAppendixA1(unittest.TestCase):
 
 
 class TestLawProperties(unittest.TestCase):
-    """Properties of §2.3 that hold for every d0, k and c in [0, 1]."""
+    """Properties of docs/design.md that hold for every d0, k and c in [0, 1]."""
 
     CS = (0.0, 0.1, 0.25, 0.5, 0.75, 1.0)
 
@@ -176,7 +176,7 @@ def _central_force_on_1(ens, s1):
 
 
 class TestCallbackMechanism(unittest.TestCase):
-    """§2.11: the class attribute is looked up at every call and used in all three places."""
+    """docs/design.md: the class attribute is looked up at every call and used in all three places."""
 
     def setUp(self):
         self._saved = CircleBasicElasticity.__dict__["call_back_elastic_force_law"]
@@ -224,7 +224,7 @@ class TestCallbackMechanism(unittest.TestCase):
         self.assertLessEqual(abs(f - ref), 1e-13 * abs(ref))
 
     def test_callback_sets_coulomb_bound(self):
-        """A fast tangential slip saturates at |μ·law(d, d0, k, c)| of the active callback (§2.6)."""
+        """A fast tangential slip saturates at |μ·law(d, d0, k, c)| of the active callback (docs/design.md)."""
         d, mu = 60.0, 0.3
         for law in (elastic_force_law, elastic_force_law_plateau):
             with self.subTest(law=law.__name__):

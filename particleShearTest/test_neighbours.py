@@ -1,7 +1,7 @@
-"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (§3.1, §4.2, B.4).
+"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, docs/design.md, B.4).
 
 The oracle here is written independently of the package: the minimum image of
-§3.1 (y image first, shifting x by Ly·γ; half-open intervals; one period
+docs/design.md (y image first, shifting x by Ly·γ; half-open intervals; one period
 subtracted at a time) over every pair, and the strict contact test
 ``d < r_i + r_j``.
 """

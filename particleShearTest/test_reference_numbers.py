@@ -121,7 +121,7 @@ class TestAppendixA4(_RefCase):
         for name, value in ref.items():
             self.assertRef(name, snap[name], value, scale)
 
-    # §11.3, tested evaluation = step 62 (index 61): 56 plain, 5 × (plain, evaluate), 1 evaluated
+    # manual Part 4 scenario 3 (frictionless central collision), tested evaluation = step 62 (index 61): 56 plain, 5 × (plain, evaluate), 1 evaluated
     def test_central_collision(self):
         ens = _ens()
         ens.nu = 0
@@ -146,7 +146,7 @@ class TestAppendixA4(_RefCase):
             "stress_tensor_linear_acceleration_otsuki": [[-9.935782610222843e-10, 8.582318066648385e-10],
                                                          [8.582318066648385e-10, -7.413224130058466e-10]]})
 
-    # §11.4, tested evaluation = step 50 (index 49), dt = 0.01
+    # manual Part 4 scenario 4 (purely tangential interaction), tested evaluation = step 50 (index 49), dt = 0.01
     def test_tangential(self):
         ens = _ens()
         s1 = _sph(ens, 150, 200, 1)
@@ -174,7 +174,7 @@ class TestAppendixA4(_RefCase):
                                                          [3.755210953000282e-11, -4.340087518605995e-11]],
             "stress_tensor_with_external_forces": _diag(0.0)})
 
-    # §11.5, tested evaluation = step 50 (index 49), dt = 0.01
+    # manual Part 4 scenario 5 (general collision with a permanent link), tested evaluation = step 50 (index 49), dt = 0.01
     def test_general(self):
         ens = _ens()
         s1 = _sph(ens, 150, 200, 1)
@@ -205,7 +205,7 @@ class TestAppendixA4(_RefCase):
             "stress_tensor_internal_torque": torque, "stress_tensor_unbalanced_torque": torque,
             "stress_tensor_with_external_forces": _diag(0.0)})
 
-    # §11.7, tested evaluation = step 50 (index 49), dt = 0.01
+    # manual Part 4 scenario 7 (interaction through the periodic boundary), tested evaluation = step 50 (index 49), dt = 0.01
     def test_across_periodic_boundary(self):
         ens = _ens(mu=0.5)
         s1 = _sph(ens, 20, 200, 1)
@@ -231,7 +231,7 @@ class TestAppendixA4(_RefCase):
             "stress_tensor_internal_torque": _diag(0.0),
             "stress_tensor_unbalanced_torque": _anti(3.222216340503384e-10)})
 
-    # §11.6, tested evaluation = step 70 (index 69), dt = 0.1
+    # manual Part 4 scenario 6 (sphere hitting a sphere glued to the boundary), tested evaluation = step 70 (index 69), dt = 0.1
     def test_boundary_sphere(self):
         ens = _ens(mu=0.5)
         s1 = _sph(ens, 150, 80, 1)

@@ -1,16 +1,16 @@
-"""The seven deterministic unit-test scenarios of the manual (spec §11.1–11.7).
+"""The seven deterministic unit-test scenarios of the manual (manual Part 4, scenarios 1–7).
 
 Assertions and tolerances are those of the manual: "exactly 0" is a
 floating-point equality, relative tolerances are 1e-15 (1e-13/1e-14 for the
 angular-momentum checks of the collisions).  Momenta are measured directly
 (Σ m v and Σ m (x v_y − y v_x) + Σ I ω about the cell corner) instead of through
-the reference's mean-velocity detour (§11 note).
+the reference's mean-velocity detour (manual Part 4 note).
 
 The manual also asserts that the Otsuki peculiar-acceleration tensor vanishes in
-§11.1 and §11.3; it does not (it is −Σ m v⊗v/V for moving spheres), which is why
+manual Part 4 scenario 1 (single sphere in linear motion) and manual Part 4 scenario 3 (frictionless central collision); it does not (it is −Σ m v⊗v/V for moving spheres), which is why
 the reference fails those two tests by design.  They are kept here as
 ``expectedFailure`` so that the suite reports them, and the actual value of the
-term is checked against its formula (§7.10) by ordinary tests.
+term is checked against its formula (docs/design.md) by ordinary tests.
 """
 import unittest
 
@@ -71,7 +71,7 @@ class _Checks(unittest.TestCase):
         self.assertTrue(np.all(np.asarray(tensor) == 0.0), f"{msg}: {tensor!r} is not exactly 0")
 
     def assertMomentumConserved(self, p_old, p_new):
-        """§11.3: if |new| > 1e-5 each component's change / |new| < 1e-15, else absolute change < 1e-15."""
+        """manual Part 4 scenario 3 (frictionless central collision): if |new| > 1e-5 each component's change / |new| < 1e-15, else absolute change < 1e-15."""
         norm = float(np.hypot(*p_new))
         for a in range(2):
             change = abs(p_new[a] - p_old[a])
@@ -86,7 +86,7 @@ class _Checks(unittest.TestCase):
 
 # ---------------------------------------------------------------------------------------------
 class TestSingleSphereLinearMotion(_Checks):
-    """§11.1: one sphere at (150, 200) moving with (0.7, 0.3) µm/s; no interaction at all."""
+    """manual Part 4 scenario 1 (single sphere in linear motion): one sphere at (150, 200) moving with (0.7, 0.3) µm/s; no interaction at all."""
 
     @classmethod
     def setUpClass(cls):
@@ -116,7 +116,7 @@ class TestSingleSphereLinearMotion(_Checks):
         self.assertExactlyZero(self.ev.stress_tensor_linear_acceleration_otsuki)
 
     def test_otsuki_value(self):
-        """What the term actually is (§7.10): −m v_a v_b·1e-18/V, e.g. −1.96e-12 Pa for xx."""
+        """What the term actually is (docs/design.md): −m v_a v_b·1e-18/V, e.g. −1.96e-12 Pa for xx."""
         v = np.array([0.7, 0.3])
         ref = -np.outer(v, v) * 1e-18 / V
         got = T(self.ev, "stress_tensor_linear_acceleration_otsuki")
@@ -136,7 +136,7 @@ class TestSingleSphereLinearMotion(_Checks):
 
 # ---------------------------------------------------------------------------------------------
 class TestSingleSpinningSphere(_Checks):
-    """§11.2: one sphere at rest at (150, 200) spinning with ω = 2.6 rad/s."""
+    """manual Part 4 scenario 2 (single spinning sphere): one sphere at rest at (150, 200) spinning with ω = 2.6 rad/s."""
 
     OMEGA = 2.6
 
@@ -202,7 +202,7 @@ class TestSingleSpinningSphere(_Checks):
 
 # ---------------------------------------------------------------------------------------------
 def _collision_setup():
-    """§11.3 scene: constants k=1, ν=1, k_t=1, ν_t=1, μ=0.01, then ν = k_t = ν_t = 0 (c = 0)."""
+    """manual Part 4 scenario 3 (frictionless central collision) scene: constants k=1, ν=1, k_t=1, ν_t=1, μ=0.01, then ν = k_t = ν_t = 0 (c = 0)."""
     ens = make_ensemble(k=1, nu=1, k_t=1, nu_t=1, mu=0.01)
     ens.nu = 0
     ens.k_t = 0
@@ -215,7 +215,7 @@ def _collision_setup():
 
 
 class TestFrictionlessCentralCollision(_Checks):
-    """§11.3: 56 plain steps, 5 × (plain step, evaluate), one evaluated step (the tested one), dt = 0.1."""
+    """manual Part 4 scenario 3 (frictionless central collision): 56 plain steps, 5 × (plain step, evaluate), one evaluated step (the tested one), dt = 0.1."""
 
     @classmethod
     def setUpClass(cls):
@@ -261,7 +261,7 @@ class TestFrictionlessCentralCollision(_Checks):
         self.assertExactlyZero(self.t["stress_tensor_linear_acceleration_otsuki"])
 
     def test_otsuki_value(self):
-        """−Σ m v⊗v·1e-18/V with the velocities at the start of the tested step (m = 1), §7.10."""
+        """−Σ m v⊗v·1e-18/V with the velocities at the start of the tested step (m = 1), docs/design.md."""
         got = self.t["stress_tensor_linear_acceleration_otsuki"]
         ref = -sum(np.outer(v, v) for v in self.v) * 1e-18 / V
         self.assertFalse(np.all(ref == 0))
@@ -302,7 +302,7 @@ class TestFrictionlessCentralCollision(_Checks):
 
 # ---------------------------------------------------------------------------------------------
 def _tangential_setup():
-    """§11.4: permanent link established before any step, then k = ν = 0 (pure tangential coupling)."""
+    """manual Part 4 scenario 4 (purely tangential interaction): permanent link established before any step, then k = ν = 0 (pure tangential coupling)."""
     ens = make_ensemble(k=1, nu=1, k_t=1, nu_t=1, mu=0.01)
     s1 = add_sphere(ens, 150, 200, 1)
     s2 = add_sphere(ens, 220, 260, 2)
@@ -314,7 +314,7 @@ def _tangential_setup():
 
 
 def _general_setup():
-    """§11.5: constants k=1, ν=1, k_t=1, ν_t=1, μ=0.01 unmodified; link before the first step."""
+    """manual Part 4 scenario 5 (general collision with a permanent link): constants k=1, ν=1, k_t=1, ν_t=1, μ=0.01 unmodified; link before the first step."""
     ens = make_ensemble(k=1, nu=1, k_t=1, nu_t=1, mu=0.01)
     s1 = add_sphere(ens, 150, 200, 1)
     s2 = add_sphere(ens, 220, 260, 2)
@@ -326,7 +326,7 @@ def _general_setup():
 
 
 class _LinkedPairChecks:
-    """Checks shared by §11.4 and §11.5 (momenta, unbalanced torque after 20 coarse steps)."""
+    """Checks shared by manual Part 4 scenario 4 (purely tangential interaction) and manual Part 4 scenario 5 (general collision with a permanent link) (momenta, unbalanced torque after 20 coarse steps)."""
 
     setup = None
     momentum_dt = 0.1
@@ -368,7 +368,7 @@ class _LinkedPairChecks:
 
 
 class TestPurelyTangentialInteraction(_LinkedPairChecks, _Checks):
-    """§11.4: 50 evaluated steps, dt = 0.01; checks at every step."""
+    """manual Part 4 scenario 4 (purely tangential interaction): 50 evaluated steps, dt = 0.01; checks at every step."""
 
     setup = staticmethod(_tangential_setup)
     momentum_dt = 0.1
@@ -437,7 +437,7 @@ class TestPurelyTangentialInteraction(_LinkedPairChecks, _Checks):
 
 
 class TestGeneralCollisionWithLink(_LinkedPairChecks, _Checks):
-    """§11.5: 50 evaluated steps, dt = 0.01; checks at the last (tested) step."""
+    """manual Part 4 scenario 5 (general collision with a permanent link): 50 evaluated steps, dt = 0.01; checks at the last (tested) step."""
 
     setup = staticmethod(_general_setup)
     momentum_dt = 0.01
@@ -478,7 +478,7 @@ class TestGeneralCollisionWithLink(_LinkedPairChecks, _Checks):
 
 # ---------------------------------------------------------------------------------------------
 class _ExternalOnlyChecks:
-    """§11.6 / §11.7: every interaction is external, so only the centrifugal part is left overall."""
+    """manual Part 4 scenario 6 (sphere hitting a sphere glued to the boundary) / manual Part 4 scenario 7 (interaction through the periodic boundary): every interaction is external, so only the centrifugal part is left overall."""
 
     def test_love_weber_zero(self):
         self.assertExactlyZero(self.t["stress_tensor_LW"])
@@ -505,7 +505,7 @@ def _final_tensors(ev):
 
 
 class TestSphereHittingPlateSphere(_ExternalOnlyChecks, _Checks):
-    """§11.6: sphere A hits sphere B glued to the plate (y = 10 < r); 70 evaluated steps, dt = 0.1."""
+    """manual Part 4 scenario 6 (sphere hitting a sphere glued to the boundary): sphere A hits sphere B glued to the plate (y = 10 < r); 70 evaluated steps, dt = 0.1."""
 
     @classmethod
     def setUpClass(cls):
@@ -526,7 +526,7 @@ class TestSphereHittingPlateSphere(_ExternalOnlyChecks, _Checks):
 
 
 class TestInteractionThroughPeriodicBoundary(_ExternalOnlyChecks, _Checks):
-    """§11.7: spheres at (20, 200) and (480, 230) overlap only through the x period; 50 steps, dt = 0.01."""
+    """manual Part 4 scenario 7 (interaction through the periodic boundary): spheres at (20, 200) and (480, 230) overlap only through the x period; 50 steps, dt = 0.01."""
 
     @classmethod
     def setUpClass(cls):

@@ -1,4 +1,4 @@
-"""Tests of layers 4 and 5: demodulation, recording, output file, seeds, validation, drawing, scenarios §11.8-11.10.
+"""Tests of layers 4 and 5: demodulation, recording, output file, seeds, validation, drawing, scenarios manual Part 4 scenario 8 (frictional assembly at rest)-11.10.
 
 Run with ``python -m pytest particleShearTest/test_simulation.py`` or ``python -m unittest``.
 Short protocols (``relative_frequency`` raised, few spheres) keep the whole file fast.
@@ -29,7 +29,7 @@ QUICK = dict(N=20, do_permanent_links=False, cut_lines=0, relative_frequency=0.2
 
 
 def reference_demodulation(t, s, f, A, pre, P, post):
-    """Direct transcription of the reference formula of spec §8.5 (drift-sign quirk included)."""
+    """Direct transcription of the reference formula of docs/design.md (drift-sign quirk included)."""
     t = list(t)
     s = list(s)
     e = 1 if P >= 2 else 0
@@ -125,7 +125,7 @@ class TestEvaluationHandler(unittest.TestCase):
         for _ in range(40):
             ens.mechanical_simulation_step_calculate_forces()
             ens.record_total_particle_forces()
-            h.record(ens)                       # reference crashed here (§12 #34)
+            h.record(ens)                       # reference crashed here (the reference defects listed in docs/output.md #34)
             ens.mechanical_simulation_step_calculate_acceleration(1, 0.05)
             ens.mechanical_simulation_step_calculate_movement(0.05)
             ens.reset_force()
@@ -161,7 +161,7 @@ class TestEvaluationHandler(unittest.TestCase):
 
 
 def parse_header(text):
-    """The downstream regular expressions of spec §9.2 on the first 100 lines (first match wins)."""
+    """The downstream regular expressions of docs/design.md on the first 100 lines (first match wins)."""
     head = "\n".join(text.split("\n")[:100])
     num = r"([0-9]*\.?[0-9]*)"
     gnum = r"(-?[0-9]*\.?[0-9]*)"
@@ -244,10 +244,10 @@ class TestOutputFile(unittest.TestCase):
         self.assertEqual((h["irc"], h["irt"]), ("1", "1"))
         self.assertEqual((h["keep"], h["ctb"], h["tri"]), ("False", "False", "True"))
         self.assertEqual((h["rlf"], h["removed"]), ("0", "0"))
-        # fixed bookkeeping defects (§12 #21, #22)
+        # fixed bookkeeping defects (the reference defects listed in docs/output.md #21, #22)
         self.assertIn("\nPost-measurement periods = 1 [-]\n", self.text)
         self.assertIn("\nSimulated time = " + str(6 / self.res.f) + "s\n", self.text)
-        # literal layout details of §9.1
+        # literal layout details of docs/design.md
         self.assertTrue(self.text.startswith("Dermal filler Ensemble: \n\tCutting lines used to generate the "
                                              "particles3\n\tN=30 spheres, nominal packing density = 1.5\n"))
         self.assertIn("\tYoung modulus of the individual spheres = 8000 Pa \n", self.text)
@@ -272,10 +272,10 @@ class TestOutputFile(unittest.TestCase):
         np.testing.assert_array_equal(col["t"], s["t"])
         np.testing.assert_array_equal(col["stress_measured_at_surface"], s["stress_surface"])
         np.testing.assert_array_equal(col["shear_stress_internal_stress-tensor"], s["stress_internal"])
-        # strain is the running sum of rate·dt (§8.2)
+        # strain is the running sum of rate·dt (docs/design.md)
         dt = self.res.dt
         np.testing.assert_array_equal(col["strain"][1:], col["strain"][:-1] + col["strain_rate"][:-1] * dt)
-        # the header G values are reproduced by §8.5 from the stored columns
+        # the header G values are reproduced by docs/design.md from the stored columns
         p = self.res.parameters
         for c, G in (("shear_stress_internal_stress-tensor", self.res.G_internal),
                      ("stress_measured_at_surface", self.res.G_surface)):
@@ -478,7 +478,7 @@ class TestRunLayer(unittest.TestCase):
 
 
 class TestStochasticScenarios(unittest.TestCase):
-    """Spec §11.8-11.10 with the tolerances stated there (three seeds each)."""
+    """Spec manual Part 4 scenario 8 (frictional assembly at rest)-11.10 with the tolerances stated there (three seeds each)."""
 
     seeds = (1, 2, 3)
 

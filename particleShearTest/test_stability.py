@@ -1,8 +1,8 @@
 """Stability matrix and stability guard (issue "Accuracy and stability").
 
-Every case builds a real ensemble with the §6.4 builder (``do_debug=True``: ten times shorter
+Every case builds a real ensemble with the docs/design.md builder (``do_debug=True``: ten times shorter
 constitution, same physics), runs the experiment's fixed-plate pre-equilibration and a limited
-number of protocol steps (§8.2–§8.4, the reference per-step order), and asserts physical
+number of protocol steps (docs/design.md–docs/design.md, the reference per-step order), and asserts physical
 truths at every step through a read-only monitor installed where the stability guard sits
 (``ensemble.stability_guard``; it is called after every force phase with the pair geometry
 of the step):
@@ -10,7 +10,7 @@ of the step):
 * the state stays finite;
 * the peculiar kinetic energy (relative to the affine flow) stays bounded (see ``KE_FRACTION``);
 * the overall stress tensor is symmetric to ``SYM_TOL`` relative (eq. S1-24: it is the sum of a
-  symmetric part and of torque terms that cancel exactly in its construction — §7.8 — so only
+  symmetric part and of torque terms that cancel exactly in its construction — docs/design.md — so only
   round-off remains, ~1e-16);
 * no sphere pair passes through another: ``min d/(r_i + r_j)`` over transient contacts stays > 0
   and no pair's contact normal flips sign between consecutive steps while it is in contact
@@ -21,7 +21,7 @@ periodic boundary) use a dilute two-sphere builder ensemble with positions set b
 same monitor checks them, plus energy statements specific to an isolated pair.
 
 Slow full runs (convergence, long protocols) live in ``benchmarks/accuracy_study.py``.
-Units: µm, s, mg per m depth (internal units of §1.1); energies in mg·µm²·s⁻² per m.
+Units: µm, s, mg per m depth (internal units of docs/design.md); energies in mg·µm²·s⁻² per m.
 """
 import math
 import os
@@ -103,7 +103,7 @@ def reference_energy(ens):
 
 
 def pair_energy(d, d0, k, c=1.0):
-    """Elastic energy stored by the default law (§2.3, cap included) at distance d: ∫_d^d0 −F(s) ds."""
+    """Elastic energy stored by the default law (docs/design.md, cap included) at distance d: ∫_d^d0 −F(s) ds."""
     cap = d0 / 1000
     lin = 0.5 * k * (1 - c) * (d0 - d) ** 2
     e = max(d, cap)
@@ -136,7 +136,7 @@ def build(N=30, seed=1, links=True, cut_lines=3, packing_fraction=1.5, E=8000.0,
 
 
 def shear(exp, n_steps, pre=True, monitor=None):
-    """Pre-equilibrate (fixed plates, §8.4) and run ``n_steps`` protocol steps with every tensor kept."""
+    """Pre-equilibrate (fixed plates, docs/design.md) and run ``n_steps`` protocol steps with every tensor kept."""
     ens = exp.theEnsemble
     mon = monitor or ContactMonitor()
     ens.stability_guard = mon
@@ -164,7 +164,7 @@ class StabilityAssertions:
         a = ens._a
         for name in ("x", "y", "xspeed", "yspeed", "omega"):
             self.assertTrue(np.isfinite(a[name]).all(), f"{label}: {name} not finite")
-        # positions wrapped into the cell (§3.3)
+        # positions wrapped into the cell (docs/design.md)
         self.assertTrue(((a["x"] >= 0) & (a["x"] < ens.size_x)).all(), f"{label}: x outside [0, Lx)")
         self.assertTrue(((a["y"] >= 0) & (a["y"] < ens.size_y)).all(), f"{label}: y outside [0, Ly)")
         E_ref = reference_energy(ens)
@@ -316,7 +316,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
         self.assertLessEqual(max(mon.ke), U0)
 
     def test_coincident_centres(self):
-        """d = 0: a random normal (§2.1) and the capped force 999·k·c·d0 (eq. S1-6) separate the pair."""
+        """d = 0: a random normal (docs/design.md) and the capped force 999·k·c·d0 (eq. S1-6) separate the pair."""
         sim, exp, ens = self.pair((250.0, 250.0), (250.0, 250.0))
         d0 = float(ens._a["r"].sum())
         mon = ContactMonitor(skip_first=True)
