@@ -42,6 +42,26 @@ class StressInputs:
     def __init__(self, **arrays):
         self.__dict__.update(arrays)
 
+    def tensor(self, function):
+        """``function(self)``, evaluated once per force phase (the overall tensor reuses its parts).
+
+        The inputs describe one force phase and are made anew for the next, so the memo needs
+        no invalidation: its key is the tensor function, its lifetime this object's.
+
+        Parameters
+        ----------
+        function : callable
+            A tensor function of :data:`TENSORS` (``function(q) -> (B, 2, 2)``).
+
+        Returns
+        -------
+        ndarray (B, 2, 2)
+        """
+        memo = self.__dict__.setdefault("_tensors", {})
+        if function not in memo:
+            memo[function] = function(self)
+        return memo[function]
+
     def per_replica(self, weights, by_pair=True):
         """Σ of ``weights`` per replica (pairs or spheres), in row order.
 
@@ -245,7 +265,7 @@ def overall(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return love_weber(q) + internal_torque(q) + spin_kinetic_energy(q)
+    return q.tensor(love_weber) + q.tensor(internal_torque) + q.tensor(spin_kinetic_energy)
 
 
 #: one registry entry per tensor: name (StressTensorEvaluation attribute), output-column stem, equation
@@ -278,4 +298,4 @@ def evaluate_all(q):
     ndarray (B, 9, 2, 2)
         ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
     """
-    return np.stack([t.function(q) for t in TENSORS], axis=1)
+    return np.stack([q.tensor(t.function) for t in TENSORS], axis=1)
