@@ -257,9 +257,6 @@ class TestCallbackMechanism(unittest.TestCase):
         self.assertLessEqual(abs(f_exp - ref), 1e-12 * ref)
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 class TestEngineLawConstants(unittest.TestCase):
     """The engine evaluates the built-in law with cached per-pair constants: bit-identical to the law."""
@@ -281,3 +278,55 @@ class TestEngineLawConstants(unittest.TestCase):
                 with self.subTest(k=k, c=c):
                     np.testing.assert_array_equal(ens._central_law(d, d0, k, c, holder),
                                                   elastic_force_law(d, d0, k, c))
+
+
+def _engine_central(d, d0, k, c, bond):
+    """Central law of one candidate through the engine (:meth:`PairConstants.set_bonds`, :func:`central_term`)."""
+    from types import SimpleNamespace
+
+    from particleShear.engine.forces import PairConstants, central_term
+
+    one = np.ones(1)
+    s = SimpleNamespace(k=k * one, c=c * one, prc=one, nu=0 * one, keep=one, k_t=0 * one, prt=one, nu_t=0 * one,
+                        mu=0 * one)
+    C = SimpleNamespace(rep=np.zeros(1, dtype=int), d0=np.array([d0]))
+    PairConstants.set_bonds(C, s, np.array([2 if bond else 0], dtype=np.int8), np.array([d0]))
+    f, law = central_term(C, np.array([d]), np.zeros(1), np.ones(1, dtype=bool))
+    return float(f[0]), float(law[0])
+
+
+class TestOneLawEverywhere(unittest.TestCase):
+    """The documented callbacks, the classes' array step and the engine evaluate one law (docs/design.md).
+
+    The same pair geometry (d0 = 120 µm, k = 2, at rest, no viscosity, no friction) must give the
+    same central force, bit for bit, in all three: they share the arithmetic of
+    ``particleShear.engine.laws``, so the tolerance is 0.  The distances cover the linear, blended
+    and divergent laws, the cap d0/d ≤ 1000 (eq. S1-6) and a bond in compression and in tension.
+    """
+
+    CASES = [  # (d, c, bonded)
+        (100.0, 0.0, False), (100.0, 0.5, False), (100.0, 1.0, False), (60.0, 1.0, False),
+        (0.05, 1.0, False), (0.05, 0.3, False), (100.0, 0.3, True), (60.0, 1.0, True), (130.0, 0.5, True),
+    ]
+
+    def test_same_force_in_callback_class_step_and_engine(self):
+        d0, k = 120.0, 2.0
+        for d, c, bonded in self.CASES:
+            with self.subTest(d=d, c=c, bonded=bonded):
+                ens, s1, s2 = _pair_scene(d, link=bonded, c=c)
+                d_geo = s2.x - s1.x   # the distance the step sees (200 + d − 200 need not be d)
+                if d_geo > d0:
+                    ref = elastic_force_law_tensile(d_geo, d0, k)
+                    self.assertGreater(ref, 0)   # a stretched bond attracts
+                else:
+                    ref = elastic_force_law(d_geo, d0, k, c)
+                    self.assertLess(ref, 0)      # a compressed pair repels
+                self.assertIs(type(ref), float)
+                self.assertEqual(_central_force_on_1(ens, s1), ref)          # along n_12 = +x
+                f_engine, law_engine = _engine_central(d_geo, d0, k, c, bonded)
+                self.assertEqual(law_engine, ref)
+                self.assertEqual(f_engine, ref)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -29,6 +29,7 @@ from .namespace import (bincount as _bincount, concatenate as _concat, copyto as
                         count_nonzero as _nz, where as _where)
 from . import laws
 from .laws import call_law_vectorised
+from ..engine import laws as _engine_laws
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
@@ -1556,17 +1557,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     @staticmethod
     def _builtin_law_inside(d, d0, k, c, holder):
         """The built-in law (eqs. S1-5a, S1-5b) as if every pair were in contact (no cut-off at ``d0``), with its
-        per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder``; same operations as
-        :func:`~particleShear.base.laws.elastic_force_law`."""
+        per-pair constants (``d0/1000``, ``−k(1−c)``, ``−k·c·d0``) kept on ``holder``; the arithmetic of
+        :func:`particleShear.engine.laws.central_inside`, as in :func:`~particleShear.base.laws.elastic_force_law`."""
         lc = holder.law
         if lc is None or lc[0] != (k, c):
-            lc = holder.law = ((k, c), d0 / 1000, -k * c * d0, -k * (1 - c))
-        _, d0_cap, a_div, a_lin = lc
-        if c == 1:
-            return a_div * (d0 / np.maximum(d, d0_cap) - 1)   # the linear part is ±0 here
-        if c == 0:
-            return a_lin * (d0 - d)                           # the divergent part is ±0 here
-        return a_lin * (d0 - d) + a_div * (d0 / np.maximum(d, d0_cap) - 1)
+            lc = holder.law = ((k, c), _engine_laws.central_constants(d0, k, c), _engine_laws.central_form(c))
+        return _engine_laws.central_inside(d, d0, *lc[1], form=lc[2])
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""

@@ -9,6 +9,8 @@ __docformat__ = "numpy"
 
 import numpy as np
 
+from ..engine import laws as _engine_laws
+
 __all__ = [
     "elastic_force_law", "elastic_force_law_plateau", "distance_transform_plateau",
     "PlateauConfiguration", "elastic_force_law_tensile",
@@ -28,7 +30,9 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
     """Blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law; 0 for d > d0.
 
     The force is ``-k (1 - c)(d0 - d) - k c d0 (d0/d - 1)``; the divergent part is capped at
-    ``d0/d = 1000`` (eq. S1-6).
+    ``d0/d = 1000`` (eq. S1-6).  The arithmetic is that of
+    :func:`particleShear.engine.laws.central_inside`, shared with the classes' vectorised step
+    and the engine.
 
     Parameters
     ----------
@@ -50,17 +54,9 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
     if np.ndim(d) == 0 and np.ndim(d0) == 0:
         if d > d0:
             return 0
-        f_lin = -k * (1 - c) * (d0 - d)
-        f_nl = -k * c * d0 * (d0 / max(d, d0 / 1000) - 1)
-        return _scalar_result(f_lin + f_nl, k, c)
-    d = np.asarray(d, dtype=float)
-    if np.ndim(c) == 0 and c == 1:
-        f = -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)   # the linear part is ±0 here
-    elif np.ndim(c) == 0 and c == 0:
-        f = -k * (1 - c) * (d0 - d)                                # the divergent part is ±0 here
-    else:
-        f = -k * (1 - c) * (d0 - d) + -k * c * d0 * (d0 / np.maximum(d, d0 / 1000) - 1)
-    return np.where(d > d0, 0.0, f)
+        f = _engine_laws.central_inside(d, d0, *_engine_laws.central_constants(d0, k, c), maximum=max)
+        return _scalar_result(f, k, c)
+    return _engine_laws.central_law(d, d0, k, c)
 
 
 class PlateauConfiguration:
@@ -143,6 +139,9 @@ def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
 def elastic_force_law_tensile(d, d0, k):
     """Linear tensile law of permanent links: ``-k (d0 - d)`` (eq. S1-5a in tension).
 
+    The arithmetic is that of :func:`particleShear.engine.laws.tensile_inside`, shared with the
+    classes' vectorised step and the engine.
+
     Parameters
     ----------
     d : float or numpy.ndarray
@@ -157,7 +156,7 @@ def elastic_force_law_tensile(d, d0, k):
     float or numpy.ndarray
         Central force (mg·µm·s⁻² per m depth); positive (attractive) for ``d > d0``.
     """
-    return -k * (d0 - d)
+    return _engine_laws.tensile_inside(d, d0, -k)
 
 
 class TensileConfiguration:

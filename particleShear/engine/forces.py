@@ -17,6 +17,7 @@ import numpy as np
 
 from .tangential import tangential_two_pass
 from .box import min_image
+from . import laws
 
 __all__ = ["PairConstants", "geometry", "central_term", "tangential_term", "scatter", "shear_stresses"]
 
@@ -91,11 +92,9 @@ class PairConstants:
         k, c = s.k[g], s.c[g]
         self.k = k
         self.d_law = np.where(perm, d_eq, self.d0)         # contact distance of the compressive law
-        self.d_cap = self.d_law / 1000
-        self.a_lin = -k * (1 - c)
-        self.a_div = -k * c * self.d_law
-        self.d_eq = np.where(perm, d_eq, 0.0)   # tensile law k·(d − d_eq) on bonds, (d − 0)·0 on contacts
-        self.k_tens = np.where(perm, k, 0.0)
+        self.d_cap, self.a_lin, self.a_div = laws.central_constants(self.d_law, k, c)
+        self.d_eq = np.where(perm, d_eq, 0.0)   # tensile law −k·(d_eq − d) on bonds, −0·(0 − d) = +0 on contacts
+        self.a_tens = -np.where(perm, k, 0.0)
         self.ratio_c = np.where(perm, s.prc[g], 1.0)
         keep = s.keep[g] != 0
         self.nu = s.nu[g] * np.where(perm & ~keep, s.prc[g], 1.0)
@@ -192,8 +191,8 @@ def central_term(C, d, vn, active):
     law : ndarray (P,)
         The elastic law before the permanent ratio (same unit), the base of the Coulomb bound.
     """
-    inside = C.a_lin * (C.d_law - d) + C.a_div * (C.d_law / np.maximum(d, C.d_cap) - 1)
-    law = np.where(d > C.d_law, (d - C.d_eq) * C.k_tens, inside)   # contacts beyond d0: (d − 0)·0 = 0
+    inside = laws.central_inside(d, C.d_law, C.d_cap, C.a_lin, C.a_div)   # c per replica: the general blend
+    law = np.where(d > C.d_law, laws.tensile_inside(d, C.d_eq, C.a_tens), inside)   # contacts beyond d0: +0
     f = law * C.ratio_c
     f += np.where(active, C.nu, 0.0) * vn
     return f, law

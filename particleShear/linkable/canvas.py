@@ -16,6 +16,7 @@ from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image
 from ..base.namespace import count_nonzero as _nz, where as _where
 from ..base.laws import call_law_vectorised, elastic_force_law, elastic_force_law_tensile
+from ..engine import laws as _engine_laws
 from ..base.neighbours import PERMANENT, SLIP
 from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
@@ -251,7 +252,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             if _nz(stretched):
                 tensile = SphereLinkable.call_back_elastic_force_law_tensile
                 if tensile is elastic_force_law_tensile:
-                    f_t = -k * (B.deq - g.d)    # the built-in linear tensile law, inline
+                    f_t = _engine_laws.tensile_inside(g.d, B.deq, -k)    # the built-in linear tensile law
                 else:
                     f_t = call_law_vectorised(tensile, g.d, B.deq, k)
                 f_i = _where(stretched, f_t, f_i)
@@ -265,14 +266,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
     @staticmethod
     def _tensile_inline(d, k, B, perm):
-        """Built-in tensile law ``−k (d_eq − d)``, computed as ``k (d − d_eq)`` (the same number) on
-        bonds and as ``(d − 0)·0 = +0`` on contacts; the factors are kept on the bond structure."""
+        """Built-in tensile law ``−k (d_eq − d)`` (:func:`particleShear.engine.laws.tensile_inside`) on bonds and
+        ``−0·(0 − d) = +0`` on contacts; the masked constants ``−k`` and ``d_eq`` are kept on the bond structure."""
         kd = B.tensile
         if kd is None or kd[0] != k:
-            kd = B.tensile = (k, _where(perm, k, 0.0), _where(perm, B.deq, 0.0))
-        f = d - kd[2]
-        f *= kd[1]
-        return f
+            kd = B.tensile = (k, -_where(perm, k, 0.0), _where(perm, B.deq, 0.0))
+        return _engine_laws.tensile_inside(d, kd[2], kd[1])
 
     def _tangential_terms(self):
         """Transient contacts and bonds in one two-visit pass; bonds have no Coulomb bound."""
