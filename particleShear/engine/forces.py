@@ -19,7 +19,7 @@ from .tangential import tangential_two_pass
 from .box import min_image
 from . import laws
 
-__all__ = ["PairConstants", "geometry", "central_term", "tangential_term", "scatter", "shear_stresses"]
+__all__ = ["PairConstants", "geometry", "central_term", "tangential_term", "scatter", "replica_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -52,6 +52,9 @@ class PairConstants:
         self.ai = np.concatenate([p.i for p in pairs]) + base
         self.aj = np.concatenate([p.j for p in pairs]) + base
         self.P = len(self.ai)
+        # segments of the replicas for replica_sums (an empty replica reads a valid index and is masked)
+        self.starts = np.minimum(offsets[:-1], max(self.P - 1, 0))
+        self.nonempty = offsets[1:] > offsets[:-1]
         g = self.rep
         self.ri = s.r[self.ai]
         self.rj = s.r[self.aj]
@@ -62,7 +65,6 @@ class PairConstants:
         self.Ly = s.Ly[g]
         self.hy = self.Ly / 2
         self.hx = self.Lx / 2
-        self.rep3 = np.concatenate((self.rep, self.rep + s.B, self.rep + 2 * s.B))
         nb = s.B * N
         self.scatter_idx = np.concatenate((self.ai, self.aj, self.ai + nb, self.aj + nb, self.ai + 2 * nb,
                                            self.aj + 2 * nb))
@@ -258,6 +260,32 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     return np.bincount(C.scatter_idx, w, 3 * n_spheres).reshape(3, n_spheres)
 
 
+def replica_sums(C, W):
+    """Σ of each row of ``W`` over each replica's own candidates: a (rows, B) array.
+
+    The candidates of a replica are contiguous (``C.offsets``), so each sum is one reduction over
+    that replica's own segment, in list order (NumPy's pairwise summation of the segment): it
+    depends only on the replica's own pairs, never on the rest of the batch, and it costs one
+    pass over ``W`` (a ``bincount`` over the replica index adds every pair of a replica into the
+    same bin one after the other, which serialises on that bin: ~20× slower at B = 32).
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (``starts``, ``nonempty`` of the replicas' segments).
+    W : ndarray (rows, P)
+        Weights per candidate pair, any unit.
+
+    Returns
+    -------
+    ndarray (rows, B)
+        ``out[r, b] = Σ_{pairs p of replica b} W[r, p]`` (0 for a replica without candidates).
+    """
+    if C.P == 0:
+        return np.zeros((W.shape[0], len(C.nonempty)))
+    return np.where(C.nonempty, np.add.reduceat(W, C.starts, axis=1), 0.0)
+
+
 def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     """τ_internal = −σ_xy of the overall tensor and τ_surface = −σ_xy of the external-force tensor (Pa).
 
@@ -267,7 +295,7 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     (eq. S1-16): a pair is internal when both spheres are mobile and no image shift was used,
     otherwise each mobile sphere receives an external entry.  ``yc`` is ``y − Ly/2`` per sphere,
     ``flags`` = (mobile i, mobile j, not both mobile) per candidate.  Sums per replica over its
-    own pairs in list order (``bincount`` over the replica index).
+    own pairs in list order (:func:`replica_sums`).
 
     Parameters
     ----------
@@ -303,9 +331,8 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     internal = active & ~ext
     lever = yc[C.ai] * (ext & mi)
     lever -= yc[C.aj] * (ext & mj)
-    # three per-replica sums in one bincount: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
-    w = np.concatenate((fx_i * dy * internal, dF * internal, fx_i * lever))
-    lw, tint, surf = np.bincount(C.rep3, w, 3 * B).reshape(3, B)
+    # three per-replica sums in one reduction: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
+    lw, tint, surf = replica_sums(C, np.stack((fx_i * dy * internal, dF * internal, fx_i * lever)))
     sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)
     return -sigma_all, -sigma_ext
