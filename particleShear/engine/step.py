@@ -357,22 +357,20 @@ class BatchEngine:
         bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
         C = self.C
         ratio = np.where(active & C.trans, d / C.d0, np.inf)
-        lo, hi = C.offsets[:-1], C.offsets[1:]
-        closest = np.minimum.reduceat(np.append(ratio, np.inf), lo)     # pairs of a replica are contiguous
-        closest[hi == lo] = np.inf
-        for b in range(B):
-            if not self.guard[b]:
-                continue
-            if not finite[b]:
-                reason = "non-finite state"
-            elif ke[b] > bound[b]:
-                reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
-            elif closest[b] < self.min_distance_ratio:
-                reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
-            else:
-                continue
-            raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
-                                    replica=b, step=self.step_count, phase=self.phase)
+        # closest transient contact of each replica: one reduction over its own (contiguous) segment
+        closest = np.where(C.nonempty, np.minimum.reduceat(ratio, C.starts), np.inf) if C.P else np.full(B, np.inf)
+        bad = self.guard & (~finite | (ke > bound) | (closest < self.min_distance_ratio))
+        if not bad.any():      # the one device-to-host transfer of the guard: does any replica stop the batch?
+            return
+        b = int(np.flatnonzero(bad)[0])
+        if not finite[b]:
+            reason = "non-finite state"
+        elif ke[b] > bound[b]:
+            reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
+        else:
+            reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
+        raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
+                                replica=b, step=self.step_count, phase=self.phase)
 
 
 def pre_equilibration_blocks(N, dt, dt_max):
