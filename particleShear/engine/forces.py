@@ -75,9 +75,11 @@ class PairConstants:
         """Sizes and index arrays that follow from ``ai``, ``aj`` and the replicas' segments."""
         self.offsets = offsets
         self.P = len(self.ai)
-        # segments of the replicas for replica_sums (an empty replica reads a valid index and is masked)
-        self.starts = np.minimum(offsets[:-1], max(self.P - 1, 0))
-        self.nonempty = offsets[1:] > offsets[:-1]
+        # the replicas that have candidates and where their segments start, for replica_sums: each
+        # such segment ends where the next one starts (empty replicas in between have no rows)
+        self.B = len(offsets) - 1
+        self.seg_rep = np.flatnonzero(offsets[1:] > offsets[:-1])
+        self.seg_starts = offsets[:-1][self.seg_rep]
         nb = s.B * s.N
         self.scatter_idx = np.concatenate((self.ai, self.aj, self.ai + nb, self.aj + nb, self.ai + 2 * nb,
                                            self.aj + 2 * nb))
@@ -329,12 +331,14 @@ def replica_sums(C, W):
     that replica's own segment, in list order (NumPy's pairwise summation of the segment): it
     depends only on the replica's own pairs, never on the rest of the batch, and it costs one
     pass over ``W`` (a ``bincount`` over the replica index adds every pair of a replica into the
-    same bin one after the other, which serialises on that bin: ~20× slower at B = 32).
+    same bin one after the other, which serialises on that bin: 244 against 11 µs for three
+    sums over 19,600 pairs at B = 32).
 
     Parameters
     ----------
     C : PairConstants
-        The candidates (``starts``, ``nonempty`` of the replicas' segments).
+        The candidates (``seg_rep``, ``seg_starts``: the replicas with candidates and where
+        their segments start).
     W : ndarray (rows, P)
         Weights per candidate pair, any unit.
 
@@ -343,9 +347,10 @@ def replica_sums(C, W):
     ndarray (rows, B)
         ``out[r, b] = Σ_{pairs p of replica b} W[r, p]`` (0 for a replica without candidates).
     """
-    if C.P == 0:
-        return np.zeros((W.shape[0], len(C.nonempty)))
-    return np.where(C.nonempty, np.add.reduceat(W, C.starts, axis=1), 0.0)
+    out = np.zeros((W.shape[0], C.B))
+    if C.P:
+        out[:, C.seg_rep] = np.add.reduceat(W, C.seg_starts, axis=1)
+    return out
 
 
 def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):

@@ -381,7 +381,9 @@ class BatchEngine:
         C = self.C
         ratio = np.where(active & C.trans, d / C.d0, np.inf)
         # closest transient contact of each replica: one reduction over its own (contiguous) segment
-        closest = np.where(C.nonempty, np.minimum.reduceat(ratio, C.starts), np.inf) if C.P else np.full(B, np.inf)
+        closest = np.full(B, np.inf)
+        if C.P:
+            closest[C.seg_rep] = np.minimum.reduceat(ratio, C.seg_starts)
         bad = self.guard & (~finite | (ke > bound) | (closest < self.min_distance_ratio))
         if not bad.any():      # the one device-to-host transfer of the guard: does any replica stop the batch?
             return
