@@ -1,8 +1,13 @@
-"""Stress tensors from the force register (eqs. S1-16 to S1-25; Nicot et al. with the factor 3/2).
+"""Stress tensors of the documented classes, computed by the engine's tensor functions.
 
-All tensors are 2×2 in Pa, index ``[a][b]`` = (force component, lever-arm
-component), compression positive.  Internal units are converted here only:
-forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and inertias ×1e-18.
+Every tensor (eqs. S1-16 to S1-24; Nicot et al. with the factor 3/2) is one function of the
+engine's registry :data:`particleShear.engine.stress.TENSORS`.  :class:`StressTensorEvaluation` is
+an adapter: it turns a :class:`~particleShear.base.register.Force_register` and a list of spheres
+into the engine's inputs (:class:`~particleShear.engine.stress.StressInputs`) for a batch of one
+replica and calls the registry; the shear stresses G needs come from the engine's shear-stress
+function (:func:`particleShear.engine.forces.shear_stresses`).  All tensors are 2×2 in Pa, index
+``[a][b]`` = (force component, lever-arm component), compression positive; forces ×1e-12 (N/m),
+lengths ×1e-6 (m), torques and inertias ×1e-18 (docs/design.md, docs/output.md).
 """
 __docformat__ = "numpy"
 
@@ -10,75 +15,103 @@ from operator import attrgetter
 
 import numpy as np
 
-from .fields import MASS_ROWS
-from .namespace import dot as _dot
+from ..engine import stress as _es
+from ..engine.forces import shear_stresses as _engine_shear_stresses
+from ..engine.stress import TENSORS, StressInputs
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
 
-#: tensor attribute names in the column order of the output table (docs/output.md, "Table columns")
-TENSOR_NAMES = (
-    "stress_tensor_LW",
-    "stress_tensor_linear_acceleration_otsuki",
-    "stress_tensor_with_external_forces",
-    "stress_tensor_linear_acceleration",
-    "stress_tensor_unbalanced_forces",
-    "stress_tensor_unbalanced_torque",
-    "stress_tensor_internal_torque",
-    "stress_tensor_spin_kinetic_energy",
-    "overall_stress_tensor",
-)
-(_LW, _OT, _EXT, _LIN, _UNB, _TQ, _TINT, _CEN, _ALL) = range(9)
-# flat positions of the entries [k, a, b] (4k + 2a + b) written as scalars
-_TQ00, _TQ01, _TQ10, _TQ11 = range(4 * _TQ, 4 * _TQ + 4)
-_TI00, _TI01, _TI10, _TI11 = range(4 * _TINT, 4 * _TINT + 4)
-_CE00, _CE01, _CE10, _CE11 = range(4 * _CEN, 4 * _CEN + 4)
+#: tensor attribute names in the column order of the output table (docs/output.md, "Table columns"):
+#: the names of the engine's registry
+TENSOR_NAMES = tuple(t.name for t in TENSORS)
+_INDEX = {t.function: k for k, t in enumerate(TENSORS)}
+_EXT = _INDEX[_es.external_forces]
+_ALL = _INDEX[_es.overall]
 
-#: rows (m, m, inertia) of the ensemble state block: weights of (u_x, u_y, ω) in the kinetic tensors
-_MASS_ROWS = np.array(MASS_ROWS)
+#: which part of a force phase each tensor reads (the overall tensor adds up parts of the others)
+_PAIR_TENSORS = (_es.love_weber, _es.external_forces, _es.internal_torque)
+_TOTAL_TENSORS = (_es.unbalanced_forces, _es.linear_acceleration, _es.unbalanced_torque)
+_SPHERE_TENSORS = (_es.spin_kinetic_energy, _es.peculiar_acceleration_otsuki)
 
-_CF = 1e-12
 _ENS_OF = attrgetter("_ens")
 _IDX_OF = attrgetter("_idx")
 _NOT_ROWS = (False, None)
-_CL = 1e-6
-_CT = 1e-18
 
 
-def _internal_moment(p, pos, pos_version, out):
-    """``Σ F_i ⊗ (x_j − x_i)`` (unscaled, into the (2, 2) ``out``) over the internal pairs of an engine
-    register block with F_j = −F_i; the caller multiplies by −scale.
+class OneReplicaRows:
+    """The pair rows of a batch of one replica, as the engine's tensor functions read them.
 
-    Internal pairs never act through the boundary, so ``x_j − x_i`` is the pair vector of the force
-    phase while no sphere has moved since; otherwise positions are gathered anew.
+    These are the attributes of :class:`~particleShear.engine.forces.PairConstants` that the
+    tensors and :func:`~particleShear.engine.forces.replica_sums` use: the sphere rows of each
+    pair, its replica (0) and the one replica's segment.
+
+    Parameters
+    ----------
+    ai, aj : ndarray of int (P,)
+        Sphere rows of the two spheres of each pair row.
     """
-    S = p["S"]
-    F = p["Fi"]
-    if S.w_int is not None:
-        F = F * S.w_int2.reshape(2, -1)   # weights on both rows: a same-shape product, no broadcasting
-    if p["pos_version"] == pos_version:
-        return _dot(F, p["D"].T, out)
-    L = pos.take(p["i"], axis=1)
-    L -= pos.take(p["j"], axis=1)
-    return np.negative(_dot(F, L.T), out=out)   # −(Σ F ⊗ (x_i − x_j)); × −scale is exact
+
+    def __init__(self, ai, aj):
+        self.ai = ai
+        self.aj = aj
+        self.P = P = len(ai)
+        self.B = 1
+        self.rep = np.zeros(P, dtype=np.intp)
+        self.offsets = np.array((0, P))
+        self.seg_rep = np.flatnonzero(self.offsets[1:] > self.offsets[:-1])
+        self.seg_starts = self.offsets[:-1][self.seg_rep]
 
 
-def _external_moment(p, pos, c, scale=_CF * _CL, out=None, X=None):
-    """``scale · Σ F ⊗ (x_target − c)`` over the external entries of an engine register block, or None.
+class ForcePhase(StressInputs):
+    """The engine's inputs of one force phase of the classes, in three parts.
 
-    ``X`` may give ``pos − c`` already computed; ``scale=None`` leaves the sum unscaled (into ``out``)."""
-    S = p["S"]
-    if not len(S.ext_targets):
-        return None
-    F = p["W"].take(S.ext_flat)   # from the flat (F_i, F_j, …) array of the flush: one gather, no signs
-    if X is None:
-        Xt = pos.take(S.ext_targets, axis=1)
-        Xt -= c
-    else:
-        Xt = X.take(S.ext_targets, axis=1)
-    if scale is None:
-        return _dot(F, Xt.T, out)
-    return np.multiply(_dot(F, Xt.T), scale, out=out)
+    A register and the spheres a caller passes need not describe one set of spheres: the pair
+    tensors (Love-Weber, external forces, internal torque) read the register's pair entries, the
+    tensors of sphere totals (unbalanced forces and torque, linear acceleration) the register's
+    totals, and the kinetic tensors (spin, Otsuki) the caller's spheres.  Each part is a
+    :class:`~particleShear.engine.stress.StressInputs` of a batch of one (often the same object);
+    this one hands each tensor to its part and evaluates the overall tensor (eq. S1-24) from them.
+
+    Parameters
+    ----------
+    pairs, totals, spheres : StressInputs
+        The parts (see above); ``pairs`` also gives the cell volume ``V``.
+    """
+
+    def __init__(self, pairs, totals, spheres):
+        parts = {f: pairs for f in _PAIR_TENSORS}
+        parts.update((f, totals) for f in _TOTAL_TENSORS)
+        parts.update((f, spheres) for f in _SPHERE_TENSORS)
+        super().__init__(B=1, V=pairs.V, parts=parts)
+
+    def tensor(self, function):
+        """``function`` evaluated on its part (the overall tensor on this object, from the parts).
+
+        Parameters
+        ----------
+        function : callable
+            A tensor function of :data:`~particleShear.engine.stress.TENSORS`.
+
+        Returns
+        -------
+        ndarray (1, 2, 2)
+        """
+        part = self.parts.get(function)
+        return super().tensor(function) if part is None else part.tensor(function)
+
+
+def _cell(ev, shear_rate=0.0):
+    """The per-replica inputs of the cell of ``ev`` (arrays of one replica)."""
+    return dict(B=1, Lx=np.array((float(ev.size_x),)), Ly=np.array((float(ev.size_y),)),
+                rate=np.array((float(shear_rate),)), V=np.array((ev._volume(),)))
+
+
+def _with_mobile(q, mob):
+    """A copy of the inputs ``q`` whose sphere sums run over the spheres of mask ``mob``."""
+    d = {k: v for k, v in q.__dict__.items() if k != "_tensors"}
+    d["mob"] = mob
+    return StressInputs(**d)
 
 
 def _tensor_property(k):
@@ -91,12 +124,189 @@ def _tensor_property(k):
     return property(fget, fset, doc="2×2 tensor (Pa), nested lists; see docs/output.md (eqs. S1-16 to S1-24).")
 
 
+def _engine_block(reg):
+    """The register's single block of an engine force phase with F_j = −F_i and no manual pair
+    entries, or None (then the register is read entry by entry)."""
+    if len(reg._blocks) != 1 or reg._m_pair or reg._m_ext or reg._m_imom:
+        return None
+    p = reg._blocks[0]
+    if "S" not in p or not p.get("antisymmetric", True):
+        return None
+    return p
+
+
+class _BlockRows:
+    """What the engine's functions read of an engine register block that changes only with its
+    pairs and their internal/external flags (kept while the block's arrays are the same objects).
+
+    The register says per pair whether it is internal and whether each sphere receives an
+    external entry; the engine derives this from a mobility mask and the image shift.  Passing
+    ``shifted = ~internal`` and, to the shear-stress function, the per-pair mobility flags
+    ``(ext_i | internal, ext_j | internal, ~internal)`` makes the engine's rule give exactly the
+    register's flags (external pairs are never internal; an external entry needs a mobile sphere).
+    """
+
+    def __init__(self, p):
+        self.key = (p["i"], p["internal"], p["ext_i"], p["ext_j"])
+        internal = p["internal"]
+        self.C = OneReplicaRows(p["i"], p["j"])
+        self.not_internal = ~internal
+        self.flags = (p["ext_i"] | internal, p["ext_j"] | internal, self.not_internal)
+        self.zeros = np.zeros(self.C.P)
+        self.all_active = np.ones(self.C.P, dtype=bool)
+        self.rule_mask = _UNSET   # the mask for which the engine's rule was checked, and the answer
+        self.rule_ok = False
+
+    def same(self, p):
+        k = self.key
+        return k[0] is p["i"] and k[1] is p["internal"] and k[2] is p["ext_i"] and k[3] is p["ext_j"]
+
+    def follows_mask(self, p, mob):
+        """True when the block's flags are the engine's rule for the sphere mask ``mob`` (None: all
+        mobile) with ``shifted = ~internal``: internal pairs have both spheres mobile and each
+        external entry goes to exactly the mobile spheres of an external pair."""
+        if self.rule_mask is not mob:
+            internal, i, j = p["internal"], p["i"], p["j"]
+            if mob is None:
+                ok = np.array_equal(p["ext_i"], self.not_internal) and np.array_equal(p["ext_j"], self.not_internal)
+            else:
+                mi, mj = mob[i], mob[j]
+                ok = (np.array_equal(p["ext_i"], mi & self.not_internal)
+                      and np.array_equal(p["ext_j"], mj & self.not_internal) and not (internal & ~(mi & mj)).any())
+            self.rule_mask, self.rule_ok = mob, bool(ok)
+        return self.rule_ok
+
+
+_UNSET = object()
+
+
+def _shear_inputs(q):
+    """The arguments of the engine's shear-stress function read from pair inputs ``q`` (mobility
+    flags from ``q.mob``), after the batch of one ``C`` and ``B``."""
+    C = q.C
+    mi, mj = q.mob[C.ai], q.mob[C.aj]
+    return (q.y - q.Ly[0] / 2, (mi, mj, ~(mi & mj)), q.active, q.shifted, q.dy, q.fx_i, q.dF, q.V)
+
+
+def _entries(reg):
+    """The register's pair entries as the engine's pair inputs of a batch of one (docs/design.md).
+
+    Each entry is a row (target, source): the force on the target and the lever ``x_target −
+    x_source`` (eq. S1-19, the reference's ``pair_register``), or the force from an immobile
+    sphere or through the boundary at the target (eq. S1-16, ``external_force_register``), or an
+    internal torque (eq. S1-22, ``internal_moment_register``).  An engine block gives two entries
+    per pair, one on each sphere, with the block's flags; the manual ``record_*`` entries follow.
+    The target and the source of each entry are sphere rows of their own (rows 0 … n−1 and
+    n … 2n−1), flagged mobile where the register gives them an entry, and ``shifted`` is
+    ``~internal``: so the engine's rule (internal: both mobile, no image shift; external entry:
+    on the mobile spheres of the other pairs) reproduces the register's flags.  An internal entry
+    carries half its force, since the reference registers a contact once from each side.
+
+    Returns
+    -------
+    dict
+        ``C, x, y, mob, active, shifted, dx, dy, fx_i, fy_i, dF`` for :class:`StressInputs`.
+    """
+    tx, ty, sx, sy, fx, fy, internal, external, active, dF = ([] for _ in range(10))
+    ens = reg._ens
+    for p in reg._blocks:
+        i, j = p["i"], p["j"]
+        if not len(i):
+            continue
+        x, y = ens._a["x"], ens._a["y"]
+        act = p.get("active")
+        act = np.ones(len(i), dtype=bool) if act is None else act
+        for t, s, F, ext, torque in ((i, j, p["Fi"], p["ext_i"], p.get("ti")), (j, i, p["Fj"], p["ext_j"], p.get("tj"))):
+            tx.append(x[t])
+            ty.append(y[t])
+            sx.append(x[s])
+            sy.append(y[s])
+            fx.append(F[0])
+            fy.append(F[1])
+            internal.append(p["internal"])
+            external.append(ext)
+            active.append(act)
+            dF.append(np.zeros(len(i)) if torque is None else torque)
+    manual = ([(t, s, f, 0.0, True) for t, s, f in reg._m_pair]
+              + [(t, t, f, 0.0, False) for t, f in reg._m_ext]
+              + [(t, s, (0.0, 0.0), m, True) for t, s, m in reg._m_imom])
+    if manual:
+        rows = np.array([(t.x, t.y, s.x, s.y, f[0], f[1], m) for t, s, f, m, _ in manual], dtype=float).T
+        tx.append(rows[0])
+        ty.append(rows[1])
+        sx.append(rows[2])
+        sy.append(rows[3])
+        fx.append(rows[4])
+        fy.append(rows[5])
+        dF.append(rows[6])
+        flag = np.array([e[4] for e in manual], dtype=bool)
+        internal.append(flag)
+        external.append(~flag)
+        active.append(np.ones(len(manual), dtype=bool))
+    cat = (lambda parts, dtype=float: np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
+    tx, ty, sx, sy, fx, fy, dF = map(cat, (tx, ty, sx, sy, fx, fy, dF))
+    internal, external, active = (cat(f, bool) for f in (internal, external, active))
+    n = len(tx)
+    half = np.where(internal, 0.5, 1.0)   # × ½ is exact
+    return dict(C=OneReplicaRows(np.arange(n), np.arange(n, 2 * n)), rep=np.zeros(2 * n, dtype=np.intp),
+                x=np.concatenate((tx, sx)), y=np.concatenate((ty, sy)),
+                mob=np.concatenate((internal | external, internal)), active=active, shifted=~internal,
+                dx=sx - tx, dy=sy - ty, fx_i=fx * half, fy_i=fy * half, dF=dF)
+
+
+def _totals(reg):
+    """The register's sphere totals as the engine's sphere inputs of a batch of one.
+
+    Rows: the ensemble's spheres (total force summed over the mobile ones, eq. S1-17; net torque
+    of every sphere, immobile ones included, eq. S1-22 — the reference's quirk), then the manual
+    ``record_total_particle_force`` entries (mobile), then the manual ``record_unbalanced_moment``
+    entries (torque only).
+
+    Returns
+    -------
+    dict
+        ``rep, x, y, mob, fx, fy, torque`` for :class:`StressInputs`.
+    """
+    x, y, fx, fy, mob, torque = ([] for _ in range(6))
+    ens = reg._ens
+    if reg._tot is not None or reg._mom is not None:
+        a = ens._a
+        n = len(a["x"])
+        x.append(a["x"])
+        y.append(a["y"])
+        if reg._tot is not None:
+            mask, tfx, tfy = reg._tot
+            fx.append(tfx)
+            fy.append(tfy)
+            mob.append(np.ones(n, dtype=bool) if mask is None else mask)
+        else:
+            fx.append(np.zeros(n))
+            fy.append(np.zeros(n))
+            mob.append(np.zeros(n, dtype=bool))
+        torque.append(np.zeros(n) if reg._mom is None else reg._mom)
+    manual = ([(t, f, 0.0, True) for t, f in reg._m_tot.values()]
+              + [(t, (0.0, 0.0), m, False) for t, m in reg._m_unb.values()])
+    if manual:
+        rows = np.array([(t.x, t.y, f[0], f[1], m) for t, f, m, _ in manual], dtype=float).T
+        x.append(rows[0])
+        y.append(rows[1])
+        fx.append(rows[2])
+        fy.append(rows[3])
+        torque.append(rows[4])
+        mob.append(np.array([e[3] for e in manual], dtype=bool))
+    cat = (lambda parts, dtype=float: np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
+    x, y, fx, fy, torque = map(cat, (x, y, fx, fy, torque))
+    return dict(rep=np.zeros(len(x), dtype=np.intp), x=x, y=y, mob=cat(mob, bool), fx=fx, fy=fy, torque=torque)
+
+
 class StressTensorEvaluation:
-    """Evaluates every stress tensor (eqs. S1-16 to S1-24) from a :class:`Force_register` with array operations.
+    """Evaluates every stress tensor (eqs. S1-16 to S1-24) of a :class:`Force_register` with the engine's functions.
 
     The tensors are attributes (``overall_stress_tensor``, ``stress_tensor_LW`` …; see
     :data:`TENSOR_NAMES`), 2×2 nested lists in Pa, recomputed by each ``evaluate_*`` call.
-    The cell volume is ``V = (size_x·1e-6)·(size_y·1e-6)`` m² per m depth.
+    The cell volume is ``V = (size_x·1e-6)·(size_y·1e-6)`` m² per m depth.  Each tensor is the
+    function of that tensor in :data:`particleShear.engine.stress.TENSORS`, evaluated on the
+    register and the spheres passed as a batch of one replica (docs/design.md).
 
     Parameters
     ----------
@@ -122,10 +332,9 @@ class StressTensorEvaluation:
         self.theCanvas = theCanvas
         self.graphical_output_configuration = None
         self.toDeleteList = []
-        self._t = np.zeros((9, 2, 2))
-        self._tflat = self._t.reshape(-1)
-        self._raw = np.zeros((5, 2, 2))
-        self._w_cache = None
+        self._t = np.zeros((len(TENSORS), 2, 2))
+        self._rows = None      # _BlockRows of the last engine block read
+        self._spheres = None   # (N, rep, all-mobile mask, zero torques) of the last ensemble size
 
     for _k, _name in enumerate(TENSOR_NAMES):
         locals()[_name] = _tensor_property(_k)
@@ -137,19 +346,7 @@ class StressTensorEvaluation:
         return self._t
 
     def _volume(self):
-        return (self.size_x * _CL) * (self.size_y * _CL)
-
-    def _cell(self):
-        """(key, V, centre as a (2, 1) column, sv = 1e-18/V, scales of the first five tensors) of the
-        cell, kept per cell size."""
-        key = (self.size_x, self.size_y)
-        c = getattr(self, "_cell_cache", None)
-        if c is None or c[0] != key:
-            V = self._volume()
-            sv = _CF * _CL / V
-            scale5 = np.array((-sv, -1e-18 / V, -sv, sv, sv)).reshape(5, 1, 1)
-            c = self._cell_cache = (key, V, np.array(((self.size_x / 2,), (self.size_y / 2,))), sv, scale5)
-        return c
+        return (self.size_x * 1e-6) * (self.size_y * 1e-6)
 
     # -- sphere lists -----------------------------------------------------------------------
     @staticmethod
@@ -207,89 +404,122 @@ class StressTensorEvaluation:
         arr = np.array(vals, dtype=float).reshape(-1, 6)
         return tuple(arr[:, q] for q in range(6))
 
+    # -- the engine's inputs ------------------------------------------------------------------
+    def _block_rows(self, p):
+        rows = self._rows
+        if rows is None or not rows.same(p):
+            rows = self._rows = _BlockRows(p)
+        return rows
+
+    def _per_sphere(self, n):
+        """(replica index, all-mobile mask, zero torques) of ``n`` spheres, kept per size."""
+        s = self._spheres
+        if s is None or s[0] != n:
+            s = self._spheres = (n, np.zeros(n, dtype=np.intp), np.ones(n, dtype=bool), np.zeros(n))
+        return s[1:]
+
+    @staticmethod
+    def _block_arrays(p, rows, ens):
+        """(active, dx, dy, fx_i, fy_i, dF) of an engine block: the pair vectors of the force phase
+        (taken anew from the positions if a sphere has moved since: only internal pairs, which never
+        act through the boundary, use them) and the pair's torque ``t_i + t_j = d·F_T`` (eq. S1-3)."""
+        active = p.get("active")
+        if active is None:
+            active = rows.all_active
+        D = p["D"]
+        if p["pos_version"] != ens._pos_version:
+            pos = ens._pos
+            D = pos.take(p["j"], axis=1) - pos.take(p["i"], axis=1)
+        T = p.get("T")
+        if T is None:
+            dF = rows.zeros
+        else:
+            P = rows.C.P
+            dF = T[:P] + T[P:]
+        Fi = p["Fi"]
+        return active, D[0], D[1], Fi[0], Fi[1], dF
+
+    def _shear_from_register(self, reg, pairs=None):
+        """(τ_internal, τ_surface) of the register by the engine's shear-stress function (eq. S1-25).
+
+        The one function of both the full and the σ_xy-only evaluation, on the same inputs, so
+        G does not depend on whether tensors are kept.  ``pairs``: the register's entries when
+        already made (:func:`_entries`)."""
+        cell = _cell(self)
+        p = _engine_block(reg)
+        if p is not None:
+            ens = reg._ens
+            rows = self._block_rows(p)
+            active, _, dy, fx_i, _, dF = self._block_arrays(p, rows, ens)
+            yc = ens._a["y"] - self.size_y / 2
+            tau = _engine_shear_stresses(rows.C, 1, yc, rows.flags, active, rows.not_internal, dy, fx_i, dF,
+                                         cell["V"])
+        else:
+            q = StressInputs(**(_entries(reg) if pairs is None else pairs), **cell)
+            tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
+        return float(tau[0][0]), float(tau[1][0])
+
+    def _array_inputs(self, reg, spheres, shear_rate):
+        """The inputs of one engine force phase read from the ensemble's own arrays, or None.
+
+        Applies to a register of one engine block (F_j = −F_i, no manual entries) with its totals,
+        whose flags are the engine's rule for the totals' mobility mask, and to spheres that are
+        rows of the ensemble.  The kinetic tensors sum over the spheres passed, the unbalanced-force
+        tensor over the register's (mobile) totals."""
+        p = _engine_block(reg)
+        if p is None or reg._tot is None or reg._manual:
+            return None
+        ens = reg._ens
+        ok, mask = self._rows_of(ens, spheres)
+        if not ok:
+            return None
+        rows = self._block_rows(p)
+        mob, fx, fy = reg._tot
+        if not rows.follows_mask(p, mob):
+            return None
+        a = ens._a
+        rep, everyone, no_torque = self._per_sphere(len(a["x"]))
+        active, dx, dy, fx_i, fy_i, dF = self._block_arrays(p, rows, ens)
+        q = StressInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"], omega=a["omega"],
+                         m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob, active=active,
+                         shifted=rows.not_internal, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=fx, fy=fy,
+                         torque=no_torque if reg._mom is None else reg._mom, **_cell(self, shear_rate))
+        if mask is mob:
+            return ForcePhase(q, q, q)
+        return ForcePhase(q, q, _with_mobile(q, everyone if mask is None else mask))
+
+    def _sphere_inputs(self, theSphereList, shear_rate=0.0):
+        """The spheres of a list as the engine's sphere inputs of a batch of one (all counted)."""
+        inertia, omega, m, vx, vy, y = self._sphere_values(theSphereList)
+        n = len(m)
+        return StressInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy, y=y,
+                            mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
+
+    def _pair_inputs(self, reg, entries=None):
+        return StressInputs(**(_entries(reg) if entries is None else entries), **_cell(self))
+
+    def _total_inputs(self, reg):
+        return StressInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
+                            **_totals(reg), **_cell(self))
+
+    def _store(self, q, functions):
+        """Evaluate ``functions`` of the registry on ``q`` into the tensor attributes."""
+        for f in functions:
+            self._t[_INDEX[f]] = q.tensor(f)[0]
+
     # -- force tensors ----------------------------------------------------------------------
     def evaluate_force_stress_tensors(self, force_register):
         """Love-Weber, unbalanced-force, linear-acceleration and external-force tensors (eqs. S1-19, S1-17, S1-16).
+
+        Reads the register entry by entry (every block, manual ``record_*`` entries included).
 
         Parameters
         ----------
         force_register : Force_register
             The forces and torques of the current force phase.
         """
-        V = self._volume()
-        cx, cy = self.size_x / 2, self.size_y / 2
-        lw = np.zeros((2, 2))
-        ext = np.zeros((2, 2))
-        unb = np.zeros((2, 2))
-        reg = force_register
-        ens = reg._ens
-        for p in reg._blocks:
-            if not len(p["i"]):
-                continue
-            x = ens._a["x"]
-            y = ens._a["y"]
-            i, j = p["i"], p["j"]
-            internal = p["internal"]
-            fix, fiy, fjx, fjy = p["fix"], p["fiy"], p["fjx"], p["fjy"]
-            if not internal.all():
-                w = np.flatnonzero(internal)
-                i_, j_ = i[w], j[w]
-                fix, fiy, fjx, fjy = fix[w], fiy[w], fjx[w], fjy[w]
-            else:
-                i_, j_ = i, j
-            if len(i_):
-                ddx = x[i_] - x[j_]
-                ddy = y[i_] - y[j_]
-                if p.get("antisymmetric", True):
-                    # F_j = −F_i: the two entries of a pair are equal and their halves add up exactly
-                    lw += (np.array((fix, fiy)) * _CF) @ np.array((ddx, ddy)).T * _CL
-                else:
-                    gx = fix * _CF
-                    gy = fiy * _CF
-                    hx = fjx * _CF
-                    hy = fjy * _CF
-                    for a_, gi, gj in ((0, gx, hx), (1, gy, hy)):
-                        for b_, dd in ((0, ddx), (1, ddy)):
-                            lw[a_, b_] += np.sum(gi * dd * _CL / 2) + np.sum(gj * -dd * _CL / 2)
-            for side, idx, fx, fy in (("ext_i", i, p["fix"], p["fiy"]), ("ext_j", j, p["fjx"], p["fjy"])):
-                m = p[side]
-                if m.any():
-                    w = np.flatnonzero(m)
-                    t = idx[w]
-                    lx = (x[t] - cx) * _CL
-                    ly = (y[t] - cy) * _CL
-                    gx = fx[w] * _CF
-                    gy = fy[w] * _CF
-                    ext -= [[gx @ lx, gx @ ly], [gy @ lx, gy @ ly]]
-        if reg._tot is not None:
-            mobile, fx, fy = reg._tot
-            x = ens._a["x"]
-            y = ens._a["y"]
-            F = np.array((fx, fy))
-            X = np.array((x - cx, y - cy))
-            if mobile is not None:
-                F = F[:, mobile]
-                X = X[:, mobile]
-            unb += (F * _CF) @ (X * _CL).T
-        for t, s, f in reg._m_pair:
-            d = ((t.x - s.x) * _CL, (t.y - s.y) * _CL)
-            for a in range(2):
-                for b in range(2):
-                    lw[a, b] += f[a] * _CF * d[b] / 2
-        for t, f in reg._m_ext:
-            d = ((t.x - cx) * _CL, (t.y - cy) * _CL)
-            for a in range(2):
-                for b in range(2):
-                    ext[a, b] -= f[a] * _CF * d[b]
-        for t, f in reg._m_tot.values():
-            d = ((t.x - cx) * _CL, (t.y - cy) * _CL)
-            for a in range(2):
-                for b in range(2):
-                    unb[a, b] += f[a] * _CF * d[b]
-        self._t[_LW] = lw / V
-        self._t[_EXT] = ext / V
-        self._t[_UNB] = unb / V
-        self._t[_LIN] = self._t[_UNB]
+        self._store(self._pair_inputs(force_register), (_es.love_weber, _es.external_forces))
+        self._store(self._total_inputs(force_register), (_es.unbalanced_forces, _es.linear_acceleration))
 
     # -- rotational tensors -------------------------------------------------------------------
     def evaluate_spin_kinetic_energy_stress_tensor(self, theSphereList):
@@ -300,15 +530,7 @@ class StressTensorEvaluation:
         theSphereList : list
             The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
         """
-        inertia, omega = self._sphere_values(theSphereList)[:2]
-        K = float(np.sum((inertia * _CT) * omega ** 2 / 2))
-        v = -K / self._volume()
-        self._t[_CEN] = [[v, 0.0], [0.0, v]]
-
-    @staticmethod
-    def _antisym(total, V):
-        s = total * _CT / V
-        return [[0.0, -s / 2], [s / 2, 0.0]]
+        self._store(self._sphere_inputs(theSphereList), (_es.spin_kinetic_energy,))
 
     def evaluate_unbalanced_torque_stress_tensor(self, force_register):
         """Antisymmetric tensor of all net torques, immobile spheres included (eq. S1-22).
@@ -318,11 +540,7 @@ class StressTensorEvaluation:
         force_register : Force_register
             The forces and torques of the current force phase.
         """
-        total = 0.0
-        if force_register._mom is not None:
-            total += float(np.sum(force_register._mom))
-        total += sum(m for _, m in force_register._m_unb.values())
-        self._t[_TQ] = self._antisym(total, self._volume())
+        self._store(self._total_inputs(force_register), (_es.unbalanced_torque,))
 
     def evaluate_internal_torque_stress_tensor(self, force_register):
         """Antisymmetric tensor of the internal pair torques (eq. S1-22); symmetrises Love-Weber (eq. S1-24).
@@ -332,13 +550,7 @@ class StressTensorEvaluation:
         force_register : Force_register
             The forces and torques of the current force phase.
         """
-        total = 0.0
-        for p in force_register._blocks:
-            if p.get("ti") is not None:
-                internal = p["internal"]
-                total += float(np.sum(p["ti"][internal]) + np.sum(p["tj"][internal]))
-        total += sum(m for _, _, m in force_register._m_imom)
-        self._t[_TINT] = self._antisym(total, self._volume())
+        self._store(self._pair_inputs(force_register), (_es.internal_torque,))
 
     def evaluate_rotational_stress_tensors(self, force_register, theSphereList):
         """Centrifugal, unbalanced-torque and internal-torque tensors (eqs. S1-21, S1-22).
@@ -364,18 +576,15 @@ class StressTensorEvaluation:
         shear_rate : float
             Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
         """
-        _, _, m, vx, vy, y = self._sphere_values(theSphereList)
-        px = m * 1e-12 * (vx - shear_rate * (y - self.size_y / 2))
-        py = m * 1e-12 * vy
-        mm = m * 1e-6
-        xx = -float(np.sum(px * px / mm))
-        xy = -float(np.sum(px * py / mm))
-        yy = -float(np.sum(py * py / mm))
-        V = self._volume()
-        self._t[_OT] = [[xx / V, xy / V], [xy / V, yy / V]]
+        self._store(self._sphere_inputs(theSphereList, shear_rate), (_es.peculiar_acceleration_otsuki,))
 
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
         """Every tensor and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24).
+
+        The xy entries of the overall and external-force tensors are ``−τ_internal`` and
+        ``−τ_surface`` of the engine's shear-stress function, the numbers
+        :meth:`evaluate_shear_stresses` gives (they equal the registry's sums to rounding, ≈ 1e-16
+        relative), so G does not depend on whether tensors are kept.
 
         Parameters
         ----------
@@ -387,161 +596,42 @@ class StressTensorEvaluation:
             Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
         """
         reg = force_register
-        if len(reg._blocks) == 1 and reg._tot is not None and not reg._manual and "S" in reg._blocks[0]:
-            ok, mask = self._rows_of(reg._ens, theSphereList)
-            if ok:
-                self._evaluate_arrays(reg, mask, shear_rate)
-                return
-        self.evaluate_force_stress_tensors(force_register)
-        self.evaluate_rotational_stress_tensors(force_register, theSphereList)
-        self.evaluate_peculiar_momentum_transport_for_linear_acceleration_tensor(theSphereList, shear_rate)
-        self._t[_ALL] = self._t[_LW] + self._t[_TINT] + self._t[_CEN]
-
-    def _evaluate_arrays(self, reg, mobile, shear_rate):
-        """All tensors of one engine force phase in a few array operations (same formulas as above).
-
-        ``mobile`` is the mask of the spheres passed by the caller (None: all), the spheres of the
-        spin and Otsuki sums; the unbalanced-force tensor sums over the register's mobile spheres.
-        Sums over spheres are dot products with the masks as weights; the Otsuki and spin terms
-        come from one 3×3 product over (u_x, u_y, ω)."""
+        q = self._array_inputs(reg, theSphereList, shear_rate)
+        entries = None
+        if q is None:
+            entries = _entries(reg)
+            q = ForcePhase(self._pair_inputs(reg, entries), self._total_inputs(reg),
+                           self._sphere_inputs(theSphereList, shear_rate))
         t = self._t
-        ens = reg._ens
-        pos = ens._pos
-        _, V, c, sv, scale5 = self._cell()   # sv: forces × lever arms in SI, per volume
-        p = reg._blocks[0]
-        S = p["S"]
-        n_int = S.n_int
-        X = pos - c
-        # unscaled sums of the first five tensors (LW, Otsuki, external, linear acceleration, unbalanced),
-        # scaled by one multiply: −sv, −1e-18/V, −sv, sv, sv
-        raw = self._raw
-        lw_pairs = n_int and p["antisymmetric"]
-        if lw_pairs:
-            _internal_moment(p, pos, ens._pos_version, raw[_LW])
-        ext = n_int != S.P and _external_moment(p, pos, c, None, out=raw[_EXT], X=X) is not None
-        Wm, mobf = self._mobile_weights(ens, mobile)
-        reg_mobile = reg._tot[0]   # the spheres of total_particle_force_register
-        if reg_mobile is mobile:
-            Xm = X if mobile is None else X * mobf
-        else:
-            Xm = X if reg_mobile is None else X * reg_mobile
-        _dot(reg._tot_block[:2], Xm.T, raw[_UNB])
-        raw[_LIN] = raw[_UNB]
-        # (u_x, u_y, ω) with u the velocity relative to the affine flow; weights (m, m, I) of mobile spheres
-        U = ens._vel.copy()
-        if shear_rate:
-            U[0] -= ens._affine_vx(shear_rate)   # = shear_rate · X[1], shared with the damping
-        Wt = Wm * U
-        M = _dot(Wt, U.T)
-        raw[_OT] = M[:2, :2]   # −Σ m u⊗u / V in SI: mass 1e-6 kg/m, velocity 1e-6 m/s
-        np.multiply(raw, scale5, out=t[:5])
-        if not lw_pairs:
-            if n_int:
-                self.evaluate_force_stress_tensors(reg)
-            else:
-                t[_LW] = 0.0
-        if not ext:
-            t[_EXT] = 0.0
-        K = float(M[2, 2]) * (_CT / 2) / V
-        total = float(np.add.reduce(reg._mom)) if reg._mom is not None else 0.0
-        s_ = total * _CT / V
-        tint = self._internal_torque(p) if n_int else 0.0
-        s2 = tint * _CT / V
-        # the scalar entries of the torque, internal-torque and spin tensors, through the flat view
-        tf = self._tflat
-        tf[_TQ00] = tf[_TQ11] = 0.0
-        tf[_TQ01] = -s_ / 2
-        tf[_TQ10] = s_ / 2
-        tf[_TI00] = tf[_TI11] = 0.0
-        tf[_TI01] = -s2 / 2
-        tf[_TI10] = s2 / 2
-        tf[_CE00] = tf[_CE11] = -K
-        tf[_CE01] = tf[_CE10] = 0.0
-        np.add(t[_LW], t[_TINT], out=t[_ALL])
-        t[_ALL] += t[_CEN]
-
-    def _mobile_weights(self, ens, mobile):
-        """(m, m, I) of the mobile spheres (0 for the others), shape (3, N), and the mobility mask
-        as floats on two rows; kept while the ensemble's masses and the mask (same object while
-        unchanged) stay."""
-        key = (ens, ens._params_version, mobile)
-        w = getattr(self, "_w_cache", None)
-        if w is None or w[0][0] is not ens or w[0][1] != key[1] or w[0][2] is not mobile:
-            Wt = ens._st.take(_MASS_ROWS, axis=0)
-            mobf = None
-            if mobile is not None:
-                mobf = mobile.astype(float)
-                Wt *= mobf
-                mobf = np.array((mobf, mobf))   # for the (2, N) lever arms: same shape, no broadcasting
-            w = self._w_cache = (key, Wt, mobf)
-        return w[1], w[2]
-
-    def _centre(self):
-        """Cell centre as a (2, 1) column (µm)."""
-        return self._cell()[2]
-
-    @staticmethod
-    def _internal_torque(p):
-        """Σ (t_i + t_j) over the internal pairs of an engine register block (internal units)."""
-        T = p.get("T")
-        if T is None:
-            return 0.0
-        S = p["S"]
-        if S.w_int is None:
-            return float(np.add.reduce(T))
-        return float(_dot(S.w_int2, T))   # T = (t_i of every pair, t_j of every pair)
+        t[...] = _es.evaluate_all(q)[0]
+        tau_internal, tau_surface = self._shear_from_register(reg, entries)
+        t[_ALL, 0, 1] = -tau_internal
+        t[_EXT, 0, 1] = -tau_surface
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
         """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).
 
-        Returns ``(τ_internal, τ_surface)`` computed with exactly the operations of
-        the full evaluation, so G does not depend on whether tensors are kept.
-        The other tensor entries are not updated.
+        Returns ``(τ_internal, τ_surface)`` of the engine's shear-stress function, the numbers the
+        full evaluation puts into those entries, so G does not depend on whether tensors are kept.
+        Only the xy entries of the overall and external-force tensors are updated.
 
         Parameters
         ----------
         force_register : Force_register
             The forces and torques of the current force phase.
         theSphereList : list
-            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+            The spheres of the evaluation (in the experiment, the mobile ones); the shear stresses do
+            not depend on them (the centrifugal tensor has no xy entry).
 
         Returns
         -------
         tuple of float
             ``(τ_internal, τ_surface)`` (Pa), eq. S1-25.
         """
-        reg = force_register
-        if not (len(reg._blocks) == 1 and "S" in reg._blocks[0] and not reg._m_pair and not reg._m_ext
-                and not reg._m_imom and self._rows_of(reg._ens, theSphereList)[0]):
-            self.evaluate_stress_tensors(force_register, theSphereList, 0)
-            return self.evaluate_quasistatic_shear_stress(), self.evaluate_externally_applied_shear_stress()
-        t = self._t
-        ens = reg._ens
-        pos = ens._pos
-        V = self._volume()
-        p = reg._blocks[0]
-        S = p["S"]
-        n_int = S.n_int
-        lw01 = 0.0
-        if n_int:
-            if not p["antisymmetric"]:
-                self.evaluate_force_stress_tensors(reg)
-                lw01 = t[_LW, 0, 1]
-            else:
-                lw01 = _internal_moment(p, pos, ens._pos_version, np.empty((2, 2)))[0, 1] * -(_CF * _CL / V)
-        ext01 = 0.0
-        if n_int != S.P:
-            m_ = _external_moment(p, pos, self._centre(), -(_CF * _CL / V))
-            if m_ is not None:
-                ext01 = m_[0, 1]
-        tint = self._internal_torque(p) if n_int else 0.0
-        s_ = tint * _CT / V
-        t[_LW, 0, 1] = lw01
-        t[_EXT, 0, 1] = ext01
-        t[_TINT, 0, 1] = -s_ / 2
-        t[_CEN, 0, 1] = 0.0
-        t[_ALL, 0, 1] = t[_LW, 0, 1] + t[_TINT, 0, 1] + t[_CEN, 0, 1]
-        return -float(t[_ALL, 0, 1]), -float(t[_EXT, 0, 1])
+        tau_internal, tau_surface = self._shear_from_register(force_register)
+        self._t[_ALL, 0, 1] = -tau_internal
+        self._t[_EXT, 0, 1] = -tau_surface
+        return tau_internal, tau_surface
 
     def evaluate_quasistatic_shear_stress(self):
         """τ_internal = −σ_xy of the overall tensor (eq. S1-25).
