@@ -63,6 +63,73 @@ class OneReplicaRows:
         self.seg_starts = self.offsets[:-1][self.seg_rep]
 
 
+class OneReplicaInputs(StressInputs):
+    """:class:`~particleShear.engine.stress.StressInputs` of a batch of one replica, summed in fewer calls.
+
+    The tensor functions are the engine's; only the reductions they call are specialised to one
+    replica, with the engine's numbers bit for bit (tested): the sum over the replica's one
+    segment is the same ``add.reduceat`` from row 0, and :meth:`outer` takes the four sums of a
+    tensor in one such call over its four rows of products (each row is summed on its own, as
+    four separate calls would).  The internal flags are evaluated once per set of inputs.
+    """
+
+    @staticmethod
+    def _sums(W):
+        """``add.reduceat`` of the rows of ``W`` (k, n) from column 0: shape (k,), zeros when n = 0."""
+        if not W.shape[-1]:
+            return np.zeros(W.shape[:-1])
+        return np.add.reduceat(W, _FROM_ROW_0, axis=-1)[..., 0]
+
+    def per_replica(self, weights, by_pair=True):
+        """Σ of ``weights`` over the one replica's rows (pairs or spheres), shape (1,).
+
+        Parameters
+        ----------
+        weights : ndarray (P,) or (N,)
+            One value per pair row (``by_pair``) or per sphere row.
+        by_pair : bool
+            Unused: a batch of one has one segment of either.
+
+        Returns
+        -------
+        ndarray (1,)
+        """
+        return self._sums(weights[None])
+
+    def outer(self, u, w, by_pair=True):
+        """(1, 2, 2) array of the sums of ``u_a · w_c`` over the rows (see the engine's method).
+
+        Parameters
+        ----------
+        u, w : tuple of two ndarray
+            x and y components of the two factors, one value per row.
+        by_pair : bool
+            Unused: a batch of one has one segment of either.
+
+        Returns
+        -------
+        ndarray (1, 2, 2)
+        """
+        n = len(u[0])
+        W = np.empty((4, n))
+        np.multiply(u[0], w[0], out=W[0])
+        np.multiply(u[0], w[1], out=W[1])
+        np.multiply(u[1], w[0], out=W[2])
+        np.multiply(u[1], w[1], out=W[3])
+        return self._sums(W).reshape(1, 2, 2)
+
+    @property
+    def internal(self):
+        """The engine's internal flags (eq. S1-19), evaluated once."""
+        v = self.__dict__.get("_internal")
+        if v is None:
+            v = self._internal = StressInputs.internal.fget(self)
+        return v
+
+
+_FROM_ROW_0 = np.zeros(1, dtype=np.intp)
+
+
 class ForcePhase(StressInputs):
     """The engine's inputs of one force phase of the classes, in three parts.
 
@@ -102,16 +169,20 @@ class ForcePhase(StressInputs):
 
 
 def _cell(ev, shear_rate=0.0):
-    """The per-replica inputs of the cell of ``ev`` (arrays of one replica)."""
-    return dict(B=1, Lx=np.array((float(ev.size_x),)), Ly=np.array((float(ev.size_y),)),
-                rate=np.array((float(shear_rate),)), V=np.array((ev._volume(),)))
+    """The per-replica inputs of the cell of ``ev`` (arrays of one replica), kept per cell and rate."""
+    key = (ev.size_x, ev.size_y, shear_rate)
+    c = ev._cell_inputs
+    if c is None or c[0] != key:
+        c = ev._cell_inputs = (key, dict(B=1, Lx=np.array((float(ev.size_x),)), Ly=np.array((float(ev.size_y),)),
+                                         rate=np.array((float(shear_rate),)), V=np.array((ev._volume(),))))
+    return c[1]
 
 
 def _with_mobile(q, mob):
     """A copy of the inputs ``q`` whose sphere sums run over the spheres of mask ``mob``."""
-    d = {k: v for k, v in q.__dict__.items() if k != "_tensors"}
+    d = {k: v for k, v in q.__dict__.items() if not k.startswith("_")}   # not what was evaluated
     d["mob"] = mob
-    return StressInputs(**d)
+    return type(q)(**d)
 
 
 def _tensor_property(k):
@@ -335,6 +406,7 @@ class StressTensorEvaluation:
         self._t = np.zeros((len(TENSORS), 2, 2))
         self._rows = None      # _BlockRows of the last engine block read
         self._spheres = None   # (N, rep, all-mobile mask, zero torques) of the last ensemble size
+        self._cell_inputs = None   # (key, Lx, Ly, rate, V arrays) of the last evaluation
 
     for _k, _name in enumerate(TENSOR_NAMES):
         locals()[_name] = _tensor_property(_k)
@@ -455,7 +527,7 @@ class StressTensorEvaluation:
             tau = _engine_shear_stresses(rows.C, 1, yc, rows.flags, active, rows.not_internal, dy, fx_i, dF,
                                          cell["V"])
         else:
-            q = StressInputs(**(_entries(reg) if pairs is None else pairs), **cell)
+            q = OneReplicaInputs(**(_entries(reg) if pairs is None else pairs), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
         return float(tau[0][0]), float(tau[1][0])
 
@@ -480,7 +552,7 @@ class StressTensorEvaluation:
         a = ens._a
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
         active, dx, dy, fx_i, fy_i, dF = self._block_arrays(p, rows, ens)
-        q = StressInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"], omega=a["omega"],
+        q = OneReplicaInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"], omega=a["omega"],
                          m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob, active=active,
                          shifted=rows.not_internal, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=fx, fy=fy,
                          torque=no_torque if reg._mom is None else reg._mom, **_cell(self, shear_rate))
@@ -492,14 +564,14 @@ class StressTensorEvaluation:
         """The spheres of a list as the engine's sphere inputs of a batch of one (all counted)."""
         inertia, omega, m, vx, vy, y = self._sphere_values(theSphereList)
         n = len(m)
-        return StressInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy, y=y,
+        return OneReplicaInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy, y=y,
                             mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
 
     def _pair_inputs(self, reg, entries=None):
-        return StressInputs(**(_entries(reg) if entries is None else entries), **_cell(self))
+        return OneReplicaInputs(**(_entries(reg) if entries is None else entries), **_cell(self))
 
     def _total_inputs(self, reg):
-        return StressInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
+        return OneReplicaInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
                             **_totals(reg), **_cell(self))
 
     def _store(self, q, functions):
