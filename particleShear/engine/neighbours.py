@@ -146,14 +146,17 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
 
     The box is divided into ``nx × ny`` cells of at least ``2 r_max + skin`` (:func:`cell_grid`);
     spheres are binned by sorting their cell numbers (``argsort``, ``bincount``, ``cumsum``).
-    Each sphere's candidates are the spheres of the 3 × 3 cells around it; the row above the
-    top row is the bottom row seen through the Lees-Edwards image, so it is searched around
-    ``x − shift`` (and the row below the bottom row around ``x + shift``), as the minimum image
-    of docs/design.md moves x by the offset when it takes the y image.  Every candidate is
-    then tested exactly as :func:`near_pairs_all` tests it, so both return the same pairs.
+    A pair closer than the reach lies in the same cell or in adjacent ones (3 × 3 around each
+    sphere); each pair is visited once, from the same cell (``i < j``) or from the sphere whose
+    partner lies in the cell to the right or in one of the three cells of the row above.  The
+    row above the top row is the bottom row seen through the Lees-Edwards image, so it is
+    searched around ``x − shift``, as the minimum image of docs/design.md moves x by the offset
+    when it takes the y image.  Every candidate is then tested exactly as
+    :func:`near_pairs_all` tests it (same orientation ``i < j``, same operations), so both
+    return the same pairs.
 
-    Array operations only (a loop over the 9 neighbouring cell offsets), in the namespace of
-    the inputs.  Falls back to :func:`near_pairs_all` when the grid has fewer than 3 cells per
+    Array operations only (a loop over the 5 cell offsets of the half neighbourhood), in the
+    namespace of the inputs.  Falls back to :func:`near_pairs_all` when the grid has fewer than 3 cells per
     side.
 
     Parameters
@@ -192,32 +195,33 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     order = xp.argsort(cy * nx + cx)
     counts = xp.bincount(cy * nx + cx, minlength=nx * ny)
     start = xp.cumsum(counts) - counts
-    owners = xp.arange(N, dtype=xp.intp)
+    # half the neighbourhood: a pair in one cell once (i < j), a pair in adjacent cells from the sphere
+    # whose neighbour lies to the right in its row or in the row above (exactly one of the two spheres
+    # sees the other so with at least 3 cells per side)
+    up = cy + 1
+    col_up = column(xp.where(up >= ny, xf - shift, xf))      # the row above the top row: the bottom row at x − shift
+    up = xp.mod(up, ny)
     found_i, found_j = [], []
-    for drow in (-1, 0, 1):
-        row = cy + drow
-        if drow == 0:
-            col = cx
-        else:  # through y = 0 (row −1) the image row sits at x + shift, through y = Ly at x − shift
-            crossing = (row < 0) if drow < 0 else (row >= ny)
-            col = column(xp.where(crossing, xf + shift * (-drow), xf))
-        row = xp.mod(row, ny)
-        for dcol in (-1, 0, 1):
-            cell = row * nx + xp.mod(col + dcol, nx)
-            cnt = counts[cell]
-            ends = xp.cumsum(cnt)
-            total = int(ends[-1])
-            if total == 0:
-                continue
-            k = xp.arange(total, dtype=xp.intp)
-            who = xp.searchsorted(ends, k, side="right")          # the sphere each slot belongs to
-            other = order[start[cell][who] + (k - (ends - cnt)[who])]
-            i = owners[who]
-            keep = i < other
-            i, j = i[keep], other[keep]
-            near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
-            found_i.append(i[near])
-            found_j.append(j[near])
+    for row, col, dcol, same in ((cy, cx, 0, True), (cy, cx, 1, False), (up, col_up, -1, False),
+                                 (up, col_up, 0, False), (up, col_up, 1, False)):
+        cell = row * nx + xp.mod(col + dcol, nx)
+        cnt = counts[cell]
+        ends = xp.cumsum(cnt)
+        total = int(ends[-1])
+        if total == 0:
+            continue
+        # slot k of the expansion belongs to sphere a = #(ends ≤ k) and reads the
+        # (k − first slot of a)-th sphere of a's neighbouring cell in cell order
+        a = xp.cumsum(xp.bincount(ends[:-1], minlength=total)[:total])
+        b = order[(start[cell] - (ends - cnt))[a] + xp.arange(total, dtype=xp.intp)]
+        if same:
+            keep = a < b
+            i, j = a[keep], b[keep]
+        else:
+            i, j = xp.minimum(a, b), xp.maximum(a, b)          # the pair vector as the all-pairs search takes it
+        near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
+        found_i.append(i[near])
+        found_j.append(j[near])
     if not found_i:
         return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)
     key = xp.sort(xp.concatenate(found_i) * N + xp.concatenate(found_j))
