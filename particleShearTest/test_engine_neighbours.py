@@ -51,8 +51,8 @@ class TestCellListEqualsAllPairs(unittest.TestCase):
 
     def test_tall_and_wide_boxes(self):
         rng = np.random.default_rng(12)
-        for Lx, Ly in ((2000.0, 52.0), (52.0, 2000.0), (5000.0, 60.0), (60.0, 5000.0)):
-            N = int(Lx * Ly / 60)
+        for Lx, Ly in ((2000.0, 52.0), (52.0, 2000.0), (4000.0, 55.0), (55.0, 4000.0)):   # 3 cells across
+            N = int(Lx * Ly / 120)
             x, y, r = packing(rng, N, Lx, Ly)
             for g in GAMMAS:
                 self.assert_same(x, y, r, Lx, Ly, Ly * g, 3.0, f"{Lx}×{Ly}, γ={g}")
@@ -148,6 +148,53 @@ class TestBuildCandidates(unittest.TestCase):
         others[[got.index(far), got.index((a, b))]] = False
         self.assertFalse(new.active[others].any())                # new candidates start at rest
         self.assertFalse(new.xi[:, others].any())
+
+
+
+def constituted(seed, N, **kw):
+    """A constituted ensemble of N spheres from the run API's builder, and its time step."""
+    from particleShear.run.api import _build_simulation, _seed_sequence
+    from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
+    p = dict(_signature_defaults(), seed=seed, N=N, relative_frequency=0.2, doDrawing=False, plotStress=False, **kw)
+    _, rng = _seed_sequence(seed)
+    sim = _build_simulation({k: p[k] for k in _REFERENCE_ARGUMENTS}, rng, verbose=False, progress=None,
+                            correct_drift_sign=False, reference_header=False, renderer="none", time_step_factor=1.0,
+                            integrator="euler", stability_guard=False)
+    sim.initEnsemble()
+    e = sim.theEnsemble
+    return e, e.dt, p["relative_frequency"] / sim.model.time_constant
+
+
+class TestEngineWithTheCellList(unittest.TestCase):
+    def test_sheared_trajectory_bit_identical_to_the_all_pairs_search(self):
+        # N = 400 > CELL_LIST_MIN_N: the engine's rebuilds use the cell list; with the all-pairs search
+        # forced instead, the candidate lists, hence every force and position, must be the same bits
+        from unittest import mock
+        from particleShear.engine import neighbours
+        from particleShear.engine.state import BatchState
+        from particleShear.engine.step import BatchEngine
+        N = 400
+        self.assertGreaterEqual(N, CELL_LIST_MIN_N)
+        ens, dt, f = constituted(5, N, theMu=0.05, cut_lines=3)
+        runs = []
+        for min_n in (CELL_LIST_MIN_N, 10 ** 9):
+            with mock.patch.object(neighbours, "CELL_LIST_MIN_N", min_n):
+                s = BatchState.from_ensembles([ens])
+                eng = BatchEngine(s, skin_factor=0.2, guard=False)       # a thin skin: many rebuilds
+                s.applying_shear = True
+                eng.set_rate(np.array([0.5 * 2 * math.pi * f * 8]))     # 8× the protocol's peak rate
+                for _ in range(150):
+                    eng.step(1.0, dt)
+                eng.flush()
+                runs.append((s.pos.copy(), s.vel.copy(), [(p.i.copy(), p.j.copy()) for p in s.pairs],
+                             int(eng.rebuilds[0])))
+        (pos_c, vel_c, pairs_c, nb_c), (pos_a, vel_a, pairs_a, nb_a) = runs
+        self.assertGreater(nb_c, 3)
+        self.assertEqual(nb_c, nb_a)
+        np.testing.assert_array_equal(pos_c, pos_a)
+        np.testing.assert_array_equal(vel_c, vel_a)
+        np.testing.assert_array_equal(pairs_c[0][0], pairs_a[0][0])
+        np.testing.assert_array_equal(pairs_c[0][1], pairs_a[0][1])
 
 
 if __name__ == "__main__":

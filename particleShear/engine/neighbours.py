@@ -31,7 +31,7 @@ __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cel
 
 #: smallest N for which :func:`near_pairs` uses the cell list (below it the all-pairs search is
 #: faster; measured with ``benchmarks/bench_engine_large.py --crossover``, docs/performance.md)
-CELL_LIST_MIN_N = 300
+CELL_LIST_MIN_N = 200
 
 #: relative margin of a cell over the search reach ``2 r_max + skin``: a cell index computed in
 #: floating point can then be off only for spheres closer than this to a cell border, which the

@@ -1,0 +1,146 @@
+"""Single-run cost of the engine at large N against the documented classes, same ensemble, same run (not a test).
+
+Scene: the frictional crosslinked ensemble of ``bench_step.build(N)`` (random bimodal spheres,
+radius ratio 1.4, packing fraction 1.5, relaxed, all links permanent, a few cut lines, μ = 0.01,
+plates on, the default sphere size and dt).  The constituted ensemble is copied into a
+``BatchState`` of one replica (``BatchState.from_ensembles``) and both advance the same start
+under sinusoidal shear (A = 0.2, f ≈ 4 kHz), in alternating blocks (so a slow moment of a shared
+machine hits both):
+
+* engine: ``BatchEngine.set_rate`` + ``BatchEngine.step(cool, dt, sample=True)`` — what a run's
+  protocol does each step (the two shear stresses recorded; stability guard on, as in a run);
+* classes: ``setShearRate`` + forces + register totals + ``EvaluationHandler.record`` (the two
+  shear stresses, no tensor history) + acceleration + movement + reset — the per-step sequence
+  of ``OscillatoryShearExperiment.run_protocol`` without saving tensors.
+
+Prints µs per step and ns per particle-step (median over blocks of the block mean, so the
+engine's neighbour rebuilds — every ~100–200 steps — are included in their share), the engine's
+rebuild count, and the ratio engine / classes.  Targets (issue 11): ≤ 0.6 µs per particle-step at
+N = 10,000, ≤ 1 µs at N = 100,000.
+
+``--crossover`` also prints the cost of one near-pair search of the engine, all-pairs against
+the cell list, from N = 100 to 2,000 on packings of the same density (the basis of
+``CELL_LIST_MIN_N``), and of the classes' ``candidate_pairs`` on the same positions.
+
+Run it with ``OMP_NUM_THREADS=1`` (set here by default).
+Usage: python benchmarks/bench_engine_large.py [--sizes 10000 100000] [--steps 300] [--block 50] [--crossover]
+"""
+import os
+
+for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from bench_step import AMPLITUDE, DT, F_EXC, PHI, R_MODEL, build  # noqa: E402
+
+from particleShear import StressTensorEvaluation  # noqa: E402
+from particleShear.base.neighbours import candidate_pairs  # noqa: E402
+from particleShear.engine.neighbours import near_pairs_all, near_pairs_cells  # noqa: E402
+from particleShear.engine.state import BatchState  # noqa: E402
+from particleShear.engine.step import BatchEngine  # noqa: E402
+from particleShear.simulation.evaluation import EvaluationHandler  # noqa: E402
+
+COOL = 0.99969060716623
+W = 2 * math.pi * F_EXC
+
+
+def engine_block(eng, n):
+    """n protocol steps of the engine; wall time (s)."""
+    s = eng.s
+    t0 = time.perf_counter()
+    for _ in range(n):
+        eng.set_rate(np.array([AMPLITUDE * W * math.cos(W * float(s.t[0]))]))
+        eng.step(COOL, DT, sample=True)
+    return time.perf_counter() - t0
+
+
+def classes_block(ens, ev, handler, n):
+    """n protocol steps of the documented classes; wall time (s)."""
+    t0 = time.perf_counter()
+    for _ in range(n):
+        ens.setShearRate(AMPLITUDE * W * math.cos(W * ens.t))
+        ens.mechanical_simulation_step_calculate_forces()
+        ens.record_total_particle_forces()
+        handler.record(ens, ev)
+        ens.mechanical_simulation_step_calculate_acceleration(COOL, DT)
+        ens.mechanical_simulation_step_calculate_movement(DT)
+        ens.reset_force()
+    return time.perf_counter() - t0
+
+
+def compare(n, steps, block):
+    t0 = time.perf_counter()
+    ens = build(n)
+    t_build = time.perf_counter() - t0
+    eng = BatchEngine(BatchState.from_ensembles([ens]))
+    ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+    handler = EvaluationHandler()
+    handler.allocate(steps + 2 * block, keep_tensor_history=False)
+    engine_block(eng, 5)                 # warm-up (the first list build is not timed)
+    classes_block(ens, ev, handler, 5)
+    rebuilds0 = int(eng.rebuilds[0])
+    te, tc = [], []
+    for _ in range(max(1, steps // block)):
+        te.append(engine_block(eng, block) / block)
+        tc.append(classes_block(ens, ev, handler, block) / block)
+    e_us, c_us = statistics.median(te) * 1e6, statistics.median(tc) * 1e6
+    pairs = len(eng.C.ai)
+    print(f"N = {n:7d}: engine {e_us:10.1f} µs/step = {1e3 * e_us / n:6.0f} ns/particle-step "
+          f"({int(eng.rebuilds[0]) - rebuilds0} rebuilds in {len(te) * block} steps, {pairs} candidates); "
+          f"classes {c_us:10.1f} µs/step = {1e3 * c_us / n:6.0f} ns/particle-step; "
+          f"engine/classes = {e_us / c_us:.2f}  [L = {ens.size_x:.0f} µm, build {t_build:.1f} s]")
+    return e_us / n, c_us / n
+
+
+def crossover(sizes=(100, 150, 200, 300, 400, 600, 1000, 2000), repeat=7):
+    rng = np.random.default_rng(5)
+    print("one near-pair search (median of %d), packing fraction %.1f, skin ½ r_max, γ = 0.3:" % (repeat, PHI))
+    for n in sizes:
+        L = math.sqrt(n * math.pi * R_MODEL ** 2 / PHI)
+        x, y = rng.uniform(0, L, n), rng.uniform(0, L, n)
+        r = np.where(rng.random(n) < 0.5, R_MODEL * math.sqrt(1.4), R_MODEL / math.sqrt(1.4))
+        skin = 0.5 * float(r.max())
+        row = []
+        for f in (lambda: near_pairs_all(x, y, r, L, L, 0.3 * L, skin),
+                  lambda: near_pairs_cells(x, y, r, L, L, 0.3 * L, skin),
+                  lambda: candidate_pairs(x, y, r, L, L, 0.3 * L, skin)):
+            f()
+            ts = []
+            for _ in range(repeat):
+                t0 = time.perf_counter()
+                f()
+                ts.append(time.perf_counter() - t0)
+            row.append(statistics.median(ts) * 1e6)
+        print(f"  N = {n:5d}: engine all-pairs {row[0]:9.0f} µs, engine cell list {row[1]:7.0f} µs, "
+              f"classes' candidate_pairs {row[2]:7.0f} µs")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[10000, 100000])
+    ap.add_argument("--steps", type=int, default=300, help="timed steps of each side per size")
+    ap.add_argument("--block", type=int, default=50, help="steps per alternating block")
+    ap.add_argument("--crossover", action="store_true", help="also time one near-pair search by N")
+    args = ap.parse_args()
+    print(f"particleShear engine vs classes at large N; numpy {np.__version__}, threads pinned to 1")
+    if args.crossover:
+        crossover()
+    res = {n: compare(n, args.steps, args.block) for n in args.sizes}
+    for n, target in ((10000, 0.6), (100000, 1.0)):
+        if n in res:
+            ok = res[n][0] <= target
+            print(f"target N = {n}: engine ≤ {target} µs/particle-step: {'met' if ok else 'MISSED'} "
+                  f"({res[n][0]:.3f})")
+
+
+if __name__ == "__main__":
+    main()
