@@ -1,29 +1,38 @@
 """Single-run cost of the engine at large N against the documented classes, same ensemble, same run (not a test).
 
-Scene: the frictional crosslinked ensemble of ``bench_step.build(N)`` (random bimodal spheres,
-radius ratio 1.4, packing fraction 1.5, relaxed, all links permanent, a few cut lines, μ = 0.01,
-plates on, the default sphere size and dt).  The constituted ensemble is copied into a
-``BatchState`` of one replica (``BatchState.from_ensembles``) and both advance the same start
-under sinusoidal shear (A = 0.2, f ≈ 4 kHz), in alternating blocks (so a slow moment of a shared
-machine hits both):
+Two scenes (``--scene``):
+
+* ``relaxed`` (default): the frictional crosslinked ensemble of ``bench_step.build(N)`` (random
+  bimodal spheres, radius ratio 1.4, packing fraction 1.5, a short damped relaxation, all links
+  permanent, a few cut lines, μ = 0.01, plates on, the default sphere size and dt) — the scene of
+  the issue's figures (a lively one: the engine rebuilds its list every ~15 steps);
+* ``default``: the scene a run measures, built as ``doParticleShearSimulation`` builds it
+  (``bench_scenes.build``: the builder's crosslinked particles, 5 cut lines, μ = 0.01,
+  pre-equilibrated with plates; the constitution grows faster than N: ~10 s at N = 10,000).
+
+The ensemble is copied into a ``BatchState`` of one replica (``BatchState.from_ensembles``) and
+both advance the same start under sinusoidal shear, in alternating blocks (so a slow moment of a
+shared machine hits both):
 
 * engine: ``BatchEngine.set_rate`` + ``BatchEngine.step(cool, dt, sample=True)`` — what a run's
   protocol does each step (the two shear stresses recorded; stability guard on, as in a run);
-* classes: ``setShearRate`` + forces + register totals + ``EvaluationHandler.record`` (the two
-  shear stresses, no tensor history) + acceleration + movement + reset — the per-step sequence
-  of ``OscillatoryShearExperiment.run_protocol`` without saving tensors.
+* classes, ``relaxed``: ``setShearRate`` + forces + register totals + ``EvaluationHandler.record``
+  (the two shear stresses, no tensor history) + acceleration + movement + reset;
+  ``default``: ``OscillatoryShearExperiment.run_protocol`` itself (what a run through the classes
+  does per step).
 
 Prints µs per step and ns per particle-step (median over blocks of the block mean, so the
-engine's neighbour rebuilds — every ~100–200 steps — are included in their share), the engine's
-rebuild count, and the ratio engine / classes.  Targets (issue 11): ≤ 0.6 µs per particle-step at
-N = 10,000, ≤ 1 µs at N = 100,000.
+engine's neighbour rebuilds are included in their share), the engine's rebuild count, and the
+ratio engine / classes.  Targets (issue 11): ≤ 0.6 µs per particle-step at N = 10,000, ≤ 1 µs at
+N = 100,000.
 
 ``--crossover`` also prints the cost of one near-pair search of the engine, all-pairs against
 the cell list, from N = 100 to 2,000 on packings of the same density (the basis of
 ``CELL_LIST_MIN_N``), and of the classes' ``candidate_pairs`` on the same positions.
 
 Run it with ``OMP_NUM_THREADS=1`` (set here by default).
-Usage: python benchmarks/bench_engine_large.py [--sizes 10000 100000] [--steps 300] [--block 50] [--crossover]
+Usage: python benchmarks/bench_engine_large.py [--scene relaxed|default] [--sizes 10000 100000] [--steps 300]
+[--block 50] [--crossover]
 """
 import os
 
@@ -40,6 +49,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from bench_scenes import build as build_default_scene  # noqa: E402
 from bench_step import AMPLITUDE, DT, F_EXC, PHI, R_MODEL, build  # noqa: E402
 
 from particleShear import StressTensorEvaluation  # noqa: E402
@@ -53,13 +63,22 @@ COOL = 0.99969060716623
 W = 2 * math.pi * F_EXC
 
 
-def engine_block(eng, n):
+def engine_block(eng, n, amplitude=AMPLITUDE, f=F_EXC, dt=DT, cool=COOL):
     """n protocol steps of the engine; wall time (s)."""
     s = eng.s
+    w = 2 * math.pi * f
     t0 = time.perf_counter()
     for _ in range(n):
-        eng.set_rate(np.array([AMPLITUDE * W * math.cos(W * float(s.t[0]))]))
-        eng.step(COOL, DT, sample=True)
+        eng.set_rate(np.array([amplitude * w * math.cos(w * float(s.t[0]))]))
+        eng.step(cool, dt, sample=True)
+    return time.perf_counter() - t0
+
+
+def experiment_block(exp, n, cool):
+    """n steps of the classes' own protocol loop (``run_protocol``); wall time (s)."""
+    exp.prepare_recording()
+    t0 = time.perf_counter()
+    exp.run_protocol(cool, n)
     return time.perf_counter() - t0
 
 
@@ -77,27 +96,34 @@ def classes_block(ens, ev, handler, n):
     return time.perf_counter() - t0
 
 
-def compare(n, steps, block):
+def compare(n, steps, block, scene):
     t0 = time.perf_counter()
-    ens = build(n)
+    if scene == "default":
+        exp, ens, cool = build_default_scene(n, 1, 0.01, True, 5)
+        run_engine = (lambda eng, k: engine_block(eng, k, exp.amplitude, exp.f, exp.dt, cool))
+        run_classes = (lambda k: experiment_block(exp, k, cool))
+    else:
+        ens = build(n)
+        ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+        handler = EvaluationHandler()
+        handler.allocate(steps + 2 * block, keep_tensor_history=False)
+        run_engine = engine_block
+        run_classes = (lambda k: classes_block(ens, ev, handler, k))
     t_build = time.perf_counter() - t0
     eng = BatchEngine(BatchState.from_ensembles([ens]))
-    ev = StressTensorEvaluation(ens.size_x, ens.size_y)
-    handler = EvaluationHandler()
-    handler.allocate(steps + 2 * block, keep_tensor_history=False)
-    engine_block(eng, 5)                 # warm-up (the first list build is not timed)
-    classes_block(ens, ev, handler, 5)
+    run_engine(eng, 5)                 # warm-up (the first list build is not timed)
+    run_classes(5)
     rebuilds0 = int(eng.rebuilds[0])
     te, tc = [], []
     for _ in range(max(1, steps // block)):
-        te.append(engine_block(eng, block) / block)
-        tc.append(classes_block(ens, ev, handler, block) / block)
+        te.append(run_engine(eng, block) / block)
+        tc.append(run_classes(block) / block)
     e_us, c_us = statistics.median(te) * 1e6, statistics.median(tc) * 1e6
     pairs = len(eng.C.ai)
-    print(f"N = {n:7d}: engine {e_us:10.1f} µs/step = {1e3 * e_us / n:6.0f} ns/particle-step "
+    print(f"{scene} N = {n:7d}: engine {e_us:10.1f} µs/step = {1e3 * e_us / n:6.0f} ns/particle-step "
           f"({int(eng.rebuilds[0]) - rebuilds0} rebuilds in {len(te) * block} steps, {pairs} candidates); "
           f"classes {c_us:10.1f} µs/step = {1e3 * c_us / n:6.0f} ns/particle-step; "
-          f"engine/classes = {e_us / c_us:.2f}  [L = {ens.size_x:.0f} µm, build {t_build:.1f} s]")
+          f"engine/classes = {e_us / c_us:.2f}  [L = {ens.size_x:.0f} µm, build {t_build:.1f} s]", flush=True)
     return e_us / n, c_us / n
 
 
@@ -130,11 +156,12 @@ def main():
     ap.add_argument("--steps", type=int, default=300, help="timed steps of each side per size")
     ap.add_argument("--block", type=int, default=50, help="steps per alternating block")
     ap.add_argument("--crossover", action="store_true", help="also time one near-pair search by N")
+    ap.add_argument("--scene", choices=("relaxed", "default"), default="relaxed")
     args = ap.parse_args()
     print(f"particleShear engine vs classes at large N; numpy {np.__version__}, threads pinned to 1")
     if args.crossover:
         crossover()
-    res = {n: compare(n, args.steps, args.block) for n in args.sizes}
+    res = {n: compare(n, args.steps, args.block, args.scene) for n in args.sizes}
     for n, target in ((10000, 0.6), (100000, 1.0)):
         if n in res:
             ok = res[n][0] <= target
