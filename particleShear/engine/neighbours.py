@@ -179,6 +179,8 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     if N < 2:
         return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)
     Lx, Ly, shift, skin = float(Lx), float(Ly), float(shift), float(skin)
+    # device-to-host transfers on CuPy (once per rebuild): the largest radius sizes the grid, and
+    # each expansion's length below sizes its arrays
     nx, ny = cell_grid(Lx, Ly, 2 * float(r.max()) + skin, N)
     if nx < 3 or ny < 3:
         return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
