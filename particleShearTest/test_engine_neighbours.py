@@ -119,6 +119,23 @@ class TestCellListEqualsAllPairs(unittest.TestCase):
             np.testing.assert_array_equal(i, ai)
             np.testing.assert_array_equal(j, aj)
 
+    def test_positions_outside_the_cell_and_non_finite(self):
+        # spheres moved by whole periods (a y period with the offset of its image row) are the same
+        # spheres: binned by their folded position, tested on the raw differences as the all-pairs
+        # search tests them; a non-finite sphere has no pair (its distance test fails) and breaks nothing
+        rng = np.random.default_rng(16)
+        N, Lx, Ly, g = 700, 300.0, 260.0, 0.3
+        x, y, r = packing(rng, N, Lx, Ly)
+        k = rng.integers(-1, 2, (2, N))
+        x2, y2 = x + Lx * k[0] + Ly * g * k[1], y + Ly * k[1]
+        n = self.assert_same(x2, y2, r, Lx, Ly, Ly * g, 3.0, "outside")
+        self.assertEqual(n, self.assert_same(x, y, r, Lx, Ly, Ly * g, 3.0, "inside"))
+        x2[5], y2[9], x2[11] = np.nan, np.inf, -np.inf
+        with np.errstate(invalid="ignore"):
+            self.assert_same(x2, y2, r, Lx, Ly, Ly * g, 3.0, "non-finite")
+            i, j = near_pairs_cells(x2, y2, r, Lx, Ly, Ly * g, 3.0)
+        self.assertFalse(np.isin([5, 9, 11], np.concatenate((i, j))).any())
+
     def test_fewer_than_two_spheres(self):
         for N in (0, 1):
             i, j = near_pairs_cells(np.zeros(N), np.zeros(N), np.ones(N), 100.0, 100.0, 0.0, 1.0)

@@ -186,13 +186,19 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
         return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
     cw, ch = Lx / nx, Ly / ny
 
+    def index(v, size, n):
+        # cell index of coordinates in [0, n·size]; a non-finite coordinate goes to cell 0 (its pairs
+        # fail the distance test anyway), one on the far border to the last cell
+        c = xp.floor(v / size)
+        return xp.minimum(xp.where(c >= 0, c, 0), n - 1).astype(xp.intp)
+
     def column(xs):
-        return xp.clip(xp.floor(xp.mod(xs, Lx) / cw), 0, nx - 1).astype(xp.intp)
+        return index(xp.mod(xs, Lx), cw, nx)
 
     # bin: fold into the cell (a y period moves x by the offset), cell number, spheres sorted by cell
     ky = xp.floor(y / Ly)
     xf = x - shift * ky
-    cy = xp.clip(xp.floor((y - Ly * ky) / ch), 0, ny - 1).astype(xp.intp)
+    cy = index(y - Ly * ky, ch, ny)
     cx = column(xf)
     order = xp.argsort(cy * nx + cx)
     counts = xp.bincount(cy * nx + cx, minlength=nx * ny)
