@@ -13,8 +13,9 @@ replica, an upper bound of how much any pair separation can have shrunk since th
 bound reaches the skin.  The contacts of every step are therefore exactly those of an all-pairs
 search (tested), and a replica's list depends only on its own history.
 
-Array namespace: the cell list takes the namespace of its inputs (NumPy, or CuPy when CuPy is
-imported and the inputs are CuPy arrays); the all-pairs oracle is NumPy only.
+Array namespace: both searches take the namespace of their inputs (NumPy, or CuPy when CuPy is
+imported and the inputs are CuPy arrays; the minimum image of :mod:`.box` must then accept them
+too); :func:`build_candidates`, which merges the bonds and carries the history over, is NumPy.
 """
 __docformat__ = "numpy"
 
@@ -103,6 +104,9 @@ def near_pairs_all(x, y, r, Lx, Ly, shift, skin):
         The pairs, sorted by ``(i, j)``.
     """
     i, j = all_pairs(len(x))
+    xp = _namespace(x)
+    if xp is not np:          # the cached index arrays live on the host
+        i, j = xp.asarray(i), xp.asarray(j)
     near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
     return i[near], j[near]
 
@@ -287,11 +291,13 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     key = i * N + j
     key_old = old.i * N + old.j
     bonds = key_old[old.state == PERMANENT]
-    if len(bonds):   # a bond stretched beyond the reach stays a candidate
-        key = np.sort(np.concatenate((key, bonds)))
-        if len(key) > 1:
-            key = key[np.concatenate(([True], key[1:] != key[:-1]))]
-        i, j = key // N, key % N
+    if len(bonds):   # a bond stretched beyond the reach stays a candidate (bonds are distinct and sorted)
+        at = np.searchsorted(key, bonds)
+        found = at < len(key)
+        found[found] = key[at[found]] == bonds[found]
+        if not found.all():
+            key = np.sort(np.concatenate((key, bonds[~found])))
+            i, j = key // N, key % N
     C = len(key)
     state = np.zeros(C, np.int8)
     xi = np.zeros((2, C))
