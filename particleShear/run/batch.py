@@ -32,7 +32,10 @@ __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLI
 
 _log = logging.getLogger(__name__)
 
-#: largest N measured by the engine (its candidate search is all-pairs per replica at each rebuild)
+#: largest N measured by the engine.  Its candidate search is a cell list (O(N) per rebuild), so this
+#: is no longer a limit of the search; single runs above it stay on the documented classes because the
+#: engine's step is slower there (1.4–1.6× on the scene a run measures at N = 500–5,000, about equal on
+#: a livelier scene at N = 2,000–100,000; docs/performance.md, benchmarks/bench_engine_large.py)
 ENGINE_MAX_N = 2000
 
 #: parameters a replica may choose on its own (everything else must agree within a batch)
