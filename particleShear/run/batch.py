@@ -271,9 +271,9 @@ def measure_batch(runs):
         seeds.append((seed_entropy, spawn_key, params))
     where = ["constitution", 0, 0]
     try:
+        _constitute(sessions)
         sched = []
         for run in sessions:
-            run.constitute()
             run.prepare()
             # the schedule of the replica: the one function runSimulation uses
             sc = run.schedule
@@ -305,6 +305,47 @@ def measure_batch(runs):
     finally:
         for run in sessions:
             run.close()
+
+
+def _constitute(sessions):
+    """Constitute every replica: bookkeeping per replica through the classes, relaxations in the engine.
+
+    Each session's constitution (:meth:`~particleShear.simulation.simulations.RunSession.constitution`)
+    yields its relaxation requests; the pending requests of equal key (steps, ``dt``, ``dt_max``)
+    run together in one engine (:func:`particleShear.engine.relax.relax_ensembles`), the key of
+    the first waiting replica first, until every constitution is done.  A replica's ensemble does
+    not depend on its companions (each has its own generator, and the engine's relaxation is per
+    replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
+    the relaxations it took part in."""
+    from ..engine.relax import relax_ensembles
+    from ..linkable.builders import MAX_RELAXATIONS
+
+    steps = [run.constitution() for run in sessions]
+    pending = {}            # replica -> its waiting Relaxation
+    since = {}              # replica -> when it was suspended
+
+    def advance(b, share=0.0):
+        if b in since:
+            sessions[b].waited += time.perf_counter() - since.pop(b) - share
+        try:
+            pending[b] = next(steps[b])
+            since[b] = time.perf_counter()
+        except StopIteration:
+            pending.pop(b, None)
+
+    for b in range(len(sessions)):
+        advance(b)
+    for _ in range(MAX_RELAXATIONS * max(len(sessions), 1)):   # each round serves at least one request
+        if not pending:
+            return
+        key = pending[min(pending)].key
+        group = [b for b in sorted(pending) if pending[b].key == key]
+        t0 = time.perf_counter()
+        relax_ensembles([pending[b].ensemble for b in group], key[0])
+        share = (time.perf_counter() - t0) / len(group)
+        for b in group:
+            advance(b, share)
+    raise RuntimeError("the constitutions of a batch yielded more relaxations than allowed")
 
 
 def _measure(sessions, sched, where):
