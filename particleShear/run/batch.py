@@ -35,6 +35,14 @@ _log = logging.getLogger(__name__)
 #: largest N measured by the engine (its candidate search is all-pairs per replica at each rebuild)
 ENGINE_MAX_N = 2000
 
+#: Verlet skin of the engines of a batch (constitution and measurement), in units of each
+#: replica's largest radius.  The contacts of every step are exact for any skin and the zero
+#: terms of candidates out of contact change no sum, so the numbers do not depend on it; at
+#: 0.2 r_max a compressed packing has ~0.9 of its candidates in contact against ~0.6 at 0.5, and
+#: a step of 32 default replicas costs ~30 % less (measured: protocol 95–100 → 65–68 µs per
+#: replica-step, constitution ~40 % less CPU time), the extra rebuilds included.
+ENGINE_SKIN_FACTOR = 0.2
+
 #: parameters a replica may choose on its own (everything else must agree within a batch)
 PER_REPLICA_PARAMETERS = frozenset((
     "seed", "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "remove_link_fraction",
@@ -341,7 +349,7 @@ def _constitute(sessions):
         key = pending[min(pending)].key
         group = [b for b in sorted(pending) if pending[b].key == key]
         t0 = time.perf_counter()
-        relax_ensembles([pending[b].ensemble for b in group], key[0])
+        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR)
         share = (time.perf_counter() - t0) / len(group)
         for b in group:
             advance(b, share)
@@ -370,14 +378,15 @@ def _measure(sessions, sched, where):
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
             say, report = _console(sims, group, "pre-equilibration", where)
-            _guarded(pre_equilibrate, BatchEngine(st, guard=[guard_of[b] for b in group]), pre[1], dt, pre[0],
-                     cool, say, report, dt=dt)
+            engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group])
+            _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)
             for b in group:
                 timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states), guard=[guard_of[b] for b in order])
+        engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
+                             guard=[guard_of[b] for b in order])
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
