@@ -59,6 +59,9 @@ class TestAgainstTheClasses(unittest.TestCase):
         pr, pe = ref._pairs, eng._pairs
         self.assertEqual(pr.key[pr.active].tolist(), pe.key[pe.active].tolist())
         self.assertEqual(pr.state[pr.active].tolist(), pe.state[pe.active].tolist())
+        # ... created in the same order (creation numbers order ``neighbors``)
+        self.assertEqual(pr.birth[pr.active].tolist(), pe.birth[pe.active].tolist())
+        self.assertEqual(pr._births, pe._births)
         self.assertGreaterEqual(int((pe.state == 2).sum()), min_bonds)
         xr, xe = pr.xi[:, pr.active], pe.xi[:, pe.active]
         self.assertLessEqual(np.abs(xr - xe).max(), 1e-12 * max(np.abs(xr).max(), 1e-300))

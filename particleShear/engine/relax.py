@@ -30,7 +30,8 @@ import numpy as np
 from .state import PERMANENT, SLIP, STICK, BatchState
 from .step import BatchEngine
 
-__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels"]
+__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
+           "RelationAges"]
 
 #: most coarse levels of one relaxation (halving a finite step reaches any dt > 0 in fewer)
 MAX_LEVELS = 2100
@@ -102,9 +103,99 @@ def remove_linear_drift(state):
         state.vy[rows] -= state.vy[rows].sum() / N
 
 
-def _steps(engine, n, cool, dt):
+class RelationAges:
+    """Creation numbers of the relations of a batch, given as the classes give them.
+
+    The classes number relations in the order they form: at every step the newly touching pairs
+    take the next numbers of their ensemble's counter in ``(i, j)`` order (``PairTable.birth``;
+    it orders ``sphere.neighbors`` and so which relation ``join_isolated_spheres`` draws).  This
+    tracker does the same per replica after every engine step, follows the candidates through
+    the engine's list rebuilds, and :func:`write_back` puts the numbers and the counter into the
+    ensemble.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine before its first step; its ``s.pairs`` were copied from ``ensembles``.
+    ensembles : sequence of ensemble
+        The ensembles of the replicas, in order (their pair tables give the numbers so far).
+    """
+
+    def __init__(self, engine, ensembles):
+        s = engine.s
+        self.B, self.BN = s.B, s.B * s.N
+        keys, numbers = [], []
+        for b, (p, e) in enumerate(zip(s.pairs, ensembles)):
+            keys.append(self._keys(p.i + b * s.N, p.j + b * s.N))
+            pt = e._pairs
+            slot = pt.find(p.i, p.j) if len(p.i) else np.zeros(0, np.intp)
+            known = p.active & (slot >= 0)
+            numbers.append(np.where(known, pt.birth[np.where(known, slot, 0)] if len(pt.birth) else 0, 0))
+        self.key = np.concatenate(keys).astype(np.int64)
+        self.number = np.concatenate(numbers).astype(np.int64)
+        self.active = np.concatenate([p.active for p in s.pairs]).astype(bool)
+        self.next = np.array([e._pairs._births for e in ensembles], dtype=np.int64)
+        self.C = None
+
+    def _keys(self, ai, aj):
+        return np.asarray(ai, dtype=np.int64) * self.BN + np.asarray(aj, dtype=np.int64)
+
+    def after_step(self, engine):
+        """Number the relations formed in the step the engine has just made.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The engine, right after a step.
+        """
+        C = engine.C
+        if C is not self.C:   # the candidate lists were rebuilt: carry the records over by pair
+            key = self._keys(C.ai, C.aj)
+            if len(self.key):
+                at = np.minimum(np.searchsorted(self.key, key), len(self.key) - 1)
+                found = self.key[at] == key
+                self.number = np.where(found, self.number[at], 0)
+                self.active = found & self.active[at]
+            else:
+                self.number = np.zeros(len(key), np.int64)
+                self.active = np.zeros(len(key), bool)
+            self.key, self.C = key, C
+        newly = engine.active & ~self.active
+        if newly.any():
+            idx = np.flatnonzero(newly)               # replica by replica, (i, j) order within each
+            reps = C.rep[idx]
+            counts = np.bincount(reps, minlength=self.B)
+            first = np.cumsum(counts) - counts
+            self.number[idx] = self.next[reps] + (np.arange(len(idx)) - first[reps])
+            self.next += counts
+        self.active = engine.active
+
+    def births(self, b, pt):
+        """Creation numbers of replica ``b``'s candidates; sets the counter of ``pt`` (its pair table).
+
+        Parameters
+        ----------
+        b : int
+            Replica index.
+        pt : PairTable
+            The replica's ensemble's pair table.
+
+        Returns
+        -------
+        ndarray of int64
+            One number per candidate of replica b in the engine's canonical order (0 where the
+            candidate is not a relation).
+        """
+        lo, hi = self.C.offsets[b], self.C.offsets[b + 1]
+        pt._births = int(self.next[b])
+        return np.where(self.active[lo:hi], self.number[lo:hi], 0)
+
+
+def _steps(engine, n, cool, dt, ages=None):
     for _ in range(n):
         engine.step(cool, dt)
+        if ages is not None:
+            ages.after_step(engine)
 
 
 def _frictionless_slip(engine):
@@ -128,7 +219,7 @@ def _frictionless_slip(engine):
         engine.xi[:, m] = 0.0
 
 
-def free_relaxation(engine, N, dt, dt_max, mu):
+def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
     """``free_pre_equilibration(N)`` of the classes on every replica of ``engine``.
 
     Shear and plates off.  μ = 0 during the coarse levels (:func:`relaxation_levels`: N steps
@@ -148,6 +239,8 @@ def free_relaxation(engine, N, dt, dt_max, mu):
         Step of the first level (s).
     mu : array_like (B,)
         Friction coefficient of each replica for the last block.
+    ages : RelationAges, optional
+        Records when the relations form (for :func:`write_back`).
 
     Returns
     -------
@@ -168,27 +261,29 @@ def free_relaxation(engine, N, dt, dt_max, mu):
     s.applying_shear = False
     engine.set_mu(np.zeros(s.B))
     for level_dt, cf in levels:
-        _steps(engine, N, cf, level_dt)
+        _steps(engine, N, cf, level_dt, ages)
         remove_linear_drift(s)
-    _steps(engine, N, 1, dt)
+    _steps(engine, N, 1, dt, ages)
     _frictionless_slip(engine)
     engine.set_mu(mu)
-    _steps(engine, N, 1, dt)
+    _steps(engine, N, 1, dt, ages)
     _frictionless_slip(engine)
     engine.flush()
     return N * (len(levels) + 2)
 
 
-def write_back(engine, b, ensemble, steps=0):
+def write_back(engine, b, ensemble, steps=0, ages=None):
     """Put replica ``b`` of a relaxed engine back into its ensemble.
 
     Positions, angles φ, velocities, forces, clock and strain of the spheres; the candidate
     pairs of the replica become the ensemble's pair table with their relations, states, ξ and
     ``d_eq`` (inactive transient candidates: stick, ξ = 0, as the classes leave them), so the
-    crosslinking sees the contacts of the engine's last neighbour update.  A relation that was
-    a relation of the ensemble before keeps its creation number (the order of ``neighbors``);
-    new relations get the next numbers in ``(i, j)`` order.  The ensemble's neighbour list and
-    caches are invalidated; its ``step_count`` and ``n_constitution_steps`` advance by ``steps``.
+    crosslinking sees the contacts of the engine's last neighbour update.  The creation numbers
+    of the relations (the order of ``neighbors``) are the classes' when ``ages`` recorded the
+    relaxation (:class:`RelationAges`); without it, a relation of the ensemble before keeps its
+    number and new relations get the next numbers in ``(i, j)`` order.  The ensemble's neighbour
+    list and caches are invalidated; its ``step_count`` and ``n_constitution_steps`` advance by
+    ``steps``.
 
     Parameters
     ----------
@@ -200,6 +295,8 @@ def write_back(engine, b, ensemble, steps=0):
         The ensemble the replica was copied from (same N).
     steps : int, optional
         Steps the replica was advanced (bookkeeping of the classes).
+    ages : RelationAges, optional
+        The record of when the relations formed during the relaxation.
     """
     s = engine.s
     rows = s.replica(b)
@@ -219,14 +316,17 @@ def write_back(engine, b, ensemble, steps=0):
     key = (i.astype(np.int64) << 32) | j.astype(np.int64)
     keep = p.active | (p.state == PERMANENT)
     active = np.array(p.active, dtype=bool)
-    birth = np.zeros(len(i), dtype=np.int64)
-    had = np.zeros(len(i), dtype=bool)
-    if len(pt.key):
-        at = np.minimum(np.searchsorted(pt.key, key), len(pt.key) - 1)
-        had = (pt.key[at] == key) & pt.active[at] & active
-        birth[had] = pt.birth[at[had]]
-    born = active & ~had
-    birth[born] = pt.next_births(int(born.sum()))
+    if ages is not None and ages.C is not None:
+        birth = ages.births(b, pt)
+    else:
+        birth = np.zeros(len(i), dtype=np.int64)
+        had = np.zeros(len(i), dtype=bool)
+        if len(pt.key):
+            at = np.minimum(np.searchsorted(pt.key, key), len(pt.key) - 1)
+            had = (pt.key[at] == key) & pt.active[at] & active
+            birth[had] = pt.birth[at[had]]
+        born = active & ~had
+        birth[born] = pt.next_births(int(born.sum()))
     pt.i, pt.j, pt.key = i, j, key
     pt.state = np.where(keep, p.state, STICK).astype(np.int8)
     pt.xi = np.where(active, p.xi, 0.0)
@@ -283,7 +383,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN):
     mu = state.mu.copy()
     engine = BatchEngine(state, skin_factor=skin_factor, guard=False)   # no guard: the classes guard the measurement only
     engine.phase = "constitution"
-    steps = free_relaxation(engine, N, dt, dt_max, mu)
+    ages = RelationAges(engine, ensembles)
+    steps = free_relaxation(engine, N, dt, dt_max, mu, ages)
     for b, e in enumerate(ensembles):
-        write_back(engine, b, e, steps)
+        write_back(engine, b, e, steps, ages)
     return steps
