@@ -9,9 +9,10 @@ of a :class:`~particleShear.engine.step.BatchEngine`; :func:`remove_linear_drift
 ``correct_linear_drift`` per replica; :func:`write_back` puts a relaxed replica back into its
 ensemble (spheres, clock, and the relations, states and ξ of its pair table) so that the
 bookkeeping that follows (crosslinking, cutting, link removal, joining isolated spheres) runs
-through the documented classes on the contacts the engine ended with.
-:func:`relax_ensembles` does all three for a list of ensembles (docs/design.md, "Batches of
-replicas").
+through the documented classes on the contacts the engine ended with, and
+:class:`RelationAges` gives the relations the creation numbers the classes would give them.
+:func:`relax_ensembles` does all of it for a list of ensembles (docs/design.md, "Batches of
+replicas", "Constitution of a batch").
 
 A replica's relaxation does not depend on its batch (every operation of the step is per
 replica, see :mod:`.step`; the drift is removed per replica), so a run constituted in a batch
@@ -24,6 +25,7 @@ Units: µm, s, mg per m depth (docs/parameters.md).
 __docformat__ = "numpy"
 
 import math
+import numbers
 
 import numpy as np
 
@@ -68,7 +70,7 @@ def relaxation_levels(dt, dt_max):
     ValueError
         If ``dt`` is not a finite number > 0 or ``dt_max`` is not finite.
     """
-    if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+    if isinstance(dt, bool) or not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt={dt!r} is out of range: allowed a finite number > 0 (free_pre_equilibration)")
     if not math.isfinite(dt_max):
         raise ValueError(f"dt_max={dt_max!r} is out of range: allowed a finite number (free_pre_equilibration)")
