@@ -18,12 +18,36 @@ from particleShear.run.batch import batches, run_batch, schedule_key
 QUICK = dict(N=20, relative_frequency=0.2, pre_periods=0.5, periods=1, post_periods=0.5, doDrawing=False,
              plotStress=False, verbose=False)
 
-#: four mixed replicas sharing one schedule: frictional only; crosslinked and cut with stronger
-#: friction and a larger amplitude; crosslinked without friction; crosslinked, uncut
+#: five mixed replicas sharing one schedule whose constitutions differ: frictional only; crosslinked
+#: and cut with stronger friction and a larger amplitude; crosslinked without friction; crosslinked,
+#: uncut, at an amplitude below 0.1 (extra relaxation blocks, some with μ = 0); crosslinked with
+#: reinforced interfaces (shorter relaxation blocks), cut into three, links removed
 MIXED = [dict(QUICK, seed=1, theAmplitude=0.2, theMu=0.01, do_permanent_links=False, cut_lines=0),
          dict(QUICK, seed=2, theAmplitude=0.3, theMu=0.05, do_permanent_links=True, cut_lines=2),
          dict(QUICK, seed=3, theAmplitude=0.1, theMu=0.0, do_permanent_links=True, cut_lines=2),
-         dict(QUICK, seed=4, theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=0)]
+         dict(QUICK, seed=4, theAmplitude=0.07, theMu=0.01, do_permanent_links=True, cut_lines=0),
+         dict(QUICK, seed=5, theAmplitude=0.15, theMu=0.02, do_permanent_links=True, cut_lines=3,
+              interface_reenforcement_central=2, remove_link_fraction=0.2)]
+
+
+def relaxation_sequence(kw):
+    """(steps, dt, dt_max, μ) of every relaxation block of a run's constitution (run with the classes)."""
+    from particleShear.run.api import _build_simulation, _seed_sequence
+    from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
+    p = dict(_signature_defaults(), **kw)
+    sim = _build_simulation({k: p[k] for k in _REFERENCE_ARGUMENTS}, _seed_sequence(p["seed"])[1], verbose=False,
+                            progress=None, correct_drift_sign=False, reference_header=False, renderer="none",
+                            time_step_factor=1.0, integrator="euler", stability_guard=False)
+    seq = []
+    gen = sim.constitution_steps()
+    try:
+        request = next(gen)
+        while True:
+            seq.append(request.key + (request.ensemble.mu,))
+            request.run()
+            request = next(gen)
+    except StopIteration:
+        return seq
 
 
 class InlineExecutor(concurrent.futures.Executor):
@@ -62,14 +86,19 @@ class TestBatchOfMixedReplicas(unittest.TestCase):
         cls.pair = run_batch([MIXED[2], MIXED[0]])  # other companions, other order
 
     def test_scene_is_mixed(self):
-        # the replicas really differ: links where asked, different moduli, one schedule
+        # the replicas really differ: links where asked, different moduli, one schedule, and
+        # constitutions of different relaxation blocks (the batch groups equal blocks)
         self.assertEqual(len({schedule_key(kw) for kw in MIXED}), 1)
-        self.assertEqual(len({r.G_surface for r in self.single}), 4)
+        self.assertEqual(len({r.G_surface for r in self.single}), len(MIXED))
+        sequences = [relaxation_sequence(kw) for kw in MIXED]
+        self.assertEqual(len({tuple(q) for q in sequences}), len(MIXED))
+        self.assertEqual(len({len(q) for q in sequences}), 3)
+        self.assertIn(0, [block[3] for block in sequences[3][3:]])   # a μ = 0 block after crosslinking
         self.assertEqual(len({r.N_steps for r in self.single}), 1)
         self.assertGreater(self.single[0].N_steps, 100)
 
     def test_each_replica_equals_its_single_run(self):
-        self.assertEqual(len(self.batch), 4)
+        self.assertEqual(len(self.batch), len(MIXED))
         for n, (b, s) in enumerate(zip(self.batch, self.single)):
             with self.subTest(replica=n):
                 assert_same_result(self, b, s)
@@ -122,8 +151,10 @@ class TestBatchGrouping(unittest.TestCase):
 class TestConsoleAndProgress(unittest.TestCase):
     def test_engine_path_prints_and_reports_as_the_classes(self):
         # verbose messages line by line and progress calls, engine path (doDrawing=False) against the
-        # documented classes (doDrawing=True with no renderer); numbers agree to rounding (≈ 1e-15 over
-        # this short protocol), compared to 9 significant digits
+        # documented classes (doDrawing=True with no renderer).  The numbers in the messages are not
+        # compared: the engine constitutes the ensemble too, and ~3,000 relaxation steps of a random
+        # packing amplify the rounding differences of the two paths (their agreement over short
+        # blocks is tested in test_relax.py and test_engine.py); every number is replaced by "#"
         import contextlib
         import io
         import re
@@ -135,7 +166,7 @@ class TestConsoleAndProgress(unittest.TestCase):
             with contextlib.redirect_stdout(out):
                 doParticleShearSimulation(**kw)
             num = re.compile(r"-?\d+\.\d+(?:e[-+]?\d+)?")
-            return [num.sub(lambda m: f"{float(m.group()):.9g}", line) for line in out.getvalue().splitlines()], prog
+            return [num.sub("#", line) for line in out.getvalue().splitlines()], prog
 
         engine, classes = run(doDrawing=False), run(doDrawing=True, renderer="none")
         self.assertGreater(len(engine[0]), 15)

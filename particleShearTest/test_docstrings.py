@@ -93,6 +93,7 @@ ENGINE_MODULES = [
     "particleShear.engine.forces",
     "particleShear.engine.laws",
     "particleShear.engine.neighbours",
+    "particleShear.engine.relax",
     "particleShear.engine.state",
     "particleShear.engine.step",
     "particleShear.engine.stress",

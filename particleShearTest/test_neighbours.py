@@ -1,4 +1,7 @@
-"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, docs/design.md, B.4).
+"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, "Neighbour search").
+
+The classes' ``candidate_pairs`` is the engine's ``near_pairs`` (all pairs below
+``CELL_LIST_MIN_N`` spheres, the cell list from there: n = 70 and n ≥ 500 below test both).
 
 The oracle here is written independently of the package: the minimum image of
 docs/design.md (y image first, shifting x by Ly·γ; half-open intervals; one period
@@ -81,6 +84,7 @@ class TestCandidatePairs(unittest.TestCase):
         i, j = candidate_pairs(x, y, r, Lx, Ly, Ly * shear, skin)
         got = list(zip(i.tolist(), j.tolist()))
         self.assertTrue(np.all(i < j))
+        self.assertEqual(got, sorted(got), "not in canonical (i, j) order")
         self.assertEqual(len(got), len(set(got)), "duplicate pairs")
         expected = oracle_pairs(x, y, r, Lx, Ly, shear, extra=skin)
         self.assertEqual(set(got), expected)

@@ -10,7 +10,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from .kernels import in_cell_passes, min_image
+from ..engine.neighbours import near_pairs
 from .namespace import count_nonzero as _nz
 
 __all__ = ["PairTable", "STICK", "SLIP", "PERMANENT", "STATE_NAMES", "candidate_pairs", "all_pairs"]
@@ -19,8 +19,6 @@ STICK, SLIP, PERMANENT = 0, 1, 2
 STATE_NAMES = ("stick", "slip", "permanent")
 STATE_CODES = {"stick": STICK, "slip": SLIP, "permanent": PERMANENT}
 
-
-_OFFSETS = np.array((-1, 0, 1), dtype=np.intp)
 
 
 def _key(i, j):
@@ -186,9 +184,11 @@ def all_pairs(n):
 def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
     """Pairs i < j whose minimum-image distance is below ``r_i + r_j + skin``.
 
-    Cell list with rows above/below the cell searched at the x position moved
-    by the Lees-Edwards offset ``shift = Ly·γ``; all-pairs when the cell grid
-    would be smaller than 3 × 3.  ``x``, ``y`` must lie in the cell.
+    The engine's search, written once for both layers
+    (:func:`particleShear.engine.neighbours.near_pairs`): a cell list whose rows above/below
+    the cell are searched at the x position moved by the Lees-Edwards offset
+    ``shift = Ly·γ``, or all pairs for small systems and for cell grids smaller than 3 × 3.
+    ``x``, ``y`` should lie in the cell.
 
     Parameters
     ----------
@@ -206,42 +206,6 @@ def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
     Returns
     -------
     tuple of numpy.ndarray
-        ``(i, j)`` with ``i < j``, the candidate pairs.
+        ``(i, j)`` with ``i < j``, the candidate pairs, sorted by ``(i, j)``.
     """
-    n = len(x)
-    if n < 2:
-        return np.zeros(0, np.intp), np.zeros(0, np.intp)
-    rc = 2 * float(r.max()) + skin
-    nx = int(Lx // rc) if rc > 0 else 0
-    ny = int(Ly // rc) if rc > 0 else 0
-    if nx < 3 or ny < 3 or n < 64:
-        i, j = all_pairs(n)
-    else:
-        cw = Lx / nx
-        ch = Ly / ny
-        cx = np.minimum((x / cw).astype(np.intp), nx - 1)
-        cy = np.minimum((y / ch).astype(np.intp), ny - 1)
-        cell = cy * nx + cx
-        order = np.argsort(cell, kind="stable")
-        counts = np.bincount(cell, minlength=nx * ny)
-        start = np.concatenate(([0], np.cumsum(counts)[:-1]))
-        # the 3 × 3 cells around each sphere; through y = 0 / Ly the row is searched at x ∓ shift
-        xs = np.empty((n, 3))
-        xs[:, 0] = np.where(cy - 1 < 0, x + shift, x)
-        xs[:, 1] = x
-        xs[:, 2] = np.where(cy + 1 >= ny, x - shift, x)
-        c0 = np.minimum((np.mod(xs, Lx) / cw).astype(np.intp), nx - 1)
-        rows = np.mod(cy[:, None] + _OFFSETS, ny)
-        cells = (rows[:, :, None] * nx + np.mod(c0[:, :, None] + _OFFSETS, nx)).reshape(n, 9)
-        cnt = counts[cells].ravel()
-        total = int(cnt.sum())
-        owner = np.repeat(np.repeat(np.arange(n, dtype=np.intp), 9), cnt)
-        first = np.repeat(start[cells].ravel(), cnt)
-        offs = np.arange(total, dtype=np.intp) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        other = order[first + offs]
-        sel = owner < other
-        i, j = owner[sel], other[sel]
-    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift, passes=in_cell_passes(Lx, shift))
-    reach = r[i] + r[j] + skin
-    sel = dx * dx + dy * dy < reach * reach
-    return i[sel], j[sel]
+    return near_pairs(x, y, r, Lx, Ly, shift, skin)

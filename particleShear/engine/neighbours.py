@@ -1,29 +1,57 @@
 """Verlet candidates of one replica: an explicit neighbour list in canonical ``(i, j)`` order.
 
 A candidate is a pair whose Lees-Edwards minimum-image distance is below
-``r_i + r_j + skin``, or a bond.  The list stays valid while no pair can have come into
-contact: :func:`verlet_bound` is, per replica, an upper bound of how much any pair separation
-can have shrunk since the list was built (from the peculiar displacements and the accumulated
-strain), and the list is rebuilt when the bound reaches the skin.  The contacts of every step
-are therefore exactly those of an all-pairs search (tested), and a replica's list depends only
-on its own history.
+``r_i + r_j + skin``, or a bond.  The near pairs come from a cell list (:func:`near_pairs_cells`,
+O(N), sort-based binning with array operations only) or, for small replicas and boxes of fewer
+than 3 cells per side, from the all-pairs search (:func:`near_pairs_all`, also the test oracle).
+Both select with the same minimum image and the same comparison, so they return the same pairs
+bit for bit (tested).
+
+The list stays valid while no pair can have come into contact: :func:`verlet_bound` is, per
+replica, an upper bound of how much any pair separation can have shrunk since the list was built
+(from the peculiar displacements and the accumulated strain), and the list is rebuilt when the
+bound reaches the skin.  The contacts of every step are therefore exactly those of an all-pairs
+search (tested), and a replica's list depends only on its own history.
+
+Array namespace: both searches take the namespace of their inputs (NumPy, or CuPy when CuPy is
+imported and the inputs are CuPy arrays; the minimum image of :mod:`.box` must then accept them
+too); :func:`build_candidates`, which merges the bonds and carries the history over, is NumPy.
 """
 __docformat__ = "numpy"
+
+import math
+import sys
 
 import numpy as np
 
 from .box import min_image
 from .state import PERMANENT, ReplicaPairs
 
-__all__ = ["all_pairs", "build_candidates", "verlet_bound"]
+__all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
+           "verlet_bound", "CELL_LIST_MIN_N"]
+
+#: smallest N for which :func:`near_pairs` uses the cell list (below it the all-pairs search is
+#: faster; measured with ``benchmarks/bench_engine_large.py --crossover``, docs/performance.md)
+CELL_LIST_MIN_N = 200
+
+#: relative margin of a cell over the search reach ``2 r_max + skin``: a cell index computed in
+#: floating point can then be off only for spheres closer than this to a cell border, which the
+#: margin covers, so rounding never hides a pair
+CELL_MARGIN = 1e-9
 
 _TRIU = {}
+
+
+def _namespace(x):
+    """Array module of ``x``: CuPy's when CuPy is imported (and ``x`` is a CuPy array), else NumPy."""
+    cp = sys.modules.get("cupy")
+    return cp.get_array_module(x) if cp is not None else np
 
 
 def all_pairs(N):
     """``(i, j)`` of every pair ``i < j`` of N spheres, in canonical order (kept per N).
 
-    The all-pairs search that :func:`build_candidates` filters; cached for the last few N
+    The all-pairs search that :func:`near_pairs_all` filters; cached for the last few N
     so a rebuild does not allocate the index arrays again.
 
     Parameters
@@ -45,6 +73,198 @@ def all_pairs(N):
     return ij
 
 
+def _near(i, j, x, y, r, Lx, Ly, shift, skin):
+    """Mask of the pairs ``(i, j)`` whose minimum-image distance is below ``r_i + r_j + skin``.
+
+    The one selection both searches use (the same operations element by element, so the same
+    decisions bit for bit)."""
+    dx, dy, _, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+    reach = r[i] + r[j] + skin
+    return dx * dx + dy * dy < reach * reach
+
+
+def near_pairs_all(x, y, r, Lx, Ly, shift, skin):
+    """Pairs ``i < j`` within ``r_i + r_j + skin`` (minimum image), by testing every pair.
+
+    O(N²) time and memory: the search of small replicas and small boxes, and the oracle
+    of the cell list in the tests.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+
+    Returns
+    -------
+    i, j : ndarray of int
+        The pairs, sorted by ``(i, j)``.
+    """
+    i, j = all_pairs(len(x))
+    xp = _namespace(x)
+    if xp is not np:          # the cached index arrays live on the host
+        i, j = xp.asarray(i), xp.asarray(j)
+    near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
+    return i[near], j[near]
+
+
+def cell_grid(Lx, Ly, reach, N):
+    """Cells per side of the cell list: each at least ``reach·(1 + CELL_MARGIN)`` wide and high.
+
+    A pair closer than ``reach`` then lies in the same or adjacent cells (the rows through
+    ``y = 0`` / ``Ly`` taken at the x moved by the Lees-Edwards offset).  The grid is made
+    coarser (cells larger, still valid) where it would have more than ``2N + 9`` cells, so
+    the cell arrays stay O(N) for sparse boxes.
+
+    Parameters
+    ----------
+    Lx, Ly : float
+        Box (µm).
+    reach : float
+        Largest distance searched, ``2 r_max + skin`` (µm).
+    N : int
+        Number of spheres.
+
+    Returns
+    -------
+    nx, ny : int
+        Cells along x and y; 0 where ``reach`` is not positive and finite.  The cell list
+        needs at least 3 of each (otherwise a row or column would be visited twice).
+    """
+    if not (reach > 0 and math.isfinite(reach) and Lx > 0 and Ly > 0):
+        return 0, 0
+    size = reach * (1 + CELL_MARGIN)
+    nx, ny = int(Lx // size), int(Ly // size)
+    most = 2 * N + 9
+    if nx * ny > most:
+        f = math.sqrt(nx * ny / most)
+        nx, ny = max(3, int(nx / f)), max(3, int(ny / f))
+    return nx, ny
+
+
+def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
+    """Pairs ``i < j`` within ``r_i + r_j + skin`` (minimum image), by a cell list in O(N).
+
+    The box is divided into ``nx × ny`` cells of at least ``2 r_max + skin`` (:func:`cell_grid`);
+    spheres are binned by sorting their cell numbers (``argsort``, ``bincount``, ``cumsum``).
+    A pair closer than the reach lies in the same cell or in adjacent ones (3 × 3 around each
+    sphere); each pair is visited once, from the same cell (``i < j``) or from the sphere whose
+    partner lies in the cell to the right or in one of the three cells of the row above.  The
+    row above the top row is the bottom row seen through the Lees-Edwards image, so it is
+    searched around ``x − shift``, as the minimum image of docs/design.md moves x by the offset
+    when it takes the y image.  Every candidate is then tested exactly as
+    :func:`near_pairs_all` tests it (same orientation ``i < j``, same operations), so both
+    return the same pairs.
+
+    Array operations only (a loop over the 5 cell offsets of the half neighbourhood), in the
+    namespace of the inputs.  Falls back to :func:`near_pairs_all` when the grid has fewer than 3 cells per
+    side.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).  Positions outside the cell are
+        folded into it for the binning (whole periods, with the offset of the y images).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+
+    Returns
+    -------
+    i, j : ndarray of int
+        The pairs, sorted by ``(i, j)``.
+    """
+    xp = _namespace(x)
+    N = int(x.shape[0])
+    if N < 2:
+        return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)
+    Lx, Ly, shift, skin = float(Lx), float(Ly), float(shift), float(skin)
+    # device-to-host transfers on CuPy (once per rebuild): the largest radius sizes the grid, and
+    # each expansion's length below sizes its arrays
+    nx, ny = cell_grid(Lx, Ly, 2 * float(r.max()) + skin, N)
+    if nx < 3 or ny < 3:
+        return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
+    cw, ch = Lx / nx, Ly / ny
+
+    def index(v, size, n):
+        # cell index of coordinates in [0, n·size]; a non-finite coordinate goes to cell 0 (its pairs
+        # fail the distance test anyway), one on the far border to the last cell
+        c = xp.floor(v / size)
+        return xp.minimum(xp.where(c >= 0, c, 0), n - 1).astype(xp.intp)
+
+    def column(xs):
+        return index(xp.mod(xs, Lx), cw, nx)
+
+    # bin: fold into the cell (a y period moves x by the offset), cell number, spheres sorted by cell
+    ky = xp.floor(y / Ly)
+    xf = x - shift * ky
+    cy = index(y - Ly * ky, ch, ny)
+    cx = column(xf)
+    order = xp.argsort(cy * nx + cx)
+    counts = xp.bincount(cy * nx + cx, minlength=nx * ny)
+    start = xp.cumsum(counts) - counts
+    # half the neighbourhood: a pair in one cell once (i < j), a pair in adjacent cells from the sphere
+    # whose neighbour lies to the right in its row or in the row above (exactly one of the two spheres
+    # sees the other so with at least 3 cells per side)
+    up = cy + 1
+    col_up = column(xp.where(up >= ny, xf - shift, xf))      # the row above the top row: the bottom row at x − shift
+    up = xp.mod(up, ny)
+    found_i, found_j = [], []
+    for row, col, dcol, same in ((cy, cx, 0, True), (cy, cx, 1, False), (up, col_up, -1, False),
+                                 (up, col_up, 0, False), (up, col_up, 1, False)):
+        cell = row * nx + xp.mod(col + dcol, nx)
+        cnt = counts[cell]
+        ends = xp.cumsum(cnt)
+        total = int(ends[-1])
+        if total == 0:
+            continue
+        # slot k of the expansion belongs to sphere a = #(ends ≤ k) and reads the
+        # (k − first slot of a)-th sphere of a's neighbouring cell in cell order
+        a = xp.cumsum(xp.bincount(ends[:-1], minlength=total)[:total])
+        b = order[(start[cell] - (ends - cnt))[a] + xp.arange(total, dtype=xp.intp)]
+        if same:
+            keep = a < b
+            i, j = a[keep], b[keep]
+        else:
+            i, j = xp.minimum(a, b), xp.maximum(a, b)          # the pair vector as the all-pairs search takes it
+        near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
+        found_i.append(i[near])
+        found_j.append(j[near])
+    if not found_i:
+        return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)
+    key = xp.sort(xp.concatenate(found_i) * N + xp.concatenate(found_j))
+    return key // N, key % N
+
+
+def near_pairs(x, y, r, Lx, Ly, shift, skin):
+    """Pairs ``i < j`` within ``r_i + r_j + skin`` (minimum image), by the faster search.
+
+    The cell list (:func:`near_pairs_cells`) from :data:`CELL_LIST_MIN_N` spheres on, the
+    all-pairs search (:func:`near_pairs_all`) below; both give the same pairs.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+
+    Returns
+    -------
+    i, j : ndarray of int
+        The pairs, sorted by ``(i, j)``.
+    """
+    if len(x) >= CELL_LIST_MIN_N:
+        return near_pairs_cells(x, y, r, Lx, Ly, shift, skin)
+    return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
+
+
 def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     """New candidate list of one replica, keeping the history of pairs that stay candidates.
 
@@ -62,22 +282,23 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     Returns
     -------
     ReplicaPairs
-        The candidates in canonical ``(i, j)`` order; a pair of ``old`` that is still a
-        candidate keeps its state, ξ, ``d_eq`` and relation, a new one starts at rest.
+        The near pairs (:func:`near_pairs`) and every bond of ``old``, in canonical ``(i, j)``
+        order; a pair of ``old`` that is still a candidate keeps its state, ξ, ``d_eq`` and
+        relation, a new one starts at rest.
     """
     N = len(x)
-    i, j = all_pairs(N)
-    dx, dy, _, _ = min_image(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-    reach = r[i] + r[j] + skin
-    near = dx * dx + dy * dy < reach * reach
-    key_new = i * N + j
+    i, j = near_pairs(x, y, r, Lx, Ly, shift, skin)
+    key = i * N + j
     key_old = old.i * N + old.j
     bonds = key_old[old.state == PERMANENT]
-    if len(bonds):
-        near[np.searchsorted(key_new, bonds)] = True
-    sel = np.flatnonzero(near)
-    key = key_new[sel]
-    C = len(sel)
+    if len(bonds):   # a bond stretched beyond the reach stays a candidate (bonds are distinct and sorted)
+        at = np.searchsorted(key, bonds)
+        found = at < len(key)
+        found[found] = key[at[found]] == bonds[found]
+        if not found.all():
+            key = np.sort(np.concatenate((key, bonds[~found])))
+            i, j = key // N, key % N
+    C = len(key)
     state = np.zeros(C, np.int8)
     xi = np.zeros((2, C))
     d_eq = np.zeros(C)
@@ -93,7 +314,7 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
         xi[:, dst] = old.xi[:, src]
         d_eq[dst] = old.d_eq[src]
         active[dst] = old.active[src]
-    return ReplicaPairs(i[sel], j[sel], state, xi, d_eq, active)
+    return ReplicaPairs(i, j, state, xi, d_eq, active)
 
 
 def verlet_bound(u_max, strain, r_max):

@@ -240,6 +240,21 @@ class BatchEngine:
         s.omega -= d_s / 2
         s.rate = np.array(rate, dtype=float)
 
+    def set_mu(self, mu):
+        """Change the Coulomb friction coefficient μ of each replica (the constitution's μ = 0 blocks).
+
+        The per-candidate μ of :attr:`C` is refreshed with it; nothing else depends on μ.
+
+        Parameters
+        ----------
+        mu : array_like (B,)
+            New μ of each replica (≥ 0).
+        """
+        s = self.s
+        s.mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
+        if self.C is not None:
+            self.C.mu = s.mu[self.C.rep]
+
     def step(self, cool, dt, sample=False):
         """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when
         ``sample``, and also every tensor of :data:`~particleShear.engine.stress.TENSORS` as a

@@ -20,6 +20,7 @@ from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustabl
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
+           "adjustable_interface_constitution", "Relaxation", "relax_with_classes",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
 
 #: attempts at cutting without a height-spanning particle before giving up (the reference loops forever)
@@ -169,10 +170,80 @@ def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut
         attempts += 1
 
 
+class Relaxation:
+    """One relaxation of a constitution: ``ensemble.free_pre_equilibration(N)`` at its current settings.
+
+    A constitution written as a generator (:func:`adjustable_interface_constitution`) yields one
+    request per relaxation block and resumes once it is done.  Whoever drives the generator runs
+    it: :func:`relax_with_classes` with the documented classes (:meth:`run`), or the engine
+    for a whole batch at once (:func:`particleShear.engine.relax.relax_ensembles`; docs/design.md,
+    "Batches of replicas").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
+    it is run, so requests with equal :attr:`key` run the same steps (the replicas' μ may differ).
+
+    Parameters
+    ----------
+    ensemble : EnsembleCompactParticles
+        The ensemble to relax.
+    N : int
+        Steps per level and per final block of ``free_pre_equilibration`` (>= 0).
+    """
+    __slots__ = ("ensemble", "N")
+
+    def __init__(self, ensemble, N):
+        self.ensemble = ensemble
+        self.N = int(N)
+
+    @property
+    def key(self):
+        """``(N, dt, dt_max)``: requests with equal keys run the same number of steps of the same lengths."""
+        e = self.ensemble
+        return (self.N, float(e.dt), float(e.dt_max))
+
+    def run(self):
+        """Relax with the documented classes: ``ensemble.free_pre_equilibration(N)``."""
+        self.ensemble.free_pre_equilibration(self.N)
+
+    def __repr__(self):
+        N, dt, dt_max = self.key
+        return f"Relaxation(N={N}, dt={dt!r}, dt_max={dt_max!r}, mu={self.ensemble.mu!r})"
+
+
+#: most requests one constitution may yield (the builder yields at most 20): a bound, not a tuning knob
+MAX_RELAXATIONS = 10000
+
+
+def relax_with_classes(steps):
+    """Drive a constitution generator, running each of its :class:`Relaxation` requests with the classes.
+
+    Parameters
+    ----------
+    steps : generator
+        A constitution such as :func:`adjustable_interface_constitution`.
+
+    Returns
+    -------
+    object
+        What the generator returns (the constituted ensemble).
+
+    Raises
+    ------
+    RuntimeError
+        If the generator yields more than :data:`MAX_RELAXATIONS` requests.
+    """
+    try:
+        request = next(steps)
+        for _ in range(MAX_RELAXATIONS):
+            request.run()
+            request = next(steps)
+    except StopIteration as done:
+        return done.value
+    raise RuntimeError(f"a constitution yielded more than {MAX_RELAXATIONS} relaxations")
+
+
 def _free_mu0(ens, n, mu):
-    """``μ=0: free(n)``: run a relaxation block with the ensemble's μ set to 0, then restore it."""
+    """``μ=0: free(n)``: a relaxation block with the ensemble's μ set to 0, then μ restored (generator)."""
     ens.mu = 0
-    ens.free_pre_equilibration(n)
+    yield Relaxation(ens, n)
     ens.mu = mu
 
 
@@ -277,6 +348,122 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
     RuntimeError
         If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
     """
+    return relax_with_classes(adjustable_interface_constitution(
+        size_x=size_x, size_y=size_y, N=N, packing_fraction=packing_fraction, mu=mu,
+        Young_modulus_spheres=Young_modulus_spheres, density=density, bimodal_factor=bimodal_factor,
+        cut_lines=cut_lines, do_permanent_links=do_permanent_links, theTk=theTk,
+        do_pre_equilibration=do_pre_equilibration, relative_viscosity=relative_viscosity,
+        central_repulsion_coefficient=central_repulsion_coefficient, anticipated_amplitude=anticipated_amplitude,
+        relative_transversal_link_strength=relative_transversal_link_strength,
+        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+        avoid_height_spanning_particles=avoid_height_spanning_particles,
+        interface_reenforcement_central=interface_reenforcement_central,
+        interface_reenforcement_tangential=interface_reenforcement_tangential,
+        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant, cut_top_bottom=cut_top_bottom,
+        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
+        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, do_debug=do_debug, rng=rng, verbose=verbose))
+
+
+def adjustable_interface_constitution(
+        size_x=500, size_y=500, N=100, packing_fraction=1, mu=1, Young_modulus_spheres=10000, density=50,
+        bimodal_factor=1.4, cut_lines=5, do_permanent_links=True, theTk=False, do_pre_equilibration=True,
+        relative_viscosity=0.01, central_repulsion_coefficient=0, anticipated_amplitude=0.1,
+        relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
+        avoid_height_spanning_particles=False, interface_reenforcement_central=1,
+        interface_reenforcement_tangential=1, keep_viscosity_coefficients_constant=True, cut_top_bottom=True,
+        doCutByTriangulation=True, remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, do_debug=False,
+        rng=None, verbose=False):
+    """The constitution of :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters`
+    as a generator of its relaxations.
+
+    The same validation, placement, crosslinking, cutting, link removal and joining of isolated
+    spheres as the builder (every bookkeeping step through the documented classes), but each of
+    its ``free_pre_equilibration`` blocks is yielded as a :class:`Relaxation` request; the
+    generator resumes when the caller has run it and returns the ensemble (``StopIteration.value``).
+    :func:`relax_with_classes` runs the requests with the classes (that is the builder);
+    ``particleShear.run.batch`` runs those of all replicas of a batch together in the engine
+    (docs/design.md, "Batches of replicas").
+
+    Parameters
+    ----------
+    size_x, size_y : float, optional
+        Width and height of the periodic cell (µm), > 0.
+    N : int, optional
+        Number of spheres, >= 2.
+    packing_fraction : float, optional
+        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
+    Young_modulus_spheres : float, optional
+        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
+    density : float, optional
+        Density of the sphere material (kg/m³), > 0.
+    bimodal_factor : float, optional
+        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
+    cut_lines : int, optional
+        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
+        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
+    do_permanent_links : bool, optional
+        Crosslink all contacts after the relaxation and cut the gel into particles (False:
+        frictional spheres only).
+    theTk : object, optional
+        Accepted for compatibility with particleShear 1.0.2; not used.
+    do_pre_equilibration : bool, optional
+        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
+    relative_viscosity : float, optional
+        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
+    central_repulsion_coefficient : float, optional
+        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
+    anticipated_amplitude : float, optional
+        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
+        length of the relaxation.
+    relative_transversal_link_strength : float, optional
+        rts = k_t/k = ν_t/ν, >= 0.
+    avoid_horizontal_angle_degree : float, optional
+        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
+        lines that are redrawn.
+    avoid_height_spanning_particles : bool, optional
+        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
+        ignored when the cut cannot produce separate particles.
+    interface_reenforcement_central : float, optional
+        irc, factor on k (and ν) of transient contacts relative to bonds, > 0.
+    interface_reenforcement_tangential : float, optional
+        irt, the same for k_t (and ν_t), > 0.
+    keep_viscosity_coefficients_constant : bool, optional
+        True: the viscosities are not scaled by the reinforcement factors.
+    cut_top_bottom : bool, optional
+        Cut every bond through the y-periodic boundary (wall-slip emulation).
+    doCutByTriangulation : bool, optional
+        Particles by periodic Voronoi cells (False: random straight lines).
+    remove_link_fraction : float, optional
+        Target fraction (0 … 1) of non-essential links to remove after cutting.
+    edge_fuzziness : float, optional
+        Random roughening of the Voronoi borders in units of the largest radius, >= 0.
+    doDrawing : bool, optional
+        Whether the ensemble draws its spheres (no window is opened here).
+    do_debug : bool, optional
+        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
+    rng : numpy.random.Generator, int or None, optional
+        Random generator or seed driving every random choice (placement, cutting, link removal);
+        None draws fresh entropy.
+    verbose : bool, optional
+        Log the progress messages (INFO) of particleShear 1.0.2.
+
+    Yields
+    ------
+    Relaxation
+        The next relaxation block (the ensemble's ``dt``, ``dt_max`` and ``mu`` are set for it).
+
+    Returns
+    -------
+    EnsembleCompactParticlesAdjustableInterfaceStrength
+        The constituted ensemble, as the builder returns it.
+
+    Raises
+    ------
+    TypeError, ValueError, RuntimeError
+        As the builder, on the first ``next()`` (before any work).
+    """
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
                      relative_transversal_link_strength, avoid_horizontal_angle_degree)
@@ -319,16 +506,16 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         if packing_fraction > 2:
             ens.dt_max = ens.dt_max / 2
         n1 = int(300 / R) if prc == 1 else int(100 / R)
-        ens.free_pre_equilibration(n1)
+        yield Relaxation(ens, n1)
         if A <= 0.01 or rts < 0.1:
-            ens.free_pre_equilibration(n1)
+            yield Relaxation(ens, n1)
         ens.dt = dt
         ens.dt_max = dt_max
-        ens.free_pre_equilibration(int(200 / R) if prc == 1 else int(100 / R))
+        yield Relaxation(ens, int(200 / R) if prc == 1 else int(100 / R))
         if A <= 0.01 and prc == 1:
-            ens.free_pre_equilibration(int(200 / R))
+            yield Relaxation(ens, int(200 / R))
         if A <= 0.001 and prc == 1:
-            ens.free_pre_equilibration(int(200 / R))
+            yield Relaxation(ens, int(200 / R))
 
     if do_permanent_links:
         _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose)
@@ -342,23 +529,23 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         ens.dt_max = min(2 * ens.dt, ens.dt_max)
         if rts > 5:
             ens.dt_max = ens.dt_max / 2
-        ens.free_pre_equilibration(int(300 / R))
+        yield Relaxation(ens, int(300 / R))
         n = int(150 / R)
         if A < 0.1:
-            _free_mu0(ens, n, mu)
-            ens.free_pre_equilibration(n)
+            yield from _free_mu0(ens, n, mu)
+            yield Relaxation(ens, n)
         n = int(100 / R)
         for threshold in (0.01, 0.001, 0.0001):
             if A <= threshold:
-                ens.free_pre_equilibration(n)
-                _free_mu0(ens, n, mu)
-                ens.free_pre_equilibration(n)
+                yield Relaxation(ens, n)
+                yield from _free_mu0(ens, n, mu)
+                yield Relaxation(ens, n)
         if A <= 0.001 and (irt != 1 or irc != 1):
             ens.dt_max = ens.dt_max / 3
             n = int(200 / R)
-            ens.free_pre_equilibration(n)
-            _free_mu0(ens, n, mu)
-            ens.free_pre_equilibration(n)
+            yield Relaxation(ens, n)
+            yield from _free_mu0(ens, n, mu)
+            yield Relaxation(ens, n)
     return ens
 
 

@@ -32,8 +32,19 @@ __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLI
 
 _log = logging.getLogger(__name__)
 
-#: largest N measured by the engine (its candidate search is all-pairs per replica at each rebuild)
+#: largest N measured by the engine.  Its candidate search is a cell list (O(N) per rebuild), so this
+#: is no longer a limit of the search; single runs above it stay on the documented classes because the
+#: engine's step is slower there (1.4–1.6× on the scene a run measures at N = 500–5,000, about equal on
+#: a livelier scene at N = 2,000–100,000; docs/performance.md, benchmarks/bench_engine_large.py)
 ENGINE_MAX_N = 2000
+
+#: Verlet skin of the engines of a batch (constitution and measurement), in units of each
+#: replica's largest radius.  The contacts of every step are exact for any skin and the zero
+#: terms of candidates out of contact change no sum, so the numbers do not depend on it; at
+#: 0.2 r_max a compressed packing has ~0.9 of its candidates in contact against ~0.6 at 0.5, and
+#: a step of 32 default replicas costs ~30 % less (measured: protocol 95–100 → 65–68 µs per
+#: replica-step, constitution ~40 % less CPU time), the extra rebuilds included.
+ENGINE_SKIN_FACTOR = 0.2
 
 #: parameters a replica may choose on its own (everything else must agree within a batch)
 PER_REPLICA_PARAMETERS = frozenset((
@@ -271,9 +282,9 @@ def measure_batch(runs):
         seeds.append((seed_entropy, spawn_key, params))
     where = ["constitution", 0, 0]
     try:
+        _constitute(sessions)
         sched = []
         for run in sessions:
-            run.constitute()
             run.prepare()
             # the schedule of the replica: the one function runSimulation uses
             sc = run.schedule
@@ -307,6 +318,47 @@ def measure_batch(runs):
             run.close()
 
 
+def _constitute(sessions):
+    """Constitute every replica: bookkeeping per replica through the classes, relaxations in the engine.
+
+    Each session's constitution (:meth:`~particleShear.simulation.simulations.RunSession.constitution`)
+    yields its relaxation requests; the pending requests of equal key (steps, ``dt``, ``dt_max``)
+    run together in one engine (:func:`particleShear.engine.relax.relax_ensembles`), the key of
+    the first waiting replica first, until every constitution is done.  A replica's ensemble does
+    not depend on its companions (each has its own generator, and the engine's relaxation is per
+    replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
+    the relaxations it took part in."""
+    from ..engine.relax import relax_ensembles
+    from ..linkable.builders import MAX_RELAXATIONS
+
+    steps = [run.constitution() for run in sessions]
+    pending = {}            # replica -> its waiting Relaxation
+    since = {}              # replica -> when it was suspended
+
+    def advance(b, share=0.0):
+        if b in since:
+            sessions[b].waited += time.perf_counter() - since.pop(b) - share
+        try:
+            pending[b] = next(steps[b])
+            since[b] = time.perf_counter()
+        except StopIteration:
+            pending.pop(b, None)
+
+    for b in range(len(sessions)):
+        advance(b)
+    for _ in range(MAX_RELAXATIONS * max(len(sessions), 1)):   # each round serves at least one request
+        if not pending:
+            return
+        key = pending[min(pending)].key
+        group = [b for b in sorted(pending) if pending[b].key == key]
+        t0 = time.perf_counter()
+        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR)
+        share = (time.perf_counter() - t0) / len(group)
+        for b in group:
+            advance(b, share)
+    raise RuntimeError("the constitutions of a batch yielded more relaxations than allowed")
+
+
 def _measure(sessions, sched, where):
     """The engine measurement of the replicas: one engine per protocol schedule, after
     pre-equilibrating in one engine per pre-equilibration schedule.  Returns each replica's
@@ -329,14 +381,15 @@ def _measure(sessions, sched, where):
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
             say, report = _console(sims, group, "pre-equilibration", where)
-            _guarded(pre_equilibrate, BatchEngine(st, guard=[guard_of[b] for b in group]), pre[1], dt, pre[0],
-                     cool, say, report, dt=dt)
+            engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group])
+            _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)
             for b in group:
                 timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states), guard=[guard_of[b] for b in order])
+        engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
+                             guard=[guard_of[b] for b in order])
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,

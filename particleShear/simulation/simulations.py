@@ -20,7 +20,8 @@ import time
 from collections import namedtuple
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
-                                 EnsembleCompactParticlesFromModelParameters)
+                                 EnsembleCompactParticlesFromModelParameters, adjustable_interface_constitution,
+                                 relax_with_classes)
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
@@ -129,14 +130,36 @@ class RunSession:
 
     def constitute(self):
         """Build the ensemble (``initEnsemble``), with the progress calls of the constitution."""
+        relax_with_classes(self.constitution())
+
+    def constitution(self):
+        """:meth:`constitute` as a generator of the constitution's relaxations (docs/design.md).
+
+        Yields each :class:`~particleShear.linkable.builders.Relaxation` of the builder (the
+        caller runs it, with the classes or in the engine for a whole batch, and resumes) when the
+        simulation is a :class:`Simulation_interlocking_rheology` whose ``initEnsemble`` is the
+        documented one; any other ``initEnsemble`` (a subclass's own) is called as it is, with
+        nothing yielded.  The progress calls are those of :meth:`constitute`; the ``constitution``
+        timing is the wall time since the start less :attr:`waited` (time the caller spent on
+        other runs while this one was suspended).
+
+        Yields
+        ------
+        Relaxation
+            The next relaxation block of the constitution.
+        """
         sim = self.sim
         sim.write_error = None
         sim.theExperiment = None
         self.t_start = time.perf_counter()  # the run's clock starts with its own constitution
+        self.waited = 0.0
         if sim.progress is not None:
             sim.progress("constitution", 0, 0, 0.0)
-        sim.initEnsemble()
-        sim.timings["constitution"] = time.perf_counter() - self.t_start
+        if type(sim).initEnsemble is Simulation_interlocking_rheology.initEnsemble:
+            yield from sim.constitution_steps()
+        else:
+            sim.initEnsemble()
+        sim.timings["constitution"] = time.perf_counter() - self.t_start - self.waited
         if sim.progress is not None:
             sim.progress("constitution", 1, 1, sim.timings["constitution"])
 
@@ -989,7 +1012,33 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
             The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
         """
-        self.theEnsemble = EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
+        return relax_with_classes(self.constitution_steps(do_debug))
+
+    def constitution_steps(self, do_debug=False):
+        """:meth:`initEnsemble` as a generator of the builder's relaxations.
+
+        Runs :func:`~particleShear.linkable.builders.adjustable_interface_constitution` with this
+        simulation's parameters, yielding each of its
+        :class:`~particleShear.linkable.builders.Relaxation` requests, and sets ``theEnsemble``,
+        ``model``, ``dt`` and ``dt_max`` at the end, as :meth:`initEnsemble` does (which runs
+        the requests with the classes).
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Yields
+        ------
+        Relaxation
+            The next relaxation block.
+
+        Returns
+        -------
+        EnsembleCompactParticlesAdjustableInterfaceStrength
+            The constituted ensemble (also ``self.theEnsemble``).
+        """
+        self.theEnsemble = yield from adjustable_interface_constitution(
             **self._builder_arguments(do_debug),
             interface_reenforcement_central=self.interface_reenforcement_central,
             interface_reenforcement_tangential=self.interface_reenforcement_tangential,

@@ -1,0 +1,210 @@
+"""The constitution's relaxation in the engine (particleShear.engine.relax) against its definition.
+
+* Over short blocks the engine's free relaxation follows the documented classes'
+  ``free_pre_equilibration`` on the same ensemble: both integrate the same equations, the engine
+  with its sums in another order, so positions and velocities agree to rounding.  Over 40–80
+  steps rounding of ~1e-16 per operation grows by at most a few orders of magnitude in a damped
+  system; 1e-12 of each quantity's scale leaves room for that and still fails for any
+  difference of physics (one step more or less, a missed contact or a wrong μ moves spheres by
+  ≫ 1e-6 of their scale).  The relations and their states are the same sets.
+* A relaxed random packing is relaxed: the damped levels remove most of the elastic energy of
+  the random placement and the large overlaps.
+* The drift removal gives each replica zero mean velocity (the classes' unweighted mean).
+* A replica's relaxation is the same bit for bit with or without companions.
+"""
+import unittest
+
+import numpy as np
+
+from particleShear.engine.box import min_image
+from particleShear.engine.relax import (free_relaxation, relax_ensembles, relaxation_levels,
+                                        remove_linear_drift)
+from particleShear.engine.state import BatchState
+from particleShear.engine.step import BatchEngine
+from particleShear.linkable.builders import adjustable_interface_constitution, relax_with_classes
+
+#: a small scene of the run API's builder (nominal area fraction 1: a jammed packing)
+SCENE = dict(N=40, packing_fraction=1.0, mu=0.1, Young_modulus_spheres=1000, cut_lines=3, anticipated_amplitude=0.1,
+             central_repulsion_coefficient=1, doDrawing=False)
+
+SPHERE_ROWS = ("x", "y", "phi", "xspeed", "yspeed", "omega")
+
+
+def random_packing(seed, **kw):
+    """The builder's ensemble at its first relaxation: spheres placed at random, at rest."""
+    return next(adjustable_interface_constitution(**dict(SCENE, rng=seed, **kw))).ensemble
+
+
+def constituted(seed, **kw):
+    """A relaxed, crosslinked and cut ensemble (the builder with a tenth of its relaxation)."""
+    return relax_with_classes(adjustable_interface_constitution(**dict(SCENE, rng=seed, do_debug=True, **kw)))
+
+
+class TestAgainstTheClasses(unittest.TestCase):
+    def assert_same_relaxation(self, ref, eng, N, min_bonds=0):
+        """``ref.free_pre_equilibration(N)`` (classes) against :func:`relax_ensembles` on a copy."""
+        self.assertTrue(all(np.array_equal(ref._a[k], eng._a[k]) for k in SPHERE_ROWS))   # the same start
+        ref.free_pre_equilibration(N)
+        steps = relax_ensembles([eng], N)
+        self.assertEqual(steps, ref.n_constitution_steps - (eng.n_constitution_steps - steps))
+        self.assertEqual(eng.n_constitution_steps, ref.n_constitution_steps)
+        self.assertAlmostEqual(eng.t, ref.t, delta=1e-12 * ref.t)
+        self.assertEqual(eng.mu, ref.mu)
+        for k in SPHERE_ROWS:
+            a, b = ref._a[k], eng._a[k]
+            scale = np.abs(a).max()   # 0 only for ω and φ without tangential forces: then both exactly 0
+            self.assertTrue(scale > 0.0 or k in ("omega", "phi"), k)
+            self.assertLessEqual(np.abs(a - b).max(), 1e-12 * scale, k)
+        # the relations (and so what the crosslinking links) and their states are the same
+        pr, pe = ref._pairs, eng._pairs
+        self.assertEqual(pr.key[pr.active].tolist(), pe.key[pe.active].tolist())
+        self.assertEqual(pr.state[pr.active].tolist(), pe.state[pe.active].tolist())
+        # ... created in the same order (creation numbers order ``neighbors``)
+        self.assertEqual(pr.birth[pr.active].tolist(), pe.birth[pe.active].tolist())
+        self.assertEqual(pr._births, pe._births)
+        self.assertGreaterEqual(int((pe.state == 2).sum()), min_bonds)
+        xr, xe = pr.xi[:, pr.active], pe.xi[:, pe.active]
+        self.assertLessEqual(np.abs(xr - xe).max(), 1e-12 * max(np.abs(xr).max(), 1e-300))
+        return ref, eng
+
+    def test_random_packing_levels_and_final_blocks(self):
+        # two coarse levels (4 dt, 2 dt; damped, frictionless, drift removed) and the two blocks at dt
+        ref, eng = random_packing(3), random_packing(3)
+        for e in (ref, eng):
+            e.dt_max = 4 * e.dt
+        self.assertEqual(len(relaxation_levels(ref.dt, ref.dt_max)), 2)
+        self.assert_same_relaxation(ref, eng, 20)
+        # friction acted in the last block: some contact sticks with a history
+        self.assertGreater(np.abs(eng._pairs.xi).max(), 0.0)
+
+    def test_crosslinked_ensemble_with_bonds_and_friction(self):
+        # after crosslinking and cutting (bonds scaled by 1/irc, 1/irt): one level at 2 dt, then dt
+        kw = dict(mu=0.3, interface_reenforcement_central=2, interface_reenforcement_tangential=1.5)
+        ref, eng = constituted(5, **kw), constituted(5, **kw)
+        self.assertEqual(len(relaxation_levels(ref.dt, ref.dt_max)), 1)
+        self.assert_same_relaxation(ref, eng, 30, min_bonds=20)
+
+    def test_frictionless_without_viscosity(self):
+        # μ = 0 and no bonds: the classes skip the tangential kernel (every contact slips, ξ = 0)
+        ref, eng = random_packing(4, mu=0.0, relative_viscosity=0.0), random_packing(4, mu=0.0, relative_viscosity=0.0)
+        for e in (ref, eng):
+            e.dt_max = 2 * e.dt
+        ref, eng = self.assert_same_relaxation(ref, eng, 20)
+        pe = eng._pairs
+        self.assertTrue(np.all(pe.xi == 0.0))
+        self.assertTrue(np.all(pe.state[pe.active] == 1))   # SLIP
+
+    def test_mu_zero_blocks_of_the_builder(self):
+        # the builder's "μ = 0: free(n)" block: the ensemble's μ is 0 while it runs, restored after
+        from particleShear.linkable.builders import Relaxation, _free_mu0
+        ref, eng = constituted(6), constituted(6)
+        for e in (ref, eng):
+            e.dt_max = 2 * e.dt
+        seen = []
+        for e, serve in ((ref, lambda r: r.run()), (eng, lambda r: relax_ensembles([r.ensemble], r.N))):
+            gen = _free_mu0(e, 15, 0.1)
+            request = next(gen)
+            self.assertIsInstance(request, Relaxation)
+            seen.append(request.key)
+            self.assertEqual(e.mu, 0)
+            serve(request)
+            with self.assertRaises(StopIteration):
+                next(gen)
+            self.assertEqual(e.mu, 0.1)
+        self.assertEqual(seen[0], seen[1])
+        for k in SPHERE_ROWS:
+            scale = np.abs(ref._a[k]).max()
+            self.assertLessEqual(np.abs(ref._a[k] - eng._a[k]).max(), 1e-12 * scale, k)
+
+
+def energies(e):
+    """Kinetic energy, elastic energy ½k·overlap² of the linear law (c = 0) and the largest
+    relative overlap of an ensemble (all pairs; reference units)."""
+    a = e._a
+    n = len(e.sphereList)
+    i, j = np.triu_indices(n, 1)
+    dx, dy, _, _ = min_image(a["x"][j] - a["x"][i], a["y"][j] - a["y"][i], e.size_x, e.size_y, 0.0)
+    d0 = a["r"][i] + a["r"][j]
+    overlap = np.maximum(d0 - np.hypot(dx, dy), 0.0)
+    kinetic = 0.5 * np.sum(a["m"] * (a["xspeed"] ** 2 + a["yspeed"] ** 2) + a["inertia"] * a["omega"] ** 2)
+    return kinetic, 0.5 * e.k * np.sum(overlap ** 2), float((overlap / d0).max())
+
+
+class TestRelaxedState(unittest.TestCase):
+    def test_relaxation_removes_the_energy_of_the_random_placement(self):
+        # the builder's first relaxation (300 steps per level) of random packings with the linear law:
+        # the placement overlaps spheres by up to ~90 % of their contact distance and stores all its
+        # energy elastically; the damped levels remove it.  Observed: total energy 4–7 % of the start,
+        # kinetic energy < 0.4 % of it, largest overlap < 19 %; bounds with a margin of ~2×.
+        for seed in (4, 5, 6):
+            with self.subTest(seed=seed):
+                gen = adjustable_interface_constitution(**dict(SCENE, N=60, central_repulsion_coefficient=0, rng=seed))
+                request = next(gen)
+                e = request.ensemble
+                k0, u0, ov0 = energies(e)
+                self.assertEqual(k0, 0.0)
+                self.assertGreater(ov0, 0.8)
+                relax_ensembles([e], request.N)
+                k1, u1, ov1 = energies(e)
+                self.assertLess(k1 + u1, 0.15 * u0)
+                self.assertLess(k1, 0.01 * u0)
+                self.assertLess(ov1, 0.3)
+
+
+class TestDriftRemoval(unittest.TestCase):
+    def test_zero_mean_velocity_per_replica(self):
+        # three replicas with different drifts: each loses its own mean velocity, to rounding of a sum
+        # of N terms (N·ε relative to the largest velocity), and keeps its velocity differences
+        rng = np.random.default_rng(1)
+        s = BatchState(3, 50)
+        s.vx[...] = rng.normal(size=150) + np.repeat([5.0, -3.0, 0.0], 50)
+        s.vy[...] = rng.normal(size=150) * 2 + np.repeat([0.0, 7.0, -1.0], 50)
+        before = (s.vx.copy(), s.vy.copy())
+        remove_linear_drift(s)
+        for b in range(3):
+            rows = s.replica(b)
+            for v, v0 in zip((s.vx, s.vy), before):
+                scale = np.abs(v0[rows]).max()
+                self.assertLessEqual(abs(v[rows].mean()), 50 * np.finfo(float).eps * scale)
+                d, d0 = np.diff(v[rows]), np.diff(v0[rows])
+                self.assertLessEqual(np.abs(d - d0).max(), 4 * np.finfo(float).eps * scale)
+
+
+class TestBatchIndependence(unittest.TestCase):
+    def test_replica_alone_equals_replica_in_a_batch(self):
+        a1, a2 = random_packing(8), random_packing(8)
+        other = random_packing(9, mu=0.0)
+        for e in (a1, a2, other):
+            e.dt_max = 4 * e.dt
+        relax_ensembles([a1], 15)
+        relax_ensembles([other, a2], 15)
+        for k in SPHERE_ROWS:
+            self.assertEqual(a1._a[k].tobytes(), a2._a[k].tobytes(), k)
+        for name in ("key", "state", "xi", "d_eq", "active", "birth"):
+            self.assertEqual(getattr(a1._pairs, name).tobytes(), getattr(a2._pairs, name).tobytes(), name)
+        self.assertEqual(a1.t, a2.t)
+
+    def test_result_does_not_depend_on_the_verlet_skin(self):
+        # the candidate list only has to contain every contact: a thin skin (more rebuilds, fewer
+        # candidates) and a thick one give the same contacts, and the zero terms of the other
+        # candidates change no sum, so the same bits
+        a, b = random_packing(10), random_packing(10)
+        relax_ensembles([a], 40, skin_factor=0.5)
+        relax_ensembles([b], 40, skin_factor=0.1)
+        for k in SPHERE_ROWS:
+            self.assertEqual(a._a[k].tobytes(), b._a[k].tobytes(), k)
+        self.assertEqual(a._pairs.key[a._pairs.active].tolist(), b._pairs.key[b._pairs.active].tolist())
+
+    def test_mismatched_schedules_are_refused(self):
+        a, b = random_packing(1), random_packing(2)
+        b.dt_max = 2 * b.dt
+        with self.assertRaisesRegex(ValueError, "dt_max"):
+            relax_ensembles([a, b], 5)
+        with self.assertRaisesRegex(ValueError, "dt="):
+            relaxation_levels(0.0, 1.0)
+        with self.assertRaisesRegex(ValueError, "dt_max="):
+            relaxation_levels(1.0, float("inf"))
+
+
+if __name__ == "__main__":
+    unittest.main()
