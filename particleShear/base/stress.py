@@ -523,7 +523,8 @@ class StressTensorEvaluation:
             ens = reg._ens
             rows = self._block_rows(p)
             active, _, dy, fx_i, _, dF = self._block_arrays(p, rows, ens)
-            yc = ens._a["y"] - self.size_y / 2
+            # y − Ly/2 of the spheres: the ensemble's own (kept per position update) when the cells agree
+            yc = ens._y_centred() if ens.size_y == self.size_y else ens._a["y"] - self.size_y / 2
             tau = _engine_shear_stresses(rows.C, 1, yc, rows.flags, active, rows.not_internal, dy, fx_i, dF,
                                          cell["V"])
         else:
@@ -610,7 +611,8 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The forces and torques of the current force phase.
+            The current force phase: the net torque of every sphere (``unbalanced_moment_register``)
+            is summed.
         """
         self._store(self._total_inputs(force_register), (_es.unbalanced_torque,))
 
@@ -620,7 +622,8 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The forces and torques of the current force phase.
+            The current force phase: its internal tangential torques (``internal_moment_register``)
+            are summed.
         """
         self._store(self._pair_inputs(force_register), (_es.internal_torque,))
 
@@ -661,9 +664,11 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The forces and torques of the current force phase.
+            The current force phase: its pair entries and its sphere totals (the unbalanced-force
+            tensor sums over the register's mobile spheres).
         theSphereList : list
-            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+            The spheres of the spin and Otsuki sums (in the experiment, the mobile ones:
+            ``movableSphereList()``).
         shear_rate : float
             Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
         """
