@@ -502,12 +502,8 @@ class StressTensorEvaluation:
         if p["pos_version"] != ens._pos_version:
             pos = ens._pos
             D = pos.take(p["j"], axis=1) - pos.take(p["i"], axis=1)
-        T = p.get("T")
-        if T is None:
-            dF = rows.zeros
-        else:
-            P = rows.C.P
-            dF = T[:P] + T[P:]
+        ti = p.get("ti")
+        dF = rows.zeros if ti is None else ti + p["tj"]
         Fi = p["Fi"]
         return active, D[0], D[1], Fi[0], Fi[1], dF
 

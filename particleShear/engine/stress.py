@@ -193,7 +193,7 @@ def linear_acceleration(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return unbalanced_forces(q)
+    return q.tensor(unbalanced_forces)
 
 
 def unbalanced_torque(q):
