@@ -168,14 +168,17 @@ class ForcePhase(StressInputs):
         return super().tensor(function) if part is None else part.tensor(function)
 
 
-def _cell(ev, shear_rate=0.0):
-    """The per-replica inputs of the cell of ``ev`` (arrays of one replica), kept per cell and rate."""
-    key = (ev.size_x, ev.size_y, shear_rate)
+def _cell(ev, shear_rate=None):
+    """The per-replica inputs of the cell of ``ev`` (arrays of one replica: ``Lx, Ly, V``, kept per
+    cell size, and ``rate`` when ``shear_rate`` is given)."""
+    key = (ev.size_x, ev.size_y)
     c = ev._cell_inputs
     if c is None or c[0] != key:
         c = ev._cell_inputs = (key, dict(B=1, Lx=np.array((float(ev.size_x),)), Ly=np.array((float(ev.size_y),)),
-                                         rate=np.array((float(shear_rate),)), V=np.array((ev._volume(),))))
-    return c[1]
+                                         V=np.array((ev._volume(),))))
+    if shear_rate is None:
+        return c[1]
+    return dict(c[1], rate=np.array((float(shear_rate),)))
 
 
 def _with_mobile(q, mob):
@@ -549,10 +552,11 @@ class StressTensorEvaluation:
         a = ens._a
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
         active, dx, dy, fx_i, fy_i, dF = self._block_arrays(p, rows, ens)
-        q = OneReplicaInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"], omega=a["omega"],
-                         m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob, active=active,
-                         shifted=rows.not_internal, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=fx, fy=fy,
-                         torque=no_torque if reg._mom is None else reg._mom, **_cell(self, shear_rate))
+        q = OneReplicaInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
+                             omega=a["omega"], m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob,
+                             active=active, shifted=rows.not_internal, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
+                             fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
+                             **_cell(self, shear_rate))
         if mask is mob:
             return ForcePhase(q, q, q)
         return ForcePhase(q, q, _with_mobile(q, everyone if mask is None else mask))
@@ -561,15 +565,15 @@ class StressTensorEvaluation:
         """The spheres of a list as the engine's sphere inputs of a batch of one (all counted)."""
         inertia, omega, m, vx, vy, y = self._sphere_values(theSphereList)
         n = len(m)
-        return OneReplicaInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy, y=y,
-                            mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
+        return OneReplicaInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy,
+                                y=y, mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
 
     def _pair_inputs(self, reg, entries=None):
         return OneReplicaInputs(**(_entries(reg) if entries is None else entries), **_cell(self))
 
     def _total_inputs(self, reg):
         return OneReplicaInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
-                            **_totals(reg), **_cell(self))
+                                **_totals(reg), **_cell(self))
 
     def _store(self, q, functions):
         """Evaluate ``functions`` of the registry on ``q`` into the tensor attributes."""
