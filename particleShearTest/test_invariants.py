@@ -116,7 +116,7 @@ class TestShearedCrosslinkedEnsemble(unittest.TestCase):
             ens.evaluate_stress_tensors(ev)
             cls.records.append(tensors(ev))
             if len(cls.records) % 10 == 1:
-                # the same tensors from the generic path: per-block loops and a plain list of mobile spheres
+                # the same tensors through the generic adapter (register entries as rows) and a plain list of mobile spheres
                 ref = StressTensorEvaluation(L, L)
                 mobile = list(ens.movableSphereList())
                 ref.evaluate_force_stress_tensors(ens.force_register)
