@@ -12,6 +12,7 @@ and it runs the device variants of the step (branch-free, no host caches) agains
 With CuPy and a CUDA device, a batch on the GPU is compared with the NumPy batch (tolerance
 justified in :class:`TestCuPy`).
 """
+import collections
 import concurrent.futures
 import contextlib
 import io
@@ -281,12 +282,16 @@ class TestBatchOnTheStandInDevice(unittest.TestCase):
             assert_bit_identical(self, d, h)
 
     def test_host_reads_are_named_and_few(self):
-        # every read has a reason of REASONS (to_host refuses others) and the per-step flags dominate:
-        # at most a few reads per step (the flags, the d = 0 checks), not one per kernel
-        self.assertTrue(set(self.reads) <= set(xpmod.REASONS), set(self.reads) - set(xpmod.REASONS))
-        self.assertIn("series", self.reads)
-        steps = sum(r.N_steps for r in self.device) / len(self.device)  # protocol steps (the longer phase)
-        self.assertLess(len(self.reads), 2 * 4 * 3 * steps)   # runs of the batch and the series, < 4 per step
+        # every read has a reason of REASONS (to_host refuses others); a step reads its flags once and
+        # checks twice for pairs at d = 0; everything else (list rebuilds, copies of the state, the
+        # series at the end) is rare
+        c = collections.Counter(self.reads)
+        self.assertTrue(set(c) <= set(xpmod.REASONS), set(c) - set(xpmod.REASONS))
+        steps = c["flags"]
+        self.assertGreater(steps, 2 * self.device[0].N_steps)     # the protocols of the batch and of the series
+        self.assertEqual(c["d = 0"], 2 * steps)
+        self.assertGreater(c["series"], 0)
+        self.assertLess(sum(n for why, n in c.items() if why not in ("flags", "d = 0")), 0.2 * steps)
 
 
 class TestBadBackend(unittest.TestCase):
@@ -359,7 +364,7 @@ class TestSegmentSum(unittest.TestCase):
         index = rng.integers(0, 40, 500)
         index[:7] = 5                     # a crowded bin; bins without rows stay 0
         numpy_ordered = xpmod.get_backend("numpy")
-        padded = xpmod.Backend("padded", np, True, np.asarray, np.asarray, numpy_ordered.owns, ordered_bincount=False)
+        padded = xpmod.Backend("padded", np, True, np.asarray, np.asarray, numpy_ordered.owns, ordered_reductions=False)
         # integer-valued weights: every partial sum is exact, so any order of the additions gives the same bits
         w = rng.integers(-1000, 1000, 500).astype(float)
         self.assertEqual(xpmod.SegmentSum(index, 45, padded)(w).tobytes(), np.bincount(index, w, 45).tobytes())

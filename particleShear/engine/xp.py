@@ -43,6 +43,8 @@ REASONS = {
     "state": "the final state of a batch, when it is copied back or inspected",
 }
 
+_HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
+
 _log = None   # list receiving each reason while record_host_reads() is active
 
 
@@ -81,16 +83,17 @@ class Backend:
         ``to_host(device_array) -> numpy.ndarray``.
     owns : callable
         ``owns(array) -> bool``: the array belongs to this backend.
-    ordered_bincount : bool, default True
-        The namespace's ``bincount(index, weights, minlength)`` sums each bin in row order without
-        a host read (NumPy); False (CuPy: atomic adds, and a host read of ``max(index)``) makes
-        :class:`SegmentSum` use the padded gather.
+    ordered_reductions : bool, default True
+        The namespace's ``bincount(index, weights, minlength)`` and ``add.reduceat`` sum in row
+        order without a host read (NumPy); False (CuPy: ``bincount`` adds atomically, in no fixed
+        order, and reads ``max(index)`` on the host) makes :class:`SegmentSum` and the per-replica
+        sums use a padded gather and a reduction along rows.
     """
 
-    def __init__(self, name, xp, host, asarray, to_host, owns, ordered_bincount=True):
+    def __init__(self, name, xp, host, asarray, to_host, owns, ordered_reductions=True):
         self.name, self.xp, self.host = name, xp, bool(host)
         self.asarray, self._to_host, self.owns = asarray, to_host, owns
-        self.ordered_bincount = bool(ordered_bincount)
+        self.ordered_reductions = bool(ordered_reductions)
 
     def __repr__(self):
         return f"Backend({self.name!r})"
@@ -115,7 +118,7 @@ def _cupy_backend():
         raise ValueError("backend='cupy' needs CuPy and a CUDA device: CuPy found no CUDA device; "
                          "choose backend='numpy'")
     return Backend("cupy", cupy, False, cupy.asarray, cupy.asnumpy, lambda a: isinstance(a, cupy.ndarray),
-                   ordered_bincount=False)
+                   ordered_reductions=False)
 
 
 _FACTORIES = {"numpy": _numpy_backend, "cupy": _cupy_backend}
@@ -203,7 +206,7 @@ def backend_of(*arrays):
     Backend
     """
     for a in arrays:
-        if a is None or isinstance(a, (bool, int, float, complex, np.ndarray, np.generic)):
+        if isinstance(a, _HOST_TYPES):
             continue
         for name, b in _MADE.items():
             if name != "numpy" and b.owns(a):
@@ -228,7 +231,10 @@ def array_namespace(*arrays):
     module
         The namespace whose functions accept and return such arrays.
     """
-    return backend_of(*arrays).xp
+    for a in arrays:
+        if not isinstance(a, _HOST_TYPES):
+            return backend_of(*arrays).xp
+    return np
 
 
 def to_host(array, why):
@@ -257,7 +263,7 @@ def to_host(array, why):
         raise ValueError(f"why={why!r} is out of range: allowed {', '.join(map(repr, REASONS))}")
     if _log is not None:
         _log.append(why)
-    if isinstance(array, np.ndarray):
+    if isinstance(array, (np.ndarray, np.generic)):
         return array
     return backend_of(array)._to_host(array)
 
@@ -267,8 +273,9 @@ class SegmentSum:
 
     Built once per index (the scatter of a candidate set, the replica of each row) and applied
     every step.  On NumPy it is ``numpy.bincount(index, w, n)`` (each bin summed in row order);
-    on CuPy (:attr:`Backend.ordered_bincount` false) the rows of each bin are gathered into a padded ``(n, width)`` matrix (padding
-    points to an appended 0) and summed along its rows — deterministic and free of host reads.
+    on CuPy (:attr:`Backend.ordered_reductions` false) the rows of each bin are gathered into a
+    padded ``(n, width)`` matrix (padding points to an appended 0) and summed along its rows —
+    deterministic and free of host reads.
     The two agree to rounding (a different order of the same additions).
 
     Parameters
@@ -284,24 +291,45 @@ class SegmentSum:
     def __init__(self, index, n, backend):
         self.n = int(n)
         self.backend = backend
-        index = np.asarray(index, dtype=np.intp)
-        if backend.ordered_bincount:
+        index = self._host_index = np.asarray(index, dtype=np.intp)
+        self._min_gather = None
+        if backend.ordered_reductions:
             self.index = backend.asarray(index)
             self.gather = None
             return
+        self._host_index = index
+        self.gather = self._padded()
+
+    def _padded(self):
+        """The (n, width) gather matrix: row k lists the rows of bin k in order, padded with P (→ the appended value)."""
+        index = self._host_index
         order = np.argsort(index, kind="stable")
         counts = np.bincount(index, minlength=self.n)
         width = int(counts.max()) if len(counts) else 0
         start = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.intp)
         rank = np.arange(len(index)) - np.repeat(start, counts)     # position of each row within its bin
-        gather = np.full((self.n, max(width, 1)), len(index), dtype=np.intp)   # padding → the appended 0
+        gather = np.full((self.n, max(width, 1)), len(index), dtype=np.intp)
         gather[index[order], rank] = order
-        self.gather = backend.asarray(gather)
+        return self.backend.asarray(gather)
 
     def __call__(self, w):
-        """The sums of ``w`` (P,) per bin, an array (n,) of the backend."""
+        """The sums per bin of ``w`` (P,), or of each row of ``w`` (rows, P): an array (n,) or (rows, n)."""
         xp = self.backend.xp
         if self.gather is None:
-            return xp.bincount(self.index, w, self.n)
-        padded = xp.concatenate((w, xp.zeros(1, dtype=w.dtype)))
-        return padded[self.gather].sum(axis=1)
+            if w.ndim == 1:
+                return xp.bincount(self.index, w, self.n)
+            return xp.stack([xp.bincount(self.index, w[k], self.n) for k in range(w.shape[0])])
+        pad = xp.zeros(w.shape[:-1] + (1,), dtype=w.dtype)
+        padded = xp.concatenate((w, pad), axis=-1)
+        return padded[..., self.gather].sum(axis=-1)
+
+    def minimum(self, w):
+        """The smallest value of ``w`` (P,) per bin (``inf`` for a bin without rows): an array (n,).
+
+        Order-free, so every backend uses the padded gather (padding ``inf``)."""
+        xp = self.backend.xp
+        if self.gather is None and self._min_gather is None:
+            self._min_gather = self._padded()
+        gather = self._min_gather if self.gather is None else self.gather
+        padded = xp.concatenate((w, xp.full(1, float("inf"), dtype=w.dtype)))
+        return padded[gather].min(axis=1)
