@@ -313,7 +313,17 @@ class SegmentSum:
         return self.backend.asarray(gather)
 
     def __call__(self, w):
-        """The sums per bin of ``w`` (P,), or of each row of ``w`` (rows, P): an array (n,) or (rows, n)."""
+        """The sums per bin of ``w`` (P,), or of each row of ``w`` (rows, P).
+
+        Parameters
+        ----------
+        w : array (P,) or (rows, P)
+            Weights of the rows, any unit, on the backend.
+
+        Returns
+        -------
+        array (n,) or (rows, n)
+        """
         xp = self.backend.xp
         if self.gather is None:
             if w.ndim == 1:
@@ -324,9 +334,19 @@ class SegmentSum:
         return padded[..., self.gather].sum(axis=-1)
 
     def minimum(self, w):
-        """The smallest value of ``w`` (P,) per bin (``inf`` for a bin without rows): an array (n,).
+        """The smallest value of ``w`` per bin (``inf`` for a bin without rows).
 
-        Order-free, so every backend uses the padded gather (padding ``inf``)."""
+        Order-free, so every backend uses the padded gather (padding ``inf``).
+
+        Parameters
+        ----------
+        w : array (P,)
+            Values of the rows, on the backend.
+
+        Returns
+        -------
+        array (n,)
+        """
         xp = self.backend.xp
         if self.gather is None and self._min_gather is None:
             self._min_gather = self._padded()
