@@ -356,6 +356,19 @@ class TestBadBackend(unittest.TestCase):
             self.assertIn("backend='nonsense' (--backend) is out of range", err.getvalue())
 
 
+class TestNoCuPyAtImport(unittest.TestCase):
+    def test_importing_the_package_does_not_import_cupy(self):
+        # CuPy initialises CUDA when imported: a NumPy user must never pay for it, nor a forked worker break
+        import subprocess
+        import sys
+        code = ("import sys, particleShear, particleShear.engine.step, particleShear.run.batch; "
+                "from particleShear.engine.xp import array_namespace; import numpy; "
+                "assert array_namespace(numpy.zeros(2)) is numpy; print('cupy' in sys.modules)")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertEqual(out.stdout.strip(), "False")
+
+
 class TestSegmentSum(unittest.TestCase):
     """The device scatter (padded gather) sums the same rows into the same bins as bincount."""
 
