@@ -17,9 +17,14 @@ __all__ = ["min_image", "wrap", "flow_velocity", "MAX_PASSES"]
 MAX_PASSES = 4
 
 
-def _count(v, half):
+def _count(v, half, minus_half):
     """−1, 0 or +1 per element as float: a period to subtract (``v ≥ half``) or to add (``v < −half``)."""
-    return (v >= half).astype(float) - (v < -half)
+    return (v >= half).astype(float) - (v < minus_half)
+
+
+def _accumulate(total, k):
+    """Running count of periods removed: the first pass's counts themselves, then their sum."""
+    return k if total is None else total + k
 
 
 def min_image(dx, dy, Lx, Ly, shift):
@@ -52,30 +57,35 @@ def min_image(dx, dy, Lx, Ly, shift):
     At most :data:`MAX_PASSES` one-period passes, then the rest is folded in closed form, so
     the cost does not grow with the size of a separation.
     """
-    ky_total = np.zeros(np.shape(dx))
+    hy, hx = Ly / 2, Lx / 2          # the interval bounds, computed once for all passes
+    mhy, mhx = -hy, -hx
+    ky_total = kx_total = None
     for _ in range(MAX_PASSES):
-        ky = _count(dy, Ly / 2)
+        ky = _count(dy, hy, mhy)
         if not ky.any():
             break
         dy = dy - Ly * ky
         dx = dx - shift * ky
-        ky_total += ky
+        ky_total = _accumulate(ky_total, ky)
     else:  # absurd separation: fold the rest at once (non-finite values become NaN for the guard)
-        ky = np.floor((dy + Ly / 2) / Ly)
+        ky = np.floor((dy + hy) / Ly)
         dy = dy - Ly * ky
         dx = dx - shift * ky
-        ky_total += ky
-    kx_total = np.zeros(np.shape(dx))
+        ky_total = _accumulate(ky_total, ky)
     for _ in range(MAX_PASSES):
-        kx = _count(dx, Lx / 2)
+        kx = _count(dx, hx, mhx)
         if not kx.any():
             break
         dx = dx - Lx * kx
-        kx_total += kx
+        kx_total = _accumulate(kx_total, kx)
     else:
-        kx = np.floor((dx + Lx / 2) / Lx)
+        kx = np.floor((dx + hx) / Lx)
         dx = dx - Lx * kx
-        kx_total += kx
+        kx_total = _accumulate(kx_total, kx)
+    if ky_total is None:
+        ky_total = np.zeros(np.shape(dx))
+    if kx_total is None:
+        kx_total = np.zeros(np.shape(dx))
     return dx, dy, ky_total, kx_total
 
 

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from .box import min_image, wrap
-from .forces import PairConstants, central_term, normals, scatter, shear_stresses, tangential_term
+from .forces import PairConstants, central_term, normals, scatter, shear_stresses, splice_arrays, tangential_term
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
 from .stress import StressInputs, evaluate_all
@@ -102,10 +102,11 @@ class BatchEngine:
         self._mob_flags = None    # mobility flags of the candidates (with the C and mask they belong to)
 
     # -- the one cache ---------------------------------------------------------------------------
-    def _sync_down(self):
-        """Write the flat pair history back into the per-replica lists."""
+    def _sync_down(self, replicas=None):
+        """Write the flat pair history back into the per-replica lists (of ``replicas``; all by default)."""
         C = self.C
-        for b, p in enumerate(self.s.pairs):
+        for b in range(self.s.B) if replicas is None else replicas:
+            p = self.s.pairs[b]
             lo, hi = C.offsets[b], C.offsets[b + 1]
             p.state = self.state_p[lo:hi].copy()
             p.xi = self.xi[:, lo:hi].copy()
@@ -113,14 +114,18 @@ class BatchEngine:
 
     def neighbours(self):
         """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
-        per-candidate constants with them (the one invalidation point)."""
+        per-candidate constants with them (the one invalidation point).
+
+        Only the rebuilt replicas' constants are computed; the other replicas' segments are copied
+        from the previous constants (:meth:`~particleShear.engine.forces.PairConstants.splice`)."""
         need = self.bound >= self.skin
         if not need.any():
             return
         s = self.s
+        changed = np.flatnonzero(need)
         if self.C is not None:
-            self._sync_down()
-        for b in np.flatnonzero(need):
+            self._sync_down(changed)     # the history the rebuilt lists carry over
+        for b in changed:
             rows = s.replica(b)
             s.pairs[b] = build_candidates(s.x[rows], s.y[rows], s.r[rows], s.Lx[b], s.Ly[b], s.Ly[b] * s.gamma[b],
                                           self.skin[b], s.pairs[b])
@@ -130,11 +135,29 @@ class BatchEngine:
             self.strain[b] = 0.0
             self.rebuilds[b] += 1
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
-        C = self.C = PairConstants(s, offsets)
-        self.state_p = np.concatenate([p.state for p in s.pairs])
-        self.xi = np.concatenate([p.xi for p in s.pairs], axis=1)
-        self.active = np.concatenate([p.active for p in s.pairs])
-        C.set_bonds(s, self.state_p, np.concatenate([p.d_eq for p in s.pairs]))
+        fresh = [s.pairs[b] for b in changed]
+        new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed)
+        new.set_bonds(s, np.concatenate([p.state for p in fresh]), np.concatenate([p.d_eq for p in fresh]))
+        state_p = np.concatenate([p.state for p in fresh])
+        xi = np.concatenate([p.xi for p in fresh], axis=1)
+        active = np.concatenate([p.active for p in fresh])
+        if self.C is None or len(changed) == s.B:
+            self.C, self.state_p, self.xi, self.active = new, state_p, xi, active
+            return
+        # the batch's arrays: the unchanged replicas' segments from the old arrays, in replica order
+        old_off, segments, k = self.C.offsets, [], 0
+        for b in range(s.B):
+            if k < len(changed) and changed[k] == b:
+                segments.append((True, new.offsets[k], new.offsets[k + 1]))
+                k += 1
+            elif segments and not segments[-1][0] and segments[-1][2] == old_off[b]:
+                segments[-1] = (False, segments[-1][1], old_off[b + 1])     # extend a run of unchanged replicas
+            else:
+                segments.append((False, old_off[b], old_off[b + 1]))
+        self.state_p = splice_arrays(self.state_p, state_p, segments)
+        self.xi = splice_arrays(self.xi, xi, segments)
+        self.active = splice_arrays(self.active, active, segments)
+        self.C = PairConstants.splice(s, self.C, new, segments, offsets)
 
     def _images(self, raw_x, raw_y, shift_p):
         """Minimum image of the candidates, reusing the period counts of the last step while they
@@ -357,22 +380,22 @@ class BatchEngine:
         bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
         C = self.C
         ratio = np.where(active & C.trans, d / C.d0, np.inf)
-        lo, hi = C.offsets[:-1], C.offsets[1:]
-        closest = np.minimum.reduceat(np.append(ratio, np.inf), lo)     # pairs of a replica are contiguous
-        closest[hi == lo] = np.inf
-        for b in range(B):
-            if not self.guard[b]:
-                continue
-            if not finite[b]:
-                reason = "non-finite state"
-            elif ke[b] > bound[b]:
-                reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
-            elif closest[b] < self.min_distance_ratio:
-                reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
-            else:
-                continue
-            raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
-                                    replica=b, step=self.step_count, phase=self.phase)
+        # closest transient contact of each replica: one reduction over its own (contiguous) segment
+        closest = np.full(B, np.inf)
+        if C.P:
+            closest[C.seg_rep] = np.minimum.reduceat(ratio, C.seg_starts)
+        bad = self.guard & (~finite | (ke > bound) | (closest < self.min_distance_ratio))
+        if not bad.any():      # the one device-to-host transfer of the guard: does any replica stop the batch?
+            return
+        b = int(np.flatnonzero(bad)[0])
+        if not finite[b]:
+            reason = "non-finite state"
+        elif ke[b] > bound[b]:
+            reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
+        else:
+            reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
+        raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
+                                replica=b, step=self.step_count, phase=self.phase)
 
 
 def pre_equilibration_blocks(N, dt, dt_max):

@@ -2,7 +2,7 @@
 
 Each function takes the :class:`StressInputs` of one force phase of a batch and returns a
 ``(B, 2, 2)`` array (Pa; index ``[b, a, c]``: replica, force component, position component).
-Sums run per replica over its own rows (``bincount`` over the replica index), so a replica's
+Sums run per replica over its own rows (one reduction over each replica's segment), so a replica's
 tensors do not depend on its batch.  Units as in the reference: forces ×1e-12 (N per m depth),
 lengths ×1e-6 (m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from
 the cell centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
@@ -12,6 +12,8 @@ __docformat__ = "numpy"
 import collections
 
 import numpy as np
+
+from .forces import replica_sums
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
 
@@ -76,8 +78,19 @@ class StressInputs:
         -------
         ndarray (B,)
             The sums, in the unit of ``weights``.
+
+        Notes
+        -----
+        A replica's pairs and its spheres are contiguous rows, so each sum is one reduction over
+        the replica's own segment (:func:`~particleShear.engine.forces.replica_sums`): it does
+        not depend on the rest of the batch.
         """
-        return np.bincount(self.C.rep if by_pair else self.rep, weights, self.B)
+        if by_pair:
+            return replica_sums(self.C, weights[None])[0]
+        n = len(weights) // self.B if self.B else 0
+        if n == 0:
+            return np.zeros(self.B)
+        return np.add.reduceat(weights, np.arange(self.B) * n)
 
     def outer(self, u, w, by_pair=True):
         """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows).
