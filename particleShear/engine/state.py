@@ -121,6 +121,19 @@ class BatchState:
         self.rng = [None] * self.B
         self.applying_shear = True
 
+    def __getstate__(self):
+        """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load."""
+        state = dict(self.__dict__)
+        state["backend"] = self.backend.name
+        del state["xp"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self.backend = get_backend(state["backend"])
+        self.xp = self.backend.xp
+        self._views()
+
     def _views(self):
         """Row views of the position, velocity and force blocks (indexing, not iteration: no host read)."""
         self.x, self.y = self.pos[0], self.pos[1]
