@@ -35,9 +35,12 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--relative-frequency", type=float, default=0.025)
     args = ap.parse_args()
-    sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
+    try:
+        sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
+    except ValueError:
+        sizes = []
     if not sizes or min(sizes) < 1:
-        raise SystemExit(f"--sizes={args.sizes!r} is invalid: allowed comma-separated integers >= 1")
+        ap.error(f"--sizes={args.sizes!r} is invalid: allowed comma-separated integers >= 1")
 
     from particleShear.engine.xp import get_backend
     try:

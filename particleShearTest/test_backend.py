@@ -262,6 +262,7 @@ class TestBatchOnTheStandInDevice(unittest.TestCase):
         cls.numpy = run_batch(MIXED)
         with standin_registered(), xpmod.record_host_reads() as reads:
             cls.device = run_batch(MIXED, backend=STANDIN)
+            cls.single = doParticleShearSimulation(**MIXED[1], backend=STANDIN, return_result=True)
             cls.series = doParticleShearSimulationSeries(
                 executor=InlineExecutor(), batch_size=2, backend=STANDIN, N_repetitions=1, amplitudes=[0.2, 0.3],
                 mu=[0.01], cut_lines=0, seed=7, **{k: v for k, v in QUICK.items() if k != "verbose"})
@@ -280,6 +281,10 @@ class TestBatchOnTheStandInDevice(unittest.TestCase):
             with self.subTest(replica=n):
                 assert_bit_identical(self, d, h)
                 self.assertEqual(d.parameters["backend"], STANDIN)
+
+    def test_single_run_is_bit_identical_to_numpy(self):
+        # a single run is a batch of one, and a replica of a batch equals its single run
+        assert_bit_identical(self, self.single, self.numpy[1])
 
     def test_series_is_bit_identical_to_numpy(self):
         self.assertEqual(len(self.series), 2)
