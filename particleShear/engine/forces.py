@@ -95,8 +95,10 @@ class PairConstants:
         nb = s.B * s.N
         ai, aj = self.ai_host, self.aj_host
         self.scatter_idx = np.concatenate((ai, aj, ai + nb, aj + nb, ai + 2 * nb, aj + 2 * nb))
-        #: pair forces → sphere totals (bincount on NumPy, a padded gather on CuPy)
-        self.scatter = SegmentSum(self.scatter_idx, 3 * nb, be)
+        #: pair forces → sphere totals: one bincount over the three components on NumPy; on CuPy a
+        #: padded gather over (ai, aj), applied to each component's row (a third of the layout to build)
+        self.scatter = SegmentSum(self.scatter_idx if be.ordered_reductions else np.concatenate((ai, aj)),
+                                  3 * nb if be.ordered_reductions else nb, be)
         self.replica_sum = None       # pair rows → replica sums on a device without ordered reduceat
         if be.ordered_reductions:
             self.seg_rep_b, self.seg_starts_b = be.asarray(self.seg_rep), be.asarray(self.seg_starts)
@@ -348,7 +350,9 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
         Per-sphere totals F_x, F_y (mg·µm·s⁻² per m depth) and torque (mg·µm²·s⁻² per m depth).
     """
     w = array_namespace(fx_i).concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
-    return C.scatter(w).reshape(3, n_spheres)
+    if C.backend.ordered_reductions:
+        return C.scatter(w).reshape(3, n_spheres)
+    return C.scatter(w.reshape(3, -1))       # rows (F_x, F_y, torque) of (on i, on j) each
 
 
 def replica_sums(C, W):

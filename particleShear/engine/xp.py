@@ -38,6 +38,7 @@ REASONS = {
     "d = 0": "a pair at zero distance needs a random normal from its replica's NumPy generator",
     "rebuild": "positions of the replicas whose candidate list is rebuilt (the candidate search runs on the host)",
     "pair history": "state, ξ and relations of the candidate pairs, written back into the per-replica lists",
+    "layout": "the width (largest bin) of the padded gather of a new candidate set",
     "guard": "the values the stability guard reports when a replica failed",
     "series": "the recorded series and tensors, at the end of a phase",
     "state": "the final state of a batch, when it is copied back or inspected",
@@ -291,26 +292,29 @@ class SegmentSum:
     def __init__(self, index, n, backend):
         self.n = int(n)
         self.backend = backend
-        index = self._host_index = np.asarray(index, dtype=np.intp)
+        self.index = backend.asarray(np.asarray(index, dtype=np.intp))
         self._min_gather = None
-        if backend.ordered_reductions:
-            self.index = backend.asarray(index)
-            self.gather = None
-            return
-        self._host_index = index
-        self.gather = self._padded()
+        self.gather = None if backend.ordered_reductions else self._padded()
 
     def _padded(self):
-        """The (n, width) gather matrix: row k lists the rows of bin k in order, padded with P (→ the appended value)."""
-        index = self._host_index
-        order = np.argsort(index, kind="stable")
-        counts = np.bincount(index, minlength=self.n)
-        width = int(counts.max()) if len(counts) else 0
-        start = np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.intp)
-        rank = np.arange(len(index)) - np.repeat(start, counts)     # position of each row within its bin
-        gather = np.full((self.n, max(width, 1)), len(index), dtype=np.intp)
-        gather[index[order], rank] = order
-        return self.backend.asarray(gather)
+        """The (n, width) gather matrix: row k lists the rows of bin k in order, padded with P (→ the appended value).
+
+        Built on the backend (a stable sort of the index); its width is read on the host ("layout")."""
+        xp = self.backend.xp
+        index = self.index
+        P = len(index)
+        try:
+            order = xp.argsort(index, kind="stable")
+        except TypeError:  # pragma: no cover - CuPy before v12 sorts stably without the keyword
+            order = xp.argsort(index)
+        counts = xp.bincount(index, minlength=self.n)
+        width = int(to_host(counts.max(), "layout")) if P else 0
+        start = xp.cumsum(counts) - counts                     # first sorted row of each bin
+        bins = index[order]
+        rank = xp.arange(P) - start[bins]                     # position of each row within its bin
+        gather = xp.full((self.n, max(width, 1)), P, dtype=np.intp)
+        gather[bins, rank] = order
+        return gather
 
     def __call__(self, w):
         """The sums per bin of ``w`` (P,), or of each row of ``w`` (rows, P).
