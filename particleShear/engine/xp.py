@@ -6,11 +6,11 @@ once for both:
 
 * :func:`get_backend` — a backend by name (``"numpy"``, ``"cupy"``, or one registered with
   :func:`register_backend`, e.g. the CPU stand-in device of the tests), checked before any work;
-* :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres, the sums
-  over a replica's rows): ``bincount`` on NumPy; on a device a gather of each bin's rows into a
-  padded (bins, width) matrix and a sum along its rows, which is deterministic (no atomic adds,
-  so a GPU run is reproducible bit for bit) and needs no host synchronisation (``cupy.bincount``
-  computes ``max(x) + 1`` on the host);
+* :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres; on CuPy
+  also the sums and minima over a replica's rows): ``bincount`` on NumPy; on CuPy a gather of each
+  bin's rows into a padded (bins, width) matrix, built once per candidate set, and a sum along its
+  rows, which is deterministic (no atomic adds, so a GPU run is reproducible bit for bit) and reads
+  nothing on the host per step (``cupy.bincount`` computes ``max(x) + 1`` on the host every call);
 * :func:`to_host` — **the one door from the device to the host**.  Every read of a device value
   by the engine goes through it with a reason from :data:`REASONS`; CuPy forbids the implicit
   ones (``numpy.asarray(device_array)``, ``float()``, ``if device_bool:``) and a step performs only
@@ -41,7 +41,7 @@ REASONS = {
     "layout": "the width (largest bin) of the padded gather of a new candidate set",
     "guard": "the values the stability guard reports when a replica failed",
     "series": "the recorded series and tensors, at the end of a phase",
-    "state": "the final state of a batch, when it is copied back or inspected",
+    "state": "copies of the state between host and device: at set-up (radii, boxes, skins) or when inspected",
 }
 
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
