@@ -98,6 +98,7 @@ ENGINE_MODULES = [
     "particleShear.engine.step",
     "particleShear.engine.stress",
     "particleShear.engine.tangential",
+    "particleShear.engine.xp",
 ]
 
 #: Modules deliberately not checked: ``__main__`` runs the command line when imported.

@@ -10,6 +10,7 @@ Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central l
 :mod:`.tangential` (the two-visit tangential rule, shared with the canvas classes),
 :mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica),
 :mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, the
-pre-equilibration and the protocol).  NumPy only in this version.
+pre-equilibration and the protocol); :mod:`.xp` is the array namespace (NumPy, or CuPy with
+``backend="cupy"``) and the one door from the device to the host (docs/design.md, "Backends").
 """
 __docformat__ = "numpy"

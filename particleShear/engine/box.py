@@ -3,11 +3,15 @@
 Every function takes per-element box lengths and offsets (arrays or scalars), so one call
 serves pairs or spheres of many replicas with different boxes and strains.  Lengths in µm,
 velocities in µm/s.  Periods are removed one at a time (as the reference does) in a bounded
-number of passes.
+number of passes.  The functions take the array namespace of their inputs (NumPy or CuPy,
+:mod:`.xp`): on NumPy a pass loop stops as soon as nothing moved; on a device, where knowing
+that would need a host read, every pass runs (a pass that moves nothing changes no value).
 """
 __docformat__ = "numpy"
 
-import numpy as np
+import contextlib
+
+from .xp import backend_of
 
 __all__ = ["min_image", "wrap", "flow_velocity", "MAX_PASSES"]
 
@@ -25,6 +29,17 @@ def _count(v, half, minus_half):
 def _accumulate(total, k):
     """Running count of periods removed: the first pass's counts themselves, then their sum."""
     return k if total is None else total + k
+
+
+def _outside(v, lo, hi):
+    """1.0 where ``v`` is outside ``[lo, hi)``, else 0.0 (NaN counts as inside and stays NaN for the guard)."""
+    return ((v >= hi) | (v < lo)).astype(float)
+
+
+def _quiet_invalid(xp):
+    """Suppress NumPy's "invalid value" warning (inf − inf → NaN, reported by the guard); devices do not warn."""
+    errstate = getattr(xp, "errstate", None)
+    return errstate(invalid="ignore") if errstate is not None else contextlib.nullcontext()
 
 
 def min_image(dx, dy, Lx, Ly, shift):
@@ -57,35 +72,41 @@ def min_image(dx, dy, Lx, Ly, shift):
     At most :data:`MAX_PASSES` one-period passes, then the rest is folded in closed form, so
     the cost does not grow with the size of a separation.
     """
+    be = backend_of(dx, dy)
+    xp = be.xp
     hy, hx = Ly / 2, Lx / 2          # the interval bounds, computed once for all passes
     mhy, mhx = -hy, -hx
     ky_total = kx_total = None
     for _ in range(MAX_PASSES):
         ky = _count(dy, hy, mhy)
-        if not ky.any():
+        if be.host and not ky.any():
             break
         dy = dy - Ly * ky
         dx = dx - shift * ky
         ky_total = _accumulate(ky_total, ky)
     else:  # absurd separation: fold the rest at once (non-finite values become NaN for the guard)
-        ky = np.floor((dy + hy) / Ly)
+        ky = xp.floor((dy + hy) / Ly)
+        if not be.host:   # the device ran every pass: fold only what is still outside
+            ky = ky * _outside(dy, mhy, hy)
         dy = dy - Ly * ky
         dx = dx - shift * ky
         ky_total = _accumulate(ky_total, ky)
     for _ in range(MAX_PASSES):
         kx = _count(dx, hx, mhx)
-        if not kx.any():
+        if be.host and not kx.any():
             break
         dx = dx - Lx * kx
         kx_total = _accumulate(kx_total, kx)
     else:
-        kx = np.floor((dx + hx) / Lx)
+        kx = xp.floor((dx + hx) / Lx)
+        if not be.host:
+            kx = kx * _outside(dx, mhx, hx)
         dx = dx - Lx * kx
         kx_total = _accumulate(kx_total, kx)
     if ky_total is None:
-        ky_total = np.zeros(np.shape(dx))
+        ky_total = xp.zeros(getattr(dx, "shape", ()))
     if kx_total is None:
-        kx_total = np.zeros(np.shape(dx))
+        kx_total = xp.zeros(getattr(dx, "shape", ()))
     return dx, dy, ky_total, kx_total
 
 
@@ -110,36 +131,45 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
 
     Returns
     -------
-    bool
-        True if any sphere was moved by a period.
+    bool or None
+        True if any sphere was moved by a period; None on a device (knowing it needs a host read).
 
     At most :data:`MAX_PASSES` one-period passes per axis, then the rest is folded in closed
     form (an infinite coordinate becomes NaN, which the stability guard reports).
     """
-    moved = False
+    be = backend_of(x, y)
+    xp = be.xp
+    moved = False if be.host else None
     for _ in range(MAX_PASSES):
         up = (y >= Ly).astype(float) - (y < 0)
-        if not up.any():
-            break
-        moved = True
+        if be.host:
+            if not up.any():
+                break
+            moved = True
         y -= Ly * up
         x -= shift * up
         vx -= (Ly * rate) * up
     else:  # absurd coordinate: fold the rest at once (non-finite values become NaN for the guard)
-        with np.errstate(invalid="ignore"):
-            up = np.floor(y / Ly)
+        with _quiet_invalid(xp):
+            up = xp.floor(y / Ly)
+            if not be.host:   # the device ran every pass: fold only what is still outside
+                up = up * _outside(y, 0.0, Ly)
             y -= Ly * up
             x -= shift * up
             vx -= (Ly * rate) * up
     for _ in range(MAX_PASSES):
         right = (x >= Lx).astype(float) - (x < 0)
-        if not right.any():
-            break
-        moved = True
+        if be.host:
+            if not right.any():
+                break
+            moved = True
         x -= Lx * right
     else:
-        with np.errstate(invalid="ignore"):  # inf - inf: NaN, reported by the guard
-            x -= Lx * np.floor(x / Lx)
+        with _quiet_invalid(xp):  # inf - inf: NaN, reported by the guard
+            right = xp.floor(x / Lx)
+            if not be.host:
+                right = right * _outside(x, 0.0, Lx)
+            x -= Lx * right
     return moved
 
 

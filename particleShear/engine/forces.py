@@ -10,13 +10,19 @@ S1-22/S1-24 (torque terms, overall tensor); details in ``docs/design.md``.
 Shapes: P candidate pairs of the whole batch (the replicas' lists concatenated in replica
 order), B replicas, B·N spheres.  Units: µm, µm/s, forces in mg·µm·s⁻² per m depth, torques
 in mg·µm²·s⁻² per m depth (docs/parameters.md).
+
+The arrays live on the state's backend (NumPy or CuPy, :mod:`.xp`); the index arrays of a
+candidate set are built on the host from the per-replica lists and copied to the device once.
 """
 __docformat__ = "numpy"
+
+import math
 
 import numpy as np
 
 from .tangential import tangential_two_pass
 from .box import min_image
+from .xp import SegmentSum, array_namespace, to_host
 from . import laws
 
 __all__ = ["PairConstants", "splice_arrays", "geometry", "central_term", "tangential_term", "scatter", "replica_sums", "shear_stresses"]
@@ -50,15 +56,20 @@ class PairConstants:
     PER_PAIR = ("rep", "ai", "aj", "ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "perm", "trans", "k",
                 "d_law", "d_cap", "a_lin", "a_div", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu",
                 "fc_inf", "perm_code")
+    #: host copies of the index arrays (the same arrays on NumPy), for the host's bookkeeping
+    HOST_PER_PAIR = ("rep_host", "ai_host", "aj_host")
 
     def __init__(self, s, offsets, replicas=None):
+        be = self.backend = s.backend
         replicas = np.arange(s.B) if replicas is None else np.asarray(replicas)
         pairs = [s.pairs[b] for b in replicas]
         N = s.N
-        self.rep = np.repeat(replicas, [len(p.i) for p in pairs])
-        base = self.rep * N
-        self.ai = np.concatenate([p.i for p in pairs]) + base
-        self.aj = np.concatenate([p.j for p in pairs]) + base
+        # index arrays on the host (from the per-replica lists), then once on the device
+        self.rep_host = np.repeat(replicas, [len(p.i) for p in pairs])
+        base = self.rep_host * N
+        self.ai_host = np.concatenate([p.i for p in pairs]) + base
+        self.aj_host = np.concatenate([p.j for p in pairs]) + base
+        self.rep, self.ai, self.aj = (be.asarray(a) for a in (self.rep_host, self.ai_host, self.aj_host))
         self._index(s, offsets)
         g = self.rep
         self.ri = s.r[self.ai]
@@ -73,16 +84,26 @@ class PairConstants:
 
     def _index(self, s, offsets):
         """Sizes and index arrays that follow from ``ai``, ``aj`` and the replicas' segments."""
+        be = self.backend
         self.offsets = offsets
-        self.P = len(self.ai)
+        self.P = len(self.ai_host)
         # the replicas that have candidates and where their segments start, for replica_sums: each
         # such segment ends where the next one starts (empty replicas in between have no rows)
         self.B = len(offsets) - 1
         self.seg_rep = np.flatnonzero(offsets[1:] > offsets[:-1])
         self.seg_starts = offsets[:-1][self.seg_rep]
         nb = s.B * s.N
-        self.scatter_idx = np.concatenate((self.ai, self.aj, self.ai + nb, self.aj + nb, self.ai + 2 * nb,
-                                           self.aj + 2 * nb))
+        ai, aj = self.ai_host, self.aj_host
+        self.scatter_idx = np.concatenate((ai, aj, ai + nb, aj + nb, ai + 2 * nb, aj + 2 * nb))
+        #: pair forces → sphere totals: one bincount over the three components on NumPy; on CuPy a
+        #: padded gather over (ai, aj), applied to each component's row (a third of the layout to build)
+        self.scatter = SegmentSum(self.scatter_idx if be.ordered_reductions else np.concatenate((ai, aj)),
+                                  3 * nb if be.ordered_reductions else nb, be)
+        self.replica_sum = None       # pair rows → replica sums on a device without ordered reduceat
+        if be.ordered_reductions:
+            self.seg_rep_b, self.seg_starts_b = be.asarray(self.seg_rep), be.asarray(self.seg_starts)
+        elif self.B == s.B:           # the whole batch (not the rebuilt replicas alone)
+            self.replica_sum = SegmentSum(self.rep_host, s.B, be)
 
     @classmethod
     def splice(cls, s, old, new, segments, offsets):
@@ -111,7 +132,8 @@ class PairConstants:
         PairConstants
         """
         C = cls.__new__(cls)
-        for name in cls.PER_PAIR:
+        C.backend = old.backend
+        for name in cls.PER_PAIR + cls.HOST_PER_PAIR:
             setattr(C, name, splice_arrays(getattr(old, name), getattr(new, name), segments))
         C._index(s, offsets)
         return C
@@ -140,17 +162,18 @@ class PairConstants:
         self.trans = ~perm
         k, c = s.k[g], s.c[g]
         self.k = k
-        self.d_law = np.where(perm, d_eq, self.d0)         # contact distance of the compressive law
+        xp = array_namespace(state, d_eq)
+        self.d_law = xp.where(perm, d_eq, self.d0)         # contact distance of the compressive law
         self.d_cap, self.a_lin, self.a_div = laws.central_constants(self.d_law, k, c)
-        self.d_eq = np.where(perm, d_eq, 0.0)   # tensile law −k·(d_eq − d) on bonds, −0·(0 − d) = +0 on contacts
-        self.a_tens = -np.where(perm, k, 0.0)
-        self.ratio_c = np.where(perm, s.prc[g], 1.0)
+        self.d_eq = xp.where(perm, d_eq, 0.0)   # tensile law −k·(d_eq − d) on bonds, −0·(0 − d) = +0 on contacts
+        self.a_tens = -xp.where(perm, k, 0.0)
+        self.ratio_c = xp.where(perm, s.prc[g], 1.0)
         keep = s.keep[g] != 0
-        self.nu = s.nu[g] * np.where(perm & ~keep, s.prc[g], 1.0)
-        self.k_t = s.k_t[g] * np.where(perm, s.prt[g], 1.0)
-        self.nu_t = s.nu_t[g] * np.where(perm & ~keep, s.prt[g], 1.0)
+        self.nu = s.nu[g] * xp.where(perm & ~keep, s.prc[g], 1.0)
+        self.k_t = s.k_t[g] * xp.where(perm, s.prt[g], 1.0)
+        self.nu_t = s.nu_t[g] * xp.where(perm & ~keep, s.prt[g], 1.0)
         self.mu = s.mu[g]
-        self.fc_inf = np.where(perm, np.inf, 0.0)
+        self.fc_inf = xp.where(perm, math.inf, 0.0)
         self.perm_code = perm.view(np.int8) * np.int8(2)
 
 
@@ -168,7 +191,8 @@ def splice_arrays(old, new, segments):
     -------
     ndarray (…, Σ (hi − lo))
     """
-    return np.concatenate([(new if from_new else old)[..., lo:hi] for from_new, lo, hi in segments], axis=-1)
+    xp = array_namespace(old, new)
+    return xp.concatenate([(new if from_new else old)[..., lo:hi] for from_new, lo, hi in segments], axis=-1)
 
 
 def geometry(C, x, y, shift_p):
@@ -194,7 +218,7 @@ def geometry(C, x, y, shift_p):
     """
     ai, aj = C.ai, C.aj
     dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, shift_p)
-    d = np.sqrt(dx * dx + dy * dy)
+    d = array_namespace(dx).sqrt(dx * dx + dy * dy)
     return dx, dy, d, ky, kx
 
 
@@ -220,14 +244,18 @@ def normals(dx, dy, d, rep, rng):
     nx, ny : ndarray (P,)
         Components of the unit normal from i towards j.
     """
+    xp = array_namespace(d)
     zero = d == 0
-    if not zero.any():
+    if not to_host(zero.any(), "d = 0"):
         return dx / d, dy / d
-    safe = np.where(zero, 1.0, d)
+    safe = xp.where(zero, 1.0, d)
     nx, ny = dx / safe, dy / safe
-    for p in np.flatnonzero(zero):
-        theta = 2 * np.pi * rng[int(rep[p])].random()
-        nx[p], ny[p] = np.cos(theta), np.sin(theta)
+    # the draws happen on the host, pair by pair in list order, from each pair's own replica's generator
+    where = to_host(xp.flatnonzero(zero), "d = 0")
+    theta = [2 * np.pi * rng[int(b)].random() for b in to_host(rep, "d = 0")[where]]
+    idx = where if isinstance(d, np.ndarray) else xp.asarray(where)
+    nx[idx] = xp.asarray(np.array([np.cos(t) for t in theta]))
+    ny[idx] = xp.asarray(np.array([np.sin(t) for t in theta]))
     return nx, ny
 
 
@@ -258,9 +286,10 @@ def central_term(C, d, vn, active):
         The elastic law before the permanent ratio (same unit), the base of the Coulomb bound.
     """
     inside = laws.central_inside(d, C.d_law, C.d_cap, C.a_lin, C.a_div)   # c per replica: the general blend
-    law = np.where(d > C.d_law, laws.tensile_inside(d, C.d_eq, C.a_tens), inside)   # contacts beyond d0: +0
+    xp = array_namespace(d)
+    law = xp.where(d > C.d_law, laws.tensile_inside(d, C.d_eq, C.a_tens), inside)   # contacts beyond d0: +0
     f = law * C.ratio_c
-    f += np.where(active, C.nu, 0.0) * vn
+    f += xp.where(active, C.nu, 0.0) * vn
     return f, law
 
 
@@ -291,7 +320,7 @@ def tangential_term(C, vt, touching, xi, law):
     slip : ndarray of bool (P,)
         The final slip flag.
     """
-    fc = np.abs(C.mu * law)
+    fc = abs(C.mu * law)
     fc += C.fc_inf
     return tangential_two_pass(vt, touching, xi, C.k_t, C.k_t, C.nu_t, C.nu_t, fc)
 
@@ -320,8 +349,10 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     ndarray (3, n_spheres)
         Per-sphere totals F_x, F_y (mg·µm·s⁻² per m depth) and torque (mg·µm²·s⁻² per m depth).
     """
-    w = np.concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
-    return np.bincount(C.scatter_idx, w, 3 * n_spheres).reshape(3, n_spheres)
+    w = array_namespace(fx_i).concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
+    if C.backend.ordered_reductions:
+        return C.scatter(w).reshape(3, n_spheres)
+    return C.scatter(w.reshape(3, -1))       # rows (F_x, F_y, torque) of (on i, on j) each
 
 
 def replica_sums(C, W):
@@ -347,9 +378,12 @@ def replica_sums(C, W):
     ndarray (rows, B)
         ``out[r, b] = Σ_{pairs p of replica b} W[r, p]`` (0 for a replica without candidates).
     """
-    out = np.zeros((W.shape[0], C.B))
+    if C.replica_sum is not None:      # a device: the padded gather of SegmentSum
+        return C.replica_sum(W)
+    xp = array_namespace(W)
+    out = xp.zeros((W.shape[0], C.B))
     if C.P:
-        out[:, C.seg_rep] = np.add.reduceat(W, C.seg_starts, axis=1)
+        out[:, C.seg_rep_b] = xp.add.reduceat(W, C.seg_starts_b, axis=1)
     return out
 
 
@@ -399,7 +433,8 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
     lever = yc[C.ai] * (ext & mi)
     lever -= yc[C.aj] * (ext & mj)
     # three per-replica sums in one reduction: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
-    lw, tint, surf = replica_sums(C, np.stack((fx_i * dy * internal, dF * internal, fx_i * lever)))
+    sums = replica_sums(C, array_namespace(fx_i).stack((fx_i * dy * internal, dF * internal, fx_i * lever)))
+    lw, tint, surf = sums[0], sums[1], sums[2]
     sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)
     return -sigma_all, -sigma_ext

@@ -11,11 +11,14 @@ The laws are split into their constants (:func:`central_constants`, ``−k`` for
 law) and a function of those constants (:func:`central_inside`, :func:`tensile_inside`), so
 that a caller evaluating the same pairs every step computes the constants once.
 
-Forces in mg·µm·s⁻² per m depth; negative = repulsion.
+The functions take the array namespace of their inputs (NumPy or CuPy, :mod:`.xp`).  Forces in
+mg·µm·s⁻² per m depth; negative = repulsion.
 """
 __docformat__ = "numpy"
 
-import numpy as np
+import numbers
+
+from .xp import array_namespace
 
 __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", "central_inside",
            "central_law", "tensile_inside", "tensile_law"]
@@ -36,10 +39,10 @@ def central_form(c):
     Returns
     -------
     str
-        :data:`LINEAR` for a scalar ``c == 0`` (eq. S1-5a), :data:`DIVERGENT` for a scalar
-        ``c == 1`` (eq. S1-5b), else :data:`BLEND` (arrays always blend).
+        :data:`LINEAR` for a number ``c == 0`` (eq. S1-5a), :data:`DIVERGENT` for a number
+        ``c == 1`` (eq. S1-5b), else :data:`BLEND` (arrays, 0-d ones included, always blend).
     """
-    if np.ndim(c) == 0:
+    if isinstance(c, numbers.Real):   # a Python or NumPy number (a device value would need a host read)
         if c == 1:
             return DIVERGENT
         if c == 0:
@@ -71,7 +74,7 @@ def central_constants(d0, k, c):
     return d0 / 1000, -k * (1 - c), -k * c * d0
 
 
-def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND, maximum=np.maximum):
+def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND, maximum=None):
     """Compressive law from its constants, as if every pair were in contact (no cut-off at ``d0``).
 
     ``a_lin (d0 − d) + a_div (d0 / max(d, d0_cap) − 1)``, i.e. with the constants of
@@ -87,14 +90,17 @@ def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND, maximum=np.maximum):
     form : {BLEND, LINEAR, DIVERGENT}, default BLEND
         :data:`LINEAR` keeps only the linear term, :data:`DIVERGENT` only the divergent term
         (the other one is ±0 for c = 0, resp. c = 1; see :func:`central_form`).
-    maximum : callable, default numpy.maximum
-        Element-wise maximum; the scalar path passes the builtin :func:`max`.
+    maximum : callable, optional
+        Element-wise maximum (default: ``maximum`` of the namespace of ``d``); the scalar path
+        passes the builtin :func:`max`.
 
     Returns
     -------
     ndarray or float
         Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0 for ``d ≤ d0``).
     """
+    if maximum is None:
+        maximum = array_namespace(d, d0_cap).maximum
     if form is DIVERGENT:
         return a_div * (d0 / maximum(d, d0_cap) - 1)
     if form is LINEAR:
@@ -125,9 +131,10 @@ def central_law(d, d0, k, c):
         Scalar central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0, repulsive,
         and 0 beyond ``d0``).
     """
-    d = np.asarray(d, dtype=float)
+    xp = array_namespace(d, d0)
+    d = xp.asarray(d, dtype=float)
     inside = central_inside(d, d0, *central_constants(d0, k, c), form=central_form(c))
-    return np.where(d > d0, 0.0, inside)
+    return xp.where(d > d0, 0.0, inside)
 
 
 def tensile_inside(d, d_eq, a_t):

@@ -5,11 +5,17 @@ values (box, strain, rate, model constants) are arrays of length B and are gathe
 or pairs where a kernel needs them.  Pairs are kept per replica (:class:`ReplicaPairs`, sorted by
 ``(i, j)``) and concatenated in replica order into the flat arrays a step works on.
 
+The arrays live on the state's backend (:attr:`BatchState.backend`, NumPy by default, CuPy with
+``backend="cupy"``; :mod:`.xp`); the per-replica pair lists and the random generators stay on the
+host (the candidate search and the draws at ``d = 0`` run there).
+
 Units: µm, s, mg per m depth (reference units, docs/parameters.md).
 """
 __docformat__ = "numpy"
 
 import numpy as np
+
+from .xp import get_backend
 
 __all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM"]
 
@@ -66,11 +72,15 @@ class BatchState:
     k, nu, k_t, nu_t, mu, c, prc, prt, keep : ndarray (B,)
         Ensemble constants of each replica (the values a step of its ensemble uses).
     pairs : list of ReplicaPairs
-        Candidate pairs of each replica.
+        Candidate pairs of each replica (NumPy arrays, on the host).
     rng : list of numpy.random.Generator
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
+    backend : Backend
+        Where the arrays live (:func:`~particleShear.engine.xp.get_backend`).
+    xp : module
+        Its array namespace (``numpy`` or ``cupy``).
 
     Parameters
     ----------
@@ -78,30 +88,86 @@ class BatchState:
         Number of replicas (≥ 0).
     N : int
         Spheres per replica (≥ 0).  Every array starts at zero; :meth:`from_ensembles` fills them.
+    backend : str or Backend, default "numpy"
+        Array backend of the state (``"numpy"``, ``"cupy"``, or a registered one).
+
+    Raises
+    ------
+    ValueError
+        For an unknown backend, or ``"cupy"`` without CuPy or a CUDA device.
     """
 
-    def __init__(self, B, N):
+    #: names of the per-sphere (B·N,) and per-replica (B,) arrays, in the order :meth:`concat` copies them
+    SPHERE_ARRAYS = ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia", "fx", "fy", "torque")
+    REPLICA_ARRAYS = ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep")
+
+    def __init__(self, B, N, backend="numpy"):
+        self.backend = get_backend(backend)
+        xp = self.xp = self.backend.xp
         self.B = int(B)
         self.N = int(N)
         n = self.B * self.N
         # positions and velocities as row views of two blocks: one gather fetches all rows of a pair side
-        self.pos = np.zeros((2, n))
-        self.x, self.y = self.pos
-        self.vel = np.zeros((3, n))
-        self.vx, self.vy, self.omega = self.vel
+        self.pos = xp.zeros((2, n))
+        self.vel = xp.zeros((3, n))
+        self.frc = xp.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
+        self._views()
         for name in ("phi", "r", "m", "inertia"):
-            setattr(self, name, np.zeros(n))
-        for name in ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
-            setattr(self, name, np.zeros(self.B))
-        self.rep = np.repeat(np.arange(self.B), self.N)
+            setattr(self, name, xp.zeros(n))
+        for name in self.REPLICA_ARRAYS:
+            setattr(self, name, xp.zeros(self.B))
+        self.rep = xp.repeat(xp.arange(self.B), self.N)
         self.pairs = [None] * self.B
         self.rng = [None] * self.B
         self.applying_shear = True
-        self.frc = np.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
-        self.fx, self.fy, self.torque = self.frc
+
+    def __getstate__(self):
+        """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load."""
+        state = dict(self.__dict__)
+        state["backend"] = self.backend.name
+        del state["xp"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self.backend = get_backend(state["backend"])
+        self.xp = self.backend.xp
+        self._views()
+
+    def _views(self):
+        """Row views of the position, velocity and force blocks (indexing, not iteration: no host read)."""
+        self.x, self.y = self.pos[0], self.pos[1]
+        self.vx, self.vy, self.omega = self.vel[0], self.vel[1], self.vel[2]
+        self.fx, self.fy, self.torque = self.frc[0], self.frc[1], self.frc[2]
+
+    def to_backend(self, backend):
+        """This state with its arrays copied to ``backend`` (the same object if it is there already).
+
+        Pair lists and generators are shared (they stay on the host).
+
+        Parameters
+        ----------
+        backend : str or Backend
+            The target backend.
+
+        Returns
+        -------
+        BatchState
+        """
+        target = get_backend(backend)
+        if target is self.backend:
+            return self
+        from .xp import to_host
+        out = object.__new__(type(self))
+        out.__dict__.update(self.__dict__)
+        out.backend, out.xp = target, target.xp
+        for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep") + self.REPLICA_ARRAYS:
+            out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
+        out._views()
+        return out
 
     @classmethod
-    def from_ensembles(cls, ensembles):
+    def from_ensembles(cls, ensembles, backend="numpy"):
         """Copy B ensembles of equal N (after constitution) into one batch state.
 
         The ensembles are not modified; each replica keeps a reference to its ensemble's
@@ -112,6 +178,9 @@ class BatchState:
         ensembles : sequence of ensemble
             Constituted ensembles (``particleShear.objects`` or ``particleShear.linkable``
             ensembles), all with the same number of spheres.
+        backend : str or Backend, default "numpy"
+            Where the arrays of the state live: the ensembles are read on the host and the
+            state is copied to the device once.
 
         Returns
         -------
@@ -123,8 +192,9 @@ class BatchState:
         ------
         ValueError
             If the ensembles differ in N, or a per-sphere parameter of :data:`PER_SPHERE_UNIFORM`
-            differs within an ensemble.
+            differs within an ensemble, or for an unusable backend (before any copy).
         """
+        target = get_backend(backend)
         Ns = {len(e.sphereList) for e in ensembles}
         if len(Ns) != 1:
             raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
@@ -154,7 +224,7 @@ class BatchState:
             s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
                                       pt.active[keep])
             s.rng[b] = e._rng
-        return s
+        return s.to_backend(target)
 
     @classmethod
     def concat(cls, states):
@@ -174,15 +244,18 @@ class BatchState:
         Raises
         ------
         ValueError
-            If the states differ in N.
+            If the states differ in N or in backend.
         """
         Ns = {st.N for st in states}
         if len(Ns) != 1:
             raise ValueError(f"states have N = {sorted(Ns)}: a batch needs one N")
-        out = cls(sum(st.B for st in states), Ns.pop())
-        for name in ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia", "fx", "fy", "torque", "Lx", "Ly",
-                     "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
-            getattr(out, name)[...] = np.concatenate([getattr(st, name) for st in states])
+        backends = {st.backend.name for st in states}
+        if len(backends) != 1:
+            raise ValueError(f"states live on the backends {sorted(backends)}: a batch needs one backend")
+        out = cls(sum(st.B for st in states), Ns.pop(), backend=states[0].backend)
+        xp = out.xp
+        for name in cls.SPHERE_ARRAYS + cls.REPLICA_ARRAYS:
+            getattr(out, name)[...] = xp.concatenate([getattr(st, name) for st in states])
         out.pairs = [p for st in states for p in st.pairs]
         out.rng = [g for st in states for g in st.rng]
         out.applying_shear = all(st.applying_shear for st in states)

@@ -9,6 +9,15 @@ step) are the measurement of the oscillatory experiment on a batch.
 The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
 place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
 
+The arrays live on the state's backend (NumPy or CuPy, :mod:`.xp`).  A step reads device values
+on the host only through :func:`~particleShear.engine.xp.to_host`, for named reasons: once at its
+end, the per-replica flags (neighbour-list rebuilds due, the stability guard's verdict) in one
+small array; the check for pairs at ``d = 0``, whose random normal comes from the replica's NumPy
+generator; and, when a list is rebuilt, the positions of the replicas concerned (the candidate
+search runs on the host) and their pair history.  The recorded series come back at the end of
+the protocol.  On NumPy (reading is free) the step keeps a few early exits and caches that a
+device replaces by branch-free code; both give the same numbers.
+
 Shapes: B replicas, B·N sphere rows, P candidate pairs; units µm, s, mg per m depth, stresses
 in Pa (docs/parameters.md, docs/output.md).
 """
@@ -23,6 +32,7 @@ from .forces import PairConstants, central_term, normals, scatter, shear_stresse
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
 from .stress import StressInputs, evaluate_all
+from .xp import to_host
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
@@ -78,22 +88,28 @@ class BatchEngine:
         if not skin_factor > 0:
             raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
         s = self.s = state
+        xp = self.xp = s.xp
+        self.backend = s.backend
         B, N = s.B, s.N
         self.r_max = s.r.reshape(B, N).max(axis=1)
         self.skin = skin_factor * self.r_max
-        self.bound = np.full(B, np.inf)        # first step builds every list
-        self.u = np.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
-        self.u_max = np.zeros(B)               # running maximum of |u| per replica
-        self.strain = np.zeros(B)              # Σ |γ̇| dt per replica since its list was built
+        self.bound = xp.full(B, math.inf)      # Verlet bound of each replica (see verlet_bound)
+        self.need = np.ones(B, bool)           # host: list rebuild due (the first step builds every list)
+        self.u = xp.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
+        self.u_max = xp.zeros(B)               # running maximum of |u| per replica
+        self.strain = xp.zeros(B)              # Σ |γ̇| dt per replica since its list was built
         self.C = None
         self.Lx_s = s.Lx[s.rep]
         self.Ly_s = s.Ly[s.rep]
         self.hy_s = self.Ly_s / 2
         self.V = (s.Lx * 1e-6) * (s.Ly * 1e-6)
-        self.mmi = np.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
+        self.mmi = xp.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
+        # what the candidate search (on the host) needs besides the positions: radii, boxes, skins
+        self.host_consts = [to_host(a, "state") for a in (s.r, s.Lx, s.Ly, self.skin)]
         self.check_interval = int(check_interval)
-        self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica
-        self.rate_max = np.zeros(B)
+        self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica, on the host
+        self.guard_dev = self.backend.asarray(self.guard)
+        self.rate_max = xp.zeros(B)
         self.min_distance_ratio = 0.05
         self.step_count = 0
         self.phase = "pre-equilibration"
@@ -103,44 +119,61 @@ class BatchEngine:
 
     # -- the one cache ---------------------------------------------------------------------------
     def _sync_down(self, replicas=None):
-        """Write the flat pair history back into the per-replica lists (of ``replicas``; all by default)."""
-        C = self.C
-        for b in range(self.s.B) if replicas is None else replicas:
+        """Write the flat pair history back into the per-replica lists (of ``replicas``; all by default).
+
+        On a device the rows of those replicas are gathered there and read on the host at once."""
+        C, be = self.C, self.backend
+        which = list(range(self.s.B)) if replicas is None else list(replicas)
+        spans = [(C.offsets[b], C.offsets[b + 1]) for b in which]
+        state_p, xi, active = self.state_p, self.xi, self.active
+        if not be.host and which:
+            sel = be.asarray(np.concatenate([np.arange(lo, hi) for lo, hi in spans]))
+            state_p, xi, active = (to_host(a, "pair history") for a in (state_p[sel], xi[:, sel], active[sel]))
+            ends = np.cumsum([hi - lo for lo, hi in spans])
+            spans = list(zip(ends - [hi - lo for lo, hi in spans], ends))
+        for b, (lo, hi) in zip(which, spans):
             p = self.s.pairs[b]
-            lo, hi = C.offsets[b], C.offsets[b + 1]
-            p.state = self.state_p[lo:hi].copy()
-            p.xi = self.xi[:, lo:hi].copy()
-            p.active = self.active[lo:hi].copy()
+            p.state = state_p[lo:hi].copy()
+            p.xi = xi[:, lo:hi].copy()
+            p.active = active[lo:hi].copy()
 
     def neighbours(self):
         """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
         per-candidate constants with them (the one invalidation point).
 
         Only the rebuilt replicas' constants are computed; the other replicas' segments are copied
-        from the previous constants (:meth:`~particleShear.engine.forces.PairConstants.splice`)."""
-        need = self.bound >= self.skin
+        from the previous constants (:meth:`~particleShear.engine.forces.PairConstants.splice`).
+        Which replicas are due was read at the end of the previous step (:attr:`need`, on the
+        host); the candidate search runs on the host, on the positions of those replicas."""
+        need = self.need
         if not need.any():
             return
-        s = self.s
+        s, xp, be = self.s, self.xp, self.backend
         changed = np.flatnonzero(need)
         if self.C is not None:
             self._sync_down(changed)     # the history the rebuilt lists carry over
-        for b in changed:
-            rows = s.replica(b)
-            s.pairs[b] = build_candidates(s.x[rows], s.y[rows], s.r[rows], s.Lx[b], s.Ly[b], s.Ly[b] * s.gamma[b],
-                                          self.skin[b], s.pairs[b])
-            self.bound[b] = 0.0
-            self.u[:, rows] = 0.0
-            self.u_max[b] = 0.0
-            self.strain[b] = 0.0
+        rows = np.concatenate([np.arange(b * s.N, (b + 1) * s.N) for b in changed])
+        pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
+        gamma = to_host(s.gamma, "rebuild")
+        r, Lx, Ly, skin = self.host_consts
+        for k, b in enumerate(changed):
+            mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
+            s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], Ly[b] * gamma[b], skin[b],
+                                          s.pairs[b])
             self.rebuilds[b] += 1
+        due = be.asarray(need)
+        self.bound = xp.where(due, 0.0, self.bound)
+        self.u = xp.where(due[s.rep], 0.0, self.u)
+        self.u_max = xp.where(due, 0.0, self.u_max)
+        self.strain = xp.where(due, 0.0, self.strain)
+        self.need = np.zeros(s.B, bool)
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
         fresh = [s.pairs[b] for b in changed]
         new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed)
-        new.set_bonds(s, np.concatenate([p.state for p in fresh]), np.concatenate([p.d_eq for p in fresh]))
-        state_p = np.concatenate([p.state for p in fresh])
-        xi = np.concatenate([p.xi for p in fresh], axis=1)
-        active = np.concatenate([p.active for p in fresh])
+        state_p = be.asarray(np.concatenate([p.state for p in fresh]))
+        xi = be.asarray(np.concatenate([p.xi for p in fresh], axis=1))
+        active = be.asarray(np.concatenate([p.active for p in fresh]))
+        new.set_bonds(s, state_p, be.asarray(np.concatenate([p.d_eq for p in fresh])))
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active = new, state_p, xi, active
             return
@@ -165,7 +198,7 @@ class BatchEngine:
         the same number as a fresh :func:`~particleShear.engine.box.min_image`)."""
         C = self.C
         img = self._img
-        if img is not None and img[0] is C:
+        if img is not None and img[0] is C:   # (NumPy only: deciding the reuse reads the arrays)
             _, Lyky, ky, Lxkx, kx = img
             dy = raw_y - Lyky
             dx = raw_x - shift_p * ky
@@ -173,14 +206,15 @@ class BatchEngine:
             if (np.abs(dy) < C.hy).all() and (np.abs(dx) < C.hx).all():
                 return dx, dy, ky, kx
         dx, dy, ky, kx = min_image(raw_x, raw_y, C.Lx, C.Ly, shift_p)
-        one = (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all()
-        self._img = (C, C.Ly * ky, ky, C.Lx * kx, kx) if one else None
+        if self.backend.host:
+            one = (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all()
+            self._img = (C, C.Ly * ky, ky, C.Lx * kx, kx) if one else None
         return dx, dy, ky, kx
 
     def _mobility_flags(self, mob):
         """(mob_i, mob_j, not both mobile) of the candidates, kept while the mask and the lists stay."""
-        fl = self._mob_flags
-        if fl is None or fl[0] is not self.C or not np.array_equal(fl[1], mob):
+        fl = self._mob_flags   # (kept on NumPy only: comparing the masks reads them)
+        if fl is None or fl[0] is not self.C or not self.backend.host or not np.array_equal(fl[1], mob):
             mi, mj = mob[self.C.ai], mob[self.C.aj]
             fl = self._mob_flags = (self.C, mob, mi, mj, ~(mi & mj))
         return fl[2:]
@@ -213,12 +247,12 @@ class BatchEngine:
 
         Returns
         -------
-        ndarray of bool (B·N,)
-            True for the spheres that move freely.
+        array of bool (B·N,)
+            True for the spheres that move freely (on the state's backend).
         """
         s = self.s
         if not s.applying_shear:
-            return np.ones(len(s.y), bool)
+            return self.xp.ones(len(s.y), bool)
         return (s.r < s.y) & (s.y < self.Ly_s - s.r)
 
     # -- the step --------------------------------------------------------------------------------
@@ -238,7 +272,7 @@ class BatchEngine:
         d_s = delta[s.rep]
         s.vx += (s.y - self.hy_s) * d_s
         s.omega -= d_s / 2
-        s.rate = np.array(rate, dtype=float)
+        s.rate = self.xp.array(rate, dtype=float)
 
     def set_mu(self, mu):
         """Change the Coulomb friction coefficient μ of each replica (the constitution's μ = 0 blocks).
@@ -282,11 +316,8 @@ class BatchEngine:
         EngineInstability
             If the stability guard finds a guarded replica unstable (checked every
             ``check_interval`` steps).
-        RuntimeError
-            If the Lees-Edwards geometry needs more than
-            :data:`~particleShear.engine.box.MAX_PASSES` periods (a non-finite state).
         """
-        s = self.s
+        s, xp = self.s, self.xp
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         # neighbours (positions at the start of the step)
         self.neighbours()
@@ -297,14 +328,12 @@ class BatchEngine:
         raw = s.pos.take(aj, axis=1)
         raw -= s.pos.take(ai, axis=1)
         dx, dy, ky, kx = self._images(raw[0], raw[1], (s.Ly * s.gamma)[C.rep])
-        d = np.sqrt(dx * dx + dy * dy)
-        nx, ny = normals(dx, dy, d, C.rep, s.rng)
+        d = xp.sqrt(dx * dx + dy * dy)
+        nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
         touching = d < C.d0
         active = C.perm | touching
-        newly = active & ~self.active
-        if newly.any():
-            self.state_p[newly] = STICK
-        self.xi = xi = np.where(active, self.xi, 0.0)   # an opened contact loses its history
+        xp.copyto(self.state_p, STICK, where=active & ~self.active)   # a new relation starts sticking
+        self.xi = xi = xp.where(active, self.xi, 0.0)   # an opened contact loses its history
         self.active = active
         # relative velocities (image velocity −Ly·γ̇ per period above)
         dvx = -(C.Ly * s.rate[C.rep]) * ky
@@ -334,19 +363,22 @@ class BatchEngine:
                                  Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
                                  dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
                 out = out + (evaluate_all(q),)
+        verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
-            self._check(d, active)
+            verdict = self._check(d, active)
+            if self.backend.host:     # NumPy: report at once (a device reports with the flags at the end)
+                self._report(verdict, self.step_count)
+                verdict = None
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
         kick = s.frc * dt
         kick /= self.mmi                                    # (F_x/m, F_y/m, T/I)·dt
         s.vel += kick
         s.frc[...] = 0.0
-        imm = ~mob
-        if imm.any():
-            plate = np.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
-            vy[imm] = 0.0
-            vx[imm] = plate[imm]
+        imm = ~mob      # immobile spheres move with their plate
+        plate = xp.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
+        xp.copyto(vy, 0.0, where=imm)
+        xp.copyto(vx, plate, where=imm)
         flow = yc * rate_s
         vx -= flow
         vx *= cool
@@ -354,7 +386,7 @@ class BatchEngine:
         vy *= cool
         om *= cool
         # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
-        kd = np.where(active & (self.state_p != SLIP), dt, 0.0)
+        kd = xp.where(active & (self.state_p != SLIP), dt, 0.0)
         Vi = s.vel.take(ai, axis=1)
         Vj = s.vel.take(aj, axis=1)
         rvx = Vj[0] - Vi[0] + dvx
@@ -363,7 +395,7 @@ class BatchEngine:
         inc_ij = rvx * -ny + rvy * nx - spin
         Rx = Vi[0] * dt - dx
         Ry = Vi[1] * dt - dy
-        mx, my = normals(Rx, Ry, np.sqrt(Rx * Rx + Ry * Ry), C.rep, s.rng)
+        mx, my = normals(Rx, Ry, xp.sqrt(Rx * Rx + Ry * Ry), C.rep_host, s.rng)
         inc_ji = rvx * my - rvy * mx - spin
         xi[0] += inc_ij * kd
         xi[1] += inc_ji * kd
@@ -371,46 +403,65 @@ class BatchEngine:
         u = self.u
         u[0] += (vx - flow) * dt
         u[1] += vy * dt
-        self.u_max = np.maximum(self.u_max, np.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
-        self.strain += np.abs(s.rate) * dt
+        self.u_max = xp.maximum(self.u_max, xp.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
+        self.strain += abs(s.rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         s.pos += s.vel[:2] * dt
         s.phi += om * dt
         s.gamma = s.gamma + s.rate * dt
         wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
         s.t = s.t + dt
+        # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
+        due = self.bound >= self.skin
+        flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
+        self.need = flags[:s.B]
+        if verdict is not None and flags[s.B:].any():
+            self._report(verdict, self.step_count)
         self.step_count += 1
         return out
 
     def _check(self, d, active):
-        """The stability guard (see the class docstring); raises :class:`EngineInstability`."""
-        s = self.s
+        """The stability guard's verdict (see the class docstring), on the state's backend.
+
+        Returns ``(code, ke, bound, closest)``, arrays (B,): ``code`` 0 for a sound (or unguarded)
+        replica, 1 non-finite state, 2 kinetic energy above its bound, 3 interpenetration."""
+        s, xp = self.s, self.xp
         B, N = s.B, s.N
-        self.rate_max = np.maximum(self.rate_max, np.abs(s.rate))
-        state = np.stack((s.x, s.y, s.vx, s.vy, s.omega)).reshape(5, B, N)
-        finite = np.isfinite(state).all(axis=(0, 2))
+        self.rate_max = xp.maximum(self.rate_max, abs(s.rate))
+        state = xp.stack((s.x, s.y, s.vx, s.vy, s.omega)).reshape(5, B, N)
+        finite = xp.isfinite(state).all(axis=(0, 2))
         u = s.vx - (s.y - self.hy_s) * s.rate[s.rep]
         ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
         plate = self.rate_max * s.Ly / 2
         bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
         C = self.C
-        ratio = np.where(active & C.trans, d / C.d0, np.inf)
+        ratio = xp.where(active & C.trans, d / C.d0, math.inf)
         # closest transient contact of each replica: one reduction over its own (contiguous) segment
-        closest = np.full(B, np.inf)
-        if C.P:
-            closest[C.seg_rep] = np.minimum.reduceat(ratio, C.seg_starts)
-        bad = self.guard & (~finite | (ke > bound) | (closest < self.min_distance_ratio))
-        if not bad.any():      # the one device-to-host transfer of the guard: does any replica stop the batch?
+        if C.replica_sum is not None:       # a device: the padded gather (inf for a replica without pairs)
+            closest = C.replica_sum.minimum(ratio)
+        else:
+            closest = xp.full(B, math.inf)
+            if C.P:
+                closest[C.seg_rep_b] = xp.minimum.reduceat(ratio, C.seg_starts_b)
+        code = xp.where(~finite, 1, xp.where(ke > bound, 2, xp.where(closest < self.min_distance_ratio, 3, 0)))
+        return code * self.guard_dev, ke, bound, closest
+
+    def _report(self, verdict, step):
+        """Raise :class:`EngineInstability` for the first guarded replica whose verdict is not sound."""
+        code = to_host(verdict[0], "guard")
+        bad = np.flatnonzero(code)
+        if not len(bad):
             return
-        b = int(np.flatnonzero(bad)[0])
-        if not finite[b]:
+        b = int(bad[0])
+        ke, bound, closest = (to_host(a, "guard") for a in verdict[1:])
+        if code[b] == 1:
             reason = "non-finite state"
-        elif ke[b] > bound[b]:
+        elif code[b] == 2:
             reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
         else:
             reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"
-        raise EngineInstability(f"replica {b}: {reason} at step {self.step_count} of phase {self.phase!r}",
-                                replica=b, step=self.step_count, phase=self.phase)
+        raise EngineInstability(f"replica {b}: {reason} at step {step} of phase {self.phase!r}",
+                                replica=b, step=step, phase=self.phase)
 
 
 def pre_equilibration_blocks(N, dt, dt_max):
@@ -493,7 +544,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
         step += 1
         report(step, total)
     for _ in range(int(N)):
-        s.rate = np.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
+        s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
         engine.step(cool, dt)
         step += 1
         report(step, total)
@@ -527,34 +578,35 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
 
     Returns
     -------
-    dict of ndarray (n_steps, B)
+    dict of numpy.ndarray (n_steps, B)
         "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step, and
         "first_tensors", "last_tensors" (B, 9, 2, 2): every tensor at the first and last step.
-        Times in s, strain dimensionless, strain rate in 1/s, stresses and tensors in Pa.
+        Times in s, strain dimensionless, strain rate in 1/s, stresses and tensors in Pa.  The
+        record is kept on the state's backend and copied to the host once, at the end.
 
     Raises
     ------
     EngineInstability
         If a guarded replica becomes unstable.
     """
-    s = engine.s
+    s, xp = engine.s, engine.xp
     s.applying_shear = True
-    s.t = np.zeros(s.B)
+    s.t = xp.zeros(s.B)
+    t = 0.0                    # the clock of every replica, kept on the host too (same additions of dt)
     T_total = (periods + pre + post) / f
     n_steps = int(T_total / dt)
     lo = pre / (f * dt)
     hi = (periods + pre) / (f * dt)
-    A = np.asarray(amplitudes, dtype=float)
-    rec = {name: np.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
+    A = engine.backend.asarray(np.asarray(amplitudes, dtype=float))
+    rec = {name: xp.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
                                                          "stress_surface")}
     if keep_tensors:
-        rec["tensors"] = np.empty((n_steps, s.B, 9, 2, 2))
+        rec["tensors"] = xp.empty((n_steps, s.B, 9, 2, 2))
     say("Start application shear protocol, total N= " + str(n_steps) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
-    zero = np.zeros(s.B)
+    zero = xp.zeros(s.B)
     for i in range(n_steps):
-        t = float(s.t[0])      # every replica has the same clock (same dt, same schedule)
         if lo <= i <= hi:
             rate = A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
         else:
@@ -573,6 +625,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
             rec["first_tensors"] = out[2]
         if i == n_steps - 1:
             rec["last_tensors"] = out[2]
+        t = t + dt             # = s.t[b] for every b (same dt, same schedule)
         report(i + 1, n_steps)
     engine.flush()
-    return rec
+    return {name: to_host(v, "series") for name, v in rec.items()}

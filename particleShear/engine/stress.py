@@ -14,6 +14,7 @@ import collections
 import numpy as np
 
 from .forces import replica_sums
+from .xp import array_namespace
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
 
@@ -87,10 +88,13 @@ class StressInputs:
         """
         if by_pair:
             return replica_sums(self.C, weights[None])[0]
+        xp = array_namespace(weights)
         n = len(weights) // self.B if self.B else 0
         if n == 0:
-            return np.zeros(self.B)
-        return np.add.reduceat(weights, np.arange(self.B) * n)
+            return xp.zeros(self.B)
+        if self.C.backend.ordered_reductions:
+            return xp.add.reduceat(weights, xp.arange(self.B) * n)
+        return weights.reshape(self.B, n).sum(axis=1)      # a device: one reduction along each replica's row
 
     def outer(self, u, w, by_pair=True):
         """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows).
@@ -109,7 +113,7 @@ class StressInputs:
         ndarray (B, 2, 2)
             ``out[b, a, c] = Σ_rows of b  u_a · w_c`` (unscaled).
         """
-        out = np.empty((self.B, 2, 2))
+        out = array_namespace(u[0]).empty((self.B, 2, 2))
         for a in range(2):
             for c in range(2):
                 out[:, a, c] = self.per_replica(u[a] * w[c], by_pair)
@@ -209,7 +213,8 @@ def unbalanced_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return q.per_replica(q.torque, by_pair=False)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
+    rot = array_namespace(q.torque).asarray(_ROT)
+    return q.per_replica(q.torque, by_pair=False)[:, None, None] * 1e-18 / q.V[:, None, None] * rot
 
 
 def internal_torque(q):
@@ -225,7 +230,8 @@ def internal_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return q.per_replica(q.dF * q.internal)[:, None, None] * 1e-18 / q.V[:, None, None] * _ROT
+    rot = array_namespace(q.dF).asarray(_ROT)
+    return q.per_replica(q.dF * q.internal)[:, None, None] * 1e-18 / q.V[:, None, None] * rot
 
 
 def spin_kinetic_energy(q):
@@ -242,7 +248,7 @@ def spin_kinetic_energy(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     k = q.per_replica(q.inertia * q.omega * q.omega * q.mob, by_pair=False) * 1e-18 / 2
-    return -(k / q.V)[:, None, None] * np.eye(2)
+    return -(k / q.V)[:, None, None] * array_namespace(k).eye(2)
 
 
 def peculiar_acceleration_otsuki(q):
@@ -311,4 +317,4 @@ def evaluate_all(q):
     ndarray (B, 9, 2, 2)
         ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
     """
-    return np.stack([q.tensor(t.function) for t in TENSORS], axis=1)
+    return array_namespace(q.x).stack([q.tensor(t.function) for t in TENSORS], axis=1)

@@ -1,11 +1,14 @@
 """Tangential two-visit rule over arrays (docs/design.md, "One step"), written once.
 
-Used by the engine's step and by the documented canvas classes alike.  Forces in
-mg·µm·s⁻² per m depth, ξ in µm, velocities in µm/s.
+Used by the engine's step and by the documented canvas classes alike, on the array namespace of
+its inputs (NumPy or CuPy, :mod:`.xp`).  Forces in mg·µm·s⁻² per m depth, ξ in µm, velocities
+in µm/s.
 """
 __docformat__ = "numpy"
 
 import numpy as np
+
+from .xp import array_namespace
 
 __all__ = ["tangential_two_pass"]
 
@@ -46,6 +49,8 @@ def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
     slip2 : ndarray of bool (P,)
         The final slip flag (visit 2 exceeded the bound).
     """
+    xp = array_namespace(xi, vt)
+    on_host = isinstance(xi, np.ndarray)   # NumPy: skip the resets when nothing slipped (free to know on the host)
     # viscous part on touching pairs only: ×1 is exact; ×0 gives a zero whose sign may differ from
     # +0, which changes nothing downstream (added to k_t·ξ, and ξ is never −0)
     ftv_i = nut_i * vt
@@ -58,26 +63,26 @@ def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
     if kt_j is kt_i:
         ft = kt_i * xi
     else:
-        ft = np.empty_like(xi)
-        np.multiply(kt_i, xi[0], out=ft[0])
-        np.multiply(kt_j, xi[1], out=ft[1])
+        ft = xp.empty_like(xi)
+        xp.multiply(kt_i, xi[0], out=ft[0])
+        xp.multiply(kt_j, xi[1], out=ft[1])
     if ftv_j is ftv_i:
         ft += ftv_i
     else:
         ft[0] += ftv_i
         ft[1] += ftv_j
-    a = np.abs(ft)
+    a = xp.abs(ft)
     slip1 = a[0] > f_coulomb
-    any_slip1 = np.count_nonzero(slip1)
+    any_slip1 = xp.count_nonzero(slip1) if on_host else True   # a device resets where-masked, unconditionally
     if any_slip1:
         # visit 2 sees ξ_ji = 0 after a slip in visit 1
-        np.copyto(ft[1], ftv_j, where=slip1)
-        np.abs(ft[1], out=a[1])
+        xp.copyto(ft[1], ftv_j, where=slip1)
+        xp.abs(ft[1], out=a[1])
     slip2 = a[1] > f_coulomb
-    F = np.copysign(np.minimum(a, f_coulomb, out=a), ft, out=a)
+    F = xp.copysign(xp.minimum(a, f_coulomb, out=a), ft, out=a)
     if any_slip1:
         slip2_or_1 = slip1 | slip2
-        np.copyto(xi, 0.0, where=slip2_or_1)
-    elif np.count_nonzero(slip2):
-        np.copyto(xi, 0.0, where=slip2)
+        xp.copyto(xi, 0.0, where=slip2_or_1)
+    elif xp.count_nonzero(slip2):
+        xp.copyto(xi, 0.0, where=slip2)
     return F, slip2

@@ -18,7 +18,7 @@ from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import validate_options, validate_series, validate_simulation_parameters
-from .batch import check_backend, check_batch_size, engine_supports, measure_batch
+from .batch import check_backend, check_batch_size, check_run_backend, engine_supports, measure_batch
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -372,11 +372,14 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     strict_io : bool, default False
         Keyword-only.  Raise the ``OSError`` of a failed write after the run; False: return the
         result with ``write_error`` set (``last_result`` holds it either way).
-    backend : {"numpy"}, default "numpy"
-        Keyword-only.  Array library of the measurement (only NumPy in this version; see
-        :mod:`particleShear.run.batch`).  Runs without drawing or snapshots (files or not) measure through
-        the engine (:mod:`particleShear.engine`) as a batch of one, so that a run in a batched
-        series (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it.
+    backend : {"numpy", "cupy"}, default "numpy"
+        Keyword-only.  Array library of the measurement: "numpy", or "cupy" to measure on a CUDA
+        GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding,
+        not bit for bit).  Runs without drawing or snapshots (files or not) measure through the
+        engine (:mod:`particleShear.engine`) as a batch of one, so that a run in a batched series
+        (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it; "cupy"
+        needs such a run (``doDrawing=False, plotStress=False``; see
+        :func:`particleShear.run.batch.check_run_backend`).
 
     Returns
     -------
@@ -441,6 +444,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
                   output_format=output_format, strict_io=strict_io,
                   saveOutputMovie=saveOutputMovie, backend=backend)
+    check_run_backend(params)   # another backend than NumPy only for runs the engine measures
     seed_entropy = None if ss is None else ss.entropy
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
@@ -621,8 +625,10 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
         unbatched series, in the same order (and resumes like it with a ``root_folder``).
         Default None: one task per run.
-    backend : {"numpy"}, default "numpy"
-        Keyword-only.  Array backend of every run.
+    backend : {"numpy", "cupy"}, default "numpy"
+        Keyword-only.  Array backend of every run ("cupy": on a CUDA GPU, for runs without
+        drawing and plotting; see :func:`doParticleShearSimulation`).  With ``batch_size`` a
+        batch of replicas is measured in one set of device arrays.
     **options
         Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
         ``reference_header``, ``renderer``, ``time_step_factor``, ...).
@@ -681,6 +687,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         kw = dict(common, theAmplitude=A, theMu=m, do_permanent_links=links, cut_lines=cl, seed=child,
                   verbose=verbose, backend=backend, **options)
         validate_simulation_parameters({**kw})  # every run is checked before any work starts
+        check_run_backend(kw)
         all_kwargs.append(kw)
     if not all_kwargs:
         return []

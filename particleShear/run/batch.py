@@ -28,7 +28,7 @@ import numpy as np
 from ..linkable.builders import time_steps_from_model
 
 __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
-           "ENGINE_MAX_N"]
+           "ENGINE_MAX_N", "check_backend", "check_run_backend"]
 
 _log = logging.getLogger(__name__)
 
@@ -62,8 +62,8 @@ SCHEDULE_PARAMETERS = ("N", "packing_fraction", "Young_modulus_spheres", "densit
                        "relative_viscosity", "relative_frequency", "pre_periods", "periods", "post_periods",
                        "cool_factor", "time_step_factor", "integrator")
 
-#: array backends a batch can run on
-BACKENDS = ("numpy",)
+#: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
+BACKENDS = ("numpy", "cupy")
 
 def _signature_defaults():
     """Defaults of every keyword of ``doParticleShearSimulation`` (read from its signature)."""
@@ -75,16 +75,57 @@ def _signature_defaults():
 
 
 def check_backend(backend):
-    """Raise ValueError unless ``backend`` is one of :data:`BACKENDS`.
+    """Raise ValueError unless ``backend`` names a backend that can run here.
 
     Parameters
     ----------
     backend : str
-        Name of the array library of a measurement.
+        Name of the array library of a measurement: one of :data:`BACKENDS` (or a backend
+        registered with :func:`particleShear.engine.xp.register_backend`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (naming ``backend``, its value and the allowed values), or for
+        ``"cupy"`` without CuPy or without a CUDA device.
     """
-    if backend not in BACKENDS:
-        raise ValueError(f"backend={backend!r} is out of range: allowed {', '.join(map(repr, BACKENDS))} "
-                         "(the CuPy backend needs the array-namespace engine, not in this version)")
+    from ..engine.xp import get_backend
+    get_backend(backend)
+
+
+def check_run_backend(kw):
+    """Check the backend of one run: usable here, and the run one the engine measures.
+
+    Runs the engine does not measure (drawing, plotting, snapshots, the Verlet integrator,
+    replaced force laws, N > :data:`ENGINE_MAX_N`) go through the documented classes, which
+    step NumPy arrays only: with another backend they are refused rather than silently
+    measured with NumPy.
+
+    Parameters
+    ----------
+    kw : dict
+        Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` (missing
+        ones take their defaults).
+
+    Raises
+    ------
+    ValueError
+        Naming ``backend``, for an unusable backend or a run the engine does not measure.
+    """
+    full = dict(_signature_defaults(), **kw)
+    backend = full["backend"]
+    check_backend(backend)
+    if backend == "numpy" or engine_supports(full):
+        return
+    why = [f"{name}={full[name]!r}" for name in ("doDrawing", "plotStress", "saveOutputImages") if full[name]]
+    if full["integrator"] != "euler":
+        why.append(f"integrator={full['integrator']!r}")
+    if int(full["N"]) > ENGINE_MAX_N:
+        why.append(f"N={full['N']!r} > {ENGINE_MAX_N}")
+    raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why) or 'replaced force laws'}): "
+                     "only runs the engine measures can use a backend other than 'numpy' (doDrawing=False, "
+                     f"plotStress=False, saveOutputImages=False, integrator='euler', N <= {ENGINE_MAX_N}, the "
+                     "built-in force laws); the documented classes step NumPy arrays only")
 
 
 def check_batch_size(batch_size):
@@ -161,7 +202,7 @@ def batches(all_kwargs, batch_size):
     return out
 
 
-def run_batch(list_of_kwargs, backend="numpy"):
+def run_batch(list_of_kwargs, backend=None):
     """Run a batch of replicas that share a step schedule; one result per replica, in order.
 
     Parameters
@@ -169,8 +210,9 @@ def run_batch(list_of_kwargs, backend="numpy"):
     list_of_kwargs : list of dict
         Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` per replica
         (``return_result`` is implied).  All must have the same :func:`schedule_key`.
-    backend : {"numpy"}
-        Array backend of the batch.
+    backend : {None, "numpy", "cupy"}, default None
+        Array backend of the batch; None: the runs' own ``backend`` keyword (default "numpy").
+        A backend other than "numpy" needs runs the engine measures (see :func:`check_run_backend`).
 
     Returns
     -------
@@ -186,8 +228,9 @@ def run_batch(list_of_kwargs, backend="numpy"):
     from .api import doParticleShearSimulation
     from .validation import validate_simulation_parameters
 
-    check_backend(backend)
-    runs = [dict(kw) for kw in list_of_kwargs]
+    if backend is not None:
+        check_backend(backend)
+    runs = [dict(kw) if backend is None else dict(kw, backend=backend) for kw in list_of_kwargs]
     if not runs:
         raise ValueError("list_of_kwargs=[] is invalid: a batch needs at least one run")
     keys = [schedule_key(kw) for kw in runs]
@@ -205,6 +248,7 @@ def run_batch(list_of_kwargs, backend="numpy"):
             raise ValueError(f"list_of_kwargs[{n}] has unknown parameters {unknown}: allowed the keywords of "
                              "doParticleShearSimulation")
         validate_simulation_parameters(dict(defaults, **kw))
+        check_run_backend(kw)
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
     if not all(engine_supports(kw) for kw in full):
         return [doParticleShearSimulation(**kw, return_result=True) for kw in runs]
@@ -368,6 +412,7 @@ def _measure(sessions, sched, where):
     from ..engine.step import BatchEngine, pre_equilibrate, protocol
 
     sims = [run.sim for run in sessions]
+    backend = sims[0].parameters.get("backend", "numpy")    # one backend per batch (part of the schedule key)
     guard_of = [bool(run.sim.stability_guard) for run in sessions]
     rec = [None] * len(sessions)
     timings = [dict() for _ in sessions]
@@ -379,7 +424,7 @@ def _measure(sessions, sched, where):
         for pre in dict.fromkeys(sched[b][1] for b in members):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
-            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group])
+            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend)
             say, report = _console(sims, group, "pre-equilibration", where)
             engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group])
             _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)

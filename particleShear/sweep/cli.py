@@ -21,7 +21,7 @@ def build_parser():
     argparse.ArgumentParser
         Positional ``SPEC``; ``--out DIR`` (required), ``--workers``, ``--dask``, ``--scheduler``,
         ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``,
-        ``--retry-failed``, ``--keep-going``, ``--quiet``.
+        ``--retry-failed``, ``--keep-going``, ``--quiet``, ``--backend``.
     """
     p = argparse.ArgumentParser(prog="particleShear sweep",
                                 description="Run (or resume) every run of a sweep SPEC (.toml or .json) into DIR; "
@@ -33,6 +33,9 @@ def build_parser():
     a("--batch-size", type=int, default=None, metavar="B",
       help="measure runs of one step schedule (same N, time-step rule, protocol) in batches of up to B "
            "replicas, one task each; rows identical to unbatched runs (default: one task per run)")
+    a("--backend", default=None, metavar="NAME",
+      help="array backend of every run: numpy, or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`; runs "
+           "without drawing); sets the SPEC's backend (default: the SPEC's, numpy)")
     a("--dask", action="store_true", help="run on a dask.distributed LocalCluster of --workers processes")
     a("--scheduler", metavar="ADDRESS", default=None, help="run on an existing Dask cluster (e.g. tcp://host:8786)")
     a("--task-index", type=int, default=None, metavar="I", help="job-array task I (0-based) of --task-count K")
@@ -81,7 +84,8 @@ def _main(args):
         if args.dask and args.scheduler:
             raise ValueError("--dask and --scheduler exclude each other: --dask starts a cluster, "
                              "--scheduler joins one")
-        sweep = Sweep(args.spec, args.out, task_index=args.task_index, task_count=args.task_count)
+        sweep = Sweep(args.spec, args.out, task_index=args.task_index, task_count=args.task_count,
+                      backend=args.backend)
     except (ValueError, TypeError) as exc:
         print(f"particleShear sweep: invalid input: {exc}", file=sys.stderr)
         return 2

@@ -198,6 +198,27 @@ def execute_batch(tasks):
                 shutil.rmtree(run_dir, ignore_errors=True)
 
 
+def _pool_context(parameters):
+    """Start method of the default worker pool: "spawn" when a run uses a device backend.
+
+    The parent has initialised CUDA when it checked ``backend="cupy"``, and a forked child
+    cannot use CUDA after that; fresh ("spawn") workers can.  NumPy runs keep the platform's default.
+
+    Parameters
+    ----------
+    parameters : iterable of dict
+        The runs' keyword arguments.
+
+    Returns
+    -------
+    multiprocessing context or None
+    """
+    import multiprocessing
+    if any(p.get("backend", "numpy") != "numpy" for p in parameters):
+        return multiprocessing.get_context("spawn")
+    return None
+
+
 def _ignore_sigint():
     """Worker initializer: Ctrl-C reaches only the driving process, which then stops cleanly."""
     import signal
@@ -302,15 +323,30 @@ class Sweep:
     task_index, task_count : int, optional
         Job-array share: this process runs the runs with ``index % task_count == task_index``
         and writes its rows to its own table, merged later by :meth:`merge`.
+    backend : str, optional
+        Array backend of every run (``--backend``), set as the SPEC's ``[parameters] backend``:
+        "numpy" or "cupy" (a CUDA GPU; runs without drawing).  It is part of each run's
+        identity, so a sweep measured on the GPU does not resume the rows of a NumPy sweep.
+        Default: the SPEC's (``"numpy"`` unless it sets one).
     """
 
-    def __init__(self, spec, out_dir, *, task_index=None, task_count=None):
+    def __init__(self, spec, out_dir, *, task_index=None, task_count=None, backend=None):
         if isinstance(spec, SweepSpec):
             self.spec = spec
         elif isinstance(spec, dict):
             self.spec = parse_spec(spec)
         else:
             self.spec = load_spec(spec)
+        if backend is not None:
+            from ..run.batch import check_backend
+            try:
+                check_backend(backend)
+            except ValueError as exc:
+                raise ValueError(str(exc).replace(f"backend={backend!r}", f"backend={backend!r} (--backend)", 1)) \
+                    from None
+            if "backend" in self.spec.grid or any("backend" in z for z in self.spec.zips):
+                raise ValueError(f"backend={backend!r} (--backend) conflicts with the SPEC, which varies backend")
+            self.spec = dataclasses.replace(self.spec, parameters=dict(self.spec.parameters, backend=backend))
         if (task_index is None) != (task_count is None):
             raise ValueError("task_index and task_count (--task-index, --task-count) go together")
         if task_count is not None:
@@ -480,7 +516,8 @@ class Sweep:
                 return
             own = executor is None
             if own:
-                executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+                executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
+                                                                  mp_context=_pool_context(r.parameters for r in todo))
             futures, recorded = {}, set()
             try:
                 by_id = {r.run_id: r for r in todo}
@@ -722,7 +759,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
     else:
         own = executor is None
         if own:
-            executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers)
+            executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers,
+                                                              mp_context=_pool_context(r.parameters for r in runs))
         try:
             tasks = [{"run_id": r.run_id, "index": r.index, "parameters": r.parameters,
                       "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "",

@@ -305,6 +305,8 @@ def _check_options(p, where):
     for name in ("correct_drift_sign", "reference_header", "stability_guard"):
         if name in p and not isinstance(p[name], bool):
             raise ValueError(f"{where}: {name}={p[name]!r} is invalid: allowed true or false")
+    from ..run.batch import check_run_backend
+    check_run_backend(p)   # backend usable here, and "cupy" only for runs the engine measures
 
 
 def expand_runs(spec):

@@ -1,0 +1,359 @@
+"""The array namespace of the engine: NumPy by default, CuPy with ``backend="cupy"`` (docs/design.md, "Backends").
+
+The engine's kernels take the namespace of their inputs (:func:`array_namespace`) and call only
+functions that NumPy and CuPy share.  This module holds the few things that cannot be written
+once for both:
+
+* :func:`get_backend` — a backend by name (``"numpy"``, ``"cupy"``, or one registered with
+  :func:`register_backend`, e.g. the CPU stand-in device of the tests), checked before any work;
+* :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres; on CuPy
+  also the sums and minima over a replica's rows): ``bincount`` on NumPy; on CuPy a gather of each
+  bin's rows into a padded (bins, width) matrix, built once per candidate set, and a sum along its
+  rows, which is deterministic (no atomic adds, so a GPU run is reproducible bit for bit) and reads
+  nothing on the host per step (``cupy.bincount`` computes ``max(x) + 1`` on the host every call);
+* :func:`to_host` — **the one door from the device to the host**.  Every read of a device value
+  by the engine goes through it with a reason from :data:`REASONS`; CuPy forbids the implicit
+  ones (``numpy.asarray(device_array)``, ``float()``, ``if device_bool:``) and a step performs only
+  the named ones.
+
+CuPy is never imported by importing this module: only :func:`get_backend` ("cupy") imports it,
+and :func:`array_namespace` recognises CuPy arrays only once CuPy has been imported by someone.
+"""
+__docformat__ = "numpy"
+
+import contextlib
+import sys
+
+import numpy as np
+
+__all__ = ["Backend", "get_backend", "register_backend", "unregister_backend", "backend_names", "array_namespace",
+           "backend_of", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+
+#: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
+CUPY_INSTALL = "pip install cupy-cuda12x"
+
+#: the reasons for which the engine reads device values on the host (the argument ``why`` of :func:`to_host`)
+REASONS = {
+    "flags": "the per-step flags: neighbour-list rebuilds due, the stability guard's verdict",
+    "d = 0": "a pair at zero distance needs a random normal from its replica's NumPy generator",
+    "rebuild": "positions of the replicas whose candidate list is rebuilt (the candidate search runs on the host)",
+    "pair history": "state, ξ and relations of the candidate pairs, written back into the per-replica lists",
+    "layout": "the width (largest bin) of the padded gather of a new candidate set",
+    "guard": "the values the stability guard reports when a replica failed",
+    "series": "the recorded series and tensors, at the end of a phase",
+    "state": "copies of the state between host and device: at set-up (radii, boxes, skins) or when inspected",
+}
+
+_HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
+
+_log = None   # list receiving each reason while record_host_reads() is active
+
+
+@contextlib.contextmanager
+def record_host_reads():
+    """Record the reason of every :func:`to_host` call made inside the ``with`` block.
+
+    Yields
+    ------
+    list of str
+        The ``why`` of each call, in order (filled while the block runs).
+    """
+    global _log
+    outer, _log = _log, []
+    try:
+        yield _log
+    finally:
+        _log = outer
+
+
+class Backend:
+    """An array backend: its namespace and how arrays go to and come back from it.
+
+    Parameters
+    ----------
+    name : str
+        The name users pass as ``backend=``.
+    xp : module or object
+        The array namespace (NumPy's functions: ``zeros``, ``where``, ``sqrt``, ``concatenate``, ...).
+    host : bool
+        True when the arrays live in host memory and reading them is free (NumPy): the engine
+        then keeps the early exits and caches that cost a host read on a device.
+    asarray : callable
+        ``asarray(numpy_array) -> device array`` (a copy on the device).
+    to_host : callable
+        ``to_host(device_array) -> numpy.ndarray``.
+    owns : callable
+        ``owns(array) -> bool``: the array belongs to this backend.
+    ordered_reductions : bool, default True
+        The namespace's ``bincount(index, weights, minlength)`` and ``add.reduceat`` sum in row
+        order without a host read (NumPy); False (CuPy: ``bincount`` adds atomically, in no fixed
+        order, and reads ``max(index)`` on the host) makes :class:`SegmentSum` and the per-replica
+        sums use a padded gather and a reduction along rows.
+    """
+
+    def __init__(self, name, xp, host, asarray, to_host, owns, ordered_reductions=True):
+        self.name, self.xp, self.host = name, xp, bool(host)
+        self.asarray, self._to_host, self.owns = asarray, to_host, owns
+        self.ordered_reductions = bool(ordered_reductions)
+
+    def __repr__(self):
+        return f"Backend({self.name!r})"
+
+
+def _numpy_backend():
+    return Backend("numpy", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
+
+
+def _cupy_backend():
+    try:
+        import cupy
+    except Exception as exc:  # ImportError, or a CuPy build that fails to load its CUDA libraries
+        raise ValueError(f"backend='cupy' needs CuPy and a CUDA device: CuPy cannot be imported ({exc}); "
+                         f"install it with `{CUPY_INSTALL}` (CUDA 12) or choose backend='numpy'") from None
+    try:
+        n = cupy.cuda.runtime.getDeviceCount()
+    except Exception as exc:  # no driver, no device
+        raise ValueError(f"backend='cupy' needs CuPy and a CUDA device: no CUDA device is usable ({exc}); "
+                         "choose backend='numpy'") from None
+    if n < 1:
+        raise ValueError("backend='cupy' needs CuPy and a CUDA device: CuPy found no CUDA device; "
+                         "choose backend='numpy'")
+    return Backend("cupy", cupy, False, cupy.asarray, cupy.asnumpy, lambda a: isinstance(a, cupy.ndarray),
+                   ordered_reductions=False)
+
+
+_FACTORIES = {"numpy": _numpy_backend, "cupy": _cupy_backend}
+_MADE = {}
+
+
+def backend_names():
+    """Names accepted by :func:`get_backend`, in registration order.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(_FACTORIES)
+
+
+def register_backend(name, factory):
+    """Make ``factory()`` (returning a :class:`Backend`) available as ``backend=name``.
+
+    Used by the tests for a CPU stand-in device; a factory raises ValueError when its backend
+    cannot run here.
+
+    Parameters
+    ----------
+    name : str
+        The new backend's name.
+    factory : callable
+        ``factory() -> Backend``, called at the first :func:`get_backend` of ``name``.
+    """
+    _FACTORIES[name] = factory
+    _MADE.pop(name, None)
+
+
+def unregister_backend(name):
+    """Remove a backend added with :func:`register_backend` ("numpy" and "cupy" stay).
+
+    Parameters
+    ----------
+    name : str
+    """
+    if name not in ("numpy", "cupy"):
+        _FACTORIES.pop(name, None)
+        _MADE.pop(name, None)
+
+
+def get_backend(name="numpy"):
+    """The backend called ``name``, checked to be usable here.
+
+    Parameters
+    ----------
+    name : str or Backend
+        ``"numpy"`` (default), ``"cupy"`` (needs CuPy and a CUDA device) or a registered name; a
+        :class:`Backend` is returned as it is.
+
+    Returns
+    -------
+    Backend
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (naming ``backend``, its value and the allowed values), or for
+        ``"cupy"`` without CuPy or without a CUDA device.
+    """
+    if isinstance(name, Backend):
+        return name
+    if not isinstance(name, str) or name not in _FACTORIES:
+        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, _FACTORIES))}")
+    b = _MADE.get(name)
+    if b is None:
+        b = _MADE[name] = _FACTORIES[name]()
+    return b
+
+
+def backend_of(*arrays):
+    """The :class:`Backend` of the arrays (NumPy for ndarrays and Python numbers).
+
+    Parameters
+    ----------
+    *arrays : array or number
+        Arrays of one backend (numbers and None are ignored).
+
+    Returns
+    -------
+    Backend
+    """
+    for a in arrays:
+        if isinstance(a, _HOST_TYPES):
+            continue
+        for name, b in _MADE.items():
+            if name != "numpy" and b.owns(a):
+                return b
+        if "cupy" in sys.modules and "cupy" not in _MADE:   # a CuPy array made outside get_backend
+            import cupy
+            if cupy.get_array_module(a) is cupy:
+                return get_backend("cupy")
+    return get_backend("numpy")
+
+
+def array_namespace(*arrays):
+    """The array namespace of the arrays: ``numpy`` for ndarrays, ``cupy`` for CuPy arrays.
+
+    Parameters
+    ----------
+    *arrays : array or number
+        Arrays of one backend (numbers and None are ignored).
+
+    Returns
+    -------
+    module
+        The namespace whose functions accept and return such arrays.
+    """
+    for a in arrays:
+        if not isinstance(a, _HOST_TYPES):
+            return backend_of(*arrays).xp
+    return np
+
+
+def to_host(array, why):
+    """Read a device array on the host: the engine's only device → host transfer.
+
+    On NumPy it returns the array itself (no copy).  ``why`` names the reason (a key of
+    :data:`REASONS`); it is recorded while :func:`record_host_reads` is active.
+
+    Parameters
+    ----------
+    array : array
+        An array of any backend.
+    why : str
+        A key of :data:`REASONS`.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ValueError
+        If ``why`` is not a key of :data:`REASONS` (a host read without a named reason).
+    """
+    if why not in REASONS:
+        raise ValueError(f"why={why!r} is out of range: allowed {', '.join(map(repr, REASONS))}")
+    if _log is not None:
+        _log.append(why)
+    if isinstance(array, (np.ndarray, np.generic)):
+        return array
+    return backend_of(array)._to_host(array)
+
+
+class SegmentSum:
+    """Sums of weights into ``n`` bins by a fixed index: ``out[k] = Σ_{index[p] = k} w[p]``.
+
+    Built once per index (the scatter of a candidate set, the replica of each row) and applied
+    every step.  On NumPy it is ``numpy.bincount(index, w, n)`` (each bin summed in row order);
+    on CuPy (:attr:`Backend.ordered_reductions` false) the rows of each bin are gathered into a
+    padded ``(n, width)`` matrix (padding points to an appended 0) and summed along its rows —
+    deterministic and free of host reads.
+    The two agree to rounding (a different order of the same additions).
+
+    Parameters
+    ----------
+    index : numpy.ndarray of int (P,)
+        Bin of each row (0 … n−1), on the host.
+    n : int
+        Number of bins.
+    backend : Backend
+        Where the weights live.
+    """
+
+    def __init__(self, index, n, backend):
+        self.n = int(n)
+        self.backend = backend
+        self.index = backend.asarray(np.asarray(index, dtype=np.intp))
+        self._min_gather = None
+        self.gather = None if backend.ordered_reductions else self._padded()
+
+    def _padded(self):
+        """The (n, width) gather matrix: row k lists the rows of bin k in order, padded with P (→ the appended value).
+
+        Built on the backend (a stable sort of the index); its width is read on the host ("layout")."""
+        xp = self.backend.xp
+        index = self.index
+        P = len(index)
+        try:
+            order = xp.argsort(index, kind="stable")
+        except TypeError:  # pragma: no cover - CuPy before v12 sorts stably without the keyword
+            order = xp.argsort(index)
+        counts = xp.bincount(index, minlength=self.n)
+        width = int(to_host(counts.max(), "layout")) if P else 0
+        start = xp.cumsum(counts) - counts                     # first sorted row of each bin
+        bins = index[order]
+        rank = xp.arange(P) - start[bins]                     # position of each row within its bin
+        gather = xp.full((self.n, max(width, 1)), P, dtype=np.intp)
+        gather[bins, rank] = order
+        return gather
+
+    def __call__(self, w):
+        """The sums per bin of ``w`` (P,), or of each row of ``w`` (rows, P).
+
+        Parameters
+        ----------
+        w : array (P,) or (rows, P)
+            Weights of the rows, any unit, on the backend.
+
+        Returns
+        -------
+        array (n,) or (rows, n)
+        """
+        xp = self.backend.xp
+        if self.gather is None:
+            if w.ndim == 1:
+                return xp.bincount(self.index, w, self.n)
+            return xp.stack([xp.bincount(self.index, w[k], self.n) for k in range(w.shape[0])])
+        pad = xp.zeros(w.shape[:-1] + (1,), dtype=w.dtype)
+        padded = xp.concatenate((w, pad), axis=-1)
+        return padded[..., self.gather].sum(axis=-1)
+
+    def minimum(self, w):
+        """The smallest value of ``w`` per bin (``inf`` for a bin without rows).
+
+        Order-free, so every backend uses the padded gather (padding ``inf``).
+
+        Parameters
+        ----------
+        w : array (P,)
+            Values of the rows, on the backend.
+
+        Returns
+        -------
+        array (n,)
+        """
+        xp = self.backend.xp
+        if self.gather is None and self._min_gather is None:
+            self._min_gather = self._padded()
+        gather = self._min_gather if self.gather is None else self.gather
+        padded = xp.concatenate((w, xp.full(1, float("inf"), dtype=w.dtype)))
+        return padded[gather].min(axis=1)
