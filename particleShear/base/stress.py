@@ -18,6 +18,7 @@ import numpy as np
 from ..engine import stress as _es
 from ..engine.forces import shear_stresses as _engine_shear_stresses
 from ..engine.stress import TENSORS, StressInputs
+from ..engine.xp import get_backend
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
@@ -59,8 +60,10 @@ class OneReplicaRows:
         self.B = 1
         self.rep = np.zeros(P, dtype=np.intp)
         self.offsets = np.array((0, P))
-        self.seg_rep = np.flatnonzero(self.offsets[1:] > self.offsets[:-1])
-        self.seg_starts = self.offsets[:-1][self.seg_rep]
+        self.seg_rep = self.seg_rep_b = np.flatnonzero(self.offsets[1:] > self.offsets[:-1])
+        self.seg_starts = self.seg_starts_b = self.offsets[:-1][self.seg_rep]
+        self.backend = get_backend("numpy")   # the classes step NumPy arrays
+        self.replica_sum = None                 # ordered reduceat per segment, as the engine on NumPy
 
 
 class OneReplicaInputs(StressInputs):

@@ -13,19 +13,20 @@ replica, an upper bound of how much any pair separation can have shrunk since th
 bound reaches the skin.  The contacts of every step are therefore exactly those of an all-pairs
 search (tested), and a replica's list depends only on its own history.
 
-Array namespace: both searches take the namespace of their inputs (NumPy, or CuPy when CuPy is
-imported and the inputs are CuPy arrays; the minimum image of :mod:`.box` must then accept them
-too); :func:`build_candidates`, which merges the bonds and carries the history over, is NumPy.
+Array namespace: both searches take the namespace of their inputs
+(:func:`~particleShear.engine.xp.array_namespace`); the engine runs them on the host (the
+positions of a rebuilt replica are read through the named transfer "rebuild", also for a GPU
+batch), and :func:`build_candidates`, which merges the bonds and carries the history over, is NumPy.
 """
 __docformat__ = "numpy"
 
 import math
-import sys
 
 import numpy as np
 
 from .box import min_image
 from .state import PERMANENT, ReplicaPairs
+from .xp import array_namespace
 
 __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
            "verlet_bound", "CELL_LIST_MIN_N"]
@@ -40,12 +41,6 @@ CELL_LIST_MIN_N = 200
 CELL_MARGIN = 1e-9
 
 _TRIU = {}
-
-
-def _namespace(x):
-    """Array module of ``x``: CuPy's when CuPy is imported (and ``x`` is a CuPy array), else NumPy."""
-    cp = sys.modules.get("cupy")
-    return cp.get_array_module(x) if cp is not None else np
 
 
 def all_pairs(N):
@@ -104,7 +99,7 @@ def near_pairs_all(x, y, r, Lx, Ly, shift, skin):
         The pairs, sorted by ``(i, j)``.
     """
     i, j = all_pairs(len(x))
-    xp = _namespace(x)
+    xp = array_namespace(x)
     if xp is not np:          # the cached index arrays live on the host
         i, j = xp.asarray(i), xp.asarray(j)
     near = _near(i, j, x, y, r, Lx, Ly, shift, skin)
@@ -178,7 +173,7 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     i, j : ndarray of int
         The pairs, sorted by ``(i, j)``.
     """
-    xp = _namespace(x)
+    xp = array_namespace(x)
     N = int(x.shape[0])
     if N < 2:
         return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)

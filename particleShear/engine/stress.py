@@ -317,4 +317,5 @@ def evaluate_all(q):
     ndarray (B, 9, 2, 2)
         ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
     """
-    return array_namespace(q.x).stack([q.tensor(t.function) for t in TENSORS], axis=1)
+    tensors = [q.tensor(t.function) for t in TENSORS]
+    return array_namespace(tensors[0]).stack(tensors, axis=1)
