@@ -3,13 +3,16 @@
 The engine advances B independent replicas of the measurement (pre-equilibration with plates,
 then the oscillatory protocol) in one set of flat arrays: spheres of replica b occupy rows
 ``b·N … b·N + N − 1``, pairs are kept per replica in canonical ``(i, j)`` order, and every sum
-over a replica is a ``bincount`` over its own rows, so a replica's numbers do not depend on the
-other replicas of its batch.
+over a replica is a reduction over its own rows (a segment of the pair or sphere arrays), so a
+replica's numbers do not depend on the other replicas of its batch.
 
 Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central laws),
 :mod:`.tangential` (the two-visit tangential rule, shared with the canvas classes),
-:mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica),
-:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.step` (one step, top to bottom, the
+:mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica from a cell
+list; also the classes' neighbour search), :mod:`.relax` (the constitution's free relaxation of a
+batch),
+:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.stress` (every tensor once, in one
+registry; also the classes' tensors), :mod:`.step` (one step, top to bottom, the
 pre-equilibration and the protocol); :mod:`.xp` is the array namespace (NumPy, or CuPy with
 ``backend="cupy"``) and the one door from the device to the host (docs/design.md, "Backends").
 """
