@@ -384,71 +384,6 @@ def adjustable_interface_constitution(
     ``particleShear.run.batch`` runs those of all replicas of a batch together in the engine
     (docs/design.md, "Batches of replicas").
 
-    Parameters
-    ----------
-    size_x, size_y : float, optional
-        Width and height of the periodic cell (µm), > 0.
-    N : int, optional
-        Number of spheres, >= 2.
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
-    Young_modulus_spheres : float, optional
-        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
-    density : float, optional
-        Density of the sphere material (kg/m³), > 0.
-    bimodal_factor : float, optional
-        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
-    cut_lines : int, optional
-        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
-        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
-    do_permanent_links : bool, optional
-        Crosslink all contacts after the relaxation and cut the gel into particles (False:
-        frictional spheres only).
-    theTk : object, optional
-        Accepted for compatibility with particleShear 1.0.2; not used.
-    do_pre_equilibration : bool, optional
-        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
-    relative_viscosity : float, optional
-        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
-    central_repulsion_coefficient : float, optional
-        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
-    anticipated_amplitude : float, optional
-        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
-        length of the relaxation.
-    relative_transversal_link_strength : float, optional
-        rts = k_t/k = ν_t/ν, >= 0.
-    avoid_horizontal_angle_degree : float, optional
-        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
-        lines that are redrawn.
-    avoid_height_spanning_particles : bool, optional
-        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
-        ignored when the cut cannot produce separate particles.
-    interface_reenforcement_central : float, optional
-        irc, factor on k (and ν) of transient contacts relative to bonds, > 0.
-    interface_reenforcement_tangential : float, optional
-        irt, the same for k_t (and ν_t), > 0.
-    keep_viscosity_coefficients_constant : bool, optional
-        True: the viscosities are not scaled by the reinforcement factors.
-    cut_top_bottom : bool, optional
-        Cut every bond through the y-periodic boundary (wall-slip emulation).
-    doCutByTriangulation : bool, optional
-        Particles by periodic Voronoi cells (False: random straight lines).
-    remove_link_fraction : float, optional
-        Target fraction (0 … 1) of non-essential links to remove after cutting.
-    edge_fuzziness : float, optional
-        Random roughening of the Voronoi borders in units of the largest radius, >= 0.
-    doDrawing : bool, optional
-        Whether the ensemble draws its spheres (no window is opened here).
-    do_debug : bool, optional
-        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
-    rng : numpy.random.Generator, int or None, optional
-        Random generator or seed driving every random choice (placement, cutting, link removal);
-        None draws fresh entropy.
-    verbose : bool, optional
-        Log the progress messages (INFO) of particleShear 1.0.2.
-
     Yields
     ------
     Relaxation
@@ -547,6 +482,19 @@ def adjustable_interface_constitution(
             yield from _free_mu0(ens, n, mu)
             yield Relaxation(ens, n)
     return ens
+
+
+def _parameters_section(doc):
+    """The numpydoc ``Parameters`` section of ``doc`` (up to the next section), indented as given."""
+    start = doc.index("    Parameters\n")
+    end = doc.index("    Returns\n", start)
+    return doc[start:end]
+
+
+# the generator takes the builder's parameters: their documentation is written once, in the builder
+adjustable_interface_constitution.__doc__ = adjustable_interface_constitution.__doc__.replace(
+    "    Yields\n", _parameters_section(
+        EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters.__doc__) + "    Yields\n", 1)
 
 
 def EnsembleCompactParticlesFromModelParameters(
