@@ -185,7 +185,7 @@ class TestAllocatorTuning(unittest.TestCase):
         import os
         import subprocess
         import sys
-        code = ("import particleShear.base.memory as m; from particleShear import EnsembleLinkable; "
+        code = ("import particleShear.engine.memory as m; from particleShear import EnsembleLinkable; "
                 "EnsembleLinkable(500, 500, 0); print(m._done)")
         env = dict(os.environ, PARTICLESHEAR_NO_MALLOPT="1")
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)

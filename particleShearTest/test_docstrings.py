@@ -92,6 +92,7 @@ ENGINE_MODULES = [
     "particleShear.engine.box",
     "particleShear.engine.forces",
     "particleShear.engine.laws",
+    "particleShear.engine.memory",
     "particleShear.engine.neighbours",
     "particleShear.engine.relax",
     "particleShear.engine.state",

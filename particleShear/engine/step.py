@@ -29,6 +29,7 @@ import numpy as np
 
 from .box import min_image, wrap
 from .forces import PairConstants, central_term, normals, scatter, shear_stresses, splice_arrays, tangential_term
+from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
 from .stress import StressInputs, evaluate_all
@@ -90,6 +91,8 @@ class BatchEngine:
         s = self.s = state
         xp = self.xp = s.xp
         self.backend = s.backend
+        if xp is np:
+            tune_allocator()   # step temporaries stay mapped (engine/memory.py; measured, see there)
         B, N = s.B, s.N
         self.r_max = s.r.reshape(B, N).max(axis=1)
         self.skin = skin_factor * self.r_max
