@@ -190,36 +190,7 @@ class BatchEngine:
         self.state_p = splice_arrays(self.state_p, state_p, segments)
         self.xi = splice_arrays(self.xi, xi, segments)
         self.active = splice_arrays(self.active, active, segments)
-        old = self.C
-        self.C = PairConstants.splice(s, old, new, segments, offsets)
-        self._carry_over(old, new, segments)
-
-    def _carry_over(self, old, new, segments):
-        """Keep what the step reuses from the last step (the image counts of :meth:`_images`, the
-        mobility flags of :meth:`_mobility_flags`) across a rebuild of some replicas' lists: the
-        other replicas' segments are copied, the rebuilt replicas' ones computed for their
-        candidates alone, at the positions this step starts from.
-
-        The step checks both before it uses them (separations inside the intervals, the same
-        mobility mask), so the numbers are those of a fresh evaluation; this only spares it the
-        evaluation over the whole batch after each rebuild.  NumPy only, like the reuse itself."""
-        if not self.backend.host:
-            return
-        s, C = self.s, self.C
-        img, fl = self._img, self._mob_flags
-        if img is not None and img[0] is old:
-            raw = s.pos.take(new.aj, axis=1)
-            raw -= s.pos.take(new.ai, axis=1)
-            _, _, ky, kx = min_image(raw[0], raw[1], new.Lx, new.Ly, (s.Ly * s.gamma)[new.rep])
-            self._img = None
-            if (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all():
-                parts = (new.Ly * ky, ky, new.Lx * kx, kx)
-                self._img = (C,) + tuple(splice_arrays(a, b, segments) for a, b in zip(img[1:], parts))
-        if fl is not None and fl[0] is old:
-            mob = fl[1]
-            mi = splice_arrays(fl[2], mob[new.ai], segments)
-            mj = splice_arrays(fl[3], mob[new.aj], segments)
-            self._mob_flags = (C, mob, mi, mj, ~(mi & mj))
+        self.C = PairConstants.splice(s, self.C, new, segments, offsets)
 
     def _images(self, raw_x, raw_y, shift_p):
         """Minimum image of the candidates, reusing the period counts of the last step while they
