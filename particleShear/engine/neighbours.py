@@ -5,7 +5,8 @@ A candidate is a pair whose Lees-Edwards minimum-image distance is below
 O(N), sort-based binning with array operations only) or, for small replicas and boxes of fewer
 than 3 cells per side, from the all-pairs search (:func:`near_pairs_all`, also the test oracle).
 Both select with the same minimum image and the same comparison, so they return the same pairs
-bit for bit (tested).
+bit for bit (tested).  On the host the all-pairs search tests only the pairs of the y band that
+can be within reach (:func:`_y_band`), which returns the same pairs for a fraction of the work.
 
 The list stays valid while no pair can have come into contact: :func:`verlet_bound` is, per
 replica, an upper bound of how much any pair separation can have shrunk since the list was built
