@@ -39,6 +39,14 @@ class PairConstants:
     each pair's replica, ``ai``/``aj`` the global sphere rows.  The bond-dependent constants are
     added by :meth:`set_bonds`.
 
+    The constants are stored in three stacked blocks of P columns, one per kind: :attr:`f`
+    (floats, rows :data:`FLOAT_ROWS`), :attr:`i` (sphere and replica indices, :data:`INT_ROWS`,
+    with its host copy :attr:`i_host`) and :attr:`b` (flags, :data:`BOOL_ROWS`).  Each named
+    attribute (``C.ri``, ``C.mu``, …) is a view of its row, and assigning one writes into the
+    row, so the blocks always hold every constant and a rebuild of some replicas' lists
+    (:meth:`splice`) is a few concatenations of blocks instead of one per constant
+    (docs/design.md, "Caching").
+
     Parameters
     ----------
     s : BatchState
@@ -52,52 +60,83 @@ class PairConstants:
         concatenated; ``offsets`` then describes that concatenation), for :meth:`splice`.
     """
 
+    #: rows of the float block :attr:`f`: radii and weights ``r/(r_i + r_j)``, box and half box (µm),
+    #: then the constants of :meth:`set_bonds`
+    FLOAT_ROWS = ("ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "k", "d_law", "d_cap", "a_lin", "a_div",
+                  "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
+    #: rows of the index block :attr:`i` (and of its host copy :attr:`i_host`): replica, sphere rows i and j
+    INT_ROWS = ("rep", "ai", "aj")
+    #: rows of the flag block :attr:`b`: bond, transient candidate
+    BOOL_ROWS = ("perm", "trans")
     #: the per-candidate arrays (length P), in the order the replicas' candidates are concatenated
-    PER_PAIR = ("rep", "ai", "aj", "ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "perm", "trans", "k",
-                "d_law", "d_cap", "a_lin", "a_div", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu",
-                "fc_inf", "perm_code")
-    #: host copies of the index arrays (the same arrays on NumPy), for the host's bookkeeping
+    #: (``perm_code`` = 2·perm, int8, follows from ``perm``)
+    PER_PAIR = INT_ROWS + FLOAT_ROWS + BOOL_ROWS + ("perm_code",)
+    #: host copies of the index arrays (rows of :attr:`i_host`; the same arrays on NumPy)
     HOST_PER_PAIR = ("rep_host", "ai_host", "aj_host")
+    #: the blocks, each (rows, P)
+    BLOCKS = ("f", "i", "b", "i_host")
+    #: attribute → (block, row)
+    _ROWS = {**{n: ("f", k) for k, n in enumerate(FLOAT_ROWS)}, **{n: ("i", k) for k, n in enumerate(INT_ROWS)},
+             **{n: ("b", k) for k, n in enumerate(BOOL_ROWS)},
+             **{n: ("i_host", k) for k, n in enumerate(HOST_PER_PAIR)}}
 
     def __init__(self, s, offsets, replicas=None):
         be = self.backend = s.backend
+        xp = s.xp
         replicas = np.arange(s.B) if replicas is None else np.asarray(replicas)
         pairs = [s.pairs[b] for b in replicas]
         N = s.N
-        # index arrays on the host (from the per-replica lists), then once on the device
-        self.rep_host = np.repeat(replicas, [len(p.i) for p in pairs])
-        base = self.rep_host * N
-        self.ai_host = np.concatenate([p.i for p in pairs]) + base
-        self.aj_host = np.concatenate([p.j for p in pairs]) + base
-        self.rep, self.ai, self.aj = (be.asarray(a) for a in (self.rep_host, self.ai_host, self.aj_host))
+        # index rows on the host (from the per-replica lists), then once on the device
+        rep = np.repeat(replicas, [len(p.i) for p in pairs])
+        P = len(rep)
+        i_host = np.empty((3, P), dtype=np.intp)
+        i_host[0] = rep
+        i_host[1] = np.concatenate([p.i for p in pairs]) + rep * N
+        i_host[2] = np.concatenate([p.j for p in pairs]) + rep * N
+        self._blocks(xp.zeros((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
         self._index(s, offsets)
-        g = self.rep
-        self.ri = s.r[self.ai]
-        self.rj = s.r[self.aj]
-        self.d0 = self.ri + self.rj
-        self.w_i = self.ri / self.d0
-        self.w_j = self.rj / self.d0
-        self.Lx = s.Lx[g]
-        self.Ly = s.Ly[g]
-        self.hy = self.Ly / 2
-        self.hx = self.Lx / 2
+        f = self.f
+        f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
+        f[2] = f[0] + f[1]                        # d0 = r_i + r_j
+        f[3:5] = f[0:2] / f[2]                    # w_i, w_j = r/d0
+        f[5:7] = xp.stack((s.Lx, s.Ly))[:, self.rep]
+        f[7:9] = f[6:4:-1] / 2                    # hy, hx
+
+    def _blocks(self, f, i, b, i_host):
+        """Take the blocks and bind every named attribute to a view of its row."""
+        d = self.__dict__
+        d.update(f=f, i=i, b=b, i_host=i_host)
+        for name, (block, k) in self._ROWS.items():
+            d[name] = d[block][k]
+        d["perm_code"] = self.perm.view(np.int8) * np.int8(2)
+
+    def __setattr__(self, name, value):
+        """Assigning a named constant writes into its row of the block (the block stays complete)."""
+        where = self._ROWS.get(name)
+        if where is None or where[0] not in self.__dict__:
+            object.__setattr__(self, name, value)
+            return
+        self.__dict__[where[0]][where[1]] = value
+        if name == "perm":
+            self.__dict__["perm_code"] = self.perm.view(np.int8) * np.int8(2)
 
     def _index(self, s, offsets):
         """Sizes and index arrays that follow from ``ai``, ``aj`` and the replicas' segments."""
         be = self.backend
         self.offsets = offsets
-        self.P = len(self.ai_host)
+        self.P = self.i_host.shape[1]
         # the replicas that have candidates and where their segments start, for replica_sums: each
         # such segment ends where the next one starts (empty replicas in between have no rows)
         self.B = len(offsets) - 1
         self.seg_rep = np.flatnonzero(offsets[1:] > offsets[:-1])
         self.seg_starts = offsets[:-1][self.seg_rep]
         nb = s.B * s.N
-        ai, aj = self.ai_host, self.aj_host
-        self.scatter_idx = np.concatenate((ai, aj, ai + nb, aj + nb, ai + 2 * nb, aj + 2 * nb))
+        pair_rows = self.i_host[1:3]          # (ai, aj)
+        # (ai, aj, ai + nb, aj + nb, ai + 2nb, aj + 2nb): the rows of the three components (F_x, F_y, torque)
+        self.scatter_idx = (pair_rows + (nb * np.arange(3))[:, None, None]).reshape(-1)
         #: pair forces → sphere totals: one bincount over the three components on NumPy; on CuPy a
         #: padded gather over (ai, aj), applied to each component's row (a third of the layout to build)
-        self.scatter = SegmentSum(self.scatter_idx if be.ordered_reductions else np.concatenate((ai, aj)),
+        self.scatter = SegmentSum(self.scatter_idx if be.ordered_reductions else pair_rows.reshape(-1),
                                   3 * nb if be.ordered_reductions else nb, be)
         self.replica_sum = None       # pair rows → replica sums on a device without ordered reduceat
         if be.ordered_reductions:
@@ -111,7 +150,7 @@ class PairConstants:
         other replicas are copied from ``old``, those of the rebuilt ones from ``new``.
 
         Every constant is an elementwise function of its own pair and replica, so the result is
-        the same number as a full rebuild (and costs a copy instead of ~40 array operations).
+        the same number as a full rebuild; it costs one concatenation per block.
 
         Parameters
         ----------
@@ -133,8 +172,9 @@ class PairConstants:
         """
         C = cls.__new__(cls)
         C.backend = old.backend
-        for name in cls.PER_PAIR + cls.HOST_PER_PAIR:
-            setattr(C, name, splice_arrays(getattr(old, name), getattr(new, name), segments))
+        f, i, b = (splice_arrays(getattr(old, n), getattr(new, n), segments) for n in ("f", "i", "b"))
+        i_host = i if old.i_host is old.i else splice_arrays(old.i_host, new.i_host, segments)
+        C._blocks(f, i, b, i_host)
         C._index(s, offsets)
         return C
 
@@ -156,25 +196,25 @@ class PairConstants:
         d_eq : ndarray (P,)
             Equilibrium distance of each candidate (µm; used for bonds only).
         """
-        g = self.rep
+        xp = array_namespace(state, d_eq)
+        # the per-replica constants of each candidate's replica, gathered at once
+        rows = xp.stack((s.k, s.c, s.prc, s.prt, s.keep, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
+        k, c, prc, prt, keep, nu, k_t, nu_t, mu = (rows[r] for r in range(9))
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
-        k, c = s.k[g], s.c[g]
         self.k = k
-        xp = array_namespace(state, d_eq)
         self.d_law = xp.where(perm, d_eq, self.d0)         # contact distance of the compressive law
         self.d_cap, self.a_lin, self.a_div = laws.central_constants(self.d_law, k, c)
         self.d_eq = xp.where(perm, d_eq, 0.0)   # tensile law −k·(d_eq − d) on bonds, −0·(0 − d) = +0 on contacts
         self.a_tens = -xp.where(perm, k, 0.0)
-        self.ratio_c = xp.where(perm, s.prc[g], 1.0)
-        keep = s.keep[g] != 0
-        self.nu = s.nu[g] * xp.where(perm & ~keep, s.prc[g], 1.0)
-        self.k_t = s.k_t[g] * xp.where(perm, s.prt[g], 1.0)
-        self.nu_t = s.nu_t[g] * xp.where(perm & ~keep, s.prt[g], 1.0)
-        self.mu = s.mu[g]
+        self.ratio_c = xp.where(perm, prc, 1.0)
+        loose = perm & (keep == 0)               # bonds whose viscosities take the permanent ratios
+        self.nu = nu * xp.where(loose, prc, 1.0)
+        self.k_t = k_t * xp.where(perm, prt, 1.0)
+        self.nu_t = nu_t * xp.where(loose, prt, 1.0)
+        self.mu = mu
         self.fc_inf = xp.where(perm, math.inf, 0.0)
-        self.perm_code = perm.view(np.int8) * np.int8(2)
 
 
 def splice_arrays(old, new, segments):
