@@ -70,14 +70,15 @@ class StressInputs:
 
         Parameters
         ----------
-        weights : ndarray (P,) or (B·N,)
-            One value per candidate pair (``by_pair``) or per sphere.
+        weights : ndarray (P,) or (B·N,), or (k, P) or (k, B·N)
+            One value per candidate pair (``by_pair``) or per sphere; a 2-D array sums each of
+            its k rows on its own (one reduction call for all of them).
         by_pair : bool
             True: sum over each replica's candidates (``C.rep``); False: over its spheres.
 
         Returns
         -------
-        ndarray (B,)
+        ndarray (B,) or (k, B)
             The sums, in the unit of ``weights``.
 
         Notes
@@ -86,18 +87,25 @@ class StressInputs:
         the replica's own segment (:func:`~particleShear.engine.forces.replica_sums`): it does
         not depend on the rest of the batch.
         """
+        W = weights if weights.ndim == 2 else weights[None]
         if by_pair:
-            return replica_sums(self.C, weights[None])[0]
-        xp = array_namespace(weights)
-        n = len(weights) // self.B if self.B else 0
-        if n == 0:
-            return xp.zeros(self.B)
-        if self.C.backend.ordered_reductions:
-            return xp.add.reduceat(weights, xp.arange(self.B) * n)
-        return weights.reshape(self.B, n).sum(axis=1)      # a device: one reduction along each replica's row
+            out = replica_sums(self.C, W)
+        else:
+            xp = array_namespace(W)
+            n = W.shape[1] // self.B if self.B else 0
+            if n == 0:
+                out = xp.zeros((W.shape[0], self.B))
+            elif self.C.backend.ordered_reductions:
+                out = xp.add.reduceat(W, xp.arange(self.B) * n, axis=1)
+            else:                     # a device: one reduction along each replica's row
+                out = W.reshape(W.shape[0], self.B, n).sum(axis=2)
+        return out if weights.ndim == 2 else out[0]
 
     def outer(self, u, w, by_pair=True):
         """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows).
+
+        The four products are summed in one reduction over their stacked rows (each row on its
+        own, so the same numbers as four separate sums).
 
         Parameters
         ----------
@@ -113,11 +121,8 @@ class StressInputs:
         ndarray (B, 2, 2)
             ``out[b, a, c] = Σ_rows of b  u_a · w_c`` (unscaled).
         """
-        out = array_namespace(u[0]).empty((self.B, 2, 2))
-        for a in range(2):
-            for c in range(2):
-                out[:, a, c] = self.per_replica(u[a] * w[c], by_pair)
-        return out
+        W = array_namespace(u[0]).stack((u[0] * w[0], u[0] * w[1], u[1] * w[0], u[1] * w[1]))
+        return self.per_replica(W, by_pair).T.reshape(self.B, 2, 2)
 
     @property
     def internal(self):
