@@ -207,14 +207,7 @@ class _Structure:
     """Arrays over the active pairs that stay valid while the set of relations does."""
     __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
                  "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j",
-                 "flags", "bond", "view", "flush")
-
-
-class _Flags:
-    """What the stress tensors need of the internal/external flags of one mobility mask (docs/design.md):
-    number and float weights (None: all) of internal pairs; positions in the flush's flat force array
-    and target spheres of the external forces."""
-    __slots__ = ("P", "n_int", "w_int", "w_int2", "ext_flat", "ext_targets")
+                 "bond", "view", "flush")
 
 
 class _Geometry:
@@ -1089,16 +1082,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             S.ext_j = mj & ~S.internal
         S.mob = mob
         S.view.update(internal=S.internal, ext_i=S.ext_i, ext_j=S.ext_j)
-        S.flags = F = _Flags()
-        F.P = len(S.ai)
-        F.n_int = n_int = _nz(S.internal)
-        F.w_int = None if n_int == F.P else S.internal.astype(float)
-        F.w_int2 = None if F.w_int is None else _concat((F.w_int, F.w_int))
-        wi = np.flatnonzero(S.ext_i)
-        wj = np.flatnonzero(S.ext_j)
-        P = F.P   # the same entries in the flat (F_i, F_j, …) array of the flush, x row then y row
-        F.ext_flat = np.array((_concat((wi, wj + 2 * P)), _concat((wi + P, wj + 3 * P))))
-        F.ext_targets = _concat((S.ai.take(wi), S.aj.take(wj)))
 
     def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
         """Per-pair data that change only when the candidates, bonds or images change — or, for a
@@ -1236,7 +1219,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             if spin:
                 Fj -= Tf
         ti = tj = None
-        T = fa[3]
         if spin:
             df = g.d * g.ft
             Wt = fa[4]
@@ -1248,9 +1230,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             idx = S.idx6 if spin else S.idx6[:4 * P]
             self._frc[:k] += _bincount(idx, W, k * n).reshape(k, n)
         self.force_register._set_pairs(self, PairBlock({
-            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj, "W": W,
-            "ti": ti, "tj": tj, "T": T, "internal": g.internal, "ext_i": g.ext_i,
-            "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "S": S.flags, "D": g.D,
+            "i": g.ai, "j": g.aj, "Fi": Fi, "Fj": Fj,
+            "ti": ti, "tj": tj, "internal": g.internal, "ext_i": g.ext_i,
+            "ext_j": g.ext_j, "active": g.active, "antisymmetric": antisymmetric, "engine": True, "D": g.D,
             "pos_version": self._pos_version,
             # per-visit terms for the reference lists of the register (read only when asked for)
             "visits": (g.parts, g.ft_visits, g.n, g.t, g.d, S.w2, g.touching, g.perm, self._pairs.birth,

@@ -71,9 +71,8 @@ class OneReplicaInputs(StressInputs):
 
     The tensor functions are the engine's; only the reductions they call are specialised to one
     replica, with the engine's numbers bit for bit (tested): the sum over the replica's one
-    segment is the same ``add.reduceat`` from row 0, and :meth:`outer` takes the four sums of a
-    tensor in one such call over its four rows of products (each row is summed on its own, as
-    four separate calls would).  The internal flags are evaluated once per set of inputs.
+    segment is the same ``add.reduceat`` from row 0 (the engine's ``outer`` passes its four rows
+    of products in one call, each row summed on its own).  The internal flags are evaluated once per set of inputs.
     """
 
     @staticmethod
@@ -84,42 +83,25 @@ class OneReplicaInputs(StressInputs):
         return np.add.reduceat(W, _FROM_ROW_0, axis=-1)[..., 0]
 
     def per_replica(self, weights, by_pair=True):
-        """Σ of ``weights`` over the one replica's rows (pairs or spheres), shape (1,).
+        """Σ of ``weights`` over the one replica's rows (pairs or spheres): shape (1,), or (k, 1) for k rows.
+
+        The engine's :meth:`~particleShear.engine.stress.StressInputs.outer` sums its four product
+        rows through this method in one call.
 
         Parameters
         ----------
-        weights : ndarray (P,) or (N,)
-            One value per pair row (``by_pair``) or per sphere row.
+        weights : ndarray (P,) or (N,), or (k, P) or (k, N)
+            One value per pair row (``by_pair``) or per sphere row; a 2-D array sums each row.
         by_pair : bool
             Unused: a batch of one has one segment of either.
 
         Returns
         -------
-        ndarray (1,)
+        ndarray (1,) or (k, 1)
         """
+        if weights.ndim == 2:
+            return self._sums(weights)[:, None]
         return self._sums(weights[None])
-
-    def outer(self, u, w, by_pair=True):
-        """(1, 2, 2) array of the sums of ``u_a · w_c`` over the rows (see the engine's method).
-
-        Parameters
-        ----------
-        u, w : tuple of two ndarray
-            x and y components of the two factors, one value per row.
-        by_pair : bool
-            Unused: a batch of one has one segment of either.
-
-        Returns
-        -------
-        ndarray (1, 2, 2)
-        """
-        n = len(u[0])
-        W = np.empty((4, n))
-        np.multiply(u[0], w[0], out=W[0])
-        np.multiply(u[0], w[1], out=W[1])
-        np.multiply(u[1], w[0], out=W[2])
-        np.multiply(u[1], w[1], out=W[3])
-        return self._sums(W).reshape(1, 2, 2)
 
     @property
     def internal(self):
@@ -207,7 +189,7 @@ def _engine_block(reg):
     if len(reg._blocks) != 1 or reg._m_pair or reg._m_ext or reg._m_imom:
         return None
     p = reg._blocks[0]
-    if "S" not in p or not p.get("antisymmetric", True):
+    if not p.get("engine") or not p.get("antisymmetric", True):
         return None
     return p
 
