@@ -91,6 +91,7 @@ ENGINE_MODULES = [
     "particleShear.engine",
     "particleShear.engine.box",
     "particleShear.engine.forces",
+    "particleShear.engine.integrate",
     "particleShear.engine.laws",
     "particleShear.engine.memory",
     "particleShear.engine.neighbours",

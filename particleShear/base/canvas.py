@@ -30,6 +30,7 @@ from .namespace import (bincount as _bincount, concatenate as _concat, copyto as
 from . import laws
 from .laws import call_law_vectorised
 from ..engine import laws as _engine_laws
+from ..engine.integrate import damp, kick, plates_follow, xi_increments
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
@@ -499,14 +500,8 @@ class CanvasPoints:
         f : float
             Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
         """
-        a = self._a
         rate = getattr(self, "shear_rate", 0)
-        if rate:
-            u = self._affine_vx(rate)
-            a["xspeed"][:] = u + (a["xspeed"] - u) * f
-        else:
-            a["xspeed"] *= f
-        a["yspeed"] *= f
+        damp(self._vel[:2], self._affine_vx(rate) if rate else None, f)
         self._cool_spin(f)
 
     def _drift(self, dt):
@@ -1330,7 +1325,6 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self._mob_key = None
         self._mob = None
         self._mob_limits = None
-        self._plates = None
 
     def canMove(self, theSphere):
         """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (docs/design.md).
@@ -1379,30 +1373,16 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         dt : float
             Time step (s), finite and > 0.
         """
-        a = self._a
-        F = self._frc[:2]
-        kick = F * dt
-        kick /= a["m"]
-        self._vel[:2] += kick
-        F[...] = 0.0
+        kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
         self._plates_follow()
 
     def _plates_follow(self):
         """Immobile (plate) spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity (docs/design.md)."""
-        a = self._a
         mob = self._mobile_mask()
         if mob is None:
             return
-        pl = self._plates
-        if pl is None or pl[0] is not mob:
-            imm = np.flatnonzero(~mob)
-            # immobile spheres do not move in y, so their plate (top or bottom) stays with the mask
-            pl = self._plates = (mob, imm, _where(self._y_centred().take(imm) > 0, 1.0, -1.0))
-        imm = pl[1]
-        if len(imm):
-            v = self.shear_rate * self.size_y / 2
-            a["yspeed"][imm] = 0.0
-            a["xspeed"][imm] = pl[2] * v
+        a = self._a
+        plates_follow(a["xspeed"], a["yspeed"], ~mob, self._y_centred(), self.shear_rate * self.size_y / 2)
 
     def transmit_lees_edwards_parameters(self, theSphere):
         """Copy the cell size, strain, rate and Lees-Edwards flag to a sphere.
@@ -2050,10 +2030,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if (cls.do_linear_acceleration is CanvasPointsShear.do_linear_acceleration
                 and cls.do_rotational_acceleration is friction.do_rotational_acceleration):
             # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
-            kick = self._frc * dt
-            kick /= self._kick_weights()
-            self._vel += kick
-            self._frc[...] = 0.0
+            kick(self._vel, self._frc, self._kick_weights(), dt)
             self._plates_follow()
         else:
             self.do_linear_acceleration(dt)
@@ -2077,15 +2054,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         """
         if type(self)._cool_spin is not CanvasPointsFrictionElasticityLeesEdwards._cool_spin:
             return CanvasPointsBasicElasticityLeesEdwards.cool(self, f)
-        V = self._vel
         rate = getattr(self, "shear_rate", 0)
-        if rate:
-            u = self._affine_vx(rate)
-            V[0] -= u
-            V *= f
-            V[0] += u       # u + (v_x − u)·f
-        else:
-            V *= f
+        damp(self._vel, self._affine_vx(rate) if rate else None, f)
 
     def _integrate_xi(self, dt):
         """Sequential ξ rule of the reference, without a Python loop (docs/design.md).
@@ -2093,7 +2063,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         Relation i→j (i < j) sees both spheres at their old positions; relation
         j→i sees i already moved by ``v_i·dt``.  Both use the velocities after
         the kick and damping; slip relations are not integrated (their increment
-        is multiplied by 0, which leaves their ξ = 0 exactly).
+        is multiplied by 0, which leaves their ξ = 0 exactly).  The increments are
+        :func:`particleShear.engine.integrate.xi_increments`, the engine's own.
         """
         g = self._g
         if g is None or not g.P or g.all_slip:
@@ -2109,45 +2080,23 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         vel = self._vel
         Vi = vel.take(g.ai, axis=1)
         Vj = vel.take(g.aj, axis=1)
-        rv = Vj[:2] - Vi[:2]
-        spin = g.ri * Vi[2]
-        spin += g.rj * Vj[2]
-        inc = np.empty((2, P))
-        # relation i→j: both spheres still at their old positions (the force-phase geometry);
-        # relation j→i sees the image from the other side, i.e. the velocity −(rv_x + dvx, rv_y)
-        if g.dvx is not None:
-            rv[0] += g.dvx
-        svx = rv[0]
-        w = rv * g.t
-        np.add(w[0], w[1], out=inc[0])
         # relation j→i: i has moved by v_i·dt; the pair vector is −(x_j − x_i) of the force phase
         # plus that move (same image, the cell being much larger than any candidate pair)
         R = Vi[:2] * dt
         R -= g.D
-        RR = R * R
-        dm = np.sqrt(RR[0] + RR[1])
+        dvx_ji = None
         if not g.S.safe_images:
             Lx, Ly = float(self.size_x), float(self.size_y)
             if np.abs(R[0]).max() >= Lx / 2 or np.abs(R[1]).max() >= Ly / 2:
+                # a cell barely larger than a contact: R may lie in another image than the force phase's D
                 rx = (self._pos[0].take(g.ai) + Vi[0] * dt) - self._pos[0].take(g.aj)
                 ry = (self._pos[1].take(g.ai) + Vi[1] * dt) - self._pos[1].take(g.aj)
-                dx, dy, dvx = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
+                dx, dy, dvx_ji = min_image(rx, ry, Lx, Ly, self._le_shift(), self._shear_rate_for_images())
                 R = np.array((dx, dy))
-                svx = Vj[0] - Vi[0]
-                if dvx is not None:
-                    svx = svx - dvx
-                RR = R * R
-                dm = np.sqrt(RR[0] + RR[1])
-        if _nz(dm) != P:
-            _, mx, my = pair_geometry(R[0], R[1], self._rng)
-        else:
-            M = R / dm
-            mx = M[0]
-            my = M[1]
-        # ((−svx)·(−m_y) + (−rv_y)·m_x − spin) = (svx·m_y − rv_y·m_x) − spin, exact sign flips only
-        b_ = np.multiply(svx, my, out=inc[1])
-        b_ -= rv[1] * mx
-        inc -= spin
+                if dvx_ji is None:
+                    dvx_ji = 0.0
+        inc = np.array(xi_increments(Vi, Vj, g.dvx, g.n[0], g.n[1], g.ri, g.rj, R[0], R[1], self._unit_vectors,
+                                     dvx_ji))
         inc *= kd   # ×dt on kept relations, ×0 (±0) on the others
         if sel is None:
             pt.xi += inc
@@ -2155,6 +2104,15 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             flat = pt.xi.reshape(-1)
             inc += flat.take(g.S.sel2).reshape(2, P)
             flat[g.S.sel2] = inc.reshape(-1)
+
+    def _unit_vectors(self, rx, ry):
+        """Unit vectors of ``(rx, ry)``; a random direction from the ensemble's generator where the length is 0."""
+        rr = rx * rx + ry * ry
+        dm = np.sqrt(rr)
+        if _nz(dm) != len(dm):
+            _, mx, my = pair_geometry(rx, ry, self._rng)
+            return mx, my
+        return rx / dm, ry / dm
 
     def move(self, dt=1):
         """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule).

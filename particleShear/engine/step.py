@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from .box import min_image, wrap
+from .integrate import damp, drift, kick, plates_follow, xi_increments
 from .forces import PairConstants, central_term, normals, scatter, shear_stresses, splice_arrays, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
@@ -374,32 +375,16 @@ class BatchEngine:
                 verdict = None
         # kick (plates follow), rotational kick, damping
         rate_s = s.rate[s.rep]
-        kick = s.frc * dt
-        kick /= self.mmi                                    # (F_x/m, F_y/m, T/I)·dt
-        s.vel += kick
-        s.frc[...] = 0.0
-        imm = ~mob      # immobile spheres move with their plate
-        plate = xp.where(yc > 0, 1.0, -1.0) * (rate_s * self.Ly_s / 2)
-        xp.copyto(vy, 0.0, where=imm)
-        xp.copyto(vx, plate, where=imm)
+        kick(s.vel, s.frc, self.mmi, dt)                    # (F_x/m, F_y/m, T/I)·dt
+        plates_follow(vx, vy, ~mob, yc, rate_s * self.Ly_s / 2)
         flow = yc * rate_s
-        vx -= flow
-        vx *= cool
-        vx += flow
-        vy *= cool
-        om *= cool
+        damp(s.vel, flow, cool)
         # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
         kd = xp.where(active & (self.state_p != SLIP), dt, 0.0)
         Vi = s.vel.take(ai, axis=1)
-        Vj = s.vel.take(aj, axis=1)
-        rvx = Vj[0] - Vi[0] + dvx
-        rvy = Vj[1] - Vi[1]
-        spin = C.ri * Vi[2] + C.rj * Vj[2]
-        inc_ij = rvx * -ny + rvy * nx - spin
-        Rx = Vi[0] * dt - dx
-        Ry = Vi[1] * dt - dy
-        mx, my = normals(Rx, Ry, xp.sqrt(Rx * Rx + Ry * Ry), C.rep_host, s.rng)
-        inc_ji = rvx * my - rvy * mx - spin
+        inc_ij, inc_ji = xi_increments(Vi, s.vel.take(aj, axis=1), dvx, nx, ny, C.ri, C.rj, Vi[0] * dt - dx,
+                                       Vi[1] * dt - dy,
+                                       lambda Rx, Ry: normals(Rx, Ry, xp.sqrt(Rx * Rx + Ry * Ry), C.rep_host, s.rng))
         xi[0] += inc_ij * kd
         xi[1] += inc_ji * kd
         # drift, strain, wrap, clock
@@ -409,8 +394,7 @@ class BatchEngine:
         self.u_max = xp.maximum(self.u_max, xp.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
         self.strain += abs(s.rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
-        s.pos += s.vel[:2] * dt
-        s.phi += om * dt
+        drift(s.pos, s.phi, s.vel, dt)
         s.gamma = s.gamma + s.rate * dt
         wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
         s.t = s.t + dt

@@ -1,0 +1,157 @@
+"""Integration of one Euler step: kick, plates, damping, the sequential ξ rule, drift (eqs. S1-10 … S1-12).
+
+Small pure functions over arrays that the batch engine's step (:meth:`~particleShear.engine.step.BatchEngine.step`)
+and the documented canvas classes (``mechanical_simulation_step_calculate_acceleration`` and
+``…_calculate_movement``) both call, so each of these operations is written once.  They work in place
+on the rows they are given (a sphere block of B·N columns, or of the N spheres of one ensemble), in
+the array namespace of their inputs (NumPy or CuPy).
+
+The order of a step (docs/design.md, "One step"): forces → :func:`kick` → :func:`plates_follow`
+→ :func:`damp` → :func:`xi_increments` (velocities after the kick and damping, positions of the force
+phase) → :func:`drift` → strain → wrap (:func:`~particleShear.engine.box.wrap`) → clock.
+
+Units: µm, s, mg per m depth; forces mg·µm·s⁻², torques mg·µm²·s⁻² per m depth.
+"""
+__docformat__ = "numpy"
+
+from .xp import array_namespace
+
+__all__ = ["kick", "plates_follow", "damp", "xi_increments", "drift"]
+
+
+def kick(vel, frc, weights, dt):
+    """Kick every velocity by its force and reset the forces: ``v += F·dt/m``, ``ω += T·dt/I``.
+
+    Parameters
+    ----------
+    vel : ndarray (k, n)
+        Velocity rows (``vx, vy`` and, with k = 3, ``ω``) in µm/s and rad/s, modified in place.
+    frc : ndarray (k, n)
+        The matching force rows (``F_x, F_y`` and torque), set to 0 afterwards.
+    weights : ndarray (k, n)
+        ``(m, m, I)`` of every sphere (mg and mg·µm² per m depth), or ``(m, m)`` for k = 2.
+    dt : float
+        Time step (s).
+    """
+    step = frc * dt
+    step /= weights
+    vel += step
+    frc[...] = 0.0
+
+
+def plates_follow(vx, vy, immobile, yc, plate_speed):
+    """Immobile (plate) spheres take the velocity of their plate and no y velocity (docs/design.md).
+
+    A sphere overlapping ``y = 0`` or ``y = Ly`` while the shear is applied is glued to its plate:
+    ``vx = ±γ̇·Ly/2`` (+ above the centre line), ``vy = 0``.  Applied after :func:`kick`, which
+    gives the mobile spheres exactly the reference kick.
+
+    Parameters
+    ----------
+    vx, vy : ndarray (n,)
+        Velocities (µm/s), modified in place.
+    immobile : ndarray of bool (n,)
+        The plate spheres.
+    yc : ndarray (n,)
+        Height above the cell's centre line, ``y − Ly/2`` (µm).
+    plate_speed : ndarray (n,) or float
+        ``γ̇·Ly/2`` of each sphere's replica (µm/s).
+    """
+    xp = array_namespace(vx)
+    plate = xp.where(yc > 0, 1.0, -1.0) * plate_speed
+    xp.copyto(vy, 0.0, where=immobile)
+    xp.copyto(vx, plate, where=immobile)
+
+
+def damp(vel, flow, cool):
+    """Damp the velocity relative to the affine flow and the spin: ``v_x ← u + (v_x − u)·f``, ``v_y, ω ← f·…``.
+
+    SLLOD-like damping (docs/design.md): only the peculiar velocity loses ``1 − f`` per step, so
+    a steady shear flow ``u = γ̇ (y − Ly/2)`` is not slowed down.
+
+    Parameters
+    ----------
+    vel : ndarray (k, n)
+        Velocity rows ``vx, vy`` (and ``ω``), modified in place.
+    flow : ndarray (n,) or None
+        The flow velocity ``u`` at each sphere (µm/s); None when there is no flow (γ̇ = 0), which
+        multiplies the rows by ``f`` without subtracting and adding 0.
+    cool : float
+        Damping factor ``f`` of this step (1 = no damping).
+    """
+    if flow is None:
+        vel *= cool
+        return
+    vel[0] -= flow
+    vel *= cool
+    vel[0] += flow
+
+
+def xi_increments(Vi, Vj, dvx, nx, ny, ri, rj, Rx, Ry, unit, dvx_ji=None):
+    """Increments per unit time of the two tangential histories of a pair (sequential rule, Appendix B.2).
+
+    The reference integrates ξ sphere by sphere after the kick: the relation i→j (i < j) is
+    visited with both spheres at their positions of the force phase, the relation j→i with i
+    already moved by ``v_i·dt``.  Both use the velocities after the kick and damping:
+
+    * ``ξ̇_ij = (v_j − v_i + Δv_image)·t_ij − (r_i ω_i + r_j ω_j)``, ``t_ij = (−n_y, n_x)``;
+    * ``ξ̇_ji = −(v_j − v_i + Δv_image)·t'_ji − (r_i ω_i + r_j ω_j)``, with ``t'_ji`` the tangent of
+      the unit vector ``m`` along ``R = (x_i + v_i dt) − x_j`` (the pair vector seen from j after
+      i moved).
+
+    Parameters
+    ----------
+    Vi, Vj : ndarray (3, P)
+        ``(vx, vy, ω)`` of spheres i and j of every pair (after the kick and damping).
+    dvx : ndarray (P,) or float or None
+        x velocity of j's image relative to j, ``−Ly·γ̇·k_y`` (µm/s); None or 0 when no pair
+        interacts across the sheared boundary.
+    nx, ny : ndarray (P,)
+        Unit normal from i towards j of the force phase.
+    ri, rj : ndarray (P,)
+        Radii (µm).
+    Rx, Ry : ndarray (P,)
+        ``R = v_i·dt − D`` (µm), D the force phase's pair vector ``x_j − x_i``.
+    unit : callable
+        ``unit(Rx, Ry) -> (mx, my)``: the unit vector of R (with the random direction at
+        ``|R| = 0`` of the caller's generator, see :func:`~particleShear.engine.forces.normals`).
+    dvx_ji : ndarray (P,) or None
+        x velocity of the image of i seen from j in the second visit, when R was taken to another
+        image than the force phase's pair vector (a cell barely larger than a contact); None: the
+        same image, i.e. ``−dvx``.
+
+    Returns
+    -------
+    inc_ij, inc_ji : ndarray (P,)
+        ``dξ_ij/dt`` and ``dξ_ji/dt`` (µm/s); the caller multiplies by ``dt`` on the relations that
+        stick (0 on slipped ones and on candidates out of contact) and adds them to ξ.
+    """
+    rvx = Vj[0] - Vi[0]
+    if dvx is not None:
+        rvx = rvx + dvx
+    rvy = Vj[1] - Vi[1]
+    spin = ri * Vi[2] + rj * Vj[2]
+    inc_ij = rvx * -ny + rvy * nx - spin
+    mx, my = unit(Rx, Ry)
+    rvx_ji = rvx if dvx_ji is None else (Vj[0] - Vi[0]) - dvx_ji
+    inc_ji = rvx_ji * my - rvy * mx - spin
+    return inc_ij, inc_ji
+
+
+def drift(pos, phi, vel, dt):
+    """Drift and turn: ``x, y += (v_x, v_y)·dt``, ``φ += ω·dt`` (in place).
+
+    Parameters
+    ----------
+    pos : ndarray (2, n)
+        Positions (µm).
+    phi : ndarray (n,) or None
+        Orientations (rad); None to leave them (a canvas without spin).
+    vel : ndarray (3, n) or (2, n)
+        Velocities ``(vx, vy, ω)`` (µm/s, rad/s).
+    dt : float
+        Time step (s).
+    """
+    pos += vel[:2] * dt
+    if phi is not None:
+        phi += vel[2] * dt
