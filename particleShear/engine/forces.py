@@ -75,6 +75,10 @@ class PairConstants:
     HOST_PER_PAIR = ("rep_host", "ai_host", "aj_host")
     #: the blocks, each (rows, P)
     BLOCKS = ("f", "i", "b", "i_host")
+    #: the candidates' image period counts of the last step ``(Ly·k_y, k_y, Lx·k_x, k_x)``, reused by
+    #: :meth:`~particleShear.engine.step.BatchEngine.step` while they still place every separation
+    #: in its interval; None until set, and gone with these constants at a rebuild
+    images = None
     #: attribute → (block, row)
     _ROWS = {**{n: ("f", k) for k, n in enumerate(FLOAT_ROWS)}, **{n: ("i", k) for k, n in enumerate(INT_ROWS)},
              **{n: ("b", k) for k, n in enumerate(BOOL_ROWS)},
