@@ -59,6 +59,9 @@ def main():
           f"protocol {sum(r.timings['protocol'] for r in res) / len(res):.3f} s")
     print(f"  protocol: {1e6 * step:.1f} us per replica-step at N = {single.parameters['N']} (target <= 90 us; "
           "LAMMPS pair_style granular: 46-51 us per single-replica step)")
+    scale = 0.025 / args.relative_frequency      # a run's length scales with 1/relative_frequency
+    print(f"  a campaign of 50,000 default runs (the paper's, ~30,000 CPU-hours on particleShear 1.0.2) on one core: "
+          f"{50000 * per_run * scale / 3600:.1f} core-hours batched, {50000 * w_single * scale / 3600:.1f} single")
 
 
 if __name__ == "__main__":
