@@ -162,7 +162,12 @@ def pair_geometry(dx, dy, rng=None):
     """
     d = np.sqrt(dx * dx + dy * dy)
     gen = np.random if rng is None else rng
-    nx, ny = _normals(dx, dy, d, None, (gen,))
+    if np.ndim(d) == 1:
+        nx, ny = _normals(dx, dy, d, None, (gen,))
+    else:   # the engine's normals are over a flat pair axis: draw in row-major order, as a mask did
+        shape = np.shape(d)
+        flat = [np.ravel(np.broadcast_to(a, shape)).astype(float) for a in (dx, dy, d)]
+        nx, ny = (a.reshape(shape) for a in _normals(*flat, None, (gen,)))
     return d, nx, ny
 
 
