@@ -24,7 +24,7 @@ import numpy as np
 
 from .fields import FIELDS, MASS_ROWS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import in_cell_passes, le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import le_wrap, min_image, pair_geometry, tangential_two_pass
 from .namespace import (bincount as _bincount, concatenate as _concat, copyto as _copyto,
                         count_nonzero as _nz, where as _where)
 from . import laws
@@ -836,10 +836,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._in_cell = False
         self._images_valid = False
 
-    def _passes(self):
-        """Fixed minimum-image passes when every position is known to lie in the cell."""
-        return in_cell_passes(self.size_x, self._le_shift()) if self._in_cell else None
-
     def _links_changed(self):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
         self._links_version += 1
@@ -972,7 +968,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             dvx = None
         else:
             dx, dy, dvx, ky, kx = min_image(D0[0], D0[1], Lx, Ly, self._le_shift(), self._shear_rate_for_images(),
-                                            self._passes(), counts=True)
+                                            counts=True)
             D = np.array((dx, dy))
             self._store_images(ky, kx, C)
             self._images_token += 1

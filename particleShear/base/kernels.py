@@ -1,51 +1,29 @@
-"""Small pure functions over arrays: Lees-Edwards geometry and pair terms (docs/design.md).
+"""Adapters of the Lees-Edwards box and the pair normals for the documented classes (docs/design.md).
 
-Every function takes and returns NumPy arrays (or scalars) and never touches an
-ensemble; they are the hot path of a step and reusable by other back-ends.
-Lengths in µm, velocities in µm/s, forces in mg·µm·s⁻² per m depth.
+The box is written once, in :mod:`particleShear.engine.box` (minimum image, wrap) and the
+normals in :func:`particleShear.engine.forces.normals`; the functions here keep the
+signatures and return conventions of the canvas classes and of scripts written against
+earlier versions (scalar box, an image velocity correction that is None when nothing wrapped,
+int period counts) and call the engine.  Every function takes and returns NumPy arrays (or
+scalars) and never touches an ensemble.  Lengths in µm, velocities in µm/s.
 """
 __docformat__ = "numpy"
 
 import numpy as np
 
+from ..engine import box as _box
+from ..engine.forces import normals as _normals
 # NumPy-only speed shims live in the namespace module (no private NumPy import here)
-from .namespace import count_nonzero as _nz, where as _where
+from .namespace import count_nonzero as _nz
 
 __all__ = ["min_image", "le_wrap", "pair_geometry", "tangential_two_pass", "MAX_LOOP_PASSES"]
 
 
-#: one-period passes applied one at a time, as the reference does, before the closed form takes over;
-#: ordinary coordinates (within a couple of periods of the cell) never reach it, so their results stay
-#: bit-identical to the reference loop, while a huge coordinate costs O(1) instead of O(|x| / L) passes
-MAX_LOOP_PASSES = 4
-
-
-def _wrap_count(v, half):
-    """−1, 0 or +1 per element: one period to subtract (``v ≥ half``) or add (``v < −half``)."""
-    return (v >= half).view(np.int8) - (v < -half).view(np.int8)
-
-
-def _periods_to_subtract(v, L, lo):
-    """Whole periods ``k`` (float array) that bring ``v − k·L`` into ``[lo, lo + L)``; 0 where already there.
-
-    The closed form for coordinates that one-period passes would need many iterations for;
-    non-finite entries give NaN (``inf − inf``), which the stability guard and the step report.
-    """
-    with np.errstate(invalid="ignore", over="ignore"):
-        k = np.floor((v - lo) / L)
-    return np.where((v >= lo) & (v < lo + L), 0.0, k)
-
-
-def _fold(v, L, lo):
-    """``v`` brought into ``[lo, lo + L)`` with the closed form; returns (folded v, periods subtracted)."""
-    k = _periods_to_subtract(v, L, lo)
-    with np.errstate(invalid="ignore"):
-        w = v - k * L
-        # rounding of v − k·L can land one period off; a huge |v| can leave an ulp-sized excess
-        w = np.where(w >= lo + L, w - L, w)
-        w = np.where(w < lo, w + L, w)
-        w = np.where(np.isfinite(w), np.clip(w, lo, np.nextafter(lo + L, lo)), w)
-    return w, k
+#: one-period passes per axis before the closed form takes over (the engine's
+#: :data:`particleShear.engine.box.MAX_PASSES`): ordinary coordinates (within a couple of periods
+#: of the cell) never reach it, so their results stay bit-identical to the reference loop, while
+#: a huge coordinate costs O(1) instead of O(|x| / L) passes
+MAX_LOOP_PASSES = _box.MAX_PASSES
 
 
 def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
@@ -53,15 +31,13 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
 
     The y image is chosen first and moves x by ``shift = Ly·γ``; intervals are
     half-open (``[-L/2, L/2)``) and periods are subtracted one at a time, as the
-    reference does, so the result is bit-identical to it.  ``passes`` = (ny, nx)
-    fixes the number of one-period passes when the caller knows the range of the
-    differences (positions inside the cell); by default passes repeat until done.
-    At most :data:`MAX_LOOP_PASSES` passes run per axis; what is still outside then
-    (a difference of many periods, or a large shift) is folded in closed form, so the
-    cost never depends on the size of a coordinate.
+    reference does, so the result is bit-identical to it; beyond
+    :data:`MAX_LOOP_PASSES` passes the rest is folded in closed form, so the cost never
+    depends on the size of a coordinate.  The arithmetic is that of
+    :func:`particleShear.engine.box.min_image`, which this function calls.
 
     Returns ``(dx, dy, dvx)`` where ``dvx`` is the x velocity correction of the
-    image (``-Ly·γ̇`` per image above) — an array, or None when nothing wrapped in y.
+    image (``−Ly·γ̇`` per image above) — an array, or None when nothing wrapped in y.
     With ``counts`` also the numbers of y and x periods subtracted (int arrays or None).
 
     Parameters
@@ -75,7 +51,11 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     shear_rate : float
         Shear rate γ̇ (1/s), for the image velocity correction ``dvx``.
     passes : tuple of two int, optional
-        ``(ny, nx)`` one-period passes per axis (see :func:`in_cell_passes`); None: until done.
+        Accepted and ignored.  It once fixed the number of one-period passes for
+        differences of positions inside the cell (see :func:`in_cell_passes`); the passes
+        now stop as soon as one moves nothing, which gives the same numbers (a pass that
+        moves nothing changes no value) at a cost that differs by less than the noise of
+        a step (docs/performance.md).
     counts : bool
         Also return the period counts.
 
@@ -84,76 +64,33 @@ def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
     dx, dy : ndarray (P,)
         Minimum-image separation (µm), each in ``[−L/2, L/2)``.
     dvx : ndarray (P,) or None
-        x velocity of j's image relative to j (µm/s); None when no y pass was applied
-        (nothing wrapped) or γ̇ = 0.
-    ky, kx : ndarray (P,) or None
+        x velocity of j's image relative to j, ``−Ly·γ̇·ky`` (µm/s); None when no pair
+        wrapped in y or γ̇ = 0.
+    ky, kx : ndarray of int8 (P,) or None
         Only with ``counts``: y and x periods subtracted per pair; both None when some pair
-        needed more than one period (a count could not reproduce the result bit for bit).
+        needed more than one period (a count could not reproduce the result bit for bit)
+        or a difference was not finite.
     """
-    dx = np.asarray(dx, dtype=float)
-    dy = np.asarray(dy, dtype=float)
-    Lx = float(Lx)
     Ly = float(Ly)
-    shift = float(shift)
-    hy = Ly / 2
-    hx = Lx / 2
+    dx, dy, ky, kx = _box.min_image(np.asarray(dx, dtype=float), np.asarray(dy, dtype=float),
+                                    float(Lx), Ly, float(shift))
     rate_shift = Ly * float(shear_rate)
-    dvx = None
-    ky_total = None
-    n_y = passes[0] if passes is not None else None
-    p = 0
-    many = False  # some difference needed more passes than the loop runs
-    while p < (MAX_LOOP_PASSES if n_y is None else min(n_y, MAX_LOOP_PASSES)):
-        ky = _wrap_count(dy, hy)
-        if n_y is None and not _nz(ky):
-            break
-        dy = dy - Ly * ky
-        dx = dx - shift * ky
-        ky_total = ky if ky_total is None else ky_total + ky
-        p += 1
-    else:
-        if n_y is None or n_y > MAX_LOOP_PASSES:
-            dy, k = _fold(dy, Ly, -hy)
-            if _nz(k):
-                many = True
-                dx = dx - shift * k
-                ky_total = k if ky_total is None else ky_total + k
-    if ky_total is not None and rate_shift != 0:
-        dvx = -rate_shift * ky_total
-    n_x = passes[1] if passes is not None else None
-    p = 0
-    kx_total = None
-    while p < (MAX_LOOP_PASSES if n_x is None else min(n_x, MAX_LOOP_PASSES)):
-        kx = _wrap_count(dx, hx)
-        if n_x is None and not _nz(kx):
-            break
-        dx = dx - Lx * kx
-        kx_total = kx if kx_total is None else kx_total + kx
-        p += 1
-    else:
-        if n_x is None or n_x > MAX_LOOP_PASSES:
-            dx, k = _fold(dx, Lx, -hx)
-            if _nz(k):
-                many = True
-                kx_total = k if kx_total is None else kx_total + k
-    if counts:
-        # period counts per pair (zeros where nothing wrapped); None when some pair needed
-        # several periods, whose repeated subtraction a count cannot reproduce bit for bit
-        if ky_total is None:
-            ky_total = np.zeros(dx.shape, np.int8)
-        if kx_total is None:
-            kx_total = np.zeros(dx.shape, np.int8)
-        if many or np.abs(ky_total).max(initial=0) > 1 or np.abs(kx_total).max(initial=0) > 1:
-            ky_total = kx_total = None
-        return dx, dy, dvx, ky_total, kx_total
-    return dx, dy, dvx
+    dvx = -rate_shift * ky if rate_shift != 0 and _nz(ky) else None
+    if not counts:
+        return dx, dy, dvx
+    # per pair −1, 0 or +1; a count of several periods (or NaN) cannot reproduce the repeated
+    # subtraction bit for bit, so callers then recompute the images
+    if (np.abs(ky) <= 1).all() and (np.abs(kx) <= 1).all():
+        return dx, dy, dvx, ky.astype(np.int8), kx.astype(np.int8)
+    return dx, dy, dvx, None, None
 
 
 def in_cell_passes(Lx, shift, margin=0.01):
     """(ny, nx) one-period passes that suffice for differences of positions inside the cell.
 
     With both positions in ``[0, Lx) × [0, Ly)`` one y pass suffices; the y image moves x by
-    up to ``|shift|``, so x needs ``|shift|/Lx`` more passes (rounded, plus one).
+    up to ``|shift|``, so x needs ``|shift|/Lx`` more passes (rounded, plus one).  Kept for
+    scripts that pass it as :func:`min_image`'s ``passes``, which that function now ignores.
 
     Parameters
     ----------
@@ -167,45 +104,20 @@ def in_cell_passes(Lx, shift, margin=0.01):
     Returns
     -------
     tuple of two int
-        ``(ny, nx)``, to pass as :func:`min_image`'s ``passes``.
+        ``(ny, nx)``.
     """
     return 1, int(0.5 + abs(shift) / Lx + margin) + 1
-
-
-def _wrap_axis(v, L, carry=None, carry_step=0.0):
-    """Bring ``v`` into ``[0, L)`` in place, one period at a time for at most :data:`MAX_LOOP_PASSES` passes,
-    then in closed form; ``carry`` (if given) moves by ``−carry_step`` per period subtracted."""
-    for _ in range(MAX_LOOP_PASSES):
-        m = v >= L
-        if not _nz(m):
-            break
-        v[m] -= L
-        if carry is not None:
-            carry[m] -= carry_step
-    for _ in range(MAX_LOOP_PASSES):
-        m = v < 0
-        if not _nz(m):
-            break
-        v[m] += L
-        if carry is not None:
-            carry[m] += carry_step
-    out = ~((v >= 0) & (v < L))  # NaN counts as outside
-    if _nz(out):
-        w, k = _fold(v[out], L, 0.0)
-        v[out] = w
-        if carry is not None:
-            with np.errstate(invalid="ignore"):
-                carry[out] -= carry_step * k
 
 
 def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
     """Bring positions back into ``[0, Lx) × [0, Ly)`` in place (Lees-Edwards wrap).
 
-    Crossing y = Ly moves x by ``-shift`` and vx by ``-Ly·γ̇`` (and the reverse
-    through y = 0); periods are applied one at a time, as the reference does, for
-    a few passes, and in closed form (floor) beyond, so the cost is O(1) in the
-    size of a coordinate.  Non-finite coordinates come out NaN.
-    Returns True if anything was wrapped.
+    Crossing y = Ly moves x by ``−shift`` and vx by ``−Ly·γ̇`` (and the reverse
+    through y = 0; ``vx += (y' − y)·γ̇`` as in the reference); periods are applied one
+    at a time, as the reference does, for a few passes, and in closed form beyond, so
+    the cost is O(1) in the size of a coordinate.  An infinite coordinate comes out
+    NaN; a NaN stays NaN.  The arithmetic is that of
+    :func:`particleShear.engine.box.wrap`, which this function calls.
 
     Parameters
     ----------
@@ -221,25 +133,16 @@ def le_wrap(x, y, vx, Lx, Ly, shift, shear_rate):
     Returns
     -------
     bool
-        True if any coordinate was wrapped.
+        True if any coordinate was moved by a period.
     """
-    if not len(y):
-        return False
-    wrapped = False
-    if not (y.min() >= 0 and y.max() < Ly):
-        y0 = y.copy()
-        _wrap_axis(y, Ly, x, shift)
-        with np.errstate(invalid="ignore"):
-            vx += (y - y0) * shear_rate
-        wrapped = True
-    if not (x.min() >= 0 and x.max() < Lx):
-        _wrap_axis(x, Lx)
-        wrapped = True
-    return wrapped
+    return bool(_box.wrap(x, y, vx, float(Lx), float(Ly), float(shift), float(shear_rate)))
 
 
 def pair_geometry(dx, dy, rng=None):
     """Distance and unit normal of min-image separations; a random normal where d == 0.
+
+    The normals are those of :func:`particleShear.engine.forces.normals`, which this
+    function calls with the one generator.
 
     Parameters
     ----------
@@ -247,7 +150,8 @@ def pair_geometry(dx, dy, rng=None):
         Minimum-image pair vectors ``x_j − x_i`` (µm).
     rng : numpy.random.Generator, optional
         Source of the random directions at ``d = 0`` (the ensemble's generator, so a run
-        follows its seed); None uses NumPy's global generator.
+        follows its seed): one uniform number ``u`` per pair at ``d = 0``, in pair order,
+        and the normal ``(cos 2πu, sin 2πu)``.  None uses NumPy's global generator.
 
     Returns
     -------
@@ -257,17 +161,13 @@ def pair_geometry(dx, dy, rng=None):
         Unit normal from i towards j.
     """
     d = np.sqrt(dx * dx + dy * dy)
-    zero = d == 0
-    if _nz(zero):
-        d_safe = _where(zero, 1.0, d)
-        nx = dx / d_safe
-        ny = dy / d_safe
-        theta = 2 * np.pi * (rng.random(int(zero.sum())) if rng is not None else np.random.random(int(zero.sum())))
-        nx[zero] = np.cos(theta)
-        ny[zero] = np.sin(theta)
-    else:
-        nx = dx / d
-        ny = dy / d
+    gen = np.random if rng is None else rng
+    if np.ndim(d) == 1:
+        nx, ny = _normals(dx, dy, d, None, (gen,))
+    else:   # the engine's normals are over a flat pair axis: draw in row-major order, as a mask did
+        shape = np.shape(d)
+        flat = [np.ravel(np.broadcast_to(a, shape)).astype(float) for a in (dx, dy, d)]
+        nx, ny = (a.reshape(shape) for a in _normals(*flat, None, (gen,)))
     return d, nx, ny
 
 

@@ -31,15 +31,26 @@ def _accumulate(total, k):
     return k if total is None else total + k
 
 
-def _outside(v, lo, hi):
-    """1.0 where ``v`` is outside ``[lo, hi)``, else 0.0 (NaN counts as inside and stays NaN for the guard)."""
-    return ((v >= hi) | (v < lo)).astype(float)
-
-
 def _quiet_invalid(xp):
     """Suppress NumPy's "invalid value" warning (inf − inf → NaN, reported by the guard); devices do not warn."""
     errstate = getattr(xp, "errstate", None)
     return errstate(invalid="ignore") if errstate is not None else contextlib.nullcontext()
+
+
+def _fold(v, L, lo, hi, xp):
+    """``v`` brought into ``[lo, hi)`` (``hi = lo + L``) in closed form; returns ``(folded v, periods removed)``.
+
+    The whole periods ``k = floor((v − lo)/L)`` are removed from the elements outside the
+    interval only (0 elsewhere, also for NaN, which stays NaN for the stability guard; an
+    infinite element becomes NaN).  ``v − k·L`` can round onto ``hi`` or just outside for a
+    coordinate of many periods; it is then clipped into ``[lo, hi)``, an adjustment of rounding
+    size that changes no period count (so no Lees-Edwards carry), which keeps the post-condition
+    of :func:`min_image` and :func:`wrap` for any finite input.
+    """
+    with _quiet_invalid(xp):
+        k = xp.where((v >= hi) | (v < lo), xp.floor((v - lo) / L), 0.0)
+        w = xp.clip(v - L * k, lo, xp.nextafter(hi, lo))
+    return w, k
 
 
 def min_image(dx, dy, Lx, Ly, shift):
@@ -69,8 +80,13 @@ def min_image(dx, dy, Lx, Ly, shift):
 
     Notes
     -----
-    At most :data:`MAX_PASSES` one-period passes, then the rest is folded in closed form, so
-    the cost does not grow with the size of a separation.
+    Periods are subtracted one at a time, as in the reference (so the result is bit-identical
+    to its loop, which differs from ``dx − k·Lx`` by an ulp when ``|k| ≥ 2``), for at most
+    :data:`MAX_PASSES` passes; what is still outside then is folded in closed form and clipped
+    into the interval against rounding, so the cost does not grow with the size of a separation
+    and the result is inside the intervals for any finite input.  A NaN stays NaN (count 0); an
+    infinite difference becomes NaN.  This is the one minimum image of the package: the
+    documented classes call it through :func:`particleShear.base.kernels.min_image`.
     """
     be = backend_of(dx, dy)
     xp = be.xp
@@ -84,12 +100,10 @@ def min_image(dx, dy, Lx, Ly, shift):
         dy = dy - Ly * ky
         dx = dx - shift * ky
         ky_total = _accumulate(ky_total, ky)
-    else:  # absurd separation: fold the rest at once (non-finite values become NaN for the guard)
-        ky = xp.floor((dy + hy) / Ly)
-        if not be.host:   # the device ran every pass: fold only what is still outside
-            ky = ky * _outside(dy, mhy, hy)
-        dy = dy - Ly * ky
-        dx = dx - shift * ky
+    else:  # absurd separation (or a device, which ran every pass): fold what is still outside at once
+        dy, ky = _fold(dy, Ly, mhy, hy, xp)
+        with _quiet_invalid(xp):
+            dx = dx - shift * ky
         ky_total = _accumulate(ky_total, ky)
     for _ in range(MAX_PASSES):
         kx = _count(dx, hx, mhx)
@@ -98,10 +112,7 @@ def min_image(dx, dy, Lx, Ly, shift):
         dx = dx - Lx * kx
         kx_total = _accumulate(kx_total, kx)
     else:
-        kx = xp.floor((dx + hx) / Lx)
-        if not be.host:
-            kx = kx * _outside(dx, mhx, hx)
-        dx = dx - Lx * kx
+        dx, kx = _fold(dx, Lx, mhx, hx, xp)
         kx_total = _accumulate(kx_total, kx)
     if ky_total is None:
         ky_total = xp.zeros(getattr(dx, "shape", ()))
@@ -116,7 +127,9 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     A sphere leaving through the top re-enters at the bottom in the image frame that moves
     with the flow: crossing ``y = Ly`` moves x by ``−shift`` (``shift = Ly·γ`` after the strain
     update) and vx by ``−Ly·γ̇``; crossing ``y = 0`` the reverse.  Then x is wrapped into
-    ``[0, Lx)``.
+    ``[0, Lx)``.  The velocity correction is the reference's ``vx += (y' − y)·γ̇`` with ``y`` and
+    ``y'`` the heights before and after the wrap (exactly ``∓Ly·γ̇`` for one crossing; the
+    same number as the reference's also for several).
 
     Parameters
     ----------
@@ -134,29 +147,39 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     bool or None
         True if any sphere was moved by a period; None on a device (knowing it needs a host read).
 
-    At most :data:`MAX_PASSES` one-period passes per axis, then the rest is folded in closed
-    form (an infinite coordinate becomes NaN, which the stability guard reports).
+    Notes
+    -----
+    Periods are subtracted one at a time, as in the reference, for at most :data:`MAX_PASSES`
+    passes per axis; what is still outside then is folded in closed form and clipped into the
+    cell against rounding, so the cost is O(1) in the size of a coordinate and every finite
+    position ends inside the cell.  A NaN coordinate stays NaN (and is not moved); an infinite
+    one becomes NaN, which the stability guard reports.  Unlike the reference's sequential
+    loops (first every ``y ≥ Ly`` pass, then every ``y < 0`` pass), each pass tests both sides,
+    so a coordinate a hair below 0 that rounds onto ``L`` ends at 0, inside the half-open cell.
+    This is the one wrap of the package: the documented classes call it through
+    :func:`particleShear.base.kernels.le_wrap`.
     """
     be = backend_of(x, y)
     xp = be.xp
     moved = False if be.host else None
+    y0 = None if be.host else y.copy()   # heights before the wrap, for the velocity correction
     for _ in range(MAX_PASSES):
         up = (y >= Ly).astype(float) - (y < 0)
         if be.host:
             if not up.any():
                 break
+            if y0 is None:
+                y0 = y.copy()
             moved = True
         y -= Ly * up
         x -= shift * up
-        vx -= (Ly * rate) * up
-    else:  # absurd coordinate: fold the rest at once (non-finite values become NaN for the guard)
+    else:  # absurd coordinate (or a device, which ran every pass): fold what is still outside at once
+        y[...], up = _fold(y, Ly, 0.0, Ly, xp)
         with _quiet_invalid(xp):
-            up = xp.floor(y / Ly)
-            if not be.host:   # the device ran every pass: fold only what is still outside
-                up = up * _outside(y, 0.0, Ly)
-            y -= Ly * up
             x -= shift * up
-            vx -= (Ly * rate) * up
+    if y0 is not None:
+        with _quiet_invalid(xp):
+            vx += (y - y0) * rate
     for _ in range(MAX_PASSES):
         right = (x >= Lx).astype(float) - (x < 0)
         if be.host:
@@ -165,11 +188,7 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
             moved = True
         x -= Lx * right
     else:
-        with _quiet_invalid(xp):  # inf - inf: NaN, reported by the guard
-            right = xp.floor(x / Lx)
-            if not be.host:
-                right = right * _outside(x, 0.0, Lx)
-            x -= Lx * right
+        x[...], _ = _fold(x, Lx, 0.0, Lx, xp)
     return moved
 
 

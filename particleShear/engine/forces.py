@@ -278,10 +278,11 @@ def normals(dx, dy, d, rep, rng):
         Pair vectors (µm).
     d : ndarray (P,)
         Their lengths (µm, ≥ 0).
-    rep : ndarray of int (P,)
-        Replica of each pair (index into ``rng``).
+    rep : ndarray of int (P,) or None
+        Replica of each pair (index into ``rng``); None: every pair is of replica 0.
     rng : sequence of numpy.random.Generator
-        One generator per replica; one uniform number is drawn per pair at ``d = 0``.
+        One generator per replica; one uniform number ``u`` is drawn per pair at ``d = 0``,
+        in pair order, and the normal is ``(cos 2πu, sin 2πu)``.
 
     Returns
     -------
@@ -296,7 +297,8 @@ def normals(dx, dy, d, rep, rng):
     nx, ny = dx / safe, dy / safe
     # the draws happen on the host, pair by pair in list order, from each pair's own replica's generator
     where = to_host(xp.flatnonzero(zero), "d = 0")
-    theta = [2 * np.pi * rng[int(b)].random() for b in to_host(rep, "d = 0")[where]]
+    reps = [0] * len(where) if rep is None else to_host(rep, "d = 0")[where]
+    theta = [2 * np.pi * rng[int(b)].random() for b in reps]
     idx = where if isinstance(d, np.ndarray) else xp.asarray(where)
     nx[idx] = xp.asarray(np.array([np.cos(t) for t in theta]))
     ny[idx] = xp.asarray(np.array([np.sin(t) for t in theta]))
