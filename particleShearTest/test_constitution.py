@@ -34,25 +34,77 @@ def phys_pairs(ens):
     return ens.permanent_pairs(physical_neighbors_only=True)
 
 
+def model_time_constant(E, rho, N=150, L=500.0, phi=1.5):
+    """τ = sqrt(m/k) from its definition (eq. S1-8 for k): r = sqrt(L²φ/(Nπ)) µm,
+    m = π r² ρ in mg per m depth, k = π E / 8 in mg s⁻² per m depth."""
+    r_m = math.sqrt(L * L * phi / (N * math.pi)) * 1e-6
+    m = math.pi * r_m ** 2 * rho * 1e6
+    k = math.pi / 8 * E * 1e6
+    return math.sqrt(m / k)
+
+
+def time_step_rule(tau, bf, mu, rts, A, rv):
+    """(dt, dt_max) from the builders' time-step rule (as documented by ``time_steps_from_model``), written out here:
+    dt = 0.1 τ/bf halved for small μ, small and large amplitudes; dt_max = 0.25 τ/bf or less; dt ≤ dt_max."""
+    dt = 0.1 * tau / bf
+    halvings = [mu <= 1 or rts < 1, A <= 0.05, mu <= 0.1 or rts < 0.1, A <= 0.005, A >= 0.5]
+    dt /= 2 ** sum(halvings)
+    dt_max = 0.25 * tau / bf
+    if (rv <= 0.1 and mu < 0.1) or rts < 0.1 or rts > 5:
+        dt_max = 0.125 * tau / bf
+    if (rv < 0.01 and mu < 0.01) or rts < 0.01:
+        dt_max = 0.04 * tau / bf
+    dt = min(dt, dt_max)
+    if rv > 1:
+        dt_max /= rv
+    return dt, dt_max
+
+
 class TestDerivedConstants(unittest.TestCase):
+    """The derived constants against their definitions (evaluated here, independently of the model
+    class: agreement to 4 ulp, the operations being grouped differently) and against the reference
+    implementation's printed values (equal bit for bit: the package reproduces the reference's order
+    of operations)."""
+
     def test_time_steps_default_run(self):
         tau = particle_shear_model_parameters(500, 500, 150, 1.5, 8000, 50, 1).time_constant
-        self.assertEqual(tau, 6.3078313050504005e-06)
+        self.assertAlmostEqual(tau / model_time_constant(8000, 50), 1.0, delta=4e-16)
+        self.assertEqual(tau, 6.3078313050504005e-06)        # the reference's value
         dt, dt_max = time_steps_from_model(tau, 1.4, 0.01, 1, 0.2, 0.1)
+        self.assertEqual((dt, dt_max), time_step_rule(tau, 1.4, 0.01, 1, 0.2, 0.1))
+        self.assertEqual(dt, 0.025 * tau / 1.4)              # two halvings (μ ≤ 0.1), cap inactive
         self.assertEqual(dt, 1.1263984473304288e-07)
         self.assertEqual(dt_max, 5.631992236652144e-07)
-        self.assertEqual(0.2 * tau / 1.4, 9.01118757864343e-07)
 
     def test_time_steps_header_example(self):
         tau = particle_shear_model_parameters(500, 500, 150, 1.5, 10000, 1000, 1).time_constant
+        self.assertAlmostEqual(tau / model_time_constant(10000, 1000), 1.0, delta=4e-16)
         self.assertEqual(tau, 2.5231325220201602e-05)
         dt, dt_max = time_steps_from_model(tau, 1.4, 0.01, 1, 0.3, 0.1)
+        self.assertEqual((dt, dt_max), time_step_rule(tau, 1.4, 0.01, 1, 0.3, 0.1))
         self.assertEqual(dt, 4.505593789321715e-07)
         self.assertEqual(dt_max, 2.2527968946608574e-06)
-        self.assertEqual(0.2 * tau / 1.4, 3.604475031457372e-06)
+
+    def test_time_step_rule_branches(self):
+        # every branch of the rule: μ, rts, amplitude and viscosity on both sides of each threshold
+        tau, bf = 1.0, 1.4
+        for mu in (0.005, 0.05, 0.5, 2.0):
+            for rts in (0.005, 0.05, 0.5, 1.0, 8.0):
+                for A in (0.001, 0.01, 0.2, 0.6):
+                    for rv in (0.005, 0.1, 0.5, 3.0):
+                        with self.subTest(mu=mu, rts=rts, A=A, rv=rv):
+                            self.assertEqual(time_steps_from_model(tau, bf, mu, rts, A, rv),
+                                             time_step_rule(tau, bf, mu, rts, A, rv))
 
     def test_ensemble_constants(self):
         ens = Build(**dict(RUN, do_pre_equilibration=False, do_permanent_links=False, rng=0))
+        # definitions (eq. S1-8, S1-9, S1-14): k = π E/8, ν = rv·k·τ = rv·√(m k), r = r_b/√bf or r_b·√bf
+        tau = model_time_constant(8000, 50)
+        self.assertAlmostEqual(ens.k / (math.pi / 8 * 8000 * 1e6), 1.0, delta=4e-16)
+        self.assertAlmostEqual(ens.nu / (0.1 * ens.k * tau), 1.0, delta=8e-16)
+        r_b = math.sqrt(500 * 500 * 1.5 / (150 * math.pi) * 2 / (1.4 + 1 / 1.4))
+        np.testing.assert_allclose(np.unique(ens._a["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)], rtol=4e-16)
+        # and the reference's printed values, bit for bit
         self.assertEqual(ens.k, 3141592653.5897927)
         self.assertEqual(ens.k_t, 3141592653.5897927)
         self.assertEqual(ens.nu, 1981.6636488030053)
