@@ -72,10 +72,35 @@ class TestAppendixA1(unittest.TestCase):
                 np.testing.assert_array_equal(arr, scal)
 
 
+def central_law_definition(d, d0, k, c):
+    """The compressive law written out from eq. S1-5a/b and the cap of eq. S1-6, independently of the
+    package: F = −k(1−c)(d0−d) − k·c·d0·(d0/max(d, d0/1000) − 1) for d ≤ d0, else 0 (negative = repulsion).
+    Returns (F, scale) with scale = |linear part| + |divergent part|, the magnitude rounding is relative to."""
+    if d > d0:
+        return 0.0, 0.0
+    linear = -k * (1 - c) * (d0 - d)
+    divergent = -k * c * d0 * (d0 / max(d, d0 / 1000) - 1)
+    return linear + divergent, abs(linear) + abs(divergent)
+
+
 class TestLawProperties(unittest.TestCase):
     """Properties of docs/design.md that hold for every d0, k and c in [0, 1]."""
 
     CS = (0.0, 0.1, 0.25, 0.5, 0.75, 1.0)
+
+    def test_law_equals_its_definition(self):
+        # random geometry over the linear, blended, divergent and capped ranges; the package groups the
+        # constants differently (a few roundings), so 1e-14 of the terms' magnitude bounds the difference
+        rng = np.random.default_rng(2)
+        d0 = rng.uniform(1.0, 150.0, 400)
+        d = d0 * np.concatenate((rng.uniform(0.0, 0.002, 50), rng.uniform(0.002, 1.2, 350)))
+        for k in (1.0, 3.14e9):
+            for c in self.CS:
+                for a, b in zip(d, d0):
+                    with self.subTest(d=a, d0=b, k=k, c=c):
+                        ref, scale = central_law_definition(float(a), float(b), k, c)
+                        got = elastic_force_law(float(a), float(b), k, c)
+                        self.assertLessEqual(abs(got - ref), 1e-14 * scale)
 
     def test_slope_k_at_contact_for_any_c(self):
         # one-sided difference from inside the contact: analytically
