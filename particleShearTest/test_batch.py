@@ -219,9 +219,6 @@ class TestBatchBadInput(unittest.TestCase):
             run_batch([dict(QUICK), dict(QUICK, theMu=-1)])
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 SERIES = ("t", "strain", "strain_rate", "stress_surface", "stress_internal")
 
@@ -324,3 +321,7 @@ class TestBatchedSeriesWithFiles(unittest.TestCase):
                     self.assertEqual(data[key].tobytes(), np.asarray(a.series[key]).tobytes(), key)
             self.assertEqual(len({a.output_path for a in batched}), 4)
             self.assertEqual([n for n in os.listdir(d2) if n.endswith(".part")], [])
+
+
+if __name__ == "__main__":
+    unittest.main()
