@@ -108,8 +108,15 @@ class TestBatchOfMixedReplicas(unittest.TestCase):
         assert_same_result(self, self.pair[1], self.single[0])
 
     def test_whole_protocol_recorded(self):
+        # the protocol's length by its definition, int((pre + P + post)/f / dt) steps (truncated), each
+        # sample at its step's clock k·dt (a running sum of dt: rounding ≲ k·ε·t)
         for r in self.batch:
-            self.assertEqual(len(r.series["t"]), r.N_steps)
+            T = (QUICK["pre_periods"] + QUICK["periods"] + QUICK["post_periods"]) / r.f
+            self.assertEqual(r.N_steps, int(T / r.dt))
+            t = np.asarray(r.series["t"])
+            self.assertEqual(len(t), r.N_steps)
+            k = np.arange(len(t))
+            self.assertLessEqual(np.max(np.abs(t - k * r.dt)), len(t) * np.finfo(float).eps * t[-1])
             self.assertTrue(np.all(np.isfinite(r.series["stress_surface"])))
 
 
