@@ -140,7 +140,10 @@ class TestDerivedConstants(unittest.TestCase):
     def test_default_schedule_and_particle_info(self):
         ens = Build(**dict(RUN, rng=3))
         self.assertIsInstance(ens, EnsembleCompactParticlesAdjustableInterfaceStrength)
-        self.assertEqual(ens.n_constitution_steps, 3400)
+        # the reference builder's schedule, N steps per level while the level > dt
+        # (= 0.025 τ/bf), then 2N at dt: free(300) from 0.2 τ/bf (levels 0.2, 0.1, 0.05), free(200) from
+        # 0.125 τ/bf (0.125, 0.0625, 0.03125), after crosslinking free(300) from 2 dt (one level)
+        self.assertEqual(ens.n_constitution_steps, (3 + 2) * 300 + (3 + 2) * 200 + (1 + 2) * 300)
         self.assertEqual(ens.dt, 1.1263984473304288e-07)
         self.assertEqual(ens.dt_max, 2.2527968946608576e-07)  # experiment dt_max (= 2 dt)
         self.assertEqual(ens.mu, 0.01)
