@@ -145,7 +145,8 @@ class TestDerivedConstants(unittest.TestCase):
         # 0.125 τ/bf (0.125, 0.0625, 0.03125), after crosslinking free(300) from 2 dt (one level)
         self.assertEqual(ens.n_constitution_steps, (3 + 2) * 300 + (3 + 2) * 200 + (1 + 2) * 300)
         self.assertEqual(ens.dt, 1.1263984473304288e-07)
-        self.assertEqual(ens.dt_max, 2.2527968946608576e-07)  # experiment dt_max (= 2 dt)
+        self.assertEqual(ens.dt_max, 2 * ens.dt)              # min(2 dt, dt_max) after crosslinking
+        self.assertEqual(ens.dt_max, 2.2527968946608576e-07)  # the reference's experiment dt_max
         self.assertEqual(ens.mu, 0.01)
         self.assertFalse(ens.cut_top_bottom)
         self.assertTrue(ens.doCutByTriangulation)
