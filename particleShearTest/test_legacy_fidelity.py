@@ -12,6 +12,8 @@
 """
 import io
 import math
+import os
+import tempfile
 import unittest
 
 import numpy as np
@@ -357,8 +359,16 @@ class FalseMeansNoFileTest(unittest.TestCase):
                 sim.write_information_on_simulation_to_file(False)
                 sim.write_information_on_simulation_to_file(buf)
                 self.assertIn("Function call : \ncall", buf.getvalue())
-                sim.createFolder(False)
-                sim.createFolder(None)
+                # no folder named "False" or "None" (nor any other) appears where the script runs
+                here = os.getcwd()
+                with tempfile.TemporaryDirectory() as d:
+                    os.chdir(d)
+                    try:
+                        sim.createFolder(False)
+                        sim.createFolder(None)
+                        self.assertEqual(os.listdir(d), [])
+                    finally:
+                        os.chdir(here)
 
     def test_experiment_without_file(self):
         ens = two_sphere_scene(**SCENES["slip_then_stick"])
