@@ -52,7 +52,8 @@ class TestBox(unittest.TestCase):
             mx, my, ky, kx = min_image(dx, dy, Lx, Ly, shift)
             self.assertTrue(np.all((-Ly / 2 <= my) & (my < Ly / 2)))
             self.assertTrue(np.all((-Lx / 2 <= mx) & (mx < Lx / 2)))
-            # counts reproduce the image (to rounding of the subtractions)
+            # counts reproduce the image (to rounding of the subtractions: |Δ| ≤ ~1000 µm, ε·1000 ≈ 2e-13 µm;
+            # 1e-9 µm is far below any wrong image, which is off by a period of ≥ 200 µm)
             np.testing.assert_allclose(mx, dx - ky * shift - kx * Lx, rtol=0, atol=1e-9)
             np.testing.assert_allclose(my, dy - ky * Ly, rtol=0, atol=1e-9)
             # separations well inside the cell are the nearest image
@@ -99,11 +100,11 @@ class TestLaws(unittest.TestCase):
         k, d0 = 2.0, 10.0
         self.assertEqual(central_law(np.array([d0]), d0, k, 1.0)[0], 0.0)      # zero at contact
         self.assertEqual(central_law(np.array([11.0]), d0, k, 0.5)[0], 0.0)    # nothing beyond contact
-        h = 1e-6
+        h = 1e-6   # truncation c·h/(d0 − h) ≈ 1e-7 relative, rounding ε·k·d0/(k·h) ≈ 2e-9: 1e-4 is ample
         for c in (0.0, 0.5, 1.0):                                               # slope k at contact
             slope = (central_law(np.array([d0]), d0, k, c)[0] - central_law(np.array([d0 - h]), d0, k, c)[0]) / h
             self.assertAlmostEqual(slope, k, delta=1e-4 * k)
-        cap = central_law(np.array([d0 / 1e6]), d0, k, 1.0)[0]                  # eq. S1-6: −999·k·d0
+        cap = central_law(np.array([d0 / 1e6]), d0, k, 1.0)[0]                  # eq. S1-6: −999·k·d0 (a few roundings)
         self.assertAlmostEqual(cap, -999 * k * d0, delta=1e-9 * k * d0)
         self.assertEqual(tensile_law(12.0, 10.0, 3.0), 6.0)
 

@@ -152,7 +152,8 @@ class TestLawProperties(unittest.TestCase):
                     expected = -k * (1 - c) * (d0 - d) + frozen
                     self.assertLessEqual(abs(f - expected), 1e-13 * abs(expected))
                     self.assertLessEqual(abs(f), bound * (1 + 1e-15))
-            # continuous at the clamp, monotone repulsion growing with overlap
+            # continuous at the clamp (a step of 1e-12·d_c in d changes F by ≈ k·c·d0·1e-12, far below 1e-9 of
+            # the bound), monotone repulsion growing with overlap (differences ≥ −rounding of F)
             dc = d0 / 1000
             self.assertLessEqual(abs(elastic_force_law(dc, d0, k, c) - elastic_force_law(dc * (1 - 1e-12), d0, k, c)),
                                  1e-9 * bound)
@@ -174,6 +175,8 @@ class TestLawProperties(unittest.TestCase):
             PlateauConfiguration.relative_plateau_slope = saved
 
     def test_distance_transform_is_continuous(self):
+        # slopes are ≤ 1 (µm per µm): a step of 1e-12 relative (≤ 1e-10 µm) moves the value by ≤ 1e-10 µm;
+        # a jump at an edge would be O(1 µm)
         pb, pe, s = 36.0, 96.0, 0.1
         for edge in (pb, pe):
             lo = distance_transform_plateau(edge * (1 - 1e-12), pb, pe, s)

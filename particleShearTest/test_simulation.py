@@ -76,6 +76,8 @@ class TestDemodulation(unittest.TestCase):
         return t, offset + drift * t + osc
 
     def test_correct_sign_recovers_moduli(self):
+        # 1000 samples per period, none on a window edge: the discrete projections on sin/cos are exact to
+        # ~1e-9 for whole periods; the drift is removed up to its discretisation, ~1e-7 of G: 1e-6 bounds both
         t, s = self.signal()
         SA, SB, Gp, Gpp = demodulation(t, s, self.f, self.A, self.pre, self.P, self.post, correct_drift_sign=True)
         self.assertLess(abs(Gp - self.Gp) / self.Gp, 1e-6)
@@ -87,6 +89,8 @@ class TestDemodulation(unittest.TestCase):
         s = s + 3.0 * np.sin(7.3 * t * self.f)  # something the projections do not remove exactly
         ours = demodulation(t, s, self.f, self.A, self.pre, self.P, self.post)
         ref = reference_demodulation(t, s, self.f, self.A, self.pre, self.P, self.post)
+        # the same formula, sums of 6000 terms in another order (NumPy vs a Python loop), with the drift
+        # term cancelling most of the signal: rounding ≲ 1e-12, so 1e-9 relative
         for a, b in zip(ours, ref):
             self.assertLess(abs(a - b), 1e-9 * abs(b))
         # the quirk doubles a linear drift instead of removing it: the default result differs
