@@ -255,6 +255,7 @@ class TestCutting(unittest.TestCase):
         ens.cutLine = lambda point, angle: seen.append(angle)
         for _ in range(300):
             ens.cutRandomLine()
+        self.assertEqual(len(seen), 300)                     # one accepted line per call: not vacuous
         self.assertTrue(all(ens.angle_OK(a) for a in seen))
         with self.assertRaises(ValueError):
             EnsembleCompactParticles(500, 500, 0, avoid_horizontal_angle_degree=90)
