@@ -1,4 +1,5 @@
-"""Ensemble constitution: derived constants (spec A.2), builders (docs/design.md, docs/design.md), cutting and particles (docs/design.md-6.10)."""
+"""Ensemble constitution: derived constants (the reference's values and their definitions), builders, cutting,
+link removal and particles (docs/design.md)."""
 import math
 import unittest
 from unittest import mock

@@ -1,4 +1,4 @@
-"""Central force laws (docs/design.md, docs/design.md, docs/design.md, docs/design.md; reference numbers of Appendix A.1).
+"""Central force laws (eq. S1-5a/b, S1-6; docs/design.md) and the reference numbers of Appendix A.1.
 
 Sign convention: negative = repulsion.  The reference numbers are compared to
 1e-12 relative (an exact 0 where the reference prints 0).

@@ -1,4 +1,4 @@
-"""Tests of layers 4 and 5: demodulation, recording, output file, seeds, validation, drawing, scenarios manual Part 4 scenario 8 (frictional assembly at rest)-11.10.
+"""Tests of layers 4 and 5: demodulation, recording, output file, seeds, validation, drawing, the manual's Part 4 scenarios 8–10 (frictional and crosslinked assemblies at rest and during shear).
 
 Run with ``python -m pytest particleShearTest/test_simulation.py`` or ``python -m unittest``.
 Short protocols (``relative_frequency`` raised, few spheres) keep the whole file fast.
@@ -496,7 +496,8 @@ class TestRunLayer(unittest.TestCase):
 
 
 class TestStochasticScenarios(unittest.TestCase):
-    """Spec manual Part 4 scenario 8 (frictional assembly at rest)-11.10 with the tolerances stated there (three seeds each)."""
+    """The manual's Part 4 scenarios 8–10 (frictional assembly at rest, during shear; crosslinked assembly during shear)
+    with the tolerances stated there (three seeds each)."""
 
     seeds = (1, 2, 3)
 

@@ -2,7 +2,7 @@
 
 Every case builds a real ensemble with the docs/design.md builder (``do_debug=True``: ten times shorter
 constitution, same physics), runs the experiment's fixed-plate pre-equilibration and a limited
-number of protocol steps (docs/design.md–docs/design.md, the reference per-step order), and asserts physical
+number of protocol steps (docs/design.md, the reference per-step order), and asserts physical
 truths at every step through a read-only monitor installed where the stability guard sits
 (``ensemble.stability_guard``; it is called after every force phase with the pair geometry
 of the step):
