@@ -114,7 +114,9 @@ class TestIntegrators(unittest.TestCase):
         self.assertRaises(ValueError, linkable().set_integrator, "rk4")
 
     def test_verlet_converges_to_the_same_trajectory(self):
-        # both schemes approximate the same ODE: their difference shrinks with dt
+        # both schemes approximate the same ODE to first order at least (the velocity forces make the
+        # explicit kick first order): their difference shrinks ∝ dt, 4× from dt = 0.04 to 0.01 (measured
+        # 0.30 → 0.075); a factor 2.5 leaves room for higher-order terms and fails if it does not converge
         T = 8.0
         diffs = []
         for dt in (0.04, 0.02, 0.01):

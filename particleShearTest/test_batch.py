@@ -108,8 +108,15 @@ class TestBatchOfMixedReplicas(unittest.TestCase):
         assert_same_result(self, self.pair[1], self.single[0])
 
     def test_whole_protocol_recorded(self):
+        # the protocol's length by its definition, int((pre + P + post)/f / dt) steps (truncated), each
+        # sample at its step's clock k·dt (a running sum of dt: rounding ≲ k·ε·t)
         for r in self.batch:
-            self.assertEqual(len(r.series["t"]), r.N_steps)
+            T = (QUICK["pre_periods"] + QUICK["periods"] + QUICK["post_periods"]) / r.f
+            self.assertEqual(r.N_steps, int(T / r.dt))
+            t = np.asarray(r.series["t"])
+            self.assertEqual(len(t), r.N_steps)
+            k = np.arange(len(t))
+            self.assertLessEqual(np.max(np.abs(t - k * r.dt)), len(t) * np.finfo(float).eps * t[-1])
             self.assertTrue(np.all(np.isfinite(r.series["stress_surface"])))
 
 
@@ -219,9 +226,6 @@ class TestBatchBadInput(unittest.TestCase):
             run_batch([dict(QUICK), dict(QUICK, theMu=-1)])
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 SERIES = ("t", "strain", "strain_rate", "stress_surface", "stress_internal")
 
@@ -324,3 +328,7 @@ class TestBatchedSeriesWithFiles(unittest.TestCase):
                     self.assertEqual(data[key].tobytes(), np.asarray(a.series[key]).tobytes(), key)
             self.assertEqual(len({a.output_path for a in batched}), 4)
             self.assertEqual([n for n in os.listdir(d2) if n.endswith(".part")], [])
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,4 +1,5 @@
-"""Ensemble constitution: derived constants (spec A.2), builders (docs/design.md, docs/design.md), cutting and particles (docs/design.md-6.10)."""
+"""Ensemble constitution: derived constants (the reference's values and their definitions), builders, cutting,
+link removal and particles (docs/design.md)."""
 import math
 import unittest
 from unittest import mock
@@ -34,25 +35,77 @@ def phys_pairs(ens):
     return ens.permanent_pairs(physical_neighbors_only=True)
 
 
+def model_time_constant(E, rho, N=150, L=500.0, phi=1.5):
+    """τ = sqrt(m/k) from its definition (eq. S1-8 for k): r = sqrt(L²φ/(Nπ)) µm,
+    m = π r² ρ in mg per m depth, k = π E / 8 in mg s⁻² per m depth."""
+    r_m = math.sqrt(L * L * phi / (N * math.pi)) * 1e-6
+    m = math.pi * r_m ** 2 * rho * 1e6
+    k = math.pi / 8 * E * 1e6
+    return math.sqrt(m / k)
+
+
+def time_step_rule(tau, bf, mu, rts, A, rv):
+    """(dt, dt_max) from the builders' time-step rule (as documented by ``time_steps_from_model``), written out here:
+    dt = 0.1 τ/bf halved for small μ, small and large amplitudes; dt_max = 0.25 τ/bf or less; dt ≤ dt_max."""
+    dt = 0.1 * tau / bf
+    halvings = [mu <= 1 or rts < 1, A <= 0.05, mu <= 0.1 or rts < 0.1, A <= 0.005, A >= 0.5]
+    dt /= 2 ** sum(halvings)
+    dt_max = 0.25 * tau / bf
+    if (rv <= 0.1 and mu < 0.1) or rts < 0.1 or rts > 5:
+        dt_max = 0.125 * tau / bf
+    if (rv < 0.01 and mu < 0.01) or rts < 0.01:
+        dt_max = 0.04 * tau / bf
+    dt = min(dt, dt_max)
+    if rv > 1:
+        dt_max /= rv
+    return dt, dt_max
+
+
 class TestDerivedConstants(unittest.TestCase):
+    """The derived constants against their definitions (evaluated here, independently of the model
+    class: agreement to 4 ulp, the operations being grouped differently) and against the reference
+    implementation's printed values (equal bit for bit: the package reproduces the reference's order
+    of operations)."""
+
     def test_time_steps_default_run(self):
         tau = particle_shear_model_parameters(500, 500, 150, 1.5, 8000, 50, 1).time_constant
-        self.assertEqual(tau, 6.3078313050504005e-06)
+        self.assertAlmostEqual(tau / model_time_constant(8000, 50), 1.0, delta=4e-16)
+        self.assertEqual(tau, 6.3078313050504005e-06)        # the reference's value
         dt, dt_max = time_steps_from_model(tau, 1.4, 0.01, 1, 0.2, 0.1)
+        self.assertEqual((dt, dt_max), time_step_rule(tau, 1.4, 0.01, 1, 0.2, 0.1))
+        self.assertEqual(dt, 0.025 * tau / 1.4)              # two halvings (μ ≤ 0.1), cap inactive
         self.assertEqual(dt, 1.1263984473304288e-07)
         self.assertEqual(dt_max, 5.631992236652144e-07)
-        self.assertEqual(0.2 * tau / 1.4, 9.01118757864343e-07)
 
     def test_time_steps_header_example(self):
         tau = particle_shear_model_parameters(500, 500, 150, 1.5, 10000, 1000, 1).time_constant
+        self.assertAlmostEqual(tau / model_time_constant(10000, 1000), 1.0, delta=4e-16)
         self.assertEqual(tau, 2.5231325220201602e-05)
         dt, dt_max = time_steps_from_model(tau, 1.4, 0.01, 1, 0.3, 0.1)
+        self.assertEqual((dt, dt_max), time_step_rule(tau, 1.4, 0.01, 1, 0.3, 0.1))
         self.assertEqual(dt, 4.505593789321715e-07)
         self.assertEqual(dt_max, 2.2527968946608574e-06)
-        self.assertEqual(0.2 * tau / 1.4, 3.604475031457372e-06)
+
+    def test_time_step_rule_branches(self):
+        # every branch of the rule: μ, rts, amplitude and viscosity on both sides of each threshold
+        tau, bf = 1.0, 1.4
+        for mu in (0.005, 0.05, 0.5, 2.0):
+            for rts in (0.005, 0.05, 0.5, 1.0, 8.0):
+                for A in (0.001, 0.01, 0.2, 0.6):
+                    for rv in (0.005, 0.1, 0.5, 3.0):
+                        with self.subTest(mu=mu, rts=rts, A=A, rv=rv):
+                            self.assertEqual(time_steps_from_model(tau, bf, mu, rts, A, rv),
+                                             time_step_rule(tau, bf, mu, rts, A, rv))
 
     def test_ensemble_constants(self):
         ens = Build(**dict(RUN, do_pre_equilibration=False, do_permanent_links=False, rng=0))
+        # definitions (eq. S1-8, S1-9, S1-14): k = π E/8, ν = rv·k·τ = rv·√(m k), r = r_b/√bf or r_b·√bf
+        tau = model_time_constant(8000, 50)
+        self.assertAlmostEqual(ens.k / (math.pi / 8 * 8000 * 1e6), 1.0, delta=4e-16)
+        self.assertAlmostEqual(ens.nu / (0.1 * ens.k * tau), 1.0, delta=8e-16)
+        r_b = math.sqrt(500 * 500 * 1.5 / (150 * math.pi) * 2 / (1.4 + 1 / 1.4))
+        np.testing.assert_allclose(np.unique(ens._a["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)], rtol=4e-16)
+        # and the reference's printed values, bit for bit
         self.assertEqual(ens.k, 3141592653.5897927)
         self.assertEqual(ens.k_t, 3141592653.5897927)
         self.assertEqual(ens.nu, 1981.6636488030053)
@@ -88,9 +141,13 @@ class TestDerivedConstants(unittest.TestCase):
     def test_default_schedule_and_particle_info(self):
         ens = Build(**dict(RUN, rng=3))
         self.assertIsInstance(ens, EnsembleCompactParticlesAdjustableInterfaceStrength)
-        self.assertEqual(ens.n_constitution_steps, 3400)
+        # the reference builder's schedule, N steps per level while the level > dt
+        # (= 0.025 τ/bf), then 2N at dt: free(300) from 0.2 τ/bf (levels 0.2, 0.1, 0.05), free(200) from
+        # 0.125 τ/bf (0.125, 0.0625, 0.03125), after crosslinking free(300) from 2 dt (one level)
+        self.assertEqual(ens.n_constitution_steps, (3 + 2) * 300 + (3 + 2) * 200 + (1 + 2) * 300)
         self.assertEqual(ens.dt, 1.1263984473304288e-07)
-        self.assertEqual(ens.dt_max, 2.2527968946608576e-07)  # experiment dt_max (= 2 dt)
+        self.assertEqual(ens.dt_max, 2 * ens.dt)              # min(2 dt, dt_max) after crosslinking
+        self.assertEqual(ens.dt_max, 2.2527968946608576e-07)  # the reference's experiment dt_max
         self.assertEqual(ens.mu, 0.01)
         self.assertFalse(ens.cut_top_bottom)
         self.assertTrue(ens.doCutByTriangulation)
@@ -199,6 +256,7 @@ class TestCutting(unittest.TestCase):
         ens.cutLine = lambda point, angle: seen.append(angle)
         for _ in range(300):
             ens.cutRandomLine()
+        self.assertEqual(len(seen), 300)                     # one accepted line per call: not vacuous
         self.assertTrue(all(ens.angle_OK(a) for a in seen))
         with self.assertRaises(ValueError):
             EnsembleCompactParticles(500, 500, 0, avoid_horizontal_angle_degree=90)

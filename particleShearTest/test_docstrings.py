@@ -13,7 +13,7 @@ pdoc renders a ``Parameters`` section as a section only when the module declares
 
 The checked objects are the public names defined in the modules of :data:`DOCUMENTED_MODULES`
 (every name of ``particleShear.__all__`` and of the subpackages' ``__all__`` is defined in one of them),
-and, as expected failures until the engine rewrite is merged, in :data:`ENGINE_MODULES`.
+and in :data:`ENGINE_MODULES` (checked as a whole).
 """
 import importlib
 import inspect
@@ -62,8 +62,7 @@ PENDING_DOCSTRINGS = set()
 #: Modules whose "§" references are replaced on another branch (run.api, see above).
 PENDING_SECTION_SIGNS = set()
 
-#: The engine layers (being rewritten; documented after the engine merge).  Checked as a whole,
-#: as an expected failure for now: the lead turns it into a plain test after the engine merge.
+#: The engine layers and the documented classes over them, checked as a whole (one test for all).
 ENGINE_MODULES = [
     "particleShear.base",
     "particleShear.base.canvas",

@@ -3,8 +3,9 @@
 * ``box.min_image`` gives the nearest Lees-Edwards image (checked against every image of a
   5×5 block) in the half-open intervals; ``box.wrap`` puts spheres in the cell at an equivalent
   image with the velocity of that image.
-* ``laws.central_law`` is the law of docs/parameters.md (checked against the scalar reference law
-  and its defining properties: zero at contact, slope k, cap of eq. S1-6).
+* ``laws.central_law`` is the law of eq. S1-5a/b with the cap of eq. S1-6 (checked against the
+  definition written out in ``test_force_laws.central_law_definition`` and its defining properties:
+  zero at contact, slope k, cap).
 * ``neighbours.build_candidates`` holds every pair within ``r_i + r_j + skin`` of an all-pairs
   search over all images, and the Verlet bound keeps every contact of a sheared run in the list.
 * The engine's measurement (pre-equilibration + protocol) of a constituted ensemble gives the
@@ -17,7 +18,6 @@ import unittest
 
 import numpy as np
 
-from particleShear.base.laws import elastic_force_law
 from particleShear.engine.box import min_image, wrap
 from particleShear.engine.laws import central_law, tensile_law
 from particleShear.engine.neighbours import build_candidates, verlet_bound
@@ -26,6 +26,7 @@ from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.run.api import _build_simulation, _seed_sequence
 from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
 from particleShear.simulation.experiment import OscillatoryShearExperiment
+from particleShearTest.test_force_laws import central_law_definition
 
 
 def brute_image(dx, dy, Lx, Ly, shift):
@@ -51,11 +52,13 @@ class TestBox(unittest.TestCase):
             mx, my, ky, kx = min_image(dx, dy, Lx, Ly, shift)
             self.assertTrue(np.all((-Ly / 2 <= my) & (my < Ly / 2)))
             self.assertTrue(np.all((-Lx / 2 <= mx) & (mx < Lx / 2)))
-            # counts reproduce the image (to rounding of the subtractions)
+            # counts reproduce the image (to rounding of the subtractions: |Δ| ≤ ~1000 µm, ε·1000 ≈ 2e-13 µm;
+            # 1e-9 µm is far below any wrong image, which is off by a period of ≥ 200 µm)
             np.testing.assert_allclose(mx, dx - ky * shift - kx * Lx, rtol=0, atol=1e-9)
             np.testing.assert_allclose(my, dy - ky * Ly, rtol=0, atol=1e-9)
             # separations well inside the cell are the nearest image
             close = np.hypot(mx, my) < min(Lx, Ly) / 4
+            self.assertGreater(int(close.sum()), 20)          # the comparison below is not vacuous
             for k in np.flatnonzero(close):
                 ex, ey = brute_image(dx[k], dy[k], Lx, Ly, shift)
                 self.assertAlmostEqual(mx[k], ex, delta=1e-9)
@@ -81,25 +84,28 @@ class TestBox(unittest.TestCase):
 
 
 class TestLaws(unittest.TestCase):
-    def test_central_law_is_the_reference_law(self):
+    def test_central_law_is_its_definition(self):
+        # against eq. S1-5a/b and S1-6 written out in the test (not against base.laws, which shares the
+        # engine's arithmetic); other grouping of the constants: ≤ 1e-14 of the terms' magnitude
         rng = np.random.default_rng(3)
         d0 = rng.uniform(10, 30, 300)
         d = d0 * rng.uniform(0.0001, 1.3, 300)
         for c in (0.0, 0.4, 1.0):
             for k in (1.0, 3.1e9):
                 got = central_law(d, d0, k, c)
-                ref = np.array([elastic_force_law(float(a), float(b), k, c) for a, b in zip(d, d0)])
-                np.testing.assert_allclose(got, ref, rtol=1e-14, atol=0)
+                ref, scale = np.array([central_law_definition(float(a), float(b), k, c) for a, b in zip(d, d0)]).T
+                self.assertTrue(np.all(np.abs(got - ref) <= 1e-14 * scale))
+                self.assertTrue(np.all(got[d > d0] == 0.0))
 
     def test_defining_properties(self):
         k, d0 = 2.0, 10.0
         self.assertEqual(central_law(np.array([d0]), d0, k, 1.0)[0], 0.0)      # zero at contact
         self.assertEqual(central_law(np.array([11.0]), d0, k, 0.5)[0], 0.0)    # nothing beyond contact
-        h = 1e-6
+        h = 1e-6   # truncation c·h/(d0 − h) ≈ 1e-7 relative, rounding ε·k·d0/(k·h) ≈ 2e-9: 1e-4 is ample
         for c in (0.0, 0.5, 1.0):                                               # slope k at contact
             slope = (central_law(np.array([d0]), d0, k, c)[0] - central_law(np.array([d0 - h]), d0, k, c)[0]) / h
             self.assertAlmostEqual(slope, k, delta=1e-4 * k)
-        cap = central_law(np.array([d0 / 1e6]), d0, k, 1.0)[0]                  # eq. S1-6: −999·k·d0
+        cap = central_law(np.array([d0 / 1e6]), d0, k, 1.0)[0]                  # eq. S1-6: −999·k·d0 (a few roundings)
         self.assertAlmostEqual(cap, -999 * k * d0, delta=1e-9 * k * d0)
         self.assertEqual(tensile_law(12.0, 10.0, 3.0), 6.0)
 

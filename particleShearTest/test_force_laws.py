@@ -1,4 +1,4 @@
-"""Central force laws (docs/design.md, docs/design.md, docs/design.md, docs/design.md; reference numbers of Appendix A.1).
+"""Central force laws (eq. S1-5a/b, S1-6; docs/design.md) and the reference numbers of Appendix A.1.
 
 Sign convention: negative = repulsion.  The reference numbers are compared to
 1e-12 relative (an exact 0 where the reference prints 0).
@@ -72,10 +72,35 @@ class TestAppendixA1(unittest.TestCase):
                 np.testing.assert_array_equal(arr, scal)
 
 
+def central_law_definition(d, d0, k, c):
+    """The compressive law written out from eq. S1-5a/b and the cap of eq. S1-6, independently of the
+    package: F = −k(1−c)(d0−d) − k·c·d0·(d0/max(d, d0/1000) − 1) for d ≤ d0, else 0 (negative = repulsion).
+    Returns (F, scale) with scale = |linear part| + |divergent part|, the magnitude rounding is relative to."""
+    if d > d0:
+        return 0.0, 0.0
+    linear = -k * (1 - c) * (d0 - d)
+    divergent = -k * c * d0 * (d0 / max(d, d0 / 1000) - 1)
+    return linear + divergent, abs(linear) + abs(divergent)
+
+
 class TestLawProperties(unittest.TestCase):
     """Properties of docs/design.md that hold for every d0, k and c in [0, 1]."""
 
     CS = (0.0, 0.1, 0.25, 0.5, 0.75, 1.0)
+
+    def test_law_equals_its_definition(self):
+        # random geometry over the linear, blended, divergent and capped ranges; the package groups the
+        # constants differently (a few roundings), so 1e-14 of the terms' magnitude bounds the difference
+        rng = np.random.default_rng(2)
+        d0 = rng.uniform(1.0, 150.0, 400)
+        d = d0 * np.concatenate((rng.uniform(0.0, 0.002, 50), rng.uniform(0.002, 1.2, 350)))
+        for k in (1.0, 3.14e9):
+            for c in self.CS:
+                for a, b in zip(d, d0):
+                    with self.subTest(d=a, d0=b, k=k, c=c):
+                        ref, scale = central_law_definition(float(a), float(b), k, c)
+                        got = elastic_force_law(float(a), float(b), k, c)
+                        self.assertLessEqual(abs(got - ref), 1e-14 * scale)
 
     def test_slope_k_at_contact_for_any_c(self):
         # one-sided difference from inside the contact: analytically
@@ -127,7 +152,8 @@ class TestLawProperties(unittest.TestCase):
                     expected = -k * (1 - c) * (d0 - d) + frozen
                     self.assertLessEqual(abs(f - expected), 1e-13 * abs(expected))
                     self.assertLessEqual(abs(f), bound * (1 + 1e-15))
-            # continuous at the clamp, monotone repulsion growing with overlap
+            # continuous at the clamp (a step of 1e-12·d_c in d changes F by ≈ k·c·d0·1e-12, far below 1e-9 of
+            # the bound), monotone repulsion growing with overlap (differences ≥ −rounding of F)
             dc = d0 / 1000
             self.assertLessEqual(abs(elastic_force_law(dc, d0, k, c) - elastic_force_law(dc * (1 - 1e-12), d0, k, c)),
                                  1e-9 * bound)
@@ -149,6 +175,8 @@ class TestLawProperties(unittest.TestCase):
             PlateauConfiguration.relative_plateau_slope = saved
 
     def test_distance_transform_is_continuous(self):
+        # slopes are ≤ 1 (µm per µm): a step of 1e-12 relative (≤ 1e-10 µm) moves the value by ≤ 1e-10 µm;
+        # a jump at an edge would be O(1 µm)
         pb, pe, s = 36.0, 96.0, 0.1
         for edge in (pb, pe):
             lo = distance_transform_plateau(edge * (1 - 1e-12), pb, pe, s)

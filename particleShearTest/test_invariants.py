@@ -1,4 +1,4 @@
-"""Physical invariants of the stress evaluation and of the integrator (docs/design.md, docs/design.md).
+"""Physical invariants of the stress evaluation and of the integrator (docs/design.md).
 
 * The overall tensor σ = σ_LW + σ_Tint + σ_cen is symmetric (the internal-torque
   term cancels the antisymmetric Love–Weber part of the tangential forces) in a

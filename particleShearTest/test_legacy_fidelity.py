@@ -12,6 +12,8 @@
 """
 import io
 import math
+import os
+import tempfile
 import unittest
 
 import numpy as np
@@ -357,8 +359,16 @@ class FalseMeansNoFileTest(unittest.TestCase):
                 sim.write_information_on_simulation_to_file(False)
                 sim.write_information_on_simulation_to_file(buf)
                 self.assertIn("Function call : \ncall", buf.getvalue())
-                sim.createFolder(False)
-                sim.createFolder(None)
+                # no folder named "False" or "None" (nor any other) appears where the script runs
+                here = os.getcwd()
+                with tempfile.TemporaryDirectory() as d:
+                    os.chdir(d)
+                    try:
+                        sim.createFolder(False)
+                        sim.createFolder(None)
+                        self.assertEqual(os.listdir(d), [])
+                    finally:
+                        os.chdir(here)
 
     def test_experiment_without_file(self):
         ens = two_sphere_scene(**SCENES["slip_then_stick"])
@@ -460,20 +470,33 @@ class DocumentedStepLoopTest(unittest.TestCase):
 
     def test_selection_is_a_list(self):
         ens = random_scene(11, n=30)
+        ev0 = StressTensorEvaluation(ens.size_x, ens.size_y)
+        for _ in range(5):                    # sheared steps with friction: the spheres spin
+            self._step(ens, ev0, 2e3)
         ens.mechanical_simulation_step_calculate_forces()
         sel = ens.movableSphereList()
         self.assertIsInstance(sel, list)
         self.assertEqual(sel, [s for s in ens.sphereList if ens.canMove(s)])
         self.assertIsNot(ens.movableSphereList(), sel)   # a new list on each call
-        # changing it keeps it a list and the evaluation then reads it sphere by sphere (same numbers)
+        # the evaluation reads the list it is given, sphere by sphere: reversed, the same sums in another
+        # order (rounding, 1e-12 of the largest entry); without one sphere, the spin tensor (eq. S1-21,
+        # a sum over the listed spheres) loses exactly that sphere's −I ω²/2 / V
         ens.record_total_particle_forces()
         ev = StressTensorEvaluation(ens.size_x, ens.size_y)
         ev.evaluate_stress_tensors(ens.force_register, sel, ens.shear_rate)
         ref = ev.tensors.copy()
-        extra = sel.pop()
-        sel.append(extra)
+        spin = np.array(ev.stress_tensor_spin_kinetic_energy, dtype=float)
+        ev.evaluate_stress_tensors(ens.force_register, sel[::-1], ens.shear_rate)
+        np.testing.assert_allclose(ev.tensors, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+        spinning = max(sel, key=lambda s: abs(s.omega))
+        self.assertNotEqual(spinning.omega, 0.0)
+        sel.remove(spinning)
         ev.evaluate_stress_tensors(ens.force_register, sel, ens.shear_rate)
-        np.testing.assert_allclose(ev.tensors, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+        V = (ens.size_x * 1e-6) * (ens.size_y * 1e-6)
+        own = -spinning.inertia * 1e-18 * spinning.omega ** 2 / 2 / V
+        np.testing.assert_allclose(np.array(ev.stress_tensor_spin_kinetic_energy, dtype=float), spin - own * np.eye(2),
+                                   rtol=0, atol=1e-12 * np.abs(spin).max())
+        self.assertGreater(abs(own), 1e-6 * np.abs(spin).max())   # the dropped sphere's share is visible
 
 
 if __name__ == "__main__":

@@ -198,9 +198,6 @@ class TestEnsembleRelationsDuringShear(unittest.TestCase):
         self.assertLess(len(calls), 120)
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 class TestVerletCriterionUnderAffineFlow(unittest.TestCase):
     """Spheres carried exactly by the shear flow have no peculiar displacement, yet pairs stretch
@@ -324,3 +321,7 @@ class TestStepLeavesNoCyclicGarbage(unittest.TestCase):
                     self.assertEqual(gc.collect(), 0)
                 finally:
                     gc.enable()
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -137,6 +137,7 @@ class TestSweepPlot(unittest.TestCase):
                 # error bar = standard error s/√n (ddof = 1), drawn from mean − se to mean + se
                 se = [expected[(name, mu, A)][:, c].std(ddof=1) / math.sqrt(3) for A in (0.01, 0.1, 1.0)]
                 segs = cont.lines[2][0].get_segments()
+                # the bar's end points are mean ± se in float64; their difference loses ~ε·mean/se ≲ 1e-14
                 np.testing.assert_allclose([s[1][1] - s[0][1] for s in segs], 2 * np.array(se), rtol=1e-9)
 
     def test_groups_means_and_files(self):

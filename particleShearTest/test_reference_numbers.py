@@ -322,6 +322,9 @@ class TestAppendixA5(_RefCase):
         cls.sp = sp
 
     def test_link_equilibrium_distance(self):
+        # a link's equilibrium distance is the contact distance r_i + r_j when it is made (30 + 25 µm),
+        # not the centre distance then (√2600 ≈ 51.0 µm)
+        self.assertEqual(self.d_eq, self.sp[0].r + self.sp[1].r)
         self.assertEqual(self.d_eq, 55.0)
 
     def test_table_rows(self):

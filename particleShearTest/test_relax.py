@@ -44,9 +44,13 @@ class TestAgainstTheClasses(unittest.TestCase):
     def assert_same_relaxation(self, ref, eng, N, min_bonds=0):
         """``ref.free_pre_equilibration(N)`` (classes) against :func:`relax_ensembles` on a copy."""
         self.assertTrue(all(np.array_equal(ref._a[k], eng._a[k]) for k in SPHERE_ROWS))   # the same start
+        n_levels = len(relaxation_levels(ref.dt, ref.dt_max))
+        before = ref.n_constitution_steps
         ref.free_pre_equilibration(N)
         steps = relax_ensembles([eng], N)
-        self.assertEqual(steps, ref.n_constitution_steps - (eng.n_constitution_steps - steps))
+        # the schedule's definition: N steps per coarse level, then two blocks of N at dt
+        self.assertEqual(steps, N * (n_levels + 2))
+        self.assertEqual(ref.n_constitution_steps - before, steps)
         self.assertEqual(eng.n_constitution_steps, ref.n_constitution_steps)
         self.assertAlmostEqual(eng.t, ref.t, delta=1e-12 * ref.t)
         self.assertEqual(eng.mu, ref.mu)

@@ -2,7 +2,7 @@
 
 Every case builds a real ensemble with the docs/design.md builder (``do_debug=True``: ten times shorter
 constitution, same physics), runs the experiment's fixed-plate pre-equilibration and a limited
-number of protocol steps (docs/design.md–docs/design.md, the reference per-step order), and asserts physical
+number of protocol steps (docs/design.md, the reference per-step order), and asserts physical
 truths at every step through a read-only monitor installed where the stability guard sits
 (``ensemble.stability_guard``; it is called after every force phase with the pair geometry
 of the step):
@@ -405,7 +405,7 @@ class TestStabilityGuard(unittest.TestCase):
             self.assertIsNotNone(m, str(e))
             sim_dt, sug = float(m.group(1)), float(m.group(2))
             self.assertLess(e.suggested_dt, sim_dt)
-            self.assertAlmostEqual(sug, e.suggested_dt, delta=1e-3 * e.suggested_dt)
+            self.assertAlmostEqual(sug, e.suggested_dt, delta=1e-3 * e.suggested_dt)   # printed with 4 digits
             # no result was published and no (partial) output file is left
             self.assertIsNone(doParticleShearSimulation.last_result)
             self.assertEqual(os.listdir(tmp), [])
