@@ -676,8 +676,7 @@ class TestCuPy(unittest.TestCase):
 
     Tolerance: each CuPy ufunc is one kernel, IEEE-rounded like NumPy's, but the reductions (the
     padded-gather scatter and replica sums, ``sum``/``mean`` along an axis) add in another order
-    and ``**`` is CUDA's ``pow`` (≤ 2 ulp; docs/design.md, "Backends"), so single operations
-    differ by ~1 ulp (1e-16 relative).  How much the dynamics amplifies such differences was measured on the CPU:
+    (docs/design.md, "Backends"), so single sums differ by ~1 ulp (1e-16 relative).  How much the dynamics amplifies such differences was measured on the CPU:
     a 1-ulp change of every initial position and velocity of these replicas changes the recorded
     stresses by at most 1.2e-14 of their scale and G′/G″ by at most 5e-15 over this protocol
     (~1,000 steps).  A GPU injects ~1 ulp at every step, which adds up to well below 1e-12; the
