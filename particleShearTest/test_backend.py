@@ -466,6 +466,30 @@ class TestStandInIsCuPy(unittest.TestCase):
         self.assertEqual(API_MISSES, [])
 
 
+class TestGuardOnTheStandInDevice(unittest.TestCase):
+    """The stability guard fires on a device as on the host: same replica, step, phase and numbers.
+
+    A run at 40 times the default time step blows up within a few steps (kinetic energy ~40 times
+    its bound at step 4 on NumPy); the device computes the verdict branch-free and reads it with the
+    step's flags, then reports through the same host code."""
+
+    def test_same_instability_as_numpy(self):
+        from particleShear.base.stability import SimulationInstabilityError
+        kw = dict(N=20, do_permanent_links=False, cut_lines=0, seed=1, time_step_factor=40, doDrawing=False,
+                  plotStress=False, verbose=False, return_result=True)
+        with self.assertRaises(SimulationInstabilityError) as host:
+            doParticleShearSimulation(**kw)
+        API_MISSES.clear()
+        for name, ordered in (("cpu-standin-ordered", True), ("cpu-standin-cupy", False)):
+            with self.subTest(name), standin_registered(name, ordered=ordered):
+                with self.assertRaises(SimulationInstabilityError) as dev:
+                    doParticleShearSimulation(backend=name, **kw)
+                self.assertEqual((dev.exception.step, dev.exception.phase, dev.exception.pair),
+                                 (host.exception.step, host.exception.phase, host.exception.pair))
+                self.assertEqual(str(dev.exception), str(host.exception))
+        self.assertEqual(API_MISSES, [])
+
+
 class TestBatchOnTheStandInDevice(unittest.TestCase):
     """A mixed batch measured on the stand-in device equals the NumPy batch bit for bit."""
 
