@@ -5,7 +5,9 @@ arrays (:class:`DeviceArray`) wrap ndarrays and refuse every implicit read on th
 value, ``float``/``int``/index conversion, ``item``, ``tolist``, ``tobytes``, iteration,
 ``numpy.asarray`` — and every mix with a host array, as CuPy does (and stricter: CuPy turns a
 truth value into a silent synchronisation).  Only :func:`particleShear.engine.xp.to_host` can read
-them.  The stand-in computes with NumPy underneath, operation for operation, so a batch measured
+them.  The stand-in offers only the CuPy API audited for the engine (``CUPY_*`` below; the table
+of docs/design.md, "Backends"), so a NumPy-only function, method, ufunc method or keyword, a
+repeated-index assignment (undefined order in CuPy) or a boolean-mask read fails here too.  The stand-in computes with NumPy underneath, operation for operation, so a batch measured
 on it must be bit-identical to the NumPy batch: the comparison is exact and needs no tolerance,
 and it runs the device variants of the step (branch-free, no host caches) against NumPy's.
 
