@@ -7,8 +7,9 @@ value, ``float``/``int``/index conversion, ``item``, ``tolist``, ``tobytes``, it
 truth value into a silent synchronisation).  Only :func:`particleShear.engine.xp.to_host` can read
 them.  The stand-in offers only the CuPy API audited for the engine (``CUPY_*`` below; the table
 of docs/design.md, "Backends"), so a NumPy-only function, method, ufunc method or keyword, a
-repeated-index assignment (undefined order in CuPy) or a boolean-mask read fails here too.  The stand-in computes with NumPy underneath, operation for operation, so a batch measured
-on it must be bit-identical to the NumPy batch: the comparison is exact and needs no tolerance,
+repeated-index assignment (undefined order in CuPy) or a boolean-mask index fails here too.
+The stand-in computes with NumPy underneath, operation for operation, so a batch measured on it
+must be bit-identical to the NumPy batch: the comparison is exact and needs no tolerance,
 and it runs the device variants of the step (branch-free, no host caches) against NumPy's.
 
 With CuPy and a CUDA device, a batch on the GPU is compared with the NumPy batch (tolerance
@@ -244,8 +245,8 @@ class DeviceArray(np.lib.mixins.NDArrayOperatorsMixin):
     def __setitem__(self, key, value):
         key, value = _unwrap(key), _unwrap(value)
         arrays = _key_arrays(key)
-        if any(k.dtype == bool for k in arrays) and isinstance(value, np.ndarray) and value.ndim:
-            _forbid("an array assigned through a boolean mask (CuPy reads its True entries on the host)")
+        if any(k.dtype == bool for k in arrays):
+            _forbid("assignment through a boolean mask (CuPy reads the number of its True entries on the host)")
         if any(k.dtype != bool for k in arrays):
             # CuPy stores an undefined one of the values aimed at one element (NumPy: the last)
             target = np.arange(self._a.size).reshape(self._a.shape)[key].ravel()
@@ -438,6 +439,8 @@ class TestStandInIsCuPy(unittest.TestCase):
                 a[xp.asarray(np.array([1, 1]))] = xp.asarray(np.array([5.0, 6.0]))
             with self.assertRaises(HostReadError):          # CuPy counts the mask on the host
                 a[a > 2]
+            with self.assertRaises(HostReadError):          # also to assign a scalar (copyto(where=) does not)
+                a[a > 2] = 0.0
             self.assertEqual(xpmod.to_host(xp.argsort(a, kind="stable"), "state").tolist(), list(range(6)))
         API_MISSES.clear()
         ATTEMPTS.clear()
