@@ -415,7 +415,7 @@ class BatchEngine:
         u = s.vx - (s.y - self.hy_s) * s.rate[s.rep]
         ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
         plate = self.rate_max * s.Ly / 2
-        bound = N * s.k * s.r.reshape(B, N).mean(axis=1) ** 2 + s.m.reshape(B, N).sum(axis=1) * plate * plate
+        bound = N * s.k * xp.square(s.r.reshape(B, N).mean(axis=1)) + s.m.reshape(B, N).sum(axis=1) * plate * plate
         C = self.C
         ratio = xp.where(active & C.trans, d / C.d0, math.inf)
         # closest transient contact of each replica: one reduction over its own (contiguous) segment

@@ -85,10 +85,13 @@ class Backend:
     owns : callable
         ``owns(array) -> bool``: the array belongs to this backend.
     ordered_reductions : bool, default True
-        The namespace's ``bincount(index, weights, minlength)`` and ``add.reduceat`` sum in row
-        order without a host read (NumPy); False (CuPy: ``bincount`` adds atomically, in no fixed
-        order, and reads ``max(index)`` on the host) makes :class:`SegmentSum` and the per-replica
-        sums use a padded gather and a reduction along rows.
+        The namespace's ``bincount(index, weights, minlength)``, ``add.reduceat`` and
+        ``minimum.reduceat`` reduce each bin or segment in row order without a host read (NumPy).
+        False (CuPy: ``bincount`` adds atomically, in no fixed order, and reads ``max(index)`` on
+        the host; ``add.reduceat`` is a difference of two prefix sums, which rounds otherwise;
+        ``minimum.reduceat`` does not exist; docs/design.md, "Backends") makes
+        :class:`SegmentSum` and the per-replica sums and minima use a padded gather and a
+        reduction along rows.
     """
 
     def __init__(self, name, xp, host, asarray, to_host, owns, ordered_reductions=True):
@@ -299,7 +302,9 @@ class SegmentSum:
     def _padded(self):
         """The (n, width) gather matrix: row k lists the rows of bin k in order, padded with P (→ the appended value).
 
-        Built on the backend (a stable sort of the index); its width is read on the host ("layout")."""
+        Built on the backend (a stable sort of the index, each bin's first and last sorted row by
+        ``searchsorted``); its width is read on the host ("layout").  ``bincount`` is avoided: on
+        CuPy it reads ``any(index < 0)`` and ``max(index)`` on the host at every call."""
         xp = self.backend.xp
         index = self.index
         P = len(index)
@@ -307,10 +312,11 @@ class SegmentSum:
             order = xp.argsort(index, kind="stable")
         except TypeError:  # pragma: no cover - CuPy before v12 sorts stably without the keyword
             order = xp.argsort(index)
-        counts = xp.bincount(index, minlength=self.n)
-        width = int(to_host(counts.max(), "layout")) if P else 0
-        start = xp.cumsum(counts) - counts                     # first sorted row of each bin
-        bins = index[order]
+        bins = index[order]                                   # the bin of each sorted row (non-decreasing)
+        edges = xp.arange(self.n)
+        start = xp.searchsorted(bins, edges, side="left")    # first sorted row of each bin
+        counts = xp.searchsorted(bins, edges, side="right") - start
+        width = int(to_host(counts.max(), "layout")) if P and self.n else 0
         rank = xp.arange(P) - start[bins]                     # position of each row within its bin
         gather = xp.full((self.n, max(width, 1)), P, dtype=np.intp)
         gather[bins, rank] = order
