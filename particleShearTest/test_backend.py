@@ -55,6 +55,7 @@ STANDIN = "cpu-standin"
 #: namespace functions -> the keywords CuPy accepts (all the same in NumPy for these uses)
 CUPY_FUNCTIONS = {
     "arange": {"dtype"}, "array": {"dtype", "copy"}, "asarray": {"dtype"},
+    "clip": set(),                         # cupy.clip(a, a_min, a_max): the box's fold into its interval
     "argsort": {"axis", "kind"},           # kind: only None or "stable" (CuPy >= 12; always stable)
     "concatenate": {"axis"}, "copyto": {"casting", "where"}, "count_nonzero": {"axis"},
     "cumsum": {"axis", "dtype"}, "empty": {"dtype"}, "empty_like": {"dtype"}, "eye": {"dtype"},
@@ -71,7 +72,7 @@ CUPY_FUNCTIONS = {
 CUPY_UFUNCS = {"absolute", "add", "subtract", "multiply", "divide", "negative", "floor", "sqrt", "square",
                "maximum", "minimum", "copysign", "isfinite", "equal", "not_equal", "greater", "greater_equal",
                "less", "less_equal", "bitwise_and", "bitwise_or", "invert", "logical_not", "power", "remainder",
-               "floor_divide"}
+               "floor_divide", "nextafter"}
 #: the namespace's names of the ufuncs (CuPy has all of them under these names)
 CUPY_UFUNC_NAMES = {"abs": "absolute", "absolute": "absolute", "add": "add", "subtract": "subtract",
                     "multiply": "multiply", "divide": "divide", "true_divide": "divide", "negative": "negative",
@@ -81,7 +82,7 @@ CUPY_UFUNC_NAMES = {"abs": "absolute", "absolute": "absolute", "add": "add", "su
                     "less": "less", "less_equal": "less_equal", "bitwise_and": "bitwise_and",
                     "bitwise_or": "bitwise_or", "invert": "invert", "logical_not": "logical_not",
                     "power": "power", "mod": "remainder", "remainder": "remainder",
-                    "floor_divide": "floor_divide"}
+                    "floor_divide": "floor_divide", "nextafter": "nextafter"}
 #: keywords of a CuPy ufunc call (no public ``where=``: CuPy raises TypeError("Wrong arguments"))
 CUPY_UFUNC_KEYWORDS = {"out", "dtype", "casting"}
 #: ufunc methods -> the ufuncs that have them in CuPy (None: all).  Left out: ``at`` (only ufuncs
