@@ -1,17 +1,22 @@
-"""What each cache of the canvas classes buys per step (not a test).
+"""What each value kept in the canvas classes' memo buys per step, and the step against a baseline (not a test).
 
-For every cache the classes keep between steps, the step is timed with the cache disabled (the
-value recomputed where it is used, by an instance-level patch of the method that keeps it) and
-enabled, in alternating blocks in one process on the same scene, and the median µs per step of
-each is printed with the saving (the median over block pairs of disabled − enabled) in µs and as a fraction of
-the enabled step.
+For every entry of the one cache mechanism (:class:`particleShear.base.memo.Memo`) the step is timed
+with the entry disabled (its value recomputed at every ``get``) and enabled, in alternating blocks
+in one process on the same scene; printed: the median µs per step of each state and the saving
+(the median over block pairs of disabled − enabled, adjacent blocks seeing the same machine load)
+in µs and as a fraction of the enabled step.  With ``--baseline REV`` the whole step of the working
+tree is also timed against the step of git revision REV (its package loaded under another name)
+on the same scene, alternating blocks: what the deleted caches cost together.
 
-The step is what a run does (docs/design.md, "Caching"): ``setShearRate``, the force phase, the
-register totals, the σ_xy-only evaluation on every other step (what the experiment samples), the
-acceleration and the movement — on the crosslinked, frictional, sheared scenes of ``bench_step.py``
-at N = 150 and N = 10,000.
+The caches deleted from the classes (each buying < 10 % of a step at N = 150 and at N = 10,000)
+were measured by this script at commit 89efadd, which disabled each by an instance-level patch of
+the method that kept it; docs/design.md ("Caching") has both tables.
 
-Usage: python benchmarks/bench_caches.py [--sizes 150,10000] [--blocks K] [--only NAME,...]
+The step is what a run does: ``setShearRate``, the force phase, the register totals, the σ_xy-only
+evaluation on every other step (what the experiment samples), the acceleration and the movement —
+on the crosslinked, frictional, sheared scenes of ``bench_step.py`` at N = 150 and N = 10,000.
+
+Usage: python benchmarks/bench_caches.py [--sizes 150,10000] [--blocks K] [--baseline REV]
 """
 import os
 
@@ -19,21 +24,23 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
 
 import argparse  # noqa: E402
+import importlib  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
+import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tarfile  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
-import types  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
+import bench_step  # noqa: E402
 from bench_step import AMPLITUDE, DT, F_EXC, build  # noqa: E402
 
 from particleShear import StressTensorEvaluation  # noqa: E402
-from particleShear.base import canvas as C  # noqa: E402
-from particleShear.base.register import SphereSelection  # noqa: E402
-from particleShear.engine import laws as engine_laws  # noqa: E402
+from particleShear.base.memo import Memo  # noqa: E402
 
 COOL = 0.99969060716623
 
@@ -55,170 +62,115 @@ def run_steps(ens, ev, n_steps):
     return times
 
 
-# -- the patches that disable one cache each (instance attributes shadow the class's methods) --------
-def _wrap_tnr(ens, before):
-    """test_neighbor_relation preceded by ``before(ens)`` (drops a cache kept across steps)."""
-    orig = type(ens).test_neighbor_relation
+class BypassMemo(Memo):
+    """A memo that recomputes the entries ``names`` (a ``+``-separated string) at every ``get``."""
 
-    def tnr(self):
-        before(self)
-        return orig(self)
-    return {"test_neighbor_relation": types.MethodType(tnr, ens)}
+    __slots__ = ("_bypass",)
 
+    def __init__(self, values, names):
+        Memo.__init__(self)
+        self._values.update(values)
+        self._bypass = set(names.split("+"))
 
-def _struct_attr(name):
-    def before(self):
-        S = self._struct
-        if S is not None:
-            setattr(S, name, None if name != "mob" else C._UNSET)
-    return before
+    def get(self, name, key, compute):
+        if name in self._bypass:
+            return compute()
+        return Memo.get(self, name, key, compute)
 
 
-def _bond_attr(name):
-    def before(self):
-        S = self._struct
-        if S is not None and S.bond is not None:
-            setattr(S.bond, name, None)
-    return before
-
-
-def no_yc(ens):
-    return {"_y_centred": types.MethodType(lambda self: self._pos[1] - self.size_y / 2, ens)}
-
-
-def no_u(ens):
-    return {"_affine_vx": types.MethodType(lambda self, rate: self._y_centred() * rate, ens)}
-
-
-def no_mob(ens):
-    def mob(self):
-        if not self.applyingShear:
-            return None
-        y, r = self._pos[1], self._a["r"]
-        m = r < y
-        m &= y < self.size_y - r
-        return m
-    return {"_mobile_mask": types.MethodType(mob, ens)}
-
-
-def no_mob_limits(ens):
-    def before(self):
-        self._mob_limits = None
-    orig = type(ens)._mobile_mask
-
-    def mob(self):
-        before(self)
-        return orig(self)
-    return {"_mobile_mask": types.MethodType(mob, ens)}
-
-
-def no_selection(ens):
-    return {"_mobile_selection": types.MethodType(lambda self: SphereSelection(self, self._mobile_mask()), ens)}
-
-
-def no_kw(ens):
-    return {"_kick_weights": types.MethodType(lambda self: self._st.take(C._MASS_ROWS, axis=0), ens)}
-
-
-def no_on_relations(ens):
-    return {"_on_relations": types.MethodType(lambda self, value, g: value * g.active, ens)}
-
-
-def no_uniform(ens):
-    def param(self, name):
-        arr = self._a[name]
-        return float(arr[0]) if len(arr) and (arr == arr[0]).all() else None
-    return {"_param": types.MethodType(param, ens)}
-
-
-def no_law(ens):
-    def inside(d, d0, k, c, holder):
-        return engine_laws.central_inside(d, d0, *engine_laws.central_constants(d0, k, c),
-                                          form=engine_laws.central_form(c))
-    return {"_builtin_law_inside": inside}
-
-
-def no_flush(ens):
-    orig = type(ens)._flush_pair_forces
-    return {"_flush_pair_forces": types.MethodType(lambda self, reuse=False: orig(self, False), ens)}
-
-
-def no_cand(ens):
-    def before(self):
-        self._cand_key = None
-    return _wrap_tnr(ens, before)
-
-
-def no_struct(ens):
-    def before(self):
-        self._struct = None
-    return _wrap_tnr(ens, before)
-
-
-CACHES = {
-    "_yc (_y_centred)": no_yc,
-    "_u (_affine_vx)": no_u,
-    "_mob (_mobile_mask, whole)": no_mob,
-    "_mob_limits (r, Ly - r)": no_mob_limits,
-    "_selection (_mobile_selection)": no_selection,
-    "_kw (_kick_weights)": no_kw,
-    "_rel_factors (_on_relations)": no_on_relations,
-    "_uniform (_param)": no_uniform,
-    "_cand_* (rsum, perm, ji)": no_cand,
-    "_struct (pair structure, all on it)": no_struct,
-    "S.mob (internal flags)": lambda ens: _wrap_tnr(ens, _struct_attr("mob")),
-    "S.flush (flush arrays)": no_flush,
-    "holder.law (law constants)": no_law,
-    "S.bond (bond constants, all)": lambda ens: _wrap_tnr(ens, _struct_attr("bond")),
-    "B.params": lambda ens: _wrap_tnr(ens, _bond_attr("params")),
-    "B.tensile": lambda ens: _wrap_tnr(ens, _bond_attr("tensile")),
-    "B.tangential": lambda ens: _wrap_tnr(ens, _bond_attr("tangential")),
-    "B.viscous": lambda ens: _wrap_tnr(ens, _bond_attr("viscous")),
+ENTRIES = {
+    "pair_structure": "pair structure (indices, radii, levers, images)",
+    "internal_flags": "internal/external flags of the pairs",
+    "mobile": "mobile mask, per position update",
+    "mobile_content": "mobile mask: the same array while equal",
+    "bond_constants": "bond constants (d_eq, law d0, codes, Coulomb bound)",
+    "pair_structure+internal_flags+bond_constants": "the structure with what is derived from it",
+    "mobile+mobile_content": "mobile mask, both entries",
 }
 
 
-def measure(ens, ev, patch, blocks, steps):
+def measure(ens, ev, name, blocks, steps):
     """(disabled, enabled, saved) s per step: the medians over all steps of each state, and the median
     over block pairs of the difference of their block medians (adjacent blocks see the same load)."""
     off, on, saved = [], [], []
-    patches = patch(ens)
     for b in range(blocks):
         med = {}
         for state in ((0, 1) if b % 2 == 0 else (1, 0)):
+            kept = ens._memo
             if state == 0:
-                ens.__dict__.update(patches)
-                t = run_steps(ens, ev, steps)
-                off += t
-                for name in patches:
-                    del ens.__dict__[name]
-            else:
-                t = run_steps(ens, ev, steps)
-                on += t
+                ens._memo = BypassMemo(kept._values, name)
+            t = run_steps(ens, ev, steps)
+            if state == 0:
+                kept._values.update(ens._memo._values)
+                ens._memo = kept
+            (off if state == 0 else on).extend(t)
             med[state] = statistics.median(t)
         saved.append(med[0] - med[1])
     return statistics.median(off), statistics.median(on), statistics.median(saved)
+
+
+def baseline_package(rev):
+    """The package ``particleShear`` of git revision ``rev``, imported as ``particleShear_baseline``."""
+    root = os.path.dirname(HERE)
+    tmp = tempfile.mkdtemp()
+    archive = os.path.join(tmp, "rev.tar")
+    subprocess.run(["git", "-C", root, "archive", "-o", archive, rev, "particleShear"], check=True)
+    with tarfile.open(archive) as tf:
+        tf.extractall(tmp)
+    os.rename(os.path.join(tmp, "particleShear"), os.path.join(tmp, "particleShear_baseline"))
+    sys.path.insert(0, tmp)
+    return importlib.import_module("particleShear_baseline")
+
+
+def build_with(pkg, n):
+    """``bench_step.build(n)`` with the classes of package ``pkg`` (same seed, same scene)."""
+    saved = bench_step.EnsembleLinkable, bench_step.SphereLinkable
+    bench_step.EnsembleLinkable, bench_step.SphereLinkable = pkg.EnsembleLinkable, pkg.SphereLinkable
+    try:
+        return build(n)
+    finally:
+        bench_step.EnsembleLinkable, bench_step.SphereLinkable = saved
+
+
+def against_baseline(pkg, n, blocks, steps):
+    """Median s per step of (baseline, working tree) on the same scene, alternating blocks."""
+    import particleShear
+    scenes = {}
+    for key, p in (("baseline", pkg), ("tree", particleShear)):
+        ens = build_with(p, n)
+        ev = p.StressTensorEvaluation(ens.size_x, ens.size_y)
+        run_steps(ens, ev, 10)
+        scenes[key] = (ens, ev)
+    times = {"baseline": [], "tree": []}
+    for b in range(blocks):
+        for key in (("baseline", "tree") if b % 2 == 0 else ("tree", "baseline")):
+            times[key] += run_steps(*scenes[key], steps)
+    return statistics.median(times["baseline"]), statistics.median(times["tree"])
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="150,10000")
     ap.add_argument("--blocks", type=int, default=20)
-    ap.add_argument("--only", default="")
+    ap.add_argument("--baseline", default=None, help="git revision whose whole step is timed against this tree's")
     args = ap.parse_args()
-    only = [s for s in args.only.split(",") if s]
+    pkg = baseline_package(args.baseline) if args.baseline else None
     for n in [int(s) for s in args.sizes.split(",")]:
+        steps = 40 if n <= 1000 else 6
         ens = build(n)
         ev = StressTensorEvaluation(ens.size_x, ens.size_y)
         run_steps(ens, ev, 20)
-        steps = 40 if n <= 1000 else 6
         print(f"\nN = {n}: {args.blocks} alternating blocks of {steps} steps per state; median µs per step")
-        print(f"{'cache':40s} {'disabled':>10s} {'enabled':>10s} {'saved':>9s} {'saved %':>8s}")
-        for name, patch in CACHES.items():
-            if only and not any(o in name for o in only):
-                continue
-            t_off, t_on, dt = measure(ens, ev, patch, args.blocks, steps)
-            print(f"{name:40s} {t_off * 1e6:10.1f} {t_on * 1e6:10.1f} {dt * 1e6:9.1f} "
+        print(f"{'memo entry':44s} {'what':52s} {'disabled':>9s} {'enabled':>9s} {'saved':>8s} {'saved %':>8s}")
+        for name, what in ENTRIES.items():
+            t_off, t_on, dt = measure(ens, ev, name, args.blocks, steps)
+            print(f"{name:44s} {what:52s} {t_off * 1e6:9.1f} {t_on * 1e6:9.1f} {dt * 1e6:8.1f} "
                   f"{100 * dt / t_on:7.1f}%", flush=True)
+        if pkg is not None:
+            t_base, t_tree = against_baseline(pkg, n, args.blocks, steps)
+            print(f"whole step: {args.baseline} {t_base * 1e6:.1f} µs, this tree {t_tree * 1e6:.1f} µs "
+                  f"({100 * (t_tree - t_base) / t_base:+.1f} %; {t_tree / n * 1e6:.3f} µs per particle-step)",
+                  flush=True)
 
 
 if __name__ == "__main__":
