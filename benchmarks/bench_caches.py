@@ -86,6 +86,7 @@ ENTRIES = {
     "bond_constants": "bond constants (d_eq, law d0, codes, Coulomb bound)",
     "pair_structure+internal_flags+bond_constants": "the structure with what is derived from it",
     "mobile+mobile_content": "mobile mask, both entries",
+    "selection": "selection of the mobile spheres (the list)",
 }
 
 
@@ -152,6 +153,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="150,10000")
     ap.add_argument("--blocks", type=int, default=20)
+    ap.add_argument("--entries", default="", help="comma-separated rows of the entry table to run (default: all)")
     ap.add_argument("--baseline", default=None, help="git revision whose whole step is timed against this tree's")
     args = ap.parse_args()
     pkg = baseline_package(args.baseline) if args.baseline else None
@@ -163,6 +165,8 @@ def main():
         print(f"\nN = {n}: {args.blocks} alternating blocks of {steps} steps per state; median µs per step")
         print(f"{'memo entry':44s} {'what':52s} {'disabled':>9s} {'enabled':>9s} {'saved':>8s} {'saved %':>8s}")
         for name, what in ENTRIES.items():
+            if args.entries and name not in args.entries.split(","):
+                continue
             t_off, t_on, dt = measure(ens, ev, name, args.blocks, steps)
             print(f"{name:44s} {what:52s} {t_off * 1e6:9.1f} {t_on * 1e6:9.1f} {dt * 1e6:8.1f} "
                   f"{100 * dt / t_on:7.1f}%", flush=True)

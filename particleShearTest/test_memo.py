@@ -99,6 +99,20 @@ class TestCanvasMemo(unittest.TestCase):
         s.y = 0.5 * s.r       # onto the lower plate
         self.assertFalse(ens._mobile_mask()[k])
 
+    def test_mobile_selection_holds_the_mobile_spheres(self):
+        ens = self.ens
+        a = ens._a
+        mobile = (a["r"] < a["y"]) & (a["y"] < ens.size_y - a["r"])
+        expected = [s for s, m in zip(ens.sphereList, mobile) if m]
+        for sel in (ens._mobile_selection(), ens.movableSphereList()):
+            self.assertEqual(len(sel), len(expected))
+            self.assertTrue(all(x is y for x, y in zip(sel, expected)))
+            np.testing.assert_array_equal(sel.mask, mobile)
+        k = int(np.flatnonzero(mobile)[0])
+        ens.sphereList[k].y = 0.5 * ens.sphereList[k].r   # onto the lower plate: one sphere fewer
+        self.assertEqual(len(ens._mobile_selection()), len(expected) - 1)
+        self.assertNotIn(ens.sphereList[k], ens._mobile_selection())
+
     def test_pair_structure_is_its_definition(self):
         ens = self.ens
         g = ens._g
