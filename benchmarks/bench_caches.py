@@ -79,13 +79,9 @@ class BypassMemo(Memo):
 
 
 ENTRIES = {
-    "pair_structure": "pair structure (indices, radii, levers, images)",
+    "pair_structure": "pair structure (indices, radii, levers, images, bonds)",
     "internal_flags": "internal/external flags of the pairs",
-    "mobile": "mobile mask, per position update",
-    "mobile_content": "mobile mask: the same array while equal",
-    "bond_constants": "bond constants (d_eq, law d0, codes, Coulomb bound)",
-    "pair_structure+internal_flags+bond_constants": "the structure with what is derived from it",
-    "mobile+mobile_content": "mobile mask, both entries",
+    "pair_structure+internal_flags": "the structure and the flags",
     "selection": "selection of the mobile spheres (the list)",
 }
 

@@ -195,7 +195,7 @@ class _Structure:
     """Arrays over the pairs of the step that stay valid while the candidates, bonds and images do (and, for
     a compacted table, the set of relations); kept in the canvas's memo under ``key``."""
     __slots__ = ("key", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "view")
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "view", "bond")
 
 
 class _Geometry:
@@ -1083,7 +1083,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
                   "ri": S.ri, "rj": S.rj}
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
         S.safe_images = bool(self._images_valid)
+        S.bond = None if S.perm is None else self._bond_constants(S)
         return S
+
+    def _bond_constants(self, S):
+        """Constants of the bonds among the pairs of ``S`` (None here: bonds are added by the linkable canvas)."""
+        return None
 
     # -- pair-force accumulation -----------------------------------------------------------------
     def _geometry(self):
@@ -1293,21 +1298,15 @@ class CanvasPointsShear(CanvasPointsNeighbors):
     def _mobile(self):
         """(mask of the mobile spheres ``r < y < Ly − r``, its bytes) while shearing, else (None, None).
 
-        Kept per position update; a mask equal to the previous one is the previous array itself
-        (its bytes are its key), so what is derived from it (the internal flags here, the stress
-        evaluation's rows) is kept while the plates hold the same spheres."""
+        The bytes are the memo key of what is derived from the mask (the pairs' internal flags, the
+        selection of the mobile spheres), kept while the plates hold the same spheres."""
         if not self.applyingShear:
             return None, None
-        return self._memo.get("mobile", (self._pos_version, self._params_version, self.size_y),
-                              self._new_mobile)
-
-    def _new_mobile(self):
         y = self._pos[1]
         r = self._a["r"]
         mob = r < y
         mob &= y < self.size_y - r
-        b = mob.tobytes()
-        return self._memo.get("mobile_content", (b,), lambda: (mob, b))
+        return mob, mob.tobytes()
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres; immobile ones take the velocity of their plate.

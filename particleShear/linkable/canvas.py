@@ -27,7 +27,7 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 
 class _BondStructure:
-    """Bond constants over the pairs of a pair structure, kept in the canvas's memo under the structure's key."""
+    """Bond constants over the pairs of a pair structure (``S.bond``, made and kept with the structure)."""
     __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf")
 
 
@@ -202,12 +202,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
     # -- bond forces -------------------------------------------------------------------------------
     def _bond_structure(self, g):
-        """Per-pair bond constants of the step's pair structure, kept (memo) while the structure is the same:
-        bonds and their ``d_eq`` change only with the structure's key (candidates, links)."""
-        S = g.S
-        return self._memo.get("bond_constants", S.key, lambda: self._bond_constants(S))
+        """Per-pair bond constants of the step's pair structure: bonds and their ``d_eq`` change only with the
+        structure's key (candidates, links), so they are made with the structure."""
+        return g.S.bond
 
     def _bond_constants(self, S):
+        """The :class:`_BondStructure` of the pairs of structure ``S`` (which has bonds: ``S.perm`` is not None)."""
         B = _BondStructure()
         perm = S.perm
         B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
