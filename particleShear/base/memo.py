@@ -8,8 +8,8 @@ from), so a cached value is by construction what recomputing it gives; :meth:`Me
 drops every value at once, for the changes no counter records (relations edited in place through
 the per-sphere API, a constitution that replaces the pair table).
 
-Only values that buy at least ~10 % of a step are kept this way (docs/design.md, "Caching", has
-the measured table); everything else is recomputed where it is used.
+Only values that buy at least ~10 % of a step are kept this way (docs/design.md, "Caching of the
+classes", has the measured tables); everything else is recomputed where it is used.
 """
 __docformat__ = "numpy"
 
