@@ -70,6 +70,7 @@ ENGINE_MODULES = [
     "particleShear.base.graphics",
     "particleShear.base.kernels",
     "particleShear.base.laws",
+    "particleShear.base.memo",
     "particleShear.base.memory",
     "particleShear.base.namespace",
     "particleShear.base.neighbours",

@@ -287,24 +287,20 @@ class TestCallbackMechanism(unittest.TestCase):
 
 
 class TestEngineLawConstants(unittest.TestCase):
-    """The engine evaluates the built-in law with cached per-pair constants: bit-identical to the law."""
+    """The classes evaluate the built-in law with its per-pair constants: bit-identical to the law."""
 
     def test_cached_constants_equal_the_law(self):
         from particleShear.base.laws import elastic_force_law
-
-        class Holder:
-            law = None
 
         rng = np.random.default_rng(11)
         d0 = rng.uniform(20, 60, 500)
         d = d0 * rng.uniform(0.0005, 1.3, 500)   # beyond the cap, overlapping, touching and apart
         d[:5] = d0[:5]                           # exactly at contact
         ens = EnsembleLinkable(100, 100, 0)
-        holder = Holder()
         for k in (1.0, 3.14e9):
             for c in (0.0, 0.3, 1.0):
                 with self.subTest(k=k, c=c):
-                    np.testing.assert_array_equal(ens._central_law(d, d0, k, c, holder),
+                    np.testing.assert_array_equal(ens._central_law(d, d0, k, c),
                                                   elastic_force_law(d, d0, k, c))
 
 

@@ -31,6 +31,7 @@ from . import laws
 from .laws import call_law_vectorised
 from ..engine import laws as _engine_laws
 from ..engine.integrate import damp, kick, plates_follow, xi_increments
+from .memo import Memo
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
 from .points import CircleBasicElasticity, _check_finite, _check_positive
@@ -179,21 +180,7 @@ class SphereList(list):
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
 
 
-_UNSET = object()
 _SLIP8 = np.int8(SLIP)   # compared with the int8 state array without a scalar conversion
-_ZEROS = {}
-
-
-def _zeros(n):
-    """A read-only array of n zeros: ``where(mask, zeros, x)`` with an array is about twice as fast
-    as with the scalar 0.0, and gives the same +0.0."""
-    z = _ZEROS.get(n)
-    if z is None:
-        if len(_ZEROS) > 64:
-            _ZEROS.clear()
-        z = _ZEROS[n] = np.zeros(n)
-        z.flags.writeable = False
-    return z
 
 
 # ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
@@ -205,17 +192,17 @@ _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 
 class _Structure:
-    """Arrays over the active pairs that stay valid while the set of relations does."""
-    __slots__ = ("token", "law", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "mob", "internal", "ext_i", "ext_j",
-                 "bond", "view", "flush")
+    """Arrays over the pairs of the step that stay valid while the candidates, bonds and images do (and, for
+    a compacted table, the set of relations); kept in the canvas's memo under ``key``."""
+    __slots__ = ("key", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "view", "bond")
 
 
 class _Geometry:
     """Per-step arrays over the active pairs (positions at the start of the step).
 
-    The per-structure arrays (``ai``, ``aj``, ``d0``, ``perm``, ``trans``, ``ri``, ``rj``,
-    ``internal``, ``ext_i``, ``ext_j``) are copied in from the structure's ``view`` dictionary;
+    The per-structure arrays (``ai``, ``aj``, ``d0``, ``perm``, ``trans``, ``ri``, ``rj``) are copied in
+    from the structure's ``view`` dictionary and the flags ``internal``, ``ext_i``, ``ext_j`` from the memo;
     what the force terms compute on first use starts as the class default None."""
     fn_i = fn_j = ft = vn = vt = fel = rv = None
     parts = None       # [(term, f_i, f_j)] of the central terms, for the register's per-visit lists
@@ -266,11 +253,9 @@ class CanvasPoints:
         self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
         self._renderer = None
-        self._uniform = {}
+        self._memo = Memo()   # every value kept between calls (docs/design.md, "Caching of the classes")
         self._pos_version = 0
         self._params_version = 0
-        self._yc_key = None
-        self._u_key = None
         self._in_cell = False
         self._images_valid = False
         self.graphical_output_configuration = Graphical_output_configuration()
@@ -388,16 +373,12 @@ class CanvasPoints:
         self._in_cell = False
 
     def _params_changed(self):
-        self._uniform = {}
         self._params_version += 1
 
     def _param(self, name):
         """Scalar value of a per-sphere parameter if all spheres share it, else None."""
-        u = self._uniform
-        if name not in u:
-            arr = self._a[name]
-            u[name] = float(arr[0]) if len(arr) and (arr == arr[0]).all() else None
-        return u[name]
+        arr = self._a[name]
+        return float(arr[0]) if len(arr) and (arr == arr[0]).all() else None
 
     # -- bookkeeping ----------------------------------------------------------------------------
     def set_graphical_output_configuration(self, graphical_output_configuration):
@@ -451,7 +432,11 @@ class CanvasPoints:
 
     def _mobile_mask(self):
         """Boolean mask of mobile spheres, or None when every sphere is mobile."""
-        return None
+        return self._mobile()[0]
+
+    def _mobile(self):
+        """(mask of the mobile spheres, its bytes): (None, None) when every sphere is mobile."""
+        return None, None
 
     def movableSphereList(self):
         """The mobile spheres, in index order, as a list (a :class:`SphereSelection`: new on each call,
@@ -460,12 +445,10 @@ class CanvasPoints:
         return SphereSelection(self, sel.mask, sel)
 
     def _mobile_selection(self):
-        """The ensemble's own selection of its mobile spheres, kept while the mask is the same object."""
-        mob = self._mobile_mask()
-        sel = self.__dict__.get("_selection")
-        if sel is None or sel.mask is not mob or not sel.is_current():
-            sel = self._selection = SphereSelection(self, mob)
-        return sel
+        """The selection of the mobile spheres the stress evaluation is given (kept while the same spheres are
+        mobile: building the list of spheres costs ≈ 10 % of a step at N = 10,000)."""
+        mob, mob_bytes = self._mobile()
+        return self._memo.get("selection", (self._n, mob_bytes), lambda: SphereSelection(self, mob))
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres ``v += F·dt/m`` and reset their force.
@@ -524,22 +507,13 @@ class CanvasPoints:
         return 0.0
 
     def _y_centred(self):
-        """``y − Ly/2`` of every sphere (µm), computed once per position update: the affine flow,
-        the damping, the shear-rate change and the drift bookkeeping all need it."""
-        key = (self._pos_version, self.size_y)
-        if self._yc_key != key:
-            self._yc = self._pos[1] - self.size_y / 2
-            self._yc_key = key
-        return self._yc
+        """``y − Ly/2`` of every sphere (µm): the affine flow, the damping, the shear-rate change, the
+        drift bookkeeping and the shear stress need it."""
+        return self._pos[1] - self.size_y / 2
 
     def _affine_vx(self, rate):
-        """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s), computed once per
-        position update and rate: the damping and the kinetic stress tensors both need it."""
-        key = (self._pos_version, self.size_y, rate)
-        if self._u_key != key:
-            self._u = self._y_centred() * rate
-            self._u_key = key
-        return self._u
+        """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s)."""
+        return self._y_centred() * rate
 
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active; docs/design.md).
@@ -823,12 +797,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._disp = np.zeros((2, 0))
         self._nl_strain = 0.0
         self._nl_abs_strain = 0.0
-        self._struct = None
-        self._active_epoch = 0    # changes whenever the set of relations may have changed
-        self._rel_factors = (None, {})
         self._links_version = 0
+        self._relations_version = 0   # changes whenever the step's neighbour update changes the relations
         self._images_token = 0
-        self._cand_key = None
 
     def _invalidate_neighbours(self):
         self._nl_valid = False
@@ -945,14 +916,8 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         pos = self._pos
         C = len(pt.i)
         Lx, Ly = self.size_x, self.size_y
-        key = (pt.version, self._links_version)
-        if self._cand_key != key:
-            r = self._a["r"]
-            self._nl_rsum = r[pt.i] + r[pt.j]
-            self._cand_perm = pt.state == PERMANENT if pt.n_permanent else None
-            self._cand_ji = _concat((pt.j, pt.i))
-            self._cand_key = key
-        T = pos.take(self._cand_ji, axis=1)
+        r = self._a["r"]
+        T = pos.take(_concat((pt.j, pt.i)), axis=1)
         D0 = T[:, :C] - T[:, C:]   # raw differences (x_j − x_i, y_j − y_i)
         cached_images = self._images_valid and self._images_version == pt.version
         dvx_rate = 0.0
@@ -974,9 +939,9 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             self._images_token += 1
         DD = D * D
         d = np.sqrt(DD[0] + DD[1])
-        d0 = self._nl_rsum
+        d0 = r[pt.i] + r[pt.j]   # contact distances r_i + r_j
         touching = d < d0
-        perm = self._cand_perm
+        perm = pt.state == PERMANENT if pt.n_permanent else None
         new_active = touching if perm is None else (touching | perm)
         old = pt.active
         # most steps keep every relation: a byte comparison of the masks is cheaper than != and a count
@@ -991,27 +956,24 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             if n_born:
                 pt.birth[born] = pt.next_births(n_born)
             pt.active = new_active
-            self._active_epoch += 1
+            self._relations_version += 1
         # Small tables (overhead-bound): every force term runs over all candidate pairs, inactive ones
         # getting exactly zero force (ξ = 0, law = 0 beyond contact, viscous terms masked), so nothing
         # is gathered per step.  Large tables (throughput-bound): the terms run over the active pairs only.
         compact = C >= self.compact_pairs_from
-        S = self._struct
-        token = (key, self._images_token)
-        if S is None or S.token != token or (S.sel is None) == compact or (compact and changed):
-            S = self._pair_structure(new_active if compact else None, d0, perm, ky, kx, D0, D, d, cached_images)
-            S.token = token
-            self._struct = S
-            self._active_epoch += 1   # relations may have been changed in place by the API
-        mob = self._mobile_mask()
-        if S.mob is not mob:
-            if S.mob is _UNSET or mob is None or S.mob is None or _nz(mob != S.mob):
-                self._set_internal_flags(S, mob)
-            else:
-                S.mob = mob   # same mask, new array
+        # the pair structure depends on the candidates, the bonds, the image periods and, for a compacted
+        # table, on the relations themselves
+        key = (pt.version, self._links_version, self._images_token, compact,
+               self._relations_version if compact else None)
+        S = self._memo.get("pair_structure", key,
+                           lambda: self._pair_structure(new_active if compact else None, d0, perm, ky, kx, D0, D, d,
+                                                        cached_images, key))
+        mob, mob_bytes = self._mobile()
         g = _Geometry()
         g.S = S
         g.__dict__.update(S.view)
+        g.internal, g.ext_i, g.ext_j = self._memo.get("internal_flags", (key, mob_bytes),
+                                                      lambda: self._internal_flags(S, mob))
         sel = S.sel
         if sel is None:
             g.slots = slice(None)
@@ -1045,42 +1007,28 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._g = g
         return g
 
-    def _on_relations(self, value, g):
-        """``value`` on the relations among all candidate pairs and 0 elsewhere (``value · active``),
-        kept while the relations stay the same (ν of the viscous term, dt of the ξ rule)."""
-        epoch, kept = self._rel_factors
-        if epoch != self._active_epoch or len(kept) > 8:
-            kept = {}
-            self._rel_factors = (self._active_epoch, kept)
-        f = kept.get(value)
-        if f is None:
-            f = kept[value] = value * g.active
-        return f
-
-    def _set_internal_flags(self, S, mob):
-        """Internal/external flags of the active pairs for mobility mask ``mob`` (docs/design.md), and what the
-        stress evaluation needs of them: float weights of internal pairs, slots and targets of external forces."""
+    @staticmethod
+    def _internal_flags(S, mob):
+        """(internal, ext_i, ext_j) of the pairs of structure ``S`` for mobility mask ``mob`` (docs/design.md):
+        a pair is internal when both spheres are mobile and it does not act through the boundary; every other
+        pair gives an external force to each of its mobile spheres."""
         shifted = S.shifted
         if mob is None:
-            S.internal = ~shifted
-            S.ext_i = shifted
-            S.ext_j = shifted
-        else:
-            mi = mob.take(S.ai)
-            mj = mob.take(S.aj)
-            S.internal = mi & mj & ~shifted
-            S.ext_i = mi & ~S.internal
-            S.ext_j = mj & ~S.internal
-        S.mob = mob
-        S.view.update(internal=S.internal, ext_i=S.ext_i, ext_j=S.ext_j)
+            return ~shifted, shifted, shifted
+        mi = mob.take(S.ai)
+        mj = mob.take(S.aj)
+        internal = mi & mj & ~shifted
+        return internal, mi & ~internal, mj & ~internal
 
-    def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images):
+    def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images, key):
         """Per-pair data that change only when the candidates, bonds or images change — or, for a
-        table compacted to its ``active`` pairs, when the set of relations changes."""
+        table compacted to its ``active`` pairs, when the set of relations changes (``key``, its memo key,
+        is kept as ``S.key`` for the values derived from the structure)."""
         pt = self._pairs
         r = self._a["r"]
         n = self._n
         S = _Structure()
+        S.key = key
         if active is None:
             S.sel = S.sel2 = None
             S.ai = pt.i
@@ -1125,17 +1073,18 @@ class CanvasPointsNeighbors(CanvasPointsMass):
             rx, ry = D0[0].take(w), D0[1].take(w)
             shifted[w] = np.sqrt(rx * rx + ry * ry) != d.take(w)
         S.shifted = shifted
-        S.mob = _UNSET  # internal/external flags not computed yet
-        S.flush = None  # the force array of the flush, reused from step to step
         # what every step's geometry takes over from the structure
         # (not S itself: a structure referring to itself would wait for the cyclic collector)
         S.view = {"ai": S.ai, "aj": S.aj, "d0": S.d0, "perm": S.perm, "trans": S.trans,
                   "ri": S.ri, "rj": S.rj}
-        S.bond = None  # bond constants, filled by the linkable canvas
-        S.law = None   # constants of the built-in central law
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
         S.safe_images = bool(self._images_valid)
+        S.bond = None if S.perm is None else self._bond_constants(S)
         return S
+
+    def _bond_constants(self, S):
+        """Constants of the bonds among the pairs of ``S`` (None here: bonds are added by the linkable canvas)."""
+        return None
 
     # -- pair-force accumulation -----------------------------------------------------------------
     def _geometry(self):
@@ -1170,13 +1119,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         return (W, W[:2 * P].reshape(2, P), W[2 * P:4 * P].reshape(2, P), T,
                 None if T is None else T.reshape(2, P))
 
-    def _flush_pair_forces(self, reuse=False):
+    def _flush_pair_forces(self):
         """Apply the collected pair forces to the spheres and put them into the force register.
 
         Forces on i and j and the tangential torques go into one flat array, in contiguous (2, P)
         blocks F_i, F_j, (t_i, t_j), that a single ``bincount`` adds to the (xforce, yforce, torque)
-        rows of the state block.  With ``reuse`` (one flush per force phase, the register cleared
-        before it) that array is kept with the pair structure from step to step.
+        rows of the state block.
         """
         g = self._g
         if g is None:
@@ -1185,12 +1133,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         P = g.P
         S = g.S
         spin = g.ft is not None
-        if reuse:
-            fa = S.flush
-            if fa is None or (fa[3] is None) == spin:
-                fa = S.flush = self._flush_arrays(P, spin)
-        else:
-            fa = self._flush_arrays(P, spin)
+        fa = self._flush_arrays(P, spin)
         W = fa[0]
         Fi = fa[1]
         Fj = fa[2]
@@ -1248,8 +1191,20 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         cls = self._relation_view_class
         return [cls(self, p, int(q)) for q in partners]
 
+    def _relations_edited(self):
+        """The one place that drops every kept value (docs/design.md, "Caching of the classes"): relations were changed
+        outside the step's neighbour update (the per-sphere API, a batched constitution), which no counter
+        of the memo keys records."""
+        self._memo.invalidate()
+
+    @property
+    def _struct(self):
+        """The pair structure of the last neighbour update (None before the first one or after
+        :meth:`_relations_edited`), for inspection."""
+        return self._memo.peek("pair_structure")
+
     def _drop_relations_of(self, p):
-        self._struct = None
+        self._relations_edited()
         if self._g is not None:
             self._g.all_slip = False
         pt = self._pairs
@@ -1266,7 +1221,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     def _test_pair(self, p, q):
         """Neighbour test of one pair (the scalar ``test_neighbor_relation(theSphere)`` API)."""
-        self._struct = None
+        self._relations_edited()
         if self._g is not None:
             self._g.all_slip = False
         a = self._a
@@ -1318,9 +1273,6 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.applyingShear = False
         self.shear_rate = 0
         self.shear = 0
-        self._mob_key = None
-        self._mob = None
-        self._mob_limits = None
 
     def canMove(self, theSphere):
         """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (docs/design.md).
@@ -1339,24 +1291,18 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             return True
         return theSphere.r < theSphere.y < self.size_y - theSphere.r
 
-    def _mobile_mask(self):
+    def _mobile(self):
+        """(mask of the mobile spheres ``r < y < Ly − r``, its bytes) while shearing, else (None, None).
+
+        The bytes are the memo key of what is derived from the mask (the pairs' internal flags, the
+        selection of the mobile spheres), kept while the plates hold the same spheres."""
         if not self.applyingShear:
-            return None
-        key = (self._pos_version, self.size_y)
-        if self._mob_key != key:
-            y = self._pos[1]
-            lim = self._mob_limits
-            if lim is None or lim[0] != (self.size_y, self._params_version):
-                r = self._a["r"]
-                lim = self._mob_limits = ((self.size_y, self._params_version), r.copy(), self.size_y - r)
-            mob = lim[1] < y
-            mob &= y < lim[2]
-            # keep the same object while nothing changed: users of the mask compare by identity
-            old = self._mob
-            if old is None or len(mob) != len(old) or mob.tobytes() != old.tobytes():
-                self._mob = mob
-            self._mob_key = key
-        return self._mob
+            return None, None
+        y = self._pos[1]
+        r = self._a["r"]
+        mob = r < y
+        mob &= y < self.size_y - r
+        return mob, mob.tobytes()
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres; immobile ones take the velocity of their plate.
@@ -1500,27 +1446,24 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     def _law(self, d, d0, k, c):
         return call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, d, d0, k, c)
 
-    def _central_law(self, d, d0, k, c, holder):
+    def _central_law(self, d, d0, k, c):
         """Central elastic law of every pair of the step (already masked to relations).
 
-        The built-in law (eqs. S1-5a, S1-5b) with one repulsion coefficient is evaluated with its
-        per-pair constants (``d0/1000``, ``−k·c·d0``) kept on ``holder`` (the pair or bond
-        structure), in exactly the operations of :func:`~particleShear.base.laws.elastic_force_law`.
+        The built-in law (eqs. S1-5a, S1-5b) with one repulsion coefficient is evaluated in exactly the
+        operations of :func:`~particleShear.base.laws.elastic_force_law`; a user law pair by pair.
         """
         law = CircleBasicElasticity.call_back_elastic_force_law
-        if law is not laws.elastic_force_law or type(c) is not float or holder is None:
+        if law is not laws.elastic_force_law or type(c) is not float:
             return self._mask_law(call_law_vectorised(law, d, d0, k, c))
-        return _where(d > d0, _zeros(len(d)), self._builtin_law_inside(d, d0, k, c, holder))
+        return _where(d > d0, np.zeros(len(d)), self._builtin_law_inside(d, d0, k, c))
 
     @staticmethod
-    def _builtin_law_inside(d, d0, k, c, holder):
-        """The built-in law (eqs. S1-5a, S1-5b) as if every pair were in contact (no cut-off at ``d0``), with its
-        per-pair constants (``d0/1000``, ``−k(1−c)``, ``−k·c·d0``) kept on ``holder``; the arithmetic of
-        :func:`particleShear.engine.laws.central_inside`, as in :func:`~particleShear.base.laws.elastic_force_law`."""
-        lc = holder.law
-        if lc is None or lc[0] != (k, c):
-            lc = holder.law = ((k, c), _engine_laws.central_constants(d0, k, c), _engine_laws.central_form(c))
-        return _engine_laws.central_inside(d, d0, *lc[1], form=lc[2])
+    def _builtin_law_inside(d, d0, k, c):
+        """The built-in law (eqs. S1-5a, S1-5b) as if every pair were in contact (no cut-off at ``d0``): the
+        arithmetic of :func:`particleShear.engine.laws.central_inside` with its per-pair constants
+        (``d0/1000``, ``−k(1−c)``, ``−k·c·d0``), as in :func:`~particleShear.base.laws.elastic_force_law`."""
+        return _engine_laws.central_inside(d, d0, *_engine_laws.central_constants(d0, k, c),
+                                           form=_engine_laws.central_form(c))
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
@@ -1541,7 +1484,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             tr = g.trans
             c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
             if tr is None:
-                f_i = self._central_law(g.d, g.d0, self.k, c_i, g.S)
+                f_i = self._central_law(g.d, g.d0, self.k, c_i)
                 f_j = None if c_j is c_i else self._mask_law(self._law(g.d, g.d0, self.k, c_j))
                 g.fel = f_i
             else:
@@ -1600,7 +1543,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
                 f = nu * self._normal_speed(g)
             else:
                 # relations only: ν·1 = ν exactly, ν·0 = 0
-                f = self._on_relations(nu, g) * self._normal_speed(g)
+                f = (nu * g.active) * self._normal_speed(g)
             scale = self._viscous_scale(g)
             if scale is None:
                 self._add_normal(f, None, "viscous")
@@ -1641,7 +1584,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             self._in_force_phase = False
             if predicted is not None:
                 self._restore_velocities(predicted)
-        self._flush_pair_forces(reuse=True)
+        self._flush_pair_forces()
         if self.stability_guard is not None:
             self.stability_guard.check(self, step=self.step_count, phase=self.phase, dt=self._last_dt)
 
@@ -1937,7 +1880,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             g.ft_visits = 0.0   # every visit applies a zero force (Coulomb bound 0)
             return
         fc = np.abs(self.mu * self._coulomb_law(g))
-        self._apply_tangential(np.False_, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
+        self._apply_tangential(None, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
 
     def _coulomb_law(self, g):
         """Elastic central law of each transient contact (cached from the elastic term)."""
@@ -1946,10 +1889,11 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             return self._mask_law(self._law(g.d, g.d0, self.k, c_i))
         return g.fel
 
-    def _apply_tangential(self, permanent, kt_i, kt_j, nut_i, nut_j, fc):
+    def _apply_tangential(self, perm_code, kt_i, kt_j, nut_i, nut_j, fc):
         """Run the two-visit kernel on all candidate pairs and record states, ξ and forces.
 
-        ``permanent`` is the bond mask or ``np.False_``; ``fc`` the Coulomb bound of each
+        ``perm_code`` is the state code PERMANENT on bonds and 0 elsewhere (int8, one per pair) or None
+        when there are no bonds; ``fc`` the Coulomb bound of each
         pair (bonds: ``inf``, i.e. no bound).  Inactive candidates have ξ = 0, no viscous
         part and a zero bound, so they get exactly zero force and stay in the stick state.
         """
@@ -1961,13 +1905,13 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         F, slip = tangential_two_pass(vt, g.touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
         state = slip.view(np.int8)   # SLIP = 1, STICK = 0
         if sel is None:
-            if permanent is not np.False_:
-                state = np.add(state, g.S.bond.perm_code, out=pt.state)
+            if perm_code is not None:
+                state = np.add(state, perm_code, out=pt.state)
             else:
                 pt.state[...] = state
         else:
-            if permanent is not np.False_:
-                state = state + g.S.bond.perm_code
+            if perm_code is not None:
+                state = state + perm_code
             pt.state[sel] = state
             pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
         g.ft_visits = F
@@ -2026,19 +1970,12 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         if (cls.do_linear_acceleration is CanvasPointsShear.do_linear_acceleration
                 and cls.do_rotational_acceleration is friction.do_rotational_acceleration):
             # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
-            kick(self._vel, self._frc, self._kick_weights(), dt)
+            kick(self._vel, self._frc, self._st.take(_MASS_ROWS, axis=0), dt)   # weights (m, m, I)
             self._plates_follow()
         else:
             self.do_linear_acceleration(dt)
             self.do_rotational_acceleration(dt)
         self.cool(cool_factor)
-
-    def _kick_weights(self):
-        """(m, m, I) of every sphere as a (3, N) array, kept while masses and inertias stay the same."""
-        kw = self.__dict__.get("_kw")
-        if kw is None or kw[0] != self._params_version:
-            kw = self._kw = (self._params_version, self._st.take(_MASS_ROWS, axis=0))
-        return kw[1]
 
     def cool(self, f=0.8):
         """Damp velocity relative to the affine flow and spin by ``f`` (docs/design.md), all three rows at once.
@@ -2070,7 +2007,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         P = g.P
         # the factor dt on relations that did not slip, 0 on slipped ones and on inactive candidates
         if sel is None:
-            kd = _where(pt.state == _SLIP8, _zeros(P), self._on_relations(dt, g))
+            kd = _where(pt.state == _SLIP8, np.zeros(P), dt * g.active)
         else:
             kd = _where(pt.state.take(sel) == _SLIP8, 0.0, dt)
         vel = self._vel

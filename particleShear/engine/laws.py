@@ -3,7 +3,7 @@
 This module is the single definition of the arithmetic of the compressive law and of the
 linear tensile law of bonds.  Every caller uses it: the engine (on whole pair arrays, with
 per-candidate constants precomputed once per bond set), the classes' vectorised step (with the
-constants cached on the pair or bond structure) and the documented per-sphere callbacks
+constants computed where the law is evaluated) and the documented per-sphere callbacks
 :func:`~particleShear.base.laws.elastic_force_law` and
 :func:`~particleShear.base.laws.elastic_force_law_tensile` (on Python scalars).
 

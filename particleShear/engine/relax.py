@@ -339,8 +339,7 @@ def write_back(engine, b, ensemble, steps=0, ages=None):
 
     ensemble._invalidate_neighbours()
     ensemble._links_changed()
-    ensemble._active_epoch += 1
-    ensemble._struct = None
+    ensemble._relations_edited()
     ensemble._g = None
     ensemble._last_dt = float(ensemble.dt)
     ensemble.step_count += int(steps)

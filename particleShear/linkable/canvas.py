@@ -27,9 +27,8 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 
 class _BondStructure:
-    """Bond constants over the active pairs (valid as long as the pair structure they belong to)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf", "law", "params", "tensile", "tangential",
-                 "viscous")
+    """Bond constants over the pairs of a pair structure (``S.bond``, made and kept with the structure)."""
+    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf")
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
@@ -203,22 +202,19 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
     # -- bond forces -------------------------------------------------------------------------------
     def _bond_structure(self, g):
-        """Per-active-pair bond constants, kept while the relations and bonds stay the same."""
-        S = g.S
-        B = S.bond
-        if B is None:
-            B = S.bond = _BondStructure()
-            perm = S.perm
-            B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
-            B.d0 = _where(perm, deq, S.d0)               # contact distance of the central law
-            B.deq_stretch = _where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
-            B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
-            B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
-            B.law = None
-            B.params = None
-            B.tensile = None
-            B.tangential = None
-            B.viscous = None
+        """Per-pair bond constants of the step's pair structure: bonds and their ``d_eq`` change only with the
+        structure's key (candidates, links), so they are made with the structure."""
+        return g.S.bond
+
+    def _bond_constants(self, S):
+        """The :class:`_BondStructure` of the pairs of structure ``S`` (which has bonds: ``S.perm`` is not None)."""
+        B = _BondStructure()
+        perm = S.perm
+        B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
+        B.d0 = _where(perm, deq, S.d0)               # contact distance of the central law
+        B.deq_stretch = _where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
+        B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
+        B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
         return B
 
     def _elastic_terms(self):
@@ -229,12 +225,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             return
         B = self._bond_structure(g)
         perm = g.perm
-        pp = B.params
-        if pp is None or pp[0] != self._params_version:
-            pp = B.params = ((self._params_version,) + self._pair_param("central_repulsion_coefficient", g)
-                             + self._pair_param("permanent_ratio_central", g))
-        c_i = pp[1]
-        c_j = pp[2]
+        c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
         law = CircleBasicElasticity.call_back_elastic_force_law
         k = self.k
         if (c_j is c_i and type(c_i) is float and law is elastic_force_law
@@ -242,10 +233,10 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             # built-in laws: beyond d0 (= d_eq for bonds) a bond pulls with k·(d − d_eq) and a contact
             # has no force (k·(d − 0)·0 = +0); up to d0 both follow the compressive law
             f_i = f_j = _where(g.d > B.d0, self._tensile_inline(g.d, k, B, perm),
-                               self._builtin_law_inside(g.d, B.d0, k, c_i, B))
+                               self._builtin_law_inside(g.d, B.d0, k, c_i))
             g.fel = f_i
         else:
-            f_i = self._central_law(g.d, B.d0, k, c_i, B)
+            f_i = self._central_law(g.d, B.d0, k, c_i)
             g.fel = f_i
             f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, k, c_j))
             stretched = g.d >= B.deq_stretch
@@ -257,8 +248,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                     f_t = call_law_vectorised(tensile, g.d, B.deq, k)
                 f_i = _where(stretched, f_t, f_i)
                 f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
-        rc_i = pp[3]
-        rc_j = pp[4]
+        rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
         if not (rc_i is rc_j and rc_i == 1.0):
             f_i = f_i * _where(perm, rc_i, 1.0)
             f_j = f_j * _where(perm, rc_j, 1.0)
@@ -267,11 +257,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
     @staticmethod
     def _tensile_inline(d, k, B, perm):
         """Built-in tensile law ``−k (d_eq − d)`` (:func:`particleShear.engine.laws.tensile_inside`) on bonds and
-        ``−0·(0 − d) = +0`` on contacts; the masked constants ``−k`` and ``d_eq`` are kept on the bond structure."""
-        kd = B.tensile
-        if kd is None or kd[0] != k:
-            kd = B.tensile = (k, -_where(perm, k, 0.0), _where(perm, B.deq, 0.0))
-        return _engine_laws.tensile_inside(d, kd[2], kd[1])
+        ``−0·(0 − d) = +0`` on contacts (the constants ``−k`` and ``d_eq`` masked to the bonds)."""
+        return _engine_laws.tensile_inside(d, _where(perm, B.deq, 0.0), -_where(perm, k, 0.0))
 
     def _tangential_terms(self):
         """Transient contacts and bonds in one two-visit pass; bonds have no Coulomb bound."""
@@ -280,17 +267,13 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
             CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
             return
         B = self._bond_structure(g)
-        kt, nut = self.k_t, self.nu_t
-        key = (self._params_version, kt, nut)
-        if B.tangential is None or B.tangential[0] != key:
-            B.tangential = (key,) + self._tangential_constants(g, kt, nut)
-        _, kt_i, kt_j, nut_i, nut_j = B.tangential
+        kt_i, kt_j, nut_i, nut_j = self._tangential_constants(g, self.k_t, self.nu_t)
         fc = np.abs(self.mu * self._coulomb_law(g))
         fc += B.fc_inf
-        self._apply_tangential(g.perm, kt_i, kt_j, nut_i, nut_j, fc)
+        self._apply_tangential(B.perm_code, kt_i, kt_j, nut_i, nut_j, fc)
 
     def _tangential_constants(self, g, kt, nut):
-        """(k_t, ν_t) seen by each visit: scaled by the sphere's ratios on bonds (kept per bond structure)."""
+        """(k_t, ν_t) seen by each visit: scaled by the sphere's ratios on bonds."""
         perm = g.perm
         rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
         nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
@@ -319,14 +302,9 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                 _where(np.broadcast_to(k_j, (g.P,)) != 0, 1.0, r_j))
 
     def _viscous_scale(self, g):
+        """Per-visit factors (s_i, s_j) on ν: the viscosity ratio on bonds, 1 on contacts (None: all 1)."""
         if g.perm is None:
             return None
-        B = self._bond_structure(g)
-        if B.viscous is None or B.viscous[0] != self._params_version:
-            B.viscous = (self._params_version, self._viscous_scale_of(g))
-        return B.viscous[1]
-
-    def _viscous_scale_of(self, g):
         v_i, v_j = self._visc_ratio(g, "permanent_ratio_central")
         if type(v_i) is float and v_i == 1.0:
             return None

@@ -1,0 +1,175 @@
+"""The one cache mechanism of the canvas classes (particleShear.base.memo) and what the canvases keep in it.
+
+A kept value must be what recomputing it gives: the memo's contract (same key: the kept value; new key
+or an invalidation: recomputed), and, on a sheared crosslinked scene, every value the canvas keeps
+compared with the same value computed from the ensemble's state by its definition.
+"""
+import math
+import unittest
+
+import numpy as np
+
+from particleShear import EnsembleLinkable, SphereLinkable
+from particleShear.base.memo import Memo
+from particleShear.base.neighbours import PERMANENT
+
+
+class TestMemo(unittest.TestCase):
+    def test_same_key_keeps_new_key_recomputes(self):
+        m = Memo()
+        calls = []
+
+        def compute(v):
+            calls.append(v)
+            return v * v
+        self.assertEqual(m.get("sq", (3,), lambda: compute(3)), 9)
+        self.assertEqual(m.get("sq", (3,), lambda: compute(-1)), 9)      # kept: compute not called
+        self.assertEqual(calls, [3])
+        self.assertEqual(m.get("sq", (4,), lambda: compute(4)), 16)      # key changed: recomputed
+        self.assertEqual(calls, [3, 4])
+
+    def test_names_are_independent(self):
+        m = Memo()
+        m.get("a", (1,), lambda: "A")
+        self.assertEqual(m.get("b", (1,), lambda: "B"), "B")
+        self.assertEqual(m.get("a", (1,), lambda: "other"), "A")
+
+    def test_invalidate_drops_every_value(self):
+        m = Memo()
+        m.get("a", (1,), lambda: 1)
+        m.get("b", (1,), lambda: 2)
+        m.invalidate()
+        self.assertIsNone(m.peek("a"))
+        self.assertEqual(m.get("a", (1,), lambda: 10), 10)
+        self.assertEqual(m.get("b", (1,), lambda: 20), 20)
+
+    def test_bytes_keys_compare_by_content(self):
+        m = Memo()
+        a = np.array([True, False, True])
+        first = m.get("mask", (a.tobytes(),), lambda: a)
+        b = a.copy()
+        self.assertIs(m.get("mask", (b.tobytes(),), lambda: b), first)     # equal content: the kept array
+        c = np.array([True, True, True])
+        self.assertIs(m.get("mask", (c.tobytes(),), lambda: c), c)
+
+
+def _scene(seed=2, n=40):
+    """Crosslinked frictional bimodal spheres, compressed (φ = 1.3), a few bonds cut, plates on."""
+    rng = np.random.default_rng(seed)
+    L = 200.0
+    r_b = math.sqrt(L * L * 1.3 / (n * math.pi))
+    ens = EnsembleLinkable(L, L, 0, k=1e3, nu=1.0, k_t=1e3, nu_t=1.0, mu=0.3)
+    ens.set_random_generator(rng)
+    for p in range(n):
+        r = r_b * (1.18 if p % 2 else 0.85)
+        ens.sphereList.append(SphereLinkable("grey", float(rng.random() * L), float(rng.random() * L), 2 * r,
+                                             0.1, p, force_register=ens, size_x=L, size_y=L))
+    for _ in range(20):
+        ens.mechanical_simulation_step(cool_factor=0.7, dt=1e-3)
+    ens.test_neighbor_relation()
+    ens.makeAllLinksPermanent()
+    ens.cutRandomLine()
+    ens.applyingShear = True
+    ens.setShearRate(0.5)
+    return ens
+
+
+class TestCanvasMemo(unittest.TestCase):
+    """Each value the canvas keeps equals its definition evaluated from the current state."""
+
+    def setUp(self):
+        self.ens = _scene()
+        for _ in range(15):
+            self.ens.mechanical_simulation_step(cool_factor=0.95, dt=1e-3)
+        self.ens.mechanical_simulation_step_calculate_forces()
+
+    def test_mobile_mask_is_its_definition(self):
+        ens = self.ens
+        a = ens._a
+        expected = (a["r"] < a["y"]) & (a["y"] < ens.size_y - a["r"])
+        mob = ens._mobile_mask()
+        np.testing.assert_array_equal(mob, expected)
+        self.assertTrue(0 < expected.sum() < len(expected))   # the scene has plate spheres
+
+    def test_mobile_mask_follows_a_moved_sphere(self):
+        ens = self.ens
+        mob = ens._mobile_mask()
+        k = int(np.flatnonzero(mob)[0])
+        s = ens.sphereList[k]
+        s.y = 0.5 * s.r       # onto the lower plate
+        self.assertFalse(ens._mobile_mask()[k])
+
+    def test_mobile_selection_holds_the_mobile_spheres(self):
+        ens = self.ens
+        a = ens._a
+        mobile = (a["r"] < a["y"]) & (a["y"] < ens.size_y - a["r"])
+        expected = [s for s, m in zip(ens.sphereList, mobile) if m]
+        for sel in (ens._mobile_selection(), ens.movableSphereList()):
+            self.assertEqual(len(sel), len(expected))
+            self.assertTrue(all(x is y for x, y in zip(sel, expected)))
+            np.testing.assert_array_equal(sel.mask, mobile)
+        k = int(np.flatnonzero(mobile)[0])
+        ens.sphereList[k].y = 0.5 * ens.sphereList[k].r   # onto the lower plate: one sphere fewer
+        self.assertEqual(len(ens._mobile_selection()), len(expected) - 1)
+        self.assertNotIn(ens.sphereList[k], ens._mobile_selection())
+
+    def test_pair_structure_is_its_definition(self):
+        ens = self.ens
+        g = ens._g
+        S = g.S
+        pt = ens._pairs
+        r = ens._a["r"]
+        slots = g.slots
+        i, j = pt.i[slots], pt.j[slots]
+        np.testing.assert_array_equal(S.ai, i)
+        np.testing.assert_array_equal(S.aj, j)
+        np.testing.assert_array_equal(S.d0, r[i] + r[j])
+        np.testing.assert_array_equal(S.ri, r[i])
+        np.testing.assert_array_equal(S.rj, r[j])
+        perm = pt.state[slots] == PERMANENT
+        np.testing.assert_array_equal(S.perm, perm)
+
+    def test_internal_flags_are_their_definition(self):
+        ens = self.ens
+        g = ens._g
+        mob = ens._mobile_mask()
+        pos = ens._pos
+        D0 = pos[:, g.aj] - pos[:, g.ai]
+        # through the boundary: raw and minimum-image distances differ
+        shifted = np.sqrt(D0[0] * D0[0] + D0[1] * D0[1]) != g.d
+        mi, mj = mob[g.ai], mob[g.aj]
+        internal = mi & mj & ~shifted
+        self.assertTrue(shifted.any() and (~(mi & mj)).any())   # both kinds of external pair occur
+        np.testing.assert_array_equal(g.internal, internal)
+        np.testing.assert_array_equal(g.ext_i, mi & ~internal)
+        np.testing.assert_array_equal(g.ext_j, mj & ~internal)
+
+    def test_bond_constants_are_their_definition(self):
+        ens = self.ens
+        g = ens._g
+        B = ens._bond_structure(g)
+        perm = ens._pairs.state[g.slots] == PERMANENT
+        self.assertTrue(perm.any() and not perm.all())
+        deq = ens._pairs.d_eq[g.slots]
+        np.testing.assert_array_equal(B.d0, np.where(perm, deq, g.d0))
+        np.testing.assert_array_equal(B.perm_code, np.where(perm, PERMANENT, 0).astype(np.int8))
+        np.testing.assert_array_equal(B.fc_inf, np.where(perm, np.inf, 0.0))
+
+    def test_cut_bond_changes_the_bond_constants(self):
+        ens = self.ens
+        B = ens._bond_structure(ens._g)
+        i, j = ens.permanent_pairs()
+        ens._cut_pairs(i[:1], j[:1])
+        ens.mechanical_simulation_step_calculate_forces()
+        B2 = ens._bond_structure(ens._g)
+        self.assertEqual(int((B2.perm_code != 0).sum()), int((B.perm_code != 0).sum()) - 1)
+
+    def test_edited_relations_drop_the_kept_values(self):
+        ens = self.ens
+        self.assertIsNotNone(ens._struct)
+        ens._relations_edited()
+        self.assertIsNone(ens._struct)
+
+
+if __name__ == "__main__":
+    unittest.main()
