@@ -5,12 +5,14 @@ Two scenes (``--scene``):
 * ``relaxed`` (default): the frictional crosslinked ensemble of ``bench_step.build(N)`` (random
   bimodal spheres, radius ratio 1.4, packing fraction 1.5, a short damped relaxation, all links
   permanent, a few cut lines, μ = 0.01, plates on, the default sphere size and dt) — the scene of
-  the issue's figures (a lively one: the engine rebuilds its list every ~15 steps);
+  the issue's figures (a lively one: with the runs' skin, 0.2 r_max, the engine rebuilds its list
+  every ~10 steps);
 * ``default``: the scene a run measures, built as ``doParticleShearSimulation`` builds it
   (``bench_scenes.build``: the builder's crosslinked particles, 5 cut lines, μ = 0.01,
   pre-equilibrated with plates; the constitution grows faster than N: ~10 s at N = 10,000).
 
-The ensemble is copied into a ``BatchState`` of one replica (``BatchState.from_ensembles``) and
+The ensemble is copied into a ``BatchState`` of one replica (``BatchState.from_ensembles``), whose
+engine has the Verlet skin of a run's engine (``run.batch.ENGINE_SKIN_FACTOR``, 0.2 r_max), and
 both advance the same start under sinusoidal shear, in alternating blocks (so a slow moment of a
 shared machine hits both):
 
@@ -56,6 +58,7 @@ from particleShear import StressTensorEvaluation  # noqa: E402
 from particleShear.engine.neighbours import near_pairs, near_pairs_all, near_pairs_cells  # noqa: E402
 from particleShear.engine.state import BatchState  # noqa: E402
 from particleShear.engine.step import BatchEngine  # noqa: E402
+from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 from particleShear.simulation.evaluation import EvaluationHandler  # noqa: E402
 
 COOL = 0.99969060716623
@@ -109,7 +112,7 @@ def compare(n, steps, block, scene):
         run_engine = engine_block
         run_classes = (lambda k: classes_block(ens, ev, handler, k))
     t_build = time.perf_counter() - t0
-    eng = BatchEngine(BatchState.from_ensembles([ens]))
+    eng = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR)   # as a run's engine
     run_engine(eng, 5)                 # warm-up (the first list build is not timed)
     run_classes(5)
     rebuilds0 = int(eng.rebuilds[0])

@@ -33,10 +33,11 @@ __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLI
 _log = logging.getLogger(__name__)
 
 #: largest N measured by the engine.  Its candidate search is a cell list (O(N) per rebuild), so this
-#: is no longer a limit of the search; single runs above it stay on the documented classes because the
-#: engine's step is slower there (1.4–1.6× on the scene a run measures at N = 500–5,000, about equal on
-#: a livelier scene at N = 2,000–100,000; docs/performance.md, benchmarks/bench_engine_large.py)
-ENGINE_MAX_N = 2000
+#: is not a limit of the search: on the scene a run measures, with the runs' skin, the engine's step
+#: costs 0.87–0.93 of the documented classes' at N = 150–5,000 and 1.08–1.09 at N = 10,000, where the
+#: classes compact their candidate table (≥ 20,000 pairs) to the contacts; single runs above this N
+#: stay on the classes (docs/performance.md, benchmarks/bench_engine_large.py)
+ENGINE_MAX_N = 5000
 
 #: Verlet skin of the engines of a batch (constitution and measurement), in units of each
 #: replica's largest radius.  The contacts of every step are exact for any skin and the zero
