@@ -31,6 +31,7 @@ from . import laws
 from .laws import call_law_vectorised
 from ..engine import laws as _engine_laws
 from ..engine.integrate import damp, kick, plates_follow, xi_increments
+from ..engine.neighbours import verlet_bound
 from .memo import Memo
 from .memory import tune_allocator
 from .neighbours import PERMANENT, SLIP, STICK, PairTable, candidate_pairs
@@ -848,14 +849,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
     def _needs_rebuild(self):
         if not self._nl_valid:
             return True
-        # relative displacement of any pair since the rebuild: peculiar part ≤ 2U, affine stretch of a
-        # pair at distance r ≤ A·r (A = accumulated |strain|, Gronwall: factor A·e^A), and any strain
-        # change not carried by the flow (e.g. γ set directly) moves boundary images by Ly·Δγ
+        # how much a pair can have approached since the rebuild: the engine's bound of the peculiar
+        # displacements U and the accumulated |strain| (engine.neighbours.verlet_bound), plus any strain
+        # change not carried by the flow (e.g. γ set directly), which moves boundary images by Ly·Δγ
         d2 = self._disp * self._disp
         U = math.sqrt(float(_max_reduce(d2[0] + d2[1]))) if self._n else 0.0
-        A = self._nl_abs_strain
-        gA = (A * math.exp(A) if A < 700 else math.inf) if A else 0.0  # e^A overflows beyond ~709
-        bound = 2 * U * (1 + gA) + gA * self._nl_reach
+        bound = verlet_bound(U, self._nl_abs_strain, self._nl_rmax)
         bound += abs(self._le_shift() - self._nl_shift - float(self.size_y) * self._nl_strain)
         return bound >= self._nl_skin or (self.size_x, self.size_y) != self._nl_box
 
@@ -872,7 +871,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_skin = skin
         self._nl_shift = shift
         self._nl_box = (self.size_x, self.size_y)
-        self._nl_reach = 2 * float(a["r"].max()) + skin if self._n else 0.0
+        self._nl_rmax = float(a["r"].max()) if self._n else 0.0
         self._nl_strain = 0.0
         self._nl_abs_strain = 0.0
         self._disp[:] = 0.0
