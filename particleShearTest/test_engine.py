@@ -134,9 +134,9 @@ class TestNeighbours(unittest.TestCase):
         self.assertEqual(verlet_bound(0.0, 0.1, 5.0), 1.0)
 
 
-def constituted(seed, **kw):
-    """A constituted ensemble of the run API's builder and its schedule."""
-    p = dict(_signature_defaults(), seed=seed, N=30, relative_frequency=0.2, pre_periods=0.5, periods=1,
+def constituted(seed, N=30, **kw):
+    """A constituted ensemble of N spheres of the run API's builder and its schedule."""
+    p = dict(_signature_defaults(), seed=seed, N=N, relative_frequency=0.2, pre_periods=0.5, periods=1,
              post_periods=0.5, doDrawing=False, plotStress=False, **kw)
     _, rng = _seed_sequence(seed)
     sim = _build_simulation({k: p[k] for k in _REFERENCE_ARGUMENTS}, rng, verbose=False, progress=None,

@@ -17,6 +17,7 @@ import numpy as np
 from particleShear.engine.neighbours import (CELL_LIST_MIN_N, build_candidates, cell_grid, near_pairs,
                                              near_pairs_all, near_pairs_cells)
 from particleShear.engine.state import PERMANENT, ReplicaPairs
+from particleShearTest.test_engine import constituted
 from particleShearTest.test_neighbours import oracle_pairs
 
 GAMMAS = (0.0, 0.3, -0.7, 1.9)
@@ -167,21 +168,6 @@ class TestBuildCandidates(unittest.TestCase):
         self.assertFalse(new.xi[:, others].any())
 
 
-
-def constituted(seed, N, **kw):
-    """A constituted ensemble of N spheres from the run API's builder, and its time step."""
-    from particleShear.run.api import _build_simulation, _seed_sequence
-    from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
-    p = dict(_signature_defaults(), seed=seed, N=N, relative_frequency=0.2, doDrawing=False, plotStress=False, **kw)
-    _, rng = _seed_sequence(seed)
-    sim = _build_simulation({k: p[k] for k in _REFERENCE_ARGUMENTS}, rng, verbose=False, progress=None,
-                            correct_drift_sign=False, reference_header=False, renderer="none", time_step_factor=1.0,
-                            integrator="euler", stability_guard=False)
-    sim.initEnsemble()
-    e = sim.theEnsemble
-    return e, e.dt, p["relative_frequency"] / sim.model.time_constant
-
-
 class TestEngineWithTheCellList(unittest.TestCase):
     def test_sheared_trajectory_bit_identical_to_the_all_pairs_search(self):
         # N = 400 > CELL_LIST_MIN_N: the engine's rebuilds use the cell list; with the all-pairs search
@@ -192,7 +178,8 @@ class TestEngineWithTheCellList(unittest.TestCase):
         from particleShear.engine.step import BatchEngine
         N = 400
         self.assertGreaterEqual(N, CELL_LIST_MIN_N)
-        ens, dt, f = constituted(5, N, theMu=0.05, cut_lines=3)
+        _, ens, sc = constituted(5, N, theMu=0.05, cut_lines=3)
+        dt, f = sc["dt"], sc["f"]
         runs = []
         for min_n in (CELL_LIST_MIN_N, 10 ** 9):
             with mock.patch.object(neighbours, "CELL_LIST_MIN_N", min_n):

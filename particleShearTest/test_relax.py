@@ -17,10 +17,8 @@ import unittest
 import numpy as np
 
 from particleShear.engine.box import min_image
-from particleShear.engine.relax import (free_relaxation, relax_ensembles, relaxation_levels,
-                                        remove_linear_drift)
+from particleShear.engine.relax import relax_ensembles, relaxation_levels, remove_linear_drift
 from particleShear.engine.state import BatchState
-from particleShear.engine.step import BatchEngine
 from particleShear.linkable.builders import adjustable_interface_constitution, relax_with_classes
 
 #: a small scene of the run API's builder (nominal area fraction 1: a jammed packing)

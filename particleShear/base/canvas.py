@@ -2027,8 +2027,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
                 R = np.array((dx, dy))
                 if dvx_ji is None:
                     dvx_ji = 0.0
-        inc = np.array(xi_increments(Vi, Vj, g.dvx, g.n[0], g.n[1], g.ri, g.rj, R[0], R[1], self._unit_vectors,
-                                     dvx_ji))
+        unit = lambda rx, ry: pair_geometry(rx, ry, self._rng)[1:]   # noqa: E731 (random direction at |R| = 0)
+        inc = np.array(xi_increments(Vi, Vj, g.dvx, g.n[0], g.n[1], g.ri, g.rj, R[0], R[1], unit, dvx_ji))
         inc *= kd   # ×dt on kept relations, ×0 (±0) on the others
         if sel is None:
             pt.xi += inc
@@ -2036,15 +2036,6 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             flat = pt.xi.reshape(-1)
             inc += flat.take(g.S.sel2).reshape(2, P)
             flat[g.S.sel2] = inc.reshape(-1)
-
-    def _unit_vectors(self, rx, ry):
-        """Unit vectors of ``(rx, ry)``; a random direction from the ensemble's generator where the length is 0."""
-        rr = rx * rx + ry * ry
-        dm = np.sqrt(rr)
-        if _nz(dm) != len(dm):
-            _, mx, my = pair_geometry(rx, ry, self._rng)
-            return mx, my
-        return rx / dm, ry / dm
 
     def move(self, dt=1):
         """ξ rule, then drift and turn: x, y, φ += (u_x, u_y, ω)·dt (φ is not read by the ξ rule).

@@ -348,20 +348,8 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
     RuntimeError
         If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
     """
-    return relax_with_classes(adjustable_interface_constitution(
-        size_x=size_x, size_y=size_y, N=N, packing_fraction=packing_fraction, mu=mu,
-        Young_modulus_spheres=Young_modulus_spheres, density=density, bimodal_factor=bimodal_factor,
-        cut_lines=cut_lines, do_permanent_links=do_permanent_links, theTk=theTk,
-        do_pre_equilibration=do_pre_equilibration, relative_viscosity=relative_viscosity,
-        central_repulsion_coefficient=central_repulsion_coefficient, anticipated_amplitude=anticipated_amplitude,
-        relative_transversal_link_strength=relative_transversal_link_strength,
-        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-        avoid_height_spanning_particles=avoid_height_spanning_particles,
-        interface_reenforcement_central=interface_reenforcement_central,
-        interface_reenforcement_tangential=interface_reenforcement_tangential,
-        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant, cut_top_bottom=cut_top_bottom,
-        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
-        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, do_debug=do_debug, rng=rng, verbose=verbose))
+    arguments = dict(locals())     # every parameter, as passed (nothing else is defined yet)
+    return relax_with_classes(adjustable_interface_constitution(**arguments))
 
 
 def adjustable_interface_constitution(
