@@ -83,6 +83,7 @@ ENTRIES = {
     "internal_flags": "internal/external flags of the pairs",
     "pair_structure+internal_flags": "the structure and the flags",
     "selection": "selection of the mobile spheres (the list)",
+    "term_constants": "constants of the force terms (laws, bonds, viscosities, Coulomb offset)",
 }
 
 

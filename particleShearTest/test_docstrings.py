@@ -99,6 +99,7 @@ ENGINE_MODULES = [
     "particleShear.engine.state",
     "particleShear.engine.step",
     "particleShear.engine.stress",
+    "particleShear.engine.terms",
     "particleShear.engine.tangential",
     "particleShear.engine.xp",
 ]

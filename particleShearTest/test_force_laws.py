@@ -287,33 +287,44 @@ class TestCallbackMechanism(unittest.TestCase):
 
 
 class TestEngineLawConstants(unittest.TestCase):
-    """The classes evaluate the built-in law with its per-pair constants: bit-identical to the law."""
+    """The elastic term from its constants (what the classes and the engine evaluate) is bit-identical to the
+    documented laws: the compressive law on contacts, and on bonds the same law below d_eq and the tensile law above."""
 
-    def test_cached_constants_equal_the_law(self):
-        from particleShear.base.laws import elastic_force_law
+    def test_term_constants_equal_the_law(self):
+        from particleShear.base.laws import elastic_force_law, elastic_force_law_tensile
+        from particleShear.engine.terms import elastic_term, term_constants
 
         rng = np.random.default_rng(11)
         d0 = rng.uniform(20, 60, 500)
         d = d0 * rng.uniform(0.0005, 1.3, 500)   # beyond the cap, overlapping, touching and apart
         d[:5] = d0[:5]                           # exactly at contact
-        ens = EnsembleLinkable(100, 100, 0)
         for k in (1.0, 3.14e9):
             for c in (0.0, 0.3, 1.0):
-                with self.subTest(k=k, c=c):
-                    np.testing.assert_array_equal(ens._central_law(d, d0, k, c),
-                                                  elastic_force_law(d, d0, k, c))
+                with self.subTest(k=k, c=c, pairs="contacts"):
+                    f, law = elastic_term(term_constants(d0, None, None, k, c, 0.0, 0.0, 0.0, 0.0), d)
+                    np.testing.assert_array_equal(law, elastic_force_law(d, d0, k, c))
+                    np.testing.assert_array_equal(f, law)
+                with self.subTest(k=k, c=c, pairs="bonds"):
+                    perm = np.ones(len(d), dtype=bool)
+                    f, law = elastic_term(term_constants(d0, perm, d0, k, c, 0.0, 0.0, 0.0, 0.0, prc=0.5), d)
+                    ref = np.array([elastic_force_law_tensile(a, b, k) if a > b else elastic_force_law(a, b, k, c)
+                                    for a, b in zip(d, d0)])
+                    np.testing.assert_array_equal(law, ref)
+                    np.testing.assert_array_equal(f, 0.5 * ref)
 
 
 def _engine_central(d, d0, k, c, bond):
     """Central law of one candidate through the engine (:meth:`PairConstants.set_bonds`, :func:`central_term`)."""
     from types import SimpleNamespace
 
-    from particleShear.engine.forces import PairConstants, central_term
+    from particleShear.engine.forces import PairConstants
+    from particleShear.engine.terms import central_term
 
     one = np.ones(1)
     s = SimpleNamespace(k=k * one, c=c * one, prc=one, nu=0 * one, keep=one, k_t=0 * one, prt=one, nu_t=0 * one,
                         mu=0 * one)
-    C = SimpleNamespace(rep=np.zeros(1, dtype=int), d0=np.array([d0]))
+    C = SimpleNamespace(rep=np.zeros(1, dtype=int), d0=np.array([d0]), TERM_ROWS=PairConstants.TERM_ROWS,
+                        form=PairConstants.form)
     PairConstants.set_bonds(C, s, np.array([2 if bond else 0], dtype=np.int8), np.array([d0]))
     f, law = central_term(C, np.array([d]), np.zeros(1), np.ones(1, dtype=bool))
     return float(f[0]), float(law[0])

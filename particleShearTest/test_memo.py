@@ -144,25 +144,57 @@ class TestCanvasMemo(unittest.TestCase):
         np.testing.assert_array_equal(g.ext_i, mi & ~internal)
         np.testing.assert_array_equal(g.ext_j, mj & ~internal)
 
-    def test_bond_constants_are_their_definition(self):
+    def test_term_constants_are_their_definition(self):
         ens = self.ens
         g = ens._g
-        B = ens._bond_structure(g)
+        K_i, K_j, differ = ens._term_constants(g)
         perm = ens._pairs.state[g.slots] == PERMANENT
         self.assertTrue(perm.any() and not perm.all())
         deq = ens._pairs.d_eq[g.slots]
-        np.testing.assert_array_equal(B.d0, np.where(perm, deq, g.d0))
-        np.testing.assert_array_equal(B.perm_code, np.where(perm, PERMANENT, 0).astype(np.int8))
-        np.testing.assert_array_equal(B.fc_inf, np.where(perm, np.inf, 0.0))
+        self.assertIs(K_j, K_i)                      # every sphere has the same parameters
+        self.assertEqual(differ, frozenset())
+        np.testing.assert_array_equal(K_i.d_law, np.where(perm, deq, g.d0))
+        np.testing.assert_array_equal(K_i.d_cap, np.where(perm, deq, g.d0) / 1000)
+        np.testing.assert_array_equal(g.S.perm_code, np.where(perm, PERMANENT, 0).astype(np.int8))
+        np.testing.assert_array_equal(K_i.fc_inf, np.where(perm, np.inf, 0.0))
+        self.assertEqual(K_i.mu, ens.mu)
 
-    def test_cut_bond_changes_the_bond_constants(self):
+    def test_sphere_parameters_give_each_visit_its_constants(self):
         ens = self.ens
-        B = ens._bond_structure(ens._g)
+        s = ens.sphereList[3]
+        s.permanent_ratio_tangential = 2.0            # one sphere: its visits see twice k_t on its bonds
+        ens.mechanical_simulation_step_calculate_forces()
+        g = ens._g
+        K_i, K_j, differ = ens._term_constants(g)
+        self.assertEqual(differ, frozenset({"tangential"}))
+        perm = ens._pairs.state[g.slots] == PERMANENT
+        ratio = np.where(np.arange(len(ens.sphereList)) == 3, 2.0, 1.0)
+        np.testing.assert_array_equal(K_i.k_t, ens.k_t * np.where(perm, ratio[g.ai], 1.0))
+        np.testing.assert_array_equal(K_j.k_t, ens.k_t * np.where(perm, ratio[g.aj], 1.0))
+        self.assertTrue(((g.ai == 3) | (g.aj == 3))[perm].any())   # the sphere has bonds
+
+    def test_changed_parameters_renew_the_term_constants(self):
+        ens = self.ens
+        for name, value in (("mu", 0.7), ("k", 2e3), ("nu", 3.0), ("k_t", 5e2), ("nu_t", 0.25)):
+            with self.subTest(name=name):
+                setattr(ens, name, value)
+                ens.mechanical_simulation_step_calculate_forces()
+                K = ens._term_constants(ens._g)[0]
+                perm = ens._pairs.state[ens._g.slots] == PERMANENT
+                got = {"mu": K.mu, "k": K.k, "nu": np.max(K.nu), "k_t": np.max(K.k_t), "nu_t": np.max(K.nu_t)}[name]
+                self.assertEqual(got, value)
+                if name == "k":
+                    np.testing.assert_array_equal(K.a_tens, -np.where(perm, value, 0.0))
+
+    def test_cut_bond_changes_the_term_constants(self):
+        ens = self.ens
+        K = ens._term_constants(ens._g)[0]
         i, j = ens.permanent_pairs()
         ens._cut_pairs(i[:1], j[:1])
         ens.mechanical_simulation_step_calculate_forces()
-        B2 = ens._bond_structure(ens._g)
-        self.assertEqual(int((B2.perm_code != 0).sum()), int((B.perm_code != 0).sum()) - 1)
+        K2 = ens._term_constants(ens._g)[0]
+        self.assertEqual(int(np.isinf(K2.fc_inf).sum()), int(np.isinf(K.fc_inf).sum()) - 1)
+        self.assertEqual(int((ens._g.S.perm_code != 0).sum()), int(np.isinf(K.fc_inf).sum()) - 1)
 
     def test_edited_relations_drop_the_kept_values(self):
         ens = self.ens

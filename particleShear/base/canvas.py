@@ -24,13 +24,13 @@ import numpy as np
 
 from .fields import FIELDS, MASS_ROWS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import le_wrap, min_image, pair_geometry, tangential_two_pass
+from .kernels import le_wrap, min_image, pair_geometry
 from .namespace import (bincount as _bincount, concatenate as _concat, copyto as _copyto,
                         count_nonzero as _nz, where as _where)
 from . import laws
 from .laws import call_law_vectorised
-from ..engine import laws as _engine_laws
 from ..engine.integrate import damp, kick, plates_follow, xi_increments
+from ..engine.terms import elastic_term, tangential_term, term_constants, viscous_term
 from ..engine.neighbours import verlet_bound
 from .memo import Memo
 from .memory import tune_allocator
@@ -196,7 +196,7 @@ class _Structure:
     """Arrays over the pairs of the step that stay valid while the candidates, bonds and images do (and, for
     a compacted table, the set of relations); kept in the canvas's memo under ``key``."""
     __slots__ = ("key", "safe_images", "sel", "sel2", "ai", "aj", "d0", "ri", "rj", "w2", "idx6",
-                 "ky", "kyf", "kx", "any_y", "perm", "trans", "shifted", "view", "bond")
+                 "ky", "kyf", "kx", "any_y", "perm", "trans", "deq", "perm_code", "shifted", "view")
 
 
 class _Geometry:
@@ -1057,10 +1057,12 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         S.kx = kx
         S.any_y = ky is not None and bool(_nz(ky))
         if perm is None or not _nz(perm):
-            S.perm = S.trans = None
+            S.perm = S.trans = S.deq = S.perm_code = None
         else:
             S.perm = perm
             S.trans = ~perm
+            S.deq = pt.d_eq.copy() if S.sel is None else pt.d_eq.take(S.sel)   # equilibrium distances of the bonds
+            S.perm_code = perm.view(np.int8) * np.int8(PERMANENT)             # state code of a bond, 0 elsewhere
         # a pair interacts through the boundary iff its raw and minimum-image distances differ;
         # with cached images the cell is much larger than a contact, so any period applied means that
         if ky is None:
@@ -1078,12 +1080,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
                   "ri": S.ri, "rj": S.rj}
         # the cell is much larger than the candidate reach: a pair's nearest image cannot change within a step
         S.safe_images = bool(self._images_valid)
-        S.bond = None if S.perm is None else self._bond_constants(S)
         return S
-
-    def _bond_constants(self, S):
-        """Constants of the bonds among the pairs of ``S`` (None here: bonds are added by the linkable canvas)."""
-        return None
 
     # -- pair-force accumulation -----------------------------------------------------------------
     def _geometry(self):
@@ -1434,35 +1431,52 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._a["central_repulsion_coefficient"][:] = central_repulsion_coefficient
         self._params_changed()
 
-    def _pair_param(self, name, g):
-        """(value seen by the visit from i, from j): one Python float when all spheres agree."""
-        v = self._param(name)
-        if v is not None:
-            return v, v
-        arr = self._a[name]
-        return arr[g.ai], arr[g.aj]
+    def _builtin_laws(self):
+        """Whether the built-in central law is in use (a law replaced through ``call_back_elastic_force_law`` is
+        evaluated by :meth:`_user_law_term`)."""
+        return CircleBasicElasticity.call_back_elastic_force_law is laws.elastic_force_law
 
-    def _law(self, d, d0, k, c):
-        return call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, d, d0, k, c)
+    def _term_constants(self, g):
+        """``(K_i, K_j, differ)``: the constants of the force terms of the step's pairs as seen by the visit from i
+        and from j (:func:`~particleShear.engine.terms.term_constants`), and the names of the terms whose two
+        visits differ (``"elastic"``, ``"viscous"``, ``"tangential"``; empty when every sphere has the same
+        parameters, and then ``K_j is K_i``).
 
-    def _central_law(self, d, d0, k, c):
-        """Central elastic law of every pair of the step (already masked to relations).
-
-        The built-in law (eqs. S1-5a, S1-5b) with one repulsion coefficient is evaluated in exactly the
-        operations of :func:`~particleShear.base.laws.elastic_force_law`; a user law pair by pair.
+        They are made from the pair structure, the ensemble's k, ν, k_t, ν_t, μ and each visit's own sphere
+        parameters (c and the permanent ratios, :data:`_PARAMS`), and kept in the memo under exactly
+        these (the structure's key, the version of the sphere parameters and the ensemble's values).
         """
-        law = CircleBasicElasticity.call_back_elastic_force_law
-        if law is not laws.elastic_force_law or type(c) is not float:
-            return self._mask_law(call_law_vectorised(law, d, d0, k, c))
-        return _where(d > d0, np.zeros(len(d)), self._builtin_law_inside(d, d0, k, c))
+        S = g.S
+        values = (self.k, self.nu, getattr(self, "k_t", 0.0), getattr(self, "nu_t", 0.0), getattr(self, "mu", 0.0))
+        return self._memo.get("term_constants", (S.key, self._params_version) + values,
+                              lambda: self._visit_constants(S, *values))
 
-    @staticmethod
-    def _builtin_law_inside(d, d0, k, c):
-        """The built-in law (eqs. S1-5a, S1-5b) as if every pair were in contact (no cut-off at ``d0``): the
-        arithmetic of :func:`particleShear.engine.laws.central_inside` with its per-pair constants
-        (``d0/1000``, ``−k(1−c)``, ``−k·c·d0``), as in :func:`~particleShear.base.laws.elastic_force_law`."""
-        return _engine_laws.central_inside(d, d0, *_engine_laws.central_constants(d0, k, c),
-                                           form=_engine_laws.central_form(c))
+    def _visit_constants(self, S, k, nu, k_t, nu_t, mu):
+        """The :meth:`_term_constants` of structure ``S``: a parameter all spheres share is one number, else the
+        value of the visiting sphere (i for the first visit, j for the second) per pair."""
+        shared = dict(zip(_PARAMS, (self._param(name) for name in _PARAMS)))
+
+        def visit(rows):
+            c, prc, prt, keep = (shared[name] if shared[name] is not None else self._a[name].take(rows)
+                                 for name in _PARAMS)
+            return term_constants(S.d0, S.perm, S.deq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
+
+        K_i = visit(S.ai)
+        # the parameters each term reads (the permanent ratios and kept viscosities only on bonds)
+        bonds = S.perm is not None
+        reads = {"elastic": ("central_repulsion_coefficient",) + (("permanent_ratio_central",) if bonds else ()),
+                 "viscous": ("permanent_ratio_central", "keep_viscosity_coefficients_constant") if bonds else (),
+                 "tangential": ("permanent_ratio_tangential", "keep_viscosity_coefficients_constant") if bonds else ()}
+        differ = frozenset(term for term, names in reads.items() if any(shared[n] is None for n in names))
+        return K_i, (visit(S.aj) if differ else K_i), differ
+
+    def _user_law_term(self, K, g):
+        """Elastic term with a law replaced through ``call_back_elastic_force_law``, pair by pair (as
+        :func:`~particleShear.engine.terms.elastic_term`): ``(law·ratio_c, law)``, 0 on inactive candidates
+        unless the law is one of the built-in ones that vanish beyond contact."""
+        law = self._mask_law(call_law_vectorised(CircleBasicElasticity.call_back_elastic_force_law, g.d, K.d_law,
+                                                 K.k, K.c))
+        return law * K.ratio_c, law
 
     def _mask_law(self, f):
         """Zero a user law's value on inactive candidates (the built-in laws are 0 beyond contact)."""
@@ -1477,29 +1491,18 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._term_done()
 
     def _elastic_terms(self):
-        """Transient contacts: ``law(d, r_i + r_j, k, c)`` along n_ij (the law is 0 beyond contact)."""
+        """Central elastic force of every relation, each visit with its own constants: contacts ``law(d, r_i + r_j,
+        k, c)`` (0 beyond contact), bonds the law at ``d_eq`` and the tensile law beyond it, × the permanent ratio
+        (:func:`~particleShear.engine.terms.elastic_term`).  Keeps the law of the visit from i as ``g.fel``, the
+        base of the Coulomb bound."""
         g = self._g
-        if g.P:
-            tr = g.trans
-            c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
-            if tr is None:
-                f_i = self._central_law(g.d, g.d0, self.k, c_i)
-                f_j = None if c_j is c_i else self._mask_law(self._law(g.d, g.d0, self.k, c_j))
-                g.fel = f_i
-            else:
-                d, d0 = g.d[tr], g.d0[tr]
-                if type(c_i) is not float:
-                    c_i, c_j = c_i[tr], c_j[tr]
-                f_i = self._mask_law(self._scatter(self._law(d, d0, self.k, c_i), tr, g.P))
-                f_j = None if c_j is c_i else self._mask_law(self._scatter(self._law(d, d0, self.k, c_j), tr, g.P))
-                g.fel = f_i
-            self._add_normal(f_i, f_j)
-
-    @staticmethod
-    def _scatter(values, mask, n):
-        out = np.zeros(n)
-        out[mask] = values
-        return out
+        if not g.P:
+            return
+        K_i, K_j, differ = self._term_constants(g)
+        term = elastic_term if self._builtin_laws() else (lambda K, d: self._user_law_term(K, g))
+        f_i, g.fel = term(K_i, g.d)
+        f_j = term(K_j, g.d)[0] if "elastic" in differ else None
+        self._add_normal(f_i, f_j)
 
     def _relative_velocity(self, g):
         """Velocity of j's nearest image relative to i (µm/s), shape (2, P), computed once per force phase.
@@ -1521,10 +1524,6 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             g.vn = rv[0] + rv[1]
         return g.vn
 
-    def _viscous_scale(self, g):
-        """Per-pair factor on ν (1 except for permanent links of the adjustable class)."""
-        return None
-
     def central_viscous_force_from_neighbors(self):
         """Central viscous force ``ν v_n`` of every relation (eq. S1-9)."""
         self._geometry()
@@ -1532,22 +1531,20 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._term_done()
 
     def _viscous_terms(self):
+        """Central viscous force of every relation, each visit with its own ν (bonds: × the permanent ratio unless
+        the viscosities are kept constant; :func:`~particleShear.engine.terms.viscous_term`)."""
         g = self._g
-        nu = self.nu
-        if g.P and nu == 0:
+        if not g.P:
+            return
+        if self.nu == 0:
             # no force, but the reference still registers ν·v_n = 0 per visit (noted for the register only)
             g.parts = (g.parts or []) + [("viscous", None, None)]
-        if g.P and nu != 0:
-            if g.active is None:
-                f = nu * self._normal_speed(g)
-            else:
-                # relations only: ν·1 = ν exactly, ν·0 = 0
-                f = (nu * g.active) * self._normal_speed(g)
-            scale = self._viscous_scale(g)
-            if scale is None:
-                self._add_normal(f, None, "viscous")
-            else:
-                self._add_normal(f * scale[0], f * scale[1], "viscous")
+            return
+        K_i, K_j, differ = self._term_constants(g)
+        vn = self._normal_speed(g)
+        f_i = viscous_term(K_i, vn, g.active)
+        f_j = viscous_term(K_j, vn, g.active) if "viscous" in differ else None
+        self._add_normal(f_i, f_j, "viscous")
 
     def elastic_force(self):
         """All-pairs variant (reference API): a neighbour update, then the elastic term."""
@@ -1862,13 +1859,15 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self._term_done()
 
     def _tangential_terms(self):
-        """Transient contacts: viscous + spring on ξ, Coulomb-limited, two visits."""
+        """Tangential force of every relation: the two-visit rule with the Coulomb bound ``|μ·law|`` (bonds: an
+        unbounded spring, k_t and ν_t × the permanent ratio; :func:`~particleShear.engine.terms.tangential_term`),
+        then the states (slip, stick, permanent) and histories ξ of the relations."""
         g = self._g
         if not g.P:
             return
-        if not self._tangential_needed():
-            # μ = 0: the Coulomb bound is zero, every moving contact slips and ξ is reset.
-            pt = self._pairs
+        pt = self._pairs
+        if g.perm is None and not self._tangential_needed():
+            # μ = 0 and no bonds: the Coulomb bound is zero, every moving contact slips and ξ is reset.
             if g.active is None:
                 pt.state[g.slots] = SLIP
                 pt.xi[:, g.slots] = 0.0
@@ -1878,40 +1877,23 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
             g.all_slip = True
             g.ft_visits = 0.0   # every visit applies a zero force (Coulomb bound 0)
             return
-        fc = np.abs(self.mu * self._coulomb_law(g))
-        self._apply_tangential(None, self.k_t, self.k_t, self.nu_t, self.nu_t, fc)
-
-    def _coulomb_law(self, g):
-        """Elastic central law of each transient contact (cached from the elastic term)."""
-        if getattr(g, "fel", None) is None:
-            c_i = self._pair_param("central_repulsion_coefficient", g)[0]
-            return self._mask_law(self._law(g.d, g.d0, self.k, c_i))
-        return g.fel
-
-    def _apply_tangential(self, perm_code, kt_i, kt_j, nut_i, nut_j, fc):
-        """Run the two-visit kernel on all candidate pairs and record states, ξ and forces.
-
-        ``perm_code`` is the state code PERMANENT on bonds and 0 elsewhere (int8, one per pair) or None
-        when there are no bonds; ``fc`` the Coulomb bound of each
-        pair (bonds: ``inf``, i.e. no bound).  Inactive candidates have ξ = 0, no viscous
-        part and a zero bound, so they get exactly zero force and stay in the stick state.
-        """
-        g = self._g
-        pt = self._pairs
-        vt = self._tangential_speed(g)
+        K_i, K_j, differ = self._term_constants(g)
+        if g.fel is None:   # the elastic term did not run in this force phase: the law of the bound
+            g.fel = (elastic_term(K_i, g.d) if self._builtin_laws() else self._user_law_term(K_i, g))[1]
         sel = g.S.sel
         xi = pt.xi if sel is None else pt.xi.take(sel, axis=1)
-        F, slip = tangential_two_pass(vt, g.touching, xi, kt_i, kt_j, nut_i, nut_j, fc)
-        state = slip.view(np.int8)   # SLIP = 1, STICK = 0
+        F, slip = tangential_term(K_i, self._tangential_speed(g), g.touching, xi, g.fel,
+                                  K_j if "tangential" in differ else None)
+        # states: slip 1, stick 0, and permanent on bonds
+        state = slip.view(np.int8)
+        perm_code = g.S.perm_code
         if sel is None:
             if perm_code is not None:
-                state = np.add(state, perm_code, out=pt.state)
+                np.add(state, perm_code, out=pt.state)
             else:
                 pt.state[...] = state
         else:
-            if perm_code is not None:
-                state = state + perm_code
-            pt.state[sel] = state
+            pt.state[sel] = state if perm_code is None else state + perm_code
             pt.xi.reshape(-1)[g.S.sel2] = xi.reshape(-1)   # flat 1-D scatter: much cheaper than [:, sel]
         g.ft_visits = F
         f = F[0] + F[1]

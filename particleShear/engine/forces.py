@@ -1,9 +1,9 @@
-"""Pair terms over the flat candidate arrays of a batch, the scatter and the shear stresses.
+"""Candidate pairs of a batch: their constants, geometry, the scatter and the shear stresses.
 
-Each function is a pure function of arrays: the geometry of the candidates, the central term
-(elastic law of :mod:`.laws` and viscous term, transient contacts and bonds), the tangential
-two-visit rule (:func:`.tangential.tangential_two_pass`), the scatter of pair
-forces to spheres and the two shear stresses G′/G″ need.  Equations: reference manual eq.
+Each function is a pure function of arrays: the per-candidate constants (:class:`PairConstants`,
+whose term constants come from :func:`.terms.term_constants`), the geometry of the candidates, the
+scatter of pair forces to spheres and the two shear stresses G′/G″ need.  The force terms
+themselves are in :mod:`.terms`.  Equations: reference manual eq.
 S1-3 (torque split), S1-5/S1-6 (laws), S1-16 (external-force tensor), S1-19 (Love-Weber),
 S1-22/S1-24 (torque terms, overall tensor); details in ``docs/design.md``.
 
@@ -16,16 +16,15 @@ candidate set are built on the host from the per-replica lists and copied to the
 """
 __docformat__ = "numpy"
 
-import math
 
 import numpy as np
 
-from .tangential import tangential_two_pass
 from .box import min_image
 from .xp import SegmentSum, array_namespace, to_host
 from . import laws
+from .terms import term_constants
 
-__all__ = ["PairConstants", "splice_arrays", "geometry", "central_term", "tangential_term", "scatter", "replica_sums", "shear_stresses"]
+__all__ = ["PairConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -64,6 +63,11 @@ class PairConstants:
     #: then the constants of :meth:`set_bonds`
     FLOAT_ROWS = ("ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "k", "d_law", "d_cap", "a_lin", "a_div",
                   "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
+    #: the rows set from :func:`~particleShear.engine.terms.term_constants` (the attributes of a
+    #: :class:`~particleShear.engine.terms.TermConstants` but ``form``)
+    TERM_ROWS = ("d_law", "d_cap", "a_lin", "a_div", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
+    #: form of the compressive law: c is a constant per candidate, so the general blend
+    form = laws.BLEND
     #: rows of the index block :attr:`i` (and of its host copy :attr:`i_host`): replica, sphere rows i and j
     INT_ROWS = ("rep", "ai", "aj")
     #: rows of the flag block :attr:`b`: bond, transient candidate
@@ -208,17 +212,9 @@ class PairConstants:
         self.perm = perm
         self.trans = ~perm
         self.k = k
-        self.d_law = xp.where(perm, d_eq, self.d0)         # contact distance of the compressive law
-        self.d_cap, self.a_lin, self.a_div = laws.central_constants(self.d_law, k, c)
-        self.d_eq = xp.where(perm, d_eq, 0.0)   # tensile law −k·(d_eq − d) on bonds, −0·(0 − d) = +0 on contacts
-        self.a_tens = -xp.where(perm, k, 0.0)
-        self.ratio_c = xp.where(perm, prc, 1.0)
-        loose = perm & (keep == 0)               # bonds whose viscosities take the permanent ratios
-        self.nu = nu * xp.where(loose, prc, 1.0)
-        self.k_t = k_t * xp.where(perm, prt, 1.0)
-        self.nu_t = nu_t * xp.where(loose, prt, 1.0)
-        self.mu = mu
-        self.fc_inf = xp.where(perm, math.inf, 0.0)
+        K = term_constants(self.d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
+        for name in self.TERM_ROWS:
+            setattr(self, name, getattr(K, name))
 
 
 def splice_arrays(old, new, segments):
@@ -303,72 +299,6 @@ def normals(dx, dy, d, rep, rng):
     nx[idx] = xp.asarray(np.array([np.cos(t) for t in theta]))
     ny[idx] = xp.asarray(np.array([np.sin(t) for t in theta]))
     return nx, ny
-
-
-def central_term(C, d, vn, active):
-    """Elastic + viscous central scalar of each candidate (along ``n_ij`` on i; −n on j) and the
-    unscaled elastic law (for the Coulomb bound).
-
-    Transient contacts: ``law(d, r_i + r_j, k, c)`` (0 beyond contact) and ``ν·v_n``; bonds:
-    ``k (d − d_eq)`` when stretched, the compressive law below, both × ``permanent_ratio_central``,
-    viscous × the ratio unless viscosities are kept constant.  Inactive candidates give 0.
-
-    Parameters
-    ----------
-    C : PairConstants
-        The candidates, with the constants of :meth:`PairConstants.set_bonds`.
-    d : ndarray (P,)
-        Centre distances (µm).
-    vn : ndarray (P,)
-        Normal relative velocity ``(v_j − v_i)·n_ij`` (µm/s; positive when separating).
-    active : ndarray of bool (P,)
-        Relations (touching, or a bond); only they get the viscous term.
-
-    Returns
-    -------
-    f : ndarray (P,)
-        Central scalar force on i along ``n_ij`` (mg·µm·s⁻² per m depth; negative repels).
-    law : ndarray (P,)
-        The elastic law before the permanent ratio (same unit), the base of the Coulomb bound.
-    """
-    inside = laws.central_inside(d, C.d_law, C.d_cap, C.a_lin, C.a_div)   # c per replica: the general blend
-    xp = array_namespace(d)
-    law = xp.where(d > C.d_law, laws.tensile_inside(d, C.d_eq, C.a_tens), inside)   # contacts beyond d0: +0
-    f = law * C.ratio_c
-    f += xp.where(active, C.nu, 0.0) * vn
-    return f, law
-
-
-def tangential_term(C, vt, touching, xi, law):
-    """Two-visit tangential rule (docs/design.md): forces of both visits and the final slip flag.
-
-    Bonds have no Coulomb bound; a transient contact is bounded by ``|μ·law|``.  Updates ``xi``
-    in place (reset on slip); inactive candidates (ξ = 0, no viscous part, bound 0) get ±0.
-
-    Parameters
-    ----------
-    C : PairConstants
-        The candidates (``k_t``, ``nu_t``, ``mu`` and the bonds' infinite bound).
-    vt : ndarray (P,)
-        Tangential slip velocity along ``t_ij`` seen from i (µm/s).
-    touching : ndarray (P,) of float
-        1 where the pair overlaps (``d < r_i + r_j``), else 0.
-    xi : ndarray (2, P)
-        Histories ξ_ij, ξ_ji (µm), updated in place.
-    law : ndarray (P,)
-        Unscaled elastic central law of each pair (mg·µm·s⁻² per m depth), from :func:`central_term`.
-
-    Returns
-    -------
-    F : ndarray (2, P)
-        Tangential forces of the two visits (mg·µm·s⁻² per m depth), see
-        :func:`~particleShear.engine.tangential.tangential_two_pass`.
-    slip : ndarray of bool (P,)
-        The final slip flag.
-    """
-    fc = abs(C.mu * law)
-    fc += C.fc_inf
-    return tangential_two_pass(vt, touching, xi, C.k_t, C.k_t, C.nu_t, C.nu_t, fc)
 
 
 def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):

@@ -29,7 +29,8 @@ import numpy as np
 
 from .box import min_image, wrap
 from .integrate import damp, drift, kick, plates_follow, xi_increments
-from .forces import PairConstants, central_term, normals, scatter, shear_stresses, splice_arrays, tangential_term
+from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
+from .terms import central_term, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs

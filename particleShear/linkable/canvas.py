@@ -15,20 +15,14 @@ import numpy as np
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image
 from ..base.namespace import count_nonzero as _nz, where as _where
-from ..base.laws import call_law_vectorised, elastic_force_law, elastic_force_law_tensile
+from ..base.laws import call_law_vectorised, elastic_force_law_tensile
 from ..engine import laws as _engine_laws
 from ..base.neighbours import PERMANENT, SLIP
-from ..base.points import CircleBasicElasticity
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
 
 
 __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
-
-
-class _BondStructure:
-    """Bond constants over the pairs of a pair structure (``S.bond``, made and kept with the structure)."""
-    __slots__ = ("deq", "d0", "deq_stretch", "perm_code", "fc_inf")
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
@@ -201,116 +195,31 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self.cutLine((0, self.size_y), math.pi / 2)
 
     # -- bond forces -------------------------------------------------------------------------------
-    def _bond_structure(self, g):
-        """Per-pair bond constants of the step's pair structure: bonds and their ``d_eq`` change only with the
-        structure's key (candidates, links), so they are made with the structure."""
-        return g.S.bond
+    # Bonds are terms of the pairs like contacts: their constants come from the engine's term_constants
+    # (the pair structure's bonds and d_eq, the spheres' permanent ratios), and the canvas's elastic, viscous
+    # and tangential terms evaluate them with the engine's functions (docs/design.md, "One step").
+    def _builtin_laws(self):
+        """Whether the built-in compressive and tensile laws are both in use."""
+        return (CanvasPointsFrictionElasticityLeesEdwards._builtin_laws(self)
+                and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
 
-    def _bond_constants(self, S):
-        """The :class:`_BondStructure` of the pairs of structure ``S`` (which has bonds: ``S.perm`` is not None)."""
-        B = _BondStructure()
-        perm = S.perm
-        B.deq = deq = self._pairs.d_eq.copy() if S.sel is None else self._pairs.d_eq.take(S.sel)
-        B.d0 = _where(perm, deq, S.d0)               # contact distance of the central law
-        B.deq_stretch = _where(perm, deq, np.inf)    # d ≥ this: tensile law (never for contacts)
-        B.perm_code = perm.view(np.int8) * np.int8(PERMANENT)
-        B.fc_inf = _where(perm, np.inf, 0.0)         # bonds have no Coulomb bound
-        return B
-
-    def _elastic_terms(self):
-        """Transient contacts as in the parent; bonds: law below ``d_eq``, tensile law above, × ratio."""
-        g = self._g
+    def _user_law_term(self, K, g):
+        """Elastic term with laws replaced through the callbacks: the compressive callback as in the parent, and on
+        bonds stretched beyond ``d_eq`` the tensile callback ``call_back_elastic_force_law_tensile`` (built-in:
+        :func:`~particleShear.engine.laws.tensile_law`); ``(law·ratio_c, law)``."""
+        f, law = CanvasPointsFrictionElasticityLeesEdwards._user_law_term(self, K, g)
         if g.perm is None:
-            CanvasPointsFrictionElasticityLeesEdwards._elastic_terms(self)
-            return
-        B = self._bond_structure(g)
-        perm = g.perm
-        c_i, c_j = self._pair_param("central_repulsion_coefficient", g)
-        law = CircleBasicElasticity.call_back_elastic_force_law
-        k = self.k
-        if (c_j is c_i and type(c_i) is float and law is elastic_force_law
-                and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile):
-            # built-in laws: beyond d0 (= d_eq for bonds) a bond pulls with k·(d − d_eq) and a contact
-            # has no force (k·(d − 0)·0 = +0); up to d0 both follow the compressive law
-            f_i = f_j = _where(g.d > B.d0, self._tensile_inline(g.d, k, B, perm),
-                               self._builtin_law_inside(g.d, B.d0, k, c_i))
-            g.fel = f_i
+            return f, law
+        stretched = g.perm & (g.d >= K.d_eq)
+        if not _nz(stretched):
+            return f, law
+        tensile = SphereLinkable.call_back_elastic_force_law_tensile
+        if tensile is elastic_force_law_tensile:
+            f_t = _engine_laws.tensile_law(g.d, K.d_eq, K.k)
         else:
-            f_i = self._central_law(g.d, B.d0, k, c_i)
-            g.fel = f_i
-            f_j = f_i if c_j is c_i else self._mask_law(call_law_vectorised(law, g.d, B.d0, k, c_j))
-            stretched = g.d >= B.deq_stretch
-            if _nz(stretched):
-                tensile = SphereLinkable.call_back_elastic_force_law_tensile
-                if tensile is elastic_force_law_tensile:
-                    f_t = _engine_laws.tensile_inside(g.d, B.deq, -k)    # the built-in linear tensile law
-                else:
-                    f_t = call_law_vectorised(tensile, g.d, B.deq, k)
-                f_i = _where(stretched, f_t, f_i)
-                f_j = f_i if c_j is c_i else _where(stretched, f_t, f_j)
-        rc_i, rc_j = self._pair_param("permanent_ratio_central", g)
-        if not (rc_i is rc_j and rc_i == 1.0):
-            f_i = f_i * _where(perm, rc_i, 1.0)
-            f_j = f_j * _where(perm, rc_j, 1.0)
-        self._add_normal(f_i, None if f_j is f_i else f_j)
-
-    @staticmethod
-    def _tensile_inline(d, k, B, perm):
-        """Built-in tensile law ``−k (d_eq − d)`` (:func:`particleShear.engine.laws.tensile_inside`) on bonds and
-        ``−0·(0 − d) = +0`` on contacts (the constants ``−k`` and ``d_eq`` masked to the bonds)."""
-        return _engine_laws.tensile_inside(d, _where(perm, B.deq, 0.0), -_where(perm, k, 0.0))
-
-    def _tangential_terms(self):
-        """Transient contacts and bonds in one two-visit pass; bonds have no Coulomb bound."""
-        g = self._g
-        if g.perm is None:
-            CanvasPointsFrictionElasticityLeesEdwards._tangential_terms(self)
-            return
-        B = self._bond_structure(g)
-        kt_i, kt_j, nut_i, nut_j = self._tangential_constants(g, self.k_t, self.nu_t)
-        fc = np.abs(self.mu * self._coulomb_law(g))
-        fc += B.fc_inf
-        self._apply_tangential(B.perm_code, kt_i, kt_j, nut_i, nut_j, fc)
-
-    def _tangential_constants(self, g, kt, nut):
-        """(k_t, ν_t) seen by each visit: scaled by the sphere's ratios on bonds."""
-        perm = g.perm
-        rt_i, rt_j = self._pair_param("permanent_ratio_tangential", g)
-        nv_i, nv_j = self._visc_ratio(g, "permanent_ratio_tangential")
-        if rt_i is rt_j and type(rt_i) is float and kt * rt_i == kt:
-            kt_i = kt_j = kt
-        else:
-            kt_i = _where(perm, kt * rt_i, kt)
-            kt_j = kt_i if rt_j is rt_i else _where(perm, kt * rt_j, kt)
-        if nv_i is nv_j and nv_i == 1.0:
-            nut_i = nut_j = nut
-        else:
-            nut_i = _where(perm, nut * nv_i, nut)
-            nut_j = _where(perm, nut * nv_j, nut)
-        return kt_i, kt_j, nut_i, nut_j
-
-    def _visc_ratio(self, g, ratio_name):
-        """Per-visit viscosity factors of bonds: the ratio unless viscosities are kept constant."""
-        r_i, r_j = self._pair_param(ratio_name, g)
-        k_i, k_j = self._pair_param("keep_viscosity_coefficients_constant", g)
-        if type(r_i) is float and type(k_i) is float:
-            v = 1.0 if k_i else r_i
-            return v, v
-        r_i = np.broadcast_to(r_i, (g.P,))
-        r_j = np.broadcast_to(r_j, (g.P,))
-        return (_where(np.broadcast_to(k_i, (g.P,)) != 0, 1.0, r_i),
-                _where(np.broadcast_to(k_j, (g.P,)) != 0, 1.0, r_j))
-
-    def _viscous_scale(self, g):
-        """Per-visit factors (s_i, s_j) on ν: the viscosity ratio on bonds, 1 on contacts (None: all 1)."""
-        if g.perm is None:
-            return None
-        v_i, v_j = self._visc_ratio(g, "permanent_ratio_central")
-        if type(v_i) is float and v_i == 1.0:
-            return None
-        s_i = _where(g.perm, v_i, 1.0)
-        s_j = _where(g.perm, v_j, 1.0)
-        return s_i, s_j
+            f_t = call_law_vectorised(tensile, g.d, K.d_eq, K.k)
+        law = _where(stretched, f_t, law)
+        return law * K.ratio_c, law
 
     @property
     def active_terms(self):

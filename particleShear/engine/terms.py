@@ -1,0 +1,228 @@
+"""The pair force terms, each written once: their constants, the elastic, viscous and tangential terms.
+
+Contacts and bonds, the engine's step and the documented canvas classes all evaluate a pair's
+forces through these functions (docs/design.md, "One step"):
+
+* :func:`term_constants` turns the model parameters seen by one visit of a pair (k, c, ν, k_t,
+  ν_t, μ and the permanent ratios of a bond) into the constants of its terms, a
+  :class:`TermConstants`;
+* :func:`elastic_term` is the central elastic law (eqs. S1-5a/b with the cap S1-6; bonds: the
+  compressive law below ``d_eq`` and the linear tensile law above it), times the permanent ratio;
+* :func:`viscous_term` is the central viscous force ``ν·v_n`` (eq. S1-9) of the relations;
+* :func:`tangential_term` is the two-visit tangential rule with the Coulomb bound ``|μ·law|``
+  (:func:`~particleShear.engine.tangential.tangential_two_pass`; bonds have no bound);
+* :func:`central_term` is the elastic plus the viscous term, the central scalar of a step.
+
+The engine gathers its per-replica parameters to the candidates and keeps the constants with them
+(:class:`~particleShear.engine.forces.PairConstants` has the attributes of a
+:class:`TermConstants`); the classes compute them from their per-sphere parameters, once for the
+visit from i and, where the spheres' parameters differ, once for the visit from j.
+
+Every function takes the array namespace of its inputs (NumPy or CuPy, :mod:`.xp`).  Units:
+distances in µm, velocities in µm/s, forces in mg·µm·s⁻² per m depth (negative central force =
+repulsion), k in mg·s⁻² and ν in mg·s⁻¹ per m depth.
+"""
+__docformat__ = "numpy"
+
+import math
+
+from . import laws
+from .tangential import tangential_two_pass
+from .xp import array_namespace
+
+__all__ = ["TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term"]
+
+
+class TermConstants:
+    """Constants of the force terms of P pairs as seen by one visit (see :func:`term_constants`).
+
+    Each attribute is an array over the pairs or a number shared by all of them.
+
+    Attributes
+    ----------
+    k, c : ndarray or float
+        Spring constant and repulsion coefficient the constants were made from (for a law given as
+        a callback, which takes them).
+    d_law : ndarray or float
+        Contact distance of the compressive law (µm): ``r_i + r_j`` for a contact, ``d_eq`` for a bond.
+    d_cap, a_lin, a_div : ndarray or float
+        Constants of the compressive law (:func:`~particleShear.engine.laws.central_constants`).
+    form : str
+        Form of the compressive law (:func:`~particleShear.engine.laws.central_form`).
+    d_eq, a_tens : ndarray or float or None
+        Equilibrium distance (µm) and ``−k`` of the tensile law of bonds (0 and −0 on contacts:
+        ``−0·(0 − d) = +0``); None when no pair is a bond.
+    ratio_c : ndarray or float
+        Factor on the elastic law: the permanent ratio (central) on bonds, 1 on contacts.
+    nu, k_t, nu_t, mu : ndarray or float
+        Central viscosity, tangential spring constant, tangential viscosity (bonds: scaled by the
+        permanent ratios; the viscosities unless kept constant) and friction coefficient.
+    fc_inf : ndarray or float
+        Added to the Coulomb bound: ``inf`` on bonds (no bound), 0 on contacts.
+    """
+
+    __slots__ = ("k", "c", "d_law", "d_cap", "a_lin", "a_div", "form", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu",
+                 "fc_inf")
+
+    def __init__(self, **values):
+        """Set every attribute.
+
+        Parameters
+        ----------
+        **values
+            One value per attribute name of :attr:`__slots__` (all of them).
+        """
+        for name in self.__slots__:
+            setattr(self, name, values[name])
+
+
+def term_constants(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc=1.0, prt=1.0, keep=1.0):
+    """Constants of the force terms of each pair, from the model parameters seen by one visit.
+
+    Contacts: the compressive law at ``d0 = r_i + r_j`` (eqs. S1-5a/b, S1-6), ``ν``, ``k_t``,
+    ``ν_t`` and the Coulomb bound ``|μ·law|``.  Bonds (``perm``): the compressive law at ``d_eq``
+    and the tensile law ``−k (d_eq − d)`` above it, both times ``prc``; ``k_t·prt``; the
+    viscosities times ``prc`` and ``prt`` unless ``keep``; no Coulomb bound.  All parameters
+    broadcast (numbers, or arrays over the pairs).
+
+    Parameters
+    ----------
+    d0 : ndarray (P,)
+        Contact distance ``r_i + r_j`` (µm).
+    perm : ndarray of bool (P,) or None
+        Which pairs are bonds; None when none is.
+    d_eq : ndarray (P,) or None
+        Equilibrium distance of each bond (µm; read on bonds only); None when ``perm`` is None.
+    k, c : ndarray or float
+        Spring constant (eq. S1-8) and central repulsion coefficient in [0, 1].
+    nu, k_t, nu_t, mu : ndarray or float
+        Central viscosity (eq. S1-9), tangential spring constant and viscosity, friction coefficient.
+    prc, prt : ndarray or float, default 1.0
+        Permanent ratios (central, tangential) of bonds.
+    keep : ndarray or float, default 1.0
+        Nonzero where a bond keeps its viscosities (``keep_viscosity_coefficients_constant``).
+
+    Returns
+    -------
+    TermConstants
+    """
+    if perm is None:
+        d_cap, a_lin, a_div = laws.central_constants(d0, k, c)
+        return TermConstants(k=k, c=c, d_law=d0, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c), d_eq=None,
+                             a_tens=None, ratio_c=1.0, nu=nu, k_t=k_t, nu_t=nu_t, mu=mu, fc_inf=0.0)
+    xp = array_namespace(d0, d_eq)
+    d_law = xp.where(perm, d_eq, d0)
+    d_cap, a_lin, a_div = laws.central_constants(d_law, k, c)
+    loose = perm & (keep == 0)               # bonds whose viscosities take the permanent ratios
+    return TermConstants(k=k, c=c, d_law=d_law, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c),
+                         d_eq=xp.where(perm, d_eq, 0.0), a_tens=-xp.where(perm, k, 0.0),
+                         ratio_c=xp.where(perm, prc, 1.0), nu=nu * xp.where(loose, prc, 1.0),
+                         k_t=k_t * xp.where(perm, prt, 1.0), nu_t=nu_t * xp.where(loose, prt, 1.0), mu=mu,
+                         fc_inf=xp.where(perm, math.inf, 0.0))
+
+
+def elastic_term(K, d):
+    """Central elastic force of each pair and its law before the permanent ratio.
+
+    The compressive law (eqs. S1-5a/b, cap S1-6) up to ``K.d_law``; beyond it the tensile law
+    ``−k (d_eq − d)`` of a stretched bond, and +0 for a contact that has separated.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs (:func:`term_constants`).
+    d : ndarray (P,)
+        Centre distances (µm).
+
+    Returns
+    -------
+    f : ndarray (P,)
+        Elastic force on i along ``n_ij``, ``law·ratio_c`` (mg·µm·s⁻² per m depth; negative repels);
+        a new array.
+    law : ndarray (P,)
+        The law before the ratio (same unit), the base of the Coulomb bound.
+    """
+    inside = laws.central_inside(d, K.d_law, K.d_cap, K.a_lin, K.a_div, form=K.form)
+    beyond = 0.0 if K.a_tens is None else laws.tensile_inside(d, K.d_eq, K.a_tens)
+    law = array_namespace(d).where(d > K.d_law, beyond, inside)
+    return law * K.ratio_c, law
+
+
+def viscous_term(K, vn, active):
+    """Central viscous force ``ν·v_n`` of each relation (eq. S1-9); 0 on other candidates.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs (``nu``).
+    vn : ndarray (P,)
+        Normal relative velocity ``(v_j − v_i)·n_ij`` (µm/s; positive when separating).
+    active : ndarray of bool (P,) or None
+        Relations (touching, or a bond); None when every pair is one.
+
+    Returns
+    -------
+    ndarray (P,)
+        Viscous force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    if active is None:
+        return K.nu * vn
+    return array_namespace(vn).where(active, K.nu, 0.0) * vn
+
+
+def central_term(K, d, vn, active):
+    """Elastic + viscous central scalar of each candidate (on i along ``n_ij``; −n on j) and the law.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs.
+    d : ndarray (P,)
+        Centre distances (µm).
+    vn : ndarray (P,)
+        Normal relative velocity (µm/s).
+    active : ndarray of bool (P,)
+        Relations; only they get the viscous term.
+
+    Returns
+    -------
+    f : ndarray (P,)
+        :func:`elastic_term` + :func:`viscous_term` (mg·µm·s⁻² per m depth).
+    law : ndarray (P,)
+        The elastic law before the permanent ratio (the base of the Coulomb bound).
+    """
+    f, law = elastic_term(K, d)
+    f += viscous_term(K, vn, active)
+    return f, law
+
+
+def tangential_term(K, vt, touching, xi, law, K_j=None):
+    """Two-visit tangential rule with the Coulomb bound ``|μ·law|`` (bonds: none); updates ``xi``.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs seen by the visit from i (``k_t``, ``nu_t``, ``mu``, ``fc_inf``).
+    vt : ndarray (P,)
+        Tangential slip velocity along ``t_ij`` seen from i (µm/s).
+    touching : ndarray (P,) of float or bool
+        1 where the pair overlaps (``d < r_i + r_j``), else 0.
+    xi : ndarray (2, P)
+        Histories ξ_ij, ξ_ji (µm), updated in place (reset on slip).
+    law : ndarray (P,)
+        Elastic law of each pair before the ratio (:func:`elastic_term`).
+    K_j : TermConstants, optional
+        Constants seen by the visit from j, where the spheres' parameters differ (default ``K``).
+
+    Returns
+    -------
+    F : ndarray (2, P)
+        Tangential forces of the two visits (mg·µm·s⁻² per m depth), see
+        :func:`~particleShear.engine.tangential.tangential_two_pass`.
+    slip : ndarray of bool (P,)
+        The final slip flag.
+    """
+    K_j = K if K_j is None else K_j
+    fc = abs(K.mu * law)
+    fc += K.fc_inf
+    return tangential_two_pass(vt, touching, xi, K.k_t, K_j.k_t, K.nu_t, K_j.nu_t, fc)
