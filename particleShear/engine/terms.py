@@ -25,6 +25,7 @@ repulsion), k in mg·s⁻² and ν in mg·s⁻¹ per m depth.
 __docformat__ = "numpy"
 
 import math
+import numbers
 
 from . import laws
 from .tangential import tangential_two_pass
@@ -111,14 +112,24 @@ def term_constants(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc=1.0, prt=1.0, ke
         return TermConstants(k=k, c=c, d_law=d0, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c), d_eq=None,
                              a_tens=None, ratio_c=1.0, nu=nu, k_t=k_t, nu_t=nu_t, mu=mu, fc_inf=0.0)
     xp = array_namespace(d0, d_eq)
+
+    def on_bonds(mask, ratio):
+        """``ratio`` on the pairs of ``mask``, 1 elsewhere (the number 1 when the ratio is the number 1)."""
+        if mask is None or (isinstance(ratio, numbers.Real) and ratio == 1):
+            return 1.0
+        return xp.where(mask, ratio, 1.0)
+
     d_law = xp.where(perm, d_eq, d0)
     d_cap, a_lin, a_div = laws.central_constants(d_law, k, c)
-    loose = perm & (keep == 0)               # bonds whose viscosities take the permanent ratios
+    # bonds whose viscosities take the permanent ratios (None: none does)
+    if isinstance(keep, numbers.Real):
+        loose = perm if keep == 0 else None
+    else:
+        loose = perm & (keep == 0)
     return TermConstants(k=k, c=c, d_law=d_law, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c),
-                         d_eq=xp.where(perm, d_eq, 0.0), a_tens=-xp.where(perm, k, 0.0),
-                         ratio_c=xp.where(perm, prc, 1.0), nu=nu * xp.where(loose, prc, 1.0),
-                         k_t=k_t * xp.where(perm, prt, 1.0), nu_t=nu_t * xp.where(loose, prt, 1.0), mu=mu,
-                         fc_inf=xp.where(perm, math.inf, 0.0))
+                         d_eq=xp.where(perm, d_eq, 0.0), a_tens=-xp.where(perm, k, 0.0), ratio_c=on_bonds(perm, prc),
+                         nu=nu * on_bonds(loose, prc), k_t=k_t * on_bonds(perm, prt), nu_t=nu_t * on_bonds(loose, prt),
+                         mu=mu, fc_inf=xp.where(perm, math.inf, 0.0))
 
 
 def elastic_term(K, d):
