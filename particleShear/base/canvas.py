@@ -30,7 +30,7 @@ from .namespace import (bincount as _bincount, concatenate as _concat, copyto as
 from . import laws
 from .laws import call_law_vectorised
 from ..engine.integrate import damp, kick, plates_follow, xi_increments
-from ..engine.terms import elastic_term, tangential_term, term_constants, viscous_term
+from ..engine.terms import elastic_term, pair_forces, tangential_term, term_constants, viscous_term
 from ..engine.neighbours import verlet_bound
 from .memo import Memo
 from .memory import tune_allocator
@@ -1134,25 +1134,21 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         Fi = fa[1]
         Fj = fa[2]
         antisymmetric = g.fn_j is None
-        if g.fn_i is None:
-            Fi[...] = 0.0
-        else:
-            np.multiply(g.n, g.fn_i, out=Fi)
-        if spin:
-            # tangential force along t_ij = (−n_y, n_x): F_i += f_t t, F_j −= f_t t
-            Tf = g.t * g.ft
-            Fi += Tf
+        # F_i = f_n·n + f_t·t and the torques d·f_t·(r_i, r_j)/(r_i + r_j) (eq. S1-3): the engine's pair_forces
+        nx, ny = g.n[0], g.n[1]
+        fx, fy, _, tq = pair_forces(0.0 if g.fn_i is None else g.fn_i, g.ft, nx, ny, g.d, S.w2)
+        Fi[0] = fx
+        Fi[1] = fy
         if antisymmetric:
             np.negative(Fi, out=Fj)
         else:
-            np.multiply(g.n, -g.fn_j, out=Fj)
-            if spin:
-                Fj -= Tf
+            fx, fy = pair_forces(g.fn_j, g.ft, nx, ny, g.d, None)[:2]
+            np.negative(fx, out=Fj[0])
+            np.negative(fy, out=Fj[1])
         ti = tj = None
         if spin:
-            df = g.d * g.ft
             Wt = fa[4]
-            np.multiply(df, S.w2, out=Wt)
+            Wt[...] = tq
             ti = Wt[0]   # indexing, not tuple unpacking (iterating an array is slow)
             tj = Wt[1]
         if P:

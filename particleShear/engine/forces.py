@@ -110,6 +110,11 @@ class PairConstants:
         f[5:7] = xp.stack((s.Lx, s.Ly))[:, self.rep]
         f[7:9] = f[6:4:-1] / 2                    # hy, hx
 
+    @property
+    def w(self):
+        """The lever fractions ``(w_i, w_j)`` as one (2, P) view of the float block (eq. S1-3)."""
+        return self.f[3:5]
+
     def _blocks(self, f, i, b, i_host):
         """Take the blocks and bind every named attribute to a view of its row."""
         d = self.__dict__

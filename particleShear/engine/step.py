@@ -30,7 +30,7 @@ import numpy as np
 from .box import min_image, wrap
 from .integrate import damp, drift, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
-from .terms import central_term, tangential_term
+from .terms import central_term, pair_forces, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
@@ -347,11 +347,8 @@ class BatchEngine:
         fn, law = central_term(C, d, vn, active)
         F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
         self.state_p = slip.view(np.int8) + C.perm_code
-        f_t = (F[0] + F[1]) * 0.5
-        fx_i = fn * nx - f_t * ny
-        fy_i = fn * ny + f_t * nx
-        dF = d * f_t
-        s.frc[...] = scatter(C, len(x), fx_i, fy_i, dF * C.w_i, dF * C.w_j)
+        fx_i, fy_i, dF, tq = pair_forces(fn, (F[0] + F[1]) * 0.5, nx, ny, d, C.w)
+        s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1])
         mob = self.mobile()
         out = None
         if sample:

@@ -11,7 +11,9 @@ forces through these functions (docs/design.md, "One step"):
 * :func:`viscous_term` is the central viscous force ``ν·v_n`` (eq. S1-9) of the relations;
 * :func:`tangential_term` is the two-visit tangential rule with the Coulomb bound ``|μ·law|``
   (:func:`~particleShear.engine.tangential.tangential_two_pass`; bonds have no bound);
-* :func:`central_term` is the elastic plus the viscous term, the central scalar of a step.
+* :func:`central_term` is the elastic plus the viscous term, the central scalar of a step;
+* :func:`pair_forces` turns the central and tangential scalars into the force vector on i and
+  splits the internal torque between the two spheres (eq. S1-3).
 
 The engine gathers its per-replica parameters to the candidates and keeps the constants with them
 (:class:`~particleShear.engine.forces.PairConstants` has the attributes of a
@@ -31,7 +33,8 @@ from . import laws
 from .tangential import tangential_two_pass
 from .xp import array_namespace
 
-__all__ = ["TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term"]
+__all__ = ["TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term",
+           "pair_forces"]
 
 
 class TermConstants:
@@ -237,3 +240,40 @@ def tangential_term(K, vt, touching, xi, law, K_j=None):
     fc = abs(K.mu * law)
     fc += K.fc_inf
     return tangential_two_pass(vt, touching, xi, K.k_t, K_j.k_t, K.nu_t, K_j.nu_t, fc)
+
+
+def pair_forces(fn, ft, nx, ny, d, w):
+    """Force on sphere i of each pair, and the torques on i and j (eq. S1-3).
+
+    ``F_i = f_n·n + f_t·t`` with ``t = (−n_y, n_x)`` (j receives ``−F_i``); the internal torque
+    ``d·f_t`` is split in proportion to the radii, ``d·f_t·r_i/(r_i + r_j)`` on i and
+    ``d·f_t·r_j/(r_i + r_j)`` on j.
+
+    Parameters
+    ----------
+    fn : ndarray (P,) or float
+        Central scalar on i along ``n_ij`` (:func:`central_term`; mg·µm·s⁻² per m depth).
+    ft : ndarray (P,) or None
+        Tangential scalar along ``t_ij`` (the mean of the two visits of :func:`tangential_term`);
+        None: no tangential force and no torques.
+    nx, ny : ndarray (P,)
+        Unit normal from i towards j.
+    d : ndarray (P,)
+        Centre distances (µm).
+    w : ndarray (2, P) or None
+        Lever fractions ``r_i/(r_i + r_j)``, ``r_j/(r_i + r_j)``; None: no torques wanted.
+
+    Returns
+    -------
+    fx_i, fy_i : ndarray (P,)
+        Force on i (mg·µm·s⁻² per m depth).
+    dF : ndarray (P,) or None
+        Internal torque ``d·f_t`` of each pair (mg·µm²·s⁻² per m depth; the torque terms of the
+        stress tensors), None without ``ft``.
+    tq : ndarray (2, P) or None
+        Torques on i and on j (mg·µm²·s⁻² per m depth), None without ``ft`` or ``w``.
+    """
+    if ft is None:
+        return fn * nx, fn * ny, None, None
+    dF = d * ft
+    return fn * nx - ft * ny, fn * ny + ft * nx, dF, (None if w is None else dF * w)
