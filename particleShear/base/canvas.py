@@ -29,7 +29,7 @@ from .namespace import (bincount as _bincount, concatenate as _concat, copyto as
                         count_nonzero as _nz, where as _where)
 from . import laws
 from .laws import call_law_vectorised
-from ..engine.integrate import damp, kick, plates_follow, xi_increments
+from ..engine.integrate import damp, half_kick, kick, plates_follow, xi_increments
 from ..engine.terms import elastic_term, pair_forces, tangential_term, term_constants, viscous_term
 from ..engine.neighbours import verlet_bound
 from .memo import Memo
@@ -1603,16 +1603,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         a["xspeed"][:], a["yspeed"][:], a["omega"][:] = saved
 
     def _store_half_kick(self, dt):
-        """Remember ``F·dt/(2m)`` of mobile spheres for the next force phase (Verlet only)."""
-        a = self._a
-        mob = self._mobile_mask()
-        hx = a["xforce"] * dt / (2 * a["m"])
-        hy = a["yforce"] * dt / (2 * a["m"])
-        ht = a["torque"] * dt / (2 * a["inertia"]) if self._torque_total() is not None else None
-        if mob is not None:
-            hx = _where(mob, hx, 0.0)
-            hy = _where(mob, hy, 0.0)
-        self._half_kick = (hx, hy, ht)
+        """Remember ``F·dt/(2m)`` of mobile spheres (and ``T·dt/(2I)``) for the next force phase (Verlet only;
+        :func:`~particleShear.engine.integrate.half_kick`)."""
+        spin = self._torque_total() is not None
+        k = 3 if spin else 2
+        h = half_kick(self._frc[:k], self._st.take(_MASS_ROWS[:k], axis=0), dt, self._mobile_mask())
+        self._half_kick = (h[0], h[1], h[2] if spin else None)
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
         """Kick the velocities with the forces of the step, then damp them (third phase of a step).

@@ -16,7 +16,7 @@ __docformat__ = "numpy"
 
 from .xp import array_namespace
 
-__all__ = ["kick", "plates_follow", "damp", "xi_increments", "drift"]
+__all__ = ["kick", "half_kick", "plates_follow", "damp", "xi_increments", "drift"]
 
 
 def kick(vel, frc, weights, dt):
@@ -37,6 +37,35 @@ def kick(vel, frc, weights, dt):
     step /= weights
     vel += step
     frc[...] = 0.0
+
+
+def half_kick(frc, weights, dt, mobile=None):
+    """The velocity Verlet predictor's half kick ``F·dt/(2m)`` (and ``T·dt/(2I)``) of every sphere.
+
+    The force phase of the next step sees the velocities moved half a kick ahead (the classes'
+    ``integrator="verlet"``); plate spheres get no linear half kick.
+
+    Parameters
+    ----------
+    frc : ndarray (k, n)
+        Force rows ``F_x, F_y`` (and, with k = 3, the torque) of the last force phase.
+    weights : ndarray (k, n)
+        ``(m, m)`` or ``(m, m, I)`` of every sphere (mg and mg·µm² per m depth).
+    dt : float
+        Time step (s).
+    mobile : ndarray of bool (n,), optional
+        The mobile spheres; the others get 0 in the linear rows.  None: every sphere is mobile.
+
+    Returns
+    -------
+    ndarray (k, n)
+        Half kicks of the velocity rows (µm/s, and rad/s for ω).
+    """
+    h = frc * dt
+    h /= 2 * weights
+    if mobile is not None:
+        h[:2] = array_namespace(h).where(mobile, h[:2], 0.0)
+    return h
 
 
 def plates_follow(vx, vy, immobile, yc, plate_speed):
