@@ -30,7 +30,8 @@ from .namespace import (bincount as _bincount, concatenate as _concat, copyto as
 from . import laws
 from .laws import call_law_vectorised
 from ..engine.integrate import damp, half_kick, kick, plates_follow, xi_increments
-from ..engine.terms import elastic_term, pair_forces, tangential_term, term_constants, viscous_term
+from ..engine.terms import (elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term,
+                            term_constants, viscous_term)
 from ..engine.neighbours import verlet_bound
 from .memo import Memo
 from .memory import tune_allocator
@@ -1506,18 +1507,14 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         Also keeps the gathered (xspeed, yspeed, omega) of both spheres for the tangential term."""
         if g.rv is None:
             vel = self._vel
-            g.Vi = Vi = vel.take(g.ai, axis=1)
-            g.Vj = Vj = vel.take(g.aj, axis=1)
-            rv = Vj[:2] - Vi[:2]
-            if g.dvx is not None:
-                rv[0] += g.dvx
-            g.rv = rv
+            g.Vi = vel.take(g.ai, axis=1)
+            g.Vj = vel.take(g.aj, axis=1)
+            g.rv = relative_velocity(g.Vi, g.Vj, g.dvx)
         return g.rv
 
     def _normal_speed(self, g):
         if g.vn is None:
-            rv = self._relative_velocity(g) * g.n
-            g.vn = rv[0] + rv[1]
+            g.vn = normal_speed(self._relative_velocity(g), g.n[0], g.n[1])
         return g.vn
 
     def central_viscous_force_from_neighbors(self):
@@ -1829,12 +1826,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def _tangential_speed(self, g):
         if g.vt is None:
-            w = self._relative_velocity(g) * g.t
-            spin = g.ri * g.Vi[2]
-            spin += g.rj * g.Vj[2]
-            vt = w[0] + w[1]
-            vt -= spin
-            g.vt = vt
+            g.vt = slip_speed(self._relative_velocity(g), g.n[0], g.n[1], g.ri, g.rj, g.Vi[2], g.Vj[2])
         return g.vt
 
     def _add_tangential(self, f_pair):

@@ -30,7 +30,7 @@ import numpy as np
 from .box import min_image, wrap
 from .integrate import damp, drift, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
-from .terms import central_term, pair_forces, tangential_term
+from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import SLIP, STICK, ReplicaPairs
@@ -338,11 +338,9 @@ class BatchEngine:
         dvx = -(C.Ly * s.rate[C.rep]) * ky
         Vi = s.vel.take(ai, axis=1)
         Vj = s.vel.take(aj, axis=1)
-        rvx = Vj[0] - Vi[0] + dvx
-        rvy = Vj[1] - Vi[1]
-        vn = rvx * nx + rvy * ny
-        spin = C.ri * Vi[2] + C.rj * Vj[2]
-        vt = rvx * -ny + rvy * nx - spin
+        rv = relative_velocity(Vi, Vj, dvx)
+        vn = normal_speed(rv, nx, ny)
+        vt = slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
         fn, law = central_term(C, d, vn, active)
         F, slip = tangential_term(C, vt, touching.astype(float), xi, law)

@@ -3,6 +3,9 @@
 Contacts and bonds, the engine's step and the documented canvas classes all evaluate a pair's
 forces through these functions (docs/design.md, "One step"):
 
+* :func:`relative_velocity`, :func:`normal_speed` and :func:`slip_speed` are the kinematics of a
+  contact: the velocity of j's image relative to i, its normal part ``v_n`` and the tangential slip
+  ``v_t`` of the two surfaces (with the spins);
 * :func:`term_constants` turns the model parameters seen by one visit of a pair (k, c, ν, k_t,
   ν_t, μ and the permanent ratios of a bond) into the constants of its terms, a
   :class:`TermConstants`;
@@ -33,8 +36,73 @@ from . import laws
 from .tangential import tangential_two_pass
 from .xp import array_namespace
 
-__all__ = ["TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term",
+__all__ = ["relative_velocity", "normal_speed", "slip_speed", "TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term",
            "pair_forces"]
+
+
+def relative_velocity(Vi, Vj, dvx=None):
+    """Velocity of j's nearest image relative to i, ``v_j − v_i`` (+ the image's ``−Ly·γ̇`` per period above).
+
+    Parameters
+    ----------
+    Vi, Vj : ndarray (≥ 2, P)
+        Velocity rows (``vx, vy``, and possibly ``ω``) of spheres i and j of each pair (µm/s).
+    dvx : ndarray (P,) or None
+        x velocity of j's image relative to j itself (µm/s; nonzero for pairs across the sheared
+        boundary); None: no pair acts through it.
+
+    Returns
+    -------
+    ndarray (2, P)
+        ``(Δv_x, Δv_y)`` (µm/s), a new array.
+    """
+    rv = Vj[:2] - Vi[:2]
+    if dvx is not None:
+        rv[0] += dvx
+    return rv
+
+
+def normal_speed(rv, nx, ny):
+    """Normal relative velocity ``v_n = Δv·n_ij`` of each pair (µm/s; positive when separating).
+
+    Parameters
+    ----------
+    rv : ndarray (2, P)
+        Relative velocity (:func:`relative_velocity`, µm/s).
+    nx, ny : ndarray (P,)
+        Unit normal from i towards j.
+
+    Returns
+    -------
+    ndarray (P,)
+    """
+    return rv[0] * nx + rv[1] * ny
+
+
+def slip_speed(rv, nx, ny, ri, rj, omega_i, omega_j):
+    """Tangential slip velocity of the two surfaces, ``v_t = Δv·t_ij − (r_i ω_i + r_j ω_j)``, ``t = (−n_y, n_x)``.
+
+    Parameters
+    ----------
+    rv : ndarray (2, P)
+        Relative velocity (:func:`relative_velocity`, µm/s).
+    nx, ny : ndarray (P,)
+        Unit normal from i towards j.
+    ri, rj : ndarray (P,)
+        Radii (µm).
+    omega_i, omega_j : ndarray (P,)
+        Spins (rad/s).
+
+    Returns
+    -------
+    ndarray (P,)
+        Slip velocity along ``t_ij`` seen from i (µm/s); 0 for rolling without slipping.
+    """
+    spin = ri * omega_i
+    spin += rj * omega_j
+    vt = rv[0] * -ny + rv[1] * nx
+    vt -= spin
+    return vt
 
 
 class TermConstants:
