@@ -11,8 +11,10 @@ Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central l
 :mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica from a cell
 list; also the classes' neighbour search), :mod:`.relax` (the constitution's free relaxation of a
 batch),
-:mod:`.forces` (pair terms, scatter, shear stresses), :mod:`.integrate` (kick, plates, damping,
-the sequential ξ rule and the drift, shared with the canvas classes), :mod:`.stress` (every tensor once, in one
+:mod:`.terms` (the force terms of a pair, each written once: kinematics, term constants, elastic,
+viscous and tangential terms, force vectors and torque split; shared with the canvas classes),
+:mod:`.forces` (per-candidate constants, geometry, scatter, shear stresses), :mod:`.integrate` (kick,
+the Verlet half kick, plates, damping, the sequential ξ rule and the drift, shared with the canvas classes), :mod:`.stress` (every tensor once, in one
 registry; also the classes' tensors), :mod:`.step` (one step, top to bottom, the
 pre-equilibration and the protocol); :mod:`.xp` is the array namespace (NumPy, or CuPy with
 ``backend="cupy"``) and the one door from the device to the host (docs/design.md, "Backends").

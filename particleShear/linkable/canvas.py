@@ -1,10 +1,12 @@
 """Ensembles with permanent links (crosslinks): bonds, cutting along lines, bond forces.
 
-``CanvasPointsLinkable`` adds the bond term to the friction canvas: bonds use
+``CanvasPointsLinkable`` adds bonds to the friction canvas: bonds use
 the compressive law below ``d_eq`` and the tensile law above it, never break,
 carry an unbounded tangential spring and are scaled by the per-sphere
-``permanent_ratio_*`` of the adjustable sphere class.  The bond kernel runs only
-while bonds exist.  The force laws are eq. S1-5a/b of the manual; the constants are those
+``permanent_ratio_*`` of the adjustable sphere class.  They are pairs of the canvas's terms with
+other constants (:func:`particleShear.engine.terms.term_constants`), evaluated by the engine's
+term functions like contacts; this class adds the bookkeeping of bonds and, for a tensile law
+replaced through ``call_back_elastic_force_law_tensile``, its evaluation.  The force laws are eq. S1-5a/b of the manual; the constants are those
 of docs/parameters.md; how bonds are made and cut is described in docs/design.md.
 """
 __docformat__ = "numpy"
