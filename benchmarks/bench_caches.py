@@ -63,18 +63,29 @@ def run_steps(ens, ev, n_steps):
 
 
 class BypassMemo(Memo):
-    """A memo that recomputes the entries ``names`` (a ``+``-separated string) at every ``get``."""
+    """A memo that recomputes the entries ``names`` (a ``+``-separated string) at every ``get``; an entry named
+    ``NAME@phase`` is recomputed once per force phase instead (per geometry object ``canvas._g``)."""
 
-    __slots__ = ("_bypass",)
+    __slots__ = ("_bypass", "_per_phase", "_canvas", "_phase")
 
-    def __init__(self, values, names):
+    def __init__(self, values, names, canvas=None):
         Memo.__init__(self)
         self._values.update(values)
-        self._bypass = set(names.split("+"))
+        names = names.split("+")
+        self._bypass = {n for n in names if not n.endswith("@phase")}
+        self._per_phase = {n[:-len("@phase")] for n in names if n.endswith("@phase")}
+        self._canvas = canvas
+        self._phase = {}
 
     def get(self, name, key, compute):
         if name in self._bypass:
             return compute()
+        if name in self._per_phase:
+            g = self._canvas._g
+            kept = self._phase.get(name)
+            if kept is None or kept[0] is not g:
+                kept = self._phase[name] = (g, compute())
+            return kept[1]
         return Memo.get(self, name, key, compute)
 
 
@@ -83,7 +94,8 @@ ENTRIES = {
     "internal_flags": "internal/external flags of the pairs",
     "pair_structure+internal_flags": "the structure and the flags",
     "selection": "selection of the mobile spheres (the list)",
-    "term_constants": "constants of the force terms (laws, bonds, viscosities, Coulomb offset)",
+    "term_constants": "constants of the force terms (laws, bonds, viscosities, Coulomb offset), at every get",
+    "term_constants@phase": "the same, computed once per force phase instead of kept",
 }
 
 
@@ -96,7 +108,7 @@ def measure(ens, ev, name, blocks, steps):
         for state in ((0, 1) if b % 2 == 0 else (1, 0)):
             kept = ens._memo
             if state == 0:
-                ens._memo = BypassMemo(kept._values, name)
+                ens._memo = BypassMemo(kept._values, name, ens)
             t = run_steps(ens, ev, steps)
             if state == 0:
                 kept._values.update(ens._memo._values)
