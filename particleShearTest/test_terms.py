@@ -13,16 +13,15 @@
 * the classes and the engine evaluate a crosslinked frictional scene with these functions: the classes'
   force phase equals the terms evaluated by hand from the pair geometry, the register and the sphere sums.
 """
-import math
 import unittest
 
 import numpy as np
 
-from particleShear import EnsembleLinkable, SphereLinkable
 from particleShear.base.neighbours import PERMANENT
 from particleShear.engine.integrate import half_kick, kick
 from particleShear.engine.terms import (elastic_term, pair_forces, tangential_term, term_constants,
                                         viscous_term)
+from particleShearTest.test_memo import _scene as memo_scene
 
 
 def _pairs(P=400, seed=3):
@@ -155,24 +154,9 @@ class TestHalfKick(unittest.TestCase):
         np.testing.assert_array_equal(hm[2], h[2])                           # spins are kicked everywhere
 
 
-def _scene(seed=4, n=30):
-    """Crosslinked frictional bimodal spheres with one sphere of other permanent ratios, sheared."""
-    rng = np.random.default_rng(seed)
-    L = 160.0
-    r_b = math.sqrt(L * L * 1.3 / (n * math.pi))
-    ens = EnsembleLinkable(L, L, 0, k=1e3, nu=1.0, k_t=1e3, nu_t=1.0, mu=0.3)
-    ens.set_random_generator(rng)
-    for p in range(n):
-        r = r_b * (1.18 if p % 2 else 0.85)
-        ens.sphereList.append(SphereLinkable("grey", float(rng.random() * L), float(rng.random() * L), 2 * r,
-                                             0.1, p, force_register=ens, size_x=L, size_y=L))
-    for _ in range(20):
-        ens.mechanical_simulation_step(cool_factor=0.7, dt=1e-3)
-    ens.test_neighbor_relation()
-    ens.makeAllLinksPermanent()
-    ens.cutRandomLine()
-    ens.applyingShear = True
-    ens.setShearRate(0.5)
+def _scene():
+    """The crosslinked frictional sheared scene of test_memo, ten steps on."""
+    ens = memo_scene(seed=4, n=30)
     for _ in range(10):
         ens.mechanical_simulation_step(cool_factor=0.95, dt=1e-3)
     return ens
