@@ -167,7 +167,8 @@ class TestSweep(unittest.TestCase):
         names = _txt(self.ref)
         self.assertEqual(len(names), 4)                       # one text file per run, nothing else
         for r in self.rows:
-            self.assertEqual(os.path.dirname(r["output_path"]), self.ref)
+            self.assertEqual(os.path.dirname(r["output_path"]), "")     # relative to the sweep folder
+            self.assertTrue(os.path.isfile(os.path.join(self.ref, r["output_path"])))
             self.assertTrue(os.path.basename(r["output_path"]).endswith("_nr_" + r["run_id"] + ".txt"))
             self.assertTrue(os.path.basename(r["output_path"]).startswith(
                 "dermal_filler_uncrosslinked0.01_f_" if r["do_permanent_links"] == "False" else "dermal_filler0.01_f_"))
@@ -187,7 +188,7 @@ class TestSweep(unittest.TestCase):
     def test_file_header_names_the_row_id(self):
         """The run id in a file's provenance header is the id of its row and of its file name."""
         for r in self.rows:
-            with open(r["output_path"], encoding="utf-8") as fh:
+            with open(os.path.join(self.ref, r["output_path"]), encoding="utf-8") as fh:
                 head = fh.read(20000)
             ids = re.findall(r"^\tRun id: (\S+)$", head, flags=re.M)
             self.assertEqual(ids, [r["run_id"]])
@@ -336,7 +337,7 @@ class TestSeriesOnSweep(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d, concurrent.futures.ThreadPoolExecutor(2) as ex:
             first = doParticleShearSimulationSeries(root_folder=d, executor=ex, **kw)
             names = _txt(d)
-            with mock.patch("particleShear.sweep.runner.execute_run", side_effect=AssertionError("ran again")):
+            with mock.patch("particleShear.sweep.tasks.execute_run", side_effect=AssertionError("ran again")):
                 again = doParticleShearSimulationSeries(root_folder=d, executor=ex, **kw)
             self.assertEqual(_txt(d), names)
         self.assertEqual(len(names), 2)

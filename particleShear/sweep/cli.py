@@ -4,6 +4,7 @@ import argparse
 import contextlib
 import logging
 import os
+import signal
 import sys
 
 from ..messages import console_messages
@@ -21,7 +22,7 @@ def build_parser():
     argparse.ArgumentParser
         Positional ``SPEC``; ``--out DIR`` (required), ``--workers``, ``--dask``, ``--scheduler``,
         ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``,
-        ``--retry-failed``, ``--keep-going``, ``--quiet``, ``--backend``.
+        ``--retry-failed``, ``--keep-going``, ``--quiet``, ``--backend``, ``--extend``.
     """
     p = argparse.ArgumentParser(prog="particleShear sweep",
                                 description="Run (or resume) every run of a sweep SPEC (.toml or .json) into DIR; "
@@ -44,6 +45,8 @@ def build_parser():
     a("--dry-run", action="store_true", help="print the size and projected cost, run nothing")
     a("--calibrate", action="store_true", help="with --dry-run: time one shortened run here and scale the projection")
     a("--retry-failed", action="store_true", help="run again the runs whose row says failed")
+    a("--extend", action="store_true",
+      help="DIR holds a sweep of another SPEC: add this SPEC's new runs to it and keep its rows (default: refuse)")
     a("--keep-going", action="store_true", help="exit 0 even when runs failed (default: exit 1)")
     a("--quiet", action="store_true", help="no progress lines")
     return p
@@ -67,16 +70,62 @@ def main(argv=None):
     Returns
     -------
     int
-        Exit status: 0 ok, 1 some runs failed (or unfinished after ``--merge``), 2 invalid
-        input (message naming the flag on stderr), 130 interrupted.
+        Exit status (:data:`EXIT_STATUS`): 0 ok, 1 some runs failed (or unfinished after
+        ``--merge``), 2 invalid input (message naming the flag on stderr), 3 DIR is in use by
+        another live sweep, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).
     """
     args = build_parser().parse_args(argv)
-    with console_messages(stream=sys.stdout):
+    with console_messages(stream=sys.stdout), _sigterm_stops():
         return _main(args)
 
 
+#: the exit statuses of ``particleShear sweep``
+EXIT_STATUS = {"ok": 0, "runs failed": 1, "invalid input": 2, "folder busy": 3, "interrupted": 130,
+               "terminated": 143}
+
+
+@contextlib.contextmanager
+def _sigterm_stops():
+    """SIGTERM (a scheduler's walltime, ``kill``) stops the sweep at once: workers killed, rows kept, 143."""
+    from .pool import SweepTerminated
+
+    def stop(signum, frame):
+        raise SweepTerminated(f"signal {signum}")
+
+    try:
+        previous = signal.signal(signal.SIGTERM, stop)
+    except ValueError:   # not the main thread: leave SIGTERM alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _check_scheduler(address):
+    """``--scheduler ADDRESS`` before any work: dask.distributed importable, ADDRESS a scheduler address."""
+    import re
+    if not re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/:]+(:\d{1,5})?/?$", address or ""):
+        raise ValueError(f"scheduler={address!r} (--scheduler) is invalid: allowed a Dask scheduler address such "
+                         "as tcp://host:8786")
+
+
+def _dask_client(args, workers, stack):
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise ValueError("--dask/--scheduler need dask.distributed: pip install 'particleShear[dask]'") from None
+    if args.scheduler:
+        return stack.enter_context(Client(args.scheduler, timeout="30s"))
+    cluster = stack.enter_context(LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                               dashboard_address=None))
+    return stack.enter_context(Client(cluster))
+
+
 def _main(args):
-    from .cost import format_cost
+    from .locks import FolderBusyError
+    from .pool import SweepTerminated
     from .runner import Sweep
     try:
         _positive("workers", "--workers", args.workers)
@@ -84,59 +133,72 @@ def _main(args):
         if args.dask and args.scheduler:
             raise ValueError("--dask and --scheduler exclude each other: --dask starts a cluster, "
                              "--scheduler joins one")
+        if args.scheduler is not None:
+            _check_scheduler(args.scheduler)
+        if args.dask or args.scheduler:
+            import importlib.util
+            if importlib.util.find_spec("distributed") is None:
+                raise ValueError("--dask/--scheduler need dask.distributed: pip install 'particleShear[dask]'")
+        if args.merge and not os.path.isdir(args.out):
+            raise ValueError(f"out_dir={args.out!r} (--out) is invalid for --merge: no such folder")
         sweep = Sweep(args.spec, args.out, task_index=args.task_index, task_count=args.task_count,
-                      backend=args.backend)
+                      backend=args.backend, extend=args.extend)
     except (ValueError, TypeError) as exc:
         print(f"particleShear sweep: invalid input: {exc}", file=sys.stderr)
         return 2
     workers = args.workers or os.cpu_count() or 1
-    if args.merge:
-        n, missing = sweep.merge()
-        _log.info(f"merged {n} rows into {os.path.join(sweep.out_dir, 'results.csv')}; {missing} runs not finished")
-        return 0 if missing == 0 else 1
-    if args.dry_run:
-        _log.info(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
-        all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
-        if args.calibrate:
-            from .cost import calibrate
-            factor = calibrate(sweep.runs[0].parameters)
-            _log.info(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
-            for c in (all_c, todo_c):
-                c["cpu_s"] *= factor
-                c["wall_s"] *= factor
-        _log.info("all runs:   " + format_cost(all_c))
-        _log.info("still to run: " + format_cost(todo_c))
-        return 0
-    failed = 0
+    try:
+        if args.merge:
+            n, missing = sweep.merge()
+            _log.info(f"merged {n} rows into {os.path.join(sweep.out_dir, 'results.csv')}; {missing} runs not "
+                      "finished")
+            for table, why in sweep.kept_tables:
+                _log.info(f"kept {table}: {why}")
+            return 0 if missing == 0 else 1
+        if args.dry_run:
+            return _dry_run(args, sweep, workers)
+        return _run(args, sweep, workers)
+    except ValueError as exc:   # a table or record that cannot be used: refused before any run
+        print(f"particleShear sweep: invalid input: {exc}", file=sys.stderr)
+        return 2
+    except FolderBusyError as exc:
+        print(f"particleShear sweep: {exc}", file=sys.stderr)
+        return 3
+    except KeyboardInterrupt:
+        print(f"\nparticleShear sweep: interrupted; {len(sweep.finished_rows())} finished rows kept in "
+              f"{sweep.table_path}; run the same command again to resume", file=sys.stderr)
+        return 130
+    except SweepTerminated:
+        print(f"particleShear sweep: terminated; {len(sweep.finished_rows())} finished rows kept in "
+              f"{sweep.table_path}; run the same command again to resume", file=sys.stderr)
+        return 143
+
+
+def _dry_run(args, sweep, workers):
+    from .cost import format_cost
+    _log.info(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
+    all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
+    if args.calibrate:
+        from .cost import calibrate
+        factor = calibrate(sweep.runs[0].parameters)
+        _log.info(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
+        for c in (all_c, todo_c):
+            c["cpu_s"] *= factor
+            c["wall_s"] *= factor
+    _log.info("all runs:   " + format_cost(all_c))
+    _log.info("still to run: " + format_cost(todo_c))
+    return 0
+
+
+def _run(args, sweep, workers):
     with contextlib.ExitStack() as stack:
         executor = None
         if args.dask or args.scheduler:
-            try:
-                from dask.distributed import Client, LocalCluster
-            except ImportError:
-                print("particleShear sweep: --dask/--scheduler need dask.distributed: pip install "
-                      "'particleShear[dask]'", file=sys.stderr)
-                return 2
-            if args.scheduler:
-                client = stack.enter_context(Client(args.scheduler))
-            else:
-                cluster = stack.enter_context(LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                           processes=True, dashboard_address=None))
-                client = stack.enter_context(Client(cluster))
-            executor = client.get_executor()
-        try:
-            for outcome in sweep.as_completed(executor=executor, workers=None if executor else workers,
-                                              retry_failed=args.retry_failed, progress=not args.quiet,
-                                              batch_size=args.batch_size):
-                failed += not outcome.ok
-        except KeyboardInterrupt:
-            done = len(sweep.finished_rows())
-            print(f"\nparticleShear sweep: interrupted; {done} finished rows kept in {sweep.table_path}; "
-                  "run the same command again to resume", file=sys.stderr)
-            return 130
-        except RuntimeError as exc:
-            print(f"particleShear sweep: {exc}", file=sys.stderr)
-            return 2
+            executor = _dask_client(args, workers, stack).get_executor()
+        for _ in sweep.as_completed(executor=executor, workers=None if executor else workers,
+                                    retry_failed=args.retry_failed, progress=not args.quiet,
+                                    batch_size=args.batch_size):
+            pass
     rows = sweep.rows()
     n_failed = sum(r["status"] == "failed" for r in rows)
     _log.info(f"{len(rows)} of {len(sweep.my_runs())} runs finished ({n_failed} failed); table: {sweep.table_path}")

@@ -13,7 +13,7 @@ import math
 from ..linkable.builders import time_steps_from_model
 from ..simulation.experiment import protocol_steps
 
-__all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "format_cost"]
+__all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "estimate_point_cost", "format_cost"]
 
 _STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step), docs/performance.md
 _CONSTITUTION_S = 0.53                                            # s at N = 150
@@ -110,6 +110,40 @@ def estimate_cost(runs, workers=1):
     return {"runs": len(params), "steps": sum(run_steps(p) for p in params),
             "bytes": sum(run_bytes(p) for p in params), "cpu_s": cpu,
             "wall_s": cpu / max(1, int(workers or 1)), "workers": max(1, int(workers or 1))}
+
+
+def estimate_point_cost(points, counts, workers=1):
+    """:func:`estimate_cost` of ``counts[p]`` runs of each point ``points[p]``, without enumerating the runs.
+
+    A run's cost depends on its parameters only (not on its seed), so a sweep of any number of
+    repetitions is sized in the time of its points.
+
+    Parameters
+    ----------
+    points : sequence of dict
+        Complete parameters of each point.
+    counts : sequence of int
+        Runs of each point (≥ 0).
+    workers : int, optional
+        Parallel workers for the wall time (default 1).
+
+    Returns
+    -------
+    dict
+        As :func:`estimate_cost`.
+    """
+    runs = steps = nbytes = 0
+    cpu = 0.0
+    for p, n in zip(points, counts):
+        n = int(n)
+        if n <= 0:
+            continue
+        runs += n
+        steps += n * run_steps(p)
+        nbytes += n * run_bytes(p)
+        cpu += n * run_seconds(p)
+    w = max(1, int(workers or 1))
+    return {"runs": runs, "steps": steps, "bytes": nbytes, "cpu_s": cpu, "wall_s": cpu / w, "workers": w}
 
 
 def _human_bytes(b):

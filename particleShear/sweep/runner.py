@@ -2,38 +2,58 @@
 
 Layout of ``DIR`` (docs/sweeps.md)::
 
+    DIR/sweep.json                          the SPEC of the folder's sweep (canonical form, SHA-256)
     DIR/results.csv                         one row per finished run (ok or failed)
     DIR/results.parquet                     the same, when pyarrow is installed (rewritten at the end)
     DIR/<reference stem><run_id>.txt        e.g. dermal_filler0.01_f_3963.3_strain_0.2_nr_3fa9c2e1b0d4.txt
-    DIR/runs/<run_id>/                      scratch folder of a running run (removed when it ends)
+    DIR/runs/<owner>/<run_id>/              scratch folder of a running run of one driving process
 
-A run writes into its scratch folder (``root_folder``); when it has finished, the worker renames
-its files into ``DIR`` (companions first, the ``.txt`` last), then the driving process appends its
-row.  A run is finished when its row is in a table and its file exists.  A sweep killed at any
-moment leaves, at worst, a scratch folder (cleared when the run starts again) and, for the run
-that was being published, a file without row: the rerun writes the same file under the same name,
-so ``DIR`` never holds two ``.txt`` files of one run.
+A run writes into its scratch folder; when it has finished, the worker renames its files into
+``DIR`` (companions first, the file last), then the driving process appends its row.  A run is
+finished when its row is in a table, the row is this run's (id, seed, parameters, numbers), and
+its file — if it saves one — exists in ``DIR`` and is complete; anything else runs again (and the
+sweep says why).  A sweep killed at any moment leaves, at worst, a scratch folder (removed by the
+next sweep) and, for the run that was being published, a file without row: the rerun writes the
+same file under the same name, so ``DIR`` never holds two files of one run.
 """
 __docformat__ = "numpy"
-import concurrent.futures
 import contextlib
 import dataclasses
+import itertools
+import json
+import logging
 import os
-import re
-import shutil
 import sys
 import time
 
 import numpy as np
 
-from .cost import estimate_cost, format_cost
-from .spec import SweepSpec, expand_runs, load_spec, parse_spec
-from .table import (TABLE_NAME, append_row, read_rows, repair_table, table_columns, task_table_name, write_parquet,
-                    write_table)
+from .cost import estimate_cost, estimate_point_cost, format_cost
+from .locks import FolderBusyError, ScratchOwner, folder_lock
+from .pool import run_jobs
+from .record import canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
+from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
+from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, row_problem, table_columns,
+                    task_table_name, write_parquet, write_table)
+from .tasks import execute_batch, execute_run
 
-__all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "SweepProgress"]
+__all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
 
-_TABLE_GLOB = re.compile(r"^results(\.task-\d+-of-\d+)?\.csv$")
+_log = logging.getLogger(__name__)
+_TABLE_PREFIX, _TABLE_SUFFIX = "results", ".csv"
+#: pending runs grouped into batches at a time (``batch_size``): bounded memory for any sweep size
+_BATCH_CHUNK = 4096
+
+
+def _is_table(name):
+    if not (name.startswith(_TABLE_PREFIX) and name.endswith(_TABLE_SUFFIX)):
+        return False
+    mid = name[len(_TABLE_PREFIX):-len(_TABLE_SUFFIX)]
+    if mid == "":
+        return True
+    parts = mid.split("-")
+    return (len(parts) == 4 and parts[0] == ".task" and parts[2] == "of" and parts[1].isdigit()
+            and parts[3].isdigit())
 
 
 @dataclasses.dataclass
@@ -59,170 +79,6 @@ class SweepOutcome:
     def ok(self):
         """True when the run succeeded (``row["status"] == "ok"``)."""
         return self.row["status"] == "ok"
-
-
-def _publish(run_dir, out_dir, produced, run_id):
-    """Move a run's files from its scratch folder into ``out_dir``, named ``<stem><run_id>...``.
-
-    ``produced`` is the text file the run wrote (``<stem><k>.txt``); every entry of the scratch
-    folder starting with ``<stem><k>`` (sidecars, other formats, the image folder) moves with it,
-    the file itself last.  Returns the new path of ``produced``.
-    """
-    base = os.path.basename(produced)
-    m = re.match(r"^(.*_)(\d+)(\.[A-Za-z][A-Za-z0-9.]*)$", base)   # <stem><k><.ext>; μ may hold dots
-    if m:
-        head, new_head = m.group(1) + m.group(2), m.group(1) + run_id
-    else:
-        head = os.path.splitext(base)[0]
-        new_head = head + "_" + run_id
-    entries = sorted(e for e in os.listdir(run_dir) if e.startswith(head) and not e.endswith(".part"))
-    entries.sort(key=lambda e: e == base)          # the text file last
-    final = None
-    for e in entries:
-        target = os.path.join(out_dir, new_head + e[len(head):])
-        src = os.path.join(run_dir, e)
-        if os.path.isdir(src) and os.path.isdir(target):
-            shutil.rmtree(target)
-        os.replace(src, target)
-        if e == base:
-            final = target
-    return final
-
-
-def _failed_row(task, exc, wall):
-    from .. import __version__
-    row = {"run_id": task["run_id"], "status": "failed", "error": f"{type(exc).__name__}: {exc}".replace("\n", " ")}
-    row.update(task["parameters"])
-    row.update(seed_entropy=task["seed_entropy"], spawn_key=list(task["spawn_key"]), package_version=__version__,
-               wall_time_s=wall, output_path="")
-    return row
-
-
-def execute_run(task):
-    """Run one sweep task (a picklable dict) in the calling process; return ``(row, result or None)``.
-
-    Never raises for a failing simulation: the exception becomes a ``failed`` row.
-
-    Parameters
-    ----------
-    task : dict
-        ``run_id``, ``index``, ``parameters`` (complete, of ``doParticleShearSimulation``),
-        ``seed_entropy``, ``spawn_key``, ``out_dir`` (sweep folder; "" writes nothing) and
-        ``keep_series`` (bool: keep the per-step series in the result).
-
-    Returns
-    -------
-    tuple
-        ``(row, result)``: the results-table row (dict) and the SimulationResult, or None
-        when the run failed.
-    """
-    from ..run.api import doParticleShearSimulation
-    t0 = time.perf_counter()
-    run_dir, kwargs = None, None
-    try:
-        run_dir, kwargs = _prepare(task)
-        result = doParticleShearSimulation(**kwargs)
-        return _finish_run(task, result, time.perf_counter() - t0)
-    except Exception as exc:  # a failed run is a row, never the end of the sweep
-        return _failed_row(task, exc, time.perf_counter() - t0), None
-    finally:
-        if run_dir:
-            shutil.rmtree(run_dir, ignore_errors=True)
-
-
-def _prepare(task):
-    """``(run_dir, kwargs)`` of a task: its empty scratch folder ("" when it writes nothing) and its call."""
-    p = task["parameters"]
-    writes = bool(task["out_dir"]) and bool(p.get("saveData") or p.get("saveOutputImages"))
-    run_dir = os.path.join(task["out_dir"], "runs", task["run_id"]) if writes else ""
-    if writes:
-        shutil.rmtree(run_dir, ignore_errors=True)      # leftovers of a killed attempt
-        os.makedirs(run_dir)
-    ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
-    return run_dir, dict(p, root_folder=run_dir, seed=ss, return_result=True, verbose=False)
-
-
-def _finish_run(task, result, wall_time_s):
-    """Publish a finished run's files under its run id; return ``(row, result)``."""
-    result.parameters = dict(task["parameters"])
-    if result.output_path:
-        run_dir = os.path.dirname(result.output_path)
-        image_folder = result.image_folder
-        result.output_path = _publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
-        if image_folder:
-            result.image_folder = result.output_path + "_images_folder"
-    row = result.to_dict()
-    if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
-        raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
-    row["output_path"] = os.path.abspath(result.output_path) if result.output_path else ""
-    row["wall_time_s"] = wall_time_s
-    if not task.get("keep_series"):
-        result.series = {}
-    return row, result
-
-
-def execute_batch(tasks):
-    """Run sweep tasks that share a step schedule as one batch of replicas; ``[(row, result), ...]`` in order.
-
-    The replicas are measured together (:func:`particleShear.run.batch.run_batch`), each
-    bit-identical to its single run, so the rows equal those of :func:`execute_run`.  If the
-    batch fails (one replica diverging stops the batch), every task runs again on its own, so
-    that only the failing run becomes a ``failed`` row.
-
-    Parameters
-    ----------
-    tasks : list of dict
-        As for :func:`execute_run`.
-
-    Returns
-    -------
-    list of tuple
-        ``(row, result or None)`` per task, in the given order.
-    """
-    from ..run.batch import run_batch
-    t0 = time.perf_counter()
-    prepared = []
-    try:
-        prepared = [_prepare(task) for task in tasks]
-        results = run_batch([kw for _, kw in prepared])
-        wall = (time.perf_counter() - t0) / len(tasks)
-        return [_finish_run(task, result, wall) for task, result in zip(tasks, results)]
-    except Exception:  # noqa: BLE001 - one bad replica: run them one by one (failed rows where they fail)
-        for run_dir, _ in prepared:
-            if run_dir:
-                shutil.rmtree(run_dir, ignore_errors=True)
-        return [execute_run(task) for task in tasks]
-    finally:
-        for run_dir, _ in prepared:
-            if run_dir:
-                shutil.rmtree(run_dir, ignore_errors=True)
-
-
-def _pool_context(parameters):
-    """Start method of the default worker pool: "spawn" when a run uses a device backend.
-
-    The parent has initialised CUDA when it checked ``backend="cupy"``, and a forked child
-    cannot use CUDA after that; fresh ("spawn") workers can.  NumPy runs keep the platform's default.
-
-    Parameters
-    ----------
-    parameters : iterable of dict
-        The runs' keyword arguments.
-
-    Returns
-    -------
-    multiprocessing context or None
-    """
-    import multiprocessing
-    if any(p.get("backend", "numpy") != "numpy" for p in parameters):
-        return multiprocessing.get_context("spawn")
-    return None
-
-
-def _ignore_sigint():
-    """Worker initializer: Ctrl-C reaches only the driving process, which then stops cleanly."""
-    import signal
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 class SweepProgress:
@@ -277,38 +133,51 @@ class SweepProgress:
             self._bar.close()
 
 
-#: seconds to wait for the table lock (a killed sweep's worker may still be exiting)
-LOCK_WAIT_S = 15.0
+def _pool_context(parameters):
+    """Start method of the default worker pool: "spawn" when a run uses a device backend.
 
+    The parent has initialised CUDA when it checked ``backend="cupy"``, and a forked child
+    cannot use CUDA after that; fresh ("spawn") workers can.  NumPy runs keep the platform's default.
 
-@contextlib.contextmanager
-def _table_lock(path, wait_s=None):
-    """Exclusive advisory lock on ``path + '.lock'``, released by the OS when its holders die.
+    Parameters
+    ----------
+    parameters : iterable of dict
+        The runs' keyword arguments.
 
-    Forked workers inherit it, so a worker of a killed sweep keeps it until it has exited;
-    we wait up to ``LOCK_WAIT_S`` for it, then refuse (another sweep writes this table).
+    Returns
+    -------
+    multiprocessing context or None
     """
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - Windows: no lock
-        yield
-        return
-    wait_s = LOCK_WAIT_S if wait_s is None else wait_s
-    fd = os.open(path + ".lock", os.O_WRONLY | os.O_CREAT, 0o644)
-    try:
-        deadline = time.monotonic() + wait_s
-        while True:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except OSError:
-                if time.monotonic() >= deadline:
-                    raise RuntimeError(f"another sweep is writing {path!r}; wait for it or use another "
-                                       "--out DIR") from None
-                time.sleep(0.05)
-        yield
-    finally:
-        os.close(fd)
+    import multiprocessing
+    if any(p.get("backend", "numpy") != "numpy" for p in parameters):
+        return multiprocessing.get_context("spawn")
+    return None
+
+
+def _spec_doc(spec):
+    """The SPEC as a document of its tables (original types), for the folder's record."""
+    return {"parameters": dict(spec.parameters), "grid": {k: list(v) for k, v in spec.grid.items()},
+            "zip": [{k: list(v) for k, v in g.items()} for g in spec.zips],
+            "seeds": {"root": spec.root, "repetitions": spec.repetitions}}
+
+
+class _Share:
+    """The runs ``k`` with ``k % count == index`` of a sequence of runs, as a lazy sequence."""
+
+    def __init__(self, runs, index, count):
+        self.runs, self.index, self.count = runs, index, count
+
+    def __len__(self):
+        n = len(self.runs)
+        return 0 if self.index >= n else (n - 1 - self.index) // self.count + 1
+
+    def __getitem__(self, j):
+        if not 0 <= j < len(self):
+            raise IndexError(j)
+        return self.runs[self.index + j * self.count]
+
+    def __iter__(self):
+        return (self.runs[k] for k in range(self.index, len(self.runs), self.count))
 
 
 class Sweep:
@@ -319,7 +188,8 @@ class Sweep:
     spec : str, os.PathLike, dict or SweepSpec
         A SPEC file (.toml/.json), its parsed dict, or a :class:`SweepSpec`.
     out_dir : str
-        Output folder (created when missing).
+        Output folder (created when the sweep first runs).  A folder keeps the SPEC it was made
+        with (``DIR/sweep.json``): another SPEC is refused, naming what changed, unless ``extend``.
     task_index, task_count : int, optional
         Job-array share: this process runs the runs with ``index % task_count == task_index``
         and writes its rows to its own table, merged later by :meth:`merge`.
@@ -328,9 +198,17 @@ class Sweep:
         "numpy" or "cupy" (a CUDA GPU; runs without drawing).  It is part of each run's
         identity, so a sweep measured on the GPU does not resume the rows of a NumPy sweep.
         Default: the SPEC's (``"numpy"`` unless it sets one).
+    extend : bool, optional
+        ``--extend``: when ``out_dir`` holds a sweep of another SPEC, add this SPEC's new runs to
+        it and keep its rows (docs/sweeps.md, "One folder, one sweep"); default False: refuse.
+
+    Raises
+    ------
+    ValueError
+        An invalid SPEC, run or option, or a folder of another SPEC — before any work.
     """
 
-    def __init__(self, spec, out_dir, *, task_index=None, task_count=None, backend=None):
+    def __init__(self, spec, out_dir, *, task_index=None, task_count=None, backend=None, extend=False):
         if isinstance(spec, SweepSpec):
             self.spec = spec
         elif isinstance(spec, dict):
@@ -355,32 +233,126 @@ class Sweep:
             if isinstance(task_index, bool) or not isinstance(task_index, int) or not 0 <= task_index < task_count:
                 raise ValueError(f"task_index={task_index!r} (--task-index) is out of range: allowed "
                                  f"0 <= value < {task_count}")
+        if not isinstance(extend, bool):
+            raise ValueError(f"extend={extend!r} (--extend) is invalid: allowed True or False")
         if not isinstance(out_dir, (str, os.PathLike)) or not os.fspath(out_dir):
             raise ValueError(f"out_dir={out_dir!r} (--out) is invalid: allowed a folder path")
         self.out_dir = os.path.abspath(os.fspath(out_dir))
         if os.path.exists(self.out_dir) and not os.path.isdir(self.out_dir):
             raise ValueError(f"out_dir={out_dir!r} (--out) is invalid: it is a file")
-        self.task_index, self.task_count = task_index, task_count
-        self.runs = expand_runs(self.spec)          # validates every run before any work
-        self.columns = table_columns(list(self.runs[0].parameters) if self.runs else None)
+        self.task_index, self.task_count, self.extend = task_index, task_count, extend
+        own = spec_runs(self.spec)                     # validates every point before any work
+        self._canonical = canonical_spec(self.spec)
+        self._segments = self._check_folder()
+        if len(self._segments) == 1:
+            self.runs = own
+        else:                                          # an extended folder: the runs of every segment
+            specs = [parse_spec(seg["doc"]) for seg in self._segments[:-1]] + [self.spec]
+            self.runs = extended_runs(specs, [spec_runs(s) for s in specs[:-1]] + [own])
+        self.columns = table_columns(list(self.runs[0].parameters) if len(self.runs) else None)
         name = TABLE_NAME if task_count is None else task_table_name(task_index, task_count)
         self.table_path = os.path.join(self.out_dir, name)
+        self._run_cache = {}
+
+    def _check_folder(self):
+        """The folder's segments (dicts ``spec``, ``doc``) with this SPEC last; refuse another SPEC."""
+        rec = read_record(self.out_dir) if os.path.isdir(self.out_dir) else None
+        mine = {"spec": self._canonical, "doc": _spec_doc(self.spec)}
+        if rec is None:
+            return [mine]
+        segments = [{"spec": s["spec"], "doc": s.get("doc")} for s in rec["segments"]]
+        specs = check_record(self.out_dir, self._canonical, self.extend)
+        if len(specs) > len(segments):
+            return segments + [mine]
+        return segments
+
+    def _record(self):
+        """Write the folder's record when it is new or extended (under the table lock)."""
+        rec = read_record(self.out_dir)
+        now = [seg["spec"] for seg in self._segments]
+        if rec is not None and [spec_hash(s["spec"]) for s in rec["segments"]] == [spec_hash(c) for c in now]:
+            return
+        if rec is not None:       # someone recorded meanwhile: check again against what is there now
+            self._segments = self._check_folder()
+        write_record(self.out_dir, [seg["spec"] for seg in self._segments],
+                     docs=[seg["doc"] for seg in self._segments])
 
     # -- state ---------------------------------------------------------------------------------
     def my_runs(self):
-        """The runs of this process (all, or this task's share)."""
+        """The runs of this process (all, or this task's share), a sequence in sweep order."""
         if self.task_count is None:
-            return list(self.runs)
-        return [r for r in self.runs if r.index % self.task_count == self.task_index]
+            return self.runs
+        return _Share(self.runs, self.task_index, self.task_count)
 
     def _tables(self):
         if not os.path.isdir(self.out_dir):
             return []
-        return sorted(os.path.join(self.out_dir, e) for e in os.listdir(self.out_dir) if _TABLE_GLOB.match(e))
+        return sorted(os.path.join(self.out_dir, e) for e in os.listdir(self.out_dir) if _is_table(e))
 
-    def _file_exists(self, path):
-        return bool(path) and (os.path.exists(path)
-                               or os.path.exists(os.path.join(self.out_dir, os.path.basename(path))))
+    def _run_of(self, row):
+        """The run of this sweep that ``row`` claims to be (by its spawn key and id), or None."""
+        rid = row.get("run_id")
+        if not isinstance(self.runs, SweepRuns):
+            if not self._run_cache:
+                self._run_cache = {r.run_id: r for r in self.runs}
+            return self._run_cache.get(rid)
+        try:
+            key = json.loads(row.get("spawn_key") or "")
+            k = key[0] if isinstance(key, list) and len(key) == 1 else None
+        except (ValueError, TypeError):
+            return None
+        if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(self.runs):
+            return None
+        run = self._run_cache.get(k)
+        if run is None:
+            run = self._run_cache[k] = self.runs[k]
+        return run if run.run_id == rid else None
+
+    def _file_problem(self, row):
+        """Why the file of an ok row cannot be trusted (None when it is there and complete)."""
+        path = row.get("output_path") or ""
+        if not path:
+            return "its row names no file"
+        full = os.path.join(self.out_dir, os.path.basename(path))   # always in DIR, never elsewhere
+        if not os.path.isfile(full):
+            return f"its file {os.path.basename(path)} is missing"
+        try:
+            from ..simulation.formats import verify_run
+        except ImportError:  # pragma: no cover - formats without verification
+            return None if os.path.getsize(full) > 0 else f"its file {os.path.basename(path)} is empty"
+        try:
+            verify_run(full)
+        except ValueError as exc:
+            return str(exc)
+        return None
+
+    def _classify(self, retry_failed=False):
+        """``(done, distrusted)``: ``{run_id: (run, row)}`` finished, ``{run_id: (run, reason)}`` to run again.
+
+        An ``ok`` row that is trustworthy (:func:`~.table.row_problem`, file verified) wins over
+        any other row of the run, in any table; a ``failed`` row counts (unless ``retry_failed``)
+        when the run has no ``ok`` row to distrust.
+        """
+        ok, failed, distrust = {}, {}, {}
+        for path in self._tables():
+            for row in read_rows(path):
+                run = self._run_of(row)
+                if run is None:
+                    continue
+                rid = run.run_id
+                problem = row_problem(row, run)
+                if problem is None and row["status"] == "ok" and run.parameters.get("saveData"):
+                    problem = self._file_problem(row)
+                if problem is not None:
+                    if row.get("status") == "ok" or rid not in distrust:
+                        distrust[rid] = (run, problem)
+                    continue
+                (ok if row["status"] == "ok" else failed).setdefault(rid, (run, row))
+        done = dict(ok)
+        for rid, item in failed.items():
+            if rid not in done and rid not in distrust and not retry_failed:
+                done[rid] = item
+        return done, {rid: v for rid, v in distrust.items() if rid not in ok}
 
     def finished_rows(self, retry_failed=False):
         """``{run_id: row}`` of this sweep's finished runs, over all tables of ``out_dir``.
@@ -394,20 +366,11 @@ class Sweep:
         -------
         dict
         """
-        ids = {r.run_id for r in self.runs}
-        done = {}
-        for path in self._tables():
-            for row in read_rows(path):
-                rid = row.get("run_id")
-                if rid not in ids or rid in done:
-                    continue
-                if row.get("status") == "ok":
-                    wants_file = row.get("saveData") == "True"
-                    if not wants_file or self._file_exists(row.get("output_path")):
-                        done[rid] = row
-                elif row.get("status") == "failed" and not retry_failed:
-                    done[rid] = row
-        return done
+        done, _ = self._classify(retry_failed)
+        return {rid: row for rid, (_, row) in done.items()}
+
+    def _mine(self, run):
+        return self.task_count is None or run.index % self.task_count == self.task_index
 
     def pending(self, retry_failed=False):
         """This process's runs that have not finished, in sweep order.
@@ -421,11 +384,27 @@ class Sweep:
         -------
         list of SweepRun
         """
-        done = self.finished_rows(retry_failed)
+        done, _ = self._classify(retry_failed)
         return [r for r in self.my_runs() if r.run_id not in done]
 
+    def _point_counts(self, done=()):
+        """Runs per point of this process's share, less the runs in ``done`` (single-SPEC sweeps)."""
+        n_points = len(self.runs.points)
+        if self.task_count is None:
+            counts = np.full(n_points, self.runs.repetitions, dtype=np.int64)
+        else:
+            counts = np.zeros(n_points, dtype=np.int64)
+            step = self.task_count * 1_000_000
+            for a in range(self.task_index, len(self.runs), step):   # chunks: bounded memory
+                counts += np.bincount(np.arange(a, min(a + step, len(self.runs)), self.task_count) % n_points,
+                                      minlength=n_points)
+        for run, _ in done:
+            if self._mine(run):
+                counts[run.point] -= 1
+        return counts
+
     def cost(self, workers=1, pending_only=False):
-        """:func:`~particleShear.sweep.cost.estimate_cost` of the (pending) runs.
+        """:func:`~particleShear.sweep.cost.estimate_cost` of the (pending) runs, without enumerating them.
 
         Parameters
         ----------
@@ -439,29 +418,58 @@ class Sweep:
         dict
             As :func:`~particleShear.sweep.cost.estimate_cost`.
         """
-        return estimate_cost(self.pending() if pending_only else self.my_runs(), workers)
+        done = self._classify()[0].values() if pending_only else ()
+        if isinstance(self.runs, SweepRuns):
+            return estimate_point_cost(self.runs.points, self._point_counts(done), workers)
+        ids = {rid for rid in (r.run_id for r, _ in done)}
+        return estimate_cost([r for r in self.my_runs() if r.run_id not in ids], workers)
 
     # -- running -------------------------------------------------------------------------------
-    def _task(self, run, keep_series):
+    def _task(self, run, keep_series, scratch_dir, batched=False):
         return {"run_id": run.run_id, "index": run.index, "parameters": run.parameters,
                 "seed_entropy": run.seed_entropy, "spawn_key": run.spawn_key, "out_dir": self.out_dir,
-                "keep_series": bool(keep_series)}
+                "scratch_dir": scratch_dir, "keep_series": bool(keep_series), "batched": batched}
+
+    def _jobs(self, todo, keep_series, scratch_dir, batch_size):
+        """Jobs (lists of tasks) of the pending runs ``todo`` (an iterator), one run or one batch each."""
+        if batch_size is None:
+            for r in todo:
+                yield [self._task(r, keep_series, scratch_dir)]
+            return
+        from ..run.batch import batches
+        while True:
+            chunk = list(itertools.islice(todo, _BATCH_CHUNK))
+            if not chunk:
+                return
+            for g in batches([r.parameters for r in chunk], batch_size):
+                yield [self._task(chunk[i], keep_series, scratch_dir, batched=True) for i in g]
+
+    def _say(self, stream, progress, text):
+        if progress is True:
+            stream.write(f"[sweep] {text}\n")
+            stream.flush()
+        else:
+            _log.warning(text)
 
     def as_completed(self, executor=None, workers=None, keep_series=False, retry_failed=False, progress=True,
                      stream=None, batch_size=None):
         """Run the pending runs; yield a :class:`SweepOutcome` per run as it finishes (completion order).
 
-        Each row is appended to the table (fsynced) before it is yielded.
-        On KeyboardInterrupt the queued runs are cancelled and the interrupt propagates; the
-        rows written so far are kept and a rerun resumes.
+        Each row is appended to the table (fsynced) before it is yielded.  The table is checked
+        (and repaired where it can be) and every finished row verified before any run starts;
+        rows that cannot be trusted are said and their runs run again.  On KeyboardInterrupt the
+        queued runs are cancelled and the interrupt propagates; the rows written so far are
+        kept and a rerun resumes.
 
         Parameters
         ----------
         executor : concurrent.futures.Executor, optional
             Where the runs execute (not shut down here; e.g. a Dask client's executor);
-            default a ``ProcessPoolExecutor(workers)`` owned by this call.
+            default a process pool of ``workers`` owned by this call, whose workers end with
+            the driving process (:mod:`particleShear.sweep.pool`).
         workers : int, optional
-            Processes of the default executor (≥ 1, ``--workers``; default: all cores).
+            Processes of the default executor (≥ 1, ``--workers``; default: all cores; never
+            more than there are pending runs).
         keep_series : bool, optional
             Keep the per-step series in each outcome's result (default False: moduli only).
         retry_failed : bool, optional
@@ -484,7 +492,10 @@ class Sweep:
         Raises
         ------
         ValueError
-            If ``workers`` is not an integer ≥ 1 (before any run starts).
+            If ``workers`` or ``batch_size`` is not an integer ≥ 1, or a table cannot be used
+            (before any run starts).
+        FolderBusyError
+            When another live sweep writes the same table.
         """
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
             raise ValueError(f"workers={workers!r} (--workers) is invalid: allowed an integer >= 1")
@@ -493,79 +504,72 @@ class Sweep:
             raise ValueError(f"batch_size={batch_size!r} (--batch-size) is invalid: allowed an integer >= 1")
         stream = stream if stream is not None else sys.stderr
         os.makedirs(self.out_dir, exist_ok=True)
-        with _table_lock(self.table_path):
-            repair_table(self.table_path)
-            todo = self.pending(retry_failed)
-            ids = {r.run_id for r in todo}
+        with folder_lock(self.table_path):
+            for note in self._check_tables():
+                self._say(stream, progress, "repaired: " + note)
+            if self.spec is not None:
+                self._record()
+            done, distrust = self._classify(retry_failed)
+            for rid, (_, why) in sorted(distrust.items()):
+                self._say(stream, progress, f"run {rid} runs again: {why}")
             rows = read_rows(self.table_path)
-            if any(row.get("run_id") in ids for row in rows):   # stale rows (failed to retry, file lost)
-                write_table(self.table_path, [r for r in rows if r.get("run_id") not in ids], self.columns)
-            n_mine = len(self.my_runs())
+            drop = set(distrust) | {row.get("run_id") for row in rows if row.get("status") == "failed"
+                                    and row.get("run_id") not in done and self._run_of(row) is not None}
+            if any(row.get("run_id") in drop for row in rows):   # stale rows of runs that run again
+                write_table(self.table_path, [r for r in rows if r.get("run_id") not in drop], self.columns)
+            mine = self.my_runs()
+            n_mine = len(mine)
+            n_todo = n_mine - sum(1 for run, _ in done.values() if self._mine(run))
             if progress is True:
-                c = estimate_cost(todo, workers or os.cpu_count())
-                stream.write(f"[sweep] {n_mine} runs in this share, {n_mine - len(todo)} already finished; "
+                c = self._pending_cost(done, workers or os.cpu_count())
+                stream.write(f"[sweep] {n_mine} runs in this share, {n_mine - n_todo} already finished; "
                              f"to run: {format_cost(c)}\n")
                 stream.flush()
-                show = SweepProgress(n_mine, n_mine - len(todo), stream)
+                show = SweepProgress(n_mine, n_mine - n_todo, stream)
             else:
                 show = progress if callable(progress) else None
-            if not todo:
-                if show is not None and hasattr(show, "close"):
-                    show.close()
-                self._finish()
-                return
-            own = executor is None
-            if own:
-                executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint,
-                                                                  mp_context=_pool_context(r.parameters for r in todo))
-            futures, recorded = {}, set()
             try:
-                by_id = {r.run_id: r for r in todo}
-                if batch_size is None:
-                    futures = {executor.submit(execute_run, self._task(r, keep_series)): [r.run_id] for r in todo}
-                else:
-                    from ..run.batch import batches
-                    groups = batches([r.parameters for r in todo], batch_size)
-                    futures = {executor.submit(execute_batch, [self._task(todo[i], keep_series) for i in g]):
-                               [todo[i].run_id for i in g] for g in groups}
-                recorded = set()
-                for fut in concurrent.futures.as_completed(futures):
-                    done = fut.result()
-                    for run_id, (row, result) in zip(futures[fut], [done] if batch_size is None else done):
-                        append_row(self.table_path, row, self.columns)
-                        outcome = SweepOutcome(by_id[run_id], row, result)
-                        if show is not None:
-                            show(outcome)
-                        yield outcome
-                    recorded.add(fut)
-            except KeyboardInterrupt:
-                for fut in futures:
-                    fut.cancel()
-                if own:                 # our workers ignore SIGINT: let the running runs finish
-                    stream.write("[sweep] interrupted: waiting for the running runs to finish "
-                                 "(Ctrl-C again to stop at once)\n")
-                    stream.flush()
-                    executor.shutdown(wait=True, cancel_futures=True)
-                for fut in futures:     # runs that finished meanwhile: keep their rows (their files exist)
-                    if fut not in recorded and fut.done() and not fut.cancelled() and fut.exception() is None:
-                        for row, _ in ([fut.result()] if batch_size is None else fut.result()):
-                            append_row(self.table_path, row, self.columns)
-                raise
-            except BaseException:
-                for fut in futures:
-                    fut.cancel()
-                raise
+                if n_todo:
+                    yield from self._execute((r for r in mine if r.run_id not in done), n_todo, executor, workers,
+                                             keep_series, batch_size, show)
             finally:
                 if show is not None and hasattr(show, "close"):
                     show.close()
-                if own:
-                    executor.shutdown(wait=True, cancel_futures=True)
             self._finish()
 
+    def _pending_cost(self, done, workers):
+        if isinstance(self.runs, SweepRuns):
+            return estimate_point_cost(self.runs.points, self._point_counts(done.values()), workers)
+        return estimate_cost([r for r in self.my_runs() if r.run_id not in done], workers)
+
+    def _check_tables(self):
+        """Check every table of the folder before any work; repair this process's own (notes)."""
+        notes = check_table(self.table_path, self.columns)
+        self._check_tables_for(self.table_path)
+        return notes
+
+    def _execute(self, todo, n_todo, executor, workers, keep_series, batch_size, show):
+        owner = ScratchOwner(self.out_dir)
+        try:
+            points = self.runs.points if isinstance(self.runs, SweepRuns) else [r.parameters for r in self.runs]
+            n_workers = min(workers or os.cpu_count() or 1, n_todo)
+            for job, outcomes in run_jobs(self._jobs(todo, keep_series, owner.path, batch_size), executor=executor,
+                                          workers=n_workers,
+                                          mp_context=_pool_context(points) if executor is None else None):
+                for task, (row, result) in zip(job, outcomes):
+                    append_row(self.table_path, row, self.columns)
+                    run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
+                        self._run_of({"run_id": task["run_id"]})
+                    outcome = SweepOutcome(run, row, result)
+                    if show is not None:
+                        show(outcome)
+                    yield outcome
+        finally:
+            owner.close()
+
     def _finish(self):
-        scratch = os.path.join(self.out_dir, "runs")
         with contextlib.suppress(OSError):
-            os.rmdir(scratch)   # only when empty
+            os.rmdir(os.path.join(self.out_dir, "runs"))   # only when empty
         if self.task_count is None:
             write_parquet(self.table_path)
 
@@ -576,7 +580,7 @@ class Sweep:
         ----------
         **kwargs
             The options of :meth:`as_completed` (``executor``, ``workers``, ``keep_series``,
-            ``retry_failed``, ``progress``, ``stream``).
+            ``retry_failed``, ``progress``, ``stream``, ``batch_size``).
 
         Returns
         -------
@@ -589,38 +593,63 @@ class Sweep:
 
     def rows(self):
         """Finished rows of this sweep in sweep order (dicts of strings, as read back from the tables)."""
-        done = self.finished_rows()
-        return [done[r.run_id] for r in self.runs if r.run_id in done]
+        done, _ = self._classify()
+        return [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
 
     def merge(self):
         """Merge every table of ``out_dir`` into ``results.csv`` (one row per run, sweep order).
 
-        Rows of other sweeps in ``results.csv`` are kept; the task tables are removed after the
-        merged table has been written.
+        Each run's trustworthy ``ok`` row is preferred over any ``failed`` row, in whichever table
+        it is.  Rows of other sweeps in ``results.csv`` are kept.  A task table is removed only
+        when every row of it is merged (and its task is not running); otherwise it is kept and
+        named in :attr:`kept_tables`.
 
         Returns
         -------
         tuple of int
             ``(n_rows, n_missing)``: rows of this sweep written, runs not finished yet.
+
+        Raises
+        ------
+        ValueError
+            When ``out_dir`` holds no results table (nothing to merge) — before any work.
         """
         path = os.path.join(self.out_dir, TABLE_NAME)
-        with _table_lock(path):
-            done = self.finished_rows()
-            ours = [done[r.run_id] for r in self.runs if r.run_id in done]
-            ids = {r.run_id for r in self.runs}
-            others = [row for row in read_rows(path) if row.get("run_id") not in ids]
+        tables = self._tables()
+        if not tables:
+            raise ValueError(f"out_dir={self.out_dir!r} (--out) holds no results table to merge")
+        self.kept_tables = []
+        with folder_lock(path):
+            check_table(path, self.columns)
+            self._check_tables_for(path)
+            done, _ = self._classify()
+            ours = [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
+            merged = set(done)
+            others = [row for row in read_rows(path) if self._run_of(row) is None]
             write_table(path, others + ours, self.columns)
-            for t in self._tables():
-                if t != path:
-                    os.remove(t)
-                    with contextlib.suppress(OSError):
-                        os.remove(t + ".lock")
+            for t in tables:
+                if t == path:
+                    continue
+                unmerged = [row for row in read_rows(t) if row.get("run_id") not in merged]
+                if unmerged:
+                    self.kept_tables.append((t, f"{len(unmerged)} row(s) not merged"))
+                    continue
+                try:
+                    with folder_lock(t, wait_s=0):
+                        os.remove(t)
+                except FolderBusyError:
+                    self.kept_tables.append((t, "its task is still running"))
             write_parquet(path)
-        return len(ours), len(self.runs) - len(ours)
+        return len(ours), len(self.my_runs()) - len(ours)
+
+    def _check_tables_for(self, path):
+        for t in self._tables():
+            if t != path:
+                check_table_header(t, self.columns)
 
 
 def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, task_count=None, keep_series=False,
-              retry_failed=False, progress=True, stream=None, batch_size=None):
+              retry_failed=False, progress=True, stream=None, batch_size=None, extend=False):
     """Run (or resume) the sweep ``spec`` into ``out_dir``; return its finished rows in sweep order.
 
     The layout of ``out_dir`` and of the table is described in docs/sweeps.md.
@@ -649,6 +678,9 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
     batch_size : int, optional
         Measure runs that share a step schedule in batches of up to ``batch_size`` replicas, one
         task each (``--batch-size``; rows identical to unbatched runs).  Default None.
+    extend : bool, optional
+        When ``out_dir`` holds a sweep of another SPEC: add this SPEC's new runs and keep the
+        folder's rows (``--extend``); default False refuses (see :class:`Sweep`).
 
     Returns
     -------
@@ -660,30 +692,34 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
     ValueError
         An invalid SPEC or run (naming the parameter), before any run starts.
     """
-    return Sweep(spec, out_dir, task_index=task_index, task_count=task_count).run(
+    return Sweep(spec, out_dir, task_index=task_index, task_count=task_count, extend=extend).run(
         executor=executor, workers=workers, keep_series=keep_series, retry_failed=retry_failed,
         progress=progress, stream=stream, batch_size=batch_size)
 
 
 def _from_runs(runs, out_dir):
-    """A :class:`Sweep` over an explicit list of SweepRun (used by the series)."""
+    """A :class:`Sweep` over an explicit list of SweepRun (used by the series; no SPEC, no record)."""
     sweep = Sweep.__new__(Sweep)
     sweep.spec = None
     sweep.out_dir = os.path.abspath(os.fspath(out_dir))
     sweep.task_index = sweep.task_count = None
+    sweep.extend = False
     sweep.runs = list(runs)
     sweep.columns = table_columns(list(sweep.runs[0].parameters) if sweep.runs else None)
     sweep.table_path = os.path.join(sweep.out_dir, TABLE_NAME)
+    sweep._run_cache = {}
     return sweep
 
 
-def _result_from_row(row, run):
+def _result_from_row(row, run, out_dir):
     """A light SimulationResult of a run finished in an earlier call (moduli, parameters, seed, path)."""
     from ..run.api import SimulationResult
     g = tuple(float(row[c]) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
     return SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
                             parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
-                            timings={"total": float(row["wall_time_s"])}, output_path=row["output_path"] or None)
+                            timings={"total": float(row["wall_time_s"])},
+                            output_path=os.path.join(out_dir, os.path.basename(row["output_path"]))
+                            if row["output_path"] else None)
 
 
 def series_parameters(kwargs):
@@ -749,7 +785,7 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         pos = {r.run_id: i for i, r in enumerate(runs)}
         for i, r in enumerate(runs):
             if r.run_id in done and done[r.run_id]["status"] == "ok":
-                results[i] = _result_from_row(done[r.run_id], r)
+                results[i] = _result_from_row(done[r.run_id], r, sweep.out_dir)
         for outcome in sweep.as_completed(executor=executor, workers=max_workers, keep_series=True,
                                           retry_failed=True, progress=False, batch_size=batch_size):
             if outcome.ok:
@@ -757,29 +793,22 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
             else:
                 failures.append(outcome.row)
     else:
-        own = executor is None
-        if own:
-            executor = concurrent.futures.ProcessPoolExecutor(max_workers=max_workers,
-                                                              mp_context=_pool_context(r.parameters for r in runs))
-        try:
-            tasks = [{"run_id": r.run_id, "index": r.index, "parameters": r.parameters,
-                      "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "",
-                      "keep_series": True} for r in runs]
-            if batch_size is None:
-                groups = [[i] for i in range(len(tasks))]
-                futures = [executor.submit(execute_run, tasks[i]) for i in range(len(tasks))]
-            else:
-                from ..run.batch import batches
-                groups = batches([r.parameters for r in runs], batch_size)
-                futures = [executor.submit(execute_batch, [tasks[i] for i in g]) for g in groups]
-            for g, fut in zip(groups, futures):
-                for i, (row, result) in zip(g, [fut.result()] if batch_size is None else fut.result()):
-                    results[i] = result
-                    if row["status"] != "ok":
-                        failures.append(row)
-        finally:
-            if own:
-                executor.shutdown(wait=True, cancel_futures=True)
+        tasks = [{"run_id": r.run_id, "index": r.index, "parameters": r.parameters, "seed_entropy": r.seed_entropy,
+                  "spawn_key": r.spawn_key, "out_dir": "", "keep_series": True, "batched": batch_size is not None}
+                 for r in runs]
+        if batch_size is None:
+            jobs = [[t] for t in tasks]
+        else:
+            from ..run.batch import batches
+            jobs = [[tasks[i] for i in g] for g in batches([r.parameters for r in runs], batch_size)]
+        n_workers = min(max_workers or os.cpu_count() or 1, len(jobs))
+        for job, outcomes in run_jobs(jobs, executor=executor, workers=n_workers,
+                                      mp_context=_pool_context(r.parameters for r in runs) if executor is None
+                                      else None):
+            for task, (row, result) in zip(job, outcomes):
+                results[task["index"]] = result
+                if row["status"] != "ok":
+                    failures.append(row)
     if failures:
         first = failures[0]
         raise RuntimeError(f"{len(failures)} of {len(runs)} runs of the series failed; first: run "

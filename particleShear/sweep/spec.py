@@ -30,14 +30,18 @@ import math
 import numbers
 import os
 
-__all__ = ["SweepSpec", "SweepRun", "load_spec", "parse_spec", "expand_runs", "sweep_parameter_defaults",
-           "SPEC_TABLES"]
+__all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
+           "sweep_parameter_defaults", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
 
 #: the tables a SPEC may hold
 SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
 _SEED_KEYS = ("root", "repetitions")
 #: arguments a SPEC may not set: the sweep chooses them
 _RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
+#: most parameter points of one SPEC: each is validated before any work (≈ 0.1 ms a point)
+MAX_POINTS = 10_000
+#: most runs of one SPEC (points × repetitions); runs are enumerated lazily, never held all at once
+MAX_RUNS = 10 ** 8
 
 
 @functools.lru_cache(maxsize=1)
@@ -275,8 +279,20 @@ def parse_spec(doc, source=""):
     if isinstance(root, bool) or not isinstance(root, numbers.Integral) or root < 0:
         raise ValueError(f"seeds.root={root!r} is invalid: allowed an integer >= 0")
     reps = seeds.get("repetitions", 1)
-    if isinstance(reps, bool) or not isinstance(reps, numbers.Integral) or reps < 1:
-        raise ValueError(f"seeds.repetitions={reps!r} is invalid: allowed an integer >= 1")
+    if isinstance(reps, bool) or not isinstance(reps, numbers.Integral) or not 1 <= reps <= MAX_RUNS:
+        shown = reps if not isinstance(reps, numbers.Integral) or abs(reps) < 10 ** 30 else \
+            f"<integer of {len(str(abs(reps)))} digits>"
+        raise ValueError(f"seeds.repetitions={shown!s} is invalid: allowed an integer 1 <= value <= {MAX_RUNS:,}")
+    n_points = 1
+    for values in list(grid.values()) + [next(iter(g.values())) for g in checked]:
+        n_points *= len(values)
+        if n_points > MAX_POINTS:
+            sizes = [len(v) for v in grid.values()] + [len(next(iter(g.values()))) for g in checked]
+            raise ValueError(f"the SPEC has {' x '.join(map(str, sizes))} parameter points: allowed at most "
+                             f"{MAX_POINTS:,} points (every point is checked before any work)")
+    if n_points * reps > MAX_RUNS:
+        raise ValueError(f"seeds.repetitions={reps} with {n_points:,} points is {n_points * reps:,} runs: allowed "
+                         f"at most {MAX_RUNS:,} runs (repetitions <= {MAX_RUNS // n_points:,})")
     return SweepSpec(parameters=dict(parameters), grid=grid, zips=checked, root=int(root), repetitions=int(reps),
                      source=str(source))
 
@@ -309,8 +325,69 @@ def _check_options(p, where):
     check_run_backend(p)   # backend usable here, and "cupy" only for runs the engine measures
 
 
+class SweepRuns:
+    """The runs of one SPEC as a lazy sequence: ``runs[k]`` is made when asked (its id hashed then).
+
+    Run ``k`` is repetition ``k // n_points`` of point ``k % n_points``; only the validated
+    points are held, so a SPEC of :data:`MAX_RUNS` runs costs the memory of its points.
+
+    Parameters
+    ----------
+    points : list of dict
+        The complete parameter set of each point (validated).
+    root : int
+        ``[seeds] root``.
+    repetitions : int
+        ``[seeds] repetitions``.
+    """
+
+    def __init__(self, points, root, repetitions):
+        self.points, self.root, self.repetitions = list(points), root, int(repetitions)
+
+    def __len__(self):
+        return len(self.points) * self.repetitions
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        n = len(self)
+        if isinstance(k, bool) or not isinstance(k, numbers.Integral):
+            raise TypeError(f"run index {k!r} is invalid: allowed an integer")
+        if k < 0:
+            k += n
+        if not 0 <= k < n:
+            raise IndexError(f"run index {k} is out of range: the sweep has {n} runs")
+        from ..simulation.provenance import run_identity
+        rep, p = divmod(int(k), len(self.points))
+        params = self.points[p]
+        return SweepRun(index=int(k), point=p, repetition=rep, parameters=params, seed_entropy=self.root,
+                        spawn_key=(int(k),), run_id=run_identity(params, self.root, (int(k),)))
+
+    def __iter__(self):
+        return (self[k] for k in range(len(self)))
+
+
+def spec_runs(spec):
+    """The runs of ``spec`` as a lazy :class:`SweepRuns`, every point validated first.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+
+    Returns
+    -------
+    SweepRuns
+
+    Raises
+    ------
+    ValueError, TypeError
+        The first invalid point, naming the parameter (and the point) — before any work.
+    """
+    return SweepRuns(_validated_points(spec), spec.root, spec.repetitions)
+
+
 def expand_runs(spec):
-    """Every run of ``spec`` in sweep order, each validated before any is returned.
+    """Every run of ``spec`` in sweep order (a list), each validated before any is returned.
 
     Parameters
     ----------
@@ -326,8 +403,12 @@ def expand_runs(spec):
     ValueError, TypeError
         The first invalid run, naming the parameter (and the run's point) — before any work.
     """
+    return list(spec_runs(spec))
+
+
+def _validated_points(spec):
+    """The complete parameter set of every point of ``spec``, each validated (point order)."""
     from ..run.validation import validate_simulation_parameters
-    from ..simulation.provenance import run_identity
     defaults = sweep_parameter_defaults()
     points = []
     for p_index, point in enumerate(_points(spec)):
@@ -339,12 +420,4 @@ def expand_runs(spec):
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
         points.append(params)
-    runs = []
-    for rep in range(spec.repetitions):
-        for p_index, params in enumerate(points):
-            k = rep * len(points) + p_index
-            key = (k,)
-            runs.append(SweepRun(index=k, point=p_index, repetition=rep, parameters=params,
-                                 seed_entropy=spec.root, spawn_key=key,
-                                 run_id=run_identity(params, spec.root, key)))
-    return runs
+    return points

@@ -16,7 +16,11 @@ import json
 import os
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
-           "write_table", "write_parquet", "TABLE_NAME", "task_table_name"]
+           "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem",
+           "REJECTED_SUFFIX"]
+
+#: lines of a table that cannot be rows (wrong number of fields) are moved to ``<table>`` + this suffix
+REJECTED_SUFFIX = ".rejected"
 
 #: the first columns of every results table
 RESULT_COLUMNS = ("run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal")
@@ -115,6 +119,137 @@ def repair_table(path):
     return True
 
 
+def check_table(path, columns):
+    """Check a table before any work: repair what can be repaired, refuse what cannot.
+
+    Repaired (and said in the returned notes): a UTF-8 byte-order mark before the header (an
+    editor's), a torn last line (a killed writer), lines that are not rows of the table (another
+    number of fields) — those are moved, unchanged, to ``<table>.rejected``, so nothing is lost.
+    Refused: a header that is not this sweep's columns (other package version, parameter set,
+    edited by hand).
+
+    Parameters
+    ----------
+    path : str
+        The table (nothing happens when it does not exist or is empty).
+    columns : sequence of str
+        This sweep's columns.
+
+    Returns
+    -------
+    list of str
+        What was repaired, one note each.
+
+    Raises
+    ------
+    ValueError
+        When the header differs from ``columns``, naming the missing and unknown columns.
+    """
+    notes = []
+    if not os.path.exists(path) or os.path.getsize(path) == 0:
+        return notes
+    if repair_table(path):
+        notes.append(f"cut a torn last line of {path}")
+    with open(path, "rb") as fh:
+        data = fh.read()
+    bom = data.startswith(b"\xef\xbb\xbf")
+    try:
+        text = data[3:].decode("utf-8") if bom else data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"results table {path!r} is not UTF-8 text ({exc}): repair it or use another --out DIR") \
+            from None
+    lines = text.splitlines(keepends=True)
+    check_table_header(path, columns)
+    header = list(columns)
+    good, bad = [lines[0]], []
+    for line in lines[1:]:
+        fields = next(csv.reader([line]), [])
+        (good if len(fields) == len(header) else bad).append(line)
+    if bom or bad:
+        if bad:
+            with open(path + REJECTED_SUFFIX, "a", encoding="utf-8", newline="") as fh:
+                fh.writelines(bad)
+                fh.flush()
+                os.fsync(fh.fileno())
+            notes.append(f"moved {len(bad)} line(s) that are not rows of {path} to {path + REJECTED_SUFFIX}")
+        if bom:
+            notes.append(f"removed a UTF-8 byte-order mark from {path}")
+        tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            fh.writelines(good)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    return notes
+
+
+def check_table_header(path, columns):
+    """Refuse a table whose header is not ``columns`` (read only; a byte-order mark is tolerated).
+
+    Parameters
+    ----------
+    path : str
+        A table (nothing happens when it is absent or empty).
+    columns : sequence of str
+        The sweep's columns.
+
+    Raises
+    ------
+    ValueError
+        Naming the table and the missing and unknown columns.
+    """
+    if not os.path.exists(path) or os.path.getsize(path) == 0:
+        return
+    with open(path, newline="", encoding="utf-8-sig", errors="replace") as fh:
+        header = next(csv.reader(fh), [])
+    if header != list(columns):
+        missing = [c for c in columns if c not in header]
+        unknown = [c for c in header if c not in columns]
+        what = "; ".join(x for x in (f"missing {missing}" if missing else "",
+                                     f"unknown {unknown}" if unknown else "",
+                                     "columns in another order" if not (missing or unknown) else "") if x)
+        raise ValueError(f"results table {path!r} does not have this sweep's columns ({what}): repair it, or use "
+                         "another --out DIR")
+
+
+def row_problem(row, run):
+    """Why ``row`` is not a trustworthy row of ``run`` (None when it is).
+
+    A row counts only when its status is ``ok`` or ``failed``, its id, seed and every parameter
+    are those of the run (as :func:`row_line` writes them), and — for an ``ok`` row — the moduli
+    and the wall time parse as numbers.
+
+    Parameters
+    ----------
+    row : dict
+        A row as read back (strings).
+    run : SweepRun
+        The run it claims to be.
+
+    Returns
+    -------
+    str or None
+    """
+    if row.get("run_id") != run.run_id:
+        return f"run_id={row.get('run_id')!r} is not {run.run_id}"
+    status = row.get("status")
+    if status not in ("ok", "failed"):
+        return f"status={status!r} (allowed ok, failed)"
+    if row.get("seed_entropy") != _cell(run.seed_entropy) or row.get("spawn_key") != _cell(list(run.spawn_key)):
+        return "its seed is not the run's"
+    for name, v in run.parameters.items():
+        if row.get(name) != _cell(v):
+            return f"{name}={row.get(name)!r} is not the run's {_cell(v)!r}"
+    numbers = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s") if status == "ok" \
+        else ("wall_time_s",)
+    for name in numbers:
+        try:
+            float(row.get(name))
+        except (TypeError, ValueError):
+            return f"{name}={row.get(name)!r} is not a number"
+    return None
+
+
 def append_row(path, row, columns):
     """Append ``row`` to the table at ``path`` (header first when new); flushed and fsynced.
 
@@ -165,7 +300,7 @@ def read_rows(path):
     """
     if not os.path.exists(path):
         return []
-    with open(path, newline="", encoding="utf-8") as fh:
+    with open(path, newline="", encoding="utf-8-sig", errors="replace") as fh:
         text = fh.read()
     if text and not text.endswith("\n"):
         text = text[:text.rfind("\n") + 1]
