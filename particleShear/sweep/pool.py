@@ -208,7 +208,11 @@ def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
         for fut in inflight:
             fut.cancel()
         if own:                                   # our workers ignore SIGINT: let the running runs finish
-            pool.shutdown(wait=True, cancel_futures=True)
+            try:
+                pool.shutdown(wait=True, cancel_futures=True)
+            except BaseException:                 # a second Ctrl-C (or SIGTERM): stop at once
+                terminate(pool)
+                raise
             for fut, job in inflight.items():
                 if fut.done() and not fut.cancelled() and fut.exception() is None:
                     yield job, _outcomes(job, fut.result())
@@ -221,4 +225,4 @@ def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
         raise
     finally:
         if own and pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+            pool.shutdown(wait=True, cancel_futures=True)   # the workers have finished or been killed
