@@ -94,7 +94,13 @@ def _outcomes(job, value):
 
 
 def terminate(pool):
-    """Kill the worker processes of a process pool at once (SIGTERM of the sweep: stop now)."""
+    """Kill the worker processes of a process pool at once (SIGTERM of the sweep: stop now).
+
+    Parameters
+    ----------
+    pool : concurrent.futures.ProcessPoolExecutor
+        The pool (its private process table; nothing happens for an executor without one).
+    """
     for p in list((getattr(pool, "_processes", None) or {}).values()):
         try:
             p.terminate()
@@ -102,33 +108,48 @@ def terminate(pool):
             pass
 
 
-def _exit_text(pool):
-    codes = [p.exitcode for p in (getattr(pool, "_processes", None) or {}).values() if p.exitcode not in (None, 0)]
-    if not codes:
-        return "the worker process running this run died"
-    code = codes[0]
-    if code < 0:
+def _death_text(exitcode):
+    if exitcode is not None and exitcode < 0:
         try:
-            name = signal.Signals(-code).name
+            name = signal.Signals(-exitcode).name
         except ValueError:
-            name = f"signal {-code}"
-        why = " (e.g. the out-of-memory killer)" if -code == signal.SIGKILL else ""
+            name = f"signal {-exitcode}"
+        why = " (e.g. the out-of-memory killer)" if -exitcode == signal.SIGKILL else ""
         return f"the worker process running this run was killed by {name}{why}"
-    return f"the worker process running this run exited with status {code}"
+    return f"the worker process running this run exited with status {exitcode} before returning"
+
+
+def _solo_child(conn, task, parent_pid):
+    worker_init(parent_pid)
+    conn.send(_tasks.execute_run(task))
+    conn.close()
 
 
 def _solo(task, mp_context):
-    """Run one task alone in a fresh single-worker pool; ``(row, result)``, a failed row if the worker dies."""
-    pool = new_pool(1, mp_context)
+    """Run one task alone in a fresh worker process; ``(row, result)``, a failed row if the process dies."""
+    import multiprocessing
+    import multiprocessing.connection
+    ctx = mp_context or multiprocessing.get_context()
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_solo_child, args=(send, dict(task, batched=False), os.getpid()), daemon=True)
     t0 = time.perf_counter()
+    proc.start()
+    send.close()
     try:
-        fut = pool.submit(_tasks.execute_run, dict(task, batched=False))
+        multiprocessing.connection.wait([recv, proc.sentinel])
         try:
-            return fut.result()
-        except BrokenProcessPool:
-            return _tasks.failed_row(task, WorkerDied(_exit_text(pool)), time.perf_counter() - t0), None
+            value = recv.recv()
+        except (EOFError, OSError):   # the process died before it could answer
+            proc.join()
+            return _tasks.failed_row(task, WorkerDied(_death_text(proc.exitcode)), time.perf_counter() - t0), None
+        proc.join()
+        return value
+    except BaseException:
+        proc.kill()
+        proc.join()
+        raise
     finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+        recv.close()
 
 
 def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):

@@ -19,6 +19,7 @@ __docformat__ = "numpy"
 import hashlib
 import json
 import os
+import secrets
 
 __all__ = ["RECORD_NAME", "canonical_spec", "spec_hash", "spec_changes", "read_record", "write_record",
            "extended_runs", "check_record"]
@@ -52,7 +53,17 @@ def canonical_spec(spec):
 
 
 def spec_hash(canonical):
-    """SHA-256 (hex) of a canonical SPEC's compact JSON."""
+    """SHA-256 (hex) of a canonical SPEC's compact JSON.
+
+    Parameters
+    ----------
+    canonical : dict
+        A canonical SPEC (:func:`canonical_spec`).
+
+    Returns
+    -------
+    str
+    """
     return hashlib.sha256(json.dumps(canonical, separators=(",", ":")).encode("utf-8")).hexdigest()
 
 
@@ -96,6 +107,15 @@ def spec_changes(old, new):
 def read_record(out_dir):
     """The record of ``out_dir`` (dict with ``segments``), or None when the folder has none.
 
+    Parameters
+    ----------
+    out_dir : str
+        The sweep folder.
+
+    Returns
+    -------
+    dict or None
+
     Raises
     ------
     ValueError
@@ -135,7 +155,7 @@ def write_record(out_dir, segments, docs):
     rec = {"format": _FORMAT, "package_version": __version__,
            "segments": [{"spec": c, "sha256": spec_hash(c), "doc": d} for c, d in zip(segments, docs)]}
     path = os.path.join(out_dir, RECORD_NAME)
-    tmp = os.path.join(out_dir, "." + RECORD_NAME + ".part")
+    tmp = os.path.join(out_dir, f".{RECORD_NAME}.{os.getpid()}.{secrets.token_hex(4)}.part")   # tasks race
     with open(tmp, "w", encoding="utf-8") as fh:
         json.dump(rec, fh, indent=1)
         fh.flush()

@@ -247,8 +247,9 @@ class Sweep:
         if len(self._segments) == 1:
             self.runs = own
         else:                                          # an extended folder: the runs of every segment
-            specs = [parse_spec(seg["doc"]) for seg in self._segments[:-1]] + [self.spec]
-            self.runs = extended_runs(specs, [spec_runs(s) for s in specs[:-1]] + [own])
+            me = spec_hash(self._canonical)
+            specs = [self.spec if spec_hash(seg["spec"]) == me else parse_spec(seg["doc"]) for seg in self._segments]
+            self.runs = extended_runs(specs, [own if s is self.spec else spec_runs(s) for s in specs])
         self.columns = table_columns(list(self.runs[0].parameters) if len(self.runs) else None)
         name = TABLE_NAME if task_count is None else task_table_name(task_index, task_count)
         self.table_path = os.path.join(self.out_dir, name)
@@ -625,7 +626,7 @@ class Sweep:
             done, _ = self._classify()
             ours = [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
             merged = set(done)
-            others = [row for row in read_rows(path) if self._run_of(row) is None]
+            others = [row for row in read_rows(path) if row.get("run_id") not in merged]   # kept, never dropped
             write_table(path, others + ours, self.columns)
             for t in tables:
                 if t == path:
