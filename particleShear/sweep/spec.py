@@ -178,7 +178,7 @@ def load_spec(path):
 
 
 def _scalar(where, v):
-    ok = isinstance(v, (bool, str)) or (isinstance(v, numbers.Real) and math.isfinite(v))
+    ok = isinstance(v, (bool, str, numbers.Integral)) or (isinstance(v, numbers.Real) and math.isfinite(v))
     if not ok:
         raise ValueError(f"{where}={v!r} is invalid: allowed a bool, a finite number or a string")
     return v
@@ -294,19 +294,11 @@ def _points(spec):
 
 
 def _check_options(p, where):
-    """The keyword-only options that ``validate_simulation_parameters`` does not cover."""
-    tsf = p.get("time_step_factor", 1.0)
-    if isinstance(tsf, bool) or not isinstance(tsf, numbers.Real) or not math.isfinite(tsf) or tsf <= 0:
-        raise ValueError(f"{where}: time_step_factor={tsf!r} is out of range: allowed finite > 0")
-    if p.get("integrator", "euler") not in ("euler", "verlet"):
-        raise ValueError(f"{where}: integrator={p['integrator']!r} is out of range: allowed 'euler' or 'verlet'")
-    if p.get("renderer", "auto") not in ("auto", "tk", "pillow", "none"):
-        raise ValueError(f"{where}: renderer={p['renderer']!r} is invalid: allowed auto, tk, pillow, none")
-    for name in ("correct_drift_sign", "reference_header", "stability_guard"):
-        if name in p and not isinstance(p[name], bool):
-            raise ValueError(f"{where}: {name}={p[name]!r} is invalid: allowed true or false")
-    from ..run.batch import check_run_backend
-    check_run_backend(p)   # backend usable here, and "cupy" only for runs the engine measures
+    """Every check of one run (:func:`particleShear.run.validation.validate_run`), without requiring
+    the output folder to exist yet (the sweep creates it: checked as the current folder); ``where``
+    (the point) is put in front of the message by :func:`expand_runs`."""
+    from ..run.validation import validate_run
+    validate_run(dict(p, root_folder=os.curdir))
 
 
 def expand_runs(spec):
@@ -326,7 +318,6 @@ def expand_runs(spec):
     ValueError, TypeError
         The first invalid run, naming the parameter (and the run's point) — before any work.
     """
-    from ..run.validation import validate_simulation_parameters
     from ..simulation.provenance import run_identity
     defaults = sweep_parameter_defaults()
     points = []
@@ -334,7 +325,6 @@ def expand_runs(spec):
         params = dict(defaults, **spec.parameters, **point)
         where = f"point {p_index} ({', '.join(f'{k}={v!r}' for k, v in point.items()) or 'fixed parameters'})"
         try:
-            validate_simulation_parameters(dict(params, root_folder=os.curdir))
             _check_options(params, where)
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
