@@ -255,7 +255,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         Crosslink all contacts after relaxation; False: frictional spheres only.
     cut_lines : int, default 5
         Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
-        <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer >= 0 that
+        <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer 0 ... 1e6 that
         leaves >= 3 spheres per particle on average (triangulation: cut_lines <= N/3).
     Young_modulus_spheres : float, default 8000
         Young modulus E of the sphere material in Pa; allowed 1e-6 ... 1e12.  Contact stiffness

@@ -521,7 +521,7 @@ def validate_run(params):
         _bool(name, p[name])
     _range("theAmplitude", p["theAmplitude"], 0, lo_open=True)
     _range("theMu", p["theMu"], 0)
-    _int("cut_lines", p["cut_lines"], 0)
+    _int("cut_lines", p["cut_lines"], 0, MAX_N)   # never more particles (or cuts) than a run has spheres
     _range("Young_modulus_spheres", p["Young_modulus_spheres"], 0, lo_open=True)
     _int("N", p["N"], 2, MAX_N)
     _range("packing_fraction", p["packing_fraction"], 0, lo_open=True)
