@@ -193,7 +193,8 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
                 rc, out, err = run_main(full_argv)
                 self.assertEqual(rc, 2)
                 self.assertEqual(out, "")
-                self.assertEqual(err, f"particleShear: invalid parameter: {cli.cli_message(message, {name: argv[0]})}\n")
+                expected = cli.cli_message(message, {name: argv[0]})   # the names replaced by the flags
+                self.assertEqual(err, f"particleShear: invalid parameter: {expected}\n")
                 self.assertIn(argv[0], err)
 
     def test_cli_flags_in_the_message(self):
