@@ -31,7 +31,8 @@ import sys
 
 from .messages import console_messages
 
-__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "sweep_groups", "cli_main", "save_figure"]
+__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "sweep_groups", "cli_main", "save_figure",
+           "check_figure_path"]
 
 _INSTALL_HINT = 'particleShear.plot needs matplotlib: pip install "particleShear[plot]"'
 
@@ -51,6 +52,48 @@ def _figure(width, height):
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def _figure_format(name, path):
+    """The matplotlib format of ``path`` from its extension; ValueError naming ``name`` for any other."""
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext not in FIGURE_FORMATS:
+        raise ValueError(f"{name}={str(path)!r} is invalid: allowed extensions {sorted(FIGURE_FORMATS)}")
+    return FIGURE_FORMATS[ext]
+
+
+def _has_matplotlib():
+    """Whether matplotlib can be imported here (found on the path; not imported)."""
+    import importlib.util
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def check_figure_path(path, name="path"):
+    """Check, before any work, that a figure can be written to ``path``.
+
+    The extension must be one of .png, .pdf, .svg, .eps, the folder of ``path`` must exist and
+    be writable (probed with an empty temporary file), and matplotlib must be installed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The figure file to be written.
+    name : str, optional
+        What the messages call ``path`` (a parameter name, or a flag such as ``"--plot"``).
+
+    Raises
+    ------
+    ValueError
+        An unsupported extension, or a folder that does not exist or is not writable.
+    ImportError
+        Without matplotlib (the message names ``name`` and the extra to install).
+    """
+    from .run.validation import check_folder_writable
+    _figure_format(name, path)
+    check_folder_writable(f"{name} folder", os.path.dirname(os.path.abspath(str(path))))
+    if not _has_matplotlib():
+        raise ImportError(f"{name}={str(path)!r} needs matplotlib, which is not installed: "
+                          "pip install 'particleShear[plot]'")
 
 
 def save_figure(fig, path, dpi=150):
@@ -78,13 +121,11 @@ def save_figure(fig, path, dpi=150):
     ValueError
         If the extension of ``path`` is none of .png, .pdf, .svg, .eps.
     """
-    ext = os.path.splitext(str(path))[1].lower()
-    if ext not in FIGURE_FORMATS:
-        raise ValueError(f"path={path!r} is invalid: allowed extensions {sorted(FIGURE_FORMATS)}")
+    fmt = _figure_format("path", path)
     folder = os.path.dirname(os.path.abspath(str(path)))
     tmp = os.path.join(folder, "." + os.path.basename(str(path)) + ".part")
     try:
-        fig.savefig(tmp, format=FIGURE_FORMATS[ext], dpi=dpi)
+        fig.savefig(tmp, format=fmt, dpi=dpi)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

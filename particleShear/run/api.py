@@ -10,15 +10,15 @@ every call (per process) or returned directly with ``return_result=True``.
 ``numpy.random.SeedSequence(seed).spawn(n)`` and returns the results in iteration order.
 """
 import dataclasses
+import inspect
 
 import numpy as np
 
 from ..messages import console_messages
-from ..simulation.formats import check_output_format
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
-from .validation import validate_options, validate_series, validate_simulation_parameters
-from .batch import check_backend, check_batch_size, check_run_backend, engine_supports, measure_batch
+from .validation import check_seed, validate_run, validate_series
+from .batch import check_batch_size, engine_supports, measure_batch
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -255,7 +255,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         Crosslink all contacts after relaxation; False: frictional spheres only.
     cut_lines : int, default 5
         Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
-        <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer >= 0 that
+        <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer 0 ... 1e6 that
         leaves >= 3 spheres per particle on average (triangulation: cut_lines <= N/3).
     Young_modulus_spheres : float, default 8000
         Young modulus E of the sphere material in Pa; allowed 1e-6 ... 1e12.  Contact stiffness
@@ -422,29 +422,15 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                   saveStressTensorData=saveStressTensorData, plotStress=plotStress,
                   relative_y_scale_force=relative_y_scale_force, pre_periods=pre_periods, periods=periods,
                   post_periods=post_periods, cool_factor=cool_factor, seed=seed)
+    options = dict(return_result=return_result, verbose=verbose, progress=progress,
+                   correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
+                   time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
+                   output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend)
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
-    validate_simulation_parameters(dict(
-        params, return_result=return_result, verbose=verbose, progress=progress,
-        correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
-        time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard))
-    if not isinstance(saveOutputMovie, (bool, np.bool_)):
-        raise TypeError(f"saveOutputMovie={saveOutputMovie!r} is invalid: allowed True or False")
-    if saveOutputMovie and not saveOutputImages:
-        raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
-                         "the snapshots (set saveOutputImages=True and a root_folder)")
-    check_output_format(output_format)
-    check_backend(backend)
-    if not isinstance(strict_io, bool):
-        raise TypeError(f"strict_io={strict_io!r} is invalid: allowed True or False")
+    validate_run(dict(params, **options))
     ss, rng = _seed_sequence(seed)
-    # every input, the keyword-only options included
-    params.update(return_result=return_result, verbose=verbose, progress=progress,
-                  correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
-                  time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
-                  output_format=output_format, strict_io=strict_io,
-                  saveOutputMovie=saveOutputMovie, backend=backend)
-    check_run_backend(params)   # another backend than NumPy only for runs the engine measures
+    params.update(options)   # every input, the keyword-only options included
     seed_entropy = None if ss is None else ss.entropy
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
@@ -630,8 +616,10 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         drawing and plotting; see :func:`doParticleShearSimulation`).  With ``batch_size`` a
         batch of replicas is measured in one set of device arrays.
     **options
-        Further keyword-only options of :func:`doParticleShearSimulation` (``correct_drift_sign``,
-        ``reference_header``, ``renderer``, ``time_step_factor``, ...).
+        Further keyword-only options of :func:`doParticleShearSimulation`, passed to every run and
+        checked as there (``progress``, ``correct_drift_sign``, ``reference_header``, ``renderer``,
+        ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
+        ``output_format``, ``strict_io``); not ``return_result`` (every run returns its result).
 
     Returns
     -------
@@ -655,11 +643,16 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     from their rows (moduli, parameters, seed, output path; no per-step series).
     """
     check_batch_size(batch_size)
-    check_backend(backend)
+    keyword_only = [n for n, par in inspect.signature(doParticleShearSimulation).parameters.items()
+                    if par.kind is par.KEYWORD_ONLY and n not in ("return_result", "verbose", "backend")]
+    for name in options:
+        if name not in keyword_only:
+            raise TypeError(f"{name}={options[name]!r} is invalid for doParticleShearSimulationSeries: allowed the "
+                            f"keyword-only options of doParticleShearSimulation {keyword_only} (every run returns "
+                            "its SimulationResult)")
     # the grid (repetitions × amplitudes × μ × controls) is checked before any job is built
     amplitudes, mu = validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
                                      do_non_frictional_control)
-    validate_options(verbose=verbose, **options)
     if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, int)
                                     or max_workers < 1):
         raise ValueError(f"max_workers={max_workers!r} is out of range: allowed None or an integer >= 1")
@@ -678,17 +671,19 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
                   doDrawing=doDrawing, saveData=saveData, saveStressTensorData=saveStressTensorData,
                   plotStress=plotStress, pre_periods=pre_periods, periods=periods, post_periods=post_periods,
                   cool_factor=cool_factor)
+    check_seed("seed", seed)
     jobs = series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_control,
                        do_non_frictional_control, N_repetitions)
     root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     children = root.spawn(len(jobs))
-    all_kwargs = []
-    for (A, m, links, cl), child in zip(jobs, children):
-        kw = dict(common, theAmplitude=A, theMu=m, do_permanent_links=links, cut_lines=cl, seed=child,
-                  verbose=verbose, backend=backend, **options)
-        validate_simulation_parameters({**kw})  # every run is checked before any work starts
-        check_run_backend(kw)
-        all_kwargs.append(kw)
+    all_kwargs = [dict(common, theAmplitude=A, theMu=m, do_permanent_links=links, cut_lines=cl, seed=child,
+                       verbose=verbose, backend=backend, **options)
+                  for (A, m, links, cl), child in zip(jobs, children)]
+    # every run is checked before any work starts (without runs: the material run of the first point, so
+    # that the options and shared parameters are checked all the same)
+    for kw in all_kwargs or [dict(common, theAmplitude=amplitudes[0], theMu=mu[0], do_permanent_links=True,
+                                  cut_lines=cut_lines, seed=root, verbose=verbose, backend=backend, **options)]:
+        validate_run(kw)
     if not all_kwargs:
         return []
     from ..sweep.runner import run_series

@@ -227,13 +227,14 @@ def run_batch(list_of_kwargs, backend=None):
         parameter of any replica, before any simulation work.
     """
     from .api import doParticleShearSimulation
-    from .validation import validate_simulation_parameters
+    from .validation import validate_run
 
-    if backend is not None:
-        check_backend(backend)
     runs = [dict(kw) if backend is None else dict(kw, backend=backend) for kw in list_of_kwargs]
     if not runs:
         raise ValueError("list_of_kwargs=[] is invalid: a batch needs at least one run")
+    for kw in runs:
+        kw.pop("return_result", None)
+        validate_run(kw)   # every replica, before any work (and before its schedule is computed)
     keys = [schedule_key(kw) for kw in runs]
     for n, key in enumerate(keys):
         if key != keys[0]:
@@ -242,14 +243,6 @@ def run_batch(list_of_kwargs, backend=None):
                              f"(differs in {', '.join(diff) or 'its parameters'}); a batch needs equal N, "
                              "time-step rule and protocol")
     defaults = _signature_defaults()
-    for n, kw in enumerate(runs):
-        kw.pop("return_result", None)
-        unknown = sorted(set(kw) - set(defaults))
-        if unknown:
-            raise ValueError(f"list_of_kwargs[{n}] has unknown parameters {unknown}: allowed the keywords of "
-                             "doParticleShearSimulation")
-        validate_simulation_parameters(dict(defaults, **kw))
-        check_run_backend(kw)
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
     if not all(engine_supports(kw) for kw in full):
         return [doParticleShearSimulation(**kw, return_result=True) for kw in runs]

@@ -128,6 +128,21 @@ def _cli_type(name, type_text, default):
     return {"bool": bool, "int": int, "float": float, "str": str}.get(first, type(default))
 
 
+def _float(text):
+    """``float(text)``; an integer literal beyond the float range stays an ``int``, so that the
+    validation refuses it as the API does (naming its range), not as ``inf``."""
+    x = float(text)
+    if not math.isfinite(x):
+        try:
+            return int(text)
+        except ValueError:
+            pass
+    return x
+
+
+_float.__name__ = "float"   # argparse names the type in its message: "invalid float value: 'x'"
+
+
 def _default_text(value):
     if isinstance(value, float):
         return f"{value:g}"
@@ -334,10 +349,11 @@ def build_parser():
                 group.add_argument(_NEGATIVE_ALIASES[name], dest=name, action=_StoreConst, const=False,
                                    default=None, help=f"same as {_negative(name)}")
         else:
-            metavar = None if choices else ("DIR" if name == "root_folder" else
-                                            {int: "INT", float: "FLOAT"}.get(cli_type, "STR"))
-            group.add_argument(*strings, dest=name, action=_Store, type=cli_type, choices=choices, default=None,
-                               metavar=metavar, help=help_text)
+            # choices are shown, and refused by the API's validation (validate_run) with its message
+            metavar = ("{" + ",".join(choices) + "}" if choices else "DIR" if name == "root_folder" else
+                       {int: "INT", float: "FLOAT"}.get(cli_type, "STR"))
+            group.add_argument(*strings, dest=name, action=_Store, type=_float if cli_type is float else cli_type,
+                               default=None, metavar=metavar, help=help_text)
     c = p.add_argument_group("command line")
     c.add_argument("--save", metavar="DIR", default=None, action=_Store,
                    help="write the output file into DIR (must exist): --root-folder DIR --save-data")
@@ -457,12 +473,30 @@ def main(argv=None):
     if "images" in typed:
         typed.setdefault("saveOutputImages", "--images")
     from .api import doParticleShearSimulation
+    from .validation import validate_run
     from ..base.stability import SimulationInstabilityError
     try:
         kw = api_kwargs(args)
     except ValueError as exc:
         print(f"particleShear: {exc}", file=sys.stderr)
         return 2
+    # before any work: the run's parameters (the API's validation, its messages with the flags),
+    # then the --plot target
+    try:
+        validate_run(kw)
+    except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
+        print(f"particleShear: {exc}", file=sys.stderr)
+        return 2
+    except (ValueError, TypeError) as exc:
+        print(f"particleShear: invalid parameter: {cli_message(exc, typed)}", file=sys.stderr)
+        return 2
+    if args.plot:
+        from ..plot import check_figure_path
+        try:
+            check_figure_path(args.plot, name="--plot")
+        except (ValueError, ImportError) as exc:
+            print(f"particleShear: invalid parameter: {exc}", file=sys.stderr)
+            return 2
     progress = kw["progress"]
     # with --json, stdout holds the JSON only: the run's console messages go to stderr
     quiet_stdout = contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext()

@@ -1,8 +1,11 @@
 """Validation of every ``doParticleShearSimulation`` parameter and option before any work (docs/parameters.md).
 
-Each failure raises ``ValueError`` (``TypeError`` for a wrong type) naming the
-parameter, its value and the allowed range.  Beyond the range of each value on
-its own, three checks of the whole run come before any work (documented, with
+:func:`validate_run` is the one check of a run's complete argument set; every way to start a
+run (the API, a series, a batch, a sweep SPEC, the command line) goes through it, so a value
+is refused with the same message whichever way it came.  Each failure raises ``ValueError``
+(``TypeError`` for a wrong type) naming the parameter, its value (a huge integer abbreviated:
+:func:`show_value`) and the allowed range; integers of any size are compared exactly, never
+converted to float first.  Beyond the range of each value on its own, three checks of the whole run come before any work (documented, with
 their limits, in ``docs/parameters.md``):
 
 * **resolution** — the protocol resolves the excitation (at least
@@ -18,16 +21,20 @@ import itertools
 import math
 import numbers
 import os
+import sys
 import tempfile
 
 import numpy as np
 
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters, r_estimate
+from ..simulation.formats import check_output_format
+from .batch import check_backend, check_run_backend
 
-__all__ = ["validate_simulation_parameters", "validate_options", "validate_series", "estimate_run_cost",
-           "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS", "INTEGRATORS",
-           "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS", "MAX_SERIES_RUNS"]
+__all__ = ["validate_run", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
+           "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
+           "INTEGRATORS", "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS",
+           "MAX_SERIES_RUNS", "SEED_LIMIT"]
 
 #: accepted ``imageFileType`` values (the reference silently wrote PostScript for anything else)
 IMAGE_FILE_TYPES = ("jpg", "png", "ps", "svg")
@@ -54,6 +61,8 @@ MAX_N = 1_000_000
 MAX_TOTAL_STEPS = 10 ** 9
 #: most runs of one series
 MAX_SERIES_RUNS = 100_000
+#: integer seeds are below this bound (the 128 bits of entropy numpy draws for a fresh SeedSequence)
+SEED_LIMIT = 2 ** 128
 
 #: upper limits (and lower limits > 0) of single physical parameters: far beyond any material, yet
 #: small enough that products of them (k·τ, m·v², …) stay finite double-precision numbers
@@ -80,40 +89,128 @@ MEMORY_FRACTION = 0.8
 
 
 # -- single values ---------------------------------------------------------------------------------
+#: integers with more digits than this are abbreviated in messages (:func:`show_value`)
+SHOW_DIGITS = 20
+
+
+def show_value(v):
+    """``repr(v)``, with an integer of more than :data:`SHOW_DIGITS` digits abbreviated to one short word.
+
+    A power of ten reads ``10**400``, any other such integer ``123456…(401 digits)`` (no conversion
+    to text of the whole number, so integers beyond Python's digit limit are shown too); used for
+    every value a validation message quotes, so a message stays one readable line.
+
+    Parameters
+    ----------
+    v : object
+        The value to show.
+
+    Returns
+    -------
+    str
+    """
+    if isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_)):
+        i = int(v)
+        a = abs(i)
+        if a >= 10 ** SHOW_DIGITS:
+            n = int(math.log10(a)) + 1          # number of digits, corrected where log10 rounds
+            if 10 ** (n - 1) > a:
+                n -= 1
+            elif 10 ** n <= a:
+                n += 1
+            sign = "-" if i < 0 else ""
+            if a == 10 ** (n - 1):
+                return f"{sign}10**{n - 1}"
+            return f"{sign}{a // 10 ** (n - 6)}…({n} digits)"
+    return repr(v)
+
+
+def _real_type(name, v):
+    """TypeError unless ``v`` is a real number (not a bool)."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
+
+
+def _as_float(v):
+    """``float(v)``, or None when ``v`` (an integer or a rational beyond ~1.8e308) has no finite float."""
+    try:
+        return float(v)
+    except OverflowError:
+        return None
+
+
 def _real(name, v):
-    if isinstance(v, bool) or not isinstance(v, numbers.Real):
-        raise TypeError(f"{name}={v!r} is invalid: allowed a real number")
-    if not math.isfinite(v):
-        raise ValueError(f"{name}={v!r} is out of range: allowed a finite number")
-    return float(v)
+    _real_type(name, v)
+    x = _as_float(v)
+    if x is None or not math.isfinite(x):
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
+    return x
 
 
 def _range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
-    x = _real(name, v)
+    """Check ``v`` against its limits, compared exactly before any conversion (a huge integer included)."""
+    _real_type(name, v)
+    if not isinstance(v, numbers.Integral):
+        x = _as_float(v)
+        if x is None or not math.isfinite(x):
+            raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
     if hi is None and name in UPPER:
         hi = UPPER[name]
     if name in LOWER and (lo is None or LOWER[name] > lo):
         lo, lo_open = LOWER[name], False
-    bad = ((lo is not None and (x <= lo if lo_open else x < lo))
-           or (hi is not None and (x >= hi if hi_open else x > hi)))
+    if hi is None and _as_float(v) is None:
+        hi = sys.float_info.max   # an integer without a finite float: beyond every unbounded range
+    w = v if isinstance(v, numbers.Integral) else float(v)   # int/float comparisons are exact in Python
+    bad = ((lo is not None and (w <= lo if lo_open else w < lo))
+           or (hi is not None and (w >= hi if hi_open else w > hi)))
     if bad:
         left = "" if lo is None else (f"{lo:g} < " if lo_open else f"{lo:g} <= ")
         right = "" if hi is None else (f" < {hi:g}" if hi_open else f" <= {hi:g}")
-        raise ValueError(f"{name}={v!r} is out of range: allowed {left}value{right}")
-    return x
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {left}value{right}")
+    return float(v)
 
 
 def _int(name, v, lo, hi=None):
-    x = _real(name, v)
-    if int(x) != x or x < lo or (hi is not None and x > hi):
+    _real_type(name, v)
+    if isinstance(v, numbers.Integral):
+        ok = lo <= v and (hi is None or v <= hi)
+    else:
+        x = _real(name, v)
+        ok = x.is_integer() and x >= lo and (hi is None or x <= hi)
+    if not ok:
         allowed = f"integers >= {lo}" if hi is None else f"integers {lo} <= value <= {hi:,}"
-        raise ValueError(f"{name}={v!r} is out of range: allowed {allowed}")
-    return int(x)
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {allowed}")
+    return int(v)
 
 
 def _bool(name, v):
     if not isinstance(v, (bool, np.bool_)):
-        raise TypeError(f"{name}={v!r} is invalid: allowed True or False")
+        raise TypeError(f"{name}={show_value(v)} is invalid: allowed True or False")
+
+
+def check_seed(name, seed):
+    """Raise ValueError unless ``seed`` is None, an integer 0 <= seed < 2**128, or a numpy seed object.
+
+    2**128 bounds the entropy numpy draws itself (``SeedSequence().entropy``); a seed below it is
+    recorded (result, results table, output header) as at most 39 digits.
+
+    Parameters
+    ----------
+    name : str
+        The parameter name used in the message (``"seed"``).
+    seed : None, int, numpy.random.SeedSequence, numpy.random.Generator or numpy.random.BitGenerator
+        The seed to check.
+
+    Raises
+    ------
+    ValueError
+        For anything else (a negative or too large integer, a bool, a float, a string, …).
+    """
+    if seed is None or isinstance(seed, (np.random.SeedSequence, np.random.Generator, np.random.BitGenerator)):
+        return
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, numbers.Integral) or not 0 <= seed < SEED_LIMIT:
+        raise ValueError(f"{name}={show_value(seed)} is invalid: allowed None, an integer 0 <= value < 2**128, "
+                         "a numpy SeedSequence or Generator")
 
 
 # -- machine ---------------------------------------------------------------------------------------
@@ -174,64 +271,34 @@ def _bytes(n):
 
 
 # -- keyword-only options --------------------------------------------------------------------------
-def validate_options(return_result=False, verbose=True, progress=None, correct_drift_sign=False,
-                     reference_header=False, renderer="auto", time_step_factor=1.0, integrator="euler",
-                     stability_guard=True):
-    """Check the keyword-only options of ``doParticleShearSimulation``; raise on the first bad value.
-
-    Parameters
-    ----------
-    return_result : bool, optional
-        Return the ``SimulationResult`` instead of ``[G′_surface, G″_surface]`` (default False).
-    verbose : bool, optional
-        Print the reference console messages (default True).
-    progress : callable or None, optional
-        ``progress(phase, step, total, elapsed_s)``; phases "constitution",
-        "pre-equilibration", "protocol" (default None).
-    correct_drift_sign : bool, optional
-        Demodulation with the correct drift sign (default False: the reference's sign,
-        docs/output.md).
-    reference_header : bool, optional
-        Write the reference's header defects #21–22 (default False, docs/output.md).
-    renderer : {"auto", "tk", "pillow", "none"} or None, optional
-        Drawing backend (default "auto": Tk when a display exists, else Pillow for snapshots).
-    time_step_factor : float, optional
-        Multiplier of the measurement's time step, finite and > 0, not a bool (default 1.0;
-        docs/accuracy.md).
-    integrator : {"euler", "verlet"}, optional
-        "euler" (default): the reference's semi-implicit Euler; "verlet": velocity Verlet with a
-        half-kick predictor.
-    stability_guard : bool, optional
-        Stop with ``SimulationInstabilityError`` on non-finite values, runaway kinetic energy or
-        near-total interpenetration (default True).
-
-    Raises
-    ------
-    TypeError
-        A boolean option that is not ``True``/``False``, a ``progress`` that is not callable, a
-        ``time_step_factor`` that is not a real number.
-    ValueError
-        An unknown ``renderer`` or ``integrator``, a ``time_step_factor`` that is not finite and > 0.
-    """
-    for name, v in (("return_result", return_result), ("verbose", verbose),
-                    ("correct_drift_sign", correct_drift_sign), ("reference_header", reference_header),
-                    ("stability_guard", stability_guard)):
-        _bool(name, v)
+def _check_keyword_options(p):
+    """The keyword-only options of one run (``p``: every argument, defaults filled in), in signature order."""
+    for name in ("return_result", "verbose"):
+        _bool(name, p[name])
+    progress = p["progress"]
     if progress is not None and not callable(progress):
         raise TypeError(f"progress={progress!r} is invalid: allowed None or a callable "
                         "progress(phase, step, total, elapsed_s)")
+    for name in ("correct_drift_sign", "reference_header"):
+        _bool(name, p[name])
+    renderer = p["renderer"]
     if renderer is not None and (not isinstance(renderer, str) or renderer.lower() not in RENDERERS):
         raise ValueError(f"renderer={renderer!r} is invalid: allowed one of {RENDERERS} or None")
+    time_step_factor = p["time_step_factor"]
     if isinstance(time_step_factor, (bool, np.bool_)) or not isinstance(time_step_factor, numbers.Real):
-        raise TypeError(f"time_step_factor={time_step_factor!r} is invalid: allowed a real number")
-    if not (math.isfinite(time_step_factor) and time_step_factor > 0):
-        raise ValueError(f"time_step_factor={time_step_factor!r} is out of range: allowed a finite value > 0")
+        raise TypeError(f"time_step_factor={show_value(time_step_factor)} is invalid: allowed a real number")
+    x = _as_float(time_step_factor)
+    if x is None or not (math.isfinite(x) and x > 0):
+        raise ValueError(f"time_step_factor={show_value(time_step_factor)} is out of range: allowed a finite "
+                         "value > 0")
+    integrator = p["integrator"]
     if not isinstance(integrator, str) or integrator not in INTEGRATORS:
         raise ValueError(f"integrator={integrator!r} is out of range: allowed one of {INTEGRATORS}")
-
-
-_OPTION_NAMES = ("return_result", "verbose", "progress", "correct_drift_sign", "reference_header", "renderer",
-                 "time_step_factor", "integrator", "stability_guard")
+    _bool("stability_guard", p["stability_guard"])
+    _bool("saveOutputMovie", p["saveOutputMovie"])
+    check_output_format(p["output_format"])
+    _bool("strict_io", p["strict_io"])
+    check_backend(p["backend"])
 
 
 # -- cost ------------------------------------------------------------------------------------------
@@ -323,8 +390,8 @@ def _check_constitution(p):
         # r_large² = L²·φ·2·max(bf, 1/bf) / (N π (bf + 1/bf)) < L²/16
         n_min = math.floor(32 * phi * max(bf, 1 / bf) / (math.pi * (bf + 1 / bf))) + 1
         raise ValueError(
-            f"N={p['N']!r} is too small for packing_fraction={p['packing_fraction']!r} and "
-            f"bimodal_factor={p['bimodal_factor']!r}: the largest spheres (radius {r_large:.3g} µm) must be "
+            f"N={show_value(p['N'])} is too small for packing_fraction={show_value(p['packing_fraction'])} and "
+            f"bimodal_factor={show_value(p['bimodal_factor'])}: the largest spheres (radius {r_large:.3g} µm) must be "
             f"smaller than a quarter of the {CELL:g} µm cell for each pair to interact through one image "
             f"only; allowed N >= {n_min} (or a smaller packing_fraction)")
     cut = int(p["cut_lines"])
@@ -339,9 +406,10 @@ def _check_constitution(p):
         cut_max = int((math.sqrt(1 + 8 * (N / MIN_SPHERES_PER_PARTICLE - 1)) - 1) / 2) if N >= 6 else 0
     if N < MIN_SPHERES_PER_PARTICLE * pieces:
         raise ValueError(
-            f"cut_lines={p['cut_lines']!r} is too many for N={p['N']!r}: {pieces} {kind} would hold fewer than "
-            f"{MIN_SPHERES_PER_PARTICLE} spheres each; allowed cut_lines <= {cut_max} for N={p['N']!r}, "
-            f"or N >= {MIN_SPHERES_PER_PARTICLE * pieces} for cut_lines={p['cut_lines']!r}, "
+            f"cut_lines={show_value(p['cut_lines'])} is too many for N={show_value(p['N'])}: {show_value(pieces)} "
+            f"{kind} would hold fewer than {MIN_SPHERES_PER_PARTICLE} spheres each; allowed cut_lines <= {cut_max} "
+            f"for N={show_value(p['N'])}, "
+            f"or N >= {show_value(MIN_SPHERES_PER_PARTICLE * pieces)} for cut_lines={show_value(p['cut_lines'])}, "
             "or cut_lines=0 (bulk gel)")
 
 
@@ -353,20 +421,21 @@ def _check_cost(p):
     rf = float(p["relative_frequency"])
     if spp < MIN_STEPS_PER_PERIOD:
         raise ValueError(
-            f"relative_frequency={p['relative_frequency']!r} is out of range: the protocol would resolve an "
+            f"relative_frequency={show_value(p['relative_frequency'])} is out of range: the protocol would resolve an "
             f"excitation period with {spp:.3g} steps, fewer than {MIN_STEPS_PER_PERIOD}; allowed "
             f"relative_frequency <= {rf * spp / MIN_STEPS_PER_PERIOD:.3g} for these parameters")
     if spp / factor < MIN_STEPS_PER_PERIOD_COARSENED:
         raise ValueError(
-            f"time_step_factor={p.get('time_step_factor')!r} is out of range: it leaves {spp / factor:.3g} steps "
-            f"per excitation period, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed time_step_factor <= "
-            f"{spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} at relative_frequency={p['relative_frequency']!r}")
+            f"time_step_factor={show_value(p.get('time_step_factor'))} is out of range: it leaves "
+            f"{spp / factor:.3g} steps per excitation period, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed "
+            f"time_step_factor <= "
+            f"{spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} at relative_frequency={show_value(p['relative_frequency'])}")
     if cost["total_steps"] > MAX_TOTAL_STEPS:
         other = cost["total_steps"] - cost["protocol_steps"]
         name, allowed = _protocol_culprit(p, cost, MAX_TOTAL_STEPS - other)
         raise ValueError(
-            f"{name}={p[name]!r} is out of range: the run would take {cost['total_steps']:.3g} steps, more than "
-            f"the limit of {MAX_TOTAL_STEPS:.0e} ({spp / factor:.4g} steps per excitation period); "
+            f"{name}={show_value(p[name])} is out of range: the run would take {cost['total_steps']:.3g} steps, "
+            f"more than the limit of {MAX_TOTAL_STEPS:.0e} ({spp / factor:.4g} steps per excitation period); "
             f"allowed {allowed}")
     avail = available_memory()
     if avail is None:
@@ -382,56 +451,77 @@ def _check_cost(p):
             f"{MEMORY_FRACTION:.0%} of the {_bytes(avail)} of memory available")
     if item == "ensemble":
         allowed = int(budget / BYTES_PER_SPHERE)
-        raise ValueError(f"N={p['N']!r} is out of range: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per "
+        raise ValueError(f"N={show_value(p['N'])} is out of range: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per "
                          f"sphere); allowed N <= {allowed:,} on this machine")
     if item == "cutting":
         allowed = int(budget / (int(p["N"]) * CUT_BYTES_PER_SPHERE_AND_SEED))
-        raise ValueError(f"cut_lines={p['cut_lines']!r} is out of range: the Voronoi cut {need}; allowed "
-                         f"cut_lines <= {allowed:,} for N={p['N']!r} on this machine")
+        raise ValueError(f"cut_lines={show_value(p['cut_lines'])} is out of range: the Voronoi cut {need}; allowed "
+                         f"cut_lines <= {allowed:,} for N={show_value(p['N'])} on this machine")
     per_step = mem["recording"] / max(cost["protocol_steps"], 1.0)
     fixed = mem["ensemble"] + mem["cutting"] + mem["output_text"]  # the streamed output's buffer does not grow
     name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - fixed) / per_step))
     hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
-    raise ValueError(f"{name}={p[name]!r} is out of range: recording {cost['protocol_steps']:.3g} protocol steps "
-                     f"{need}; allowed {allowed} on this machine{hint}")
+    raise ValueError(f"{name}={show_value(p[name])} is out of range: recording {cost['protocol_steps']:.3g} "
+                     f"protocol steps {need}; allowed {allowed} on this machine{hint}")
 
 
 # -- the whole call --------------------------------------------------------------------------------
-def validate_simulation_parameters(p):
-    """Check every argument of a ``doParticleShearSimulation`` call before any work.
+def validate_run(params):
+    """Check the complete argument set of one ``doParticleShearSimulation`` call before any work.
 
-    Single values first (type, range), then the constitution (minimum image, spheres per
-    particle), the resolution, the step count and the memory of the run, and last the
-    writability of the output folder.  Limits: ``docs/parameters.md``.
+    The one validation of a run: :func:`~particleShear.run.api.doParticleShearSimulation`, every
+    run of :func:`~particleShear.run.api.doParticleShearSimulationSeries` (all of them before the
+    first starts), :func:`~particleShear.run.batch.run_batch`, the runs of a sweep SPEC
+    (:func:`particleShear.sweep.spec.expand_runs`) and the command line all call it, so a value is
+    refused the same way, with the same message, whichever way it came.  In order: the names,
+    the keyword-only options (including ``output_format``, ``strict_io``, ``saveOutputMovie`` and
+    the usability of ``backend``), every single value (type, range — an integer of any size is
+    compared exactly, never converted first), the output folder and ``seed``, then the
+    constitution (minimum image, spheres per particle), the resolution, the step count and the
+    memory of the run, the writability of the output folder (only when something is saved), the
+    movie-needs-snapshots rule and last whether the engine measures a run with a ``backend`` other
+    than "numpy".  Limits: ``docs/parameters.md``.
 
     Parameters
     ----------
-    p : dict
-        The arguments by name; keyword-only options present in ``p`` (``verbose``, ``renderer``,
-        ``time_step_factor``, …) are checked too.
+    params : dict
+        Arguments of one call by name: the reference parameters and the keyword-only options
+        (``return_result``, ``verbose``, ``progress``, ``correct_drift_sign``, ``reference_header``,
+        ``renderer``, ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
+        ``output_format``, ``strict_io``, ``backend``); missing ones take the defaults of the
+        signature of ``doParticleShearSimulation``.  Not modified.
 
     Returns
     -------
     dict
-        The cost estimate of :func:`estimate_run_cost`.
+        The cost estimate of :func:`estimate_run_cost` (steps and memory of the run).
 
     Raises
     ------
     TypeError
-        A value of the wrong type (a boolean that is not a bool, a non-callable ``progress``, …).
+        A value of the wrong type (a boolean that is not a bool, a non-callable ``progress``, a
+        string for a number, …).
     ValueError
-        A value out of range or a run beyond a limit; the message names the parameter, its value
-        and what would be allowed.
+        An unknown parameter name, a value out of range or a run beyond a limit; the message
+        names the parameter, its value (a huge integer abbreviated, :func:`show_value`) and what
+        would be allowed.
+    ImportError
+        ``output_format="parquet"`` without pyarrow (the message names the extra to install).
     """
-    options = {k: p[k] for k in _OPTION_NAMES if k in p}
-    validate_options(**options)
+    from .batch import _signature_defaults
+    defaults = _signature_defaults()
+    unknown = sorted(set(params) - set(defaults))
+    if unknown:
+        raise ValueError(f"unknown parameters {unknown}: allowed the keywords of doParticleShearSimulation")
+    p = dict(defaults, **params)
+    _check_keyword_options(p)
     for name in ("do_permanent_links", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",
                  "cut_top_bottom", "saveOutputImages", "doCutByTriangulation", "doDrawing", "saveData",
                  "saveStressTensorData", "plotStress"):
         _bool(name, p[name])
     _range("theAmplitude", p["theAmplitude"], 0, lo_open=True)
     _range("theMu", p["theMu"], 0)
-    _int("cut_lines", p["cut_lines"], 0)
+    _int("cut_lines", p["cut_lines"], 0, MAX_N)   # never more particles (or cuts) than a run has spheres
     _range("Young_modulus_spheres", p["Young_modulus_spheres"], 0, lo_open=True)
     _int("N", p["N"], 2, MAX_N)
     _range("packing_fraction", p["packing_fraction"], 0, lo_open=True)
@@ -443,36 +533,40 @@ def validate_simulation_parameters(p):
     _range("avoid_horizontal_angle_degree", p["avoid_horizontal_angle_degree"], 0, 90, hi_open=True)
     _range("interface_reenforcement_central", p["interface_reenforcement_central"], 0, lo_open=True)
     _range("interface_reenforcement_tangential", p["interface_reenforcement_tangential"], 0, lo_open=True)
-    if p["imageFileType"] not in IMAGE_FILE_TYPES:
-        raise ValueError(f"imageFileType={p['imageFileType']!r} is invalid: allowed one of {IMAGE_FILE_TYPES}")
+    if not isinstance(p["imageFileType"], str) or p["imageFileType"] not in IMAGE_FILE_TYPES:
+        raise ValueError(f"imageFileType={show_value(p['imageFileType'])} is invalid: allowed one of "
+                         f"{IMAGE_FILE_TYPES}")
     _range("remove_link_fraction", p["remove_link_fraction"], 0, 1)
     _range("edge_fuzziness", p["edge_fuzziness"], 0)
     _range("central_repulsion_coefficient", p["central_repulsion_coefficient"], 0, 1)
-    _range("relative_y_scale_force", p.get("relative_y_scale_force", 1e8), -UPPER["relative_y_scale_force"])
+    _range("relative_y_scale_force", p["relative_y_scale_force"], -UPPER["relative_y_scale_force"])
     _range("pre_periods", p["pre_periods"], 0)
     _range("periods", p["periods"], 0, lo_open=True)
     _range("post_periods", p["post_periods"], 0)
     _range("cool_factor", p["cool_factor"], 0, 1, lo_open=True)
     root = p["root_folder"]
     if not isinstance(root, (str, os.PathLike)):
-        raise TypeError(f"root_folder={root!r} is invalid: allowed a path string")
+        raise TypeError(f"root_folder={show_value(root)} is invalid: allowed a path string")
     wants = [n + "=True" for n in ("saveData", "saveOutputImages") if p[n]]
     if wants and not root:
         raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder")
     if wants and not os.path.isdir(root):
         raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder "
                          "(no such directory)")
-    seed = p.get("seed")
-    if seed is not None and not isinstance(seed, (np.random.SeedSequence, np.random.Generator,
-                                                  np.random.BitGenerator)):
-        if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-            raise ValueError(f"seed={seed!r} is invalid: allowed None, an integer >= 0, a numpy SeedSequence "
-                             "or Generator")
+    check_seed("seed", p["seed"])
     _check_constitution(p)
     cost = _check_cost(p)
     if wants:
         check_folder_writable("root_folder", root)
+    if p["saveOutputMovie"] and not p["saveOutputImages"]:
+        raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
+                         "the snapshots (set saveOutputImages=True and a root_folder)")
+    check_run_backend(p)   # another backend than NumPy only for runs the engine measures
     return cost
+
+
+#: the former name of :func:`validate_run` (the same function)
+validate_simulation_parameters = validate_run
 
 
 def validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrosslinked_control,
@@ -524,8 +618,9 @@ def validate_series(N_repetitions, amplitudes, mu, do_bulk_control, do_uncrossli
     per_point = 1 + sum(bool(c) for c in (do_bulk_control, do_uncrosslinked_control, do_non_frictional_control))
     runs = n_rep * len(lists[0]) * len(lists[1]) * per_point
     if runs > MAX_SERIES_RUNS:
-        raise ValueError(f"N_repetitions={N_repetitions!r} with {len(lists[0])} amplitudes, {len(lists[1])} mu values "
-                         f"and {per_point} runs per point is a series of {runs:,} runs: allowed at most "
+        raise ValueError(f"N_repetitions={show_value(N_repetitions)} with {len(lists[0])} amplitudes, "
+                         f"{len(lists[1])} mu values and {per_point} runs per point is a series of {runs:,} runs: "
+                         f"allowed at most "
                          f"{MAX_SERIES_RUNS:,} runs (N_repetitions <= "
                          f"{MAX_SERIES_RUNS // (len(lists[0]) * len(lists[1]) * per_point)})")
     return lists[0], lists[1]

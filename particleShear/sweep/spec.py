@@ -182,7 +182,7 @@ def load_spec(path):
 
 
 def _scalar(where, v):
-    ok = isinstance(v, (bool, str)) or (isinstance(v, numbers.Real) and math.isfinite(v))
+    ok = isinstance(v, (bool, str, numbers.Integral)) or (isinstance(v, numbers.Real) and math.isfinite(v))
     if not ok:
         raise ValueError(f"{where}={v!r} is invalid: allowed a bool, a finite number or a string")
     return v
@@ -275,14 +275,14 @@ def parse_spec(doc, source=""):
     for key in seeds:
         if key not in _SEED_KEYS:
             raise ValueError(f"seeds.{key} is unknown: allowed {', '.join(_SEED_KEYS)}")
+    from ..run.validation import SEED_LIMIT, show_value
     root = seeds.get("root")
-    if isinstance(root, bool) or not isinstance(root, numbers.Integral) or root < 0:
-        raise ValueError(f"seeds.root={root!r} is invalid: allowed an integer >= 0")
+    if isinstance(root, bool) or not isinstance(root, numbers.Integral) or not 0 <= root < SEED_LIMIT:
+        raise ValueError(f"seeds.root={show_value(root)} is invalid: allowed an integer 0 <= value < 2**128")
     reps = seeds.get("repetitions", 1)
     if isinstance(reps, bool) or not isinstance(reps, numbers.Integral) or not 1 <= reps <= MAX_RUNS:
-        shown = reps if not isinstance(reps, numbers.Integral) or abs(reps) < 10 ** 30 else \
-            f"<integer of {len(str(abs(reps)))} digits>"
-        raise ValueError(f"seeds.repetitions={shown!s} is invalid: allowed an integer 1 <= value <= {MAX_RUNS:,}")
+        raise ValueError(f"seeds.repetitions={show_value(reps)} is invalid: allowed an integer 1 <= value <= "
+                         f"{MAX_RUNS:,}")
     n_points = 1
     for values in list(grid.values()) + [next(iter(g.values())) for g in checked]:
         n_points *= len(values)
@@ -310,19 +310,11 @@ def _points(spec):
 
 
 def _check_options(p, where):
-    """The keyword-only options that ``validate_simulation_parameters`` does not cover."""
-    tsf = p.get("time_step_factor", 1.0)
-    if isinstance(tsf, bool) or not isinstance(tsf, numbers.Real) or not math.isfinite(tsf) or tsf <= 0:
-        raise ValueError(f"{where}: time_step_factor={tsf!r} is out of range: allowed finite > 0")
-    if p.get("integrator", "euler") not in ("euler", "verlet"):
-        raise ValueError(f"{where}: integrator={p['integrator']!r} is out of range: allowed 'euler' or 'verlet'")
-    if p.get("renderer", "auto") not in ("auto", "tk", "pillow", "none"):
-        raise ValueError(f"{where}: renderer={p['renderer']!r} is invalid: allowed auto, tk, pillow, none")
-    for name in ("correct_drift_sign", "reference_header", "stability_guard"):
-        if name in p and not isinstance(p[name], bool):
-            raise ValueError(f"{where}: {name}={p[name]!r} is invalid: allowed true or false")
-    from ..run.batch import check_run_backend
-    check_run_backend(p)   # backend usable here, and "cupy" only for runs the engine measures
+    """Every check of one run (:func:`particleShear.run.validation.validate_run`), without requiring
+    the output folder to exist yet (the sweep creates it: checked as the current folder); ``where``
+    (the point) is put in front of the message by :func:`expand_runs`."""
+    from ..run.validation import validate_run
+    validate_run(dict(p, root_folder=os.curdir))
 
 
 class SweepRuns:
@@ -408,14 +400,13 @@ def expand_runs(spec):
 
 def _validated_points(spec):
     """The complete parameter set of every point of ``spec``, each validated (point order)."""
-    from ..run.validation import validate_simulation_parameters
+    from ..run.validation import show_value
     defaults = sweep_parameter_defaults()
     points = []
     for p_index, point in enumerate(_points(spec)):
         params = dict(defaults, **spec.parameters, **point)
-        where = f"point {p_index} ({', '.join(f'{k}={v!r}' for k, v in point.items()) or 'fixed parameters'})"
+        where = f"point {p_index} ({', '.join(f'{k}={show_value(v)}' for k, v in point.items()) or 'fixed parameters'})"
         try:
-            validate_simulation_parameters(dict(params, root_folder=os.curdir))
             _check_options(params, where)
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
