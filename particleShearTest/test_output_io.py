@@ -134,7 +134,7 @@ class TestProvenanceHeader(unittest.TestCase):
 
     def test_sidecar_has_every_input(self):
         r = self.small_mu
-        with open(r.output_path + ".json", encoding="utf-8") as fh:
+        with open(output.sidecar_path(r.output_path), encoding="utf-8") as fh:
             meta = json.load(fh)
         self.assertEqual(meta["run_id"], r.run_id)
         self.assertEqual(meta["seed_entropy"], 5)
@@ -180,7 +180,8 @@ class TestFormats(unittest.TestCase):
     def check_round_trip(self, fmt, tensors=True):
         r = run(self.dir.name, output_format=fmt, saveStressTensorData=tensors)
         self.assertTrue(r.output_path.endswith(formats.FORMAT_SUFFIXES[fmt]))
-        self.assertTrue(os.path.exists(r.output_path + ".json"))
+        self.assertTrue(os.path.exists(output.sidecar_path(r.output_path)))
+        self.assertFalse(os.path.exists(r.output_path + ".json"))  # the old name, which ".txt" matches
         data = read_run(r.output_path)
         self.assertEqual(data.metadata["run_id"], r.run_id)
         self.assertTrue(data.header.startswith("Dermal filler Ensemble: \n"))
@@ -319,7 +320,7 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
             names = sorted(os.listdir(d))
             base = os.path.basename(r.output_path)
             self.assertTrue(base.endswith("_nr_1.txt"), base)  # the stale reservation took no number
-            self.assertEqual(names, [base, base + ".json"])
+            self.assertEqual(names, [base[: -len(".txt")] + ".json", base])
             self.assertEqual(len(read_run(r.output_path)["t"]), r.N_steps)  # complete
 
     def test_live_reservation_is_respected(self):
