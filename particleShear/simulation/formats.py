@@ -342,7 +342,7 @@ _HEAD_CHARS = 1 << 18
 def _check_text_header(path, header):
     if not _DETAILED.search(header.rsplit("\n", 1)[-1]) or any("\n" + line + "\n" not in header
                                                                 for line in _HEADER_LINES):
-        raise _bad(path, "not a particleShear run file (no particleShear header: the lines "
+        raise _bad(path, "not a particleShear run file, or cut inside its header (the header lines "
                    + ", ".join(repr(x) for x in _HEADER_LINES + ("Detailed stress tensor data",))
                    + " are missing)")
 
@@ -482,6 +482,13 @@ def verify_run(path):
     """
     path = os.fspath(path)
     fmt = _format_of(path)
+    meta, size = _check_file(path, fmt)
+    _check_container(path, fmt, meta, size)
+    return meta
+
+
+def _check_file(path, fmt):
+    """``(sidecar content, size)``: the file exists, is not empty and has the size its sidecar records."""
     try:
         size = os.stat(path).st_size
     except FileNotFoundError:
@@ -497,6 +504,12 @@ def verify_run(path):
     if recorded is not None and size != recorded:
         raise _bad(path, f"incomplete or changed: {size} bytes, its sidecar {os.path.basename(side_path)} "
                    f"records {recorded}")
+    return meta, size
+
+
+def _check_container(path, fmt, meta, size):
+    """The cheap structure checks of :func:`verify_run` (a few kB read)."""
+    recorded = meta.get("size_bytes")
     try:
         if fmt in ("text", "text.gz"):
             opener = gzip.open if fmt == "text.gz" else open
@@ -504,7 +517,7 @@ def verify_run(path):
                 head = fh.read(_HEAD_CHARS).decode("utf-8", errors="replace")
             header, _ = _split_text(head)
             _check_text_header(path, header)
-            if fmt == "text" and recorded is None and size > len(head):
+            if fmt == "text" and recorded is None:  # no recorded size: a complete last line
                 with open(path, "rb") as fh:
                     fh.seek(max(0, size - 4096))
                     last = fh.read().decode("utf-8", errors="replace").rsplit("\n", 1)[-1]
@@ -533,7 +546,6 @@ def verify_run(path):
         raise
     except Exception as exc:  # BadZipFile, EOFError, zlib/gzip/Arrow errors: an unreadable container
         raise _bad(path, f"unreadable {fmt} file ({type(exc).__name__}: {exc})") from exc
-    return meta
 
 
 def read_run(path):
@@ -570,7 +582,7 @@ def read_run(path):
     """
     path = os.fspath(path)
     fmt = _format_of(path)
-    side = verify_run(path)
+    side, _ = _check_file(path, fmt)  # the container is checked by parsing it, after the hash
     try:
         with open(path, "rb") as fh:
             data = fh.read()
@@ -581,6 +593,8 @@ def read_run(path):
     try:
         if fmt in ("text", "text.gz"):
             raw = gzip.decompress(data) if fmt == "text.gz" else data
+            # a foreign file is named as such, also when it is not UTF-8
+            _check_text_header(path, _split_text(raw[:_HEAD_CHARS].decode("utf-8", errors="replace"))[0])
             header, cols, table = _parse_text(path, raw.decode("utf-8"))
             metadata = side
         elif fmt == "npz":
