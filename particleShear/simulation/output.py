@@ -108,15 +108,16 @@ def sidecar_path(path):
 
 
 def _quietly(action):
-    """Call ``action()`` and drop an ``OSError``/``ValueError`` it raises (clean-up after a failure).
+    """Call ``action()`` and drop any ``Exception`` it raises (clean-up after a failure).
 
-    Used when a write has already failed: closing or removing what it left must not raise a
-    second exception in place of the first (a buffered file's close flushes again, which fails
-    again on a full disk).
+    Used when a write has already failed, or for what cannot matter any more: closing or
+    removing what a failed write left must not raise a second exception in place of the first
+    (a buffered file's close flushes again, which fails again on a full disk; a zip, gzip or
+    Parquet trailer fails likewise, with the library's own exception type).
     """
     try:
         action()
-    except (OSError, ValueError):
+    except Exception:  # noqa: BLE001 - the first failure is the one reported
         pass
 
 
