@@ -13,6 +13,7 @@ import numpy as np
 
 from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
 from particleShear.run.batch import batches, run_batch, schedule_key
+from particleShear.simulation.output import sidecar_path
 
 #: ~300 protocol steps of 20 spheres (the quick scene of test_simulation.py)
 QUICK = dict(N=20, relative_frequency=0.2, pre_periods=0.5, periods=1, post_periods=0.5, doDrawing=False,
@@ -293,7 +294,7 @@ class TestSavedRunsMeasureThroughTheEngine(unittest.TestCase):
         self.assertTrue(text.startswith("Dermal filler Ensemble"))
         self.assertIn("Function call : \n", text)
         self.assertIn("Detailed stress tensor data", text)
-        with open(res.output_path + ".json", encoding="utf-8") as fh:
+        with open(sidecar_path(res.output_path), encoding="utf-8") as fh:
             meta = json.load(fh)
         self.assertEqual(meta["run_id"], res.run_id)
         self.assertEqual(os.path.basename(res.output_path), meta["file"])

@@ -9,12 +9,14 @@ import io
 import json
 import math
 import os
+import queue
 import re
 import shutil
 import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import tracemalloc
 import unittest
@@ -134,7 +136,7 @@ class TestProvenanceHeader(unittest.TestCase):
 
     def test_sidecar_has_every_input(self):
         r = self.small_mu
-        with open(r.output_path + ".json", encoding="utf-8") as fh:
+        with open(output.sidecar_path(r.output_path), encoding="utf-8") as fh:
             meta = json.load(fh)
         self.assertEqual(meta["run_id"], r.run_id)
         self.assertEqual(meta["seed_entropy"], 5)
@@ -180,7 +182,8 @@ class TestFormats(unittest.TestCase):
     def check_round_trip(self, fmt, tensors=True):
         r = run(self.dir.name, output_format=fmt, saveStressTensorData=tensors)
         self.assertTrue(r.output_path.endswith(formats.FORMAT_SUFFIXES[fmt]))
-        self.assertTrue(os.path.exists(r.output_path + ".json"))
+        self.assertTrue(os.path.exists(output.sidecar_path(r.output_path)))
+        self.assertFalse(os.path.exists(r.output_path + ".json"))  # the old name, which ".txt" matches
         data = read_run(r.output_path)
         self.assertEqual(data.metadata["run_id"], r.run_id)
         self.assertTrue(data.header.startswith("Dermal filler Ensemble: \n"))
@@ -319,7 +322,7 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
             names = sorted(os.listdir(d))
             base = os.path.basename(r.output_path)
             self.assertTrue(base.endswith("_nr_1.txt"), base)  # the stale reservation took no number
-            self.assertEqual(names, [base, base + ".json"])
+            self.assertEqual(names, [base[: -len(".txt")] + ".json", base])
             self.assertEqual(len(read_run(r.output_path)["t"]), r.N_steps)  # complete
 
     def test_live_reservation_is_respected(self):
@@ -420,25 +423,46 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
             self.assertEqual(os.listdir(d), [])  # no partial file, no image folder
 
     def test_interrupt_cli(self):
+        # event-driven: SIGINT is sent when the progress line of the protocol's first step appears
+        # on stderr; the protocol (60 periods, 148k steps, ~90 s on a 2-core host) cannot finish
+        # between that line and the signal being handled (the next Python instruction)
         with tempfile.TemporaryDirectory() as d:
             proc = self._start(d, ["--save", d, "--N", "60", "--no-permanent-links", "--cut-lines", "0",
-                                   "--periods", "30", "--quiet", "--seed", "1"])
+                                   "--periods", "60", "--seed", "1"])
+            lines = queue.Queue()
+            reader = threading.Thread(target=lambda: [lines.put(line) for line in proc.stderr] + [lines.put(None)],
+                                      daemon=True)
+            reader.start()
+            seen = []
             try:
-                started = _wait_for(lambda: any(n.endswith(".part") for n in os.listdir(d)), 90)
-                time.sleep(0.5)  # into the measurement
+                while True:
+                    line = lines.get(timeout=120)  # a safety bound only: the wait ends with the line
+                    if line is None or line.startswith("[protocol] step 1/"):
+                        break
+                    seen.append(line)
+                self.assertIsNotNone(line, "the run ended before its protocol started: " + "".join(seen))
+                self.assertTrue(any(n.endswith(".part") for n in os.listdir(d)))  # reserved, not yet written
                 proc.send_signal(signal.SIGINT)
-                out, err = proc.communicate(timeout=60)
+                proc.wait(timeout=60)
+                reader.join(timeout=60)
             finally:
                 if proc.poll() is None:
                     proc.kill()
-                    proc.communicate()
-            self.assertTrue(started)
+                    proc.wait()
+                proc.stdout.close()
+                proc.stderr.close()
+            rest = []
+            while not lines.empty():
+                item = lines.get()
+                if item is not None:
+                    rest.append(item)
+            err = "".join(seen + rest)
             self.assertEqual(proc.returncode, 130, err)
             self.assertNotIn("Traceback", err)
-            lines = [line for line in err.splitlines() if line.strip()]
-            self.assertEqual(len(lines), 1, err)
-            self.assertRegex(lines[0], r"^particleShear: interrupted at step \d+ of \d+ "
-                                       r"\((pre-equilibration|protocol)\); no file written$")
+            messages = [line for line in err.splitlines() if line.strip() and not line.startswith("[")]
+            self.assertEqual(len(messages), 1, err)  # progress lines aside, one message
+            self.assertRegex(messages[0], r"^particleShear: interrupted at step \d+ of \d+ "
+                                          r"\(protocol\); no file written$")
             self.assertEqual(os.listdir(d), [])
 
 

@@ -6,11 +6,12 @@ something is drawn or saved (see :mod:`particleShear.simulation.drawing`).
 __docformat__ = "numpy"
 from .evaluation import EvaluationHandler, EvaluationHandlerPlotter, demodulation  # noqa: F401
 from .experiment import OscillatoryShearExperiment
-from .formats import OUTPUT_FORMATS, RunData, read_run
+from .formats import OUTPUT_FORMATS, RunData, RunFileError, read_run, verify_run
 from .provenance import run_identity
 from .simulations import (OscillatorySimulation, OscillatorySimulationFragmentation,
                           Simulation_dermal_filler_rheology, Simulation_interlocking_rheology)
 
 __all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "OscillatoryShearExperiment", "OscillatorySimulation",
            "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
-           "Simulation_interlocking_rheology", "read_run", "RunData", "OUTPUT_FORMATS", "run_identity"]
+           "Simulation_interlocking_rheology", "read_run", "verify_run", "RunData", "RunFileError", "OUTPUT_FORMATS",
+           "run_identity"]

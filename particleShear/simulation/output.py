@@ -8,6 +8,7 @@ interrupted run never leaves a truncated file and the temporary files of killed 
 recognised and removed by the next run (``docs/output.md``, "Files are complete or absent").
 """
 __docformat__ = "numpy"
+import hashlib
 import math
 import os
 import shutil
@@ -31,8 +32,12 @@ PART_SUFFIX = ".part"
 IMAGE_FOLDER_SUFFIX = "_images_folder"
 #: ending of the private name a temporary file has before it is locked and linked to its ``.part`` name
 _PRIVATE_SUFFIX = ".new"
+#: the accepted values of ``output_format`` and their file suffixes (docs/output.md, "Output formats")
+FORMAT_SUFFIXES = {"text": ".txt", "text.gz": ".txt.gz", "npz": ".npz", "parquet": ".parquet"}
+#: suffix of a run's JSON sidecar, which replaces the run file's suffix (``x.txt`` → ``x.json``)
+SIDECAR_SUFFIX = ".json"
 
-__all__ = ["TABLE_COLUMNS", "AtomicOutputFile", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
+__all__ = ["TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
            "probe_writable", "iter_table_text", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
@@ -59,6 +64,77 @@ NO_TENSOR_DATA_TEXT = ("\tNot saving detailed stress tensor data. If you wish to
                        "\t  saveStressTensorData=True")
 
 
+def run_file_stem(path):
+    """``path`` without its run-file suffix (``x_nr_1.txt.gz`` → ``x_nr_1``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A run file name ending with one of :data:`FORMAT_SUFFIXES`.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ValueError
+        When ``path`` has none of the suffixes (the message lists them).
+    """
+    p = os.fspath(path)
+    for suffix in sorted(FORMAT_SUFFIXES.values(), key=len, reverse=True):  # ".txt.gz" before ".txt"
+        if p.endswith(suffix):
+            return p[: -len(suffix)]
+    raise ValueError(f"path={p!r} is not a run file: allowed suffixes " + ", ".join(FORMAT_SUFFIXES.values()))
+
+
+def sidecar_path(path):
+    """The JSON sidecar of the run file ``path``: its stem + ``.json`` (``x.txt`` → ``x.json``).
+
+    The sidecar does not end with the run file's name, so a folder reader that matches ``.txt``
+    (the downstream R package) does not take it for a run file.  Files written before this rule
+    have ``<file>.json``; :func:`~particleShear.simulation.formats.read_run` still reads those.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A run file name (one of :data:`FORMAT_SUFFIXES`).
+
+    Returns
+    -------
+    str
+    """
+    return run_file_stem(path) + SIDECAR_SUFFIX
+
+
+def _quietly(action):
+    """Call ``action()`` and drop any ``Exception`` it raises (clean-up after a failure).
+
+    Used when a write has already failed, or for what cannot matter any more: closing or
+    removing what a failed write left must not raise a second exception in place of the first
+    (a buffered file's close flushes again, which fails again on a full disk; a zip, gzip or
+    Parquet trailer fails likewise, with the library's own exception type).
+    """
+    try:
+        action()
+    except Exception:  # noqa: BLE001 - the first failure is the one reported
+        pass
+
+
+def _fsync_folder(folder):
+    """Make a rename in ``folder`` durable (no-op where folders cannot be opened, e.g. Windows)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
 class AtomicOutputFile:
     """Binary file written under a temporary name and moved to ``path`` by :meth:`commit`.
 
@@ -69,9 +145,13 @@ class AtomicOutputFile:
     lock can be taken belongs to a process that died (SIGKILL, power loss): the next run in
     the folder removes it (:func:`remove_stale_parts`).
 
-    ``abort()`` (or leaving a ``with`` block by an exception) removes the temporary file.
-    Dependent temporary entries of the same run use the names :meth:`dependent` gives
-    (``.<name>.part.<role>``) and are removed with a stale owner.
+    ``abort()`` (or leaving a ``with`` block by an exception) removes the temporary file and
+    its companions and never raises (it runs after a failure, e.g. a full disk, whose exception
+    is the one to report).  Dependent temporary entries of the same run use the names
+    :meth:`dependent` gives (``.<name>.part.<role>``) and are removed with a stale owner.
+    Companion files (:meth:`add_companion`, the sidecar) are moved into place by
+    :meth:`commit` just before the file and removed again if the file cannot follow, so a
+    companion never exists without its file.
 
     Parameters
     ----------
@@ -88,6 +168,7 @@ class AtomicOutputFile:
         self.folder = folder or "."
         self.tmp_path = os.path.join(folder, "." + name + PART_SUFFIX)
         self._fh = _create_locked(self.tmp_path, exclusive)
+        self._companions = []    # (temporary path, final path), moved into place by commit()
         self.committed = False
         self.aborted = False
 
@@ -129,31 +210,104 @@ class AtomicOutputFile:
         """
         return self.tmp_path + "." + role
 
+    def digest(self):
+        """Size and SHA-256 of the temporary file as written, read back from the file system.
+
+        Called when the file is complete, before :meth:`commit`, so that a companion (the
+        sidecar) can record what a reader must find.  Reads the file once (files are at most
+        tens of MB).
+
+        Returns
+        -------
+        tuple of (int, str)
+            ``(size in bytes, SHA-256 as 64 lower-case hex digits)``.
+        """
+        self._fh.flush()
+        h = hashlib.sha256()
+        size = 0
+        with open(self.tmp_path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+                size += len(block)
+        return size, h.hexdigest()
+
+    def add_companion(self, role, data, path):
+        """Write ``data`` durably into ``.<name>.part.<role>``, to be moved to ``path`` by :meth:`commit`.
+
+        Written with unbuffered system calls and ``fsync``, so a failure (disk full) raises once
+        and :meth:`abort` removes what was written.
+
+        Parameters
+        ----------
+        role : str
+            Names the temporary entry (:meth:`dependent`).
+        data : bytes
+            The companion's content.
+        path : str or os.PathLike
+            Its final name.
+        """
+        tmp = self.dependent(role)
+        self._companions.append((tmp, os.fspath(path)))
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
     def commit(self):
-        """Move the complete file into place (``os.replace``) and release the reservation."""
+        """Make the complete file durable and move it (after its companions) into place.
+
+        The file is flushed and ``fsync``-ed before the rename, so a committed file survives a
+        power loss; the companions are renamed first and removed again if the file's rename
+        fails.  The reservation is released.
+
+        Returns
+        -------
+        str
+            ``path``.
+        """
         if self.committed:
             return self.path
+        if self.aborted:
+            raise ValueError(f"AtomicOutputFile({self.path!r}) was aborted: nothing to commit")
         self._fh.flush()
-        if _HAVE_FLOCK:  # rename while still locked: the .part is never seen unlocked by another run
+        os.fsync(self._fh.fileno())
+        placed = []
+        try:
+            for tmp, final in self._companions:
+                os.replace(tmp, final)
+                placed.append(final)
+            if not _HAVE_FLOCK:
+                self._fh.close()
+            # with flock: renamed while still locked, the .part is never seen unlocked by another run
             os.replace(self.tmp_path, self.path)
-            self._fh.close()
-        else:
-            self._fh.close()
-            os.replace(self.tmp_path, self.path)
-        self.committed = True
+            self.committed = True
+        except BaseException:
+            for final in placed:
+                _quietly(lambda f=final: os.remove(f))
+            raise
+        _quietly(self._fh.close)  # flushed and synced: nothing left that can fail
+        _fsync_folder(self.folder)
         return self.path
 
     def abort(self):
-        """Delete the temporary file and release the reservation (nothing appears under ``path``)."""
+        """Delete the temporary file and its companions, release the reservation; never raises.
+
+        Nothing appears under ``path``.  Errors while removing or closing (the buffered file's
+        close flushes again, which fails again on a full disk) are dropped: an abort follows a
+        failure, and that failure is the one to report.
+        """
         if self.committed or self.aborted:
             return
-        try:
-            if os.path.exists(self.tmp_path):
-                os.remove(self.tmp_path)
-        finally:
-            if not self._fh.closed:
-                self._fh.close()
-            self.aborted = True
+        self.aborted = True
+        for tmp, _ in self._companions:
+            _quietly(lambda t=tmp: os.remove(t))
+        _quietly(lambda: os.remove(self.tmp_path))
+        if not self._fh.closed:
+            _quietly(self._fh.close)
 
     @property
     def closed(self):
@@ -284,8 +438,36 @@ def remove_stale_parts(folder):
     return removed
 
 
+def _number_entries(path):
+    """``(run files, other names)`` that take the number of ``path``: each format's file, the sidecar."""
+    try:
+        stem = run_file_stem(path)
+    except ValueError:  # not a run file name: only itself
+        return [str(path)], []
+    return [stem + suffix for suffix in FORMAT_SUFFIXES.values()], [stem + SIDECAR_SUFFIX]
+
+
+def _number_taken(path, own_part=None):
+    """True when a run file, image folder, sidecar or live reservation (other than ``own_part``) holds the number."""
+    files, others = _number_entries(path)
+    if any(os.path.lexists(p) for p in others):
+        return True
+    for p in files:
+        folder, name = os.path.split(p)
+        part = os.path.join(folder, "." + name + PART_SUFFIX)
+        if os.path.lexists(p) or os.path.lexists(p + IMAGE_FOLDER_SUFFIX):
+            return True
+        if part != own_part and os.path.lexists(part) and _is_live(part):
+            return True
+    return False
+
+
 def number_is_free(path):
-    """True when neither ``path``, its image folder nor a live reservation of it exists.
+    """True when no entry of the number of ``path`` exists, in any output format.
+
+    The number ``<stem><k>`` is taken by the run file of any format (``.txt``, ``.txt.gz``,
+    ``.npz``, ``.parquet``), its image folder, the shared sidecar ``<stem><k>.json`` or a live
+    reservation of any of them: runs of different formats in one folder never share a sidecar.
 
     Parameters
     ----------
@@ -296,19 +478,18 @@ def number_is_free(path):
     -------
     bool
     """
-    folder, name = os.path.split(str(path))
-    part = os.path.join(folder, "." + name + PART_SUFFIX)
-    if os.path.lexists(path) or os.path.lexists(str(path) + IMAGE_FOLDER_SUFFIX):
-        return False
-    return not os.path.lexists(part) or not _is_live(part)
+    return not _number_taken(path)
 
 
 def reserve_numbered_path(stem, suffix=".txt", max_number=1_000_000):
     """Open an :class:`AtomicOutputFile` at ``stem + str(k) + suffix`` for the smallest k ≥ 1 free.
 
     Stale temporary files of killed runs in the folder are removed first, so they never take a
-    number.  A number is free when neither the file, its image folder nor a live reservation
-    exists; the reservation is atomic, so concurrent processes never pick the same number.
+    number.  A number is free when :func:`number_is_free` says so; the reservation is atomic,
+    and a reservation that finds a live reservation of the same number in another format
+    (two runs reserving at once) is given up for the next number, so concurrent processes
+    never pick the same number.
+
     Parameters
     ----------
     stem : str
@@ -334,9 +515,13 @@ def reserve_numbered_path(stem, suffix=".txt", max_number=1_000_000):
         path = stem + str(k) + suffix
         if number_is_free(path):
             try:
-                return AtomicOutputFile(path, exclusive=True)
+                out = AtomicOutputFile(path, exclusive=True)
             except FileExistsError:
                 continue
+            if _number_taken(path, own_part=out.tmp_path):  # a rival reserved the number meanwhile
+                out.abort()
+                continue
+            return out
     raise OSError(f"no free file number below {max_number} for {stem}<k>{suffix}")
 
 

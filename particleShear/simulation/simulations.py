@@ -8,7 +8,6 @@ drives the :class:`OscillatoryShearExperiment`, then streams the file (format
 write error) is kept in ``self.result_info`` after the run.  See ``docs/output.md``.
 """
 __docformat__ = "numpy"
-import gzip
 import io
 import json
 import logging
@@ -25,9 +24,9 @@ from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStre
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
-from .formats import FORMAT_SUFFIXES, check_output_format, write_run
+from .formats import FORMAT_SUFFIXES, check_output_format, table_rows, text_stream, write_run
 from .output import (IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text, probe_writable,
-                     reserve_numbered_path)
+                     reserve_numbered_path, sidecar_path)
 from .provenance import header_number, json_safe, package_version, positional_numbers_in_call, provenance_lines
 
 _log = logging.getLogger(__name__)
@@ -588,34 +587,34 @@ class OscillatorySimulation:
         """Stream the run into the reserved ``out`` in ``output_format``, write the sidecar, commit both.
 
         Text formats are written by the experiment's own block-3 writer (summary, then the table
-        in chunks); npz and parquet by :func:`~.formats.write_run`.  The sidecar
-        ``<file>.json`` is moved into place just before the file itself.
+        in chunks); npz and parquet by :func:`~.formats.write_run`.  When the file is complete
+        its size and SHA-256 are read back and recorded, with the table's row count
+        (``n_rows``), in the sidecar ``<stem>.json`` (:func:`~.output.sidecar_path`), which
+        :meth:`~.output.AtomicOutputFile.commit` moves into place just before the file.  A
+        failure raises the exception of the failing write; the caller aborts ``out``, which
+        removes the temporary file and the temporary sidecar.
         """
         metadata = self.run_metadata(output_format, out.path)
+        p = exp.plotter
+        tensors = p.tensor_history if self.saveStressTensorData else None
+        metadata["n_rows"] = table_rows(output_format, len(p), tensors is not None)
         if output_format in ("text", "text.gz"):
-            gz = gzip.GzipFile(fileobj=out.binary, mode="wb", compresslevel=6, mtime=0) \
-                if output_format == "text.gz" else None
-            sink = _TextSink(gz if gz is not None else out.binary)
-            sink.write(header)
-            sink.write(exp.description_text)
-            exp.output_file = sink
-            try:
-                exp.write_output_information_to_file()
-            finally:
-                exp.output_file = False
-            if gz is not None:
-                gz.close()
+            with text_stream(out.binary, output_format) as raw:
+                sink = _TextSink(raw)
+                sink.write(header)
+                sink.write(exp.description_text)
+                exp.output_file = sink
+                try:
+                    exp.write_output_information_to_file()
+                finally:
+                    exp.output_file = False
         else:
-            p = exp.plotter
             G_int, G_surf = exp.results["internal"], exp.results["surface"]
             text = (header + exp.description_text
                     + output_summary_text(G_int, G_surf, reference_header=self.reference_header))
-            tensors = p.tensor_history if self.saveStressTensorData else None
             write_run(out.binary, output_format, text, p._scal[: len(p)], tensors, metadata)
-        tmp_json = out.dependent("json")
-        with open(tmp_json, "w", encoding="utf-8") as fh:
-            json.dump(metadata, fh, indent=1)
-        os.replace(tmp_json, out.path + ".json")
+        metadata["size_bytes"], metadata["sha256"] = out.digest()
+        out.add_companion("json", json.dumps(metadata, indent=1).encode("utf-8"), sidecar_path(out.path))
         out.commit()
 
     def _close_windows(self):
