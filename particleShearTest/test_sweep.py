@@ -23,7 +23,7 @@ from unittest import mock
 
 import numpy as np
 
-from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
+from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries, read_run
 from particleShear.sweep import Sweep, expand_runs, load_spec, parse_spec, run_identity, run_sweep
 from particleShear.sweep.cli import main as sweep_main
 from particleShear.sweep.cost import run_steps
@@ -169,6 +169,10 @@ class TestSweep(unittest.TestCase):
         for r in self.rows:
             self.assertEqual(os.path.dirname(r["output_path"]), "")     # relative to the sweep folder
             self.assertTrue(os.path.isfile(os.path.join(self.ref, r["output_path"])))
+            with open(os.path.join(self.ref, r["output_path"][:-len(".txt")] + ".json"), encoding="utf-8") as fh:
+                self.assertEqual(json.load(fh)["file"], r["output_path"])   # the sidecar names the published file
+            self.assertEqual(read_run(os.path.join(self.ref, r["output_path"]))["t"].size, run_steps(
+                dict(runs[0].parameters)))
             self.assertTrue(os.path.basename(r["output_path"]).endswith("_nr_" + r["run_id"] + ".txt"))
             self.assertTrue(os.path.basename(r["output_path"]).startswith(
                 "dermal_filler_uncrosslinked0.01_f_" if r["do_permanent_links"] == "False" else "dermal_filler0.01_f_"))

@@ -9,12 +9,15 @@ does a run whose file could not be written (``write_error``, e.g. a full disk) â
 kept in the row and in the result.
 """
 __docformat__ = "numpy"
+import json
 import os
 import re
 import shutil
 import time
 
 import numpy as np
+
+from ..simulation.output import SIDECAR_SUFFIX
 
 __all__ = ["execute_run", "execute_batch", "failed_row", "publish"]
 
@@ -55,12 +58,26 @@ def publish(run_dir, out_dir, produced, run_id):
     for e in entries:
         target = os.path.join(out_dir, new_head + e[len(head):])
         src = os.path.join(run_dir, e)
+        if e == head + SIDECAR_SUFFIX:               # the sidecar names its file: the published name
+            _rename_in_sidecar(src, os.path.basename(new_head + base[len(head):]))
         if os.path.isdir(src) and os.path.isdir(target):
             shutil.rmtree(target)
         os.replace(src, target)
         if e == base:
             final = target
     return final
+
+
+def _rename_in_sidecar(path, name):
+    with open(path, encoding="utf-8") as fh:
+        meta = json.load(fh)
+    meta["file"] = name
+    tmp = path + ".rename"
+    with open(tmp, "w", encoding="utf-8") as fh:
+        json.dump(meta, fh, indent=1)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
 
 
 def failed_row(task, exc, wall):
