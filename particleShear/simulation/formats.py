@@ -418,6 +418,9 @@ def _parse_text(path, text):
     if not rows:
         return header, {name: np.empty(0) for name in TABLE_COLUMNS}, True
     last = rows[rows.rfind("\n") + 1:]
+    if last == "":
+        raise _bad(path, "incomplete: the table ends with a line break, which a complete file does not have "
+                   "after its last row (the file is cut at a row boundary)")
     if last.count("\t") != len(TABLE_COLUMNS) - 1:
         raise _bad(path, f"incomplete: the last row has {last.count(chr(9)) + 1} of {len(TABLE_COLUMNS)} fields "
                    "(the file is cut inside a row)")

@@ -67,8 +67,17 @@ def spec_hash(canonical):
     return hashlib.sha256(json.dumps(canonical, separators=(",", ":")).encode("utf-8")).hexdigest()
 
 
+def _plain(v):
+    """Whole floats shown as integers (``30.0`` → ``30``) in messages; the canonical form keeps floats."""
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e16:
+        return int(v)
+    if isinstance(v, list):
+        return [_plain(x) for x in v]
+    return v
+
+
 def _short(v, n=60):
-    s = json.dumps(v)
+    s = json.dumps(_plain(v))
     return s if len(s) <= n else s[:n - 1] + "…"
 
 
