@@ -19,8 +19,8 @@ import re
 
 import numpy as np
 
-__all__ = ["run_identity", "header_number", "positional_numbers_in_call", "json_safe", "provenance_lines",
-           "IDENTITY_EXCLUDED", "package_version"]
+__all__ = ["run_identity", "identity_parameters", "same_input", "header_number", "positional_numbers_in_call",
+           "json_safe", "provenance_lines", "IDENTITY_EXCLUDED", "package_version"]
 
 #: inputs that change neither the physics nor what is written: left out of the run identity
 IDENTITY_EXCLUDED = frozenset({"seed", "root_folder", "return_result", "verbose", "progress", "strict_io",
@@ -81,6 +81,53 @@ def _identity_value(value):
     return json_safe(value)
 
 
+def identity_parameters(parameters):
+    """The inputs that make a run what it is, in the form the run identity hashes them.
+
+    Keys of :data:`IDENTITY_EXCLUDED` are left out; every real number is a float (``N = 30`` and
+    ``N = 30.0``, ``0.2`` and ``numpy.float64(0.2)`` are the same input), bools stay bools.  This
+    is the one rule of "the same run": :func:`run_identity` hashes it, a sweep compares a results
+    row and matches the runs of an extended folder with it.
+
+    Parameters
+    ----------
+    parameters : dict
+        Inputs of :func:`doParticleShearSimulation` (any superset).
+
+    Returns
+    -------
+    dict
+    """
+    return {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
+
+
+def same_input(text, value):
+    """True when the text ``text`` (a results-table cell) is the input ``value`` under :func:`identity_parameters`.
+
+    Parameters
+    ----------
+    text : str or None
+        The cell as read back.
+    value : object
+        The run's input.
+
+    Returns
+    -------
+    bool
+    """
+    if text is None:
+        return False
+    want = _identity_value(value)
+    if isinstance(want, bool):
+        return text == str(want)
+    if isinstance(want, float):
+        try:
+            return float(text) == want
+        except ValueError:
+            return False
+    return text == str(want)
+
+
 def run_identity(parameters, seed_entropy, spawn_key):
     """Short deterministic id of a run: 12 hex digits of SHA-256 over its inputs and seed.
 
@@ -101,8 +148,7 @@ def run_identity(parameters, seed_entropy, spawn_key):
         12 lower-case hexadecimal digits (48 bits: collisions are negligible for campaigns of
         millions of runs).
     """
-    kept = {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
-    payload = {"parameters": kept, "seed_entropy": json_safe(seed_entropy),
+    payload = {"parameters": identity_parameters(parameters), "seed_entropy": json_safe(seed_entropy),
                "spawn_key": [int(k) for k in (spawn_key or ())]}
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]

@@ -12,7 +12,9 @@ taken belongs to nobody alive, and a sweep killed at any moment never blocks the
   (:class:`ScratchOwner`); a run writes into ``DIR/runs/<owner>/<run id>/`` and its worker moves
   the finished files into ``DIR``.  Two processes running into one folder (a plain sweep and a
   job-array task, say) therefore never touch each other's scratch; the folders of dead owners are
-  removed by the next process that starts (:func:`remove_dead_scratch`).
+  removed by the next process that starts (:func:`remove_dead_scratch`; an owner on another host
+  only once its folder has been idle for :data:`OTHER_HOST_IDLE_S`, since some cluster file
+  systems keep record locks local to a node).
 
 POSIX record locks are shared by every thread of a process, so a second lock of the same file
 in the same process is refused by an in-process registry as well.
@@ -127,10 +129,25 @@ def folder_lock(path, wait_s=None):
             _held.discard(key)
 
 
+#: the scratch-owner locks this process holds (POSIX locks do not exclude the process itself)
+_owned = set()
+#: an owner on another host is taken for dead only when its lock is free *and* its folder has not
+#: changed for this long (s): some cluster file systems keep record locks local to a node
+OTHER_HOST_IDLE_S = 3600.0
+
+
 def _is_dead_owner(lock_path):
-    """True when nobody holds ``lock_path`` (its owner died); the lock is then ours until closed."""
-    if fcntl is None:
+    """True when nobody holds ``lock_path`` (its owner died); never for an owner of this process."""
+    if fcntl is None or os.path.abspath(lock_path) in _owned:
         return False
+    owner_dir = lock_path[:-len(".lock")]
+    if not os.path.basename(owner_dir).startswith(socket.gethostname() + "-"):
+        try:
+            newest = max([os.stat(owner_dir).st_mtime] + [e.stat().st_mtime for e in os.scandir(owner_dir)])
+        except OSError:
+            newest = 0.0
+        if time.time() - newest < OTHER_HOST_IDLE_S:
+            return False
     try:
         fd = os.open(lock_path, os.O_RDWR)
     except OSError:
@@ -179,10 +196,17 @@ def remove_dead_scratch(scratch_root):
     for n in names:
         p = os.path.join(scratch_root, n)
         if not n.endswith(".lock") and n not in live and n not in removed and os.path.isdir(p) \
-                and fcntl is not None and not os.path.exists(p + ".lock"):
-            shutil.rmtree(p, ignore_errors=True)
+                and fcntl is not None and not os.path.exists(p + ".lock") and _idle(p, 60.0):
+            shutil.rmtree(p, ignore_errors=True)   # no lock at all (a crash between the two): once idle
             removed.append(n)
     return removed
+
+
+def _idle(path, seconds):
+    try:
+        return time.time() - os.stat(path).st_mtime > seconds
+    except OSError:
+        return False
 
 
 class ScratchOwner:
@@ -209,6 +233,7 @@ class ScratchOwner:
         self._fd = None
         if fcntl is not None:
             self._fd = _try_lock(self._lock_path)
+            _owned.add(os.path.abspath(self._lock_path))
         os.makedirs(self.path)
 
     def close(self):
@@ -217,5 +242,6 @@ class ScratchOwner:
         if self._fd is not None:
             _release(self._fd, self._lock_path)
             self._fd = None
+        _owned.discard(os.path.abspath(self._lock_path))
         with contextlib.suppress(OSError):
             os.rmdir(os.path.dirname(self.path))   # only when empty

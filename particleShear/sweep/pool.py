@@ -12,11 +12,14 @@ The default executor is a process pool whose workers
   :data:`WATCH_INTERVAL_S`, so they never hold a sweep's folder or CPU after it is gone.
 
 A worker that dies while running (the out-of-memory killer, a signal) breaks the pool; the jobs
-that were in flight are then run again one run at a time, each in a fresh single-worker pool, so
-the run that kills its worker is identified and becomes a ``failed`` row ("the worker process
-running this run died …") while the others finish normally; the sweep goes on in a fresh pool.
-With another executor (Dask, threads, MPI), an exception of the executor for a job (a lost Dask
-worker, say) becomes a ``failed`` row of each of its runs.
+that were in flight are then run again, each in a process of its own (``workers`` at a time,
+:func:`isolated`), so the run that kills its process is identified and becomes a ``failed`` row
+("the worker process running this run was killed by SIGKILL …") while the others finish
+normally; a batch whose process dies is split into its runs first.  The sweep then goes on in a
+fresh pool.  With another executor (Dask, threads, MPI), an exception of the executor for a job
+(a lost Dask worker, say) becomes a ``failed`` row of each of its runs; a broken process pool
+that is not ours fails the runs in flight and stops the sweep with a ``RuntimeError`` (finished
+rows kept).
 """
 __docformat__ = "numpy"
 import concurrent.futures
@@ -28,7 +31,8 @@ from concurrent.futures.process import BrokenProcessPool
 
 from . import tasks as _tasks
 
-__all__ = ["run_jobs", "WorkerDied", "SweepTerminated", "WATCH_INTERVAL_S", "worker_init", "new_pool"]
+__all__ = ["run_jobs", "isolated", "WorkerDied", "SweepTerminated", "WATCH_INTERVAL_S", "worker_init", "new_pool",
+           "terminate"]
 
 #: seconds between a worker's checks that its driving process is alive
 WATCH_INTERVAL_S = 0.2
@@ -47,22 +51,56 @@ class WorkerDied(RuntimeError):
     """The worker process that ran a run died (out-of-memory killer, a signal) before returning."""
 
 
-def _watch_parent(parent_pid):
-    while os.getppid() == parent_pid:
-        time.sleep(WATCH_INTERVAL_S)
+def _watch_parent(parent_pid, start_method):
+    """Return when the driving process is gone.
+
+    A forked worker's parent is the driving process: its parent id changes when it dies (the
+    worker is re-parented).  A spawned or forkserver worker has another parent (the fork server)
+    but holds the read end of a pipe whose write end only the driving process holds
+    (``multiprocessing.parent_process().sentinel``): it becomes readable when that process dies.
+    """
+    if start_method == "fork":
+        while os.getppid() == parent_pid:
+            time.sleep(WATCH_INTERVAL_S)
+        return
+    import multiprocessing
+    import multiprocessing.connection
+    parent = multiprocessing.parent_process()
+    if parent is None or getattr(parent, "sentinel", None) is None:  # pragma: no cover - not a child
+        while os.getppid() == parent_pid:
+            time.sleep(WATCH_INTERVAL_S)
+        return
+    multiprocessing.connection.wait([parent.sentinel])
+
+
+def _watchdog(parent_pid, start_method):
+    _watch_parent(parent_pid, start_method)
     os._exit(1)   # the sweep is gone: stop at once (its scratch folder is removed by the next sweep)
 
 
-def worker_init(parent_pid):
-    """Initializer of the default pool's workers: ignore SIGINT, exit when ``parent_pid`` is gone.
+def worker_init(parent_pid, start_method="fork"):
+    """Initializer of the default pool's workers: ignore SIGINT, default SIGTERM, exit with the driver.
+
+    The driving process handles Ctrl-C (it lets running runs finish) and may have a SIGTERM
+    handler of its own (the CLI's); a worker must not inherit either, so that the driver can stop
+    it, and it exits as soon as the driving process ``parent_pid`` is gone (:func:`_watch_parent`).
 
     Parameters
     ----------
     parent_pid : int
         The driving process.
+    start_method : str, optional
+        ``"fork"``, ``"spawn"`` or ``"forkserver"``: how the worker was started (default "fork").
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="particleShear-watch").start()
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_watchdog, args=(parent_pid, start_method), daemon=True,
+                     name="particleShear-watch").start()
+
+
+def _start_method(mp_context):
+    import multiprocessing
+    return (mp_context or multiprocessing.get_context()).get_start_method()
 
 
 def new_pool(workers, mp_context=None):
@@ -79,14 +117,20 @@ def new_pool(workers, mp_context=None):
     -------
     concurrent.futures.ProcessPoolExecutor
     """
-    return concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=mp_context,
-                                                  initializer=worker_init, initargs=(os.getpid(),))
+    return concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=mp_context, initializer=worker_init,
+                                                  initargs=(os.getpid(), _start_method(mp_context)))
+
+
+def _call(job):
+    """``(function, argument)`` that executes ``job``: one run, or a batch of replicas."""
+    if len(job) == 1 and not job[0].get("batched"):
+        return _tasks.execute_run, job[0]
+    return _tasks.execute_batch, job
 
 
 def _submit(executor, job):
-    if len(job) == 1 and not job[0].get("batched"):
-        return executor.submit(_tasks.execute_run, job[0])
-    return executor.submit(_tasks.execute_batch, job)
+    fn, arg = _call(job)
+    return executor.submit(fn, arg)
 
 
 def _outcomes(job, value):
@@ -103,7 +147,7 @@ def terminate(pool):
     """
     for p in list((getattr(pool, "_processes", None) or {}).values()):
         try:
-            p.terminate()
+            p.kill()
         except Exception:  # noqa: BLE001 - already gone
             pass
 
@@ -119,37 +163,71 @@ def _death_text(exitcode):
     return f"the worker process running this run exited with status {exitcode} before returning"
 
 
-def _solo_child(conn, task, parent_pid):
-    worker_init(parent_pid)
-    conn.send(_tasks.execute_run(task))
+def _isolated_child(conn, job, parent_pid, start_method):
+    worker_init(parent_pid, start_method)
+    fn, arg = _call(job)
+    conn.send(_outcomes(job, fn(arg)))
     conn.close()
 
 
-def _solo(task, mp_context):
-    """Run one task alone in a fresh worker process; ``(row, result)``, a failed row if the process dies."""
+def isolated(jobs, mp_context=None, workers=1):
+    """Run jobs each in a process of its own, ``workers`` at a time; yield ``(job, outcomes)`` as each ends.
+
+    Used after a worker died: a job whose process dies again is the culprit.  A single run then
+    becomes a ``failed`` row (:class:`WorkerDied`, naming the signal); a batch is split and its
+    runs are isolated in turn, so only the run that kills its process fails.
+
+    Parameters
+    ----------
+    jobs : list of list of dict
+        The jobs that were in flight when a worker died.
+    mp_context : multiprocessing context, optional
+        Start method (default the platform's).
+    workers : int, optional
+        Processes at a time (default 1).
+
+    Yields
+    ------
+    tuple
+        ``(job, [(row, result or None), ...])``.
+    """
     import multiprocessing
     import multiprocessing.connection
     ctx = mp_context or multiprocessing.get_context()
-    recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_solo_child, args=(send, dict(task, batched=False), os.getpid()), daemon=True)
-    t0 = time.perf_counter()
-    proc.start()
-    send.close()
+    queue = list(jobs)
+    running = {}                      # receiving end -> (process, job, start time)
     try:
-        multiprocessing.connection.wait([recv, proc.sentinel])
-        try:
-            value = recv.recv()
-        except (EOFError, OSError):   # the process died before it could answer
-            proc.join()
-            return _tasks.failed_row(task, WorkerDied(_death_text(proc.exitcode)), time.perf_counter() - t0), None
-        proc.join()
-        return value
-    except BaseException:
-        proc.kill()
-        proc.join()
-        raise
+        while queue or running:
+            while queue and len(running) < max(1, workers):
+                job = queue.pop(0)
+                recv, send = ctx.Pipe(duplex=False)
+                proc = ctx.Process(target=_isolated_child, daemon=True,
+                                   args=(send, job, os.getpid(), ctx.get_start_method()))
+                proc.start()
+                send.close()
+                running[recv] = (proc, job, time.perf_counter())
+            ready = multiprocessing.connection.wait(list(running) + [p.sentinel for p, _, _ in running.values()])
+            for recv in [r for r in running if r in ready or running[r][0].sentinel in ready]:
+                proc, job, t0 = running.pop(recv)
+                try:
+                    value = recv.recv()
+                except (EOFError, OSError):       # the process died before it could answer
+                    value = None
+                finally:
+                    recv.close()
+                    proc.join()
+                if value is not None:
+                    yield job, value
+                elif len(job) > 1 or job[0].get("batched"):
+                    queue.extend([dict(t, batched=False)] for t in job)      # split the batch
+                else:
+                    why = WorkerDied(_death_text(proc.exitcode))
+                    yield job, [(_tasks.failed_row(job[0], why, time.perf_counter() - t0), None)]
     finally:
-        recv.close()
+        for recv, (proc, _, _) in running.items():
+            proc.kill()
+            proc.join()
+            recv.close()
 
 
 def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
@@ -185,10 +263,10 @@ def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
     inflight = {}
     pool = new_pool(workers, mp_context) if own else None
     ex = pool if own else executor
-    exhausted = False
+    exhausted = broken_external = False
     try:
         while True:
-            while not exhausted and len(inflight) < window:
+            while not exhausted and not broken_external and len(inflight) < window:
                 try:
                     job = next(source)
                 except StopIteration:
@@ -203,9 +281,11 @@ def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
                 job = inflight.pop(fut)
                 try:
                     value = fut.result()
-                except BrokenProcessPool:
-                    if not own:
-                        raise
+                except BrokenProcessPool as exc:
+                    if not own:     # not ours to replace: its runs fail, and nothing more can be submitted
+                        yield job, [(_tasks.failed_row(t, exc, 0.0), None) for t in job]
+                        broken_external = True
+                        continue
                     lost.append(job)
                     continue
                 except Exception as exc:  # noqa: BLE001 - the executor lost the job: its runs fail, the sweep goes on
@@ -221,10 +301,12 @@ def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
                         lost.append(job)
                 inflight.clear()
                 pool.shutdown(wait=True, cancel_futures=True)
-                for job in lost:                                  # one run at a time: find the culprit
-                    for task in job:
-                        yield [dict(task, batched=False)], [_solo(task, mp_context)]
+                yield from isolated(lost, mp_context, workers)     # each job alone: find the culprit
                 pool = ex = new_pool(workers, mp_context)
+            if broken_external and not inflight:
+                raise RuntimeError("the executor's process pool is broken (a worker process died): the runs in "
+                                   "flight are failed rows, the finished rows are kept; run the sweep again with a "
+                                   "new executor to resume")
     except KeyboardInterrupt:
         for fut in inflight:
             fut.cancel()

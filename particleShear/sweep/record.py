@@ -19,7 +19,6 @@ __docformat__ = "numpy"
 import hashlib
 import json
 import os
-import secrets
 
 __all__ = ["RECORD_NAME", "canonical_spec", "spec_hash", "spec_changes", "read_record", "write_record",
            "extended_runs", "check_record"]
@@ -163,13 +162,9 @@ def write_record(out_dir, segments, docs):
     from .. import __version__
     rec = {"format": _FORMAT, "package_version": __version__,
            "segments": [{"spec": c, "sha256": spec_hash(c), "doc": d} for c, d in zip(segments, docs)]}
-    path = os.path.join(out_dir, RECORD_NAME)
-    tmp = os.path.join(out_dir, f".{RECORD_NAME}.{os.getpid()}.{secrets.token_hex(4)}.part")   # tasks race
-    with open(tmp, "w", encoding="utf-8") as fh:
+    from .table import atomic_text
+    with atomic_text(os.path.join(out_dir, RECORD_NAME)) as fh:   # a temporary name per process: tasks race
         json.dump(rec, fh, indent=1)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
 
 
 def check_record(out_dir, canonical, extend):
@@ -229,13 +224,12 @@ def extended_runs(segment_specs, segment_runs):
         indexed (spawn key) on from the runs before them.
     """
     import dataclasses
-    from ..simulation.provenance import run_identity
+    from ..simulation.provenance import identity_parameters, run_identity
     seen = set()
     out = []
     for spec, runs in zip(segment_specs, segment_runs):
         for run in runs:
-            key = (json.dumps({k: _num(v) for k, v in sorted(run.parameters.items())}), run.repetition,
-                   spec.root)
+            key = (json.dumps(identity_parameters(run.parameters), sort_keys=True), run.repetition, spec.root)
             if key in seen:
                 continue
             seen.add(key)

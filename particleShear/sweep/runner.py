@@ -31,10 +31,10 @@ import numpy as np
 from .cost import estimate_cost, estimate_point_cost, format_cost
 from .locks import FolderBusyError, ScratchOwner, folder_lock
 from .pool import run_jobs
-from .record import canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
+from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
-from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, row_problem, table_columns,
-                    task_table_name, write_parquet, write_table)
+from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
+                    row_problem, table_columns, task_table_name, write_parquet, write_table)
 from .tasks import execute_batch, execute_run
 
 __all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
@@ -241,19 +241,23 @@ class Sweep:
         if os.path.exists(self.out_dir) and not os.path.isdir(self.out_dir):
             raise ValueError(f"out_dir={out_dir!r} (--out) is invalid: it is a file")
         self.task_index, self.task_count, self.extend = task_index, task_count, extend
-        own = spec_runs(self.spec)                     # validates every point before any work
+        self._own = spec_runs(self.spec)               # validates every point before any work
         self._canonical = canonical_spec(self.spec)
-        self._segments = self._check_folder()
-        if len(self._segments) == 1:
-            self.runs = own
-        else:                                          # an extended folder: the runs of every segment
-            me = spec_hash(self._canonical)
-            specs = [self.spec if spec_hash(seg["spec"]) == me else parse_spec(seg["doc"]) for seg in self._segments]
-            self.runs = extended_runs(specs, [own if s is self.spec else spec_runs(s) for s in specs])
+        self._load_runs()
         self.columns = table_columns(list(self.runs[0].parameters) if len(self.runs) else None)
         name = TABLE_NAME if task_count is None else task_table_name(task_index, task_count)
         self.table_path = os.path.join(self.out_dir, name)
+
+    def _load_runs(self):
+        """The folder's segments (its record, this SPEC checked against it) and the runs they make."""
+        self._segments = self._check_folder()
         self._run_cache = {}
+        if len(self._segments) == 1:
+            self.runs = self._own
+            return
+        me = spec_hash(self._canonical)              # an extended folder: the runs of every segment
+        specs = [self.spec if spec_hash(seg["spec"]) == me else parse_spec(seg["doc"]) for seg in self._segments]
+        self.runs = extended_runs(specs, [self._own if s is self.spec else spec_runs(s) for s in specs])
 
     def _check_folder(self):
         """The folder's segments (dicts ``spec``, ``doc``) with this SPEC last; refuse another SPEC."""
@@ -268,15 +272,23 @@ class Sweep:
         return segments
 
     def _record(self):
-        """Write the folder's record when it is new or extended (under the table lock)."""
-        rec = read_record(self.out_dir)
-        now = [seg["spec"] for seg in self._segments]
-        if rec is not None and [spec_hash(s["spec"]) for s in rec["segments"]] == [spec_hash(c) for c in now]:
-            return
-        if rec is not None:       # someone recorded meanwhile: check again against what is there now
-            self._segments = self._check_folder()
-        write_record(self.out_dir, [seg["spec"] for seg in self._segments],
-                     docs=[seg["doc"] for seg in self._segments])
+        """Write the folder's record when it is new or extended, under the record's own lock.
+
+        Processes with different tables (job-array tasks) share the record, so it has a lock of
+        its own; when another process recorded or extended it since this sweep was made, the
+        segments and runs are made again from what is there now (or the SPEC is refused).
+        """
+        with folder_lock(os.path.join(self.out_dir, RECORD_NAME), wait_s=30.0):
+            rec = read_record(self.out_dir)
+            seen = [spec_hash(seg["spec"]) for seg in self._segments]
+            if rec is not None and [s["sha256"] for s in rec["segments"]] == seen:
+                return
+            if rec is not None and [s["sha256"] for s in rec["segments"]] != seen[:len(rec["segments"])]:
+                self._load_runs()           # recorded or extended meanwhile by another process
+                if [s["sha256"] for s in rec["segments"]] == [spec_hash(seg["spec"]) for seg in self._segments]:
+                    return
+            write_record(self.out_dir, [seg["spec"] for seg in self._segments],
+                         docs=[seg["doc"] for seg in self._segments])
 
     # -- state ---------------------------------------------------------------------------------
     def my_runs(self):
@@ -304,9 +316,7 @@ class Sweep:
             return None
         if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(self.runs):
             return None
-        run = self._run_cache.get(k)
-        if run is None:
-            run = self._run_cache[k] = self.runs[k]
+        run = self.runs[k]                 # made again (not kept): memory stays that of the points
         return run if run.run_id == rid else None
 
     def _file_problem(self, row):
@@ -514,10 +524,13 @@ class Sweep:
             for rid, (_, why) in sorted(distrust.items()):
                 self._say(stream, progress, f"run {rid} runs again: {why}")
             rows = read_rows(self.table_path)
-            drop = set(distrust) | {row.get("run_id") for row in rows if row.get("status") == "failed"
-                                    and row.get("run_id") not in done and self._run_of(row) is not None}
-            if any(row.get("run_id") in drop for row in rows):   # stale rows of runs that run again
-                write_table(self.table_path, [r for r in rows if r.get("run_id") not in drop], self.columns)
+            retried = {row.get("run_id") for row in rows if row.get("status") == "failed"
+                       and row.get("run_id") not in done and self._run_of(row) is not None}
+            stale = [row for row in rows if row.get("run_id") in distrust]
+            if stale or retried:   # rows of runs that run again: distrusted ones set aside, retried failures go
+                reject_lines(self.table_path, [row_line(row, self.columns) for row in stale])
+                write_table(self.table_path, [r for r in rows if r.get("run_id") not in distrust
+                                              and r.get("run_id") not in retried], self.columns)
             mine = self.my_runs()
             n_mine = len(mine)
             n_todo = n_mine - sum(1 for run, _ in done.values() if self._mine(run))
@@ -550,22 +563,56 @@ class Sweep:
         return notes
 
     def _execute(self, todo, n_todo, executor, workers, keep_series, batch_size, show):
+        """Run the pending runs; append each row, then yield its outcome.
+
+        An interrupt (Ctrl-C) raised while an outcome is being recorded or handled by the caller
+        (outside :func:`~.pool.run_jobs`) is passed into it, so that the running runs finish and
+        their rows are kept, as for an interrupt during the wait; the same when the caller stops
+        iterating (the generator is closed).
+        """
         owner = ScratchOwner(self.out_dir)
+        points = self.runs.points if isinstance(self.runs, SweepRuns) else [r.parameters for r in self.runs]
+        jobs = run_jobs(self._jobs(todo, keep_series, owner.path, batch_size), executor=executor,
+                        workers=min(workers or os.cpu_count() or 1, n_todo),
+                        mp_context=_pool_context(points) if executor is None else None)
+
+        def record(item):
+            job, outcomes = item
+            done = []
+            for task, (row, result) in zip(job, outcomes):
+                append_row(self.table_path, row, self.columns)
+                run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
+                    self._run_of({"run_id": task["run_id"]})
+                outcome = SweepOutcome(run, row, result)
+                if show is not None:
+                    show(outcome)
+                done.append(outcome)
+            return done
+
         try:
-            points = self.runs.points if isinstance(self.runs, SweepRuns) else [r.parameters for r in self.runs]
-            n_workers = min(workers or os.cpu_count() or 1, n_todo)
-            for job, outcomes in run_jobs(self._jobs(todo, keep_series, owner.path, batch_size), executor=executor,
-                                          workers=n_workers,
-                                          mp_context=_pool_context(points) if executor is None else None):
-                for task, (row, result) in zip(job, outcomes):
-                    append_row(self.table_path, row, self.columns)
-                    run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
-                        self._run_of({"run_id": task["run_id"]})
-                    outcome = SweepOutcome(run, row, result)
-                    if show is not None:
-                        show(outcome)
-                    yield outcome
+            interrupt = None
+            while True:
+                try:
+                    item = next(jobs) if interrupt is None else jobs.throw(interrupt)
+                except StopIteration:
+                    return
+                interrupt = None
+                try:
+                    for outcome in record(item):
+                        yield outcome
+                except KeyboardInterrupt as exc:    # in our code or the caller's: let the runs finish
+                    interrupt = exc
+        except GeneratorExit:                       # the caller stopped (break, Ctrl-C in its loop)
+            try:
+                item = jobs.throw(KeyboardInterrupt())
+                while True:
+                    record(item)
+                    item = next(jobs)
+            except (KeyboardInterrupt, StopIteration):
+                pass
+            raise
         finally:
+            jobs.close()
             owner.close()
 
     def _finish(self):

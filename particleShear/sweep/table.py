@@ -10,13 +10,22 @@ complete line on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed s
 most one torn last line, which :func:`read_rows` drops and :func:`repair_table` cuts off.
 """
 __docformat__ = "numpy"
+import contextlib
 import csv
 import io
 import json
+import numbers
 import os
+import secrets
+import socket
+
+import numpy as np
+
+from ..simulation.provenance import IDENTITY_EXCLUDED, same_input
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
-           "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem",
+           "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
+           "reject_lines",
            "REJECTED_SUFFIX"]
 
 #: lines of a table that cannot be rows (wrong number of fields) are moved to ``<table>`` + this suffix
@@ -66,12 +75,18 @@ def table_columns(parameter_names=None):
 
 
 def _cell(v):
+    """Text of one value: lists as JSON, NumPy scalars as the Python number they are (``0.2``, not
+    ``np.float64(0.2)``), floats with ``repr`` (round trip), other values with ``str``."""
     if v is None:
         return ""
     if isinstance(v, (list, tuple)):
         return json.dumps([int(x) for x in v])
-    if isinstance(v, float):
-        return repr(v)
+    if isinstance(v, (bool, np.bool_)):
+        return str(bool(v))
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        return repr(float(v))
     return str(v)
 
 
@@ -158,29 +173,46 @@ def check_table(path, columns):
     except UnicodeDecodeError as exc:
         raise ValueError(f"results table {path!r} is not UTF-8 text ({exc}): repair it or use another --out DIR") \
             from None
-    lines = text.splitlines(keepends=True)
+    lines = [line + "\n" for line in text.split("\n")]   # rows end with "\n" only (csv.writer)
+    if lines and lines[-1] == "\n":
+        lines.pop()                                       # text ends with "\n": no line after it
     check_table_header(path, columns)
     header = list(columns)
     good, bad = [lines[0]], []
     for line in lines[1:]:
-        fields = next(csv.reader([line]), [])
+        try:
+            fields = next(csv.reader([line]), [])
+        except csv.Error:
+            fields = []
         (good if len(fields) == len(header) else bad).append(line)
     if bom or bad:
         if bad:
-            with open(path + REJECTED_SUFFIX, "a", encoding="utf-8", newline="") as fh:
-                fh.writelines(bad)
-                fh.flush()
-                os.fsync(fh.fileno())
+            reject_lines(path, bad)
             notes.append(f"moved {len(bad)} line(s) that are not rows of {path} to {path + REJECTED_SUFFIX}")
         if bom:
             notes.append(f"removed a UTF-8 byte-order mark from {path}")
-        tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
-        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        with atomic_text(path) as fh:
             fh.writelines(good)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
     return notes
+
+
+def reject_lines(path, lines):
+    """Append ``lines`` (complete text lines) to ``<table>.rejected``, fsynced: set aside, never lost.
+
+    Parameters
+    ----------
+    path : str
+        The table.
+    lines : iterable of str
+        Lines, each ending with a newline (nothing is written for none).
+    """
+    lines = list(lines)
+    if not lines:
+        return
+    with open(path + REJECTED_SUFFIX, "a", encoding="utf-8", newline="") as fh:
+        fh.writelines(lines)
+        fh.flush()
+        os.fsync(fh.fileno())
 
 
 def check_table_header(path, columns):
@@ -238,7 +270,7 @@ def row_problem(row, run):
     if row.get("seed_entropy") != _cell(run.seed_entropy) or row.get("spawn_key") != _cell(list(run.spawn_key)):
         return "its seed is not the run's"
     for name, v in run.parameters.items():
-        if row.get(name) != _cell(v):
+        if name not in IDENTITY_EXCLUDED and not same_input(row.get(name), v):
             return f"{name}={row.get(name)!r} is not the run's {_cell(v)!r}"
     numbers = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s") if status == "ok" \
         else ("wall_time_s",)
@@ -304,7 +336,42 @@ def read_rows(path):
         text = fh.read()
     if text and not text.endswith("\n"):
         text = text[:text.rfind("\n") + 1]
-    return list(csv.DictReader(io.StringIO(text)))
+    try:
+        return list(csv.DictReader(io.StringIO(text)))
+    except csv.Error as exc:
+        raise ValueError(f"results table {os.fspath(path)!r} cannot be read as CSV ({exc}): repair it, or use "
+                         "another --out DIR") from None
+
+
+@contextlib.contextmanager
+def atomic_text(path):
+    """A text file (UTF-8, ``newline=""``) that replaces ``path`` only when the block completes.
+
+    Written under a hidden name unique to the process in the same folder, fsynced, then moved
+    into place with ``os.replace``; an exception removes it and leaves ``path`` as it was.  Every
+    whole-file write of a sweep folder (tables, the record, a published sidecar) goes through it.
+
+    Parameters
+    ----------
+    path : str
+        The file to replace.
+
+    Yields
+    ------
+    file object
+    """
+    tmp = os.path.join(os.path.dirname(path) or ".",
+                       f".{os.path.basename(path)}.{os.getpid()}.{secrets.token_hex(4)}.part")
+    try:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
 
 
 def write_table(path, rows, columns):
@@ -319,14 +386,10 @@ def write_table(path, rows, columns):
     columns : sequence of str
         The header and column order.
     """
-    tmp = os.path.join(os.path.dirname(path) or ".", "." + os.path.basename(path) + ".part")
-    with open(tmp, "w", newline="", encoding="utf-8") as fh:
+    with atomic_text(path) as fh:
         fh.write(row_line({c: c for c in columns}, columns))
         for row in rows:
             fh.write(row_line(row, columns))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
 
 
 def write_parquet(csv_path):

@@ -18,8 +18,9 @@ import time
 import numpy as np
 
 from ..simulation.output import SIDECAR_SUFFIX
+from .table import atomic_text
 
-__all__ = ["execute_run", "execute_batch", "failed_row", "publish"]
+__all__ = ["execute_run", "execute_batch", "failed_row", "publish", "error_text"]
 
 
 def publish(run_dir, out_dir, produced, run_id):
@@ -72,12 +73,25 @@ def _rename_in_sidecar(path, name):
     with open(path, encoding="utf-8") as fh:
         meta = json.load(fh)
     meta["file"] = name
-    tmp = path + ".rename"
-    with open(tmp, "w", encoding="utf-8") as fh:
+    with atomic_text(path) as fh:
         json.dump(meta, fh, indent=1)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+
+
+def error_text(exc):
+    """``"<type>: <message>"`` on one line: every character that is not printable becomes a space.
+
+    A results row is one line of the table; a line break, carriage return or other separator
+    (``\\x0b``, U+2028, ...) inside a message must not split it or break the CSV reader.
+
+    Parameters
+    ----------
+    exc : BaseException
+
+    Returns
+    -------
+    str
+    """
+    return "".join(c if c.isprintable() else " " for c in f"{type(exc).__name__}: {exc}")
 
 
 def failed_row(task, exc, wall):
@@ -97,7 +111,7 @@ def failed_row(task, exc, wall):
     dict
     """
     from .. import __version__
-    row = {"run_id": task["run_id"], "status": "failed", "error": f"{type(exc).__name__}: {exc}".replace("\n", " ")}
+    row = {"run_id": task["run_id"], "status": "failed", "error": error_text(exc)}
     row.update(task["parameters"])
     row.update(seed_entropy=task["seed_entropy"], spawn_key=list(task["spawn_key"]), package_version=__version__,
                wall_time_s=wall, output_path="")
@@ -170,7 +184,7 @@ def _finish_run(task, result, wall_time_s):
     row["wall_time_s"] = wall_time_s
     err = getattr(result, "write_error", None)
     if err is not None:
-        row.update(status="failed", error=f"write failed: {type(err).__name__}: {err}".replace("\n", " "),
+        row.update(status="failed", error="write failed: " + error_text(err),
                    output_path="")
     if not task.get("keep_series"):
         result.series = {}
