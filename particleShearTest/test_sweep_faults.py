@@ -20,6 +20,9 @@ import time
 import unittest
 from unittest import mock
 
+import numpy as np
+
+from particleShear import doParticleShearSimulationSeries
 from particleShear.sweep import Sweep, expand_runs, parse_spec, run_sweep
 from particleShear.sweep.cli import main as sweep_main
 from particleShear.sweep.locks import FolderBusyError
@@ -141,6 +144,43 @@ class TestKilledDriver(unittest.TestCase):
         self._resume_is_complete()
 
 
+@unittest.skipUnless(sys.platform.startswith("linux"), "reads /proc")
+class TestSigtermStopsRunningRuns(unittest.TestCase):
+    def test_sigterm_kills_the_running_runs_instead_of_waiting_for_them(self):
+        """Runs of many seconds each: after SIGTERM none may finish (a row would be appended)."""
+        with tempfile.TemporaryDirectory() as d:
+            spec = _write_spec(d, dict(SPEC, parameters=dict(TINY, periods=400), grid={"theAmplitude": [0.2]},
+                                       zip=[], seeds={"root": 1, "repetitions": 3}))
+            out = os.path.join(d, "out")
+            proc = _cli([spec, "--out", out, "--workers", "2", "--quiet"])
+            runs = os.path.join(out, "runs")
+
+            def started():         # the run folders in the driver's scratch folder: the runs that started
+                found = set()
+                try:
+                    for o in os.listdir(runs):
+                        if os.path.isdir(os.path.join(runs, o)):
+                            found |= {e for e in os.listdir(os.path.join(runs, o)) if not e.startswith(".")}
+                except OSError:
+                    pass
+                return found
+
+            _wait_for(lambda: proc.poll() is not None or len(started()) >= 2, "two running runs")
+            before = started()
+            workers = _children(proc.pid)
+            proc.send_signal(signal.SIGTERM)
+            after = set()
+            while proc.poll() is None:        # a run takes many seconds: a run started now is seen
+                after |= started()
+                time.sleep(0.02)
+            _, err = proc.communicate(timeout=DEADLINE_S)
+            self.assertEqual(proc.returncode, 143, err)
+            self.assertLessEqual(after, before, "a queued run started after SIGTERM")
+            self.assertFalse(os.path.exists(os.path.join(out, "results.csv")) and _rows(os.path.join(out, "results.csv")),
+                             "a run finished after SIGTERM: the workers were not stopped")
+            _wait_for(lambda: not any(_alive(w) for w in workers), "the workers to exit")
+
+
 class TestLockAndExitStatus(unittest.TestCase):
     def test_live_lock_refuses_with_status_3_dead_lock_is_taken_over(self):
         with tempfile.TemporaryDirectory() as d:
@@ -188,6 +228,124 @@ class TestKilledWorker(unittest.TestCase):
         self.assertEqual([r["status"] for r in rows], ["ok", "ok", "ok", "failed"])
         self.assertIn("killed by SIGKILL", rows[3]["error"])
         self.assertEqual(rows[3]["error"].split(":")[0], "WorkerDied")
+
+
+class TestStartMethods(unittest.TestCase):
+    def test_forkserver_and_spawn_workers_run_and_watch_their_driver(self):
+        import multiprocessing
+        from particleShear.sweep import runner
+        one = dict(SPEC, grid={"theAmplitude": [0.2]}, zip=[])
+        for method in ("forkserver", "spawn"):
+            if method not in multiprocessing.get_all_start_methods():
+                continue
+            with self.subTest(method=method), tempfile.TemporaryDirectory() as d, \
+                    mock.patch.object(runner, "_pool_context", lambda _: multiprocessing.get_context(method)):
+                rows = run_sweep(one, d, workers=1, progress=False)
+                self.assertEqual([r["status"] for r in rows], ["ok"], rows[0]["error"])
+
+    def test_isolated_jobs_under_spawn(self):
+        """The isolation after a worker died works with spawned processes (a CUDA sweep's start method)."""
+        import multiprocessing
+        from particleShear.sweep import pool
+        from particleShear.sweep import run_identity
+        runs = expand_runs(parse_spec(dict(SPEC, parameters=dict(TINY, saveData=False), grid={"theAmplitude": [0.2]},
+                                           zip=[])))
+        task = {"run_id": run_identity(runs[0].parameters, 7, (0,)), "index": 0, "parameters": runs[0].parameters,
+                "seed_entropy": 7, "spawn_key": (0,), "out_dir": "", "keep_series": False}
+        (job, outcomes), = list(pool.isolated([[task]], multiprocessing.get_context("spawn")))
+        self.assertEqual(outcomes[0][0]["status"], "ok", outcomes[0][0]["error"])
+
+
+class TestInterruptInTheCallersLoop(unittest.TestCase):
+    @unittest.skipUnless(hasattr(os, "fork"), "needs the default pool")
+    def test_ctrl_c_in_the_loop_body_lets_the_running_runs_finish(self):
+        with tempfile.TemporaryDirectory() as d:
+            sweep = Sweep(SPEC, d)
+            seen = []
+            with self.assertRaises(KeyboardInterrupt):
+                for outcome in sweep.as_completed(workers=2, progress=False):
+                    seen.append(outcome.row["run_id"])
+                    raise KeyboardInterrupt     # as if Ctrl-C came while the caller handles the first outcome
+            rows = _rows(os.path.join(d, "results.csv"))
+            self.assertEqual(len(seen), 1)
+            self.assertGreaterEqual(len(rows), 2, "the run that was running with the first was killed, not finished")
+            self.assertTrue(all(r["status"] == "ok" for r in rows))
+            self.assertEqual(len([e for e in os.listdir(d) if e.endswith(".txt")]), len(rows))
+
+
+class TestSameRun(unittest.TestCase):
+    def test_a_number_spelled_otherwise_and_numpy_inputs_are_the_same_run(self):
+        with tempfile.TemporaryDirectory() as d:
+            base = dict(SPEC, grid={"theAmplitude": [0.2]}, zip=[])
+            run_sweep(base, d, workers=1, progress=False)
+            respelled = dict(base, parameters=dict(TINY, periods=1.0, N=30.0))
+            self.assertEqual(Sweep(respelled, d).pending(), [])
+            kw = dict(TINY, cut_lines=0, mu=[0.01], N_repetitions=1, seed=3, max_workers=1, doDrawing=False)
+            first = doParticleShearSimulationSeries(root_folder=d, amplitudes=[0.2], **kw)
+            with mock.patch("particleShear.sweep.tasks.execute_run", side_effect=AssertionError("ran again")), \
+                    concurrent.futures.ThreadPoolExecutor(1) as ex:
+                again = doParticleShearSimulationSeries(root_folder=d, amplitudes=np.array([0.2]), executor=ex,
+                                                        **dict(kw, plotStress=True))
+            self.assertEqual(again[0].G_surface, first[0].G_surface)
+            with open(os.path.join(d, "results.csv"), encoding="utf-8") as fh:
+                self.assertNotIn("np.float64", fh.read())
+
+    def test_control_characters_in_an_error_keep_the_row_one_line(self):
+        from particleShear.run import api
+        real = api.doParticleShearSimulation
+
+        @functools.wraps(real)
+        def odd(**kw):
+            if kw["theAmplitude"] == 0.1:
+                raise RuntimeError("line\rbreak\x0bvt\u2028ls\x85nel\nnl")
+            return real(**kw)
+
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", odd), \
+                concurrent.futures.ThreadPoolExecutor(2) as ex:
+            run_sweep(SPEC, d, executor=ex, progress=False)
+            rows = Sweep(SPEC, d).rows()
+            self.assertEqual(len(rows), 4)
+            self.assertEqual(rows[2]["error"], "RuntimeError: line break vt ls nel nl")
+            with open(os.path.join(d, "results.csv"), encoding="utf-8") as fh:
+                self.assertEqual(len(fh.read().split("\n")), 6)       # header, 4 rows, final newline
+            self.assertFalse(os.path.exists(os.path.join(d, "results.csv.rejected")))
+            self.assertEqual(list(Sweep(SPEC, d).as_completed(workers=1, progress=False)), [])
+
+
+class TestScratchOwners(unittest.TestCase):
+    def test_a_second_owner_in_one_process_keeps_the_first(self):
+        from particleShear.sweep.locks import ScratchOwner
+        with tempfile.TemporaryDirectory() as d:
+            a = ScratchOwner(d)
+            os.makedirs(os.path.join(a.path, "abc"))
+            b = ScratchOwner(d)
+            self.assertTrue(os.path.isdir(os.path.join(a.path, "abc")))
+            b.close()
+            self.assertTrue(os.path.isdir(a.path))
+            a.close()
+            self.assertFalse(os.path.exists(os.path.join(d, "runs")))
+
+
+class TestExternalProcessPool(unittest.TestCase):
+    @unittest.skipUnless(hasattr(os, "fork"), "needs fork (the patched run reaches the workers through it)")
+    def test_a_broken_pool_of_the_caller_fails_its_runs_and_stops_clearly(self):
+        import multiprocessing
+        from particleShear.run import api
+        real = api.doParticleShearSimulation
+
+        @functools.wraps(real)
+        def oom(**kw):
+            if kw["theAmplitude"] == 0.1:
+                os.kill(os.getpid(), signal.SIGKILL)
+            return real(**kw)
+
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", oom), \
+                concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as ex:
+            with self.assertRaisesRegex(RuntimeError, "process pool is broken"):
+                run_sweep(dict(SPEC, zip=[]), d, executor=ex, progress=False)
+            rows = _rows(os.path.join(d, "results.csv"))
+            self.assertEqual(rows[0]["status"], "ok")
+            self.assertIn("BrokenProcessPool", rows[1]["error"])
 
 
 class TestOneFolderOneSpec(unittest.TestCase):

@@ -72,7 +72,8 @@ def main(argv=None):
     int
         Exit status (:data:`EXIT_STATUS`): 0 ok, 1 some runs failed (or unfinished after
         ``--merge``), 2 invalid input (message naming the flag on stderr), 3 DIR is in use by
-        another live sweep, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).
+        another live sweep, 4 the sweep folder cannot be written (a full disk), 130 interrupted
+        (Ctrl-C), 143 terminated (SIGTERM).
     """
     args = build_parser().parse_args(argv)
     with console_messages(stream=sys.stdout), _sigterm_stops():
@@ -80,8 +81,8 @@ def main(argv=None):
 
 
 #: the exit statuses of ``particleShear sweep``
-EXIT_STATUS = {"ok": 0, "runs failed": 1, "invalid input": 2, "folder busy": 3, "interrupted": 130,
-               "terminated": 143}
+EXIT_STATUS = {"ok": 0, "runs failed": 1, "invalid input": 2, "folder busy": 3, "folder not writable": 4,
+               "interrupted": 130, "terminated": 143}
 
 
 @contextlib.contextmanager
@@ -165,13 +166,17 @@ def _main(args):
         print(f"particleShear sweep: {exc}", file=sys.stderr)
         return 3
     except KeyboardInterrupt:
-        print(f"\nparticleShear sweep: interrupted; {len(sweep.finished_rows())} finished rows kept in "
-              f"{sweep.table_path}; run the same command again to resume", file=sys.stderr)
+        print(f"\nparticleShear sweep: interrupted; the rows in {sweep.table_path} are kept; run the same command "
+              "again to resume", file=sys.stderr)
         return 130
     except SweepTerminated:
-        print(f"particleShear sweep: terminated; {len(sweep.finished_rows())} finished rows kept in "
-              f"{sweep.table_path}; run the same command again to resume", file=sys.stderr)
+        print(f"particleShear sweep: terminated; the rows in {sweep.table_path} are kept; run the same command "
+              "again to resume", file=sys.stderr)
         return 143
+    except OSError as exc:   # the sweep folder itself cannot be written (a full disk, permissions)
+        print(f"particleShear sweep: cannot write the sweep folder {sweep.out_dir}: {exc}; the rows written so "
+              "far are kept; free the space and run the same command again to resume", file=sys.stderr)
+        return 4
 
 
 def _dry_run(args, sweep, workers):

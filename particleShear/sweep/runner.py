@@ -34,7 +34,8 @@ from .pool import run_jobs
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
 from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
-                    row_problem, table_columns, task_table_name, write_parquet, write_table)
+                    remove_dead_temporaries, row_problem, table_columns, task_table_name, write_parquet,
+                    write_table)
 from .tasks import execute_batch, execute_run
 
 __all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
@@ -332,9 +333,11 @@ class Sweep:
         except ImportError:  # pragma: no cover - formats without verification
             return None if os.path.getsize(full) > 0 else f"its file {os.path.basename(path)} is empty"
         try:
-            verify_run(full)
+            meta = verify_run(full)
         except ValueError as exc:
             return str(exc)
+        if meta.get("run_id") not in (None, row.get("run_id")):
+            return f"its file {os.path.basename(path)} is the file of run {meta.get('run_id')}"
         return None
 
     def _classify(self, retry_failed=False):
@@ -516,6 +519,7 @@ class Sweep:
         stream = stream if stream is not None else sys.stderr
         os.makedirs(self.out_dir, exist_ok=True)
         with folder_lock(self.table_path):
+            remove_dead_temporaries(self.out_dir)
             for note in self._check_tables():
                 self._say(stream, progress, "repaired: " + note)
             if self.spec is not None:
@@ -639,6 +643,10 @@ class Sweep:
             pass
         return self.rows()
 
+    def table_rows(self):
+        """Number of rows in this process's table (as written; nothing verified): cheap."""
+        return len(read_rows(self.table_path))
+
     def rows(self):
         """Finished rows of this sweep in sweep order (dicts of strings, as read back from the tables)."""
         done, _ = self._classify()
@@ -678,13 +686,13 @@ class Sweep:
             for t in tables:
                 if t == path:
                     continue
-                unmerged = [row for row in read_rows(t) if row.get("run_id") not in merged]
-                if unmerged:
-                    self.kept_tables.append((t, f"{len(unmerged)} row(s) not merged"))
-                    continue
                 try:
-                    with folder_lock(t, wait_s=0):
-                        os.remove(t)
+                    with folder_lock(t, wait_s=0):     # the task is not running: its table is final
+                        unmerged = [row for row in read_rows(t) if row.get("run_id") not in merged]
+                        if unmerged:
+                            self.kept_tables.append((t, f"{len(unmerged)} row(s) not merged"))
+                        else:
+                            os.remove(t)
                 except FolderBusyError:
                     self.kept_tables.append((t, "its task is still running"))
             write_parquet(path)

@@ -25,7 +25,7 @@ from ..simulation.provenance import IDENTITY_EXCLUDED, same_input
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
            "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
-           "reject_lines",
+           "reject_lines", "remove_dead_temporaries",
            "REJECTED_SUFFIX"]
 
 #: lines of a table that cannot be rows (wrong number of fields) are moved to ``<table>`` + this suffix
@@ -361,7 +361,7 @@ def atomic_text(path):
     file object
     """
     tmp = os.path.join(os.path.dirname(path) or ".",
-                       f".{os.path.basename(path)}.{os.getpid()}.{secrets.token_hex(4)}.part")
+                       f".{os.path.basename(path)}.{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(4)}.part")
     try:
         with open(tmp, "w", newline="", encoding="utf-8") as fh:
             yield fh
@@ -372,6 +372,43 @@ def atomic_text(path):
         with contextlib.suppress(OSError):
             os.remove(tmp)
         raise
+
+
+def remove_dead_temporaries(folder):
+    """Remove the temporary files of :func:`atomic_text` left in ``folder`` by dead processes of this host.
+
+    Parameters
+    ----------
+    folder : str
+        The sweep folder.
+
+    Returns
+    -------
+    list of str
+        The names removed.
+    """
+    import re
+    host = socket.gethostname()
+    removed = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    for name in names:
+        m = re.search(r"-(\d+)-[0-9a-f]{8}\.part$", name)
+        if not (name.startswith(".") and m and name[:m.start()].endswith("." + host)):
+            continue
+        try:
+            os.kill(int(m.group(1)), 0)
+            continue                              # alive (or another user's): leave it
+        except ProcessLookupError:
+            pass
+        except (PermissionError, OverflowError, ValueError):
+            continue
+        with contextlib.suppress(OSError):
+            os.remove(os.path.join(folder, name))
+            removed.append(name)
+    return removed
 
 
 def write_table(path, rows, columns):
@@ -417,8 +454,8 @@ def write_parquet(csv_path):
         return None
     with open(csv_path, newline="", encoding="utf-8") as fh:
         header = next(csv.reader(fh), [])
-    strings = {c: pa.string() for c in ("run_id", "status", "error", "spawn_key", "package_version",
-                                       "output_path") if c in header}
+    strings = {c: pa.string() for c in ("run_id", "status", "error", "seed_entropy", "spawn_key", "package_version",
+                                       "output_path") if c in header}   # seeds up to 2**128: exact as text
     table = pacsv.read_csv(csv_path, convert_options=pacsv.ConvertOptions(column_types=strings,
                                                                           strings_can_be_null=False))
     out = os.path.splitext(csv_path)[0] + ".parquet"
