@@ -44,6 +44,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.pool",
     "particleShear.sweep.record",
     "particleShear.sweep.runner",
+    "particleShear.sweep.series",
     "particleShear.sweep.spec",
     "particleShear.sweep.table",
     "particleShear.sweep.tasks",

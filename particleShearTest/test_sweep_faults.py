@@ -239,7 +239,7 @@ class TestStartMethods(unittest.TestCase):
             if method not in multiprocessing.get_all_start_methods():
                 continue
             with self.subTest(method=method), tempfile.TemporaryDirectory() as d, \
-                    mock.patch.object(runner, "_pool_context", lambda _: multiprocessing.get_context(method)):
+                    mock.patch.object(runner, "pool_context", lambda _: multiprocessing.get_context(method)):
                 rows = run_sweep(one, d, workers=1, progress=False)
                 self.assertEqual([r["status"] for r in rows], ["ok"], rows[0]["error"])
 

@@ -73,7 +73,7 @@ def no_work():
     with mock.patch("particleShear.run.api._build_simulation", _work), \
             mock.patch("particleShear.run.api.measure_batch", _work), \
             mock.patch("particleShear.run.batch.measure_batch", _work), \
-            mock.patch("particleShear.sweep.runner.run_series", _work):
+            mock.patch("particleShear.sweep.series.run_series", _work):
         yield
 
 

@@ -686,5 +686,5 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         validate_run(kw)
     if not all_kwargs:
         return []
-    from ..sweep.runner import run_series
+    from ..sweep.series import run_series
     return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size)

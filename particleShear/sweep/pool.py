@@ -31,7 +31,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 from . import tasks as _tasks
 
-__all__ = ["run_jobs", "isolated", "WorkerDied", "SweepTerminated", "WATCH_INTERVAL_S", "worker_init", "new_pool",
+__all__ = ["run_jobs", "isolated", "pool_context", "WorkerDied", "SweepTerminated", "WATCH_INTERVAL_S", "worker_init", "new_pool",
            "terminate"]
 
 #: seconds between a worker's checks that its driving process is alive
@@ -228,6 +228,27 @@ def isolated(jobs, mp_context=None, workers=1):
             proc.kill()
             proc.join()
             recv.close()
+
+
+def pool_context(parameters):
+    """Start method of the default worker pool: "spawn" when a run uses a device backend.
+
+    The parent has initialised CUDA when it checked ``backend="cupy"``, and a forked child
+    cannot use CUDA after that; fresh ("spawn") workers can.  NumPy runs keep the platform's default.
+
+    Parameters
+    ----------
+    parameters : iterable of dict
+        The runs' keyword arguments.
+
+    Returns
+    -------
+    multiprocessing context or None
+    """
+    import multiprocessing
+    if any(p.get("backend", "numpy") != "numpy" for p in parameters):
+        return multiprocessing.get_context("spawn")
+    return None
 
 
 def run_jobs(jobs, executor=None, workers=1, mp_context=None, window=None):
