@@ -30,7 +30,7 @@ import zipfile
 
 import numpy as np
 
-from .output import (FORMAT_SUFFIXES, NO_TENSOR_DATA_TEXT, TABLE_COLUMNS, _quietly, iter_table_text,
+from .output import (FORMAT_SUFFIXES, format_of, NO_TENSOR_DATA_TEXT, TABLE_COLUMNS, _quietly, iter_table_text,
                      sidecar_path)
 
 __all__ = ["OUTPUT_FORMATS", "FORMAT_SUFFIXES", "read_run", "verify_run", "RunData", "RunFileError", "write_run",
@@ -298,15 +298,6 @@ class RunFileError(ValueError):
     """
 
 
-def _format_of(path):
-    p = str(path)
-    for fmt in ("text.gz", "text", "npz", "parquet"):
-        if p.endswith(FORMAT_SUFFIXES[fmt]):
-            return fmt
-    raise ValueError(f"path={p!r} is not a run file: allowed suffixes "
-                     + ", ".join(FORMAT_SUFFIXES.values()))
-
-
 def _bad(path, what):
     return RunFileError(f"{path}: {what}")
 
@@ -484,7 +475,7 @@ def verify_run(path):
         For a path without a run-file suffix.
     """
     path = os.fspath(path)
-    fmt = _format_of(path)
+    fmt = format_of(path)
     meta, size = _check_file(path, fmt)
     _check_container(path, fmt, meta, size)
     return meta
@@ -584,7 +575,7 @@ def read_run(path):
         For a Parquet file without pyarrow.
     """
     path = os.fspath(path)
-    fmt = _format_of(path)
+    fmt = format_of(path)
     side, _ = _check_file(path, fmt)  # the container is checked by parsing it, after the hash
     try:
         with open(path, "rb") as fh:

@@ -37,7 +37,7 @@ FORMAT_SUFFIXES = {"text": ".txt", "text.gz": ".txt.gz", "npz": ".npz", "parquet
 #: suffix of a run's JSON sidecar, which replaces the run file's suffix (``x.txt`` → ``x.json``)
 SIDECAR_SUFFIX = ".json"
 
-__all__ = ["TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
+__all__ = ["TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "format_of", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
            "probe_writable", "iter_table_text", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
@@ -64,6 +64,31 @@ NO_TENSOR_DATA_TEXT = ("\tNot saving detailed stress tensor data. If you wish to
                        "\t  saveStressTensorData=True")
 
 
+def format_of(path):
+    """The output format of a run file, by its suffix (``x.txt.gz`` → ``"text.gz"``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A run file name ending with one of :data:`FORMAT_SUFFIXES`.
+
+    Returns
+    -------
+    str
+        A key of :data:`FORMAT_SUFFIXES`.
+
+    Raises
+    ------
+    ValueError
+        When ``path`` has none of the suffixes (the message lists them).
+    """
+    p = os.fspath(path)
+    for fmt, suffix in sorted(FORMAT_SUFFIXES.items(), key=lambda kv: -len(kv[1])):  # ".txt.gz" before ".txt"
+        if p.endswith(suffix):
+            return fmt
+    raise ValueError(f"path={p!r} is not a run file: allowed suffixes " + ", ".join(FORMAT_SUFFIXES.values()))
+
+
 def run_file_stem(path):
     """``path`` without its run-file suffix (``x_nr_1.txt.gz`` → ``x_nr_1``).
 
@@ -82,10 +107,7 @@ def run_file_stem(path):
         When ``path`` has none of the suffixes (the message lists them).
     """
     p = os.fspath(path)
-    for suffix in sorted(FORMAT_SUFFIXES.values(), key=len, reverse=True):  # ".txt.gz" before ".txt"
-        if p.endswith(suffix):
-            return p[: -len(suffix)]
-    raise ValueError(f"path={p!r} is not a run file: allowed suffixes " + ", ".join(FORMAT_SUFFIXES.values()))
+    return p[: -len(FORMAT_SUFFIXES[format_of(p)])]
 
 
 def sidecar_path(path):

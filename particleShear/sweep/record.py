@@ -167,22 +167,25 @@ def write_record(out_dir, segments, docs):
         json.dump(rec, fh, indent=1)
 
 
-def check_record(out_dir, canonical, extend):
-    """The segments of ``out_dir``'s sweep when ``canonical`` runs into it; refuse a different SPEC.
+def check_record(out_dir, segments, canonical, extend):
+    """Whether ``canonical`` runs into a folder of the recorded ``segments`` as a new segment; refuse another SPEC.
 
     Parameters
     ----------
     out_dir : str
-        The sweep folder.
+        The sweep folder (for the message).
+    segments : list of dict
+        The canonical SPECs the folder records, oldest first (:func:`read_record`).
     canonical : dict
         The canonical SPEC about to run.
     extend : bool
-        True: a different SPEC becomes a further segment (see the module docstring).
+        True: a SPEC that is none of the segments becomes a further one (see the module docstring).
 
     Returns
     -------
-    list of dict
-        The canonical SPECs of the folder's segments, ``canonical`` last.
+    bool
+        True when ``canonical`` is to be recorded as a new segment; False when it is the newest
+        segment (or, with ``extend``, an earlier one).
 
     Raises
     ------
@@ -190,21 +193,15 @@ def check_record(out_dir, canonical, extend):
         When the folder records another SPEC and ``extend`` is False; the message lists the
         changes and names ``--extend``.
     """
-    rec = read_record(out_dir)
-    if rec is None:
-        return [canonical]
-    segments = [s["spec"] for s in rec["segments"]]
-    if spec_hash(segments[-1]) == spec_hash(canonical):
-        return segments
-    if any(spec_hash(s) == spec_hash(canonical) for s in segments):
-        if extend:
-            return segments
+    h = spec_hash(canonical)
+    if spec_hash(segments[-1]) == h or (extend and any(spec_hash(s) == h for s in segments)):
+        return False
     if not extend:
         changes = "; ".join(spec_changes(segments[-1], canonical)) or "the SPEC differs"
         raise ValueError(f"out_dir={out_dir!r} (--out) holds a sweep of another SPEC ({changes}); use another "
                          "--out DIR, or pass --extend (extend=True) to add the new runs to this folder's sweep and "
                          "keep its rows")
-    return segments + [canonical]
+    return True
 
 
 def extended_runs(segment_specs, segment_runs):

@@ -23,6 +23,7 @@ import itertools
 import json
 import logging
 import os
+import re
 import sys
 import time
 
@@ -41,20 +42,10 @@ from .tasks import execute_batch, execute_run
 __all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
 
 _log = logging.getLogger(__name__)
-_TABLE_PREFIX, _TABLE_SUFFIX = "results", ".csv"
+#: the tables of a sweep folder: results.csv and the job-array tasks' results.task-000I-of-000K.csv
+_TABLE_NAME = re.compile(r"^results(\.task-\d+-of-\d+)?\.csv$")
 #: pending runs grouped into batches at a time (``batch_size``): bounded memory for any sweep size
 _BATCH_CHUNK = 4096
-
-
-def _is_table(name):
-    if not (name.startswith(_TABLE_PREFIX) and name.endswith(_TABLE_SUFFIX)):
-        return False
-    mid = name[len(_TABLE_PREFIX):-len(_TABLE_SUFFIX)]
-    if mid == "":
-        return True
-    parts = mid.split("-")
-    return (len(parts) == 4 and parts[0] == ".task" and parts[2] == "of" and parts[1].isdigit()
-            and parts[3].isdigit())
 
 
 @dataclasses.dataclass
@@ -246,8 +237,7 @@ class Sweep:
         if rec is None:
             return [mine]
         segments = [{"spec": s["spec"], "doc": s.get("doc")} for s in rec["segments"]]
-        specs = check_record(self.out_dir, self._canonical, self.extend)
-        if len(specs) > len(segments):
+        if check_record(self.out_dir, [seg["spec"] for seg in segments], self._canonical, self.extend):
             return segments + [mine]
         return segments
 
@@ -280,7 +270,7 @@ class Sweep:
     def _tables(self):
         if not os.path.isdir(self.out_dir):
             return []
-        return sorted(os.path.join(self.out_dir, e) for e in os.listdir(self.out_dir) if _is_table(e))
+        return sorted(os.path.join(self.out_dir, e) for e in os.listdir(self.out_dir) if _TABLE_NAME.match(e))
 
     def _run_of(self, row):
         """The run of this sweep that ``row`` claims to be (by its spawn key and id), or None."""
@@ -499,7 +489,7 @@ class Sweep:
         os.makedirs(self.out_dir, exist_ok=True)
         with folder_lock(self.table_path):
             remove_dead_temporaries(self.out_dir)
-            for note in self._check_tables():
+            for note in self._check_tables(self.table_path):
                 self._say(stream, progress, "repaired: " + note)
             if self.spec is not None:
                 self._record()
@@ -539,10 +529,12 @@ class Sweep:
             return estimate_point_cost(self.runs.points, self._point_counts(done.values()), workers)
         return estimate_cost([r for r in self.my_runs() if r.run_id not in done], workers)
 
-    def _check_tables(self):
-        """Check every table of the folder before any work; repair this process's own (notes)."""
-        notes = check_table(self.table_path, self.columns)
-        self._check_tables_for(self.table_path)
+    def _check_tables(self, own):
+        """Check every table of the folder before any work: repair ``own`` (notes), refuse another header."""
+        notes = check_table(own, self.columns)
+        for t in self._tables():
+            if t != own:
+                check_table_header(t, self.columns)
         return notes
 
     def _execute(self, todo, n_todo, executor, workers, keep_series, batch_size, show):
@@ -622,10 +614,6 @@ class Sweep:
             pass
         return self.rows()
 
-    def table_rows(self):
-        """Number of rows in this process's table (as written; nothing verified): cheap."""
-        return len(read_rows(self.table_path))
-
     def rows(self):
         """Finished rows of this sweep in sweep order (dicts of strings, as read back from the tables)."""
         done, _ = self._classify()
@@ -655,8 +643,7 @@ class Sweep:
             raise ValueError(f"out_dir={self.out_dir!r} (--out) holds no results table to merge")
         self.kept_tables = []
         with folder_lock(path):
-            check_table(path, self.columns)
-            self._check_tables_for(path)
+            self._check_tables(path)
             done, _ = self._classify()
             ours = [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
             merged = set(done)
@@ -676,11 +663,6 @@ class Sweep:
                     self.kept_tables.append((t, "its task is still running"))
             write_parquet(path)
         return len(ours), len(self.my_runs()) - len(ours)
-
-    def _check_tables_for(self, path):
-        for t in self._tables():
-            if t != path:
-                check_table_header(t, self.columns)
 
 
 def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, task_count=None, keep_series=False,

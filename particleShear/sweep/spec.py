@@ -309,14 +309,6 @@ def _points(spec):
         yield point
 
 
-def _check_options(p, where):
-    """Every check of one run (:func:`particleShear.run.validation.validate_run`), without requiring
-    the output folder to exist yet (the sweep creates it: checked as the current folder); ``where``
-    (the point) is put in front of the message by :func:`expand_runs`."""
-    from ..run.validation import validate_run
-    validate_run(dict(p, root_folder=os.curdir))
-
-
 class SweepRuns:
     """The runs of one SPEC as a lazy sequence: ``runs[k]`` is made when asked (its id hashed then).
 
@@ -400,14 +392,14 @@ def expand_runs(spec):
 
 def _validated_points(spec):
     """The complete parameter set of every point of ``spec``, each validated (point order)."""
-    from ..run.validation import show_value
+    from ..run.validation import show_value, validate_run
     defaults = sweep_parameter_defaults()
     points = []
     for p_index, point in enumerate(_points(spec)):
         params = dict(defaults, **spec.parameters, **point)
         where = f"point {p_index} ({', '.join(f'{k}={show_value(v)}' for k, v in point.items()) or 'fixed parameters'})"
         try:
-            _check_options(params, where)
+            validate_run(dict(params, root_folder=os.curdir))   # the sweep makes DIR: not required yet
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
         points.append(params)
