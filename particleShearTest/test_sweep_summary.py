@@ -1,0 +1,242 @@
+"""sweep_summary (particleShear.analysis.sweep): characteristics of mean G′/G″ curves and their bootstrap intervals.
+
+The truths used here:
+
+* a Maxwell-like model sweep G′ = G₀/(1+x²), G″ = rG₀x/(1+x²), x = A/A_c: G′ = G″ at x = 1/r, and
+  log G′ − log G″ = −log(r x) is linear in log A, so the log-log interpolated flow point is exact;
+  G′ falls to (1 − p) of its value at the smallest amplitude x₀ where x² = (1 + x₀²)/(1 − p) − 1
+  (x ≈ 0.2294 for p = 5 %, 1/3 for 10 %), found by log-log interpolation up to the interpolation
+  error bound h²/8 · max|f″| / min|f′| of f(u) = log G′(eᵘ) on the grid spacing h;
+* the bootstrap of a mean over resampled seeds: identical seeds give a zero-width interval; two
+  seeds a, b give replicate means a, (a+b)/2, b with probabilities ¼, ½, ¼, so the 2.5 % and 97.5 %
+  percentiles are a and b;
+* coverage: for n normal seeds the percentile interval is about x̄ ± z·σ̂/√n with the ddof = 0
+  deviation σ̂, i.e. it covers the true mean with probability P(|T_{n−1}| < z·√((n−1)/n)) (Student
+  t), 0.904 for n = 10 and 95 %; the measured coverage over M independent sweeps is binomial.
+"""
+import math
+import unittest
+import warnings
+
+import numpy as np
+
+from particleShear.analysis.sweep import CHARACTERISTICS, POINT_NAMES, SweepSummary, sweep_summary
+
+G0, R, AC = 1000.0, 0.5, 0.05        # plateau (Pa), G″/G′ ratio per unit x, characteristic amplitude
+
+
+def model(A, g0=G0, r=R, ac=AC):
+    x = np.asarray(A, float) / ac
+    return g0 / (1 + x ** 2), r * g0 * x / (1 + x ** 2)
+
+
+def t_cdf_interval(c, nu):
+    """P(|T_nu| < c) for Student's t by Simpson's rule on its density (no SciPy)."""
+    t = np.linspace(0.0, c, 20001)
+    logk = math.lgamma((nu + 1) / 2) - math.lgamma(nu / 2) - 0.5 * math.log(nu * math.pi)
+    f = np.exp(logk - (nu + 1) / 2 * np.log1p(t ** 2 / nu))
+    h = t[1] - t[0]
+    simpson = h / 3 * (f[0] + f[-1] + 4 * f[1:-1:2].sum() + 2 * f[2:-1:2].sum())
+    return 2 * simpson
+
+
+class ModelSweep(unittest.TestCase):
+    """Exact and interpolation-bounded truths of the model sweep (two identical seeds per amplitude)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.x = np.logspace(-3, 2, 501)          # 100 points per decade
+        cls.h = math.log(10) / 100               # grid spacing in log A
+        A = AC * cls.x
+        gp, gpp = model(A)
+        cls.s = sweep_summary(np.repeat(A, 2), np.repeat(gp, 2), np.repeat(gpp, 2), n_boot=50, rng=0)
+
+    def test_plateau_is_the_mean_at_the_smallest_amplitude(self):
+        self.assertAlmostEqual(self.s.plateau, G0 / (1 + self.x[0] ** 2), delta=1e-12 * G0)
+        self.assertEqual(self.s.amplitudes[0], AC * self.x[0])
+
+    def test_flow_point_is_exact(self):
+        # log G′ − log G″ = −log(r x): linear in log A, so log-log interpolation is exact
+        self.assertAlmostEqual(self.s.flow_point / (AC / R), 1.0, delta=1e-12)
+
+    def _bound(self, x_true):
+        """Interpolation error bound (relative, in A) at x_true: h²/8 · max|f″| / min|f′| on the bracket."""
+        u = np.linspace(math.log(x_true) - self.h, math.log(x_true) + self.h, 201)
+        x2 = np.exp(2 * u)
+        f1 = 2 * x2 / (1 + x2)                    # |f′| of f(u) = log G′
+        f2 = 4 * x2 / (1 + x2) ** 2               # |f″|
+        du = self.h ** 2 / 8 * f2.max() / f1.min()
+        return math.expm1(du)
+
+    def test_linear_limits_within_the_interpolation_bound(self):
+        x0 = self.x[0]
+        for p, value, approx in ((0.05, self.s.linear_limit_5, 0.2294), (0.10, self.s.linear_limit_10, 1 / 3)):
+            x_true = math.sqrt((1 + x0 ** 2) / (1 - p) - 1)
+            self.assertAlmostEqual(x_true, approx, delta=1e-4)       # the textbook values (x₀ → 0)
+            bound = self._bound(x_true)
+            self.assertLess(bound, 2e-4)                               # the grid is fine enough to mean something
+            self.assertLessEqual(abs(value / (AC * x_true) - 1), bound, msg=f"p={p}")
+
+    def test_identical_seeds_collapse_every_interval(self):
+        s = self.s
+        np.testing.assert_allclose(s.Gp_ci, np.c_[s.Gp_mean, s.Gp_mean], rtol=1e-12)
+        np.testing.assert_allclose(s.Gpp_ci, np.c_[s.Gpp_mean, s.Gpp_mean], rtol=1e-12)
+        for name in CHARACTERISTICS:
+            v, (lo, hi) = s.value(name)
+            if math.isfinite(v):
+                np.testing.assert_allclose([lo, hi], [v, v], rtol=1e-9, err_msg=name)
+                self.assertEqual(s.defined_fraction[name], 1.0)
+            else:
+                self.assertTrue(math.isnan(lo) and math.isnan(hi), name)
+                self.assertEqual(s.defined_fraction[name], 0.0)
+
+    def test_points_are_those_of_the_mean_curve(self):
+        from particleShear.analysis.curves import stress_curve_points
+        direct = stress_curve_points(self.s.amplitudes, self.s.Gp_mean, self.s.Gpp_mean)
+        for name in POINT_NAMES:
+            np.testing.assert_allclose(self.s.points[name], direct[name], rtol=1e-12, equal_nan=True)
+            self.assertEqual(self.s.points_ci[name].shape, (3, 2))
+
+    def test_frozen_and_read_only(self):
+        with self.assertRaises(AttributeError):
+            self.s.plateau = 1.0
+        with self.assertRaises(ValueError):
+            self.s.Gp_mean[0] = 1.0
+        with self.assertRaises(TypeError):
+            self.s.points["yield"] = (1, 2, 3)
+        self.assertIsInstance(self.s, SweepSummary)
+
+    def test_table_row(self):
+        row = self.s.to_dict()
+        self.assertEqual(row["n_runs"], 2 * len(self.x))
+        self.assertEqual(row["n_amplitudes"], len(self.x))
+        for name in CHARACTERISTICS:
+            for suffix in ("", "_ci_low", "_ci_high", "_defined"):
+                self.assertIsInstance(row[name + suffix], float)
+        rows = self.s.curve_rows()
+        self.assertEqual(len(rows), len(self.x))
+        self.assertEqual(rows[0]["n_seeds"], 2)
+
+
+class Bootstrap(unittest.TestCase):
+
+    def test_two_seeds_give_their_values_as_the_interval(self):
+        # replicate means a, (a+b)/2, b with probabilities 1/4, 1/2, 1/4: the 2.5 % / 97.5 % percentiles are a, b
+        a, b = 900.0, 1100.0
+        A = [0.01, 0.01, 0.1, 0.1, 1.0, 1.0]
+        s = sweep_summary(A, [a, b, 500, 520, 10, 12], [1, 1, 2, 2, 50, 50], n_boot=4000, rng=3)
+        self.assertEqual(s.plateau, (a + b) / 2)
+        self.assertEqual(s.plateau_ci, (a, b))
+        np.testing.assert_array_equal(s.Gp_ci, [[a, b], [500, 520], [10, 12]])   # resampled within each amplitude
+        np.testing.assert_array_equal(s.n_seeds, [2, 2, 2])
+
+    def test_reproducible_from_rng(self):
+        rng = np.random.default_rng(11)
+        A = np.repeat(np.logspace(-3, 0, 6), 4)
+        gp, gpp = model(A)
+        gp, gpp = gp * (1 + 0.1 * rng.standard_normal(A.size)), gpp * (1 + 0.1 * rng.standard_normal(A.size))
+        one = sweep_summary(A, gp, gpp, n_boot=300, rng=5).to_dict()
+        two = sweep_summary(A, gp, gpp, n_boot=300, rng=5).to_dict()
+        gen = sweep_summary(A, gp, gpp, n_boot=300, rng=np.random.default_rng(5)).to_dict()
+        other = sweep_summary(A, gp, gpp, n_boot=300, rng=6).to_dict()
+        np.testing.assert_equal(one, two)
+        np.testing.assert_equal(one, gen)
+        self.assertNotEqual(one["plateau_ci_low"], other["plateau_ci_low"])
+        self.assertEqual(one["plateau"], other["plateau"])                  # the point estimate has no randomness
+
+    def test_characteristic_undefined_in_some_replicates(self):
+        # at the small amplitude the mean G′ is 1, 2 or 3 (prob. 1/4, 1/2, 1/4) against G″ = 2: G′ > G″ (a flow
+        # point exists) only in the quarter of the replicates with mean 3; the mean curve itself has G′ = G″ there
+        s = sweep_summary([0.1, 0.1, 1.0, 1.0], [1.0, 3.0, 1.0, 1.0], [2.0, 2.0, 5.0, 5.0], n_boot=4000, rng=2)
+        self.assertTrue(math.isnan(s.flow_point))
+        frac = s.defined_fraction["flow_point"]
+        self.assertLess(abs(frac - 0.25), 4 * math.sqrt(0.25 * 0.75 / 4000))   # binomial, 4 standard deviations
+        self.assertTrue(all(math.isfinite(v) for v in s.flow_point_ci))
+        self.assertTrue(0.1 < s.flow_point_ci[0] <= s.flow_point_ci[1] < 1.0)
+
+    def test_non_positive_means_give_nan_not_errors(self):
+        A = np.repeat([0.01, 0.1, 1.0, 10.0], 2)
+        gp = np.repeat([100.0, 99.9, 50.0, -10.0], 2)        # G′ < 0 at the largest amplitude (fluid-like)
+        gpp = np.repeat([10.0, 20.0, 40.0, 60.0], 2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            s = sweep_summary(A, gp, gpp, n_boot=100, rng=0)
+        self.assertTrue(math.isnan(s.flow_point))           # crossing between G′ = 50 and G′ = −10: no log
+        self.assertTrue(math.isfinite(s.linear_limit_5))    # 99.9 → 50 brackets the 5 % limit
+        low = sweep_summary(A, np.repeat([100.0, 99.9, -5.0, -10.0], 2), gpp, n_boot=100, rng=0)
+        self.assertTrue(math.isnan(low.linear_limit_5))      # the first value below 95 is negative
+        neg = sweep_summary(A, -gp, gpp, n_boot=100, rng=0)
+        self.assertTrue(math.isnan(neg.linear_limit_5) and math.isnan(neg.linear_limit_10))
+        self.assertEqual(neg.plateau, -100.0)
+
+    def test_one_seed_per_amplitude_warns_and_collapses(self):
+        A = np.logspace(-3, 0, 6)
+        gp, gpp = model(A)
+        with self.assertWarnsRegex(UserWarning, "one run"):
+            s = sweep_summary(A, gp, gpp, n_boot=20, rng=0)
+        self.assertEqual(s.plateau_ci, (s.plateau, s.plateau))
+        with self.assertWarnsRegex(UserWarning, r"amplitude\(s\) \[0.001\]"):
+            sweep_summary(np.r_[A, A[1:]], np.r_[gp, gp[1:]], np.r_[gpp, gpp[1:]], n_boot=20, rng=0)
+
+    def test_coverage_of_plateau_and_flow_point(self):
+        """M noisy sweeps (n seeds each, 10 % normal multiplicative noise): the 95 % intervals cover the truth
+        about as often as the percentile bootstrap of a mean from n seeds should, P(|T_{n−1}| < z√((n−1)/n))."""
+        M, n, sigma = 300, 10, 0.10
+        z = 1.959963984540054
+        expected = t_cdf_interval(z * math.sqrt((n - 1) / n), n - 1)        # 0.904 for n = 10
+        self.assertAlmostEqual(expected, 0.904, delta=0.002)
+        # binomial: 3 standard deviations of a proportion over M sweeps, plus 0.02 for the normal approximation
+        # of the bootstrap distribution (discrete resampling, n_boot = 400 percentiles, nonlinearity of the
+        # flow point)
+        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
+        rng = np.random.default_rng(20240521)
+        A = np.repeat(AC * np.logspace(-2, 1.5, 5), n)         # flow point A_c/r = 0.1 inside
+        gp0, gpp0 = model(A)
+        plateau_true, flow_true = model(A[0])[0], AC / R
+        hits = np.zeros(2)
+        for _ in range(M):
+            gp = gp0 * (1 + sigma * rng.standard_normal(A.size))
+            gpp = gpp0 * (1 + sigma * rng.standard_normal(A.size))
+            s = sweep_summary(A, gp, gpp, n_boot=400, rng=rng)
+            hits += [s.plateau_ci[0] <= plateau_true <= s.plateau_ci[1],
+                     s.flow_point_ci[0] <= flow_true <= s.flow_point_ci[1]]
+        coverage = hits / M
+        print(f"coverage over {M} sweeps: plateau {coverage[0]:.3f}, flow point {coverage[1]:.3f}; "
+              f"expected {expected:.3f} ± {tol:.3f}")
+        for name, c in zip(("plateau", "flow_point"), coverage):
+            self.assertLess(abs(c - expected), tol, msg=f"{name}: coverage {c:.3f}, expected {expected:.3f} ± {tol:.3f}")
+
+
+class BadInput(unittest.TestCase):
+    A = [0.01, 0.1, 1.0]
+    G = [1.0, 2.0, 3.0]
+
+    def check(self, pattern, *args, **kw):
+        with self.assertRaisesRegex(ValueError, pattern):
+            sweep_summary(*args, **kw)
+
+    def test_errors_name_parameter_value_and_range(self):
+        A, G = self.A, self.G
+        self.check(r"amplitude, Gp, Gpp .*equal lengths, got 3, 2, 3", A, G[:2], G)
+        self.check(r"Gpp\[1\]=nan .*finite", A, G, [1.0, math.nan, 1.0])
+        self.check(r"Gp\[2\]=inf .*finite", A, [1.0, 1.0, math.inf], G)
+        self.check(r"amplitude\[0\]=0.0 .*amplitude > 0", [0.0, 0.1, 1.0], G, G)
+        self.check(r"amplitude\[1\]=-0.1 .*amplitude > 0", [0.01, -0.1, 1.0], G, G)
+        self.check(r"amplitude=\[0.1, 0.1, 0.1\] .*1 distinct .*at least 2", [0.1] * 3, G, G)
+        self.check(r"amplitude is invalid: allowed a 1-D", [[0.1, 1.0]], [[1.0, 2.0]], [[1.0, 2.0]])
+        self.check(r"Gp is invalid", A, ["a", "b", "c"], G)
+        for bad in (0, -3):
+            self.check(rf"n_boot={bad} is out of range: allowed an integer >= 1", A, G, G, n_boot=bad)
+        for bad in (1.5, True, "10"):
+            self.check(rf"n_boot={bad!r} is invalid: allowed an integer >= 1", A, G, G, n_boot=bad)
+        for bad in (0, 1, 1.5, -0.2, math.nan, True):
+            self.check(rf"confidence={bad!r} is out of range: allowed a number in \(0, 1\)", A, G, G,
+                       confidence=bad)
+        self.check(r"rng=-1 is out of range", A, G, G, rng=-1)
+        self.check(r"rng='x' is invalid", A, G, G, rng="x")
+        with self.assertRaisesRegex(ValueError, r"name='nope' is invalid"):
+            sweep_summary(A, G, G, n_boot=5, rng=0).value("nope")
+
+
+if __name__ == "__main__":
+    unittest.main()
