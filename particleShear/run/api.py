@@ -99,11 +99,75 @@ class SimulationResult:
     series: dict = dataclasses.field(default_factory=dict, repr=False)
     run_id: str = ""
     write_error: object = None
+    _measures: dict = dataclasses.field(default=None, init=False, repr=False, compare=False)
 
     @property
     def G(self):
         """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns."""
         return [self.G_surface[0], self.G_surface[1]]
+
+    @property
+    def measures(self):
+        """Standard errors, steady-state flag and LAOS ratios of the run (dict, the results-table columns
+        :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`), evaluated once from ``series``
+        (:func:`~particleShear.analysis.measures.run_measures`; docs/analysis.md)."""
+        if self._measures is None:
+            from ..analysis.measures import run_measures
+            p = self.parameters or {}
+            self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0), p.get("pre_periods", 0),
+                                          p.get("periods", 0))
+        return self._measures
+
+    @property
+    def G_surface_se(self):
+        """(se G′, se G″) in Pa of the surface estimator: standard error over the measured periods."""
+        return self.measures["Gp_surface_se"], self.measures["Gpp_surface_se"]
+
+    @property
+    def G_internal_se(self):
+        """(se G′, se G″) in Pa of the internal estimator: standard error over the measured periods."""
+        return self.measures["Gp_internal_se"], self.measures["Gpp_internal_se"]
+
+    @property
+    def steady_state(self):
+        """True when no modulus drifts from period to period beyond its error, False when one does,
+        None with fewer than 3 measured periods (docs/analysis.md)."""
+        return self.measures["steady_state"]
+
+    def laos(self, estimator="surface", n_max=15):
+        """Large-amplitude oscillatory shear measures of the measured excitation periods.
+
+        Parameters
+        ----------
+        estimator : {"surface", "internal"}, default "surface"
+            Which shear stress: plate forces or the overall stress tensor.
+        n_max : int, default 15
+            Highest harmonic order fitted.
+
+        Returns
+        -------
+        particleShear.analysis.laos.LaosResult
+            Harmonics G′_n, G″_n, Chebyshev e_n, v_n, G_M, G_L, η_M, η_L, S, T, I₃/I₁, Q.
+
+        Raises
+        ------
+        ValueError
+            For another estimator, a result without its series, or a measured span shorter than
+            one period.
+        """
+        from ..analysis.demodulation import ESTIMATOR_COLUMNS
+        from ..analysis.laos import laos
+        from ..analysis.measures import measured_window
+        if estimator not in ESTIMATOR_COLUMNS:
+            raise ValueError(f"estimator={estimator!r} is not allowed: use 'surface' or 'internal'")
+        key = ESTIMATOR_COLUMNS[estimator][1]
+        s = self.series
+        if not s or key not in s:
+            raise ValueError("laos needs the recorded series of the run (a result of this session, not one rebuilt "
+                             "from a results table)")
+        p = self.parameters
+        w = measured_window(s["t"], self.f, p["pre_periods"], p["periods"])
+        return laos(np.asarray(s["t"])[w], np.asarray(s["strain"])[w], np.asarray(s[key])[w], self.f, n_max=n_max)
 
     def plot(self, path=None):
         """Strain and stress traces against time plus the Lissajous loop (needs ``particleShear[plot]``).
@@ -127,7 +191,7 @@ class SimulationResult:
 
         Keys in table order: ``run_id`` (hash of the complete parameter set and seed),
         ``status`` ("ok"), ``error`` (""), ``Gp_surface, Gpp_surface, Gp_internal,
-        Gpp_internal`` (Pa), every parameter (defaults filled in for those not recorded),
+        Gpp_internal`` (Pa), the :attr:`measures` (standard errors, ``steady_state``, LAOS ratios), every parameter (defaults filled in for those not recorded),
         ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.
         """
         from .. import __version__
@@ -138,6 +202,7 @@ class SimulationResult:
         row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
                "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),
                "Gp_internal": float(self.G_internal[0]), "Gpp_internal": float(self.G_internal[1])}
+        row.update(self.measures)
         row.update(params)
         row.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
                    wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")

@@ -507,6 +507,11 @@ def validate_run(params):
         would be allowed.
     ImportError
         ``output_format="parquet"`` without pyarrow (the message names the extra to install).
+
+    Warns
+    -----
+    particleShear.analysis.measures.MeasurementWarning
+        When ``periods`` measures fewer than 2 whole excitation periods (no standard error).
     """
     from .batch import _signature_defaults
     defaults = _signature_defaults()
@@ -562,6 +567,8 @@ def validate_run(params):
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
+    from ..analysis.measures import warn_few_periods
+    warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
     return cost
 
 

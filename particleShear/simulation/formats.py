@@ -40,6 +40,16 @@ __all__ = ["OUTPUT_FORMATS", "FORMAT_SUFFIXES", "read_run", "verify_run", "RunDa
 OUTPUT_FORMATS = tuple(FORMAT_SUFFIXES)
 
 #: series key of SimulationResult.series → table column (the five base series)
+_NUMBER = r"([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)"
+#: header patterns of the protocol values a RunData exposes (first pattern that matches wins)
+_PROTOCOL_PATTERNS = {
+    "frequency": (re.compile(r"\nFrequency = " + _NUMBER + "Hz"),),
+    "strain_amplitude": (re.compile(r"[(,]amplitude=" + _NUMBER + r"[,)]"),
+                         re.compile(r"\nStrain amplitude = " + _NUMBER + "%")),
+    "pre_periods": (re.compile(r"baseline_pre_periods = " + _NUMBER), re.compile(r"Pre-measurement periods = " + _NUMBER)),
+    "periods": (re.compile(r"runSimulation\(periods=" + _NUMBER + ","),
+                re.compile(r"Oscillatory shear periods = " + _NUMBER)),
+}
 _SERIES_COLUMNS = (("t", "t"), ("strain", "strain"), ("strain_rate", "strain_rate"),
                    ("stress_surface", "stress_measured_at_surface"),
                    ("stress_internal", "shear_stress_internal_stress-tensor"))
@@ -268,6 +278,34 @@ class RunData(dict):
         self.metadata = metadata
         self.path = path
         self.output_format = output_format
+
+    def _header_value(self, name):
+        for pattern in _PROTOCOL_PATTERNS[name]:
+            m = pattern.search(self.header)
+            if m:
+                return float(m.group(1)) / (100.0 if m.group(0).endswith("%") else 1.0)
+        raise RunFileError(f"{self.path}: its header records no {name.replace('_', ' ')}")
+
+    @property
+    def frequency(self):
+        """The excitation frequency f (Hz), from the header line ``Frequency = …Hz``."""
+        return self._header_value("frequency")
+
+    @property
+    def strain_amplitude(self):
+        """The strain amplitude γ₀ (dimensionless), from the call's ``amplitude=…`` in the header
+        (exactly the value given), else ``Strain amplitude = …%`` / 100."""
+        return self._header_value("strain_amplitude")
+
+    @property
+    def pre_periods(self):
+        """Baseline periods before the excitation, from ``Pre-measurement periods = …``."""
+        return self._header_value("pre_periods")
+
+    @property
+    def periods(self):
+        """Excitation periods, from ``Oscillatory shear periods = …``."""
+        return self._header_value("periods")
 
     @property
     def series(self):

@@ -31,12 +31,23 @@ def _from_runs(runs, out_dir):
 def _result_from_row(row, run, out_dir):
     """A light SimulationResult of a run finished in an earlier call (moduli, parameters, seed, path)."""
     from ..run.api import SimulationResult
+    from ..analysis.measures import MEASURE_COLUMNS
     g = tuple(float(row[c]) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
-    return SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
-                            parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
-                            timings={"total": float(row["wall_time_s"])},
-                            output_path=os.path.join(out_dir, os.path.basename(row["output_path"]))
-                            if row["output_path"] else None)
+    result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
+                              parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
+                              timings={"total": float(row["wall_time_s"])},
+                              output_path=os.path.join(out_dir, os.path.basename(row["output_path"]))
+                              if row["output_path"] else None)
+    result._measures = {c: ({"True": True, "False": False}.get(row.get(c)) if c == "steady_state"
+                            else _number(row.get(c))) for c in MEASURE_COLUMNS}
+    return result
+
+
+def _number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def series_parameters(kwargs):

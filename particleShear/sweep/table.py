@@ -1,7 +1,8 @@
 """The results table of a sweep: ``DIR/results.csv``, one row per finished run.
 
 Columns, in this order: ``run_id, status, error, Gp_surface, Gpp_surface, Gp_internal,
-Gpp_internal`` (Pa), every parameter of the run (signature order of
+Gpp_internal`` (Pa), the measures of :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`
+(standard errors in Pa, ``steady_state``, LAOS ratios; docs/analysis.md), every parameter of the run (signature order of
 ``doParticleShearSimulation``), ``seed_entropy``, ``spawn_key`` (JSON list), ``package_version``,
 ``wall_time_s``, ``output_path``.
 
@@ -21,6 +22,7 @@ import socket
 
 import numpy as np
 
+from ..analysis.measures import MEASURE_COLUMNS
 from ..simulation.provenance import IDENTITY_EXCLUDED, same_input
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
@@ -32,7 +34,8 @@ __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_ro
 REJECTED_SUFFIX = ".rejected"
 
 #: the first columns of every results table
-RESULT_COLUMNS = ("run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal")
+RESULT_COLUMNS = ("run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") \
+    + MEASURE_COLUMNS
 _TAIL_COLUMNS = ("seed_entropy", "spawn_key", "package_version", "wall_time_s", "output_path")
 TABLE_NAME = "results.csv"
 

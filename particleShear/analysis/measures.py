@@ -1,0 +1,149 @@
+"""What every run reports beyond G′ and G″: their standard errors, a steady-state flag, LAOS measures.
+
+:func:`run_measures` evaluates them once from a run's recorded series; they go into
+``SimulationResult.measures`` and the results table (:data:`MEASURE_COLUMNS`, docs/analysis.md).
+"""
+__docformat__ = "numpy"
+import math
+import warnings
+
+import numpy as np
+
+from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
+
+__all__ = ["MEASURE_COLUMNS", "MeasurementWarning", "run_measures", "measured_window", "warn_few_periods",
+           "measured_periods"]
+
+#: columns of the results table after the four moduli, in order (units in docs/analysis.md)
+MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_internal_se", "steady_state",
+                   "I3_I1_surface", "I3_I1_internal", "S_surface", "T_surface", "S_internal", "T_internal")
+
+
+class MeasurementWarning(UserWarning):
+    """A run measures too little of the excitation for its G′, G″ to carry an error bar."""
+
+
+def measured_periods(periods):
+    """Whole excitation periods the package's demodulation window holds.
+
+    The window is ``[(pre+e)/f, (pre+P)/f]`` with ``e = 1`` when ``P ≥ 2`` (the first period is
+    a transient and skipped), else 0; it holds ``floor(P) − e`` whole periods.
+
+    Parameters
+    ----------
+    periods : float
+        Excitation periods P (> 0).
+
+    Returns
+    -------
+    int
+    """
+    P = float(periods)
+    return max(int(math.floor(P)) - (1 if P >= 2 else 0), 0)
+
+
+def warn_few_periods(periods):
+    """Warn (:class:`MeasurementWarning`) when fewer than 2 whole excitation periods are measured.
+
+    With fewer, G′ and G″ come from one period or a fraction of one: no standard error, no
+    steady-state check, and a fraction of a period does not even separate G′ from G″.
+
+    Parameters
+    ----------
+    periods : float
+        Excitation periods P of the run.
+
+    Returns
+    -------
+    bool
+        True when it warned.
+    """
+    n = measured_periods(periods)
+    if n >= 2:
+        return False
+    skipped = " after the first, a transient" if float(periods) >= 2 else ""
+    warnings.warn(f"periods={periods!r} measures {n} whole excitation period(s){skipped}: G′ and G″ get no "
+                  "standard error and a fraction of a period mixes them; use periods >= 3 (--periods 3)",
+                  MeasurementWarning, stacklevel=3)
+    return True
+
+
+def measured_window(t, f, pre_periods, periods):
+    """Mask of the samples the measures use: the R package's ``"oscillatory_measurement"``.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times since the start of the protocol (s).
+    f : float
+        Excitation frequency (Hz).
+    pre_periods, periods : float
+        Baseline periods before the excitation and excitation periods.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+    """
+    return measurement_periods(t, f, pre_periods, periods) == "oscillatory_measurement"
+
+
+def _nan_row():
+    return {c: (None if c == "steady_state" else math.nan) for c in MEASURE_COLUMNS}
+
+
+def run_measures(series, f, strain_amplitude, pre_periods, periods):
+    """The standard errors, steady-state flag and LAOS measures of one run (:data:`MEASURE_COLUMNS`).
+
+    * ``G*_se`` — standard error of the mean over the whole excitation periods of the
+      package's demodulation window, each demodulated alone
+      (:func:`~particleShear.analysis.periods.period_moduli`); NaN with fewer than 2 periods.
+    * ``steady_state`` — False when G′ or G″ of either estimator drifts from period to period
+      by more than twice the error of that trend, True when neither does, None (empty in the
+      table) with fewer than 3 measured periods.
+    * ``I3_I1_*``, ``S_*``, ``T_*`` — intensity ratio of the third harmonic and the
+      Ewoldt–Hosoi–McKinley stiffening and thickening ratios over the ``"oscillatory_measurement"``
+      samples (:func:`~particleShear.analysis.laos.laos`); NaN when that span is shorter than a period.
+
+    Parameters
+    ----------
+    series : dict of numpy.ndarray
+        ``SimulationResult.series``: "t" (s), "strain", "stress_surface", "stress_internal" (Pa).
+    f : float
+        Excitation frequency (Hz).
+    strain_amplitude : float
+        γ₀ (dimensionless).
+    pre_periods, periods : float
+        The protocol's baseline periods before the excitation and excitation periods.
+
+    Returns
+    -------
+    dict
+        Column → value (float; ``steady_state`` bool or None).
+    """
+    from .laos import laos
+    from .periods import period_moduli
+    row = _nan_row()
+    if not series or "t" not in series or len(series["t"]) == 0 or not f:
+        return row
+    t = np.asarray(series["t"], dtype=float)
+    flags = []
+    window = measured_window(t, f, pre_periods, periods)
+    for est, (_col, key) in ESTIMATOR_COLUMNS.items():
+        if key not in series:
+            continue
+        stress = np.asarray(series[key], dtype=float)
+        try:
+            pm = period_moduli(t, stress, f, strain_amplitude, pre_periods, periods)
+        except ValueError:
+            pm = None
+        if pm is not None:
+            row[f"Gp_{est}_se"], row[f"Gpp_{est}_se"] = float(pm.Gp_se), float(pm.Gpp_se)
+            flags.append(pm.steady)
+        try:
+            m = laos(t[window], np.asarray(series["strain"], dtype=float)[window], stress[window], f)
+        except (ValueError, KeyError, np.linalg.LinAlgError):
+            continue
+        row[f"I3_I1_{est}"], row[f"S_{est}"], row[f"T_{est}"] = float(m.I3_I1), float(m.S), float(m.T)
+    known = [x for x in flags if x is not None]
+    row["steady_state"] = None if not known or len(known) < len(flags) else all(known)
+    return row
