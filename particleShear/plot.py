@@ -31,7 +31,7 @@ import sys
 
 from .messages import console_messages
 
-__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "sweep_groups", "cli_main", "save_figure",
+__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
            "check_figure_path"]
 
 _INSTALL_HINT = 'particleShear.plot needs matplotlib: pip install "particleShear[plot]"'
@@ -269,6 +269,45 @@ def group_of(row):
     return "crosslinked" if _float(row.get("cut_lines", 0)) > 0 else "bulk control"
 
 
+def ok_moduli(rows, estimator="surface"):
+    """The rows of a sweep that count: status ``ok`` and finite amplitude and moduli, with those numbers.
+
+    Parameters
+    ----------
+    rows : iterable of dict
+        Rows of ``results.csv`` (as :func:`read_sweep_table` returns them).
+    estimator : {"surface", "internal"}, optional
+        Which moduli: ``Gp_surface``/``Gpp_surface`` (plate forces, default) or
+        ``Gp_internal``/``Gpp_internal`` (overall stress tensor, eq. S1-24).
+
+    Returns
+    -------
+    kept : list of tuple
+        ``(row, amplitude, G′, G″)`` for each row that counts, in input order (floats; Pa).
+    skipped : int
+        Rows with status ``ok`` left out because the amplitude or a modulus is missing or not
+        finite (rows of any other status are not counted).
+
+    Raises
+    ------
+    ValueError
+        If ``estimator`` is not "surface" or "internal".
+    """
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS}")
+    kept, skipped = [], 0
+    for row in rows:
+        if str(row.get("status", "")).strip() != "ok":
+            continue
+        gp, gpp = _float(row.get("Gp_" + estimator)), _float(row.get("Gpp_" + estimator))
+        A = _float(row.get("theAmplitude"))
+        if not (math.isfinite(gp) and math.isfinite(gpp) and math.isfinite(A)):
+            skipped += 1
+            continue
+        kept.append((row, A, gp, gpp))
+    return kept, skipped
+
+
 def sweep_groups(rows, estimator="surface"):
     """Mean and standard error over seeds of G′ and G″ per (group, μ) and amplitude.
 
@@ -294,16 +333,8 @@ def sweep_groups(rows, estimator="surface"):
     ValueError
         If ``estimator`` is not "surface" or "internal".
     """
-    if estimator not in ESTIMATORS:
-        raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS}")
     cells = {}
-    for row in rows:
-        if str(row.get("status", "")).strip() != "ok":
-            continue
-        gp, gpp = _float(row.get("Gp_" + estimator)), _float(row.get("Gpp_" + estimator))
-        A = _float(row.get("theAmplitude"))
-        if not (math.isfinite(gp) and math.isfinite(gpp) and math.isfinite(A)):
-            continue
+    for row, A, gp, gpp in ok_moduli(rows, estimator)[0]:
         key = (group_of(row), _float(row.get("theMu", 0)))
         cells.setdefault(key, {}).setdefault(A, []).append((gp, gpp))
     out = {}

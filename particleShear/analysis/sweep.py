@@ -31,12 +31,14 @@ import warnings
 
 import numpy as np
 
+from .curves import CURVE_POINTS
+
 __all__ = ["CHARACTERISTICS", "CURVE_COLUMNS", "POINT_NAMES", "SCALAR_NAMES", "SweepSummary", "sweep_summary"]
 
 #: the characteristics that are one number each
 SCALAR_NAMES = ("plateau", "linear_limit_5", "linear_limit_10", "flow_point")
 #: the points of :func:`particleShear.analysis.curves.stress_curve_points`, in strain order
-POINT_NAMES = ("low_strain_plateau", "softening", "soft_plateau", "yield")
+POINT_NAMES = CURVE_POINTS
 _POINT_PARTS = (("strain", "1", "strain amplitude"), ("Gp", "Pa", "mean G′"), ("Gpp", "Pa", "mean G″"))
 _POINT_TEXT = {"low_strain_plateau": "low-strain plateau point", "softening": "softening point",
                "soft_plateau": "soft-plateau point", "yield": "yield point (G′ = G″)"}
@@ -218,7 +220,7 @@ def _vector(name, x):
     bad = ~np.isfinite(a)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ValueError(f"{name}[{i}]={a[i]!r} is out of range: allowed finite numbers")
+        raise ValueError(f"{name}[{i}]={float(a[i])!r} is out of range: allowed finite numbers")
     return a
 
 
@@ -235,7 +237,7 @@ def _check(amplitude, Gp, Gpp, n_boot, confidence, rng):
                          f"{len(gpp)}")
     if (A <= 0).any():
         i = int(np.argmax(A <= 0))
-        raise ValueError(f"amplitude[{i}]={A[i]!r} is out of range: allowed amplitude > 0")
+        raise ValueError(f"amplitude[{i}]={float(A[i])!r} is out of range: allowed amplitude > 0")
     n_amp = len(np.unique(A))
     if n_amp < 2:
         raise ValueError(f"amplitude={_short(A)} is out of range: {n_amp} distinct value(s), allowed at least 2 "
