@@ -459,10 +459,14 @@ def main(argv=None):
     if argv[:1] == ["sweep"]:  # python -m particleShear sweep SPEC --out DIR (particleShear.sweep.cli)
         from ..sweep.cli import main as sweep_main
         return sweep_main(argv[1:])
+    if argv[:1] in (["analyse"], ["analyze"]):  # python -m particleShear analyse DIR (particleShear.analysis.cli)
+        from ..analysis.cli import main as analyse_main
+        return analyse_main(argv[1:])
     if argv[:1] == ["run"]:
         argv = argv[1:]
     elif argv and not argv[0].startswith("-"):
-        print(f"particleShear: invalid parameter: unknown command {argv[0]!r}: allowed run (default), sweep, plot",
+        print(f"particleShear: invalid parameter: unknown command {argv[0]!r}: allowed run (default), sweep, plot, "
+              "analyse",
               file=sys.stderr)
         return 2
     args = build_parser().parse_args(argv)
