@@ -29,6 +29,10 @@ import particleShear
 #: Modules whose public API is fully documented (checked; a failure is a defect).
 DOCUMENTED_MODULES = [
     "particleShear",
+    "particleShear.analysis",
+    "particleShear.analysis.curves",
+    "particleShear.analysis.demodulation",
+    "particleShear.analysis.measures",
     "particleShear.simulation",
     "particleShear.simulation.drawing",
     "particleShear.simulation.evaluation",
