@@ -150,9 +150,8 @@ class Synthetic(unittest.TestCase):
             base = dict(sweep_parameter_defaults())
             with open(os.path.join(d, "results.csv"), "w", newline="", encoding="utf-8") as fh:
                 fh.write(row_line({c: c for c in cols}, cols))
-                for k, (A, gp, gpp) in enumerate([(0.01, 100.0, 10.0), (0.1, 60.0, 30.0), (1.0, -5.0, 40.0)] * 2):
-                    fh.write(row_line(dict(base, theAmplitude=A, run_id=f"r{k}", status="ok", Gp_surface=gp,
-                                           Gpp_surface=gpp, Gp_internal=gp, Gpp_internal=gpp), cols))
+                fh.writelines(row_line(dict(base, theAmplitude=A, run_id=f"r{k}", status="ok", Gp_surface=gp,
+                                           Gpp_surface=gpp, Gp_internal=gp, Gpp_internal=gpp), cols) for k, (A, gp, gpp) in enumerate([(0.01, 100.0, 10.0), (0.1, 60.0, 30.0), (1.0, -5.0, 40.0)] * 2))
             rc, out, err = run(["analyse", d, "--seed", "0", "--n-boot", "20"])
             self.assertEqual(rc, 0, err)
             row = read_analysis(d)[0]

@@ -20,7 +20,12 @@ import warnings
 
 import numpy as np
 
-from particleShear.analysis.sweep import CHARACTERISTICS, POINT_NAMES, SweepSummary, sweep_summary
+from particleShear.analysis.sweep import (
+    CHARACTERISTICS,
+    POINT_NAMES,
+    SweepSummary,
+    sweep_summary,
+)
 
 G0, R, AC = 1000.0, 0.5, 0.05        # plateau (Pa), G″/G′ ratio per unit x, characteristic amplitude
 
@@ -208,8 +213,8 @@ class Bootstrap(unittest.TestCase):
 
 
 class BadInput(unittest.TestCase):
-    A = [0.01, 0.1, 1.0]
-    G = [1.0, 2.0, 3.0]
+    A = (0.01, 0.1, 1.0)
+    G = (1.0, 2.0, 3.0)
 
     def check(self, pattern, *args, **kw):
         with self.assertRaisesRegex(ValueError, pattern):
