@@ -5,8 +5,8 @@ One panel per group of the sweep folder, log-log axes: the mean G′ (solid, fil
 points of :class:`~particleShear.analysis.sweep.SweepSummary` marked, labelled and drawn with their
 intervals as error bars, the number of seeds in the panel title, one legend for all panels below
 them (never over the data).  A mean that is zero or negative cannot be drawn on a log axis: it is
-marked by a triangle on the lower edge of the panel at its amplitude and said in the panel; band
-ends at or below zero are drawn at the lower edge (said too).  Drawn on an Agg canvas
+marked by an open triangle on the lower edge of the panel at its amplitude and said in a note
+under the panel; band ends at or below zero are drawn at the lower edge (said too).  Drawn on an Agg canvas
 (:func:`particleShear.plot._figure`), headless; written with :func:`particleShear.plot.save_figure`.
 """
 __docformat__ = "numpy"
@@ -69,9 +69,8 @@ def _panel(ax, title, s, notes):
             ax.plot(A[~ok], np.full((~ok).sum(), floor), ls="none", marker="v", ms=8, color=colour, mfc="none",
                     clip_on=False, label=f"{key} mean <= 0 (not on the log axis)")
             bad = ", ".join(f"{a:g}" for a in A[~ok])
-            text = f"mean {key} <= 0 at A = {bad}: marked on the lower edge"
-            if not any(text.split(":")[0] in n for n in said):
-                said.append(text)
+            said = [n for n in said if not n.startswith(f"mean {key} <= 0")]   # said here, more precisely
+            said.append(f"mean {key} <= 0 at A = {bad}: not on the log axis, marked ▽ on the lower edge")
     plateau = s.plateau
     marks = []
     for name, frac in (("linear_limit_5", 0.05), ("linear_limit_10", 0.10)):
@@ -104,9 +103,10 @@ def _panel(ax, title, s, notes):
     ax.set_ylabel("G′, G″ (Pa)")
     ax.set_title(f"{title}\n{_seeds_text(s.n_seeds)}, {int(s.n_seeds.sum())} runs", fontsize="small")
     ax.grid(True, which="both", color="0.92", lw=0.5)
-    if said:
-        ax.text(0.01, 0.01, "\n".join(said), transform=ax.transAxes, fontsize="xx-small", va="bottom", ha="left",
-                color="C3", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+    if said:   # below the axis label, outside the data (constrained layout makes room for it)
+        import textwrap
+        ax.set_xlabel(ax.get_xlabel() + "\n" + "\n".join(textwrap.fill("note: " + n, 70) for n in said),
+                      fontsize="small")
     return said
 
 
