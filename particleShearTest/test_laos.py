@@ -48,14 +48,15 @@ def expected(gamma0, G=G, c=C, eta=ETA, d=D):
     G_M, G_L = G, G + c * gamma0 ** 2
     eta_M, eta_L = eta, eta + d * gamma0 ** 2 * w ** 2
     I3_I1 = math.hypot(Gp3, Gpp3) / math.hypot(Gp1, Gpp1)
-    return dict(Gp1=Gp1, Gp3=Gp3, Gpp1=Gpp1, Gpp3=Gpp3, e3=c * gamma0 ** 2 / 4, v3=d * gamma0 ** 2 * w ** 2 / 4,
-                v1=Gpp1 / w, G_M=G_M, G_L=G_L, eta_M=eta_M, eta_L=eta_L, S=(G_L - G_M) / G_L,
-                T=(eta_L - eta_M) / eta_L, I3_I1=I3_I1, Q=I3_I1 / gamma0 ** 2)
+    return {"Gp1": Gp1, "Gp3": Gp3, "Gpp1": Gpp1, "Gpp3": Gpp3, "e3": c * gamma0 ** 2 / 4,
+            "v3": d * gamma0 ** 2 * w ** 2 / 4, "v1": Gpp1 / w, "G_M": G_M, "G_L": G_L, "eta_M": eta_M,
+            "eta_L": eta_L, "S": (G_L - G_M) / G_L, "T": (eta_L - eta_M) / eta_L, "I3_I1": I3_I1,
+            "Q": I3_I1 / gamma0 ** 2}
 
 
 def times(cycles, n_per_cycle=400, start=0.0):
     """Evenly spaced samples covering ``cycles`` periods (the end excluded)."""
-    n = int(round(cycles * n_per_cycle))
+    n = round(cycles * n_per_cycle)
     return start + np.arange(n) / (n_per_cycle * F)
 
 
