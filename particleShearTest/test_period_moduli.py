@@ -97,6 +97,19 @@ class TestPerPeriodValues(unittest.TestCase):
             self.assertAlmostEqual(got_se / (math.sqrt(cov[0, 0]) * span), 1.0, delta=1e-6)
             self.assertAlmostEqual(mean_se / (np.std(y, ddof=1) / math.sqrt(8)), 1.0, delta=1e-6)
 
+    def test_no_drift_correction(self):
+        """A linear drift D·t shifts every G′ by −D/(π f γ₀) and leaves G″ alone (no correction is applied).
+
+        The shift is the ratio of ∫u sin 2πu = −1/(2π) to ∫sin² 2πu = 1/2 over a period; the sum over
+        N evenly spaced samples differs from the integrals by a factor 1 + (π/N)²/6 ≈ 1 + 4e-4
+        for N = 64, hence the tolerance 1e-3.  G″: ∫u cos 2πu = 0 over a whole period.
+        """
+        D = 2e5                                              # Pa/s
+        r = period_moduli(self.t, self.s + D * self.t, F, A, 1.0, self.P)
+        np.testing.assert_allclose(r.Gp - self.Gp_true[1:], -D / (math.pi * F * A), rtol=1e-3)
+        np.testing.assert_allclose(r.Gpp, self.Gpp_true[1:], rtol=RTOL)
+        self.assertAlmostEqual(r.Gp_trend / (25.0 * 4), 1.0, delta=1e-6)   # a constant shift: same trend
+
     def test_result_is_frozen(self):
         with self.assertRaises(dataclasses.FrozenInstanceError):
             self.r.steady = True
@@ -165,6 +178,13 @@ class TestWindow(unittest.TestCase):
         r = period_moduli(t[keep], s[keep], F, A, 1.0, 4)
         np.testing.assert_array_equal(r.period, [1, 3])
         np.testing.assert_allclose(r.Gp, gap.Gp[[0, 2]], rtol=RTOL)
+
+    def test_long_protocol_short_record(self):
+        """Only the periods the data reach are looked at: a protocol of 1e9 periods costs nothing more."""
+        t, s = signal(self.Gp[:5], np.full(5, 50.0))
+        r = period_moduli(t, s, F, A, 1.0, 1e9)
+        self.assertEqual((r.n_periods, r.n_expected), (4, 10 ** 9 - 1))
+        np.testing.assert_allclose(r.Gp, self.Gp[1:5], rtol=RTOL)
 
     def test_sample_order_does_not_matter(self):
         t, s = signal(self.Gp[:4], np.full(4, 50.0))

@@ -35,9 +35,9 @@ and the non-orthogonality of the basis on a span that is not a whole number of p
 the odd orders (the ones of a response that is odd in the strain and its rate) are reported.
 The fit therefore works on any span of at least one period, any starting phase.
 
-Signs follow the stress as given: a stress that opposes the deformation (``−τ`` of a cell that is
-sheared, as :class:`~particleShear.simulation.evaluation.EvaluationHandler` records
-``τ_internal``) must be negated by the caller first.
+Signs follow the stress as given, as in
+:func:`~particleShear.simulation.evaluation.demodulation`: ``G'_1 > 0`` for a stress in phase
+with the strain.
 
 References
 ----------

@@ -219,7 +219,11 @@ def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods):
     t = t[order]
     stress = stress[order]
     ks, gps, gpps = [], [], []
-    for k in range(e, e + n_expected):
+    first, stop = e, e + n_expected
+    if len(t):     # only the periods the data reach (a long protocol with a short record)
+        first = max(first, math.floor(f * t[0] - pre))
+        stop = min(stop, math.floor(f * t[-1] - pre) + 1)
+    for k in range(first, stop):
         start, end = (pre + k) / f, (pre + k + 1) / f
         lo, hi = np.searchsorted(t, start, side="left"), np.searchsorted(t, end, side="left")
         tk = t[lo:hi]
