@@ -62,7 +62,6 @@ DOCUMENTED_MODULES = [
     "particleShear.run.batch",
     "particleShear.run.cli",
     "particleShear.run.validation",
-    "particleShear.analysis",
     "particleShear.analysis.laos",
     "particleShear.analysis.periods",
 ]
@@ -72,9 +71,7 @@ DOCUMENTED_MODULES = [
 #: it passes).  run.api: doParticleShearSimulation's docstring is written by the helper of the
 #: API docstring (issue 13 item 3), not on this branch; run.cli: rewritten by the helper of the
 #: generated command line (issue 13 item 5).
-#: particleShear.analysis: its __init__ is an empty placeholder on the laos branch (issue 21);
-#: the documented one is written on main.
-PENDING_DOCSTRINGS = {"particleShear.analysis"}
+PENDING_DOCSTRINGS = set()
 
 #: Modules whose "§" references are replaced on another branch (run.api, see above).
 PENDING_SECTION_SIGNS = set()

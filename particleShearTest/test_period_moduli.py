@@ -226,11 +226,11 @@ class TestSteadiness(unittest.TestCase):
         self.assertIs(r.steady, True)
 
     def test_false_alarm_rate(self):
-        """Under no trend, |trend| > 2·se happens with P(|t₃| > 2) = 0.139 per modulus for 5 periods.
+        """Under no trend each modulus crosses its t_c (α/2 two-sided) with probability 0.025.
 
         G′ and G″ errors of white noise are independent on a whole period (Σ sin·cos = 0), so
-        ``steady`` is False with probability 1 − (1 − 0.1393)² = 0.259; 400 seeded trials: ±4
-        binomial standard deviations (0.022 each).
+        ``steady`` is False with probability 1 − (1 − 0.025)² = 0.0494 ≤ ``false_alarm``; 400
+        seeded trials at 5 periods: ±4 binomial standard deviations (0.011 each).
         """
         rng = np.random.default_rng(99)
         base = signal(np.full(6, 1000.0), np.full(6, 300.0))
@@ -238,11 +238,28 @@ class TestSteadiness(unittest.TestCase):
         for _ in range(400):
             s = base[1] + 10.0 * rng.standard_normal(base[1].size)
             false += period_moduli(base[0], s, F, A, 1.0, 6).steady is False
-        x = 2 / math.sqrt(3)                 # Student's t with 3 degrees of freedom, closed-form CDF
-        p = 1 - 2 * (0.5 + (x / (1 + x * x) + math.atan(x)) / math.pi - 0.5)
-        expected = 1 - (1 - p) ** 2
+        expected = 1 - (1 - 0.025) ** 2
         sd = math.sqrt(expected * (1 - expected) / 400)
         self.assertAlmostEqual(false / 400, expected, delta=4 * sd)
+
+    def test_t_critical_against_the_closed_form_cdf(self):
+        """t_c of 3 degrees of freedom against the closed-form distribution function and table values."""
+        from particleShear.analysis.periods import t_critical
+        tc = t_critical(3, 0.05)
+        x = tc / math.sqrt(3)                 # P(|T| <= t) = (2/π)(atan x + x/(1 + x²)) for 3 dof
+        self.assertAlmostEqual(2 / math.pi * (math.atan(x) + x / (1 + x * x)), 0.95, delta=1e-12)
+        # one degree of freedom is Cauchy: t_c = tan(π(1 − α)/2) exactly
+        self.assertAlmostEqual(t_critical(1, 0.05) / math.tan(math.pi * 0.95 / 2), 1.0, delta=1e-11)
+        # two degrees of freedom: P(|T| <= t) = t/√(2 + t²) = q  ->  t_c² = 2q²/(1 − q²)
+        a = 0.01
+        q = 1 - a
+        self.assertAlmostEqual(t_critical(2, a), math.sqrt(2 * q * q / (1 - q * q)), delta=1e-9)
+        # many degrees of freedom approach the normal 1.959964
+        self.assertAlmostEqual(t_critical(2000, 0.05), 1.959964, delta=2e-3)
+        with self.assertRaisesRegex(ValueError, "dof"):
+            t_critical(0, 0.05)
+        with self.assertRaisesRegex(ValueError, "false_alarm"):
+            period_moduli(*signal(np.full(4, 1000.0), np.full(4, 300.0)), F, A, 1.0, 4, false_alarm=1.5)
 
 
 class TestAgainstDemodulation(unittest.TestCase):

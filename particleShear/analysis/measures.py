@@ -11,8 +11,7 @@ import numpy as np
 
 from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
 
-__all__ = ["MEASURE_COLUMNS", "MeasurementWarning", "run_measures", "measured_window", "warn_few_periods",
-           "measured_periods"]
+__all__ = ["MEASURE_COLUMNS", "MeasurementWarning", "run_measures", "measured_window", "warn_few_periods"]
 
 #: columns of the results table after the four moduli, in order (units in docs/analysis.md)
 MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_internal_se", "steady_state",
@@ -21,25 +20,6 @@ MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_int
 
 class MeasurementWarning(UserWarning):
     """A run measures too little of the excitation for its G′, G″ to carry an error bar."""
-
-
-def measured_periods(periods):
-    """Whole excitation periods the package's demodulation window holds.
-
-    The window is ``[(pre+e)/f, (pre+P)/f]`` with ``e = 1`` when ``P ≥ 2`` (the first period is
-    a transient and skipped), else 0; it holds ``floor(P) − e`` whole periods.
-
-    Parameters
-    ----------
-    periods : float
-        Excitation periods P (> 0).
-
-    Returns
-    -------
-    int
-    """
-    P = float(periods)
-    return max(int(math.floor(P)) - (1 if P >= 2 else 0), 0)
 
 
 def warn_few_periods(periods):
@@ -58,13 +38,15 @@ def warn_few_periods(periods):
     bool
         True when it warned.
     """
-    n = measured_periods(periods)
+    from .periods import measured_period_count
+    n = measured_period_count(0, periods)
     if n >= 2:
         return False
-    skipped = " after the first, a transient" if float(periods) >= 2 else ""
-    warnings.warn(f"periods={periods!r} measures {n} whole excitation period(s){skipped}: G′ and G″ get no "
-                  "standard error and a fraction of a period mixes them; use periods >= 3 (--periods 3)",
-                  MeasurementWarning, stacklevel=3)
+    skipped = " after the first, a transient," if float(periods) >= 2 else ""
+    why = "G′ and G″ get no standard error" + ("" if float(periods) >= 1 else
+                                                 ", and a fraction of a period does not separate G′ from G″")
+    warnings.warn(f"periods={periods!r} measures {n} whole excitation period(s){skipped}: {why}; use periods >= 3 "
+                  "(--periods 3)", MeasurementWarning, stacklevel=3)
     return True
 
 
@@ -98,8 +80,9 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
       package's demodulation window, each demodulated alone
       (:func:`~particleShear.analysis.periods.period_moduli`); NaN with fewer than 2 periods.
     * ``steady_state`` — False when G′ or G″ of either estimator drifts from period to period
-      by more than twice the error of that trend, True when neither does, None (empty in the
-      table) with fewer than 3 measured periods.
+      significantly (a linear trend larger than its own error, Student's t at a level such that a
+      run without drift is called unsteady with probability ≤ 5 %), True when none does, None
+      (empty in the table) with fewer than 3 measured periods.
     * ``I3_I1_*``, ``S_*``, ``T_*`` — intensity ratio of the third harmonic and the
       Ewoldt–Hosoi–McKinley stiffening and thickening ratios over the ``"oscillatory_measurement"``
       samples (:func:`~particleShear.analysis.laos.laos`); NaN when that span is shorter than a period.
@@ -121,7 +104,7 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
         Column → value (float; ``steady_state`` bool or None).
     """
     from .laos import laos
-    from .periods import period_moduli
+    from .periods import FALSE_ALARM, period_moduli
     row = _nan_row()
     if not series or "t" not in series or len(series["t"]) == 0 or not f:
         return row
@@ -133,7 +116,8 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
             continue
         stress = np.asarray(series[key], dtype=float)
         try:
-            pm = period_moduli(t, stress, f, strain_amplitude, pre_periods, periods)
+            # each estimator at half the run's false-alarm level: the run's flag errs with <= 5 %
+            pm = period_moduli(t, stress, f, strain_amplitude, pre_periods, periods, false_alarm=FALSE_ALARM / 2)
         except ValueError:
             pm = None
         if pm is not None:

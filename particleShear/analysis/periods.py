@@ -28,15 +28,15 @@ import numbers
 
 import numpy as np
 
-__all__ = ["PeriodModuli", "measured_period_count", "period_moduli"]
+__all__ = ["PeriodModuli", "measured_period_count", "period_moduli", "t_critical", "FALSE_ALARM"]
 
 #: A period with fewer samples is not a whole measured period.
 MIN_SAMPLES_PER_PERIOD = 8
 #: A period whose samples leave a gap (its ends included) longer than this fraction of the
 #: period is not a whole measured period (data that stop or start inside it).
 MAX_GAP_FRACTION = 1 / 8
-#: ``steady`` is False when |trend| exceeds this many standard errors of the trend.
-TREND_SIGNIFICANCE = 2.0
+#: default probability that ``steady`` is False for a response without trend (both moduli together)
+FALSE_ALARM = 0.05
 #: A trend below this fraction of |G*| is below the resolution of the demodulation and never counts.
 TREND_RESOLUTION = 1e-9
 
@@ -48,13 +48,15 @@ class PeriodModuli:
     ``trend`` is the ordinary-least-squares slope of the per-period values against the period
     index times the index span ``k_last − k_first`` (``n_periods − 1`` when no period was left
     out): the change of the modulus across the measurement.  ``steady`` is False when, for G′ or
-    for G″, ``|trend| > 2·trend_se`` (and above ``1e-9·|G*|``, the rounding level): under the
-    hypothesis of no trend and independent Gaussian per-period errors, ``trend/trend_se``
-    follows Student's t with ``n − 2`` degrees of freedom, and a factor 2 is the usual ≈ 95 %
-    two-sided level for many periods (it is crossed by chance with probability 5 % for
-    ``n → ∞``, 8 % for ``n = 10``, 14 % for ``n = 5``, 30 % for ``n = 3``, per modulus): a
-    False with few periods is a hint, not a verdict.  A trend is only a *linear* drift; a
-    response that oscillates from period to period shows in ``Gp_se`` instead.
+    for G″, the trend is significantly larger than its own error: ``|trend| > t_c·trend_se``
+    (and above ``1e-9·|G*|``, the rounding level), where under the hypothesis of no trend and
+    independent Gaussian per-period errors ``trend/trend_se`` follows Student's t with
+    ``n − 2`` degrees of freedom and t_c is its two-sided ``false_alarm/2`` critical value
+    (Bonferroni over the two moduli): a response without trend is called unsteady with
+    probability at most ``false_alarm`` whatever the number of periods (t_c = 25.5 for n = 3,
+    6.2 for n = 4, 3.5 for n = 6, 2.24 for n → ∞ at the default 0.05), so few periods detect
+    only a large drift.  A trend is only a *linear* drift; a response that oscillates from
+    period to period shows in ``Gp_se`` instead.
 
     Parameters
     ----------
@@ -144,6 +146,62 @@ def measured_period_count(pre_periods, periods):
     return max(0, math.floor(P) - _first_measured(P))
 
 
+def _t_two_sided(x, dof):
+    """P(|T| ≤ x) for Student's t with an integer number of degrees of freedom (A&S 26.7.3–4)."""
+    theta = math.atan(x / math.sqrt(dof))
+    c2 = math.cos(theta) ** 2
+    if dof % 2:           # odd: (2/π)(θ + sin θ cos θ (1 + 2/3 cos² θ + 2·4/(3·5) cos⁴ θ + …))
+        term, total = 1.0, 1.0
+        for j in range(1, (dof - 1) // 2):
+            term *= c2 * (2 * j) / (2 * j + 1)
+            total += term
+        series = math.sin(theta) * math.cos(theta) * total if dof > 1 else 0.0
+        return 2 / math.pi * (theta + series)
+    term, total = 1.0, 1.0  # even: sin θ (1 + 1/2 cos² θ + 1·3/(2·4) cos⁴ θ + …)
+    for j in range(1, dof // 2):
+        term *= c2 * (2 * j - 1) / (2 * j)
+        total += term
+    return math.sin(theta) * total
+
+
+def t_critical(dof, alpha):
+    """The two-sided critical value of Student's t: P(|T| > t_c) = ``alpha``.
+
+    Parameters
+    ----------
+    dof : int
+        Degrees of freedom (≥ 1).
+    alpha : float
+        Two-sided tail probability, 0 < alpha < 1.
+
+    Returns
+    -------
+    float
+        t_c (bisection to 1e-12 relative on the closed-form distribution function).
+
+    Raises
+    ------
+    ValueError
+        For ``dof`` < 1 or ``alpha`` outside (0, 1).
+    """
+    if isinstance(dof, bool) or not isinstance(dof, numbers.Integral) or dof < 1:
+        raise ValueError(f"dof={dof!r} is not allowed: an integer >= 1")
+    if not (isinstance(alpha, numbers.Real) and 0 < alpha < 1):
+        raise ValueError(f"alpha={alpha!r} is not allowed: a number in (0, 1)")
+    lo, hi = 0.0, 1.0
+    while 1 - _t_two_sided(hi, int(dof)) > alpha:
+        hi *= 2.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if 1 - _t_two_sided(mid, int(dof)) > alpha:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-12 * hi:
+            break
+    return 0.5 * (lo + hi)
+
+
 def _trend(k, y):
     """OLS trend across the index span and its standard error (NaN where undefined)."""
     n = len(y)
@@ -160,7 +218,7 @@ def _trend(k, y):
     return slope * span, se * span
 
 
-def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods):
+def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods, false_alarm=FALSE_ALARM):
     """G′ and G″ of each whole excitation period of the demodulation window, with their spread and trend.
 
     Parameters
@@ -178,6 +236,8 @@ def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods):
         Baseline periods before the excitation (≥ 0).
     periods : float
         Excitation periods P (> 0).
+    false_alarm : float, default 0.05
+        Largest probability that ``steady`` is False for a response without trend (0 < … < 1).
 
     Returns
     -------
@@ -212,6 +272,7 @@ def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods):
     amplitude = _check_number("strain_amplitude", strain_amplitude, "a finite strain amplitude > 0",
                               lambda x: x > 0)
     pre, P = _check_protocol(pre_periods, periods)
+    false_alarm = _check_number("false_alarm", false_alarm, "a probability in (0, 1)", lambda x: 0 < x < 1)
     e = _first_measured(P)
     n_expected = max(0, math.floor(P) - e)
 
@@ -253,7 +314,8 @@ def period_moduli(t, stress, f, strain_amplitude, pre_periods, periods):
     Gpp_trend, Gpp_trend_se = _trend(k, Gpp)
     if n >= 3:
         floor = TREND_RESOLUTION * math.hypot(Gp_mean, Gpp_mean)
-        steady = not any(abs(tr) > max(TREND_SIGNIFICANCE * se, floor)
+        tc = t_critical(n - 2, false_alarm / 2)
+        steady = not any(abs(tr) > max(tc * se, floor)
                          for tr, se in ((Gp_trend, Gp_trend_se), (Gpp_trend, Gpp_trend_se)))
     else:
         steady = None
