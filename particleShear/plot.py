@@ -137,13 +137,17 @@ def save_figure(fig, path, dpi=150):
 # one run
 # ---------------------------------------------------------------------------------------------
 def plot_result(result, path=None):
-    """Trace and Lissajous figure of one run.
+    """Trace, Lissajous loop and Lissajous–Bowditch curves of one run.
 
-    Left: strain γ (right axis, dimensionless) and the shear stresses τ_surface and τ_internal
+    Top left: strain γ (right axis, dimensionless) and the shear stresses τ_surface and τ_internal
     (Pa) against time t (s); the baseline periods before and after the excitation are shaded
-    grey and the excitation window is bounded by dotted lines.  Right: the Lissajous loop
+    grey and the excitation window is bounded by dotted lines.  Top right: the Lissajous loop
     τ(γ) of both estimators during the excitation (an elastic solid gives a line of slope G′,
-    a viscous response opens it into an ellipse of area π·G″·A²).
+    a viscous response opens it into an ellipse of area π·G″·A²).  Bottom: the elastic
+    (σ′ against γ) and viscous (σ″ against γ̇) Lissajous–Bowditch curves of the measured periods
+    (:meth:`SimulationResult.laos`, docs/analysis.md) over the measured stress, and their LAOS
+    ratios; a straight σ′(γ) is a linear elastic response, an upturn at large |γ| strain
+    stiffening (S > 0).
 
     Parameters
     ----------
@@ -157,6 +161,8 @@ def plot_result(result, path=None):
     Returns
     -------
     matplotlib.figure.Figure
+        Axes in order: trace, Lissajous loop, the trace's strain axis, elastic and viscous
+        Lissajous–Bowditch curves.
     """
     import numpy as np
     s = result.series
@@ -172,8 +178,10 @@ def plot_result(result, path=None):
     P = float(result.parameters.get("periods", 0))
     t_on, t_off = pre / f, (pre + P) / f
 
-    fig = _figure(10, 4)
-    ax, lj = fig.subplots(1, 2, gridspec_kw={"width_ratios": [2, 1]})
+    fig = _figure(12, 7.5)
+    grid = fig.add_gridspec(2, 3)
+    ax = fig.add_subplot(grid[0, :2])
+    lj = fig.add_subplot(grid[0, 2])
     ax.axvspan(t[0] if len(t) else 0, t_on, color="0.92", label="baseline")
     ax.axvspan(t_off, t[-1] if len(t) else t_off, color="0.92")
     ax.axvline(t_on, color="0.4", ls=":", lw=1)
@@ -201,9 +209,51 @@ def plot_result(result, path=None):
     lj.set_ylabel("shear stress τ (Pa)")
     lj.set_title("Lissajous loop (excitation)", fontsize="medium")
     lj.legend(loc="upper left", fontsize="x-small", framealpha=0.85)
+    _lissajous_bowditch(result, fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1]),
+                        fig.add_subplot(grid[1, 2]))
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+def _lissajous_bowditch(result, elastic, viscous, text):
+    """Elastic σ′(γ) and viscous σ″(γ̇) curves of both estimators, and a table of their LAOS ratios."""
+    import numpy as np
+    from .analysis.measures import measured_window
+    s = result.series
+    w = measured_window(s["t"], result.f, result.parameters.get("pre_periods", 0),
+                        result.parameters.get("periods", 0))
+    rate = np.asarray(s.get("strain_rate", np.zeros(len(s["t"]))))
+    lines = ["LAOS of the measured periods", ""]
+    for est, color in (("surface", "C0"), ("internal", "C1")):
+        key = "stress_" + est
+        try:
+            m = result.laos(est)
+        except ValueError as exc:
+            lines.append(f"{est}: {exc}")
+            continue
+        c = m.lissajous(400)
+        stress = np.asarray(s[key])[w]
+        elastic.plot(np.asarray(s["strain"])[w], stress, color=color, lw=0.5, alpha=0.35)
+        elastic.plot(c["strain"], c["elastic_stress"], color=color, lw=1.8, label=f"σ′ {est}")
+        if np.any(rate[w]):
+            viscous.plot(rate[w], stress, color=color, lw=0.5, alpha=0.35)
+        viscous.plot(c["strain_rate"], c["viscous_stress"], color=color, lw=1.8, label=f"σ″ {est}")
+        lines += [f"{est}:", f"  G_M = {m.G_M:.4g} Pa,  G_L = {m.G_L:.4g} Pa,  S = {m.S:.3g}",
+                  f"  η_M = {m.eta_M:.4g} Pa·s,  η_L = {m.eta_L:.4g} Pa·s,  T = {m.T:.3g}",
+                  f"  I₃/I₁ = {m.I3_I1:.3g},  Q = {m.Q:.3g}", ""]
+    elastic.set_xlabel("strain γ (–)")
+    elastic.set_ylabel("elastic stress σ′ (Pa)")
+    elastic.set_title("elastic Lissajous–Bowditch (thin: measured τ)", fontsize="medium")
+    viscous.set_xlabel("strain rate γ̇ (1/s)")
+    viscous.set_ylabel("viscous stress σ″ (Pa)")
+    viscous.set_title("viscous Lissajous–Bowditch", fontsize="medium")
+    for a in (elastic, viscous):
+        if a.get_legend_handles_labels()[0]:
+            a.legend(loc="upper left", fontsize="x-small", framealpha=0.85)
+    text.axis("off")
+    text.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", fontsize="x-small", family="monospace",
+              transform=text.transAxes)
 
 
 # ---------------------------------------------------------------------------------------------
