@@ -142,7 +142,8 @@ def plot_analysis(panels, estimator="surface", path=None):
     n = len(panels)
     ncols = min(n, 3)
     nrows = math.ceil(n / ncols)
-    fig = _figure(4.6 * ncols, 3.9 * nrows + 1.1)
+    legend_cols = max(1, min(3, ncols + 1))          # the shared legend must fit the figure's width
+    fig = _figure(max(4.6 * ncols, 3.3 * legend_cols), 3.9 * nrows + 0.4 * math.ceil(12 / legend_cols) + 0.6)
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     handles = {}
     confidence = None
@@ -160,13 +161,13 @@ def plot_analysis(panels, estimator="surface", path=None):
     for ax in axes[n:]:
         ax.set_axis_off()
     what = f"{confidence:.0%} bootstrap intervals over seeds" if confidence is not None else "no summary"
-    fig.suptitle(f"Amplitude sweeps, {estimator} estimator: mean G′, G″ and {what}", fontsize="medium")
+    fig.suptitle(f"{estimator} estimator: mean G′, G″ and {what}", fontsize="medium")
     if handles:
         try:
-            fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=3,
+            fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=legend_cols,
                        fontsize="x-small", frameon=False)
         except (ValueError, TypeError):   # matplotlib < 3.7: no "outside" locations
-            fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=3, fontsize="x-small",
+            fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=legend_cols, fontsize="x-small",
                        frameon=False, bbox_to_anchor=(0.5, 0.0))
     if path is not None:
         save_figure(fig, path)
