@@ -221,15 +221,20 @@ def _lissajous_bowditch(result, elastic, viscous, text):
     import numpy as np
     from .analysis.measures import measured_window
     s = result.series
-    w = measured_window(s["t"], result.f, result.parameters.get("pre_periods", 0),
-                        result.parameters.get("periods", 0))
+    try:
+        w = measured_window(s["t"], result.f, result.parameters.get("pre_periods", 0),
+                            result.parameters.get("periods", 0))
+    except ValueError as exc:
+        text.axis("off")
+        text.text(0.0, 1.0, f"no LAOS: {exc}", va="top", ha="left", fontsize="small", transform=text.transAxes)
+        return
     rate = np.asarray(s.get("strain_rate", np.zeros(len(s["t"]))))
     lines = ["LAOS of the measured periods", ""]
     for est, color in (("surface", "C0"), ("internal", "C1")):
         key = "stress_" + est
         try:
             m = result.laos(est)
-        except ValueError as exc:
+        except (ValueError, KeyError) as exc:
             lines.append(f"{est}: {exc}")
             continue
         c = m.lissajous(400)

@@ -129,11 +129,16 @@ class Bootstrap(unittest.TestCase):
         # replicate means a, (a+b)/2, b with probabilities 1/4, 1/2, 1/4: the 2.5 % / 97.5 % percentiles are a, b
         a, b = 900.0, 1100.0
         A = [0.01, 0.01, 0.1, 0.1, 1.0, 1.0]
-        s = sweep_summary(A, [a, b, 500, 520, 10, 12], [1, 1, 2, 2, 50, 50], n_boot=4000, rng=3)
+        s = sweep_summary(A, [a, b, 500, 520, 10, 12], [1, 1, 2, 2, 50, 50], n_boot=4000, rng=3, student=False)
         self.assertEqual(s.plateau, (a + b) / 2)
         self.assertEqual(s.plateau_ci, (a, b))
         np.testing.assert_array_equal(s.Gp_ci, [[a, b], [500, 520], [10, 12]])   # resampled within each amplitude
         np.testing.assert_array_equal(s.n_seeds, [2, 2, 2])
+        # Student width: the replicates' deviations from the mean times √(n/(n−1))·t_{n−1}/z, n = 2
+        from particleShear.analysis.periods import t_critical
+        widen = math.sqrt(2.0) * t_critical(1, 0.05) / 1.959963984540054
+        s = sweep_summary(A, [a, b, 500, 520, 10, 12], [1, 1, 2, 2, 50, 50], n_boot=4000, rng=3)
+        np.testing.assert_allclose(s.plateau_ci, (1000 - widen * 100, 1000 + widen * 100), rtol=1e-9)
 
     def test_reproducible_from_rng(self):
         rng = np.random.default_rng(11)
@@ -183,9 +188,33 @@ class Bootstrap(unittest.TestCase):
         with self.assertWarnsRegex(UserWarning, r"amplitude\(s\) \[0.001\]"):
             sweep_summary(np.r_[A, A[1:]], np.r_[gp, gp[1:]], np.r_[gpp, gpp[1:]], n_boot=20, rng=0)
 
+    def test_coverage_with_student_width(self):
+        """M noisy sweeps of 4 seeds each (10 % normal multiplicative noise): the default 95 % intervals hold
+        the truth in ≈ 95 % of the sweeps (the Student-t width of a mean, carried into the flow point)."""
+        M, n, sigma = 250, 4, 0.10
+        expected = 0.95
+        # binomial: 3 standard deviations over M sweeps, plus 0.02 for the discreteness of resampling 4 seeds
+        # and the nonlinearity of the flow point
+        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
+        rng = np.random.default_rng(20261202)
+        A = np.repeat(AC * np.logspace(-2, 1.5, 5), n)
+        gp0, gpp0 = model(A)
+        plateau_true, flow_true = model(A[0])[0], AC / R
+        hits = np.zeros(2)
+        for _ in range(M):
+            gp = gp0 * (1 + sigma * rng.standard_normal(A.size))
+            gpp = gpp0 * (1 + sigma * rng.standard_normal(A.size))
+            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng)
+            hits += [s.plateau_ci[0] <= plateau_true <= s.plateau_ci[1],
+                     s.flow_point_ci[0] <= flow_true <= s.flow_point_ci[1]]
+        coverage = hits / M
+        print(f"coverage over {M} sweeps of {n} seeds: plateau {coverage[0]:.3f}, flow point {coverage[1]:.3f}")
+        for name, c in zip(("plateau", "flow_point"), coverage):
+            self.assertLess(abs(c - expected), tol, msg=f"{name}: coverage {c:.3f}, expected {expected} ± {tol:.3f}")
+
     def test_coverage_of_plateau_and_flow_point(self):
-        """M noisy sweeps (n seeds each, 10 % normal multiplicative noise): the 95 % intervals cover the truth
-        about as often as the percentile bootstrap of a mean from n seeds should, P(|T_{n−1}| < z√((n−1)/n))."""
+        """Plain percentile bootstrap (student=False), M noisy sweeps of n seeds: the 95 % intervals cover the
+        truth about as often as the percentile bootstrap of a mean from n seeds should, P(|T_{n−1}| < z√((n−1)/n))."""
         M, n, sigma = 250, 10, 0.10
         z = 1.959963984540054
         expected = t_cdf_interval(z * math.sqrt((n - 1) / n), n - 1)        # 0.904 for n = 10
@@ -202,7 +231,7 @@ class Bootstrap(unittest.TestCase):
         for _ in range(M):
             gp = gp0 * (1 + sigma * rng.standard_normal(A.size))
             gpp = gpp0 * (1 + sigma * rng.standard_normal(A.size))
-            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng)
+            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng, student=False)
             hits += [s.plateau_ci[0] <= plateau_true <= s.plateau_ci[1],
                      s.flow_point_ci[0] <= flow_true <= s.flow_point_ci[1]]
         coverage = hits / M

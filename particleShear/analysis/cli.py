@@ -5,9 +5,12 @@ Reads ``DIR/results.csv`` (:func:`particleShear.plot.read_sweep_table`), keeps t
 column except the strain amplitude ``theAmplitude`` (the parameter columns are the keys of
 :func:`particleShear.sweep.spec.sweep_parameter_defaults` present in the header; the inputs that
 change neither the physics nor the output, :data:`particleShear.simulation.provenance.IDENTITY_EXCLUDED`
-— ``doDrawing``, ``plotStress``, ``renderer``, ``strict_io`` — do not split groups; the runs of one
-group are its seeds), and summarises each group with
-:func:`particleShear.analysis.sweep.sweep_summary`.  Writes, atomically:
+— ``doDrawing``, ``plotStress``, ``renderer``, ``strict_io`` — and those of :data:`OUTPUT_ONLY` (what is
+saved, the backend) do not split groups; the runs of one group are its seeds), and summarises each
+group with :func:`particleShear.analysis.sweep.sweep_summary`.  The runs of a group are taken in
+the order (amplitude, run id) and each group's bootstrap stream is derived from ``--seed`` and the
+group's parameters, so the intervals depend neither on the order the runs finished in nor on the
+other groups of the folder.  Writes, atomically:
 
 ``DIR/analysis.csv``
     One row per group: ``group`` (a label), the parameters that differ between groups, the
@@ -30,8 +33,10 @@ import json
 import math
 import sys
 import warnings
+import zlib
 
 __all__ = [
+    "OUTPUT_ONLY",
     "ANALYSIS_NAME",
     "FIGURE_NAME",
     "SCHEMA_NAME",
@@ -51,6 +56,9 @@ FIGURE_NAME = "analysis"
 
 _PROG = "particleShear analyse"
 _AMPLITUDE = "theAmplitude"
+#: parameters that change what is written, not the moduli: they do not split groups
+OUTPUT_ONLY = frozenset({"saveData", "saveStressTensorData", "saveOutputImages", "saveOutputMovie", "imageFileType",
+                         "output_format", "backend", "root_folder"})
 
 #: columns before the characteristics: name → (type, unit, description)
 _HEAD_COLUMNS = {
@@ -168,9 +176,12 @@ def group_runs(rows, estimator="surface"):
     header = list(rows[0]) if rows else []
     if rows and _AMPLITUDE not in header:
         raise ValueError(f"results.csv has no {_AMPLITUDE} column: not a sweep table")
-    names = [c for c in sweep_parameter_defaults() if c in header and c != _AMPLITUDE and c not in IDENTITY_EXCLUDED]
+    names = [c for c in sweep_parameter_defaults() if c in header and c != _AMPLITUDE and c not in IDENTITY_EXCLUDED
+             and c not in OUTPUT_ONLY]
     cells = {}
-    for row, A, gp, gpp in kept:
+    # runs in a fixed order (amplitude, run id), not the order they finished in: the bootstrap draws
+    # the same resamples from the same seed however the table was written
+    for row, A, gp, gpp in sorted(kept, key=lambda k: (k[1], str(k[0].get("run_id", "")))):
         key = tuple(str(row.get(c, "")) for c in names)
         d = cells.setdefault(key, {"parameters": dict(zip(names, key)), "amplitude": [], "Gp": [], "Gpp": []})
         d["amplitude"].append(A)
@@ -311,9 +322,12 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     if skipped:
         notes.append(f"left out {skipped} row(s) with status ok but a missing or non-finite amplitude or "
                      f"{estimator} modulus")
-    rng = np.random.default_rng(seed)
     out_rows, panels = [], []
     for g in groups:
+        # each group its own stream, from the seed and the group's parameters: a group's intervals do not
+        # depend on which other groups the folder holds
+        label = "\x1f".join(f"{k}={v}" for k, v in sorted(g["parameters"].items()))
+        rng = np.random.default_rng(None if seed is None else [int(seed), zlib.crc32(label.encode("utf-8"))])
         summary, group_notes = _summarise(g, n_boot, confidence, rng)
         out_rows.append(_row(g, varying, summary, group_notes, estimator, n_boot, confidence, seed))
         panels.append((out_rows[-1]["group"], summary, group_notes))

@@ -54,7 +54,7 @@ def _yield_bracket(s, gp, gpp, interpolation):
             db = math.log(gp[b]) - math.log(gpp[b])
             la, lb = math.log(s[a]), math.log(s[b])
             x = math.exp(la + (0.0 - da) * (lb - la) / (db - da))
-        w = (x - s[a]) / (s[b] - s[a]) if s[b] != s[a] else 0.0
+        w = (x - s[a]) / (s[b] - s[a]) if s[b] != s[a] else 0.5   # a tie in strain: the mean of the two
     return float(x), float(gp[a] + w * (gp[b] - gp[a])), float(gpp[a] + w * (gpp[b] - gpp[a]))
 
 
@@ -91,15 +91,17 @@ def yield_point(strain, Gp, Gpp, interpolation="log"):
     return _yield_bracket(s, gp, gpp, interpolation)[0]
 
 
-def _first_max(values):
-    """0-based position of the first maximum; NaN counts as smaller than everything."""
-    v = np.where(np.isnan(values), -np.inf, values)
-    return int(np.argmax(v))
+def _first_extreme(values, largest):
+    """0-based position of the first maximum (minimum) over the non-NaN values; None when all are NaN.
 
-
-def _first_min(values):
-    v = np.where(np.isnan(values), np.inf, values)
-    return int(np.argmin(v))
+    NaN (a slope between repeated strains) is skipped, as R's which.max skips NA, so it can neither
+    win nor tie with an infinite slope.
+    """
+    ok = np.flatnonzero(~np.isnan(values))
+    if len(ok) == 0:
+        return None
+    v = values[ok]
+    return int(ok[np.argmax(v) if largest else np.argmin(v)])
 
 
 def _at_position(pos, ls, gp, gpp):
@@ -131,7 +133,8 @@ def stress_curve_points(strain, Gp, Gpp, guess_softening_strain=0.01, guess_soft
     * **yield** — :func:`yield_point` with ``interpolation="linear"``, G′ and G″ interpolated
       linearly in strain there.
 
-    NaN in the slopes (repeated strains) counts as neither the largest nor the smallest.
+    NaN in the slopes (repeated strains) is skipped: it is neither the largest nor the smallest.
+    At a yield bracket of two points with the same strain, G′ and G″ are their means.
 
     Parameters
     ----------
@@ -176,8 +179,10 @@ def stress_curve_points(strain, Gp, Gpp, guess_softening_strain=0.01, guess_soft
     D = -(p[:-1] + p[1:]) / 2.0                      # length n
     k = np.arange(n)
     g = float(guess_softening_strain)
-    i1 = _first_max(np.where((s >= g / 5) & (s <= 5 * g), gpp, 0.0))
-    i2 = _first_max(np.where(np.abs(k - i1) <= 3, D, 0.0))
+    i1 = _first_extreme(np.where((s >= g / 5) & (s <= 5 * g), gpp, 0.0), True)
+    i2 = None if i1 is None else _first_extreme(np.where(np.abs(k - i1) <= 3, D, 0.0), True)
+    if i2 is None:
+        return out
     soft = _at_position((i1 + i2) / 2.0, ls, gp, gpp)
     out["softening"] = soft
     h = float(guess_soft_plateau_strain)
@@ -190,8 +195,10 @@ def stress_curve_points(strain, Gp, Gpp, guess_softening_strain=0.01, guess_soft
             factor *= 3.0
             candidates = np.flatnonzero((s >= 1.5 * soft[0]) & (s <= factor * h))
     if len(candidates):
-        j1 = int(candidates[_first_min(gpp[candidates])])
-        window = np.flatnonzero(np.abs(k - j1) <= 3)
-        j2 = int(window[_first_min(D[window])])
-        out["soft_plateau"] = _at_position((j1 + j2) / 2.0, ls, gp, gpp)
+        c1 = _first_extreme(gpp[candidates], False)
+        j1 = None if c1 is None else int(candidates[c1])
+        window = np.flatnonzero(np.abs(k - j1) <= 3) if j1 is not None else np.zeros(0, dtype=int)
+        c2 = _first_extreme(D[window], False) if len(window) else None
+        if c2 is not None:
+            out["soft_plateau"] = _at_position((j1 + int(window[c2])) / 2.0, ls, gp, gpp)
     return out

@@ -11,7 +11,11 @@ import numpy as np
 
 from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
 
-__all__ = ["MEASURE_COLUMNS", "MeasurementWarning", "run_measures", "measured_window", "warn_few_periods"]
+__all__ = ["MEASURE_COLUMNS", "MEASURE_N_MAX", "MeasurementWarning", "empty_measures", "run_measures", "measured_window", "warn_few_periods"]
+
+#: highest harmonic order of the table's LAOS ratios: G_M and η_M weight order n by n, and orders above
+#: 5 of a run at N <= 150 are at its noise level (their S, T change sign with the order kept)
+MEASURE_N_MAX = 5
 
 #: columns of the results table after the four moduli, in order (units in docs/analysis.md)
 MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_internal_se", "steady_state",
@@ -46,7 +50,7 @@ def warn_few_periods(periods):
     why = "G′ and G″ get no standard error" + ("" if float(periods) >= 1 else
                                                  ", and a fraction of a period does not separate G′ from G″")
     warnings.warn(f"periods={periods!r} measures {n} whole excitation period(s){skipped}: {why}; use periods >= 3 "
-                  "(--periods 3)", MeasurementWarning, stacklevel=3)
+                  "(--periods 3)", MeasurementWarning, stacklevel=2)   # one place: shown once per process
     return True
 
 
@@ -69,7 +73,13 @@ def measured_window(t, f, pre_periods, periods):
     return measurement_periods(t, f, pre_periods, periods) == "oscillatory_measurement"
 
 
-def _nan_row():
+def empty_measures():
+    """The measures of a run that has none: NaN, ``steady_state`` None.
+
+    Returns
+    -------
+    dict
+    """
     return {c: (None if c == "steady_state" else math.nan) for c in MEASURE_COLUMNS}
 
 
@@ -85,7 +95,8 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
       (empty in the table) with fewer than 3 measured periods.
     * ``I3_I1_*``, ``S_*``, ``T_*`` — intensity ratio of the third harmonic and the
       Ewoldt–Hosoi–McKinley stiffening and thickening ratios over the ``"oscillatory_measurement"``
-      samples (:func:`~particleShear.analysis.laos.laos`); NaN when that span is shorter than a period.
+      samples (:func:`~particleShear.analysis.laos.laos` with orders up to :data:`MEASURE_N_MAX`); NaN
+      when that span is shorter than a period.
 
     Parameters
     ----------
@@ -105,7 +116,7 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
     """
     from .laos import laos
     from .periods import FALSE_ALARM, period_moduli
-    row = _nan_row()
+    row = empty_measures()
     if not series or "t" not in series or len(series["t"]) == 0 or not f:
         return row
     t = np.asarray(series["t"], dtype=float)
@@ -124,7 +135,8 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
             row[f"Gp_{est}_se"], row[f"Gpp_{est}_se"] = float(pm.Gp_se), float(pm.Gpp_se)
             flags.append(pm.steady)
         try:
-            m = laos(t[window], np.asarray(series["strain"], dtype=float)[window], stress[window], f)
+            m = laos(t[window], np.asarray(series["strain"], dtype=float)[window], stress[window], f,
+                     n_max=MEASURE_N_MAX)
         except (ValueError, KeyError, np.linalg.LinAlgError):
             continue
         row[f"I3_I1_{est}"], row[f"S_{est}"], row[f"T_{est}"] = float(m.I3_I1), float(m.S), float(m.T)

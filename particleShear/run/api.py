@@ -112,10 +112,16 @@ class SimulationResult:
         :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`), evaluated once from ``series``
         (:func:`~particleShear.analysis.measures.run_measures`; docs/analysis.md)."""
         if self._measures is None:
-            from ..analysis.measures import run_measures
+            import warnings
+            from ..analysis.measures import empty_measures, run_measures
             p = self.parameters or {}
-            self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0), p.get("pre_periods", 0),
-                                          p.get("periods", 0))
+            try:
+                self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0),
+                                              p.get("pre_periods", 0), p.get("periods", 0))
+            except Exception as exc:  # noqa: BLE001 - a measure must never turn a finished run into a failure
+                warnings.warn(f"the measures of run {self.run_id or '?'} could not be evaluated "
+                              f"({type(exc).__name__}: {exc}); they are left empty", RuntimeWarning, stacklevel=2)
+                self._measures = empty_measures()
         return self._measures
 
     @property
@@ -134,15 +140,16 @@ class SimulationResult:
         None with fewer than 3 measured periods (docs/analysis.md)."""
         return self.measures["steady_state"]
 
-    def laos(self, estimator="surface", n_max=15):
+    def laos(self, estimator="surface", n_max=5):
         """Large-amplitude oscillatory shear measures of the measured excitation periods.
 
         Parameters
         ----------
         estimator : {"surface", "internal"}, default "surface"
             Which shear stress: plate forces or the overall stress tensor.
-        n_max : int, default 15
-            Highest harmonic order fitted.
+        n_max : int, default 5
+            Highest harmonic order fitted (5, as the results table: higher orders of a run at
+            N <= 150 are at its noise level; see docs/analysis.md).
 
         Returns
         -------
