@@ -47,6 +47,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep",
     "particleShear.sweep.cli",
     "particleShear.sweep.cost",
+    "particleShear.sweep.calibration",
     "particleShear.sweep.locks",
     "particleShear.sweep.pool",
     "particleShear.sweep.record",

@@ -326,7 +326,7 @@ class TestSweep(unittest.TestCase):
             json.dump(dict(SPEC, seeds={"root": 7, "repetitions": 6}), fh)
         out = io.StringIO()
         with mock.patch.object(sys, "stdout", out):
-            self.assertEqual(sweep_main([spec_path, "--out", os.path.join(self.tmp, "dry"), "--dry-run"]), 0)
+            self.assertEqual(sweep_main([spec_path, "--out", os.path.join(self.tmp, "dry"), "--dry-run", "--no-calibrate"]), 0)
         self.assertIn("24 runs, 5,352 protocol steps", out.getvalue())     # 24 × 223 steps
         self.assertFalse(os.path.exists(os.path.join(self.tmp, "dry")))
         err = io.StringIO()

@@ -522,7 +522,7 @@ class TestBoundedAndChecked(unittest.TestCase):
             spec = _write_spec(d, doc)
             out = io.StringIO()
             with mock.patch.object(provenance, "run_identity", counted), mock.patch.object(sys, "stdout", out):
-                self.assertEqual(sweep_main([spec, "--out", os.path.join(d, "o"), "--dry-run"]), 0)
+                self.assertEqual(sweep_main([spec, "--out", os.path.join(d, "o"), "--dry-run", "--no-calibrate"]), 0)
             self.assertIn("10000000 runs", out.getvalue())
             self.assertLess(len(calls), 10)
             self.assertFalse(os.path.exists(os.path.join(d, "o")))

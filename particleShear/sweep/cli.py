@@ -21,7 +21,7 @@ def build_parser():
     -------
     argparse.ArgumentParser
         Positional ``SPEC``; ``--out DIR`` (required), ``--workers``, ``--dask``, ``--scheduler``,
-        ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``,
+        ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``, ``--no-calibrate``,
         ``--retry-failed``, ``--keep-going``, ``--quiet``, ``--backend``, ``--extend``.
     """
     p = argparse.ArgumentParser(prog="particleShear sweep",
@@ -43,7 +43,10 @@ def build_parser():
     a("--task-count", type=int, default=None, metavar="K", help="number of job-array tasks sharing the sweep")
     a("--merge", action="store_true", help="merge the per-task tables into DIR/results.csv and exit")
     a("--dry-run", action="store_true", help="print the size and projected cost, run nothing")
-    a("--calibrate", action="store_true", help="with --dry-run: time one shortened run here and scale the projection")
+    a("--calibrate", action="store_true",
+      help="with --dry-run: measure the calibration again even when one is cached (default: use the cache)")
+    a("--no-calibrate", action="store_true",
+      help="with --dry-run: only the static model of documented per-step costs, no timed run here")
     a("--retry-failed", action="store_true", help="run again the runs whose row says failed")
     a("--extend", action="store_true",
       help="DIR holds a sweep of another SPEC: add this SPEC's new runs to it and keep its rows (default: refuse)")
@@ -183,15 +186,25 @@ def _dry_run(args, sweep, workers):
     from .cost import format_cost
     _log.info(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
     all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
-    if args.calibrate:
-        from .cost import calibrate
-        factor = calibrate(sweep.runs[0].parameters)
-        _log.info(f"calibration: a shortened first run took {factor:.2f} x the documented per-step cost")
-        for c in (all_c, todo_c):
-            c["cpu_s"] *= factor
-            c["wall_s"] *= factor
-    _log.info("all runs:   " + format_cost(all_c))
-    _log.info("still to run: " + format_cost(todo_c))
+    _log.info("all runs:   " + format_cost(all_c) + " [static model]")
+    _log.info("still to run: " + format_cost(todo_c) + " [static model]")
+    if args.no_calibrate or not hasattr(sweep.runs, "points"):
+        return 0
+    from .calibration import cache_path, format_projection, load_or_measure, project_cost, representative_point
+    points = sweep.runs.points
+    counts = sweep._point_counts()
+    todo = sweep._point_counts(sweep._classify()[0].values())
+    p = representative_point(points, counts)
+    cal, cached = load_or_measure(p, refresh=args.calibrate)
+    how = "cached calibration" if cached else "calibration"
+    med = {k: sorted(cal[k])[len(cal[k]) // 2] for k in ("per_step_s", "fixed_s", "single_s")}
+    _log.info(f"{how} (point N={p['N']}, {cal['steps']} steps, {len(cal['per_step_s'])} samples): "
+              f"{1e6 * med['per_step_s']:.0f} us per step, {med['fixed_s']:.2f} s fixed per run; batch of "
+              f"{cal['replicas']}: {cal['batch_s'] / (cal['replicas'] * med['single_s']):.2f} of a single run "
+              f"per run (cache {cache_path()})")
+    for label, c in (("all runs:   ", counts), ("still to run: ", todo)):
+        _log.info(label + format_projection(project_cost(points, c, cal, workers=workers,
+                                                         batch_size=args.batch_size), workers, args.batch_size))
     return 0
 
 
