@@ -365,6 +365,8 @@ def sweep_groups(rows, estimator="surface"):
 
     Only rows with ``status == "ok"`` and finite moduli count.  The standard error is
     ``s/√n`` with the sample standard deviation ``s`` (ddof = 1); 0 for a single seed.
+    Rows that differ in any other parameter (a frequency, N, ...) fall into the same cell, as if
+    they were seeds; :func:`particleShear.sweep_plot.sweep_panels` keeps them apart.
 
     Parameters
     ----------
