@@ -11,11 +11,13 @@ plot_result
     and the Lissajous loop (stress against strain) of one :class:`~particleShear.run.api.SimulationResult`.
     Also available as ``result.plot(path)``.
 plot_sweep
-    G′ and G″ against strain amplitude (log axes) from a sweep folder's ``results.csv``, one
-    line per group (crosslinked / uncrosslinked / bulk control, per μ), mean ± standard error
-    over seeds.
+    G′ and G″ (log axes) from a sweep folder's ``results.csv`` against the amplitude or frequency,
+    one panel per material and per value of any other varying parameter, colour by μ, means over
+    seeds with bootstrap intervals (amplitude) or standard errors (:mod:`particleShear.sweep_plot`).
+sweep_groups
+    Mean and standard error over seeds per (material, μ) and amplitude (a table, no figure).
 cli_main
-    ``python -m particleShear plot DIR [--estimator internal]``.
+    ``python -m particleShear plot DIR [--estimator internal] [--x NAME] [--no-split]``.
 
 The estimators are defined in ``docs/output.md``: "surface" = shear stress from the forces on
 the plate bands (the value :func:`doParticleShearSimulation` returns), "internal" = xy component
@@ -368,6 +370,8 @@ def sweep_groups(rows, estimator="surface"):
 
     Only rows with ``status == "ok"`` and finite moduli count.  The standard error is
     ``s/√n`` with the sample standard deviation ``s`` (ddof = 1); 0 for a single seed.
+    Rows that differ in any other parameter (a frequency, N, ...) fall into the same cell, as if
+    they were seeds; :func:`particleShear.sweep_plot.sweep_panels` keeps them apart.
 
     Parameters
     ----------
@@ -410,15 +414,21 @@ def sweep_groups(rows, estimator="surface"):
     return out
 
 
-def plot_sweep(folder_or_csv, estimator="surface", path=None):
-    """G′ and G″ against strain amplitude of a sweep, one line per group and μ.
+def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=True, n_boot=2000, confidence=0.95,
+               bootstrap_seed=0, max_panels=12):
+    """G′ and G″ of a sweep against the parameter it varies; nothing but seeds pooled.
 
-    Reads ``DIR/results.csv`` (columns run_id, status, error, Gp_surface, Gpp_surface,
-    Gp_internal, Gpp_internal, then the parameters: theAmplitude, theMu, do_permanent_links,
-    cut_lines, ...).  Only ``status == "ok"`` rows are used; each point is the mean over seeds
-    with an error bar of one standard error.  Both axes are logarithmic, so a non-positive mean
-    (e.g. a negative G′ of a fluid-like group) is not shown; G′ is drawn with solid lines and filled
-    circles, G″ with dashed lines and open squares, same colour per group.
+    Reads ``DIR/results.csv``; only ``status == "ok"`` rows with finite moduli count.  The x-axis is
+    the strain amplitude ``theAmplitude`` or the frequency ``relative_frequency`` — whichever varies
+    (the amplitude if both do), or ``x``.  One panel per material (crosslinked / uncrosslinked /
+    bulk control, :func:`group_of`) and per value of every other parameter that varies (named in
+    the panel titles; with ``split=False`` such a parameter is refused instead), one colour per μ,
+    the legend beside the panels.  Each point is the mean over the seeds of one parameter set with
+    the 95 % bootstrap interval of :func:`particleShear.analysis.sweep.sweep_summary` (amplitude
+    x-axis) or ± one standard error (otherwise); the legend says which.  The number of seeds per
+    point is in the panel titles (or beside the points); fewer than 3 warn.  A mean ≤ 0 cannot be
+    drawn on the log axis: it is marked at the panel's lower edge, listed in a note and warned about.
+    Details: :mod:`particleShear.sweep_plot`.
 
     Parameters
     ----------
@@ -427,50 +437,56 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None):
     estimator : {"surface", "internal"}
         Which moduli to plot (default the surface estimator, as ``doParticleShearSimulation`` returns).
     path : str, os.PathLike or None
-        None (default): write ``DIR/G_vs_amplitude.png`` and ``DIR/G_vs_amplitude.pdf`` beside
-        the CSV.  A path: write only that file (format by extension).  False: write nothing.
+        None (default): write ``DIR/G_vs_amplitude.png`` and ``.pdf`` (``G_vs_frequency`` for a
+        frequency x-axis, ``G_vs_<x>`` for another) beside the CSV.  A path: write only that file
+        (format by extension).  False: write nothing.
+    x : str, optional
+        The x-axis parameter column (``"amplitude"``, ``"frequency"`` or a column name such as
+        ``"theAmplitude"``, ``"relative_frequency"``, ``"N"``; CLI ``--x``).  Default: chosen as above.
+    split : bool, optional
+        True (default): other varying parameters split the panels.  False: a ValueError names
+        them (CLI ``--no-split``).
+    n_boot : int, optional
+        Bootstrap replicates of the intervals (amplitude x-axis), >= 1 (default 2000).
+    confidence : float, optional
+        Level of the bootstrap intervals, in (0, 1) (default 0.95).
+    bootstrap_seed : int or None, optional
+        Seed of the resampling, >= 0 (default 0: the figure is reproducible); None: fresh entropy.
+    max_panels : int, optional
+        More panels than this are refused with a ValueError naming the parameters (default 12).
 
     Returns
     -------
     matplotlib.figure.Figure
-        One Line2D per group for G′ (label "G′ <group>, μ=<μ>") and one for G″.
+        Labelled with its file stem; axes: one per panel, then the legend axes.  In each panel
+        one errorbar container per modulus and μ, labelled ``"G′ μ=<μ>"`` and ``"G″ μ=<μ>"``.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter: an unknown ``estimator`` or ``x``, a varying parameter that can be
+        neither the x-axis nor a panel, no usable rows, a setting out of range.
+
+    Warns
+    -----
+    UserWarning
+        Means ≤ 0 (marked, not drawn), fewer than 3 seeds at a point, ``ok`` rows left out.
     """
+    from .sweep_plot import draw_sweep, sweep_panels
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS} (CLI --estimator)")
     rows = read_sweep_table(folder_or_csv)
-    groups = sweep_groups(rows, estimator)
-    if not groups:
-        raise ValueError(f"folder_or_csv={folder_or_csv!r} has no rows with status 'ok' and finite moduli")
-    import numpy as np
-    fig = _figure(6.4, 4.4)
-    ax = fig.subplots()
-    for k, ((group, mu), d) in enumerate(groups.items()):
-        d = {key: np.asarray(v, dtype=float) for key, v in d.items()}
-        colour = f"C{k % 10}"
-        name = f"{group}, μ={mu:g}"
-        ax.errorbar(d["A"], d["Gp"], yerr=d["Gp_err"], color=colour, marker="o", ls="-", capsize=3,
-                    label="G′ " + name)
-        ax.errorbar(d["A"], d["Gpp"], yerr=d["Gpp_err"], color=colour, marker="s", mfc="white", ls="--",
-                    capsize=3, label="G″ " + name)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    amplitudes = sorted({a for d in groups.values() for a in d["A"]})
-    if len(amplitudes) <= 12:  # label the measured amplitudes themselves, no crowded minor labels
-        from matplotlib.ticker import NullFormatter
-        ax.set_xticks(amplitudes, [f"{a:g}" for a in amplitudes])
-        ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel("strain amplitude A (–)")
-    ax.set_ylabel(f"G′, G″ (Pa), {estimator} estimator")
-    n_seeds = sorted({n for d in groups.values() for n in d["n"]})
-    ax.set_title(f"mean ± standard error over {n_seeds[0]}–{n_seeds[-1]} seeds" if len(n_seeds) > 1
-                 else f"mean ± standard error over {n_seeds[0]} seed(s)", fontsize="medium")
-    ax.grid(True, which="both", color="0.9", lw=0.6)
-    ax.legend(fontsize="x-small", ncol=2 if len(groups) > 2 else 1)
+    try:
+        table = sweep_panels(rows, estimator, x=x, split=split, n_boot=n_boot, confidence=confidence,
+                             bootstrap_seed=bootstrap_seed, max_panels=max_panels)
+    except ValueError as exc:
+        raise ValueError(f"folder_or_csv={str(folder_or_csv)!r}: {exc}") from None
+    fig = draw_sweep(table)
     if path is None:
         src = str(folder_or_csv)
         folder = src if os.path.isdir(src) else os.path.dirname(os.path.abspath(src))
         for ext in (".png", ".pdf"):
-            save_figure(fig, os.path.join(folder, "G_vs_amplitude" + ext))
+            save_figure(fig, os.path.join(folder, fig.get_label() + ext))
     elif path is not False:
         save_figure(fig, path)
     return fig
@@ -485,21 +501,32 @@ def build_parser():
     Returns
     -------
     argparse.ArgumentParser
-        Positional ``DIR``, options ``--estimator {surface,internal}`` and ``--output FILE``.
+        Positional ``DIR``, options ``--estimator {surface,internal}``, ``--output FILE``,
+        ``--x NAME`` and ``--no-split``.
     """
     p = argparse.ArgumentParser(prog="particleShear plot",
-                                description="Plot G' and G'' against strain amplitude of a sweep folder "
-                                            "(reads DIR/results.csv, writes DIR/G_vs_amplitude.png and .pdf).")
+                                description="Plot G' and G'' of a sweep folder against the parameter it varies "
+                                            "(amplitude or frequency), one panel per material and per value of any "
+                                            "other varying parameter (reads DIR/results.csv, writes "
+                                            "DIR/G_vs_amplitude.png and .pdf, or G_vs_frequency.*).")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv (or the CSV file)")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
                    help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
     p.add_argument("--output", metavar="FILE", default=None,
                    help="write this file instead of DIR/G_vs_amplitude.png and .pdf")
+    p.add_argument("--x", metavar="NAME", default=None,
+                   help="x-axis parameter: amplitude (theAmplitude), frequency (relative_frequency) or another "
+                        "numeric parameter column (default: the one of amplitude and frequency that varies)")
+    p.add_argument("--no-split", dest="split", action="store_false",
+                   help="refuse (exit 2) instead of splitting the panels by a parameter that varies besides the "
+                        "x-axis, mu and the material")
     return p
 
 
 def cli_main(argv=None):
-    """``python -m particleShear plot DIR [--estimator internal] [--output FILE]``.
+    """``python -m particleShear plot DIR [--estimator internal] [--output FILE] [--x NAME] [--no-split]``.
+
+    The warnings of :func:`plot_sweep` (means ≤ 0, few seeds) are printed on stderr.
 
     Parameters
     ----------
@@ -511,9 +538,14 @@ def cli_main(argv=None):
     int
         Exit status: 0 written, 1 matplotlib missing, 2 invalid input (message on stderr).
     """
+    import warnings
     args = build_parser().parse_args(argv)
     try:
-        plot_sweep(args.folder, estimator=args.estimator, path=args.output)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fig = plot_sweep(args.folder, estimator=args.estimator, path=args.output, x=args.x, split=args.split)
+        for w in caught:
+            print(f"particleShear plot: warning: {w.message}", file=sys.stderr)
     except ImportError as exc:
         print(f"particleShear plot: {exc}", file=sys.stderr)
         return 1
@@ -521,7 +553,7 @@ def cli_main(argv=None):
         print(f"particleShear plot: {exc}", file=sys.stderr)
         return 2
     folder = args.folder if os.path.isdir(args.folder) else os.path.dirname(os.path.abspath(args.folder))
-    written = [args.output] if args.output else [os.path.join(folder, "G_vs_amplitude" + e) for e in (".png", ".pdf")]
+    written = [args.output] if args.output else [os.path.join(folder, fig.get_label() + e) for e in (".png", ".pdf")]
     with console_messages(stream=sys.stdout):
         for w in written:
             logging.getLogger(__name__).info("wrote %s", w)

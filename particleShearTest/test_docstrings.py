@@ -57,6 +57,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.table",
     "particleShear.sweep.tasks",
     "particleShear.plot",
+    "particleShear.sweep_plot",
     "particleShear.messages",
     "particleShear.run",
     "particleShear.run.api",

@@ -1,24 +1,24 @@
-"""Figures (matplotlib, extra ``[plot]``): a run's trace and Lissajous loop, a sweep's G′/G″ vs amplitude.
+"""Figures (matplotlib, extra ``[plot]``): a run's trace and Lissajous loop, a sweep's G′/G″ panels.
 
-The sweep test writes its own ``results.csv`` following the column contract of the sweep
-runner (run_id, status, error, Gp_surface, Gpp_surface, Gp_internal, Gpp_internal, parameters)
-and checks the plotted points against means and standard errors computed here with NumPy.
+The sweep tests write their own ``results.csv`` with the sweep runner's header
+(:func:`particleShear.sweep.table.table_columns`, rows by :func:`~particleShear.sweep.table.row_line`,
+every parameter column filled with its default unless a run sets it) and check the plotted points
+against means, standard errors and bootstrap properties computed here with NumPy.
 """
-import csv
 import importlib.util
+import io
 import math
 import os
 import sys
 import tempfile
 import unittest
+import warnings
 from unittest import mock
 
 import numpy as np
 
 HAVE_MPL = importlib.util.find_spec("matplotlib") is not None
 
-COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal",
-           "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "seed"]
 
 
 def synthetic_result(G1=300.0, G2=60.0, A=0.2, f=2.0, pre=1.0, P=2.0, post=1.0):
@@ -37,6 +37,25 @@ def synthetic_result(G1=300.0, G2=60.0, A=0.2, f=2.0, pre=1.0, P=2.0, post=1.0):
                                         "post_periods": post}, f=f, series=series)
 
 
+def write_table(folder, runs):
+    """Write ``folder/results.csv`` with the real header; ``runs`` are dicts of the columns they set
+    (moduli, status, parameters); every other parameter column holds its default."""
+    from particleShear.sweep.spec import sweep_parameter_defaults
+    from particleShear.sweep.table import row_line, table_columns
+    columns = table_columns()
+    defaults = sweep_parameter_defaults()
+    with open(os.path.join(folder, "results.csv"), "w", newline="", encoding="utf-8") as fh:
+        fh.write(row_line({c: c for c in columns}, columns))
+        for k, run in enumerate(runs):
+            row = {**defaults, "run_id": k, "status": "ok", "spawn_key": [k], **run}
+            fh.write(row_line(row, columns))
+
+
+def moduli(rng):
+    gp, gpp, gpi, gppi = rng.uniform(50, 500, 4)
+    return {"Gp_surface": gp, "Gpp_surface": gpp, "Gp_internal": gpi, "Gpp_internal": gppi}
+
+
 def write_sweep_csv(folder):
     """3 amplitudes × 3 seeds × 4 groups (crosslinked μ=0.01 and 0.1, uncrosslinked, bulk control),
     plus one failed row with absurd moduli that must not count.  Returns the table of expected values."""
@@ -44,23 +63,35 @@ def write_sweep_csv(folder):
     groups = [("crosslinked", 0.01, True, 5), ("crosslinked", 0.1, True, 5), ("uncrosslinked", 0.01, False, 0),
               ("bulk control", 0.01, True, 0)]
     expected = {}
-    rows = []
-    k = 0
+    runs = []
     for name, mu, links, cl in groups:
         for A in (0.01, 0.1, 1.0):
             vals = []
-            for seed in range(3):
-                gp, gpp, gpi, gppi = rng.uniform(50, 500, 4)
-                vals.append((gp, gpp, gpi, gppi))
-                rows.append([k, "ok", "", gp, gpp, gpi, gppi, A, mu, links, cl, seed])
-                k += 1
+            for _ in range(3):
+                m = moduli(rng)
+                vals.append((m["Gp_surface"], m["Gpp_surface"], m["Gp_internal"], m["Gpp_internal"]))
+                runs.append(dict(m, theAmplitude=A, theMu=mu, do_permanent_links=links, cut_lines=cl))
             expected[(name, mu, A)] = np.array(vals)
-    rows.append([k, "error", "SimulationInstabilityError: diverged", 1e12, 1e12, 1e12, 1e12, 0.1, 0.01, True, 5, 9])
-    with open(os.path.join(folder, "results.csv"), "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(COLUMNS)
-        w.writerows(rows)
+    runs.append(dict(status="error", error="SimulationInstabilityError: diverged", Gp_surface=1e12, Gpp_surface=1e12,
+                     Gp_internal=1e12, Gpp_internal=1e12, theAmplitude=0.1, theMu=0.01, do_permanent_links=True,
+                     cut_lines=5))
+    write_table(folder, runs)
     return expected
+
+
+def panel_axes(fig):
+    """The data panels of a sweep figure (the last axes holds the legend)."""
+    return fig.axes[:-1]
+
+
+def containers(ax):
+    return {c.get_label(): c for c in ax.containers}
+
+
+def bar_ends(cont):
+    """(low, high) of each error bar of an errorbar container."""
+    segs = cont.lines[2][0].get_segments()
+    return np.array([s[0][1] for s in segs]), np.array([s[1][1] for s in segs])
 
 
 @unittest.skipUnless(HAVE_MPL, "matplotlib not installed (extra [plot])")
@@ -114,42 +145,192 @@ class TestResultPlot(unittest.TestCase):
 
 @unittest.skipUnless(HAVE_MPL, "matplotlib not installed (extra [plot])")
 class TestSweepPlot(unittest.TestCase):
+    AMPS = (0.01, 0.1, 1.0)
+
     def check_figure(self, fig, expected, estimator):
-        ax = fig.axes[0]
-        self.assertEqual(ax.get_xscale(), "log")
-        self.assertEqual(ax.get_yscale(), "log")
-        self.assertEqual(ax.get_xlabel(), "strain amplitude A (–)")
-        self.assertIn("(Pa)", ax.get_ylabel())
-        self.assertIn(estimator, ax.get_ylabel())
-        by_label = {c.get_label(): c for c in ax.containers}
-        gp_lines = [lab for lab in by_label if lab.startswith("G′ ")]
-        gpp_lines = [lab for lab in by_label if lab.startswith("G″ ")]
-        self.assertEqual(len(gp_lines), 4)   # one line per group and μ
-        self.assertEqual(len(gpp_lines), 4)
+        axes = panel_axes(fig)
+        # one panel per material, crosslinked first; μ by colour inside the crosslinked panel
+        self.assertEqual([ax.get_title().split("\n")[0] for ax in axes], ["crosslinked", "uncrosslinked", "bulk control"])
         col = {"surface": (0, 1), "internal": (2, 3)}[estimator]
+        for ax in axes:
+            self.assertEqual(ax.get_xscale(), "log")
+            self.assertEqual(ax.get_yscale(), "log")
+            self.assertEqual(ax.get_xlabel(), "strain amplitude A (–)")
+            self.assertIn("(Pa)", ax.get_ylabel())
+            self.assertIn(estimator, ax.get_ylabel())
+            self.assertIn("n = 3 seed(s) per point", ax.get_title())
         for (name, mu) in {(k[0], k[1]) for k in expected}:
+            ax = axes[["crosslinked", "uncrosslinked", "bulk control"].index(name)]
             for which, c in (("G′", col[0]), ("G″", col[1])):
-                cont = by_label[f"{which} {name}, μ={mu:g}"]
+                cont = containers(ax)[f"{which} μ={mu:g}"]
                 data_line = cont.lines[0]
-                np.testing.assert_allclose(data_line.get_xdata(), [0.01, 0.1, 1.0])
-                means = [expected[(name, mu, A)][:, c].mean() for A in (0.01, 0.1, 1.0)]
-                np.testing.assert_allclose(data_line.get_ydata(), means, rtol=1e-12)
-                # error bar = standard error s/√n (ddof = 1), drawn from mean − se to mean + se
-                se = [expected[(name, mu, A)][:, c].std(ddof=1) / math.sqrt(3) for A in (0.01, 0.1, 1.0)]
-                segs = cont.lines[2][0].get_segments()
-                # the bar's end points are mean ± se in float64; their difference loses ~ε·mean/se ≲ 1e-14
-                np.testing.assert_allclose([s[1][1] - s[0][1] for s in segs], 2 * np.array(se), rtol=1e-9)
+                np.testing.assert_allclose(data_line.get_xdata(), self.AMPS)
+                seeds = [expected[(name, mu, A)][:, c] for A in self.AMPS]
+                np.testing.assert_allclose(data_line.get_ydata(), [v.mean() for v in seeds], rtol=1e-12)
+                # a bootstrap mean of resampled seeds lies between the smallest and largest seed,
+                # so the interval does too, and it holds the mean (a percentile of a distribution that
+                # has the mean in its support between both ends at 95 % for 3 seeds: P(all = min) = 1/27)
+                low, high = bar_ends(cont)
+                self.assertTrue(np.all(low >= np.array([v.min() for v in seeds]) - 1e-9))
+                self.assertTrue(np.all(high <= np.array([v.max() for v in seeds]) + 1e-9))
+                self.assertTrue(np.all((low <= data_line.get_ydata()) & (data_line.get_ydata() <= high)))
+        legend = fig.axes[-1].get_legend()
+        self.assertIn("95 % bootstrap interval", legend.get_title().get_text())
+        self.assertEqual(len(fig.axes[-1].lines) + len(fig.axes[-1].containers), 0)   # the legend axes holds no data
 
     def test_groups_means_and_files(self):
         from particleShear.plot import plot_sweep
         with tempfile.TemporaryDirectory() as d:
             expected = write_sweep_csv(d)
-            fig = plot_sweep(d)
+            fig = plot_sweep(d, n_boot=400)
             for name in ("G_vs_amplitude.png", "G_vs_amplitude.pdf"):
                 self.assertGreater(os.path.getsize(os.path.join(d, name)), 1000)
             self.check_figure(fig, expected, "surface")
-            fig = plot_sweep(os.path.join(d, "results.csv"), estimator="internal", path=False)
+            fig = plot_sweep(os.path.join(d, "results.csv"), estimator="internal", path=False, n_boot=400)
             self.check_figure(fig, expected, "internal")
+
+    def test_bootstrap_interval_of_three_seeds_is_their_range(self):
+        # resampling 3 seeds, the mean of a resample is the smallest seed with probability 1/27 = 3.7 %
+        # > 2.5 %: with 20000 resamples (741 ± 27 such draws, 500 needed) both 95 % ends are the seeds'
+        # minimum and maximum exactly.  The plotted interval is sweep_summary's: equal to it too.
+        from particleShear.analysis.sweep import sweep_summary
+        from particleShear.plot import plot_sweep
+        rng = np.random.default_rng(11)
+        runs, A, gp, gpp = [], [], [], []
+        for amp in (0.05, 0.2):
+            for _ in range(3):
+                m = moduli(rng)
+                runs.append(dict(m, theAmplitude=amp))
+                A.append(amp)
+                gp.append(m["Gp_surface"])
+                gpp.append(m["Gpp_surface"])
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            fig = plot_sweep(d, path=False, n_boot=20000, bootstrap_seed=3)
+        conts = containers(panel_axes(fig)[0])
+        ref = sweep_summary(A, gp, gpp, n_boot=20000, rng=3)
+        for label, values, ci in (("G′ μ=0.01", gp, ref.Gp_ci), ("G″ μ=0.01", gpp, ref.Gpp_ci)):
+            v = np.array(values).reshape(2, 3)
+            low, high = bar_ends(conts[label])
+            np.testing.assert_allclose(low, v.min(axis=1), rtol=1e-12)
+            np.testing.assert_allclose(high, v.max(axis=1), rtol=1e-12)
+            np.testing.assert_allclose(np.c_[low, high], ci, rtol=1e-12)
+
+    def frequency_runs(self, amplitudes=(0.1,), seeds=3, extra=None):
+        rng = np.random.default_rng(2)
+        runs, expected = [], {}
+        for amp in amplitudes:
+            for f in (0.02, 0.05, 0.1):
+                vals = [moduli(rng) for _ in range(seeds)]
+                runs += [dict(m, theAmplitude=amp, relative_frequency=f, **(extra or {})) for m in vals]
+                expected[(amp, f)] = np.array([m["Gp_surface"] for m in vals])
+        return runs, expected
+
+    def test_frequency_sweep_plots_frequency_and_does_not_pool(self):
+        from particleShear.plot import plot_sweep
+        runs, expected = self.frequency_runs()
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")          # 3 seeds, positive means: nothing to warn about
+                fig = plot_sweep(d)
+            self.assertTrue(os.path.isfile(os.path.join(d, "G_vs_frequency.png")))
+            self.assertFalse(os.path.exists(os.path.join(d, "G_vs_amplitude.png")))
+        ax, = panel_axes(fig)
+        self.assertEqual(ax.get_xlabel(), "relative frequency f·τ (–)")
+        cont = containers(ax)["G′ μ=0.01"]
+        np.testing.assert_allclose(cont.lines[0].get_xdata(), [0.02, 0.05, 0.1])
+        means = np.array([expected[(0.1, f)].mean() for f in (0.02, 0.05, 0.1)])
+        se = np.array([expected[(0.1, f)].std(ddof=1) / math.sqrt(3) for f in (0.02, 0.05, 0.1)])
+        np.testing.assert_allclose(cont.lines[0].get_ydata(), means, rtol=1e-12)
+        low, high = bar_ends(cont)
+        # mean ± se in float64: the ends carry rounding of ~ε·mean, far below 1e-9·se
+        np.testing.assert_allclose(low, means - se, rtol=1e-9)
+        np.testing.assert_allclose(high, means + se, rtol=1e-9)
+        self.assertIn("standard error", fig.axes[-1].get_legend().get_title().get_text())
+
+    def test_amplitude_axis_on_a_frequency_sweep_splits_by_frequency(self):
+        from particleShear.plot import plot_sweep
+        runs, expected = self.frequency_runs()
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            fig = plot_sweep(d, path=False, x="amplitude")
+        axes = panel_axes(fig)
+        self.assertEqual([ax.get_title().split("\n")[0] for ax in axes],
+                         [f"crosslinked, relative_frequency = {f:g}" for f in (0.02, 0.05, 0.1)])
+        for ax, f in zip(axes, (0.02, 0.05, 0.1)):
+            ydata = containers(ax)["G′ μ=0.01"].lines[0].get_ydata()
+            np.testing.assert_allclose(ydata, [expected[(0.1, f)].mean()], rtol=1e-12)
+        # one amplitude per curve: no bootstrap summary, standard errors, and the legend says why
+        title = fig.axes[-1].get_legend().get_title().get_text()
+        self.assertIn("standard error", title)
+        self.assertIn(">= 2 amplitudes", title)
+
+    def test_third_varying_parameter_splits_panels_or_is_refused_by_name(self):
+        from particleShear.plot import plot_sweep
+        from particleShear.run.cli import main
+        runs = []
+        for n in (30, 60):
+            r, _ = self.frequency_runs(amplitudes=(0.05, 0.2), extra={"N": n})
+            runs += r
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            # amplitude and frequency both vary: the amplitude is the x-axis, frequency and N split panels
+            fig = plot_sweep(d, path=False, n_boot=200)
+            titles = [ax.get_title().split("\n")[0] for ax in panel_axes(fig)]
+            self.assertEqual(len(titles), 6)
+            self.assertIn("crosslinked, N = 30, relative_frequency = 0.02", titles)
+            self.assertIn("crosslinked, N = 60, relative_frequency = 0.1", titles)
+            self.assertIn("N, relative_frequency", fig.get_suptitle())
+            with self.assertRaisesRegex(ValueError, r"\['N', 'relative_frequency'\] vary"):
+                plot_sweep(d, path=False, split=False)
+            with self.assertRaisesRegex(ValueError, r"6 panels .*'N', 'relative_frequency'.*max_panels=4"):
+                plot_sweep(d, path=False, max_panels=4)
+            err = io.StringIO()
+            with mock.patch("sys.stderr", err):
+                self.assertEqual(main(["plot", d, "--x", "frequency", "--no-split"]), 2)
+            self.assertIn("['theAmplitude', 'N']", err.getvalue())
+
+    def test_nonpositive_means_are_marked_and_reported(self):
+        from particleShear.plot import plot_sweep
+        rng = np.random.default_rng(4)
+        runs = []
+        for amp in (0.05, 0.2, 0.8):
+            for gp in ((-40.0, -20.0, 5.0) if amp == 0.8 else rng.uniform(50, 500, 3)):
+                runs.append(dict(moduli(rng), Gp_surface=gp, theAmplitude=amp, do_permanent_links=False))
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            with self.assertWarnsRegex(UserWarning, r"<= 0 .*uncrosslinked μ=0.01: G′ = -18.3 Pa at A = 0.8"):
+                fig = plot_sweep(d, path=False, n_boot=200)
+        ax, = panel_axes(fig)
+        ydata = containers(ax)["G′ μ=0.01"].lines[0].get_ydata()
+        self.assertTrue(np.isnan(ydata[2]) and np.all(ydata[:2] > 0))   # not drawn on the log axis ...
+        marks = [ln for ln in ax.lines if ln.get_gid() == "nonpositive"]
+        self.assertEqual(len(marks), 1)                                   # ... but marked there
+        np.testing.assert_allclose(marks[0].get_xdata(), [0.8])
+        np.testing.assert_allclose(marks[0].get_ydata(), [0.0])          # axes fraction 0: the lower edge
+        note = [t for t in fig.axes[-1].texts if t.get_gid() == "note"]
+        self.assertIn("G′ = -18.3 Pa at A = 0.8", note[0].get_text())
+
+    def test_fewer_than_three_seeds_warns(self):
+        from particleShear.plot import plot_sweep
+        runs, _ = self.frequency_runs(seeds=2)
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            with self.assertWarnsRegex(UserWarning, "fewer than 3 seeds at 3 of 3 point"):
+                fig = plot_sweep(d, path=False)
+        self.assertIn("n = 2 seed(s) per point", panel_axes(fig)[0].get_title())
+
+    def test_seed_counts_that_differ_are_written_beside_the_points(self):
+        from particleShear.plot import plot_sweep
+        runs, _ = self.frequency_runs(seeds=3)
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs[:-1])                     # the last frequency has 2 seeds
+            with self.assertWarnsRegex(UserWarning, "fewer than 3 seeds at 1 of 3"):
+                fig = plot_sweep(d, path=False)
+        ax, = panel_axes(fig)
+        self.assertIn("n = 2–3 seeds per point", ax.get_title())
+        self.assertEqual(sorted(t.get_text() for t in ax.texts), ["n=2", "n=3", "n=3"])
 
     def test_cli_plot_subcommand(self):
         from particleShear.run.cli import main
@@ -162,11 +343,27 @@ class TestSweepPlot(unittest.TestCase):
                 self.assertEqual(main(["plot", os.path.join(d, "nothing_here")]), 2)
                 with self.assertRaises(SystemExit):
                     main(["plot", d, "--estimator", "bogus"])
+        runs, _ = self.frequency_runs(seeds=2)
+        with tempfile.TemporaryDirectory() as d:
+            write_table(d, runs)
+            out, err = io.StringIO(), io.StringIO()
+            with mock.patch("sys.stdout", out), mock.patch("sys.stderr", err):
+                self.assertEqual(main(["plot", d]), 0)
+            self.assertIn("G_vs_frequency.png", out.getvalue())
+            self.assertTrue(os.path.isfile(os.path.join(d, "G_vs_frequency.pdf")))
+            self.assertIn("warning: plot_sweep: fewer than 3 seeds", err.getvalue())
 
-    def test_bad_estimator_is_named(self):
+    def test_bad_estimator_and_x_are_named(self):
         from particleShear.plot import plot_sweep
         with self.assertRaisesRegex(ValueError, "estimator='tensor'"):
             plot_sweep(".", estimator="tensor")
+        with tempfile.TemporaryDirectory() as d:
+            write_sweep_csv(d)
+            for bad in ("amplitud", "do_permanent_links", "integrator"):
+                with self.assertRaisesRegex(ValueError, f"x='{bad}' is invalid: .*allowed 'theAmplitude'"):
+                    plot_sweep(d, path=False, x=bad)
+            with self.assertRaisesRegex(ValueError, "n_boot=0 is out of range"):
+                plot_sweep(d, path=False, n_boot=0)
 
 
 if __name__ == "__main__":
