@@ -411,7 +411,9 @@ class TestRunLayer(unittest.TestCase):
             image_N = int(r.N_steps / 200) if r.N_steps > 200 else 1
             expected = ["image%07d.png" % k for k in range(0, r.N_steps, image_N)]
             self.assertEqual(files, expected)
-            self.assertTrue(r.image_folder.endswith("_nr_1.txt_images_folder"))
+            # named after the run (no text file exists: saveData=False), not after a ".txt" path
+            self.assertTrue(r.image_folder.endswith("_nr_1_images"), r.image_folder)
+            self.assertEqual(os.listdir(d), [os.path.basename(r.image_folder)])
             self.assertEqual(r.output_path, None)  # saveData=False: no text file, only images
             from PIL import Image
             with Image.open(os.path.join(r.image_folder, files[-1])) as im:
