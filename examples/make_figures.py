@@ -1,4 +1,4 @@
-"""Make the README's three pictures in docs/figures/ (needs ``pip install "particleShear[plot]"``).
+"""Make the README's three pictures in docs/figures/ at 150 dpi (needs ``pip install "particleShear[plot]"``).
 
 1. ``trace.png``: one run's strain and stress traces and its Lissajous loop (``result.plot``).
 2. ``sweep.png``: G′ and G″ against strain amplitude of a small real sweep (crosslinked,
@@ -23,6 +23,8 @@ import numpy as np
 from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
 from particleShear.plot import plot_sweep, save_figure
 
+#: resolution of the raster figures (dots per inch)
+DPI = 150
 SMALL = dict(N=40, pre_periods=0.5, periods=2, post_periods=0.5, doDrawing=False, plotStress=False)
 COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal",
            "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "spawn_key"]
@@ -31,7 +33,7 @@ COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_interna
 def trace_and_snapshot(out, work):
     res = doParticleShearSimulation(work, theAmplitude=0.2, cut_lines=4, saveOutputImages=True, imageFileType="png",
                                     seed=1, verbose=False, return_result=True, **SMALL)
-    save_figure(res.plot(), os.path.join(out, "trace.png"), dpi=80)
+    save_figure(res.plot(), os.path.join(out, "trace.png"), dpi=DPI)
     # the snapshot nearest to the first strain maximum: t = (pre + 1/4)/f
     t_max = (SMALL["pre_periods"] + 0.25) / res.f
     step = int(round(t_max / res.dt))
@@ -60,7 +62,7 @@ def small_sweep(out, work, workers):
 def replot_sweep(out):
     """Redraw sweep.png from the saved ``sweep_results.csv`` (no simulation)."""
     fig = plot_sweep(os.path.join(out, "sweep_results.csv"), path=False)
-    save_figure(fig, os.path.join(out, "sweep.png"), dpi=80)
+    save_figure(fig, os.path.join(out, "sweep.png"), dpi=DPI)
 
 
 def main(argv=None):

@@ -34,7 +34,7 @@ import sys
 from .messages import console_messages
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
-           "check_figure_path"]
+           "check_figure_path", "align_zeros"]
 
 _INSTALL_HINT = 'particleShear.plot needs matplotlib: pip install "particleShear[plot]"'
 
@@ -138,12 +138,49 @@ def save_figure(fig, path, dpi=150):
 # ---------------------------------------------------------------------------------------------
 # one run
 # ---------------------------------------------------------------------------------------------
+def align_zeros(ax, other):
+    """Widen the y limits of two axes sharing an x axis so that y = 0 is at the same height on both.
+
+    Each range is first extended to include 0; then the one whose zero lies lower is extended
+    downwards or the other upwards (limits are only widened, never narrowed), so the fraction
+    ``−lo / (hi − lo)`` is the same on both axes.
+
+    Parameters
+    ----------
+    ax, other : matplotlib.axes.Axes
+        The two axes (e.g. an axis and its ``twinx``).
+
+    Returns
+    -------
+    float
+        That common fraction of the height below 0.
+    """
+    limits = []
+    for a in (ax, other):
+        lo, hi = a.get_ylim()
+        lo, hi = min(lo, 0.0), max(hi, 0.0)
+        if hi == lo:
+            lo, hi = -1.0, 1.0
+        limits.append((lo, hi))
+    fracs = [-lo / (hi - lo) for lo, hi in limits]
+    target = min(max(max(fracs), 0.05), 0.95)   # a zero at the very edge would squash the other axis
+    for a, (lo, hi), frac in zip((ax, other), limits, fracs):
+        if frac < target:      # more room below 0
+            lo = -hi * target / (1 - target)
+        elif frac > target:    # more room above 0
+            hi = -lo * (1 - target) / target
+        a.set_ylim(lo, hi)
+    return target
+
+
 def plot_result(result, path=None):
     """Trace, Lissajous loop and Lissajous–Bowditch curves of one run.
 
     Top left: strain γ (right axis, dimensionless) and the shear stresses τ_surface and τ_internal
-    (Pa) against time t (s); the baseline periods before and after the excitation are shaded
-    grey and the excitation window is bounded by dotted lines.  Top right: the Lissajous loop
+    (Pa) against time in excitation periods t·f (the excitation starts at t·f = ``pre_periods``);
+    the zeros of the two y axes are at the same height (:func:`align_zeros`); the baseline
+    periods before and after the excitation are shaded grey and the excitation window is bounded
+    by dotted lines.  Top right: the Lissajous loop
     τ(γ) of both estimators during the excitation (an elastic solid gives a line of slope G′,
     a viscous response opens it into an ellipse of area π·G″·A²).  Bottom: the elastic
     (σ′ against γ) and viscous (σ″ against γ̇) Lissajous–Bowditch curves of the measured periods
@@ -179,22 +216,24 @@ def plot_result(result, path=None):
     pre = float(result.parameters.get("pre_periods", 0))
     P = float(result.parameters.get("periods", 0))
     t_on, t_off = pre / f, (pre + P) / f
+    periods = t * f                        # time in excitation periods
 
     fig = _figure(12, 7.5)
     grid = fig.add_gridspec(2, 3)
     ax = fig.add_subplot(grid[0, :2])
     lj = fig.add_subplot(grid[0, 2])
-    ax.axvspan(t[0] if len(t) else 0, t_on, color="0.92", label="baseline")
-    ax.axvspan(t_off, t[-1] if len(t) else t_off, color="0.92")
-    ax.axvline(t_on, color="0.4", ls=":", lw=1)
-    ax.axvline(t_off, color="0.4", ls=":", lw=1)
-    ax.plot(t, tau_s, color="C0", lw=1, label="τ surface (plate forces)")
-    ax.plot(t, tau_i, color="C1", lw=1, label="τ internal (stress tensor)")
-    ax.set_xlabel("time t (s)")
+    ax.axvspan(periods[0] if len(t) else 0, pre, color="0.92", label="baseline")
+    ax.axvspan(pre + P, periods[-1] if len(t) else pre + P, color="0.92")
+    ax.axvline(pre, color="0.4", ls=":", lw=1)
+    ax.axvline(pre + P, color="0.4", ls=":", lw=1)
+    ax.plot(periods, tau_s, color="C0", lw=1, label="τ surface (plate forces)")
+    ax.plot(periods, tau_i, color="C1", lw=1, label="τ internal (stress tensor)")
+    ax.set_xlabel("time t·f (periods)")
     ax.set_ylabel("shear stress τ (Pa)")
     ax2 = ax.twinx()
-    ax2.plot(t, strain, color="k", lw=1, ls="--", label="strain γ")
+    ax2.plot(periods, strain, color="k", lw=1, ls="--", label="strain γ")
     ax2.set_ylabel("strain γ (–)")
+    align_zeros(ax, ax2)
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, loc="upper left", fontsize="small", framealpha=0.85)

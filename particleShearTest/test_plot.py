@@ -105,7 +105,7 @@ class TestResultPlot(unittest.TestCase):
                 with open(path, "rb") as fh:
                     self.assertEqual(fh.read(len(magic)), magic)
         trace, strain_axis, loop = fig.axes[0], fig.axes[2], fig.axes[1]
-        self.assertEqual(trace.get_xlabel(), "time t (s)")
+        self.assertEqual(trace.get_xlabel(), "time t·f (periods)")
         self.assertEqual(trace.get_ylabel(), "shear stress τ (Pa)")
         self.assertIn("strain", strain_axis.get_ylabel())
         self.assertEqual(loop.get_xlabel(), "strain γ (–)")
@@ -114,9 +114,36 @@ class TestResultPlot(unittest.TestCase):
         np.testing.assert_array_equal(lines["τ surface (plate forces)"].get_ydata(), res.series["stress_surface"])
         np.testing.assert_array_equal(lines["τ internal (stress tensor)"].get_ydata(), res.series["stress_internal"])
         np.testing.assert_array_equal(lines["strain γ"].get_ydata(), res.series["strain"])
-        # excitation window marked at t = pre/f and (pre + P)/f
+        # time in periods: x = t·f
+        np.testing.assert_allclose(lines["strain γ"].get_xdata(), res.series["t"] * res.f, rtol=1e-12)
+        # excitation window marked at t·f = pre and pre + P (periods)
         marks = sorted(ln.get_xdata()[0] for ln in trace.get_lines() if ln.get_linestyle() == ":")
-        self.assertEqual(marks, [0.5, 1.5])
+        self.assertEqual(marks, [1.0, 3.0])
+        self.assertEqual(len(fig.axes), 6)   # trace, loop, strain twin, elastic LB, viscous LB, text
+
+    def test_stress_and_strain_zeros_at_the_same_height(self):
+        # an offset stress (a residual stress of +40 % of its amplitude) makes the autoscaled zeros differ
+        for offset in (0.0, 0.4, -0.9):
+            res = synthetic_result()
+            for key in ("stress_surface", "stress_internal"):
+                res.series[key] = res.series[key] + offset * 60.0
+            fig = res.plot()
+            fig.canvas.draw()                # limits as drawn
+            trace, strain_axis = fig.axes[0], fig.axes[2]
+            zeros = []
+            for a in (trace, strain_axis):
+                lo, hi = a.get_ylim()
+                self.assertLess(lo, 0)
+                self.assertGreater(hi, 0)
+                zeros.append(-lo / (hi - lo))
+            self.assertAlmostEqual(zeros[0], zeros[1], delta=1e-9)
+            # every sample stays inside the (widened, never narrowed) limits
+            for a in (trace, strain_axis):
+                lo, hi = a.get_ylim()
+                for ln in a.get_lines():
+                    y = np.asarray(ln.get_ydata(), dtype=float)
+                    if len(y) > 2:
+                        self.assertTrue(np.all((y >= lo) & (y <= hi)))
 
     def test_lissajous_loop_encloses_pi_Gpp_A2(self):
         # the loop τ(γ) of a linear viscoelastic solid encloses π·G″·A² per period (definition of G″)

@@ -411,11 +411,27 @@ class TestRunLayer(unittest.TestCase):
             image_N = int(r.N_steps / 200) if r.N_steps > 200 else 1
             expected = ["image%07d.png" % k for k in range(0, r.N_steps, image_N)]
             self.assertEqual(files, expected)
-            self.assertTrue(r.image_folder.endswith("_nr_1.txt_images_folder"))
+            # named after the run (no text file exists: saveData=False), not after a ".txt" path
+            self.assertTrue(r.image_folder.endswith("_nr_1_images"), r.image_folder)
+            self.assertEqual(os.listdir(d), [os.path.basename(r.image_folder)])
             self.assertEqual(r.output_path, None)  # saveData=False: no text file, only images
             from PIL import Image
             with Image.open(os.path.join(r.image_folder, files[-1])) as im:
                 self.assertEqual(im.size, (500, 500 + 44))  # cell (1 px = 1 µm) + caption strip
+
+    def test_image_folder_names_take_the_number(self):
+        """``<run name>_images``; the reference's ``<file>.txt_images_folder`` with reference_header=True;
+        a folder under either name takes its number (docs/output.md, "Snapshots")."""
+        quick = dict(QUICK, doDrawing=False, saveOutputImages=True, imageFileType="png", renderer="pillow",
+                     return_result=True, seed=2)
+        with tempfile.TemporaryDirectory() as d:
+            r1 = doParticleShearSimulation(root_folder=d, reference_header=True, **quick)
+            r2 = doParticleShearSimulation(root_folder=d, **quick)
+            r3 = doParticleShearSimulation(root_folder=d, **quick)
+            self.assertTrue(r1.image_folder.endswith("_nr_1.txt_images_folder"), r1.image_folder)
+            self.assertTrue(r2.image_folder.endswith("_nr_2_images"), r2.image_folder)
+            self.assertTrue(r3.image_folder.endswith("_nr_3_images"), r3.image_folder)
+            self.assertEqual(sorted(os.listdir(d)), sorted(os.path.basename(r.image_folder) for r in (r1, r2, r3)))
 
     def test_tk_backend_with_fake_tkinter(self):
         """Exercise the live drawing code paths (particle window, stress plot) without a display."""

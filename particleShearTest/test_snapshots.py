@@ -91,6 +91,100 @@ class TestCaption(unittest.TestCase):
         self.assertEqual(img.getpixel((185, 230)), (0, 0, 255))
 
 
+def two_particles_and_a_loose_sphere():
+    """Spheres 0–1 bonded (one particle), 2–3 bonded (another), 4 without a bond; radius 30 µm."""
+    ens = EnsembleLinkable(500, 500, 0, k=1, nu=1, k_t=1, nu_t=1, mu=0.01)
+    pos = [(100, 100), (150, 130), (350, 100), (400, 130), (250, 400)]
+    s = [SphereLinkable("grey", x, y, 60, 1, k + 1, force_register=ens) for k, (x, y) in enumerate(pos)]
+    for sp in s:
+        ens.sphereList.append(sp)
+    s[0].establish_permanent_link(s[1])
+    s[2].establish_permanent_link(s[3])
+    ens.mechanical_simulation_step_calculate_forces()
+    return ens
+
+
+def components(n, i, j):
+    """Connected components by union-find (independent of the package's label propagation)."""
+    parent = list(range(n))
+
+    def root(a):
+        while parent[a] != a:
+            a = parent[a]
+        return a
+
+    for a, b in zip(i, j):
+        parent[root(a)] = root(b)
+    return [root(a) for a in range(n)]
+
+
+class TestParticleColours(unittest.TestCase):
+    def test_each_particle_its_colour_loose_spheres_grey(self):
+        img = PillowRenderer().render(two_particles_and_a_loose_sphere(), caption=False)
+        # points inside one disc only, away from the bond lines (centre to centre) and the outlines
+        first = img.getpixel((75, 100)), img.getpixel((175, 130))
+        second = img.getpixel((325, 100)), img.getpixel((425, 130))
+        self.assertEqual(first[0], first[1])                 # one particle, one colour
+        self.assertEqual(second[0], second[1])
+        self.assertNotEqual(first[0], second[0])             # two particles, two colours
+        for c in (first[0], second[0]):
+            self.assertNotIn(c, (GREY, WHITE))
+        self.assertEqual(img.getpixel((250, 400)), GREY)     # no bond: grey as before
+        self.assertEqual(img.getpixel((250, 420)), GREY)
+
+    def test_colours_of_a_crosslinked_run_are_per_particle_and_stable(self):
+        """Every SVG snapshot of a real run: the circle fills against the bond graph of the ensemble."""
+        from unittest import mock
+        from particleShear import doParticleShearSimulation
+        from particleShear.simulation.drawing import periodic_offsets
+        frames = []
+        original = PillowRenderer.vector
+
+        def recording(renderer, ens, fmt, step=None):
+            text = original(renderer, ens, fmt, step)
+            pt = ens._pairs
+            perm = pt.state == 2                             # PERMANENT
+            frames.append(dict(svg=text, x=ens._a["x"].copy(), y=ens._a["y"].copy(), r=ens._a["r"].copy(),
+                               i=pt.i[perm].copy(), j=pt.j[perm].copy(), shift=ens._le_shift(),
+                               L=(ens.size_x, ens.size_y)))
+            return text
+
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(PillowRenderer, "vector", recording):
+            doParticleShearSimulation(d, N=12, cut_lines=2, pre_periods=0.25, periods=0.5, post_periods=0.25,
+                                      doDrawing=False, plotStress=False, saveOutputImages=True, imageFileType="svg",
+                                      seed=3, verbose=False)
+        self.assertGreater(len(frames), 2)
+        fills_per_frame = []
+        for fr in (frames[0], frames[len(frames) // 2], frames[-1]):
+            circles = [(float(e.get("cx")), float(e.get("cy")), e.get("fill"))
+                       for e in ET.fromstring(fr["svg"]).iter() if e.tag.endswith("circle")]
+            fills = []
+            for x, y in zip(fr["x"], fr["y"]):   # the fill of a drawn copy of each sphere
+                for ox, oy in periodic_offsets(*fr["L"], fr["shift"]):
+                    hit = [c for c in circles if abs(c[0] - (x + ox)) < 0.01 and abs(c[1] - (y + oy)) < 0.01]
+                    if hit:
+                        fills.append(hit[0][2])
+                        break
+            self.assertEqual(len(fills), len(fr["x"]))
+            fills_per_frame.append(fills)
+            comp = components(len(fr["x"]), fr["i"].tolist(), fr["j"].tolist())
+            bonded = set(fr["i"].tolist()) | set(fr["j"].tolist())
+            roots = sorted({comp[k] for k in bonded})
+            self.assertGreaterEqual(len(roots), 2)           # cut_lines=2: at least two particles
+            colour_of = {}
+            for k in range(len(comp)):
+                if k in bonded:
+                    colour_of.setdefault(comp[k], set()).add(fills[k])
+                else:
+                    self.assertEqual(fills[k], "rgb(128, 128, 128)")
+            for root in roots:
+                self.assertEqual(len(colour_of[root]), 1)    # one particle, one colour
+            if len(roots) <= 11:                             # the palette's size: distinct colours
+                self.assertEqual(len({next(iter(colour_of[root])) for root in roots}), len(roots))
+        for fills in fills_per_frame[1:]:
+            self.assertEqual(fills, fills_per_frame[0])      # the same colour of every sphere in every frame
+
+
 class TestStressWindowTicks(unittest.TestCase):
     def test_nice_ticks_are_round_and_cover_the_range(self):
         from particleShear.simulation.drawing import nice_ticks

@@ -106,6 +106,69 @@ class SimulationResult:
         """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns."""
         return [self.G_surface[0], self.G_surface[1]]
 
+    def _summary(self):
+        """(estimator rows, run fields) of :meth:`__repr__` and :meth:`_repr_html_`.
+
+        Rows: ``(name, G′, se G′, G″, se G″)`` with the standard errors None where not finite
+        (fewer than 2 measured periods, or no recorded series); fields: ``(label, text)`` of N,
+        A, μ, seed and run id as recorded.
+        """
+        rows = []
+        for name, G, se_name in (("surface", self.G_surface, "G_surface_se"),
+                                 ("internal", self.G_internal, "G_internal_se")):
+            try:
+                se = getattr(self, se_name)
+            except Exception:  # noqa: BLE001 - a repr never fails: no error bars then
+                se = (float("nan"), float("nan"))
+            se = [float(v) if v is not None and np.isfinite(v) else None for v in se]
+            rows.append((name, float(G[0]), se[0], float(G[1]), se[1]))
+        p = self.parameters or {}
+        seed = "None" if self.seed is None else str(self.seed)
+        if self.spawn_key:
+            seed += " spawn " + ",".join(str(k) for k in self.spawn_key)
+        fields = [("N", str(p.get("N", "?"))), ("A", str(p.get("theAmplitude", "?"))),
+                  ("μ", str(p.get("theMu", "?"))), ("seed", seed), ("run_id", self.run_id or "–")]
+        return rows, fields
+
+    @staticmethod
+    def _modulus_text(value, se):
+        return f"{value:.4g}" + ("" if se is None else f" ± {se:.2g}")
+
+    def __repr__(self):
+        """A short summary: G′, G″ of both estimators (± standard error over the measured periods where
+        finite), N, A, μ, seed and run id — not the parameter dict (``result.parameters``).
+
+        Returns
+        -------
+        str
+        """
+        rows, fields = self._summary()
+        head = ", ".join(f"{k}={v}" for k, v in fields)
+        lines = [f"SimulationResult({head}"]
+        for name, g1, s1, g2, s2 in rows:
+            lines.append(f"  {name + ':':<9} G′ = {self._modulus_text(g1, s1)} Pa, "
+                         f"G″ = {self._modulus_text(g2, s2)} Pa")
+        return "\n".join(lines) + ")"
+
+    def _repr_html_(self):
+        """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
+
+        Returns
+        -------
+        str
+        """
+        import html
+        rows, fields = self._summary()
+        esc = html.escape
+        cap = ", ".join(f"{esc(k)} = {esc(v)}" for k, v in fields)
+        out = ["<table>", f"<caption>SimulationResult: {cap}</caption>",
+               "<tr><th>estimator</th><th>G′ (Pa)</th><th>G″ (Pa)</th></tr>"]
+        for name, g1, s1, g2, s2 in rows:
+            out.append(f"<tr><td>{esc(name)}</td><td>{esc(self._modulus_text(g1, s1))}</td>"
+                       f"<td>{esc(self._modulus_text(g2, s2))}</td></tr>")
+        out.append("</table>")
+        return "\n".join(out)
+
     @property
     def measures(self):
         """Standard errors, steady-state flag and LAOS ratios of the run (dict, the results-table columns
@@ -436,7 +499,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         phase, worst pair, suggested time step) instead of returning NaN moduli.
     saveOutputMovie : bool, default False
         Keyword-only.  Also write the snapshots as the animated GIF ``movie.gif`` in the image
-        folder (needs ``saveOutputImages``; at most 200 frames, at most 500 px wide).
+        folder (needs ``saveOutputImages``): 80 ms a frame, each snapshot scaled down to 320 px
+        wide (kept as it is when narrower); every snapshot is a frame (201 by default) until 400
+        are kept, then every second kept frame is dropped and only every second later snapshot is
+        kept, so a movie has fewer than 400 frames.
     output_format : {"text", "text.gz", "npz", "parquet"}, default "text"
         Keyword-only.  File format of ``saveData``: the reference text, the same gzip-compressed,
         NumPy .npz, or Parquet (needs particleShear[parquet]); read any with

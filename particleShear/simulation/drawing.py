@@ -33,7 +33,7 @@ from ..base.neighbours import PERMANENT, SLIP
 
 __all__ = ["Renderer", "PillowRenderer", "TkRenderer", "StressPlotWindow", "display_available",
            "make_renderer", "open_stress_plot", "nice_ticks", "scene_geometry", "scene_primitives", "periodic_offsets",
-           "IMAGE_EXTENSIONS", "CAPTION_HEIGHT"]
+           "particle_labels", "sphere_fills", "IMAGE_EXTENSIONS", "CAPTION_HEIGHT", "PARTICLE_COLOURS"]
 
 #: imageFileType → (file extension, Pillow format)
 IMAGE_EXTENSIONS = {"jpg": (".jpg", "JPEG"), "png": (".png", "PNG"), "ps": (".ps", "EPS"), "eps": (".eps", "EPS"),
@@ -111,6 +111,71 @@ def scene_geometry(ens):
     out["links"] = np.stack([x[i][perm], y[i][perm], x[i][perm] + dx[perm], y[i][perm] + dy[perm]], axis=1)
     out["perm_chords"] = chords[perm & touching & ok]
     return out
+
+
+#: fills of the crosslinked particles: ColorBrewer "Set3" without its grey — light colours, so the red,
+#: green and blue contact and bond lines drawn over the discs stay visible, and none is grey
+PARTICLE_COLOURS = ("#8dd3c7", "#ffffb3", "#bebada", "#fb8072", "#80b1d3", "#fdb462", "#b3de69", "#fccde5",
+                    "#bc80bd", "#ccebc5", "#ffed6f")
+
+
+def particle_labels(ens):
+    """Per sphere, the id of its crosslinked particle; −1 for a sphere without a bond.
+
+    A particle is a connected component of the permanent links (bonds through the periodic
+    boundary included: a particle crossing an edge is one particle); its id is the smallest
+    sphere index in it.  Bonds are made before the protocol and never removed, and spheres are
+    never reordered, so the id of a sphere is the same in every snapshot of a run.
+
+    Parameters
+    ----------
+    ens : ensemble
+        An ensemble of this package (its pair table is read, not changed); one without a pair
+        table has no particles.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Shape (n,): the particle id of each sphere, or −1.
+    """
+    from ..linkable.compact import component_labels
+    n = len(ens._a["x"])
+    pt = getattr(ens, "_pairs", None)
+    if pt is None or not len(pt.i):
+        return np.full(n, -1, dtype=np.intp)
+    perm = np.asarray(pt.state) == PERMANENT
+    i, j = np.asarray(pt.i)[perm], np.asarray(pt.j)[perm]
+    lab = component_labels(n, i, j)
+    bonded = np.zeros(n, dtype=bool)
+    bonded[i] = True
+    bonded[j] = True
+    return np.where(bonded, lab, -1)
+
+
+def sphere_fills(ens, unlinked="grey"):
+    """Fill colour of each sphere: its particle's colour, ``unlinked`` for a sphere without a bond.
+
+    Particle ``k`` in the order of the ids of :func:`particle_labels` (the smallest sphere index)
+    gets ``PARTICLE_COLOURS[k % 11]``: distinct colours for up to 11 particles, the same colour of a
+    particle in every snapshot of a run.
+
+    Parameters
+    ----------
+    ens : ensemble
+        The ensemble drawn.
+    unlinked : str, default "grey"
+        Colour of spheres without a bond (``color_spheres_volume`` of the drawing configuration).
+
+    Returns
+    -------
+    list of str
+        One colour per sphere.
+    """
+    lab = particle_labels(ens)
+    ids = np.unique(lab[lab >= 0])
+    rank = np.searchsorted(ids, lab)
+    return [PARTICLE_COLOURS[k % len(PARTICLE_COLOURS)] if l >= 0 else unlinked
+            for l, k in zip(lab.tolist(), rank.tolist())]
 
 
 class Renderer:
@@ -229,9 +294,9 @@ def scene_primitives(ens, cfg=None):
     offsets = periodic_offsets(Lx, Ly, ens._le_shift() if hasattr(ens, "_le_shift") else 0.0)
     discs, segs = [], []
     how = opt("draw_spheres_as", "spheres")
-    fill = opt("color_spheres_volume", "grey")
     if how != "none":
-        for xx, yy, rr in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist()):
+        fills = sphere_fills(ens, opt("color_spheres_volume", "grey"))
+        for xx, yy, rr, fill in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist(), fills):
             rad = rr if how == "spheres" else 2.0
             for ox, oy in offsets:
                 X, Y = xx + ox, yy + oy
@@ -690,10 +755,10 @@ class TkRenderer(Renderer):
         c.delete("all")
         cfg = self.cfg if self.cfg is not None else getattr(ens, "graphical_output_configuration", None)
         g = scene_geometry(ens)
-        fill = getattr(cfg, "color_spheres_volume", "grey")
         how = getattr(cfg, "draw_spheres_as", "spheres")
         if how != "none":
-            for xx, yy, rr in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist()):
+            fills = sphere_fills(ens, getattr(cfg, "color_spheres_volume", "grey"))
+            for xx, yy, rr, fill in zip(g["x"].tolist(), g["y"].tolist(), g["r"].tolist(), fills):
                 rad = rr if how == "spheres" else 2.0
                 c.create_oval(xx - rad, yy - rad, xx + rad, yy + rad, fill=fill)
         if getattr(cfg, "draw_active_interface", True):

@@ -28,8 +28,12 @@ from .provenance import header_number
 
 #: suffix of a run's temporary output file (``.<name>.part``)
 PART_SUFFIX = ".part"
-#: suffix of a run's snapshot folder after the text file name (docs/output.md, "Snapshots")
-IMAGE_FOLDER_SUFFIX = "_images_folder"
+#: suffix of a run's snapshot folder after the run's name without its format suffix (``x_nr_1`` →
+#: ``x_nr_1_images``; docs/output.md, "Snapshots")
+IMAGE_FOLDER_SUFFIX = "_images"
+#: suffix of the snapshot folder after the text file name with ``reference_header=True``, as the
+#: reference names it (``x_nr_1.txt`` → ``x_nr_1.txt_images_folder``)
+REFERENCE_IMAGE_FOLDER_SUFFIX = "_images_folder"
 #: ending of the private name a temporary file has before it is locked and linked to its ``.part`` name
 _PRIVATE_SUFFIX = ".new"
 #: the accepted values of ``output_format`` and their file suffixes (docs/output.md, "Output formats")
@@ -461,12 +465,13 @@ def remove_stale_parts(folder):
 
 
 def _number_entries(path):
-    """``(run files, other names)`` that take the number of ``path``: each format's file, the sidecar."""
+    """``(run files, other names)`` that take the number of ``path``: each format's file, the sidecar, the
+    image folder (and, through each run file, the reference-named image folder)."""
     try:
         stem = run_file_stem(path)
     except ValueError:  # not a run file name: only itself
         return [str(path)], []
-    return [stem + suffix for suffix in FORMAT_SUFFIXES.values()], [stem + SIDECAR_SUFFIX]
+    return [stem + suffix for suffix in FORMAT_SUFFIXES.values()], [stem + SIDECAR_SUFFIX, stem + IMAGE_FOLDER_SUFFIX]
 
 
 def _number_taken(path, own_part=None):
@@ -477,7 +482,7 @@ def _number_taken(path, own_part=None):
     for p in files:
         folder, name = os.path.split(p)
         part = os.path.join(folder, "." + name + PART_SUFFIX)
-        if os.path.lexists(p) or os.path.lexists(p + IMAGE_FOLDER_SUFFIX):
+        if os.path.lexists(p) or os.path.lexists(p + REFERENCE_IMAGE_FOLDER_SUFFIX):
             return True
         if part != own_part and os.path.lexists(part) and _is_live(part):
             return True
@@ -488,7 +493,7 @@ def number_is_free(path):
     """True when no entry of the number of ``path`` exists, in any output format.
 
     The number ``<stem><k>`` is taken by the run file of any format (``.txt``, ``.txt.gz``,
-    ``.npz``, ``.parquet``), its image folder, the shared sidecar ``<stem><k>.json`` or a live
+    ``.npz``, ``.parquet``), its image folder (``<stem><k>_images`` or ``<file>_images_folder``), the shared sidecar ``<stem><k>.json`` or a live
     reservation of any of them: runs of different formats in one folder never share a sidecar.
 
     Parameters

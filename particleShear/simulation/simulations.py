@@ -25,8 +25,8 @@ from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
 from .formats import FORMAT_SUFFIXES, check_output_format, table_rows, text_stream, write_run
-from .output import (IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text, probe_writable,
-                     reserve_numbered_path, sidecar_path)
+from .output import (IMAGE_FOLDER_SUFFIX, REFERENCE_IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text,
+                     probe_writable, reserve_numbered_path, run_file_stem, sidecar_path)
 from .provenance import header_number, json_safe, package_version, positional_numbers_in_call, provenance_lines
 
 _log = logging.getLogger(__name__)
@@ -391,18 +391,25 @@ class OscillatorySimulation:
         raise OSError("no free file number for " + stem + "<k>" + suffix)
 
     def image_folder_path(self, fileName):
-        """``<text file path>_images_folder`` (docs/output.md, "Snapshots").
+        """The snapshot folder of the run file ``fileName`` (docs/output.md, "Snapshots").
+
+        ``<run name>_images``: the file's path without its format suffix (``x_nr_1.txt`` →
+        ``x_nr_1_images``), so the folder is named after the run whether or not a file is written;
+        with ``reference_header=True`` the reference's ``<file path>_images_folder``
+        (``x_nr_1.txt_images_folder``).
 
         Parameters
         ----------
         fileName : str or os.PathLike
-            The text file's path.
+            The path of the run's (reserved) output file.
 
         Returns
         -------
         str
         """
-        return str(fileName) + IMAGE_FOLDER_SUFFIX
+        if getattr(self, "reference_header", False):
+            return str(fileName) + REFERENCE_IMAGE_FOLDER_SUFFIX
+        return run_file_stem(fileName) + IMAGE_FOLDER_SUFFIX
 
     def createFolder(self, directory):
         """Create ``directory`` (and its parents); ``False``/None (no folder, as in the reference) does nothing.

@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from ..simulation.output import SIDECAR_SUFFIX
+from ..simulation.output import SIDECAR_SUFFIX, run_file_stem
 from .table import atomic_text
 
 __all__ = ["execute_run", "execute_batch", "failed_row", "publish", "error_text"]
@@ -173,10 +173,11 @@ def _finish_run(task, result, wall_time_s):
     result.parameters = dict(task["parameters"])
     if result.output_path:
         run_dir = os.path.dirname(result.output_path)
-        image_folder = result.image_folder
+        image_folder, produced = result.image_folder, result.output_path
         result.output_path = publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
-        if image_folder:
-            result.image_folder = result.output_path + "_images_folder"
+        if image_folder:  # published beside the file: its name after the run's name, renamed as the file
+            tail = os.path.basename(image_folder)[len(os.path.basename(run_file_stem(produced))):]
+            result.image_folder = run_file_stem(result.output_path) + tail
     row = result.to_dict()
     if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
         raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")

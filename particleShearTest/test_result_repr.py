@@ -1,0 +1,96 @@
+"""The notebook face of a run: ``repr(SimulationResult)`` and its HTML table.
+
+The documented content (G′, G″ of both estimators with their standard errors where finite, N,
+A, μ, seed, run id) is checked against the result's own attributes; the parameter dict must
+not be dumped; every text in the HTML is escaped.
+"""
+import dataclasses
+import re
+import unittest
+
+import numpy as np
+
+from particleShear.run.api import SimulationResult
+from particleShearTest.test_plot import synthetic_result
+
+
+def noisy_result(P=4.0, noise=2.0, run_id="0123456789ab"):
+    """An ideal viscoelastic solid plus white noise on the stresses: a finite, non-zero standard error."""
+    res = synthetic_result(P=P)
+    rng = np.random.default_rng(1)
+    for key in ("stress_surface", "stress_internal"):
+        res.series[key] = res.series[key] + rng.normal(0, noise, res.series[key].shape)
+    res.parameters.update(N=40, Young_modulus_spheres=8000, relative_viscosity=0.1)
+    res.seed, res.spawn_key, res.run_id = 7, (2,), run_id
+    return res
+
+
+def numbers_after(label, text):
+    """(value, se or None) of the first ``label = value [± se]`` in ``text``."""
+    m = re.search(re.escape(label) + r" = ([-+0-9.e]+)(?: ± ([-+0-9.e]+))?", text)
+    return float(m.group(1)), (float(m.group(2)) if m.group(2) else None)
+
+
+class TestRepr(unittest.TestCase):
+    def test_short_repr_names_moduli_errors_and_run(self):
+        res = noisy_result()
+        text = repr(res)
+        self.assertLessEqual(len(text.splitlines()), 4)
+        for fragment in ("N=40", "A=0.2", "μ=0.01", "seed=7", "0123456789ab"):
+            self.assertIn(fragment, text)
+        surface, internal = (line for line in text.splitlines() if "G′" in line)
+        self.assertIn("surface", surface)
+        self.assertIn("internal", internal)
+        for line, G, se in ((surface, res.G_surface, res.G_surface_se), (internal, res.G_internal, res.G_internal_se)):
+            for label, k in (("G′", 0), ("G″", 1)):
+                value, err = numbers_after(label, line)
+                self.assertAlmostEqual(value / G[k], 1, delta=5e-4)       # 4 significant digits
+                self.assertTrue(np.isfinite(se[k]) and se[k] > 0)
+                self.assertAlmostEqual(err / se[k], 1, delta=0.05)        # 2 significant digits
+
+    def test_no_parameter_dict(self):
+        text = repr(noisy_result())
+        self.assertNotIn("Young_modulus_spheres", text)
+        self.assertNotIn("parameters", text)
+        self.assertNotIn("{", text)
+        self.assertLess(len(text), 400)
+
+    def test_no_error_bar_without_periods(self):
+        res = noisy_result()
+        res.series = {}               # a result rebuilt without its series: standard errors are NaN
+        text = repr(res)
+        self.assertNotIn("±", text)
+        value, err = numbers_after("G′", text)
+        self.assertAlmostEqual(value / res.G_surface[0], 1, delta=5e-4)
+        self.assertIsNone(err)
+
+    def test_dataclass_behaviour_kept(self):
+        a, b = synthetic_result(), synthetic_result()
+        a.series = b.series = {}
+        self.assertEqual(a, b)
+        self.assertNotEqual(a, dataclasses.replace(b, G_surface=(1.0, 2.0)))
+        self.assertEqual(dataclasses.asdict(a)["G_surface"], a.G_surface)
+
+
+class TestHtmlRepr(unittest.TestCase):
+    def test_table_with_both_estimators(self):
+        res = noisy_result()
+        h = res._repr_html_()
+        self.assertTrue(h.startswith("<table>") and h.rstrip().endswith("</table>"))
+        self.assertEqual(h.count("<tr>"), 3)              # header + surface + internal
+        for fragment in ("surface", "internal", "G′ (Pa)", "G″ (Pa)", "0123456789ab", "±"):
+            self.assertIn(fragment, h)
+        self.assertNotIn("Young_modulus_spheres", h)
+
+    def test_text_is_escaped(self):
+        res = noisy_result(run_id="<b>&x</b>")
+        res.parameters["theMu"] = "<script>"
+        h = res._repr_html_()
+        self.assertNotIn("<b>", h)
+        self.assertNotIn("<script>", h)
+        self.assertIn("&lt;b&gt;&amp;x&lt;/b&gt;", h)
+        self.assertIn("&lt;script&gt;", h)
+
+
+if __name__ == "__main__":
+    unittest.main()
