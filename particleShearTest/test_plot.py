@@ -17,6 +17,8 @@ from unittest import mock
 
 import numpy as np
 
+from particleShear.analysis.periods import t_critical
+
 HAVE_MPL = importlib.util.find_spec("matplotlib") is not None
 
 
@@ -194,12 +196,14 @@ class TestSweepPlot(unittest.TestCase):
                 np.testing.assert_allclose(data_line.get_xdata(), self.AMPS)
                 seeds = [expected[(name, mu, A)][:, c] for A in self.AMPS]
                 np.testing.assert_allclose(data_line.get_ydata(), [v.mean() for v in seeds], rtol=1e-12)
-                # a bootstrap mean of resampled seeds lies between the smallest and largest seed,
-                # so the interval does too, and it holds the mean (a percentile of a distribution that
-                # has the mean in its support between both ends at 95 % for 3 seeds: P(all = min) = 1/27)
+                # a bootstrap mean of resampled seeds lies between the smallest and largest seed; the
+                # Student widening moves it from the mean by at most √(3/2)·t₂/z, so the interval lies in
+                # mean ± that factor × the seeds' spread, and it holds the mean
                 low, high = bar_ends(cont)
-                self.assertTrue(np.all(low >= np.array([v.min() for v in seeds]) - 1e-9))
-                self.assertTrue(np.all(high <= np.array([v.max() for v in seeds]) + 1e-9))
+                mean = np.array([v.mean() for v in seeds])
+                widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
+                self.assertTrue(np.all(low >= mean + widen * (np.array([v.min() for v in seeds]) - mean) - 1e-9))
+                self.assertTrue(np.all(high <= mean + widen * (np.array([v.max() for v in seeds]) - mean) + 1e-9))
                 self.assertTrue(np.all((low <= data_line.get_ydata()) & (data_line.get_ydata() <= high)))
         legend = fig.axes[-1].get_legend()
         self.assertIn("95 % bootstrap interval", legend.get_title().get_text())
@@ -219,7 +223,7 @@ class TestSweepPlot(unittest.TestCase):
     def test_bootstrap_interval_of_three_seeds_is_their_range(self):
         # resampling 3 seeds, the mean of a resample is the smallest seed with probability 1/27 = 3.7 %
         # > 2.5 %: with 20000 resamples (741 ± 27 such draws, 500 needed) both 95 % ends are the seeds'
-        # minimum and maximum exactly.  The plotted interval is sweep_summary's: equal to it too.
+        # minimum and maximum exactly (before the Student widening).  The plotted interval is sweep_summary's.
         from particleShear.analysis.sweep import sweep_summary
         from particleShear.plot import plot_sweep
         rng = np.random.default_rng(11)
@@ -239,8 +243,11 @@ class TestSweepPlot(unittest.TestCase):
         for label, values, ci in (("G′ μ=0.01", gp, ref.Gp_ci), ("G″ μ=0.01", gpp, ref.Gpp_ci)):
             v = np.array(values).reshape(2, 3)
             low, high = bar_ends(conts[label])
-            np.testing.assert_allclose(low, v.min(axis=1), rtol=1e-12)
-            np.testing.assert_allclose(high, v.max(axis=1), rtol=1e-12)
+            # the percentile ends are the seeds' extremes, widened from the mean by √(3/2)·t₂/z (Student width)
+            mean = v.mean(axis=1)
+            widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
+            np.testing.assert_allclose(low, mean + widen * (v.min(axis=1) - mean), rtol=1e-12)
+            np.testing.assert_allclose(high, mean + widen * (v.max(axis=1) - mean), rtol=1e-12)
             np.testing.assert_allclose(np.c_[low, high], ci, rtol=1e-12)
 
     def frequency_runs(self, amplitudes=(0.1,), seeds=3, extra=None):
