@@ -26,6 +26,8 @@ import re
 import sys
 import time
 
+from .guard import SuggestingParser
+
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
 
@@ -267,8 +269,9 @@ def _flags_for_messages():
 _flags_for_messages()
 
 
-class _Parser(argparse.ArgumentParser):
-    """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block."""
+class _Parser(SuggestingParser):
+    """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block; no prefix
+    abbreviations, an unknown flag named with the closest flags (:class:`~particleShear.run.guard.SuggestingParser`)."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: invalid parameter: {' '.join(message.split())}\n")
