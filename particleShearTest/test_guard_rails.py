@@ -122,7 +122,7 @@ class TestAliases(unittest.TestCase):
         from particleShear.run.cli import parameter_docs
         docs = parameter_docs(doParticleShearSimulation)
         for alias, name in PARAMETER_ALIASES.items():
-            self.assertIn(f"``{alias}``", docs[name][1])
+            self.assertIn(f"Python alias: ``{alias}=``", docs[name][1])
         with open(os.path.join(os.path.dirname(__file__), os.pardir, "docs", "parameters.md"), encoding="utf-8") as f:
             text = f.read()
         self.assertIn("`amplitude`", text)

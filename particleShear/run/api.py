@@ -314,11 +314,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         True (probed with an empty temporary file before any work).
     theAmplitude : float, default 0.2
         Strain amplitude A, dimensionless (0.2 = 20 %); allowed 0 < A <= 100.  Also the
-        builder's anticipated amplitude (time step, relaxation length).  Alias: the keyword
-        ``amplitude`` (the same run and run id; not together with ``theAmplitude``).
+        builder's anticipated amplitude (time step, relaxation length).  Python alias:
+        ``amplitude=`` (the same run and run id; not together with ``theAmplitude``).
     theMu : float, default 0.01
         Coulomb friction coefficient μ of transient contacts, dimensionless; allowed
-        0 <= μ <= 1e6 (permanent links are not limited by friction).  Alias: the keyword ``mu``
+        0 <= μ <= 1e6 (permanent links are not limited by friction).  Python alias: ``mu=``
         (the same run and run id; not together with ``theMu``).
     do_permanent_links : bool, default True
         Crosslink all contacts after relaxation; False: frictional spheres only.

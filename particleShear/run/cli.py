@@ -343,7 +343,8 @@ def build_parser():
     kinds = {n: par.kind for n, par in signature(doParticleShearSimulation).parameters.items()}
     for name, (strings, cli_type, choices, default) in _flags().items():
         group = groups[kinds[name] != Parameter.KEYWORD_ONLY]
-        desc = _CLI_HELP.get(name) or docs.get(name, ("", ""))[1]
+        # the Python keyword aliases (``amplitude=``) are the flags' own names here: not repeated
+        desc = re.sub(r"\s*Python alias: .*$", "", _CLI_HELP.get(name) or docs.get(name, ("", ""))[1])
         shown = _CLI_DEFAULTS.get(name, _default_text(default))
         help_text = _help(cli_message(desc)) + f" [default: {shown}]"
         if cli_type is bool:

@@ -237,6 +237,7 @@ def checked_keywords(where=None, documented=RUN_PARAMETERS_DOC, aliases=None, hi
         positional = [n for n, p in params.items() if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
         open_kwargs = any(p.kind is p.VAR_KEYWORD for p in params.values())
         label = where or func.__name__
+        known = frozenset(names)
         allowed_cache = []
 
         def allowed():
@@ -247,10 +248,10 @@ def checked_keywords(where=None, documented=RUN_PARAMETERS_DOC, aliases=None, hi
 
         @functools.wraps(func)
         def wrapper(*args, **kwargs):
-            if all(k in names for k in kwargs):
+            if known.issuperset(kwargs):
                 return func(*args, **kwargs)
             if open_kwargs and not extra:   # any name passes: only the aliases are resolved
-                kwargs = {(aliases or {}).get(k, k) if k not in names else k: v for k, v in kwargs.items()}
+                kwargs = {(aliases or {}).get(k, k) if k not in known else k: v for k, v in kwargs.items()}
                 return func(*args, **kwargs)
             kwargs = resolve_names(kwargs, allowed(), label, documented, aliases=aliases, hints=hints,
                                    bound=positional[:len(args)])
