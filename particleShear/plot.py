@@ -24,7 +24,6 @@ the plate bands (the value :func:`doParticleShearSimulation` returns), "internal
 of the overall stress tensor (eq. S1-24).
 """
 __docformat__ = "numpy"
-import argparse
 import csv
 import logging
 import math
@@ -32,6 +31,7 @@ import os
 import sys
 
 from .messages import console_messages
+from .run.guard import SuggestingParser
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
            "check_figure_path", "align_zeros"]
@@ -539,15 +539,15 @@ def build_parser():
 
     Returns
     -------
-    argparse.ArgumentParser
+    particleShear.run.guard.SuggestingParser
         Positional ``DIR``, options ``--estimator {surface,internal}``, ``--output FILE``,
         ``--x NAME`` and ``--no-split``.
     """
-    p = argparse.ArgumentParser(prog="particleShear plot",
-                                description="Plot G' and G'' of a sweep folder against the parameter it varies "
-                                            "(amplitude or frequency), one panel per material and per value of any "
-                                            "other varying parameter (reads DIR/results.csv, writes "
-                                            "DIR/G_vs_amplitude.png and .pdf, or G_vs_frequency.*).")
+    p = SuggestingParser(prog="particleShear plot",  # no prefix abbreviations; unknown flags get suggestions
+                         description="Plot G' and G'' of a sweep folder against the parameter it varies "
+                                     "(amplitude or frequency), one panel per material and per value of any "
+                                     "other varying parameter (reads DIR/results.csv, writes "
+                                     "DIR/G_vs_amplitude.png and .pdf, or G_vs_frequency.*).")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv (or the CSV file)")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
                    help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")

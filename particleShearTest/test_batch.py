@@ -221,7 +221,7 @@ class TestBatchBadInput(unittest.TestCase):
             run_batch([])
         with self.assertRaisesRegex(ValueError, r"list_of_kwargs\[1\].*\bN\b"):
             run_batch([dict(QUICK), dict(QUICK, N=30)])
-        with self.assertRaisesRegex(ValueError, "unknown parameters"):
+        with self.assertRaisesRegex(ValueError, r"'nonsense' is not a parameter of run_batch list_of_kwargs\[0\]"):
             run_batch([dict(QUICK, nonsense=1)])
         with self.assertRaisesRegex(ValueError, "theMu"):
             run_batch([dict(QUICK), dict(QUICK, theMu=-1)])

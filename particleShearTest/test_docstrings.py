@@ -63,6 +63,7 @@ DOCUMENTED_MODULES = [
     "particleShear.run.api",
     "particleShear.run.batch",
     "particleShear.run.cli",
+    "particleShear.run.guard",
     "particleShear.run.validation",
     "particleShear.analysis.laos",
     "particleShear.analysis.periods",

@@ -27,13 +27,14 @@ Exit status: 0 written, 2 invalid input (no results.csv, no usable rows, a bad f
 one-line message on stderr.
 """
 __docformat__ = "numpy"
-import argparse
 import io
 import json
 import math
 import sys
 import warnings
 import zlib
+
+from ..run.guard import SuggestingParser
 
 __all__ = [
     "OUTPUT_ONLY",
@@ -83,8 +84,9 @@ class _UsageError(Exception):
     """A bad command line (one line for stderr)."""
 
 
-class _Parser(argparse.ArgumentParser):
-    """Argument parser whose usage errors become :class:`_UsageError` (one line, status 2)."""
+class _Parser(SuggestingParser):
+    """Argument parser whose usage errors become :class:`_UsageError` (one line, status 2); no prefix
+    abbreviations, an unknown flag named with the closest flags."""
 
     def error(self, message):
         raise _UsageError(" ".join(message.split()))
@@ -95,7 +97,7 @@ def build_parser():
 
     Returns
     -------
-    argparse.ArgumentParser
+    particleShear.run.guard.SuggestingParser
         Positional ``DIR``; options ``--estimator {surface,internal}``, ``--json``, ``--n-boot N``,
         ``--confidence C``, ``--seed S`` (values checked by :func:`main`).
     """

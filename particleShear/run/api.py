@@ -19,6 +19,7 @@ from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, validate_run, validate_series
 from .batch import check_batch_size, engine_supports, measure_batch
+from .guard import PARAMETER_ALIASES, checked_keywords
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -350,6 +351,7 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     return theSimulation
 
 
+@checked_keywords(aliases=PARAMETER_ALIASES)
 def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=5,
                               Young_modulus_spheres=8000, N=150, packing_fraction=1.5, density=50,
                               bimodal_factor=1.4, relative_viscosity=0.1, relative_transversal_link_strength=1,
@@ -382,10 +384,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         True (probed with an empty temporary file before any work).
     theAmplitude : float, default 0.2
         Strain amplitude A, dimensionless (0.2 = 20 %); allowed 0 < A <= 100.  Also the
-        builder's anticipated amplitude (time step, relaxation length).
+        builder's anticipated amplitude (time step, relaxation length).  Python alias:
+        ``amplitude=`` (the same run and run id; not together with ``theAmplitude``).
     theMu : float, default 0.01
         Coulomb friction coefficient μ of transient contacts, dimensionless; allowed
-        0 <= μ <= 1e6 (permanent links are not limited by friction).
+        0 <= μ <= 1e6 (permanent links are not limited by friction).  Python alias: ``mu=``
+        (the same run and run id; not together with ``theMu``).
     do_permanent_links : bool, default True
         Crosslink all contacts after relaxation; False: frictional spheres only.
     cut_lines : int, default 5
@@ -530,6 +534,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     ------
     ValueError, TypeError
         For any invalid parameter, naming it, its value and the allowed range, before any work.
+    particleShear.run.guard.UnknownParameterError
+        For a keyword that is not a parameter (``theAmplitud=``), naming the closest parameters
+        ("did you mean theAmplitude?"), or for a parameter given under both spellings
+        (``amplitude`` and ``theAmplitude``); a subclass of TypeError and ValueError.
     SimulationInstabilityError
         When the measurement diverges (``stability_guard``).
 
@@ -669,6 +677,19 @@ def _series_worker(kwargs):
     return doParticleShearSimulation(**kwargs, return_result=True)
 
 
+def _run_options():
+    """The keyword-only options of doParticleShearSimulation (what ``**options`` of a series may name)."""
+    return [n for n, par in inspect.signature(doParticleShearSimulation).parameters.items()
+            if par.kind is par.KEYWORD_ONLY]
+
+
+#: names a series user may mean by a name of doParticleShearSimulation (the series takes lists)
+_SERIES_HINTS = {"theAmplitude": "amplitudes", "amplitude": "amplitudes", "theMu": "mu", "mus": "mu",
+                 "repetitions": "N_repetitions"}
+
+
+@checked_keywords(documented="help(particleShear.doParticleShearSimulationSeries) and docs/parameters.md",
+                  hints=_SERIES_HINTS, extra=_run_options)
 def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01], cut_lines=5,  # noqa: B006
                                     Young_modulus_spheres=8000, do_bulk_control=False,
                                     do_uncrosslinked_control=False, do_non_frictional_control=False,
@@ -695,7 +716,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Output folder.  Empty: nothing is written.  Otherwise the series is a resumable sweep
         into this folder (see Notes); it must exist and be writable.
     amplitudes : list of float, default [0.2]
-        Strain amplitudes A (dimensionless), each as ``theAmplitude``; 1 ... 1e5 values.
+        Strain amplitudes A (dimensionless), each as ``theAmplitude``; 1 ... 1e5 values.  (The
+        series has no ``theAmplitude``/``amplitude`` keyword: those name one value of one run.)
     mu : list of float, default [0.01]
         Friction coefficients μ (dimensionless), each as ``theMu``; 1 ... 1e5 values.
     cut_lines : int, default 5
@@ -769,6 +791,10 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     ------
     ValueError, TypeError
         For an invalid grid or parameter of any run, before any run starts.
+    particleShear.run.guard.UnknownParameterError
+        For a keyword that is neither a parameter of the series nor a keyword-only option of
+        :func:`doParticleShearSimulation`, naming the closest names (``theAmplitude`` →
+        ``amplitudes``: the series takes lists; a subclass of TypeError and ValueError).
     RuntimeError
         When a run failed (raised once the other runs have finished).
 

@@ -26,6 +26,7 @@ import time
 import numpy as np
 
 from ..linkable.builders import time_steps_from_model
+from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
 __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "ENGINE_MAX_N", "check_backend", "check_run_backend"]
@@ -203,6 +204,7 @@ def batches(all_kwargs, batch_size):
     return out
 
 
+@checked_keywords(documented="help(particleShear.run.batch.run_batch)")
 def run_batch(list_of_kwargs, backend=None):
     """Run a batch of replicas that share a step schedule; one result per replica, in order.
 
@@ -210,7 +212,8 @@ def run_batch(list_of_kwargs, backend=None):
     ----------
     list_of_kwargs : list of dict
         Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` per replica
-        (``return_result`` is implied).  All must have the same :func:`schedule_key`.
+        (``return_result`` is implied; the aliases ``amplitude`` and ``mu`` are accepted as there).
+        All must have the same :func:`schedule_key`.
     backend : {None, "numpy", "cupy"}, default None
         Array backend of the batch; None: the runs' own ``backend`` keyword (default "numpy").
         A backend other than "numpy" needs runs the engine measures (see :func:`check_run_backend`).
@@ -225,11 +228,17 @@ def run_batch(list_of_kwargs, backend=None):
     ValueError
         For an empty batch, an unknown backend, replicas of different schedules or any invalid
         parameter of any replica, before any simulation work.
+    particleShear.run.guard.UnknownParameterError
+        For a key of a replica's dict that is not a parameter (naming ``list_of_kwargs[n]`` and
+        the closest parameters), or a keyword of this function that is not one of its parameters.
     """
     from .api import doParticleShearSimulation
     from .validation import validate_run
 
-    runs = [dict(kw) if backend is None else dict(kw, backend=backend) for kw in list_of_kwargs]
+    names = list(_signature_defaults())
+    runs = [resolve_names(kw, names, f"run_batch list_of_kwargs[{n}]", aliases=PARAMETER_ALIASES)
+            for n, kw in enumerate(list_of_kwargs)]
+    runs = [kw if backend is None else dict(kw, backend=backend) for kw in runs]
     if not runs:
         raise ValueError("list_of_kwargs=[] is invalid: a batch needs at least one run")
     for kw in runs:

@@ -26,6 +26,8 @@ import re
 import sys
 import time
 
+from .guard import SuggestingParser
+
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
 
@@ -267,8 +269,9 @@ def _flags_for_messages():
 _flags_for_messages()
 
 
-class _Parser(argparse.ArgumentParser):
-    """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block."""
+class _Parser(SuggestingParser):
+    """Argument parser whose usage errors are one line on stderr (exit status 2), no usage block; no prefix
+    abbreviations, an unknown flag named with the closest flags (:class:`~particleShear.run.guard.SuggestingParser`)."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: invalid parameter: {' '.join(message.split())}\n")
@@ -340,7 +343,8 @@ def build_parser():
     kinds = {n: par.kind for n, par in signature(doParticleShearSimulation).parameters.items()}
     for name, (strings, cli_type, choices, default) in _flags().items():
         group = groups[kinds[name] != Parameter.KEYWORD_ONLY]
-        desc = _CLI_HELP.get(name) or docs.get(name, ("", ""))[1]
+        # the Python keyword aliases (``amplitude=``) are the flags' own names here: not repeated
+        desc = re.sub(r"\s*Python alias: .*$", "", _CLI_HELP.get(name) or docs.get(name, ("", ""))[1])
         shown = _CLI_DEFAULTS.get(name, _default_text(default))
         help_text = _help(cli_message(desc)) + f" [default: {shown}]"
         if cli_type is bool:

@@ -502,7 +502,8 @@ def validate_run(params):
         A value of the wrong type (a boolean that is not a bool, a non-callable ``progress``, a
         string for a number, …).
     ValueError
-        An unknown parameter name, a value out of range or a run beyond a limit; the message
+        An unknown parameter name (:class:`~particleShear.run.guard.UnknownParameterError`, naming
+        the closest parameters), a value out of range or a run beyond a limit; the message
         names the parameter, its value (a huge integer abbreviated, :func:`show_value`) and what
         would be allowed.
     ImportError
@@ -517,7 +518,12 @@ def validate_run(params):
     defaults = _signature_defaults()
     unknown = sorted(set(params) - set(defaults))
     if unknown:
-        raise ValueError(f"unknown parameters {unknown}: allowed the keywords of doParticleShearSimulation")
+        from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
+        near = {n: close_names(n, list(defaults), hints=PARAMETER_ALIASES) for n in unknown}
+        guess = "; ".join(f"{n}: did you mean {' or '.join(s)}?" for n, s in near.items() if s)
+        raise UnknownParameterError(f"unknown parameters {unknown}{': ' + guess if guess else ''} (allowed the "
+                                    f"keywords of doParticleShearSimulation: {RUN_PARAMETERS_DOC})",
+                                    name=unknown[0], suggestions=near[unknown[0]])
     p = dict(defaults, **params)
     _check_keyword_options(p)
     for name in ("do_permanent_links", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",

@@ -1,6 +1,5 @@
 """``python -m particleShear sweep SPEC --out DIR``: run, resume, dry-run or merge a sweep (docs/sweeps.md)."""
 __docformat__ = "numpy"
-import argparse
 import contextlib
 import logging
 import os
@@ -8,6 +7,7 @@ import signal
 import sys
 
 from ..messages import console_messages
+from ..run.guard import SuggestingParser
 
 _log = logging.getLogger(__name__)
 
@@ -19,14 +19,14 @@ def build_parser():
 
     Returns
     -------
-    argparse.ArgumentParser
+    particleShear.run.guard.SuggestingParser
         Positional ``SPEC``; ``--out DIR`` (required), ``--workers``, ``--dask``, ``--scheduler``,
         ``--task-index``/``--task-count``, ``--merge``, ``--dry-run``, ``--calibrate``, ``--no-calibrate``,
         ``--retry-failed``, ``--keep-going``, ``--quiet``, ``--backend``, ``--extend``.
     """
-    p = argparse.ArgumentParser(prog="particleShear sweep",
-                                description="Run (or resume) every run of a sweep SPEC (.toml or .json) into DIR; "
-                                            "one row per run in DIR/results.csv.")
+    p = SuggestingParser(prog="particleShear sweep",  # no prefix abbreviations; unknown flags get suggestions
+                         description="Run (or resume) every run of a sweep SPEC (.toml or .json) into DIR; "
+                                     "one row per run in DIR/results.csv.")
     a = p.add_argument
     a("spec", metavar="SPEC", help="sweep specification: tables [parameters], [grid], [[zip]], [seeds]")
     a("--out", metavar="DIR", required=True, help="output folder (created; the same DIR resumes)")

@@ -15,6 +15,9 @@
     root = 2021
     repetitions = 6
 
+``amplitude`` and ``mu`` are accepted as aliases of ``theAmplitude`` and ``theMu`` (the same
+runs, the same run ids); an unknown key is refused with the closest parameter names.
+
 Run ``k = repetition · n_points + point`` gets ``numpy.random.SeedSequence(root, spawn_key=(k,))``,
 i.e. ``SeedSequence(root).spawn(n)[k]``: adding repetitions keeps the ids of the earlier ones.
 Points enumerate the grid keys in file order, then each ``[[zip]]`` group, the last varying
@@ -144,7 +147,86 @@ def _read_toml(path):
         try:
             return tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"SPEC={path!r} is not valid TOML: {exc}") from None
+            raise ValueError(toml_error_message(path, exc)) from None
+
+
+#: the usual fixes of a SPEC that is not valid TOML (named in every TOML error)
+TOML_FIXES = ("TOML booleans are lowercase true/false; strings need quotes (\"png\"); lists use square brackets "
+              "[0.1, 0.2]; a number needs a digit on both sides of its point (0.5, 5.0); there is no None (leave "
+              "a key out for its default); each key once per table, and every [[zip]] group in double brackets")
+
+
+def _toml_hint(line):
+    """The fix of the usual mistake on ``line`` of a TOML file (empty when none is recognised)."""
+    import re
+    m = re.match(r"\s*([\w.\"'-]+)\s*=\s*(.*?)\s*(#.*)?$", line)
+    if not m:
+        return ""
+    key, value = m.group(1), m.group(2)
+    words = r"(?<![\w\"'])(True|False|TRUE|FALSE)(?![\w\"'])"
+    if re.search(words, value):
+        fixed = re.sub(words, lambda b: b.group(1).lower(), value)
+        return f"TOML booleans are lowercase: write {key} = {fixed}"
+    if re.fullmatch(r"(?i)none|null|nil", value):
+        return f"TOML has no None: leave {key} out to keep its default"
+    if value.startswith("("):
+        return f"lists use square brackets: {key} = [{value[1:-1] if value.endswith(')') else value[1:]}]"
+    if re.fullmatch(r"[+-]?\.\d.*", value) or re.fullmatch(r"[+-]?\d+\.", value):
+        fixed = re.sub(r"^([+-]?)\.", r"\g<1>0.", value)
+        fixed = fixed + "0" if fixed.endswith(".") else fixed
+        return f"a number needs a digit on both sides of its point: write {key} = {fixed}"
+    if re.fullmatch(r"[A-Za-z_][\w./-]*", value) and value not in ("inf", "nan"):
+        return f'strings need quotes: write {key} = "{value}"'
+    return ""
+
+
+def toml_error_message(path, exc):
+    """The message for a SPEC that is not valid TOML: the file, the line, its likely fix and the usual fixes.
+
+    Parameters
+    ----------
+    path : str
+        The SPEC file.
+    exc : Exception
+        The ``TOMLDecodeError`` of ``tomllib`` (or ``tomli``), whose text ends with
+        "(at line L, column C)" or "(at end of document)".
+
+    Returns
+    -------
+    str
+        ``SPEC 'path' is not valid TOML: <error>``, then the offending line with a caret under the
+        column, the fix of a recognised mistake (``doDrawing = False`` → "TOML booleans are
+        lowercase: write doDrawing = false") and :data:`TOML_FIXES`.
+    """
+    import re
+    text = str(exc)
+    lineno, colno = getattr(exc, "lineno", None), getattr(exc, "colno", None)
+    m = re.search(r"at line (\d+), column (\d+)", text)
+    if lineno is None and m:
+        lineno, colno = int(m.group(1)), int(m.group(2))
+    msg = getattr(exc, "msg", None) or re.sub(r"\s*\(at (line \d+, column \d+|end of document)\)\s*$", "", text)
+    where = f"line {lineno}, column {colno}" if lineno else "end of document" if "end of document" in text else ""
+    out = [f"SPEC {path!r} is not valid TOML: {msg}" + (f" (at {where})" if where else "")]
+    hint = ""
+    if lineno:
+        try:
+            with open(path, encoding="utf-8", errors="replace") as fh:
+                lines = fh.read().splitlines()
+        except OSError:
+            lines = []
+        if 0 < lineno <= len(lines):
+            line = lines[lineno - 1]
+            label = f"  line {lineno}: "
+            out.append(label + line)
+            if colno:
+                out.append(" " * (len(label) + colno - 1) + "^")
+            hint = _toml_hint(line)
+    if "Cannot overwrite" in msg or "Cannot declare" in msg:
+        hint = hint or "a key or a table is set twice (repeated [[zip]] groups need double brackets)"
+    if hint:
+        out.append(hint + ".")
+    out.append("Usual fixes: " + TOML_FIXES + ".")
+    return "\n".join(out)
 
 
 def load_spec(path):
@@ -175,7 +257,9 @@ def load_spec(path):
             try:
                 doc = json.load(fh)
             except json.JSONDecodeError as exc:
-                raise ValueError(f"SPEC={path!r} is not valid JSON: {exc}") from None
+                raise ValueError(f"SPEC={path!r} is not valid JSON: {exc}; JSON booleans are lowercase true/false, "
+                                 "strings need double quotes, no trailing commas, null is not a value a "
+                                 "parameter takes (leave the key out)") from None
     else:
         raise ValueError(f"SPEC={path!r} is invalid: allowed a .toml or .json file")
     return parse_spec(doc, source=path)
@@ -190,8 +274,16 @@ def _scalar(where, v):
 
 def _known(where, name, known):
     if name not in known:
-        hint = " (set by the sweep itself)" if name in _RESERVED else ""
-        raise ValueError(f"{where}.{name} is not a parameter of doParticleShearSimulation{hint}")
+        from ..run.guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
+        if name in _RESERVED:
+            raise UnknownParameterError(f"{where}.{name} is not a parameter a SPEC may set: the sweep sets it "
+                                        "itself", name=name)
+        near = close_names(name, list(known) + list(PARAMETER_ALIASES))
+        guess = f"did you mean {' or '.join(near)}?" if near else "no parameter name is close"
+        raise UnknownParameterError(f"{where}.{name} is not a parameter of doParticleShearSimulation: {guess} "
+                                    f"(the parameters: {RUN_PARAMETERS_DOC}; aliases: "
+                                    f"{', '.join(f'{a} = {t}' for a, t in PARAMETER_ALIASES.items())})",
+                                    name=name, suggestions=near)
 
 
 def _values(where, v):
@@ -218,36 +310,53 @@ def parse_spec(doc, source=""):
     Raises
     ------
     ValueError
-        Unknown table or parameter, a parameter set twice, zip lists of unequal length, a
-        missing or invalid seed (the message names the key).
+        Unknown table or parameter (an unknown parameter:
+        :class:`~particleShear.run.guard.UnknownParameterError`, naming the closest parameters), a
+        parameter set twice (also under its alias), zip lists of unequal length, a missing or
+        invalid seed (the message names the key).
+
+    Notes
+    -----
+    ``amplitude`` and ``mu`` are accepted as aliases of ``theAmplitude`` and ``theMu`` in
+    [parameters], [grid] and [[zip]] (:data:`particleShear.run.guard.PARAMETER_ALIASES`); the
+    parsed SPEC holds the parameter names, so the runs and their ids are those of the same SPEC
+    written with ``theAmplitude`` and ``theMu``.
     """
     if not isinstance(doc, dict):
         raise ValueError(f"SPEC {source!r} is invalid: allowed a table of the tables {SPEC_TABLES}")
     for table in doc:
         if table not in SPEC_TABLES:
             raise ValueError(f"SPEC table [{table}] is unknown: allowed {', '.join(SPEC_TABLES)}")
+    from ..run.guard import PARAMETER_ALIASES
     known = sweep_parameter_defaults()
     seen = {}
 
     def claim(name, where):
-        _known(where, name, known)
-        if name in seen:
-            raise ValueError(f"{where}.{name} is set twice: also in {seen[name]}")
-        seen[name] = where
+        """The parameter ``name`` stands for (an alias resolved), checked and claimed once."""
+        target = PARAMETER_ALIASES.get(name, name) if name not in known else name
+        _known(where, target, known)
+        if target in seen:
+            first, spelled = seen[target]
+            alias = name if name != target else spelled
+            also = "" if spelled == name else f" (as {spelled}; {alias} is an alias of {target}: keep one)"
+            raise ValueError(f"{where}.{name} is set twice: also in {first}{also}")
+        seen[target] = (where, name)
+        return target
 
     parameters = doc.get("parameters", {})
     if not isinstance(parameters, dict):
         raise ValueError("[parameters] is invalid: allowed a table of fixed values")
+    fixed = {}
     for name, v in parameters.items():
-        claim(name, "parameters")
-        _scalar(f"parameters.{name}", v)
+        target = claim(name, "parameters")
+        fixed[target] = _scalar(f"parameters.{name}", v)
+    parameters = fixed
 
     grid = doc.get("grid", {})
     if not isinstance(grid, dict):
         raise ValueError("[grid] is invalid: allowed a table of lists")
     grid = {name: _values(f"grid.{name}", v) for name, v in grid.items()}
-    for name in grid:
-        claim(name, "grid")
+    grid = {claim(name, "grid"): v for name, v in grid.items()}
 
     zips = doc.get("zip", [])
     if isinstance(zips, dict):
@@ -263,9 +372,7 @@ def parse_spec(doc, source=""):
         lengths = {name: len(v) for name, v in group.items()}
         if len(set(lengths.values())) != 1:
             raise ValueError(f"{where} is invalid: its lists must have equal lengths, got {lengths}")
-        for name in group:
-            claim(name, where)
-        checked.append(group)
+        checked.append({claim(name, where): v for name, v in group.items()})
 
     if "seeds" not in doc:
         raise ValueError("[seeds] is missing: allowed root = <integer >= 0> and repetitions = <integer >= 1>")
