@@ -267,7 +267,9 @@ def _lissajous_bowditch(result, elastic, viscous, text):
                             result.parameters.get("periods", 0))
     except ValueError as exc:
         text.axis("off")
-        text.text(0.0, 1.0, f"no LAOS: {exc}", va="top", ha="left", fontsize="small", transform=text.transAxes)
+        import textwrap
+        text.text(0.0, 1.0, "\n".join(textwrap.wrap(f"no LAOS measures: {exc}", 48)), va="top", ha="left",
+                  fontsize="small", transform=text.transAxes)
         return
     rate = np.asarray(s.get("strain_rate", np.zeros(len(s["t"]))))
     lines = ["LAOS of the measured periods", ""]
@@ -276,7 +278,8 @@ def _lissajous_bowditch(result, elastic, viscous, text):
         try:
             m = result.laos(est)
         except (ValueError, KeyError) as exc:
-            lines.append(f"{est}: {exc}")
+            import textwrap
+            lines += textwrap.wrap(f"{est}: no LAOS measures: {exc}", 48) + [""]
             continue
         c = m.lissajous(400)
         stress = np.asarray(s[key])[w]

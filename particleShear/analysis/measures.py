@@ -46,7 +46,7 @@ def warn_few_periods(periods):
     n = measured_period_count(0, periods)
     if n >= 2:
         return False
-    skipped = " after the first, a transient," if float(periods) >= 2 else ""
+    skipped = " (the first, a transient, is skipped)" if float(periods) >= 2 else ""
     why = "G′ and G″ get no standard error" + ("" if float(periods) >= 1 else
                                                  ", and a fraction of a period does not separate G′ from G″")
     warnings.warn(f"periods={periods!r} measures {n} whole excitation period(s){skipped}: {why}; use periods >= 3 "
