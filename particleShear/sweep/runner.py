@@ -136,6 +136,12 @@ def _spec_doc(spec):
             "seeds": {"root": spec.root, "repetitions": spec.repetitions}}
 
 
+def _run_key(run):
+    """What makes two runs of a folder's segments one run (:func:`~.record.extended_runs`)."""
+    from ..simulation.provenance import identity_parameters
+    return json.dumps(identity_parameters(run.parameters), sort_keys=True), run.repetition, run.seed_entropy
+
+
 class _Share:
     """The runs ``k`` with ``k % count == index`` of a sequence of runs, as a lazy sequence."""
 
@@ -227,12 +233,16 @@ class Sweep:
         """The folder's segments (its record, this SPEC checked against it) and the runs they make."""
         self._segments = self._check_folder()
         self._run_cache = {}
+        self._order = None
         if len(self._segments) == 1:
             self.runs = self._own
             return
         me = spec_hash(self._canonical)              # an extended folder: the runs of every segment
         specs = [self.spec if spec_hash(seg["spec"]) == me else parse_spec(seg["doc"]) for seg in self._segments]
         self.runs = extended_runs(specs, [self._own if s is self.spec else spec_runs(s) for s in specs])
+        # the folder's run id of each run of this SPEC -> its position in this SPEC (the table's order)
+        folder_id = {_run_key(r): r.run_id for r in self.runs}
+        self._order = {folder_id[_run_key(r)]: j for j, r in enumerate(self._own) if _run_key(r) in folder_id}
 
     def _check_folder(self):
         """The folder's segments (dicts ``spec``, ``doc``) with this SPEC last; refuse another SPEC."""
@@ -605,19 +615,12 @@ class Sweep:
             write_parquet(self.table_path)
 
     def _spec_index(self, row):
-        """The index of ``row``'s run in this SPEC (None for a row of another segment or of no run)."""
-        runs = getattr(self, "_own", None)
-        if runs is None:                         # a series: its runs, in order
-            run = self._run_of(row)
-            return None if run is None else run.index
-        try:
-            key = json.loads(row.get("spawn_key") or "")
-        except (TypeError, ValueError):
-            return None
-        k = key[0] if isinstance(key, list) and len(key) == 1 else None
-        if isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < len(runs):
-            return None
-        return k if runs[k].run_id == row.get("run_id") else None
+        """The position of ``row``'s run in this SPEC (None for a row of another segment or of no run)."""
+        order = getattr(self, "_order", None)
+        if order is not None:                    # an extended folder: this SPEC's runs, in its order
+            return order.get(row.get("run_id"))
+        run = self._run_of(row)                  # one SPEC (or a series): the run's index
+        return None if run is None else run.index
 
     def run(self, **kwargs):
         """Run the pending runs; return every finished row in sweep order.

@@ -98,7 +98,8 @@ def _parameter_descriptions():
         for m in re.finditer(r"^(\w+) : [^\n]*\n((?:    [^\n]*\n?)+)", doc, flags=re.M):
             text = " ".join(line.strip() for line in m.group(2).splitlines())
             text = re.sub(r"^Keyword-only\.\s*", "", text)
-            found[m.group(1)] = re.split(r"(?<=[a-z0-9)\]])\.\s", text + " ", maxsplit=1)[0].strip().rstrip(".")
+            found[m.group(1)] = re.split(r"(?<!\beq)(?<!e\.g)\.\s+(?=[A-Z(`])", text + " ", maxsplit=1)[0].strip() \
+                .rstrip(".")
         _parameter_cache["doc"] = found
     return _parameter_cache["doc"]
 
@@ -336,7 +337,7 @@ def typed_row(row, schema=None):
         try:
             out[name] = typed_value(text, kind)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"column {name}={text!r} is not a {kind} ({exc})") from None
+            raise ValueError(f"column {name}={text!r} is not of type {kind} ({exc})") from None
     return out
 
 

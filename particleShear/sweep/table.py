@@ -290,7 +290,7 @@ def row_problem(row, run):
         kind = column_spec(name)["type"]
         why = cell_problem(text, kind)
         if why is not None:
-            return f"{name}={text!r} is not a {kind}"
+            return f"{name}={text!r} is not of type {kind} ({why})"
     return None
 
 
