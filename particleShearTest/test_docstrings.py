@@ -52,6 +52,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.pool",
     "particleShear.sweep.record",
     "particleShear.sweep.runner",
+    "particleShear.sweep.schema",
     "particleShear.sweep.series",
     "particleShear.sweep.spec",
     "particleShear.sweep.table",

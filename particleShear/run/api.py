@@ -11,6 +11,7 @@ every call (per process) or returned directly with ``return_result=True``.
 """
 import dataclasses
 import inspect
+import math
 
 import numpy as np
 
@@ -61,6 +62,9 @@ class SimulationResult:
         Excitation frequency in Hz.
     N_steps : int, default 0
         Number of protocol steps.
+    repetition : int, default 0
+        Index of the run among the repetitions of its parameter point in a sweep or series
+        (0 for a single run).
     damping_factor : float, default 1.0
         Per-step velocity damping factor (``cool_factor`` per step), dimensionless.
     removed_fraction : float, default 0.0
@@ -95,6 +99,7 @@ class SimulationResult:
     dt: float = 0.0
     f: float = 0.0
     N_steps: int = 0
+    repetition: int = 0
     damping_factor: float = 1.0
     removed_fraction: float = 0.0
     series: dict = dataclasses.field(default_factory=dict, repr=False)
@@ -262,8 +267,16 @@ class SimulationResult:
 
         Keys in table order: ``run_id`` (hash of the complete parameter set and seed),
         ``status`` ("ok"), ``error`` (""), ``Gp_surface, Gpp_surface, Gp_internal,
-        Gpp_internal`` (Pa), the :attr:`measures` (standard errors, ``steady_state``, LAOS ratios), every parameter (defaults filled in for those not recorded),
-        ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.
+        Gpp_internal`` (Pa), the :attr:`measures` (standard errors, ``steady_state``, LAOS ratios),
+        ``repetition``, ``frequency_Hz`` (f, Hz), ``omega`` (2πf, rad/s), ``dt`` (s), ``N_steps``,
+        every parameter (defaults filled in for those not recorded), ``seed_entropy``,
+        ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.  Values are
+        typed: float, int, bool (``steady_state`` None when it cannot be judged), str, the spawn
+        key a list (types, units: :mod:`particleShear.sweep.schema`).
+
+        Returns
+        -------
+        dict
         """
         from .. import __version__
         from ..sweep.spec import sweep_parameter_defaults
@@ -274,10 +287,25 @@ class SimulationResult:
                "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),
                "Gp_internal": float(self.G_internal[0]), "Gpp_internal": float(self.G_internal[1])}
         row.update(self.measures)
+        row.update(repetition=int(self.repetition), frequency_Hz=float(self.f), omega=2 * math.pi * float(self.f),
+                   dt=float(self.dt), N_steps=int(self.N_steps))
         row.update(params)
         row.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
                    wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")
         return row
+
+    def to_dataframe(self):
+        """:meth:`to_dict` as a pandas Series (index: the column names, table order; needs pandas).
+
+        Returns
+        -------
+        pandas.Series
+            Object dtype, named by the run id: each value keeps its Python type (float, int,
+            bool, str, list).
+        """
+        import pandas as pd
+        row = self.to_dict()
+        return pd.Series(row, dtype=object, name=row["run_id"])
 
 
 def _seed_sequence(seed):
@@ -851,4 +879,6 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     if not all_kwargs:
         return []
     from ..sweep.series import run_series
-    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size)
+    per_repetition = len(jobs) // int(N_repetitions)
+    return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size,
+                      repetitions=[k // per_repetition for k in range(len(jobs))])

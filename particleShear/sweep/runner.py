@@ -4,7 +4,8 @@ Layout of ``DIR`` (docs/sweeps.md)::
 
     DIR/sweep.json                          the SPEC of the folder's sweep (canonical form, SHA-256)
     DIR/results.csv                         one row per finished run (ok or failed)
-    DIR/results.parquet                     the same, when pyarrow is installed (rewritten at the end)
+    DIR/results.schema.json                 type, unit and description of every column of the table
+    DIR/results.parquet                     the same, typed, when pyarrow is installed (rewritten at the end)
     DIR/<reference stem><run_id>.txt        e.g. dermal_filler0.01_f_3963.3_strain_0.2_nr_3fa9c2e1b0d4.txt
     DIR/runs/<owner>/<run_id>/              scratch folder of a running run of one driving process
 
@@ -12,7 +13,8 @@ A run writes into its scratch folder; when it has finished, the worker renames i
 ``DIR`` (companions first, the file last), then the driving process appends its row.  A run is
 finished when its row is in a table, the row is this run's (id, seed, parameters, numbers), and
 its file — if it saves one — exists in ``DIR`` and is complete; anything else runs again (and the
-sweep says why).  A sweep killed at any moment leaves, at worst, a scratch folder (removed by the
+sweep says why).  Rows are appended in completion order; when the sweep has finished, the table
+is rewritten (atomically, under its lock) in SPEC order, rows of other segments after.  A sweep killed at any moment leaves, at worst, a scratch folder (removed by the
 next sweep) and, for the run that was being published, a file without row: the rerun writes the
 same file under the same name, so ``DIR`` never holds two files of one run.
 """
@@ -34,9 +36,10 @@ from .locks import FolderBusyError, ScratchOwner, folder_lock
 from .pool import pool_context, run_jobs
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
+from .schema import typed_row, write_schema
 from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
-                    remove_dead_temporaries, row_problem, table_columns, task_table_name, write_parquet,
-                    write_table)
+                    remove_dead_temporaries, row_problem, sort_table, table_columns, task_table_name,
+                    write_parquet, write_table)
 from .tasks import execute_batch, execute_run
 
 __all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
@@ -57,7 +60,8 @@ class SweepOutcome:
     run : SweepRun
         The run (parameters, seed, run id).
     row : dict
-        Its row of ``results.csv`` (status ``ok`` or ``failed``, moduli in Pa, parameters, ...).
+        Its row of ``results.csv`` (status ``ok`` or ``failed``, moduli in Pa, parameters, ...),
+        values typed as the worker produced them (floats, ints, bools, the spawn key a list).
     result : SimulationResult or None, optional
         The :class:`~particleShear.run.api.SimulationResult` (None for a failed run);
         its per-step ``series`` are kept only with ``keep_series=True``.
@@ -130,6 +134,12 @@ def _spec_doc(spec):
     return {"parameters": dict(spec.parameters), "grid": {k: list(v) for k, v in spec.grid.items()},
             "zip": [{k: list(v) for k, v in g.items()} for g in spec.zips],
             "seeds": {"root": spec.root, "repetitions": spec.repetitions}}
+
+
+def _run_key(run):
+    """What makes two runs of a folder's segments one run (:func:`~.record.extended_runs`)."""
+    from ..simulation.provenance import identity_parameters
+    return json.dumps(identity_parameters(run.parameters), sort_keys=True), run.repetition, run.seed_entropy
 
 
 class _Share:
@@ -223,12 +233,16 @@ class Sweep:
         """The folder's segments (its record, this SPEC checked against it) and the runs they make."""
         self._segments = self._check_folder()
         self._run_cache = {}
+        self._order = None
         if len(self._segments) == 1:
             self.runs = self._own
             return
         me = spec_hash(self._canonical)              # an extended folder: the runs of every segment
         specs = [self.spec if spec_hash(seg["spec"]) == me else parse_spec(seg["doc"]) for seg in self._segments]
         self.runs = extended_runs(specs, [self._own if s is self.spec else spec_runs(s) for s in specs])
+        # the folder's run id of each run of this SPEC -> its position in this SPEC (the table's order)
+        folder_id = {_run_key(r): r.run_id for r in self.runs}
+        self._order = {folder_id[_run_key(r)]: j for j, r in enumerate(self._own) if _run_key(r) in folder_id}
 
     def _check_folder(self):
         """The folder's segments (dicts ``spec``, ``doc``) with this SPEC last; refuse another SPEC."""
@@ -348,9 +362,10 @@ class Sweep:
         Returns
         -------
         dict
+            Run id → row, typed as in :meth:`rows`.
         """
         done, _ = self._classify(retry_failed)
-        return {rid: row for rid, (_, row) in done.items()}
+        return {rid: typed_row(row) for rid, (_, row) in done.items()}
 
     def _mine(self, run):
         return self.task_count is None or run.index % self.task_count == self.task_index
@@ -409,7 +424,7 @@ class Sweep:
 
     # -- running -------------------------------------------------------------------------------
     def _task(self, run, keep_series, scratch_dir, batched=False):
-        return {"run_id": run.run_id, "index": run.index, "parameters": run.parameters,
+        return {"run_id": run.run_id, "index": run.index, "repetition": run.repetition, "parameters": run.parameters,
                 "seed_entropy": run.seed_entropy, "spawn_key": run.spawn_key, "out_dir": self.out_dir,
                 "scratch_dir": scratch_dir, "keep_series": bool(keep_series), "batched": batched}
 
@@ -493,6 +508,7 @@ class Sweep:
                 self._say(stream, progress, "repaired: " + note)
             if self.spec is not None:
                 self._record()
+            write_schema(self.out_dir, self.columns)
             done, distrust = self._classify(retry_failed)
             for rid, (_, why) in sorted(distrust.items()):
                 self._say(stream, progress, f"run {rid} runs again: {why}")
@@ -591,10 +607,20 @@ class Sweep:
             owner.close()
 
     def _finish(self):
+        """End of a sweep, under the table lock: the table in SPEC order, the Parquet copy, no scratch root."""
         with contextlib.suppress(OSError):
             os.rmdir(os.path.join(self.out_dir, "runs"))   # only when empty
+        sort_table(self.table_path, self.columns, self._spec_index)
         if self.task_count is None:
             write_parquet(self.table_path)
+
+    def _spec_index(self, row):
+        """The position of ``row``'s run in this SPEC (None for a row of another segment or of no run)."""
+        order = getattr(self, "_order", None)
+        if order is not None:                    # an extended folder: this SPEC's runs, in its order
+            return order.get(row.get("run_id"))
+        run = self._run_of(row)                  # one SPEC (or a series): the run's index
+        return None if run is None else run.index
 
     def run(self, **kwargs):
         """Run the pending runs; return every finished row in sweep order.
@@ -615,12 +641,21 @@ class Sweep:
         return self.rows()
 
     def rows(self):
-        """Finished rows of this sweep in sweep order (dicts of strings, as read back from the tables)."""
+        """Finished rows of this sweep in sweep order, typed by the table's schema.
+
+        Returns
+        -------
+        list of dict
+            One dict per finished run (column → value): moduli and measures float (None where
+            empty), ``N``, ``repetition``, ``N_steps`` int, flags bool (``steady_state`` None
+            when it cannot be judged), ``seed_entropy`` int, ``spawn_key`` a list of int,
+            strings as strings (:mod:`particleShear.sweep.schema`).
+        """
         done, _ = self._classify()
-        return [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
+        return [typed_row(row) for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
 
     def merge(self):
-        """Merge every table of ``out_dir`` into ``results.csv`` (one row per run, sweep order).
+        """Merge every table of ``out_dir`` into ``results.csv`` (one row per run, sweep order, others after).
 
         Each run's trustworthy ``ok`` row is preferred over any ``failed`` row, in whichever table
         it is.  Rows of other sweeps in ``results.csv`` are kept.  A task table is removed only
@@ -644,11 +679,12 @@ class Sweep:
         self.kept_tables = []
         with folder_lock(path):
             self._check_tables(path)
+            write_schema(self.out_dir, self.columns)
             done, _ = self._classify()
             ours = [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
             merged = set(done)
             others = [row for row in read_rows(path) if row.get("run_id") not in merged]   # kept, never dropped
-            write_table(path, others + ours, self.columns)
+            write_table(path, ours + others, self.columns)
             for t in tables:
                 if t == path:
                     continue
@@ -702,7 +738,8 @@ def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, ta
     Returns
     -------
     list of dict
-        The finished rows in sweep order (dicts of strings).
+        The finished rows in sweep order, typed (:meth:`Sweep.rows`: floats, ints, bools, the
+        spawn key a list; :mod:`particleShear.sweep.schema`).
 
     Raises
     ------

@@ -29,25 +29,25 @@ def _from_runs(runs, out_dir):
 
 
 def _result_from_row(row, run, out_dir):
-    """A light SimulationResult of a run finished in an earlier call (moduli, parameters, seed, path)."""
+    """A light SimulationResult of a run finished in an earlier call, from its typed row (moduli, measures,
+    time scales, parameters, seed, path; no series)."""
     from ..run.api import SimulationResult
     from ..analysis.measures import MEASURE_COLUMNS
-    g = tuple(float(row[c]) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
+    g = tuple(_number(row.get(c)) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
     result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
                               parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
-                              timings={"total": float(row["wall_time_s"])},
+                              timings={"total": _number(row.get("wall_time_s"))},
                               output_path=os.path.join(out_dir, os.path.basename(row["output_path"]))
-                              if row["output_path"] else None)
-    result._measures = {c: ({"True": True, "False": False}.get(row.get(c)) if c == "steady_state"
-                            else _number(row.get(c))) for c in MEASURE_COLUMNS}
+                              if row.get("output_path") else None,
+                              dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
+                              N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
+    result._measures = {c: (row.get(c) if c == "steady_state" else _number(row.get(c))) for c in MEASURE_COLUMNS}
     return result
 
 
-def _number(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return float("nan")
+def _number(value):
+    """A typed cell as float: None (empty) is NaN."""
+    return float("nan") if value is None else float(value)
 
 
 def series_parameters(kwargs):
@@ -70,7 +70,7 @@ def series_parameters(kwargs):
                 **{n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")})
 
 
-def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None):
+def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None, repetitions=None):
     """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
 
     Parameters
@@ -86,6 +86,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         Processes of the default pool (default: all cores).
     batch_size : int, optional
         Runs sharing a step schedule measured in batches of up to ``batch_size`` (one task each).
+    repetitions : sequence of int, optional
+        ``repetitions[k]``: the repetition of run k (the ``repetition`` column; default 0 each).
 
     Returns
     -------
@@ -103,7 +105,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
     for k, kw in enumerate(all_kwargs):
         ss = kw["seed"]
         params = series_parameters(kw)
-        runs.append(SweepRun(index=k, point=k, repetition=0, parameters=params, seed_entropy=ss.entropy,
+        rep = 0 if repetitions is None else int(repetitions[k])
+        runs.append(SweepRun(index=k, point=k, repetition=rep, parameters=params, seed_entropy=ss.entropy,
                              spawn_key=tuple(ss.spawn_key), run_id=run_identity(params, ss.entropy, ss.spawn_key)))
     results = [None] * len(runs)
     failures = []
@@ -121,8 +124,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
             else:
                 failures.append(outcome.row)
     else:
-        tasks = [{"run_id": r.run_id, "index": r.index, "parameters": r.parameters, "seed_entropy": r.seed_entropy,
-                  "spawn_key": r.spawn_key, "out_dir": "", "keep_series": True, "batched": batch_size is not None}
+        tasks = [{"run_id": r.run_id, "index": r.index, "repetition": r.repetition, "parameters": r.parameters,
+                  "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "", "keep_series": True, "batched": batch_size is not None}
                  for r in runs]
         if batch_size is None:
             jobs = [[t] for t in tasks]

@@ -2,9 +2,11 @@
 
 Columns, in this order: ``run_id, status, error, Gp_surface, Gpp_surface, Gp_internal,
 Gpp_internal`` (Pa), the measures of :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`
-(standard errors in Pa, ``steady_state``, LAOS ratios; docs/analysis.md), every parameter of the run (signature order of
-``doParticleShearSimulation``), ``seed_entropy``, ``spawn_key`` (JSON list), ``package_version``,
-``wall_time_s``, ``output_path``.
+(standard errors in Pa, ``steady_state``, LAOS ratios; docs/analysis.md), the run columns
+:data:`~particleShear.sweep.schema.RUN_COLUMNS` (``repetition, frequency_Hz, omega, dt, N_steps``),
+every parameter of the run (signature order of ``doParticleShearSimulation``), ``seed_entropy``,
+``spawn_key`` (JSON list), ``package_version``, ``wall_time_s``, ``output_path``.  Each column's
+type, unit and description: :mod:`particleShear.sweep.schema` (``DIR/results.schema.json``).
 
 Rows are appended by one writer (the sweep's driving process) with a single ``os.write`` of a
 complete line on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
@@ -24,18 +26,19 @@ import numpy as np
 
 from ..analysis.measures import MEASURE_COLUMNS
 from ..simulation.provenance import IDENTITY_EXCLUDED, same_input
+from .schema import RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema, typed_row
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
            "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
            "reject_lines", "remove_dead_temporaries",
-           "REJECTED_SUFFIX"]
+           "REJECTED_SUFFIX", "sort_table"]
 
 #: lines of a table that cannot be rows (wrong number of fields) are moved to ``<table>`` + this suffix
 REJECTED_SUFFIX = ".rejected"
 
 #: the first columns of every results table
 RESULT_COLUMNS = ("run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") \
-    + MEASURE_COLUMNS
+    + MEASURE_COLUMNS + RUN_COLUMNS
 _TAIL_COLUMNS = ("seed_entropy", "spawn_key", "package_version", "wall_time_s", "output_path")
 TABLE_NAME = "results.csv"
 
@@ -251,8 +254,9 @@ def row_problem(row, run):
     """Why ``row`` is not a trustworthy row of ``run`` (None when it is).
 
     A row counts only when its status is ``ok`` or ``failed``, its id, seed and every parameter
-    are those of the run (as :func:`row_line` writes them), and — for an ``ok`` row — the moduli
-    and the wall time parse as numbers.
+    are those of the run (as :func:`row_line` writes them), every cell is a value of its
+    column's type (:mod:`~particleShear.sweep.schema`), and — for an ``ok`` row — the moduli
+    and the wall time are not empty.
 
     Parameters
     ----------
@@ -282,6 +286,11 @@ def row_problem(row, run):
             float(row.get(name))
         except (TypeError, ValueError):
             return f"{name}={row.get(name)!r} is not a number"
+    for name, text in row.items():
+        kind = column_spec(name)["type"]
+        why = cell_problem(text, kind)
+        if why is not None:
+            return f"{name}={text!r} is not of type {kind} ({why})"
     return None
 
 
@@ -432,10 +441,42 @@ def write_table(path, rows, columns):
             fh.write(row_line(row, columns))
 
 
+def sort_table(path, columns, index_of):
+    """Rewrite the table at ``path`` atomically with its rows in sweep order; True when it changed.
+
+    Rows for which ``index_of(row)`` is an integer come first, sorted by it (stable: rows of
+    one run keep their order); the others (rows of other SPEC segments, or of no run of the
+    sweep) follow in their order.  Every row is kept.  Call it under the table's lock.
+
+    Parameters
+    ----------
+    path : str
+        The table (nothing happens when it is absent).
+    columns : sequence of str
+        Its columns (its header).
+    index_of : callable
+        ``index_of(row) -> int or None``: the run's index in the SPEC.
+
+    Returns
+    -------
+    bool
+    """
+    rows = read_rows(path)
+    keys = [index_of(r) for r in rows]
+    ours = sorted((k, i) for i, k in enumerate(keys) if k is not None)
+    order = [i for _, i in ours] + [i for i, k in enumerate(keys) if k is None]
+    if order == list(range(len(rows))):
+        return False
+    write_table(path, [rows[i] for i in order], columns)
+    return True
+
+
 def write_parquet(csv_path):
     """Write ``results.parquet`` next to ``csv_path`` when pyarrow is installed; its path, or None.
 
-    Numeric columns are typed by pyarrow's CSV reader; ``error`` and ``output_path`` stay strings.
+    The columns are typed by the table's schema (:func:`~particleShear.sweep.schema.results_schema`):
+    Arrow types, with each column's unit and description as field metadata and the whole schema
+    as the schema metadata ``particleShear.schema``.
 
     Parameters
     ----------
@@ -448,19 +489,15 @@ def write_parquet(csv_path):
         The Parquet file's path; None without pyarrow or without the CSV file.
     """
     try:
-        import pyarrow.csv as pacsv
         import pyarrow.parquet as pq
-        import pyarrow as pa
     except ImportError:
         return None
     if not os.path.exists(csv_path):
         return None
-    with open(csv_path, newline="", encoding="utf-8") as fh:
+    with open(csv_path, newline="", encoding="utf-8-sig") as fh:
         header = next(csv.reader(fh), [])
-    strings = {c: pa.string() for c in ("run_id", "status", "error", "seed_entropy", "spawn_key", "package_version",
-                                       "output_path") if c in header}   # seeds up to 2**128: exact as text
-    table = pacsv.read_csv(csv_path, convert_options=pacsv.ConvertOptions(column_types=strings,
-                                                                          strings_can_be_null=False))
+    schema = results_schema(header)
+    table = arrow_table([typed_row(r, schema) for r in read_rows(csv_path)], schema)
     out = os.path.splitext(csv_path)[0] + ".parquet"
     tmp = os.path.join(os.path.dirname(out) or ".", "." + os.path.basename(out) + ".part")
     pq.write_table(table, tmp)

@@ -1,6 +1,6 @@
 """What a sweep's worker runs: one task (a picklable dict) or a batch of them, and the publication of the files.
 
-A task is ``{"run_id", "index", "parameters", "seed_entropy", "spawn_key", "out_dir",
+A task is ``{"run_id", "index", "repetition", "parameters", "seed_entropy", "spawn_key", "out_dir",
 "scratch_dir", "keep_series"}``.  A run writes into its scratch folder
 ``scratch_dir/<run id>/`` (cleared first: leftovers of a killed attempt); when it has finished,
 the worker renames its files into ``out_dir`` under the run id (companions first, the file
@@ -111,7 +111,8 @@ def failed_row(task, exc, wall):
     dict
     """
     from .. import __version__
-    row = {"run_id": task["run_id"], "status": "failed", "error": error_text(exc)}
+    row = {"run_id": task["run_id"], "status": "failed", "error": error_text(exc),
+           "repetition": int(task.get("repetition", 0))}
     row.update(task["parameters"])
     row.update(seed_entropy=task["seed_entropy"], spawn_key=list(task["spawn_key"]), package_version=__version__,
                wall_time_s=wall, output_path="")
@@ -126,7 +127,8 @@ def execute_run(task):
     Parameters
     ----------
     task : dict
-        ``run_id``, ``index``, ``parameters`` (complete, of ``doParticleShearSimulation``),
+        ``run_id``, ``index``, ``repetition`` (of its point; default 0), ``parameters`` (complete,
+        of ``doParticleShearSimulation``),
         ``seed_entropy``, ``spawn_key``, ``out_dir`` (sweep folder; "" writes nothing),
         ``scratch_dir`` (this driving process's scratch folder) and ``keep_series`` (bool).
 
@@ -171,6 +173,7 @@ def _finish_run(task, result, wall_time_s):
     row naming the write error, its moduli kept.
     """
     result.parameters = dict(task["parameters"])
+    result.repetition = int(task.get("repetition", 0))
     if result.output_path:
         run_dir = os.path.dirname(result.output_path)
         image_folder, produced = result.image_folder, result.output_path

@@ -1,0 +1,477 @@
+"""The schema of a results table: every column's type, unit and description, defined once.
+
+A sweep writes it as ``DIR/results.schema.json`` beside ``DIR/results.csv``
+(:func:`write_schema`), :func:`load_results` applies it when it reads the table back, and
+``results.parquet`` carries it (:func:`arrow_schema`: the types as Arrow types, unit and
+description as field metadata).  ``run_sweep`` returns rows typed by it (:func:`typed_row`).
+
+Column types (``"type"`` in the JSON file):
+
+============  ==========================  =====================  ========================
+type          Python value (typed dict)   pandas dtype           Arrow type
+============  ==========================  =====================  ========================
+``float``     float (empty: None)         ``float64`` (NaN)      ``double``
+``int``       int (empty: None)           ``int64`` / ``Int64``  ``int64``
+``bool``      bool (empty: None)          ``bool`` / ``boolean``  ``bool``
+``string``    str (empty: "")             ``str`` / ``object``   ``string``
+``bigint``    int of any size             ``object``             ``string`` (decimal)
+``int_list``  list of int (JSON text)     ``object``             ``list<int64>``
+============  ==========================  =====================  ========================
+
+A column that may be empty (``"nullable": true``: the moduli, measures and run columns of a
+failed row, ``steady_state`` when it cannot be judged) gets pandas' nullable dtype for ints and
+bools (``Int64``, ``boolean``); floats are NaN where empty.
+"""
+__docformat__ = "numpy"
+import csv
+import inspect
+import io
+import json
+import math
+import os
+import re
+
+__all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "results_schema", "column_spec", "write_schema",
+           "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
+           "load_results"]
+
+#: file name of the schema beside ``results.csv``
+SCHEMA_NAME = "results.schema.json"
+#: the allowed column types (module docstring)
+COLUMN_TYPES = ("float", "int", "bool", "string", "bigint", "int_list")
+#: the run's time scales and repetition, after the measures in the table (docs/sweeps.md)
+RUN_COLUMNS = ("repetition", "frequency_Hz", "omega", "dt", "N_steps")
+
+_G = "{} modulus G{} from the {} (Pa); empty for a failed run"
+_SE = "standard error of {} over the measured excitation periods (Pa); NaN with fewer than 2 periods"
+#: column -> (type, unit, description, nullable) of every column that is not a parameter
+_FIXED = {
+    "run_id": ("string", "", "12 hex digits identifying the complete parameter set and seed", False),
+    "status": ("string", "", "'ok' or 'failed'", False),
+    "error": ("string", "", "exception type and message of a failed run; empty when ok", False),
+    "Gp_surface": ("float", "Pa", _G.format("storage", "′", "plate (surface) forces"), True),
+    "Gpp_surface": ("float", "Pa", _G.format("loss", "″", "plate (surface) forces"), True),
+    "Gp_internal": ("float", "Pa", _G.format("storage", "′", "overall stress tensor (internal, eq. S1-24)"), True),
+    "Gpp_internal": ("float", "Pa", _G.format("loss", "″", "overall stress tensor (internal, eq. S1-24)"), True),
+    "Gp_surface_se": ("float", "Pa", _SE.format("Gp_surface"), True),
+    "Gpp_surface_se": ("float", "Pa", _SE.format("Gpp_surface"), True),
+    "Gp_internal_se": ("float", "Pa", _SE.format("Gp_internal"), True),
+    "Gpp_internal_se": ("float", "Pa", _SE.format("Gpp_internal"), True),
+    "steady_state": ("bool", "", "False when a modulus drifts from period to period beyond its error, True when "
+                     "none does; empty with fewer than 3 measured periods (docs/analysis.md)", True),
+    "I3_I1_surface": ("float", "1", "intensity ratio of the third to the first stress harmonic, surface stress", True),
+    "I3_I1_internal": ("float", "1", "intensity ratio of the third to the first stress harmonic, internal stress",
+                       True),
+    "S_surface": ("float", "1", "Ewoldt-Hosoi-McKinley stiffening ratio S, surface stress", True),
+    "T_surface": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, surface stress", True),
+    "S_internal": ("float", "1", "Ewoldt-Hosoi-McKinley stiffening ratio S, internal stress", True),
+    "T_internal": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, internal stress", True),
+    "repetition": ("int", "", "index of the run among the repetitions of its parameter point (0-based; "
+                   "SweepRun.repetition)", False),
+    "frequency_Hz": ("float", "Hz", "excitation frequency f; empty for a failed run", True),
+    "omega": ("float", "rad/s", "angular excitation frequency 2πf; empty for a failed run", True),
+    "dt": ("float", "s", "protocol time step; empty for a failed run", True),
+    "N_steps": ("int", "", "number of protocol steps; empty for a failed run", True),
+    "seed_entropy": ("bigint", "", "entropy of the run's numpy.random.SeedSequence (the SPEC's [seeds] root; "
+                     "an integer below 2**128)", False),
+    "spawn_key": ("int_list", "", "spawn key of the run's SeedSequence, a JSON list ([k] for run k of a sweep)",
+                  False),
+    "package_version": ("string", "", "particleShear version that measured the run", False),
+    "wall_time_s": ("float", "s", "wall time of the run", False),
+    "output_path": ("string", "", "the run's output file, relative to the sweep folder; empty when none", False),
+}
+#: parameters that are integers (validation: ``cut_lines``, ``N``); other numbers are floats
+_INT_PARAMETERS = ("cut_lines", "N")
+#: units of the numeric parameters that have one (docs/parameters.md); the other numbers are dimensionless
+_PARAMETER_UNITS = {"Young_modulus_spheres": "Pa", "density": "kg/m³", "avoid_horizontal_angle_degree": "degree",
+                    "edge_fuzziness": "largest radius", "pre_periods": "excitation periods",
+                    "periods": "excitation periods", "post_periods": "excitation periods"}
+_parameter_cache = {}
+
+
+def _parameter_descriptions():
+    """Parameter name -> first sentence of its entry in the docstring of ``doParticleShearSimulation``."""
+    if "doc" not in _parameter_cache:
+        from ..run.api import doParticleShearSimulation
+        doc = inspect.getdoc(doParticleShearSimulation) or ""   # empty under python -OO
+        found = {}
+        for m in re.finditer(r"^(\w+) : [^\n]*\n((?:    [^\n]*\n?)+)", doc, flags=re.M):
+            text = " ".join(line.strip() for line in m.group(2).splitlines())
+            text = re.sub(r"^Keyword-only\.\s*", "", text)
+            found[m.group(1)] = re.split(r"(?<!\beq)(?<!e\.g)\.\s+(?=[A-Z(`])", text + " ", maxsplit=1)[0].strip() \
+                .rstrip(".")
+        _parameter_cache["doc"] = found
+    return _parameter_cache["doc"]
+
+
+def column_spec(name):
+    """The schema entry of one column of a results table (a parameter or a fixed column).
+
+    Parameters
+    ----------
+    name : str
+        The column.
+
+    Returns
+    -------
+    dict
+        ``{"name", "type", "unit", "description", "nullable"}``; a column the package does not
+        know is a nullable ``string`` without description.
+    """
+    if name not in _spec_cache:
+        _spec_cache[name] = _column_spec(name)
+    return dict(_spec_cache[name])
+
+
+_spec_cache = {}
+
+
+def _column_spec(name):
+    if name in _FIXED:
+        kind, unit, text, nullable = _FIXED[name]
+        return {"name": name, "type": kind, "unit": unit, "description": text, "nullable": nullable}
+    from .spec import sweep_parameter_defaults
+    defaults = sweep_parameter_defaults()
+    if name not in defaults:
+        return {"name": name, "type": "string", "unit": "", "description": "", "nullable": True}
+    d = defaults[name]
+    if isinstance(d, bool):
+        kind, unit = "bool", ""
+    elif isinstance(d, str):
+        kind, unit = "string", ""
+    else:
+        kind = "int" if name in _INT_PARAMETERS else "float"
+        unit = _PARAMETER_UNITS.get(name, "" if kind == "int" else "1")
+    text = _parameter_descriptions().get(name, "")
+    return {"name": name, "type": kind, "unit": unit,
+            "description": f"parameter {name} of doParticleShearSimulation: {text}" if text else
+            f"parameter {name} of doParticleShearSimulation", "nullable": False}
+
+
+def results_schema(columns=None):
+    """The schema of a results table: one entry per column, in table order.
+
+    Parameters
+    ----------
+    columns : sequence of str, optional
+        The table's columns (default: :func:`~particleShear.sweep.table.table_columns`).
+
+    Returns
+    -------
+    dict
+        ``{"format": "particleShear results schema", "version": 1, "columns": [entry, ...]}``,
+        each entry as :func:`column_spec`.
+    """
+    if columns is None:
+        from .table import table_columns
+        columns = table_columns()
+    return {"format": "particleShear results schema", "version": 1, "table": "results.csv",
+            "columns": [column_spec(c) for c in columns]}
+
+
+def write_schema(folder, columns):
+    """Write ``folder/results.schema.json`` (atomically) for a table of ``columns``; its path.
+
+    Parameters
+    ----------
+    folder : str
+        The sweep folder.
+    columns : sequence of str
+        The table's columns.
+
+    Returns
+    -------
+    str
+    """
+    from .table import atomic_text
+    path = os.path.join(folder, SCHEMA_NAME)
+    text = json.dumps(results_schema(columns), indent=1, ensure_ascii=False) + "\n"
+    try:
+        with open(path, encoding="utf-8") as fh:
+            if fh.read() == text:
+                return path
+    except OSError:
+        pass
+    with atomic_text(path) as fh:
+        fh.write(text)
+    return path
+
+
+def read_schema(path):
+    """The schema in ``path`` (a ``results.schema.json``), checked.
+
+    Parameters
+    ----------
+    path : str
+        The schema file.
+
+    Returns
+    -------
+    dict
+        As :func:`results_schema`.
+
+    Raises
+    ------
+    ValueError
+        When the file is not JSON or an entry has no name or an unknown type.
+    """
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"schema {path!r} cannot be read ({exc}): delete it to use the package's schema") from None
+    cols = doc.get("columns") if isinstance(doc, dict) else None
+    if not isinstance(cols, list) or not all(isinstance(c, dict) and isinstance(c.get("name"), str)
+                                             and c.get("type") in COLUMN_TYPES for c in cols):
+        raise ValueError(f"schema {path!r} is invalid: allowed 'columns', a list of entries with a name and a type "
+                         f"in {list(COLUMN_TYPES)}")
+    return doc
+
+
+def typed_value(text, kind):
+    """The value of one table cell as its column's type (module docstring); empty text is None.
+
+    Parameters
+    ----------
+    text : str or None
+        The cell as read back (a value already typed is returned converted).
+    kind : str
+        One of :data:`COLUMN_TYPES`.
+
+    Returns
+    -------
+    object
+
+    Raises
+    ------
+    ValueError
+        When the text is not a value of that type.
+    """
+    if kind == "string":
+        return "" if text is None else str(text)
+    if text is None or text == "":
+        return None
+    if not isinstance(text, str):
+        if kind == "float":
+            return float(text)
+        if kind in ("int", "bigint"):
+            return _integer(text)
+        if kind == "bool":
+            return bool(text)
+        return [int(x) for x in text]
+    if kind == "float":
+        return float(text)
+    if kind in ("int", "bigint"):
+        return _integer(text)
+    if kind == "bool":
+        if text in ("True", "true", "1"):
+            return True
+        if text in ("False", "false", "0"):
+            return False
+        raise ValueError(f"{text!r} is not True or False")
+    value = json.loads(text)
+    if not isinstance(value, list) or not all(isinstance(x, int) and not isinstance(x, bool) for x in value):
+        raise ValueError(f"{text!r} is not a JSON list of integers")
+    return value
+
+
+def _integer(v):
+    if isinstance(v, bool):
+        raise ValueError(f"{v!r} is not an integer")
+    if isinstance(v, int):
+        return v
+    try:
+        return int(v)
+    except (TypeError, ValueError):
+        x = float(v)
+        if not x.is_integer():
+            raise ValueError(f"{v!r} is not an integer") from None
+        return int(x)
+
+
+def cell_problem(text, kind):
+    """Why ``text`` is not a value of type ``kind`` (None when it is, or when it is empty).
+
+    Parameters
+    ----------
+    text : str or None
+        A cell as read back.
+    kind : str
+        One of :data:`COLUMN_TYPES`.
+
+    Returns
+    -------
+    str or None
+    """
+    try:
+        typed_value(text, kind)
+    except (TypeError, ValueError) as exc:
+        return str(exc) or f"{text!r} is not a {kind}"
+    return None
+
+
+def typed_row(row, schema=None):
+    """A table row (dict of strings) with every value typed by the schema.
+
+    Parameters
+    ----------
+    row : dict
+        Column -> text (as :func:`~particleShear.sweep.table.read_rows` gives).
+    schema : dict, optional
+        As :func:`results_schema` (default: the package's entry of each column).
+
+    Returns
+    -------
+    dict
+        Same keys and order; values as the module docstring's "Python value".
+
+    Raises
+    ------
+    ValueError
+        Naming the column and the text, when a cell is not a value of its type.
+    """
+    kinds = {c["name"]: c["type"] for c in schema["columns"]} if schema else {}
+    out = {}
+    for name, text in row.items():
+        kind = kinds.get(name) or column_spec(name)["type"]
+        try:
+            out[name] = typed_value(text, kind)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"column {name}={text!r} is not of type {kind} ({exc})") from None
+    return out
+
+
+def arrow_schema(schema):
+    """The ``pyarrow.Schema`` of a results schema: Arrow types, unit and description as field metadata.
+
+    Parameters
+    ----------
+    schema : dict
+        As :func:`results_schema`.
+
+    Returns
+    -------
+    pyarrow.Schema
+        Field metadata ``type`` (the schema's type), ``unit``, ``description``; schema metadata
+        ``particleShear.schema``: the schema as JSON.
+    """
+    import pyarrow as pa
+    arrow = {"float": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "string": pa.string(),
+             "bigint": pa.string(), "int_list": pa.list_(pa.int64())}
+    fields = [pa.field(c["name"], arrow[c["type"]], nullable=True,
+                       metadata={"type": c["type"], "unit": c.get("unit", ""),
+                                 "description": c.get("description", "")}) for c in schema["columns"]]
+    return pa.schema(fields, metadata={"particleShear.schema": json.dumps(schema, ensure_ascii=False)})
+
+
+def arrow_table(rows, schema):
+    """A ``pyarrow.Table`` of typed rows (:func:`typed_row`) under :func:`arrow_schema`.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Typed rows.
+    schema : dict
+        As :func:`results_schema`.
+
+    Returns
+    -------
+    pyarrow.Table
+    """
+    import pyarrow as pa
+    sch = arrow_schema(schema)
+    cols = []
+    for c in schema["columns"]:
+        values = [r.get(c["name"]) for r in rows]
+        if c["type"] == "bigint":
+            values = [None if v is None else str(v) for v in values]
+        cols.append(pa.array(values, type=sch.field(c["name"]).type))
+    return pa.Table.from_arrays(cols, schema=sch)
+
+
+def _frame(rows, schema):
+    import numpy as np
+    import pandas as pd
+    data = {}
+    for c in schema["columns"]:
+        name, kind = c["name"], c["type"]
+        values = [r.get(name) for r in rows]
+        missing = any(v is None for v in values)
+        if kind == "float":
+            data[name] = pd.Series(np.array([math.nan if v is None else v for v in values], dtype=np.float64))
+        elif kind == "int":
+            data[name] = pd.Series(values, dtype="Int64" if c.get("nullable") or missing else np.int64)
+        elif kind == "bool":
+            data[name] = pd.Series(values, dtype="boolean" if c.get("nullable") or missing else bool)
+        elif kind == "string":
+            data[name] = pd.Series(values, dtype=str)
+        else:
+            data[name] = pd.Series(values, dtype=object)
+    return pd.DataFrame(data, columns=[c["name"] for c in schema["columns"]])
+
+
+def load_results(folder_or_csv, as_frame=None):
+    """A sweep's results table, typed by its schema: a pandas DataFrame, or a list of typed dicts.
+
+    Reads ``DIR/results.csv`` and applies ``DIR/results.schema.json`` (the package's schema of
+    the table's columns when the file is absent).  Every row is kept, ``ok`` and ``failed``, in
+    the table's order (SPEC order once a sweep has finished).
+
+    Parameters
+    ----------
+    folder_or_csv : str or os.PathLike
+        The sweep folder, or a results table (``.csv``) itself (its schema is looked for beside it).
+    as_frame : bool, optional
+        True: a DataFrame (needs pandas); False: a list of dicts; None (default): a DataFrame when
+        pandas is installed, else the list.
+
+    Returns
+    -------
+    pandas.DataFrame or list of dict
+        Columns typed as the schema says (module docstring): moduli float64, ``N`` int64,
+        ``steady_state`` boolean (nullable), ``N_steps`` Int64, parameters of their type,
+        strings as strings.
+
+    Raises
+    ------
+    ValueError
+        When there is no table, the table cannot be read, a cell is not a value of its column's
+        type, or ``as_frame`` is not None, True or False.
+    ImportError
+        When ``as_frame=True`` and pandas is not installed.
+    """
+    from .table import TABLE_NAME
+    if as_frame not in (None, True, False):
+        raise ValueError(f"as_frame={as_frame!r} is invalid: allowed None, True or False")
+    path = os.fspath(folder_or_csv)
+    if os.path.isdir(path):
+        path = os.path.join(path, TABLE_NAME)
+    if not os.path.isfile(path):
+        raise ValueError(f"folder_or_csv={os.fspath(folder_or_csv)!r} is invalid: no results table there")
+    with open(path, newline="", encoding="utf-8-sig") as fh:
+        text = fh.read()
+    if text and not text.endswith("\n"):
+        text = text[:text.rfind("\n") + 1]        # a torn last line (killed writer) is no row
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader, [])
+    schema_path = os.path.join(os.path.dirname(path) or ".", SCHEMA_NAME)
+    known = read_schema(schema_path) if os.path.isfile(schema_path) else {"columns": []}
+    by_name = {c["name"]: c for c in known["columns"]}
+    schema = {"columns": [by_name.get(c) or column_spec(c) for c in header]}
+    rows = []
+    for k, fields in enumerate(reader, start=2):
+        if len(fields) != len(header):
+            raise ValueError(f"results table {path!r}, line {k}: {len(fields)} fields, the header has "
+                             f"{len(header)}: repair it (a sweep over the folder does)")
+        try:
+            rows.append(typed_row(dict(zip(header, fields)), schema))
+        except ValueError as exc:
+            raise ValueError(f"results table {path!r}, line {k}: {exc}") from None
+    if as_frame is False:
+        return rows
+    try:
+        return _frame(rows, schema)
+    except ImportError:
+        if as_frame:
+            raise
+        return rows
