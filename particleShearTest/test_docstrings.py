@@ -62,6 +62,7 @@ DOCUMENTED_MODULES = [
     "particleShear.messages",
     "particleShear.run",
     "particleShear.run.api",
+    "particleShear.run.result",
     "particleShear.run.batch",
     "particleShear.run.cli",
     "particleShear.run.guard",
