@@ -131,8 +131,8 @@ def _resolve_x(x, params, varying, kept):
 def _interval_label(kind, n_boot, confidence, bootstrap_seed, why=""):
     if kind == "bootstrap":
         seed = "fresh entropy" if bootstrap_seed is None else f"seed {bootstrap_seed}"
-        return (f"bars: {100 * confidence:g} % bootstrap interval of the mean\nover seeds (analysis.sweep_summary, "
-                f"\n{n_boot} resamples, {seed})")
+        return (f"bars: {100 * confidence:g} % bootstrap interval of the mean\nover seeds, Student-t width "
+                f"(analysis.sweep_summary,\n{n_boot} resamples, {seed})")
     return "bars: mean ± 1 standard error\nover seeds (s/√n, ddof = 1)" + (f"\n{why}" if why else "")
 
 

@@ -62,7 +62,7 @@ def _panel(ax, title, s, notes):
         clipped |= bool(np.any((lo <= 0) & (hi > 0)))
         band_ok = hi > 0
         ax.fill_between(A[band_ok], np.maximum(lo[band_ok], floor), hi[band_ok], color=colour, alpha=0.18, lw=0,
-                        label=f"{key}: {s.confidence:.0%} bootstrap interval of the mean")
+                        label=f"{key}: {s.confidence:.0%} bootstrap interval of the mean (Student-t width)")
         ax.plot(A[ok], mean[ok], color=colour, ls=style, marker=marker, mfc=mfc, ms=4, lw=1.3,
                 label=f"{key} mean over seeds")
         if (~ok).any():
