@@ -8,11 +8,8 @@
 * no command line takes prefix abbreviations, and an unknown flag names the closest flags;
 * a SPEC that is not valid TOML is refused naming the file, the line and the usual fix.
 """
-import contextlib
 import inspect
-import io
 import os
-import sys
 import tempfile
 import unittest
 import warnings
@@ -22,6 +19,7 @@ from particleShear import doParticleShearSimulation, doParticleShearSimulationSe
 from particleShear.run.guard import PARAMETER_ALIASES, UnknownParameterError, close_names
 from particleShear.run.validation import validate_run
 from particleShear.sweep.spec import expand_runs, load_spec, parse_spec
+from particleShearTest.test_cli import run_main
 
 #: a run of about a second: 12 spheres, no cuts, one period at a high relative frequency
 TINY = dict(N=12, cut_lines=0, relative_frequency=0.5, pre_periods=0, periods=1, post_periods=0, seed=11,
@@ -29,15 +27,9 @@ TINY = dict(N=12, cut_lines=0, relative_frequency=0.5, pre_periods=0, periods=1,
 
 
 def run_cli(argv):
-    """(exit status, stderr) of ``particleShear.run.cli.main(argv)``; argparse's SystemExit counts as a status."""
-    from particleShear.run.cli import main
-    out, err = io.StringIO(), io.StringIO()
-    with mock.patch.object(sys, "stdout", out), mock.patch.object(sys, "stderr", err):
-        try:
-            rc = main(list(argv))
-        except SystemExit as exc:
-            rc = exc.code
-    return rc, err.getvalue()
+    """(exit status, stderr) of ``particleShear.run.cli.main(argv)`` (test_cli's runner)."""
+    rc, _, err = run_main(argv)
+    return rc, err
 
 
 def quiet(func, *args, **kwargs):

@@ -188,42 +188,11 @@ class Bootstrap(unittest.TestCase):
         with self.assertWarnsRegex(UserWarning, r"amplitude\(s\) \[0.001\]"):
             sweep_summary(np.r_[A, A[1:]], np.r_[gp, gp[1:]], np.r_[gpp, gpp[1:]], n_boot=20, rng=0)
 
-    def test_coverage_with_student_width(self):
-        """M noisy sweeps of 4 seeds each (10 % normal multiplicative noise): the default 95 % intervals hold
-        the truth in ≈ 95 % of the sweeps (the Student-t width of a mean, carried into the flow point)."""
-        M, n, sigma = 250, 4, 0.10
-        expected = 0.95
-        # binomial: 3 standard deviations over M sweeps, plus 0.02 for the discreteness of resampling 4 seeds
-        # and the nonlinearity of the flow point
-        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
-        rng = np.random.default_rng(20261202)
-        A = np.repeat(AC * np.logspace(-2, 1.5, 5), n)
-        gp0, gpp0 = model(A)
-        plateau_true, flow_true = model(A[0])[0], AC / R
-        hits = np.zeros(2)
-        for _ in range(M):
-            gp = gp0 * (1 + sigma * rng.standard_normal(A.size))
-            gpp = gpp0 * (1 + sigma * rng.standard_normal(A.size))
-            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng)
-            hits += [s.plateau_ci[0] <= plateau_true <= s.plateau_ci[1],
-                     s.flow_point_ci[0] <= flow_true <= s.flow_point_ci[1]]
-        coverage = hits / M
-        print(f"coverage over {M} sweeps of {n} seeds: plateau {coverage[0]:.3f}, flow point {coverage[1]:.3f}")
-        for name, c in zip(("plateau", "flow_point"), coverage):
-            self.assertLess(abs(c - expected), tol, msg=f"{name}: coverage {c:.3f}, expected {expected} ± {tol:.3f}")
-
-    def test_coverage_of_plateau_and_flow_point(self):
-        """Plain percentile bootstrap (student=False), M noisy sweeps of n seeds: the 95 % intervals cover the
-        truth about as often as the percentile bootstrap of a mean from n seeds should, P(|T_{n−1}| < z√((n−1)/n))."""
-        M, n, sigma = 250, 10, 0.10
-        z = 1.959963984540054
-        expected = t_cdf_interval(z * math.sqrt((n - 1) / n), n - 1)        # 0.904 for n = 10
-        self.assertAlmostEqual(expected, 0.904, delta=0.002)
-        # binomial: 3 standard deviations of a proportion over M sweeps, plus 0.02 for the normal approximation
-        # of the bootstrap distribution (discrete resampling, percentiles of n_boot = 200 replicates, nonlinearity of the
-        # flow point)
-        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
-        rng = np.random.default_rng(20240521)
+    @staticmethod
+    def coverage(M, n, sigma, seed, student):
+        """Fraction of M noisy model sweeps (n seeds, normal multiplicative scatter sigma) whose intervals
+        of the plateau and of the flow point hold the truth."""
+        rng = np.random.default_rng(seed)
         A = np.repeat(AC * np.logspace(-2, 1.5, 5), n)         # flow point A_c/r = 0.1 inside
         gp0, gpp0 = model(A)
         plateau_true, flow_true = model(A[0])[0], AC / R
@@ -231,14 +200,37 @@ class Bootstrap(unittest.TestCase):
         for _ in range(M):
             gp = gp0 * (1 + sigma * rng.standard_normal(A.size))
             gpp = gpp0 * (1 + sigma * rng.standard_normal(A.size))
-            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng, student=False)
+            s = sweep_summary(A, gp, gpp, n_boot=200, rng=rng, student=student)
             hits += [s.plateau_ci[0] <= plateau_true <= s.plateau_ci[1],
                      s.flow_point_ci[0] <= flow_true <= s.flow_point_ci[1]]
-        coverage = hits / M
-        print(f"coverage over {M} sweeps: plateau {coverage[0]:.3f}, flow point {coverage[1]:.3f}; "
-              f"expected {expected:.3f} ± {tol:.3f}")
+        return hits / M
+
+    def check_coverage(self, coverage, expected, tol):
+        print(f"coverage: plateau {coverage[0]:.3f}, flow point {coverage[1]:.3f}; expected {expected:.3f} ± {tol:.3f}")
         for name, c in zip(("plateau", "flow_point"), coverage):
             self.assertLess(abs(c - expected), tol, msg=f"{name}: coverage {c:.3f}, expected {expected:.3f} ± {tol:.3f}")
+
+    def test_coverage_with_student_width(self):
+        """M noisy sweeps of 4 seeds each (10 % normal multiplicative noise): the default 95 % intervals hold
+        the truth in ≈ 95 % of the sweeps (the Student-t width of a mean, carried into the flow point)."""
+        M, expected = 250, 0.95
+        # binomial: 3 standard deviations over M sweeps, plus 0.02 for the discreteness of resampling 4 seeds
+        # and the nonlinearity of the flow point
+        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
+        self.check_coverage(self.coverage(M, 4, 0.10, 20261202, student=True), expected, tol)
+
+    def test_coverage_of_plateau_and_flow_point(self):
+        """Plain percentile bootstrap (student=False), M noisy sweeps of n seeds: the 95 % intervals cover the
+        truth about as often as the percentile bootstrap of a mean from n seeds should, P(|T_{n−1}| < z√((n−1)/n))."""
+        M, n = 250, 10
+        z = 1.959963984540054
+        expected = t_cdf_interval(z * math.sqrt((n - 1) / n), n - 1)        # 0.904 for n = 10
+        self.assertAlmostEqual(expected, 0.904, delta=0.002)
+        # binomial: 3 standard deviations of a proportion over M sweeps, plus 0.02 for the normal approximation
+        # of the bootstrap distribution (discrete resampling, percentiles of n_boot = 200 replicates, nonlinearity of the
+        # flow point)
+        tol = 3 * math.sqrt(expected * (1 - expected) / M) + 0.02
+        self.check_coverage(self.coverage(M, n, 0.10, 20240521, student=False), expected, tol)
 
 
 class BadInput(unittest.TestCase):

@@ -169,9 +169,7 @@ class LaosResult:
         float or numpy.ndarray
             σ′ (Pa), of the shape of ``theta``.
         """
-        theta = np.asarray(theta, dtype=float)
-        out = self.strain_amplitude * (np.sin(np.multiply.outer(theta, self.n)) @ self.Gp)
-        return out if out.ndim else float(out)
+        return self._odd_series(np.sin, theta, self.Gp)
 
     def viscous_stress(self, theta):
         """The viscous stress ``σ″ = γ₀ Σ G''_n cos nθ`` (odd orders only).
@@ -188,8 +186,12 @@ class LaosResult:
         float or numpy.ndarray
             σ″ (Pa), of the shape of ``theta``.
         """
+        return self._odd_series(np.cos, theta, self.Gpp)
+
+    def _odd_series(self, trig, theta, coefficients):
+        """γ₀ Σ_n c_n trig(nθ) over the odd orders, of the shape of ``theta``."""
         theta = np.asarray(theta, dtype=float)
-        out = self.strain_amplitude * (np.cos(np.multiply.outer(theta, self.n)) @ self.Gpp)
+        out = self.strain_amplitude * (trig(np.multiply.outer(theta, self.n)) @ coefficients)
         return out if out.ndim else float(out)
 
     def lissajous(self, n_points=200):
