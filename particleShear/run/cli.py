@@ -27,6 +27,7 @@ import sys
 import time
 
 from .guard import SuggestingParser
+from .validation import IMAGE_FILE_TYPES
 
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
@@ -361,8 +362,8 @@ def build_parser():
     c = p.add_argument_group("command line")
     c.add_argument("--save", metavar="DIR", default=None, action=_Store,
                    help="write the output file into DIR (must exist): --root-folder DIR --save-data")
-    c.add_argument("--images", nargs="?", const="jpg", default=None, choices=("jpg", "png", "ps"), action=_Store,
-                   help="with --save: save ~200 snapshots of type jpg (default), png or ps: "
+    c.add_argument("--images", nargs="?", const="jpg", default=None, choices=IMAGE_FILE_TYPES, action=_Store,
+                   help="with --save: save ~200 snapshots of type jpg (default), png, ps or svg: "
                         "--save-output-images --image-file-type TYPE")
     c.add_argument("--draw", action="store_true",
                    help="show the live particle and stress windows (needs a display): "
