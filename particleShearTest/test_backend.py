@@ -622,8 +622,6 @@ class TestBadBackend(unittest.TestCase):
         with standin_registered():
             with self.assertRaisesRegex(ValueError, r"backend='cpu-standin' is invalid for this run \(doDrawing=True"):
                 doParticleShearSimulation(backend=STANDIN, **dict(QUICK, doDrawing=True))
-            with self.assertRaisesRegex(ValueError, r"integrator='verlet'"):
-                doParticleShearSimulationSeries(backend=STANDIN, integrator="verlet", **QUICK)
 
     def test_cli_names_the_flag(self):
         from particleShear.run.cli import main

@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from .box import min_image, wrap
-from .integrate import damp, drift, kick, plates_follow, xi_increments
+from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
@@ -64,6 +64,18 @@ class EngineInstability(RuntimeError):
         self.phase = phase
 
 
+class _ForceRecord:
+    """What a force phase leaves for the acceleration and movement phases and for the register
+    (the candidates' geometry, relations, pair forces and the mobility mask; see
+    :meth:`BatchEngine.force_phase`)."""
+    __slots__ = ("dx", "dy", "d", "nx", "ny", "dvx", "ky", "kx", "yc", "mob", "touching", "active", "shifted", "fn",
+                 "F", "fx_i", "fy_i", "dF", "tq")
+
+    def __init__(self, **kw):
+        for k, v in kw.items():
+            setattr(self, k, v)
+
+
 class BatchEngine:
     """Advances a :class:`~particleShear.engine.state.BatchState` step by step.
 
@@ -80,16 +92,29 @@ class BatchEngine:
         :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
         energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
         contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
+    integrator : {"euler", "verlet"}
+        ``"euler"``: the reference's semi-implicit Euler.  ``"verlet"``: velocity Verlet with a
+        half-kick predictor — the velocity-dependent terms of a force phase see the velocities
+        moved ``F·dt/(2m)`` ahead by the forces of the previous step (the classes'
+        ``set_integrator("verlet")``).
 
     Raises
     ------
     ValueError
-        If ``skin_factor`` is not > 0.
+        If ``skin_factor`` is not > 0 or ``integrator`` is unknown.
     """
 
-    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True):
+    INTEGRATORS = ("euler", "verlet")
+
+    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler"):
         if not skin_factor > 0:
             raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
+        if integrator not in self.INTEGRATORS:
+            raise ValueError(f"integrator={integrator!r} is not allowed: one of {self.INTEGRATORS}")
+        self.integrator = integrator
+        self.half = None          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
+        self.g = None             # the record of the last force phase (_ForceRecord)
+        self.verdict = None       # a device's guard verdict of the force phase, read at the end of the step
         s = self.s = state
         xp = self.xp = s.xp
         self.backend = s.backend
@@ -289,9 +314,11 @@ class BatchEngine:
             self.C.mu = s.mu[self.C.rep]
 
     def step(self, cool, dt, sample=False):
-        """One step of every replica; returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when
-        ``sample``, and also every tensor of :data:`~particleShear.engine.stress.TENSORS` as a
-        (B, 9, 2, 2) array when ``sample == "tensors"``.
+        """One step of every replica: :meth:`force_phase`, :meth:`accelerate`, :meth:`move`.
+
+        Returns ``(τ_internal, τ_surface)`` (Pa, arrays of B) when ``sample``, and also every
+        tensor of :data:`~particleShear.engine.stress.TENSORS` as a (B, 9, 2, 2) array when
+        ``sample == "tensors"``.
 
         Parameters
         ----------
@@ -316,6 +343,31 @@ class BatchEngine:
             If the stability guard finds a guarded replica unstable (checked every
             ``check_interval`` steps).
         """
+        out = self.force_phase(sample)
+        self.accelerate(cool, dt)
+        self.move(dt)
+        return out
+
+    def force_phase(self, sample=False):
+        """Neighbours (when due) → geometry and relations → kinematics → force terms → scatter.
+
+        Writes the forces and torques of every sphere into ``state.frc`` and keeps what the other
+        phases and the register read in :attr:`g` (the geometry of the candidates: ``dx, dy, d,
+        nx, ny``, the image velocity ``dvx``, ``active``, ``touching``, the pair forces on i
+        ``fx_i, fy_i``, their difference ``dF``, the torques, the mobility mask).  With the
+        velocity Verlet integrator (:attr:`integrator`) the velocity-dependent terms see the
+        velocities moved half a kick ahead (the half kick of the previous step).
+
+        Parameters
+        ----------
+        sample : bool or str
+            False: no stresses; True: the two shear stresses; ``"tensors"``: also every tensor.
+
+        Returns
+        -------
+        None or tuple
+            As :meth:`step`.
+        """
         s, xp = self.s, self.xp
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         # neighbours (positions at the start of the step)
@@ -334,10 +386,11 @@ class BatchEngine:
         xp.copyto(self.state_p, STICK, where=active & ~self.active)   # a new relation starts sticking
         self.xi = xi = xp.where(active, self.xi, 0.0)   # an opened contact loses its history
         self.active = active
-        # relative velocities (image velocity −Ly·γ̇ per period above)
+        # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
         dvx = -(C.Ly * s.rate[C.rep]) * ky
-        Vi = s.vel.take(ai, axis=1)
-        Vj = s.vel.take(aj, axis=1)
+        vel = s.vel if self.half is None else s.vel + self.half
+        Vi = vel.take(ai, axis=1)
+        Vj = vel.take(aj, axis=1)
         rv = relative_velocity(Vi, Vj, dvx)
         vn = normal_speed(rv, nx, ny)
         vt = slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
@@ -349,6 +402,7 @@ class BatchEngine:
         s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1])
         mob = self.mobile()
         out = None
+        shifted = None
         if sample:
             shifted = (ky != 0) | (kx != 0)
             mi, mj = mob[ai], mob[aj]
@@ -358,45 +412,85 @@ class BatchEngine:
                                  Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
                                  dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
                 out = out + (evaluate_all(q),)
-        verdict = None
+        self.verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)
             if self.backend.host:     # NumPy: report at once (a device reports with the flags at the end)
                 self._report(verdict, self.step_count)
-                verdict = None
-        # kick (plates follow), rotational kick, damping
+            else:
+                self.verdict = verdict
+        self.g = _ForceRecord(dx=dx, dy=dy, d=d, nx=nx, ny=ny, dvx=dvx, ky=ky, kx=kx, yc=yc, mob=mob,
+                              touching=touching, active=active, shifted=shifted, fn=fn, F=F, fx_i=fx_i,
+                              fy_i=fy_i, dF=dF, tq=tq)
+        return out
+
+    def accelerate(self, cool, dt):
+        """Kick (plates follow), rotational kick and damping of every replica (eqs. S1-10, S1-11).
+
+        With velocity Verlet the half kick ``F·dt/(2m)`` of the mobile spheres is kept for the
+        next force phase (:func:`~particleShear.engine.integrate.half_kick`).
+
+        Parameters
+        ----------
+        cool : float
+            Damping factor of the velocity relative to the flow and of ω (1 = no damping).
+        dt : float
+            Time step (s).
+        """
+        s, g = self.s, self.g
+        if self.integrator == "verlet":
+            self.half = half_kick(s.frc, self.mmi, dt, g.mob)
         rate_s = s.rate[s.rep]
         kick(s.vel, s.frc, self.mmi, dt)                    # (F_x/m, F_y/m, T/I)·dt
-        plates_follow(vx, vy, ~mob, yc, rate_s * self.Ly_s / 2)
-        flow = yc * rate_s
-        damp(s.vel, flow, cool)
-        # ξ of sticking contacts and bonds: sequential rule (Appendix B.2)
-        kd = xp.where(active & (self.state_p != SLIP), dt, 0.0)
-        Vi = s.vel.take(ai, axis=1)
-        inc_ij, inc_ji = xi_increments(Vi, s.vel.take(aj, axis=1), dvx, nx, ny, C.ri, C.rj, Vi[0] * dt - dx,
-                                       Vi[1] * dt - dy,
+        plates_follow(s.vx, s.vy, ~g.mob, g.yc, rate_s * self.Ly_s / 2)
+        damp(s.vel, g.yc * rate_s, cool)
+
+    def move(self, dt):
+        """ξ of sticking contacts and bonds (sequential rule, Appendix B.2), drift, strain, wrap, clock.
+
+        Ends with the step's one read of per-replica flags on the host: the lists due for a
+        rebuild (and, on a device, the stability guard's verdict).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+
+        Raises
+        ------
+        EngineInstability
+            On a device, if the force phase's guard verdict is not sound.
+        """
+        s, xp, C, g = self.s, self.xp, self.C, self.g
+        vx, vy = s.vx, s.vy
+        kd = xp.where(g.active & (self.state_p != SLIP), dt, 0.0)
+        Vi = s.vel.take(C.ai, axis=1)
+        inc_ij, inc_ji = xi_increments(Vi, s.vel.take(C.aj, axis=1), g.dvx, g.nx, g.ny, C.ri, C.rj,
+                                       Vi[0] * dt - g.dx, Vi[1] * dt - g.dy,
                                        lambda Rx, Ry: normals(Rx, Ry, xp.sqrt(Rx * Rx + Ry * Ry), C.rep_host, s.rng))
+        xi = self.xi
         xi[0] += inc_ij * kd
         xi[1] += inc_ji * kd
         # drift, strain, wrap, clock
+        rate_s = s.rate[s.rep]
         u = self.u
-        u[0] += (vx - flow) * dt
+        u[0] += (vx - g.yc * rate_s) * dt
         u[1] += vy * dt
         self.u_max = xp.maximum(self.u_max, xp.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
         self.strain += abs(s.rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         drift(s.pos, s.phi, s.vel, dt)
         s.gamma = s.gamma + s.rate * dt
-        wrap(x, y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
+        wrap(s.x, s.y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
+        verdict = self.verdict
         due = self.bound >= self.skin
         flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
         self.need = flags[:s.B]
         if verdict is not None and flags[s.B:].any():
             self._report(verdict, self.step_count)
         self.step_count += 1
-        return out
 
     def _check(self, d, active):
         """The stability guard's verdict (see the class docstring), on the state's backend.

@@ -13,7 +13,7 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, plotting or snapshots, the Euler integrator, the built-in force laws,
+no drawing, plotting or snapshots, the built-in force laws,
 N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — measure through
 :mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
@@ -98,7 +98,7 @@ def check_backend(backend):
 def check_run_backend(kw):
     """Check the backend of one run: usable here, and the run one the engine measures.
 
-    Runs the engine does not measure (drawing, plotting, snapshots, the Verlet integrator,
+    Runs the engine does not measure (drawing, plotting, snapshots,
     replaced force laws, N > :data:`ENGINE_MAX_N`) go through the documented classes, which
     step NumPy arrays only: with another backend they are refused rather than silently
     measured with NumPy.
@@ -120,13 +120,11 @@ def check_run_backend(kw):
     if backend == "numpy" or engine_supports(full):
         return
     why = [f"{name}={full[name]!r}" for name in ("doDrawing", "plotStress", "saveOutputImages") if full[name]]
-    if full["integrator"] != "euler":
-        why.append(f"integrator={full['integrator']!r}")
     if int(full["N"]) > ENGINE_MAX_N:
         why.append(f"N={full['N']!r} > {ENGINE_MAX_N}")
     raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why) or 'replaced force laws'}): "
                      "only runs the engine measures can use a backend other than 'numpy' (doDrawing=False, "
-                     f"plotStress=False, saveOutputImages=False, integrator='euler', N <= {ENGINE_MAX_N}, the "
+                     f"plotStress=False, saveOutputImages=False, N <= {ENGINE_MAX_N}, the "
                      "built-in force laws); the documented classes step NumPy arrays only")
 
 
@@ -263,8 +261,8 @@ def run_batch(list_of_kwargs, backend=None):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted or rendered into snapshots, the integrator is "euler",
-    the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
+    It does when nothing is drawn, plotted or rendered into snapshots (with either integrator), the
+    force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
     qualify: their files are written as ``runSimulation`` writes them (console messages and
     progress callbacks work as in the documented classes).
 
@@ -281,7 +279,6 @@ def engine_supports(kw):
     from ..base.points import CircleBasicElasticity
     from ..linkable.spheres import SphereLinkable
     return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveOutputImages"]
-            and kw["integrator"] == "euler"
             and int(kw["N"]) <= ENGINE_MAX_N
             and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
             and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
@@ -319,7 +316,7 @@ def measure_batch(runs):
         params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
         sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
                                 correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
-                                renderer="none", time_step_factor=kw["time_step_factor"], integrator="euler",
+                                renderer="none", time_step_factor=kw["time_step_factor"], integrator=kw["integrator"],
                                 stability_guard=kw["stability_guard"])
         sim.output_format = kw.get("output_format", "text")
         sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
@@ -422,22 +419,27 @@ def _measure(sessions, sched, where):
     for proto in dict.fromkeys(p for p, _ in sched):
         members = [b for b, (p, _) in enumerate(sched) if p == proto]
         dt, f, cool, pre_p, periods, post = proto
-        states = []
+        states, halves = [], []
         order = []
+        integrator = sims[members[0]].integrator        # part of the schedule key
         for pre in dict.fromkeys(sched[b][1] for b in members):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
             st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend)
             say, report = _console(sims, group, "pre-equilibration", where)
-            engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group])
+            engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
+                                 integrator=integrator)
             _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)
+            halves.append(engine.half)
             for b in group:
                 timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
             states.append(st)
             order += group
         t0 = time.perf_counter()
         engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
-                             guard=[guard_of[b] for b in order])
+                             guard=[guard_of[b] for b in order], integrator=integrator)
+        if integrator == "verlet" and all(h is not None for h in halves):   # the predictor carries on from the pre-equilibration, as in one ensemble
+            engine.half = engine.xp.concatenate(halves, axis=1)
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
