@@ -14,7 +14,7 @@ submits every batch as one task of its executor.
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
 no drawing, plotting or snapshots, the built-in force laws,
-N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — measure through
+any N; saving data is fine) — single runs included — measure through
 :mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
@@ -29,16 +29,9 @@ from ..linkable.builders import time_steps_from_model
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
 __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
-           "ENGINE_MAX_N", "check_backend", "check_run_backend"]
+           "check_backend", "check_run_backend"]
 
 _log = logging.getLogger(__name__)
-
-#: largest N measured by the engine.  Its candidate search is a cell list (O(N) per rebuild), so this
-#: is not a limit of the search: on the scene a run measures, with the runs' skin, the engine's step
-#: costs 0.87–0.93 of the documented classes' at N = 150–5,000 and 1.08–1.09 at N = 10,000, where the
-#: classes compact their candidate table (≥ 20,000 pairs) to the contacts; single runs above this N
-#: stay on the classes (docs/performance.md, benchmarks/bench_engine_large.py)
-ENGINE_MAX_N = 5000
 
 #: Verlet skin of the engines of a batch (constitution and measurement), in units of each
 #: replica's largest radius.  The contacts of every step are exact for any skin and the zero
@@ -99,7 +92,7 @@ def check_run_backend(kw):
     """Check the backend of one run: usable here, and the run one the engine measures.
 
     Runs the engine does not measure (drawing, plotting, snapshots,
-    replaced force laws, N > :data:`ENGINE_MAX_N`) go through the documented classes, which
+    replaced force laws) go through the documented classes, which
     step NumPy arrays only: with another backend they are refused rather than silently
     measured with NumPy.
 
@@ -120,11 +113,9 @@ def check_run_backend(kw):
     if backend == "numpy" or engine_supports(full):
         return
     why = [f"{name}={full[name]!r}" for name in ("doDrawing", "plotStress", "saveOutputImages") if full[name]]
-    if int(full["N"]) > ENGINE_MAX_N:
-        why.append(f"N={full['N']!r} > {ENGINE_MAX_N}")
     raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why) or 'replaced force laws'}): "
                      "only runs the engine measures can use a backend other than 'numpy' (doDrawing=False, "
-                     f"plotStress=False, saveOutputImages=False, N <= {ENGINE_MAX_N}, the "
+                     "plotStress=False, saveOutputImages=False, the "
                      "built-in force laws); the documented classes step NumPy arrays only")
 
 
@@ -262,7 +253,7 @@ def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
     It does when nothing is drawn, plotted or rendered into snapshots (with either integrator), the
-    force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
+    force laws are the built-in ones (any N).  Runs that save their data
     qualify: their files are written as ``runSimulation`` writes them (console messages and
     progress callbacks work as in the documented classes).
 
@@ -279,7 +270,6 @@ def engine_supports(kw):
     from ..base.points import CircleBasicElasticity
     from ..linkable.spheres import SphereLinkable
     return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveOutputImages"]
-            and int(kw["N"]) <= ENGINE_MAX_N
             and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
             and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
 
