@@ -10,7 +10,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from ..engine.neighbours import near_pairs
+from ..engine.neighbours import all_pairs, near_pairs
 from .namespace import count_nonzero as _nz
 
 __all__ = ["PairTable", "STICK", "SLIP", "PERMANENT", "STATE_NAMES", "candidate_pairs", "all_pairs"]
@@ -162,23 +162,6 @@ class PairTable:
             self.replace(i[miss], j[miss], keep_existing=True)
             slots = self.find(i, j)
         return slots
-
-
-def all_pairs(n):
-    """Every pair i < j (test oracle and small systems).
-
-    Parameters
-    ----------
-    n : int
-        Number of spheres.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``(i, j)``, index arrays of the ``n (n - 1) / 2`` pairs.
-    """
-    i, j = np.triu_indices(n, 1)
-    return i.astype(np.intp), j.astype(np.intp)
 
 
 def candidate_pairs(x, y, r, Lx, Ly, shift, skin):
