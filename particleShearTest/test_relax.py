@@ -19,7 +19,7 @@ import numpy as np
 from particleShear.engine.box import min_image
 from particleShear.engine.relax import relax_ensembles, relaxation_levels, remove_linear_drift
 from particleShear.engine.state import BatchState
-from particleShear.linkable.builders import adjustable_interface_constitution, relax_with_classes
+from particleShear.linkable.builders import adjustable_interface_constitution, relax_constitution
 
 #: a small scene of the run API's builder (nominal area fraction 1: a jammed packing)
 SCENE = dict(N=40, packing_fraction=1.0, mu=0.1, Young_modulus_spheres=1000, cut_lines=3, anticipated_amplitude=0.1,
@@ -35,7 +35,7 @@ def random_packing(seed, **kw):
 
 def constituted(seed, **kw):
     """A relaxed, crosslinked and cut ensemble (the builder with a tenth of its relaxation)."""
-    return relax_with_classes(adjustable_interface_constitution(**dict(SCENE, rng=seed, do_debug=True, **kw)))
+    return relax_constitution(adjustable_interface_constitution(**dict(SCENE, rng=seed, do_debug=True, **kw)))
 
 
 class TestAgainstTheClasses(unittest.TestCase):
@@ -103,7 +103,7 @@ class TestAgainstTheClasses(unittest.TestCase):
         for e in (ref, eng):
             e.dt_max = 2 * e.dt
         seen = []
-        for e, serve in ((ref, lambda r: r.run()), (eng, lambda r: relax_ensembles([r.ensemble], r.N))):
+        for e, serve in ((ref, lambda r: r.ensemble.free_pre_equilibration(r.N)), (eng, lambda r: r.run())):
             gen = _free_mu0(e, 15, 0.1)
             request = next(gen)
             self.assertIsInstance(request, Relaxation)

@@ -20,7 +20,7 @@ from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustabl
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
-           "adjustable_interface_constitution", "Relaxation", "relax_with_classes",
+           "adjustable_interface_constitution", "Relaxation", "relax_constitution",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
 
 #: attempts at cutting without a height-spanning particle before giving up (the reference loops forever)
@@ -175,9 +175,9 @@ class Relaxation:
 
     A constitution written as a generator (:func:`adjustable_interface_constitution`) yields one
     request per relaxation block and resumes once it is done.  Whoever drives the generator runs
-    it: :func:`relax_with_classes` with the documented classes (:meth:`run`), or the engine
-    for a whole batch at once (:func:`particleShear.engine.relax.relax_ensembles`; docs/design.md,
-    "Batches of replicas").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
+    it: :func:`relax_constitution` one request at a time (:meth:`run`), or a batch's driver for
+    all its replicas at once; both relax in the engine (:func:`particleShear.engine.relax.relax_ensembles`;
+    docs/design.md, "Batches of replicas").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
     it is run, so requests with equal :attr:`key` run the same steps (the replicas' μ may differ).
 
     Parameters
@@ -200,8 +200,10 @@ class Relaxation:
         return (self.N, float(e.dt), float(e.dt_max))
 
     def run(self):
-        """Relax with the documented classes: ``ensemble.free_pre_equilibration(N)``."""
-        self.ensemble.free_pre_equilibration(self.N)
+        """Relax this ensemble alone in the engine (a batch of one): the steps of
+        ``ensemble.free_pre_equilibration(N)`` (:func:`particleShear.engine.relax.relax_ensembles`)."""
+        from ..engine.relax import relax_ensembles
+        relax_ensembles([self.ensemble], self.N)
 
     def __repr__(self):
         N, dt, dt_max = self.key
@@ -212,8 +214,8 @@ class Relaxation:
 MAX_RELAXATIONS = 10000
 
 
-def relax_with_classes(steps):
-    """Drive a constitution generator, running each of its :class:`Relaxation` requests with the classes.
+def relax_constitution(steps):
+    """Drive a constitution generator, running each of its :class:`Relaxation` requests (:meth:`Relaxation.run`).
 
     Parameters
     ----------
@@ -349,7 +351,7 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
     """
     arguments = dict(locals())     # every parameter, as passed (nothing else is defined yet)
-    return relax_with_classes(adjustable_interface_constitution(**arguments))
+    return relax_constitution(adjustable_interface_constitution(**arguments))
 
 
 def adjustable_interface_constitution(
@@ -368,7 +370,7 @@ def adjustable_interface_constitution(
     spheres as the builder (every bookkeeping step through the documented classes), but each of
     its ``free_pre_equilibration`` blocks is yielded as a :class:`Relaxation` request; the
     generator resumes when the caller has run it and returns the ensemble (``StopIteration.value``).
-    :func:`relax_with_classes` runs the requests with the classes (that is the builder);
+    :func:`relax_constitution` runs the requests one by one (that is the builder);
     ``particleShear.run.batch`` runs those of all replicas of a batch together in the engine
     (docs/design.md, "Batches of replicas").
 

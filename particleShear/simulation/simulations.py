@@ -20,7 +20,7 @@ from collections import namedtuple
 
 from ..linkable.builders import (EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters,
                                  EnsembleCompactParticlesFromModelParameters, adjustable_interface_constitution,
-                                 relax_with_classes)
+                                 relax_constitution)
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
 from .experiment import OscillatoryShearExperiment
@@ -129,7 +129,7 @@ class RunSession:
 
     def constitute(self):
         """Build the ensemble (``initEnsemble``), with the progress calls of the constitution."""
-        relax_with_classes(self.constitution())
+        relax_constitution(self.constitution())
 
     def constitution(self):
         """:meth:`constitute` as a generator of the constitution's relaxations (docs/design.md).
@@ -1018,7 +1018,7 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
             The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
         """
-        return relax_with_classes(self.constitution_steps(do_debug))
+        return relax_constitution(self.constitution_steps(do_debug))
 
     def constitution_steps(self, do_debug=False):
         """:meth:`initEnsemble` as a generator of the builder's relaxations.
