@@ -182,6 +182,35 @@ class TestEngineAgainstClasses(unittest.TestCase):
                 self.assertGreater(np.max(np.abs(ref["stress_surface"])), 0.0)
 
 
+class TestFrictionlessReplicas(unittest.TestCase):
+    """A replica with μ = 0 and no bond has no tangential force (Coulomb bound 0): the engine leaves
+    the term out for it, so its relations all slip with ξ = 0 (the classes' rule), alone or beside a
+    frictional replica, and a batch of both equals the single runs bit for bit."""
+
+    def test_free_replica_alone_and_in_a_mixed_batch(self):
+        scenes = [dict(theMu=mu, do_permanent_links=False, cut_lines=0, theAmplitude=0.2) for mu in (0.0, 0.3)]
+        sc = constituted(3, **scenes[0])[2]
+
+        def measure(which):
+            ensembles = [constituted(3 + n, **scenes[n])[1] for n in which]
+            eng = BatchEngine(BatchState.from_ensembles(ensembles))
+            pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+            return eng, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, 1, 0.5)
+
+        single = [measure([n])[1] for n in (0, 1)]
+        eng, both = measure([0, 1])
+        for b in range(2):
+            for key in ("stress_internal", "stress_surface", "strain"):
+                self.assertEqual(both[key][:, b].tobytes(), single[b][key][:, 0].tobytes(), (b, key))
+        # the free replica: every relation slips and carries no history; the frictional one sticks somewhere
+        p0, p1 = eng.pairs_of(0), eng.pairs_of(1)
+        self.assertGreater(int(p0.active.sum()), 0)
+        self.assertTrue(np.all(p0.state[p0.active] == 1))
+        self.assertTrue(np.all(p0.xi == 0.0))
+        self.assertTrue(np.any(p1.state[p1.active] == 0))
+        self.assertTrue(np.any(p1.xi != 0.0))
+
+
 class TestStressRegistry(unittest.TestCase):
     """Every engine tensor against the documented classes' StressTensorEvaluation along a protocol
     (same states to ≈ 1e-15, see above; tolerance 1e-12 of the pressure scale, or of the tensor's own

@@ -29,7 +29,7 @@ import numbers
 
 import numpy as np
 
-from .state import PERMANENT, SLIP, STICK, BatchState
+from .state import PERMANENT, STICK, BatchState
 from .step import BatchEngine
 
 __all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
@@ -200,27 +200,6 @@ def _steps(engine, n, cool, dt, ages=None):
             ages.after_step(engine)
 
 
-def _frictionless_slip(engine):
-    """What the classes do in a step with μ = 0 and no bonds: every relation slips, ξ = 0.
-
-    The classes then skip the tangential kernel; the engine evaluates it, where every contact
-    with a non-zero tangential force slips too (Coulomb bound 0) and the force is zero either
-    way, but a contact whose force is exactly zero (no viscosity, ξ = 0) sticks and integrates
-    ξ for a step.  Applied at the end of a run of μ = 0 steps, it leaves the replicas in the
-    classes' state.
-    """
-    C = engine.C
-    if C is None:
-        return
-    s = engine.s
-    bonded = np.bincount(C.rep[C.perm], minlength=s.B) > 0
-    skip = (s.mu == 0) & ~bonded
-    m = skip[C.rep] & engine.active
-    if m.any():
-        engine.state_p[m] = SLIP
-        engine.xi[:, m] = 0.0
-
-
 def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
     """``free_pre_equilibration(N)`` of the classes on every replica of ``engine``.
 
@@ -266,10 +245,8 @@ def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
         _steps(engine, N, cf, level_dt, ages)
         remove_linear_drift(s)
     _steps(engine, N, 1, dt, ages)
-    _frictionless_slip(engine)
     engine.set_mu(mu)
     _steps(engine, N, 1, dt, ages)
-    _frictionless_slip(engine)
     engine.flush()
     return N * (len(levels) + 2)
 

@@ -33,7 +33,7 @@ from .forces import PairConstants, normals, scatter, shear_stresses, splice_arra
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .state import SLIP, STICK, ReplicaPairs
+from .state import PERMANENT, SLIP, STICK, ReplicaPairs
 from .stress import StressInputs, evaluate_all
 from .xp import to_host
 
@@ -114,6 +114,7 @@ class BatchEngine:
         self.integrator = integrator
         self.half = None          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
         self.g = None             # the record of the last force phase (_ForceRecord)
+        self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
         self.verdict = None       # a device's guard verdict of the force phase, read at the end of the step
         s = self.s = state
         xp = self.xp = s.xp
@@ -204,6 +205,7 @@ class BatchEngine:
         new.set_bonds(s, state_p, be.asarray(np.concatenate([p.d_eq for p in fresh])))
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active = new, state_p, xi, active
+            self._frictionless()
             return
         # the batch's arrays: the unchanged replicas' segments from the old arrays, in replica order
         old_off, segments, k = self.C.offsets, [], 0
@@ -219,6 +221,7 @@ class BatchEngine:
         self.xi = splice_arrays(self.xi, xi, segments)
         self.active = splice_arrays(self.active, active, segments)
         self.C = PairConstants.splice(s, self.C, new, segments, offsets)
+        self._frictionless()
 
     def _images(self, raw_x, raw_y, shift_p):
         """Minimum image of the candidates, reusing the period counts of the last step while they
@@ -312,6 +315,7 @@ class BatchEngine:
         s.mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
         if self.C is not None:
             self.C.mu = s.mu[self.C.rep]
+        self._frictionless()
 
     def step(self, cool, dt, sample=False):
         """One step of every replica: :meth:`force_phase`, :meth:`accelerate`, :meth:`move`.
@@ -396,7 +400,7 @@ class BatchEngine:
         vt = slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
         fn, law = central_term(C, d, vn, active)
-        F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
+        F, slip = self._tangential(C, vt, touching, xi, law, active)
         self.state_p = slip.view(np.int8) + C.perm_code
         fx_i, fy_i, dF, tq = pair_forces(fn, (F[0] + F[1]) * 0.5, nx, ny, d, C.w)
         s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1])
@@ -423,6 +427,40 @@ class BatchEngine:
                               touching=touching, active=active, shifted=shifted, fn=fn, F=F, fx_i=fx_i,
                               fy_i=fy_i, dF=dF, tq=tq)
         return out
+
+    def _tangential(self, C, vt, touching, xi, law, active):
+        """The tangential term, left out for the replicas without friction and bonds.
+
+        A replica with μ = 0 and no bond has no tangential force (its Coulomb bound is 0), so
+        every relation slips and keeps ξ = 0 — what the documented classes do by skipping the
+        term.  When every replica of the batch is such a replica the term is not evaluated.
+
+        Returns ``(F, slip)`` as :func:`~particleShear.engine.terms.tangential_term`.
+        """
+        free = self.free_p
+        if free is None:
+            return tangential_term(C, vt, touching.astype(float), xi, law)
+        if free is True:
+            xi[...] = 0.0
+            return self.xp.zeros((2, len(vt))), active
+        F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
+        self.xp.copyto(xi, 0.0, where=free)
+        return F, slip | (free & active)
+
+    def _frictionless(self):
+        """Which replicas have no tangential force (μ = 0 and no bond): sets :attr:`free_p`, per
+        candidate (None when no replica is such, True when all are); after a rebuild and a change of μ."""
+        s = self.s
+        if self.C is None:
+            return
+        mu = to_host(s.mu, "state") if not isinstance(s.mu, np.ndarray) else s.mu
+        free = (mu == 0) & ~np.array([bool((p.state == PERMANENT).any()) for p in s.pairs], dtype=bool)
+        if not free.any():
+            self.free_p = None
+        elif free.all():
+            self.free_p = True
+        else:
+            self.free_p = self.backend.asarray(free)[self.C.rep]
 
     def accelerate(self, cool, dt):
         """Kick (plates follow), rotational kick and damping of every replica (eqs. S1-10, S1-11).
