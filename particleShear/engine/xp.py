@@ -1,4 +1,4 @@
-"""The array namespace of the engine: NumPy by default, CuPy with ``backend="cupy"`` (docs/design.md, "Backends").
+"""The array namespace of the engine: NumPy by default, CuPy with ``backend="cupy"`` (docs/backends.md).
 
 The engine's kernels take the namespace of their inputs (:func:`array_namespace`) and call only
 functions that NumPy and CuPy share.  This module holds the few things that cannot be written
@@ -89,7 +89,7 @@ class Backend:
         ``minimum.reduceat`` reduce each bin or segment in row order without a host read (NumPy).
         False (CuPy: ``bincount`` adds atomically, in no fixed order, and reads ``max(index)`` on
         the host; ``add.reduceat`` is a difference of two prefix sums, which rounds otherwise;
-        ``minimum.reduceat`` does not exist; docs/design.md, "Backends") makes
+        ``minimum.reduceat`` does not exist; docs/backends.md) makes
         :class:`SegmentSum` and the per-replica sums and minima use a padded gather and a
         reduction along rows.
     """
