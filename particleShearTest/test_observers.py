@@ -208,6 +208,57 @@ class TestDrawnRunEqualsHeadless(unittest.TestCase):
             self.assertGreater(np.ptp(g), 0.3)       # the strains shown differ from frame to frame
 
 
+class DotCanvas:
+    """A stress window's canvas and root that keep every dot (centre and colour)."""
+
+    def __init__(self):
+        self.dots = []
+        self.canvas, self.tk = self, self
+        self.updates = 0
+
+    def create_oval(self, x0, y0, x1, y1, fill=None, outline=None):
+        self.dots.append(((x0 + x1) / 2, (y0 + y1) / 2, fill))
+
+    def update(self):
+        self.updates += 1
+
+    def draw_axes(self, *a):
+        pass
+
+
+class TestClassesLoopUsesTheObservers(unittest.TestCase):
+    def test_snapshots_and_stress_dots_of_run_protocol(self):
+        # the documented classes' own loop calls the same observers, with the ensemble as the scene
+        from particleShear.simulation.experiment import OscillatoryShearExperiment
+        _, ens, sc = constituted(11, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)
+        with tempfile.TemporaryDirectory() as d:
+            exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"],
+                                             imageOutputFolder=d, imageBaseFileName="image", imageFileType="svg",
+                                             plotStress=True)
+            exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+            exp.renderer = PillowRenderer()
+            exp.stress_window = window = DotCanvas()
+            ens.applyingShear = True
+            exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+            ens.t = 0
+            n = exp.run_protocol(sc["cool"])
+            image_N = int(n / 200) if n > 200 else 1
+            self.assertEqual(sorted(os.listdir(d)), ["image%07d.svg" % k for k in range(0, n, image_N)])
+            self.assertEqual(exp.n_images_saved, len(range(0, n, image_N)))
+        rec = exp.plotter.arrays()
+        self.assertEqual(len(window.dots), 3 * n)
+        self.assertEqual(window.updates, n)
+        p = exp._make_plotter(1.0)      # the mapping: y = offset − (value − value(0))·scale (EvaluationHandlerPlotter)
+        for colour, key, scale in (("red", "stress_internal", p.y_scale_force), ("blue", "stress_surface", p.y_scale_force),
+                                   ("green", "strain", p.y_scale_strain)):
+            y = np.array([dot[1] for dot in window.dots if dot[2] == colour])
+            v = rec[key] - (rec[key][0] if key != "strain" else 0.0)
+            np.testing.assert_allclose(y, exp.height / 2 - v * scale, rtol=0, atol=1e-9 * (1 + np.max(np.abs(y))))
+        x = np.array([dot[0] for dot in window.dots if dot[2] == "green"])
+        T_total = (exp.periods + exp.baseline_pre_periods + exp.baseline_post_periods) / exp.f
+        np.testing.assert_allclose(x, rec["t"] * exp.width / T_total, rtol=1e-12, atol=1e-9)
+
+
 class TestBatchOfDrawnReplicas(unittest.TestCase):
     def test_each_replica_writes_the_snapshots_of_its_single_run(self):
         runs = [dict(QUICK, seed=1, theAmplitude=0.2, theMu=0.01), dict(QUICK, seed=2, theAmplitude=0.3, theMu=0.05)]
