@@ -619,9 +619,24 @@ class TestBadBackend(unittest.TestCase):
             self.skipTest("CuPy and a CUDA device are present")
 
     def test_runs_the_engine_cannot_measure(self):
+        import os
+        import tempfile
         with standin_registered():
-            with self.assertRaisesRegex(ValueError, r"backend='cpu-standin' is invalid for this run \(doDrawing=True"):
-                doParticleShearSimulation(backend=STANDIN, **dict(QUICK, doDrawing=True))
+            # a drawn run is the engine's (its drawing observes the loops, reading the device state)
+            plain = doParticleShearSimulation(backend=STANDIN, seed=2, return_result=True, **QUICK)
+            with tempfile.TemporaryDirectory() as d:
+                drawn = doParticleShearSimulation(d, backend=STANDIN, seed=2, return_result=True,
+                                                  **dict(QUICK, doDrawing=True, plotStress=True, saveOutputImages=True,
+                                                         imageFileType="svg", renderer="pillow"))
+                self.assertEqual(len(os.listdir(drawn.image_folder)), drawn.n_images)
+            self.assertGreater(drawn.n_images, 100)
+            for key in plain.series:
+                self.assertEqual(np.asarray(plain.series[key]).tobytes(), np.asarray(drawn.series[key]).tobytes(), key)
+            # a Verlet run too (the engine's integrator)
+            verlet = doParticleShearSimulation(backend=STANDIN, seed=2, integrator="verlet", return_result=True,
+                                               **QUICK)
+            numpy_verlet = doParticleShearSimulation(seed=2, integrator="verlet", return_result=True, **QUICK)
+            self.assertEqual(verlet.G_surface, numpy_verlet.G_surface)
 
     def test_cli_names_the_flag(self):
         from particleShear.run.cli import main

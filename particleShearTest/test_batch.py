@@ -172,8 +172,9 @@ class TestBatchGrouping(unittest.TestCase):
 
 class TestConsoleAndProgress(unittest.TestCase):
     def test_engine_path_prints_and_reports_as_the_classes(self):
-        # verbose messages line by line and progress calls, engine path (doDrawing=False) against the
-        # documented classes (doDrawing=True with no renderer).  The numbers in the messages are not
+        # verbose messages line by line and progress calls, engine path against the documented
+        # classes (the simulation's own runSimulation, as a run the engine cannot measure calls it).
+        # The numbers in the messages are not
         # compared: the engine constitutes the ensemble too, and ~3,000 relaxation steps of a random
         # packing amplify the rounding differences of the two paths (their agreement over short
         # blocks is tested in test_relax.py and test_engine.py); every number is replaced by "#"
@@ -181,16 +182,29 @@ class TestConsoleAndProgress(unittest.TestCase):
         import io
         import re
 
-        def run(**extra):
+        from particleShear.messages import console_messages
+        from particleShear.run.api import _build_simulation, _seed_sequence
+        from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
+
+        def run(through_classes):
             out, prog = io.StringIO(), []
             kw = dict(QUICK, seed=1, do_permanent_links=True, cut_lines=2, verbose=True,
-                      progress=lambda *a: prog.append(a[:3]), **extra)
+                      progress=lambda *a: prog.append(a[:3]))
             with contextlib.redirect_stdout(out):
-                doParticleShearSimulation(**kw)
+                if through_classes:
+                    p = dict(_signature_defaults(), **kw)
+                    sim = _build_simulation({k: p[k] for k in _REFERENCE_ARGUMENTS}, _seed_sequence(1)[1],
+                                            verbose=True, progress=kw["progress"], correct_drift_sign=False,
+                                            reference_header=False, renderer="none", time_step_factor=1.0,
+                                            integrator="euler", stability_guard=True)
+                    with console_messages(True):
+                        sim.runSimulation(periods=p["periods"], cool_factor=p["cool_factor"], plotStress=False)
+                else:
+                    doParticleShearSimulation(**kw)
             num = re.compile(r"-?\d+\.\d+(?:e[-+]?\d+)?")
             return [num.sub("#", line) for line in out.getvalue().splitlines()], prog
 
-        engine, classes = run(doDrawing=False), run(doDrawing=True, renderer="none")
+        engine, classes = run(False), run(True)
         self.assertGreater(len(engine[0]), 15)
         self.assertEqual(engine[0], classes[0])
         # progress is throttled in time (~10 calls/s): compare the first and the last call of every phase

@@ -16,7 +16,8 @@ viscous and tangential terms, force vectors and torque split; shared with the ca
 :mod:`.forces` (per-candidate constants, geometry, scatter, shear stresses), :mod:`.integrate` (kick,
 the Verlet half kick, plates, damping, the sequential ξ rule and the drift, shared with the canvas classes), :mod:`.stress` (every tensor once, in one
 registry; also the classes' tensors), :mod:`.step` (one step, top to bottom, the
-pre-equilibration and the protocol); :mod:`.xp` is the array namespace (NumPy, or CuPy with
+pre-equilibration and the protocol), :mod:`.observers` (what the loops call to watch a run
+without changing it: drawing, snapshots, the live stress window); :mod:`.xp` is the array namespace (NumPy, or CuPy with
 ``backend="cupy"``) and the one door from the device to the host (docs/backends.md).
 """
 __docformat__ = "numpy"

@@ -33,6 +33,7 @@ from .forces import PairConstants, normals, scatter, shear_stresses, splice_arra
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
+from .observers import check_observers, notify
 from .state import PERMANENT, SLIP, STICK, ReplicaPairs
 from .stress import StressInputs, evaluate_all
 from .xp import to_host
@@ -607,7 +608,7 @@ def _quiet(*args):
     pass
 
 
-def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
+def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, observers=()):
     """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at ``dt`` (damping
     0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment (docs/design.md).
 
@@ -627,12 +628,19 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
         ``say(message)`` receives the reference's console messages.
     report : callable
         ``report(step, total)`` is called after every step (progress).
+    observers : sequence, default ()
+        Observers (:mod:`particleShear.engine.observers`): each is called as
+        ``observe(engine, "pre-equilibration", step, total)`` after every step that is a multiple
+        of its ``every`` and after the last step; they only read the state.
 
     Raises
     ------
+    ValueError
+        For an observer without an int ``every`` ≥ 1 or an ``observe`` method (before any step).
     EngineInstability
         If a guarded replica becomes unstable.
     """
+    check_observers(observers)
     s = engine.s
     s.applying_shear = True
     engine.phase = "pre-equilibration"
@@ -642,26 +650,31 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet):
     say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt " + str(dt_max)
         + " final dt " + str(dt))
     step = 0
+    phase = engine.phase
     for n, level_dt, cf in blocks:
         say("dt= " + str(level_dt))
         for _ in range(n):
             engine.step(cf, level_dt)
             step += 1
             report(step, total)
+            notify(observers, engine, phase, step, total)
     say("  Setting final dt= " + str(dt))
     for _ in range(2 * int(N)):
         engine.step(0.98, dt)
         step += 1
         report(step, total)
+        notify(observers, engine, phase, step, total)
     for _ in range(int(N)):
         s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
         engine.step(cool, dt)
         step += 1
         report(step, total)
+        notify(observers, engine, phase, step, total)
     engine.flush()
 
 
-def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet):
+def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet,
+             observers=()):
     """The oscillatory protocol of every replica, clock reset to 0 (docs/design.md).
 
     Every step first sets γ̇ = ``A·2πf·cos(2π(f t − pre))`` during the shear periods (0 in the
@@ -685,6 +698,12 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
         Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
     say, report : callable
         Receive the reference's console message and ``(step, total)`` after every step.
+    observers : sequence, default ()
+        Observers (:mod:`particleShear.engine.observers`): each is called as
+        ``observe(engine, "protocol", step, total)`` after every step that is a multiple of its
+        ``every`` and after the last step; while the protocol runs, ``engine.record`` holds the
+        record below as it fills (rows ``0 … step − 1`` written, on the state's backend).
+        They only read the state.
 
     Returns
     -------
@@ -696,9 +715,12 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
 
     Raises
     ------
+    ValueError
+        For an observer without an int ``every`` ≥ 1 or an ``observe`` method (before any step).
     EngineInstability
         If a guarded replica becomes unstable.
     """
+    check_observers(observers)
     s, xp = engine.s, engine.xp
     s.applying_shear = True
     s.t = xp.zeros(s.B)
@@ -712,6 +734,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
                                                          "stress_surface")}
     if keep_tensors:
         rec["tensors"] = xp.empty((n_steps, s.B, 9, 2, 2))
+    engine.record = rec        # what observers read of the record (the rows written so far)
     say("Start application shear protocol, total N= " + str(n_steps) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
@@ -737,5 +760,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
             rec["last_tensors"] = out[2]
         t = t + dt             # = s.t[b] for every b (same dt, same schedule)
         report(i + 1, n_steps)
+        notify(observers, engine, "protocol", i + 1, n_steps)
     engine.flush()
+    engine.record = None
     return {name: to_host(v, "series") for name, v in rec.items()}

@@ -262,11 +262,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     backend : {"numpy", "cupy"}, default "numpy"
         Keyword-only.  Array library of the measurement: "numpy", or "cupy" to measure on a CUDA
         GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding,
-        not bit for bit).  Runs without drawing or snapshots (files or not) measure through the
-        engine (:mod:`particleShear.engine`) as a batch of one, so that a run in a batched series
-        (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it; "cupy"
-        needs such a run (``doDrawing=False, plotStress=False``; see
-        :func:`particleShear.run.batch.check_run_backend`).
+        not bit for bit).  Runs with the Euler integrator and the built-in force laws (drawn or
+        not, files and snapshots or not) measure through the engine (:mod:`particleShear.engine`)
+        as a batch of one, so that a run in a batched series
+        (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it and a drawn
+        run to the same run headless (the drawing observes the engine's loops); "cupy" needs such
+        a run (see :func:`particleShear.run.batch.check_run_backend`).
 
     Returns
     -------
@@ -330,6 +331,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         with console_messages(verbose):
             result = measure_batch([params])[0]
         result.parameters, result.run_id = params, run_id
+        if plotStress and doDrawing and result.output_path:
+            _save_headless_stress_plot(result, renderer)
         doParticleShearSimulation.last_result = result
         if strict_io and result.write_error is not None:
             raise result.write_error

@@ -13,11 +13,11 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, plotting or snapshots, the built-in force laws,
-any N; saving data is fine) — single runs included — measure through
-:mod:`particleShear.engine`, all
-replicas of a batch in one set of arrays; other runs go through the documented classes one after
-the other.  See ``docs/design.md`` (section "Batches of replicas").
+any integrator, the built-in force laws, any N; drawn or not, saving data and snapshots or not)
+— single runs included — measure through :mod:`particleShear.engine`,
+all replicas of a batch in one set of arrays, each replica's drawing an observer of its replica
+(:mod:`particleShear.simulation.observers`); other runs go through the documented classes one
+after the other.  See ``docs/design.md`` (sections "Batches of replicas" and "Observers").
 """
 __docformat__ = "numpy"
 import logging
@@ -91,8 +91,7 @@ def check_backend(backend):
 def check_run_backend(kw):
     """Check the backend of one run: usable here, and the run one the engine measures.
 
-    Runs the engine does not measure (drawing, plotting, snapshots,
-    replaced force laws) go through the documented classes, which
+    Runs the engine does not measure (replaced force laws) go through the documented classes, which
     step NumPy arrays only: with another backend they are refused rather than silently
     measured with NumPy.
 
@@ -112,11 +111,9 @@ def check_run_backend(kw):
     check_backend(backend)
     if backend == "numpy" or engine_supports(full):
         return
-    why = [f"{name}={full[name]!r}" for name in ("doDrawing", "plotStress", "saveOutputImages") if full[name]]
-    raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why) or 'replaced force laws'}): "
-                     "only runs the engine measures can use a backend other than 'numpy' (doDrawing=False, "
-                     "plotStress=False, saveOutputImages=False, the "
-                     "built-in force laws); the documented classes step NumPy arrays only")
+    raise ValueError(f"backend={backend!r} is invalid for this run (replaced force laws): "
+                     "only runs the engine measures can use a backend other than 'numpy' (the built-in "
+                     "force laws); the documented classes step NumPy arrays only")
 
 
 def check_batch_size(batch_size):
@@ -252,10 +249,11 @@ def run_batch(list_of_kwargs, backend=None):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted or rendered into snapshots (with either integrator), the
-    force laws are the built-in ones (any N).  Runs that save their data
-    qualify: their files are written as ``runSimulation`` writes them (console messages and
-    progress callbacks work as in the documented classes).
+    It does when the force laws are the built-in ones (any integrator, any N).  Drawn runs qualify
+    (live windows, snapshots and the movie are observers of the engine's loops,
+    :mod:`particleShear.simulation.observers`), and so do runs that save their data: their files
+    are written as ``runSimulation`` writes them (console messages and progress callbacks work
+    as in the documented classes).
 
     Parameters
     ----------
@@ -269,8 +267,7 @@ def engine_supports(kw):
     from ..base.laws import elastic_force_law, elastic_force_law_tensile
     from ..base.points import CircleBasicElasticity
     from ..linkable.spheres import SphereLinkable
-    return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveOutputImages"]
-            and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
+    return (CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
             and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
 
 
@@ -306,9 +303,10 @@ def measure_batch(runs):
         params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
         sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
                                 correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
-                                renderer="none", time_step_factor=kw["time_step_factor"], integrator=kw["integrator"],
-                                stability_guard=kw["stability_guard"])
+                                renderer=kw.get("renderer", "auto"), time_step_factor=kw["time_step_factor"],
+                                integrator=kw["integrator"], stability_guard=kw["stability_guard"])
         sim.output_format = kw.get("output_format", "text")
+        sim.saveOutputMovie = bool(kw.get("saveOutputMovie", False))
         sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
         sim.parameters = kw
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
@@ -397,11 +395,22 @@ def _measure(sessions, sched, where):
     """The engine measurement of the replicas: one engine per protocol schedule, after
     pre-equilibrating in one engine per pre-equilibration schedule.  Returns each replica's
     record of :func:`~particleShear.engine.step.protocol` and its timings; ``where`` follows
-    ``(phase, step, total)``."""
+    ``(phase, step, total)``.  Each replica's drawing (live window, snapshots, movie, stress
+    window: :meth:`~particleShear.simulation.experiment.OscillatoryShearExperiment.observers`)
+    observes its own replica in both loops."""
     from ..engine.state import BatchState
     from ..engine.step import BatchEngine, pre_equilibrate, protocol
+    from ..simulation.observers import ReplicaScene
 
     sims = [run.sim for run in sessions]
+    scenes = [ReplicaScene(getattr(run.sim.theEnsemble, "graphical_output_configuration", None)) for run in sessions]
+    watch = [run.exp.observers(sc, sc.samples) for run, sc in zip(sessions, scenes)]
+
+    def observers(engine, members):     # each member's observers, shown its replica in this engine
+        for col, b in enumerate(members):
+            scenes[b].bind(engine, col)
+        return [ob for b in members for ob in watch[b]]
+
     backend = sims[0].parameters.get("backend", "numpy")    # one backend per batch (part of the schedule key)
     guard_of = [bool(run.sim.stability_guard) for run in sessions]
     rec = [None] * len(sessions)
@@ -419,7 +428,7 @@ def _measure(sessions, sched, where):
             say, report = _console(sims, group, "pre-equilibration", where)
             engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                                  integrator=integrator)
-            _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)
+            _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, observers(engine, group), dt=dt)
             halves.append(engine.half)
             for b in group:
                 timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
@@ -428,12 +437,13 @@ def _measure(sessions, sched, where):
         t0 = time.perf_counter()
         engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
                              guard=[guard_of[b] for b in order], integrator=integrator)
-        if integrator == "verlet" and all(h is not None for h in halves):   # the predictor carries on from the pre-equilibration, as in one ensemble
+        if integrator == "verlet" and all(h is not None for h in halves):
+            # the predictor carries on from the pre-equilibration, as in one ensemble
             engine.half = engine.xp.concatenate(halves, axis=1)
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
-                       post, any(keep), say, report, dt=dt)
+                       post, any(keep), say, report, observers(engine, order), dt=dt)
         for col, b in enumerate(order):
             rec[b] = {key: (np.ascontiguousarray(v[col]) if key.endswith("_tensors") else
                             np.ascontiguousarray(v[:, col])) for key, v in out.items()

@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 
 from ..base.stress import StressTensorEvaluation
+from ..engine.observers import notify
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 
@@ -110,6 +111,8 @@ class OscillatoryShearExperiment:
     stress_window : StressPlotWindow or None
     image_N : int or None
         Snapshot interval; None = reference rule :func:`image_cadence`.
+    save_movie : bool
+        Also write the snapshots as ``movie.gif`` (see :meth:`observers`).
     progress : callable or None
         ``progress(phase, step, total, elapsed_s)`` called about 10 times per second.
     verbose : bool
@@ -156,6 +159,7 @@ class OscillatoryShearExperiment:
         self.stress_window = None
         self.image_N = None
         self.progress = None
+        self.save_movie = False
         self.verbose = False
         self.keep_tensor_history = None
         self.timings = {}
@@ -296,32 +300,95 @@ class OscillatoryShearExperiment:
         ext = IMAGE_EXTENSIONS.get(self.imageFileType, IMAGE_EXTENSIONS["ps"])[0]
         return os.path.join(str(self.imageOutputFolder), str(self.imageBaseFileName) + f"{index:07d}" + ext)
 
-    def save_canvas_image(self, index):
+    def save_canvas_image(self, index, scene=None):
         """Save a snapshot of the particle picture for protocol step ``index`` (if a renderer exists).
 
         Parameters
         ----------
         index : int
             Protocol step, used in the file name (:meth:`image_path`).
+        scene : ensemble or ReplicaView, optional
+            What is drawn (default :attr:`theEnsemble`; the engine's runs pass the
+            :class:`~.observers.ReplicaView` of their replica).
         """
-        if self.renderer is None or not self.imageOutputFolder or not self.imageBaseFileName:
+        if not self.saves_images():
             return
-        self.renderer.save(self.theEnsemble, self.image_path(index), self.imageFileType, step=index)
+        scene = self.theEnsemble if scene is None else scene
+        self.renderer.save(scene, self.image_path(index), self.imageFileType, step=index)
         self.n_images_saved += 1
 
+    def saves_images(self):
+        """Whether snapshots are saved: a renderer, an image folder and a base name exist.
+
+        Returns
+        -------
+        bool
+        """
+        return self.renderer is not None and bool(self.imageOutputFolder) and bool(self.imageBaseFileName)
+
+    def observers(self, scene, samples, live=True):
+        """The observers of this experiment's drawing (:mod:`.observers`), for the loops of a measurement.
+
+        A live particle window (with ``live`` and a live renderer), the snapshots and the movie
+        (:meth:`saves_images`, ``save_movie``; the renderer starts collecting movie frames) and
+        the live stress window (``plotStress`` and an open :attr:`stress_window`; its axes are
+        drawn now).  Call once per measurement.
+
+        Parameters
+        ----------
+        scene : callable
+            ``scene(engine)``: what is drawn (a :class:`~.observers.ReplicaScene`, or a function
+            returning the ensemble for the classes' own loop).
+        samples : callable
+            ``samples(engine, lo, hi)``: t, γ, τ_surface, τ_internal of protocol steps
+            ``lo … hi − 1`` (:meth:`~.observers.ReplicaScene.samples`).
+        live : bool, default True
+            Include the live particle window (the documented ensemble redraws it itself when
+            the classes step it).
+
+        Returns
+        -------
+        list of Observer
+        """
+        from .observers import LiveDrawing, SnapshotWriter, StressWindow
+        out = []
+        r = self.renderer
+        if live and r is not None and r.live:
+            out.append(LiveDrawing(r, scene))
+        T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
+        if self.saves_images():
+            movie = None
+            if self.save_movie:
+                r.collect_movie = True
+                folder = str(self.imageOutputFolder)
+                movie = lambda: r.write_movie(os.path.join(folder, "movie.gif"))  # noqa: E731
+            n = protocol_steps(self.periods, self.baseline_pre_periods, self.baseline_post_periods, self.f, self.dt)
+            out.append(SnapshotWriter(self.save_canvas_image, scene, self.image_N or image_cadence(n), movie))
+        if self.plotStress and self.stress_window is not None:
+            out.append(StressWindow(self._make_plotter(T_total, self.stress_window), self.stress_window, samples))
+        return out
+
     # -- the protocol ----------------------------------------------------------------------------
-    def _make_plotter(self, T_total):
-        canvas = self.stress_window.canvas if (self.plotStress and self.stress_window is not None) else False
-        plotter = EvaluationHandlerPlotter(self.stress_window.tk if canvas else False, canvas,
+    def _make_plotter(self, T_total, window=None):
+        """The recording plotter (``window`` None: draws nothing), or the plotter of the live stress
+        ``window``, whose axes it draws (the :class:`~.observers.StressWindow` plots with it)."""
+        canvas = window.canvas if window is not None else False
+        plotter = EvaluationHandlerPlotter(window.tk if canvas else False, canvas,
                                            x_scale=self.width / T_total, y_scale_strain=30 / self.amplitude,
                                            y_scale_force=self.force_scale, r=2, offset_x=0,
                                            offset_y=self.height / 2, plotStress=bool(canvas))
-        self.outputCanvas = canvas
         if canvas:
-            self.stress_window.draw_axes(T_total, plotter.x_scale, plotter.y_scale_force, plotter.y_scale_strain,
-                                         self.amplitude, self.baseline_pre_periods / self.f,
-                                         (self.baseline_pre_periods + self.periods) / self.f)
+            self.outputCanvas = canvas
+            window.draw_axes(T_total, plotter.x_scale, plotter.y_scale_force, plotter.y_scale_strain,
+                             self.amplitude, self.baseline_pre_periods / self.f,
+                             (self.baseline_pre_periods + self.periods) / self.f)
         return plotter
+
+    def _recorded_samples(self, _ensemble, lo, hi):
+        """``samples`` of the classes' own loop: rows ``lo … hi − 1`` of :attr:`plotter` (t, γ, τ_surface,
+        τ_internal)."""
+        from .evaluation import _FORCE, _SHEAR, _STRAIN, _T
+        return self.plotter._scal[lo:hi][:, [_T, _STRAIN, _FORCE, _SHEAR]]
 
     def prepare_recording(self):
         """Create the evaluator and the plotter and preallocate the recording for the whole protocol."""
@@ -342,7 +409,8 @@ class OscillatoryShearExperiment:
 
         Needs :meth:`prepare_recording` first.  Each step: set the shear rate
         (``A·2πf·cos(2π(f t − pre))`` during the excitation, else 0), forces, recording,
-        acceleration with damping, movement, snapshot every ``image_N`` steps.
+        acceleration with damping, movement, then the experiment's observers (:meth:`observers`:
+        snapshots every ``image_N`` steps, movie, live stress window).
 
         Parameters
         ----------
@@ -368,12 +436,8 @@ class OscillatoryShearExperiment:
             self.prepare_recording()
         plotter = self.plotter
         evaluator = self.theEvaluator
-        save_images = self.renderer is not None and bool(self.imageOutputFolder) and bool(self.imageBaseFileName)
-        movie = save_images and getattr(self, "save_movie", False)
-        if movie:
-            self.renderer.collect_movie = True
-        image_N = self.image_N or image_cadence(N_steps)
-        window = self.stress_window if self.plotStress else None
+        # snapshots, movie, stress window (the ensemble redraws a live particle window itself)
+        observers = self.observers(lambda _: ens, self._recorded_samples, live=False)
         n_run = N_steps if n_steps is None else min(int(n_steps), N_steps)
         self._say("Start application shear protocol, total N= " + str(N_steps) + " steps")
         ens.phase = "protocol"
@@ -392,14 +456,9 @@ class OscillatoryShearExperiment:
             ens.mechanical_simulation_step_calculate_acceleration(cool_factor, dt)  # kick + damping
             ens.mechanical_simulation_step_calculate_movement(dt)     # ξ, drift, γ, wrap, t += dt
             ens.reset_force()
-            if window is not None:
-                window.update()
-            if save_images and i % image_N == 0:
-                self.save_canvas_image(i)
             self.position = ("protocol", i + 1, n_run)
             self._report("protocol", i + 1, n_run, t0, state)
-        if movie:  # the snapshots as an animated GIF beside the frames
-            self.renderer.write_movie(os.path.join(str(self.imageOutputFolder), "movie.gif"))
+            notify(observers, ens, "protocol", i + 1, n_run)
         self.timings["protocol"] = time.perf_counter() - t0
         self.N_steps = n_run
         return n_run
@@ -571,7 +630,8 @@ class OscillatoryShearExperiment:
             for piece in iter_table_text(p._scal[: len(p)], p.tensor_history):  # streamed: bounded memory
                 out.write(piece)
         elif self.saveStressTensorData:
-            warnings.warn("OscillatoryShearExperiment: tensor history was not kept; writing no table", RuntimeWarning)
+            warnings.warn("OscillatoryShearExperiment: tensor history was not kept; writing no table", RuntimeWarning,
+                          stacklevel=2)
             out.write("\n" + NO_TENSOR_DATA_TEXT)
         else:
             out.write("\n" + NO_TENSOR_DATA_TEXT)
