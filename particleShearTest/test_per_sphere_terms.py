@@ -35,12 +35,14 @@ import unittest
 
 import numpy as np
 
-from particleShear import Force_register, SphereLinkableAdjustableInterfaceStrength
+from particleShear import (CircleBasicElasticity, Force_register, SphereLinkable, SphereLinkableAdjustableInterfaceStrength,
+                           elastic_force_law_plateau, elastic_force_law_tensile_exponential)
 from particleShear.engine.box import flow_velocity, min_image, wrap
 from particleShear.engine.integrate import damp, kick, xi_increments
 from particleShear.engine.terms import (elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
                                         tangential_term, term_constants, viscous_term)
 from particleShear.linkable.spheres import neighbor_relation_linkable
+from particleShear.objects.spheres import SphereLeesEdwards
 from particleShearTest.test_legacy_fidelity import SCENES, two_sphere_scene
 
 L = 500.0
@@ -166,6 +168,23 @@ class GeometryTest(unittest.TestCase):
         self.assertEqual(a.relative_vector(b), [20.0, 7.0 - L])
         self.assertEqual(a.relative_speed(b), [1.0, -0.5])
 
+    def test_without_spin_and_helpers(self):
+        """A frictionless sphere's slip speed is the translational part ``Δv·t``; n·d, the raw distance, the
+        neighbour test of spheres alone."""
+        pairs, st, _ = random_pairs()
+        v = vectorised(st)
+        (ri, rj) = st["r"]
+        no_spin = slip_speed(v["rv"], v["nx"], v["ny"], ri, rj, 0.0, 0.0)
+        for p, (a, b) in enumerate(pairs[:16]):
+            fa, fb = (SphereLeesEdwards("grey", s.x, s.y, 2 * s.r, size_x=L, size_y=L) for s in (a, b))
+            for f, s in ((fa, a), (fb, b)):
+                f.xspeed, f.yspeed, f.shear, f.shear_rate = s.xspeed, s.yspeed, SHEAR, RATE
+            self.assertEqual(fa.tangential_speed(fb), no_spin[p])
+            self.assertEqual(a.relative_position(b), [v["nx"][p] * v["d"][p], v["ny"][p] * v["d"][p]])
+            self.assertAlmostEqual(a.d_euclidian(b), math.hypot(b.x - a.x, b.y - a.y), delta=1e-12 * L)
+            fa.test_neighbor_relation(fb)
+            self.assertEqual(fa.findNeighborIndex(fb), 0 if v["touching"][p] else -1)
+
     def test_random_normal_at_contact(self):
         reg = Force_register()
         a, b = _sphere(10.0, 10.0, 5.0, 0.0, True, reg), _sphere(10.0, 10.0, 5.0, 0.0, True, reg)
@@ -237,7 +256,7 @@ class CentralTermsTest(unittest.TestCase):
         for s in others[1:]:
             me.neighbors.append(neighbor_relation_linkable(0, "stick", s))
             s.neighbors.append(neighbor_relation_linkable(0, "stick", me))
-        for q, s in enumerate(others):
+        for q in range(3):
             me.neighbors[q].friction_position = 0.3 * (q - 1)
         st = dict(x=(np.full(3, me.x), np.array([s.x for s in others])), y=(np.full(3, me.y), np.array([s.y for s in others])),
                   V=(np.array([[me.xspeed], [me.yspeed], [me.omega]]).repeat(3, 1),
@@ -260,6 +279,42 @@ class CentralTermsTest(unittest.TestCase):
         for q, s in enumerate(others):
             self.assertEqual(s.torque, (v["d"] * ft * v["w"][1])[q])
         self.assertEqual(len(reg.pair_register), 3 + 3 + 2 * 3)   # one entry per central visit, two per tangential
+
+
+class ReplacedLawsTest(unittest.TestCase):
+    """Laws replaced through the class callbacks are the laws of the per-sphere API and of its Coulomb bound."""
+
+    def setUp(self):
+        saved = (CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile)
+
+        def restore():
+            CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile = saved
+        self.addCleanup(restore)
+        CircleBasicElasticity.call_back_elastic_force_law = elastic_force_law_plateau
+        SphereLinkable.call_back_elastic_force_law_tensile = elastic_force_law_tensile_exponential
+
+    def test_plateau_and_exponential_tensile(self):
+        pairs, st, _ = random_pairs(c=0.4)
+        v = vectorised(st)
+        (ri, rj) = st["r"]
+        checked = 0
+        for p, (a, b) in enumerate(pairs):
+            d, d0 = v["d"][p], ri[p] + rj[p]
+            law = elastic_force_law_plateau(d, d0, K, 0.4)
+            self.assertEqual(a.get_elastic_force(b, K), law)
+            if st["perm"][p]:
+                de = st["d_eq"][p]
+                bond = (elastic_force_law_tensile_exponential(d, de, K) if d >= de
+                        else elastic_force_law_plateau(d, de, K, 0.4)) * PRC
+                self.assertEqual(a.get_elastic_force_permanent(b, K), bond)
+                self.assertEqual(a.elastic_force(b, K), [bond * v["nx"][p], bond * v["ny"][p]])
+            elif d < d0:
+                # the Coulomb bound of the replaced law: a large history slips at exactly μ|law|
+                a.neighbors[0].friction_position = 1e3
+                self.assertEqual(abs(a.tangential_force(b, NU_T, MU, K, K_T)), abs(MU * law))
+                self.assertEqual(a.neighbors[0].interface_type, "slip")
+                checked += 1
+        self.assertGreater(checked, 3)
 
 
 class TangentialTest(unittest.TestCase):
@@ -352,7 +407,7 @@ class MovementTest(unittest.TestCase):
         Vi, Vj = st["V"]
         (ri, rj) = st["r"]
         inc = xi_increments(Vi, Vj, v["dvx"], v["nx"], v["ny"], ri, rj, -v["dx"], -v["dy"], lambda x, y: (x, y))[0]
-        for p, (a, b) in enumerate(pairs):
+        for p, (a, _) in enumerate(pairs):
             rel = a.neighbors[0]
             if p % 5 == 0 and not st["perm"][p]:
                 rel.interface_type = "slip"
@@ -376,6 +431,11 @@ class MovementTest(unittest.TestCase):
         self.assertEqual([s.xspeed, s.yspeed], vel[:, 0].tolist())
         self.assertAlmostEqual(s.xspeed - u, f * (2.0 - u), delta=1e-12 * abs(u))     # peculiar velocity × f
         self.assertAlmostEqual(s.omega, kappa * u + f * (0.5 - kappa * u), delta=1e-12 * abs(u))
+        plain = _sphere(30.0, 400.0, 10.0, 0.0, True, reg)
+        plain.use_lees_edwards = False   # plain damping: v·f, ω·f
+        plain.xspeed, plain.yspeed, plain.omega = 2.0, -1.0, 0.5
+        plain.cool(f)
+        self.assertEqual((plain.xspeed, plain.yspeed, plain.omega), (2.0 * f, -1.0 * f, 0.5 * f))
         s.xforce, s.yforce, s.torque = 3.0, -6.0, 1.5
         v0, w0 = [s.xspeed, s.yspeed], s.omega
         s.do_linear_acceleration(0.01)
@@ -405,6 +465,18 @@ class EnsembleForcePhaseTest(unittest.TestCase):
     """In an ensemble, the per-sphere force phase of a 1.0.2 script is the ensemble's own force phase."""
 
     def test_scenes(self):
+        self._scenes()
+
+    def test_scenes_with_replaced_laws(self):
+        saved = (CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile)
+        try:
+            CircleBasicElasticity.call_back_elastic_force_law = elastic_force_law_plateau
+            SphereLinkable.call_back_elastic_force_law_tensile = elastic_force_law_tensile_exponential
+            self._scenes()
+        finally:
+            CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile = saved
+
+    def _scenes(self):
         for name, spec in SCENES.items():
             with self.subTest(scene=name):
                 mine, ref = two_sphere_scene(**spec), two_sphere_scene(**spec)
