@@ -461,6 +461,35 @@ class MovementTest(unittest.TestCase):
         self.assertEqual((s.x, s.y, s.xspeed), (L - 5.0, 1.0, vx))
 
 
+class ScriptOf102Test(unittest.TestCase):
+    """A 1.0.2 script with integer coordinates and speeds: every method runs and returns Python floats."""
+
+    def test_integer_inputs(self):
+        a, b = SphereLinkable("grey", 100, 100, 20), SphereLinkable("grey", 115, 100, 20)
+        a.test_neighbor_relation(b)
+        b.test_neighbor_relation(a)
+        self.assertEqual((a.d(b), a.n(b), a.relative_speed(b), a.tangential_speed(b)), (15.0, [1.0, 0.0], [0.0, 0.0], 0.0))
+        self.assertEqual(a.get_elastic_force(b, 1), -5.0)   # linear law: −k δ, δ = 20 − 15
+        self.assertEqual(a.elastic_force(b, 1), [-5.0, 0.0])
+        b.yspeed = 2
+        self.assertEqual(a.get_central_viscous_force(b, 1), 0.0)
+        self.assertEqual(a.tangential_speed(b), 2.0)
+        self.assertEqual(a.tangential_force(b, 1, 1, 1, 1), 2.0)   # ν_t v_t = 2 < μ|law| = 5: sticks
+        self.assertEqual(a.neighbors[0].interface_type, "stick")
+        self.assertEqual((a.yforce, b.yforce, a.torque, b.torque), (1.0, -1.0, 7.5, 7.5))   # d·f/2·r/(r + r)
+        a.move(1)
+        self.assertEqual((a.neighbors[0].friction_position, a.x), (2.0, 100.0))
+        a.cool()
+        a.do_linear_acceleration(1)
+        a.do_rotational_acceleration(1)
+        a.boundary_conditions(500, 500)
+        for value in (a.d(b), a.get_elastic_force(b, 1), a.get_central_viscous_force(b, 1), a.tangential_speed(b),
+                      a.tangential_force_viscous(b, 1), a.tangential_force_elastic(b, 1), a.tangential_force(b, 1, 1, 1, 1),
+                      a.xspeed, a.yspeed, a.omega, a.x, a.y, a.xforce, a.torque, *a.relative_vector(b),
+                      *a.lee_edwards_closest_to_zero(1, 2), *a.lee_edwards_positive(-1, 2)):
+            self.assertIs(type(value), float)
+
+
 class EnsembleForcePhaseTest(unittest.TestCase):
     """In an ensemble, the per-sphere force phase of a 1.0.2 script is the ensemble's own force phase."""
 
