@@ -25,10 +25,15 @@ then read at each pair; and, where a two-sphere value is known in closed form, a
   ``damp``, ``kick`` and ``wrap`` (analytic: the peculiar velocity relative to the flow scaled by
   f; ``v + F dt/m``; a sphere leaving through the top re-enters at the bottom, x shifted by
   ``−Ly·γ`` and vx by ``−Ly·γ̇``);
+* laws replaced through ``call_back_elastic_force_law`` (plateau) and
+  ``call_back_elastic_force_law_tensile`` (exponential) are the laws of the contacts, of the two
+  branches of a bond (× the ratio) and of the Coulomb bound (a large history slips at ``μ|law|``);
+* a 1.0.2 script with integer coordinates and speeds runs and gets Python floats back;
 * in an ensemble, the per-sphere force phase (every sphere's ``*_from_neighbors`` in list order,
   as the scripts of 1.0.2 do) gives the ensemble's own force phase: the totals, torques, states and
   histories, and the six register lists entry by entry (to 1e-12 of a list's largest entry: the
-  ensemble adds the two half visits of a pair before scaling).
+  ensemble adds the two half visits of a pair before scaling), with the built-in and with the
+  replaced laws.
 """
 import math
 import unittest
