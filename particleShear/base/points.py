@@ -6,6 +6,17 @@ keeps its own values; once appended, its state attributes (``x``, ``xspeed``,
 its ``neighbors`` are views of the ensemble's pair table.  The scalar methods
 here (``d``, ``elastic_force``, ``tangential_force`` …) are the documented API
 for scripts and tests; the ensembles never call them in a step.
+
+Each of them evaluates the engine's pure functions on the pairs it is asked about, as arrays
+of length 1 (or over one sphere's relations): the minimum image and wrap of
+:mod:`particleShear.engine.box`, the normals of :func:`particleShear.engine.forces.normals`,
+the kinematics, term constants, elastic, viscous and tangential terms and the force vectors of
+:mod:`particleShear.engine.terms`, and the kick, damping, ξ increments and drift of
+:mod:`particleShear.engine.integrate`.  What stays here is 1.0.2's bookkeeping: one visit per
+call, half of a tangential visit's force applied by that visit, and the register entries and
+relation states each call leaves.  The rounding is the engine's (e.g. the torque
+``d·f·(r_i/(r_i + r_j))``, the permanent ratio on the constant rather than on the force); no
+test needs 1.0.2's own order of the operations of a single pair.
 """
 __docformat__ = "numpy"
 
@@ -14,6 +25,11 @@ import random as _random
 
 import numpy as np
 
+from ..engine.box import flow_velocity, min_image, wrap
+from ..engine.forces import normals
+from ..engine.integrate import damp, drift, kick, xi_increments
+from ..engine.terms import (TermConstants, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
+                            tangential_term, term_constants, viscous_term)
 from .laws import elastic_force_law
 from .register import Force_register
 from .relations import neighbor_relation
@@ -128,19 +144,59 @@ class EnsembleField:
         obj.__dict__[self.key] = value
 
 
-def _le_closest(dx, dy, Lx, Ly, shear):
-    """Scalar Lees-Edwards minimum image, identical to the array kernel."""
-    while dy >= Ly / 2:
-        dy -= Ly
-        dx -= Ly * shear
-    while dy < -Ly / 2:
-        dy += Ly
-        dx += Ly * shear
-    while dx >= Lx / 2:
-        dx -= Lx
-    while dx < -Lx / 2:
-        dx += Lx
-    return dx, dy
+def _one(*values):
+    """The numbers as a float array over the pairs (a pair of one: length 1)."""
+    return np.array(values, dtype=float)
+
+
+def _with(K, **values):
+    """Copy of the term constants ``K`` with some of them replaced."""
+    return TermConstants(**{**{name: getattr(K, name) for name in TermConstants.__slots__}, **values})
+
+
+def _wrapped(x, y, vx, Lx, Ly, shift, rate):
+    """:func:`~particleShear.engine.box.wrap` of one position: ``(x, y, vx)`` as Python floats."""
+    xyv = _one(x, y, vx)[:, None]
+    wrap(xyv[0], xyv[1], xyv[2], Lx, Ly, shift, rate)
+    return xyv[:, 0].tolist()
+
+
+class _Pairs:
+    """The engine's inputs for the visits from sphere ``me`` to ``spheres``, as arrays over the partners.
+
+    Image vectors and image velocities (``image``, default ``me._image``), distances, normals
+    (if ``normal``; a random direction at ``d = 0`` from the ensemble's generator, or Python's
+    for a sphere alone), velocity rows ``(vx, vy, ω)`` and radii.
+    """
+
+    def __init__(self, me, spheres, normal=True, image=None):
+        dx = _one(*(s.x for s in spheres)) - me.x
+        dy = _one(*(s.y for s in spheres)) - me.y
+        self.me, self.spheres = me, spheres
+        self.dx, self.dy, self.dvx = (me._image if image is None else image)(dx, dy)
+        self.d = np.sqrt(self.dx * self.dx + self.dy * self.dy)
+        if normal:
+            ens = me.__dict__.get("_ens")
+            self.nx, self.ny = normals(self.dx, self.dy, self.d, None, (_random if ens is None else ens._rng,))
+
+    def rows(self, s):
+        """Velocity rows ``(vx, vy, ω)`` of spheres ``s`` (µm/s, rad/s; ω = 0 unless the visitor spins)."""
+        spin = self.me._spins
+        return np.array([[p.xspeed for p in s], [p.yspeed for p in s], [p.omega if spin else 0.0 for p in s]], dtype=float)
+
+    def velocity(self):
+        """:func:`~particleShear.engine.terms.relative_velocity` of the partners' images (µm/s), (2, P)."""
+        return relative_velocity(self.rows([self.me]), self.rows(self.spheres), self.dvx)
+
+    def radii(self):
+        """Radii ``r_i`` (1,) and ``r_j`` (P,) (µm)."""
+        return _one(self.me.r), _one(*(s.r for s in self.spheres))
+
+    def slip(self):
+        """:func:`~particleShear.engine.terms.slip_speed` of the pairs (µm/s), with the spins if the visitor spins."""
+        ri, rj = self.radii()
+        Vi, Vj = self.rows([self.me]), self.rows(self.spheres)
+        return slip_speed(relative_velocity(Vi, Vj, self.dvx), self.nx, self.ny, ri, rj, Vi[2], Vj[2])
 
 
 class Point:
@@ -184,24 +240,26 @@ class Point:
         """
         return [self.x, self.y, 0]
 
+    #: whether the sphere spins (ω enters its slip speed, φ its drift)
+    _spins = False
+
     def boundary_conditions(self, boundary_x, boundary_y):
-        """Plain periodic wrap into ``[0, boundary)``.
+        """Plain periodic wrap into ``[0, boundary)`` (:func:`~particleShear.engine.box.wrap` without shift).
 
         Parameters
         ----------
         boundary_x, boundary_y : float
             Cell size (µm).
         """
-        x, y = self.x, self.y
-        while x >= boundary_x:
-            x -= boundary_x
-        while x < 0:
-            x += boundary_x
-        while y >= boundary_y:
-            y -= boundary_y
-        while y < 0:
-            y += boundary_y
-        self.x, self.y = x, y
+        self.x, self.y, _ = _wrapped(self.x, self.y, 0.0, boundary_x, boundary_y, 0.0, 0.0)
+
+    def _image(self, dx, dy):
+        """Pair vectors from raw differences (µm) and the x velocities of the images (µm/s; None: no image)."""
+        return dx, dy, None
+
+    def _pairs(self, spheres, normal=True, image=None):
+        """The :class:`_Pairs` of this point with ``spheres`` (arrays over the partners)."""
+        return _Pairs(self, spheres, normal, image)
 
     def d_euclidian(self, theSphere):
         """Euclidean distance to the other point, without periodic images (µm).
@@ -219,7 +277,7 @@ class Point:
         return math.sqrt((theSphere.x - self.x) ** 2 + (theSphere.y - self.y) ** 2)
 
     def relative_vector(self, theSphere):
-        """Vector from this point to the other one (µm); the minimum image in subclasses.
+        """Vector from this point to the other one (µm): the Lees-Edwards minimum image where used.
 
         Parameters
         ----------
@@ -231,7 +289,8 @@ class Point:
         list of float
             ``[dx, dy]`` (µm).
         """
-        return [theSphere.x - self.x, theSphere.y - self.y]
+        p = self._pairs([theSphere], normal=False)
+        return [p.dx.item(), p.dy.item()]
 
     def d(self, theSphere):
         """Distance to the other point (µm), the length of :meth:`relative_vector`.
@@ -246,14 +305,13 @@ class Point:
         float
             Distance (µm).
         """
-        v = self.relative_vector(theSphere)
-        return math.sqrt(v[0] ** 2 + v[1] ** 2)
+        return self._pairs([theSphere], normal=False).d.item()
 
     def n(self, theSphere):
         """Unit vector towards the other point; a random direction when the two coincide.
 
-        The random direction comes from the ensemble's random generator (the run's seed) when the
-        point is in an ensemble.
+        The random direction (:func:`~particleShear.engine.forces.normals`) comes from the
+        ensemble's random generator (the run's seed) when the point is in an ensemble.
 
         Parameters
         ----------
@@ -265,13 +323,8 @@ class Point:
         list of float
             ``[n_x, n_y]``, of length 1.
         """
-        v = self.relative_vector(theSphere)
-        d = math.sqrt(v[0] ** 2 + v[1] ** 2)
-        if d > 0:
-            return [v[0] / d, v[1] / d]
-        ens = self.__dict__.get("_ens")
-        u = ens._rng.random() if ens is not None else _random.random()
-        return [math.cos(2 * math.pi * u), math.sin(2 * math.pi * u)]
+        p = self._pairs([theSphere])
+        return [p.nx.item(), p.ny.item()]
 
     def relative_position(self, theSphere):
         """Vector to the other point as ``n·d`` (µm).
@@ -291,15 +344,26 @@ class Point:
         return [n[0] * d, n[1] * d]
 
     def move(self, dt=1):
-        """Drift: advance the position by velocity × ``dt``.
+        """Drift: advance the position by velocity × ``dt`` (:func:`~particleShear.engine.integrate.drift`).
 
         Parameters
         ----------
         dt : float
             Time step (s).
         """
-        self.x = self.x + self.xspeed * dt
-        self.y = self.y + self.yspeed * dt
+        pos = _one(self.x, self.y)[:, None]
+        vel = _one(self.xspeed, self.yspeed, getattr(self, "omega", 0.0))[:, None]
+        phi = _one(self.phi) if self._spins else None
+        drift(pos, phi, vel, dt)
+        if phi is not None:
+            self.phi = phi.item()
+        self.x, self.y = pos[:, 0].tolist()
+
+    def _damp(self, f, flow):
+        """:func:`~particleShear.engine.integrate.damp` of ``(xspeed, yspeed)`` relative to the flow (None: none)."""
+        vel = _one(self.xspeed, self.yspeed)[:, None]
+        damp(vel, flow, f)
+        self.xspeed, self.yspeed = vel[:, 0].tolist()
 
     def cool(self, f=0.8):
         """Multiply both velocity components by ``f`` (damping).
@@ -309,11 +373,13 @@ class Point:
         f : float
             Factor (0 < f ≤ 1; 1 = no damping).
         """
-        self.xspeed = self.xspeed * f
-        self.yspeed = self.yspeed * f
+        self._damp(f, None)
 
     def relative_speed(self, theSphere):
-        """Velocity of the other point relative to this one (µm/s).
+        """Velocity of the other point relative to this one (µm/s); of its nearest image where Lees-Edwards is used.
+
+        :func:`~particleShear.engine.terms.relative_velocity`; an image one row up moves faster by
+        ``Ly·γ̇`` in x.
 
         Parameters
         ----------
@@ -325,7 +391,7 @@ class Point:
         list of float
             ``[v_x, v_y]``. (µm/s)
         """
-        return [theSphere.xspeed - self.xspeed, theSphere.yspeed - self.yspeed]
+        return self._pairs([theSphere], normal=False).velocity()[:, 0].tolist()
 
 
 class PointLeesEdwards(Point):
@@ -375,10 +441,21 @@ class PointLeesEdwards(Point):
         else:
             Point.boundary_conditions(self, boundary_x, boundary_y)
 
+    def _image(self, dx, dy):
+        """The Lees-Edwards minimum image (:meth:`_le_image`) if used, else the plain differences (see
+        :meth:`Point._image`)."""
+        return self._le_image(dx, dy) if self.use_lees_edwards else (dx, dy, None)
+
+    def _le_image(self, dx, dy):
+        """:func:`~particleShear.engine.box.min_image` with shift ``Ly·γ``, and the image velocities ``−Ly·γ̇·k_y``."""
+        Ly = self.size_y
+        dx, dy, ky, _ = min_image(dx, dy, self.size_x, Ly, Ly * self.shear)
+        return dx, dy, -(Ly * self.shear_rate) * ky
+
     def lee_edwards_closest_to_zero(self, x, y):
         """Minimum image of a difference vector in the sheared cell.
 
-        Crossing the y boundary shifts x by ``∓Ly·γ``; see docs/design.md.
+        Crossing the y boundary shifts x by ``∓Ly·γ`` (:func:`~particleShear.engine.box.min_image`).
 
         Parameters
         ----------
@@ -390,10 +467,11 @@ class PointLeesEdwards(Point):
         list of float
             ``[dx, dy]``, with ``-Lx/2 ≤ dx < Lx/2`` and ``-Ly/2 ≤ dy < Ly/2`` (µm).
         """
-        return list(_le_closest(x, y, self.size_x, self.size_y, self.shear))
+        dx, dy, _ = self._le_image(_one(x), _one(y))
+        return [dx.item(), dy.item()]
 
     def lee_edwards_positive(self, x, y):
-        """Map a position into the cell, without velocity correction.
+        """Map a position into the cell, without velocity correction (:func:`~particleShear.engine.box.wrap`).
 
         Parameters
         ----------
@@ -405,21 +483,10 @@ class PointLeesEdwards(Point):
         list of float
             ``[x, y]`` inside ``[0, Lx) × [0, Ly)`` (µm).
         """
-        Lx, Ly, g = self.size_x, self.size_y, self.shear
-        while y >= Ly:
-            y -= Ly
-            x -= Ly * g
-        while y < 0:
-            y += Ly
-            x += Ly * g
-        while x >= Lx:
-            x -= Lx
-        while x < 0:
-            x += Lx
-        return [x, y]
+        return _wrapped(x, y, 0.0, self.size_x, self.size_y, self.size_y * self.shear, 0.0)[:2]
 
     def lee_edwards_relative_speed(self, theSphere):
-        """Velocity of the nearest image of the other point relative to this one.
+        """Velocity of the nearest Lees-Edwards image of the other point relative to this one.
 
         An image one row up moves faster by ``Ly·γ̇`` in x.
 
@@ -433,40 +500,12 @@ class PointLeesEdwards(Point):
         list of float
             ``[v_x, v_y]``. (µm/s)
         """
-        vx = theSphere.xspeed - self.xspeed
-        vy = theSphere.yspeed - self.yspeed
-        dy = theSphere.y - self.y
-        Ly = self.size_y
-        while dy >= Ly / 2:
-            dy -= Ly
-            vx -= Ly * self.shear_rate
-        while dy < -Ly / 2:
-            dy += Ly
-            vx += Ly * self.shear_rate
-        return [vx, vy]
-
-    def relative_speed(self, theSphere):
-        """Velocity of the other point relative to this one: Lees-Edwards image or plain.
-
-        Parameters
-        ----------
-        theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[v_x, v_y]``. (µm/s)
-        """
-        if self.use_lees_edwards:
-            return self.lee_edwards_relative_speed(theSphere)
-        return Point.relative_speed(self, theSphere)
+        return self._pairs([theSphere], normal=False, image=self._le_image).velocity()[:, 0].tolist()
 
     def lee_edwards_boundary_conditions(self):
-        """Wrap into the cell; crossing y changes x by ∓Ly·γ and vx by ∓Ly·γ̇ (docs/design.md)."""
-        y_old = self.y
-        x, y = self.lee_edwards_positive(self.x, self.y)
-        self.xspeed = self.xspeed + (y - y_old) * self.shear_rate
+        """Wrap into the cell; crossing y changes x by ∓Ly·γ and vx by ∓Ly·γ̇ (:func:`~particleShear.engine.box.wrap`)."""
+        x, y, self.xspeed = _wrapped(self.x, self.y, self.xspeed, self.size_x, self.size_y,
+                                     self.size_y * self.shear, self.shear_rate)
         self.x, self.y = x, y
 
     def lee_edwards_relative_vector(self, theSphere):
@@ -483,23 +522,6 @@ class PointLeesEdwards(Point):
             ``[dx, dy]`` (µm).
         """
         return self.lee_edwards_closest_to_zero(theSphere.x - self.x, theSphere.y - self.y)
-
-    def relative_vector(self, theSphere):
-        """Vector to the other point: Lees-Edwards minimum image or plain difference (µm).
-
-        Parameters
-        ----------
-        theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[dx, dy]`` (µm).
-        """
-        if self.use_lees_edwards:
-            return self.lee_edwards_relative_vector(theSphere)
-        return Point.relative_vector(self, theSphere)
 
     def transmit_lees_edwards_parameters(self, theSphere):
         """Copy the cell size, strain, rate and Lees-Edwards flag to another point.
@@ -523,9 +545,7 @@ class PointLeesEdwards(Point):
         f : float
             Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
         """
-        u = self.shear_rate * (self.y - self.size_y / 2)
-        self.xspeed = u + (self.xspeed - u) * f
-        self.yspeed = self.yspeed * f
+        self._damp(f, flow_velocity(_one(self.y), self.size_y, self.shear_rate))
 
 
 def _check_finite(name, value):
@@ -647,7 +667,11 @@ class Circle(PointLeesEdwards):
         return [-n[1], n[0]]
 
     def tangential_speed(self, theSphere):
-        """Relative translational speed along ``t_ij`` (no spin part, µm/s).
+        """Slip velocity along ``t_ij`` (:func:`~particleShear.engine.terms.slip_speed`, µm/s).
+
+        ``Δv·t_ij − (r_i ω_i + r_j ω_j)``: the translational part only for a sphere without spin,
+        the slip of the two surfaces at the contact point for a spinning one
+        (:class:`CircleFrictionElasticity`).
 
         Parameters
         ----------
@@ -659,7 +683,7 @@ class Circle(PointLeesEdwards):
         float
             Speed (µm/s).
         """
-        return dotProduct2(self.relative_speed(theSphere), self.tangential_vector(theSphere))
+        return self._pairs([theSphere]).slip().item()
 
 
 class CircleMass(Circle):
@@ -712,16 +736,18 @@ class CircleMass(Circle):
     def do_linear_acceleration(self, dt):
         """Register the total force, kick the velocity by ``F dt / m``, reset the force.
 
+        :func:`~particleShear.engine.integrate.kick` on this sphere.
+
         Parameters
         ----------
         dt : float
             Time step (s).
         """
         self.record_total_particle_force()
-        self.xspeed = self.xspeed + self.xforce * dt / self.m
-        self.yspeed = self.yspeed + self.yforce * dt / self.m
-        self.xforce = 0
-        self.yforce = 0
+        vel, frc = _one(self.xspeed, self.yspeed)[:, None], _one(self.xforce, self.yforce)[:, None]
+        kick(vel, frc, self.m, dt)
+        self.xspeed, self.yspeed = vel[:, 0].tolist()
+        self.xforce, self.yforce = frc[:, 0].tolist()
 
     def applyInternalForceAndRegister(self, force_vector, source, register_homolog=False):
         """Add a pair force to the accumulator and record it as internal.
@@ -936,8 +962,45 @@ class CircleBasicElasticity(CircleMassNeighbors):
                                      force_register, use_lees_edwards)
         self.central_repulsion_coefficient = 0
 
+    def _bond(self, theSphere):
+        """Equilibrium distance (µm) of the bond to ``theSphere``; None: a contact (these spheres have no bonds)."""
+        return None
+
+    def _terms(self, theSphere, d_eq=None, k=1.0, nu=0.0, k_t=0.0, nu_t=0.0, mu=0.0):
+        """:func:`~particleShear.engine.terms.term_constants` of the visit from this sphere to ``theSphere`` (a contact,
+        or a bond at ``d_eq``), with this sphere's c and permanent ratios (1 where it has none); the constants a
+        method does not take keep their defaults and do not enter its term."""
+        bond = d_eq is not None
+        return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None, _one(d_eq) if bond else None,
+                              k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
+                              getattr(self, "permanent_ratio_central", 1.0), getattr(self, "permanent_ratio_tangential", 1.0),
+                              getattr(self, "keep_viscosity_coefficients_constant", 1.0))
+
+    def _replaced_law(self, K, d):
+        """A replaced ``call_back_elastic_force_law`` at ``(d, d_law, k, c)`` as an array of 1 (called with floats,
+        as in 1.0.2); None for the built-in law."""
+        law = CircleBasicElasticity.call_back_elastic_force_law
+        return None if law is elastic_force_law else _one(law(d.item(), K.d_law.item(), K.k, K.c))
+
+    def _elastic(self, K, d):
+        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1): :func:`~particleShear.engine.terms.elastic_term`,
+        or the replaced callbacks."""
+        law = self._replaced_law(K, d)
+        return elastic_term(K, d) if law is None else (law * K.ratio_c, law)
+
+    def _apply_central(self, theSphere, p, f):
+        """Apply and register the central force ``f·n`` of the pair ``p`` (:func:`~particleShear.engine.terms.pair_forces`);
+        returns ``[F_x, F_y]``."""
+        fx, fy = pair_forces(f, None, p.nx, p.ny, p.d, None)[:2]
+        vec = [fx.item(), fy.item()]
+        self.applyInternalForceAndRegister(vec, theSphere)
+        return vec
+
     def get_elastic_force(self, theSphere, k=1):
-        """Scalar central elastic force of the active law (negative = repulsion).
+        """Scalar central elastic force of the active contact law, ``law(d, r_i + r_j, k, c)`` (negative = repulsion).
+
+        :func:`~particleShear.engine.terms.elastic_term` of the pair (eqs. S1-5a/b, cap S1-6),
+        or the replaced ``call_back_elastic_force_law``.
 
         Parameters
         ----------
@@ -949,19 +1012,15 @@ class CircleBasicElasticity(CircleMassNeighbors):
         Returns
         -------
         float
-            Force (mg·µm·s⁻² per m depth).
+            Force (mg·µm·s⁻² per m depth); 0 beyond contact for the built-in laws.
         """
-        return CircleBasicElasticity.call_back_elastic_force_law(
-            self.d(theSphere), self.r + theSphere.r, k, self.central_repulsion_coefficient)
-
-    def _apply_along_n(self, theSphere, f):
-        n = self.n(theSphere)
-        vec = [f * n[0], f * n[1]]
-        self.applyInternalForceAndRegister(vec, theSphere)
-        return vec
+        return self._elastic(self._terms(theSphere, k=k), self._pairs([theSphere], normal=False).d)[0].item()
 
     def elastic_force(self, theSphere, k):
-        """Apply and register the central elastic force along ``n`` if the discs overlap.
+        """Apply and register the central elastic force along ``n`` if the discs overlap (a bond: at any distance).
+
+        A contact takes the law of :meth:`get_elastic_force`, a bond of a linkable sphere that of
+        ``get_elastic_force_permanent``.
 
         Parameters
         ----------
@@ -973,14 +1032,16 @@ class CircleBasicElasticity(CircleMassNeighbors):
         Returns
         -------
         list of float
-            The force vector on this sphere (``[0, 0]`` without overlap).
+            The force vector on this sphere (``[0, 0]`` for a contact without overlap).
         """
-        if self.d(theSphere) < self.r + theSphere.r:
-            return self._apply_along_n(theSphere, self.get_elastic_force(theSphere, k))
-        return [0, 0]
+        d_eq = self._bond(theSphere)
+        p = self._pairs([theSphere])
+        if d_eq is None and not p.d[0] < self.r + theSphere.r:
+            return [0, 0]
+        return self._apply_central(theSphere, p, self._elastic(self._terms(theSphere, d_eq, k=k), p.d)[0])
 
     def elastic_force_from_neighbors(self, k):
-        """Apply the central elastic force of every relation.
+        """Apply the central elastic force of every relation (:meth:`elastic_force`, in ``neighbors`` order).
 
         Parameters
         ----------
@@ -990,8 +1051,16 @@ class CircleBasicElasticity(CircleMassNeighbors):
         for rel in list(self.neighbors):
             self.elastic_force(rel.theSphere, k)
 
+    def _viscous(self, theSphere, nu):
+        """The pair's :class:`_Pairs` and its :func:`~particleShear.engine.terms.viscous_term` ``ν·v_n`` (a bond's ν × its
+        ratio unless kept constant)."""
+        p = self._pairs([theSphere])
+        vn = normal_speed(p.velocity(), p.nx, p.ny)
+        return p, viscous_term(self._terms(theSphere, self._bond(theSphere), nu=nu), vn, None)
+
     def get_central_viscous_force(self, theSphere, nu):
-        """Scalar central viscous force ``ν v_n``.
+        """Scalar central viscous force ``ν v_n`` (eq. S1-9; a linkable sphere's bond: × ``permanent_ratio_central``
+        unless ``keep_viscosity_coefficients_constant``).
 
         Parameters
         ----------
@@ -1005,10 +1074,10 @@ class CircleBasicElasticity(CircleMassNeighbors):
         float
             Force (mg·µm·s⁻² per m depth).
         """
-        return nu * dotProduct2(self.relative_speed(theSphere), self.n(theSphere))
+        return self._viscous(theSphere, nu)[1].item()
 
     def central_viscous_force(self, theSphere, nu):
-        """Apply and register the central viscous force ``ν v_n n``.
+        """Apply and register the central viscous force ``ν v_n n`` (of :meth:`get_central_viscous_force`).
 
         Parameters
         ----------
@@ -1022,10 +1091,10 @@ class CircleBasicElasticity(CircleMassNeighbors):
         list of float
             The force vector on this sphere.
         """
-        return self._apply_along_n(theSphere, self.get_central_viscous_force(theSphere, nu))
+        return self._apply_central(theSphere, *self._viscous(theSphere, nu))
 
     def central_viscous_force_from_neighbors(self, nu):
-        """Apply the central viscous force of every relation.
+        """Apply the central viscous force of every relation (:meth:`central_viscous_force`, in ``neighbors`` order).
 
         Parameters
         ----------
@@ -1067,6 +1136,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         If ``diameter`` or ``m`` is not a finite number > 0, or ``x``/``y`` is not finite.
     """
 
+    _spins = True
     phi = ArrayField(-math.pi / 2)
     omega = ArrayField(0.0)
     torque = ArrayField(0.0)
@@ -1085,36 +1155,52 @@ class CircleFrictionElasticity(CircleBasicElasticity):
     def cool(self, f=0.8, shear_rate_to_rotation_rate_coefficient=0):
         """Damp the velocity relative to the affine flow and the spin relative to the local rotation rate.
 
+        :func:`~particleShear.engine.integrate.damp` of ``(v_x, v_y)`` relative to
+        ``u = γ̇ (y − Ly/2)`` (plain damping without Lees-Edwards) and of ω relative to ``κ·u``.
+
         Parameters
         ----------
         f : float
             Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
         shear_rate_to_rotation_rate_coefficient : float
-            Spin of the flow the rotation is damped towards, as a multiple of ``γ̇ (y − Ly/2)``
+            κ: spin of the flow the rotation is damped towards, as a multiple of ``γ̇ (y − Ly/2)``
             (0 = damp towards no rotation).
         """
         PointLeesEdwards.cool(self, f) if self.use_lees_edwards else Point.cool(self, f)
-        w_loc = self.shear_rate * (self.y - self.size_y / 2) * shear_rate_to_rotation_rate_coefficient
-        self.omega = w_loc + f * (self.omega - w_loc)
+        spin = _one(self.omega)[:, None]
+        damp(spin, flow_velocity(_one(self.y), self.size_y, self.shear_rate) * shear_rate_to_rotation_rate_coefficient, f)
+        self.omega = spin.item()
 
-    def tangential_speed(self, theSphere):
-        """Slip velocity of the other surface along ``t_ij`` at the contact point, spin included.
+    def _visit(self, theSphere, p, K, xi_ij, xi_ji=0.0, bounded=True):
+        """One visit from this sphere of the tangential rule, :func:`~particleShear.engine.terms.tangential_term`.
 
-        Parameters
-        ----------
-        theSphere : Point
-            The other point or sphere.
+        The visit is the second visit of the engine's two-visit rule on the pair after a first one
+        that applies nothing (``k_t = ν_t = 0``), so the force, the slip decision and the reset of
+        both histories are this visit's: ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` with the
+        bound ``|μ·law|`` (bonds, and ``bounded=False``: none).
 
-        Returns
-        -------
-        float
-            ``v_t`` (µm/s).
+        ``xi_ij``, ``xi_ji`` are the histories of this sphere's relation and of the partner's (µm).
+        Returns the visit's force along ``t_ij`` (array of 1), whether it slipped, and the (2, 1)
+        histories ``ξ_ji, ξ_ij`` after it (both 0 after a slip).
         """
-        return (dotProduct2(self.relative_speed(theSphere), self.tangential_vector(theSphere))
-                - (self.r * self.omega + theSphere.r * theSphere.omega))
+        ri, rj = p.radii()
+        law = self._elastic(K, p.d)[1] if bounded else _one(0.0)
+        first = _with(K, k_t=0.0, nu_t=0.0, fc_inf=K.fc_inf if bounded else math.inf)
+        xi = _one(xi_ji, xi_ij)[:, None]
+        F, slip = tangential_term(first, p.slip(), p.d < ri + rj, xi, law, K)
+        return F[1], bool(slip[0]), xi
+
+    def _tangential_part(self, theSphere, bond, xi=None, **constants):
+        """A part of a visit's force without bound (:meth:`_visit`): the viscous part (``xi`` None; 0 without
+        overlap) or the elastic part ``k_t ξ``; ``bond``: with a bond's constants (``d_eq`` does not enter them)."""
+        p = self._pairs([theSphere])
+        if xi is None and not p.d[0] < self.r + theSphere.r:
+            return 0
+        K = self._terms(theSphere, self.r + theSphere.r if bond else None, **constants)
+        return self._visit(theSphere, p, K, 0.0 if xi is None else xi, bounded=False)[0].item()
 
     def tangential_force_viscous(self, theSphere, nu):
-        """Tangential viscous force ``ν_t v_t`` if the discs overlap, else 0.
+        """Tangential viscous force ``ν_t v_t`` if the discs overlap, else 0 (the viscous part of a visit).
 
         Parameters
         ----------
@@ -1128,12 +1214,10 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         float
             Force (mg·µm·s⁻² per m depth).
         """
-        if self.d(theSphere) < self.r + theSphere.r:
-            return nu * self.tangential_speed(theSphere)
-        return 0
+        return self._tangential_part(theSphere, False, nu_t=nu)
 
     def tangential_force_elastic(self, theSphere, k_t):
-        """Tangential elastic force ``k_t ξ`` if the discs overlap and are related, else 0.
+        """Tangential elastic force ``k_t ξ`` if the discs overlap and are related, else 0 (the elastic part of a visit).
 
         Parameters
         ----------
@@ -1148,12 +1232,16 @@ class CircleFrictionElasticity(CircleBasicElasticity):
             Force (mg·µm·s⁻² per m depth).
         """
         rel = self._relation(theSphere)
-        if rel is not None and self.d(theSphere) < self.r + theSphere.r:
-            return k_t * rel.friction_position
-        return 0
+        if rel is None or not self.d(theSphere) < self.r + theSphere.r:
+            return 0
+        return self._tangential_part(theSphere, False, rel.friction_position, k_t=k_t)
 
     def distribute_tangential_couple(self, theSphere, force):
         """Apply ``force`` along ``t_ij`` on self and the opposite on the partner, torques split by radii (eq. S1-3).
+
+        :func:`~particleShear.engine.terms.pair_forces` of the pair: ``±f·t`` and the torques
+        ``d·f·r_i/(r_i + r_j)`` on self and ``d·f·r_j/(r_i + r_j)`` on the partner (same sign),
+        each registered (two forces, two torques).
 
         Parameters
         ----------
@@ -1162,13 +1250,13 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         force : float
             Tangential force (mg·µm·s⁻² per m depth).
         """
-        t = self.tangential_vector(theSphere)
-        d = self.d(theSphere)
-        vec = [force * t[0], force * t[1]]
+        p = self._pairs([theSphere])
+        w = _one(self.r, theSphere.r)[:, None] / (self.r + theSphere.r)
+        fx, fy, _, tq = pair_forces(0.0, _one(force), p.nx, p.ny, p.d, w)
+        vec = [fx.item(), fy.item()]
         self.applyInternalForceAndRegister(vec, theSphere)
         theSphere.applyInternalForceAndRegister([-vec[0], -vec[1]], self)
-        ti = d * force * self.r / (self.r + theSphere.r)
-        tj = d * force * theSphere.r / (self.r + theSphere.r)
+        ti, tj = tq[:, 0].tolist()
         self.torque = self.torque + ti
         theSphere.torque = theSphere.torque + tj
         reg = self.force_register
@@ -1178,27 +1266,13 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         if hasattr(reg, "record_individual_internal_torque"):
             reg.record_individual_internal_torque(theSphere, self, tj)
 
-    def _coulomb_limited(self, theSphere, rel, f_t, mu, k):
-        f_c = abs(mu * CircleBasicElasticity.call_back_elastic_force_law(
-            self.d(theSphere), self.r + theSphere.r, k, self.central_repulsion_coefficient))
-        back = theSphere._relation(self) if hasattr(theSphere, "_relation") else None
-        if abs(f_t) <= f_c:
-            state = "stick"
-        else:
-            state = "slip"
-            rel.friction_position = 0
-            if back is not None:
-                back.friction_position = 0
-        rel.interface_type = state
-        if back is not None:
-            back.interface_type = state
-        return math.copysign(min(abs(f_t), f_c), f_t) if f_t != 0 else 0.0
-
     def tangential_force(self, theSphere, nu, mu, k, k_t):
-        """One visit of the tangential routine for a transient contact.
+        """One visit of the tangential routine (a contact; for a linkable sphere also a bond).
 
-        The force ``ν_t v_t + k_t ξ`` is limited by ``μ |F_n|`` (the contact slips and ξ is reset
-        when it exceeds it); half of it is applied per visit (see docs/design.md).
+        The force ``ν_t v_t·[d < r_i + r_j] + k_t ξ`` of :meth:`_visit`: a contact is limited by
+        ``μ |law(d, r_i + r_j, k, c)|`` — this visit sets the state of both directions (stick or
+        slip) and a slip resets both histories — a bond has no bound and keeps its state; half
+        of the force is applied (:meth:`distribute_tangential_couple`; docs/design.md).
 
         Parameters
         ----------
@@ -1216,18 +1290,29 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         Returns
         -------
         float
-            The limited tangential force (mg·µm·s⁻² per m depth), 0 without contact.
+            The limited tangential force (mg·µm·s⁻² per m depth), 0 without a relation and for a
+            contact without overlap.
         """
         rel = self._relation(theSphere)
-        if rel is None or self.d(theSphere) >= self.r + theSphere.r:
+        d_eq = self._bond(theSphere)
+        p = self._pairs([theSphere])
+        if rel is None or (d_eq is None and not p.d[0] < self.r + theSphere.r):
             return 0
-        f_t = self.tangential_force_viscous(theSphere, nu) + self.tangential_force_elastic(theSphere, k_t)
-        f = self._coulomb_limited(theSphere, rel, f_t, mu, k)
+        back = theSphere._relation(self) if hasattr(theSphere, "_relation") else None
+        F, slip, xi = self._visit(theSphere, p, self._terms(theSphere, d_eq, k=k, k_t=k_t, nu_t=nu, mu=mu),
+                                  rel.friction_position, 0.0 if back is None else back.friction_position)
+        if d_eq is None:
+            state = "slip" if slip else "stick"
+            for r, x in ((rel, xi[1]), (back, xi[0])):
+                if r is not None:
+                    r.friction_position = x.item()
+                    r.interface_type = state
+        f = F.item()
         self.distribute_tangential_couple(theSphere, f / 2)
         return f
 
     def tangential_force_from_neighbors(self, nu, mu, k, k_t):
-        """Apply the tangential routine to every relation.
+        """Apply the tangential routine to every relation (:meth:`tangential_force`, in ``neighbors`` order).
 
         Parameters
         ----------
@@ -1244,7 +1329,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
             self.tangential_force(rel.theSphere, nu, mu, k, k_t)
 
     def do_rotational_acceleration(self, dt):
-        """Register the net torque, kick the spin by ``T dt / I``, reset the torque.
+        """Register the net torque, kick the spin by ``T dt / I``, reset the torque (:func:`~particleShear.engine.integrate.kick`).
 
         Parameters
         ----------
@@ -1254,19 +1339,29 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         reg = self.force_register
         if hasattr(reg, "record_unbalanced_moment"):
             reg.record_unbalanced_moment(self, self.torque)
-        self.omega = self.omega + self.torque * dt / self.inertia
-        self.torque = 0
+        spin, torque = _one(self.omega)[:, None], _one(self.torque)[:, None]
+        kick(spin, torque, self.inertia, dt)
+        self.omega, self.torque = spin.item(), torque.item()
 
     def move(self, dt=1):
-        """Advance φ, integrate ξ of stick/permanent relations, then drift.
+        """Advance φ, integrate ξ of the stick and permanent relations, then drift (sequential rule, Appendix B.2).
+
+        ``ξ_ij += v_t·dt`` with the current velocities and positions (partners moved before this
+        sphere count at their new positions): the increment ``ξ̇_ij`` of
+        :func:`~particleShear.engine.integrate.xi_increments` over this sphere's relations; the
+        partner's history is integrated by the partner's own move.
 
         Parameters
         ----------
         dt : float
             Time step (s).
         """
-        self.phi = self.phi + self.omega * dt
-        for rel in self.neighbors:
-            if rel.interface_type in ("stick", "permanent"):
-                rel.friction_position = rel.friction_position + self.tangential_speed(rel.theSphere) * dt
+        rels = [rel for rel in self.neighbors if rel.interface_type in ("stick", "permanent")]
+        if rels:
+            p = self._pairs([rel.theSphere for rel in rels])
+            ri, rj = p.radii()
+            inc = xi_increments(p.rows([self]), p.rows(p.spheres), p.dvx, p.nx, p.ny, ri, rj, -p.dx, -p.dy,
+                                lambda Rx, Ry: (-p.nx, -p.ny))[0]
+            for rel, step in zip(rels, (inc * dt).tolist()):
+                rel.friction_position = rel.friction_position + step
         Circle.move(self, dt)

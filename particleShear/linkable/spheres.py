@@ -10,7 +10,7 @@ metre of depth (docs/design.md).
 """
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
-from ..base.points import ArrayField, CircleBasicElasticity, _check_finite
+from ..base.points import ArrayField, _check_finite, _one
 from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
 
@@ -72,7 +72,12 @@ def _same_ensemble(a, b):
 
 
 class SphereLinkable(SphereFrictionLeesEdwards):
-    """Frictional Lees-Edwards sphere that can be permanently bonded to its neighbours."""
+    """Frictional Lees-Edwards sphere that can be permanently bonded to its neighbours.
+
+    The inherited ``elastic_force``, ``get_central_viscous_force``, ``central_viscous_force`` and
+    ``tangential_force`` treat a permanent relation as a bond: the terms of the engine with the
+    bond's constants (tensile law beyond ``d_eq``, permanent ratios, no Coulomb bound; eqs. S1-5a/b).
+    """
 
     call_back_elastic_force_law_tensile = elastic_force_law_tensile
     permanent_ratio_central = ArrayField(1.0, param=True)
@@ -172,16 +177,27 @@ class SphereLinkable(SphereFrictionLeesEdwards):
                     out.append(s)
         return out
 
-    # -- scalar pair forces of bonds (API; the ensemble uses array kernels) ---------------------------
-    def _perm_ratio_c(self):
-        return self.permanent_ratio_central
+    # -- pair forces of bonds (the per-sphere API; the terms are the engine's, see base/points.py) -------
+    def _bond(self, theSphere):
+        """``d_eq`` of the bond to ``theSphere`` (µm), None when the relation is missing or not permanent."""
+        rel = self._relation(theSphere)
+        return rel.equilibrium_distance if rel is not None and rel.interface_type == "permanent" else None
+
+    def _replaced_law(self, K, d):
+        """A stretched bond (``d ≥ d_eq``) takes the tensile callback when it is replaced (else None: the built-in
+        law of :func:`~particleShear.engine.terms.elastic_term`); contacts and compressed bonds the parent's rule."""
+        if K.a_tens is None or d.item() < K.d_eq.item():
+            return SphereFrictionLeesEdwards._replaced_law(self, K, d)
+        tensile = SphereLinkable.call_back_elastic_force_law_tensile
+        return None if tensile is elastic_force_law_tensile else _one(tensile(d.item(), K.d_eq.item(), K.k))
 
     def get_elastic_force_permanent(self, theSphere, k=1):
         """Scalar central elastic force of the bond to ``theSphere`` (negative = repulsion).
 
         Tensile law ``call_back_elastic_force_law_tensile(d, d_eq, k)`` for ``d >= d_eq``, the
         compressive contact law (eq. S1-5b with the sphere's ``central_repulsion_coefficient``)
-        below it, times ``permanent_ratio_central``.
+        below it, times ``permanent_ratio_central``: the engine's
+        :func:`~particleShear.engine.terms.elastic_term` of a bond (or the replaced callbacks).
 
         Parameters
         ----------
@@ -195,61 +211,8 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         float
             The force along the unit vector towards the partner (mg·µm·s⁻² per metre of depth).
         """
-        rel = self._relation(theSphere)
-        d = self.d(theSphere)
-        d_eq = rel.equilibrium_distance
-        if d >= d_eq:
-            f = SphereLinkable.call_back_elastic_force_law_tensile(d, d_eq, k)
-        else:
-            f = CircleBasicElasticity.call_back_elastic_force_law(d, d_eq, k, self.central_repulsion_coefficient)
-        return f * self.permanent_ratio_central
-
-    def elastic_force(self, theSphere, k):
-        """Apply the central elastic force of the pair to this sphere and register it.
-
-        A bond uses :meth:`get_elastic_force_permanent` at any distance; a transient contact the
-        contact law of the parent class (only while overlapping).
-
-        Parameters
-        ----------
-        theSphere : SphereLinkable
-            The partner.
-        k : float
-            Central spring constant (mg·s⁻² per metre of depth).
-
-        Returns
-        -------
-        list of float
-            The force vector ``[fx, fy]`` applied to this sphere (mg·µm·s⁻² per metre of depth).
-        """
-        rel = self._relation(theSphere)
-        if rel is None or rel.interface_type != "permanent":
-            return SphereFrictionLeesEdwards.elastic_force(self, theSphere, k)
-        return self._apply_along_n(theSphere, self.get_elastic_force_permanent(theSphere, k))
-
-    def get_central_viscous_force(self, theSphere, nu):
-        """Scalar central viscous force ``ν·v_n`` of the pair.
-
-        On a bond it is multiplied by ``permanent_ratio_central`` unless
-        ``keep_viscosity_coefficients_constant``.
-
-        Parameters
-        ----------
-        theSphere : SphereLinkable
-            The partner.
-        nu : float
-            Central viscosity constant ν (mg·s⁻¹ per metre of depth).
-
-        Returns
-        -------
-        float
-            The force along the unit vector towards the partner (mg·µm·s⁻² per metre of depth).
-        """
-        f = SphereFrictionLeesEdwards.get_central_viscous_force(self, theSphere, nu)
-        rel = self._relation(theSphere)
-        if rel is not None and rel.interface_type == "permanent" and not self.keep_viscosity_coefficients_constant:
-            f = f * self.permanent_ratio_central
-        return f
+        K = self._terms(theSphere, self._relation(theSphere).equilibrium_distance, k=k)
+        return self._elastic(K, self._pairs([theSphere], normal=False).d)[0].item()
 
     def tangential_force_viscous_permanent(self, theSphere, nu):
         """Tangential viscous force ``ν_t·v_t`` of a bond (non-zero only while the spheres overlap).
@@ -268,10 +231,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         float
             The scalar tangential force (mg·µm·s⁻² per metre of depth).
         """
-        f = self.tangential_force_viscous(theSphere, nu)
-        if not self.keep_viscosity_coefficients_constant:
-            f = f * self.permanent_ratio_tangential
-        return f
+        return self._tangential_part(theSphere, True, nu_t=nu)
 
     def tangential_force_elastic_permanent(self, theSphere, k_t):
         """Tangential elastic force ``k_t·ξ·permanent_ratio_tangential`` of a bond (no Coulomb bound).
@@ -288,43 +248,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         float
             The scalar tangential force (mg·µm·s⁻² per metre of depth).
         """
-        return k_t * self._relation(theSphere).friction_position * self.permanent_ratio_tangential
-
-    def tangential_force(self, theSphere, nu, mu, k, k_t):
-        """One visit of the tangential routine, bonds included.
-
-        A transient contact is handled by the parent class (Coulomb bound ``μ·|F_n|``, slip resets
-        ξ); a bond adds its viscous and elastic tangential forces without bound.  Half of the
-        force is applied per visit, with the torques split in proportion to the radii (eq. S1-3).
-
-        Parameters
-        ----------
-        theSphere : SphereLinkable
-            The partner.
-        nu : float
-            Tangential viscosity constant ν_t (mg·s⁻¹ per metre of depth).
-        mu : float
-            Coulomb friction coefficient μ of transient contacts.
-        k : float
-            Central spring constant (mg·s⁻² per metre of depth), for the Coulomb bound.
-        k_t : float
-            Tangential spring constant (mg·s⁻² per metre of depth).
-
-        Returns
-        -------
-        float
-            The scalar tangential force of this visit (mg·µm·s⁻² per metre of depth); 0 without
-            a relation.
-        """
-        rel = self._relation(theSphere)
-        if rel is None:
-            return 0
-        if rel.interface_type != "permanent":
-            return SphereFrictionLeesEdwards.tangential_force(self, theSphere, nu, mu, k, k_t)
-        f = (self.tangential_force_viscous_permanent(theSphere, nu)
-             + self.tangential_force_elastic_permanent(theSphere, k_t))
-        self.distribute_tangential_couple(theSphere, f / 2)
-        return f
+        return self._tangential_part(theSphere, True, self._relation(theSphere).friction_position, k_t=k_t)
 
     def contactLineColor(self, interface_type):
         """Colour of the line drawn for a relation: locked for stick contacts and bonds, else slip.

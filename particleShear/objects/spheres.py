@@ -1,7 +1,8 @@
 """Concrete non-crosslinkable spheres: frictionless or frictional, with or without Lees-Edwards geometry.
 
 These are the sphere classes of particleShear 1.0.2 (public API).  The ensembles create them; a
-sphere created alone keeps its own state and computes its pair forces with the scalar laws.
+sphere created alone keeps its own state and computes its pair forces with the engine's terms
+evaluated on the pair (base/points.py).
 Lengths are in µm, masses in mg per metre of depth (docs/design.md).
 """
 __docformat__ = "numpy"
