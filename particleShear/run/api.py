@@ -16,8 +16,8 @@ import numpy as np
 from ..messages import console_messages
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
-from .validation import check_seed, validate_run, validate_series
-from .batch import check_batch_size, engine_supports, measure_batch
+from .validation import check_seed, contact_law_spec, validate_run, validate_series
+from .batch import check_batch_size, engine_supports, installed_law, measure_batch
 from .guard import PARAMETER_ALIASES, checked_keywords
 from .result import SimulationResult
 
@@ -110,7 +110,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
-                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy"):
+                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy",
+                              contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -267,6 +268,22 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it; "cupy"
         needs such a run (``doDrawing=False, plotStress=False``; see
         :func:`particleShear.run.batch.check_run_backend`).
+    contact_law : {"linear", "plateau"}, default "linear"
+        Keyword-only.  Central contact law, a name of the registry
+        :data:`particleShear.engine.laws.LAWS` (laws added with ``register_law`` are allowed too):
+        "linear" the blend of eqs. S1-5a/b with the cap S1-6 (or the law assigned to
+        ``CircleBasicElasticity.call_back_elastic_force_law``, the class-attribute way of 1.0.2),
+        "plateau" the same law of a plateau-transformed distance (spongy particles, the manual's
+        ``elastic_force_law_plateau``; docs/parameters.md).
+    plateau_begin : float, default 0.3
+        Keyword-only.  Begin of the plateau of ``contact_law="plateau"``, a fraction of the
+        contact distance; allowed 0 < plateau_begin < plateau_end.
+    plateau_end : float, default 0.8
+        Keyword-only.  End of the plateau, a fraction of the contact distance; allowed
+        plateau_begin < plateau_end <= 1.
+    plateau_slope : float, default 0.1
+        Keyword-only.  Slope of the force on the plateau relative to the law's (0 flat, 1 no
+        plateau); allowed 0 ... 1.
 
     Returns
     -------
@@ -316,7 +333,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     options = dict(return_result=return_result, verbose=verbose, progress=progress,
                    correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
                    time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
-                   output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend)
+                   output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend,
+                   contact_law=contact_law, plateau_begin=plateau_begin, plateau_end=plateau_end,
+                   plateau_slope=plateau_slope)
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
@@ -343,8 +362,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     theSimulation.output_format = output_format
     theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
     theSimulation.parameters = params
+    theSimulation.contact_law = contact_law_spec(params)
 
-    with console_messages(verbose):  # verbose: this call's INFO messages on stdout, the reference's text
+    # verbose: this call's INFO messages on stdout, the reference's text; the classes evaluate the
+    # run's contact law through the documented callback, installed for the run
+    with console_messages(verbose), installed_law(theSimulation.contact_law):
         G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
 
     info = theSimulation.result_info

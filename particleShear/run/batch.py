@@ -13,14 +13,20 @@ submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
 G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-no drawing, plotting or snapshots, the Euler integrator, the built-in force laws,
-N ≤ :data:`ENGINE_MAX_N`; saving data is fine) — single runs included — measure through
+no drawing, plotting or snapshots, the Euler integrator, N ≤ :data:`ENGINE_MAX_N`; any contact law,
+saving data is fine) — single runs included — measure through
 :mod:`particleShear.engine`, all
 replicas of a batch in one set of arrays; other runs go through the documented classes one after
 the other.  See ``docs/design.md`` (section "Batches of replicas").
+
+The contact law (``contact_law``) must agree within a batch (:func:`batches` groups runs by it, as
+it groups them by schedule): the engine evaluates one law function on all candidates of a step.
+Its parameters (``plateau_begin``, ``plateau_end``, ``plateau_slope``) may differ per replica.
 """
 __docformat__ = "numpy"
+import contextlib
 import logging
+import threading
 import time
 
 import numpy as np
@@ -29,7 +35,7 @@ from ..linkable.builders import time_steps_from_model
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
 __all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
-           "ENGINE_MAX_N", "check_backend", "check_run_backend"]
+           "ENGINE_MAX_N", "check_backend", "check_run_backend", "installed_law"]
 
 _log = logging.getLogger(__name__)
 
@@ -56,7 +62,7 @@ PER_REPLICA_PARAMETERS = frozenset((
     "avoid_height_spanning_particles", "cut_top_bottom", "doCutByTriangulation", "keep_viscosity_coefficients_constant",
     "root_folder", "saveData", "saveStressTensorData", "saveOutputImages", "imageFileType", "doDrawing",
     "plotStress", "relative_y_scale_force", "verbose", "progress", "reference_header", "correct_drift_sign",
-    "renderer", "stability_guard",
+    "renderer", "stability_guard", "plateau_begin", "plateau_end", "plateau_slope",
 ))
 
 #: parameters that fix the step schedule: N, the model constants behind τ, the protocol and the integrator
@@ -99,7 +105,7 @@ def check_run_backend(kw):
     """Check the backend of one run: usable here, and the run one the engine measures.
 
     Runs the engine does not measure (drawing, plotting, snapshots, the Verlet integrator,
-    replaced force laws, N > :data:`ENGINE_MAX_N`) go through the documented classes, which
+    N > :data:`ENGINE_MAX_N`) go through the documented classes, which
     step NumPy arrays only: with another backend they are refused rather than silently
     measured with NumPy.
 
@@ -124,10 +130,10 @@ def check_run_backend(kw):
         why.append(f"integrator={full['integrator']!r}")
     if int(full["N"]) > ENGINE_MAX_N:
         why.append(f"N={full['N']!r} > {ENGINE_MAX_N}")
-    raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why) or 'replaced force laws'}): "
+    raise ValueError(f"backend={backend!r} is invalid for this run ({', '.join(why)}): "
                      "only runs the engine measures can use a backend other than 'numpy' (doDrawing=False, "
-                     f"plotStress=False, saveOutputImages=False, integrator='euler', N <= {ENGINE_MAX_N}, the "
-                     "built-in force laws); the documented classes step NumPy arrays only")
+                     f"plotStress=False, saveOutputImages=False, integrator='euler', N <= {ENGINE_MAX_N}); "
+                     "the documented classes step NumPy arrays only")
 
 
 def check_batch_size(batch_size):
@@ -263,10 +269,11 @@ def run_batch(list_of_kwargs, backend=None):
 def engine_supports(kw):
     """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
 
-    It does when nothing is drawn, plotted or rendered into snapshots, the integrator is "euler",
-    the force laws are the built-in ones and N ≤ :data:`ENGINE_MAX_N`.  Runs that save their data
-    qualify: their files are written as ``runSimulation`` writes them (console messages and
-    progress callbacks work as in the documented classes).
+    It does when nothing is drawn, plotted or rendered into snapshots, the integrator is "euler"
+    and N ≤ :data:`ENGINE_MAX_N`, whatever the contact law (``contact_law``, or a law assigned to
+    the documented callbacks).  Runs that save their data qualify: their files are written as
+    ``runSimulation`` writes them (console messages and progress callbacks work as in the
+    documented classes).
 
     Parameters
     ----------
@@ -277,14 +284,51 @@ def engine_supports(kw):
     -------
     bool
     """
-    from ..base.laws import elastic_force_law, elastic_force_law_tensile
-    from ..base.points import CircleBasicElasticity
-    from ..linkable.spheres import SphereLinkable
     return (not kw["doDrawing"] and not kw["plotStress"] and not kw["saveOutputImages"]
             and kw["integrator"] == "euler"
-            and int(kw["N"]) <= ENGINE_MAX_N
-            and CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
-            and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
+            and int(kw["N"]) <= ENGINE_MAX_N)
+
+
+_LAW_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def installed_law(spec):
+    """The run's contact law as the documented callback, for a run the classes measure.
+
+    The documented classes evaluate ``CircleBasicElasticity.call_back_elastic_force_law``; for
+    ``spec`` = ``(name, values)`` (:func:`~particleShear.run.validation.contact_law_spec`) it is
+    set, for the ``with`` block, to that law of the registry with the run's parameters (0 beyond
+    contact), and restored afterwards.  None (the linear law or a law the user assigned) leaves
+    the callback as it is.  The callback is a class attribute: two runs with different laws in
+    threads of one process exclude each other (a lock); processes are independent.
+
+    Parameters
+    ----------
+    spec : tuple or None
+        ``(name, values)`` of the run's law, or None.
+
+    Yields
+    ------
+    None
+    """
+    if spec is None:
+        yield
+        return
+    from ..base.points import CircleBasicElasticity
+    from ..engine.laws import LAWS
+    law, values = LAWS[spec[0]], tuple(spec[1])
+
+    def callback(d, d0, k, c):
+        return np.where(np.asarray(d) > d0, 0.0, law.function(d, d0, k, c, *values))
+    callback.accepts_arrays = True
+    with _LAW_LOCK:
+        saved = CircleBasicElasticity.__dict__["call_back_elastic_force_law"]
+        CircleBasicElasticity.call_back_elastic_force_law = callback
+        try:
+            yield
+        finally:
+            CircleBasicElasticity.call_back_elastic_force_law = saved
 
 
 def measure_batch(runs):
@@ -311,6 +355,7 @@ def measure_batch(runs):
     from ..simulation.provenance import run_identity
     from ..simulation.simulations import RunSession
     from .api import SimulationResult, _build_simulation, _seed_sequence
+    from .validation import contact_law_spec
 
     sims, seeds, sessions = [], [], []
     for kw in runs:  # every replica's settings are checked before any work
@@ -324,6 +369,7 @@ def measure_batch(runs):
         sim.output_format = kw.get("output_format", "text")
         sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
         sim.parameters = kw
+        sim.contact_law = contact_law_spec(kw)
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
         seeds.append((seed_entropy, spawn_key, params))
@@ -399,7 +445,8 @@ def _constitute(sessions):
         key = pending[min(pending)].key
         group = [b for b in sorted(pending) if pending[b].key == key]
         t0 = time.perf_counter()
-        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR)
+        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR,
+                        laws=[sessions[b].sim.contact_law for b in group])
         share = (time.perf_counter() - t0) / len(group)
         for b in group:
             advance(b, share)
@@ -427,7 +474,8 @@ def _measure(sessions, sched, where):
         for pre in dict.fromkeys(sched[b][1] for b in members):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
-            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend)
+            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
+                                           laws=[sims[b].contact_law for b in group])
             say, report = _console(sims, group, "pre-equilibration", where)
             engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group])
             _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, dt=dt)
