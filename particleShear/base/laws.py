@@ -195,10 +195,10 @@ def elastic_force_law_tensile_exponential(d, d0, k):
 
 
 # the package's law functions accept arrays; the engine knows the registered ones by their callbacks
-_engine_laws.register_callback(elastic_force_law, lambda: ("linear", {}))
-_engine_laws.register_callback(elastic_force_law_plateau, lambda: ("plateau", dict(zip(
-    ("plateau_begin", "plateau_end", "plateau_slope"), PlateauConfiguration.values()))))
-_engine_laws.register_callback(elastic_force_law_tensile, lambda: ("tensile", {}))
+_engine_laws.register_callback(elastic_force_law, "linear")
+_engine_laws.register_callback(elastic_force_law_plateau, "plateau", lambda: dict(zip(
+    ("plateau_begin", "plateau_end", "plateau_slope"), PlateauConfiguration.values())))
+_engine_laws.register_callback(elastic_force_law_tensile, "tensile")
 elastic_force_law_tensile_exponential.accepts_arrays = True
 
 #: evaluate a (possibly user-supplied, scalar-only) law on pair arrays (:func:`particleShear.engine.laws.call_law`)

@@ -508,24 +508,34 @@ register_law("tensile", tensile_law, kind="tensile")
 
 
 # -- the documented callbacks ----------------------------------------------------------------------
-_CALLBACKS = {}
+_CALLBACKS = {}         # callback -> (name of its registered law, its parameters() or None)
+
+
+def _registered(callback):
+    """Name of the registered law of a callback (:func:`register_callback`), else None."""
+    try:
+        return _CALLBACKS.get(callback, (None,))[0]
+    except TypeError:     # an unhashable callable
+        return None
 #: callbacks found to accept numbers only (evaluated pair by pair without trying arrays again)
 _SCALAR_ONLY = weakref.WeakSet()
 
 
-def register_callback(callback, law):
-    """Declare a law function of the classes' callbacks to be a registered law.
+def register_callback(callback, name, parameters=None):
+    """Declare a law function of the classes' callbacks to be the registered law ``name``.
 
     Parameters
     ----------
     callback : callable
         A function users assign to ``call_back_elastic_force_law`` (or ``…_tensile``).
-    law : callable
-        ``law()`` returns ``(name, {parameter: value})`` of the registered law it is, read
-        when a force phase looks the callback up (the plateau law reads
-        ``PlateauConfiguration`` then).
+    name : str
+        The registered law it is.
+    parameters : callable, optional
+        ``parameters()`` returns ``{parameter: value}`` of the law, read when a force phase
+        looks the callback up (the plateau law reads ``PlateauConfiguration`` then); None: the
+        law's defaults.
     """
-    _CALLBACKS[callback] = law
+    _CALLBACKS[callback] = (name, parameters)
     try:
         callback.accepts_arrays = True
     except (AttributeError, TypeError):
@@ -550,9 +560,11 @@ def callback_law(callback):
         return None
     if found is None:
         return None
-    name, given = found()
+    name, given = found
     law = LAWS[name]
-    return law, law_values(law, given)
+    if given is None and not law.parameters:
+        return law, ()
+    return law, law_values(law, None if given is None else given())
 
 
 def call_law(law, *args, select=None):
@@ -613,9 +625,15 @@ def class_callbacks():
     -------
     tuple of callable
     """
-    from ..base.points import CircleBasicElasticity
-    from ..linkable.spheres import SphereLinkable
-    return CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile
+    if not _CLASSES:
+        from ..base.points import CircleBasicElasticity
+        from ..linkable.spheres import SphereLinkable
+        _CLASSES.extend((CircleBasicElasticity, SphereLinkable))
+    central, tensile = _CLASSES
+    return central.call_back_elastic_force_law, tensile.call_back_elastic_force_law_tensile
+
+
+_CLASSES = []     # the two classes of the documented callbacks, imported at the first look-up
 
 
 def _on_host(law, *args, select=None):
@@ -665,6 +683,8 @@ def force_phase_laws(s, C):
         built-in one (prepared constants).
     """
     compressive, stretched = class_callbacks()
+    if s.law is None and _registered(compressive) == "linear" and _registered(stretched) == "tensile":
+        return None, None           # the default: both laws from the prepared constants
     central = None
     if s.law is not None:
         law = LAWS[s.law]
