@@ -42,7 +42,8 @@ import numpy as np
 from .xp import array_namespace, to_host
 
 __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", "central_inside",
-           "central_law", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_law",
+           "central_law", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_constants",
+           "plateau_inside", "plateau_law",
            "check_plateau", "ContactLaw", "LAWS", "register_law", "unregister_law", "get_law", "law_names",
            "law_values", "register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks"]
 
@@ -251,8 +252,51 @@ def plateau_distance(d, plateau_begin, plateau_end, slope):
         Transformed distance (µm).
     """
     pb, pe, s = plateau_begin, plateau_end, slope
+    return _plateau_map(d, pb, pe, s, pe + (pb - pe) * s)
+
+
+def _plateau_map(d, pb, pe, s, low):
+    """:func:`plateau_distance` with its constant ``low = pe + (pb − pe)·s`` (the map at ``d = pb``)."""
     xp = array_namespace(d, pb, pe, s)
-    return xp.where(d >= pe, d, xp.where(d >= pb, pe + (d - pe) * s, d * (pe + (pb - pe) * s) / pb))
+    return xp.where(d >= pe, d, xp.where(d >= pb, pe + (d - pe) * s, d * low / pb))
+
+
+def plateau_constants(d0, k, c, plateau_begin, plateau_end, plateau_slope):
+    """Per-pair constants of :func:`plateau_law`: the plateau in µm, the map's constant, the law's.
+
+    Parameters
+    ----------
+    d0, k, c : ndarray or float
+        Contact distance (µm), spring constant, repulsion coefficient (as in :func:`linear_law`).
+    plateau_begin, plateau_end, plateau_slope : ndarray or float
+        The law's parameters (fractions of ``d0``, relative slope).
+
+    Returns
+    -------
+    tuple
+        ``(pb, pe, s, pe + (pb − pe)·s, d0)`` followed by :func:`central_constants` of
+        ``(d0, k, c)``: the arguments after ``d`` of :func:`plateau_inside`.
+    """
+    pb, pe, s = plateau_begin * d0, plateau_end * d0, plateau_slope
+    return (pb, pe, s, pe + (pb - pe) * s, d0) + central_constants(d0, k, c)
+
+
+def plateau_inside(d, pb, pe, s, low, d0, d0_cap, a_lin, a_div):
+    """:func:`plateau_law` from its constants (:func:`plateau_constants`), as if in contact.
+
+    Parameters
+    ----------
+    d : ndarray or float
+        Centre distance (µm).
+    pb, pe, s, low, d0, d0_cap, a_lin, a_div : ndarray or float
+        The constants of :func:`plateau_constants`.
+
+    Returns
+    -------
+    ndarray
+        Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return central_inside(_plateau_map(d, pb, pe, s, low), d0, d0_cap, a_lin, a_div)
 
 
 def plateau_law(d, d0, k, c, plateau_begin, plateau_end, plateau_slope):
@@ -261,7 +305,9 @@ def plateau_law(d, d0, k, c, plateau_begin, plateau_end, plateau_slope):
     ``linear_law(dp, d0, k, c)`` with ``dp = plateau_distance(d, plateau_begin·d0,
     plateau_end·d0, plateau_slope)``: the force grows with the overlap as the default law down to
     ``plateau_end·d0``, by the factor ``plateau_slope`` more slowly on the plateau, and again
-    steeply below ``plateau_begin·d0`` (the manual's ``elastic_force_law_plateau``).
+    steeply below ``plateau_begin·d0`` (the manual's ``elastic_force_law_plateau``).  The engine
+    evaluates it as :func:`plateau_inside` of :func:`plateau_constants` kept per candidate set
+    (the same arithmetic).
 
     Parameters
     ----------
@@ -277,8 +323,7 @@ def plateau_law(d, d0, k, c, plateau_begin, plateau_end, plateau_slope):
     ndarray
         Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0 for ``d ≤ d0``).
     """
-    dp = plateau_distance(d, plateau_begin * d0, plateau_end * d0, plateau_slope)
-    return central_inside(dp, d0, *central_constants(d0, k, c))
+    return plateau_inside(d, *plateau_constants(d0, k, c, plateau_begin, plateau_end, plateau_slope))
 
 
 def check_plateau(plateau_begin, plateau_end, plateau_slope):
@@ -332,12 +377,16 @@ class ContactLaw:
     check : callable or None
         ``check(**values)`` raises ValueError for values the law does not allow; None: any
         finite numbers.
+    prepared : tuple or None
+        ``(constants, inside)`` with ``function(d, d0, k, c, *p) == inside(d, *constants(d0, k,
+        c, *p))``: the engine keeps the constants per candidate set; None: it calls ``function``.
     """
 
-    __slots__ = ("name", "function", "parameters", "kind", "check")
+    __slots__ = ("name", "function", "parameters", "kind", "check", "prepared")
 
-    def __init__(self, name, function, parameters, kind, check):
+    def __init__(self, name, function, parameters, kind, check, prepared=None):
         self.name, self.function, self.parameters, self.kind, self.check = name, function, parameters, kind, check
+        self.prepared = prepared
 
     @property
     def description(self):
@@ -353,7 +402,7 @@ LAWS = {}
 _BUILT_IN = ("linear", "plateau", "tensile")
 
 
-def register_law(name, function, parameters=None, kind="central", check=None, replace=False):
+def register_law(name, function, parameters=None, kind="central", check=None, replace=False, prepared=None):
     """Add a contact law to :data:`LAWS`, the one place the engine and the run layer read laws from.
 
     The function must accept arrays (the engine calls it once per force phase on all candidate
@@ -375,6 +424,9 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
         ``check(**values)`` raising ValueError for values the law does not allow.
     replace : bool, default False
         Replace a law already registered under ``name`` (the built-in ones cannot be replaced).
+    prepared : tuple, optional
+        ``(constants, inside)``: the law split into per-pair constants and a function of them
+        (:class:`ContactLaw`), so that the engine computes the constants once per candidate set.
 
     Returns
     -------
@@ -402,7 +454,7 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
         function.accepts_arrays = True
     except (AttributeError, TypeError):
         pass
-    LAWS[name] = law = ContactLaw(name, function, parameters, kind, check)
+    LAWS[name] = law = ContactLaw(name, function, parameters, kind, check, prepared)
     return law
 
 
@@ -503,7 +555,7 @@ def law_values(law, given=None):
 
 register_law("linear", linear_law)
 register_law("plateau", plateau_law, {"plateau_begin": 0.3, "plateau_end": 0.8, "plateau_slope": 0.1},
-             check=check_plateau)
+             check=check_plateau, prepared=(plateau_constants, plateau_inside))
 register_law("tensile", tensile_law, kind="tensile")
 
 
@@ -689,9 +741,8 @@ def force_phase_laws(s, C):
     if s.law is not None:
         law = LAWS[s.law]
         if law.name != "linear" or law.parameters:
-            args = _cached(C, (law.name, id(s.law_params)),
-                           lambda: (C.d_law, C.k, s.c[C.rep]) + tuple(s.law_params[:, C.rep]))
-            central = _bind(law.function, args)
+            central = _prepared(law, C, (law.name, id(s.law_params)),
+                                lambda: (C.d_law, C.k, s.c[C.rep]) + tuple(s.law_params[:, C.rep]))
     else:
         found = callback_law(compressive)
         if found is None:
@@ -699,8 +750,7 @@ def force_phase_laws(s, C):
             central = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
         elif found[0].name != "linear":
             law, values = found
-            args = _cached(C, (law.name,), lambda: (C.d_law, C.k, s.c[C.rep]))
-            central = _bind(law.function, args + values)
+            central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, s.c[C.rep]) + values)
     tensile = None
     found = callback_law(stretched)
     if found is None or found[0].name != "tensile":
@@ -709,9 +759,16 @@ def force_phase_laws(s, C):
     return central, tensile
 
 
-def _bind(function, args):
-    """``function(d, *args)`` as a function of ``d``."""
-    return lambda d: function(d, *args)
+def _prepared(law, C, key, arguments):
+    """``law`` as a function of ``d`` on the candidates ``C``: ``inside(d, *constants)`` with the
+    constants kept with ``C`` under ``key`` when the law is prepared, else ``function(d, *arguments())``
+    (``arguments()``: ``(d0, k, c, *parameters)`` per candidate)."""
+    if law.prepared is None:
+        args = _cached(C, key, arguments)
+        return lambda d: law.function(d, *args)
+    constants, inside = law.prepared
+    args = _cached(C, key, lambda: constants(*arguments()))
+    return lambda d: inside(d, *args)
 
 
 def _stretched(law, C, d):
