@@ -330,6 +330,14 @@ class TestBadInput(unittest.TestCase):
                 with self.assertRaisesRegex(exc, message):
                     doParticleShearSimulation(N=20, doDrawing=False, verbose=False, **kw)
 
+    def test_misnamed_parameters_are_pointed_to(self):
+        from particleShear.run.guard import UnknownParameterError
+        for name, meant in (("law", "contact_law"), ("plateau_start", "plateau_begin"), ("plateau_slop", "plateau_slope")):
+            with self.subTest(name=name):
+                with self.assertRaises(UnknownParameterError) as cm:
+                    doParticleShearSimulation(**{name: 0.2})
+                self.assertEqual(cm.exception.suggestions[0], meant)
+
     def test_batch_and_series(self):
         with self.assertRaisesRegex(ValueError, r"plateau_end=1\.2"):
             run_batch([dict(QUICK), dict(QUICK, plateau_end=1.2)])

@@ -18,7 +18,7 @@ from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, contact_law_spec, validate_run, validate_series
 from .batch import check_batch_size, engine_supports, installed_law, measure_batch
-from .guard import PARAMETER_ALIASES, checked_keywords
+from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 
 __docformat__ = "numpy"
@@ -96,7 +96,7 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     return theSimulation
 
 
-@checked_keywords(aliases=PARAMETER_ALIASES)
+@checked_keywords(aliases=PARAMETER_ALIASES, hints=PARAMETER_HINTS)
 def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=5,
                               Young_modulus_spheres=8000, N=150, packing_fraction=1.5, density=50,
                               bimodal_factor=1.4, relative_viscosity=0.1, relative_transversal_link_strength=1,
@@ -546,7 +546,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Further keyword-only options of :func:`doParticleShearSimulation`, passed to every run and
         checked as there (``progress``, ``correct_drift_sign``, ``reference_header``, ``renderer``,
         ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
-        ``output_format``, ``strict_io``); not ``return_result`` (every run returns its result).
+        ``output_format``, ``strict_io``, ``contact_law``, ``plateau_begin``, ``plateau_end``,
+        ``plateau_slope``); not ``return_result`` (every run returns its result).
 
     Returns
     -------

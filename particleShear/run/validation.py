@@ -531,7 +531,8 @@ def validate_run(params):
         Arguments of one call by name: the reference parameters and the keyword-only options
         (``return_result``, ``verbose``, ``progress``, ``correct_drift_sign``, ``reference_header``,
         ``renderer``, ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
-        ``output_format``, ``strict_io``, ``backend``); missing ones take the defaults of the
+        ``output_format``, ``strict_io``, ``backend``, ``contact_law``, ``plateau_begin``,
+        ``plateau_end``, ``plateau_slope``); missing ones take the defaults of the
         signature of ``doParticleShearSimulation``.  Not modified.
 
     Returns
