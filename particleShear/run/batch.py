@@ -300,8 +300,9 @@ def installed_law(spec):
     ``spec`` = ``(name, values)`` (:func:`~particleShear.run.validation.contact_law_spec`) it is
     set, for the ``with`` block, to that law of the registry with the run's parameters (0 beyond
     contact), and restored afterwards.  None (the linear law or a law the user assigned) leaves
-    the callback as it is.  The callback is a class attribute: two runs with different laws in
-    threads of one process exclude each other (a lock); processes are independent.
+    the callback as it is.  The callback is a class attribute: two runs with such laws in
+    threads of one process take turns (a lock), and a run of the classes in another thread sees
+    the installed law meanwhile; processes are independent.
 
     Parameters
     ----------
