@@ -60,10 +60,25 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
 
 
 class PlateauConfiguration:
-    """Static parameters of the plateau law, as fractions of the contact distance."""
+    """Static parameters of the plateau law, as fractions of the contact distance.
+
+    The class-attribute way of particleShear 1.0.2; a run's ``contact_law="plateau"`` with
+    ``plateau_begin``, ``plateau_end`` and ``plateau_slope`` gives the same law per run
+    (:func:`particleShear.engine.laws.plateau_law`).
+    """
     relative_plateau_begin = 0.3
     relative_plateau_end = 0.8
     relative_plateau_slope = 0.1
+
+    @classmethod
+    def values(cls):
+        """``(begin, end, slope)`` now, the parameters of :func:`~particleShear.engine.laws.plateau_law`.
+
+        Returns
+        -------
+        tuple of float
+        """
+        return cls.relative_plateau_begin, cls.relative_plateau_end, cls.relative_plateau_slope
 
 
 def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_slope):
@@ -90,13 +105,8 @@ def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_s
     """
     pb, pe, s = plateau_begin, plateau_end, relative_plateau_slope
     if np.ndim(d) == 0 and np.ndim(pb) == 0 and np.ndim(pe) == 0:
-        if d >= pe:
-            return d
-        if d >= pb:
-            return pe + (d - pe) * s
-        return d * (pe + (pb - pe) * s) / pb
-    d = np.asarray(d, dtype=float)
-    return np.where(d >= pe, d, np.where(d >= pb, pe + (d - pe) * s, d * (pe + (pb - pe) * s) / pb))
+        return float(_engine_laws.plateau_distance(d, pb, pe, s))
+    return _engine_laws.plateau_distance(np.asarray(d, dtype=float), pb, pe, s)
 
 
 def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
@@ -104,6 +114,7 @@ def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
 
     The plateau lies between ``PlateauConfiguration.relative_plateau_begin·d0`` and
     ``relative_plateau_end·d0`` (see :func:`distance_transform_plateau`); 0 for ``d > d0``.
+    The arithmetic is :func:`particleShear.engine.laws.plateau_law` (the registry's ``"plateau"``).
 
     Parameters
     ----------
@@ -121,19 +132,14 @@ def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
     float or numpy.ndarray
         Central force (mg·µm·s⁻² per m depth); negative = repulsion; a float for scalar input.
     """
-    pb = PlateauConfiguration.relative_plateau_begin * d0
-    pe = PlateauConfiguration.relative_plateau_end * d0
-    s = PlateauConfiguration.relative_plateau_slope
     c = central_repulsion_coefficient
+    values = PlateauConfiguration.values()
     if np.ndim(d) == 0 and np.ndim(d0) == 0:
         if d > d0:
             return 0
-        dp = distance_transform_plateau(d, pb, pe, s)
-        return _scalar_result(-k * (1 - c) * (d0 - dp) - k * c * d0 * (d0 / max(dp, d0 / 1000) - 1), k, c)
+        return _scalar_result(_engine_laws.plateau_law(d, d0, k, c, *values), k, c)
     d = np.asarray(d, dtype=float)
-    dp = distance_transform_plateau(d, pb, pe, s)
-    val = -k * (1 - c) * (d0 - dp) - k * c * d0 * (d0 / np.maximum(dp, d0 / 1000) - 1)
-    return np.where(d > d0, 0.0, val)
+    return np.where(d > d0, 0.0, _engine_laws.plateau_law(d, d0, k, c, *values))
 
 
 def elastic_force_law_tensile(d, d0, k):
@@ -188,38 +194,12 @@ def elastic_force_law_tensile_exponential(d, d0, k):
     return k * d0 * delta * (1 - np.exp(-(d - d0) / (d0 * delta)))
 
 
-_NUMPY_AWARE = {elastic_force_law, elastic_force_law_plateau, elastic_force_law_tensile,
-                elastic_force_law_tensile_exponential}
+# the package's law functions accept arrays; the engine knows the registered ones by their callbacks
+_engine_laws.register_callback(elastic_force_law, "linear")
+_engine_laws.register_callback(elastic_force_law_plateau, "plateau", lambda: dict(zip(
+    ("plateau_begin", "plateau_end", "plateau_slope"), PlateauConfiguration.values())))
+_engine_laws.register_callback(elastic_force_law_tensile, "tensile")
+elastic_force_law_tensile_exponential.accepts_arrays = True
 
-
-def call_law_vectorised(law, *args):
-    """Evaluate a (possibly user-supplied, scalar-only) law on pair arrays.
-
-    Laws of this module accept arrays directly; any other callable is tried on
-    arrays and, if that fails or returns the wrong shape, applied element-wise.
-
-    Parameters
-    ----------
-    law : callable
-        Force law ``law(d, d0, k[, c])`` returning the central force (negative = repulsion).
-    *args : float or numpy.ndarray
-        Its arguments, arrays of one length (the pairs) or scalars; the first sets the length.
-
-    Returns
-    -------
-    numpy.ndarray
-        Force of every pair (mg·µm·s⁻² per m depth), float array of the first argument's shape.
-    """
-    n = np.shape(args[0])
-    if law in _NUMPY_AWARE:
-        return np.asarray(law(*args), dtype=float)
-    if n == () or n[0] == 0:
-        return np.zeros(n)
-    try:
-        out = np.asarray(law(*args), dtype=float)
-        if out.shape == n:
-            return out
-    except Exception:
-        pass
-    bc = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in args])
-    return np.array([float(law(*vals)) for vals in zip(*[b.tolist() for b in bc])], dtype=float)
+#: evaluate a (possibly user-supplied, scalar-only) law on pair arrays (:func:`particleShear.engine.laws.call_law`)
+call_law_vectorised = _engine_laws.call_law

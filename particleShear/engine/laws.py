@@ -1,27 +1,51 @@
-"""The central force laws, written once (eqs. S1-5a, S1-5b, S1-6; docs/design.md "Force laws").
+"""The contact laws, written once, and their registry: the one place to add a law.
 
-This module is the single definition of the arithmetic of the compressive law and of the
-linear tensile law of bonds.  Every caller uses it: the engine (on whole pair arrays, with
-per-candidate constants precomputed once per bond set), the classes' vectorised step (with the
-constants computed where the law is evaluated) and the documented per-sphere callbacks
-:func:`~particleShear.base.laws.elastic_force_law` and
-:func:`~particleShear.base.laws.elastic_force_law_tensile` (on Python scalars).
+A *central law* is a pure function ``law(d, d0, k, c, *parameters)`` of arrays (centre distance
+``d`` and contact distance ``d0`` in µm, spring constant ``k``, repulsion coefficient ``c``, and
+the law's own parameters, one value per pair or one number): the central force on i along
+``n_ij`` as if the pair were in contact (negative = repulsion, mg·µm·s⁻² per m depth).  The
+caller applies the cut-off: 0 beyond contact for a contact, the tensile law beyond ``d_eq`` for
+a bond.  A *tensile law* ``law(d, d_eq, k)`` is the force of a stretched bond (positive attracts).
+:func:`register_law` adds a law under a name (:data:`LAWS`); ``contact_law=<name>`` of a run
+selects it (docs/design.md, "Adding a contact law").  Built in:
 
-The laws are split into their constants (:func:`central_constants`, ``−k`` for the tensile
-law) and a function of those constants (:func:`central_inside`, :func:`tensile_inside`), so
-that a caller evaluating the same pairs every step computes the constants once.
+* ``"linear"`` (:func:`linear_law`): the blend of the linear (eq. S1-5a) and divergent (eq.
+  S1-5b) law with the cap of eq. S1-6 — the default;
+* ``"plateau"`` (:func:`plateau_law`): the same law of a plateau-transformed distance
+  (:func:`plateau_distance`), the spongy particles of the manual (parameters ``plateau_begin``,
+  ``plateau_end``, ``plateau_slope``: 0.3, 0.8, 0.1);
+* ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``): the linear tensile law of bonds.
+
+The documented callbacks of particleShear 1.0.2 (``CircleBasicElasticity.call_back_elastic_force_law``,
+``SphereLinkable.call_back_elastic_force_law_tensile``) keep working: the engine looks them up
+once per force phase (:func:`force_phase_laws`); a callback registered with
+:func:`register_callback` (the package's own law functions) is its registered law, any other one
+is evaluated by :func:`call_law`, on arrays when it accepts them and pair by pair otherwise.
+
+The linear and tensile laws are also split into their constants (:func:`central_constants`,
+``−k`` for the tensile law) and a function of those constants (:func:`central_inside`,
+:func:`tensile_inside`), so that a caller evaluating the same pairs every step computes the
+constants once (the engine's default path).
 
 The functions take the array namespace of their inputs (NumPy or CuPy, :mod:`.xp`).  Forces in
 mg·µm·s⁻² per m depth; negative = repulsion.
 """
 __docformat__ = "numpy"
 
+import difflib
+import math
 import numbers
+import weakref
 
-from .xp import array_namespace
+import numpy as np
+
+from .xp import array_namespace, to_host
 
 __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", "central_inside",
-           "central_law", "tensile_inside", "tensile_law"]
+           "central_law", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_constants",
+           "plateau_inside", "plateau_law",
+           "check_plateau", "ContactLaw", "LAWS", "register_law", "unregister_law", "get_law", "law_names",
+           "law_values", "register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks"]
 
 #: forms of the compressive law: the general blend, and the two pure laws of c = 0 and c = 1
 #: (they drop the term whose coefficient is ±0, which leaves the force unchanged and is faster)
@@ -178,3 +202,580 @@ def tensile_law(d, d_eq, k):
         Scalar central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; positive attracts).
     """
     return tensile_inside(d, d_eq, -k)
+
+
+# -- the built-in laws of the registry ------------------------------------------------------------
+def linear_law(d, d0, k, c):
+    """The default compressive law as if in contact: ``−k(1−c)(d0−d) − k·c·d0·(d0/max(d, d0/1000) − 1)``.
+
+    The blend of the linear law (eq. S1-5a, c = 0) and the divergent law (eq. S1-5b, c = 1)
+    with the cap ``d0/d ≤ 1000`` of eq. S1-6: :func:`central_inside` of :func:`central_constants`
+    (the engine evaluates it from constants prepared once per candidate set).
+
+    Parameters
+    ----------
+    d : ndarray or float
+        Centre distance of the pair (µm).
+    d0 : ndarray or float
+        Contact distance (µm, > 0): ``r_i + r_j`` for a contact, ``d_eq`` for a bond.
+    k : ndarray or float
+        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+    c : ndarray or float
+        Central repulsion coefficient in [0, 1].
+
+    Returns
+    -------
+    ndarray or float
+        Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0 for ``d ≤ d0``).
+    """
+    return central_inside(d, d0, *central_constants(d0, k, c))
+
+
+def plateau_distance(d, plateau_begin, plateau_end, slope):
+    """Continuous distance mapping that flattens a law between ``plateau_begin`` and ``plateau_end``.
+
+    ``d`` for ``d ≥ pe``; ``pe + (d − pe)·s`` on the plateau ``pb ≤ d < pe``; below it
+    ``d·(pe + (pb − pe)·s)/pb``, a linear map to 0 that is continuous at ``pb``.
+
+    Parameters
+    ----------
+    d : ndarray or float
+        Centre distance (µm).
+    plateau_begin, plateau_end : ndarray or float
+        Where the plateau begins and ends (µm), ``0 < pb < pe``.
+    slope : ndarray or float
+        Slope of the mapping on the plateau (dimensionless; 0 = flat, 1 = no plateau).
+
+    Returns
+    -------
+    ndarray
+        Transformed distance (µm).
+    """
+    pb, pe, s = plateau_begin, plateau_end, slope
+    return _plateau_map(d, pb, pe, s, pe + (pb - pe) * s)
+
+
+def _plateau_map(d, pb, pe, s, low):
+    """:func:`plateau_distance` with its constant ``low = pe + (pb − pe)·s`` (the map at ``d = pb``)."""
+    xp = array_namespace(d, pb, pe, s)
+    return xp.where(d >= pe, d, xp.where(d >= pb, pe + (d - pe) * s, d * low / pb))
+
+
+def plateau_constants(d0, k, c, plateau_begin, plateau_end, plateau_slope):
+    """Per-pair constants of :func:`plateau_law`: the plateau in µm, the map's constant, the law's.
+
+    Parameters
+    ----------
+    d0, k, c : ndarray or float
+        Contact distance (µm), spring constant, repulsion coefficient (as in :func:`linear_law`).
+    plateau_begin, plateau_end, plateau_slope : ndarray or float
+        The law's parameters (fractions of ``d0``, relative slope).
+
+    Returns
+    -------
+    tuple
+        ``(pb, pe, s, pe + (pb − pe)·s, d0)`` followed by :func:`central_constants` of
+        ``(d0, k, c)``: the arguments after ``d`` of :func:`plateau_inside`.
+    """
+    pb, pe, s = plateau_begin * d0, plateau_end * d0, plateau_slope
+    return (pb, pe, s, pe + (pb - pe) * s, d0) + central_constants(d0, k, c)
+
+
+def plateau_inside(d, pb, pe, s, low, d0, d0_cap, a_lin, a_div):
+    """:func:`plateau_law` from its constants (:func:`plateau_constants`), as if in contact.
+
+    Parameters
+    ----------
+    d : ndarray or float
+        Centre distance (µm).
+    pb, pe, s, low, d0, d0_cap, a_lin, a_div : ndarray or float
+        The constants of :func:`plateau_constants`.
+
+    Returns
+    -------
+    ndarray
+        Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return central_inside(_plateau_map(d, pb, pe, s, low), d0, d0_cap, a_lin, a_div)
+
+
+def plateau_law(d, d0, k, c, plateau_begin, plateau_end, plateau_slope):
+    """Law of spongy particles: :func:`linear_law` of the plateau-transformed distance.
+
+    ``linear_law(dp, d0, k, c)`` with ``dp = plateau_distance(d, plateau_begin·d0,
+    plateau_end·d0, plateau_slope)``: the force grows with the overlap as the default law down to
+    ``plateau_end·d0``, by the factor ``plateau_slope`` more slowly on the plateau, and again
+    steeply below ``plateau_begin·d0`` (the manual's ``elastic_force_law_plateau``).  The engine
+    evaluates it as :func:`plateau_inside` of :func:`plateau_constants` kept per candidate set
+    (the same arithmetic).
+
+    Parameters
+    ----------
+    d, d0, k, c : ndarray or float
+        As in :func:`linear_law` (µm, µm, mg·s⁻² per m depth, dimensionless).
+    plateau_begin, plateau_end : ndarray or float
+        Begin and end of the plateau as fractions of ``d0`` (:func:`check_plateau`).
+    plateau_slope : ndarray or float
+        Relative slope of the force on the plateau (dimensionless).
+
+    Returns
+    -------
+    ndarray
+        Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0 for ``d ≤ d0``).
+    """
+    return plateau_inside(d, *plateau_constants(d0, k, c, plateau_begin, plateau_end, plateau_slope))
+
+
+def check_plateau(plateau_begin, plateau_end, plateau_slope):
+    """Raise ValueError unless ``0 < plateau_begin < plateau_end ≤ 1`` and ``0 ≤ plateau_slope ≤ 1``.
+
+    The transformed distance must stay positive and increasing (which needs
+    ``slope < end/(end − begin)``, more than 1); a slope above 1 would make the plateau steeper
+    than the law itself, so the allowed slopes are 0 (flat) … 1 (no plateau).
+
+    Parameters
+    ----------
+    plateau_begin, plateau_end : float
+        Begin and end of the plateau (fractions of the contact distance).
+    plateau_slope : float
+        Relative slope on the plateau.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, its value and the allowed range.
+    """
+    values = {"plateau_begin": plateau_begin, "plateau_end": plateau_end, "plateau_slope": plateau_slope}
+    for name, v in values.items():
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+            raise ValueError(f"{name}={v!r} is invalid: allowed a finite number")
+    if not 0 < plateau_begin < plateau_end:
+        raise ValueError(f"plateau_begin={plateau_begin!r} is out of range: allowed 0 < plateau_begin < plateau_end "
+                         f"(plateau_end={plateau_end!r})")
+    if not plateau_end <= 1:
+        raise ValueError(f"plateau_end={plateau_end!r} is out of range: allowed plateau_begin < plateau_end <= 1 "
+                         "(fractions of the contact distance)")
+    if not 0 <= plateau_slope <= 1:
+        raise ValueError(f"plateau_slope={plateau_slope!r} is out of range: allowed 0 <= plateau_slope <= 1")
+
+
+# -- the registry ---------------------------------------------------------------------------------
+class ContactLaw:
+    """A registered law: its name, function, parameters with their defaults, kind and check.
+
+    Parameters
+    ----------
+    name : str
+        The name a run selects it by (``contact_law=name``).
+    function : callable
+        ``function(d, d0, k, c, *parameters)`` (kind ``"central"``) or ``function(d, d_eq, k)``
+        (kind ``"tensile"``), on arrays; see the module docstring.
+    parameters : dict
+        Parameter name → default, in the order ``function`` takes them.
+    kind : {"central", "tensile"}
+        Compressive law of contacts and bonds, or tensile law of stretched bonds.
+    check : callable or None
+        ``check(**values)`` raises ValueError for values the law does not allow; None: any
+        finite numbers.
+    prepared : tuple or None
+        ``(constants, inside)`` with ``function(d, d0, k, c, *p) == inside(d, *constants(d0, k,
+        c, *p))``: the engine keeps the constants per candidate set; None: it calls ``function``.
+    """
+
+    __slots__ = ("name", "function", "parameters", "kind", "check", "prepared")
+
+    def __init__(self, name, function, parameters, kind, check, prepared=None):
+        self.name, self.function, self.parameters, self.kind, self.check = name, function, parameters, kind, check
+        self.prepared = prepared
+
+    @property
+    def description(self):
+        """First line of the law function's docstring (its equation), str."""
+        return ((self.function.__doc__ or "").strip().splitlines() or [""])[0]
+
+    def __repr__(self):
+        return f"ContactLaw({self.name!r}, {self.kind}, parameters={self.parameters!r})"
+
+
+#: the registered laws, name → :class:`ContactLaw` (add one with :func:`register_law`)
+LAWS = {}
+_BUILT_IN = ("linear", "plateau", "tensile")
+
+
+def register_law(name, function, parameters=None, kind="central", check=None, replace=False, prepared=None):
+    """Add a contact law to :data:`LAWS`, the one place the engine and the run layer read laws from.
+
+    The function must accept arrays (the engine calls it once per force phase on all candidate
+    pairs, values beyond contact are discarded); it is marked ``accepts_arrays``.
+
+    Parameters
+    ----------
+    name : str
+        Name of the law (a run selects it with ``contact_law=name``).
+    function : callable
+        ``function(d, d0, k, c, *parameters)`` for kind ``"central"``: the force as if in
+        contact (mg·µm·s⁻² per m depth, negative repels); ``function(d, d_eq, k)`` for kind
+        ``"tensile"``.
+    parameters : dict, optional
+        Parameter name → default value, in the order of the function's extra arguments.
+    kind : {"central", "tensile"}, default "central"
+        Which law it is.
+    check : callable, optional
+        ``check(**values)`` raising ValueError for values the law does not allow.
+    replace : bool, default False
+        Replace a law already registered under ``name`` (the built-in ones cannot be replaced).
+    prepared : tuple, optional
+        ``(constants, inside)``: the law split into per-pair constants and a function of them
+        (:class:`ContactLaw`), so that the engine computes the constants once per candidate set.
+
+    Returns
+    -------
+    ContactLaw
+
+    Raises
+    ------
+    ValueError
+        For an empty or taken name, a non-callable function, an unknown kind or non-numeric defaults.
+    """
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"name={name!r} is invalid: allowed a non-empty identifier")
+    if name in LAWS and (not replace or name in _BUILT_IN):
+        raise ValueError(f"name={name!r} is invalid: a law of that name is registered (replace=True replaces "
+                         f"one that is not built in: {', '.join(_BUILT_IN)})")
+    if not callable(function):
+        raise ValueError(f"function={function!r} is invalid: allowed a callable")
+    if kind not in ("central", "tensile"):
+        raise ValueError(f"kind={kind!r} is invalid: allowed 'central' or 'tensile'")
+    parameters = dict(parameters or {})
+    for p, v in parameters.items():
+        if isinstance(v, bool) or not isinstance(v, numbers.Real):
+            raise ValueError(f"parameters[{p!r}]={v!r} is invalid: allowed a number")
+    try:
+        function.accepts_arrays = True
+    except (AttributeError, TypeError):
+        pass
+    LAWS[name] = law = ContactLaw(name, function, parameters, kind, check, prepared)
+    return law
+
+
+def unregister_law(name):
+    """Remove a law registered with :func:`register_law` (not a built-in one).
+
+    Parameters
+    ----------
+    name : str
+        Its name.
+
+    Raises
+    ------
+    ValueError
+        For a built-in or unknown name.
+    """
+    if name in _BUILT_IN or name not in LAWS:
+        raise ValueError(f"name={name!r} is invalid: allowed a registered law that is not built in "
+                         f"({', '.join(n for n in LAWS if n not in _BUILT_IN) or 'none'})")
+    del LAWS[name]
+
+
+def law_names(kind="central"):
+    """Names of the registered laws of one kind, in registration order (list of str).
+
+    Parameters
+    ----------
+    kind : {"central", "tensile"}, default "central"
+        Which laws.
+
+    Returns
+    -------
+    list of str
+    """
+    return [n for n, law in LAWS.items() if law.kind == kind]
+
+
+def get_law(name, kind="central", what="contact_law"):
+    """The registered law ``name`` of the given kind.
+
+    Parameters
+    ----------
+    name : str
+        Its name.
+    kind : {"central", "tensile"}, default "central"
+        The kind wanted.
+    what : str, default "contact_law"
+        The parameter named in the error.
+
+    Returns
+    -------
+    ContactLaw
+
+    Raises
+    ------
+    ValueError
+        For an unknown name: naming ``what``, the value, the allowed names and the closest one.
+    """
+    law = LAWS.get(name) if isinstance(name, str) else None
+    if law is not None and law.kind == kind:
+        return law
+    names = law_names(kind)
+    close = difflib.get_close_matches(str(name), names, n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise ValueError(f"{what}={name!r} is invalid: allowed {', '.join(repr(n) for n in names)}{hint}")
+
+
+def law_values(law, given=None):
+    """The parameter values of ``law``: ``given`` where it names one, else the default; checked.
+
+    Parameters
+    ----------
+    law : ContactLaw or str
+        The law (or its name).
+    given : dict, optional
+        Parameter name → value (names the law does not take are ignored).
+
+    Returns
+    -------
+    tuple of float
+        In the order of ``law.parameters``.
+
+    Raises
+    ------
+    ValueError
+        From the law's check, or for a value that is not a finite number.
+    """
+    law = get_law(law) if isinstance(law, str) else law
+    given = given or {}
+    values = {p: given.get(p, default) for p, default in law.parameters.items()}
+    for p, v in values.items():
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+            raise ValueError(f"{p}={v!r} is invalid: allowed a finite number")
+    if law.check is not None:
+        law.check(**values)
+    return tuple(float(v) for v in values.values())
+
+
+register_law("linear", linear_law)
+register_law("plateau", plateau_law, {"plateau_begin": 0.3, "plateau_end": 0.8, "plateau_slope": 0.1},
+             check=check_plateau, prepared=(plateau_constants, plateau_inside))
+register_law("tensile", tensile_law, kind="tensile")
+
+
+# -- the documented callbacks ----------------------------------------------------------------------
+_CALLBACKS = {}         # callback -> (name of its registered law, its parameters() or None)
+
+
+def _registered(callback):
+    """Name of the registered law of a callback (:func:`register_callback`), else None."""
+    try:
+        return _CALLBACKS.get(callback, (None,))[0]
+    except TypeError:     # an unhashable callable
+        return None
+#: callbacks found to accept numbers only (evaluated pair by pair without trying arrays again)
+_SCALAR_ONLY = weakref.WeakSet()
+
+
+def register_callback(callback, name, parameters=None):
+    """Declare a law function of the classes' callbacks to be the registered law ``name``.
+
+    Parameters
+    ----------
+    callback : callable
+        A function users assign to ``call_back_elastic_force_law`` (or ``…_tensile``).
+    name : str
+        The registered law it is.
+    parameters : callable, optional
+        ``parameters()`` returns ``{parameter: value}`` of the law, read when a force phase
+        looks the callback up (the plateau law reads ``PlateauConfiguration`` then); None: the
+        law's defaults.
+    """
+    _CALLBACKS[callback] = (name, parameters)
+    try:
+        callback.accepts_arrays = True
+    except (AttributeError, TypeError):
+        pass
+
+
+def callback_law(callback):
+    """``(ContactLaw, values)`` of a callback declared by :func:`register_callback`, else None.
+
+    Parameters
+    ----------
+    callback : callable
+        The callback.
+
+    Returns
+    -------
+    tuple or None
+    """
+    try:
+        found = _CALLBACKS.get(callback)
+    except TypeError:     # an unhashable callable
+        return None
+    if found is None:
+        return None
+    name, given = found
+    law = LAWS[name]
+    if given is None and not law.parameters:
+        return law, ()
+    return law, law_values(law, None if given is None else given())
+
+
+def call_law(law, *args, select=None):
+    """Evaluate a (possibly user-supplied, number-only) law on pair arrays (NumPy).
+
+    A law that accepts arrays (``law.accepts_arrays``, or one whose call on the arrays returns
+    an array of their shape) is called once on the arrays; any other one is applied pair by
+    pair, on the pairs of ``select`` only when given (0 elsewhere), and remembered as such.
+
+    Parameters
+    ----------
+    law : callable
+        Force law ``law(d, d0, k[, c])`` returning the central force (negative = repulsion).
+    *args : float or numpy.ndarray
+        Its arguments, arrays of one length (the pairs) or numbers; the first sets the length.
+    select : numpy.ndarray of bool, optional
+        The pairs whose value is needed (the pair-by-pair path evaluates only these).
+
+    Returns
+    -------
+    numpy.ndarray
+        Force of every pair (mg·µm·s⁻² per m depth), float array of the first argument's shape.
+    """
+    n = np.shape(args[0])
+    if getattr(law, "accepts_arrays", False):
+        return np.asarray(law(*args), dtype=float)
+    if n == () or n[0] == 0:
+        return np.zeros(n)
+    try:
+        scalar_only = law in _SCALAR_ONLY
+    except TypeError:
+        scalar_only = False
+    if not scalar_only:
+        try:
+            out = np.asarray(law(*args), dtype=float)
+            if out.shape == n:
+                return out
+        except Exception:
+            pass
+        try:
+            _SCALAR_ONLY.add(law)
+        except TypeError:
+            pass
+    bc = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in args])
+    if select is None:
+        return np.array([float(law(*vals)) for vals in zip(*[b.tolist() for b in bc])], dtype=float)
+    out = np.zeros(n)
+    idx = np.flatnonzero(select)
+    out[idx] = [float(law(*vals)) for vals in zip(*[b[idx].tolist() for b in bc])]
+    return out
+
+
+def class_callbacks():
+    """The documented law callbacks now: ``(CircleBasicElasticity.call_back_elastic_force_law,
+    SphereLinkable.call_back_elastic_force_law_tensile)``.
+
+    Returns
+    -------
+    tuple of callable
+    """
+    if not _CLASSES:
+        from ..base.points import CircleBasicElasticity
+        from ..linkable.spheres import SphereLinkable
+        _CLASSES.extend((CircleBasicElasticity, SphereLinkable))
+    central, tensile = _CLASSES
+    return central.call_back_elastic_force_law, tensile.call_back_elastic_force_law_tensile
+
+
+_CLASSES = []     # the two classes of the documented callbacks, imported at the first look-up
+
+
+def _on_host(law, *args, select=None):
+    """:func:`call_law` of a callback on the arrays' backend (a device's arrays are read on the host)."""
+    xp = array_namespace(*args)
+    if xp is np:
+        return call_law(law, *args, select=select)
+    host = [a if isinstance(a, numbers.Number) else to_host(a, "scalar law") for a in args]
+    return xp.asarray(call_law(law, *host, select=None if select is None else to_host(select, "scalar law")))
+
+
+def _cached(C, key, make):
+    """The per-candidate arguments of a law, kept with the candidates' constants ``C`` under ``key``
+    (dropped with ``C`` at the one invalidation point, a rebuild of the candidate lists)."""
+    got = C.__dict__.get("law_args")
+    if got is None or got[0] != key:
+        got = (key, make())
+        C.__dict__["law_args"] = got
+    return got[1]
+
+
+def force_phase_laws(s, C):
+    """The central and tensile laws of one force phase of the engine, looked up once per phase.
+
+    The central law is the state's ``s.law`` (a run's ``contact_law``, its parameters per
+    replica in ``s.law_params``) when set, else the documented callback
+    ``CircleBasicElasticity.call_back_elastic_force_law``: a registered law when it was declared
+    one (:func:`register_callback`), a user function otherwise (:func:`call_law`, pair by pair on
+    the pairs inside their contact distance when it accepts numbers only).  The tensile law of
+    bonds is the callback ``SphereLinkable.call_back_elastic_force_law_tensile`` in the same way.
+
+    Parameters
+    ----------
+    s : BatchState
+        The batch (``law``, ``law_params``, the repulsion coefficients ``c``).
+    C : PairConstants
+        Its candidates (``rep``, ``k``, ``d_law``, ``d_eq``, ``perm``).
+
+    Returns
+    -------
+    central : callable or None
+        ``central(d)``: the compressive law of every candidate as if in contact; None for the
+        linear law, which :func:`~particleShear.engine.terms.elastic_term` evaluates from the
+        prepared constants of ``C``.
+    tensile : callable or None
+        ``tensile(d)``: the tensile law on the stretched bonds (0 elsewhere); None for the
+        built-in one (prepared constants).
+    """
+    compressive, stretched = class_callbacks()
+    if s.law is None and _registered(compressive) == "linear" and _registered(stretched) == "tensile":
+        return None, None           # the default: both laws from the prepared constants
+    central = None
+    if s.law is not None:
+        law = LAWS[s.law]
+        if law.name != "linear" or law.parameters:
+            central = _prepared(law, C, (law.name, id(s.law_params)),
+                                lambda: (C.d_law, C.k, s.c[C.rep]) + tuple(s.law_params[:, C.rep]))
+    else:
+        found = callback_law(compressive)
+        if found is None:
+            args = _cached(C, ("callback",), lambda: (C.d_law, C.k, s.c[C.rep]))
+            central = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
+        elif found[0].name != "linear":
+            law, values = found
+            central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, s.c[C.rep]) + values)
+    tensile = None
+    found = callback_law(stretched)
+    if found is None or found[0].name != "tensile":
+        law = stretched if found is None else found[0].function
+        tensile = (lambda d: _stretched(law, C, d))
+    return central, tensile
+
+
+def _prepared(law, C, key, arguments):
+    """``law`` as a function of ``d`` on the candidates ``C``: ``inside(d, *constants)`` with the
+    constants kept with ``C`` under ``key`` when the law is prepared, else ``function(d, *arguments())``
+    (``arguments()``: ``(d0, k, c, *parameters)`` per candidate)."""
+    if law.prepared is None:
+        args = _cached(C, key, arguments)
+        return lambda d: law.function(d, *args)
+    constants, inside = law.prepared
+    args = _cached(C, key, lambda: constants(*arguments()))
+    return lambda d: inside(d, *args)
+
+
+def _stretched(law, C, d):
+    """A tensile callback on the stretched bonds of ``C`` (``d > d_eq``), 0 on every other candidate."""
+    xp = array_namespace(d)
+    out = xp.zeros_like(d)
+    idx = xp.flatnonzero(C.perm & (d > C.d_law))
+    if idx.size:
+        out[idx] = _on_host(law, d[idx], C.d_eq[idx], C.k[idx])
+    return out

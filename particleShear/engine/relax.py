@@ -324,7 +324,7 @@ def write_back(engine, b, ensemble, steps=0, ages=None):
         ensemble.n_constitution_steps += int(steps)
 
 
-def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN):
+def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     """``free_pre_equilibration(N)`` of every ensemble, all in one engine, written back.
 
     Parameters
@@ -338,6 +338,9 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN):
         Verlet skin of the engine in units of each replica's largest radius (> 0).  The result
         does not depend on it: the contacts are exact for any skin, and the zero terms of the
         candidates out of contact change no sum.
+    laws : sequence, optional
+        The central law of each ensemble, as :meth:`~particleShear.engine.state.BatchState.from_ensembles`
+        takes them (default: the documented callback for every one).
 
     Returns
     -------
@@ -357,7 +360,7 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN):
         raise ValueError(f"ensembles have (dt, dt_max) = {sorted(dts)}: one engine relaxes one schedule")
     (dt, dt_max), = dts
     relaxation_levels(dt, dt_max)   # checks the steps before any work
-    state = BatchState.from_ensembles(ensembles)
+    state = BatchState.from_ensembles(ensembles, laws=laws)
     mu = state.mu.copy()
     engine = BatchEngine(state, skin_factor=skin_factor, guard=False)   # no guard: the classes guard the measurement only
     engine.phase = "constitution"

@@ -77,6 +77,12 @@ class BatchState:
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
+    law : str or None
+        Central law of every replica, a name of :data:`~particleShear.engine.laws.LAWS` (one per
+        batch), or None: the documented callback ``call_back_elastic_force_law`` (looked up once
+        per force phase, :func:`~particleShear.engine.laws.force_phase_laws`).
+    law_params : ndarray (n, B)
+        The law's parameters per replica, in the order of its ``parameters`` (n = 0 for None).
     backend : Backend
         Where the arrays live (:func:`~particleShear.engine.xp.get_backend`).
     xp : module
@@ -120,6 +126,8 @@ class BatchState:
         self.pairs = [None] * self.B
         self.rng = [None] * self.B
         self.applying_shear = True
+        self.law = None
+        self.law_params = xp.zeros((0, self.B))
 
     def __getstate__(self):
         """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load."""
@@ -161,13 +169,13 @@ class BatchState:
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
-        for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep") + self.REPLICA_ARRAYS:
+        for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         out._views()
         return out
 
     @classmethod
-    def from_ensembles(cls, ensembles, backend="numpy"):
+    def from_ensembles(cls, ensembles, backend="numpy", laws=None):
         """Copy B ensembles of equal N (after constitution) into one batch state.
 
         The ensembles are not modified; each replica keeps a reference to its ensemble's
@@ -181,6 +189,11 @@ class BatchState:
         backend : str or Backend, default "numpy"
             Where the arrays of the state live: the ensembles are read on the host and the
             state is copied to the device once.
+        laws : sequence, optional
+            The central law of each ensemble: ``None`` (the documented callback) or
+            ``(name, values)``, a name of :data:`~particleShear.engine.laws.LAWS` and its
+            parameter values in order (:func:`~particleShear.engine.laws.law_values`).  One law
+            per batch; the values may differ between replicas.  Default: None for every one.
 
         Returns
         -------
@@ -192,9 +205,15 @@ class BatchState:
         ------
         ValueError
             If the ensembles differ in N, or a per-sphere parameter of :data:`PER_SPHERE_UNIFORM`
-            differs within an ensemble, or for an unusable backend (before any copy).
+            differs within an ensemble, or their laws differ, or for an unusable backend (before
+            any copy).
         """
         target = get_backend(backend)
+        laws = [None] * len(ensembles) if laws is None else list(laws)
+        names = {None if law is None else law[0] for law in laws}
+        if len(laws) != len(ensembles) or len(names) > 1:
+            raise ValueError(f"laws={laws!r} is invalid: one law per ensemble, the same law for every one "
+                             "(its parameters may differ)")
         Ns = {len(e.sphereList) for e in ensembles}
         if len(Ns) != 1:
             raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
@@ -224,6 +243,9 @@ class BatchState:
             s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
                                       pt.active[keep])
             s.rng[b] = e._rng
+        s.law = names.pop() if names else None
+        if s.law is not None:
+            s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
         return s.to_backend(target)
 
     @classmethod
@@ -252,6 +274,9 @@ class BatchState:
         backends = {st.backend.name for st in states}
         if len(backends) != 1:
             raise ValueError(f"states live on the backends {sorted(backends)}: a batch needs one backend")
+        laws = {st.law for st in states}
+        if len(laws) != 1:
+            raise ValueError(f"states have the laws {sorted(map(str, laws))}: a batch needs one law")
         out = cls(sum(st.B for st in states), Ns.pop(), backend=states[0].backend)
         xp = out.xp
         for name in cls.SPHERE_ARRAYS + cls.REPLICA_ARRAYS:
@@ -259,6 +284,8 @@ class BatchState:
         out.pairs = [p for st in states for p in st.pairs]
         out.rng = [g for st in states for g in st.rng]
         out.applying_shear = all(st.applying_shear for st in states)
+        out.law = laws.pop()
+        out.law_params = xp.concatenate([st.law_params for st in states], axis=1)
         return out
 
     def replica(self, b):

@@ -30,6 +30,7 @@ import numpy as np
 from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
+from .laws import force_phase_laws
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
@@ -400,7 +401,7 @@ class BatchEngine:
         vn = normal_speed(rv, nx, ny)
         vt = slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
-        fn, law = central_term(C, d, vn, active)
+        fn, law = central_term(C, d, vn, active, *force_phase_laws(s, C))   # the laws, looked up once per phase
         F, slip = self._tangential(C, vt, touching, xi, law, active)
         self.state_p = slip.view(np.int8) + C.perm_code
         fx_i, fy_i, dF, tq = pair_forces(fn, (F[0] + F[1]) * 0.5, nx, ny, d, C.w)

@@ -203,11 +203,12 @@ def term_constants(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc=1.0, prt=1.0, ke
                          mu=mu, fc_inf=xp.where(perm, math.inf, 0.0))
 
 
-def elastic_term(K, d):
+def elastic_term(K, d, central=None, tensile=None):
     """Central elastic force of each pair and its law before the permanent ratio.
 
-    The compressive law (eqs. S1-5a/b, cap S1-6) up to ``K.d_law``; beyond it the tensile law
-    ``−k (d_eq − d)`` of a stretched bond, and +0 for a contact that has separated.
+    The compressive law (eqs. S1-5a/b, cap S1-6, or the law ``central``) up to ``K.d_law``;
+    beyond it the tensile law of a stretched bond (``−k (d_eq − d)``, or the law ``tensile``),
+    and +0 for a contact that has separated.
 
     Parameters
     ----------
@@ -215,6 +216,13 @@ def elastic_term(K, d):
         Constants of the pairs (:func:`term_constants`).
     d : ndarray (P,)
         Centre distances (µm).
+    central : callable, optional
+        ``central(d)``: the compressive law of every pair as if in contact (a law of the
+        registry, :func:`~particleShear.engine.laws.force_phase_laws`); None: the linear law
+        from the constants of ``K``.
+    tensile : callable, optional
+        ``tensile(d)``: the tensile law on the stretched bonds, 0 on the other pairs; None: the
+        linear tensile law from the constants of ``K``.
 
     Returns
     -------
@@ -224,8 +232,14 @@ def elastic_term(K, d):
     law : ndarray (P,)
         The law before the ratio (same unit), the base of the Coulomb bound.
     """
-    inside = laws.central_inside(d, K.d_law, K.d_cap, K.a_lin, K.a_div, form=K.form)
-    beyond = 0.0 if K.a_tens is None else laws.tensile_inside(d, K.d_eq, K.a_tens)
+    if central is None:
+        inside = laws.central_inside(d, K.d_law, K.d_cap, K.a_lin, K.a_div, form=K.form)
+    else:
+        inside = central(d)
+    if K.a_tens is None:
+        beyond = 0.0
+    else:
+        beyond = laws.tensile_inside(d, K.d_eq, K.a_tens) if tensile is None else tensile(d)
     law = array_namespace(d).where(d > K.d_law, beyond, inside)
     return law * K.ratio_c, law
 
@@ -252,7 +266,7 @@ def viscous_term(K, vn, active):
     return array_namespace(vn).where(active, K.nu, 0.0) * vn
 
 
-def central_term(K, d, vn, active):
+def central_term(K, d, vn, active, central=None, tensile=None):
     """Elastic + viscous central scalar of each candidate (on i along ``n_ij``; −n on j) and the law.
 
     Parameters
@@ -265,6 +279,8 @@ def central_term(K, d, vn, active):
         Normal relative velocity (µm/s).
     active : ndarray of bool (P,)
         Relations; only they get the viscous term.
+    central, tensile : callable, optional
+        The laws of this force phase (:func:`elastic_term`); None: the linear laws.
 
     Returns
     -------
@@ -273,7 +289,7 @@ def central_term(K, d, vn, active):
     law : ndarray (P,)
         The elastic law before the permanent ratio (the base of the Coulomb bound).
     """
-    f, law = elastic_term(K, d)
+    f, law = elastic_term(K, d, central, tensile)
     f += viscous_term(K, vn, active)
     return f, law
 

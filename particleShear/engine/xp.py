@@ -42,6 +42,7 @@ REASONS = {
     "guard": "the values the stability guard reports when a replica failed",
     "series": "the recorded series and tensors, at the end of a phase",
     "state": "copies of the state between host and device: at set-up (radii, boxes, skins) or when inspected",
+    "scalar law": "a force law callback that accepts only numbers, evaluated pair by pair on the host",
 }
 
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))

@@ -17,8 +17,8 @@ from ..messages import console_messages
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, validate_run, validate_series
-from .batch import check_batch_size, engine_supports, measure_batch
-from .guard import PARAMETER_ALIASES, checked_keywords
+from .batch import check_batch_size, measure_batch
+from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 
 __docformat__ = "numpy"
@@ -96,7 +96,7 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     return theSimulation
 
 
-@checked_keywords(aliases=PARAMETER_ALIASES)
+@checked_keywords(aliases=PARAMETER_ALIASES, hints=PARAMETER_HINTS)
 def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=5,
                               Young_modulus_spheres=8000, N=150, packing_fraction=1.5, density=50,
                               bimodal_factor=1.4, relative_viscosity=0.1, relative_transversal_link_strength=1,
@@ -110,7 +110,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
-                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy"):
+                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy",
+                              contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -262,12 +263,27 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     backend : {"numpy", "cupy"}, default "numpy"
         Keyword-only.  Array library of the measurement: "numpy", or "cupy" to measure on a CUDA
         GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding,
-        not bit for bit).  Runs with the Euler integrator and the built-in force laws (drawn or
-        not, files and snapshots or not) measure through the engine (:mod:`particleShear.engine`)
-        as a batch of one, so that a run in a batched series
-        (``doParticleShearSimulationSeries(..., batch_size=B)``) is bit-identical to it and a drawn
-        run to the same run headless (the drawing observes the engine's loops); "cupy" needs such
-        a run (see :func:`particleShear.run.batch.check_run_backend`).
+        not bit for bit).  Every run measures through the engine (:mod:`particleShear.engine`) as a
+        batch of one — drawn or not, with files and snapshots or not, either integrator, any law —
+        so that a run in a batched series (``doParticleShearSimulationSeries(..., batch_size=B)``)
+        is bit-identical to it and a drawn run to the same run headless (the drawing observes the
+        engine's loops).
+    contact_law : {"linear", "plateau"}, default "linear"
+        Keyword-only.  Central contact law, a name of the registry
+        :data:`particleShear.engine.laws.LAWS` (laws added with ``register_law`` are allowed too):
+        "linear" the blend of eqs. S1-5a/b with the cap S1-6 (or the law assigned to
+        ``CircleBasicElasticity.call_back_elastic_force_law``, the class-attribute way of 1.0.2),
+        "plateau" the same law of a plateau-transformed distance (spongy particles, the manual's
+        ``elastic_force_law_plateau``; docs/parameters.md).
+    plateau_begin : float, default 0.3
+        Keyword-only.  Begin of the plateau of ``contact_law="plateau"``, a fraction of the
+        contact distance; allowed 0 < plateau_begin < plateau_end.
+    plateau_end : float, default 0.8
+        Keyword-only.  End of the plateau, a fraction of the contact distance; allowed
+        plateau_begin < plateau_end <= 1.
+    plateau_slope : float, default 0.1
+        Keyword-only.  Slope of the force on the plateau relative to the law's (0 flat, 1 no
+        plateau); allowed 0 ... 1.
 
     Returns
     -------
@@ -317,7 +333,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     options = dict(return_result=return_result, verbose=verbose, progress=progress,
                    correct_drift_sign=correct_drift_sign, reference_header=reference_header, renderer=renderer,
                    time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
-                   output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend)
+                   output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend,
+                   contact_law=contact_law, plateau_begin=plateau_begin, plateau_end=plateau_end,
+                   plateau_slope=plateau_slope)
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
@@ -327,48 +345,16 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
 
-    if engine_supports(params):  # measured by the engine: a batch of one (particleShear.run.batch)
-        with console_messages(verbose):
-            result = measure_batch([params])[0]
-        result.parameters, result.run_id = params, run_id
-        if plotStress and doDrawing and result.output_path:
-            _save_headless_stress_plot(result, renderer)
-        doParticleShearSimulation.last_result = result
-        if strict_io and result.write_error is not None:
-            raise result.write_error
-        return result if return_result else result.G
-
-    theSimulation = _build_simulation(params, rng, verbose=verbose, progress=progress,
-                                      correct_drift_sign=correct_drift_sign, reference_header=reference_header,
-                                      renderer=renderer, time_step_factor=time_step_factor, integrator=integrator,
-                                      stability_guard=stability_guard)
-    theSimulation.saveOutputMovie = bool(saveOutputMovie)
-    theSimulation.output_format = output_format
-    theSimulation.run_id, theSimulation.seed_entropy, theSimulation.spawn_key = run_id, seed_entropy, spawn_key
-    theSimulation.parameters = params
-
-    with console_messages(verbose):  # verbose: this call's INFO messages on stdout, the reference's text
-        G = theSimulation.runSimulation(periods=periods, cool_factor=cool_factor, plotStress=plotStress)
-
-    info = theSimulation.result_info
-    series = theSimulation.theExperiment.plotter.arrays()
-    result = SimulationResult(
-        G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-        stress_internal=info["stress_internal"], parameters=params,
-        seed=None if ss is None else ss.entropy, spawn_key=() if ss is None else tuple(ss.spawn_key),
-        timings=info["timings"], output_path=info["output_path"], image_folder=info["image_folder"],
-        n_images=info["n_images"], dt=info["dt"], f=info["f"], N_steps=info["N_steps"],
-        damping_factor=info["damping_factor"],
-        removed_fraction=getattr(theSimulation.theEnsemble, "removed_fraction", 0.0), series=series,
-        run_id=run_id, write_error=info.get("write_error"))
+    # measured by the engine, a batch of one (particleShear.run.batch)
+    with console_messages(verbose):
+        result = measure_batch([params])[0]
+    result.parameters, result.run_id = params, run_id
     if plotStress and doDrawing and result.output_path:
         _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
     if strict_io and result.write_error is not None:
         raise result.write_error
-    if return_result:
-        return result
-    return G
+    return result if return_result else result.G
 
 
 doParticleShearSimulation.last_result = None
@@ -527,7 +513,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Further keyword-only options of :func:`doParticleShearSimulation`, passed to every run and
         checked as there (``progress``, ``correct_drift_sign``, ``reference_header``, ``renderer``,
         ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
-        ``output_format``, ``strict_io``); not ``return_result`` (every run returns its result).
+        ``output_format``, ``strict_io``, ``contact_law``, ``plateau_begin``, ``plateau_end``,
+        ``plateau_slope``); not ``return_result`` (every run returns its result).
 
     Returns
     -------

@@ -12,12 +12,15 @@ per replica, in the given order; :func:`batches` splits a list of runs into batc
 submits every batch as one task of its executor.
 
 A replica's result does not depend on the other replicas of its batch: its recorded series and
-G′/G″ are bit-identical to its single run (tested).  Runs the engine supports (:func:`engine_supports`:
-any integrator, the built-in force laws, any N; drawn or not, saving data and snapshots or not)
-— single runs included — measure through :mod:`particleShear.engine`,
-all replicas of a batch in one set of arrays, each replica's drawing an observer of its replica
-(:mod:`particleShear.simulation.observers`); other runs go through the documented classes one
-after the other.  See ``docs/design.md`` (sections "Batches of replicas" and "Observers").
+G′/G″ are bit-identical to its single run (tested).  Every run — single runs included, drawn or
+not, any integrator, any contact law, any N, saving data and snapshots or not — measures through :mod:`particleShear.engine`, all replicas of a batch
+in one set of arrays, each replica's drawing an observer of its replica
+(:mod:`particleShear.simulation.observers`).  See ``docs/design.md`` (sections "Batches of
+replicas" and "Observers").
+
+The contact law (``contact_law``) must agree within a batch (:func:`batches` groups runs by it, as
+it groups them by schedule): the engine evaluates one law function on all candidates of a step.
+Its parameters (``plateau_begin``, ``plateau_end``, ``plateau_slope``) may differ per replica.
 """
 __docformat__ = "numpy"
 import logging
@@ -28,7 +31,7 @@ import numpy as np
 from ..linkable.builders import time_steps_from_model
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
-__all__ = ["run_batch", "batches", "schedule_key", "engine_supports", "PER_REPLICA_PARAMETERS", "BACKENDS",
+__all__ = ["run_batch", "batches", "schedule_key", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
 
 _log = logging.getLogger(__name__)
@@ -49,7 +52,7 @@ PER_REPLICA_PARAMETERS = frozenset((
     "avoid_height_spanning_particles", "cut_top_bottom", "doCutByTriangulation", "keep_viscosity_coefficients_constant",
     "root_folder", "saveData", "saveStressTensorData", "saveOutputImages", "imageFileType", "doDrawing",
     "plotStress", "relative_y_scale_force", "verbose", "progress", "reference_header", "correct_drift_sign",
-    "renderer", "stability_guard",
+    "renderer", "stability_guard", "plateau_begin", "plateau_end", "plateau_slope",
 ))
 
 #: parameters that fix the step schedule: N, the model constants behind τ, the protocol and the integrator
@@ -89,11 +92,7 @@ def check_backend(backend):
 
 
 def check_run_backend(kw):
-    """Check the backend of one run: usable here, and the run one the engine measures.
-
-    Runs the engine does not measure (replaced force laws) go through the documented classes, which
-    step NumPy arrays only: with another backend they are refused rather than silently
-    measured with NumPy.
+    """Check the backend of one run: usable here (every run is measured by the engine).
 
     Parameters
     ----------
@@ -104,16 +103,9 @@ def check_run_backend(kw):
     Raises
     ------
     ValueError
-        Naming ``backend``, for an unusable backend or a run the engine does not measure.
+        Naming ``backend``, for an unusable backend.
     """
-    full = dict(_signature_defaults(), **kw)
-    backend = full["backend"]
-    check_backend(backend)
-    if backend == "numpy" or engine_supports(full):
-        return
-    raise ValueError(f"backend={backend!r} is invalid for this run (replaced force laws): "
-                     "only runs the engine measures can use a backend other than 'numpy' (the built-in "
-                     "force laws); the documented classes step NumPy arrays only")
+    check_backend(dict(_signature_defaults(), **kw)["backend"])
 
 
 def check_batch_size(batch_size):
@@ -239,36 +231,9 @@ def run_batch(list_of_kwargs, backend=None):
                              "time-step rule and protocol")
     defaults = _signature_defaults()
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
-    if not all(engine_supports(kw) for kw in full):
-        return [doParticleShearSimulation(**kw, return_result=True) for kw in runs]
     results = measure_batch(full)
     doParticleShearSimulation.last_result = results[-1]
     return results
-
-
-def engine_supports(kw):
-    """Whether the engine measures this run (``kw``: every keyword of doParticleShearSimulation).
-
-    It does when the force laws are the built-in ones (any integrator, any N).  Drawn runs qualify
-    (live windows, snapshots and the movie are observers of the engine's loops,
-    :mod:`particleShear.simulation.observers`), and so do runs that save their data: their files
-    are written as ``runSimulation`` writes them (console messages and progress callbacks work
-    as in the documented classes).
-
-    Parameters
-    ----------
-    kw : dict
-        Every keyword of :func:`~particleShear.run.api.doParticleShearSimulation`.
-
-    Returns
-    -------
-    bool
-    """
-    from ..base.laws import elastic_force_law, elastic_force_law_tensile
-    from ..base.points import CircleBasicElasticity
-    from ..linkable.spheres import SphereLinkable
-    return (CircleBasicElasticity.call_back_elastic_force_law is elastic_force_law
-            and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
 
 
 def measure_batch(runs):
@@ -295,6 +260,7 @@ def measure_batch(runs):
     from ..simulation.provenance import run_identity
     from ..simulation.simulations import RunSession
     from .api import SimulationResult, _build_simulation, _seed_sequence
+    from .validation import contact_law_spec
 
     sims, seeds, sessions = [], [], []
     for kw in runs:  # every replica's settings are checked before any work
@@ -309,6 +275,7 @@ def measure_batch(runs):
         sim.saveOutputMovie = bool(kw.get("saveOutputMovie", False))
         sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
         sim.parameters = kw
+        sim.contact_law = contact_law_spec(kw)
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
         seeds.append((seed_entropy, spawn_key, params))
@@ -384,7 +351,8 @@ def _constitute(sessions):
         key = pending[min(pending)].key
         group = [b for b in sorted(pending) if pending[b].key == key]
         t0 = time.perf_counter()
-        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR)
+        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR,
+                        laws=[sessions[b].sim.contact_law for b in group])
         share = (time.perf_counter() - t0) / len(group)
         for b in group:
             advance(b, share)
@@ -424,7 +392,8 @@ def _measure(sessions, sched, where):
         for pre in dict.fromkeys(sched[b][1] for b in members):
             group = [b for b in members if sched[b][1] == pre]
             t0 = time.perf_counter()
-            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend)
+            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
+                                           laws=[sims[b].contact_law for b in group])
             say, report = _console(sims, group, "pre-equilibration", where)
             engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                                  integrator=integrator)

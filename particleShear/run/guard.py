@@ -23,12 +23,16 @@ import difflib
 import functools
 import inspect
 
-__all__ = ["UnknownParameterError", "PARAMETER_ALIASES", "close_names", "unknown_name_message", "resolve_names",
+__all__ = ["UnknownParameterError", "PARAMETER_ALIASES", "PARAMETER_HINTS", "close_names", "unknown_name_message", "resolve_names",
            "checked_keywords", "SuggestingParser"]
 
 #: documented aliases of parameters of ``doParticleShearSimulation`` (alias → parameter); the
 #: command line has the same short names (``--amplitude``, ``--mu``)
 PARAMETER_ALIASES = {"amplitude": "theAmplitude", "mu": "theMu"}
+
+#: names people use for parameters of a run that are no spelling of them (name → parameter, suggested)
+PARAMETER_HINTS = {"law": "contact_law", "force_law": "contact_law", "elastic_force_law": "contact_law",
+                   "plateau_start": "plateau_begin", "plateau_stop": "plateau_end"}
 
 #: where the parameters of a run are documented (named in every unknown-name message)
 RUN_PARAMETERS_DOC = "help(particleShear.doParticleShearSimulation) and docs/parameters.md"

@@ -34,7 +34,7 @@ from .batch import check_backend, check_run_backend
 __all__ = ["validate_run", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
            "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
            "INTEGRATORS", "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS",
-           "MAX_SERIES_RUNS", "SEED_LIMIT"]
+           "MAX_SERIES_RUNS", "SEED_LIMIT", "contact_law_spec"]
 
 #: accepted ``imageFileType`` values (the reference silently wrote PostScript for anything else)
 IMAGE_FILE_TYPES = ("jpg", "png", "ps", "svg")
@@ -299,6 +299,49 @@ def _check_keyword_options(p):
     check_output_format(p["output_format"])
     _bool("strict_io", p["strict_io"])
     check_backend(p["backend"])
+    contact_law_spec(p)
+
+
+def contact_law_spec(p):
+    """The central law of one run as the engine takes it: None for "linear", else ``(name, values)``.
+
+    "linear" is the documented callback ``CircleBasicElasticity.call_back_elastic_force_law``
+    (the built-in linear law unless replaced: the class-attribute way of 1.0.2); another name of
+    :data:`particleShear.engine.laws.LAWS` is that law with its parameters (the plateau law's are
+    ``plateau_begin``, ``plateau_end``, ``plateau_slope``; a registered law's other parameters
+    take their defaults).  The plateau parameters are checked whatever the law.
+
+    Parameters
+    ----------
+    p : dict
+        Arguments of the run (``contact_law`` and the ``plateau_*`` ones; missing ones take
+        their defaults).
+
+    Returns
+    -------
+    tuple or None
+        ``(name, values)``: the law's name and its parameter values in order.
+
+    Raises
+    ------
+    TypeError
+        For a plateau parameter that is not a real number.
+    ValueError
+        For an unknown law (naming ``contact_law``, the allowed names and the closest one) or a
+        plateau parameter out of range (naming it, its value and the range).
+    """
+    from ..engine import laws
+    given = {}
+    for name, default in laws.LAWS["plateau"].parameters.items():
+        v = p.get(name, default)
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+            raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
+        given[name] = float(v)
+    laws.check_plateau(**given)
+    law = laws.get_law(p.get("contact_law", "linear"))
+    if law.name == "linear":
+        return None
+    return law.name, laws.law_values(law, given)
 
 
 # -- cost ------------------------------------------------------------------------------------------
@@ -488,7 +531,8 @@ def validate_run(params):
         Arguments of one call by name: the reference parameters and the keyword-only options
         (``return_result``, ``verbose``, ``progress``, ``correct_drift_sign``, ``reference_header``,
         ``renderer``, ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
-        ``output_format``, ``strict_io``, ``backend``); missing ones take the defaults of the
+        ``output_format``, ``strict_io``, ``backend``, ``contact_law``, ``plateau_begin``,
+        ``plateau_end``, ``plateau_slope``); missing ones take the defaults of the
         signature of ``doParticleShearSimulation``.  Not modified.
 
     Returns

@@ -84,7 +84,10 @@ def _identity_value(value):
 def identity_parameters(parameters):
     """The inputs that make a run what it is, in the form the run identity hashes them.
 
-    Keys of :data:`IDENTITY_EXCLUDED` are left out; every real number is a float (``N = 30`` and
+    Keys of :data:`IDENTITY_EXCLUDED` are left out, and so are ``contact_law="linear"`` and the
+    plateau parameters of a run of another law than "plateau" (they change nothing of such a run,
+    and a run of the default law keeps the id it had before the law was a parameter); every real
+    number is a float (``N = 30`` and
     ``N = 30.0``, ``0.2`` and ``numpy.float64(0.2)`` are the same input), bools stay bools.  This
     is the one rule of "the same run": :func:`run_identity` hashes it, a sweep compares a results
     row and matches the runs of an extended folder with it.
@@ -98,7 +101,13 @@ def identity_parameters(parameters):
     -------
     dict
     """
-    return {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED}
+    law = parameters.get("contact_law", "linear")
+    unused = (() if law == "plateau" else _PLATEAU) + (("contact_law",) if law == "linear" else ())
+    return {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED and k not in unused}
+
+
+#: the parameters of the plateau law (``contact_law="plateau"``)
+_PLATEAU = ("plateau_begin", "plateau_end", "plateau_slope")
 
 
 def same_input(text, value):
@@ -197,7 +206,8 @@ def positional_numbers_in_call(text):
     return _CALL_EXPONENT.sub(lambda m: m.group(1) + header_number(float(m.group(2))), text)
 
 
-def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrator, correct_drift_sign):
+def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrator, correct_drift_sign,
+                     contact_law=None):
     """The provenance lines of the header's first block (each TAB-indented, joined by newlines).
 
     The labels use ``:`` instead of ``=`` and none contains a label that the downstream R
@@ -218,6 +228,9 @@ def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrat
     correct_drift_sign : bool
         Whether the demodulation's drift correction had the correct sign (docs/output.md).
 
+    contact_law : tuple or None, optional
+        ``(name, values)`` of the run's contact law (``contact_law_spec`` of the run layer), or
+        None for "linear" (the documented callback).
     Returns
     -------
     str
@@ -232,4 +245,15 @@ def provenance_lines(run_id, seed_entropy, spawn_key, time_step_factor, integrat
         "\tTime step factor: " + header_number(time_step_factor),
         "\tIntegrator: " + str(integrator),
         "\tCorrect drift sign: " + str(bool(correct_drift_sign)),
+        "\tContact law: " + _law_text(contact_law),
     ])
+
+
+def _law_text(spec):
+    """``linear`` or e.g. ``plateau (plateau_begin 0.3, plateau_end 0.8, plateau_slope 0.1)``."""
+    if spec is None:
+        return "linear"
+    from ..engine.laws import LAWS
+    name, values = spec
+    pairs = ", ".join(f"{p} {header_number(v)}" for p, v in zip(LAWS[name].parameters, values))
+    return name + (f" ({pairs})" if pairs else "")

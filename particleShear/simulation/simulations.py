@@ -764,7 +764,7 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
             num, call = header_number, positional_numbers_in_call(self.function_call)
             extra = provenance_lines(self.run_id, self.seed_entropy, self.spawn_key,
                                      getattr(self, "time_step_factor", 1.0), getattr(self, "integrator", "euler"),
-                                     self.correct_drift_sign) + "\n"
+                                     self.correct_drift_sign, getattr(self, "contact_law", None)) + "\n"
         theFile.write(head
                       + "\tN=" + num(self.N) + " spheres, nominal packing density = " + num(self.packing_fraction)
                       + "\n\tYoung modulus of the individual spheres = " + num(self.Young_modulus_spheres) + " Pa \n"

@@ -85,7 +85,8 @@ _INT_PARAMETERS = ("cut_lines", "N")
 #: units of the numeric parameters that have one (docs/parameters.md); the other numbers are dimensionless
 _PARAMETER_UNITS = {"Young_modulus_spheres": "Pa", "density": "kg/m³", "avoid_horizontal_angle_degree": "degree",
                     "edge_fuzziness": "largest radius", "pre_periods": "excitation periods",
-                    "periods": "excitation periods", "post_periods": "excitation periods"}
+                    "periods": "excitation periods", "post_periods": "excitation periods",
+                    "plateau_begin": "contact distance", "plateau_end": "contact distance"}
 _parameter_cache = {}
 
 

@@ -25,7 +25,7 @@ import socket
 import numpy as np
 
 from ..analysis.measures import MEASURE_COLUMNS
-from ..simulation.provenance import IDENTITY_EXCLUDED, same_input
+from ..simulation.provenance import identity_parameters, same_input
 from .schema import RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema, typed_row
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
@@ -276,8 +276,9 @@ def row_problem(row, run):
         return f"status={status!r} (allowed ok, failed)"
     if row.get("seed_entropy") != _cell(run.seed_entropy) or row.get("spawn_key") != _cell(list(run.spawn_key)):
         return "its seed is not the run's"
+    compared = identity_parameters(run.parameters)   # the one rule of "the same run"
     for name, v in run.parameters.items():
-        if name not in IDENTITY_EXCLUDED and not same_input(row.get(name), v):
+        if name in compared and not same_input(row.get(name), v):
             return f"{name}={row.get(name)!r} is not the run's {_cell(v)!r}"
     numbers = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s") if status == "ok" \
         else ("wall_time_s",)
