@@ -31,7 +31,7 @@ import numpy as np
 from ..linkable.builders import time_steps_from_model
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
-__all__ = ["run_batch", "batches", "schedule_key", "PER_REPLICA_PARAMETERS", "BACKENDS",
+__all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
 
 _log = logging.getLogger(__name__)
@@ -279,36 +279,64 @@ def measure_batch(runs):
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
         seeds.append((seed_entropy, spawn_key, params))
+    measure_sessions(sessions)
+    results = []
+    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
+        info = sim.result_info
+        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
+        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
+                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
+        results.append(SimulationResult(
+            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
+            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
+            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
+            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
+            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
+            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
+            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
+        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
+    return results
+
+
+def measure_sessions(sessions):
+    """The phases of ``runSimulation`` for every session, the measurement in the engine.
+
+    Constitution (relaxations in the engine, :func:`_constitute`), then per session the
+    reservation of its output file, the experiment and the schedule
+    (:meth:`~particleShear.simulation.simulations.RunSession.prepare`), then the measurement of
+    all sessions in the engine (:func:`_measure`), and per session the adoption of its record
+    and the writing (:meth:`~particleShear.simulation.simulations.RunSession.finish`, which
+    fills ``sim.result_info``).  ``runSimulation`` calls it with its one session,
+    :func:`measure_batch` with a batch's.  An interrupt (``KeyboardInterrupt``) removes every
+    reservation and is re-raised with ``position = (phase, step, total)``.
+
+    Parameters
+    ----------
+    sessions : list of RunSession
+        The sessions (not constituted yet) of runs that share one schedule.
+
+    Returns
+    -------
+    list of list of float
+        ``[G′_surface, G″_surface]`` (Pa) of each session, in order.
+    """
     where = ["constitution", 0, 0]
     try:
         _constitute(sessions)
         sched = []
         for run in sessions:
             run.prepare()
-            # the schedule of the replica: the one function runSimulation uses
+            # the schedule of the replica: the one function of the measurement
             sc = run.schedule
             sched.append(((sc.dt, sc.f, sc.cool, run.exp.baseline_pre_periods, run.exp.periods,
                            run.exp.baseline_post_periods), (sc.dt_max, sc.N_pre)))
         rec, timings = _measure(sessions, sched, where)
-        results = []
-        for b, (kw, sim, run, (seed_entropy, spawn_key, params)) in enumerate(zip(runs, sims, sessions, seeds)):
+        G = []
+        for b, run in enumerate(sessions):
             run.exp.adopt_measurement(sched[b][0][2], rec[b], timings[b])
             rec[b] = None  # the experiment's recording holds it now
-            run.finish()
-            info = sim.result_info
-            # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
-            info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
-                                           ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
-            results.append(SimulationResult(
-                G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-                stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
-                spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
-                image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
-                N_steps=info["N_steps"], damping_factor=info["damping_factor"],
-                removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
-                series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
-            results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
-        return results
+            G.append(run.finish())
+        return G
     except KeyboardInterrupt as exc:
         exc.position = tuple(where)
         raise
@@ -379,7 +407,7 @@ def _measure(sessions, sched, where):
             scenes[b].bind(engine, col)
         return [ob for b in members for ob in watch[b]]
 
-    backend = sims[0].parameters.get("backend", "numpy")    # one backend per batch (part of the schedule key)
+    backend = (sims[0].parameters or {}).get("backend", "numpy")    # one backend per batch (part of the schedule key)
     guard_of = [bool(run.sim.stability_guard) for run in sessions]
     rec = [None] * len(sessions)
     timings = [dict() for _ in sessions]

@@ -86,10 +86,10 @@ damping factor per step, pre-equilibration step unit and coarsest pre-equilibrat
 class RunSession:
     """One run of :meth:`OscillatorySimulation.runSimulation`, in its phases.
 
-    The phases are shared by the documented classes (``runSimulation``: the experiment measures)
-    and the engine path (:func:`particleShear.run.batch.measure_batch`: the engine measures and
-    the experiment adopts its record), so both build, reserve, write and clean up in one way
-    (docs/output.md, docs/design.md "Batches of replicas").
+    :func:`particleShear.run.batch.measure_sessions` drives the phases of one session
+    (``runSimulation``) or of a batch's (``run_batch``, ``doParticleShearSimulation``): the engine
+    measures and each experiment adopts its record, so every run builds, reserves, writes and
+    cleans up in one way (docs/output.md, docs/design.md "Batches of replicas").
 
     Parameters
     ----------
@@ -126,10 +126,6 @@ class RunSession:
         self.exp = None
         self.schedule = None
         self.t_start = time.perf_counter()
-
-    def constitute(self):
-        """Build the ensemble (``initEnsemble``), with the progress calls of the constitution."""
-        relax_constitution(self.constitution())
 
     def constitution(self):
         """:meth:`constitute` as a generator of the constitution's relaxations (docs/design.md).
@@ -314,6 +310,8 @@ class OscillatorySimulation:
     seed_entropy = None
     spawn_key = ()
     parameters = None
+    #: the contact law of the run, ``(name, values)`` of ``run.validation.contact_law_spec`` (None: the callbacks')
+    contact_law = None
     #: the exception of a failed write after the run (None when the output was written)
     write_error = None
 
@@ -492,6 +490,11 @@ class OscillatorySimulation:
     def runSimulation(self, cool_factor=1, periods=2, plotStress=True):
         """Build, equilibrate, shear, write; return ``[G′_surface, G″_surface]`` (Pa).
 
+        Measured as ``doParticleShearSimulation`` measures: the constitution's relaxations, the
+        pre-equilibration and the protocol run in the engine, a batch of one
+        (:func:`particleShear.run.batch.measure_sessions`); the drawing, snapshots and the live
+        stress window observe its loops.
+
         Output (see ``docs/output.md``): the folder is probed for writability before any work;
         the file number is reserved (a locked ``.part`` file) when the ensemble exists, snapshots
         go to a temporary folder renamed when the protocol is complete, and the file (format
@@ -523,18 +526,8 @@ class OscillatorySimulation:
             For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
             unknown output format — before any work.
         """
-        run = RunSession(self, cool_factor, periods, plotStress)
-        try:
-            run.constitute()
-            run.prepare()
-            run.exp.oscillatory_shear_experiment(cool_factor=run.schedule.cool,
-                                                 N_pre_equilibration_fixed_boundaries=run.schedule.N_pre)
-            return run.finish()
-        except KeyboardInterrupt as exc:
-            exc.position = run.position()
-            raise
-        finally:
-            run.close()
+        from ..run.batch import measure_sessions
+        return measure_sessions([RunSession(self, cool_factor, periods, plotStress)])[0]
 
     def time_steps(self):
         """``(dt, f, dt_max)`` of the measurement: the ensemble's steps times ``time_step_factor`` and
