@@ -10,7 +10,7 @@ on the same scene, alternating blocks: what the deleted caches cost together.
 
 The caches deleted from the classes (each buying < 10 % of a step at N = 150 and at N = 10,000)
 were measured by this script at commit 89efadd, which disabled each by an instance-level patch of
-the method that kept it; docs/design.md ("Caching") has both tables.
+the method that kept it; docs/design.md ("The one cache") has both tables.
 
 The step is what a run does: ``setShearRate``, the force phase, the register totals, the σ_xy-only
 evaluation on every other step (what the experiment samples), the acceleration and the movement —

@@ -6,7 +6,7 @@ value, ``float``/``int``/index conversion, ``item``, ``tolist``, ``tobytes``, it
 ``numpy.asarray`` — and every mix with a host array, as CuPy does (and stricter: CuPy turns a
 truth value into a silent synchronisation).  Only :func:`particleShear.engine.xp.to_host` can read
 them.  The stand-in offers only the CuPy API audited for the engine (``CUPY_*`` below; the table
-of docs/design.md, "Backends"), so a NumPy-only function, method, ufunc method or keyword, a
+of docs/backends.md), so a NumPy-only function, method, ufunc method or keyword, a
 repeated-index assignment (undefined order in CuPy) or a boolean-mask index fails here too.
 The stand-in computes with NumPy underneath, operation for operation, so a batch measured on it
 must be bit-identical to the NumPy batch: the comparison is exact and needs no tolerance,
@@ -411,7 +411,7 @@ class TestStandInDevice(unittest.TestCase):
 
 
 class TestStandInIsCuPy(unittest.TestCase):
-    """The stand-in refuses what CuPy lacks or treats differently (the audit of docs/design.md, "Backends")."""
+    """The stand-in refuses what CuPy lacks or treats differently (the audit of docs/backends.md)."""
 
     def test_numpy_only_calls_raise(self):
         with standin_registered("cpu-standin-cupy", ordered=False):
@@ -719,7 +719,7 @@ class TestCuPy(unittest.TestCase):
 
     Tolerance: each CuPy ufunc is one kernel, IEEE-rounded like NumPy's, but the reductions (the
     padded-gather scatter and replica sums, ``sum``/``mean`` along an axis) add in another order
-    (docs/design.md, "Backends"), so single sums differ by ~1 ulp (1e-16 relative).  How much the dynamics amplifies such differences was measured on the CPU:
+    (docs/backends.md), so single sums differ by ~1 ulp (1e-16 relative).  How much the dynamics amplifies such differences was measured on the CPU:
     a 1-ulp change of every initial position and velocity of these replicas changes the recorded
     stresses by at most 1.2e-14 of their scale and G′/G″ by at most 5e-15 over this protocol
     (~1,000 steps).  A GPU injects ~1 ulp at every step, which adds up to well below 1e-12; the

@@ -1,4 +1,4 @@
-"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, "Neighbour search").
+"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, "Neighbour lists and box").
 
 The classes' ``candidate_pairs`` is the engine's ``near_pairs`` (all pairs below
 ``CELL_LIST_MIN_N`` spheres, the cell list from there: n = 70 and n ≥ 500 below test both).

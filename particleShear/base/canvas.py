@@ -255,7 +255,7 @@ class CanvasPoints:
         self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
         self._renderer = None
-        self._memo = Memo()   # every value kept between calls (docs/design.md, "Caching of the classes")
+        self._memo = Memo()   # every value kept between calls (docs/design.md, "The documented classes")
         self._pos_version = 0
         self._params_version = 0
         self._in_cell = False
@@ -1185,7 +1185,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         return [cls(self, p, int(q)) for q in partners]
 
     def _relations_edited(self):
-        """The one place that drops every kept value (docs/design.md, "Caching of the classes"): relations were changed
+        """The one place that drops every kept value (docs/design.md, "The documented classes"): relations were changed
         outside the step's neighbour update (the per-sphere API, a batched constitution), which no counter
         of the memo keys records."""
         self._memo.invalidate()

@@ -44,7 +44,7 @@ class PairConstants:
     attribute (``C.ri``, ``C.mu``, …) is a view of its row, and assigning one writes into the
     row, so the blocks always hold every constant and a rebuild of some replicas' lists
     (:meth:`splice`) is a few concatenations of blocks instead of one per constant
-    (docs/design.md, "Caching").
+    (docs/design.md, "The one cache").
 
     Parameters
     ----------

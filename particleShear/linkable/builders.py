@@ -177,7 +177,7 @@ class Relaxation:
     request per relaxation block and resumes once it is done.  Whoever drives the generator runs
     it: :func:`relax_constitution` one request at a time (:meth:`run`), or a batch's driver for
     all its replicas at once; both relax in the engine (:func:`particleShear.engine.relax.relax_ensembles`;
-    docs/design.md, "Batches of replicas").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
+    docs/design.md, "Runs").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
     it is run, so requests with equal :attr:`key` run the same steps (the replicas' μ may differ).
 
     Parameters
@@ -372,7 +372,7 @@ def adjustable_interface_constitution(
     generator resumes when the caller has run it and returns the ensemble (``StopIteration.value``).
     :func:`relax_constitution` runs the requests one by one (that is the builder);
     ``particleShear.run.batch`` runs those of all replicas of a batch together in the engine
-    (docs/design.md, "Batches of replicas").
+    (docs/design.md, "Runs").
 
     Yields
     ------

@@ -89,7 +89,7 @@ class RunSession:
     :func:`particleShear.run.batch.measure_sessions` drives the phases of one session
     (``runSimulation``) or of a batch's (``run_batch``, ``doParticleShearSimulation``): the engine
     measures and each experiment adopts its record, so every run builds, reserves, writes and
-    cleans up in one way (docs/output.md, docs/design.md "Batches of replicas").
+    cleans up in one way (docs/output.md, docs/design.md "Runs").
 
     Parameters
     ----------
