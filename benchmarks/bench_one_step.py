@@ -246,7 +246,7 @@ class Row:
     def __init__(self, key, label, unit, target, kind):
         self.key, self.label, self.unit, self.target, self.kind = key, label, unit, target, kind
         self.value = {"baseline": None, "current": None}
-        self.note = {"baseline": "", "current": ""}
+        self.ratio = None
 
 
 def measure(trees, cpu, setup, blocks):
@@ -314,17 +314,17 @@ def main():
         b, c = r.value["baseline"], r.value["current"]
         ratio = (c / b) if (b and c) else None
         r.ratio = ratio
-        print(f"  {r.label}: baseline {fmt(b, r.unit)} {r.unit}{r.note['baseline']}, current "
-              f"{fmt(c, r.unit)} {r.unit}{r.note['current']}, current/baseline "
+        print(f"  {r.label}: baseline {fmt(b, r.unit)} {r.unit}, current "
+              f"{fmt(c, r.unit)} {r.unit}, current/baseline "
               f"{'n/a' if ratio is None else f'{ratio:.3f}'}  [{time.perf_counter() - t_start:.0f} s]", flush=True)
         rows.append(r)
 
-    def fill(r, out, fn):
+    def fill(r, out, fn, quiet=False):
         for lab, res in out.items():
-            if isinstance(res, dict):
-                r.note[lab] = f" ({res.get('na') or res.get('error')})"
-            else:
+            if not isinstance(res, dict):
                 r.value[lab] = fn(res)
+            elif not quiet:
+                print(f"    {lab}: n/a ({res.get('na') or res.get('error')})", flush=True)
 
     if "a" in args.rows:
         r = Row("a", "(a) documented step loop, N = 150", "µs/step", ("ratio", 0.6), "loop")
@@ -335,7 +335,7 @@ def main():
         report(r)
     if "b" in args.rows:
         r = Row("b", f"(b) protocol per replica-step, B = {B}", "µs", ("ratio", 1.05), "series")
-        kw = {"relative_frequency": 0.5 if q else 0.1}
+        kw = {"relative_frequency": 0.5 if q else 0.25}
         out, _ = measure(trees, cpu, ("setup_runs", {}),
                          [("series", {"B": B, "seed": 100 + i, "kw": kw}) for i in range(1 if q else 2)])
         fill(r, out, lambda res: 1e6 * statistics.median([rep["replica_step"] for _, rep in res]))
@@ -361,12 +361,12 @@ def main():
         r2 = Row(key, f"({key}) {name}, batch of {B}, per run", "s/run", None, "series")
         r3 = Row(key, f"({key}) {name}, batch per run / single run", "ratio", ("abs", 0.4), "ratio")
         r4 = Row(key, f"({key}) {name}, same, protocol part only", "ratio", None, "ratio")
-        fill(r1, out, lambda res: statistics.median([rep["wall"] for c, rep in res if c == "single"]))
-        fill(r2, out, lambda res: statistics.median([rep["wall"] for c, rep in res if c == "series"]))
-        fill(r3, out, lambda res: (statistics.median([rep["wall"] for c, rep in res if c == "series"])
-                                   / statistics.median([rep["wall"] for c, rep in res if c == "single"])))
-        fill(r4, out, lambda res: (statistics.median([rep["protocol"] for c, rep in res if c == "series"])
-                                   / statistics.median([rep["protocol"] for c, rep in res if c == "single"])))
+        def med(res, cmd, key):
+            return statistics.median([rep[key] for c, rep in res if c == cmd])
+        fill(r1, out, lambda res: med(res, "single", "wall"))
+        fill(r2, out, quiet=True, fn=lambda res: med(res, "series", "wall"))
+        fill(r3, out, quiet=True, fn=lambda res: med(res, "series", "wall") / med(res, "single", "wall"))
+        fill(r4, out, quiet=True, fn=lambda res: med(res, "series", "protocol") / med(res, "single", "protocol"))
         for r in (r1, r2, r3, r4):
             report(r)
     if "f" in args.rows:
