@@ -38,6 +38,7 @@ Usage: python benchmarks/bench_one_step.py [--baseline PATH] [--current PATH] [-
 import argparse
 import concurrent.futures
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -83,8 +84,6 @@ class Worker:
         return {}
 
     def setup_engine(self, N, warm):
-        import math
-
         import numpy as np
 
         import bench_step
@@ -158,7 +157,7 @@ class Worker:
         res = doParticleShearSimulation(doDrawing=False, plotStress=False, saveData=False, seed=seed,
                                         verbose=False, return_result=True, **dict(self.kw, **kw))
         wall = time.perf_counter() - t0
-        return {"wall": wall, "protocol": res.timings["protocol"], "steps": res.N_steps}
+        return {"wall": wall, "protocol": res.timings.get("protocol", math.nan), "steps": res.N_steps}
 
     def series(self, B, seed, kw):
         from particleShear import doParticleShearSimulationSeries
@@ -167,7 +166,7 @@ class Worker:
                                               seed=seed, doDrawing=False, plotStress=False, saveData=False,
                                               **dict(self.kw, **kw))
         wall = time.perf_counter() - t0
-        prot = sum(r.timings["protocol"] for r in res)
+        prot = sum(r.timings.get("protocol", math.nan) for r in res)
         return {"wall": wall / len(res), "protocol": prot / len(res),
                 "replica_step": prot / sum(r.N_steps for r in res)}
 
@@ -231,8 +230,11 @@ class Proc:
         return self.recv()
 
     def close(self):
-        self.p.stdin.close()
-        self.p.wait(timeout=60)
+        try:
+            self.p.stdin.close()
+            self.p.wait(timeout=60)
+        except (OSError, subprocess.TimeoutExpired):
+            self.p.kill()
         self.log.close()
 
 
@@ -252,7 +254,15 @@ class Row:
 def measure(trees, cpu, setup, blocks):
     """Start one worker per tree, set both up, pin them, run ``blocks`` (list of (cmd, args)) alternately.
 
-    Returns {tree label: list of replies, or {"na"/"error": text}} and the set-up replies."""
+    Returns {tree label: list of (cmd, reply), or {"na"/"error": text}} and the set-up replies; a worker
+    that dies makes the row an error for both trees (the script goes on with the next row)."""
+    try:
+        return _measure(trees, cpu, setup, blocks)
+    except (RuntimeError, OSError, ValueError) as exc:
+        return {lab: {"error": str(exc)} for lab in trees}, {lab: {} for lab in trees}
+
+
+def _measure(trees, cpu, setup, blocks):
     procs = {lab: Proc(lab, path, cpu) for lab, path in trees.items()}
     try:
         for pr in procs.values():
@@ -345,7 +355,7 @@ def main():
         r = Row("c", "(c) single default run" + (" (relative_frequency 0.5)" if q else ""), "s/run",
                 ("ratio", 1.05), "single")
         out, _ = measure(trees, cpu, ("setup_runs", {}),
-                         [("single", {"seed": 1 + i, "kw": kw}) for i in range(1 if q else 3)])
+                         [("single", {"seed": 1 + i, "kw": kw}) for i in range(1 if q else 4)])
         fill(r, out, lambda res: statistics.median([rep["wall"] for _, rep in res]))
         report(r)
     for key, name, setup in (("d", "plateau law (class attribute)", {"law": "attr"}),

@@ -116,7 +116,10 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(args.workers) as pool:
         futs = {pool.submit(run_job, trees[lab], sc[scene], ch): (scene, lab) for scene, lab, ch in jobs}
         for f in concurrent.futures.as_completed(futs):
-            res[futs[f]] += f.result()
+            got = f.result()
+            res[futs[f]] += got
+            print(f"  {futs[f][0]}, {futs[f][1]}: seeds {got[0]['seed']}–{got[-1]['seed']} done "
+                  f"[{time.perf_counter() - t0:.0f} s]", flush=True)
     wall = time.perf_counter() - t0
     worst = 0.0
     for scene, kw in sc.items():
