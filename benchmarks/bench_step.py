@@ -42,8 +42,6 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from particleShear import EnsembleLinkable, SphereLinkable, StressTensorEvaluation  # noqa: E402
-from particleShear.base.kernels import min_image  # noqa: E402
-from particleShear.base.points import _le_closest  # noqa: E402
 
 E = 8000.0
 K = math.pi / 8 * E * 1e6          # 3.14e9 mg s^-2 per m depth
@@ -141,6 +139,7 @@ def documented_vs_protocol(n_blocks, block=50):
 def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
     """The reference's O(N²) pure-Python neighbour update: every ordered pair, LE minimum image,
     linear search of the relation list by index."""
+    from particleShear.base.points import _le_closest   # here: build() and the step loops import without it
     n = len(xs)
     for i in range(n):
         rel = relations[i]
@@ -160,6 +159,7 @@ def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
 
 
 def numpy_all_pairs_step(x, y, r, L, shift):
+    from particleShear.base.kernels import min_image
     i, j = np.triu_indices(len(x), 1)
     dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], L, L, shift)
     d = np.sqrt(dx * dx + dy * dy)
