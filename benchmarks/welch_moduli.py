@@ -18,7 +18,7 @@ bit-identical between the trees.
 Runs execute in worker processes with ``PYTHONPATH`` set to the tree and one thread each,
 ``--workers`` (default 2) at a time; each worker runs a chunk of seeds of one tree and scene.
 
-Usage: python benchmarks/welch_moduli.py [--baseline PATH] [--current PATH] [--seeds 16] [--workers 2] [--mu 0.01]
+Usage: python benchmarks/welch_moduli.py [--baseline PATH] [--current PATH] [--seeds 16] [--workers 2] [--mu 0.01] [--drawn]
 """
 import argparse
 import concurrent.futures
@@ -37,9 +37,12 @@ QUANTITIES = (("G′ surface", "G_surface", 0), ("G″ surface", "G_surface", 1)
               ("G′ internal", "G_internal", 0), ("G″ internal", "G_internal", 1))
 
 
-def scenes(mu):
-    return {"default": {},
-            "frictional": {"do_permanent_links": False, "cut_lines": 0, "theMu": mu}}
+def scenes(mu, drawn=False):
+    """The two scenes; ``drawn``: with ``doDrawing=True`` and no window (``renderer="none"``), the path
+    a tree measures drawn runs on (the documented classes' own step in trees before observers)."""
+    extra = {"doDrawing": True, "renderer": "none"} if drawn else {}
+    return {"default": dict(extra),
+            "frictional": dict(extra, do_permanent_links=False, cut_lines=0, theMu=mu)}
 
 
 def worker(tree, scene_kw, seeds):
@@ -54,8 +57,8 @@ def worker(tree, scene_kw, seeds):
     out = []
     for s in seeds:
         t0 = time.perf_counter()
-        r = doParticleShearSimulation(doDrawing=False, plotStress=False, saveData=False, seed=s, verbose=False,
-                                      return_result=True, **scene_kw)
+        kw = dict(dict(doDrawing=False, plotStress=False, saveData=False, verbose=False), **scene_kw)
+        r = doParticleShearSimulation(seed=s, return_result=True, **kw)
         out.append({"seed": s, "G_surface": [float(v) for v in r.G_surface],
                     "G_internal": [float(v) for v in r.G_internal], "wall": time.perf_counter() - t0})
     print(json.dumps(out))
@@ -89,6 +92,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=16, help="seeds 1 … SEEDS per scene and tree (≥ 16 for the issue)")
     ap.add_argument("--workers", type=int, default=2, help="worker processes at a time")
     ap.add_argument("--mu", type=float, default=0.01, help="μ of the frictional scene (default: the docs' 0.01)")
+    ap.add_argument("--drawn", action="store_true",
+                    help="drawn runs without a window (doDrawing=True, renderer='none'), in both trees")
     ap.add_argument("--chunk", type=int, default=4, help="seeds per worker process")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--scene-json", help=argparse.SUPPRESS)
@@ -105,7 +110,7 @@ def main():
     for lab, path in trees.items():
         if not os.path.isdir(os.path.join(path, "particleShear")):
             ap.error(f"--{lab} {path!r} is not a tree with a particleShear package")
-    sc = scenes(args.mu)
+    sc = scenes(args.mu, args.drawn)
     seeds = list(range(1, args.seeds + 1))
     chunks = [seeds[i:i + args.chunk] for i in range(0, len(seeds), args.chunk)]
     print(f"Welch comparison of G′/G″: baseline {trees['baseline']}, current {trees['current']}; seeds 1–{args.seeds}; "
