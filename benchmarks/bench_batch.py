@@ -4,8 +4,8 @@ Prints, in one run:
 
 * a single default run ``doParticleShearSimulation(doDrawing=False, plotStress=False, verbose=False)``
   (measured by the engine as a batch of one; the fastest of ``--single-repeat`` seeds is the
-  reference) and the same run through the documented classes (``doDrawing=True, renderer="none"``:
-  nothing is drawn, but a drawing run takes the classes),
+  reference) and the same run drawn without a window (``doDrawing=True, renderer="none"``: the
+  engine with its observers),
   wall time and µs per protocol step;
 * a series of ``--batch`` default-scene runs with ``batch_size=--batch``, ``executor=None,
   max_workers=1`` (one worker process): wall time per run, its ratio to the single run
@@ -43,7 +43,7 @@ def main():
     classic = doParticleShearSimulation(seed=args.seed, verbose=False, return_result=True,
                                         **dict(kw, doDrawing=True), renderer="none")
     w_classic = time.perf_counter() - t0
-    print(f"single run (documented classes):   {w_classic:.2f} s, "
+    print(f"single run (drawn, no window):     {w_classic:.2f} s, "
           f"{1e6 * classic.timings['protocol'] / classic.N_steps:.0f} us/step")
 
     t0 = time.perf_counter()

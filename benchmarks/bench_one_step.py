@@ -47,7 +47,7 @@ import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_BASELINE = "/work/baseline-e45c1fa"
+DEFAULT_BASELINE = os.path.normpath(os.path.join(HERE, "..", "..", "baseline-e45c1fa"))   # beside the repo
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 

@@ -32,7 +32,7 @@ import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_BASELINE = "/work/baseline-e45c1fa"
+DEFAULT_BASELINE = os.path.normpath(os.path.join(HERE, "..", "..", "baseline-e45c1fa"))   # beside the repo
 QUANTITIES = (("G′ surface", "G_surface", 0), ("G″ surface", "G_surface", 1),
               ("G′ internal", "G_internal", 0), ("G″ internal", "G_internal", 1))
 

@@ -357,3 +357,39 @@ class TestBatchedSeriesWithFiles(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestDocumentedSimulationWithPerSphereParameters(unittest.TestCase):
+    """A script's simulation whose spheres carry their own parameters (one sphere's permanent ratio,
+    set through its handle) still runs with runSimulation: the engine has one set of parameters per
+    replica, so that run is measured on the documented classes, and its moduli are those of the
+    classes' experiment on the same constituted ensemble (built twice from one seed)."""
+
+    def test_per_sphere_parameters_run_on_the_classes(self):
+        from particleShear.engine.state import uniform_parameters
+        from particleShear.simulation.simulations import Simulation_interlocking_rheology
+
+        class Mine(Simulation_interlocking_rheology):
+            def initEnsemble(self, do_debug=False):
+                ens = Simulation_interlocking_rheology.initEnsemble(self, do_debug)
+                ens.sphereList[0].permanent_ratio_central = 2.0
+                return ens
+
+        def make():
+            s = Mine("", N=20, cut_lines=2, do_permanent_links=True, relative_frequency=0.2, doDrawing=False,
+                     saveData=False)
+            s.baseline_pre_periods = s.baseline_post_periods = 0.5
+            s.rng = np.random.default_rng(3)
+            return s
+
+        sim = make()
+        G = sim.runSimulation(periods=1, cool_factor=0.5, plotStress=False)
+        self.assertFalse(uniform_parameters(sim.theEnsemble))
+        self.assertTrue(all(np.isfinite(G)))
+        # the same ensemble measured by the classes' experiment directly
+        ref = make()
+        ref.initEnsemble()
+        exp = ref.createExperiment(False, 1, False)
+        sched = ref.measurement_schedule(0.5)
+        self.assertEqual(exp.oscillatory_shear_experiment(cool_factor=sched.cool,
+                                                          N_pre_equilibration_fixed_boundaries=sched.N_pre), G)

@@ -17,13 +17,30 @@ import numpy as np
 
 from .xp import get_backend
 
-__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM"]
+__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM", "uniform_parameters"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
 #: per-sphere model parameters that must be uniform within a replica for the engine
 PER_SPHERE_UNIFORM = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
                       "keep_viscosity_coefficients_constant")
+
+
+def uniform_parameters(ensemble):
+    """Whether every per-sphere parameter of :data:`PER_SPHERE_UNIFORM` is one value in ``ensemble``
+    (what :meth:`BatchState.from_ensembles` needs: the engine has one set per replica).
+
+    Parameters
+    ----------
+    ensemble : ensemble
+        A documented ensemble (its ``_a`` rows are read).
+
+    Returns
+    -------
+    bool
+    """
+    a, n = ensemble._a, len(ensemble.sphereList)
+    return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_UNIFORM) if n else True
 
 
 class ReplicaPairs:

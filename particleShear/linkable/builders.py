@@ -592,16 +592,16 @@ def EnsembleCompactParticlesFromModelParameters(
     if do_pre_equilibration:
         ens.dt = dt
         ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
-        ens.free_pre_equilibration(int(300 / R))
+        Relaxation(ens, int(300 / R)).run()
         if A <= 0.01 or rts < 0.1:
-            ens.free_pre_equilibration(int(300 / R))
+            Relaxation(ens, int(300 / R)).run()
         ens.dt = dt
         ens.dt_max = dt_max
-        ens.free_pre_equilibration(int(200 / R))
+        Relaxation(ens, int(200 / R)).run()
         if A <= 0.01:
-            ens.free_pre_equilibration(int(200 / R))
+            Relaxation(ens, int(200 / R)).run()
         if A <= 0.001:
-            ens.free_pre_equilibration(int(200 / R))
+            Relaxation(ens, int(200 / R)).run()
 
     if do_permanent_links:
         _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, 0, True, avoid, verbose)
@@ -609,5 +609,5 @@ def EnsembleCompactParticlesFromModelParameters(
         ens.dt_max = min(2 * ens.dt, ens.dt_max)
         if rts > 5:
             ens.dt_max = ens.dt_max / 2
-        ens.free_pre_equilibration()
+        Relaxation(ens, 25).run()   # free_pre_equilibration() with its default N
     return ens

@@ -298,7 +298,7 @@ def measure_batch(runs):
     return results
 
 
-def measure_sessions(sessions):
+def measure_sessions(sessions, constituted=False):
     """The phases of ``runSimulation`` for every session, the measurement in the engine.
 
     Constitution (relaxations in the engine, :func:`_constitute`), then per session the
@@ -313,7 +313,9 @@ def measure_sessions(sessions):
     Parameters
     ----------
     sessions : list of RunSession
-        The sessions (not constituted yet) of runs that share one schedule.
+        The sessions of runs that share one schedule.
+    constituted : bool, default False
+        The sessions' ensembles are built already (their constitution is skipped).
 
     Returns
     -------
@@ -322,7 +324,8 @@ def measure_sessions(sessions):
     """
     where = ["constitution", 0, 0]
     try:
-        _constitute(sessions)
+        if not constituted:
+            _constitute(sessions)
         sched = []
         for run in sessions:
             run.prepare()
@@ -434,9 +437,10 @@ def _measure(sessions, sched, where):
         t0 = time.perf_counter()
         engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
                              guard=[guard_of[b] for b in order], integrator=integrator)
-        if integrator == "verlet" and all(h is not None for h in halves):
-            # the predictor carries on from the pre-equilibration, as in one ensemble
-            engine.half = engine.xp.concatenate(halves, axis=1)
+        if integrator == "verlet":
+            # the predictor carries on from the pre-equilibration, as in one ensemble (no step yet: none)
+            engine.half = engine.xp.concatenate([engine.xp.zeros((3, st.B * st.N)) if h is None else h
+                                                 for h, st in zip(halves, states)], axis=1)
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,

@@ -128,13 +128,13 @@ class RunSession:
         self.t_start = time.perf_counter()
 
     def constitution(self):
-        """:meth:`constitute` as a generator of the constitution's relaxations (docs/design.md).
+        """The constitution as a generator of its relaxations (docs/design.md, "Runs").
 
         Yields each :class:`~particleShear.linkable.builders.Relaxation` of the builder (the
-        caller runs it, with the classes or in the engine for a whole batch, and resumes) when the
+        caller runs it in the engine, alone or with a batch's, and resumes) when the
         simulation is a :class:`Simulation_interlocking_rheology` whose ``initEnsemble`` is the
         documented one; any other ``initEnsemble`` (a subclass's own) is called as it is, with
-        nothing yielded.  The progress calls are those of :meth:`constitute`; the ``constitution``
+        nothing yielded.  It reports ``progress("constitution", …)`` at its start and end; the ``constitution``
         timing is the wall time since the start less :attr:`waited` (time the caller spent on
         other runs while this one was suspended).
 
@@ -493,7 +493,9 @@ class OscillatorySimulation:
         Measured as ``doParticleShearSimulation`` measures: the constitution's relaxations, the
         pre-equilibration and the protocol run in the engine, a batch of one
         (:func:`particleShear.run.batch.measure_sessions`); the drawing, snapshots and the live
-        stress window observe its loops.
+        stress window observe its loops.  An ensemble whose spheres have their own per-sphere
+        parameters (``PER_SPHERE_UNIFORM``, set through the sphere handles) is measured by the
+        experiment's own loop on the documented classes (the engine has one set per replica).
 
         Output (see ``docs/output.md``): the folder is probed for writability before any work;
         the file number is reserved (a locked ``.part`` file) when the ensemble exists, snapshots
@@ -526,8 +528,30 @@ class OscillatorySimulation:
             For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
             unknown output format — before any work.
         """
+        from ..engine.state import uniform_parameters
         from ..run.batch import measure_sessions
-        return measure_sessions([RunSession(self, cool_factor, periods, plotStress)])[0]
+        run = RunSession(self, cool_factor, periods, plotStress)
+        try:
+            relax_constitution(run.constitution())
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt):
+                exc.position = run.position()
+            run.close()
+            raise
+        if self.theEnsemble is None or uniform_parameters(self.theEnsemble):
+            return measure_sessions([run], constituted=True)[0]
+        # spheres of the ensemble have their own c, permanent ratios or kept viscosities (set through
+        # their handles): the engine has one set per replica, so the experiment steps the ensemble itself
+        try:
+            run.prepare()
+            run.exp.oscillatory_shear_experiment(cool_factor=run.schedule.cool,
+                                                 N_pre_equilibration_fixed_boundaries=run.schedule.N_pre)
+            return run.finish()
+        except KeyboardInterrupt as exc:
+            exc.position = run.position()
+            raise
+        finally:
+            run.close()
 
     def time_steps(self):
         """``(dt, f, dt_max)`` of the measurement: the ensemble's steps times ``time_step_factor`` and
