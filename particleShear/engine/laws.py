@@ -45,7 +45,7 @@ __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", 
            "central_law", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_constants",
            "plateau_inside", "plateau_law",
            "check_plateau", "ContactLaw", "LAWS", "register_law", "unregister_law", "get_law", "law_names",
-           "law_values", "register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks"]
+           "law_values", "register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks", "hold_callbacks"]
 
 #: forms of the compressive law: the general blend, and the two pure laws of c = 0 and c = 1
 #: (they drop the term whose coefficient is ±0, which leaves the force unchanged and is faster)
@@ -669,23 +669,45 @@ def call_law(law, *args, select=None):
     return out
 
 
+def hold_callbacks(kind, cls):
+    """Name the class whose attribute is a documented law callback (called by the classes' modules).
+
+    ``kind`` "central": ``cls.call_back_elastic_force_law`` (``base.points.CircleBasicElasticity``);
+    "tensile": ``cls.call_back_elastic_force_law_tensile`` (``linkable.spheres.SphereLinkable``).
+    The engine reads the attribute at every force phase and never imports the classes' layers.
+
+    Parameters
+    ----------
+    kind : {"central", "tensile"}
+        Which callback the class holds.
+    cls : type
+        The class.
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is neither.
+    """
+    if kind not in ("central", "tensile"):
+        raise ValueError(f"kind={kind!r} is not allowed: 'central' or 'tensile'")
+    _HOLDERS[kind] = cls
+
+
 def class_callbacks():
     """The documented law callbacks now: ``(CircleBasicElasticity.call_back_elastic_force_law,
-    SphereLinkable.call_back_elastic_force_law_tensile)``.
+    SphereLinkable.call_back_elastic_force_law_tensile)``; None for a callback whose class is not
+    loaded (then the built-in law).
 
     Returns
     -------
-    tuple of callable
+    tuple of callable or None
     """
-    if not _CLASSES:
-        from ..base.points import CircleBasicElasticity
-        from ..linkable.spheres import SphereLinkable
-        _CLASSES.extend((CircleBasicElasticity, SphereLinkable))
-    central, tensile = _CLASSES
-    return central.call_back_elastic_force_law, tensile.call_back_elastic_force_law_tensile
+    central, tensile = _HOLDERS.get("central"), _HOLDERS.get("tensile")
+    return (None if central is None else central.call_back_elastic_force_law,
+            None if tensile is None else tensile.call_back_elastic_force_law_tensile)
 
 
-_CLASSES = []     # the two classes of the documented callbacks, imported at the first look-up
+_HOLDERS = {}     # kind -> the class holding that documented callback (hold_callbacks)
 
 
 def _on_host(law, *args, select=None):
@@ -735,7 +757,9 @@ def force_phase_laws(s, C):
         built-in one (prepared constants).
     """
     compressive, stretched = class_callbacks()
-    if s.law is None and _registered(compressive) == "linear" and _registered(stretched) == "tensile":
+    builtin_c = compressive is None or _registered(compressive) == "linear"
+    builtin_t = stretched is None or _registered(stretched) == "tensile"
+    if s.law is None and builtin_c and builtin_t:
         return None, None           # the default: both laws from the prepared constants
     central = None
     if s.law is not None:
@@ -743,7 +767,7 @@ def force_phase_laws(s, C):
         if law.name != "linear" or law.parameters:
             central = _prepared(law, C, (law.name, id(s.law_params)),
                                 lambda: (C.d_law, C.k, s.c[C.rep]) + tuple(s.law_params[:, C.rep]))
-    else:
+    elif not builtin_c:
         found = callback_law(compressive)
         if found is None:
             args = _cached(C, ("callback",), lambda: (C.d_law, C.k, s.c[C.rep]))
@@ -752,10 +776,11 @@ def force_phase_laws(s, C):
             law, values = found
             central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, s.c[C.rep]) + values)
     tensile = None
-    found = callback_law(stretched)
-    if found is None or found[0].name != "tensile":
-        law = stretched if found is None else found[0].function
-        tensile = (lambda d: _stretched(law, C, d))
+    if not builtin_t:
+        found = callback_law(stretched)
+        if found is None or found[0].name != "tensile":
+            law = stretched if found is None else found[0].function
+            tensile = (lambda d: _stretched(law, C, d))
     return central, tensile
 
 

@@ -10,6 +10,7 @@ metre of depth (docs/design.md).
 """
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
+from ..engine import laws as _engine_laws
 from ..base.points import ArrayField, _check_finite, _one
 from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
@@ -343,3 +344,7 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
         if interface_type == "permanent":
             return "darkorange"
         return cfg.color_interface_slip
+
+
+# the engine reads the documented callback from this class at every force phase (it never imports this layer)
+_engine_laws.hold_callbacks("tensile", SphereLinkable)
