@@ -113,6 +113,7 @@ ENGINE_MODULES = [
     "particleShear.engine.forces",
     "particleShear.engine.integrate",
     "particleShear.engine.laws",
+    "particleShear.engine.callbacks",
     "particleShear.engine.memory",
     "particleShear.engine.neighbours",
     "particleShear.engine.observers",

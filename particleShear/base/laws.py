@@ -9,6 +9,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
+from ..engine import callbacks as _callbacks
 from ..engine import laws as _engine_laws
 
 __all__ = [
@@ -195,11 +196,11 @@ def elastic_force_law_tensile_exponential(d, d0, k):
 
 
 # the package's law functions accept arrays; the engine knows the registered ones by their callbacks
-_engine_laws.register_callback(elastic_force_law, "linear")
-_engine_laws.register_callback(elastic_force_law_plateau, "plateau", lambda: dict(zip(
+_callbacks.register_callback(elastic_force_law, "linear")
+_callbacks.register_callback(elastic_force_law_plateau, "plateau", lambda: dict(zip(
     ("plateau_begin", "plateau_end", "plateau_slope"), PlateauConfiguration.values())))
-_engine_laws.register_callback(elastic_force_law_tensile, "tensile")
+_callbacks.register_callback(elastic_force_law_tensile, "tensile")
 elastic_force_law_tensile_exponential.accepts_arrays = True
 
-#: evaluate a (possibly user-supplied, scalar-only) law on pair arrays (:func:`particleShear.engine.laws.call_law`)
-call_law_vectorised = _engine_laws.call_law
+#: evaluate a (possibly user-supplied, scalar-only) law on pair arrays (:func:`particleShear.engine.callbacks.call_law`)
+call_law_vectorised = _callbacks.call_law

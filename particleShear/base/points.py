@@ -25,7 +25,7 @@ import random as _random
 
 import numpy as np
 
-from ..engine import laws as _engine_laws
+from ..engine import callbacks as _engine_callbacks
 from ..engine.box import flow_velocity, min_image, wrap
 from ..engine.forces import normals
 from ..engine.integrate import damp, drift, kick, xi_increments
@@ -1369,4 +1369,4 @@ class CircleFrictionElasticity(CircleBasicElasticity):
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
-_engine_laws.hold_callbacks("central", CircleBasicElasticity)
+_engine_callbacks.hold_callbacks("central", CircleBasicElasticity)

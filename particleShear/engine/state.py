@@ -97,7 +97,7 @@ class BatchState:
     law : str or None
         Central law of every replica, a name of :data:`~particleShear.engine.laws.LAWS` (one per
         batch), or None: the documented callback ``call_back_elastic_force_law`` (looked up once
-        per force phase, :func:`~particleShear.engine.laws.force_phase_laws`).
+        per force phase, :func:`~particleShear.engine.callbacks.force_phase_laws`).
     law_params : ndarray (n, B)
         The law's parameters per replica, in the order of its ``parameters`` (n = 0 for None).
     backend : Backend

@@ -30,7 +30,7 @@ import numpy as np
 from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
-from .laws import force_phase_laws
+from .callbacks import force_phase_laws
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound

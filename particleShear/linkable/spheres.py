@@ -10,7 +10,7 @@ metre of depth (docs/design.md).
 """
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
-from ..engine import laws as _engine_laws
+from ..engine import callbacks as _engine_callbacks
 from ..base.points import ArrayField, _check_finite, _one
 from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
@@ -347,4 +347,4 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
-_engine_laws.hold_callbacks("tensile", SphereLinkable)
+_engine_callbacks.hold_callbacks("tensile", SphereLinkable)
