@@ -67,15 +67,14 @@ class EngineInstability(RuntimeError):
 
 
 class _ForceRecord:
-    """What a force phase leaves for the acceleration and movement phases and for the register
-    (the candidates' geometry, relations, pair forces and the mobility mask; see
-    :meth:`BatchEngine.force_phase`)."""
-    __slots__ = ("dx", "dy", "d", "nx", "ny", "dvx", "ky", "kx", "yc", "mob", "touching", "active", "shifted", "fn",
-                 "F", "fx_i", "fy_i", "dF", "tq")
+    """What a force phase leaves for the acceleration and movement phases of its step (see
+    :meth:`BatchEngine.force_phase`): the candidates' minimum-image vectors, normals and image
+    velocity, the relations, the heights above the centre line and the mobility mask."""
+    __slots__ = ("dx", "dy", "nx", "ny", "dvx", "active", "yc", "mob")
 
-    def __init__(self, **kw):
-        for k, v in kw.items():
-            setattr(self, k, v)
+    def __init__(self, dx, dy, nx, ny, dvx, active, yc, mob):
+        self.dx, self.dy, self.nx, self.ny, self.dvx = dx, dy, nx, ny, dvx
+        self.active, self.yc, self.mob = active, yc, mob
 
 
 class BatchEngine:
@@ -358,9 +357,9 @@ class BatchEngine:
         """Neighbours (when due) → geometry and relations → kinematics → force terms → scatter.
 
         Writes the forces and torques of every sphere into ``state.frc`` and keeps what the other
-        phases and the register read in :attr:`g` (the geometry of the candidates: ``dx, dy, d,
-        nx, ny``, the image velocity ``dvx``, ``active``, ``touching``, the pair forces on i
-        ``fx_i, fy_i``, their difference ``dF``, the torques, the mobility mask).  With the
+        two phases of the step read in :attr:`g` (the candidates' ``dx, dy``, normals ``nx, ny``,
+        image velocity ``dvx``, relations ``active``, the heights ``y − Ly/2``, the mobility
+        mask; dropped at the end of :meth:`move`).  With the
         velocity Verlet integrator (:attr:`integrator`) the velocity-dependent terms see the
         velocities moved half a kick ahead (the half kick of the previous step).
 
@@ -408,7 +407,6 @@ class BatchEngine:
         s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1])
         mob = self.mobile()
         out = None
-        shifted = None
         if sample:
             shifted = (ky != 0) | (kx != 0)
             mi, mj = mob[ai], mob[aj]
@@ -425,9 +423,7 @@ class BatchEngine:
                 self._report(verdict, self.step_count)
             else:
                 self.verdict = verdict
-        self.g = _ForceRecord(dx=dx, dy=dy, d=d, nx=nx, ny=ny, dvx=dvx, ky=ky, kx=kx, yc=yc, mob=mob,
-                              touching=touching, active=active, shifted=shifted, fn=fn, F=F, fx_i=fx_i,
-                              fy_i=fy_i, dF=dF, tq=tq)
+        self.g = _ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob)
         return out
 
     def _tangential(self, C, vt, touching, xi, law, active):
