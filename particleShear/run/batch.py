@@ -257,9 +257,48 @@ def measure_batch(runs):
     -------
     list of SimulationResult
     """
+    from .api import SimulationResult
+
+    sims, seeds, sessions = build_sessions(runs)
+    measure_sessions(sessions)
+    results = []
+    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
+        info = sim.result_info
+        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
+        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
+                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
+        results.append(SimulationResult(
+            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
+            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
+            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
+            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
+            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
+            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
+            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
+        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
+    return results
+
+
+def build_sessions(runs):
+    """The simulation object and :class:`~particleShear.simulation.simulations.RunSession` of every run.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Complete, validated keyword dicts of the replicas.
+
+    Returns
+    -------
+    sims : list
+        The documented simulation of each run (not constituted).
+    seeds : list of tuple
+        ``(seed entropy, spawn key, reference parameters)`` of each run.
+    sessions : list of RunSession
+        One session per run, in order.
+    """
     from ..simulation.provenance import run_identity
     from ..simulation.simulations import RunSession
-    from .api import SimulationResult, _build_simulation, _seed_sequence
+    from .api import _build_simulation, _seed_sequence
     from .validation import contact_law_spec
 
     sims, seeds, sessions = [], [], []
@@ -279,23 +318,7 @@ def measure_batch(runs):
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
         seeds.append((seed_entropy, spawn_key, params))
-    measure_sessions(sessions)
-    results = []
-    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
-        info = sim.result_info
-        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
-        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
-                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
-        results.append(SimulationResult(
-            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
-            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
-            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
-            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
-            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
-            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
-        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
-    return results
+    return sims, seeds, sessions
 
 
 def measure_sessions(sessions, constituted=False):
@@ -397,8 +420,7 @@ def _measure(sessions, sched, where):
     ``(phase, step, total)``.  Each replica's drawing (live window, snapshots, movie, stress
     window: :meth:`~particleShear.simulation.experiment.OscillatoryShearExperiment.observers`)
     observes its own replica in both loops."""
-    from ..engine.state import BatchState
-    from ..engine.step import BatchEngine, pre_equilibrate, protocol
+    from ..engine.step import protocol
     from ..simulation.observers import ReplicaScene
 
     sims = [run.sim for run in sessions]
@@ -410,37 +432,14 @@ def _measure(sessions, sched, where):
             scenes[b].bind(engine, col)
         return [ob for b in members for ob in watch[b]]
 
-    backend = (sims[0].parameters or {}).get("backend", "numpy")    # one backend per batch (part of the schedule key)
-    guard_of = [bool(run.sim.stability_guard) for run in sessions]
     rec = [None] * len(sessions)
     timings = [dict() for _ in sessions]
     for proto in dict.fromkeys(p for p, _ in sched):
         members = [b for b, (p, _) in enumerate(sched) if p == proto]
         dt, f, cool, pre_p, periods, post = proto
-        states, halves = [], []
-        order = []
-        integrator = sims[members[0]].integrator        # part of the schedule key
-        for pre in dict.fromkeys(sched[b][1] for b in members):
-            group = [b for b in members if sched[b][1] == pre]
-            t0 = time.perf_counter()
-            st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
-                                           laws=[sims[b].contact_law for b in group])
-            say, report = _console(sims, group, "pre-equilibration", where)
-            engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
-                                 integrator=integrator)
-            _guarded(pre_equilibrate, engine, pre[1], dt, pre[0], cool, say, report, observers(engine, group), dt=dt)
-            halves.append(engine.half)
-            for b in group:
-                timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
-            states.append(st)
-            order += group
+        engine, order = pre_equilibrated(sessions, members, [sched[b][1] for b in members], dt, cool, where,
+                                         observers, timings)
         t0 = time.perf_counter()
-        engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
-                             guard=[guard_of[b] for b in order], integrator=integrator)
-        if integrator == "verlet":
-            # the predictor carries on from the pre-equilibration, as in one ensemble (no step yet: none)
-            engine.half = engine.xp.concatenate([engine.xp.zeros((3, st.B * st.N)) if h is None else h
-                                                 for h, st in zip(halves, states)], axis=1)
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
@@ -452,6 +451,71 @@ def _measure(sessions, sched, where):
             timings[b]["protocol"] = (time.perf_counter() - t0) / len(order)
         del out
     return rec, timings
+
+
+def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings):
+    """The pre-equilibrated engine of the replicas ``members``, ready for a protocol at step ``dt``.
+
+    Each group of equal pre-equilibration schedule ``(dt_max, N_pre)`` is pre-equilibrated in an
+    engine of its own (:func:`~particleShear.engine.step.pre_equilibrate`); the states are then
+    joined into one engine, the Verlet predictor carried on.  Each member's
+    ``timings["pre_equilibration"]`` is its share of its group's wall time.
+
+    Parameters
+    ----------
+    sessions : list of RunSession
+        All sessions of the batch (constituted).
+    members : list of int
+        The sessions measured together (one protocol schedule).
+    pre : list of tuple
+        ``(dt_max, N_pre)`` of each member, in the order of ``members``.
+    dt : float
+        Final time step (s).
+    cool : float
+        Damping factor per step of the last N_pre steps.
+    where : list
+        ``[phase, step, total]``, followed for an interrupt's position.
+    observers : callable
+        ``observers(engine, members) -> list`` of the observers of those members in that engine.
+    timings : list of dict
+        Per session, filled with ``"pre_equilibration"``.
+
+    Returns
+    -------
+    engine : BatchEngine
+        The engine of the joined state (no step taken yet).
+    order : list of int
+        The session of each replica of ``engine``, in replica order.
+    """
+    from ..engine.state import BatchState
+    from ..engine.step import BatchEngine, pre_equilibrate
+
+    sims = [run.sim for run in sessions]
+    backend = (sims[members[0]].parameters or {}).get("backend", "numpy")   # one backend per batch
+    guard_of = [bool(run.sim.stability_guard) for run in sessions]
+    integrator = sims[members[0]].integrator        # part of the schedule key
+    states, halves, order = [], [], []
+    for key in dict.fromkeys(pre):
+        group = [b for b, k in zip(members, pre) if k == key]
+        t0 = time.perf_counter()
+        st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
+                                       laws=[sims[b].contact_law for b in group])
+        say, report = _console(sims, group, "pre-equilibration", where)
+        engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
+                             integrator=integrator)
+        _guarded(pre_equilibrate, engine, key[1], dt, key[0], cool, say, report, observers(engine, group), dt=dt)
+        halves.append(engine.half)
+        for b in group:
+            timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
+        states.append(st)
+        order += group
+    engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
+                         guard=[guard_of[b] for b in order], integrator=integrator)
+    if integrator == "verlet":
+        # the predictor carries on from the pre-equilibration, as in one ensemble (no step yet: none)
+        engine.half = engine.xp.concatenate([engine.xp.zeros((3, st.B * st.N)) if h is None else h
+                                             for h, st in zip(halves, states)], axis=1)
+    return engine, order
 
 
 def _console(sims, members, phase, where):
