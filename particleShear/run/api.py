@@ -111,7 +111,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
                               saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy",
-                              contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1):
+                              contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1,
+                              protocol="oscillatory", relative_rate=0.01, total_strain=2.0, ramp_time=1.0,
+                              hold_time=200.0, creep_stress=None, creep_modulus=None, creep_response_time=5.0,
+                              sweep_amplitudes=None, sweep_frequencies=None):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -284,13 +287,49 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     plateau_slope : float, default 0.1
         Keyword-only.  Slope of the force on the plateau relative to the law's (0 flat, 1 no
         plateau); allowed 0 ... 1.
+    protocol : {"oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", "frequency_sweep"}, default "oscillatory"
+        Keyword-only.  What the rheometer does after the pre-equilibration (docs/protocols.md):
+        the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude``
+        and hold; a constant applied stress; or, on one packing, the oscillation at each of
+        ``sweep_amplitudes`` or ``sweep_frequencies`` in turn.  The other protocols are headless
+        (no drawing, no snapshots) and return a :class:`~particleShear.run.rheometer.RheometerResult`.
+    relative_rate : float, default 0.01
+        Keyword-only.  ``protocol="steady"``: shear rate γ̇·τ, dimensionless like
+        ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant);
+        allowed > 0 with at most 0.005 strain per time step.
+    total_strain : float, default 2.0
+        Keyword-only.  ``protocol="steady"``: strain sheared in all; allowed 0 < value <= 1e6.
+    ramp_time : float, default 1.0
+        Keyword-only.  ``protocol="relaxation"``: duration of the strain ramp to γ₀, in units of τ;
+        allowed > 0 with at most 0.005 strain per time step.
+    hold_time : float, default 200.0
+        Keyword-only.  ``protocol="relaxation"`` and ``"creep"``: duration of the hold, in units of τ;
+        allowed 0 < value <= 1e9 within the step limit.
+    creep_stress : float or None, default None
+        Keyword-only.  ``protocol="creep"`` (required there): applied shear stress σ₀ in Pa, > 0.
+    creep_modulus : float or None, default None
+        Keyword-only.  ``protocol="creep"``: modulus scale G_c (Pa) of the stress controller;
+        None: Young_modulus_spheres/8 (docs/protocols.md).
+    creep_response_time : float, default 5.0
+        Keyword-only.  ``protocol="creep"``: response time T_c of the stress controller in units of
+        τ; allowed >= 10 time steps.
+    sweep_amplitudes : list of float or None, default None
+        Keyword-only.  ``protocol="amplitude_sweep"`` (required there): the strain amplitudes, in
+        the order run, strictly increasing or strictly decreasing, each 0 < A <= 100;
+        ``theAmplitude`` is set to the first.
+    sweep_frequencies : list of float or None, default None
+        Keyword-only.  ``protocol="frequency_sweep"`` (required there): the relative frequencies
+        f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first.
 
     Returns
     -------
     list of float or SimulationResult
         ``[G′_surface, G″_surface]`` in Pa (the moduli from the surface forces, as the reference
         returns), or the :class:`SimulationResult` with ``return_result=True``; the full result
-        of the last call is ``doParticleShearSimulation.last_result`` either way.
+        of the last call is ``doParticleShearSimulation.last_result`` either way.  Other
+        protocols: ``RheometerResult.values`` (steady ``[σ, η]``, relaxation ``[G_plateau]``,
+        creep ``[creep rate, σ₀/γ̇]``, sweeps ``[[G′, G″], …]``), or the
+        :class:`~particleShear.run.rheometer.RheometerResult` with ``return_result=True``.
 
     Raises
     ------
@@ -335,7 +374,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                    time_step_factor=time_step_factor, integrator=integrator, stability_guard=stability_guard,
                    output_format=output_format, strict_io=strict_io, saveOutputMovie=saveOutputMovie, backend=backend,
                    contact_law=contact_law, plateau_begin=plateau_begin, plateau_end=plateau_end,
-                   plateau_slope=plateau_slope)
+                   plateau_slope=plateau_slope, protocol=protocol, relative_rate=relative_rate,
+                   total_strain=total_strain, ramp_time=ramp_time, hold_time=hold_time, creep_stress=creep_stress,
+                   creep_modulus=creep_modulus, creep_response_time=creep_response_time,
+                   sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies)
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
@@ -344,6 +386,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     seed_entropy = None if ss is None else ss.entropy
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
+    if protocol != "oscillatory":
+        from .rheometer import measure_rheometer, normalize_protocol
+        with console_messages(verbose):
+            result = measure_rheometer([normalize_protocol(params)])[0]
+        doParticleShearSimulation.last_result = result
+        return result if return_result else result.values
 
     # measured by the engine, a batch of one (particleShear.run.batch)
     with console_messages(verbose):

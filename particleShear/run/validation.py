@@ -609,6 +609,9 @@ def validate_run(params):
         raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder "
                          "(no such directory)")
     check_seed("seed", p["seed"])
+    from .rheometer import check_protocol, normalize_protocol
+    check_protocol(p)             # the protocol's own parameters and steps (docs/protocols.md)
+    p = normalize_protocol(p)     # a sweep is constituted for its first value
     _check_constitution(p)
     cost = _check_cost(p)
     if wants:

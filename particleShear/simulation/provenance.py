@@ -103,11 +103,26 @@ def identity_parameters(parameters):
     """
     law = parameters.get("contact_law", "linear")
     unused = (() if law == "plateau" else _PLATEAU) + (("contact_law",) if law == "linear" else ())
+    unused += _protocol_unused(parameters.get("protocol", "oscillatory"))
     return {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED and k not in unused}
 
 
 #: the parameters of the plateau law (``contact_law="plateau"``)
 _PLATEAU = ("plateau_begin", "plateau_end", "plateau_slope")
+
+#: the parameters each protocol reads (docs/protocols.md); the others change nothing of its runs
+_PROTOCOL_READS = {"oscillatory": (), "steady": ("protocol", "relative_rate", "total_strain"),
+                   "relaxation": ("protocol", "ramp_time", "hold_time"),
+                   "creep": ("protocol", "hold_time", "creep_stress", "creep_modulus", "creep_response_time"),
+                   "amplitude_sweep": ("protocol", "sweep_amplitudes"),
+                   "frequency_sweep": ("protocol", "sweep_frequencies")}
+
+
+def _protocol_unused(protocol):
+    """The protocol parameters a run of ``protocol`` does not read (left out of its identity, so an
+    oscillatory run keeps the id it had before the protocols were parameters)."""
+    every = {k for v in _PROTOCOL_READS.values() for k in v}
+    return tuple(sorted(every - set(_PROTOCOL_READS.get(protocol, ()))))
 
 
 def same_input(text, value):

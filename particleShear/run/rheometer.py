@@ -1,0 +1,389 @@
+"""The rheometer's protocols of a run: ``protocol=`` of :func:`~particleShear.run.api.doParticleShearSimulation`.
+
+``"oscillatory"`` (the default) is the reference's experiment (:mod:`particleShear.run.batch`).
+The others constitute and pre-equilibrate exactly as it does (the same functions, so one seed
+gives the same packing), then drive the engine with another rate schedule
+(:mod:`particleShear.engine.rheometer`, docs/protocols.md):
+
+``"steady"``
+    γ̇ = ``relative_rate``/τ until the strain ``total_strain``; the steady shear stress (mean and
+    standard error by blocking after the detected transient), the viscosity σ/γ̇ and the first
+    normal-stress difference N1 of the overall tensor.
+``"relaxation"``
+    A ramp to γ₀ = ``theAmplitude`` over ``ramp_time``·τ, then ``hold_time``·τ at constant
+    strain; G(t) = σ(t)/γ₀ (t from the end of the ramp) on a log-spaced grid and its plateau.
+``"creep"``
+    The plate stress held at ``creep_stress`` (Pa) for ``hold_time``·τ by a PI controller on the
+    strain rate; J(t) = γ(t)/σ₀ on a log grid, the final creep rate, σ₀/γ̇ and the strain plateau.
+``"amplitude_sweep"`` / ``"frequency_sweep"``
+    One packing, then the oscillatory protocol (``pre_periods``, ``periods``, ``post_periods``)
+    for each amplitude of ``sweep_amplitudes`` (or relative frequency of ``sweep_frequencies``)
+    in the given order, each after the previous one; one G′/G″ (with standard errors and LAOS
+    measures) per step.  The constitution and the first step are those of the independent run
+    with the first amplitude (frequency): ``theAmplitude`` (``relative_frequency``) is set to it.
+
+τ is the model time constant (docs/parameters.md): γ̇ in 1/s is ``relative_rate / τ``.
+"""
+__docformat__ = "numpy"
+import difflib
+import math
+import time
+
+import numpy as np
+
+__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
+           "normalize_protocol", "protocol_steps", "measure_rheometer"]
+
+PROTOCOLS = ("oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", "frequency_sweep")
+
+#: the keyword-only parameters of the protocols and their defaults (as in doParticleShearSimulation)
+PROTOCOL_DEFAULTS = {"protocol": "oscillatory", "relative_rate": 0.01, "total_strain": 2.0, "ramp_time": 1.0,
+                     "hold_time": 200.0, "creep_stress": None, "creep_modulus": None, "creep_response_time": 5.0,
+                     "sweep_amplitudes": None, "sweep_frequencies": None}
+
+#: largest strain increment |γ̇|·dt of one step (≈ 9× the default oscillation's peak, 5.6e-4):
+#: neighbours 2r apart then move by at most 1 % of r relative to each other per step
+MAX_STRAIN_PER_STEP = 0.005
+
+#: the controller's modulus scale, as a fraction of Young_modulus_spheres when creep_modulus is None
+#: (the default packing has G′ ≈ 0.14 E, so the closed loop settles in about one response time)
+CREEP_MODULUS_FRACTION = 0.125
+
+#: N1 of the overall tensor is sampled every this many steps (the tensors cost about one step)
+N1_EVERY = 10
+
+
+def _dt_over_tau(p, amplitude=None):
+    """Protocol time step in units of τ (the time-step rule is linear in τ)."""
+    from ..linkable.builders import time_steps_from_model
+    A = p["theAmplitude"] if amplitude is None else amplitude
+    return time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"], A,
+                                 p["relative_viscosity"])[0] * p["time_step_factor"]
+
+
+def _positive(name, v, hi=math.inf):
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}={v!r} is invalid: allowed a real number > 0 (flag --{name.replace('_', '-')})")
+    if not (math.isfinite(v) and 0 < v <= hi):
+        raise ValueError(f"{name}={v!r} is out of range: allowed 0 < {name} <= {hi:g} "
+                         f"(flag --{name.replace('_', '-')})")
+    return float(v)
+
+
+def _values(name, v, lo, hi):
+    if v is None or isinstance(v, (str, bytes)) or not hasattr(v, "__len__"):
+        raise ValueError(f"{name}={v!r} is invalid: the sweep needs a list of values in ({lo:g}, {hi:g}]")
+    vals = [_positive(name, x, hi) for x in list(v)[:10001]]
+    if not 1 <= len(vals) <= 10000:
+        raise ValueError(f"{name} has {len(vals)} values: allowed 1 ... 10000")
+    d = np.diff(vals)
+    if len(vals) > 1 and not ((d > 0).all() or (d < 0).all()):
+        raise ValueError(f"{name}={vals!r} is invalid: a sweep runs in one direction on one sample, so the values "
+                         "must be strictly increasing or strictly decreasing (no repeats)")
+    return vals
+
+
+def check_protocol(p):
+    """Check the protocol parameters of one run (``p``: every argument, defaults filled in).
+
+    Parameters
+    ----------
+    p : dict
+        The arguments of the run.
+
+    Returns
+    -------
+    dict
+        The steps of the protocol (:func:`protocol_steps`).
+
+    Raises
+    ------
+    ValueError, TypeError
+        An unknown protocol (the closest name suggested), a missing or non-positive rate, strain,
+        time or stress, a sweep list that is empty or not monotonic, a rate or ramp the time step
+        cannot resolve (more than :data:`MAX_STRAIN_PER_STEP` strain per step), a controller
+        response time shorter than 10 steps, or options of the drawing with a protocol other
+        than "oscillatory".
+    """
+    proto = p.get("protocol", "oscillatory")
+    if proto not in PROTOCOLS:
+        near = difflib.get_close_matches(str(proto), PROTOCOLS, n=1)
+        raise ValueError(f"protocol={proto!r} is invalid: allowed one of {PROTOCOLS}"
+                         + (f"; did you mean {near[0]!r}?" if near else "") + " (flag --protocol)")
+    if proto == "oscillatory":
+        return {}
+    if p.get("saveOutputImages") or p.get("saveOutputMovie"):
+        raise ValueError(f"saveOutputImages=True is invalid with protocol={proto!r}: snapshots are taken of the "
+                         "oscillatory protocol only")
+    q = normalize_protocol(p)
+    steps = protocol_steps(q)
+    dtr = steps["dt_over_tau"]
+    if proto == "steady":
+        rate = _positive("relative_rate", q["relative_rate"])
+        _positive("total_strain", q["total_strain"], 1e6)
+        if rate * dtr > MAX_STRAIN_PER_STEP:
+            raise ValueError(f"relative_rate={rate!r} is out of range: the time step (dt = {dtr:.3g} τ) resolves "
+                             f"at most {MAX_STRAIN_PER_STEP} strain per step, i.e. relative_rate <= "
+                             f"{MAX_STRAIN_PER_STEP / dtr:.4g} (flag --relative-rate)")
+    if proto in ("relaxation", "creep"):
+        _positive("hold_time", q["hold_time"], 1e9)
+    if proto == "relaxation":
+        _positive("ramp_time", q["ramp_time"], 1e9)
+        per_step = q["theAmplitude"] / steps["ramp"]
+        if per_step > MAX_STRAIN_PER_STEP:
+            raise ValueError(f"ramp_time={q['ramp_time']!r} is out of range: a ramp to theAmplitude="
+                             f"{q['theAmplitude']!r} in {steps['ramp']} steps is {per_step:.3g} strain per step, more "
+                             f"than {MAX_STRAIN_PER_STEP}; allowed ramp_time >= "
+                             f"{q['theAmplitude'] / MAX_STRAIN_PER_STEP * dtr:.4g} (flag --ramp-time)")
+    if proto == "creep":
+        if q["creep_stress"] is None:
+            raise ValueError("creep_stress=None is invalid with protocol='creep': give the applied stress σ₀ in Pa "
+                             "(> 0; flag --creep-stress)")
+        _positive("creep_stress", q["creep_stress"], 1e12)
+        if q["creep_modulus"] is not None:
+            _positive("creep_modulus", q["creep_modulus"], 1e15)
+        T = _positive("creep_response_time", q["creep_response_time"], 1e9)
+        if T < 10 * dtr:
+            raise ValueError(f"creep_response_time={T!r} is out of range: the controller needs >= 10 steps per "
+                             f"response time, allowed >= {10 * dtr:.4g} (flag --creep-response-time)")
+    total = sum(steps["segments"]) if proto.endswith("sweep") else steps["steps"]
+    from .validation import MAX_TOTAL_STEPS
+    if total > MAX_TOTAL_STEPS:
+        raise ValueError(f"protocol={proto!r} needs {total:.3g} steps, more than the limit of {MAX_TOTAL_STEPS:.0e}: "
+                         "shorten total_strain, hold_time or the sweep")
+    return steps
+
+
+def normalize_protocol(p):
+    """The arguments of a run as its protocol measures them: a sweep's first value becomes
+    ``theAmplitude`` (amplitude sweep) or ``relative_frequency`` (frequency sweep).
+
+    Parameters
+    ----------
+    p : dict
+        The arguments of the run (defaults filled in); not modified.
+
+    Returns
+    -------
+    dict
+        A copy with the sweep's first value put in (lists as lists of float).
+
+    Raises
+    ------
+    ValueError
+        For a sweep without its list, or a list that is empty or not monotonic.
+    """
+    q = dict(p)
+    proto = q.get("protocol", "oscillatory")
+    if proto == "amplitude_sweep":
+        q["sweep_amplitudes"] = _values("sweep_amplitudes", q.get("sweep_amplitudes"), 0, 100)
+        q["theAmplitude"] = q["sweep_amplitudes"][0]
+    elif proto == "frequency_sweep":
+        q["sweep_frequencies"] = _values("sweep_frequencies", q.get("sweep_frequencies"), 0, 1e6)
+        q["relative_frequency"] = q["sweep_frequencies"][0]
+    return q
+
+
+def protocol_steps(q):
+    """Step counts of a (normalized, checked) protocol.
+
+    Parameters
+    ----------
+    q : dict
+        The arguments of the run (:func:`normalize_protocol`).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau``; ``steps`` (steady, relaxation, creep: all steps), ``ramp`` (relaxation);
+        ``segments`` (sweeps: the oscillatory steps of each step of the sweep) and ``dts`` (sweeps:
+        each step's dt/τ).
+    """
+    proto = q.get("protocol", "oscillatory")
+    dtr = _dt_over_tau(q)
+    out = {"dt_over_tau": dtr}
+    if proto == "steady":
+        out["steps"] = int(math.ceil(float(q["total_strain"]) / (float(q["relative_rate"]) * dtr)))
+    elif proto == "relaxation":
+        out["ramp"] = max(1, int(round(float(q["ramp_time"]) / dtr)))
+        out["steps"] = out["ramp"] + int(math.ceil(float(q["hold_time"]) / dtr))
+    elif proto == "creep":
+        out["steps"] = int(math.ceil(float(q["hold_time"]) / dtr))
+    elif proto.endswith("sweep"):
+        amps = q["sweep_amplitudes"] if proto == "amplitude_sweep" else [q["theAmplitude"]] * len(q["sweep_frequencies"])
+        freqs = q["sweep_frequencies"] if proto == "frequency_sweep" else [q["relative_frequency"]] * len(amps)
+        out["dts"] = [_dt_over_tau(q, A) for A in amps]
+        n_per = float(q["pre_periods"]) + float(q["periods"]) + float(q["post_periods"])
+        out["segments"] = [int(n_per / fr / d) for fr, d in zip(freqs, out["dts"])]
+    return out
+
+
+class RheometerResult:
+    """What a run of a protocol other than "oscillatory" produced (docs/protocols.md).
+
+    Attributes
+    ----------
+    protocol : str
+        The protocol.
+    parameters : dict
+        Every argument of the run (normalized: a sweep's first value in ``theAmplitude`` or
+        ``relative_frequency``).
+    seed, spawn_key, run_id
+        As :class:`~particleShear.run.api.SimulationResult`.
+    tau : float
+        Model time constant τ (s).
+    dt : float
+        Time step (s; of the first step for sweeps).
+    series : dict of numpy.ndarray
+        The record (steady, relaxation, creep): "t" (s), "strain", "strain_rate" (1/s),
+        "stress_internal", "stress_surface" (Pa) and for "steady" "N1" (Pa, NaN where not sampled).
+    summary : dict
+        Scalar results by name (units in docs/protocols.md).
+    curves : dict
+        ``name -> (t, y, y_sem)`` on log-spaced grids: "G" (relaxation, Pa), "J" (creep, 1/Pa).
+    steps : list of dict
+        Sweeps: one dict per step (position, amplitude, relative_frequency, f, G′/G″ of both
+        estimators with standard errors, LAOS measures).
+    timings : dict
+        Wall times (s) of "constitution", "pre_equilibration", "protocol", "analysis".
+    values : list of float
+        What ``doParticleShearSimulation`` returns without ``return_result``: steady ``[σ, η]``
+        (surface), relaxation ``[G_plateau]``, creep ``[final creep rate, σ₀/γ̇]``, sweeps
+        ``[[G′, G″], …]`` per step (surface).
+    """
+
+    def __init__(self, protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps,
+                 timings):
+        self.protocol, self.parameters, self.seed, self.spawn_key, self.run_id = (protocol, parameters, seed,
+                                                                                  spawn_key, run_id)
+        self.tau, self.dt, self.series, self.summary, self.curves, self.steps = tau, dt, series, summary, curves, steps
+        self.timings = timings
+        self.output_path = None
+        self.write_error = None
+
+    @property
+    def values(self):
+        """The main numbers of the protocol (see the class docstring)."""
+        s = self.summary
+        if self.protocol == "steady":
+            return [s["stress_surface"], s["viscosity_surface"]]
+        if self.protocol == "relaxation":
+            return [s["G_plateau_surface"]]
+        if self.protocol == "creep":
+            return [s["creep_rate"], s["creep_viscosity"]]
+        return [[st["Gp_surface"], st["Gpp_surface"]] for st in self.steps]
+
+    def rows(self):
+        """Rows of a results table: one per run, or one per step of a sweep (``position`` 0, 1, …).
+
+        Returns
+        -------
+        list of dict
+            Column → value: ``protocol``, ``run_id``, the summary (or the step's values).
+        """
+        base = {"protocol": self.protocol, "run_id": self.run_id}
+        if self.steps:
+            return [dict(base, **st) for st in self.steps]
+        return [dict(base, **self.summary)]
+
+    def __repr__(self):
+        main = ", ".join(f"{v:.4g}" if isinstance(v, float) else repr(v) for v in
+                         (self.values if not self.steps else [len(self.steps)]))
+        return f"RheometerResult(protocol={self.protocol!r}, {'steps' if self.steps else 'values'}=[{main}])"
+
+
+def measure_rheometer(runs):
+    """Constitute, pre-equilibrate and measure runs of one protocol other than "oscillatory".
+
+    The constitution and pre-equilibration are those of the oscillatory runs
+    (:func:`~particleShear.run.batch.build_sessions`, ``_constitute``,
+    :func:`~particleShear.run.batch.pre_equilibrated`); every replica then runs its rate
+    schedule in one engine.  Replicas may differ in rate, strain, stress, γ₀ and amplitude list;
+    the batch runs the longest and cuts each record at the replica's own length.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Complete, validated, normalized keyword dicts sharing a protocol and a schedule.
+
+    Returns
+    -------
+    list of RheometerResult
+    """
+    from ..engine import rheometer as eng
+    from ..engine.step import protocol as oscillatory
+    from ..simulation.provenance import run_identity
+    from .batch import _console, _constitute, _guarded, build_sessions, pre_equilibrated
+
+    proto = runs[0]["protocol"]
+    sims, seeds, sessions = build_sessions(runs)
+    where = ["constitution", 0, 0]
+    _constitute(sessions)
+    scheds, steps = [], []
+    for run, kw in zip(sessions, runs):
+        scheds.append(run.sim.measurement_schedule(kw["cool_factor"]))
+        steps.append(protocol_steps(kw))
+    sc = scheds[0]
+    timings = [dict(constitution=run.sim.timings.get("constitution", 0.0)) for run in sessions]
+    members = list(range(len(sessions)))
+    engine, order = pre_equilibrated(sessions, members, [(s.dt_max, s.N_pre) for s in scheds], sc.dt, sc.cool,
+                                     where, lambda e, m: [], timings)
+    kws = [runs[b] for b in order]
+    tau = sc.dt / steps[0]["dt_over_tau"]
+    say, report = _console(sims, order, "protocol", where)
+    loop = dict(say=say, report=report)
+    t0 = time.perf_counter()
+    recs, sweep_recs = None, None
+    if proto == "steady":
+        n = max(steps[b]["steps"] for b in order)
+        recs = _guarded(lambda e: eng.steady_shear(e, sc.dt, sc.cool, [k["relative_rate"] / tau for k in kws], n,
+                                                   N1_EVERY, **loop), engine, dt=sc.dt)
+    elif proto == "relaxation":
+        st = steps[order[0]]
+        recs = _guarded(lambda e: eng.stress_relaxation(e, sc.dt, sc.cool, [k["theAmplitude"] for k in kws],
+                                                        st["ramp"], st["steps"] - st["ramp"], **loop), engine, dt=sc.dt)
+    elif proto == "creep":
+        G_c = [k["creep_modulus"] if k["creep_modulus"] is not None else
+               CREEP_MODULUS_FRACTION * k["Young_modulus_spheres"] for k in kws]
+        rate_max = MAX_STRAIN_PER_STEP / sc.dt
+        recs = _guarded(lambda e: eng.creep(e, sc.dt, sc.cool, [k["creep_stress"] for k in kws], G_c,
+                                            kws[0]["creep_response_time"] * tau, steps[order[0]]["steps"], rate_max,
+                                            **loop), engine, dt=sc.dt)
+    else:
+        sweep_recs = []
+        st = steps[order[0]]
+        for j, dtr in enumerate(st["dts"]):
+            dt = dtr * tau
+            if proto == "amplitude_sweep":
+                f, A = sc.f, [k["sweep_amplitudes"][j] for k in kws]
+            else:
+                f, A = kws[0]["sweep_frequencies"][j] / tau, [k["theAmplitude"] for k in kws]
+            cool = kws[0]["cool_factor"] ** (f * dt)
+            out = _guarded(oscillatory, engine, dt, f, A, cool, kws[0]["pre_periods"], kws[0]["periods"],
+                           kws[0]["post_periods"], False, say, report, (), dt=dt)
+            sweep_recs.append((f, A, dt, out))
+    t_protocol = (time.perf_counter() - t0) / len(order)
+    results = [None] * len(sessions)
+    for col, b in enumerate(order):
+        kw = runs[b]
+        t1 = time.perf_counter()
+        from .rheometer_analysis import analyse_record, analyse_sweep
+        if sweep_recs is None:
+            n = steps[b]["steps"]
+            series = {key: np.ascontiguousarray(v[:n, col]) for key, v in recs.items()}
+            summary, curves = analyse_record(proto, kw, series, tau, steps[b])
+            sweep = []
+        else:
+            series, curves = {}, {}
+            sweep = analyse_sweep(kw, [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()
+                                                        if not key.endswith("tensors")})
+                                       for f, A, dt, out in sweep_recs], tau)
+            summary = {}
+        seed_entropy, spawn_key, _ = seeds[b]
+        tm = dict(timings[b], protocol=t_protocol, analysis=time.perf_counter() - t1)
+        results[b] = RheometerResult(proto, dict(kw), seed_entropy, spawn_key,
+                                     run_identity(kw, seed_entropy, spawn_key), tau, sc.dt, series, summary, curves,
+                                     sweep, tm)
+    for run in sessions:
+        run.close()
+    return results
