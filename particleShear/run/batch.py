@@ -53,6 +53,7 @@ PER_REPLICA_PARAMETERS = frozenset((
     "root_folder", "saveData", "saveStressTensorData", "saveOutputImages", "imageFileType", "doDrawing",
     "plotStress", "relative_y_scale_force", "verbose", "progress", "reference_header", "correct_drift_sign",
     "renderer", "stability_guard", "plateau_begin", "plateau_end", "plateau_slope",
+    "relative_rate", "total_strain", "creep_stress", "creep_modulus", "sweep_amplitudes",
 ))
 
 #: parameters that fix the step schedule: N, the model constants behind τ, the protocol and the integrator
@@ -142,14 +143,19 @@ def schedule_key(kwargs):
     -------
     tuple
     """
-    full = dict(_signature_defaults(), **kwargs)
+    from .rheometer import normalize_protocol, protocol_steps
+    full = normalize_protocol(dict(_signature_defaults(), **kwargs))
     shared = tuple((name, repr(full[name])) for name in SCHEDULE_PARAMETERS)
     steps = time_steps_from_model(1.0, full["bimodal_factor"], full["theMu"],
                                   full["relative_transversal_link_strength"], full["theAmplitude"],
                                   full["relative_viscosity"])[0]
     other = tuple(sorted((k, repr(v)) for k, v in kwargs.items()
                          if k not in PER_REPLICA_PARAMETERS and k not in SCHEDULE_PARAMETERS))
-    return shared + (("steps", steps),) + other
+    segments = ()
+    if full["protocol"].endswith("sweep"):     # each step of a one-packing sweep has its own dt
+        st = protocol_steps(full)
+        segments = (("segments", repr((tuple(st["dts"]), tuple(st["segments"])))),)
+    return shared + (("steps", steps),) + other + segments
 
 
 def batches(all_kwargs, batch_size):
@@ -231,6 +237,11 @@ def run_batch(list_of_kwargs, backend=None):
                              "time-step rule and protocol")
     defaults = _signature_defaults()
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
+    if full[0]["protocol"] != "oscillatory":      # the protocol is part of the schedule key
+        from .rheometer import measure_rheometer, normalize_protocol
+        results = measure_rheometer([normalize_protocol(kw) for kw in full])
+        doParticleShearSimulation.last_result = results[-1]
+        return results
     results = measure_batch(full)
     doParticleShearSimulation.last_result = results[-1]
     return results

@@ -116,25 +116,13 @@ def check_protocol(p):
         raise ValueError(f"saveOutputImages=True is invalid with protocol={proto!r}: snapshots are taken of the "
                          "oscillatory protocol only")
     q = normalize_protocol(p)
-    steps = protocol_steps(q)
-    dtr = steps["dt_over_tau"]
     if proto == "steady":
-        rate = _positive("relative_rate", q["relative_rate"])
+        _positive("relative_rate", q["relative_rate"])
         _positive("total_strain", q["total_strain"], 1e6)
-        if rate * dtr > MAX_STRAIN_PER_STEP:
-            raise ValueError(f"relative_rate={rate!r} is out of range: the time step (dt = {dtr:.3g} τ) resolves "
-                             f"at most {MAX_STRAIN_PER_STEP} strain per step, i.e. relative_rate <= "
-                             f"{MAX_STRAIN_PER_STEP / dtr:.4g} (flag --relative-rate)")
     if proto in ("relaxation", "creep"):
         _positive("hold_time", q["hold_time"], 1e9)
     if proto == "relaxation":
         _positive("ramp_time", q["ramp_time"], 1e9)
-        per_step = q["theAmplitude"] / steps["ramp"]
-        if per_step > MAX_STRAIN_PER_STEP:
-            raise ValueError(f"ramp_time={q['ramp_time']!r} is out of range: a ramp to theAmplitude="
-                             f"{q['theAmplitude']!r} in {steps['ramp']} steps is {per_step:.3g} strain per step, more "
-                             f"than {MAX_STRAIN_PER_STEP}; allowed ramp_time >= "
-                             f"{q['theAmplitude'] / MAX_STRAIN_PER_STEP * dtr:.4g} (flag --ramp-time)")
     if proto == "creep":
         if q["creep_stress"] is None:
             raise ValueError("creep_stress=None is invalid with protocol='creep': give the applied stress σ₀ in Pa "
@@ -142,7 +130,24 @@ def check_protocol(p):
         _positive("creep_stress", q["creep_stress"], 1e12)
         if q["creep_modulus"] is not None:
             _positive("creep_modulus", q["creep_modulus"], 1e15)
-        T = _positive("creep_response_time", q["creep_response_time"], 1e9)
+        _positive("creep_response_time", q["creep_response_time"], 1e9)
+    steps = protocol_steps(q)
+    dtr = steps["dt_over_tau"]
+    if proto == "steady":
+        rate = float(q["relative_rate"])
+        if rate * dtr > MAX_STRAIN_PER_STEP:
+            raise ValueError(f"relative_rate={rate!r} is out of range: the time step (dt = {dtr:.3g} τ) resolves "
+                             f"at most {MAX_STRAIN_PER_STEP} strain per step, i.e. relative_rate <= "
+                             f"{MAX_STRAIN_PER_STEP / dtr:.4g} (flag --relative-rate)")
+    if proto == "relaxation":
+        per_step = q["theAmplitude"] / steps["ramp"]
+        if per_step > MAX_STRAIN_PER_STEP:
+            raise ValueError(f"ramp_time={q['ramp_time']!r} is out of range: a ramp to theAmplitude="
+                             f"{q['theAmplitude']!r} in {steps['ramp']} steps is {per_step:.3g} strain per step, more "
+                             f"than {MAX_STRAIN_PER_STEP}; allowed ramp_time >= "
+                             f"{q['theAmplitude'] / MAX_STRAIN_PER_STEP * dtr:.4g} (flag --ramp-time)")
+    if proto == "creep":
+        T = float(q["creep_response_time"])
         if T < 10 * dtr:
             raise ValueError(f"creep_response_time={T!r} is out of range: the controller needs >= 10 steps per "
                              f"response time, allowed >= {10 * dtr:.4g} (flag --creep-response-time)")

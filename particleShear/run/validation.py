@@ -621,7 +621,8 @@ def validate_run(params):
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
     from ..analysis.measures import warn_few_periods
-    warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
+    if p["protocol"] in ("oscillatory", "amplitude_sweep", "frequency_sweep"):
+        warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
     return cost
 
 
