@@ -70,6 +70,10 @@ DOCUMENTED_MODULES = [
     "particleShear.run.validation",
     "particleShear.analysis.laos",
     "particleShear.analysis.periods",
+    "particleShear.analysis.rheometry",
+    "particleShear.engine.rheometer",
+    "particleShear.run.rheometer",
+    "particleShear.run.rheometer_analysis",
 ]
 
 #: Modules of DOCUMENTED_MODULES still being completed on another branch: their docstring

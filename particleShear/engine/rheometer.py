@@ -224,7 +224,18 @@ class CreepController:
         self.rate = xp.zeros_like(sigma0)
 
     def rate_of(self, i):
-        """γ̇ of step i (1/s) from the filtered stress of the steps before it."""
+        """γ̇ of step i (1/s) from the filtered stress of the steps before it.
+
+        Parameters
+        ----------
+        i : int
+            Step index (unused: the controller's state carries the history).
+
+        Returns
+        -------
+        array (B,)
+            The strain rate of each replica (1/s).
+        """
         xp = self.xp
         e = self.sigma0 - self.filtered
         trial = self.integral + e * self.dt
@@ -235,7 +246,15 @@ class CreepController:
         return self.rate
 
     def after_step(self, i, tau_internal, tau_surface):
-        """Filter the plate stress of the step just taken."""
+        """Filter the plate stress of the step just taken.
+
+        Parameters
+        ----------
+        i : int
+            Step index (unused).
+        tau_internal, tau_surface : array (B,)
+            Shear stresses of the step (Pa); the plate's, ``tau_surface``, is the controlled one.
+        """
         self.filtered = self.filtered + (tau_surface - self.filtered) * self.alpha
 
 

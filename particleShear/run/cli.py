@@ -55,7 +55,9 @@ _CLI_DEFAULTS = {
 _CLI_HELP = {"progress": "Show a progress line on stderr (phase, step, elapsed, estimated remaining time), "
                          "the progress callback of the API."}
 #: the command-line type of parameters whose Python type is wider
-_CLI_TYPES = {"seed": int, "progress": bool}
+_CLI_TYPES = {"seed": int, "progress": bool, "creep_stress": float, "creep_modulus": float,
+              "sweep_amplitudes": lambda text: [float(x) for x in text.split(",") if x.strip()],
+              "sweep_frequencies": lambda text: [float(x) for x in text.split(",") if x.strip()]}
 
 
 def flag_name(name):
@@ -437,6 +439,8 @@ def _json_row(res):
         if isinstance(v, (list, tuple)):
             return [clean(x) for x in v]
         return v
+    if not hasattr(res, "to_dict"):      # a RheometerResult: its table rows
+        return json.dumps([{k: clean(v) for k, v in row.items()} for row in res.rows()], default=str)
     return json.dumps({k: clean(v) for k, v in res.to_dict().items()}, default=str)
 
 
@@ -537,6 +541,9 @@ def main(argv=None):
     info = sys.stderr if args.json else sys.stdout
     if args.json:
         print(_json_row(res))
+    elif not hasattr(res, "G_internal"):     # another protocol than "oscillatory" (docs/protocols.md)
+        for row in res.rows():
+            print("  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in row.items()))
     else:
         print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
         print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
@@ -548,7 +555,7 @@ def main(argv=None):
             print("output file: " + res.output_path)
         if res.image_folder:
             print(f"images: {res.n_images} in {res.image_folder}")
-    if res.write_error is not None:
+    if getattr(res, "write_error", None) is not None:
         print(f"particleShear: writing the output failed, nothing was saved: {res.write_error}", file=sys.stderr)
         return 1
     if args.plot:

@@ -226,6 +226,13 @@ def protocol_steps(q):
 class RheometerResult:
     """What a run of a protocol other than "oscillatory" produced (docs/protocols.md).
 
+    The constructor's parameters are the attributes below of the same names (``values`` is derived).
+
+    Parameters
+    ----------
+    protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps, timings
+        See Attributes.
+
     Attributes
     ----------
     protocol : str
