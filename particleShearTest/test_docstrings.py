@@ -34,6 +34,7 @@ DOCUMENTED_MODULES = [
     "particleShear.analysis.demodulation",
     "particleShear.analysis.measures",
     "particleShear.analysis.sweep",
+    "particleShear.analysis.flow_curve",
     "particleShear.analysis.cli",
     "particleShear.analysis.figure",
     "particleShear.simulation",

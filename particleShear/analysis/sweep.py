@@ -243,6 +243,11 @@ def _check(amplitude, Gp, Gpp, n_boot, confidence, rng):
     if n_amp < 2:
         raise ValueError(f"amplitude={_short(A)} is out of range: {n_amp} distinct value(s), allowed at least 2 "
                          "distinct amplitudes")
+    return (A, gp, gpp) + _check_resampling(n_boot, confidence, rng)
+
+
+def _check_resampling(n_boot, confidence, rng):
+    """The checked bootstrap settings ``(n_boot, confidence, generator)`` (ValueError otherwise)."""
     if isinstance(n_boot, (bool, np.bool_)) or not isinstance(n_boot, numbers.Integral):
         raise ValueError(f"n_boot={n_boot!r} is invalid: allowed an integer >= 1")  # noqa: TRY004 (the API's rule)
     if n_boot < 1:
@@ -259,7 +264,7 @@ def _check(amplitude, Gp, Gpp, n_boot, confidence, rng):
         gen = np.random.default_rng(int(rng))
     else:
         raise ValueError(f"rng={rng!r} is invalid: allowed None, an integer >= 0 or a numpy.random.Generator")
-    return A, gp, gpp, int(n_boot), float(confidence), gen
+    return int(n_boot), float(confidence), gen
 
 
 # ---------------------------------------------------------------------------------------------
