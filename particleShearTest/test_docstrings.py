@@ -61,6 +61,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.tasks",
     "particleShear.plot",
     "particleShear.sweep_plot",
+    "particleShear.rheometer_plot",
     "particleShear.messages",
     "particleShear.run",
     "particleShear.run.api",

@@ -1,0 +1,271 @@
+"""Figures of the virtual rheometer's protocols with matplotlib (optional extra ``[plot]``).
+
+Install with ``pip install "particleShear[plot]"``.  Like :mod:`particleShear.plot`, every
+figure is a :class:`matplotlib.figure.Figure` on an Agg canvas (no pyplot, headless-safe).
+Every function checks its input (equal lengths, finite numbers) and, when ``path`` is given,
+the figure path, before drawing; points that cannot be on a log axis (non-positive) are left
+out and a text note on the figure says how many.
+
+Functions
+---------
+plot_flow_curve
+    Stress σ and viscosity η = σ/γ̇ against the shear rate γ̇ (log–log), optionally a fitted
+    yield-stress curve (Herschel–Bulkley σ = σ_y + K γ̇^n).
+plot_relaxation
+    Relaxation modulus G(t) against time, optionally a plateau band.
+plot_creep
+    Creep compliance J(t) against time (log–log).
+plot_amplitude_sweeps
+    G′ and G″ against the strain amplitude, one packing swept amplitude after amplitude and
+    independent packings.
+"""
+__docformat__ = "numpy"
+import numpy as np
+
+from .plot import _figure, check_figure_path, save_figure
+
+__all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps"]
+
+
+def _series(name, values, n=None):
+    """``values`` as a 1-d finite float array (of length ``n`` if given); ValueError naming ``name``."""
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}={values!r} is invalid: must be a sequence of finite numbers") from exc
+    if a.ndim != 1:
+        raise ValueError(f"{name} is invalid: must be one-dimensional, got shape {a.shape}")
+    if n is not None and len(a) != n:
+        raise ValueError(f"{name} is invalid: length {len(a)}, must equal the length {n} of the data")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}={a.tolist()!r} is invalid: all values must be finite")
+    return a
+
+
+def _note(ax, dropped, what):
+    """Write on ``ax`` how many non-positive points were left out of a log axis."""
+    if dropped:
+        ax.text(0.02, 0.02, f"{dropped} non-positive point(s) of {what} dropped (log axes)",
+                transform=ax.transAxes, ha="left", va="bottom", fontsize="small", gid="dropped-note")
+
+
+def _finish(fig, path):
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None):
+    """Flow curve: σ (Pa) and η = σ/γ̇ (Pa·s) against γ̇ (1/s), both log–log.
+
+    Parameters
+    ----------
+    rate : array_like
+        Shear rates γ̇ in 1/s.
+    stress : array_like
+        Steady shear stresses σ in Pa, same length as ``rate``.
+    stress_err : array_like, optional
+        Standard errors of ``stress`` in Pa (error bars; η's error is stress_err/rate).
+    fit : object, optional
+        A fitted flow law with attributes ``sigma_y`` (Pa), ``K`` (Pa·s^n), ``n`` and a method
+        ``stress(rate)``; drawn on a log-spaced grid over the data range on both panels, with
+        σ_y as a dashed horizontal line on the σ panel.
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes 0: σ against γ̇; axes 1: η against γ̇.
+
+    Raises
+    ------
+    ValueError
+        Unequal lengths, non-finite numbers, or a bad ``path``.
+    """
+    rate = _series("rate", rate)
+    stress = _series("stress", stress, len(rate))
+    err = None if stress_err is None else _series("stress_err", stress_err, len(rate))
+    if path is not None:
+        check_figure_path(path, "path")
+    keep = (rate > 0) & (stress > 0)
+    r, s = rate[keep], stress[keep]
+    e = None if err is None else err[keep]
+    fig = _figure(9.0, 4.0)
+    ax_s, ax_e = fig.subplots(1, 2)
+    ax_s.errorbar(r, s, yerr=e, fmt="o", label="data")
+    ax_e.errorbar(r, s / r, yerr=None if e is None else e / r, fmt="o", label="data")
+    if fit is not None and len(r):
+        grid = np.logspace(np.log10(r.min()), np.log10(r.max()), 200)
+        fs = np.asarray(fit.stress(grid), dtype=float)
+        label = f"fit: σ_y={fit.sigma_y:.3g} Pa, K={fit.K:.3g} Pa·s^n, n={fit.n:.3g}"
+        ax_s.plot(grid, fs, "-", label=label, gid="fit")
+        ax_e.plot(grid, fs / grid, "-", label=label, gid="fit")
+        if fit.sigma_y > 0:
+            ax_s.axhline(fit.sigma_y, ls="--", color="grey", label="σ_y", gid="sigma_y")
+    for ax in (ax_s, ax_e):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("shear rate γ̇ (1/s)")
+        ax.legend(fontsize="small")
+    ax_s.set_ylabel("stress σ (Pa)")
+    ax_e.set_ylabel("viscosity η = σ/γ̇ (Pa·s)")
+    _note(ax_s, int((~keep).sum()), "(γ̇, σ)")
+    return _finish(fig, path)
+
+
+def plot_relaxation(t, G, G_err=None, plateau=None, path=None):
+    """Stress relaxation: G(t) (Pa) against t (s), log x; log y when all G > 0, else linear y.
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s after the strain step; non-positive times are dropped (log x).
+    G : array_like
+        Relaxation modulus G(t) = σ(t)/γ₀ in Pa, same length as ``t``.
+    G_err : array_like, optional
+        Standard errors of ``G`` in Pa (error bars).
+    plateau : tuple of float, optional
+        (value, error) of the plateau modulus in Pa, drawn as a horizontal band.
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes.
+
+    Raises
+    ------
+    ValueError
+        Unequal lengths, non-finite numbers, a bad ``plateau``, or a bad ``path``.
+    """
+    t = _series("t", t)
+    G = _series("G", G, len(t))
+    err = None if G_err is None else _series("G_err", G_err, len(t))
+    if plateau is not None:
+        plateau = _series("plateau", plateau, 2)
+    if path is not None:
+        check_figure_path(path, "path")
+    keep = t > 0
+    fig = _figure(6.0, 4.0)
+    ax = fig.subplots()
+    ax.errorbar(t[keep], G[keep], yerr=None if err is None else err[keep], fmt="o", label="G(t)")
+    if plateau is not None:
+        v, e = plateau
+        ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"plateau {v:.3g} ± {e:.3g} Pa", gid="plateau")
+    ax.set_xscale("log")
+    if np.all(G[keep] > 0):
+        ax.set_yscale("log")
+    else:
+        ax.text(0.98, 0.98, "linear G axis: some G ≤ 0", transform=ax.transAxes, ha="right", va="top",
+                fontsize="small", gid="linear-note")
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("relaxation modulus G(t) (Pa)")
+    ax.legend(fontsize="small")
+    _note(ax, int((~keep).sum()), "t")
+    return _finish(fig, path)
+
+
+def plot_creep(t, J, path=None):
+    """Creep: compliance J(t) = γ(t)/σ₀ (1/Pa) against t (s), log–log on the positive points.
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s after the stress step.
+    J : array_like
+        Creep compliance in 1/Pa, same length as ``t``.
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes.
+
+    Raises
+    ------
+    ValueError
+        Unequal lengths, non-finite numbers, or a bad ``path``.
+    """
+    t = _series("t", t)
+    J = _series("J", J, len(t))
+    if path is not None:
+        check_figure_path(path, "path")
+    keep = (t > 0) & (J > 0)
+    fig = _figure(6.0, 4.0)
+    ax = fig.subplots()
+    ax.plot(t[keep], J[keep], "o-", label="J(t)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("creep compliance J(t) (1/Pa)")
+    _note(ax, int((~keep).sum()), "(t, J)")
+    return _finish(fig, path)
+
+
+_SWEEP_NAMES = {"one_packing": "one packing (amplitude after amplitude)", "independent": "independent packings"}
+
+
+def _sweep(name, data):
+    """Validate one amplitude-sweep mapping; returns dict of arrays (errors None when absent)."""
+    try:
+        keys = set(data)
+    except TypeError as exc:
+        raise ValueError(f"{name}={data!r} is invalid: must be a mapping with keys amplitude, Gp, Gpp") from exc
+    missing = {"amplitude", "Gp", "Gpp"} - keys
+    if missing:
+        raise ValueError(f"{name} is invalid: missing keys {sorted(missing)}")
+    a = _series(f"{name}['amplitude']", data["amplitude"])
+    out = {"amplitude": a}
+    for k in ("Gp", "Gpp", "Gp_err", "Gpp_err"):
+        out[k] = None if data.get(k) is None else _series(f"{name}[{k!r}]", data[k], len(a))
+    return out
+
+
+def plot_amplitude_sweeps(one_packing, independent=None, path=None):
+    """G′ (filled markers) and G″ (open markers) in Pa against the strain amplitude, log–log.
+
+    Parameters
+    ----------
+    one_packing : mapping
+        One packing swept amplitude after amplitude: keys "amplitude", "Gp", "Gpp" (Pa) and
+        optional "Gp_err", "Gpp_err" (standard errors, Pa).
+    independent : mapping, optional
+        A fresh packing per amplitude, same keys.
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes; line labels start with the series name.
+
+    Raises
+    ------
+    ValueError
+        A missing key, unequal lengths, non-finite numbers, or a bad ``path``.
+    """
+    sweeps = {"one_packing": _sweep("one_packing", one_packing)}
+    if independent is not None:
+        sweeps["independent"] = _sweep("independent", independent)
+    if path is not None:
+        check_figure_path(path, "path")
+    fig = _figure(6.0, 4.5)
+    ax = fig.subplots()
+    dropped = 0
+    for (key, d), colour in zip(sweeps.items(), ("C0", "C1")):
+        for k, face in (("Gp", colour), ("Gpp", "none")):
+            keep = (d["amplitude"] > 0) & (d[k] > 0)
+            dropped += int((~keep).sum())
+            err = d[k + "_err"]
+            ax.errorbar(d["amplitude"][keep], d[k][keep], yerr=None if err is None else err[keep], fmt="o-",
+                        color=colour, mfc=face, label=f"{_SWEEP_NAMES[key]}: {'G′' if k == 'Gp' else 'G″'}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("strain amplitude γ₀")
+    ax.set_ylabel("G′, G″ (Pa)")
+    ax.legend(fontsize="small")
+    _note(ax, dropped, "G′/G″")
+    return _finish(fig, path)
