@@ -48,6 +48,8 @@ def sample_value(name, cli_type, choices, default):
         return "7", 7
     if cli_type is float:
         return "0.375", 0.375    # exact in binary: the parsed float equals the literal
+    if cli_type is cli.float_list:
+        return "0.25,0.5", [0.25, 0.5]
     return "some_folder", "some_folder"
 
 

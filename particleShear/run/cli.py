@@ -55,9 +55,24 @@ _CLI_DEFAULTS = {
 _CLI_HELP = {"progress": "Show a progress line on stderr (phase, step, elapsed, estimated remaining time), "
                          "the progress callback of the API."}
 #: the command-line type of parameters whose Python type is wider
+def float_list(text):
+    """A comma-separated list of numbers (``--sweep-amplitudes 0.01,0.1,1``) as a list of float.
+
+    Parameters
+    ----------
+    text : str
+        The flag's text.
+
+    Returns
+    -------
+    list of float
+    """
+    return [float(x) for x in text.split(",") if x.strip()]
+
+
+float_list.__name__ = "comma-separated float list"   # argparse names the type in its message
 _CLI_TYPES = {"seed": int, "progress": bool, "creep_stress": float, "creep_modulus": float,
-              "sweep_amplitudes": lambda text: [float(x) for x in text.split(",") if x.strip()],
-              "sweep_frequencies": lambda text: [float(x) for x in text.split(",") if x.strip()]}
+              "sweep_amplitudes": float_list, "sweep_frequencies": float_list}
 
 
 def flag_name(name):
