@@ -29,16 +29,10 @@ __all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_s
 
 def _series(name, values, n=None):
     """``values`` as a 1-d finite float array (of length ``n`` if given); ValueError naming ``name``."""
-    try:
-        a = np.asarray(values, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}={values!r} is invalid: must be a sequence of finite numbers") from exc
-    if a.ndim != 1:
-        raise ValueError(f"{name} is invalid: must be one-dimensional, got shape {a.shape}")
+    from .analysis.sweep import _vector
+    a = _vector(name, values)
     if n is not None and len(a) != n:
         raise ValueError(f"{name} is invalid: length {len(a)}, must equal the length {n} of the data")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}={a.tolist()!r} is invalid: all values must be finite")
     return a
 
 

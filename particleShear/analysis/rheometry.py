@@ -25,12 +25,9 @@ SteadyState = collections.namedtuple("SteadyState", "mean sem t_transient i_tran
 
 
 def _series(name, x):
-    a = np.asarray(x, dtype=float)
-    if a.ndim != 1:
-        raise ValueError(f"{name} has shape {a.shape}: allowed a 1-D series")
-    if not np.isfinite(a).all():
-        raise ValueError(f"{name} has non-finite values: allowed finite numbers")
-    return a
+    """``x`` as a finite 1-D float array (the sweep analysis's check; ValueError naming ``name``)."""
+    from .sweep import _vector
+    return _vector(name, x)
 
 
 def _fraction(fraction):

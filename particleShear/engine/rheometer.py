@@ -239,9 +239,8 @@ class CreepController:
         xp = self.xp
         e = self.sigma0 - self.filtered
         trial = self.integral + e * self.dt
-        raw = (e + trial / self.T_i) / self.eta_c
-        free = xp.abs(raw) <= self.rate_max
-        self.integral = xp.where(free, trial, self.integral)
+        # the integral advances only where its rate is within the bound (no wind-up)
+        self.integral = xp.where(xp.abs(e + trial / self.T_i) <= self.rate_max * self.eta_c, trial, self.integral)
         self.rate = xp.clip((e + self.integral / self.T_i) / self.eta_c, -self.rate_max, self.rate_max)
         return self.rate
 

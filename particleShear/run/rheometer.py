@@ -326,6 +326,7 @@ def measure_rheometer(runs):
     from ..engine.step import protocol as oscillatory
     from ..simulation.provenance import run_identity
     from .batch import _console, _constitute, _guarded, build_sessions, pre_equilibrated
+    from .rheometer_analysis import analyse_record, analyse_sweep
 
     proto = runs[0]["protocol"]
     sims, seeds, sessions = build_sessions(runs)
@@ -379,7 +380,6 @@ def measure_rheometer(runs):
     for col, b in enumerate(order):
         kw = runs[b]
         t1 = time.perf_counter()
-        from .rheometer_analysis import analyse_record, analyse_sweep
         if sweep_recs is None:
             n = steps[b]["steps"]
             series = {key: np.ascontiguousarray(v[:n, col]) for key, v in recs.items()}
