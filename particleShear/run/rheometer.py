@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 
-__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
+__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
 PROTOCOLS = ("oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", "frequency_sweep")
@@ -40,6 +40,14 @@ PROTOCOLS = ("oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", 
 PROTOCOL_DEFAULTS = {"protocol": "oscillatory", "relative_rate": 0.01, "total_strain": 2.0, "ramp_time": 1.0,
                      "hold_time": 200.0, "creep_stress": None, "creep_modulus": None, "creep_response_time": 5.0,
                      "sweep_amplitudes": None, "sweep_frequencies": None}
+
+#: the protocol parameters whose value is a list (one value of a sweep is a whole list)
+LIST_PARAMETERS = ("sweep_amplitudes", "sweep_frequencies")
+
+#: key of a sweep step (``RheometerResult.steps``) -> its column in a results table (the other keys,
+#: the moduli and measures, are columns of the same name)
+STEP_COLUMNS = {"position": "sweep_position", "amplitude": "sweep_amplitude",
+                "relative_frequency": "sweep_relative_frequency", "f": "frequency_Hz", "dt": "dt", "N_steps": "N_steps"}
 
 #: largest strain increment |γ̇|·dt of one step (≈ 9× the default oscillation's peak, 5.6e-4):
 #: neighbours 2r apart then move by at most 1 % of r relative to each other per step
@@ -286,17 +294,79 @@ class RheometerResult:
         return [[st["Gp_surface"], st["Gpp_surface"]] for st in self.steps]
 
     def rows(self):
-        """Rows of a results table: one per run, or one per step of a sweep (``position`` 0, 1, …).
+        """The rows of this run in a sweep's results table: one, or one per step of a sweep.
+
+        Keys as :func:`particleShear.sweep.table.table_columns` of a protocol sweep: ``run_id``,
+        ``status`` ("ok"), ``error``, the moduli and measures (sweep steps), the run columns
+        (``repetition``, ``frequency_Hz`` and ``omega`` of a sweep step, ``dt``, ``N_steps``), the
+        protocol columns (:data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`: the summary, or
+        ``sweep_position``, ``sweep_amplitude``, ``sweep_relative_frequency`` of a step), every
+        parameter, ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s),
+        ``output_path``.  Columns a protocol does not produce are absent (empty cells).
 
         Returns
         -------
         list of dict
-            Column → value: ``protocol``, ``run_id``, the summary (or the step's values).
         """
-        base = {"protocol": self.protocol, "run_id": self.run_id}
-        if self.steps:
-            return [dict(base, **st) for st in self.steps]
-        return [dict(base, **self.summary)]
+        from .. import __version__
+        from ..simulation.provenance import run_identity
+        from ..sweep.schema import PROTOCOL_COLUMNS
+        from ..sweep.spec import sweep_parameter_defaults
+        params = sweep_parameter_defaults(protocols=True)
+        params.update({k: v for k, v in self.parameters.items() if k in params})
+        base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
+                "repetition": int(getattr(self, "repetition", 0)), "dt": float(self.dt)}
+        base.update({k: v for k, v in self.summary.items() if k in PROTOCOL_COLUMNS})
+        if self.protocol in ("steady", "relaxation", "creep"):
+            base["N_steps"] = int(len(self.series["t"])) if "t" in self.series else None
+        base.update(params)
+        base.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
+                    wall_time_s=float(sum(self.timings.values())), output_path=self.output_path or "")
+        if not self.steps:
+            return [base]
+        out = []
+        for st in self.steps:
+            row = dict(base, **{STEP_COLUMNS.get(k, k): v for k, v in st.items()})
+            row["omega"] = 2 * math.pi * float(st["f"])
+            out.append(row)
+        return out
+
+    @classmethod
+    def from_rows(cls, rows, parameters, seed, spawn_key, output_path=None):
+        """The result of a finished run rebuilt from its table rows (no series, no curves).
+
+        Used when a series or a sweep resumes: the summary, or the steps of a sweep, are the
+        rows' values (the inverse of :meth:`rows`).
+
+        Parameters
+        ----------
+        rows : list of dict
+            The run's typed rows (:func:`particleShear.sweep.schema.typed_row`), in step order.
+        parameters : dict
+            The run's parameters.
+        seed, spawn_key
+            The run's seed entropy and spawn key.
+        output_path : str, optional
+            The run's file.
+
+        Returns
+        -------
+        RheometerResult
+        """
+        from ..analysis.measures import MEASURE_COLUMNS
+        from ..sweep.schema import PROTOCOL_COLUMNS
+        first = rows[0]
+        proto = parameters["protocol"]
+        inverse = {c: k for k, c in STEP_COLUMNS.items()}
+        moduli = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") + tuple(MEASURE_COLUMNS)
+        steps = [{inverse.get(c, c): r.get(c) for c in tuple(STEP_COLUMNS.values()) + moduli}
+                 for r in rows] if proto in ("amplitude_sweep", "frequency_sweep") else []
+        summary = {} if steps else {c: first[c] for c in PROTOCOL_COLUMNS if first.get(c) is not None}
+        dt = float(first["dt"])
+        res = cls(proto, dict(parameters), seed, tuple(spawn_key), first["run_id"], dt / _dt_over_tau(parameters), dt,
+                  {}, summary, {}, steps, {"total": float(first.get("wall_time_s") or 0.0)})
+        res.output_path = output_path
+        return res
 
     def __repr__(self):
         main = ", ".join(f"{v:.4g}" if isinstance(v, float) else repr(v) for v in

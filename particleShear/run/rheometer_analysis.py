@@ -44,17 +44,17 @@ def analyse_record(protocol, kw, series, tau, steps):
     out, curves = {}, {}
     if protocol == "steady":
         rate = kw["relative_rate"] / tau
-        out["rate"] = rate
+        out["strain_rate"] = rate
         for est, key in _EST:
             ss = steady_state(t, series[key])
-            out[f"stress_{est}"], out[f"stress_{est}_sem"] = ss.mean, ss.sem
-            out[f"viscosity_{est}"], out[f"viscosity_{est}_sem"] = ss.mean / rate, ss.sem / rate
+            out[f"stress_{est}"], out[f"stress_{est}_se"] = ss.mean, ss.sem
+            out[f"viscosity_{est}"], out[f"viscosity_{est}_se"] = ss.mean / rate, ss.sem / rate
             if est == "surface":
                 out["t_transient"], out["strain_transient"] = ss.t_transient, ss.t_transient * rate
         n1 = series["N1"]
         keep = np.isfinite(n1) & (t >= out["t_transient"])
         ba = plateau(t[keep], n1[keep], 1.0) if keep.sum() >= 2 else None
-        out["N1"], out["N1_sem"] = (ba.mean, ba.sem) if ba else (math.nan, math.nan)
+        out["N1"], out["N1_se"] = (ba.mean, ba.sem) if ba else (math.nan, math.nan)
     elif protocol == "relaxation":
         g0 = kw["theAmplitude"]
         n_ramp = steps["ramp"]
@@ -64,7 +64,7 @@ def analyse_record(protocol, kw, series, tau, steps):
         for est, key in _EST:
             G = series[key][n_ramp:] / g0
             ba = plateau(th, G)
-            out[f"G_plateau_{est}"], out[f"G_plateau_{est}_sem"] = ba.mean, ba.sem
+            out[f"G_plateau_{est}"], out[f"G_plateau_{est}_se"] = ba.mean, ba.sem
             tm, gm, gs, _ = log_grid(th, G)
             curves[f"G_{est}"] = (tm, gm, gs)
     elif protocol == "creep":
@@ -75,7 +75,7 @@ def analyse_record(protocol, kw, series, tau, steps):
         out["creep_rate"], out["creep_rate_se"] = rate, rate_se
         out["creep_viscosity"] = s0 / rate if rate > 0 else math.inf
         ba = plateau(t, gam)
-        out["strain_plateau"], out["strain_plateau_sem"] = ba.mean, ba.sem
+        out["strain_plateau"], out["strain_plateau_se"] = ba.mean, ba.sem
         half = t >= t[-1] / 2
         out["stress_tracking"] = float((series["stress_surface"][half].mean() - s0) / s0)
         tm, jm, js, _ = log_grid(t, gam / s0)
@@ -104,7 +104,8 @@ def analyse_sweep(kw, segments, tau):
     rows = []
     pre, periods, post = kw["pre_periods"], kw["periods"], kw["post_periods"]
     for j, (f, A, dt, rec) in enumerate(segments):
-        row = {"position": j, "amplitude": A, "relative_frequency": f * tau, "f": f, "dt": dt}
+        row = {"position": j, "amplitude": A, "relative_frequency": f * tau, "f": f, "dt": dt,
+               "N_steps": len(rec["t"])}
         for est, key in _EST:
             SA, SB, Gp, Gpp = demodulation(rec["t"], rec[key], f, A, pre, periods, post,
                                            correct_drift_sign=kw["correct_drift_sign"])

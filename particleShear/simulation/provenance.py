@@ -142,6 +142,14 @@ def same_input(text, value):
     if text is None:
         return False
     want = _identity_value(value)
+    if want is None:                 # an unset option (creep_modulus=None) is an empty cell
+        return text == ""
+    if isinstance(want, list):       # a list (sweep_amplitudes) is a JSON cell
+        try:
+            got = json.loads(text)
+        except ValueError:
+            return False
+        return isinstance(got, list) and got == want
     if isinstance(want, bool):
         return text == str(want)
     if isinstance(want, float):

@@ -29,6 +29,8 @@ _FORMAT = "particleShear sweep record 1"
 
 
 def _num(v):
+    if isinstance(v, list):          # one value of sweep_amplitudes / sweep_frequencies
+        return [_num(x) for x in v]
     return v if isinstance(v, (bool, str)) else float(v)
 
 

@@ -53,7 +53,7 @@ _BATCH_CHUNK = 4096
 
 @dataclasses.dataclass
 class SweepOutcome:
-    """A finished run: its :class:`~particleShear.sweep.spec.SweepRun`, its table row, and its result.
+    """A finished run: its :class:`~particleShear.sweep.spec.SweepRun`, its table row(s), and its result.
 
     Parameters
     ----------
@@ -61,20 +61,55 @@ class SweepOutcome:
         The run (parameters, seed, run id).
     row : dict
         Its row of ``results.csv`` (status ``ok`` or ``failed``, moduli in Pa, parameters, ...),
-        values typed as the worker produced them (floats, ints, bools, the spawn key a list).
-    result : SimulationResult or None, optional
-        The :class:`~particleShear.run.api.SimulationResult` (None for a failed run);
-        its per-step ``series`` are kept only with ``keep_series=True``.
+        values typed as the worker produced them (floats, ints, bools, the spawn key a list);
+        the first step's row for a one-packing sweep.
+    result : SimulationResult, RheometerResult or None, optional
+        The :class:`~particleShear.run.api.SimulationResult` (a
+        :class:`~particleShear.run.rheometer.RheometerResult` for the other protocols; None for a
+        failed run); its per-step ``series`` are kept only with ``keep_series=True``.
+    rows : list of dict, optional
+        Every row of the run: one per step of a one-packing sweep (``sweep_position`` 0, 1, ...),
+        else ``[row]`` (the default).
     """
 
     run: object
     row: dict
     result: object = None
+    rows: list = None
+
+    def __post_init__(self):
+        if self.rows is None:
+            self.rows = [self.row]
 
     @property
     def ok(self):
         """True when the run succeeded (``row["status"] == "ok"``)."""
         return self.row["status"] == "ok"
+
+
+#: the column whose value a progress line shows, per protocol (the oscillatory run's G′)
+_SHOWN = {"steady": ("stress_surface", "σ", "Pa"), "relaxation": ("G_plateau_surface", "G_plateau", "Pa"),
+          "creep": ("creep_rate", "creep rate", "1/s")}
+
+
+def _shown(row):
+    name, label, unit = _SHOWN.get(row.get("protocol") or "", ("Gp_surface", "G'", "Pa"))
+    return f"{label}={float(row[name]):.6g} {unit}"
+
+
+def _n_rows(run):
+    """Rows of an ``ok`` run in the table: one per step of a one-packing sweep, else one."""
+    proto = run.parameters.get("protocol", "oscillatory")
+    if proto == "amplitude_sweep":
+        return len(run.parameters["sweep_amplitudes"])
+    if proto == "frequency_sweep":
+        return len(run.parameters["sweep_frequencies"])
+    return 1
+
+
+def _flat(items):
+    """The rows of ``(run, row or [rows])`` items, in order."""
+    return [r for _, row in items for r in (row if isinstance(row, list) else [row])]
 
 
 class SweepProgress:
@@ -117,7 +152,7 @@ class SweepProgress:
             self._bar.set_postfix(failed=self.failed)
             return
         row = outcome.row
-        tail = f"G'={float(row['Gp_surface']):.6g} Pa" if outcome.ok else row["error"][:80]
+        tail = _shown(row) if outcome.ok else row["error"][:80]
         self.stream.write(f"[sweep] {self.done}/{self.total} done, {self.failed} failed, {rate:.3g} runs/s, "
                           f"ETA {eta:.0f} s | {row['run_id']} {row['status']} {float(row['wall_time_s']):.2f} s "
                           f"{tail}\n")
@@ -326,11 +361,12 @@ class Sweep:
     def _classify(self, retry_failed=False):
         """``(done, distrusted)``: ``{run_id: (run, row)}`` finished, ``{run_id: (run, reason)}`` to run again.
 
-        An ``ok`` row that is trustworthy (:func:`~.table.row_problem`, file verified) wins over
+        ``row`` is the list of a one-packing sweep's rows (one per step; the run counts only when
+        every step has its row).  An ``ok`` row that is trustworthy (:func:`~.table.row_problem`, file verified) wins over
         any other row of the run, in any table; a ``failed`` row counts (unless ``retry_failed``)
         when the run has no ``ok`` row to distrust.
         """
-        ok, failed, distrust = {}, {}, {}
+        ok, failed, distrust, steps = {}, {}, {}, {}
         for path in self._tables():
             for row in read_rows(path):
                 run = self._run_of(row)
@@ -344,7 +380,18 @@ class Sweep:
                     if row.get("status") == "ok" or rid not in distrust:
                         distrust[rid] = (run, problem)
                     continue
-                (ok if row["status"] == "ok" else failed).setdefault(rid, (run, row))
+                if row["status"] != "ok":
+                    failed.setdefault(rid, (run, row))
+                elif _n_rows(run) == 1:
+                    ok.setdefault(rid, (run, row))
+                else:                               # a step of a one-packing sweep
+                    steps.setdefault(rid, (run, {}))[1].setdefault(int(row["sweep_position"]), row)
+        for rid, (run, got) in steps.items():
+            n = _n_rows(run)
+            if sorted(got) == list(range(n)):
+                ok.setdefault(rid, (run, [got[k] for k in range(n)]))
+            elif rid not in ok:
+                distrust[rid] = (run, f"rows of {len(got)} of its {n} sweep steps (positions {sorted(got)})")
         done = dict(ok)
         for rid, item in failed.items():
             if rid not in done and rid not in distrust and not retry_failed:
@@ -362,10 +409,12 @@ class Sweep:
         Returns
         -------
         dict
-            Run id → row, typed as in :meth:`rows`.
+            Run id → row, typed as in :meth:`rows` (the list of its rows for a one-packing sweep
+            that finished).
         """
         done, _ = self._classify(retry_failed)
-        return {rid: typed_row(row) for rid, (_, row) in done.items()}
+        return {rid: [typed_row(r) for r in row] if isinstance(row, list) else typed_row(row)
+                for rid, (_, row) in done.items()}
 
     def _mine(self, run):
         return self.task_count is None or run.index % self.task_count == self.task_index
@@ -571,10 +620,11 @@ class Sweep:
             job, outcomes = item
             done = []
             for task, (row, result) in zip(job, outcomes):
-                append_row(self.table_path, row, self.columns)
+                rows = row if isinstance(row, list) else [row]
+                append_row(self.table_path, rows, self.columns)
                 run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
                     self._run_of({"run_id": task["run_id"]})
-                outcome = SweepOutcome(run, row, result)
+                outcome = SweepOutcome(run, rows[0], result, rows)
                 if show is not None:
                     show(outcome)
                 done.append(outcome)
@@ -646,13 +696,13 @@ class Sweep:
         Returns
         -------
         list of dict
-            One dict per finished run (column → value): moduli and measures float (None where
+            One dict per finished run (one per step of a one-packing sweep; column → value): moduli and measures float (None where
             empty), ``N``, ``repetition``, ``N_steps`` int, flags bool (``steady_state`` None
             when it cannot be judged), ``seed_entropy`` int, ``spawn_key`` a list of int,
             strings as strings (:mod:`particleShear.sweep.schema`).
         """
         done, _ = self._classify()
-        return [typed_row(row) for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
+        return [typed_row(row) for row in _flat(sorted(done.values(), key=lambda item: item[0].index))]
 
     def merge(self):
         """Merge every table of ``out_dir`` into ``results.csv`` (one row per run, sweep order, others after).
@@ -665,7 +715,8 @@ class Sweep:
         Returns
         -------
         tuple of int
-            ``(n_rows, n_missing)``: rows of this sweep written, runs not finished yet.
+            ``(n_rows, n_missing)``: rows of this sweep written (one per step of a one-packing
+            sweep), runs not finished yet.
 
         Raises
         ------
@@ -681,7 +732,7 @@ class Sweep:
             self._check_tables(path)
             write_schema(self.out_dir, self.columns)
             done, _ = self._classify()
-            ours = [row for _, (run, row) in sorted(done.items(), key=lambda kv: kv[1][0].index)]
+            ours = _flat(sorted(done.values(), key=lambda item: item[0].index))
             merged = set(done)
             others = [row for row in read_rows(path) if row.get("run_id") not in merged]   # kept, never dropped
             write_table(path, ours + others, self.columns)
@@ -698,7 +749,7 @@ class Sweep:
                 except FolderBusyError:
                     self.kept_tables.append((t, "its task is still running"))
             write_parquet(path)
-        return len(ours), len(self.my_runs()) - len(ours)
+        return len(ours), len(self.my_runs()) - len(done)
 
 
 def run_sweep(spec, out_dir, *, executor=None, workers=None, task_index=None, task_count=None, keep_series=False,

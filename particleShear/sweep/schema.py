@@ -7,19 +7,21 @@ description as field metadata).  ``run_sweep`` returns rows typed by it (:func:`
 
 Column types (``"type"`` in the JSON file):
 
-============  ==========================  =====================  ========================
-type          Python value (typed dict)   pandas dtype           Arrow type
-============  ==========================  =====================  ========================
-``float``     float (empty: None)         ``float64`` (NaN)      ``double``
-``int``       int (empty: None)           ``int64`` / ``Int64``  ``int64``
-``bool``      bool (empty: None)          ``bool`` / ``boolean``  ``bool``
-``string``    str (empty: "")             ``str`` / ``object``   ``string``
-``bigint``    int of any size             ``object``             ``string`` (decimal)
-``int_list``  list of int (JSON text)     ``object``             ``list<int64>``
-============  ==========================  =====================  ========================
+==============  =========================  ======================  ====================
+type            Python value (typed dict)  pandas dtype            Arrow type
+==============  =========================  ======================  ====================
+``float``       float (empty: None)        ``float64`` (NaN)       ``double``
+``int``         int (empty: None)          ``int64`` / ``Int64``   ``int64``
+``bool``        bool (empty: None)         ``bool`` / ``boolean``  ``bool``
+``string``      str (empty: "")            ``str`` / ``object``    ``string``
+``bigint``      int of any size            ``object``              ``string`` (decimal)
+``int_list``    list of int (JSON text)    ``object``              ``list<int64>``
+``float_list``  list of float (JSON text)  ``object``              ``list<double>``
+==============  =========================  ======================  ====================
 
 A column that may be empty (``"nullable": true``: the moduli, measures and run columns of a
-failed row, ``steady_state`` when it cannot be judged) gets pandas' nullable dtype for ints and
+failed row, ``steady_state`` when it cannot be judged, the columns of the protocols that a row's
+protocol does not produce) gets pandas' nullable dtype for ints and
 bools (``Int64``, ``boolean``); floats are NaN where empty.
 """
 __docformat__ = "numpy"
@@ -31,14 +33,14 @@ import math
 import os
 import re
 
-__all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "results_schema", "column_spec", "write_schema",
+__all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "results_schema", "column_spec", "write_schema",
            "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
            "load_results"]
 
 #: file name of the schema beside ``results.csv``
 SCHEMA_NAME = "results.schema.json"
 #: the allowed column types (module docstring)
-COLUMN_TYPES = ("float", "int", "bool", "string", "bigint", "int_list")
+COLUMN_TYPES = ("float", "int", "bool", "string", "bigint", "int_list", "float_list")
 #: the run's time scales and repetition, after the measures in the table (docs/sweeps.md)
 RUN_COLUMNS = ("repetition", "frequency_Hz", "omega", "dt", "N_steps")
 
@@ -80,13 +82,62 @@ _FIXED = {
     "wall_time_s": ("float", "s", "wall time of the run", False),
     "output_path": ("string", "", "the run's output file, relative to the sweep folder; empty when none", False),
 }
+_P = "; empty unless protocol is {}"
+_SW = "'amplitude_sweep' or 'frequency_sweep'"
+#: the outputs of the rheometer's protocols (docs/protocols.md), after the run columns in a table
+#: whose SPEC sets a protocol parameter: name -> (type, unit, description)
+_PROTOCOL_FIXED = {
+    "sweep_position": ("int", "", "position of the step in its one-packing sweep (0, 1, ...; one row per step)"
+                       + _P.format(_SW)),
+    "sweep_amplitude": ("float", "1", "strain amplitude of the step" + _P.format(_SW)),
+    "sweep_relative_frequency": ("float", "1", "relative frequency f·τ of the step" + _P.format(_SW)),
+    "strain_rate": ("float", "1/s", "imposed shear rate γ̇ = relative_rate/τ" + _P.format("'steady'")),
+    "stress_surface": ("float", "Pa", "steady shear stress from the plate forces (mean after the transient)"
+                       + _P.format("'steady'")),
+    "stress_surface_se": ("float", "Pa", "standard error of stress_surface by block averaging" + _P.format("'steady'")),
+    "stress_internal": ("float", "Pa", "steady shear stress of the overall stress tensor (eq. S1-24)"
+                        + _P.format("'steady'")),
+    "stress_internal_se": ("float", "Pa", "standard error of stress_internal by block averaging"
+                           + _P.format("'steady'")),
+    "viscosity_surface": ("float", "Pa·s", "viscosity stress_surface/strain_rate" + _P.format("'steady'")),
+    "viscosity_surface_se": ("float", "Pa·s", "standard error of viscosity_surface" + _P.format("'steady'")),
+    "viscosity_internal": ("float", "Pa·s", "viscosity stress_internal/strain_rate" + _P.format("'steady'")),
+    "viscosity_internal_se": ("float", "Pa·s", "standard error of viscosity_internal" + _P.format("'steady'")),
+    "N1": ("float", "Pa", "first normal-stress difference σ_xx − σ_yy of the overall tensor after the transient"
+           + _P.format("'steady'")),
+    "N1_se": ("float", "Pa", "standard error of N1 by block averaging" + _P.format("'steady'")),
+    "t_transient": ("float", "s", "end of the start-up transient (MSER-5 on the plate stress)" + _P.format("'steady'")),
+    "strain_transient": ("float", "1", "strain at the end of the start-up transient" + _P.format("'steady'")),
+    "ramp_time_s": ("float", "s", "duration of the strain ramp to theAmplitude" + _P.format("'relaxation'")),
+    "G_plateau_surface": ("float", "Pa", "long-time plateau of G(t) = σ(t)/γ₀, plate forces (last 20 % of the hold)"
+                          + _P.format("'relaxation'")),
+    "G_plateau_surface_se": ("float", "Pa", "standard error of G_plateau_surface by block averaging"
+                             + _P.format("'relaxation'")),
+    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), overall stress tensor" + _P.format("'relaxation'")),
+    "G_plateau_internal_se": ("float", "Pa", "standard error of G_plateau_internal by block averaging"
+                              + _P.format("'relaxation'")),
+    "creep_rate": ("float", "1/s", "final creep rate dγ/dt over the last 20 % of the hold" + _P.format("'creep'")),
+    "creep_rate_se": ("float", "1/s", "standard error of creep_rate (5 sub-windows)" + _P.format("'creep'")),
+    "creep_viscosity": ("float", "Pa·s", "creep_stress/creep_rate (inf when the strain does not grow)"
+                        + _P.format("'creep'")),
+    "strain_plateau": ("float", "1", "strain γ(t) − γ(0) over the last 20 % of the hold (its plateau for a solid)"
+                       + _P.format("'creep'")),
+    "strain_plateau_se": ("float", "1", "standard error of strain_plateau by block averaging" + _P.format("'creep'")),
+    "stress_tracking": ("float", "1", "(mean plate stress over the second half of the hold − σ₀)/σ₀"
+                        + _P.format("'creep'")),
+}
+#: the protocol columns, in table order
+PROTOCOL_COLUMNS = tuple(_PROTOCOL_FIXED)
+_FIXED.update({k: v + (True,) for k, v in _PROTOCOL_FIXED.items()})
 #: parameters that are integers (validation: ``cut_lines``, ``N``); other numbers are floats
 _INT_PARAMETERS = ("cut_lines", "N")
 #: units of the numeric parameters that have one (docs/parameters.md); the other numbers are dimensionless
 _PARAMETER_UNITS = {"Young_modulus_spheres": "Pa", "density": "kg/m³", "avoid_horizontal_angle_degree": "degree",
                     "edge_fuzziness": "largest radius", "pre_periods": "excitation periods",
                     "periods": "excitation periods", "post_periods": "excitation periods",
-                    "plateau_begin": "contact distance", "plateau_end": "contact distance"}
+                    "plateau_begin": "contact distance", "plateau_end": "contact distance",
+                    "ramp_time": "τ", "hold_time": "τ", "creep_response_time": "τ", "creep_stress": "Pa",
+                    "creep_modulus": "Pa"}
 _parameter_cache = {}
 
 
@@ -131,12 +182,15 @@ def _column_spec(name):
     if name in _FIXED:
         kind, unit, text, nullable = _FIXED[name]
         return {"name": name, "type": kind, "unit": unit, "description": text, "nullable": nullable}
+    from ..run.rheometer import LIST_PARAMETERS
     from .spec import sweep_parameter_defaults
-    defaults = sweep_parameter_defaults()
+    defaults = sweep_parameter_defaults(protocols=True)
     if name not in defaults:
         return {"name": name, "type": "string", "unit": "", "description": "", "nullable": True}
     d = defaults[name]
-    if isinstance(d, bool):
+    if name in LIST_PARAMETERS:
+        kind, unit = "float_list", "1"
+    elif isinstance(d, bool):
         kind, unit = "bool", ""
     elif isinstance(d, str):
         kind, unit = "string", ""
@@ -146,7 +200,7 @@ def _column_spec(name):
     text = _parameter_descriptions().get(name, "")
     return {"name": name, "type": kind, "unit": unit,
             "description": f"parameter {name} of doParticleShearSimulation: {text}" if text else
-            f"parameter {name} of doParticleShearSimulation", "nullable": False}
+            f"parameter {name} of doParticleShearSimulation", "nullable": d is None}
 
 
 def results_schema(columns=None):
@@ -259,7 +313,7 @@ def typed_value(text, kind):
             return _integer(text)
         if kind == "bool":
             return bool(text)
-        return [int(x) for x in text]
+        return [float(x) for x in text] if kind == "float_list" else [int(x) for x in text]
     if kind == "float":
         return float(text)
     if kind in ("int", "bigint"):
@@ -271,6 +325,11 @@ def typed_value(text, kind):
             return False
         raise ValueError(f"{text!r} is not True or False")
     value = json.loads(text)
+    if kind == "float_list":
+        if not isinstance(value, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                  for x in value):
+            raise ValueError(f"{text!r} is not a JSON list of numbers")
+        return [float(x) for x in value]
     if not isinstance(value, list) or not all(isinstance(x, int) and not isinstance(x, bool) for x in value):
         raise ValueError(f"{text!r} is not a JSON list of integers")
     return value
@@ -358,7 +417,7 @@ def arrow_schema(schema):
     """
     import pyarrow as pa
     arrow = {"float": pa.float64(), "int": pa.int64(), "bool": pa.bool_(), "string": pa.string(),
-             "bigint": pa.string(), "int_list": pa.list_(pa.int64())}
+             "bigint": pa.string(), "int_list": pa.list_(pa.int64()), "float_list": pa.list_(pa.float64())}
     fields = [pa.field(c["name"], arrow[c["type"]], nullable=True,
                        metadata={"type": c["type"], "unit": c.get("unit", ""),
                                  "description": c.get("description", "")}) for c in schema["columns"]]

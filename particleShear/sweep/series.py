@@ -28,17 +28,23 @@ def _from_runs(runs, out_dir):
     return sweep
 
 
-def _result_from_row(row, run, out_dir):
-    """A light SimulationResult of a run finished in an earlier call, from its typed row (moduli, measures,
-    time scales, parameters, seed, path; no series)."""
+def _result_from_rows(rows, run, out_dir):
+    """A light result of a run finished in an earlier call, from its typed rows (moduli or the protocol's
+    values, measures, time scales, parameters, seed, path; no series)."""
     from ..run.api import SimulationResult
+    row = rows[0]
+    path = os.path.join(out_dir, os.path.basename(row["output_path"])) if row.get("output_path") else None
+    if run.parameters.get("protocol", "oscillatory") != "oscillatory":
+        from ..run.rheometer import RheometerResult
+        res = RheometerResult.from_rows(rows, run.parameters, run.seed_entropy, run.spawn_key, path)
+        res.repetition = run.repetition
+        return res
     from ..analysis.measures import MEASURE_COLUMNS
     g = tuple(_number(row.get(c)) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
     result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
                               parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
                               timings={"total": _number(row.get("wall_time_s"))},
-                              output_path=os.path.join(out_dir, os.path.basename(row["output_path"]))
-                              if row.get("output_path") else None,
+                              output_path=path,
                               dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
                               N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
     result._measures = {c: (row.get(c) if c == "steady_state" else _number(row.get(c))) for c in MEASURE_COLUMNS}
@@ -54,7 +60,9 @@ def series_parameters(kwargs):
     """The complete parameter set a series records for one run (``SimulationResult.parameters``).
 
     Every parameter a SPEC may set, defaults filled in, from the run's keyword arguments; the
-    folder, seed and console choice of the series are not part of it.
+    folder, seed and console choice of the series are not part of it.  With a protocol parameter
+    (docs/protocols.md) the protocol parameters are part of it, and a one-packing sweep's first
+    value is put in ``theAmplitude`` (``relative_frequency``), as a sweep does.
 
     Parameters
     ----------
@@ -65,9 +73,12 @@ def series_parameters(kwargs):
     -------
     dict
     """
-    from .spec import sweep_parameter_defaults
-    return dict(sweep_parameter_defaults(),
-                **{n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")})
+    from ..run.rheometer import normalize_protocol
+    from .spec import sweep_parameter_defaults, uses_protocols
+    given = {n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")}
+    if not uses_protocols(given):          # the oscillatory series: its table keeps its columns
+        return dict(sweep_parameter_defaults(), **given)
+    return normalize_protocol(dict(sweep_parameter_defaults(protocols=True), **given))
 
 
 def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None, repetitions=None):
@@ -115,8 +126,10 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         done = sweep.finished_rows()
         pos = {r.run_id: i for i, r in enumerate(runs)}
         for i, r in enumerate(runs):
-            if r.run_id in done and done[r.run_id]["status"] == "ok":
-                results[i] = _result_from_row(done[r.run_id], r, sweep.out_dir)
+            rows = done.get(r.run_id)
+            rows = rows if isinstance(rows, list) or rows is None else [rows]
+            if rows and rows[0]["status"] == "ok":
+                results[i] = _result_from_rows(rows, r, sweep.out_dir)
         for outcome in sweep.as_completed(executor=executor, workers=max_workers, keep_series=True,
                                           retry_failed=True, progress=False, batch_size=batch_size):
             if outcome.ok:
@@ -138,6 +151,7 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
                                       else None):
             for task, (row, result) in zip(job, outcomes):
                 results[task["index"]] = result
+                row = row[0] if isinstance(row, list) else row
                 if row["status"] != "ok":
                     failures.append(row)
     if failures:

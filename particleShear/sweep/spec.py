@@ -34,7 +34,7 @@ import numbers
 import os
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
-           "sweep_parameter_defaults", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
+           "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
 
 #: the tables a SPEC may hold
 SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
@@ -47,21 +47,54 @@ MAX_POINTS = 10_000
 MAX_RUNS = 10 ** 8
 
 
-@functools.lru_cache(maxsize=1)
-def _defaults():
+@functools.lru_cache(maxsize=2)
+def _defaults(protocols):
     from ..run.api import doParticleShearSimulation
     from ..run.rheometer import PROTOCOL_DEFAULTS
     sig = inspect.signature(doParticleShearSimulation)
-    # the protocols other than "oscillatory" (docs/protocols.md) are not sweepable yet: their
-    # parameters are no SPEC keys and no results columns
     return tuple((name, p.default) for name, p in sig.parameters.items()
-                 if name not in _RESERVED and name not in PROTOCOL_DEFAULTS
+                 if name not in _RESERVED and (protocols or name not in PROTOCOL_DEFAULTS)
                  and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
 
 
-def sweep_parameter_defaults():
-    """Every parameter a SPEC may set, with the default of ``doParticleShearSimulation`` (dict, signature order)."""
-    return dict(_defaults())
+def sweep_parameter_defaults(protocols=False):
+    """Every parameter a SPEC may set, with the default of ``doParticleShearSimulation`` (dict, signature order).
+
+    Parameters
+    ----------
+    protocols : bool, optional
+        True: with the parameters of the rheometer's protocols (``protocol``, ``relative_rate``,
+        ... :data:`particleShear.run.rheometer.PROTOCOL_DEFAULTS`).  They are parameters (and
+        table columns) of a sweep only when its SPEC sets one of them (:func:`uses_protocols`), so
+        the tables of oscillatory sweeps keep their columns.  Default False.
+
+    Returns
+    -------
+    dict
+    """
+    return dict(_defaults(bool(protocols)))
+
+
+def uses_protocols(names):
+    """True when one of ``names`` (the keys a SPEC or a series sets) is a protocol parameter.
+
+    Parameters
+    ----------
+    names : iterable of str
+
+    Returns
+    -------
+    bool
+    """
+    from ..run.rheometer import PROTOCOL_DEFAULTS
+    return any(n in PROTOCOL_DEFAULTS for n in names)
+
+
+def _spec_keys(spec):
+    keys = list(spec.parameters) + list(spec.grid)
+    for group in spec.zips:
+        keys += list(group)
+    return keys
 
 
 @dataclasses.dataclass(frozen=True)
@@ -269,7 +302,12 @@ def load_spec(path):
     return parse_spec(doc, source=path)
 
 
-def _scalar(where, v):
+def _scalar(where, v, name=None):
+    from ..run.rheometer import LIST_PARAMETERS
+    if name in LIST_PARAMETERS:   # a list is one value of these (the steps of a one-packing sweep)
+        if not isinstance(v, list) or not v:
+            raise ValueError(f"{where}={v!r} is invalid: allowed a non-empty list of numbers (one value of {name})")
+        return [_scalar(f"{where}[{i}]", x) for i, x in enumerate(v)]
     ok = isinstance(v, (bool, str, numbers.Integral)) or (isinstance(v, numbers.Real) and math.isfinite(v))
     if not ok:
         raise ValueError(f"{where}={v!r} is invalid: allowed a bool, a finite number or a string")
@@ -290,10 +328,10 @@ def _known(where, name, known):
                                     name=name, suggestions=near)
 
 
-def _values(where, v):
+def _values(where, v, name=None):
     if not isinstance(v, list) or not v:
         raise ValueError(f"{where}={v!r} is invalid: allowed a non-empty list of values")
-    return [_scalar(f"{where}[{i}]", x) for i, x in enumerate(v)]
+    return [_scalar(f"{where}[{i}]", x, name) for i, x in enumerate(v)]
 
 
 def parse_spec(doc, source=""):
@@ -332,7 +370,7 @@ def parse_spec(doc, source=""):
         if table not in SPEC_TABLES:
             raise ValueError(f"SPEC table [{table}] is unknown: allowed {', '.join(SPEC_TABLES)}")
     from ..run.guard import PARAMETER_ALIASES
-    known = sweep_parameter_defaults()
+    known = sweep_parameter_defaults(protocols=True)
     seen = {}
 
     def claim(name, where):
@@ -353,14 +391,14 @@ def parse_spec(doc, source=""):
     fixed = {}
     for name, v in parameters.items():
         target = claim(name, "parameters")
-        fixed[target] = _scalar(f"parameters.{name}", v)
+        fixed[target] = _scalar(f"parameters.{name}", v, target)
     parameters = fixed
 
     grid = doc.get("grid", {})
     if not isinstance(grid, dict):
         raise ValueError("[grid] is invalid: allowed a table of lists")
-    grid = {name: _values(f"grid.{name}", v) for name, v in grid.items()}
-    grid = {claim(name, "grid"): v for name, v in grid.items()}
+    grid = {target: _values(f"grid.{name}", v, target) for name, v, target in
+            [(name, v, claim(name, "grid")) for name, v in grid.items()]}
 
     zips = doc.get("zip", [])
     if isinstance(zips, dict):
@@ -372,11 +410,12 @@ def parse_spec(doc, source=""):
         where = f"zip[{i}]"
         if not isinstance(group, dict) or not group:
             raise ValueError(f"{where} is invalid: allowed a non-empty table of equal-length lists")
-        group = {name: _values(f"{where}.{name}", v) for name, v in group.items()}
-        lengths = {name: len(v) for name, v in group.items()}
+        lengths = {name: len(v) if isinstance(v, list) else 0 for name, v in group.items()}
+        group = {target: _values(f"{where}.{name}", v, target) for name, v, target in
+                 [(name, v, claim(name, where)) for name, v in group.items()]}
         if len(set(lengths.values())) != 1:
             raise ValueError(f"{where} is invalid: its lists must have equal lengths, got {lengths}")
-        checked.append({claim(name, where): v for name, v in group.items()})
+        checked.append(group)
 
     if "seeds" not in doc:
         raise ValueError("[seeds] is missing: allowed root = <integer >= 0> and repetitions = <integer >= 1>")
@@ -503,8 +542,9 @@ def expand_runs(spec):
 
 def _validated_points(spec):
     """The complete parameter set of every point of ``spec``, each validated (point order)."""
+    from ..run.rheometer import normalize_protocol
     from ..run.validation import show_value, validate_run
-    defaults = sweep_parameter_defaults()
+    defaults = sweep_parameter_defaults(protocols=uses_protocols(_spec_keys(spec)))
     points = []
     for p_index, point in enumerate(_points(spec)):
         params = dict(defaults, **spec.parameters, **point)
@@ -513,5 +553,7 @@ def _validated_points(spec):
             validate_run(dict(params, root_folder=os.curdir))   # the sweep makes DIR: not required yet
         except (ValueError, TypeError) as exc:
             raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
-        points.append(params)
+        # a one-packing sweep is constituted for its first value: its row says so (and its id is the
+        # id of the same call to doParticleShearSimulation)
+        points.append(normalize_protocol(params) if "protocol" in params else params)
     return points

@@ -4,12 +4,17 @@ Columns, in this order: ``run_id, status, error, Gp_surface, Gpp_surface, Gp_int
 Gpp_internal`` (Pa), the measures of :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`
 (standard errors in Pa, ``steady_state``, LAOS ratios; docs/analysis.md), the run columns
 :data:`~particleShear.sweep.schema.RUN_COLUMNS` (``repetition, frequency_Hz, omega, dt, N_steps``),
-every parameter of the run (signature order of ``doParticleShearSimulation``), ``seed_entropy``,
+then — in a table whose sweep sets a protocol parameter (docs/protocols.md) — the protocol columns
+:data:`~particleShear.sweep.schema.PROTOCOL_COLUMNS`, every parameter of the run (signature
+order of ``doParticleShearSimulation``), ``seed_entropy``,
 ``spawn_key`` (JSON list), ``package_version``, ``wall_time_s``, ``output_path``.  Each column's
 type, unit and description: :mod:`particleShear.sweep.schema` (``DIR/results.schema.json``).
 
-Rows are appended by one writer (the sweep's driving process) with a single ``os.write`` of a
-complete line on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
+A run of a one-packing sweep protocol has one row per step (``sweep_position`` 0, 1, ...), all
+written in one append; every other run has one row.
+
+Rows are appended by one writer (the sweep's driving process) with a single ``os.write`` of
+complete lines on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
 most one torn last line, which :func:`read_rows` drops and :func:`repair_table` cuts off.
 """
 __docformat__ = "numpy"
@@ -26,7 +31,7 @@ import numpy as np
 
 from ..analysis.measures import MEASURE_COLUMNS
 from ..simulation.provenance import identity_parameters, same_input
-from .schema import RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema, typed_row
+from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema, typed_row
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
            "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
@@ -67,8 +72,9 @@ def table_columns(parameter_names=None):
     Parameters
     ----------
     parameter_names : iterable of str, optional
-        The parameter columns, in order (default: every SPEC-settable parameter, signature
-        order of ``doParticleShearSimulation``).
+        The parameter columns, in order (default: every SPEC-settable parameter of the
+        oscillatory protocol, signature order of ``doParticleShearSimulation``).  When they hold
+        ``protocol``, the protocol columns come before them.
 
     Returns
     -------
@@ -77,7 +83,9 @@ def table_columns(parameter_names=None):
     if parameter_names is None:
         from .spec import sweep_parameter_defaults
         parameter_names = list(sweep_parameter_defaults())
-    return list(RESULT_COLUMNS) + list(parameter_names) + list(_TAIL_COLUMNS)
+    parameter_names = list(parameter_names)
+    extra = list(PROTOCOL_COLUMNS) if "protocol" in parameter_names else []
+    return list(RESULT_COLUMNS) + extra + parameter_names + list(_TAIL_COLUMNS)
 
 
 def _cell(v):
@@ -85,8 +93,9 @@ def _cell(v):
     ``np.float64(0.2)``), floats with ``repr`` (round trip), other values with ``str``."""
     if v is None:
         return ""
-    if isinstance(v, (list, tuple)):
-        return json.dumps([int(x) for x in v])
+    if isinstance(v, (list, tuple)):   # a spawn key (integers) or a sweep's list of values (floats)
+        ints = all(isinstance(x, numbers.Integral) and not isinstance(x, (bool, np.bool_)) for x in v)
+        return json.dumps([int(x) if ints else float(x) for x in v])
     if isinstance(v, (bool, np.bool_)):
         return str(bool(v))
     if isinstance(v, numbers.Integral):
@@ -250,13 +259,23 @@ def check_table_header(path, columns):
                          "another --out DIR")
 
 
+#: the columns an ``ok`` row of each protocol must hold a number in
+_OK_NUMBERS = {"oscillatory": ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s"),
+               "steady": ("stress_surface", "stress_internal", "strain_rate", "wall_time_s"),
+               "relaxation": ("G_plateau_surface", "G_plateau_internal", "wall_time_s"),
+               "creep": ("creep_rate", "strain_plateau", "wall_time_s"),
+               "amplitude_sweep": ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "sweep_position",
+                                   "wall_time_s")}
+_OK_NUMBERS["frequency_sweep"] = _OK_NUMBERS["amplitude_sweep"]
+
+
 def row_problem(row, run):
     """Why ``row`` is not a trustworthy row of ``run`` (None when it is).
 
     A row counts only when its status is ``ok`` or ``failed``, its id, seed and every parameter
     are those of the run (as :func:`row_line` writes them), every cell is a value of its
-    column's type (:mod:`~particleShear.sweep.schema`), and — for an ``ok`` row — the moduli
-    and the wall time are not empty.
+    column's type (:mod:`~particleShear.sweep.schema`), and — for an ``ok`` row — the numbers
+    its protocol produces (the moduli of an oscillatory run) and the wall time are not empty.
 
     Parameters
     ----------
@@ -280,8 +299,8 @@ def row_problem(row, run):
     for name, v in run.parameters.items():
         if name in compared and not same_input(row.get(name), v):
             return f"{name}={row.get(name)!r} is not the run's {_cell(v)!r}"
-    numbers = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s") if status == "ok" \
-        else ("wall_time_s",)
+    numbers = _OK_NUMBERS.get(run.parameters.get("protocol", "oscillatory"), _OK_NUMBERS["oscillatory"]) \
+        if status == "ok" else ("wall_time_s",)
     for name in numbers:
         try:
             float(row.get(name))
@@ -296,14 +315,15 @@ def row_problem(row, run):
 
 
 def append_row(path, row, columns):
-    """Append ``row`` to the table at ``path`` (header first when new); flushed and fsynced.
+    """Append ``row`` to the table at ``path`` (header first when new) in one write; flushed and fsynced.
 
     Parameters
     ----------
     path : str or os.PathLike
         The table (created when absent); a torn last line is cut first (:func:`repair_table`).
-    row : dict
-        Column name → value (see :func:`row_line`).
+    row : dict or list of dict
+        Column name → value (see :func:`row_line`); a list: the rows of one run (the steps of a
+        one-packing sweep), appended together.
     columns : sequence of str
         The table's columns; must equal the existing header.
 
@@ -319,7 +339,8 @@ def append_row(path, row, columns):
             header = next(csv.reader(fh), None)
         if header != list(columns):
             raise ValueError(f"results table {path!r} has other columns than this sweep: use another --out DIR")
-    text = (row_line({c: c for c in columns}, columns) if new else "") + row_line(row, columns)
+    rows = row if isinstance(row, list) else [row]
+    text = (row_line({c: c for c in columns}, columns) if new else "") + "".join(row_line(r, columns) for r in rows)
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
     try:
         data = text.encode("utf-8")

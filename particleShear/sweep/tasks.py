@@ -168,6 +168,8 @@ def _prepare(task):
 def _finish_run(task, result, wall_time_s):
     """Publish a finished run's files under its run id; return ``(row, result)``.
 
+    ``row`` is a dict, or the list of the rows of a one-packing sweep (one per step).
+
     The row's ``output_path`` is relative to the sweep folder (the folder can be moved or
     copied); the result's is absolute.  A run whose file could not be written is a ``failed``
     row naming the write error, its moduli kept.
@@ -176,20 +178,24 @@ def _finish_run(task, result, wall_time_s):
     result.repetition = int(task.get("repetition", 0))
     if result.output_path:
         run_dir = os.path.dirname(result.output_path)
-        image_folder, produced = result.image_folder, result.output_path
+        image_folder, produced = getattr(result, "image_folder", None), result.output_path
         result.output_path = publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
         if image_folder:  # published beside the file: its name after the run's name, renamed as the file
             tail = os.path.basename(image_folder)[len(os.path.basename(run_file_stem(produced))):]
             result.image_folder = run_file_stem(result.output_path) + tail
-    row = result.to_dict()
-    if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
-        raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
-    row["output_path"] = os.path.relpath(result.output_path, task["out_dir"]) if result.output_path else ""
-    row["wall_time_s"] = wall_time_s
+    rows = result.rows() if hasattr(result, "steps") else [result.to_dict()]   # a protocol run: its rows
     err = getattr(result, "write_error", None)
+    for row in rows:
+        if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
+            raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
+        row["output_path"] = os.path.relpath(result.output_path, task["out_dir"]) if result.output_path else ""
+        row["wall_time_s"] = wall_time_s
+        if err is not None:
+            row.update(status="failed", error="write failed: " + error_text(err),
+                       output_path="")
     if err is not None:
-        row.update(status="failed", error="write failed: " + error_text(err),
-                   output_path="")
+        rows = rows[:1]          # a failed run has one row (its values kept in the result)
+    row = rows[0] if len(rows) == 1 else rows
     if not task.get("keep_series"):
         result.series = {}
     return row, result
