@@ -17,14 +17,21 @@ plot_creep
     Creep compliance J(t) against time (log–log).
 plot_amplitude_sweeps
     G′ and G″ against the strain amplitude, one packing swept amplitude after amplitude and
-    independent packings.
+    independent packings (``x="relative_frequency"``: against f·τ, a frequency sweep).
+plot_steady_run
+    The stress of one steady-shear run against the strain, with its steady mean and the end of
+    the transient.
+plot_rheometer_result
+    The figure of one :class:`~particleShear.run.rheometer.RheometerResult` (``result.plot()``
+    and the command line's ``--plot``): one of the above, chosen by its protocol.
 """
 __docformat__ = "numpy"
 import numpy as np
 
 from .plot import _figure, check_figure_path, save_figure
 
-__all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps"]
+__all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps", "plot_steady_run",
+           "plot_rheometer_result"]
 
 
 def _series(name, values, n=None):
@@ -202,23 +209,23 @@ def plot_creep(t, J, path=None):
 _SWEEP_NAMES = {"one_packing": "one packing (amplitude after amplitude)", "independent": "independent packings"}
 
 
-def _sweep(name, data):
-    """Validate one amplitude-sweep mapping; returns dict of arrays (errors None when absent)."""
+def _sweep(name, data, x="amplitude"):
+    """Validate one sweep mapping; returns dict of arrays (errors None when absent)."""
     try:
         keys = set(data)
     except TypeError as exc:
-        raise ValueError(f"{name}={data!r} is invalid: must be a mapping with keys amplitude, Gp, Gpp") from exc
-    missing = {"amplitude", "Gp", "Gpp"} - keys
+        raise ValueError(f"{name}={data!r} is invalid: must be a mapping with keys {x}, Gp, Gpp") from exc
+    missing = {x, "Gp", "Gpp"} - keys
     if missing:
         raise ValueError(f"{name} is invalid: missing keys {sorted(missing)}")
-    a = _series(f"{name}['amplitude']", data["amplitude"])
+    a = _series(f"{name}[{x!r}]", data[x])
     out = {"amplitude": a}
     for k in ("Gp", "Gpp", "Gp_err", "Gpp_err"):
         out[k] = None if data.get(k) is None else _series(f"{name}[{k!r}]", data[k], len(a))
     return out
 
 
-def plot_amplitude_sweeps(one_packing, independent=None, path=None):
+def plot_amplitude_sweeps(one_packing, independent=None, path=None, *, x="amplitude"):
     """G′ (filled markers) and G″ (open markers) in Pa against the strain amplitude, log–log.
 
     Parameters
@@ -230,6 +237,9 @@ def plot_amplitude_sweeps(one_packing, independent=None, path=None):
         A fresh packing per amplitude, same keys.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    x : {"amplitude", "relative_frequency"}, default "amplitude"
+        Keyword-only.  The abscissa's key: the strain amplitude γ₀, or the relative frequency
+        f·τ of a frequency sweep.
 
     Returns
     -------
@@ -241,9 +251,11 @@ def plot_amplitude_sweeps(one_packing, independent=None, path=None):
     ValueError
         A missing key, unequal lengths, non-finite numbers, or a bad ``path``.
     """
-    sweeps = {"one_packing": _sweep("one_packing", one_packing)}
+    if x not in ("amplitude", "relative_frequency"):
+        raise ValueError(f"x={x!r} is invalid: allowed 'amplitude', 'relative_frequency'")
+    sweeps = {"one_packing": _sweep("one_packing", one_packing, x)}
     if independent is not None:
-        sweeps["independent"] = _sweep("independent", independent)
+        sweeps["independent"] = _sweep("independent", independent, x)
     if path is not None:
         check_figure_path(path, "path")
     fig = _figure(6.0, 4.5)
@@ -258,8 +270,109 @@ def plot_amplitude_sweeps(one_packing, independent=None, path=None):
                         color=colour, mfc=face, label=f"{_SWEEP_NAMES[key]}: {'G′' if k == 'Gp' else 'G″'}")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("strain amplitude γ₀")
+    ax.set_xlabel("strain amplitude γ₀" if x == "amplitude" else "relative frequency f·τ")
     ax.set_ylabel("G′, G″ (Pa)")
     ax.legend(fontsize="small")
     _note(ax, dropped, "G′/G″")
     return _finish(fig, path)
+
+
+def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=None):
+    """One steady-shear run: the shear stress σ (Pa) against the strain γ, linear axes.
+
+    Parameters
+    ----------
+    strain : array_like
+        Strain of every step.
+    stress : array_like
+        Shear stress in Pa, same length.
+    steady : tuple of float, optional
+        (mean, standard error) of the steady stress in Pa, drawn as a band after the transient.
+    strain_transient : float, optional
+        Strain at the detected end of the start-up transient (a vertical line).
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes.
+
+    Raises
+    ------
+    ValueError
+        Unequal lengths, non-finite numbers, a bad ``steady``, or a bad ``path``.
+    """
+    g = _series("strain", strain)
+    s = _series("stress", stress, len(g))
+    if steady is not None:
+        steady = _series("steady", steady, 2)
+    if strain_transient is not None:
+        strain_transient = float(_series("strain_transient", [strain_transient])[0])
+    if path is not None:
+        check_figure_path(path, "path")
+    fig = _figure(6.0, 4.0)
+    ax = fig.subplots()
+    ax.plot(g, s, "-", lw=0.8, label="σ (plate)")
+    if steady is not None:
+        v, e = steady
+        ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"steady {v:.3g} ± {e:.3g} Pa", gid="steady")
+    if strain_transient is not None:
+        ax.axvline(strain_transient, color="k", ls=":", label="end of transient", gid="transient")
+    ax.set_xlabel("strain γ")
+    ax.set_ylabel("shear stress σ (Pa)")
+    ax.legend(fontsize="small")
+    return _finish(fig, path)
+
+
+def plot_rheometer_result(result, path=None):
+    """The figure of one protocol run, chosen by ``result.protocol``.
+
+    steady: :func:`plot_steady_run` (plate stress against strain, steady band, transient);
+    relaxation: :func:`plot_relaxation` of the curve ``G_surface`` with the plateau;
+    creep: :func:`plot_creep` of ``J``; sweeps: :func:`plot_amplitude_sweeps` of the steps
+    (against γ₀, or f·τ for a frequency sweep) with their standard errors.
+
+    Parameters
+    ----------
+    result : RheometerResult
+        A run of this session (the series and curves are needed; a result rebuilt from a
+        results table has the steps only, enough for the sweeps).
+    path : str or os.PathLike, optional
+        Write the figure there (.png, .pdf, .svg, .eps).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        A result without the data its figure needs, or a bad ``path``.
+    """
+    proto, summ = result.protocol, result.summary
+    if proto in ("amplitude_sweep", "frequency_sweep"):
+        x = "amplitude" if proto == "amplitude_sweep" else "relative_frequency"
+        st = result.steps
+        data = {x: [s[x] for s in st], "Gp": [s["Gp_surface"] for s in st], "Gpp": [s["Gpp_surface"] for s in st]}
+        for k in ("Gp", "Gpp"):
+            errs = [s.get(f"{k}_surface_se") for s in st]
+            if all(e is not None and np.isfinite(e) for e in errs):
+                data[k + "_err"] = errs
+        return plot_amplitude_sweeps(data, path=path, x=x)
+    if proto == "steady":
+        if "strain" not in result.series:
+            raise ValueError("plot needs the recorded series of the run (a result of this session or read_run "
+                             "of its file, not one rebuilt from a results table)")
+        return plot_steady_run(result.series["strain"], result.series["stress_surface"],
+                               (summ["stress_surface"], summ["stress_surface_se"]), summ.get("strain_transient"),
+                               path)
+    name = "G_surface" if proto == "relaxation" else "J"
+    if name not in result.curves:
+        raise ValueError(f"plot needs the curve {name!r} of the run (a result of this session, not one rebuilt "
+                         "from a results table)")
+    t, y, err = result.curves[name]
+    if proto == "relaxation":
+        plateau = (summ["G_plateau_surface"], summ["G_plateau_surface_se"])
+        return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path)
+    return plot_creep(t, y, path)

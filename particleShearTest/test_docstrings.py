@@ -76,6 +76,7 @@ DOCUMENTED_MODULES = [
     "particleShear.engine.rheometer",
     "particleShear.run.rheometer",
     "particleShear.run.rheometer_analysis",
+    "particleShear.run.rheometer_files",
 ]
 
 #: Modules of DOCUMENTED_MODULES still being completed on another branch: their docstring

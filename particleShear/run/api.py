@@ -391,6 +391,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         with console_messages(verbose):
             result = measure_rheometer([normalize_protocol(params)])[0]
         doParticleShearSimulation.last_result = result
+        if strict_io and result.write_error is not None:
+            raise result.write_error
         return result if return_result else result.values
 
     # measured by the engine, a batch of one (particleShear.run.batch)

@@ -557,8 +557,18 @@ def main(argv=None):
     if args.json:
         print(_json_row(res))
     elif not hasattr(res, "G_internal"):     # another protocol than "oscillatory" (docs/protocols.md)
-        for row in res.rows():
-            print("  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in row.items()))
+        def shown(items):
+            return "  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
+        for st in res.steps:
+            print(shown((k, st[k]) for k in ("position", "amplitude", "relative_frequency", "Gp_surface",
+                                             "Gp_surface_se", "Gpp_surface", "Gpp_surface_se", "Gp_internal",
+                                             "Gpp_internal")))
+        if res.summary:
+            print(shown(res.summary.items()))
+        print(f"protocol = {res.protocol}; seed entropy = {res.seed}; tau = {res.tau:.6g} s; wall time "
+              + ", ".join(f"{k} {v:.2f} s" for k, v in res.timings.items()))
+        if res.output_path:
+            print("output file: " + res.output_path)
     else:
         print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
         print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")

@@ -255,8 +255,13 @@ class RheometerResult:
     dt : float
         Time step (s; of the first step for sweeps).
     series : dict of numpy.ndarray
-        The record (steady, relaxation, creep): "t" (s), "strain", "strain_rate" (1/s),
-        "stress_internal", "stress_surface" (Pa) and for "steady" "N1" (Pa, NaN where not sampled).
+        The record of every step: "t" (s), "strain", "strain_rate" (1/s), "stress_internal",
+        "stress_surface" (Pa), for "steady" "N1" (Pa, NaN where not sampled); for sweeps the
+        steps' records one after the other with "sweep_position" (each step's clock from 0).
+    output_path : str or None
+        The run's file (``saveData=True``; :mod:`particleShear.run.rheometer_files`), else None.
+    write_error : Exception or None
+        Why writing the file failed (the result is kept), else None.
     summary : dict
         Scalar results by name (units in docs/protocols.md).
     curves : dict
@@ -368,10 +373,36 @@ class RheometerResult:
         res.output_path = output_path
         return res
 
+    def plot(self, path=None):
+        """The protocol's figure (needs ``particleShear[plot]``): the stress against strain of a
+        steady run, G(t), J(t), or G′/G″ of a sweep's steps
+        (:func:`particleShear.rheometer_plot.plot_rheometer_result`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike, optional
+            File to write (PNG, PDF, SVG or EPS, chosen by the extension); None writes nothing.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from ..rheometer_plot import plot_rheometer_result
+        return plot_rheometer_result(self, path)
+
     def __repr__(self):
         main = ", ".join(f"{v:.4g}" if isinstance(v, float) else repr(v) for v in
                          (self.values if not self.steps else [len(self.steps)]))
         return f"RheometerResult(protocol={self.protocol!r}, {'steps' if self.steps else 'values'}=[{main}])"
+
+
+def _concatenated(records):
+    """The records of a sweep's steps one after the other, with ``sweep_position`` (each step keeps
+    its own clock ``t``)."""
+    keys = ("t", "strain", "strain_rate", "stress_surface", "stress_internal")
+    out = {key: np.concatenate([rec[key] for rec in records]) for key in keys}
+    out["sweep_position"] = np.concatenate([np.full(len(rec["t"]), j, dtype=np.int64) for j, rec in enumerate(records)])
+    return out
 
 
 def measure_rheometer(runs):
@@ -397,6 +428,7 @@ def measure_rheometer(runs):
     from ..simulation.provenance import run_identity
     from .batch import _console, _constitute, _guarded, build_sessions, pre_equilibrated
     from .rheometer_analysis import analyse_record, analyse_sweep
+    from .rheometer_files import write_protocol_file
 
     proto = runs[0]["protocol"]
     sims, seeds, sessions = build_sessions(runs)
@@ -456,16 +488,19 @@ def measure_rheometer(runs):
             summary, curves = analyse_record(proto, kw, series, tau, steps[b])
             sweep = []
         else:
-            series, curves = {}, {}
-            sweep = analyse_sweep(kw, [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()
-                                                        if not key.endswith("tensors")})
-                                       for f, A, dt, out in sweep_recs], tau)
-            summary = {}
+            segments = [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()
+                                         if not key.endswith("tensors")}) for f, A, dt, out in sweep_recs]
+            sweep = analyse_sweep(kw, segments, tau)
+            series, curves, summary = _concatenated([rec for *_, rec in segments]), {}, {}
         seed_entropy, spawn_key, _ = seeds[b]
         tm = dict(timings[b], protocol=t_protocol, analysis=time.perf_counter() - t1)
         results[b] = RheometerResult(proto, dict(kw), seed_entropy, spawn_key,
                                      run_identity(kw, seed_entropy, spawn_key), tau, sc.dt, series, summary, curves,
                                      sweep, tm)
+        if kw["saveData"]:
+            t2 = time.perf_counter()
+            write_protocol_file(sessions[b].sim, results[b])
+            tm["output"] = time.perf_counter() - t2
     for run in sessions:
         run.close()
     return results

@@ -34,7 +34,8 @@ from .output import (FORMAT_SUFFIXES, format_of, NO_TENSOR_DATA_TEXT, TABLE_COLU
                      sidecar_path)
 
 __all__ = ["OUTPUT_FORMATS", "FORMAT_SUFFIXES", "read_run", "verify_run", "RunData", "RunFileError", "write_run",
-           "check_output_format", "series_columns", "table_rows", "text_stream", "sidecar_path"]
+           "write_columns", "check_output_format", "series_columns", "table_rows", "text_stream", "sidecar_path",
+           "RHEOMETER_TITLE", "RHEOMETER_DETAILED", "RHEOMETER_EXTRA_COLUMNS"]
 
 #: the accepted values of ``output_format`` (keys of :data:`FORMAT_SUFFIXES`)
 OUTPUT_FORMATS = tuple(FORMAT_SUFFIXES)
@@ -60,6 +61,12 @@ _PARQUET_ROWS = 16384
 _DETAILED = re.compile(r"Detailed[a-zA-Z0-9\s].*data")
 #: key of the JSON (header, metadata) in a Parquet file's schema metadata
 _PARQUET_KEY = b"particleShear"
+#: the title line of the experiment block of a rheometer protocol's file (particleShear.run.rheometer_files)
+RHEOMETER_TITLE = "Rheometer protocol experiment"
+#: the line after which a protocol file's table starts (the reference's "Detailed … data" pattern)
+RHEOMETER_DETAILED = "Detailed rheometer protocol data"
+#: the columns of a protocol file after the first six: N1 (Pa, "steady"), sweep_position (sweeps)
+RHEOMETER_EXTRA_COLUMNS = ("N1", "sweep_position")
 
 
 def _pyarrow():
@@ -224,9 +231,52 @@ def write_run(fh, output_format, header_text, scalars, tensors, metadata):
     if tensors is not None:
         series["tensors"] = tensors
     cols = series_columns(series)
+    write_columns(fh, output_format, header_text, cols,
+                  dict(metadata, n_rows=table_rows(output_format, len(cols["index"]), tensors is not None)))
+
+
+def _text_rows(cols, chunk_rows=1024):
+    """The names line and the rows of ``cols`` as TAB-separated text, in pieces (bounded memory);
+    floats as ``str`` (exact round trip), integer columns as integers."""
+    names = list(cols)
     n = len(cols["index"])
-    meta = json.dumps({"header": header_text,
-                       "metadata": dict(metadata, n_rows=table_rows(output_format, n, tensors is not None))})
+    yield "\n" + "\t".join(names)
+    for a in range(0, n, chunk_rows):
+        b = min(n, a + chunk_rows)
+        block = list(zip(*(cols[name][a:b].tolist() for name in names)))
+        yield "".join("\n" + "\t".join(map(str, row)) for row in block)
+
+
+def write_columns(fh, output_format, header_text, cols, metadata):
+    """Stream a table of named columns into the open binary file ``fh`` in ``output_format``.
+
+    The writer of every table but the reference text (:func:`write_run`): npz and parquet of
+    oscillatory runs, and the rheometer protocols' files in every format (the text formats:
+    ``header_text``, then the names line and TAB-separated rows, ``str`` of each float).
+
+    Parameters
+    ----------
+    fh : binary file object
+    output_format : str
+        One of :data:`OUTPUT_FORMATS`.
+    header_text : str
+        The text header, ending with its "Detailed … data" line.
+    cols : dict
+        Column name → 1-D array of one length; ``index`` (0 … n-1) first; integer columns are
+        written as int64, the others as float64.
+    metadata : dict
+        JSON-safe run description with ``n_rows``, stored inside npz/parquet.
+    """
+    if output_format not in FORMAT_SUFFIXES:
+        raise ValueError(f"output_format={output_format!r} is invalid: allowed " + ", ".join(OUTPUT_FORMATS))
+    if output_format in ("text", "text.gz"):
+        with text_stream(fh, output_format) as out:
+            out.write(header_text.encode("utf-8"))
+            for piece in _text_rows(cols):
+                out.write(piece.encode("utf-8"))
+        return
+    n = len(cols["index"])
+    meta = json.dumps({"header": header_text, "metadata": metadata})
     if output_format == "npz":
         # what numpy.savez writes, one column at a time (one column copy in memory, not the table)
         with _closing(zipfile.ZipFile(fh, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True)) as zf:
@@ -237,7 +287,8 @@ def write_run(fh, output_format, header_text, scalars, tensors, metadata):
                     np.lib.format.write_array(member, v, allow_pickle=False)
         return
     pa, pq = _pyarrow()
-    schema = pa.schema([(name, pa.int64() if name == "index" else pa.float64()) for name in cols],
+    schema = pa.schema([(name, pa.int64() if np.asarray(v).dtype.kind in "iu" else pa.float64())
+                        for name, v in cols.items()],
                        metadata={_PARQUET_KEY: meta.encode("utf-8")})
     with _closing(pq.ParquetWriter(fh, schema, use_dictionary=False, write_page_checksum=True)) as writer:
         for a in range(0, max(n, 1), _PARQUET_ROWS):  # row groups: bounded extra memory
@@ -252,7 +303,10 @@ class RunData(dict):
     Keys are the table's column names (``index``, ``t``, ``strain``, ``strain_rate``,
     ``stress_measured_at_surface``, ``shear_stress_internal_stress-tensor`` and the 36
     ``stress_tensor_*`` columns when saved); empty for a text file written with
-    ``saveStressTensorData=False`` (the reference writes no table then).
+    ``saveStressTensorData=False`` (the reference writes no table then).  A rheometer
+    protocol's file (docs/protocols.md) has the first six columns and ``N1`` (steady) or
+    ``sweep_position`` (sweeps); its ``protocol``, ``summary``, ``steps`` and ``curves`` are
+    properties.
 
     Made by :func:`read_run`; the parameters are also its attributes.
 
@@ -308,9 +362,37 @@ class RunData(dict):
         return self._header_value("periods")
 
     @property
+    def protocol(self):
+        """The run's protocol: "oscillatory", or the rheometer protocol the file records."""
+        if RHEOMETER_TITLE not in self.header:
+            return "oscillatory"
+        m = re.search(r"\nProtocol = (\w+)\n", self.header)
+        return m.group(1) if m else self.metadata.get("protocol", "")
+
+    @property
+    def summary(self):
+        """A protocol file's scalar results (``RheometerResult.summary``, from the metadata; {} when absent)."""
+        return dict(self.metadata.get("summary") or {})
+
+    @property
+    def steps(self):
+        """A sweep file's steps (``RheometerResult.steps``, from the metadata; [] when absent)."""
+        return [dict(st) for st in self.metadata.get("steps") or []]
+
+    @property
+    def curves(self):
+        """A protocol file's log-grid curves ``name -> (t, y, y_spread)`` as arrays (from the
+        metadata; {} when absent — :func:`particleShear.analysis.rheometry.log_grid` of the
+        series gives them again)."""
+        return {name: tuple(np.asarray(v, dtype=float) for v in c)
+                for name, c in (self.metadata.get("curves") or {}).items()}
+
+    @property
     def series(self):
-        """The columns under the keys of ``SimulationResult.series`` (tensors as (n, 9, 2, 2))."""
+        """The columns under the keys of ``SimulationResult.series`` (tensors as (n, 9, 2, 2)), and
+        of ``RheometerResult.series`` for a protocol file (``N1``, ``sweep_position``)."""
         out = {key: self[col] for key, col in _SERIES_COLUMNS if col in self}
+        out.update({col: self[col] for col in RHEOMETER_EXTRA_COLUMNS if col in self})
         names = TABLE_COLUMNS[6:]
         if all(name in self for name in names):
             out["tensors"] = np.stack([self[name] for name in names], axis=1).reshape(-1, 9, 2, 2)
@@ -362,15 +444,28 @@ def _sidecar(path, fmt):
     return None, {}
 
 
-#: lines every particleShear text header holds (blocks 1–3, docs/output.md "Blocks")
+#: lines every particleShear text header holds (blocks 1–3, docs/output.md "Blocks"; a protocol
+#: file has RHEOMETER_TITLE instead of the first)
 _HEADER_LINES = ("Oscillatory shear experiment", "Summary data")
+
+
+def _is_rheometer(header):
+    return "\n" + RHEOMETER_TITLE + "\n" in header
+
+
+def _tables(header):
+    """The column sets a table under ``header`` may have."""
+    base = tuple(TABLE_COLUMNS[:6])
+    if _is_rheometer(header):
+        return [base] + [base + (extra,) for extra in RHEOMETER_EXTRA_COLUMNS]
+    return [base, tuple(TABLE_COLUMNS)]
 #: what the first lines must contain (the header is < 10 kB; 256 kB leaves room for long calls)
 _HEAD_CHARS = 1 << 18
 
 
 def _check_text_header(path, header):
-    if not _DETAILED.search(header.rsplit("\n", 1)[-1]) or any("\n" + line + "\n" not in header
-                                                                for line in _HEADER_LINES):
+    lines = _HEADER_LINES[1:] if _is_rheometer(header) else _HEADER_LINES
+    if not _DETAILED.search(header.rsplit("\n", 1)[-1]) or any("\n" + line + "\n" not in header for line in lines):
         raise _bad(path, "not a particleShear run file, or cut inside its header (the header lines "
                    + ", ".join(repr(x) for x in _HEADER_LINES + ("Detailed stress tensor data",))
                    + " are missing)")
@@ -412,9 +507,9 @@ def _check_rows(path, cols, n_recorded, header, table_written):
     """Columns complete and of one length equal to the recorded row count (sidecar or header)."""
     names = list(cols)
     if table_written:
-        allowed = (TABLE_COLUMNS[:6], TABLE_COLUMNS)
+        allowed = _tables(header)
         if sorted(names) not in [sorted(a) for a in allowed]:
-            missing = [c for c in TABLE_COLUMNS[:6] if c not in cols] or [c for c in TABLE_COLUMNS if c not in cols]
+            missing = [c for c in allowed[0] if c not in cols] or [c for c in allowed[-1] if c not in cols]
             raise _bad(path, "the table's columns are incomplete (missing: " + ", ".join(missing[:5])
                        + (", …" if len(missing) > 5 else "") + ")")
         lengths = {len(v) for v in cols.values()}
@@ -427,7 +522,7 @@ def _check_rows(path, cols, n_recorded, header, table_written):
         n = 0
     expected = n_recorded
     source = "its sidecar/metadata records"
-    if expected is None and table_written:
+    if expected is None and table_written and not _is_rheometer(header):
         expected, source = _header_steps(header), "its header records"
     if expected is not None and n != expected:
         raise _bad(path, f"incomplete: the table has {n} rows, {source} {expected}")
@@ -439,28 +534,34 @@ def _parse_text(path, text):
     _check_text_header(path, header)
     if body == "\n" + NO_TENSOR_DATA_TEXT:
         return header, {}, False
-    names_line = "\n" + "\t".join(TABLE_COLUMNS)
-    if not body.startswith(names_line) or (len(body) > len(names_line) and body[len(names_line)] != "\n"):
-        raise _bad(path, "incomplete: after 'Detailed stress tensor data' neither the 42-column table "
+    columns = [c for c in _tables(header) if len(c) > 6 or _is_rheometer(header)]
+    for names in sorted(columns, key=len, reverse=True):
+        names_line = "\n" + "\t".join(names)
+        if body.startswith(names_line) and (len(body) == len(names_line) or body[len(names_line)] == "\n"):
+            break
+    else:
+        raise _bad(path, "incomplete: after its 'Detailed … data' line neither the table's names line "
                    "nor the no-table notice is complete")
     rows = body[len(names_line) + 1:]
     if not rows:
-        return header, {name: np.empty(0) for name in TABLE_COLUMNS}, True
+        return header, {name: np.empty(0) for name in names}, True
     last = rows[rows.rfind("\n") + 1:]
     if last == "":
         raise _bad(path, "incomplete: the table ends with a line break, which a complete file does not have "
                    "after its last row (the file is cut at a row boundary)")
-    if last.count("\t") != len(TABLE_COLUMNS) - 1:
-        raise _bad(path, f"incomplete: the last row has {last.count(chr(9)) + 1} of {len(TABLE_COLUMNS)} fields "
+    if last.count("\t") != len(names) - 1:
+        raise _bad(path, f"incomplete: the last row has {last.count(chr(9)) + 1} of {len(names)} fields "
                    "(the file is cut inside a row)")
     try:
         data = np.loadtxt(io.StringIO(rows), delimiter="\t", ndmin=2)
     except ValueError as exc:
         raise _bad(path, f"the table is damaged ({exc})") from exc
-    if data.shape[1] != len(TABLE_COLUMNS):
-        raise _bad(path, f"the table has {data.shape[1]} columns, not {len(TABLE_COLUMNS)}")
-    cols = {name: data[:, j] for j, name in enumerate(TABLE_COLUMNS)}
-    cols["index"] = cols["index"].astype(np.int64)
+    if data.shape[1] != len(names):
+        raise _bad(path, f"the table has {data.shape[1]} columns, not {len(names)}")
+    cols = {name: data[:, j] for j, name in enumerate(names)}
+    for name in ("index", "sweep_position"):
+        if name in cols:
+            cols[name] = cols[name].astype(np.int64)
     return header, cols, True
 
 
@@ -553,7 +654,9 @@ def _check_container(path, fmt, meta, size):
                 with open(path, "rb") as fh:
                     fh.seek(max(0, size - 4096))
                     last = fh.read().decode("utf-8", errors="replace").rsplit("\n", 1)[-1]
-                if last != NO_TENSOR_DATA_TEXT.rsplit("\n", 1)[-1] and last.count("\t") != len(TABLE_COLUMNS) - 1:
+                n_fields = max(len(c) for c in _tables(header)) if not _is_rheometer(header) else \
+                    len(head[len(header):].lstrip("\n").split("\n", 1)[0].split("\t"))
+                if last != NO_TENSOR_DATA_TEXT.rsplit("\n", 1)[-1] and last.count("\t") != n_fields - 1:
                     raise _bad(path, "incomplete: the last row is cut")
         elif fmt == "npz":
             with zipfile.ZipFile(path) as zf:
@@ -651,5 +754,5 @@ def read_run(path):
         raise
     except Exception as exc:  # EOFError, BadZipFile (CRC), zlib/gzip/Arrow errors, UnicodeDecodeError, KeyError …
         raise _bad(path, f"damaged or unreadable {fmt} file ({type(exc).__name__}: {exc})") from exc
-    ordered = {name: cols[name] for name in TABLE_COLUMNS if name in cols}
+    ordered = {name: cols[name] for name in tuple(TABLE_COLUMNS) + RHEOMETER_EXTRA_COLUMNS if name in cols}
     return RunData(ordered, header, metadata, path, fmt)
