@@ -3,7 +3,7 @@ import unittest
 
 import numpy as np
 
-from particleShear.analysis import herschel_bulkley_bootstrap, herschel_bulkley_fit
+from particleShear.analysis import fit_flow_curve, flow_curve_table, herschel_bulkley_bootstrap, herschel_bulkley_fit
 
 RATE = np.logspace(-2, 2, 9)
 
@@ -107,6 +107,44 @@ class TestBootstrap(unittest.TestCase):
                 lo, hi = res.intervals[name]
                 covered[i] += lo <= true <= hi
         self.assertTrue((covered >= 24).all(), covered)
+
+
+class TestFromTable(unittest.TestCase):
+    """A steady-shear sweep's table (rows as load_results gives them) into the fit."""
+
+    @staticmethod
+    def rows(law, tau=1e-3, reps=3, failed=()):
+        out = []
+        for rep in range(reps):
+            for rel in (0.08, 0.01, 0.04, 0.02):        # table order need not be rate order
+                ok = (rel, rep) not in failed
+                out.append({"protocol": "steady", "status": "ok" if ok else "failed", "repetition": rep,
+                            "relative_rate": rel, "strain_rate": rel / tau if ok else None,
+                            "stress_surface": law(rel / tau) + 0.1 * (rep - 1) if ok else None})
+        return out
+
+    def test_grouping_and_exact_recovery(self):
+        law = lambda g: 4.0 + 0.5 * g ** 0.6     # noqa: E731
+        rate, stress = flow_curve_table(self.rows(law, failed={(0.04, 2)}))
+        np.testing.assert_array_equal(rate, [10.0, 20.0, 40.0, 80.0])
+        self.assertEqual(stress.shape, (4, 3))
+        self.assertTrue(np.isnan(stress[2, 2]) and np.isfinite(stress).sum() == 11)
+        # repetitions offset by -0.1, 0, +0.1 Pa: the seed mean is the law itself, fitted exactly
+        fit = fit_flow_curve(self.rows(law), n_boot=200, rng=1)
+        self.assertAlmostEqual(fit.fit.sigma_y, 4.0, delta=1e-6)
+        self.assertAlmostEqual(fit.fit.n, 0.6, delta=1e-6)
+        lo, hi = fit.intervals["sigma_y"]
+        self.assertLessEqual(lo, 4.0 + 1e-6)
+        self.assertGreaterEqual(hi, 4.0 - 1e-6)
+
+    def test_mixed_materials_and_no_steady_rows_refused(self):
+        rows = self.rows(lambda g: g) + [dict(self.rows(lambda g: g, tau=2e-3)[0], repetition=5)]
+        with self.assertRaisesRegex(ValueError, "mixes materials"):
+            flow_curve_table(rows)
+        with self.assertRaisesRegex(ValueError, "no rows of protocol 'steady'"):
+            flow_curve_table([{"protocol": "creep", "status": "ok"}])
+        with self.assertRaisesRegex(ValueError, "estimator"):
+            flow_curve_table(self.rows(lambda g: g), estimator="plate")
 
 
 if __name__ == "__main__":

@@ -66,6 +66,13 @@ class TestSteadyInASweep(unittest.TestCase):
         # the rate in 1/s is relative_rate/τ: the ratio of the two rows' rates is that of the relative rates
         self.assertAlmostEqual(df["strain_rate"][1] / df["strain_rate"][0], 2.0, places=12)
 
+    def test_flow_curve_of_the_table(self):
+        from particleShear.analysis import flow_curve_table
+        rate, stress = flow_curve_table(load_results(self.out))
+        by_rate = sorted(self.rows, key=lambda r: r["relative_rate"])
+        np.testing.assert_array_equal(rate, [r["strain_rate"] for r in by_rate])
+        np.testing.assert_array_equal(stress[:, 0], [r["stress_surface"] for r in by_rate])
+
     def test_resume_runs_nothing_again(self):
         seen = []
         again = run_sweep(STEADY, self.out, workers=1, progress=seen.append)

@@ -13,7 +13,8 @@
 * :mod:`~particleShear.analysis.sweep` — an amplitude sweep's mean curves and characteristics
   with bootstrap intervals over seeds (:func:`sweep_summary`).
 * :mod:`~particleShear.analysis.flow_curve` — Herschel–Bulkley fit of a flow curve with bootstrap
-  intervals over seeds (:func:`herschel_bulkley_bootstrap`).
+  intervals over seeds (:func:`herschel_bulkley_bootstrap`; of a steady-shear sweep's table:
+  :func:`fit_flow_curve`).
 * :mod:`~particleShear.analysis.cli` — ``python -m particleShear analyse DIR``;
   :mod:`~particleShear.analysis.figure` its figure.
 
@@ -22,7 +23,8 @@ Definitions, units and when to use which estimator: docs/analysis.md.
 __docformat__ = "numpy"
 from .curves import CURVE_POINTS, stress_curve_points, yield_point
 from .demodulation import ESTIMATOR_COLUMNS, PHASES, demodulate, evaluate_run, jump_corrected, measurement_periods
-from .flow_curve import FlowCurveFit, HerschelBulkley, herschel_bulkley_bootstrap, herschel_bulkley_fit
+from .flow_curve import (FlowCurveFit, HerschelBulkley, fit_flow_curve, flow_curve_table, herschel_bulkley_bootstrap,
+                         herschel_bulkley_fit)
 from .laos import LaosResult, laos
 from .measures import MEASURE_COLUMNS, MeasurementWarning, run_measures
 from .periods import PeriodModuli, measured_period_count, period_moduli
@@ -32,4 +34,5 @@ __all__ = ["demodulate", "jump_corrected", "measurement_periods", "evaluate_run"
            "yield_point", "stress_curve_points", "CURVE_POINTS", "laos", "LaosResult", "period_moduli",
            "PeriodModuli", "measured_period_count", "run_measures", "MEASURE_COLUMNS", "MeasurementWarning",
            "sweep_summary", "SweepSummary",
-           "herschel_bulkley_fit", "HerschelBulkley", "herschel_bulkley_bootstrap", "FlowCurveFit"]
+           "herschel_bulkley_fit", "HerschelBulkley", "herschel_bulkley_bootstrap", "FlowCurveFit", "fit_flow_curve",
+           "flow_curve_table"]

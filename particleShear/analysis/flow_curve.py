@@ -29,7 +29,8 @@ import numpy as np
 
 from .sweep import _check_resampling, _percentile_interval, _vector
 
-__all__ = ["FlowCurveFit", "HerschelBulkley", "N_GRID", "herschel_bulkley_bootstrap", "herschel_bulkley_fit"]
+__all__ = ["FlowCurveFit", "HerschelBulkley", "N_GRID", "fit_flow_curve", "flow_curve_table", "herschel_bulkley_bootstrap",
+           "herschel_bulkley_fit"]
 
 #: number of flow indices n = 2k/N_GRID (k = 1 … N_GRID) of the coarse search
 N_GRID = 41
@@ -360,3 +361,91 @@ def _means(T):
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(count > 0, total / count, 0.0)
     return mean, (count > 0).astype(float)
+
+
+def _records(results):
+    """The rows of a results table: a pandas DataFrame (``load_results``) or a sequence of dicts."""
+    if hasattr(results, "to_dict") and hasattr(results, "columns"):
+        return results.to_dict("records")
+    try:
+        rows = list(results)
+    except TypeError as exc:
+        raise ValueError("results is invalid: a results table (load_results(DIR)) or a list of row dicts") from exc
+    if not all(isinstance(r, dict) for r in rows):
+        raise ValueError("results is invalid: a results table (load_results(DIR)) or a list of row dicts")
+    return rows
+
+
+def flow_curve_table(results, estimator="surface"):
+    """The flow curve of a steady-shear sweep's table: rates and the stresses of each repetition.
+
+    Rows of protocol "steady" are grouped by ``relative_rate`` (ascending); column j holds the
+    steady stress of repetition j (NaN for a failed or missing run).  Every rate's rows must
+    share one ``strain_rate`` in 1/s (one material: filter a table of several first).
+
+    Parameters
+    ----------
+    results : pandas.DataFrame or sequence of dict
+        A sweep's results table (:func:`particleShear.sweep.schema.load_results`, ``run_sweep``'s rows).
+    estimator : {"surface", "internal"}, default "surface"
+        Which stress: the plate-band estimator or the overall tensor's (docs/protocols.md).
+
+    Returns
+    -------
+    rate : numpy.ndarray, shape (n_rates,)
+        Shear rates γ̇ in 1/s.
+    stress : numpy.ndarray, shape (n_rates, n_repetitions)
+        Steady shear stresses in Pa, NaN where a run failed or is missing.
+
+    Raises
+    ------
+    ValueError
+        A bad ``estimator``, no steady rows, or one relative rate with two different rates in 1/s.
+    """
+    if estimator not in ("surface", "internal"):
+        raise ValueError(f"estimator={estimator!r} is invalid: allowed 'surface', 'internal'")
+    rows = [r for r in _records(results) if r.get("protocol") == "steady"]
+    if not rows:
+        raise ValueError("results has no rows of protocol 'steady': a flow curve needs a steady-shear sweep")
+    rates, reps = {}, set()
+    for r in rows:
+        rel, rep = float(r["relative_rate"]), int(r.get("repetition") or 0)
+        reps.add(rep)
+        ok = r.get("status") == "ok" and r.get(f"stress_{estimator}") is not None
+        if ok:
+            g = float(r["strain_rate"])
+            if rates.setdefault(rel, {}).setdefault("rate", g) != g:
+                raise ValueError(f"results mixes materials: relative_rate={rel} is {rates[rel]['rate']} and {g} 1/s; "
+                                 "select the rows of one material first")
+            rates[rel][rep] = float(r[f"stress_{estimator}"])
+        else:
+            rates.setdefault(rel, {})
+    order = sorted(k for k in rates if "rate" in rates[k])
+    if not order:
+        raise ValueError("results has no finished steady run")
+    columns = sorted(reps)
+    stress = np.array([[rates[k].get(j, np.nan) for j in columns] for k in order], dtype=float)
+    return np.array([rates[k]["rate"] for k in order]), stress
+
+
+def fit_flow_curve(results, estimator="surface", n_boot=2000, confidence=0.95, rng=None):
+    """Herschel–Bulkley fit of a steady-shear sweep's flow curve with bootstrap intervals over seeds.
+
+    :func:`herschel_bulkley_bootstrap` of :func:`flow_curve_table`; the yield stress it implies
+    is ``fit.fit.sigma_y`` with the interval ``fit.intervals["sigma_y"]``.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame or sequence of dict
+        A steady-shear sweep's results table (a grid over ``relative_rate``, repetitions as seeds).
+    estimator : {"surface", "internal"}, default "surface"
+        Which stress (see :func:`flow_curve_table`).
+    n_boot, confidence, rng
+        As :func:`herschel_bulkley_bootstrap`.
+
+    Returns
+    -------
+    FlowCurveFit
+    """
+    rate, stress = flow_curve_table(results, estimator)
+    return herschel_bulkley_bootstrap(rate, stress, n_boot=n_boot, confidence=confidence, rng=rng)
