@@ -564,12 +564,17 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         checked as there (``progress``, ``correct_drift_sign``, ``reference_header``, ``renderer``,
         ``time_step_factor``, ``integrator``, ``stability_guard``, ``saveOutputMovie``,
         ``output_format``, ``strict_io``, ``contact_law``, ``plateau_begin``, ``plateau_end``,
-        ``plateau_slope``); not ``return_result`` (every run returns its result).
+        ``plateau_slope``, and the rheometer's ``protocol``, ``relative_rate``, ``total_strain``,
+        ``ramp_time``, ``hold_time``, ``creep_stress``, ``creep_modulus``, ``creep_response_time``,
+        ``sweep_amplitudes``, ``sweep_frequencies``: docs/protocols.md); not ``return_result``
+        (every run returns its result).
 
     Returns
     -------
-    list of SimulationResult
-        In the reference iteration order (repetition, amplitude, μ, then bulk control, material,
+    list of SimulationResult or list of RheometerResult
+        One result per run (a :class:`~particleShear.run.rheometer.RheometerResult` for a
+        protocol other than "oscillatory"; resumed runs rebuilt from the table's rows), in the
+        reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
 
     Raises

@@ -102,8 +102,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
 
     Returns
     -------
-    list of SimulationResult
-        In the order of ``all_kwargs``.
+    list of SimulationResult or list of RheometerResult
+        In the order of ``all_kwargs`` (RheometerResult for a protocol other than "oscillatory").
 
     Raises
     ------
