@@ -470,7 +470,9 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     x-axis) or ± one standard error (otherwise); the legend says which.  The number of seeds per
     point is in the panel titles (or beside the points); fewer than 3 warn.  A mean ≤ 0 cannot be
     drawn on the log axis: it is marked at the panel's lower edge, listed in a note and warned about.
-    Details: :mod:`particleShear.sweep_plot`.
+    Details: :mod:`particleShear.sweep_plot`.  A steady-shear sweep (every row of protocol
+    "steady") gives its flow curve instead
+    (:func:`particleShear.rheometer_plot.plot_flow_curve_sweep`, ``DIR/flow_curve.png``).
 
     Parameters
     ----------
@@ -518,6 +520,10 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS} (CLI --estimator)")
     rows = read_sweep_table(folder_or_csv)
+    if rows and all(r.get("protocol") == "steady" for r in rows):   # a flow curve (docs/protocols.md)
+        from .rheometer_plot import plot_flow_curve_sweep
+        return plot_flow_curve_sweep(folder_or_csv, estimator, path, n_boot=n_boot, confidence=confidence,
+                                     bootstrap_seed=bootstrap_seed)
     try:
         table = sweep_panels(rows, estimator, x=x, split=split, n_boot=n_boot, confidence=confidence,
                              bootstrap_seed=bootstrap_seed, max_panels=max_panels)

@@ -21,6 +21,9 @@ plot_amplitude_sweeps
 plot_steady_run
     The stress of one steady-shear run against the strain, with its steady mean and the end of
     the transient.
+plot_flow_curve_sweep
+    The flow curve of a steady-shear sweep's table: seed means with standard errors and the
+    Herschel–Bulkley fit with bootstrap intervals (``particleShear plot DIR`` of such a sweep).
 plot_rheometer_result
     The figure of one :class:`~particleShear.run.rheometer.RheometerResult` (``result.plot()``
     and the command line's ``--plot``): one of the above, chosen by its protocol.
@@ -31,7 +34,7 @@ import numpy as np
 from .plot import _figure, check_figure_path, save_figure
 
 __all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps", "plot_steady_run",
-           "plot_rheometer_result"]
+           "plot_rheometer_result", "plot_flow_curve_sweep"]
 
 
 def _series(name, values, n=None):
@@ -376,3 +379,63 @@ def plot_rheometer_result(result, path=None):
         plateau = (summ["G_plateau_surface"], summ["G_plateau_surface_se"])
         return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path)
     return plot_creep(t, y, path)
+
+
+def plot_flow_curve_sweep(folder_or_csv, estimator="surface", path=None, n_boot=2000, confidence=0.95,
+                          bootstrap_seed=0):
+    """The flow curve of a steady-shear sweep with its Herschel–Bulkley fit (log–log).
+
+    Each point is the mean over the repetitions at one ``relative_rate`` with ± one standard error
+    (failed runs left out); the fit is :func:`particleShear.analysis.fit_flow_curve`, its
+    bootstrap interval of σ_y in the legend.
+
+    Parameters
+    ----------
+    folder_or_csv : str or os.PathLike
+        The sweep folder or its ``results.csv``.
+    estimator : {"surface", "internal"}, default "surface"
+        Which stress.
+    path : str, os.PathLike, None or False
+        None (default): write ``DIR/flow_curve.png`` and ``.pdf``; a path: that file; False: nothing.
+    n_boot, confidence, bootstrap_seed
+        As :func:`particleShear.analysis.flow_curve.herschel_bulkley_bootstrap` (``rng``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Labelled "flow_curve"; axes as :func:`plot_flow_curve`.
+
+    Raises
+    ------
+    ValueError
+        No steady rows, mixed materials, or fewer than three rates with a finished run.
+    """
+    import os
+    import warnings
+
+    from .analysis.flow_curve import fit_flow_curve, flow_curve_table
+    from .sweep.schema import load_results
+    src = os.fspath(folder_or_csv)
+    table = load_results(src, as_frame=False)
+    rate, stress = flow_curve_table(table, estimator)
+    have = np.isfinite(stress).sum(axis=1)
+    if (have > 0).sum() < 3:
+        raise ValueError(f"folder_or_csv={src!r}: a flow curve needs finished runs at >= 3 rates, "
+                         f"it has {(have > 0).sum()}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean = np.nanmean(stress, axis=1)
+        sem = np.where(have > 1, np.nanstd(stress, axis=1, ddof=1) / np.sqrt(np.maximum(have, 1)), 0.0)
+    keep = have > 0
+    fc = fit_flow_curve(table, estimator, n_boot=n_boot, confidence=confidence, rng=bootstrap_seed)
+    fig = plot_flow_curve(rate[keep], mean[keep], np.nan_to_num(sem[keep]), fit=fc.fit,
+                          path=path if path not in (None, False) else None)
+    lo, hi = fc.intervals["sigma_y"]
+    fig.axes[0].set_title(f"{estimator} stress, {stress.shape[1]} seed(s); σ_y {100 * confidence:g} % interval "
+                          f"[{lo:.3g}, {hi:.3g}] Pa", fontsize="small")
+    fig.set_label("flow_curve")
+    if path is None:
+        folder = src if os.path.isdir(src) else os.path.dirname(os.path.abspath(src))
+        for ext in (".png", ".pdf"):
+            save_figure(fig, os.path.join(folder, "flow_curve" + ext))
+    return fig

@@ -22,7 +22,7 @@ from particleShear.sweep.schema import load_results
 SMALL = dict(N=30, cut_lines=0, relative_frequency=0.2, pre_periods=0.2, periods=3, post_periods=0,
              doDrawing=False, plotStress=False)
 STEADY = {"parameters": dict(SMALL, protocol="steady", total_strain=0.04),
-          "grid": {"relative_rate": [0.01, 0.02]}, "seeds": {"root": 5, "repetitions": 1}}
+          "grid": {"relative_rate": [0.01, 0.02, 0.04]}, "seeds": {"root": 5, "repetitions": 1}}
 SWEEP = {"parameters": dict(SMALL, protocol="amplitude_sweep"),
          "grid": {"sweep_amplitudes": [[0.05, 0.1, 0.15]]}, "seeds": {"root": 9, "repetitions": 1}}
 
@@ -48,7 +48,7 @@ class TestSteadyInASweep(unittest.TestCase):
         cls.tmp.cleanup()
 
     def test_rows_equal_the_direct_calls(self):
-        self.assertEqual(len(self.rows), 2)
+        self.assertEqual(len(self.rows), 3)
         for run, row in zip(self.runs, self.rows):
             res = direct(run)
             self.assertEqual(row["run_id"], run.run_id)
@@ -59,7 +59,7 @@ class TestSteadyInASweep(unittest.TestCase):
 
     def test_typed_table_has_the_protocol_columns(self):
         df = load_results(self.out)
-        self.assertEqual(list(df["protocol"]), ["steady", "steady"])
+        self.assertEqual(list(df["protocol"]), ["steady"] * 3)
         self.assertEqual(str(df["stress_surface"].dtype), "float64")
         # σ/γ̇ of the table's own columns is the viscosity (a definition evaluated independently)
         np.testing.assert_allclose(df["viscosity_surface"], df["stress_surface"] / df["strain_rate"], rtol=1e-12)
@@ -72,6 +72,20 @@ class TestSteadyInASweep(unittest.TestCase):
         by_rate = sorted(self.rows, key=lambda r: r["relative_rate"])
         np.testing.assert_array_equal(rate, [r["strain_rate"] for r in by_rate])
         np.testing.assert_array_equal(stress[:, 0], [r["stress_surface"] for r in by_rate])
+
+    def test_flow_curve_figure_of_the_folder(self):
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            self.skipTest("matplotlib not installed")
+        from particleShear.plot import plot_sweep
+        fig = plot_sweep(self.out, path=False, n_boot=50)
+        self.assertEqual(fig.get_label(), "flow_curve")
+        # the σ panel's points are the table's stresses at its rates (one repetition: the values)
+        pts = fig.axes[0].containers[0].lines[0].get_xydata()
+        by_rate = sorted(self.rows, key=lambda r: r["relative_rate"])
+        np.testing.assert_array_equal(pts[:, 0], [r["strain_rate"] for r in by_rate])
+        np.testing.assert_array_equal(pts[:, 1], [r["stress_surface"] for r in by_rate])
 
     def test_resume_runs_nothing_again(self):
         seen = []
