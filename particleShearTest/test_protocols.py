@@ -40,6 +40,17 @@ class TestBatchedEqualsSingle(unittest.TestCase):
                 np.testing.assert_array_equal(res.series[key], single.series[key])
 
 
+    def test_amplitude_sweep_replicas_with_different_lists(self):
+        # lists with the same time steps (docs/protocols.md, "Batches") batch; each replica equals its run
+        kws = [dict(SMALL, seed=3, protocol="amplitude_sweep", sweep_amplitudes=[0.05, 0.1]),
+               dict(SMALL, seed=4, protocol="amplitude_sweep", sweep_amplitudes=[0.04, 0.08])]
+        batch = run_batch(kws)
+        for kw, res in zip(kws, batch):
+            single = doParticleShearSimulation(**kw, return_result=True)
+            self.assertEqual(res.steps, single.steps)
+            for key in single.series:
+                np.testing.assert_array_equal(res.series[key], single.series[key])
+
 class TestProtocols(unittest.TestCase):
     def test_frequency_sweep_first_step_is_the_independent_run(self):
         sweep = run(seed=7, protocol="frequency_sweep", sweep_frequencies=[0.2, 0.3])
