@@ -54,6 +54,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.pool",
     "particleShear.sweep.record",
     "particleShear.sweep.runner",
+    "particleShear.sweep.progress",
     "particleShear.sweep.schema",
     "particleShear.sweep.series",
     "particleShear.sweep.spec",

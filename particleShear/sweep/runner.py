@@ -27,13 +27,13 @@ import logging
 import os
 import re
 import sys
-import time
 
 import numpy as np
 
 from .cost import estimate_cost, estimate_point_cost, format_cost
 from .locks import FolderBusyError, ScratchOwner, folder_lock
 from .pool import pool_context, run_jobs
+from .progress import SweepProgress
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
 from .schema import typed_row, write_schema
@@ -87,16 +87,6 @@ class SweepOutcome:
         return self.row["status"] == "ok"
 
 
-#: the column whose value a progress line shows, per protocol (the oscillatory run's G′)
-_SHOWN = {"steady": ("stress_surface", "σ", "Pa"), "relaxation": ("G_plateau_surface", "G_plateau", "Pa"),
-          "creep": ("creep_rate", "creep rate", "1/s")}
-
-
-def _shown(row):
-    name, label, unit = _SHOWN.get(row.get("protocol") or "", ("Gp_surface", "G'", "Pa"))
-    return f"{label}={float(row[name]):.6g} {unit}"
-
-
 def _n_rows(run):
     """Rows of an ``ok`` run in the table: one per step of a one-packing sweep, else one."""
     proto = run.parameters.get("protocol", "oscillatory")
@@ -110,58 +100,6 @@ def _n_rows(run):
 def _flat(items):
     """The rows of ``(run, row or [rows])`` items, in order."""
     return [r for _, row in items for r in (row if isinstance(row, list) else [row])]
-
-
-class SweepProgress:
-    """One line per finished run: done/failed/total, rate, ETA (a tqdm bar on a terminal when installed).
-
-    Call it with each :class:`SweepOutcome`; :meth:`close` at the end.
-
-    Parameters
-    ----------
-    total : int
-        Number of runs of the sweep (or of this task's share).
-    already : int, optional
-        Runs finished before this call (resumed sweep), counted as done (default 0).
-    stream : file-like, optional
-        Where the lines go (default ``sys.stderr``); a terminal gets a tqdm bar when installed.
-    """
-
-    def __init__(self, total, already=0, stream=None):
-        self.total, self.done, self.failed = total, already, 0
-        self.started = 0
-        self.stream = stream if stream is not None else sys.stderr
-        self.t0 = time.perf_counter()
-        self._bar = None
-        if hasattr(self.stream, "isatty") and self.stream.isatty():
-            try:
-                from tqdm import tqdm
-                self._bar = tqdm(total=total, initial=already, file=self.stream, unit="run")
-            except ImportError:
-                pass
-
-    def __call__(self, outcome):
-        self.done += 1
-        self.started += 1
-        self.failed += not outcome.ok
-        elapsed = time.perf_counter() - self.t0
-        rate = self.started / elapsed if elapsed > 0 else float("inf")
-        eta = (self.total - self.done) / rate if rate > 0 else float("inf")
-        if self._bar is not None:
-            self._bar.update(1)
-            self._bar.set_postfix(failed=self.failed)
-            return
-        row = outcome.row
-        tail = _shown(row) if outcome.ok else row["error"][:80]
-        self.stream.write(f"[sweep] {self.done}/{self.total} done, {self.failed} failed, {rate:.3g} runs/s, "
-                          f"ETA {eta:.0f} s | {row['run_id']} {row['status']} {float(row['wall_time_s']):.2f} s "
-                          f"{tail}\n")
-        self.stream.flush()
-
-    def close(self):
-        """Close the tqdm bar, if one is shown (lines need no closing)."""
-        if self._bar is not None:
-            self._bar.close()
 
 
 def _spec_doc(spec):
