@@ -111,7 +111,8 @@ def part_b_d(base, seeds, rates, strain, hold, gamma0, f, times):
     ok_d = z >= -3.0
     print(f"  {'σ_steady(γ₀ω) - |G*|γ₀':38s} diff {m:+.4g} ± {se:.2g}  z = {z:+.2f}  "
           f"{'PASS' if ok_d else 'FAIL'} (bound: σ_steady ≥ |G*|γ₀)")
-    return ok_b, ok_d
+    return ok_b, ok_d, dict(sig=sig, rates=all_rates, s0=s0, crate=crate, seed_rate=np.array(seed_rate),
+                            gstar=gstar, speak=speak)
 
 
 def main(argv=None):
@@ -130,7 +131,7 @@ def main(argv=None):
     warnings.simplefilter("ignore")
     t0 = time.perf_counter()
     ok_a, _ = part_a(base, seeds, gamma0=0.02, f=0.05, hold=hold, times=times)
-    ok_b, ok_d = part_b_d(base, seeds, rates=(0.003, 0.01, 0.03), strain=1.0, hold=hold, gamma0=0.3,
+    ok_b, ok_d, _ = part_b_d(base, seeds, rates=(0.003, 0.01, 0.03), strain=1.0, hold=hold, gamma0=0.3,
                           f=0.05, times=times)
     print("wall time per run (s), whole batch / replicas:")
     for k, v in times.items():
