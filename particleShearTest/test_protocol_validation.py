@@ -36,9 +36,9 @@ class TestProtocolValidation(unittest.TestCase):
         f·τ = 0.05; each inequality within 3 paired standard errors. The creep inverse and G′ also
         agree within 3 paired standard errors (measured z ≈ −1.4); the relaxation plateau after a
         50 τ hold is lower than both (z ≈ −3.8 and −5.8: the slow relaxation of the solid), so equality
-        is not asserted for it. Both the plateau and the creep inverse also carry the packing's
-        residual plate stress at γ = 0 divided by γ₀ (not subtracted by the protocols; large at
-        γ₀ = 0.02), which is the seed spread here."""
+        is not asserted for it. Both count from the packing's residual plate stress σ_res at rest
+        (step 0): G(t) = (σ(t) − σ_res)/γ₀ and the creep inverse (σ₀ − σ_res)/γ(hold); without that
+        origin the bias σ_res/γ₀ would dominate at γ₀ = 0.02."""
         gp, gpl, gc = self.a["gp"], self.a["gpl"], self.a["gc"]
         for lo, hi in ((gpl, gc), (gc, gp), (gpl, gp)):
             m, se, _ = vp.paired(hi, lo)

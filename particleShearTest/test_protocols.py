@@ -67,9 +67,10 @@ class TestProtocols(unittest.TestCase):
         res = run(seed=2, protocol="relaxation", theAmplitude=0.1, ramp_time=1.0, hold_time=20.0)
         n_ramp = round(1.0 / (res.dt / res.tau))
         strain = res.series["strain"]
-        # after the ramp the strain is γ₀ (a sum of n_ramp increments γ₀/n_ramp: rounding only)
-        np.testing.assert_allclose(strain[n_ramp:], 0.1, rtol=1e-12)
-        self.assertTrue(np.all(res.series["strain_rate"][n_ramp:] == 0))
+        # step 0 at rest, then n_ramp increments γ₀/n_ramp: the strain is γ₀ after them (rounding only)
+        self.assertEqual((strain[0], strain[1], res.series["strain_rate"][0]), (0.0, 0.0, 0.0))
+        np.testing.assert_allclose(strain[n_ramp + 1:], 0.1, rtol=1e-12)
+        self.assertTrue(np.all(res.series["strain_rate"][n_ramp + 1:] == 0))
         self.assertIn("G_surface", res.curves)
 
     def test_creep_tracks_the_applied_stress(self):
@@ -77,9 +78,25 @@ class TestProtocols(unittest.TestCase):
         res = run(seed=1, protocol="creep", creep_stress=s0, hold_time=100.0)
         t, tau = res.series["t"], res.series["stress_surface"]
         late = t >= t[-1] / 2
-        # the controller's integral term leaves no steady error: the late mean within 2 % of σ₀
+        # step 0 at rest measures the residual stress σ_res; the controller holds the plate stress at
+        # σ₀ and its integral term leaves no steady error: the late mean within 2 % of σ₀
+        self.assertEqual(res.series["strain_rate"][0], 0.0)
+        self.assertEqual(res.summary["residual_stress"], tau[0])
         self.assertLess(abs(tau[late].mean() - s0) / s0, 0.02)
+        self.assertAlmostEqual(res.summary["stress_tracking"], (tau[late].mean() - s0) / s0, places=12)
         self.assertGreater(res.summary["strain_plateau"], 0)
+
+    def test_relaxation_modulus_counts_from_the_residual_stress(self):
+        # G(t) = (σ(t) − σ(0))/γ₀: two step strains of one packing (same seed, same time step for
+        # amplitudes below the rule's threshold) give plateaus that agree at small strain, while
+        # σ(t)/γ₀ alone would differ by σ_res·(1/γ₁ − 1/γ₂)
+        a = run(seed=2, protocol="relaxation", theAmplitude=0.01, hold_time=20.0)
+        b = run(seed=2, protocol="relaxation", theAmplitude=0.02, hold_time=20.0)
+        res0 = a.summary["residual_stress"]
+        self.assertEqual(res0, a.series["stress_surface"][0])
+        G_a, G_b = a.summary["G_plateau_surface"], b.summary["G_plateau_surface"]
+        self.assertLess(abs(G_a - G_b) / G_b, 0.05, (G_a, G_b, res0))
+        self.assertGreater(abs(res0) * (1 / 0.01 - 1 / 0.02), 0.05 * G_b)    # the bias the origin removes
 
     def test_bad_input_before_any_work(self):
         cases = [dict(protocol="stedy"), dict(protocol="steady", relative_rate=0.0),

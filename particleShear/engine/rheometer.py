@@ -150,7 +150,9 @@ def steady_shear(engine, dt, cool, rate, n_steps, tensors_every=10, **loop):
 
 
 def stress_relaxation(engine, dt, cool, gamma0, n_ramp, n_hold, **loop):
-    """A strain ramp to γ₀ in ``n_ramp`` steps at the rate ``γ₀/(n_ramp·dt)``, then ``n_hold`` steps at γ̇ = 0.
+    """One step at rest, a strain ramp to γ₀ in ``n_ramp`` steps at the rate ``γ₀/(n_ramp·dt)``, then ``n_hold`` steps at γ̇ = 0.
+
+    The step at rest records the residual stress of the packing, the origin of G(t).
 
     Parameters
     ----------
@@ -169,19 +171,20 @@ def stress_relaxation(engine, dt, cool, gamma0, n_ramp, n_hold, **loop):
 
     Returns
     -------
-    dict of numpy.ndarray (n_ramp + n_hold, B)
+    dict of numpy.ndarray (1 + n_ramp + n_hold, B)
         The record of :func:`shear_record`.
     """
     xp = engine.xp
     ramp = engine.backend.asarray(np.asarray(gamma0, dtype=float) / (n_ramp * dt))
     zero = xp.zeros(engine.s.B)
-    return shear_record(engine, dt, cool, n_ramp + n_hold, lambda i: ramp if i < n_ramp else zero, **loop)
+    return shear_record(engine, dt, cool, 1 + n_ramp + n_hold, lambda i: ramp if 1 <= i <= n_ramp else zero, **loop)
 
 
 class CreepController:
     """Proportional-integral control of the strain rate that holds the plate stress at σ₀.
 
-    Per replica, with the error ``e = σ₀ − σ̄`` of the filtered plate stress σ̄ (τ_surface,
+    Per replica, step 0 at rest measures the residual plate stress σ_res (the filter's start);
+    from step 1 on, with the error ``e = σ₀ − σ̄`` of the filtered plate stress σ̄ (τ_surface,
     the stress a rheometer's motor feels):
 
     ``γ̇ = (e + I/T_i)/η_c``,   ``I ← I + e·dt``   (not while γ̇ is at its bound: no wind-up),
@@ -220,16 +223,21 @@ class CreepController:
         self.dt = dt
         self.rate_max = rate_max
         self.filtered = xp.zeros_like(sigma0)
+        self.residual = xp.zeros_like(sigma0)
         self.integral = xp.zeros_like(sigma0)
         self.rate = xp.zeros_like(sigma0)
 
     def rate_of(self, i):
-        """γ̇ of step i (1/s) from the filtered stress of the steps before it.
+        """γ̇ of step i (1/s) from the filtered stress of the steps before it; 0 at step 0.
+
+        Step 0 runs at rest and measures the residual plate stress σ_res of the packing (a finite
+        packing carries one after pre-equilibration, docs/protocols.md), which starts the filter;
+        the controller holds the total plate stress at σ₀, as a stress-controlled rheometer does.
 
         Parameters
         ----------
         i : int
-            Step index (unused: the controller's state carries the history).
+            Step index.
 
         Returns
         -------
@@ -237,6 +245,8 @@ class CreepController:
             The strain rate of each replica (1/s).
         """
         xp = self.xp
+        if i == 0:
+            return self.rate
         e = self.sigma0 - self.filtered
         trial = self.integral + e * self.dt
         # the integral advances only where its rate is within the bound (no wind-up)
@@ -254,6 +264,10 @@ class CreepController:
         tau_internal, tau_surface : array (B,)
             Shear stresses of the step (Pa); the plate's, ``tau_surface``, is the controlled one.
         """
+        if i == 0:     # at rest: the residual stress, the origin of the applied stress
+            self.residual = tau_surface
+            self.filtered = tau_surface
+            return
         self.filtered = self.filtered + (tau_surface - self.filtered) * self.alpha
 
 

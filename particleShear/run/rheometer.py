@@ -10,11 +10,12 @@ gives the same packing), then drive the engine with another rate schedule
     standard error by blocking after the detected transient), the viscosity σ/γ̇ and the first
     normal-stress difference N1 of the overall tensor.
 ``"relaxation"``
-    A ramp to γ₀ = ``theAmplitude`` over ``ramp_time``·τ, then ``hold_time``·τ at constant
-    strain; G(t) = σ(t)/γ₀ (t from the end of the ramp) on a log-spaced grid and its plateau.
+    One step at rest (the residual stress σ_res), a ramp to γ₀ = ``theAmplitude`` over
+    ``ramp_time``·τ, then ``hold_time``·τ at constant strain; G(t) = (σ(t) − σ_res)/γ₀ (t from
+    the end of the ramp) on a log-spaced grid and its plateau.
 ``"creep"``
-    The plate stress held at ``creep_stress`` (Pa) for ``hold_time``·τ by a PI controller on the
-    strain rate; J(t) = γ(t)/σ₀ on a log grid, the final creep rate, σ₀/γ̇ and the strain plateau.
+    One step at rest (the residual stress σ_res), then the plate stress held at
+    ``creep_stress`` (Pa) for ``hold_time``·τ by a PI controller on the strain rate; J(t) = γ(t)/σ₀ on a log grid, the final creep rate, σ₀/γ̇ and the strain plateau.
 ``"amplitude_sweep"`` / ``"frequency_sweep"``
     One packing, then the oscillatory protocol (``pre_periods``, ``periods``, ``post_periods``)
     for each amplitude of ``sweep_amplitudes`` (or relative frequency of ``sweep_frequencies``)
@@ -219,7 +220,7 @@ def protocol_steps(q):
         out["steps"] = int(math.ceil(float(q["total_strain"]) / (float(q["relative_rate"]) * dtr)))
     elif proto == "relaxation":
         out["ramp"] = max(1, int(round(float(q["ramp_time"]) / dtr)))
-        out["steps"] = out["ramp"] + int(math.ceil(float(q["hold_time"]) / dtr))
+        out["steps"] = 1 + out["ramp"] + int(math.ceil(float(q["hold_time"]) / dtr))   # a first step at rest
     elif proto == "creep":
         out["steps"] = int(math.ceil(float(q["hold_time"]) / dtr))
     elif proto.endswith("sweep"):
@@ -456,7 +457,7 @@ def measure_rheometer(runs):
     elif proto == "relaxation":
         st = steps[order[0]]
         recs = _guarded(lambda e: eng.stress_relaxation(e, sc.dt, sc.cool, [k["theAmplitude"] for k in kws],
-                                                        st["ramp"], st["steps"] - st["ramp"], **loop), engine, dt=sc.dt)
+                                                        st["ramp"], st["steps"] - st["ramp"] - 1, **loop), engine, dt=sc.dt)
     elif proto == "creep":
         G_c = [k["creep_modulus"] if k["creep_modulus"] is not None else
                CREEP_MODULUS_FRACTION * k["Young_modulus_spheres"] for k in kws]

@@ -57,12 +57,14 @@ def analyse_record(protocol, kw, series, tau, steps):
         out["N1"], out["N1_se"] = (ba.mean, ba.sem) if ba else (math.nan, math.nan)
     elif protocol == "relaxation":
         g0 = kw["theAmplitude"]
-        n_ramp = steps["ramp"]
+        n_ramp = steps["ramp"] + 1          # the first hold sample: step 0 at rest, then the ramp
         t_end = t[n_ramp] if len(t) > n_ramp else math.nan
         th = t[n_ramp:] - t_end
         out["step_strain"], out["ramp_time_s"] = g0, t_end
+        out["residual_stress"] = float(series["stress_surface"][0])
         for est, key in _EST:
-            G = series[key][n_ramp:] / g0
+            # the stress the step strain adds to the packing's residual stress (step 0, γ = 0)
+            G = (series[key][n_ramp:] - series[key][0]) / g0
             ba = plateau(th, G)
             out[f"G_plateau_{est}"], out[f"G_plateau_{est}_se"] = ba.mean, ba.sem
             tm, gm, gs, _ = log_grid(th, G)
@@ -77,6 +79,8 @@ def analyse_record(protocol, kw, series, tau, steps):
         ba = plateau(t, gam)
         out["strain_plateau"], out["strain_plateau_se"] = ba.mean, ba.sem
         half = t >= t[-1] / 2
+        res0 = float(series["stress_surface"][0])      # step 0 at rest: the residual stress
+        out["residual_stress"] = res0
         out["stress_tracking"] = float((series["stress_surface"][half].mean() - s0) / s0)
         tm, jm, js, _ = log_grid(t, gam / s0)
         curves["J"] = (tm, jm, js)

@@ -109,7 +109,10 @@ _PROTOCOL_FIXED = {
     "t_transient": ("float", "s", "end of the start-up transient (MSER-5 on the plate stress)" + _P.format("'steady'")),
     "strain_transient": ("float", "1", "strain at the end of the start-up transient" + _P.format("'steady'")),
     "ramp_time_s": ("float", "s", "duration of the strain ramp to theAmplitude" + _P.format("'relaxation'")),
-    "G_plateau_surface": ("float", "Pa", "long-time plateau of G(t) = σ(t)/γ₀, plate forces (last 20 % of the hold)"
+    "residual_stress": ("float", "Pa", "plate stress σ_res of the packing at rest before the step strain or "
+                        "stress (the origin of G(t); a solid creeps by (σ₀ − σ_res)/G)" + _P.format("'relaxation' or 'creep'")),
+    "G_plateau_surface": ("float", "Pa", "long-time plateau of G(t) = (σ(t) − σ_res)/γ₀, plate forces (last 20 % "
+                          "of the hold)"
                           + _P.format("'relaxation'")),
     "G_plateau_surface_se": ("float", "Pa", "standard error of G_plateau_surface by block averaging"
                              + _P.format("'relaxation'")),
