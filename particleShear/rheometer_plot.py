@@ -126,7 +126,7 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None):
     t : array_like
         Times in s after the strain step; non-positive times are dropped (log x).
     G : array_like
-        Relaxation modulus G(t) = σ(t)/γ₀ in Pa, same length as ``t``.
+        Relaxation modulus G(t) = (σ(t) − σ_res)/γ₀ in Pa, same length as ``t``.
     G_err : array_like, optional
         Standard errors of ``G`` in Pa (error bars).
     plateau : tuple of float, optional
