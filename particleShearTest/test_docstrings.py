@@ -106,6 +106,8 @@ ENGINE_MODULES = [
     "particleShear.base.namespace",
     "particleShear.base.neighbours",
     "particleShear.base.points",
+    "particleShear.base.circles",
+    "particleShear.base.elastic_circles",
     "particleShear.base.register",
     "particleShear.base.relations",
     "particleShear.base.stability",
