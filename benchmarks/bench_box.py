@@ -27,10 +27,19 @@ import timeit  # noqa: E402
 
 import bench_step as B  # noqa: E402
 import particleShear.base.canvas as canvas  # noqa: E402
+import particleShear.base.elastic_canvas as elastic_canvas  # noqa: E402
+import particleShear.base.pair_canvas as pair_canvas  # noqa: E402
 import particleShear.base.kernels as current  # noqa: E402
 from particleShear import StressTensorEvaluation  # noqa: E402
 
 NAMES = ("min_image", "le_wrap", "pair_geometry")
+
+
+def set_kernel(name, fn):
+    """Make every canvas module that calls kernel ``name`` call ``fn``."""
+    for module in (canvas, pair_canvas, elastic_canvas):
+        if hasattr(module, name):
+            setattr(module, name, fn)
 
 
 def baseline_kernels(rev, folder):
@@ -100,17 +109,17 @@ def main():
             fns["now"][n] = (lambda f, n: lambda *a, **k: (counts.__setitem__(n, counts[n] + 1), f(*a, **k))[1])(f, n)
         for name, _ in variants:
             for n in NAMES:
-                setattr(canvas, n, fns[name][n])
+                set_kernel(n, fns[name][n])
             B.protocol_steps(ens, ev, 500)
         fns["now"] = bound(current, ens)   # without the counters
         times = {name: [] for name, _ in variants}
         for k in range(args.blocks):
             for name, _ in (variants if k % 2 == 0 else variants[::-1]):
                 for n in NAMES:
-                    setattr(canvas, n, fns[name][n])
+                    set_kernel(n, fns[name][n])
                 times[name] += B.protocol_steps(ens, ev, 100)
         for n in NAMES:
-            setattr(canvas, n, getattr(current, n))
+            set_kernel(n, getattr(current, n))
         print(f"classes' protocol step, N = 150 (bench_step scene), {args.blocks} alternating blocks of 100 steps; "
               f"calls in 500 warm-up steps: " + ", ".join(f"{n} {counts[n]}" for n in NAMES))
         for name, mod in variants:

@@ -15,7 +15,7 @@ from unittest import mock
 import numpy as np
 
 from particleShear import EnsembleLinkable, SphereLinkable, StressTensorEvaluation
-from particleShear.base import canvas as _canvas_module
+from particleShear.base import pair_canvas as _canvas_module
 from particleShear.base.neighbours import all_pairs, candidate_pairs
 
 
