@@ -97,6 +97,8 @@ PENDING_SECTION_SIGNS = set()
 ENGINE_MODULES = [
     "particleShear.base",
     "particleShear.base.canvas",
+    "particleShear.base.pair_canvas",
+    "particleShear.base.elastic_canvas",
     "particleShear.base.fields",
     "particleShear.base.graphics",
     "particleShear.base.kernels",
