@@ -31,7 +31,7 @@ import zipfile
 import numpy as np
 
 from .output import (FORMAT_SUFFIXES, format_of, NO_TENSOR_DATA_TEXT, TABLE_COLUMNS, _quietly, iter_table_text,
-                     sidecar_path)
+                     iter_text_rows, sidecar_path)
 
 __all__ = ["OUTPUT_FORMATS", "FORMAT_SUFFIXES", "read_run", "verify_run", "RunData", "RunFileError", "write_run",
            "write_columns", "check_output_format", "series_columns", "table_rows", "text_stream", "sidecar_path",
@@ -235,18 +235,6 @@ def write_run(fh, output_format, header_text, scalars, tensors, metadata):
                   dict(metadata, n_rows=table_rows(output_format, len(cols["index"]), tensors is not None)))
 
 
-def _text_rows(cols, chunk_rows=1024):
-    """The names line and the rows of ``cols`` as TAB-separated text, in pieces (bounded memory);
-    floats as ``str`` (exact round trip), integer columns as integers."""
-    names = list(cols)
-    n = len(cols["index"])
-    yield "\n" + "\t".join(names)
-    for a in range(0, n, chunk_rows):
-        b = min(n, a + chunk_rows)
-        block = list(zip(*(cols[name][a:b].tolist() for name in names)))
-        yield "".join("\n" + "\t".join(map(str, row)) for row in block)
-
-
 def write_columns(fh, output_format, header_text, cols, metadata):
     """Stream a table of named columns into the open binary file ``fh`` in ``output_format``.
 
@@ -272,7 +260,7 @@ def write_columns(fh, output_format, header_text, cols, metadata):
     if output_format in ("text", "text.gz"):
         with text_stream(fh, output_format) as out:
             out.write(header_text.encode("utf-8"))
-            for piece in _text_rows(cols):
+            for piece in iter_text_rows(list(cols), list(cols.values())):
                 out.write(piece.encode("utf-8"))
         return
     n = len(cols["index"])

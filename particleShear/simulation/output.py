@@ -23,6 +23,8 @@ except ImportError:  # pragma: no cover - Windows
     fcntl = None
     _HAVE_FLOCK = False
 
+import numpy as np
+
 from ..base.stress import TENSOR_NAMES
 from .provenance import header_number
 
@@ -42,7 +44,7 @@ FORMAT_SUFFIXES = {"text": ".txt", "text.gz": ".txt.gz", "npz": ".npz", "parquet
 SIDECAR_SUFFIX = ".json"
 
 __all__ = ["TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "format_of", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
-           "probe_writable", "iter_table_text", "experiment_description_text",
+           "probe_writable", "iter_table_text", "iter_text_rows", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
 #: output-table column name stems of the nine tensors, in the order of TENSOR_NAMES
@@ -717,11 +719,42 @@ def output_summary_text(G_internal, G_surface, reference_header=False):
 CHUNK_ROWS = 1024
 
 
-def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
-    """The text of :func:`table_text` in pieces of ``chunk_rows`` lines (bounded memory).
+def iter_text_rows(names, blocks, chunk_rows=CHUNK_ROWS):
+    """A TAB-separated table in pieces of ``chunk_rows`` lines (bounded memory): the names line,
+    then one line per row; the one writer of every text table (the 42-column reference table of
+    :func:`iter_table_text`, the protocol tables of :func:`~.formats.write_columns`).
 
-    Only one chunk of rows is converted to Python floats and formatted at a time, so writing
-    a 231k-step table needs a few MB instead of the whole table as one string.
+    Only one chunk of rows is converted to Python numbers and formatted at a time, so writing a
+    231k-step table needs a few MB instead of the whole table as one string.  Each value is
+    written as ``str`` of its Python number: floats round-trip exactly, integer arrays give
+    integers.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The column names (the names line).
+    blocks : sequence of numpy.ndarray
+        Each of shape (n,) (one column) or (n, ...) (its columns, row-major), one length n; the
+        line of row i is the values of row i of every block, in this order.
+    chunk_rows : int, optional
+        Rows per piece (default :data:`CHUNK_ROWS`).
+
+    Yields
+    ------
+    str
+        The names line (preceded by a newline), then the data lines in chunks, each line
+        preceded by a newline.
+    """
+    n = len(blocks[0]) if len(blocks) else 0
+    yield "\n" + "\t".join(names)
+    for a in range(0, n, chunk_rows):
+        b = min(n, a + chunk_rows)
+        parts = [["\t".join(map(str, row)) for row in block[a:b].reshape(b - a, -1).tolist()] for block in blocks]
+        yield "".join("\n" + "\t".join(row) for row in zip(*parts))
+
+
+def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
+    """The text of :func:`table_text` in pieces of ``chunk_rows`` lines (:func:`iter_text_rows`).
 
     Parameters
     ----------
@@ -738,14 +771,7 @@ def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
         The header line (preceded by a newline), then the data lines in chunks.
     """
     n = len(scalars)
-    yield "\n" + "\t".join(TABLE_COLUMNS)
-    flat = tensors.reshape(n, 36)
-    for a in range(0, n, chunk_rows):
-        b = min(n, a + chunk_rows)
-        sc = scalars[a:b].tolist()
-        tt = flat[a:b].tolist()
-        yield "".join("\n" + str(a + k) + "\t" + "\t".join(map(str, sc[k])) + "\t" + "\t".join(map(str, tt[k]))
-                      for k in range(b - a))
+    return iter_text_rows(TABLE_COLUMNS, (np.arange(n), scalars, tensors.reshape(n, 36)), chunk_rows)
 
 
 def table_text(scalars, tensors):
