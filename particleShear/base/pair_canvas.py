@@ -23,6 +23,7 @@ from .register import PairBlock
 from .relations import _BaseRelationView
 
 from .canvas import CanvasPointsMass, _max_reduce
+from .points import PointLeesEdwards
 
 __all__ = ["CanvasPointsNeighbors", "CanvasPointsShear"]
 
@@ -615,11 +616,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         theSphere : object
             The sphere that receives them.
         """
-        theSphere.size_x = self.size_x
-        theSphere.size_y = self.size_y
-        theSphere.shear = self.shear
-        theSphere.shear_rate = self.shear_rate
-        theSphere.use_lees_edwards = self.use_lees_edwards
+        PointLeesEdwards.transmit_lees_edwards_parameters(self, theSphere)   # the one hand-over (reads attributes only)
 
     def _le_shift(self):
         return self.size_y * self.shear if self.use_lees_edwards else 0.0
