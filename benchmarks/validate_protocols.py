@@ -126,6 +126,12 @@ def part_b_d(base, seeds, rates, strain, hold, gamma0, f, times):
     print(f"(b) uncrosslinked flow curve, strain {strain}: relative_rate -> σ (Pa)")
     for j, r in enumerate(all_rates):
         line(f"γ̇τ = {r:.4g}", sig[:, j])
+        early = []                    # the start-up: the mean stress over strains 0.2–1
+        for i in range(len(seeds)):
+            rec = st[i * len(all_rates) + j].series
+            g = rec["strain"] - rec["strain"][0]
+            early.append(rec["stress_surface"][(g >= 0.2) & (g < 1.0)].mean())
+        line("   mean over strains 0.2–1", np.array(early))
     # σ₀ between the two highest measured rates' mean stresses: above the lowest-rate stress (≥ σ_y)
     lr, ls = np.log(all_rates), np.log(mean)
     order = np.argsort(ls)
@@ -188,7 +194,7 @@ def part_scan(base, seeds, gamma0, freqs, ramps, hold, times):
         line(f"G'' at f·τ = {f} (Pa)", np.array([r.G_surface[1] for r in osc]))
     gs = []
     for rt in ramps:
-        rel = timed(f"relaxation ramp {rt}", [dict(b, seed=s, relative_frequency=freqs[-1], protocol="relaxation",
+        rel = timed(f"relaxation ramp {rt}", [dict(b, seed=s, relative_frequency=freqs[1], protocol="relaxation",
                                                    ramp_time=rt, hold_time=hold) for s in seeds], times)
         gs.append(np.array([r.summary["G_plateau_surface"] for r in rel]))
         line(f"G_plateau, ramp {rt} τ (Pa)", gs[-1])
@@ -201,6 +207,14 @@ def part_scan(base, seeds, gamma0, freqs, ramps, hold, times):
         m, se, z = paired(g, gs[0])
         print(f"  {'G_plateau(ramp ' + str(rt) + ') - G_plateau(ramp ' + str(ramps[0]) + ')':38s} "
               f"diff {m:+.4g} ± {se:.2g}  z = {z:+.2f}")
+    big = 4 * gamma0                  # the softening with strain, at the two higher frequencies
+    b4 = dict(b, theAmplitude=big)
+    for f in freqs[:2]:
+        osc = timed(f"oscillatory 4γ₀ f·τ={f}", [dict(b4, seed=s, relative_frequency=f) for s in seeds], times)
+        line(f"G' at γ₀ = {big:g}, f·τ = {f} (Pa)", np.array([r.G_surface[0] for r in osc]))
+    rel = timed("relaxation 4γ₀", [dict(b4, seed=s, relative_frequency=freqs[1], protocol="relaxation",
+                                        ramp_time=ramps[0], hold_time=hold) for s in seeds], times)
+    line(f"G_plateau at γ₀ = {big:g}, ramp {ramps[0]} τ (Pa)", np.array([r.summary["G_plateau_surface"] for r in rel]))
 
 
 #: the two configurations: N = 150 (docs/protocols.md, "Validation") and the test's quick one
