@@ -207,9 +207,11 @@ def force_phase_laws(s, C):
     Parameters
     ----------
     s : BatchState
-        The batch (``law``, ``law_params``, the repulsion coefficients ``c``).
-    C : PairConstants
-        Its candidates (``rep``, ``k``, ``d_law``, ``d_eq``, ``perm``).
+        The batch (``law``, ``law_params``).
+    C : PairConstants or VisitConstants
+        The constants of one visit of its candidates (``rep``, ``k``, ``c``, ``d_law``, ``d_eq``,
+        ``perm``; :class:`~particleShear.engine.forces.VisitConstants` for the visit from j of
+        spheres with parameters of their own).
 
     Returns
     -------
@@ -231,15 +233,15 @@ def force_phase_laws(s, C):
         law = LAWS[s.law]
         if law.name != "linear" or law.parameters:
             central = _prepared(law, C, (law.name, id(s.law_params)),
-                                lambda: (C.d_law, C.k, s.c[C.rep]) + tuple(s.law_params[:, C.rep]))
+                                lambda: (C.d_law, C.k, C.c) + tuple(s.law_params[:, C.rep]))
     elif not builtin_c:
         found = callback_law(compressive)
         if found is None:
-            args = _cached(C, ("callback",), lambda: (C.d_law, C.k, s.c[C.rep]))
+            args = _cached(C, ("callback",), lambda: (C.d_law, C.k, C.c))
             central = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
         elif found[0].name != "linear":
             law, values = found
-            central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, s.c[C.rep]) + values)
+            central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, C.c) + values)
     tensile = None
     if not builtin_t:
         found = callback_law(stretched)

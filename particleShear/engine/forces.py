@@ -22,9 +22,9 @@ import numpy as np
 from .box import min_image
 from .xp import SegmentSum, array_namespace, to_host
 from . import laws
-from .terms import term_constants
+from .terms import TermConstants, term_constants
 
-__all__ = ["PairConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "shear_stresses"]
+__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -61,7 +61,7 @@ class PairConstants:
 
     #: rows of the float block :attr:`f`: radii and weights ``r/(r_i + r_j)``, box and half box (µm),
     #: then the constants of :meth:`set_bonds`
-    FLOAT_ROWS = ("ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "k", "d_law", "d_cap", "a_lin", "a_div",
+    FLOAT_ROWS = ("ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "k", "c", "d_law", "d_cap", "a_lin", "a_div",
                   "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
     #: the rows set from :func:`~particleShear.engine.terms.term_constants` (the attributes of a
     #: :class:`~particleShear.engine.terms.TermConstants` but ``form``)
@@ -83,6 +83,9 @@ class PairConstants:
     #: :meth:`~particleShear.engine.step.BatchEngine.step` while they still place every separation
     #: in its interval; None until set, and gone with these constants at a rebuild
     images = None
+    #: the constants seen by the visit from j (:meth:`set_visits`) where some replica's spheres have
+    #: parameters of their own; None: every visit sees the constants of this object
+    Kj = None
     #: attribute → (block, row)
     _ROWS = {**{n: ("f", k) for k, n in enumerate(FLOAT_ROWS)}, **{n: ("i", k) for k, n in enumerate(INT_ROWS)},
              **{n: ("b", k) for k, n in enumerate(BOOL_ROWS)},
@@ -210,16 +213,62 @@ class PairConstants:
             Equilibrium distance of each candidate (µm; used for bonds only).
         """
         xp = array_namespace(state, d_eq)
-        # the per-replica constants of each candidate's replica, gathered at once
-        rows = xp.stack((s.k, s.c, s.prc, s.prt, s.keep, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
-        k, c, prc, prt, keep, nu, k_t, nu_t, mu = (rows[r] for r in range(9))
+        # the per-replica constants of each candidate's replica, gathered at once; the parameters of
+        # the spheres themselves (c, permanent ratios, kept viscosities) from sphere i: the visit from i
+        rows = xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
+        k, nu, k_t, nu_t, mu = (rows[r] for r in range(5))
+        own = s.per_replica_parameters()[:, self.ai] if s.visit is None else s.visit[:, self.ai]
+        c, prc, prt, keep = (own[r] for r in range(4))
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
         self.k = k
+        self.c = c
         K = term_constants(self.d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
         for name in self.TERM_ROWS:
             setattr(self, name, getattr(K, name))
+
+    def set_visits(self, s):
+        """Set :attr:`Kj`, the constants of the visit from j, when spheres have parameters of their own.
+
+        1.0.2 evaluates each relation once from each sphere, with that sphere's c, permanent ratios
+        and kept viscosities; where the two spheres' values differ, the central force on j is the
+        law of j's visit and the tangential rule takes j's ``k_t``, ``ν_t`` for its second visit
+        (:func:`~particleShear.engine.terms.tangential_term`).  Without :attr:`~particleShear.engine.state.BatchState.visit`
+        every visit sees this object's constants (``Kj`` None).  Called with every new set of
+        constants (the one invalidation point, a rebuild of the candidate lists).
+
+        Parameters
+        ----------
+        s : BatchState
+            The batch (its ``visit`` rows and per-replica constants).
+        """
+        if s.visit is None:
+            self.Kj = None
+            return
+        xp = s.xp
+        rows = xp.stack((s.nu, s.k_t, s.nu_t))[:, self.rep]
+        c, prc, prt, keep = (s.visit[r][self.aj] for r in range(4))
+        K = term_constants(self.d0, self.perm, self.d_eq, self.k, c, rows[0], rows[1], rows[2], self.mu, prc, prt, keep)
+        self.Kj = VisitConstants(K, self)
+
+
+class VisitConstants(TermConstants):
+    """The :class:`~particleShear.engine.terms.TermConstants` of one visit of a batch's candidates,
+    with what the laws of a force phase read besides them (:func:`~particleShear.engine.callbacks.force_phase_laws`):
+    the candidates' bonds and replicas, and a place for their prepared law arguments.
+
+    Parameters
+    ----------
+    K : TermConstants
+        The constants of the visit.
+    C : PairConstants
+        The candidates they belong to (``perm``, ``rep``).
+    """
+
+    def __init__(self, K, C):
+        TermConstants.__init__(self, **{name: getattr(K, name) for name in TermConstants.__slots__})
+        self.perm, self.rep = C.perm, C.rep
 
 
 def splice_arrays(old, new, segments):
@@ -306,7 +355,7 @@ def normals(dx, dy, d, rep, rng):
     return nx, ny
 
 
-def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
+def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j, fx_j=None, fy_j=None):
     """Pair forces to per-sphere totals: ``+F`` on i, ``−F`` on j, torques on both (eq. S1-3).
 
     One ``bincount`` over ``(ai, aj)`` of each component (offset by ``k·n_spheres``): each sphere's
@@ -324,13 +373,18 @@ def scatter(C, n_spheres, fx_i, fy_i, tq_i, tq_j):
     tq_i, tq_j : ndarray (P,)
         Torques on i and on j (mg·µm²·s⁻² per m depth): ``d·F_T`` split in proportion to the
         radii (eq. S1-3).
+    fx_j, fy_j : ndarray (P,), optional
+        The pair force of j's own visit (spheres with parameters of their own,
+        :meth:`PairConstants.set_visits`): j receives ``−(fx_j, fy_j)``.  Default: ``fx_i, fy_i``.
 
     Returns
     -------
     ndarray (3, n_spheres)
         Per-sphere totals F_x, F_y (mg·µm·s⁻² per m depth) and torque (mg·µm²·s⁻² per m depth).
     """
-    w = array_namespace(fx_i).concatenate((fx_i, -fx_i, fy_i, -fy_i, tq_i, tq_j))
+    if fx_j is None:
+        fx_j, fy_j = fx_i, fy_i
+    w = array_namespace(fx_i).concatenate((fx_i, -fx_j, fy_i, -fy_j, tq_i, tq_j))
     if C.backend.ordered_reductions:
         return C.scatter(w).reshape(3, n_spheres)
     return C.scatter(w.reshape(3, -1))       # rows (F_x, F_y, torque) of (on i, on j) each
@@ -368,7 +422,7 @@ def replica_sums(C, W):
     return out
 
 
-def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
+def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V, fx_j=None):
     """τ_internal = −σ_xy of the overall tensor and τ_surface = −σ_xy of the external-force tensor (Pa).
 
     ``σ_LW,xy = (1/V) Σ_internal F_x,i (y_i − y_j)`` (eq. S1-19) with ``y_i − y_j = −D_y`` for
@@ -401,20 +455,32 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V):
         ``d·F_T``, the internal torque of each pair (mg·µm²·s⁻² per m depth).
     V : ndarray (B,)
         Cell area of each replica, ``Lx·Ly·1e-12`` (m², i.e. m³ per m depth).
+    fx_j : ndarray (P,), optional
+        x component of the pair force of j's own visit (j receives ``−fx_j``; spheres with
+        parameters of their own): an internal pair counts the mean of the two visits (1.0.2
+        registers each visit with half its force), an external entry of j its own visit's force.
+        Default: ``fx_i``.
 
     Returns
     -------
     tau_internal, tau_surface : ndarray (B,)
         Shear stresses ``−σ_xy`` of the overall and of the external-force tensor (Pa, eq. S1-25).
     """
+    xp = array_namespace(fx_i)
     mi, mj, not_both = flags
     ext = not_both | shifted
     ext &= active
     internal = active & ~ext
     lever = yc[C.ai] * (ext & mi)
     lever -= yc[C.aj] * (ext & mj)
+    fx_lw, f_lever = fx_i, fx_i * lever
+    if fx_j is not None:
+        # F_i at i and −F_j at j: F_i·lever + (F_i − F_j)·(y_j − Ly/2), so a pair with F_j = F_i gives
+        # the same number as without fx_j (a batch's replica equals its single run)
+        fx_lw = (fx_i + fx_j) * 0.5
+        f_lever = f_lever + (fx_i - fx_j) * (yc[C.aj] * (ext & mj))
     # three per-replica sums in one reduction: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
-    sums = replica_sums(C, array_namespace(fx_i).stack((fx_i * dy * internal, dF * internal, fx_i * lever)))
+    sums = replica_sums(C, xp.stack((fx_lw * dy * internal, dF * internal, f_lever)))
     lw, tint, surf = sums[0], sums[1], sums[2]
     sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)

@@ -251,8 +251,8 @@ def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
     return N * (len(levels) + 2)
 
 
-def write_back(engine, b, ensemble, steps=0, ages=None):
-    """Put replica ``b`` of a relaxed engine back into its ensemble.
+def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True):
+    """Put replica ``b`` of a relaxed (or measured) engine back into its ensemble.
 
     Positions, angles φ, velocities, forces, clock and strain of the spheres; the candidate
     pairs of the replica become the ensemble's pair table with their relations, states, ξ and
@@ -276,6 +276,10 @@ def write_back(engine, b, ensemble, steps=0, ages=None):
         Steps the replica was advanced (bookkeeping of the classes).
     ages : RelationAges, optional
         The record of when the relations formed during the relaxation.
+    constitution : bool, default True
+        The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
+        ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
+        the shear rate of its last step).
     """
     s = engine.s
     rows = s.replica(b)
@@ -285,7 +289,9 @@ def write_back(engine, b, ensemble, steps=0, ages=None):
         a[name][...] = getattr(s, src)[rows]
     ensemble.t = float(s.t[b])
     ensemble.shear = float(s.gamma[b])
-    ensemble.applyingShear = False
+    ensemble.applyingShear = bool(s.applying_shear) and not constitution
+    if not constitution:
+        ensemble.shear_rate = float(s.rate[b])
     ensemble.mu = float(s.mu[b])
 
     p = engine.pairs_of(b)
@@ -320,7 +326,7 @@ def write_back(engine, b, ensemble, steps=0, ages=None):
     ensemble._g = None
     ensemble._last_dt = float(ensemble.dt)
     ensemble.step_count += int(steps)
-    if hasattr(ensemble, "n_constitution_steps"):
+    if constitution and hasattr(ensemble, "n_constitution_steps"):
         ensemble.n_constitution_steps += int(steps)
 
 

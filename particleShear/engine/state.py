@@ -17,18 +17,21 @@ import numpy as np
 
 from .xp import get_backend
 
-__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_UNIFORM", "uniform_parameters"]
+__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS", "uniform_parameters"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
-#: per-sphere model parameters that must be uniform within a replica for the engine
-PER_SPHERE_UNIFORM = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
-                      "keep_viscosity_coefficients_constant")
+#: per-sphere model parameters of the documented spheres, in the order of :attr:`BatchState.visit`'s rows:
+#: a pair's visit from i sees sphere i's values, its visit from j sphere j's (1.0.2's per-visit rule)
+PER_SPHERE_PARAMETERS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
+                         "keep_viscosity_coefficients_constant")
+#: the per-replica arrays of :class:`BatchState` that hold these parameters when a replica's spheres share them
+_PER_REPLICA = ("c", "prc", "prt", "keep")
 
 
 def uniform_parameters(ensemble):
-    """Whether every per-sphere parameter of :data:`PER_SPHERE_UNIFORM` is one value in ``ensemble``
-    (what :meth:`BatchState.from_ensembles` needs: the engine has one set per replica).
+    """Whether every parameter of :data:`PER_SPHERE_PARAMETERS` is one value in ``ensemble`` (then the
+    batch state holds it once per replica, else per sphere in :attr:`BatchState.visit`).
 
     Parameters
     ----------
@@ -40,7 +43,7 @@ def uniform_parameters(ensemble):
     bool
     """
     a, n = ensemble._a, len(ensemble.sphereList)
-    return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_UNIFORM) if n else True
+    return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
 
 
 class ReplicaPairs:
@@ -94,6 +97,11 @@ class BatchState:
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
+    visit : ndarray (4, B·N) or None
+        The parameters of :data:`PER_SPHERE_PARAMETERS` per sphere (c, permanent ratios, kept
+        viscosities) when the spheres of some replica do not share them, else None (then the
+        per-replica ``c, prc, prt, keep`` hold them; with ``visit`` they hold sphere 0's values).
+        Each visit of a pair sees its own sphere's values (:meth:`~particleShear.engine.forces.PairConstants.set_visits`).
     law : str or None
         Central law of every replica, a name of :data:`~particleShear.engine.laws.LAWS` (one per
         batch), or None: the documented callback ``call_back_elastic_force_law`` (looked up once
@@ -145,6 +153,7 @@ class BatchState:
         self.applying_shear = True
         self.law = None
         self.law_params = xp.zeros((0, self.B))
+        self.visit = None
 
     def __getstate__(self):
         """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load."""
@@ -188,6 +197,8 @@ class BatchState:
         out.backend, out.xp = target, target.xp
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
+        if self.visit is not None:
+            out.visit = target.asarray(to_host(self.visit, "state"))
         out._views()
         return out
 
@@ -221,8 +232,7 @@ class BatchState:
         Raises
         ------
         ValueError
-            If the ensembles differ in N, or a per-sphere parameter of :data:`PER_SPHERE_UNIFORM`
-            differs within an ensemble, or their laws differ, or for an unusable backend (before
+            If the ensembles differ in N, or their laws differ, or for an unusable backend (before
             any copy).
         """
         target = get_backend(backend)
@@ -236,6 +246,9 @@ class BatchState:
             raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
         B, N = len(ensembles), Ns.pop()
         s = cls(B, N)
+        own = [not uniform_parameters(e) for e in ensembles]     # spheres with parameters of their own
+        if any(own):
+            s.visit = np.zeros((len(_PER_REPLICA), B * N))
         for b, e in enumerate(ensembles):
             a = e._a
             rows = slice(b * N, (b + 1) * N)
@@ -243,23 +256,22 @@ class BatchState:
                               ("phi", "phi"), ("r", "r"), ("m", "m"), ("inertia", "inertia"),
                               ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
                 getattr(s, name)[rows] = a[src][:N]
-            for name in PER_SPHERE_UNIFORM:
-                v = np.asarray(a[name][:N], dtype=float)
-                if N and not np.all(v == v[0]):
-                    raise ValueError(f"ensemble {b}: {name} differs between spheres (the engine needs one value)")
             s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
             s.gamma[b], s.rate[b], s.t[b] = float(e.shear), float(e.shear_rate), float(e.t)
             s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(e.k), float(e.nu), float(e.k_t), float(e.nu_t),
                                                              float(e.mu))
-            s.c[b] = float(a["central_repulsion_coefficient"][0]) if N else 0.0
-            s.prc[b] = float(a["permanent_ratio_central"][0]) if N else 1.0
-            s.prt[b] = float(a["permanent_ratio_tangential"][0]) if N else 1.0
-            s.keep[b] = float(a["keep_viscosity_coefficients_constant"][0]) if N else 1.0
+            for name, src, empty in zip(_PER_REPLICA, PER_SPHERE_PARAMETERS, (0.0, 1.0, 1.0, 1.0)):
+                getattr(s, name)[b] = float(a[src][0]) if N else empty
+            if own[b]:
+                s.visit[:, rows] = [np.asarray(a[src][:N], dtype=float) for src in PER_SPHERE_PARAMETERS]
             pt = e._pairs
             keep = pt.active | (pt.state == PERMANENT)
             s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
                                       pt.active[keep])
             s.rng[b] = e._rng
+        if any(own):
+            shared = np.repeat(np.logical_not(own), N)
+            s.visit[:, shared] = s.per_replica_parameters()[:, shared]
         s.law = names.pop() if names else None
         if s.law is not None:
             s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
@@ -303,7 +315,28 @@ class BatchState:
         out.applying_shear = all(st.applying_shear for st in states)
         out.law = laws.pop()
         out.law_params = xp.concatenate([st.law_params for st in states], axis=1)
+        if any(st.visit is not None for st in states):
+            out.visit = xp.concatenate([st.visit_rows() for st in states], axis=1)
         return out
+
+    def per_replica_parameters(self):
+        """The per-replica parameters ``c, prc, prt, keep`` on every sphere row: a (4, B·N) array.
+
+        Returns
+        -------
+        ndarray (4, B·N)
+        """
+        return self.xp.stack([getattr(self, name) for name in _PER_REPLICA])[:, self.rep]
+
+    def visit_rows(self):
+        """The parameters of :data:`PER_SPHERE_PARAMETERS` of every sphere: :attr:`visit`, or the
+        per-replica values on every row when the spheres of each replica share them.
+
+        Returns
+        -------
+        ndarray (4, B·N)
+        """
+        return self.per_replica_parameters() if self.visit is None else self.visit
 
     def replica(self, b):
         """Row slice of replica ``b`` in the per-sphere arrays.

@@ -206,6 +206,7 @@ class BatchEngine:
         new.set_bonds(s, state_p, be.asarray(np.concatenate([p.d_eq for p in fresh])))
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active = new, state_p, xi, active
+            self.C.set_visits(s)
             self._frictionless()
             return
         # the batch's arrays: the unchanged replicas' segments from the old arrays, in replica order
@@ -222,6 +223,7 @@ class BatchEngine:
         self.xi = splice_arrays(self.xi, xi, segments)
         self.active = splice_arrays(self.active, active, segments)
         self.C = PairConstants.splice(s, self.C, new, segments, offsets)
+        self.C.set_visits(s)
         self._frictionless()
 
     def _images(self, raw_x, raw_y, shift_p):
@@ -316,6 +318,8 @@ class BatchEngine:
         s.mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
         if self.C is not None:
             self.C.mu = s.mu[self.C.rep]
+            if self.C.Kj is not None:
+                self.C.Kj.mu = self.C.mu
         self._frictionless()
 
     def step(self, cool, dt, sample=False):
@@ -403,18 +407,24 @@ class BatchEngine:
         fn, law = central_term(C, d, vn, active, *force_phase_laws(s, C))   # the laws, looked up once per phase
         F, slip = self._tangential(C, vt, touching, xi, law, active)
         self.state_p = slip.view(np.int8) + C.perm_code
-        fx_i, fy_i, dF, tq = pair_forces(fn, (F[0] + F[1]) * 0.5, nx, ny, d, C.w)
-        s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1])
+        ft = (F[0] + F[1]) * 0.5
+        fx_i, fy_i, dF, tq = pair_forces(fn, ft, nx, ny, d, C.w)
+        fx_j = fy_j = None
+        if C.Kj is not None:       # spheres with parameters of their own: the central force of j's visit
+            fn_j = central_term(C.Kj, d, vn, active, *force_phase_laws(s, C.Kj))[0]
+            fx_j, fy_j = pair_forces(fn_j, ft, nx, ny, d, None)[:2]
+        s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1], fx_j, fy_j)
         mob = self.mobile()
         out = None
         if sample:
             shifted = (ky != 0) | (kx != 0)
             mi, mj = mob[ai], mob[aj]
-            out = shear_stresses(C, s.B, yc, (mi, mj, ~(mi & mj)), active, shifted, dy, fx_i, dF, self.V)
+            out = shear_stresses(C, s.B, yc, (mi, mj, ~(mi & mj)), active, shifted, dy, fx_i, dF, self.V, fx_j)
             if sample == "tensors":
                 q = StressInputs(C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia,
                                  Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
-                                 dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
+                                 dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, fx_j=fx_j, fy_j=fy_j, dF=dF, fx=s.fx, fy=s.fy,
+                                 torque=s.torque)
                 out = out + (evaluate_all(q),)
         self.verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
@@ -437,11 +447,11 @@ class BatchEngine:
         """
         free = self.free_p
         if free is None:
-            return tangential_term(C, vt, touching.astype(float), xi, law)
+            return tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         if free is True:
             xi[...] = 0.0
             return self.xp.zeros((2, len(vt))), active
-        F, slip = tangential_term(C, vt, touching.astype(float), xi, law)
+        F, slip = tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         self.xp.copyto(xi, 0.0, where=free)
         return F, slip | (free & active)
 

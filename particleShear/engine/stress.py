@@ -27,7 +27,8 @@ class StressInputs:
     ``C`` the candidate constants, ``B`` replicas, ``rep`` sphere → replica, ``x, y, vx, vy,
     omega, m, inertia`` sphere state, ``Lx, Ly, rate, V`` per replica, ``mob`` mobility mask,
     ``active``/``shifted`` per candidate, ``dx, dy`` minimum-image pair vectors, ``fx_i, fy_i``
-    pair force on i, ``dF`` = d·F_T (internal torque of a pair), ``fx, fy, torque`` sphere totals.
+    pair force on i (``fx_j, fy_j``: that of j's own visit where spheres have parameters of their
+    own, else None), ``dF`` = d·F_T (internal torque of a pair), ``fx, fy, torque`` sphere totals.
     The arrays are kept as given (views of the step's arrays); nothing is checked or copied.
 
     Parameters
@@ -41,6 +42,9 @@ class StressInputs:
         (m², ``Lx·Ly·1e-12``); per candidate (P,): ``active``, ``shifted`` (bool), ``dx, dy``
         (µm), ``fx_i, fy_i`` (mg·µm·s⁻² per m depth) and ``dF`` (mg·µm²·s⁻² per m depth).
     """
+
+    #: the pair force of j's own visit (None: ``fx_i, fy_i``; see :meth:`~particleShear.engine.forces.PairConstants.set_visits`)
+    fx_j = fy_j = None
 
     def __init__(self, **arrays):
         self.__dict__.update(arrays)
@@ -145,7 +149,8 @@ def love_weber(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     w = q.internal
-    return q.outer((q.fx_i * w, q.fy_i * w), (-q.dx, -q.dy)) * (1e-18 / q.V)[:, None, None]
+    fx, fy = (q.fx_i, q.fy_i) if q.fx_j is None else ((q.fx_i + q.fx_j) * 0.5, (q.fy_i + q.fy_j) * 0.5)
+    return q.outer((fx * w, fy * w), (-q.dx, -q.dy)) * (1e-18 / q.V)[:, None, None]
 
 
 def external_forces(q):
@@ -168,7 +173,12 @@ def external_forces(q):
     cx, cy = (q.Lx / 2)[C.rep], (q.Ly / 2)[C.rep]
     lever_x = (q.x[C.ai] - cx) * ei - (q.x[C.aj] - cx) * ej     # F on j is −F on i
     lever_y = (q.y[C.ai] - cy) * ei - (q.y[C.aj] - cy) * ej
-    return -q.outer((q.fx_i, q.fy_i), (lever_x, lever_y)) * (1e-18 / q.V)[:, None, None]
+    S = q.outer((q.fx_i, q.fy_i), (lever_x, lever_y))
+    if q.fx_j is not None:
+        # j's visit has a force of its own (spheres with parameters of their own): −F_j at j, i.e.
+        # F_i ⊗ lever + (F_i − F_j) ⊗ (x_j − c), exactly S where F_j = F_i
+        S = S + q.outer((q.fx_i - q.fx_j, q.fy_i - q.fy_j), ((q.x[C.aj] - cx) * ej, (q.y[C.aj] - cy) * ej))
+    return -S * (1e-18 / q.V)[:, None, None]
 
 
 def unbalanced_forces(q):

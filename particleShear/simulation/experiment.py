@@ -217,6 +217,9 @@ class OscillatoryShearExperiment:
     def pre_equilibrate(self, N=25, cool_factor=0.99):
         """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at dt, N steps at dt.
 
+        Stepped by the documented classes (``mechanical_simulation_step``), for scripts that step
+        an ensemble themselves; :meth:`oscillatory_shear_experiment` measures in the engine.
+
         Runs with ``applyingShear = True`` (the plate band is immobile, the plates rest).  Each
         coarse level (step halved from ``dt_max`` down to ``dt``) takes ``int(N/2)`` steps with a
         damping factor rising from 0.5 towards 1; then 2N steps at dt with damping 0.98.  The
@@ -405,7 +408,9 @@ class OscillatoryShearExperiment:
         return N_steps
 
     def run_protocol(self, cool_factor, n_steps=None):
-        """The measurement protocol in the reference per-step order (docs/design.md, "One step").
+        """The measurement protocol in the reference per-step order (docs/design.md, "One step"),
+        stepped by the documented classes for scripts that step an ensemble themselves
+        (:meth:`oscillatory_shear_experiment` measures in the engine).
 
         Needs :meth:`prepare_recording` first.  Each step: set the shear rate
         (``A·2πf·cos(2π(f t − pre))`` during the excitation, else 0), forces, recording,
@@ -466,8 +471,10 @@ class OscillatoryShearExperiment:
     def oscillatory_shear_experiment(self, cool_factor=1, N_pre_equilibration_fixed_boundaries=25):
         """Run pre-equilibration and protocol; return ``[G′_surface, G″_surface]`` (Pa).
 
-        Both demodulations are kept in ``results`` ("internal": overall tensor, eq. S1-24;
-        "surface": external forces on the plates).
+        Measured by the engine's one step (:meth:`measure_in_engine`, as ``runSimulation`` and
+        ``doParticleShearSimulation`` measure), the ensemble left in the final state.  Both
+        demodulations are kept in ``results`` ("internal": overall tensor, eq. S1-24; "surface":
+        external forces on the plates).
 
         Parameters
         ----------
@@ -484,22 +491,80 @@ class OscillatoryShearExperiment:
         list of float
             ``[G′_surface, G″_surface]`` in Pa.
         """
-        ens = self.theEnsemble
         self.cool_factor = cool_factor
         self.description_text = experiment_description_text(self, reference_header=self.reference_header)
         if self.output_file:
             self.write_experiment_description_information_to_file()
-        self.prepare_recording()
-        ens.applyingShear = True
-        if self.do_preequilibration_with_fixed_boundaries:
-            self.pre_equilibrate(N_pre_equilibration_fixed_boundaries, cool_factor)
-        ens.t = 0
-        ens.applyingShear = True
-        self.run_protocol(cool_factor)
+        record, timings = self.measure_in_engine(cool_factor, N_pre_equilibration_fixed_boundaries)
+        return self.adopt_measurement(cool_factor, record, timings)
+
+    def measure_in_engine(self, cool_factor, N_pre=25):
+        """Pre-equilibration and protocol of this experiment in the engine, a batch of one; the
+        ensemble is left in the engine's final state.
+
+        The one step and the one protocol loop of every run (:func:`particleShear.engine.step.pre_equilibrate`,
+        :func:`~particleShear.engine.step.protocol`), with the ensemble's integrator, stability
+        guard and contact-law callbacks, observed by this experiment's drawing
+        (:meth:`observers`).  Afterwards the spheres, the clock, the strain, the shear rate and
+        the relations of the engine's replica are the ensemble's (its relations keep their
+        creation numbers, new ones get the next).
+
+        Parameters
+        ----------
+        cool_factor : float
+            Per-step damping factor of the peculiar velocity (fraction kept per step).
+        N_pre : int, optional
+            ``N`` of the pre-equilibration (skipped when ``do_preequilibration_with_fixed_boundaries``
+            is False).
+
+        Returns
+        -------
+        record : dict of ndarray
+            The replica's record of :func:`~particleShear.engine.step.protocol` (tensors only when
+            ``keep_tensor_history``; see :meth:`adopt_measurement`).
+        timings : dict
+            Wall times of "pre_equilibration" and "protocol" (s).
+        """
+        from ..engine.relax import write_back
+        from ..engine.state import BatchState
+        from ..engine.step import BatchEngine, pre_equilibrate, protocol
+        from ..run.batch import ENGINE_SKIN_FACTOR, _guarded
+        from .observers import ReplicaScene
+        ens = self.theEnsemble
+        keep = self.keep_tensor_history
+        if keep is None:
+            keep = bool(self.output_file) and bool(self.saveStressTensorData)
+        self.keep_tensor_history = keep
+        engine = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR,
+                             guard=ens.stability_guard is not None, integrator=getattr(ens, "integrator", "euler"))
+        scene = ReplicaScene(getattr(ens, "graphical_output_configuration", None))
+        scene.bind(engine, 0)
+        observers = self.observers(scene, scene.samples)
+        timings = {}
         t0 = time.perf_counter()
-        G_int = self.evaluateStressAndG(useExternalForce=False)
-        G_surf = self.evaluateStressAndG(useExternalForce=True)
-        return self._conclude(G_int, G_surf, t0)
+        state = [0.0]
+        if self.do_preequilibration_with_fixed_boundaries:
+            def report(step, total):
+                self.position = ("pre-equilibration", step, total)
+                self._report("pre-equilibration", step, total, t0, state)
+            _guarded(pre_equilibrate, engine, N_pre, self.dt, self.dt_max, cool_factor, self._say, report, observers,
+                     dt=self.dt)
+        timings["pre_equilibration"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        state = [0.0]
+
+        def report(step, total):
+            self.position = ("protocol", step, total)
+            self._report("protocol", step, total, t0, state)
+        out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
+                       self.periods, self.baseline_post_periods, keep, self._say, report, observers, dt=self.dt)
+        timings["protocol"] = time.perf_counter() - t0
+        record = {key: (np.ascontiguousarray(v[0]) if key.endswith("_tensors") else np.ascontiguousarray(v[:, 0]))
+                  for key, v in out.items() if key != "tensors" or keep}
+        ens.step_count = 0        # the protocol's steps, as the documented loop counts them
+        write_back(engine, 0, ens, len(record["t"]), constitution=False)
+        ens.phase = "protocol"
+        return record, timings
 
     def _conclude(self, G_int, G_surf, t0):
         """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""

@@ -490,9 +490,9 @@ class OscillatorySimulation:
         Measured as ``doParticleShearSimulation`` measures: the constitution's relaxations, the
         pre-equilibration and the protocol run in the engine, a batch of one
         (:func:`particleShear.run.batch.measure_sessions`); the drawing, snapshots and the live
-        stress window observe its loops.  An ensemble whose spheres have their own per-sphere
-        parameters (``PER_SPHERE_UNIFORM``, set through the sphere handles) is measured by the
-        experiment's own loop on the documented classes (the engine has one set per replica).
+        stress window observe its loops.  Spheres with parameters of their own (c, permanent
+        ratios, kept viscosities set through the sphere handles) are measured by the engine too:
+        each visit of a relation sees its own sphere's values, as in 1.0.2.
 
         Output (see ``docs/output.md``): the folder is probed for writability before any work;
         the file number is reserved (a locked ``.part`` file) when the ensemble exists, snapshots
@@ -525,7 +525,6 @@ class OscillatorySimulation:
             For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
             unknown output format — before any work.
         """
-        from ..engine.state import uniform_parameters
         from ..run.batch import measure_sessions
         run = RunSession(self, cool_factor, periods, plotStress)
         try:
@@ -535,20 +534,7 @@ class OscillatorySimulation:
                 exc.position = run.position()
             run.close()
             raise
-        if self.theEnsemble is None or uniform_parameters(self.theEnsemble):
-            return measure_sessions([run], constituted=True)[0]
-        # spheres of the ensemble have their own c, permanent ratios or kept viscosities (set through
-        # their handles): the engine has one set per replica, so the experiment steps the ensemble itself
-        try:
-            run.prepare()
-            run.exp.oscillatory_shear_experiment(cool_factor=run.schedule.cool,
-                                                 N_pre_equilibration_fixed_boundaries=run.schedule.N_pre)
-            return run.finish()
-        except KeyboardInterrupt as exc:
-            exc.position = run.position()
-            raise
-        finally:
-            run.close()
+        return measure_sessions([run], constituted=True)[0]
 
     def time_steps(self):
         """``(dt, f, dt_max)`` of the measurement: the ensemble's steps times ``time_step_factor`` and

@@ -1,0 +1,160 @@
+"""Spheres with parameters of their own, measured by the engine: each visit of a relation sees its
+own sphere's c, permanent ratios and kept viscosities (1.0.2 evaluates a relation once from each
+sphere, MODEL_SPEC, section 10; ``BatchState.visit``, ``PairConstants.set_visits``).
+
+* Two spheres: the force on each is the law of its own visit — the compressive law of eq. S1-5 with
+  its own c (against the independent definition of ``test_force_laws``), a bond's tensile law and
+  its viscous force with its own permanent ratio — to rounding (1e-12 relative: one product and one
+  sum of numbers ≈ 1e3).
+* A constituted crosslinked scene whose spheres carry different c, permanent ratios and kept
+  viscosities: the engine's measurement gives the documented classes' series and tensors to 1e-12
+  of their scale (the two differ only in the order of sums; observed ≈ 5e-16).
+* A replica with such spheres beside a uniform one: the batch equals the single runs bit for bit.
+"""
+import unittest
+
+import numpy as np
+
+from particleShear.engine.state import PERMANENT, STICK, BatchState, ReplicaPairs
+from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
+from particleShear.simulation.experiment import OscillatoryShearExperiment
+from particleShearTest.test_engine import constituted
+from particleShearTest.test_force_laws import central_law_definition as _definition
+
+K, NU = 1000.0, 7.0
+
+
+def central_law_definition(d, d0, k, c):
+    """The compressive law of eq. S1-5 from its independent definition (the value only)."""
+    return _definition(d, d0, k, c)[0]
+
+
+def two_spheres(d, visit, state=STICK, d_eq=0.0, v=0.0):
+    """A batch of one with two spheres of radius 10 µm at distance ``d`` (µm) along x, sphere 1 moving
+    at ``v`` µm/s away from sphere 0, no plates, and the per-sphere parameters ``visit`` (4, 2)."""
+    s = BatchState(1, 2)
+    s.x[:] = (100.0, 100.0 + d)
+    s.y[:] = 100.0
+    s.vx[:] = (0.0, v)
+    s.r[:] = 10.0
+    s.m[:] = s.inertia[:] = 1.0
+    s.Lx[:] = s.Ly[:] = 400.0
+    s.k[:], s.nu[:] = K, NU
+    s.c[:], s.prc[:], s.prt[:], s.keep[:] = np.asarray(visit)[:, 0]
+    s.visit = np.array(visit, dtype=float)
+    s.applying_shear = False
+    s.pairs[0] = ReplicaPairs([0], [1], [state], np.zeros((2, 1)), [d_eq], [state == PERMANENT])
+    s.rng[0] = np.random.default_rng(0)
+    eng = BatchEngine(s, guard=False)
+    eng.force_phase()
+    return s.fx.copy(), s.fy.copy()
+
+
+def perturb(ens):
+    """Give some spheres of ``ens`` parameters of their own through their handles."""
+    n = len(ens.sphereList)
+    for k in range(0, n, 3):
+        ens.sphereList[k].permanent_ratio_central = 2.0
+    for k in range(1, n, 4):
+        ens.sphereList[k].permanent_ratio_tangential = 0.5
+    for k in range(2, n, 5):
+        ens.sphereList[k].central_repulsion_coefficient = 0.5
+    for k in range(0, n, 7):
+        ens.sphereList[k].keep_viscosity_coefficients_constant = 0.0
+
+
+SCENE = dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2,
+             keep_viscosity_coefficients_constant=True)
+
+
+class TestTwoSpheres(unittest.TestCase):
+    def assertClose(self, got, want):
+        self.assertLessEqual(abs(got - want), 1e-12 * max(abs(want), 1.0), (got, want))
+
+    def test_contact_each_sphere_its_own_c(self):
+        d, c0, c1 = 17.0, 1.0, 0.4
+        fx, fy = two_spheres(d, [[c0, c1], [1, 1], [1, 1], [1, 1]])
+        # the force on i along n_ij = +x is the law of i's visit; j receives minus the law of its own
+        self.assertClose(fx[0], central_law_definition(d, 20.0, K, c0))
+        self.assertClose(fx[1], -central_law_definition(d, 20.0, K, c1))
+        self.assertNotAlmostEqual(fx[0], -fx[1])          # the two laws differ at this overlap
+        self.assertEqual(list(fy), [0.0, 0.0])
+
+    def test_bond_each_sphere_its_own_permanent_ratio(self):
+        d_eq = 19.0
+        for d in (19.5, 18.5):          # stretched: the tensile law; compressed: the law at d_eq
+            with self.subTest(d=d):
+                fx, _ = two_spheres(d, [[1, 0.5], [2.0, 0.7], [1, 1], [1, 1]], state=PERMANENT, d_eq=d_eq)
+                law_0 = K * (d - d_eq) if d > d_eq else central_law_definition(d, d_eq, K, 1.0)
+                law_1 = K * (d - d_eq) if d > d_eq else central_law_definition(d, d_eq, K, 0.5)
+                self.assertClose(fx[0], 2.0 * law_0)
+                self.assertClose(fx[1], -0.7 * law_1)
+
+    def test_bond_viscosity_kept_by_one_sphere_only(self):
+        # at d = d_eq the elastic law is 0; the viscous force ν·v_n takes the permanent ratio where
+        # the visiting sphere does not keep its viscosities (sphere 0), not where it does (sphere 1)
+        v = 3.0
+        fx, _ = two_spheres(19.0, [[1, 1], [2.0, 0.5], [1, 1], [0.0, 1.0]], state=PERMANENT, d_eq=19.0, v=v)
+        self.assertClose(fx[0], NU * 2.0 * v)
+        self.assertClose(fx[1], -NU * v)
+
+
+class TestSceneAgainstClasses(unittest.TestCase):
+    def test_series_and_tensors(self):
+        _, ens_c, sc = constituted(7, **SCENE)
+        _, ens_e, _ = constituted(7, **SCENE)
+        perturb(ens_c)
+        perturb(ens_e)
+        exp = OscillatoryShearExperiment(ens_c, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+        exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+        exp.keep_tensor_history = True
+        ens_c.applyingShear = True
+        exp.prepare_recording()
+        exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+        ens_c.t = 0
+        exp.run_protocol(sc["cool"])
+        ref = exp.plotter.arrays()
+        state = BatchState.from_ensembles([ens_e])
+        self.assertIsNotNone(state.visit)
+        eng = BatchEngine(state)
+        pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+        got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5, keep_tensors=True)
+        self.assertGreater(len(ref["t"]), 200)
+        for key in ("strain", "stress_internal", "stress_surface"):
+            a, b = ref[key], got[key][:, 0]
+            self.assertEqual(a.shape, b.shape)
+            self.assertLessEqual(np.max(np.abs(a - b)), 1e-12 * np.max(np.abs(a)), key)
+        a, b = np.asarray(ref["tensors"]), np.asarray(got["tensors"])[:, 0]
+        for k in range(a.shape[1]):
+            scale = np.max(np.abs(a[:, k]))
+            self.assertLessEqual(np.max(np.abs(a[:, k] - b[:, k])), 1e-12 * scale, k)
+
+
+class TestBatchOfOwnAndShared(unittest.TestCase):
+    def test_replicas_equal_their_single_runs(self):
+        sc = constituted(5, **SCENE)[2]
+
+        def ensemble(n):
+            e = constituted(5 + n, **SCENE)[1]
+            if n == 0:
+                perturb(e)
+            return e
+
+        def measure(which):
+            state = BatchState.from_ensembles([ensemble(n) for n in which])
+            eng = BatchEngine(state)
+            pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+            return state, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(which), sc["cool"], 0.5, 1, 0.5)
+
+        single = [measure([n]) for n in (0, 1)]
+        self.assertIsNotNone(single[0][0].visit)
+        self.assertIsNone(single[1][0].visit)        # shared parameters: one value per replica
+        state, both = measure([0, 1])
+        np.testing.assert_array_equal(state.visit[:, state.N:], state.per_replica_parameters()[:, state.N:])
+        for b in range(2):
+            for key in ("stress_internal", "stress_surface", "strain"):
+                self.assertEqual(both[key][:, b].tobytes(), single[b][1][key][:, 0].tobytes(), (b, key))
+
+
+if __name__ == "__main__":
+    unittest.main()
