@@ -181,7 +181,9 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         while the level step exceeds ``dt``; each level halves the step, moves the damping factor
         half-way to 1 and removes the mean velocity.  Then N steps at ``dt`` without friction
         and N steps with friction follow, both undamped.  Shear is off throughout; the
-        ensemble's ``mu`` is restored afterwards.
+        ensemble's ``mu`` is restored afterwards.  Run by the engine on this ensemble alone
+        (:func:`particleShear.engine.relax.relax_ensembles`, the relaxation of every
+        constitution), the result written back.
 
         Parameters
         ----------
@@ -191,31 +193,15 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         Raises
         ------
         ValueError
-            If the ensemble's ``dt`` is not > 0.
+            If the ensemble's ``dt`` is not > 0, or ``N`` < 0 (before any step).
         """
+        from ..engine.relax import relax_ensembles
         N = int(N)
         if not self.dt > 0:
             raise ValueError(f"dt must be > 0 for free_pre_equilibration, got {self.dt!r}")
-        self.applyingShear = False
-        mu_saved = self.mu
-        self.mu = 0
-        try:
-            level_dt = self.dt_max
-            cf = 0.5
-            while level_dt > self.dt:
-                self._steps(N, cf, level_dt)
-                level_dt /= 2
-                cf = (1 + cf) / 2
-                self.correct_linear_drift()
-            self._steps(N, 1, self.dt)
-        finally:
-            self.mu = mu_saved
-        self._steps(N, 1, self.dt)
-
-    def _steps(self, N, cool_factor, dt):
-        for _ in range(N):
-            self.mechanical_simulation_step(cool_factor, dt)
-        self.n_constitution_steps += N
+        if N < 0:
+            raise ValueError(f"N={N!r} is out of range for free_pre_equilibration: allowed >= 0")
+        relax_ensembles([self], N)
 
     # -- particles -----------------------------------------------------------------------------------
     def _labels(self, physical_neighbors_only=True):
