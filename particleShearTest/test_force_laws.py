@@ -315,17 +315,16 @@ class TestEngineLawConstants(unittest.TestCase):
 
 def _engine_central(d, d0, k, c, bond):
     """Central law of one candidate through the engine (:meth:`PairConstants.set_bonds`, :func:`central_term`)."""
-    from types import SimpleNamespace
-
     from particleShear.engine.forces import PairConstants
+    from particleShear.engine.state import BatchState, ReplicaPairs
     from particleShear.engine.terms import central_term
 
-    one = np.ones(1)
-    s = SimpleNamespace(k=k * one, c=c * one, prc=one, nu=0 * one, keep=one, k_t=0 * one, prt=one, nu_t=0 * one,
-                        mu=0 * one)
-    C = SimpleNamespace(rep=np.zeros(1, dtype=int), d0=np.array([d0]), TERM_ROWS=PairConstants.TERM_ROWS,
-                        form=PairConstants.form)
-    PairConstants.set_bonds(C, s, np.array([2 if bond else 0], dtype=np.int8), np.array([d0]))
+    s = BatchState(1, 2)
+    s.r[:] = d0 / 2
+    s.k[:], s.c[:], s.prc[:], s.prt[:], s.keep[:] = k, c, 1.0, 1.0, 1.0
+    s.pairs[0] = ReplicaPairs([0], [1], [2 if bond else 0], np.zeros((2, 1)), [d0], [True])
+    C = PairConstants(s, np.array([0, 1]))
+    C.set_bonds(s, np.array([2 if bond else 0], dtype=np.int8), np.array([d0]))
     f, law = central_term(C, np.array([d]), np.zeros(1), np.ones(1, dtype=bool))
     return float(f[0]), float(law[0])
 
