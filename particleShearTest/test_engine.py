@@ -150,6 +150,20 @@ def constituted(seed, N=30, **kw):
                         N_pre=25 * int(sim.adjustment_factor_for_bounded_preequilibration_steps()))
 
 
+def classes_measurement(ens, sc, keep_tensors=False):
+    """The documented classes' step loop (the experiment's ``pre_equilibrate`` and ``run_protocol``)
+    of ``ens`` with schedule ``sc`` (0.5 + 1 + 0.5 periods): the recorded arrays of its plotter."""
+    exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+    exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+    exp.keep_tensor_history = keep_tensors
+    ens.applyingShear = True
+    exp.prepare_recording()
+    exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+    ens.t = 0
+    exp.run_protocol(sc["cool"])
+    return exp.plotter.arrays()
+
+
 class TestEngineAgainstClasses(unittest.TestCase):
     SCENES = (dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2),
               dict(theMu=0.0, do_permanent_links=True, cut_lines=3, theAmplitude=0.3),
@@ -163,14 +177,7 @@ class TestEngineAgainstClasses(unittest.TestCase):
                 _, ens_c, sc = constituted(7 + n, **scene)
                 _, ens_e, _ = constituted(7 + n, **scene)
                 ens_c.set_integrator(integrator)
-                exp = OscillatoryShearExperiment(ens_c, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
-                exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
-                ens_c.applyingShear = True
-                exp.prepare_recording()
-                exp.pre_equilibrate(sc["N_pre"], sc["cool"])
-                ens_c.t = 0
-                exp.run_protocol(sc["cool"])
-                ref = exp.plotter.arrays()
+                ref = classes_measurement(ens_c, sc)
                 eng = BatchEngine(BatchState.from_ensembles([ens_e]), integrator=integrator)
                 pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
                 got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5)
@@ -221,15 +228,7 @@ class TestStressRegistry(unittest.TestCase):
         from particleShear.engine.stress import TENSORS
         _, ens_c, sc = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
         _, ens_e, _ = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
-        exp = OscillatoryShearExperiment(ens_c, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
-        exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
-        exp.keep_tensor_history = True
-        ens_c.applyingShear = True
-        exp.prepare_recording()
-        exp.pre_equilibrate(sc["N_pre"], sc["cool"])
-        ens_c.t = 0
-        exp.run_protocol(sc["cool"])
-        ref = exp.plotter.arrays()["tensors"]
+        ref = classes_measurement(ens_c, sc, keep_tensors=True)["tensors"]
         eng = BatchEngine(BatchState.from_ensembles([ens_e]))
         pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
         got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5, keep_tensors=True)

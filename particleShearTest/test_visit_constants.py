@@ -17,8 +17,7 @@ import numpy as np
 
 from particleShear.engine.state import PERMANENT, STICK, BatchState, ReplicaPairs
 from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
-from particleShear.simulation.experiment import OscillatoryShearExperiment
-from particleShearTest.test_engine import constituted
+from particleShearTest.test_engine import classes_measurement, constituted
 from particleShearTest.test_force_laws import central_law_definition as _definition
 
 K, NU = 1000.0, 7.0
@@ -105,15 +104,7 @@ class TestSceneAgainstClasses(unittest.TestCase):
         _, ens_e, _ = constituted(7, **SCENE)
         perturb(ens_c)
         perturb(ens_e)
-        exp = OscillatoryShearExperiment(ens_c, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
-        exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
-        exp.keep_tensor_history = True
-        ens_c.applyingShear = True
-        exp.prepare_recording()
-        exp.pre_equilibrate(sc["N_pre"], sc["cool"])
-        ens_c.t = 0
-        exp.run_protocol(sc["cool"])
-        ref = exp.plotter.arrays()
+        ref = classes_measurement(ens_c, sc, keep_tensors=True)
         state = BatchState.from_ensembles([ens_e])
         self.assertIsNotNone(state.visit)
         eng = BatchEngine(state)
