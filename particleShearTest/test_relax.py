@@ -111,6 +111,14 @@ class TestAgainstTheClasses(unittest.TestCase):
         # friction acted in the last block: some contact sticks with a history
         self.assertGreater(np.abs(eng._pairs.xi).max(), 0.0)
 
+    def test_velocity_verlet(self):
+        # an ensemble set to velocity Verlet relaxes with it (the engine's predictor, the classes' step)
+        ref, eng = random_packing(3), random_packing(3)
+        for e in (ref, eng):
+            e.dt_max = 2 * e.dt
+            e.set_integrator("verlet")
+        self.assert_same_relaxation(ref, eng, 20)
+
     def test_crosslinked_ensemble_with_bonds_and_friction(self):
         # after crosslinking and cutting (bonds scaled by 1/irc, 1/irt): one level at 2 dt, then dt
         kw = dict(mu=0.3, interface_reenforcement_central=2, interface_reenforcement_tangential=1.5)

@@ -17,6 +17,7 @@ import numpy as np
 
 from particleShear.engine.state import PERMANENT, STICK, BatchState, ReplicaPairs
 from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
+from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_engine import classes_measurement, constituted
 from particleShearTest.test_force_laws import central_law_definition as _definition
 
@@ -119,6 +120,46 @@ class TestSceneAgainstClasses(unittest.TestCase):
         for k in range(a.shape[1]):
             scale = np.max(np.abs(a[:, k]))
             self.assertLessEqual(np.max(np.abs(a[:, k] - b[:, k])), 1e-12 * scale, k)
+
+
+class TestExperimentInTheEngine(unittest.TestCase):
+    """``OscillatoryShearExperiment.oscillatory_shear_experiment`` of a script measures in the engine:
+    on an ensemble of ``particleShear.objects`` (no ``dt`` of its own) its series equal the classes'
+    step loop to 1e-12 of their scale (sums in another order), and the ensemble is left in the final
+    state of that loop (positions to 1e-12 of the cell: rounding over ~500 damped steps)."""
+
+    def test_objects_ensemble(self):
+        from particleShear.objects.ensembles import EnsembleFrictionLeesEdwards
+
+        def build():
+            e = EnsembleFrictionLeesEdwards(200, 200, 0, packing_fraction=1.1, nu=0.5, k=100, mu=0.1, k_t=50, nu_t=0.1)
+            e.set_random_generator(np.random.default_rng(5))
+            e._create_spheres(20, 1)
+            return e
+
+        def experiment(e):
+            exp = OscillatoryShearExperiment(e, 1e-3, 5.0, 0.05, False, dt_max=4e-3)
+            exp.periods = 1
+            return exp
+
+        ens, ref = build(), build()
+        self.assertFalse(hasattr(ens, "dt"))
+        x = experiment(ens)
+        G = x.oscillatory_shear_experiment(0.99, 4)
+        y = experiment(ref)
+        y.prepare_recording()
+        ref.applyingShear = True
+        y.pre_equilibrate(4, 0.99)
+        ref.t = 0
+        y.run_protocol(0.99)
+        a, b = x.plotter.arrays(), y.plotter.arrays()
+        self.assertEqual(len(a["t"]), len(b["t"]))
+        for key in ("strain", "stress_internal", "stress_surface"):
+            self.assertLessEqual(np.max(np.abs(a[key] - b[key])), 1e-12 * np.max(np.abs(b[key])), key)
+        self.assertTrue(all(np.isfinite(G)))
+        for name in ("x", "y"):
+            self.assertLessEqual(np.max(np.abs(ens._a[name] - ref._a[name])), 1e-12 * 200, name)
+        self.assertEqual((ens.t, ens.shear, ens.step_count), (ref.t, ref.shear, ref.step_count))
 
 
 class TestBatchOfOwnAndShared(unittest.TestCase):

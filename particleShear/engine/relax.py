@@ -31,6 +31,7 @@ import numpy as np
 
 from .state import PERMANENT, STICK, BatchState
 from .step import BatchEngine
+from .xp import to_host
 
 __all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
            "RelationAges"]
@@ -251,7 +252,7 @@ def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
     return N * (len(levels) + 2)
 
 
-def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True):
+def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True, dt=None):
     """Put replica ``b`` of a relaxed (or measured) engine back into its ensemble.
 
     Positions, angles φ, velocities, forces, clock and strain of the spheres; the candidate
@@ -279,7 +280,9 @@ def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True):
     constitution : bool, default True
         The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
         ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
-        the shear rate of its last step).
+        the shear rate of its last step; a Verlet engine's half kick becomes the ensemble's).
+    dt : float, optional
+        The time step of the last step (default: the ensemble's ``dt``).
     """
     s = engine.s
     rows = s.replica(b)
@@ -324,7 +327,10 @@ def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True):
     ensemble._links_changed()
     ensemble._relations_edited()
     ensemble._g = None
-    ensemble._last_dt = float(ensemble.dt)
+    ensemble._last_dt = float(ensemble.dt if dt is None else dt)
+    if engine.half is not None and hasattr(ensemble, "_half_kick"):
+        h = to_host(engine.half[:, rows], "state")
+        ensemble._half_kick = (h[0].copy(), h[1].copy(), h[2].copy())
     ensemble.step_count += int(steps)
     if constitution and hasattr(ensemble, "n_constitution_steps"):
         ensemble.n_constitution_steps += int(steps)
@@ -356,7 +362,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     Raises
     ------
     ValueError
-        If the ensembles differ in N, ``dt`` or ``dt_max``, or a step is not usable (before any step).
+        If the ensembles differ in N, ``dt``, ``dt_max`` or integrator, or a step is not usable
+        (before any step).
     """
     ensembles = list(ensembles)
     if not ensembles:
@@ -366,9 +373,14 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         raise ValueError(f"ensembles have (dt, dt_max) = {sorted(dts)}: one engine relaxes one schedule")
     (dt, dt_max), = dts
     relaxation_levels(dt, dt_max)   # checks the steps before any work
+    integrators = {getattr(e, "integrator", "euler") for e in ensembles}
+    if len(integrators) != 1:
+        raise ValueError(f"ensembles use the integrators {sorted(integrators)}: one engine relaxes with one")
     state = BatchState.from_ensembles(ensembles, laws=laws)
     mu = state.mu.copy()
-    engine = BatchEngine(state, skin_factor=skin_factor, guard=False)   # no guard: the classes guard the measurement only
+    # the guard where an ensemble has one (a script's; the builders guard the measurement only)
+    engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(),
+                         guard=[getattr(e, "stability_guard", None) is not None for e in ensembles])
     engine.phase = "constitution"
     ages = RelationAges(engine, ensembles)
     steps = free_relaxation(engine, N, dt, dt_max, mu, ages)

@@ -401,11 +401,16 @@ class OscillatoryShearExperiment:
         N_steps = int(T_total / self.dt)
         self.theEvaluator = StressTensorEvaluation(ens.size_x, ens.size_y)
         self.plotter = self._make_plotter(T_total)
+        self.plotter.allocate(N_steps, keep_tensor_history=self._keeps_tensors())
+        return N_steps
+
+    def _keeps_tensors(self):
+        """Whether the tensor history is recorded: ``keep_tensor_history``, or (None) when a file
+        with the tensor table is written (``output_file`` and ``saveStressTensorData``)."""
         keep = self.keep_tensor_history
         if keep is None:
             keep = bool(self.output_file) and bool(self.saveStressTensorData)
-        self.plotter.allocate(N_steps, keep_tensor_history=keep)
-        return N_steps
+        return bool(keep)
 
     def run_protocol(self, cool_factor, n_steps=None):
         """The measurement protocol in the reference per-step order (docs/design.md, "One step"),
@@ -504,8 +509,11 @@ class OscillatoryShearExperiment:
 
         The one step and the one protocol loop of every run (:func:`particleShear.engine.step.pre_equilibrate`,
         :func:`~particleShear.engine.step.protocol`), with the ensemble's integrator, stability
-        guard and contact-law callbacks, observed by this experiment's drawing
-        (:meth:`observers`).  Afterwards the spheres, the clock, the strain, the shear rate and
+        guard (its ``interval``; the criteria are the engine's, those of a default
+        :class:`~particleShear.base.stability.StabilityGuard`) and contact-law callbacks, observed
+        by this experiment's drawing (:meth:`observers`).  The recording (:attr:`plotter`,
+        :attr:`theEvaluator`) is made from the engine's record when the run is complete
+        (:meth:`adopt_measurement`).  Afterwards the spheres, the clock, the strain, the shear rate and
         the relations of the engine's replica are the ensemble's (its relations keep their
         creation numbers, new ones get the next).
 
@@ -531,12 +539,10 @@ class OscillatoryShearExperiment:
         from ..run.batch import ENGINE_SKIN_FACTOR, _guarded
         from .observers import ReplicaScene
         ens = self.theEnsemble
-        keep = self.keep_tensor_history
-        if keep is None:
-            keep = bool(self.output_file) and bool(self.saveStressTensorData)
-        self.keep_tensor_history = keep
-        engine = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR,
-                             guard=ens.stability_guard is not None, integrator=getattr(ens, "integrator", "euler"))
+        keep = self._keeps_tensors()
+        guard = getattr(ens, "stability_guard", None)
+        engine = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
+                             check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"))
         scene = ReplicaScene(getattr(ens, "graphical_output_configuration", None))
         scene.bind(engine, 0)
         observers = self.observers(scene, scene.samples)
@@ -562,7 +568,7 @@ class OscillatoryShearExperiment:
         record = {key: (np.ascontiguousarray(v[0]) if key.endswith("_tensors") else np.ascontiguousarray(v[:, 0]))
                   for key, v in out.items() if key != "tensors" or keep}
         ens.step_count = 0        # the protocol's steps, as the documented loop counts them
-        write_back(engine, 0, ens, len(record["t"]), constitution=False)
+        write_back(engine, 0, ens, len(record["t"]), constitution=False, dt=self.dt)
         ens.phase = "protocol"
         return record, timings
 
@@ -618,7 +624,7 @@ class OscillatoryShearExperiment:
         T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
         self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
         p = self.plotter = self._make_plotter(T_total)
-        keep = bool(self.keep_tensor_history) and "tensors" in record
+        keep = self._keeps_tensors() and "tensors" in record
         p.keep_tensor_history = keep
         scal = np.empty((n, 5))
         for col, key in ((_T, "t"), (_STRAIN, "strain"), (_RATE, "strain_rate"), (_FORCE, "stress_surface"),
