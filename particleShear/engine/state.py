@@ -132,6 +132,9 @@ class BatchState:
     SPHERE_ARRAYS = ("x", "y", "vx", "vy", "omega", "phi", "r", "m", "inertia", "fx", "fy", "torque")
     REPLICA_ARRAYS = ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep")
 
+    #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
+    visit = None
+
     def __init__(self, B, N, backend="numpy"):
         self.backend = get_backend(backend)
         xp = self.xp = self.backend.xp
