@@ -126,7 +126,8 @@ class TestExperimentInTheEngine(unittest.TestCase):
     """``OscillatoryShearExperiment.oscillatory_shear_experiment`` of a script measures in the engine:
     on an ensemble of ``particleShear.objects`` (no ``dt`` of its own) its series equal the classes'
     step loop to 1e-12 of their scale (sums in another order), and the ensemble is left in the final
-    state of that loop (positions to 1e-12 of the cell: rounding over ~500 damped steps)."""
+    state of that loop (positions to 1e-12 of the cell: rounding over ~500 damped steps); the
+    ensemble's stability guard guards it."""
 
     def test_objects_ensemble(self):
         from particleShear.objects.ensembles import EnsembleFrictionLeesEdwards
@@ -160,6 +161,19 @@ class TestExperimentInTheEngine(unittest.TestCase):
         for name in ("x", "y"):
             self.assertLessEqual(np.max(np.abs(ens._a[name] - ref._a[name])), 1e-12 * 200, name)
         self.assertEqual((ens.t, ens.shear, ens.step_count), (ref.t, ref.shear, ref.step_count))
+
+
+    def test_guard_of_the_ensemble(self):
+        # the thresholds of the ensemble's StabilityGuard reach the engine's guard: a bound on the
+        # kinetic energy far below that of any moving packing (1e-30) stops the run at the first check
+        from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
+        _, ens, sc = constituted(7, **SCENE)
+        ens.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=1)
+        exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+        with self.assertRaises(SimulationInstabilityError) as caught:
+            exp.oscillatory_shear_experiment(sc["cool"], sc["N_pre"])
+        self.assertIn("kinetic energy", str(caught.exception))
+        self.assertEqual(caught.exception.phase, "pre-equilibration")
 
 
 class TestBatchOfOwnAndShared(unittest.TestCase):

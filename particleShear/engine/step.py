@@ -142,7 +142,11 @@ class BatchEngine:
         self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica, on the host
         self.guard_dev = self.backend.asarray(self.guard)
         self.rate_max = xp.zeros(B)
+        #: the guard's smallest d/(r_i + r_j) of a transient contact and its bound of the kinetic energy
+        #: relative to the flow (mg·µm²/s² per m depth; None: the bound of the class docstring), as
+        #: the attributes of a :class:`~particleShear.base.stability.StabilityGuard`
         self.min_distance_ratio = 0.05
+        self.max_kinetic_energy = None
         self.step_count = 0
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
@@ -556,6 +560,8 @@ class BatchEngine:
         ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
         plate = self.rate_max * s.Ly / 2
         bound = N * s.k * xp.square(s.r.reshape(B, N).mean(axis=1)) + s.m.reshape(B, N).sum(axis=1) * plate * plate
+        if self.max_kinetic_energy is not None:
+            bound = xp.full(B, float(self.max_kinetic_energy))
         C = self.C
         ratio = xp.where(active & C.trans, d / C.d0, math.inf)
         # closest transient contact of each replica: one reduction over its own (contiguous) segment

@@ -509,8 +509,8 @@ class OscillatoryShearExperiment:
 
         The one step and the one protocol loop of every run (:func:`particleShear.engine.step.pre_equilibrate`,
         :func:`~particleShear.engine.step.protocol`), with the ensemble's integrator, stability
-        guard (its ``interval``; the criteria are the engine's, those of a default
-        :class:`~particleShear.base.stability.StabilityGuard`) and contact-law callbacks, observed
+        guard (:class:`~particleShear.base.stability.StabilityGuard`: its interval and thresholds)
+        and contact-law callbacks, observed
         by this experiment's drawing (:meth:`observers`).  The recording (:attr:`plotter`,
         :attr:`theEvaluator`) is made from the engine's record when the run is complete
         (:meth:`adopt_measurement`).  Afterwards the spheres, the clock, the strain, the shear rate and
@@ -543,6 +543,9 @@ class OscillatoryShearExperiment:
         guard = getattr(ens, "stability_guard", None)
         engine = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                              check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"))
+        if guard is not None:     # the thresholds of the ensemble's guard
+            engine.min_distance_ratio = guard.min_distance_ratio
+            engine.max_kinetic_energy = guard.max_kinetic_energy
         scene = ReplicaScene(getattr(ens, "graphical_output_configuration", None))
         scene.bind(engine, 0)
         observers = self.observers(scene, scene.samples)
