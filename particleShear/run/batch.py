@@ -456,12 +456,32 @@ def _measure(sessions, sched, where):
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
                        post, any(keep), say, report, observers(engine, order), dt=dt)
         for col, b in enumerate(order):
-            rec[b] = {key: (np.ascontiguousarray(v[col]) if key.endswith("_tensors") else
-                            np.ascontiguousarray(v[:, col])) for key, v in out.items()
-                      if key != "tensors" or keep[col]}
+            rec[b] = replica_record(out, col, keep[col])
             timings[b]["protocol"] = (time.perf_counter() - t0) / len(order)
         del out
     return rec, timings
+
+
+def replica_record(out, col, keep):
+    """Replica ``col``'s own record out of a batch's :func:`~particleShear.engine.step.protocol` record.
+
+    Parameters
+    ----------
+    out : dict of ndarray
+        The batch's record: series (n_steps, B), "first_tensors"/"last_tensors" (B, 9, 2, 2) and,
+        when kept, "tensors" (n_steps, B, 9, 2, 2).
+    col : int
+        The replica's column.
+    keep : bool
+        Keep its tensor history.
+
+    Returns
+    -------
+    dict of ndarray
+        The same keys for that replica alone (contiguous copies; "tensors" only with ``keep``).
+    """
+    return {key: (np.ascontiguousarray(v[col]) if key.endswith("_tensors") else np.ascontiguousarray(v[:, col]))
+            for key, v in out.items() if key != "tensors" or keep}
 
 
 def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings):

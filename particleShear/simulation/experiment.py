@@ -536,7 +536,7 @@ class OscillatoryShearExperiment:
         from ..engine.relax import write_back
         from ..engine.state import BatchState
         from ..engine.step import BatchEngine, pre_equilibrate, protocol
-        from ..run.batch import ENGINE_SKIN_FACTOR, _guarded
+        from ..run.batch import ENGINE_SKIN_FACTOR, _guarded, replica_record
         from .observers import ReplicaScene
         ens = self.theEnsemble
         keep = self._keeps_tensors()
@@ -568,8 +568,7 @@ class OscillatoryShearExperiment:
         out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
                        self.periods, self.baseline_post_periods, keep, self._say, report, observers, dt=self.dt)
         timings["protocol"] = time.perf_counter() - t0
-        record = {key: (np.ascontiguousarray(v[0]) if key.endswith("_tensors") else np.ascontiguousarray(v[:, 0]))
-                  for key, v in out.items() if key != "tensors" or keep}
+        record = replica_record(out, 0, keep)
         ens.step_count = 0        # the protocol's steps, as the documented loop counts them
         write_back(engine, 0, ens, len(record["t"]), constitution=False, dt=self.dt)
         ens.phase = "protocol"
