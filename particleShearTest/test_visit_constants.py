@@ -124,16 +124,20 @@ class TestSceneAgainstClasses(unittest.TestCase):
 
 class TestExperimentInTheEngine(unittest.TestCase):
     """``OscillatoryShearExperiment.oscillatory_shear_experiment`` of a script measures in the engine:
-    on an ensemble of ``particleShear.objects`` (no ``dt`` of its own) its series equal the classes'
+    on an ensemble of ``particleShear.objects`` (no ``dt`` of its own; frictionless or not) its series equal the classes'
     step loop to 1e-12 of their scale (sums in another order), and the ensemble is left in the final
     state of that loop (positions to 1e-12 of the cell: rounding over ~500 damped steps); the
     ensemble's stability guard guards it."""
 
-    def test_objects_ensemble(self):
-        from particleShear.objects.ensembles import EnsembleFrictionLeesEdwards
+    def test_objects_ensembles(self):
+        from particleShear.objects.ensembles import EnsembleFrictionLeesEdwards, EnsembleLeesEdwards
+        for cls, kw in ((EnsembleFrictionLeesEdwards, dict(mu=0.1, k_t=50, nu_t=0.1)), (EnsembleLeesEdwards, {})):
+            with self.subTest(cls=cls.__name__):
+                self.check_objects_ensemble(cls, kw)
 
+    def check_objects_ensemble(self, cls, kw):
         def build():
-            e = EnsembleFrictionLeesEdwards(200, 200, 0, packing_fraction=1.1, nu=0.5, k=100, mu=0.1, k_t=50, nu_t=0.1)
+            e = cls(200, 200, 0, packing_fraction=1.1, nu=0.5, k=100, **kw)
             e.set_random_generator(np.random.default_rng(5))
             e._create_spheres(20, 1)
             return e

@@ -295,7 +295,8 @@ def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True, dt=No
     ensemble.applyingShear = bool(s.applying_shear) and not constitution
     if not constitution:
         ensemble.shear_rate = float(s.rate[b])
-    ensemble.mu = float(s.mu[b])
+    if hasattr(ensemble, "mu"):        # a frictionless ensemble of particleShear.objects has none
+        ensemble.mu = float(s.mu[b])
 
     p = engine.pairs_of(b)
     pt = ensemble._pairs

@@ -261,8 +261,9 @@ class BatchState:
                 getattr(s, name)[rows] = a[src][:N]
             s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
             s.gamma[b], s.rate[b], s.t[b] = float(e.shear), float(e.shear_rate), float(e.t)
-            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(e.k), float(e.nu), float(e.k_t), float(e.nu_t),
-                                                             float(e.mu))
+            # a frictionless ensemble of particleShear.objects has no tangential constants: 0
+            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(e.k), float(e.nu), float(getattr(e, "k_t", 0.0)),
+                                                             float(getattr(e, "nu_t", 0.0)), float(getattr(e, "mu", 0.0)))
             for name, src, empty in zip(_PER_REPLICA, PER_SPHERE_PARAMETERS, (0.0, 1.0, 1.0, 1.0)):
                 getattr(s, name)[b] = float(a[src][0]) if N else empty
             if own[b]:

@@ -623,9 +623,9 @@ def experiment_description_text(exp, reference_header=False):
         L += ["Particle mass m = " + _s(model.m) + "mg"]
     L += ["Central spring constant k = " + _s(ens.k) + "mg*s^(-2)",
           "Central viscosity constant nu = " + _s(ens.nu) + "mg*s^(-1)",
-          "Lateral spring constant k_t = " + _s(ens.k_t) + "mg*s^(-2)",
-          "Lateral viscosity constant nu_t = " + _s(ens.nu_t) + "mg*s^(-1)",
-          "Friction coefficient mu = " + _s(ens.mu),
+          "Lateral spring constant k_t = " + _s(getattr(ens, "k_t", 0)) + "mg*s^(-2)",      # 0 without friction
+          "Lateral viscosity constant nu_t = " + _s(getattr(ens, "nu_t", 0)) + "mg*s^(-1)",
+          "Friction coefficient mu = " + _s(getattr(ens, "mu", 0)),
           "Sample width = " + _s(ens.size_x) + "micrometers",
           "Sample height = Gap height = " + _s(ens.size_y) + "micrometers",
           "Particle number = " + _s(ens.N if hasattr(ens, "N") else len(ens.sphereList)),
