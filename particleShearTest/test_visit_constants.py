@@ -15,7 +15,7 @@ import unittest
 
 import numpy as np
 
-from particleShear.engine.state import PERMANENT, STICK, BatchState, ReplicaPairs
+from particleShear.engine.state import PER_SPHERE_PARAMETERS, PERMANENT, STICK, BatchState, ReplicaPairs
 from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_engine import classes_measurement, constituted
@@ -191,16 +191,20 @@ class TestBatchOfOwnAndShared(unittest.TestCase):
             return e
 
         def measure(which):
-            state = BatchState.from_ensembles([ensemble(n) for n in which])
+            ensembles = [ensemble(n) for n in which]
+            state = BatchState.from_ensembles(ensembles)
             eng = BatchEngine(state)
             pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
-            return state, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(which), sc["cool"], 0.5, 1, 0.5)
+            return state, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(which), sc["cool"], 0.5, 1, 0.5), ensembles
 
         single = [measure([n]) for n in (0, 1)]
         self.assertIsNotNone(single[0][0].visit)
         self.assertIsNone(single[1][0].visit)        # shared parameters: one value per replica
-        state, both = measure([0, 1])
-        np.testing.assert_array_equal(state.visit[:, state.N:], state.per_replica_parameters()[:, state.N:])
+        state, both, ensembles = measure([0, 1])
+        # every sphere of the batch carries its own ensemble's values, the shared replica's included
+        for k, name in enumerate(PER_SPHERE_PARAMETERS):
+            want = np.concatenate([np.asarray(e._a[name][:state.N], dtype=float) for e in ensembles])
+            np.testing.assert_array_equal(state.visit[k], want, name)
         for b in range(2):
             for key in ("stress_internal", "stress_surface", "strain"):
                 self.assertEqual(both[key][:, b].tobytes(), single[b][1][key][:, 0].tobytes(), (b, key))

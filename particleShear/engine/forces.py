@@ -212,21 +212,23 @@ class PairConstants:
         d_eq : ndarray (P,)
             Equilibrium distance of each candidate (µm; used for bonds only).
         """
-        xp = array_namespace(state, d_eq)
-        # the per-replica constants of each candidate's replica, gathered at once; the parameters of
-        # the spheres themselves (c, permanent ratios, kept viscosities) from sphere i: the visit from i
-        rows = xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
-        k, nu, k_t, nu_t, mu = (rows[r] for r in range(5))
-        own = s.per_replica_parameters()[:, self.ai] if s.visit is None else s.visit[:, self.ai]
-        c, prc, prt, keep = (own[r] for r in range(4))
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
-        self.k = k
-        self.c = c
-        K = term_constants(self.d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
+        K = self._visit(s, self.ai, d_eq)        # the visit from i
+        self.k = K.k
+        self.c = K.c
         for name in self.TERM_ROWS:
             setattr(self, name, getattr(K, name))
+
+    def _visit(self, s, spheres, d_eq):
+        """The :class:`~particleShear.engine.terms.TermConstants` of the candidates as seen from the sphere
+        rows ``spheres`` (``ai`` or ``aj``): the per-replica constants of each candidate's replica and the
+        visiting sphere's own c, permanent ratios and kept viscosities, gathered at once."""
+        rep = s.xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
+        own = s.visit_rows()[:, spheres]
+        return term_constants(self.d0, self.perm, d_eq, rep[0], own[0], rep[1], rep[2], rep[3], rep[4], own[1], own[2],
+                              own[3])
 
     def set_visits(self, s):
         """Set :attr:`Kj`, the constants of the visit from j, when spheres have parameters of their own.
@@ -243,14 +245,7 @@ class PairConstants:
         s : BatchState
             The batch (its ``visit`` rows and per-replica constants).
         """
-        if s.visit is None:
-            self.Kj = None
-            return
-        xp = s.xp
-        rows = xp.stack((s.nu, s.k_t, s.nu_t))[:, self.rep]
-        c, prc, prt, keep = (s.visit[r][self.aj] for r in range(4))
-        K = term_constants(self.d0, self.perm, self.d_eq, self.k, c, rows[0], rows[1], rows[2], self.mu, prc, prt, keep)
-        self.Kj = VisitConstants(K, self)
+        self.Kj = None if s.visit is None else VisitConstants(self._visit(s, self.aj, self.d_eq), self)
 
 
 class VisitConstants(TermConstants):

@@ -549,24 +549,25 @@ class OscillatoryShearExperiment:
         scene = ReplicaScene(getattr(ens, "graphical_output_configuration", None))
         scene.bind(engine, 0)
         observers = self.observers(scene, scene.samples)
+        def reporter(phase):
+            """The engine's ``report(step, total)`` of ``phase``: :attr:`position` and the progress callback."""
+            t0, state = time.perf_counter(), [0.0]
+
+            def report(step, total):
+                self.position = (phase, step, total)
+                self._report(phase, step, total, t0, state)
+            return report
+
         timings = {}
         t0 = time.perf_counter()
-        state = [0.0]
         if self.do_preequilibration_with_fixed_boundaries:
-            def report(step, total):
-                self.position = ("pre-equilibration", step, total)
-                self._report("pre-equilibration", step, total, t0, state)
-            _guarded(pre_equilibrate, engine, N_pre, self.dt, self.dt_max, cool_factor, self._say, report, observers,
-                     dt=self.dt)
+            _guarded(pre_equilibrate, engine, N_pre, self.dt, self.dt_max, cool_factor, self._say,
+                     reporter("pre-equilibration"), observers, dt=self.dt)
         timings["pre_equilibration"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        state = [0.0]
-
-        def report(step, total):
-            self.position = ("protocol", step, total)
-            self._report("protocol", step, total, t0, state)
         out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
-                       self.periods, self.baseline_post_periods, keep, self._say, report, observers, dt=self.dt)
+                       self.periods, self.baseline_post_periods, keep, self._say, reporter("protocol"), observers,
+                       dt=self.dt)
         timings["protocol"] = time.perf_counter() - t0
         record = replica_record(out, 0, keep)
         ens.step_count = 0        # the protocol's steps, as the documented loop counts them
