@@ -7,7 +7,8 @@
   steps rounding of ~1e-16 per operation grows by at most a few orders of magnitude in a damped
   system; 1e-12 of each quantity's scale leaves room for that and still fails for any
   difference of physics (one step more or less, a missed contact or a wrong μ moves spheres by
-  ≫ 1e-6 of their scale).  The relations and their states are the same sets.
+  ≫ 1e-6 of their scale).  The relations and their states are the same sets, numbered in the same
+  order of formation.
 * A relaxed random packing is relaxed: the damped levels remove most of the elastic energy of
   the random placement and the large overlaps.
 * The drift removal gives each replica zero mean velocity (the classes' unweighted mean).
@@ -236,6 +237,9 @@ class TestBatchIndependence(unittest.TestCase):
         for k in SPHERE_ROWS:
             self.assertEqual(a._a[k].tobytes(), b._a[k].tobytes(), k)
         self.assertEqual(a._pairs.key[a._pairs.active].tolist(), b._pairs.key[b._pairs.active].tolist())
+        # the creation numbers follow the relations through the list rebuilds
+        self.assertEqual(a._pairs.birth[a._pairs.active].tolist(), b._pairs.birth[b._pairs.active].tolist())
+        self.assertEqual(a._pairs._births, b._pairs._births)
 
     def test_mismatched_schedules_are_refused(self):
         a, b = random_packing(1), random_packing(2)
@@ -246,6 +250,19 @@ class TestBatchIndependence(unittest.TestCase):
             relaxation_levels(0.0, 1.0)
         with self.assertRaisesRegex(ValueError, "dt_max="):
             relaxation_levels(1.0, float("inf"))
+
+    def test_write_back_needs_the_relations_numbered(self):
+        # an engine that did not number its relations as they formed cannot give the ensemble the
+        # order of its neighbors: refused, and the ensemble is left as it was
+        from particleShear.engine.relax import write_back
+        from particleShear.engine.step import BatchEngine
+        a = random_packing(3)
+        eng = BatchEngine(BatchState.from_ensembles([a]))
+        eng.step(1.0, a.dt)
+        x = a._a["x"].copy()
+        with self.assertRaisesRegex(ValueError, "numbers_relations"):
+            write_back(eng, 0, a)
+        self.assertEqual(a._a["x"].tobytes(), x.tobytes())
 
 
 if __name__ == "__main__":

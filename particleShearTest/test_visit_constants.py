@@ -165,6 +165,11 @@ class TestExperimentInTheEngine(unittest.TestCase):
         for name in ("x", "y"):
             self.assertLessEqual(np.max(np.abs(ens._a[name] - ref._a[name])), 1e-12 * 200, name)
         self.assertEqual((ens.t, ens.shear, ens.step_count), (ref.t, ref.shear, ref.step_count))
+        # the same relations, numbered in the order they formed (the order of ``neighbors``)
+        pe, pr = ens._pairs, ref._pairs
+        self.assertEqual(pe.key[pe.active].tolist(), pr.key[pr.active].tolist())
+        self.assertEqual(pe.birth[pe.active].tolist(), pr.birth[pr.active].tolist())
+        self.assertEqual(pe._births, pr._births)
 
 
     def test_guard_of_the_ensemble(self):

@@ -319,8 +319,8 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     -------
     ReplicaPairs
         The near pairs (:func:`near_pairs`) and every bond of ``old``, in canonical ``(i, j)``
-        order; a pair of ``old`` that is still a candidate keeps its state, ξ, ``d_eq`` and
-        relation, a new one starts at rest.
+        order; a pair of ``old`` that is still a candidate keeps its state, ξ, ``d_eq``,
+        relation and creation number, a new one starts at rest.
     """
     N = len(x)
     i, j = near_pairs(x, y, r, Lx, Ly, shift, skin)
@@ -339,6 +339,7 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     xi = np.zeros((2, C))
     d_eq = np.zeros(C)
     active = np.zeros(C, bool)
+    birth = np.zeros(C, np.int64)
     kept = old.active | (old.state == PERMANENT)
     if kept.any():
         pos = np.searchsorted(key, key_old[kept])
@@ -350,7 +351,8 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
         xi[:, dst] = old.xi[:, src]
         d_eq[dst] = old.d_eq[src]
         active[dst] = old.active[src]
-    return ReplicaPairs(i, j, state, xi, d_eq, active)
+        birth[dst] = old.birth[src]
+    return ReplicaPairs(i, j, state, xi, d_eq, active, birth)
 
 
 def verlet_bound(u_max, strain, r_max):

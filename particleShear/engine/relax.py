@@ -9,8 +9,8 @@ of a :class:`~particleShear.engine.step.BatchEngine`; :func:`remove_linear_drift
 ``correct_linear_drift`` per replica; :func:`write_back` puts a relaxed replica back into its
 ensemble (spheres, clock, and the relations, states and ξ of its pair table) so that the
 bookkeeping that follows (crosslinking, cutting, link removal, joining isolated spheres) runs
-through the documented classes on the contacts the engine ended with, and
-:class:`RelationAges` gives the relations the creation numbers the classes would give them.
+through the documented classes on the contacts the engine ended with, the relations numbered
+in the order they formed, as the classes number them.
 :func:`relax_ensembles` does all of it for a list of ensembles (docs/design.md, "Batches of
 replicas", "Constitution of a batch").
 
@@ -33,8 +33,7 @@ from .state import PERMANENT, STICK, BatchState
 from .step import BatchEngine
 from .xp import to_host
 
-__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
-           "RelationAges"]
+__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels"]
 
 #: most coarse levels of one relaxation (halving a finite step reaches any dt > 0 in fewer)
 MAX_LEVELS = 2100
@@ -106,102 +105,12 @@ def remove_linear_drift(state):
         state.vy[rows] -= state.vy[rows].sum() / N
 
 
-class RelationAges:
-    """Creation numbers of the relations of a batch, given as the classes give them.
-
-    The classes number relations in the order they form: at every step the newly touching pairs
-    take the next numbers of their ensemble's counter in ``(i, j)`` order (``PairTable.birth``;
-    it orders ``sphere.neighbors`` and so which relation ``join_isolated_spheres`` draws).  This
-    tracker does the same per replica after every engine step, follows the candidates through
-    the engine's list rebuilds, and :func:`write_back` puts the numbers and the counter into the
-    ensemble.
-
-    Parameters
-    ----------
-    engine : BatchEngine
-        The engine before its first step; its ``s.pairs`` were copied from ``ensembles``.
-    ensembles : sequence of ensemble
-        The ensembles of the replicas, in order (their pair tables give the numbers so far).
-    """
-
-    def __init__(self, engine, ensembles):
-        s = engine.s
-        self.B, self.BN = s.B, s.B * s.N
-        keys, numbers = [], []
-        for b, (p, e) in enumerate(zip(s.pairs, ensembles)):
-            keys.append(self._keys(p.i + b * s.N, p.j + b * s.N))
-            pt = e._pairs
-            slot = pt.find(p.i, p.j) if len(p.i) else np.zeros(0, np.intp)
-            known = p.active & (slot >= 0)
-            numbers.append(np.where(known, pt.birth[np.where(known, slot, 0)] if len(pt.birth) else 0, 0))
-        self.key = np.concatenate(keys).astype(np.int64)
-        self.number = np.concatenate(numbers).astype(np.int64)
-        self.active = np.concatenate([p.active for p in s.pairs]).astype(bool)
-        self.next = np.array([e._pairs._births for e in ensembles], dtype=np.int64)
-        self.C = None
-
-    def _keys(self, ai, aj):
-        return np.asarray(ai, dtype=np.int64) * self.BN + np.asarray(aj, dtype=np.int64)
-
-    def after_step(self, engine):
-        """Number the relations formed in the step the engine has just made.
-
-        Parameters
-        ----------
-        engine : BatchEngine
-            The engine, right after a step.
-        """
-        C = engine.C
-        if C is not self.C:   # the candidate lists were rebuilt: carry the records over by pair
-            key = self._keys(C.ai, C.aj)
-            if len(self.key):
-                at = np.minimum(np.searchsorted(self.key, key), len(self.key) - 1)
-                found = self.key[at] == key
-                self.number = np.where(found, self.number[at], 0)
-                self.active = found & self.active[at]
-            else:
-                self.number = np.zeros(len(key), np.int64)
-                self.active = np.zeros(len(key), bool)
-            self.key, self.C = key, C
-        newly = engine.active & ~self.active
-        if newly.any():
-            idx = np.flatnonzero(newly)               # replica by replica, (i, j) order within each
-            reps = C.rep[idx]
-            counts = np.bincount(reps, minlength=self.B)
-            first = np.cumsum(counts) - counts
-            self.number[idx] = self.next[reps] + (np.arange(len(idx)) - first[reps])
-            self.next += counts
-        self.active = engine.active
-
-    def births(self, b, pt):
-        """Creation numbers of replica ``b``'s candidates; sets the counter of ``pt`` (its pair table).
-
-        Parameters
-        ----------
-        b : int
-            Replica index.
-        pt : PairTable
-            The replica's ensemble's pair table.
-
-        Returns
-        -------
-        ndarray of int64
-            One number per candidate of replica b in the engine's canonical order (0 where the
-            candidate is not a relation).
-        """
-        lo, hi = self.C.offsets[b], self.C.offsets[b + 1]
-        pt._births = int(self.next[b])
-        return np.where(self.active[lo:hi], self.number[lo:hi], 0)
-
-
-def _steps(engine, n, cool, dt, ages=None):
+def _steps(engine, n, cool, dt):
     for _ in range(n):
         engine.step(cool, dt)
-        if ages is not None:
-            ages.after_step(engine)
 
 
-def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
+def free_relaxation(engine, N, dt, dt_max, mu):
     """``free_pre_equilibration(N)`` of the classes on every replica of ``engine``.
 
     Shear and plates off.  μ = 0 during the coarse levels (:func:`relaxation_levels`: N steps
@@ -221,8 +130,6 @@ def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
         Step of the first level (s).
     mu : array_like (B,)
         Friction coefficient of each replica for the last block.
-    ages : RelationAges, optional
-        Records when the relations form (for :func:`write_back`).
 
     Returns
     -------
@@ -243,48 +150,53 @@ def free_relaxation(engine, N, dt, dt_max, mu, ages=None):
     s.applying_shear = False
     engine.set_mu(np.zeros(s.B))
     for level_dt, cf in levels:
-        _steps(engine, N, cf, level_dt, ages)
+        _steps(engine, N, cf, level_dt)
         remove_linear_drift(s)
-    _steps(engine, N, 1, dt, ages)
+    _steps(engine, N, 1, dt)
     engine.set_mu(mu)
-    _steps(engine, N, 1, dt, ages)
+    _steps(engine, N, 1, dt)
     engine.flush()
     return N * (len(levels) + 2)
 
 
-def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True, dt=None):
+def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     """Put replica ``b`` of a relaxed (or measured) engine back into its ensemble.
 
     Positions, angles φ, velocities, forces, clock and strain of the spheres; the candidate
     pairs of the replica become the ensemble's pair table with their relations, states, ξ and
     ``d_eq`` (inactive transient candidates: stick, ξ = 0, as the classes leave them), so the
-    crosslinking sees the contacts of the engine's last neighbour update.  The creation numbers
-    of the relations (the order of ``neighbors``) are the classes' when ``ages`` recorded the
-    relaxation (:class:`RelationAges`); without it, a relation of the ensemble before keeps its
-    number and new relations get the next numbers in ``(i, j)`` order.  The ensemble's neighbour
+    crosslinking sees the contacts of the engine's last neighbour update.  The relations keep the
+    creation numbers (the order of ``neighbors``) the engine gave them as they formed, the
+    classes' numbers, and the ensemble's counter continues from the engine's.  The ensemble's neighbour
     list and caches are invalidated; its ``step_count`` and ``n_constitution_steps`` advance by
     ``steps``.
 
     Parameters
     ----------
     engine : BatchEngine
-        The engine after :func:`free_relaxation`.
+        The engine after :func:`free_relaxation`, with ``numbers_relations`` set before its first step.
     b : int
         Replica index (0 … B−1).
     ensemble : ensemble of ``particleShear.linkable``
         The ensemble the replica was copied from (same N).
     steps : int, optional
         Steps the replica was advanced (bookkeeping of the classes).
-    ages : RelationAges, optional
-        The record of when the relations formed during the relaxation.
     constitution : bool, default True
         The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
         ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
         the shear rate of its last step; a Verlet engine's half kick becomes the ensemble's).
     dt : float, optional
         The time step of the last step (default: the ensemble's ``dt``).
+
+    Raises
+    ------
+    ValueError
+        If the engine does not number its relations (``numbers_relations`` False).
     """
     s = engine.s
+    if not engine.numbers_relations:
+        raise ValueError("write_back needs an engine with numbers_relations = True from its first step "
+                         "(the creation numbers of the relations order the ensemble's neighbors)")
     rows = s.replica(b)
     a = ensemble._a
     for name, src in (("x", "x"), ("y", "y"), ("phi", "phi"), ("xspeed", "vx"), ("yspeed", "vy"),
@@ -305,17 +217,8 @@ def write_back(engine, b, ensemble, steps=0, ages=None, constitution=True, dt=No
     key = (i.astype(np.int64) << 32) | j.astype(np.int64)
     keep = p.active | (p.state == PERMANENT)
     active = np.array(p.active, dtype=bool)
-    if ages is not None and ages.C is not None:
-        birth = ages.births(b, pt)
-    else:
-        birth = np.zeros(len(i), dtype=np.int64)
-        had = np.zeros(len(i), dtype=bool)
-        if len(pt.key):
-            at = np.minimum(np.searchsorted(pt.key, key), len(pt.key) - 1)
-            had = (pt.key[at] == key) & pt.active[at] & active
-            birth[had] = pt.birth[at[had]]
-        born = active & ~had
-        birth[born] = pt.next_births(int(born.sum()))
+    birth = np.where(active, p.birth, 0)
+    pt._births = int(s.next_birth[b])
     pt.i, pt.j, pt.key = i, j, key
     pt.state = np.where(keep, p.state, STICK).astype(np.int8)
     pt.xi = np.where(active, p.xi, 0.0)
@@ -383,8 +286,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(),
                          guard=[getattr(e, "stability_guard", None) is not None for e in ensembles])
     engine.phase = "constitution"
-    ages = RelationAges(engine, ensembles)
-    steps = free_relaxation(engine, N, dt, dt_max, mu, ages)
+    engine.numbers_relations = True
+    steps = free_relaxation(engine, N, dt, dt_max, mu)
     for b, e in enumerate(ensembles):
-        write_back(engine, b, e, steps, ages)
+        write_back(engine, b, e, steps)
     return steps

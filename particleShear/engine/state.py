@@ -49,9 +49,10 @@ def uniform_parameters(ensemble):
 class ReplicaPairs:
     """Candidate pairs of one replica: local indices ``i < j`` in canonical order and their history.
 
-    ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds)
-    and ``active`` (a relation of the reference: touching at the last neighbour update, or a bond).
-    The arguments are converted (not validated) to the dtypes below.
+    ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds),
+    ``active`` (a relation of the reference: touching at the last neighbour update, or a bond) and
+    ``birth``, the creation number of each relation (the order of ``sphere.neighbors``; the
+    classes' ``PairTable.birth``).  The arguments are converted (not validated) to the dtypes below.
 
     Parameters
     ----------
@@ -65,16 +66,19 @@ class ReplicaPairs:
         Equilibrium distance of each bond (µm; unused for transient contacts).
     active : array_like of bool (C,)
         The candidate is a relation (touching at the last update, or a bond).
+    birth : array_like of int (C,), optional
+        Creation number of each relation (unused where ``active`` is False); default 0.
     """
-    __slots__ = ("i", "j", "state", "xi", "d_eq", "active")
+    __slots__ = ("i", "j", "state", "xi", "d_eq", "active", "birth")
 
-    def __init__(self, i, j, state, xi, d_eq, active):
+    def __init__(self, i, j, state, xi, d_eq, active, birth=None):
         self.i = np.asarray(i, dtype=np.intp)
         self.j = np.asarray(j, dtype=np.intp)
         self.state = np.asarray(state, dtype=np.int8)
         self.xi = np.asarray(xi, dtype=float).reshape(2, -1)
         self.d_eq = np.asarray(d_eq, dtype=float)
         self.active = np.asarray(active, dtype=bool)
+        self.birth = np.zeros(len(self.i), np.int64) if birth is None else np.asarray(birth, dtype=np.int64)
 
 
 class BatchState:
@@ -95,6 +99,9 @@ class BatchState:
         Candidate pairs of each replica (NumPy arrays, on the host).
     rng : list of numpy.random.Generator
         Each replica's own generator (random normals at ``d = 0``).
+    next_birth : numpy.ndarray of int64 (B,)
+        The creation number the next relation of each replica gets (on the host; the engine numbers
+        the relations that form in its steps, :meth:`~particleShear.engine.step.BatchEngine.flush`).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
     visit : ndarray (4, B·N) or None
@@ -153,6 +160,7 @@ class BatchState:
         self.rep = xp.repeat(xp.arange(self.B), self.N)
         self.pairs = [None] * self.B
         self.rng = [None] * self.B
+        self.next_birth = np.zeros(self.B, np.int64)
         self.applying_shear = True
         self.law = None
         self.law_params = xp.zeros((0, self.B))
@@ -271,7 +279,8 @@ class BatchState:
             pt = e._pairs
             keep = pt.active | (pt.state == PERMANENT)
             s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
-                                      pt.active[keep])
+                                      pt.active[keep], pt.birth[keep])
+            s.next_birth[b] = pt._births
             s.rng[b] = e._rng
         if any(own):
             shared = np.repeat(np.logical_not(own), N)
@@ -316,6 +325,7 @@ class BatchState:
             getattr(out, name)[...] = xp.concatenate([getattr(st, name) for st in states])
         out.pairs = [p for st in states for p in st.pairs]
         out.rng = [g for st in states for g in st.rng]
+        out.next_birth = np.concatenate([st.next_birth for st in states])
         out.applying_shear = all(st.applying_shear for st in states)
         out.law = laws.pop()
         out.law_params = xp.concatenate([st.law_params for st in states], axis=1)
