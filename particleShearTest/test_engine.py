@@ -258,6 +258,36 @@ class TestStressRegistry(unittest.TestCase):
         self.assertEqual([t.stem for t in TENSORS], stems)
 
 
+class TestStateOfOneEnsemble(unittest.TestCase):
+    """``BatchState.of_ensemble``: the batch of one whose sphere arrays are the ensemble's own rows.
+    The engine's steps on it write into the ensemble, and they are the steps of a copy
+    (``from_ensembles``) bit for bit: the same arithmetic on the same numbers."""
+
+    def test_steps_write_into_the_ensemble_as_on_a_copy(self):
+        _, ens_v, sc = constituted(13, theMu=0.05, do_permanent_links=True, cut_lines=1)
+        _, ens_c, _ = constituted(13, theMu=0.05, do_permanent_links=True, cut_lines=1)
+        view, copy = BatchState.of_ensemble(ens_v), BatchState.from_ensembles([ens_c])
+        self.assertIs(view.ensemble, ens_v)
+        self.assertIsNone(copy.ensemble)
+        for name, row in (("x", "x"), ("vy", "yspeed"), ("omega", "omega"), ("fx", "xforce"), ("r", "r")):
+            self.assertTrue(np.shares_memory(getattr(view, name), ens_v._a[row]), name)
+            self.assertFalse(np.shares_memory(getattr(copy, name), ens_c._a[row]), name)
+        x0 = ens_c._a["x"].copy()
+        ev, ec = BatchEngine(view), BatchEngine(copy)
+        for e in (ev, ec):
+            e.s.applying_shear = True
+            e.set_rate(np.array([0.2]))
+            for _ in range(60):
+                e.step(0.99, sc["dt"])
+        self.assertEqual(ens_c._a["x"].tobytes(), x0.tobytes())          # a copy leaves the ensemble alone
+        self.assertFalse(np.array_equal(ens_v._a["x"], x0))               # the view moved the ensemble's spheres
+        for name in BatchState.SPHERE_ARRAYS:
+            self.assertEqual(getattr(view, name).tobytes(), getattr(copy, name).tobytes(), name)
+        # a pickled (or device) copy of the view is no longer the ensemble's rows
+        import pickle
+        self.assertIsNone(pickle.loads(pickle.dumps(view)).ensemble)
+
+
 class TestVerletListKeepsEveryContact(unittest.TestCase):
     def test_contacts_equal_all_pairs_during_shear(self):
         _, ens, sc = constituted(11, theMu=0.05, do_permanent_links=False, cut_lines=0, theAmplitude=0.5)

@@ -162,7 +162,9 @@ def free_relaxation(engine, N, dt, dt_max, mu):
 def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     """Put replica ``b`` of a relaxed (or measured) engine back into its ensemble.
 
-    Positions, angles φ, velocities, forces, clock and strain of the spheres; the candidate
+    Positions, angles φ, velocities and forces of the spheres (nothing to copy when the state is
+    the ensemble's own rows, :meth:`~particleShear.engine.state.BatchState.of_ensemble`), the
+    clock and strain; the candidate
     pairs of the replica become the ensemble's pair table with their relations, states, ξ and
     ``d_eq`` (inactive transient candidates: stick, ξ = 0, as the classes leave them), so the
     crosslinking sees the contacts of the engine's last neighbour update.  The relations keep the
@@ -199,9 +201,10 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
                          "(the creation numbers of the relations order the ensemble's neighbors)")
     rows = s.replica(b)
     a = ensemble._a
-    for name, src in (("x", "x"), ("y", "y"), ("phi", "phi"), ("xspeed", "vx"), ("yspeed", "vy"),
-                      ("omega", "omega"), ("xforce", "fx"), ("yforce", "fy"), ("torque", "torque")):
-        a[name][...] = getattr(s, src)[rows]
+    if s.ensemble is not ensemble:     # a view of the ensemble (BatchState.of_ensemble) holds them already
+        for name, src in (("x", "x"), ("y", "y"), ("phi", "phi"), ("xspeed", "vx"), ("yspeed", "vy"),
+                          ("omega", "omega"), ("xforce", "fx"), ("yforce", "fy"), ("torque", "torque")):
+            a[name][...] = getattr(s, src)[rows]
     ensemble.t = float(s.t[b])
     ensemble.shear = float(s.gamma[b])
     ensemble.applyingShear = bool(s.applying_shear) and not constitution
@@ -280,7 +283,9 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     integrators = {getattr(e, "integrator", "euler") for e in ensembles}
     if len(integrators) != 1:
         raise ValueError(f"ensembles use the integrators {sorted(integrators)}: one engine relaxes with one")
-    state = BatchState.from_ensembles(ensembles, laws=laws)
+    # one ensemble: the engine steps its own sphere rows (nothing of them to write back)
+    state = (BatchState.of_ensemble(ensembles[0], laws=laws) if len(ensembles) == 1
+             else BatchState.from_ensembles(ensembles, laws=laws))
     mu = state.mu.copy()
     # the guard where an ensemble has one (a script's; the builders guard the measurement only)
     engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(),

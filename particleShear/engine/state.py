@@ -141,6 +141,8 @@ class BatchState:
 
     #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
     visit = None
+    #: the ensemble whose sphere rows this state's per-sphere arrays are (:meth:`of_ensemble`), else None
+    ensemble = None
 
     def __init__(self, B, N, backend="numpy"):
         self.backend = get_backend(backend)
@@ -171,6 +173,7 @@ class BatchState:
         state = dict(self.__dict__)
         state["backend"] = self.backend.name
         del state["xp"]
+        state.pop("ensemble", None)      # a copy is no longer the ensemble's rows
         return state
 
     def __setstate__(self, state):
@@ -206,6 +209,7 @@ class BatchState:
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
+        out.ensemble = None        # copies, no longer an ensemble's rows
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
@@ -289,6 +293,37 @@ class BatchState:
         if s.law is not None:
             s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
         return s.to_backend(target)
+
+    @classmethod
+    def of_ensemble(cls, ensemble, laws=None):
+        """The state of one ensemble as a batch of one whose per-sphere arrays are the ensemble's
+        own rows (no copy): what the engine's steps write, the ensemble holds.
+
+        Positions, φ, velocities, forces, radii, masses and moments of inertia are views of the
+        ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``); the box,
+        strain, rate, clock, constants, per-sphere parameters (which a step only reads) and the
+        pair list are copied as by :meth:`from_ensembles`.  The views stay valid while the
+        ensemble gains no sphere (an append can move its block).
+
+        Parameters
+        ----------
+        ensemble : ensemble
+            A documented ensemble of ``particleShear.objects`` or ``particleShear.linkable``.
+        laws : sequence, optional
+            As :meth:`from_ensembles` (one entry).
+
+        Returns
+        -------
+        BatchState
+            B = 1 on NumPy, with :attr:`ensemble` set to ``ensemble``.
+        """
+        s = cls.from_ensembles([ensemble], laws=laws)
+        a = ensemble._a
+        s.pos, s.vel, s.frc = ensemble._pos, ensemble._vel, ensemble._frc
+        s.phi, s.r, s.m, s.inertia = a["phi"], a["r"], a["m"], a["inertia"]
+        s._views()
+        s.ensemble = ensemble
+        return s
 
     @classmethod
     def concat(cls, states):

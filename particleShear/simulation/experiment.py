@@ -541,7 +541,7 @@ class OscillatoryShearExperiment:
         ens = self.theEnsemble
         keep = self._keeps_tensors()
         guard = getattr(ens, "stability_guard", None)
-        engine = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
+        engine = BatchEngine(BatchState.of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                              check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"))
         engine.numbers_relations = True   # the relations' creation numbers, for the write-back
         if guard is not None:     # the thresholds of the ensemble's guard
