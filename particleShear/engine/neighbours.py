@@ -26,7 +26,6 @@ import math
 import numpy as np
 
 from .box import min_image
-from .state import PERMANENT, ReplicaPairs
 from .xp import array_namespace
 
 __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
@@ -302,7 +301,7 @@ def near_pairs(x, y, r, Lx, Ly, shift, skin):
 
 
 def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
-    """New candidate list of one replica, keeping the history of pairs that stay candidates.
+    """Make the near pairs of one replica its candidates, keeping the history of those that stay.
 
     Parameters
     ----------
@@ -312,47 +311,18 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
         Box and Lees-Edwards offset ``Ly·γ`` (µm).
     skin : float
         Verlet skin (µm).
-    old : ReplicaPairs
-        The current list (bonds and relations are carried over).
+    old : PairTable
+        The replica's pair list, changed in place (:meth:`~particleShear.engine.state.PairTable.replace`).
 
     Returns
     -------
-    ReplicaPairs
-        The near pairs (:func:`near_pairs`) and every bond of ``old``, in canonical ``(i, j)``
-        order; a pair of ``old`` that is still a candidate keeps its state, ξ, ``d_eq``,
+    PairTable
+        ``old``, now the near pairs (:func:`near_pairs`) and every relation and bond it had, in
+        canonical ``(i, j)`` order; a pair that stays a candidate keeps its state, ξ, ``d_eq``,
         relation and creation number, a new one starts at rest.
     """
-    N = len(x)
-    i, j = near_pairs(x, y, r, Lx, Ly, shift, skin)
-    key = i * N + j
-    key_old = old.i * N + old.j
-    bonds = key_old[old.state == PERMANENT]
-    if len(bonds):   # a bond stretched beyond the reach stays a candidate (bonds are distinct and sorted)
-        at = np.searchsorted(key, bonds)
-        found = at < len(key)
-        found[found] = key[at[found]] == bonds[found]
-        if not found.all():
-            key = np.sort(np.concatenate((key, bonds[~found])))
-            i, j = key // N, key % N
-    C = len(key)
-    state = np.zeros(C, np.int8)
-    xi = np.zeros((2, C))
-    d_eq = np.zeros(C)
-    active = np.zeros(C, bool)
-    birth = np.zeros(C, np.int64)
-    kept = old.active | (old.state == PERMANENT)
-    if kept.any():
-        pos = np.searchsorted(key, key_old[kept])
-        found = pos < C
-        found[found] &= key[pos[found]] == key_old[kept][found]
-        src = np.flatnonzero(kept)[found]
-        dst = pos[found]
-        state[dst] = old.state[src]
-        xi[:, dst] = old.xi[:, src]
-        d_eq[dst] = old.d_eq[src]
-        active[dst] = old.active[src]
-        birth[dst] = old.birth[src]
-    return ReplicaPairs(i, j, state, xi, d_eq, active, birth)
+    old.replace(*near_pairs(x, y, r, Lx, Ly, shift, skin))
+    return old
 
 
 def verlet_bound(u_max, strain, r_max):

@@ -29,7 +29,7 @@ import numbers
 
 import numpy as np
 
-from .state import PERMANENT, STICK, BatchState
+from .state import BatchState
 from .step import BatchEngine
 from .xp import to_host
 
@@ -213,22 +213,13 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     if hasattr(ensemble, "mu"):        # a frictionless ensemble of particleShear.objects has none
         ensemble.mu = float(s.mu[b])
 
-    p = engine.pairs_of(b)
-    pt = ensemble._pairs
-    i = np.array(p.i, dtype=np.intp)
-    j = np.array(p.j, dtype=np.intp)
-    key = (i.astype(np.int64) << 32) | j.astype(np.int64)
-    keep = p.active | (p.state == PERMANENT)
-    active = np.array(p.active, dtype=bool)
-    birth = np.where(active, p.birth, 0)
-    pt._births = int(s.next_birth[b])
-    pt.i, pt.j, pt.key = i, j, key
-    pt.state = np.where(keep, p.state, STICK).astype(np.int8)
-    pt.xi = np.where(active, p.xi, 0.0)
-    pt.d_eq = np.array(p.d_eq, dtype=float)
-    pt.active = active
-    pt.birth = birth
-    pt.version += 1
+    engine.flush()
+    p, pt = s.pairs[b], ensemble._pairs
+    if p is not pt:                    # a view's pair list is the ensemble's table itself
+        for name in ("i", "j", "key", "state", "xi", "d_eq", "active", "birth"):
+            setattr(pt, name, getattr(p, name).copy())
+        pt._births = p._births
+        pt.version += 1
 
     ensemble._invalidate_neighbours()
     ensemble._links_changed()

@@ -2,7 +2,7 @@
 
 Spheres of replica b occupy rows ``b·N … b·N + N − 1`` of every per-sphere array; per-replica
 values (box, strain, rate, model constants) are arrays of length B and are gathered to spheres
-or pairs where a kernel needs them.  Pairs are kept per replica (:class:`ReplicaPairs`, sorted by
+or pairs where a kernel needs them.  Pairs are kept per replica (:class:`PairTable`, sorted by
 ``(i, j)``) and concatenated in replica order into the flat arrays a step works on.
 
 The arrays live on the state's backend (:attr:`BatchState.backend`, NumPy by default, CuPy with
@@ -17,7 +17,8 @@ import numpy as np
 
 from .xp import get_backend
 
-__all__ = ["STICK", "SLIP", "PERMANENT", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS", "uniform_parameters"]
+__all__ = ["STICK", "SLIP", "PERMANENT", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
+           "uniform_parameters"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
@@ -46,39 +47,197 @@ def uniform_parameters(ensemble):
     return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
 
 
-class ReplicaPairs:
-    """Candidate pairs of one replica: local indices ``i < j`` in canonical order and their history.
+def _key(i, j):
+    return (np.asarray(i, dtype=np.int64) << 32) | np.asarray(j, dtype=np.int64)
+
+
+class PairTable:
+    """Candidate pairs of one ensemble (one replica): sphere indices ``i < j`` in canonical ``(i, j)``
+    order and their history, as a structure of arrays.
 
     ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds),
     ``active`` (a relation of the reference: touching at the last neighbour update, or a bond) and
-    ``birth``, the creation number of each relation (the order of ``sphere.neighbors``; the
-    classes' ``PairTable.birth``).  The arguments are converted (not validated) to the dtypes below.
+    ``birth``, the creation number of each relation (the order of ``sphere.neighbors``), with the
+    counter of the next number (``_births``).  The one pair table of the package: the documented
+    ensembles hold one (``ens._pairs``), and the engine keeps one per replica
+    (:attr:`BatchState.pairs`; a state of one ensemble, :meth:`BatchState.of_ensemble`, keeps the
+    ensemble's own).  The arguments are converted (not validated) to the dtypes below.
 
     Parameters
     ----------
-    i, j : array_like of int (C,)
-        Local sphere indices (0 … N−1) of each candidate, ``i < j``, sorted by ``(i, j)``.
-    state : array_like of int (C,)
-        :data:`STICK`, :data:`SLIP` or :data:`PERMANENT` per candidate.
-    xi : array_like (2, C) or (2·C,)
-        Tangential displacement histories ξ_ij (row 0) and ξ_ji (row 1), µm.
-    d_eq : array_like (C,)
-        Equilibrium distance of each bond (µm; unused for transient contacts).
-    active : array_like of bool (C,)
-        The candidate is a relation (touching at the last update, or a bond).
+    i, j : array_like of int (C,), optional
+        Sphere indices of each candidate, ``i < j``, sorted by ``(i, j)``; default none.
+    state : array_like of int (C,), optional
+        :data:`STICK`, :data:`SLIP` or :data:`PERMANENT` per candidate (default stick).
+    xi : array_like (2, C) or (2·C,), optional
+        Tangential displacement histories ξ_ij (row 0) and ξ_ji (row 1), µm (default 0).
+    d_eq : array_like (C,), optional
+        Equilibrium distance of each bond (µm; unused for transient contacts; default 0).
+    active : array_like of bool (C,), optional
+        The candidate is a relation (touching at the last update, or a bond; default False).
     birth : array_like of int (C,), optional
         Creation number of each relation (unused where ``active`` is False); default 0.
     """
-    __slots__ = ("i", "j", "state", "xi", "d_eq", "active", "birth")
 
-    def __init__(self, i, j, state, xi, d_eq, active, birth=None):
-        self.i = np.asarray(i, dtype=np.intp)
-        self.j = np.asarray(j, dtype=np.intp)
-        self.state = np.asarray(state, dtype=np.int8)
-        self.xi = np.asarray(xi, dtype=float).reshape(2, -1)
-        self.d_eq = np.asarray(d_eq, dtype=float)
-        self.active = np.asarray(active, dtype=bool)
-        self.birth = np.zeros(len(self.i), np.int64) if birth is None else np.asarray(birth, dtype=np.int64)
+    FIELDS = ("i", "j", "state", "xi_ij", "xi_ji", "d_eq", "active", "birth")
+
+    def __init__(self, i=(), j=(), state=None, xi=None, d_eq=None, active=None, birth=None):
+        self.i = np.asarray(i, dtype=np.intp).reshape(-1)
+        self.j = np.asarray(j, dtype=np.intp).reshape(-1)
+        C = len(self.i)
+        self.key = _key(self.i, self.j)
+        self.state = np.zeros(C, np.int8) if state is None else np.asarray(state, dtype=np.int8)
+        self.xi = np.zeros((2, C)) if xi is None else np.asarray(xi, dtype=float).reshape(2, -1)
+        self.d_eq = np.zeros(C) if d_eq is None else np.asarray(d_eq, dtype=float)
+        self.active = np.zeros(C, bool) if active is None else np.asarray(active, dtype=bool)
+        self.birth = np.zeros(C, np.int64) if birth is None else np.asarray(birth, dtype=np.int64)
+        self.n_permanent = int((self.state == PERMANENT).sum())
+        self._births = 0
+        self.version = 0
+
+    def __len__(self):
+        return len(self.i)
+
+    def copy(self, rows=None):
+        """An independent table of the candidates ``rows`` (a boolean mask or indices; default all),
+        with the same counter of creation numbers.
+
+        Parameters
+        ----------
+        rows : array_like, optional
+            Which candidates to keep.
+
+        Returns
+        -------
+        PairTable
+        """
+        rows = slice(None) if rows is None else rows
+        out = PairTable(self.i[rows], self.j[rows], self.state[rows], self.xi[:, rows], self.d_eq[rows],
+                        self.active[rows], self.birth[rows])
+        out._births = self._births
+        return out
+
+    @property
+    def xi_ij(self):
+        """ξ of relation i→j (µm), a row view of ``xi`` (both directions gathered in one call)."""
+        return self.xi[0]
+
+    @property
+    def xi_ji(self):
+        """ξ of relation j→i (µm), a row view of ``xi``."""
+        return self.xi[1]
+
+    def find(self, i, j):
+        """Slots of pairs (i, j) (any order), -1 where absent.
+
+        Parameters
+        ----------
+        i, j : int or array_like of int
+            Sphere indices (``sphereList`` order) of the pairs, in either order.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Row of each pair in the table, -1 where the pair is not a candidate.
+        """
+        i = np.asarray(i)
+        j = np.asarray(j)
+        lo, hi = np.minimum(i, j), np.maximum(i, j)
+        k = _key(lo, hi)
+        pos = np.searchsorted(self.key, k)
+        pos_c = np.minimum(pos, max(len(self.key) - 1, 0))
+        found = (pos < len(self.key)) & (self.key[pos_c] == k) if len(self.key) else np.zeros(np.shape(k), bool)
+        return np.where(found, pos_c, -1)
+
+    def next_births(self, n):
+        """Reserve ``n`` consecutive birth numbers (the order in which relations were created).
+
+        Parameters
+        ----------
+        n : int
+            How many numbers to reserve (≥ 0).
+
+        Returns
+        -------
+        numpy.ndarray of int64
+            The reserved numbers, increasing.
+        """
+        b = np.arange(self._births, self._births + n, dtype=np.int64)
+        self._births += n
+        return b
+
+    def replace(self, i, j, keep_existing=False):
+        """Make (i, j) the candidate set, keeping the history of the pairs present before.
+
+        Relations (active) and bonds are always kept, also where (i, j) misses them (a bond
+        stretched beyond the search reach); with ``keep_existing`` every existing row is kept and
+        (i, j) are added.  A pair new to the table starts inactive, sticking, with ξ = 0.
+
+        Parameters
+        ----------
+        i, j : array_like of int
+            Sphere indices of the new candidate pairs, in either order (duplicates allowed).
+        keep_existing : bool
+            Keep every existing row instead of only the active and permanent ones.
+        """
+        old_key = self.key
+        k = np.sort(_key(np.minimum(i, j), np.maximum(i, j)))
+        if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
+            k = np.unique(k)
+        # rows to keep that the new candidates miss (e.g. bonds stretched beyond the search reach)
+        kept = old_key if keep_existing else old_key[self.active | (self.state == PERMANENT)]
+        if len(kept):
+            at = np.searchsorted(k, kept)
+            found = at < len(k)
+            found[found] = k[at[found]] == kept[found]
+            if not found.all():
+                k = np.union1d(k, kept[~found])
+        pos = np.searchsorted(old_key, k)
+        pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
+        had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
+        src = pos_c[had]
+        n = len(k)
+        self.i = (k >> 32).astype(np.intp)
+        self.j = (k & 0xFFFFFFFF).astype(np.intp)
+        for name, dtype in (("state", np.int8), ("d_eq", float), ("active", bool), ("birth", np.int64)):
+            arr = np.zeros(n, dtype=dtype)
+            if len(src):
+                arr[had] = getattr(self, name)[src]
+            setattr(self, name, arr)
+        xi = np.zeros((2, n))
+        if len(src):
+            dst = np.flatnonzero(had)
+            xi[0, dst] = self.xi[0, src]
+            xi[1, dst] = self.xi[1, src]
+        self.xi = xi
+        self.key = k
+        self.version += 1
+
+    def ensure(self, i, j):
+        """Slots of pairs (i, j), inserting missing ones (inactive, stick, ξ = 0).
+
+        Parameters
+        ----------
+        i, j : int or array_like of int
+            Sphere indices (``sphereList`` order) of the pairs, in either order.
+
+        Returns
+        -------
+        numpy.ndarray of int
+            Row of each pair in the table (at least one-dimensional).
+        """
+        i = np.atleast_1d(np.asarray(i, dtype=np.intp))
+        j = np.atleast_1d(np.asarray(j, dtype=np.intp))
+        slots = self.find(i, j)
+        miss = slots < 0
+        if miss.any():
+            self.replace(i[miss], j[miss], keep_existing=True)
+            slots = self.find(i, j)
+        return slots
+
+
+#: the engine's name of a replica's pair list (the same class)
+ReplicaPairs = PairTable
 
 
 class BatchState:
@@ -95,13 +254,11 @@ class BatchState:
         Box (µm), strain γ, strain rate γ̇ (1/s) and clock (s) of each replica.
     k, nu, k_t, nu_t, mu, c, prc, prt, keep : ndarray (B,)
         Ensemble constants of each replica (the values a step of its ensemble uses).
-    pairs : list of ReplicaPairs
-        Candidate pairs of each replica (NumPy arrays, on the host).
+    pairs : list of PairTable
+        Candidate pairs of each replica (NumPy arrays, on the host), each with its counter of
+        creation numbers.
     rng : list of numpy.random.Generator
         Each replica's own generator (random normals at ``d = 0``).
-    next_birth : numpy.ndarray of int64 (B,)
-        The creation number the next relation of each replica gets (on the host; the engine numbers
-        the relations that form in its steps, :meth:`~particleShear.engine.step.BatchEngine.flush`).
     applying_shear : bool
         Plates active (spheres overlapping ``y = 0`` or ``y = Ly`` are immobile).
     visit : ndarray (4, B·N) or None
@@ -162,7 +319,6 @@ class BatchState:
         self.rep = xp.repeat(xp.arange(self.B), self.N)
         self.pairs = [None] * self.B
         self.rng = [None] * self.B
-        self.next_birth = np.zeros(self.B, np.int64)
         self.applying_shear = True
         self.law = None
         self.law_params = xp.zeros((0, self.B))
@@ -282,9 +438,7 @@ class BatchState:
                 s.visit[:, rows] = [np.asarray(a[src][:N], dtype=float) for src in PER_SPHERE_PARAMETERS]
             pt = e._pairs
             keep = pt.active | (pt.state == PERMANENT)
-            s.pairs[b] = ReplicaPairs(pt.i[keep], pt.j[keep], pt.state[keep], pt.xi[:, keep], pt.d_eq[keep],
-                                      pt.active[keep], pt.birth[keep])
-            s.next_birth[b] = pt._births
+            s.pairs[b] = pt.copy(keep)
             s.rng[b] = e._rng
         if any(own):
             shared = np.repeat(np.logical_not(own), N)
@@ -300,9 +454,10 @@ class BatchState:
         own rows (no copy): what the engine's steps write, the ensemble holds.
 
         Positions, φ, velocities, forces, radii, masses and moments of inertia are views of the
-        ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``); the box,
-        strain, rate, clock, constants, per-sphere parameters (which a step only reads) and the
-        pair list are copied as by :meth:`from_ensembles`.  The views stay valid while the
+        ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``), and the
+        replica's pair list is the ensemble's pair table (``ens._pairs``) itself; the box, strain,
+        rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
+        by :meth:`from_ensembles`.  The views stay valid while the
         ensemble gains no sphere (an append can move its block).
 
         Parameters
@@ -322,6 +477,7 @@ class BatchState:
         s.pos, s.vel, s.frc = ensemble._pos, ensemble._vel, ensemble._frc
         s.phi, s.r, s.m, s.inertia = a["phi"], a["r"], a["m"], a["inertia"]
         s._views()
+        s.pairs[0] = ensemble._pairs
         s.ensemble = ensemble
         return s
 
@@ -360,7 +516,6 @@ class BatchState:
             getattr(out, name)[...] = xp.concatenate([getattr(st, name) for st in states])
         out.pairs = [p for st in states for p in st.pairs]
         out.rng = [g for st in states for g in st.rng]
-        out.next_birth = np.concatenate([st.next_birth for st in states])
         out.applying_shear = all(st.applying_shear for st in states)
         out.law = laws.pop()
         out.law_params = xp.concatenate([st.law_params for st in states], axis=1)

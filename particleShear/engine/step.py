@@ -35,7 +35,7 @@ from .terms import central_term, normal_speed, pair_forces, relative_velocity, s
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .observers import check_observers, notify
-from .state import PERMANENT, SLIP, STICK, ReplicaPairs
+from .state import PERMANENT, SLIP, STICK
 from .stress import StressInputs, evaluate_all
 from .xp import to_host
 
@@ -151,7 +151,7 @@ class BatchEngine:
         #: number the relations as they form (:meth:`_number`), for a write-back into ensembles;
         #: ``next_birth``: the number the next relation of each replica gets
         self.numbers_relations = False
-        self.next_birth = self.backend.asarray(s.next_birth.copy())
+        self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
 
@@ -170,13 +170,17 @@ class BatchEngine:
                                           for a in (state_p[sel], xi[:, sel], active[sel], birth[sel]))
             ends = np.cumsum([hi - lo for lo, hi in spans])
             spans = list(zip(ends - [hi - lo for lo, hi in spans], ends))
+        counters = to_host(self.next_birth, "pair history")
         for b, (lo, hi) in zip(which, spans):
             p = s.pairs[b]
-            p.state = state_p[lo:hi].copy()
-            p.xi = xi[:, lo:hi].copy()
-            p.active = active[lo:hi].copy()
-            p.birth = birth[lo:hi].copy()
-        s.next_birth[...] = to_host(self.next_birth, "pair history")
+            a = active[lo:hi].copy()
+            # the classes' table: a candidate that is no relation sticks, without history or number
+            p.state = np.where(a | (state_p[lo:hi] == PERMANENT), state_p[lo:hi], STICK).astype(np.int8)
+            p.xi = np.where(a, xi[:, lo:hi], 0.0)
+            p.active = a
+            p.birth = np.where(a, birth[lo:hi], 0)
+            p._births = int(counters[b])
+            p.version += 1
 
     def neighbours(self):
         """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
@@ -277,14 +281,13 @@ class BatchEngine:
 
         Returns
         -------
-        ReplicaPairs
+        PairTable
             The candidates of replica b with their current state, ξ, ``d_eq``, relations and
             creation numbers.
         """
         if self.C is not None:
             self._sync_down()
-        p = self.s.pairs[b]
-        return ReplicaPairs(p.i, p.j, p.state, p.xi, p.d_eq, p.active, p.birth)
+        return self.s.pairs[b].copy()
 
     def mobile(self):
         """Mobility mask: with the plates on, spheres overlapping ``y = 0`` or ``y = Ly`` are immobile.
