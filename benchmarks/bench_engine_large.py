@@ -18,10 +18,9 @@ shared machine hits both):
 
 * engine: ``BatchEngine.set_rate`` + ``BatchEngine.step(cool, dt, sample=True)`` — what a run's
   protocol does each step (the two shear stresses recorded; stability guard on, as in a run);
-* classes, ``relaxed``: ``setShearRate`` + forces + register totals + ``EvaluationHandler.record``
-  (the two shear stresses, no tensor history) + acceleration + movement + reset;
-  ``default``: ``OscillatoryShearExperiment.run_protocol`` itself (what a run through the classes
-  does per step).
+* classes: ``setShearRate`` + forces + register totals + ``EvaluationHandler.record`` (the two
+  shear stresses, no tensor history) + acceleration + movement + reset, the documented step loop
+  (with the schedule of the scene's experiment for ``default``).
 
 Prints µs per step and ns per particle-step (median over blocks of the block mean, so the
 engine's neighbour rebuilds are included in their share), the engine's rebuild count, and the
@@ -76,24 +75,16 @@ def engine_block(eng, n, amplitude=AMPLITUDE, f=F_EXC, dt=DT, cool=COOL):
     return time.perf_counter() - t0
 
 
-def experiment_block(exp, n, cool):
-    """n steps of the classes' own protocol loop (``run_protocol``); wall time (s)."""
-    exp.prepare_recording()
-    t0 = time.perf_counter()
-    exp.run_protocol(cool, n)
-    return time.perf_counter() - t0
-
-
-def classes_block(ens, ev, handler, n):
+def classes_block(ens, ev, handler, n, amplitude=AMPLITUDE, w=W, cool=COOL, dt=DT):
     """n protocol steps of the documented classes; wall time (s)."""
     t0 = time.perf_counter()
     for _ in range(n):
-        ens.setShearRate(AMPLITUDE * W * math.cos(W * ens.t))
+        ens.setShearRate(amplitude * w * math.cos(w * ens.t))
         ens.mechanical_simulation_step_calculate_forces()
         ens.record_total_particle_forces()
         handler.record(ens, ev)
-        ens.mechanical_simulation_step_calculate_acceleration(COOL, DT)
-        ens.mechanical_simulation_step_calculate_movement(DT)
+        ens.mechanical_simulation_step_calculate_acceleration(cool, dt)
+        ens.mechanical_simulation_step_calculate_movement(dt)
         ens.reset_force()
     return time.perf_counter() - t0
 
@@ -103,14 +94,15 @@ def compare(n, steps, block, scene):
     if scene == "default":
         exp, ens, cool = build_default_scene(n, 1, 0.01, True, 5)
         run_engine = (lambda eng, k: engine_block(eng, k, exp.amplitude, exp.f, exp.dt, cool))
-        run_classes = (lambda k: experiment_block(exp, k, cool))
+        shear = dict(amplitude=exp.amplitude, w=2 * math.pi * exp.f, cool=cool, dt=exp.dt)
     else:
         ens = build(n)
-        ev = StressTensorEvaluation(ens.size_x, ens.size_y)
-        handler = EvaluationHandler()
-        handler.allocate(steps + 2 * block, keep_tensor_history=False)
         run_engine = engine_block
-        run_classes = (lambda k: classes_block(ens, ev, handler, k))
+        shear = {}
+    ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+    handler = EvaluationHandler()
+    handler.allocate(steps + 2 * block + 5, keep_tensor_history=False)
+    run_classes = (lambda k: classes_block(ens, ev, handler, k, **shear))
     t_build = time.perf_counter() - t0
     eng = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR)   # as a run's engine
     run_engine(eng, 5)                 # warm-up (the first list build is not timed)

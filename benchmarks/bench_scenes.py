@@ -7,7 +7,8 @@ Scenes (the default builder EnsembleCompactParticlesAdjustableInterfaceStrengthF
 * frictional spheres: μ = 0.01, no links;
 * crosslinked particles: μ = 0.01, links, 5 cut lines (the default scene);
 
-each run twice through the experiment's protocol loop (OscillatoryShearExperiment.run_protocol): recording nothing but the
+each run twice through the experiment's protocol (OscillatoryShearExperiment.run_protocol, the engine's one
+protocol loop on the ensemble's own state; each batch starts the protocol anew): recording nothing but the
 scalar series (``keep_tensor_history=False``: only σ_xy of the overall tensor and the surface
 stress are evaluated per step) and keeping every tensor of every step (``True``, what
 ``saveData`` with ``saveStressTensorData`` needs).

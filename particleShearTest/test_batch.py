@@ -14,6 +14,7 @@ import numpy as np
 from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
 from particleShear.run.batch import batches, run_batch, schedule_key
 from particleShear.simulation.output import sidecar_path
+from particleShearTest.classes_loops import classes_pre_equilibrate, classes_run_protocol
 
 #: ~300 protocol steps of 20 spheres (the quick scene of test_simulation.py)
 QUICK = dict(N=20, relative_frequency=0.2, pre_periods=0.5, periods=1, post_periods=0.5, doDrawing=False,
@@ -401,9 +402,9 @@ class TestDocumentedSimulationWithPerSphereParameters(unittest.TestCase):
         exp = ref.createExperiment(False, 1, False)
         exp.prepare_recording()
         ref.theEnsemble.applyingShear = True
-        exp.pre_equilibrate(sched.N_pre, sched.cool)
+        classes_pre_equilibrate(exp, sched.N_pre, sched.cool)
         ref.theEnsemble.t = 0
-        exp.run_protocol(sched.cool)
+        classes_run_protocol(exp, sched.cool)
         G_classes = [exp.evaluateStressAndG(useExternalForce=True)[k] for k in (2, 3)]
         scale = float(np.hypot(*G_ref))
         for a, b in zip(G_classes, G_ref):

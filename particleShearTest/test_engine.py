@@ -27,6 +27,7 @@ from particleShear.run.api import _build_simulation, _seed_sequence
 from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
 from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_force_laws import central_law_definition
+from particleShearTest.classes_loops import classes_pre_equilibrate, classes_run_protocol
 
 
 def brute_image(dx, dy, Lx, Ly, shift):
@@ -151,16 +152,16 @@ def constituted(seed, N=30, **kw):
 
 
 def classes_measurement(ens, sc, keep_tensors=False):
-    """The documented classes' step loop (the experiment's ``pre_equilibrate`` and ``run_protocol``)
+    """The documented classes' step loop of the experiment (:mod:`particleShearTest.classes_loops`)
     of ``ens`` with schedule ``sc`` (0.5 + 1 + 0.5 periods): the recorded arrays of its plotter."""
     exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
     exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
     exp.keep_tensor_history = keep_tensors
     ens.applyingShear = True
     exp.prepare_recording()
-    exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+    classes_pre_equilibrate(exp, sc["N_pre"], sc["cool"])
     ens.t = 0
-    exp.run_protocol(sc["cool"])
+    classes_run_protocol(exp, sc["cool"])
     return exp.plotter.arrays()
 
 
@@ -286,6 +287,45 @@ class TestStateOfOneEnsemble(unittest.TestCase):
         # a pickled (or device) copy of the view is no longer the ensemble's rows
         import pickle
         self.assertIsNone(pickle.loads(pickle.dumps(view)).ensemble)
+
+
+class TestPhasesOneByOne(unittest.TestCase):
+    """A script's ``pre_equilibrate`` then ``run_protocol`` is the measurement of
+    ``oscillatory_shear_experiment`` bit for bit: the same loops of the engine on the ensemble's own
+    state, the Verlet predictor carried from one phase to the next through the ensemble; a
+    ``run_protocol`` stopped after n steps is the first n steps, its evaluator holding the n-th
+    step's tensors."""
+
+    def test_phases_one_by_one_equal_the_whole_experiment(self):
+        for integrator in ("euler", "verlet"):
+            with self.subTest(integrator=integrator):
+                runs = []
+                for stop in (None, None, 40):
+                    _, ens, sc = constituted(17, theMu=0.05, do_permanent_links=True, cut_lines=2)
+                    ens.set_integrator(integrator)
+                    exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+                    exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+                    exp.keep_tensor_history = True
+                    if not runs:
+                        record, _ = exp.measure_in_engine(sc["cool"], sc["N_pre"])
+                    else:
+                        exp.pre_equilibrate(sc["N_pre"], sc["cool"])
+                        self.assertEqual(ens.phase, "pre-equilibration")
+                        self.assertEqual(exp.run_protocol(sc["cool"], stop), len(exp.plotter.arrays()["t"]))
+                        record = exp.plotter.arrays()
+                    runs.append((ens, exp, record))
+                (e1, _, whole), (e2, x2, parts), (_, x3, first) = runs
+                self.assertGreater(len(whole["t"]), 200)
+                for key in ("t", "strain", "strain_rate", "stress_internal", "stress_surface", "tensors"):
+                    self.assertEqual(np.asarray(whole[key]).tobytes(), parts[key].tobytes(), key)
+                    self.assertEqual(np.asarray(whole[key])[:40].tobytes(), first[key].tobytes(), key)
+                for row in ("x", "y", "phi", "xspeed", "yspeed", "omega"):
+                    self.assertEqual(e1._a[row].tobytes(), e2._a[row].tobytes(), row)
+                self.assertEqual((e1.t, e1.shear, e1.step_count, e1.phase), (e2.t, e2.shear, e2.step_count, "protocol"))
+                self.assertEqual(e1._pairs.birth.tobytes(), e2._pairs.birth.tobytes())
+                np.testing.assert_array_equal(x2.theEvaluator.tensors, np.asarray(whole["tensors"])[-1])
+                np.testing.assert_array_equal(x3.theEvaluator.tensors, np.asarray(whole["tensors"])[39])
+                self.assertEqual(x3.N_steps, 40)
 
 
 class TestVerletListKeepsEveryContact(unittest.TestCase):

@@ -226,9 +226,9 @@ class DotCanvas:
         pass
 
 
-class TestClassesLoopUsesTheObservers(unittest.TestCase):
+class TestPhasesOneByOneUseTheObservers(unittest.TestCase):
     def test_snapshots_and_stress_dots_of_run_protocol(self):
-        # the documented classes' own loop calls the same observers, with the ensemble as the scene
+        # a script's pre_equilibrate and run_protocol call the experiment's observers too
         from particleShear.simulation.experiment import OscillatoryShearExperiment
         _, ens, sc = constituted(11, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)
         with tempfile.TemporaryDirectory() as d:

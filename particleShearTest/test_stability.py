@@ -35,6 +35,7 @@ from particleShear import Simulation_interlocking_rheology, doParticleShearSimul
 from particleShear.base.laws import elastic_force_law_plateau
 from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
 from particleShear.objects.spheres import CircleBasicElasticity
+from particleShearTest.classes_loops import classes_pre_equilibrate, classes_run_protocol
 
 #: relative asymmetry allowed for the overall stress tensor (round-off level is ~1e-16)
 SYM_TOL = 1e-13
@@ -142,12 +143,12 @@ def shear(exp, n_steps, pre=True, monitor=None):
     ens.stability_guard = mon
     f_step = 0.5 ** (exp.f * exp.dt)      # cool_factor 0.5 per period, as doParticleShearSimulation
     if pre:
-        exp.pre_equilibrate(N=25, cool_factor=f_step)
+        classes_pre_equilibrate(exp, N=25, cool_factor=f_step)
     ens.t = 0
     ens.applyingShear = True
     exp.keep_tensor_history = True
     exp.prepare_recording()
-    exp.run_protocol(f_step, n_steps)
+    classes_run_protocol(exp, f_step, n_steps)
     return mon
 
 

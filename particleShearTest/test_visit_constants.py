@@ -20,6 +20,7 @@ from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_engine import classes_measurement, constituted
 from particleShearTest.test_force_laws import central_law_definition as _definition
+from particleShearTest.classes_loops import classes_pre_equilibrate, classes_run_protocol
 
 K, NU = 1000.0, 7.0
 
@@ -154,9 +155,9 @@ class TestExperimentInTheEngine(unittest.TestCase):
         y = experiment(ref)
         y.prepare_recording()
         ref.applyingShear = True
-        y.pre_equilibrate(4, 0.99)
+        classes_pre_equilibrate(y, 4, 0.99)
         ref.t = 0
-        y.run_protocol(0.99)
+        classes_run_protocol(y, 0.99)
         a, b = x.plotter.arrays(), y.plotter.arrays()
         self.assertEqual(len(a["t"]), len(b["t"]))
         for key in ("strain", "stress_internal", "stress_surface"):

@@ -724,7 +724,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
 
 
 def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet,
-             observers=()):
+             observers=(), stop=None):
     """The oscillatory protocol of every replica, clock reset to 0 (docs/design.md).
 
     Every step first sets γ̇ = ``A·2πf·cos(2π(f t − pre))`` during the shear periods (0 in the
@@ -754,6 +754,9 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
         ``every`` and after the last step; while the protocol runs, ``engine.record`` holds the
         record below as it fills (rows ``0 … step − 1`` written, on the state's backend).
         They only read the state.
+    stop : int, optional
+        Stop after that many steps (default: the whole protocol, ``int((periods + pre + post)/f/dt)``
+        steps); the record then holds those steps, "last_tensors" of the last one run.
 
     Returns
     -------
@@ -776,7 +779,9 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
     s.t = xp.zeros(s.B)
     t = 0.0                    # the clock of every replica, kept on the host too (same additions of dt)
     T_total = (periods + pre + post) / f
-    n_steps = int(T_total / dt)
+    n_steps = total = int(T_total / dt)
+    if stop is not None:
+        n_steps = max(0, min(int(stop), n_steps))
     lo = pre / (f * dt)
     hi = (periods + pre) / (f * dt)
     A = engine.backend.asarray(np.asarray(amplitudes, dtype=float))
@@ -785,7 +790,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
     if keep_tensors:
         rec["tensors"] = xp.empty((n_steps, s.B, 9, 2, 2))
     engine.record = rec        # what observers read of the record (the rows written so far)
-    say("Start application shear protocol, total N= " + str(n_steps) + " steps")
+    say("Start application shear protocol, total N= " + str(total) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
     zero = xp.zeros(s.B)

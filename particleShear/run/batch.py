@@ -571,12 +571,12 @@ def _console(sims, members, phase, where):
     return say, report
 
 
-def _guarded(phase, engine, *args, dt):
+def _guarded(phase, engine, *args, dt, **kwargs):
     """Run an engine phase; a diverging replica raises SimulationInstabilityError (step, phase, suggested dt)."""
     from ..base.stability import SimulationInstabilityError
     from ..engine.step import EngineInstability
     try:
-        return phase(engine, *args)
+        return phase(engine, *args, **kwargs)
     except EngineInstability as e:
         raise SimulationInstabilityError(
             f"{e} (time step {dt:.3g} s, try dt <= {dt / 2:.3g} s)", step=e.step, phase=e.phase,

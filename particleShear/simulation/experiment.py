@@ -2,10 +2,11 @@
 
 ``OscillatoryShearExperiment.oscillatory_shear_experiment`` runs the fixed-boundary
 pre-equilibration and the measurement protocol (strain ``A·sin(2π(f t − pre))`` during the
-excitation periods, at rest during the baselines) in the reference per-step order (one
-visible loop in :meth:`OscillatoryShearExperiment.run_protocol`; docs/design.md, "One step"),
-records every step, demodulates τ_internal and τ_surface (:func:`~.evaluation.demodulation`)
-and returns ``[G′_surface, G″_surface]`` (Pa) as the reference does.
+excitation periods, at rest during the baselines) with the engine's one step and its one
+protocol loop on the ensemble's own state (:meth:`OscillatoryShearExperiment.engine_of_ensemble`;
+docs/design.md, "One step"), records every step, demodulates τ_internal and τ_surface
+(:func:`~.evaluation.demodulation`) and returns ``[G′_surface, G″_surface]`` (Pa) as the reference
+does.  ``pre_equilibrate`` and ``run_protocol`` run the two phases one by one.
 """
 __docformat__ = "numpy"
 import logging
@@ -17,7 +18,6 @@ import warnings
 import numpy as np
 
 from ..base.stress import StressTensorEvaluation
-from ..engine.observers import notify
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 
@@ -217,13 +217,16 @@ class OscillatoryShearExperiment:
     def pre_equilibrate(self, N=25, cool_factor=0.99):
         """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at dt, N steps at dt.
 
-        Stepped by the documented classes (``mechanical_simulation_step``), for scripts that step
-        an ensemble themselves; :meth:`oscillatory_shear_experiment` measures in the engine.
+        Stepped by the engine's one step on the ensemble's own state
+        (:func:`particleShear.engine.step.pre_equilibrate` on :meth:`engine_of_ensemble`), the
+        ensemble left in the final state (its clock, strain, relations and step count updated), for
+        scripts that run the phases one by one; :meth:`oscillatory_shear_experiment` runs both.
 
         Runs with ``applyingShear = True`` (the plate band is immobile, the plates rest).  Each
         coarse level (step halved from ``dt_max`` down to ``dt``) takes ``int(N/2)`` steps with a
         damping factor rising from 0.5 towards 1; then 2N steps at dt with damping 0.98.  The
         last N steps use ``cool_factor`` and reset γ̇ to 0 by direct assignment before each step.
+        The live particle window (if any) is redrawn after every step.
 
         Parameters
         ----------
@@ -232,44 +235,26 @@ class OscillatoryShearExperiment:
         cool_factor : float, optional
             Per-step damping factor of the last N steps: fraction of the peculiar velocity kept
             per step (default 0.99).
+
+        Raises
+        ------
+        SimulationInstabilityError
+            If the ensemble's stability guard finds the run unstable.
         """
-        ens = self.theEnsemble
-        ens.applyingShear = True
-        ens.phase = "pre-equilibration"
+        engine = self.engine_of_ensemble()
+        observers = self.observers(self._scene(engine), None, protocol=False)
+        steps = self._pre_equilibrate_in(engine, N, cool_factor, observers)
+        self._write_back(engine, steps)
+
+    def _pre_equilibrate_in(self, engine, N, cool_factor, observers):
+        """The pre-equilibration in ``engine`` (timed, guarded, reported); returns the steps run."""
+        from ..engine.step import pre_equilibrate, pre_equilibration_blocks
+        from ..run.batch import _guarded
         t0 = time.perf_counter()
-        level_dt = self.dt_max
-        cf = 0.5
-        blocks = []
-        while level_dt > self.dt:
-            blocks.append((int(N / 2), level_dt, cf))
-            level_dt = level_dt / 2
-            cf = (1 + cf) / 2
-        total = sum(b[0] for b in blocks) + 3 * int(N)
-        self._say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt "
-                  + str(self.dt_max) + " final dt " + str(self.dt))
-        state = [0.0]
-        step = 0
-        for n, ldt, c in blocks:
-            self._say("dt= " + str(ldt))
-            for _ in range(n):
-                ens.mechanical_simulation_step(c, ldt)
-                step += 1
-                self.position = ("pre-equilibration", step, total)
-                self._report("pre-equilibration", step, total, t0, state)
-        self._say("  Setting final dt= " + str(self.dt))
-        for _ in range(2 * int(N)):
-            ens.mechanical_simulation_step(0.98, self.dt)
-            step += 1
-            self.position = ("pre-equilibration", step, total)
-            self._report("pre-equilibration", step, total, t0, state)
-        for _ in range(int(N)):
-            ens.shear_rate = 0
-            ens.mechanical_simulation_step(cool_factor, self.dt)
-            ens.reset_force()
-            step += 1
-            self.position = ("pre-equilibration", step, total)
-            self._report("pre-equilibration", step, total, t0, state)
+        _guarded(pre_equilibrate, engine, N, self.dt, self.dt_max, cool_factor, self._say,
+                 self._reporter("pre-equilibration"), observers, dt=self.dt)
         self.timings["pre_equilibration"] = time.perf_counter() - t0
+        return sum(b[0] for b in pre_equilibration_blocks(N, self.dt, self.dt_max)) + 3 * int(N)
 
     def free_pre_equilibration(self):
         """Unused by the reference protocol: relaxation without plates (kept for the reference API)."""
@@ -329,7 +314,7 @@ class OscillatoryShearExperiment:
         """
         return self.renderer is not None and bool(self.imageOutputFolder) and bool(self.imageBaseFileName)
 
-    def observers(self, scene, samples, live=True):
+    def observers(self, scene, samples, live=True, protocol=True):
         """The observers of this experiment's drawing (:mod:`.observers`), for the loops of a measurement.
 
         A live particle window (with ``live`` and a live renderer), the snapshots and the movie
@@ -340,14 +325,15 @@ class OscillatoryShearExperiment:
         Parameters
         ----------
         scene : callable
-            ``scene(engine)``: what is drawn (a :class:`~.observers.ReplicaScene`, or a function
-            returning the ensemble for the classes' own loop).
+            ``scene(engine)``: what is drawn (a :class:`~.observers.ReplicaScene`).
         samples : callable
             ``samples(engine, lo, hi)``: t, γ, τ_surface, τ_internal of protocol steps
             ``lo … hi − 1`` (:meth:`~.observers.ReplicaScene.samples`).
         live : bool, default True
-            Include the live particle window (the documented ensemble redraws it itself when
-            the classes step it).
+            Include the live particle window.
+        protocol : bool, default True
+            Include the observers of the protocol (snapshots, movie, live stress window); False
+            for a pre-equilibration alone.
 
         Returns
         -------
@@ -358,6 +344,8 @@ class OscillatoryShearExperiment:
         r = self.renderer
         if live and r is not None and r.live:
             out.append(LiveDrawing(r, scene))
+        if not protocol:
+            return out
         T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
         if self.saves_images():
             movie = None
@@ -387,12 +375,6 @@ class OscillatoryShearExperiment:
                              (self.baseline_pre_periods + self.periods) / self.f)
         return plotter
 
-    def _recorded_samples(self, _ensemble, lo, hi):
-        """``samples`` of the classes' own loop: rows ``lo … hi − 1`` of :attr:`plotter` (t, γ, τ_surface,
-        τ_internal)."""
-        from .evaluation import _FORCE, _SHEAR, _STRAIN, _T
-        return self.plotter._scal[lo:hi][:, [_T, _STRAIN, _FORCE, _SHEAR]]
-
     def prepare_recording(self):
         """Create the evaluator and the plotter and preallocate the recording for the whole protocol."""
         ens = self.theEnsemble
@@ -413,14 +395,17 @@ class OscillatoryShearExperiment:
         return bool(keep)
 
     def run_protocol(self, cool_factor, n_steps=None):
-        """The measurement protocol in the reference per-step order (docs/design.md, "One step"),
-        stepped by the documented classes for scripts that step an ensemble themselves
-        (:meth:`oscillatory_shear_experiment` measures in the engine).
+        """The measurement protocol, stepped by the engine's one step and its one protocol loop
+        (:func:`particleShear.engine.step.protocol` on :meth:`engine_of_ensemble`), for scripts that
+        run the phases one by one; :meth:`oscillatory_shear_experiment` runs both.
 
-        Needs :meth:`prepare_recording` first.  Each step: set the shear rate
-        (``A·2πf·cos(2π(f t − pre))`` during the excitation, else 0), forces, recording,
-        acceleration with damping, movement, then the experiment's observers (:meth:`observers`:
-        snapshots every ``image_N`` steps, movie, live stress window).
+        Each step: set the shear rate (``A·2πf·cos(2π(f t − pre))`` during the excitation, else
+        0), forces, recording, acceleration with damping, movement, then the experiment's
+        observers (:meth:`observers`: live particle window, snapshots every ``image_N`` steps,
+        movie, live stress window).  The clock starts at 0.  Afterwards the recording
+        (:attr:`plotter`: series, tensor history when kept, first and last tensors;
+        :attr:`theEvaluator`: the tensors of the last step) holds the steps run and the ensemble
+        is in the final state.
 
         Parameters
         ----------
@@ -434,44 +419,30 @@ class OscillatoryShearExperiment:
         -------
         int
             Steps run.
+
+        Raises
+        ------
+        SimulationInstabilityError
+            If the ensemble's stability guard finds the run unstable.
         """
-        ens = self.theEnsemble
-        dt, f, A = self.dt, self.f, self.amplitude
-        pre, P, post = self.baseline_pre_periods, self.periods, self.baseline_post_periods
-        T_total = (P + pre + post) / f
-        N_steps = int(T_total / dt)
-        lo = pre / (f * dt)
-        hi = (P + pre) / (f * dt)
-        if self.plotter is None:
-            self.prepare_recording()
-        plotter = self.plotter
-        evaluator = self.theEvaluator
-        # snapshots, movie, stress window (the ensemble redraws a live particle window itself)
-        observers = self.observers(lambda _: ens, self._recorded_samples, live=False)
-        n_run = N_steps if n_steps is None else min(int(n_steps), N_steps)
-        self._say("Start application shear protocol, total N= " + str(N_steps) + " steps")
-        ens.phase = "protocol"
-        ens.step_count = 0
+        engine = self.engine_of_ensemble()
+        scene = self._scene(engine)
+        record = self._protocol_in(engine, cool_factor, self.observers(scene, scene.samples), n_steps)
+        self._write_back(engine, len(record["t"]))
+        self._record(record)
+        return self.N_steps
+
+    def _protocol_in(self, engine, cool_factor, observers, n_steps=None):
+        """The protocol in ``engine`` (timed, guarded, reported); returns the replica's record."""
+        from ..engine.step import protocol
+        from ..run.batch import _guarded, replica_record
+        keep = self._keeps_tensors()
         t0 = time.perf_counter()
-        state = [0.0]
-        for i in range(n_run):
-            if lo <= i <= hi:
-                rate = A * math.cos(2 * math.pi * (ens.t * f - pre)) * 2 * math.pi * f
-            else:
-                rate = 0
-            ens.setShearRate(rate)                                    # velocity/spin adjustment to the new rate
-            ens.mechanical_simulation_step_calculate_forces()         # neighbours + pair forces
-            ens.record_total_particle_forces()                        # register totals
-            plotter.record(ens, evaluator)                            # tensors, τ_int, τ_surf, t, γ, γ̇
-            ens.mechanical_simulation_step_calculate_acceleration(cool_factor, dt)  # kick + damping
-            ens.mechanical_simulation_step_calculate_movement(dt)     # ξ, drift, γ, wrap, t += dt
-            ens.reset_force()
-            self.position = ("protocol", i + 1, n_run)
-            self._report("protocol", i + 1, n_run, t0, state)
-            notify(observers, ens, "protocol", i + 1, n_run)
+        out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
+                       self.periods, self.baseline_post_periods, keep, self._say, self._reporter("protocol"),
+                       observers, dt=self.dt, stop=n_steps)
         self.timings["protocol"] = time.perf_counter() - t0
-        self.N_steps = n_run
-        return n_run
+        return replica_record(out, 0, keep)
 
     def oscillatory_shear_experiment(self, cool_factor=1, N_pre_equilibration_fixed_boundaries=25):
         """Run pre-equilibration and protocol; return ``[G′_surface, G″_surface]`` (Pa).
@@ -504,18 +475,15 @@ class OscillatoryShearExperiment:
         return self.adopt_measurement(cool_factor, record, timings)
 
     def measure_in_engine(self, cool_factor, N_pre=25):
-        """Pre-equilibration and protocol of this experiment in the engine, a batch of one; the
-        ensemble is left in the engine's final state.
+        """Pre-equilibration and protocol of this experiment in the engine, on the ensemble's own
+        state; the ensemble is left in the engine's final state.
 
         The one step and the one protocol loop of every run (:func:`particleShear.engine.step.pre_equilibrate`,
-        :func:`~particleShear.engine.step.protocol`), with the ensemble's integrator, stability
-        guard (:class:`~particleShear.base.stability.StabilityGuard`: its interval and thresholds)
-        and contact-law callbacks, observed
-        by this experiment's drawing (:meth:`observers`).  The recording (:attr:`plotter`,
+        :func:`~particleShear.engine.step.protocol`) in one engine (:meth:`engine_of_ensemble`),
+        observed by this experiment's drawing (:meth:`observers`).  The recording (:attr:`plotter`,
         :attr:`theEvaluator`) is made from the engine's record when the run is complete
-        (:meth:`adopt_measurement`).  Afterwards the spheres, the clock, the strain, the shear rate and
-        the relations of the engine's replica are the ensemble's (its relations keep their
-        creation numbers, new ones get the next).
+        (:meth:`adopt_measurement`).  Afterwards the ensemble's clock, strain, shear rate and
+        relations are the engine's (the spheres were stepped in place).
 
         Parameters
         ----------
@@ -533,48 +501,66 @@ class OscillatoryShearExperiment:
         timings : dict
             Wall times of "pre_equilibration" and "protocol" (s).
         """
-        from ..engine.relax import write_back
+        engine = self.engine_of_ensemble()
+        scene = self._scene(engine)
+        observers = self.observers(scene, scene.samples)
+        self.timings["pre_equilibration"] = 0.0
+        if self.do_preequilibration_with_fixed_boundaries:
+            self._pre_equilibrate_in(engine, N_pre, cool_factor, observers)
+        record = self._protocol_in(engine, cool_factor, observers)
+        self._write_back(engine, len(record["t"]))
+        return record, {k: self.timings[k] for k in ("pre_equilibration", "protocol")}
+
+    def engine_of_ensemble(self):
+        """A batch of one on the ensemble's own state (:meth:`~particleShear.engine.state.BatchState.of_ensemble`):
+        the ensemble's integrator (and its Verlet predictor), stability guard (interval and thresholds)
+        and contact-law callbacks; it numbers the relations as they form, for the write-back.
+
+        Returns
+        -------
+        BatchEngine
+        """
         from ..engine.state import BatchState
-        from ..engine.step import BatchEngine, pre_equilibrate, protocol
-        from ..run.batch import ENGINE_SKIN_FACTOR, _guarded, replica_record
-        from .observers import ReplicaScene
+        from ..engine.step import BatchEngine
+        from ..run.batch import ENGINE_SKIN_FACTOR
         ens = self.theEnsemble
-        keep = self._keeps_tensors()
         guard = getattr(ens, "stability_guard", None)
+        integrator = getattr(ens, "integrator", "euler")
         engine = BatchEngine(BatchState.of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
-                             check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"))
+                             check_interval=getattr(guard, "interval", 4), integrator=integrator)
         engine.numbers_relations = True   # the relations' creation numbers, for the write-back
         if guard is not None:     # the thresholds of the ensemble's guard
             engine.min_distance_ratio = guard.min_distance_ratio
             engine.max_kinetic_energy = guard.max_kinetic_energy
-        scene = ReplicaScene(getattr(ens, "graphical_output_configuration", None))
+        half = getattr(ens, "_half_kick", None)
+        if integrator == "verlet" and half is not None and len(half[0]) == len(ens.sphereList):
+            # the predictor carries on from the ensemble's last step (no spin half kick: none)
+            engine.half = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
+        return engine
+
+    def _scene(self, engine):
+        from .observers import ReplicaScene
+        scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
         scene.bind(engine, 0)
-        observers = self.observers(scene, scene.samples)
-        def reporter(phase):
-            """The engine's ``report(step, total)`` of ``phase``: :attr:`position` and the progress callback."""
-            t0, state = time.perf_counter(), [0.0]
+        return scene
 
-            def report(step, total):
-                self.position = (phase, step, total)
-                self._report(phase, step, total, t0, state)
-            return report
+    def _reporter(self, phase):
+        """The engine's ``report(step, total)`` of ``phase``: :attr:`position` and the progress callback."""
+        t0, state = time.perf_counter(), [0.0]
 
-        timings = {}
-        t0 = time.perf_counter()
-        if self.do_preequilibration_with_fixed_boundaries:
-            _guarded(pre_equilibrate, engine, N_pre, self.dt, self.dt_max, cool_factor, self._say,
-                     reporter("pre-equilibration"), observers, dt=self.dt)
-        timings["pre_equilibration"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
-                       self.periods, self.baseline_post_periods, keep, self._say, reporter("protocol"), observers,
-                       dt=self.dt)
-        timings["protocol"] = time.perf_counter() - t0
-        record = replica_record(out, 0, keep)
-        ens.step_count = 0        # the protocol's steps, as the documented loop counts them
-        write_back(engine, 0, ens, len(record["t"]), constitution=False, dt=self.dt)
-        ens.phase = "protocol"
-        return record, timings
+        def report(step, total):
+            self.position = (phase, step, total)
+            self._report(phase, step, total, t0, state)
+        return report
+
+    def _write_back(self, engine, steps):
+        """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble."""
+        from ..engine.relax import write_back
+        ens = self.theEnsemble
+        if engine.phase == "protocol":
+            ens.step_count = 0        # the protocol's steps, as the documented loop counts them
+        write_back(engine, 0, ens, steps, constitution=False, dt=self.dt)
+        ens.phase = engine.phase
 
     def _conclude(self, G_int, G_surf, t0):
         """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""
@@ -621,9 +607,20 @@ class OscillatoryShearExperiment:
         list of float
             ``[G′_surface, G″_surface]`` in Pa.
         """
-        from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
         self.cool_factor = cool_factor
         self.description_text = experiment_description_text(self, reference_header=self.reference_header)
+        self._record(record)
+        self.timings.update(timings or {})
+        t0 = time.perf_counter()
+        # the contiguous series of the record, demodulated as measure_batch always did
+        G_int = self.demodulation(record["t"], record["stress_internal"])
+        G_surf = self.demodulation(record["t"], record["stress_surface"])
+        return self._conclude(G_int, G_surf, t0)
+
+    def _record(self, record):
+        """The recording of a replica's record: :attr:`plotter` (series, tensor history when kept,
+        first and last tensors), :attr:`theEvaluator` (the tensors of the last step), :attr:`N_steps`."""
+        from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
         n = len(record["t"])
         T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
         self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
@@ -635,16 +632,12 @@ class OscillatoryShearExperiment:
                          (_SHEAR, "stress_internal")):
             scal[:, col] = record[key]
         p._scal, p._tens, p._n, p._planned = scal, (record["tensors"] if keep else None), n, n
-        p.first_tensors = np.array(record["first_tensors"])
-        p.last_tensors = np.array(record["last_tensors"])
-        self.timings.update(timings or {})
+        if n:
+            p.first_tensors = np.array(record["first_tensors"])
+            p.last_tensors = np.array(record["last_tensors"])
+            self.theEvaluator.tensors[...] = p.last_tensors
         self.N_steps = n
         self.position = ("protocol", n, n)
-        t0 = time.perf_counter()
-        # the contiguous series of the record, demodulated as measure_batch always did
-        G_int = self.demodulation(record["t"], record["stress_internal"])
-        G_surf = self.demodulation(record["t"], record["stress_surface"])
-        return self._conclude(G_int, G_surf, t0)
 
     # -- evaluation ------------------------------------------------------------------------------
     def demodulation(self, t, shear_stress):
