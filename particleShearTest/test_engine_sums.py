@@ -13,7 +13,7 @@ import unittest
 
 import numpy as np
 
-from particleShear.engine.forces import PairConstants, replica_sums
+from particleShear.engine.forces import PairConstants, pair_roles, replica_sums
 from particleShear.engine.state import PERMANENT, BatchState, ReplicaPairs
 from particleShear.engine.step import BatchEngine
 
@@ -78,6 +78,25 @@ def random_batch(B=4, N=30, seed=7):
         s.pairs[b] = ReplicaPairs([i], [j], [PERMANENT], np.zeros((2, 1)), [25.0], [True])
         s.rng[b] = np.random.default_rng(b)
     return s
+
+
+class TestPairRoles(unittest.TestCase):
+    """The one internal/external rule of the stresses (eqs. S1-16, S1-19): a pair is internal when
+    both spheres are mobile and it acts inside the cell; otherwise each of its mobile spheres gets
+    the pair's force as an external entry.  So every mobile sphere of a pair receives the pair's
+    force exactly once, and an immobile one never."""
+
+    def test_each_mobile_sphere_of_a_pair_receives_its_force_once(self):
+        rng = np.random.default_rng(3)
+        mi, mj, shifted = rng.random(500) < 0.7, rng.random(500) < 0.7, rng.random(500) < 0.2
+        internal, ext_i, ext_j = pair_roles(mi, mj, shifted)
+        np.testing.assert_array_equal(internal, mi & mj & ~shifted)
+        np.testing.assert_array_equal(2 * internal + ext_i + ext_j, mi.astype(int) + mj)
+        self.assertFalse((internal & (ext_i | ext_j)).any())
+        self.assertTrue(internal.any() and ext_i.any() and (mi & ~ext_i & ~internal).sum() == 0)
+        # every sphere mobile: the boundary alone decides
+        for got, want in zip(pair_roles(True, True, shifted), (~shifted, shifted, shifted)):
+            np.testing.assert_array_equal(got, want)
 
 
 class TestSplicedConstants(unittest.TestCase):

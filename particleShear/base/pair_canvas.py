@@ -16,7 +16,8 @@ from .kernels import le_wrap, min_image, pair_geometry
 from .namespace import (bincount as _bincount, concatenate as _concat, copyto as _copyto,
                         count_nonzero as _nz, where as _where)
 from ..engine.integrate import kick, plates_follow
-from ..engine.terms import (pair_forces)
+from ..engine.forces import pair_roles
+from ..engine.terms import pair_forces
 from ..engine.neighbours import verlet_bound
 from .neighbours import PERMANENT, STICK, PairTable, candidate_pairs
 from .register import PairBlock
@@ -298,16 +299,11 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     @staticmethod
     def _internal_flags(S, mob):
-        """(internal, ext_i, ext_j) of the pairs of structure ``S`` for mobility mask ``mob`` (docs/design.md):
-        a pair is internal when both spheres are mobile and it does not act through the boundary; every other
-        pair gives an external force to each of its mobile spheres."""
-        shifted = S.shifted
+        """(internal, ext_i, ext_j) of the pairs of structure ``S`` for mobility mask ``mob`` (None: all
+        mobile), by the engine's rule (:func:`~particleShear.engine.forces.pair_roles`)."""
         if mob is None:
-            return ~shifted, shifted, shifted
-        mi = mob.take(S.ai)
-        mj = mob.take(S.aj)
-        internal = mi & mj & ~shifted
-        return internal, mi & ~internal, mj & ~internal
+            return pair_roles(True, True, S.shifted)
+        return pair_roles(mob.take(S.ai), mob.take(S.aj), S.shifted)
 
     def _pair_structure(self, active, d0, perm, ky, kx, D0, D, d, cached_images, key):
         """Per-pair data that change only when the candidates, bonds or images change — or, for a

@@ -16,7 +16,7 @@ from operator import attrgetter
 import numpy as np
 
 from ..engine import stress as _es
-from ..engine.forces import shear_stresses as _engine_shear_stresses
+from ..engine.forces import pair_roles, shear_stresses as _engine_shear_stresses
 from ..engine.stress import TENSORS, StressInputs
 from ..engine.xp import get_backend
 from .register import SphereSelection
@@ -104,11 +104,11 @@ class OneReplicaInputs(StressInputs):
         return self._sums(weights[None])
 
     @property
-    def internal(self):
-        """The engine's internal flags (eq. S1-19), evaluated once."""
-        v = self.__dict__.get("_internal")
+    def roles(self):
+        """The engine's internal and external flags (eqs. S1-16, S1-19), evaluated once."""
+        v = self.__dict__.get("_roles")
         if v is None:
-            v = self._internal = StressInputs.internal.fget(self)
+            v = self._roles = StressInputs.roles.fget(self)
         return v
 
 
@@ -199,10 +199,10 @@ class _BlockRows:
     pairs and their internal/external flags (kept while the block's arrays are the same objects).
 
     The register says per pair whether it is internal and whether each sphere receives an
-    external entry; the engine derives this from a mobility mask and the image shift.  Passing
-    ``shifted = ~internal`` and, to the shear-stress function, the per-pair mobility flags
-    ``(ext_i | internal, ext_j | internal, ~internal)`` makes the engine's rule give exactly the
-    register's flags (external pairs are never internal; an external entry needs a mobile sphere).
+    external entry (``roles``, what the shear-stress function takes); the tensors derive this
+    from a mobility mask and the image shift by the engine's rule (``pair_roles``), and passing
+    ``shifted = ~internal`` makes that rule give exactly the register's flags (external pairs are
+    never internal; an external entry needs a mobile sphere).
     """
 
     def __init__(self, p):
@@ -210,7 +210,7 @@ class _BlockRows:
         internal = p["internal"]
         self.C = OneReplicaRows(p["i"], p["j"])
         self.not_internal = ~internal
-        self.flags = (p["ext_i"] | internal, p["ext_j"] | internal, self.not_internal)
+        self.roles = (internal, p["ext_i"], p["ext_j"])
         self.zeros = np.zeros(self.C.P)
         self.all_active = np.ones(self.C.P, dtype=bool)
         self.rule_mask = _UNSET   # the mask for which the engine's rule was checked, and the answer
@@ -243,8 +243,7 @@ def _shear_inputs(q):
     """The arguments of the engine's shear-stress function read from pair inputs ``q`` (mobility
     flags from ``q.mob``), after the batch of one ``C`` and ``B``."""
     C = q.C
-    mi, mj = q.mob[C.ai], q.mob[C.aj]
-    return (q.y - q.Ly[0] / 2, (mi, mj, ~(mi & mj)), q.active, q.shifted, q.dy, q.fx_i, q.dF, q.V)
+    return (q.y - q.Ly[0] / 2, pair_roles(q.mob[C.ai], q.mob[C.aj], q.shifted), q.active, q.dy, q.fx_i, q.dF, q.V)
 
 
 def _entries(reg):
@@ -509,8 +508,7 @@ class StressTensorEvaluation:
             active, _, dy, fx_i, _, dF = self._block_arrays(p, rows, ens)
             # y − Ly/2 of the spheres: the ensemble's own (kept per position update) when the cells agree
             yc = ens._y_centred() if ens.size_y == self.size_y else ens._a["y"] - self.size_y / 2
-            tau = _engine_shear_stresses(rows.C, 1, yc, rows.flags, active, rows.not_internal, dy, fx_i, dF,
-                                         cell["V"])
+            tau = _engine_shear_stresses(rows.C, 1, yc, rows.roles, active, dy, fx_i, dF, cell["V"])
         else:
             q = OneReplicaInputs(**(_entries(reg) if pairs is None else pairs), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))

@@ -24,7 +24,8 @@ from .xp import SegmentSum, array_namespace, to_host
 from . import laws
 from .terms import TermConstants, term_constants
 
-__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "shear_stresses"]
+__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "pair_roles",
+           "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -417,16 +418,37 @@ def replica_sums(C, W):
     return out
 
 
-def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V, fx_j=None):
+def pair_roles(mob_i, mob_j, shifted):
+    """Where the force of each pair is counted in the stress tensors (eqs. S1-16, S1-19): the one rule.
+
+    A pair is internal when both spheres are mobile and it does not act through the boundary (its
+    minimum image removed no period); otherwise each mobile sphere of the pair receives the pair's
+    force as an external force.  An immobile sphere receives nothing.
+
+    Parameters
+    ----------
+    mob_i, mob_j : ndarray of bool (P,) or bool
+        The pair's spheres are mobile (True: all mobile).
+    shifted : ndarray of bool (P,)
+        The minimum image of the pair removed a period.
+
+    Returns
+    -------
+    internal, ext_i, ext_j : ndarray of bool (P,)
+        The pair is internal; i, j receive an external entry.
+    """
+    internal = mob_i & mob_j & ~shifted
+    return internal, mob_i & ~internal, mob_j & ~internal
+
+
+def shear_stresses(C, B, yc, roles, active, dy, fx_i, dF, V, fx_j=None):
     """τ_internal = −σ_xy of the overall tensor and τ_surface = −σ_xy of the external-force tensor (Pa).
 
     ``σ_LW,xy = (1/V) Σ_internal F_x,i (y_i − y_j)`` (eq. S1-19) with ``y_i − y_j = −D_y`` for
     an unshifted pair; ``σ_Tint,xy = −(1/V) Σ_internal d·F_T/2`` (eq. S1-22, ``dF = d·F_T``);
     the centrifugal term has no xy part.  ``σ_ext,xy = −(1/V) Σ_external F_x (y_target − Ly/2)``
-    (eq. S1-16): a pair is internal when both spheres are mobile and no image shift was used,
-    otherwise each mobile sphere receives an external entry.  ``yc`` is ``y − Ly/2`` per sphere,
-    ``flags`` = (mobile i, mobile j, not both mobile) per candidate.  Sums per replica over its
-    own pairs in list order (:func:`replica_sums`).
+    (eq. S1-16), with the internal and external pairs of :func:`pair_roles`.  ``yc`` is ``y − Ly/2``
+    per sphere.  Sums per replica over its own pairs in list order (:func:`replica_sums`).
 
     Parameters
     ----------
@@ -436,12 +458,10 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V, fx_j=None)
         Number of replicas.
     yc : ndarray (B·N,)
         Height of each sphere above its cell's centre line, ``y − Ly/2`` (µm).
-    flags : tuple of three ndarray of bool (P,)
-        (i mobile, j mobile, not both mobile) of each candidate.
+    roles : tuple of three ndarray of bool (P,)
+        ``(internal, ext_i, ext_j)`` of each candidate (:func:`pair_roles`).
     active : ndarray of bool (P,)
         Relations (touching, or a bond): only they carry forces.
-    shifted : ndarray of bool (P,)
-        The minimum image removed a period (the pair acts through the boundary).
     dy : ndarray (P,)
         y component of the minimum-image pair vector ``D`` (µm).
     fx_i : ndarray (P,)
@@ -462,18 +482,17 @@ def shear_stresses(C, B, yc, flags, active, shifted, dy, fx_i, dF, V, fx_j=None)
         Shear stresses ``−σ_xy`` of the overall and of the external-force tensor (Pa, eq. S1-25).
     """
     xp = array_namespace(fx_i)
-    mi, mj, not_both = flags
-    ext = not_both | shifted
-    ext &= active
-    internal = active & ~ext
-    lever = yc[C.ai] * (ext & mi)
-    lever -= yc[C.aj] * (ext & mj)
+    internal, ext_i, ext_j = roles
+    internal = internal & active
+    ext_j = ext_j & active
+    lever = yc[C.ai] * (ext_i & active)
+    lever -= yc[C.aj] * ext_j
     fx_lw, f_lever = fx_i, fx_i * lever
     if fx_j is not None:
         # F_i at i and −F_j at j: F_i·lever + (F_i − F_j)·(y_j − Ly/2), so a pair with F_j = F_i gives
         # the same number as without fx_j (a batch's replica equals its single run)
         fx_lw = (fx_i + fx_j) * 0.5
-        f_lever = f_lever + (fx_i - fx_j) * (yc[C.aj] * (ext & mj))
+        f_lever = f_lever + (fx_i - fx_j) * (yc[C.aj] * ext_j)
     # three per-replica sums in one reduction: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
     sums = replica_sums(C, xp.stack((fx_lw * dy * internal, dF * internal, f_lever)))
     lw, tint, surf = sums[0], sums[1], sums[2]

@@ -29,7 +29,7 @@ import numpy as np
 
 from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
-from .forces import PairConstants, normals, scatter, shear_stresses, splice_arrays
+from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses, splice_arrays
 from .callbacks import force_phase_laws
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
@@ -439,7 +439,7 @@ class BatchEngine:
         if sample:
             shifted = (ky != 0) | (kx != 0)
             mi, mj = mob[ai], mob[aj]
-            out = shear_stresses(C, s.B, yc, (mi, mj, ~(mi & mj)), active, shifted, dy, fx_i, dF, self.V, fx_j)
+            out = shear_stresses(C, s.B, yc, pair_roles(mi, mj, shifted), active, dy, fx_i, dF, self.V, fx_j)
             if sample == "tensors":
                 q = StressInputs(C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia,
                                  Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,

@@ -13,7 +13,7 @@ import collections
 
 import numpy as np
 
-from .forces import replica_sums
+from .forces import pair_roles, replica_sums
 from .xp import array_namespace
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
@@ -129,10 +129,16 @@ class StressInputs:
         return self.per_replica(W, by_pair).T.reshape(self.B, 2, 2)
 
     @property
+    def roles(self):
+        """``(internal, ext_i, ext_j)`` of the relations (:func:`~particleShear.engine.forces.pair_roles`)."""
+        C = self.C
+        internal, ext_i, ext_j = pair_roles(self.mob[C.ai], self.mob[C.aj], self.shifted)
+        return internal & self.active, ext_i & self.active, ext_j & self.active
+
+    @property
     def internal(self):
         """Pairs counted as internal: both spheres mobile, no image shift, a relation (eq. S1-19)."""
-        C = self.C
-        return self.active & self.mob[C.ai] & self.mob[C.aj] & ~self.shifted
+        return self.roles[0]
 
 
 def love_weber(q):
@@ -168,8 +174,7 @@ def external_forces(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     C = q.C
-    ext = q.active & ~q.internal
-    ei, ej = ext & q.mob[C.ai], ext & q.mob[C.aj]
+    _, ei, ej = q.roles
     cx, cy = (q.Lx / 2)[C.rep], (q.Ly / 2)[C.rep]
     lever_x = (q.x[C.ai] - cx) * ei - (q.x[C.aj] - cx) * ej     # F on j is −F on i
     lever_y = (q.y[C.ai] - cy) * ei - (q.y[C.aj] - cy) * ej
