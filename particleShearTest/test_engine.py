@@ -219,6 +219,53 @@ class TestFrictionlessReplicas(unittest.TestCase):
         self.assertTrue(np.any(p1.xi != 0.0))
 
 
+def two_sphere_replicas(specs):
+    """A batch state of two spheres per replica: each spec ``(positions, vy, mu, seed)`` (radius 1 µm,
+    unit masses, a 10 µm cell, plates on), the pair (0, 1) a candidate."""
+    s = BatchState(len(specs), 2)
+    s.r[:], s.m[:], s.inertia[:] = 1.0, 1.0, 0.5
+    s.Lx[:] = s.Ly[:] = 10.0
+    s.k[:], s.nu[:], s.k_t[:], s.nu_t[:] = 1.0, 0.1, 1.0, 0.1
+    s.prc[:] = s.prt[:] = s.keep[:] = 1.0
+    for b, (xy, vy, mu, seed) in enumerate(specs):
+        s.x[2 * b:2 * b + 2], s.y[2 * b:2 * b + 2] = xy
+        s.vy[2 * b:2 * b + 2] = vy
+        s.mu[b] = mu
+        s.pairs[b] = ReplicaPairs([0], [1], [0], np.zeros((2, 1)), [0.0], [False])
+        s.rng[b] = np.random.default_rng(seed)
+    return s
+
+
+class TestFrictionlessReplicaDrawsNothingForXi(unittest.TestCase):
+    """A replica without friction or bonds has no ξ to integrate, so the ξ rule draws no random
+    direction for it (at |R| = 0), alone or in a batch: two coincident spheres resting in the
+    plate band (immobile, so R = 0 every step) beside a frictional replica give the single run's
+    numbers and leave the replica's generator where the single run leaves it."""
+
+    def test_coincident_plate_spheres_beside_a_frictional_replica(self):
+        free = (([5.0, 5.0], [0.5, 0.5]), [0.0, 0.0], 0.0, 1)
+        rough = (([5.0, 6.5], [5.0, 5.0]), [0.0, 1.0], 0.5, 2)     # sliding past each other
+        runs = []
+        for specs in ([free], [rough], [free, rough]):
+            eng = BatchEngine(two_sphere_replicas(specs), guard=False)
+            for _ in range(6):
+                eng.step(1.0, 1e-3)
+            runs.append(eng)
+        batch = runs[2].s
+        for b, single in enumerate(runs[:2]):
+            rows = slice(2 * b, 2 * b + 2)
+            for name in ("x", "y", "vx", "vy", "omega", "fx", "fy", "torque"):
+                self.assertEqual(getattr(batch, name)[rows].tobytes(), getattr(single.s, name).tobytes(), (b, name))
+            self.assertEqual(batch.rng[b].random(), single.s.rng[0].random(), b)
+        # the free replica drew one direction per step, for its normal at d = 0 in the force phase
+        # (the classes draw the same and integrate no ξ for it); nothing for the ξ rule
+        expected = np.random.default_rng(1)
+        for _ in range(6 + 1):
+            expected.random()
+        self.assertEqual(batch.rng[0].random(), expected.random())
+        self.assertTrue(np.any(runs[2].xi[:, 1] != 0.0))        # the frictional pair sticks and integrates ξ
+
+
 class TestStressRegistry(unittest.TestCase):
     """Every engine tensor against the documented classes' StressTensorEvaluation along a protocol
     (same states to ≈ 1e-15, see above; tolerance 1e-12 of the pressure scale, or of the tensor's own

@@ -422,7 +422,8 @@ class BatchEngine:
         Vj = vel.take(aj, axis=1)
         rv = relative_velocity(Vi, Vj, dvx)
         vn = normal_speed(rv, nx, ny)
-        vt = slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
+        # the slip speed only where a replica has a tangential force (see _tangential)
+        vt = None if self.free_p is True else slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
         fn, law = central_term(C, d, vn, active, *force_phase_laws(s, C))   # the laws, looked up once per phase
         F, slip = self._tangential(C, vt, touching, xi, law, active)
@@ -478,7 +479,8 @@ class BatchEngine:
 
         A replica with μ = 0 and no bond has no tangential force (its Coulomb bound is 0), so
         every relation slips and keeps ξ = 0 — what the documented classes do by skipping the
-        term.  When every replica of the batch is such a replica the term is not evaluated.
+        term.  When every replica of the batch is such a replica the term, the slip speed and
+        the ξ rule (:meth:`move`) are not evaluated.
 
         Returns ``(F, slip)`` as :func:`~particleShear.engine.terms.tangential_term`.
         """
@@ -487,7 +489,7 @@ class BatchEngine:
             return tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         if free is True:
             xi[...] = 0.0
-            return self.xp.zeros((2, len(vt))), active
+            return self.xp.zeros((2, len(active))), active
         F, slip = tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         self.xp.copyto(xi, 0.0, where=free)
         return F, slip | (free & active)
@@ -546,14 +548,21 @@ class BatchEngine:
         """
         s, xp, C, g = self.s, self.xp, self.C, self.g
         vx, vy = s.vx, s.vy
-        kd = xp.where(g.active & (self.state_p != SLIP), dt, 0.0)
-        Vi = s.vel.take(C.ai, axis=1)
-        inc_ij, inc_ji = xi_increments(Vi, s.vel.take(C.aj, axis=1), g.dvx, g.nx, g.ny, C.ri, C.rj,
-                                       Vi[0] * dt - g.dx, Vi[1] * dt - g.dy,
-                                       lambda Rx, Ry: normals(Rx, Ry, xp.sqrt(Rx * Rx + Ry * Ry), C.rep_host, s.rng))
-        xi = self.xi
-        xi[0] += inc_ij * kd
-        xi[1] += inc_ji * kd
+        free = self.free_p
+        if free is not True:      # replicas without friction and bonds have no ξ: every relation slips
+            kd = xp.where(g.active & (self.state_p != SLIP), dt, 0.0)
+            Vi = s.vel.take(C.ai, axis=1)
+
+            def unit(Rx, Ry):
+                """Unit vectors of R (a random one at |R| = 0, none drawn for a replica without ξ)."""
+                d = xp.sqrt(Rx * Rx + Ry * Ry)
+                return normals(Rx, Ry, d if free is None else xp.where(free, 1.0, d), C.rep_host, s.rng)
+
+            inc_ij, inc_ji = xi_increments(Vi, s.vel.take(C.aj, axis=1), g.dvx, g.nx, g.ny, C.ri, C.rj,
+                                           Vi[0] * dt - g.dx, Vi[1] * dt - g.dy, unit)
+            xi = self.xi
+            xi[0] += inc_ij * kd
+            xi[1] += inc_ji * kd
         # drift, strain, wrap, clock
         rate_s = s.rate[s.rep]
         u = self.u
