@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 import particleShear.engine.step as engine_step
-from particleShear.engine.state import BatchState, ReplicaPairs
+from particleShear.engine.state import BatchState
 from particleShear.engine.step import BatchEngine
 from particleShear.run.batch import run_batch
 
@@ -71,8 +71,7 @@ def subset(st, rows):
         getattr(out, name)[...] = np.concatenate([a[b * N:(b + 1) * N] for b in rows])
     for name in ("Lx", "Ly", "gamma", "rate", "t", "k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt", "keep"):
         getattr(out, name)[...] = getattr(st, name)[list(rows)]
-    out.pairs = [ReplicaPairs(p.i.copy(), p.j.copy(), p.state.copy(), p.xi.copy(), p.d_eq.copy(), p.active.copy())
-                 for p in (st.pairs[b] for b in rows)]
+    out.pairs = [st.pairs[b].copy() for b in rows]
     out.rng = [copy.deepcopy(st.rng[b]) for b in rows]
     out.applying_shear = st.applying_shear
     return out

@@ -153,11 +153,9 @@ class TestBuildCandidates(unittest.TestCase):
         a, b = next(iter(sorted(near)))
         far = (0, N - 1) if (0, N - 1) not in near else (1, N - 1)
         self.assertNotIn(far, near)
-        rows = [(far, 1.5, -0.5, 30.0), ((a, b), 0.25, 0.75, 12.0)]
-        rows.sort()                                             # a pair list is in canonical (i, j) order
-        old = ReplicaPairs([p[0] for p, *_ in rows], [p[1] for p, *_ in rows], [PERMANENT, PERMANENT],
-                           [[row[1] for row in rows], [row[2] for row in rows]], [row[3] for row in rows],
-                           [True, True])
+        # given in any order: the table puts its rows (and their history) in canonical (i, j) order
+        old = ReplicaPairs([far[0], a], [far[1], b], [PERMANENT, PERMANENT], [[1.5, 0.25], [-0.5, 0.75]],
+                           [30.0, 12.0], [True, True])
         new = build_candidates(x, y, r, Lx, Ly, Ly * g, skin, old)
         got = list(zip(new.i.tolist(), new.j.tolist()))
         self.assertEqual(got, sorted(near | {far}))               # near pairs + bonds, canonical, no duplicate

@@ -185,6 +185,37 @@ class TestExperimentInTheEngine(unittest.TestCase):
         self.assertIn("kinetic energy", str(caught.exception))
         self.assertEqual(caught.exception.phase, "pre-equilibration")
 
+    def test_a_failed_run_leaves_the_ensemble_as_it_was(self):
+        # the engine steps the ensemble's own spheres and pair table; a run stopped by its guard (here
+        # after a few steps of a protocol and of a relaxation) puts them back, so a retry starts from them
+        from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
+        from particleShear.engine.relax import relax_ensembles
+        from particleShear.engine.step import EngineInstability
+        _, ens, sc = constituted(7, **SCENE)
+        exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+        exp.pre_equilibrate(4, sc["cool"])
+        n = len(ens.sphereList)
+        for run in ("protocol", "relaxation"):
+            with self.subTest(run=run):
+                block, pt = ens._block[:, :n].copy(), ens._pairs.copy()
+                state = (ens.t, ens.shear, ens.step_count, ens.phase, ens._pairs._births)
+                ens.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=8)
+                with self.assertRaises(SimulationInstabilityError if run == "protocol" else EngineInstability):
+                    exp.run_protocol(sc["cool"]) if run == "protocol" else relax_ensembles([ens], 20)
+                ens.stability_guard = None
+                self.assertEqual(ens._block[:, :n].tobytes(), block.tobytes())
+                for name in ("key", "state", "xi", "d_eq", "active", "birth"):
+                    self.assertEqual(getattr(ens._pairs, name).tobytes(), getattr(pt, name).tobytes(), name)
+                self.assertEqual((ens.t, ens.shear, ens.step_count, ens.phase, ens._pairs._births), state)
+        # ... and a run after it is the run of an ensemble that never failed
+        _, ref, _ = constituted(7, **SCENE)
+        x_ref = OscillatoryShearExperiment(ref, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+        x_ref.pre_equilibrate(4, sc["cool"])
+        for e, x in ((ens, exp), (ref, x_ref)):
+            x.run_protocol(sc["cool"], 30)
+        self.assertEqual(ens._block[:, :n].tobytes(), ref._block[:, :n].tobytes())
+        self.assertEqual(exp.plotter.arrays()["stress_surface"].tobytes(), x_ref.plotter.arrays()["stress_surface"].tobytes())
+
 
 class TestBatchOfOwnAndShared(unittest.TestCase):
     def test_replicas_equal_their_single_runs(self):

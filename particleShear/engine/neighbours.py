@@ -317,11 +317,11 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
     Returns
     -------
     PairTable
-        ``old``, now the near pairs (:func:`near_pairs`) and every relation and bond it had, in
-        canonical ``(i, j)`` order; a pair that stays a candidate keeps its state, ξ, ``d_eq``,
-        relation and creation number, a new one starts at rest.
+        ``old``, now the near pairs (:func:`near_pairs`) and every bond it had, in canonical
+        ``(i, j)`` order; a pair that stays a candidate keeps its state, ξ, ``d_eq``, relation and
+        creation number, a new one starts at rest.
     """
-    old.replace(*near_pairs(x, y, r, Lx, Ly, shift, skin))
+    old.replace(*near_pairs(x, y, r, Lx, Ly, shift, skin), keep_relations=False)
     return old
 
 

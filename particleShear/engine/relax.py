@@ -24,6 +24,7 @@ Units: µm, s, mg per m depth (docs/parameters.md).
 """
 __docformat__ = "numpy"
 
+import contextlib
 import math
 import numbers
 
@@ -33,7 +34,8 @@ from .state import BatchState
 from .step import BatchEngine
 from .xp import to_host
 
-__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels"]
+__all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
+           "untouched_on_failure"]
 
 #: most coarse levels of one relaxation (halving a finite step reaches any dt > 0 in fewer)
 MAX_LEVELS = 2100
@@ -214,12 +216,8 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
         ensemble.mu = float(s.mu[b])
 
     engine.flush()
-    p, pt = s.pairs[b], ensemble._pairs
-    if p is not pt:                    # a view's pair list is the ensemble's table itself
-        for name in ("i", "j", "key", "state", "xi", "d_eq", "active", "birth"):
-            setattr(pt, name, getattr(p, name).copy())
-        pt._births = p._births
-        pt.version += 1
+    if s.pairs[b] is not ensemble._pairs:      # a view's pair list is the ensemble's table itself
+        ensemble._pairs.assign(s.pairs[b])
 
     ensemble._invalidate_neighbours()
     ensemble._links_changed()
@@ -232,6 +230,34 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     ensemble.step_count += int(steps)
     if constitution and hasattr(ensemble, "n_constitution_steps"):
         ensemble.n_constitution_steps += int(steps)
+
+
+@contextlib.contextmanager
+def untouched_on_failure(ensemble):
+    """Leave ``ensemble`` as it was when the block raises (an instability, an interrupt).
+
+    An engine on the ensemble's own state (:meth:`~particleShear.engine.state.BatchState.of_ensemble`)
+    steps its spheres and pair table in place; a run that fails before its write-back would leave
+    them half-advanced, out of step with the ensemble's clock and caches.  This keeps a copy of
+    both and puts it back (and drops the ensemble's caches) on any exception, which is re-raised.
+
+    Parameters
+    ----------
+    ensemble : ensemble
+        A documented ensemble.
+    """
+    n = len(ensemble.sphereList)
+    block, pairs = ensemble._block[:, :n].copy(), ensemble._pairs.copy()
+    try:
+        yield
+    except BaseException:
+        ensemble._block[:, :n] = block
+        ensemble._pairs.assign(pairs)
+        ensemble._invalidate_neighbours()
+        ensemble._links_changed()
+        ensemble._relations_edited()
+        ensemble._g = None
+        raise
 
 
 def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
@@ -260,8 +286,11 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     Raises
     ------
     ValueError
-        If the ensembles differ in N, ``dt``, ``dt_max`` or integrator, or a step is not usable
-        (before any step).
+        If the ensembles differ in N, ``dt``, ``dt_max``, integrator or the settings of their
+        stability guards, or a step is not usable (before any step).
+    EngineInstability
+        If the stability guard of an ensemble (its interval and thresholds) finds it unstable; an
+        ensemble relaxed alone is then left as it was (:func:`untouched_on_failure`).
     """
     ensembles = list(ensembles)
     if not ensembles:
@@ -278,12 +307,25 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     state = (BatchState.of_ensemble(ensembles[0], laws=laws) if len(ensembles) == 1
              else BatchState.from_ensembles(ensembles, laws=laws))
     mu = state.mu.copy()
-    # the guard where an ensemble has one (a script's; the builders guard the measurement only)
-    engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(),
-                         guard=[getattr(e, "stability_guard", None) is not None for e in ensembles])
+    # the guard where an ensemble has one (a script's; the builders guard the measurement only), with
+    # its interval and thresholds (one set per engine)
+    guards = [getattr(e, "stability_guard", None) for e in ensembles]
+    settings = {(getattr(g, "interval", 4), getattr(g, "min_distance_ratio", 0.05), getattr(g, "max_kinetic_energy", None))
+                for g in guards if g is not None}
+    if len(settings) > 1:
+        raise ValueError(f"the ensembles' stability guards differ ({sorted(settings, key=str)}): one engine "
+                         "relaxes with one guard")
+    interval, ratio, ke = settings.pop() if settings else (4, 0.05, None)
+    engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
+                         guard=[g is not None for g in guards])
+    engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
     engine.phase = "constitution"
     engine.numbers_relations = True
-    steps = free_relaxation(engine, N, dt, dt_max, mu)
+    if state.ensemble is None:
+        steps = free_relaxation(engine, N, dt, dt_max, mu)
+    else:
+        with untouched_on_failure(state.ensemble):     # its own state is stepped
+            steps = free_relaxation(engine, N, dt, dt_max, mu)
     for b, e in enumerate(ensembles):
         write_back(engine, b, e, steps)
     return steps

@@ -66,7 +66,8 @@ class PairTable:
     Parameters
     ----------
     i, j : array_like of int (C,), optional
-        Sphere indices of each candidate, ``i < j``, sorted by ``(i, j)``; default none.
+        Sphere indices of each candidate, ``i < j`` (put in ``(i, j)`` order with their fields when
+        given in another order); default none.
     state : array_like of int (C,), optional
         :data:`STICK`, :data:`SLIP` or :data:`PERMANENT` per candidate (default stick).
     xi : array_like (2, C) or (2·C,), optional
@@ -91,6 +92,11 @@ class PairTable:
         self.d_eq = np.zeros(C) if d_eq is None else np.asarray(d_eq, dtype=float)
         self.active = np.zeros(C, bool) if active is None else np.asarray(active, dtype=bool)
         self.birth = np.zeros(C, np.int64) if birth is None else np.asarray(birth, dtype=np.int64)
+        if C > 1 and not (self.key[1:] >= self.key[:-1]).all():      # the lookups need the canonical order
+            order = np.argsort(self.key, kind="stable")
+            for name in ("i", "j", "key", "state", "d_eq", "active", "birth"):
+                setattr(self, name, getattr(self, name)[order])
+            self.xi = self.xi[:, order]
         self.n_permanent = int((self.state == PERMANENT).sum())
         self._births = 0
         self.version = 0
@@ -112,10 +118,24 @@ class PairTable:
         PairTable
         """
         rows = slice(None) if rows is None else rows
-        out = PairTable(self.i[rows], self.j[rows], self.state[rows], self.xi[:, rows], self.d_eq[rows],
-                        self.active[rows], self.birth[rows])
+        out = PairTable(self.i[rows].copy(), self.j[rows].copy(), self.state[rows].copy(), self.xi[:, rows].copy(),
+                        self.d_eq[rows].copy(), self.active[rows].copy(), self.birth[rows].copy())
         out._births = self._births
         return out
+
+    def assign(self, other):
+        """Make this table hold copies of ``other``'s candidates, history and counter, in place (so
+        every reference to this table sees them); its version advances.
+
+        Parameters
+        ----------
+        other : PairTable
+        """
+        for name in ("i", "j", "key", "state", "xi", "d_eq", "active", "birth"):
+            setattr(self, name, getattr(other, name).copy())
+        self.n_permanent = int((self.state == PERMANENT).sum())
+        self._births = other._births
+        self.version += 1
 
     @property
     def xi_ij(self):
@@ -166,12 +186,13 @@ class PairTable:
         self._births += n
         return b
 
-    def replace(self, i, j, keep_existing=False):
+    def replace(self, i, j, keep_existing=False, keep_relations=True):
         """Make (i, j) the candidate set, keeping the history of the pairs present before.
 
-        Relations (active) and bonds are always kept, also where (i, j) misses them (a bond
-        stretched beyond the search reach); with ``keep_existing`` every existing row is kept and
-        (i, j) are added.  A pair new to the table starts inactive, sticking, with ξ = 0.
+        Bonds are always kept, also where (i, j) misses them (a bond stretched beyond the search
+        reach), and so are relations (active) with ``keep_relations``; with ``keep_existing`` every
+        existing row is kept and (i, j) are added.  A pair new to the table starts inactive,
+        sticking, with ξ = 0.
 
         Parameters
         ----------
@@ -179,13 +200,17 @@ class PairTable:
             Sphere indices of the new candidate pairs, in either order (duplicates allowed).
         keep_existing : bool
             Keep every existing row instead of only the active and permanent ones.
+        keep_relations : bool, default True
+            Keep the relations that (i, j) misses (the engine's lists keep only bonds: a relation
+            out of its reach ended).
         """
         old_key = self.key
         k = np.sort(_key(np.minimum(i, j), np.maximum(i, j)))
         if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
             k = np.unique(k)
         # rows to keep that the new candidates miss (e.g. bonds stretched beyond the search reach)
-        kept = old_key if keep_existing else old_key[self.active | (self.state == PERMANENT)]
+        bond = self.state == PERMANENT
+        kept = old_key if keep_existing else old_key[(self.active | bond) if keep_relations else bond]
         if len(kept):
             at = np.searchsorted(k, kept)
             found = at < len(k)
@@ -457,8 +482,11 @@ class BatchState:
         ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``), and the
         replica's pair list is the ensemble's pair table (``ens._pairs``) itself; the box, strain,
         rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
-        by :meth:`from_ensembles`.  The views stay valid while the
-        ensemble gains no sphere (an append can move its block).
+        by :meth:`from_ensembles`.  The views stay valid while the ensemble gains no sphere (an
+        append can move its block).  An engine on this state numbers the relations as they form,
+        and :func:`~particleShear.engine.relax.write_back` afterwards gives the ensemble its clock,
+        strain and relations and drops its caches (and
+        :func:`~particleShear.engine.relax.untouched_on_failure` puts it back after a failed run).
 
         Parameters
         ----------
@@ -488,7 +516,7 @@ class BatchState:
         Parameters
         ----------
         states : sequence of BatchState
-            States with the same N; their arrays are copied, their pair lists and generators
+            States with the same N; their arrays and pair lists are copied, their generators
             shared.
 
         Returns
@@ -514,7 +542,7 @@ class BatchState:
         xp = out.xp
         for name in cls.SPHERE_ARRAYS + cls.REPLICA_ARRAYS:
             getattr(out, name)[...] = xp.concatenate([getattr(st, name) for st in states])
-        out.pairs = [p for st in states for p in st.pairs]
+        out.pairs = [p.copy() for st in states for p in st.pairs]     # the engine changes its lists in place
         out.rng = [g for st in states for g in st.rng]
         out.applying_shear = all(st.applying_shear for st in states)
         out.law = laws.pop()

@@ -148,9 +148,10 @@ class BatchEngine:
         self.min_distance_ratio = 0.05
         self.max_kinetic_energy = None
         self.step_count = 0
-        #: number the relations as they form (:meth:`_number`), for a write-back into ensembles;
-        #: ``next_birth``: the number the next relation of each replica gets
-        self.numbers_relations = False
+        #: number the relations as they form (:meth:`_number`), for a write-back into ensembles (on
+        #: from the start for a state that is an ensemble's own); ``next_birth``: the number the
+        #: next relation of each replica gets
+        self.numbers_relations = s.ensemble is not None
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
@@ -692,6 +693,11 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
         ``observe(engine, "pre-equilibration", step, total)`` after every step that is a multiple
         of its ``every`` and after the last step; they only read the state.
 
+    Returns
+    -------
+    int
+        The steps run.
+
     Raises
     ------
     ValueError
@@ -730,6 +736,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
         report(step, total)
         notify(observers, engine, phase, step, total)
     engine.flush()
+    return step
 
 
 def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet,

@@ -18,6 +18,7 @@ import warnings
 import numpy as np
 
 from ..base.stress import StressTensorEvaluation
+from ..engine.relax import untouched_on_failure
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 
@@ -241,20 +242,21 @@ class OscillatoryShearExperiment:
         SimulationInstabilityError
             If the ensemble's stability guard finds the run unstable.
         """
-        engine = self.engine_of_ensemble()
+        engine = self.engine_of_ensemble(carry_predictor=False)
         observers = self.observers(self._scene(engine), None, protocol=False)
-        steps = self._pre_equilibrate_in(engine, N, cool_factor, observers)
+        with untouched_on_failure(self.theEnsemble):
+            steps = self._pre_equilibrate_in(engine, N, cool_factor, observers)
         self._write_back(engine, steps)
 
     def _pre_equilibrate_in(self, engine, N, cool_factor, observers):
         """The pre-equilibration in ``engine`` (timed, guarded, reported); returns the steps run."""
-        from ..engine.step import pre_equilibrate, pre_equilibration_blocks
+        from ..engine.step import pre_equilibrate
         from ..run.batch import _guarded
         t0 = time.perf_counter()
-        _guarded(pre_equilibrate, engine, N, self.dt, self.dt_max, cool_factor, self._say,
-                 self._reporter("pre-equilibration"), observers, dt=self.dt)
+        steps = _guarded(pre_equilibrate, engine, N, self.dt, self.dt_max, cool_factor, self._say,
+                         self._reporter("pre-equilibration"), observers, dt=self.dt)
         self.timings["pre_equilibration"] = time.perf_counter() - t0
-        return sum(b[0] for b in pre_equilibration_blocks(N, self.dt, self.dt_max)) + 3 * int(N)
+        return steps
 
     def free_pre_equilibration(self):
         """Unused by the reference protocol: relaxation without plates (kept for the reference API)."""
@@ -425,9 +427,10 @@ class OscillatoryShearExperiment:
         SimulationInstabilityError
             If the ensemble's stability guard finds the run unstable.
         """
-        engine = self.engine_of_ensemble()
+        engine = self.engine_of_ensemble(carry_predictor=True)
         scene = self._scene(engine)
-        record = self._protocol_in(engine, cool_factor, self.observers(scene, scene.samples), n_steps)
+        with untouched_on_failure(self.theEnsemble):
+            record = self._protocol_in(engine, cool_factor, self.observers(scene, scene.samples), n_steps)
         self._write_back(engine, len(record["t"]))
         self._record(record)
         return self.N_steps
@@ -501,20 +504,29 @@ class OscillatoryShearExperiment:
         timings : dict
             Wall times of "pre_equilibration" and "protocol" (s).
         """
-        engine = self.engine_of_ensemble()
+        engine = self.engine_of_ensemble(carry_predictor=False)
         scene = self._scene(engine)
         observers = self.observers(scene, scene.samples)
         self.timings["pre_equilibration"] = 0.0
-        if self.do_preequilibration_with_fixed_boundaries:
-            self._pre_equilibrate_in(engine, N_pre, cool_factor, observers)
-        record = self._protocol_in(engine, cool_factor, observers)
+        with untouched_on_failure(self.theEnsemble):
+            if self.do_preequilibration_with_fixed_boundaries:
+                self._pre_equilibrate_in(engine, N_pre, cool_factor, observers)
+            record = self._protocol_in(engine, cool_factor, observers)
         self._write_back(engine, len(record["t"]))
         return record, {k: self.timings[k] for k in ("pre_equilibration", "protocol")}
 
-    def engine_of_ensemble(self):
+    def engine_of_ensemble(self, carry_predictor=True):
         """A batch of one on the ensemble's own state (:meth:`~particleShear.engine.state.BatchState.of_ensemble`):
-        the ensemble's integrator (and its Verlet predictor), stability guard (interval and thresholds)
-        and contact-law callbacks; it numbers the relations as they form, for the write-back.
+        the ensemble's integrator, stability guard (its interval and the thresholds of a
+        :class:`~particleShear.base.stability.StabilityGuard`; a guard's own ``check`` is not
+        called) and contact-law callbacks; it numbers the relations as they form, for the write-back.
+
+        Parameters
+        ----------
+        carry_predictor : bool, default True
+            With velocity Verlet, carry on the ensemble's half kick (the protocol after a
+            pre-equilibration); False starts the predictor afresh, as every measurement does at its
+            pre-equilibration (the half kick of a constitution predates its crosslinking).
 
         Returns
         -------
@@ -532,7 +544,7 @@ class OscillatoryShearExperiment:
         if guard is not None:     # the thresholds of the ensemble's guard
             engine.min_distance_ratio = guard.min_distance_ratio
             engine.max_kinetic_energy = guard.max_kinetic_energy
-        half = getattr(ens, "_half_kick", None)
+        half = getattr(ens, "_half_kick", None) if carry_predictor else None
         if integrator == "verlet" and half is not None and len(half[0]) == len(ens.sphereList):
             # the predictor carries on from the ensemble's last step (no spin half kick: none)
             engine.half = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
@@ -623,8 +635,11 @@ class OscillatoryShearExperiment:
         from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
         n = len(record["t"])
         T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
-        self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
-        p = self.plotter = self._make_plotter(T_total)
+        if self.theEvaluator is None:         # a prepared recording (prepare_recording) is filled
+            self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
+        if self.plotter is None:
+            self.plotter = self._make_plotter(T_total)
+        p = self.plotter
         keep = self._keeps_tensors() and "tensors" in record
         p.keep_tensor_history = keep
         scal = np.empty((n, 5))
