@@ -135,6 +135,7 @@ ENGINE_MODULES = [
     "particleShear.engine.relax",
     "particleShear.engine.state",
     "particleShear.engine.step",
+    "particleShear.engine.loops",
     "particleShear.engine.stress",
     "particleShear.engine.terms",
     "particleShear.engine.tangential",

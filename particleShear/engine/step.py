@@ -1,10 +1,9 @@
-"""One step of a batch of replicas, top to bottom in the reference order, and the measurement.
+"""One step of a batch of replicas, top to bottom in the reference order.
 
 :meth:`BatchEngine.step` reads like the reference's step (docs/design.md, "One step"): shear rate →
 neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
-:func:`pre_equilibrate` (plates fixed: coarse levels from ``dt_max``, then 2N and N steps at
-``dt``) and :func:`protocol` (recording t, γ, γ̇, τ_internal and τ_surface of every replica and
-step) are the measurement of the oscillatory experiment on a batch.
+The measurement's loops, :func:`~.loops.pre_equilibrate` and :func:`~.loops.protocol`, are in
+:mod:`.loops` (and importable from here).
 
 The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
 place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
@@ -34,7 +33,6 @@ from .callbacks import force_phase_laws
 from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .observers import check_observers, notify
 from .state import PERMANENT, SLIP, STICK
 from .stress import StressInputs, evaluate_all
 from .xp import to_host
@@ -635,203 +633,5 @@ class BatchEngine:
                                 replica=b, step=step, phase=self.phase)
 
 
-def pre_equilibration_blocks(N, dt, dt_max):
-    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``.
-
-    Each level runs ``int(N/2)`` steps; its damping factor starts at 0.5 and moves halfway
-    to 1 at every halving.
-
-    Parameters
-    ----------
-    N : int
-        Steps per level scale of the pre-equilibration (the reference's ``N``).
-    dt : float
-        Final time step (s, > 0); levels stop once halving reaches it.
-    dt_max : float
-        Largest time step (s), the first level.
-
-    Returns
-    -------
-    list of tuple
-        ``(steps, level_dt, cool)`` per level; empty when ``dt_max ≤ dt``.
-    """
-    blocks = []
-    level_dt, cf = dt_max, 0.5
-    while level_dt > dt:
-        blocks.append((int(N / 2), level_dt, cf))
-        level_dt = level_dt / 2
-        cf = (1 + cf) / 2
-    return blocks
-
-
-def _quiet(*args):
-    pass
-
-
-def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, observers=()):
-    """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at ``dt`` (damping
-    0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment (docs/design.md).
-
-    Parameters
-    ----------
-    engine : BatchEngine
-        The engine of the batch; its state is relaxed in place (plates on, step count reset).
-    N : int
-        Steps per level scale (the reference's pre-equilibration ``N``).
-    dt : float
-        Final time step (s).
-    dt_max : float
-        Time step of the first coarse level (s), see :func:`pre_equilibration_blocks`.
-    cool : float
-        Damping factor per step of the last N steps.
-    say : callable
-        ``say(message)`` receives the reference's console messages.
-    report : callable
-        ``report(step, total)`` is called after every step (progress).
-    observers : sequence, default ()
-        Observers (:mod:`particleShear.engine.observers`): each is called as
-        ``observe(engine, "pre-equilibration", step, total)`` after every step that is a multiple
-        of its ``every`` and after the last step; they only read the state.
-
-    Returns
-    -------
-    int
-        The steps run.
-
-    Raises
-    ------
-    ValueError
-        For an observer without an int ``every`` ≥ 1 or an ``observe`` method (before any step).
-    EngineInstability
-        If a guarded replica becomes unstable.
-    """
-    check_observers(observers)
-    s = engine.s
-    s.applying_shear = True
-    engine.phase = "pre-equilibration"
-    engine.step_count = 0
-    blocks = pre_equilibration_blocks(N, dt, dt_max)
-    total = sum(b[0] for b in blocks) + 3 * int(N)
-    say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt " + str(dt_max)
-        + " final dt " + str(dt))
-    step = 0
-    phase = engine.phase
-    for n, level_dt, cf in blocks:
-        say("dt= " + str(level_dt))
-        for _ in range(n):
-            engine.step(cf, level_dt)
-            step += 1
-            report(step, total)
-            notify(observers, engine, phase, step, total)
-    say("  Setting final dt= " + str(dt))
-    for _ in range(2 * int(N)):
-        engine.step(0.98, dt)
-        step += 1
-        report(step, total)
-        notify(observers, engine, phase, step, total)
-    for _ in range(int(N)):
-        s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
-        engine.step(cool, dt)
-        step += 1
-        report(step, total)
-        notify(observers, engine, phase, step, total)
-    engine.flush()
-    return step
-
-
-def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet,
-             observers=(), stop=None):
-    """The oscillatory protocol of every replica, clock reset to 0 (docs/design.md).
-
-    Every step first sets γ̇ = ``A·2πf·cos(2π(f t − pre))`` during the shear periods (0 in the
-    baselines), so the strain follows ``A·sin(2π(f t − pre))``, then records and steps.
-
-    Parameters
-    ----------
-    engine : BatchEngine
-        The engine of the batch, after :func:`pre_equilibrate`; advanced in place.
-    dt : float
-        Time step (s), shared by the replicas.
-    f : float
-        Excitation frequency (Hz).
-    amplitudes : array_like (B,)
-        Strain amplitude of each replica.
-    cool : float
-        Damping factor per step.
-    pre, periods, post : float
-        Baseline periods before, shear periods, baseline periods after.
-    keep_tensors : bool
-        Also record every tensor of the registry ("tensors", (n_steps, B, 9, 2, 2)).
-    say, report : callable
-        Receive the reference's console message and ``(step, total)`` after every step.
-    observers : sequence, default ()
-        Observers (:mod:`particleShear.engine.observers`): each is called as
-        ``observe(engine, "protocol", step, total)`` after every step that is a multiple of its
-        ``every`` and after the last step; while the protocol runs, ``engine.record`` holds the
-        record below as it fills (rows ``0 … step − 1`` written, on the state's backend).
-        They only read the state.
-    stop : int, optional
-        Stop after that many steps (default: the whole protocol, ``int((periods + pre + post)/f/dt)``
-        steps); the record then holds those steps, "last_tensors" of the last one run.
-
-    Returns
-    -------
-    dict of numpy.ndarray (n_steps, B)
-        "t", "strain", "strain_rate", "stress_internal", "stress_surface" of every step, and
-        "first_tensors", "last_tensors" (B, 9, 2, 2): every tensor at the first and last step.
-        Times in s, strain dimensionless, strain rate in 1/s, stresses and tensors in Pa.  The
-        record is kept on the state's backend and copied to the host once, at the end.
-
-    Raises
-    ------
-    ValueError
-        For an observer without an int ``every`` ≥ 1 or an ``observe`` method (before any step).
-    EngineInstability
-        If a guarded replica becomes unstable.
-    """
-    check_observers(observers)
-    s, xp = engine.s, engine.xp
-    s.applying_shear = True
-    s.t = xp.zeros(s.B)
-    t = 0.0                    # the clock of every replica, kept on the host too (same additions of dt)
-    T_total = (periods + pre + post) / f
-    n_steps = total = int(T_total / dt)
-    if stop is not None:
-        n_steps = max(0, min(int(stop), n_steps))
-    lo = pre / (f * dt)
-    hi = (periods + pre) / (f * dt)
-    A = engine.backend.asarray(np.asarray(amplitudes, dtype=float))
-    rec = {name: xp.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
-                                                         "stress_surface")}
-    if keep_tensors:
-        rec["tensors"] = xp.empty((n_steps, s.B, 9, 2, 2))
-    engine.record = rec        # what observers read of the record (the rows written so far)
-    say("Start application shear protocol, total N= " + str(total) + " steps")
-    engine.phase = "protocol"
-    engine.step_count = 0
-    zero = xp.zeros(s.B)
-    for i in range(n_steps):
-        if lo <= i <= hi:
-            rate = A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
-        else:
-            rate = zero
-        engine.set_rate(rate)
-        rec["t"][i] = s.t
-        rec["strain"][i] = s.gamma
-        rec["strain_rate"][i] = s.rate
-        ends = i == 0 or i == n_steps - 1
-        out = engine.step(cool, dt, sample="tensors" if keep_tensors or ends else True)
-        rec["stress_internal"][i] = out[0]
-        rec["stress_surface"][i] = out[1]
-        if keep_tensors:
-            rec["tensors"][i] = out[2]
-        if i == 0:
-            rec["first_tensors"] = out[2]
-        if i == n_steps - 1:
-            rec["last_tensors"] = out[2]
-        t = t + dt             # = s.t[b] for every b (same dt, same schedule)
-        report(i + 1, n_steps)
-        notify(observers, engine, "protocol", i + 1, n_steps)
-    engine.flush()
-    engine.record = None
-    return {name: to_host(v, "series") for name, v in rec.items()}
+# the measurement's loops, re-exported here (where they were first written)
+from .loops import pre_equilibrate, pre_equilibration_blocks, protocol  # noqa: E402
