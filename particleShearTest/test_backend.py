@@ -542,13 +542,15 @@ class TestBatchOnTheStandInDevice(unittest.TestCase):
 
     def test_host_reads_are_named_and_few(self):
         # every read has a reason of REASONS (to_host refuses others); a step reads its flags once and
-        # checks twice for pairs at d = 0; everything else (list rebuilds, copies of the state, the
-        # series at the end) is rare
+        # checks for pairs at d = 0 once in the force phase and once more in the ξ rule, which a batch
+        # without friction and bonds (the constitution's μ = 0 blocks before crosslinking) leaves out;
+        # everything else (list rebuilds, copies of the state, the series at the end) is rare
         c = collections.Counter(self.reads)
         self.assertTrue(set(c) <= set(xpmod.REASONS), set(c) - set(xpmod.REASONS))
         steps = c["flags"]
         self.assertGreater(steps, 2 * self.device[0].N_steps)     # the protocols of the batch and of the series
-        self.assertEqual(c["d = 0"], 2 * steps)
+        self.assertGreater(c["d = 0"], steps + 2 * self.device[0].N_steps)   # the measured steps have the ξ rule
+        self.assertLess(c["d = 0"], 2 * steps)                    # the frictionless blocks do not
         self.assertGreater(c["series"], 0)
         self.assertLess(sum(n for why, n in c.items() if why not in ("flags", "d = 0")), 0.2 * steps)
 
