@@ -282,7 +282,8 @@ class BatchEngine:
         -------
         PairTable
             The candidates of replica b with their current state, ξ, ``d_eq``, relations and
-            creation numbers.
+            creation numbers (those formed in this engine are numbered only with
+            :attr:`numbers_relations`; else 0).
         """
         if self.C is not None:
             self._sync_down()
