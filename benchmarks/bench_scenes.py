@@ -8,7 +8,9 @@ Scenes (the default builder EnsembleCompactParticlesAdjustableInterfaceStrengthF
 * crosslinked particles: μ = 0.01, links, 5 cut lines (the default scene);
 
 each run twice through the experiment's protocol (OscillatoryShearExperiment.run_protocol, the engine's one
-protocol loop on the ensemble's own state; each batch starts the protocol anew): recording nothing but the
+protocol loop on the ensemble's own state; each batch starts the protocol anew), in alternating batches with
+the documented classes' step loop on a twin ensemble (the same run, so their ratio is read pair by pair):
+recording nothing but the
 scalar series (``keep_tensor_history=False``: only σ_xy of the overall tensor and the surface
 stress are evaluated per step) and keeping every tensor of every step (``True``, what
 ``saveData`` with ``saveStressTensorData`` needs).
@@ -26,6 +28,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
 
 import argparse  # noqa: E402
+import math  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
 import tracemalloc  # noqa: E402
@@ -60,17 +63,43 @@ def build(N, seed, mu, do_permanent_links, cut_lines):
     return exp, ens, f_step
 
 
-def per_step_us(exp, f_step, keep, steps, batches):
-    exp.keep_tensor_history = keep
-    samples = []
-    exp.prepare_recording()
+def classes_protocol(exp, cool, n):
+    """n protocol steps of the documented classes' step loop on ``exp``'s ensemble (setShearRate,
+    forces, totals, recording, acceleration, movement, reset), the loop scripts write."""
+    ens, plotter, ev = exp.theEnsemble, exp.plotter, exp.theEvaluator
+    w = 2 * math.pi * exp.f
+    for _ in range(n):
+        ens.setShearRate(exp.amplitude * w * math.cos(w * ens.t))
+        ens.mechanical_simulation_step_calculate_forces()
+        ens.record_total_particle_forces()
+        plotter.record(ens, ev)
+        ens.mechanical_simulation_step_calculate_acceleration(cool, exp.dt)
+        ens.mechanical_simulation_step_calculate_movement(exp.dt)
+        ens.reset_force()
+
+
+def per_step_us(pair, f_step, keep, steps, batches):
+    """Median and best µs per step of ``run_protocol`` (the engine) and of the classes' step loop on
+    the twin ensemble, in alternating batches, and the median of the per-batch ratios."""
+    exp, twin = pair
+    samples, ratios = ([], []), []
+    for e in (exp, twin):
+        e.keep_tensor_history = keep
+        e.prepare_recording()
     exp.run_protocol(f_step, 20)                     # warm-up
+    classes_protocol(twin, f_step, 20)
     for _ in range(batches):
         exp.prepare_recording()
         t0 = time.perf_counter()
         exp.run_protocol(f_step, steps)
-        samples.append((time.perf_counter() - t0) / steps * 1e6)
-    return statistics.median(samples), min(samples)
+        t1 = time.perf_counter()
+        twin.prepare_recording()
+        classes_protocol(twin, f_step, steps)
+        t2 = time.perf_counter()
+        samples[0].append((t1 - t0) / steps * 1e6)
+        samples[1].append((t2 - t1) / steps * 1e6)
+        ratios.append((t1 - t0) / (t2 - t1))
+    return [(statistics.median(x), min(x)) for x in samples], statistics.median(ratios)
 
 
 def peak_mib(exp, f_step, keep, steps=200):
@@ -94,19 +123,21 @@ def main(argv=None):
     rows = []
     for name, kw in SCENES.items():
         exp, ens, f_step = build(args.N, 1, **kw)
+        twin = build(args.N, 1, **kw)[0]
         terms = ", ".join(ens.active_terms)
         for keep in (False, True):
-            med, best = per_step_us(exp, f_step, keep, steps, batches)
+            ((med, best), (c_med, c_best)), ratio = per_step_us((exp, twin), f_step, keep, steps, batches)
             mem = peak_mib(exp, f_step, keep)
-            rows.append((name, terms, "all tensors kept" if keep else "nothing kept", med, best, mem))
-            print(f"{name:42s} {rows[-1][2]:17s} {med:8.1f} µs/step (best {best:.1f})  peak {mem:6.2f} MiB",
-                  flush=True)
+            rows.append((name, terms, "all tensors kept" if keep else "nothing kept", med, best, mem, c_med, ratio))
+            print(f"{name:42s} {rows[-1][2]:17s} {med:8.1f} µs/step (best {best:.1f})  peak {mem:6.2f} MiB; "
+                  f"classes' loop {c_med:8.1f} µs/step (best {c_best:.1f}); ratio {ratio:.2f}", flush=True)
     print()
     print(f"N = {args.N}, {steps} steps × {batches} batches per row, one core\n")
-    print("| scene | active_terms | recording | median µs/step | best µs/step | tracemalloc peak (MiB) |")
-    print("|---|---|---|---|---|---|")
+    print("| scene | active_terms | recording | median µs/step | best µs/step | tracemalloc peak (MiB) "
+          "| classes' step loop, median µs/step | run_protocol / classes' loop |")
+    print("|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.0f} | {r[4]:.0f} | {r[5]:.2f} |")
+        print(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.0f} | {r[4]:.0f} | {r[5]:.2f} | {r[6]:.0f} | {r[7]:.2f} |")
 
 
 if __name__ == "__main__":
