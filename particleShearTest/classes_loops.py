@@ -53,3 +53,26 @@ def classes_run_protocol(exp, cool_factor, n_steps=None):
         ens.reset_force()
     exp.N_steps = n_run
     return n_run
+
+
+REGISTER_LISTS = ("pair_register", "external_force_register", "internal_moment_register", "external_moment_register",
+                  "total_particle_force_register", "unbalanced_moment_register")
+
+
+def assert_same_register(test, a, b, rtol=1e-12):
+    """The six force-register lists of ensembles ``a`` and ``b`` hold the same entries in the same
+    order (targets and sources by their index in ``sphereList``) with values equal to ``rtol`` of
+    each list's largest value (the two ensembles' states agree to rounding)."""
+    def index(sphere):
+        return sphere.__dict__["_idx"]
+
+    for name in REGISTER_LISTS:
+        la, lb = getattr(a.force_register, name), getattr(b.force_register, name)
+        test.assertEqual(len(la), len(lb), name)
+        test.assertEqual([tuple(index(v) for v in row[:-1]) for row in la],
+                         [tuple(index(v) for v in row[:-1]) for row in lb], name)
+        va = [[float(x) for x in (row[-1] if isinstance(row[-1], list) else [row[-1]])] for row in la]
+        vb = [[float(x) for x in (row[-1] if isinstance(row[-1], list) else [row[-1]])] for row in lb]
+        scale = max((abs(x) for row in vb for x in row), default=0.0)
+        worst = max((abs(x - y) for ra, rb in zip(va, vb) for x, y in zip(ra, rb)), default=0.0)
+        test.assertLessEqual(worst, rtol * scale, name)

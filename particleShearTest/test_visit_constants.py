@@ -20,7 +20,7 @@ from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_engine import classes_measurement, constituted
 from particleShearTest.test_force_laws import central_law_definition as _definition
-from particleShearTest.classes_loops import classes_pre_equilibrate, classes_run_protocol
+from particleShearTest.classes_loops import assert_same_register, classes_pre_equilibrate, classes_run_protocol
 
 K, NU = 1000.0, 7.0
 
@@ -166,12 +166,44 @@ class TestExperimentInTheEngine(unittest.TestCase):
         for name in ("x", "y"):
             self.assertLessEqual(np.max(np.abs(ens._a[name] - ref._a[name])), 1e-12 * 200, name)
         self.assertEqual((ens.t, ens.shear, ens.step_count), (ref.t, ref.shear, ref.step_count))
+        # the force register holds the last step's forces, as the step loop leaves it
+        assert_same_register(self, ens, ref)
+        self.assertGreater(len(ens.force_register.pair_register), 0)
+        self.assertEqual(len(ens.force_register.internal_moment_register) > 0, "k_t" in kw)   # tangential visits
         # the same relations, numbered in the order they formed (the order of ``neighbors``)
         pe, pr = ens._pairs, ref._pairs
         self.assertEqual(pe.key[pe.active].tolist(), pr.key[pr.active].tolist())
         self.assertEqual(pe.birth[pe.active].tolist(), pr.birth[pr.active].tolist())
         self.assertEqual(pe._births, pr._births)
 
+
+    def test_register_and_tensors_after_the_protocol(self):
+        # spheres with parameters of their own (j's visits have forces of their own): after a script's
+        # run_protocol the six register lists are those of the step loop's last step, and so are the
+        # tensors a script evaluates from the register afterwards (of the moved spheres, as after the loop)
+        from particleShear.base.stress import StressTensorEvaluation
+        runs = []
+        for loops in (False, True):
+            _, ens, sc = constituted(7, **SCENE)
+            perturb(ens)
+            exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
+            exp.baseline_pre_periods, exp.periods, exp.baseline_post_periods = 0.5, 1, 0.5
+            exp.keep_tensor_history = True
+            if loops:
+                classes_pre_equilibrate(exp, 4, sc["cool"])
+                ens.t = 0
+                classes_run_protocol(exp, sc["cool"], 80)
+            else:
+                exp.pre_equilibrate(4, sc["cool"])
+                exp.run_protocol(sc["cool"], 80)
+            runs.append((ens, exp))
+        (ens, exp), (ref, _) = runs
+        assert_same_register(self, ens, ref)
+        got, want = (e.evaluate_stress_tensors(StressTensorEvaluation(e.size_x, e.size_y)).tensors for e in (ens, ref))
+        scale = np.abs(want).max()
+        self.assertGreater(scale, 0.0)
+        for k in range(len(want)):
+            self.assertLessEqual(np.abs(got[k] - want[k]).max(), 1e-12 * scale, k)
 
     def test_guard_of_the_ensemble(self):
         # the thresholds of the ensemble's StabilityGuard reach the engine's guard: a bound on the

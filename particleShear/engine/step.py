@@ -30,7 +30,8 @@ from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
 from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses, splice_arrays
 from .callbacks import force_phase_laws
-from .terms import central_term, normal_speed, pair_forces, relative_velocity, slip_speed, tangential_term
+from .terms import (central_term, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
+                    tangential_term, viscous_term)
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK
@@ -62,6 +63,17 @@ class EngineInstability(RuntimeError):
         self.replica = replica
         self.step = step
         self.phase = phase
+
+
+class _TermRecord:
+    """The per-candidate terms of the last force phase that the force register reads
+    (:meth:`BatchEngine.register_block`; kept only with :attr:`BatchEngine.keep_terms`)."""
+    __slots__ = ("C", "parts", "F", "dx", "dy", "nx", "ny", "d", "touching", "active", "shifted", "mob",
+                 "fx_i", "fy_i", "fx_j", "fy_j", "tq", "birth", "totals")
+
+    def __init__(self, *values):
+        for name, value in zip(self.__slots__, values):
+            setattr(self, name, value)
 
 
 class _ForceRecord:
@@ -113,6 +125,10 @@ class BatchEngine:
         self.integrator = integrator
         self.half = None          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
         self.g = None             # the record of the last force phase (_ForceRecord)
+        #: keep the per-term arrays of each force phase for the force register (:meth:`register_block`;
+        #: a script's experiment sets it, so its ensemble's register holds the engine's last step)
+        self.keep_terms = False
+        self.terms = None
         self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
         self.verdict = None       # a device's guard verdict of the force phase, read at the end of the step
         s = self.s = state
@@ -425,20 +441,24 @@ class BatchEngine:
         # the slip speed only where a replica has a tangential force (see _tangential)
         vt = None if self.free_p is True else slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
-        fn, law = central_term(C, d, vn, active, *force_phase_laws(s, C))   # the laws, looked up once per phase
+        parts = ([], [])          # the central terms of each visit, kept for the register (keep_terms)
+        fn, law = self._central(C, d, vn, active, parts[0])
         F, slip = self._tangential(C, vt, touching, xi, law, active)
         self.state_p = slip.view(np.int8) + C.perm_code
         ft = (F[0] + F[1]) * 0.5
         fx_i, fy_i, dF, tq = pair_forces(fn, ft, nx, ny, d, C.w)
         fx_j = fy_j = None
         if C.Kj is not None:       # spheres with parameters of their own: the central force of j's visit
-            fn_j = central_term(C.Kj, d, vn, active, *force_phase_laws(s, C.Kj))[0]
+            fn_j = self._central(C.Kj, d, vn, active, parts[1])[0]
             fx_j, fy_j = pair_forces(fn_j, ft, nx, ny, d, None)[:2]
         s.frc[...] = scatter(C, len(x), fx_i, fy_i, tq[0], tq[1], fx_j, fy_j)
         mob = self.mobile()
         out = None
+        shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
+        if self.keep_terms:
+            self.terms = _TermRecord(C, parts, F, dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
+                                     fx_j, fy_j, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
         if sample:
-            shifted = (ky != 0) | (kx != 0)
             mi, mj = mob[ai], mob[aj]
             out = shear_stresses(C, s.B, yc, pair_roles(mi, mj, shifted), active, dy, fx_i, dF, self.V, fx_j)
             if sample == "tensors":
@@ -456,6 +476,63 @@ class BatchEngine:
                 self.verdict = verdict
         self.g = _ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob)
         return out
+
+    def _central(self, K, d, vn, active, parts):
+        """The central term of one visit (:func:`~particleShear.engine.terms.central_term`); with
+        :attr:`keep_terms` its elastic and viscous scalars are appended to ``parts`` (the same sum)."""
+        laws = force_phase_laws(self.s, K)        # the laws, looked up once per phase
+        if not self.keep_terms:
+            return central_term(K, d, vn, active, *laws)
+        f_el, law = elastic_term(K, d, *laws)
+        f_v = viscous_term(K, vn, active)
+        parts += [f_el, f_v]
+        return f_el + f_v, law
+
+    def register_block(self, b, tangential=True):
+        """The force register's block of replica ``b``'s last force phase (:attr:`keep_terms` on),
+        in the layout the documented classes' register reads (``base.register``).
+
+        Per candidate of the replica (local sphere indices ``i < j``): the forces on i and j, the
+        torques, the internal and external flags (:func:`~particleShear.engine.forces.pair_roles`),
+        the relations, the pair vectors, and per visit the elastic and viscous scalars, the two
+        tangential visits' forces, normals, tangents, distances, lever fractions, contacts, bonds
+        and creation numbers, from which the six reference lists are built when read.
+
+        Parameters
+        ----------
+        b : int
+            Replica index (0 … B−1).
+        tangential : bool, default True
+            The replica's ensemble has the tangential term (its register lists tangential visits
+            and torques, zero forces where μ = 0 and no bond).
+
+        Returns
+        -------
+        dict
+            The block's arrays (on the host), None before a force phase that kept its terms.
+        """
+        t = self.terms
+        if t is None:
+            return None
+        C, N = t.C, self.s.N
+        lo, hi = int(C.offsets[b]), int(C.offsets[b + 1])
+        h = lambda a: None if a is None else to_host(a, "register")[..., lo:hi]   # noqa: E731
+        ai, aj = h(C.ai) - b * N, h(C.aj) - b * N
+        mob = to_host(t.mob, "register")[b * N:(b + 1) * N]
+        internal, ext_i, ext_j = pair_roles(mob[ai], mob[aj], h(t.shifted))
+        Fi = np.array((h(t.fx_i), h(t.fy_i)))
+        Fj = -Fi if t.fx_j is None else -np.array((h(t.fx_j), h(t.fy_j)))
+        nx, ny = h(t.nx), h(t.ny)
+        el_i, v_i = (h(a) for a in t.parts[0])
+        el_j, v_j = (h(a) for a in t.parts[1]) if t.parts[1] else (None, None)
+        tq = h(t.tq) if tangential else None
+        return {"i": ai, "j": aj, "Fi": Fi, "Fj": Fj, "ti": None if tq is None else tq[0],
+                "tj": None if tq is None else tq[1], "internal": internal, "ext_i": ext_i, "ext_j": ext_j,
+                "active": h(t.active), "antisymmetric": t.fx_j is None, "engine": True,
+                "D": np.array((h(t.dx), h(t.dy))),
+                "visits": ([("elastic", el_i, el_j), ("viscous", v_i, v_j)], h(t.F) if tangential else None,
+                           np.array((nx, ny)), np.array((-ny, nx)), h(t.d), h(C.w), h(t.touching), h(C.perm),
+                           h(t.birth), slice(None))}
 
     def _number(self, new):
         """Give the relations formed in this step (``new``, per candidate) their creation numbers.

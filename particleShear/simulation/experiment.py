@@ -541,6 +541,7 @@ class OscillatoryShearExperiment:
         engine = BatchEngine(BatchState.of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                              check_interval=getattr(guard, "interval", 4), integrator=integrator)
         engine.numbers_relations = True   # the relations' creation numbers, for the write-back
+        engine.keep_terms = True          # the last step's terms, for the ensemble's force register
         if guard is not None:     # the thresholds of the ensemble's guard
             engine.min_distance_ratio = guard.min_distance_ratio
             engine.max_kinetic_energy = guard.max_kinetic_energy
@@ -566,13 +567,27 @@ class OscillatoryShearExperiment:
         return report
 
     def _write_back(self, engine, steps):
-        """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble."""
+        """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble, and
+        its last force phase into the ensemble's force register (the six lists, the totals), as the
+        documented step loop leaves them."""
+        from ..base.register import PairBlock
         from ..engine.relax import write_back
+        from ..engine.xp import to_host
         ens = self.theEnsemble
         if engine.phase == "protocol":
             ens.step_count = 0        # the protocol's steps, as the documented loop counts them
         write_back(engine, 0, ens, steps, constitution=False, dt=self.dt)
         ens.phase = engine.phase
+        spin = ens._torque_total() is not None
+        block = engine.register_block(0, tangential=spin)
+        if block is None:
+            return
+        block["pos_version"] = -1     # the spheres have moved since (the register's pair vectors are redone)
+        reg = ens.force_register
+        reg.reset_force_register()
+        reg._set_pairs(ens, PairBlock(block))
+        tot = to_host(engine.terms.totals, "register")      # the sphere totals of that force phase
+        reg._set_totals(ens, to_host(engine.terms.mob, "register"), tot[0], tot[1], tot[2] if spin else None, tot)
 
     def _conclude(self, G_int, G_surf, t0):
         """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""
