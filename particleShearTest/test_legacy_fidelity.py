@@ -407,6 +407,36 @@ def random_scene(seed, n=40):
     return ens
 
 
+class MechanicalRelaxationTest(unittest.TestCase):
+    """``mechanical_relaxation(N, cool_factor, dt, theTk, StressTensorEvaluator)`` is its definition
+    (MODEL_SPEC, the class chain): N calls of ``mechanical_simulation_step(cool_factor, dt)``, each
+    followed by the Tk update and the stress evaluation when given; so its states equal those N
+    calls bit for bit, the window is updated N times and the evaluator holds the last step's tensors."""
+
+    def test_its_definition(self):
+        class Tk:
+            updates = 0
+
+            def update(self):
+                Tk.updates += 1
+
+        a, b = random_scene(5, n=24), random_scene(5, n=24)
+        for ens in (a, b):
+            ens.setShearRate(3.0)
+        ev_a, ev_b = (StressTensorEvaluation(e.size_x, e.size_y) for e in (a, b))
+        a.mechanical_relaxation(17, 0.98, 2e-7, theTk=Tk(), StressTensorEvaluator=ev_a)
+        for _ in range(17):
+            b.mechanical_simulation_step(0.98, 2e-7)
+        b.evaluate_stress_tensors(ev_b)
+        for name in ("x", "y", "phi", "xspeed", "yspeed", "omega"):
+            self.assertEqual(a._a[name].tobytes(), b._a[name].tobytes(), name)
+        self.assertEqual((a.t, a.shear, a.step_count), (b.t, b.shear, b.step_count))
+        self.assertGreater(abs(a.shear), 0.0)
+        self.assertEqual(Tk.updates, 17)
+        self.assertEqual(ev_a.tensors.tobytes(), ev_b.tensors.tobytes())
+        self.assertGreater(np.abs(ev_a.tensors).max(), 0.0)
+
+
 class DocumentedStepLoopTest(unittest.TestCase):
     """The README's loop gives the internal path's tensors bit for bit (same array operations)."""
 
