@@ -231,6 +231,9 @@ class ForceRegisterOrderTest(unittest.TestCase):
         # the first step: the relations were made (and ξ set) through the API before it
         want = reference_force_phase(ens)
         ens.mechanical_simulation_step(cool_factor=1, dt=1e-3)   # the register is read after the step
+        return self._compare(name, ens, want)
+
+    def _compare(self, name, ens, want):
         reg = ens.force_register
         sl = ens.sphereList
         for key, attr, has_source in (("pair", "pair_register", True), ("ext", "external_force_register", False),
@@ -258,6 +261,22 @@ class ForceRegisterOrderTest(unittest.TestCase):
         for name, spec in SCENES.items():
             with self.subTest(scene=name):
                 self._check(name, spec)
+
+    def test_scenes_through_the_engine(self):
+        # the engine's force phase on the ensemble's own state, its terms given to the register
+        # (Force_register.set_from_engine): the same entries, in the same order
+        from particleShear.engine.state import BatchState
+        from particleShear.engine.step import BatchEngine
+        for name, spec in SCENES.items():
+            with self.subTest(scene=name):
+                ens = two_sphere_scene(**spec)
+                want = reference_force_phase(ens)
+                eng = BatchEngine(BatchState.of_ensemble(ens), guard=False)
+                eng.keep_terms = True
+                eng.force_phase()
+                eng.flush()                    # the states of the relations into the ensemble's table
+                self.assertTrue(ens.force_register.set_from_engine(ens, eng))
+                self._compare(name, ens, want)
 
     def test_scenes_exercise_every_list(self):
         """The scenes above are not vacuous: each list is non-empty in some scene, and the slip quirk occurs."""

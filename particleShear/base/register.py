@@ -153,6 +153,40 @@ class Force_register:
         self._tot_block = np.array((fx, fy)) if block is None else block
         self._mom = torque
 
+    def set_from_engine(self, ensemble, engine, b=0):
+        """Hold the last force phase of replica ``b`` of ``engine`` (an engine with ``keep_terms``
+        on, e.g. on ``ensemble``'s own state): its pair block and its totals, as the classes' force
+        phase and ``record_total_particle_forces`` leave them, so the six lists are built from it.
+
+        Parameters
+        ----------
+        ensemble : ensemble
+            The ensemble of the replica (its spheres are the lists' entries).
+        engine : BatchEngine
+            The engine (:meth:`~particleShear.engine.step.BatchEngine.register_block`).
+        b : int, default 0
+            The replica.
+
+        Returns
+        -------
+        bool
+            Whether the engine had a force phase to give (else the register is left alone).
+        """
+        from ..engine.xp import to_host
+        spin = ensemble._torque_total() is not None
+        block = engine.register_block(b, tangential=spin)
+        if block is None:
+            return False
+        # the register's pair vectors are those of the force phase, while the spheres have not moved
+        block["pos_version"] = ensemble._pos_version if engine.g is not None else -1
+        self.reset_force_register()
+        self._set_pairs(ensemble, PairBlock(block))
+        rows = slice(b * engine.s.N, (b + 1) * engine.s.N)
+        tot = to_host(engine.terms.totals, "register")[:, rows]      # the kick resets the state's totals
+        self._set_totals(ensemble, to_host(engine.terms.mob, "register")[rows], tot[0], tot[1],
+                         tot[2] if spin else None, tot)
+        return True
+
     # -- manual API (reference signatures) ----------------------------------------------------
     def record_individual_internal_force(self, target, source, force_vector):
         """Append an internal pair force ``[target, source, F]`` to :attr:`pair_register` (Love-Weber, eq. S1-19).

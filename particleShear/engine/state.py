@@ -482,7 +482,7 @@ class BatchState:
         ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``), and the
         replica's pair list is the ensemble's pair table (``ens._pairs``) itself; the box, strain,
         rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
-        by :meth:`from_ensembles`.  The views stay valid while the ensemble gains no sphere (an
+        by :meth:`from_ensembles`, the plates (``applying_shear``) from its ``applyingShear``.  The views stay valid while the ensemble gains no sphere (an
         append can move its block).  An engine on this state numbers the relations as they form,
         and :func:`~particleShear.engine.relax.write_back` afterwards gives the ensemble its clock,
         strain and relations and drops its caches (and
@@ -506,6 +506,7 @@ class BatchState:
         s.phi, s.r, s.m, s.inertia = a["phi"], a["r"], a["m"], a["inertia"]
         s._views()
         s.pairs[0] = ensemble._pairs
+        s.applying_shear = bool(getattr(ensemble, "applyingShear", True))
         s.ensemble = ensemble
         return s
 

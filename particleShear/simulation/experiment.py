@@ -570,24 +570,13 @@ class OscillatoryShearExperiment:
         """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble, and
         its last force phase into the ensemble's force register (the six lists, the totals), as the
         documented step loop leaves them."""
-        from ..base.register import PairBlock
         from ..engine.relax import write_back
-        from ..engine.xp import to_host
         ens = self.theEnsemble
         if engine.phase == "protocol":
             ens.step_count = 0        # the protocol's steps, as the documented loop counts them
         write_back(engine, 0, ens, steps, constitution=False, dt=self.dt)
         ens.phase = engine.phase
-        spin = ens._torque_total() is not None
-        block = engine.register_block(0, tangential=spin)
-        if block is None:
-            return
-        block["pos_version"] = -1     # the spheres have moved since (the register's pair vectors are redone)
-        reg = ens.force_register
-        reg.reset_force_register()
-        reg._set_pairs(ens, PairBlock(block))
-        tot = to_host(engine.terms.totals, "register")      # the sphere totals of that force phase
-        reg._set_totals(ens, to_host(engine.terms.mob, "register"), tot[0], tot[1], tot[2] if spin else None, tot)
+        ens.force_register.set_from_engine(ens, engine)
 
     def _conclude(self, G_int, G_surf, t0):
         """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""
