@@ -172,19 +172,16 @@ class Force_register:
         bool
             Whether the engine had a force phase to give (else the register is left alone).
         """
-        from ..engine.xp import to_host
         spin = ensemble._torque_total() is not None
         block = engine.register_block(b, tangential=spin)
         if block is None:
             return False
+        tot, mobile = block.pop("totals"), block.pop("mobile")
         # the register's pair vectors are those of the force phase, while the spheres have not moved
         block["pos_version"] = ensemble._pos_version if engine.g is not None else -1
         self.reset_force_register()
         self._set_pairs(ensemble, PairBlock(block))
-        rows = slice(b * engine.s.N, (b + 1) * engine.s.N)
-        tot = to_host(engine.terms.totals, "register")[:, rows]      # the kick resets the state's totals
-        self._set_totals(ensemble, to_host(engine.terms.mob, "register")[rows], tot[0], tot[1],
-                         tot[2] if spin else None, tot)
+        self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None, tot)
         return True
 
     # -- manual API (reference signatures) ----------------------------------------------------

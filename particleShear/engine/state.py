@@ -81,6 +81,8 @@ class PairTable:
     """
 
     FIELDS = ("i", "j", "state", "xi_ij", "xi_ji", "d_eq", "active", "birth")
+    #: the arrays of a table (one value per candidate; ``xi`` one column per candidate)
+    ARRAYS = ("i", "j", "key", "state", "xi", "d_eq", "active", "birth")
 
     def __init__(self, i=(), j=(), state=None, xi=None, d_eq=None, active=None, birth=None):
         self.i = np.asarray(i, dtype=np.intp).reshape(-1)
@@ -94,9 +96,8 @@ class PairTable:
         self.birth = np.zeros(C, np.int64) if birth is None else np.asarray(birth, dtype=np.int64)
         if C > 1 and not (self.key[1:] >= self.key[:-1]).all():      # the lookups need the canonical order
             order = np.argsort(self.key, kind="stable")
-            for name in ("i", "j", "key", "state", "d_eq", "active", "birth"):
-                setattr(self, name, getattr(self, name)[order])
-            self.xi = self.xi[:, order]
+            for name in self.ARRAYS:
+                setattr(self, name, getattr(self, name)[..., order])
         self.n_permanent = int((self.state == PERMANENT).sum())
         self._births = 0
         self.version = 0
@@ -131,7 +132,7 @@ class PairTable:
         ----------
         other : PairTable
         """
-        for name in ("i", "j", "key", "state", "xi", "d_eq", "active", "birth"):
+        for name in self.ARRAYS:
             setattr(self, name, getattr(other, name).copy())
         self.n_permanent = int((self.state == PERMANENT).sum())
         self._births = other._births

@@ -519,7 +519,8 @@ class OscillatoryShearExperiment:
         """A batch of one on the ensemble's own state (:meth:`~particleShear.engine.state.BatchState.of_ensemble`):
         the ensemble's integrator, stability guard (its interval and the thresholds of a
         :class:`~particleShear.base.stability.StabilityGuard`; a guard's own ``check`` is not
-        called) and contact-law callbacks; it numbers the relations as they form, for the write-back.
+        called) and contact-law callbacks; it numbers the relations as they form (as every engine on
+        an ensemble's own state does), for the write-back.
 
         Parameters
         ----------
@@ -540,7 +541,6 @@ class OscillatoryShearExperiment:
         integrator = getattr(ens, "integrator", "euler")
         engine = BatchEngine(BatchState.of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                              check_interval=getattr(guard, "interval", 4), integrator=integrator)
-        engine.numbers_relations = True   # the relations' creation numbers, for the write-back
         engine.keep_terms = True          # the last step's terms, for the ensemble's force register
         if guard is not None:     # the thresholds of the ensemble's guard
             engine.min_distance_ratio = guard.min_distance_ratio
