@@ -113,94 +113,98 @@ class TestCanvasMemo(unittest.TestCase):
         self.assertEqual(len(ens._mobile_selection()), len(expected) - 1)
         self.assertNotIn(ens.sphereList[k], ens._mobile_selection())
 
-    def test_pair_structure_is_its_definition(self):
+    # -- the constants of the ensemble's engine (the step's one cache of per-candidate values) --------
+    def _constants(self):
+        """The per-candidate constants of the last force phase and the table rows they describe."""
         ens = self.ens
-        g = ens._g
-        S = g.S
+        C = ens._engine.C
+        pt = ens._pairs
+        return C, pt.find(C.ai, C.aj)
+
+    def test_pair_constants_are_their_definition(self):
+        ens = self.ens
+        C, slots = self._constants()
         pt = ens._pairs
         r = ens._a["r"]
-        slots = g.slots
+        self.assertTrue((slots >= 0).all())          # every candidate of the engine is a row of the table
         i, j = pt.i[slots], pt.j[slots]
-        np.testing.assert_array_equal(S.ai, i)
-        np.testing.assert_array_equal(S.aj, j)
-        np.testing.assert_array_equal(S.d0, r[i] + r[j])
-        np.testing.assert_array_equal(S.ri, r[i])
-        np.testing.assert_array_equal(S.rj, r[j])
+        np.testing.assert_array_equal(C.ai, i)
+        np.testing.assert_array_equal(C.aj, j)
+        np.testing.assert_array_equal(C.d0, r[i] + r[j])
+        np.testing.assert_array_equal(C.ri, r[i])
+        np.testing.assert_array_equal(C.rj, r[j])
         perm = pt.state[slots] == PERMANENT
-        np.testing.assert_array_equal(S.perm, perm)
+        self.assertTrue(perm.any() and not perm.all())
+        np.testing.assert_array_equal(C.perm, perm)
+        np.testing.assert_array_equal(C.trans, ~perm)
+        deq = pt.d_eq[slots]
+        np.testing.assert_array_equal(C.d_law, np.where(perm, deq, C.d0))
+        np.testing.assert_array_equal(C.d_cap, np.where(perm, deq, C.d0) / 1000)
+        np.testing.assert_array_equal(C.perm_code, np.where(perm, PERMANENT, 0).astype(np.int8))
+        np.testing.assert_array_equal(C.fc_inf, np.where(perm, np.inf, 0.0))
+        np.testing.assert_array_equal(C.mu, ens.mu)
+        self.assertIsNone(C.Kj)                       # every sphere has the same parameters
 
-    def test_internal_flags_are_their_definition(self):
+    def test_register_flags_are_their_definition(self):
         ens = self.ens
-        g = ens._g
+        p = ens.force_register._blocks[0]
         mob = ens._mobile_mask()
         pos = ens._pos
-        D0 = pos[:, g.aj] - pos[:, g.ai]
-        # through the boundary: raw and minimum-image distances differ
-        shifted = np.sqrt(D0[0] * D0[0] + D0[1] * D0[1]) != g.d
-        mi, mj = mob[g.ai], mob[g.aj]
+        D0 = pos[:, p["j"]] - pos[:, p["i"]]
+        D = p["D"]
+        # through the boundary: raw and minimum-image vectors differ
+        shifted = (D0 != D).any(axis=0)
+        mi, mj = mob[p["i"]], mob[p["j"]]
         internal = mi & mj & ~shifted
-        self.assertTrue(shifted.any() and (~(mi & mj)).any())   # both kinds of external pair occur
-        np.testing.assert_array_equal(g.internal, internal)
-        np.testing.assert_array_equal(g.ext_i, mi & ~internal)
-        np.testing.assert_array_equal(g.ext_j, mj & ~internal)
-
-    def test_term_constants_are_their_definition(self):
-        ens = self.ens
-        g = ens._g
-        K_i, K_j, differ = ens._term_constants(g)
-        perm = ens._pairs.state[g.slots] == PERMANENT
-        self.assertTrue(perm.any() and not perm.all())
-        deq = ens._pairs.d_eq[g.slots]
-        self.assertIs(K_j, K_i)                      # every sphere has the same parameters
-        self.assertEqual(differ, frozenset())
-        np.testing.assert_array_equal(K_i.d_law, np.where(perm, deq, g.d0))
-        np.testing.assert_array_equal(K_i.d_cap, np.where(perm, deq, g.d0) / 1000)
-        np.testing.assert_array_equal(g.S.perm_code, np.where(perm, PERMANENT, 0).astype(np.int8))
-        np.testing.assert_array_equal(K_i.fc_inf, np.where(perm, np.inf, 0.0))
-        self.assertEqual(K_i.mu, ens.mu)
+        live = p["active"]
+        self.assertTrue((shifted & live).any() and (~(mi & mj) & live).any())   # both kinds of external pair
+        np.testing.assert_array_equal(p["internal"], internal)
+        np.testing.assert_array_equal(p["ext_i"], mi & ~internal)
+        np.testing.assert_array_equal(p["ext_j"], mj & ~internal)
 
     def test_sphere_parameters_give_each_visit_its_constants(self):
         ens = self.ens
         s = ens.sphereList[3]
         s.permanent_ratio_tangential = 2.0            # one sphere: its visits see twice k_t on its bonds
         ens.mechanical_simulation_step_calculate_forces()
-        g = ens._g
-        K_i, K_j, differ = ens._term_constants(g)
-        self.assertEqual(differ, frozenset({"tangential"}))
-        perm = ens._pairs.state[g.slots] == PERMANENT
+        C, slots = self._constants()
+        perm = ens._pairs.state[slots] == PERMANENT
         ratio = np.where(np.arange(len(ens.sphereList)) == 3, 2.0, 1.0)
-        np.testing.assert_array_equal(K_i.k_t, ens.k_t * np.where(perm, ratio[g.ai], 1.0))
-        np.testing.assert_array_equal(K_j.k_t, ens.k_t * np.where(perm, ratio[g.aj], 1.0))
-        self.assertTrue(((g.ai == 3) | (g.aj == 3))[perm].any())   # the sphere has bonds
+        self.assertIsNotNone(C.Kj)
+        np.testing.assert_array_equal(C.k_t, ens.k_t * np.where(perm, ratio[C.ai], 1.0))
+        np.testing.assert_array_equal(C.Kj.k_t, ens.k_t * np.where(perm, ratio[C.aj], 1.0))
+        self.assertTrue(((C.ai == 3) | (C.aj == 3))[perm].any())   # the sphere has bonds
 
-    def test_changed_parameters_renew_the_term_constants(self):
+    def test_changed_parameters_renew_the_constants(self):
         ens = self.ens
         for name, value in (("mu", 0.7), ("k", 2e3), ("nu", 3.0), ("k_t", 5e2), ("nu_t", 0.25)):
             with self.subTest(name=name):
                 setattr(ens, name, value)
                 ens.mechanical_simulation_step_calculate_forces()
-                K = ens._term_constants(ens._g)[0]
-                perm = ens._pairs.state[ens._g.slots] == PERMANENT
-                got = {"mu": K.mu, "k": K.k, "nu": np.max(K.nu), "k_t": np.max(K.k_t), "nu_t": np.max(K.nu_t)}[name]
+                C, slots = self._constants()
+                perm = ens._pairs.state[slots] == PERMANENT
+                got = {"mu": np.max(C.mu), "k": np.max(C.k), "nu": np.max(C.nu), "k_t": np.max(C.k_t),
+                       "nu_t": np.max(C.nu_t)}[name]
                 self.assertEqual(got, value)
                 if name == "k":
-                    np.testing.assert_array_equal(K.a_tens, -np.where(perm, value, 0.0))
+                    np.testing.assert_array_equal(C.a_tens, -np.where(perm, value, 0.0))
 
-    def test_cut_bond_changes_the_term_constants(self):
+    def test_cut_bond_changes_the_constants(self):
         ens = self.ens
-        K = ens._term_constants(ens._g)[0]
+        n_bonds = int(np.isinf(self._constants()[0].fc_inf).sum())
         i, j = ens.permanent_pairs()
         ens._cut_pairs(i[:1], j[:1])
         ens.mechanical_simulation_step_calculate_forces()
-        K2 = ens._term_constants(ens._g)[0]
-        self.assertEqual(int(np.isinf(K2.fc_inf).sum()), int(np.isinf(K.fc_inf).sum()) - 1)
-        self.assertEqual(int((ens._g.S.perm_code != 0).sum()), int(np.isinf(K.fc_inf).sum()) - 1)
+        C = self._constants()[0]
+        self.assertEqual(int(np.isinf(C.fc_inf).sum()), n_bonds - 1)
+        self.assertEqual(int((C.perm_code != 0).sum()), n_bonds - 1)
 
-    def test_edited_relations_drop_the_kept_values(self):
+    def test_edited_relations_renew_the_constants(self):
         ens = self.ens
-        self.assertIsNotNone(ens._struct)
+        C = ens._engine.C
         ens._relations_edited()
-        self.assertIsNone(ens._struct)
+        ens.mechanical_simulation_step_calculate_forces()
+        self.assertIsNot(ens._engine.C, C)
 
 
 if __name__ == "__main__":

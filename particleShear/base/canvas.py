@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .fields import FIELDS, MASS_ROWS, ROW
+from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
 from .kernels import le_wrap
 from .namespace import (count_nonzero as _nz)
@@ -182,7 +182,6 @@ _SLIP8 = np.int8(SLIP)   # compared with the int8 state array without a scalar c
 # ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
 _max_reduce = np.maximum.reduce
 _min_reduce = np.minimum.reduce
-_MASS_ROWS = np.array(MASS_ROWS)
 #: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
 _ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
@@ -515,13 +514,16 @@ class CanvasPoints:
         self._pos_version += 1
         self._in_cell = True
 
-    def _check_positions(self):
+    def _check_positions(self, pos=None):
         """Raise :class:`SimulationInstabilityError` for a non-finite position or one more than
-        :data:`MAX_CELLS_OUTSIDE` cell lengths outside the cell (step, sphere and value in the message)."""
-        x, y = self._pos[0], self._pos[1]
+        :data:`MAX_CELLS_OUTSIDE` cell lengths outside the cell (step, sphere and value in the message).
+
+        ``pos``: the (2, n) positions to check (default the spheres' own)."""
+        pos = self._pos if pos is None else pos
+        x, y = pos[0], pos[1]
         Lx, Ly = self.size_x, self.size_y
         far = MAX_CELLS_OUTSIDE * min(Lx, Ly)
-        if _min_reduce(self._pos, axis=None) >= -far and _max_reduce(self._pos, axis=None) < max(Lx, Ly) + far:
+        if _min_reduce(pos, axis=None) >= -far and _max_reduce(pos, axis=None) < max(Lx, Ly) + far:
             return  # two reductions (False for NaN) clear the ordinary case
         with np.errstate(invalid="ignore"):
             bad = ~((np.abs(x - Lx / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Lx)

@@ -17,19 +17,20 @@ from .kernels import min_image, pair_geometry
 from .namespace import (where as _where)
 from . import laws
 from .laws import call_law_vectorised
-from ..engine.integrate import damp, half_kick, kick, xi_increments
+from ..engine.integrate import damp, xi_increments
 from ..engine.terms import (elastic_term, normal_speed, relative_velocity, slip_speed, tangential_term,
                             term_constants, viscous_term)
 from .neighbours import SLIP
 from .points import CircleBasicElasticity, _check_finite
 
-from .canvas import _MASS_ROWS, _PARAMS, _SLIP8, _ZERO_BEYOND_CONTACT, NonNegative, check_time_step
+from .canvas import _PARAMS, _SLIP8, _ZERO_BEYOND_CONTACT, NonNegative, check_time_step
 from .pair_canvas import CanvasPointsShear
+from .engine_view import EngineStep
 
 __all__ = ["CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards", "CanvasPointsFrictionElasticityLeesEdwards"]
 
 
-class CanvasPointsBasicElasticity(CanvasPointsShear):
+class CanvasPointsBasicElasticity(EngineStep, CanvasPointsShear):
     """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``.
 
     Parameters
@@ -65,7 +66,6 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.stability_guard = None
         self.phase = ""
         self.step_count = 0
-        self._half_kick = None
 
     INTEGRATORS = ("euler", "verlet")
 
@@ -233,14 +233,13 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.test_neighbor_relation()
         self.central_viscous_force_from_neighbors()
 
-    def _force_terms(self):
-        self._elastic_terms()
-        self._viscous_terms()
-
     def mechanical_simulation_step_calculate_forces(self, dt=1):
         """Clear the register, update neighbours, add every pair force (first phase of a step).
 
-        ``dt`` is accepted for the 1.0.2 signature.
+        The engine's force phase on the ensemble's own state (:mod:`particleShear.base.engine_view`):
+        the forces and torques add to those already on the spheres, and the force register holds
+        the phase's terms.  Then the stability guard, if set, checks the state.  ``dt`` is
+        accepted for the 1.0.2 signature.
 
         Parameters
         ----------
@@ -248,51 +247,18 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             Time step (s); not used by the force phase.
         """
         self.reset_force_register()
-        self.test_neighbor_relation()
-        predicted = self._predict_velocities() if self._half_kick is not None else None
-        self._in_force_phase = True
-        try:
-            self._force_terms()
-        finally:
-            self._in_force_phase = False
-            if predicted is not None:
-                self._restore_velocities(predicted)
-        self._flush_pair_forces()
+        self._engine_force_phase()
         if self.stability_guard is not None:
             self.stability_guard.check(self, step=self.step_count, phase=self.phase, dt=self._last_dt)
 
     _last_dt = None
 
-    def _predict_velocities(self):
-        """Velocity Verlet: move velocities half a kick ahead for the velocity-dependent forces."""
-        a = self._a
-        saved = (a["xspeed"].copy(), a["yspeed"].copy(), a["omega"].copy())
-        hx, hy, ht = self._half_kick
-        if len(hx) == self._n:
-            a["xspeed"] += hx
-            a["yspeed"] += hy
-            if ht is not None:
-                a["omega"] += ht
-        if self._g is not None:
-            self._g.rv = None
-            self._g.vn = None
-            self._g.vt = None
-        return saved
-
-    def _restore_velocities(self, saved):
-        a = self._a
-        a["xspeed"][:], a["yspeed"][:], a["omega"][:] = saved
-
-    def _store_half_kick(self, dt):
-        """Remember ``F·dt/(2m)`` of mobile spheres (and ``T·dt/(2I)``) for the next force phase (Verlet only;
-        :func:`~particleShear.engine.integrate.half_kick`)."""
-        spin = self._torque_total() is not None
-        k = 3 if spin else 2
-        h = half_kick(self._frc[:k], self._st.take(_MASS_ROWS[:k], axis=0), dt, self._mobile_mask())
-        self._half_kick = (h[0], h[1], h[2] if spin else None)
-
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
-        """Kick the velocities with the forces of the step, then damp them (third phase of a step).
+        """Kick the velocities with the forces of the step (the plates follow), then damp them (third
+        phase of a step; the engine's :meth:`~particleShear.engine.step.BatchEngine.accelerate`:
+        eqs. S1-10, S1-11).
+
+        With velocity Verlet the half kick of the mobile spheres is kept for the next force phase.
 
         Parameters
         ----------
@@ -307,18 +273,14 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             If ``dt`` is not a finite number > 0 (before any work).
         """
         check_time_step(dt, self.step_count)
-        if self.integrator != "euler":
-            self._store_half_kick(dt)
         self._last_dt = dt
-        self.do_linear_acceleration(dt)
-        self.cool(cool_factor)
-
-    def _advance_strain(self, dt):
-        if self.applyingShear:
-            self.shear = self.shear + self.shear_rate * dt
+        self._engine_accelerate(cool_factor, dt)
 
     def mechanical_simulation_step_calculate_movement(self, dt=1):
-        """Drift, strain update (while shearing), wrap, clock (last phase of a step).
+        """ξ rule, drift, strain update, wrap, clock (last phase of a step; the engine's
+        :meth:`~particleShear.engine.step.BatchEngine.move`).
+
+        The strain advances by ``γ̇·dt`` while shearing (always in the frictional canvases).
 
         Parameters
         ----------
@@ -331,10 +293,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
             If ``dt`` is not a finite number > 0 (before any work).
         """
         check_time_step(dt, self.step_count)
-        self.move(dt)
-        self._advance_strain(dt)
-        self.boundary_conditions()
-        self.t = self.t + dt
+        self._engine_move(dt)
         self.step_count += 1
         self._g = None
         if self._renderer is not None:
@@ -573,10 +532,6 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self.test_neighbor_relation()
         self.tangential_force_from_neighbors()
 
-    def _force_terms(self):
-        CanvasPointsBasicElasticityLeesEdwards._force_terms(self)
-        self._tangential_terms()
-
     def _torque_total(self):
         return self._a["torque"]
 
@@ -594,37 +549,6 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     def _cool_spin(self, f):
         self._a["omega"] *= f
-
-    def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
-        """Linear kick (plates), rotational kick of all spheres, damping (third phase of a step).
-
-        Parameters
-        ----------
-        cool_factor : float
-            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
-        dt : float
-            Time step (s), finite and > 0.
-
-        Raises
-        ------
-        ValueError
-            If ``dt`` is not a finite number > 0 (before any work).
-        """
-        check_time_step(dt, self.step_count)
-        if self.integrator != "euler":
-            self._store_half_kick(dt)
-        self._last_dt = dt
-        cls = type(self)
-        friction = CanvasPointsFrictionElasticityLeesEdwards
-        if (cls.do_linear_acceleration is CanvasPointsShear.do_linear_acceleration
-                and cls.do_rotational_acceleration is friction.do_rotational_acceleration):
-            # both kicks at once on the (xspeed, yspeed, omega) rows: v += F·dt/m, ω += τ·dt/I
-            kick(self._vel, self._frc, self._st.take(_MASS_ROWS, axis=0), dt)   # weights (m, m, I)
-            self._plates_follow()
-        else:
-            self.do_linear_acceleration(dt)
-            self.do_rotational_acceleration(dt)
-        self.cool(cool_factor)
 
     def cool(self, f=0.8):
         """Damp velocity relative to the affine flow and spin by ``f`` (docs/design.md), all three rows at once.
@@ -698,8 +622,8 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self._integrate_xi(dt)
         self._drift(dt, spin=True)
 
-    def _advance_strain(self, dt):
-        self.shear = self.shear + self.shear_rate * dt
+    def _strain_advances(self):
+        return True
 
     @property
     def active_terms(self):

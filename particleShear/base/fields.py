@@ -16,5 +16,3 @@ FIELDS = {
 }
 #: row of each field in the state block ``CanvasPoints._st`` (fields × spheres)
 ROW = {name: k for k, name in enumerate(FIELDS)}
-#: rows (m, m, inertia): the weights of (xspeed, yspeed, omega) in the kick and the kinetic tensors
-MASS_ROWS = (ROW["m"], ROW["m"], ROW["inertia"])

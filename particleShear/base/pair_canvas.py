@@ -85,7 +85,6 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._nl_valid = False
         self._g = None
         self._relation_view_class = _BaseRelationView
-        self._in_force_phase = False
         self._disp = np.zeros((2, 0))
         self._nl_strain = 0.0
         self._nl_abs_strain = 0.0
@@ -98,10 +97,15 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         self._pos_version += 1
         self._in_cell = False
         self._images_valid = False
+        self._drop_engine()
 
     def _links_changed(self):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
         self._links_version += 1
+        self._engine_pairs = None       # the step's engine rebuilds its candidates from the table
+
+    def _drop_engine(self):
+        """Forget the step's engine (canvases with a force law: :mod:`particleShear.base.engine_view`)."""
 
     def _spheres_changed(self):
         self._nl_valid = False
@@ -370,7 +374,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
 
     # -- pair-force accumulation -----------------------------------------------------------------
     def _geometry(self):
-        if self._g is None:
+        if not isinstance(self._g, _Geometry):     # none yet, or an engine force phase's
             self.test_neighbor_relation()
         return self._g
 
@@ -456,8 +460,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         g.ft_visits = None
 
     def _term_done(self):
-        if not self._in_force_phase:
-            self._flush_pair_forces()
+        self._flush_pair_forces()
 
     # -- views and scalar helpers for the API ------------------------------------------------------
     def _relations_of(self, p):
@@ -474,6 +477,7 @@ class CanvasPointsNeighbors(CanvasPointsMass):
         outside the step's neighbour update (the per-sphere API, a batched constitution), which no counter
         of the memo keys records."""
         self._memo.invalidate()
+        self._engine_pairs = None
 
     @property
     def _struct(self):

@@ -142,16 +142,11 @@ class StabilityGuard:
             worst = int(np.argmax(a["m"] * (u * u + vy * vy)))
             self._fail(ens, step, phase, dt, f"kinetic energy {ke:.3g} exceeds the bound {bound:.3g}",
                        pair=(worst,))
-        g = getattr(ens, "_g", None)
-        if g is not None and g.P:
-            ratio = g.d / g.d0
-            if g.trans is not None:
-                ratio = np.where(g.trans, ratio, np.inf)
-            k = int(np.argmin(ratio))
-            if ratio[k] < self.min_distance_ratio:
-                self._fail(ens, step, phase, dt,
-                           f"spheres {int(g.ai[k])} and {int(g.aj[k])} interpenetrate "
-                           f"(d/(r_i+r_j) = {float(ratio[k]):.3g})", pair=(int(g.ai[k]), int(g.aj[k])))
+        closest = ens._closest_contact() if hasattr(ens, "_closest_contact") else None
+        if closest is not None and closest[0] < self.min_distance_ratio:
+            ratio, i, j = closest
+            self._fail(ens, step, phase, dt, f"spheres {i} and {j} interpenetrate (d/(r_i+r_j) = {ratio:.3g})",
+                       pair=(i, j))
 
     def _fail(self, ens, step, phase, dt, reason, pair=None):
         sdt = self.suggested_dt(ens, dt)

@@ -169,6 +169,13 @@ class BatchEngine:
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)
+        #: per replica, 1.0 for a Lees-Edwards cell and 0.0 for a plain periodic one (the documented
+        #: ``use_lees_edwards = False`` ensembles): the factor of the image offset ``Ly·γ`` and of the
+        #: image velocity ``Ly·γ̇``; None: every replica is Lees-Edwards
+        self.lees_edwards = None
+        #: per replica, 1.0 where the strain advances by ``γ̇·dt`` in a step and 0.0 where it is held
+        #: (the documented frictionless canvases advance it only while shearing); None: everywhere
+        self.strain_advances = None
 
     # -- the one cache ---------------------------------------------------------------------------
     def _sync_down(self, replicas=None):
@@ -257,6 +264,14 @@ class BatchEngine:
         self.C = PairConstants.splice(s, self.C, new, segments, offsets)
         self.C.set_visits(s)
         self._frictionless()
+
+    def _image_frame(self):
+        """``(Ly·γ, γ̇)`` of the images of each replica (B,): the Lees-Edwards offset and the rate
+        the images move with, 0 for a plain periodic replica (:attr:`lees_edwards`)."""
+        s = self.s
+        if self.lees_edwards is None:
+            return s.Ly * s.gamma, s.rate
+        return s.Ly * s.gamma * self.lees_edwards, s.rate * self.lees_edwards
 
     def _images(self, raw_x, raw_y, shift_p):
         """Minimum image of the candidates, reusing the period counts of the last step while they
@@ -420,7 +435,8 @@ class BatchEngine:
         yc = y - self.hy_s                              # height above the cell's centre line
         raw = s.pos.take(aj, axis=1)
         raw -= s.pos.take(ai, axis=1)
-        dx, dy, ky, kx = self._images(raw[0], raw[1], (s.Ly * s.gamma)[C.rep])
+        shift, image_rate = self._image_frame()
+        dx, dy, ky, kx = self._images(raw[0], raw[1], shift[C.rep])
         d = xp.sqrt(dx * dx + dy * dy)
         nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
         touching = d < C.d0
@@ -432,7 +448,7 @@ class BatchEngine:
         self.xi = xi = xp.where(active, self.xi, 0.0)   # an opened contact loses its history
         self.active = active
         # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
-        dvx = -(C.Ly * s.rate[C.rep]) * ky
+        dvx = -(C.Ly * image_rate[C.rep]) * ky
         vel = s.vel if self.half is None else s.vel + self.half
         Vi = vel.take(ai, axis=1)
         Vj = vel.take(aj, axis=1)
@@ -604,12 +620,14 @@ class BatchEngine:
             Time step (s).
         """
         s, g = self.s, self.g
+        # the force phase's mobility and heights (a kick without a force phase: those of now)
+        mob, yc = (self.mobile(), s.y - self.hy_s) if g is None else (g.mob, g.yc)
         if self.integrator == "verlet":
-            self.half = half_kick(s.frc, self.mmi, dt, g.mob)
+            self.half = half_kick(s.frc, self.mmi, dt, mob)
         rate_s = s.rate[s.rep]
         kick(s.vel, s.frc, self.mmi, dt)                    # (F_x/m, F_y/m, T/I)·dt
-        plates_follow(s.vx, s.vy, ~g.mob, g.yc, rate_s * self.Ly_s / 2)
-        damp(s.vel, g.yc * rate_s, cool)
+        plates_follow(s.vx, s.vy, ~mob, yc, rate_s * self.Ly_s / 2)
+        damp(s.vel, yc * rate_s, cool)
 
     def move(self, dt):
         """ξ of sticking contacts and bonds (sequential rule, Appendix B.2), drift, strain, wrap, clock.
@@ -630,7 +648,7 @@ class BatchEngine:
         s, xp, C, g = self.s, self.xp, self.C, self.g
         vx, vy = s.vx, s.vy
         free = self.free_p
-        if free is not True:      # replicas without friction and bonds have no ξ: every relation slips
+        if free is not True and g is not None:   # without friction and bonds no ξ (nor without a force phase)
             kd = xp.where(g.active & (self.state_p != SLIP), dt, 0.0)
             Vi = s.vel.take(C.ai, axis=1)
 
@@ -644,17 +662,18 @@ class BatchEngine:
             xi = self.xi
             xi[0] += inc_ij * kd
             xi[1] += inc_ji * kd
-        # drift, strain, wrap, clock
-        rate_s = s.rate[s.rep]
+        # drift, strain, wrap, clock (the displacement relative to the flow the images follow)
+        image_rate = self._image_frame()[1]
+        rate_s = image_rate[s.rep]
         u = self.u
-        u[0] += (vx - g.yc * rate_s) * dt
+        u[0] += (vx - (s.y - self.hy_s if g is None else g.yc) * rate_s) * dt
         u[1] += vy * dt
         self.u_max = xp.maximum(self.u_max, xp.sqrt(u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1))
-        self.strain += abs(s.rate) * dt
+        self.strain += abs(image_rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         drift(s.pos, s.phi, s.vel, dt)
-        s.gamma = s.gamma + s.rate * dt
-        wrap(s.x, s.y, vx, self.Lx_s, self.Ly_s, (s.Ly * s.gamma)[s.rep], rate_s)
+        s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
+        wrap(s.x, s.y, vx, self.Lx_s, self.Ly_s, self._image_frame()[0][s.rep], rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = self.verdict

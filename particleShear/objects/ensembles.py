@@ -196,15 +196,11 @@ class EnsembleFriction(Ensemble):
         self.nu_t = nu_t
         self.mu = mu
 
-    def _force_terms(self):
-        Ensemble._force_terms(self)
-        self._tangential_terms()
-
 
 # EnsembleFriction takes the tangential machinery of the friction canvas (it is not on that branch
 # of the documented chain); its strain still advances only while shearing, as in its base class.
 for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
-    if not _name.startswith("__") and _name not in ("_advance_strain", "k_t", "nu_t", "mu", "_force_terms"):
+    if not _name.startswith("__") and _name not in ("_strain_advances", "k_t", "nu_t", "mu"):
         setattr(EnsembleFriction, _name, _value)
 del _name, _value
 

@@ -1,0 +1,217 @@
+"""The documented step as the engine's phases on the ensemble's own state (docs/design.md, "One step").
+
+A documented ensemble keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
+whose sphere arrays are the ensemble's own rows and whose pair list is the ensemble's pair table
+(:meth:`~particleShear.engine.state.BatchState.of_ensemble`).  The three phases of the documented
+step (``mechanical_simulation_step_calculate_forces``, ``…_acceleration``, ``…_movement``) are that
+engine's :meth:`~particleShear.engine.step.BatchEngine.force_phase`,
+:meth:`~particleShear.engine.step.BatchEngine.accelerate` and
+:meth:`~particleShear.engine.step.BatchEngine.move`; the register of a force phase is the engine's
+(:meth:`~particleShear.base.register.Force_register.set_from_engine`).
+
+What a step only reads (clock, strain, rate, μ, the plates, whether the cell is Lees-Edwards and
+whether the strain advances) is handed to the engine at every force phase, and the clock and strain
+are handed back after every movement, so the ensemble's attributes stay what scripts read and
+write.  Between steps the pair table holds the engine's relations (written back after every
+movement), so the per-sphere API, links and cuts read and edit it as before.
+
+The engine is kept under one key (the sphere block, the per-sphere parameters, the constants, the
+box, the integrator, the generator) and dropped at the one invalidation point of the ensemble
+(:meth:`EngineStep._drop_engine`: a sphere appended or moved from outside, a radius changed);
+an edit of the pair table (a link, a cut, a relation edited) makes its next force phase rebuild
+the candidates from the table.
+"""
+__docformat__ = "numpy"
+import numpy as np
+
+__all__ = ["EngineStep", "ForcePhaseGeometry"]
+
+
+class EngineStep:
+    """Mixin of the documented canvases: the step's phases on the ensemble's engine (a batch of one).
+
+    The canvas supplies the hooks :meth:`_lees_edwards` (images offset by ``Ly·γ``) and
+    :meth:`_strain_advances` (γ advances by ``γ̇·dt`` in this step).
+    """
+
+    _engine = None          # the engine of the ensemble's state (None until the first phase, after a drop)
+    _engine_key = None
+    _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
+    _engine_half = None     # the Verlet half kick while no engine is kept
+
+    def _lees_edwards(self):
+        return bool(self.use_lees_edwards)
+
+    def _strain_advances(self):
+        return bool(getattr(self, "applyingShear", False))
+
+    def _engine_view_key(self):
+        return (self._st, self._params_version, self._rng, float(self.k), float(self.nu),
+                float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)), float(self.size_x),
+                float(self.size_y), self.integrator)
+
+    def _step_engine(self):
+        """The ensemble's engine, made anew when its key changed (the half kick is carried over)."""
+        key = self._engine_view_key()
+        eng = self._engine
+        if eng is not None and len(key) == len(self._engine_key) and all(
+                a is b or a == b for a, b in zip(key, self._engine_key)):
+            return eng
+        from ..engine.state import BatchState
+        from ..engine.step import BatchEngine
+        half = self._half_kick
+        self._drop_engine()
+        eng = BatchEngine(BatchState.of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
+                          integrator=self.integrator)
+        eng.keep_terms = True      # the force register of every force phase
+        if self.integrator == "verlet" and half is not None and len(half[0]) == self._n:
+            eng.half = np.array([h if h is not None else np.zeros(self._n) for h in half])
+        self._engine, self._engine_key = eng, key
+        self._engine_pairs = (self._pairs, self._pairs.version)
+        return eng
+
+    def _drop_engine(self):
+        """Forget the engine (the one invalidation point; its Verlet half kick is kept)."""
+        eng = self._engine
+        if eng is not None:
+            self._engine_half = None if eng.half is None else tuple(np.array(h) for h in eng.half)
+            self._engine = self._engine_key = self._engine_pairs = None
+
+    @property
+    def _half_kick(self):
+        """Velocity Verlet: the half kick ``F·dt/(2m)`` of the last step, rows (vx, vy, ω), or None."""
+        eng = self._engine
+        if eng is not None:
+            return None if eng.half is None else tuple(eng.half)
+        return self._engine_half
+
+    @_half_kick.setter
+    def _half_kick(self, value):
+        self._engine_half = value
+        eng = self._engine
+        if eng is not None:
+            eng.half = None if value is None else np.array([h if h is not None else np.zeros(self._n)
+                                                            for h in value])
+
+    def _engine_pairs_edited(self):
+        """The pair table was edited outside a step (links, cuts, relations): the next force phase
+        rebuilds the candidates from it."""
+        self._engine_pairs = None
+
+    def _hand_to_engine(self, eng):
+        """What a step reads of the ensemble, into the engine's state (before a force phase)."""
+        s = eng.s
+        s.t[0] = self.t
+        s.gamma[0] = self.shear
+        s.rate[0] = self.shear_rate
+        s.applying_shear = bool(self.applyingShear)
+        mu = float(getattr(self, "mu", 0.0))
+        if s.mu[0] != mu:
+            eng.set_mu(mu)
+        eng.lees_edwards = None if self._lees_edwards() else np.zeros(1)
+        eng.strain_advances = None if self._strain_advances() else np.zeros(1)
+        pairs = self._pairs
+        if self._engine_pairs != (pairs, pairs.version) or s.pairs[0] is not pairs:
+            # edited since the engine's last write-back: candidates and constants anew from the table
+            s.pairs[0] = pairs
+            eng.C = None
+            eng.need[:] = True
+            eng.next_birth[...] = pairs._births
+        elif eng.C is not None:
+            self._share_history(eng)
+
+    def _share_history(self, eng):
+        """Make the engine's flat relation history the pair table's own arrays (a batch of one has
+        one segment), so what a phase writes, the table holds, and what was set on the table (a
+        relation's ξ or state), the engine reads."""
+        pairs = self._pairs
+        eng.state_p, eng.xi, eng.active, eng.birth = pairs.state, pairs.xi, pairs.active, pairs.birth
+
+    def _engine_force_phase(self):
+        """Force phase on the engine: neighbours, terms, scatter, the register."""
+        eng = self._step_engine()
+        self._hand_to_engine(eng)
+        extra = self._frc.copy() if self._frc.any() else None     # forces put on before the phase add up
+        eng.force_phase()
+        if extra is not None:
+            self._frc += extra
+        self.force_register.set_from_engine(self, eng)
+        self._g = ForcePhaseGeometry(eng)
+        eng.flush()                     # the phase's relations, states and ξ into the table
+        self._share_history(eng)        # (the movement's ξ rule then writes the table's ξ)
+        self._engine_pairs = (self._pairs, self._pairs.version)
+        return eng
+
+    def _engine_accelerate(self, cool, dt):
+        eng = self._engine
+        if eng is None:          # a kick without a force phase before it
+            eng = self._step_engine()
+            self._hand_to_engine(eng)
+        eng.accelerate(cool, dt)
+
+    def _engine_move(self, dt):
+        """Movement on the engine, then the clock and strain and the relations back into the ensemble."""
+        eng = self._engine
+        if eng is None:
+            eng = self._step_engine()
+            self._hand_to_engine(eng)
+        # where the drift takes the spheres: non-finite or far outside the cell stops the run (before the wrap)
+        self._check_positions(self._pos + self._vel[:2] * dt)
+        eng.move(dt)
+        s = eng.s
+        self.t = float(s.t[0])
+        self.shear = float(s.gamma[0])
+        self._nl_valid = False          # the canvas's own neighbour update starts afresh
+        self._pos_version += 1
+        self._in_cell = True
+        self._images_valid = False
+
+    def _closest_contact(self):
+        """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force
+        phase and its spheres, or None (for the stability guard)."""
+        g = self._g
+        if g is None or not g.P:
+            return None
+        ratio = g.d / g.d0
+        if g.trans is not None:
+            ratio = np.where(g.trans, ratio, np.inf)
+        k = int(np.argmin(ratio))
+        return float(ratio[k]), int(g.ai[k]), int(g.aj[k])
+
+
+class ForcePhaseGeometry:
+    """The relations of an engine force phase as the documented canvas's ``_g`` shows them (read by
+    stability guards and tests), made when first read; valid until the movement ends the step.
+
+    Per relation (``P`` of them, in the table's ``(i, j)`` order): ``slots``, its row of the pair
+    table; the sphere indices ``ai, aj`` and radii ``ri, rj``; the pair vector ``dx, dy`` (µm, j's
+    nearest image minus i), the distance ``d``, the contact distance ``d0 = r_i + r_j``, the unit
+    normal ``nx, ny``; the image velocity ``dvx`` (µm/s, ``−Ly·γ̇`` per period above); ``perm``
+    (a bond) and ``trans`` (a transient contact); ``active`` (all true).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The ensemble's engine after its force phase (a batch of one).
+    """
+
+    NAMES = ("P", "slots", "ai", "aj", "ri", "rj", "d", "d0", "nx", "ny", "dx", "dy", "dvx", "perm", "trans",
+             "active")
+
+    def __init__(self, engine):
+        self._engine = engine
+
+    def __getattr__(self, name):
+        if name not in self.NAMES:
+            raise AttributeError(name)
+        eng = self._engine
+        g, C = eng.g, eng.C
+        m = np.asarray(g.active, dtype=bool)
+        dx, dy = g.dx[m], g.dy[m]
+        ai, aj = C.ai[m], C.aj[m]
+        values = {"P": int(m.sum()), "slots": eng.s.pairs[0].find(ai, aj), "ai": ai, "aj": aj, "ri": C.ri[m],
+                  "rj": C.rj[m], "d": np.sqrt(dx * dx + dy * dy), "d0": C.d0[m], "nx": g.nx[m], "ny": g.ny[m],
+                  "dx": dx, "dy": dy, "dvx": np.broadcast_to(g.dvx, m.shape)[m], "perm": C.perm[m],
+                  "trans": C.trans[m], "active": np.ones(int(m.sum()), bool)}
+        self.__dict__.update(values)
+        return values[name]
