@@ -66,7 +66,7 @@ def bound(mod, ens):
         old = f["min_image"]
 
         def min_image(dx, dy, Lx, Ly, shift, shear_rate=0.0, passes=None, counts=False):
-            if counts and passes is None and ens._in_cell:   # the old canvas's _passes()
+            if counts and passes is None and getattr(ens, "_in_cell", False):   # the old canvas's _passes()
                 passes = hint(Lx, shift)
             return old(dx, dy, Lx, Ly, shift, shear_rate, passes, counts)
         f["min_image"] = min_image

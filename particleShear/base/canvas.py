@@ -226,8 +226,6 @@ class CanvasPoints:
         self._memo = Memo()   # every value kept between calls (docs/design.md, "The documented classes")
         self._pos_version = 0
         self._params_version = 0
-        self._in_cell = False
-        self._images_valid = False
         self.graphical_output_configuration = Graphical_output_configuration()
 
     # -- sphere list and state arrays ----------------------------------------------------------
@@ -340,7 +338,6 @@ class CanvasPoints:
 
     def _invalidate_neighbours(self):
         self._pos_version += 1
-        self._in_cell = False
 
     def _params_changed(self):
         self._params_version += 1
@@ -508,11 +505,10 @@ class CanvasPoints:
             inside = True
         if not inside:
             self._check_positions()
-        if not inside and le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
-                                  getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0):
-            self._images_valid = False
+        if not inside:
+            le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
+                    getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0)
         self._pos_version += 1
-        self._in_cell = True
 
     def _check_positions(self, pos=None):
         """Raise :class:`SimulationInstabilityError` for a non-finite position or one more than

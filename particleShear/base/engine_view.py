@@ -46,9 +46,9 @@ class EngineStep:
         return bool(getattr(self, "applyingShear", False))
 
     def _engine_view_key(self):
-        return (self._st, self._params_version, self._rng, float(self.k), float(self.nu),
-                float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)), float(self.size_x),
-                float(self.size_y), self.integrator)
+        return (self._st, self._params_version, self._rng, float(getattr(self, "k", 0.0)),
+                float(getattr(self, "nu", 0.0)), float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)),
+                float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"))
 
     def _step_engine(self):
         """The ensemble's engine, made anew when its key changed (the half kick is carried over)."""
@@ -61,10 +61,11 @@ class EngineStep:
         from ..engine.step import BatchEngine
         half = self._half_kick
         self._drop_engine()
+        integrator = getattr(self, "integrator", "euler")
         eng = BatchEngine(BatchState.of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
-                          integrator=self.integrator)
+                          integrator=integrator)
         eng.keep_terms = True      # the force register of every force phase
-        if self.integrator == "verlet" and half is not None and len(half[0]) == self._n:
+        if integrator == "verlet" and half is not None and len(half[0]) == self._n:
             eng.half = np.array([h if h is not None else np.zeros(self._n) for h in half])
         self._engine, self._engine_key = eng, key
         self._engine_pairs = (self._pairs, self._pairs.version)
@@ -101,10 +102,13 @@ class EngineStep:
     def _hand_to_engine(self, eng):
         """What a step reads of the ensemble, into the engine's state (before a force phase)."""
         s = eng.s
-        s.t[0] = self.t
-        s.gamma[0] = self.shear
-        s.rate[0] = self.shear_rate
-        s.applying_shear = bool(self.applyingShear)
+        s.t[0] = getattr(self, "t", 0.0)
+        gamma = getattr(self, "shear", 0.0)
+        if s.gamma[0] != gamma:      # a strain set from outside moves the boundary images by Ly·Δγ
+            s.gamma[0] = gamma
+            eng.need[:] = True
+        s.rate[0] = getattr(self, "shear_rate", 0.0)
+        s.applying_shear = bool(getattr(self, "applyingShear", False))
         mu = float(getattr(self, "mu", 0.0))
         if s.mu[0] != mu:
             eng.set_mu(mu)
@@ -137,10 +141,15 @@ class EngineStep:
             self._frc += extra
         self.force_register.set_from_engine(self, eng)
         self._g = ForcePhaseGeometry(eng)
-        eng.flush()                     # the phase's relations, states and ξ into the table
-        self._share_history(eng)        # (the movement's ξ rule then writes the table's ξ)
-        self._engine_pairs = (self._pairs, self._pairs.version)
+        self._take_relations(eng)
         return eng
+
+    def _take_relations(self, eng):
+        """The relations, states and ξ of the engine's last phase into the pair table, which then
+        holds the engine's history (the movement's ξ rule writes the table's ξ)."""
+        eng.flush()
+        self._share_history(eng)
+        self._engine_pairs = (self._pairs, self._pairs.version)
 
     def _engine_accelerate(self, cool, dt):
         eng = self._engine
@@ -161,10 +170,19 @@ class EngineStep:
         s = eng.s
         self.t = float(s.t[0])
         self.shear = float(s.gamma[0])
-        self._nl_valid = False          # the canvas's own neighbour update starts afresh
         self._pos_version += 1
-        self._in_cell = True
-        self._images_valid = False
+
+    def _engine_move_spheres(self, dt):
+        """The documented ``move(dt)`` of a frictional canvas: the engine's ξ rule on the relations
+        of its last force phase (none without one), then the drift of x, y, φ (no strain, wrap or
+        clock); the neighbour lists are rebuilt at the next force phase."""
+        eng = self._engine
+        if eng is None:
+            eng = self._step_engine()
+            self._hand_to_engine(eng)
+        eng.move_spheres(dt)
+        eng.need[:] = True
+        self._pos_version += 1
 
     def _closest_contact(self):
         """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force

@@ -454,10 +454,11 @@ class BatchState:
                               ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
                 getattr(s, name)[rows] = a[src][:N]
             s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
-            s.gamma[b], s.rate[b], s.t[b] = float(e.shear), float(e.shear_rate), float(e.t)
-            # a frictionless ensemble of particleShear.objects has no tangential constants: 0
-            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(e.k), float(e.nu), float(getattr(e, "k_t", 0.0)),
-                                                             float(getattr(e, "nu_t", 0.0)), float(getattr(e, "mu", 0.0)))
+            s.gamma[b], s.rate[b], s.t[b] = (float(getattr(e, name, 0.0)) for name in ("shear", "shear_rate", "t"))
+            # a frictionless ensemble of particleShear.objects has no tangential constants (a canvas
+            # without forces none at all): 0
+            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(getattr(e, name, 0.0))
+                                                             for name in ("k", "nu", "k_t", "nu_t", "mu"))
             for name, src, empty in zip(_PER_REPLICA, PER_SPHERE_PARAMETERS, (0.0, 1.0, 1.0, 1.0)):
                 getattr(s, name)[b] = float(a[src][0]) if N else empty
             if own[b]:

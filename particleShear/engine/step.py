@@ -425,28 +425,13 @@ class BatchEngine:
         None or tuple
             As :meth:`step`.
         """
-        s, xp = self.s, self.xp
+        s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
-        # neighbours (positions at the start of the step)
-        self.neighbours()
+        yc, dx, dy, ky, kx, d, touching, active, image_rate = self.relations()
         C = self.C
         ai, aj = C.ai, C.aj
-        # geometry and relations
-        yc = y - self.hy_s                              # height above the cell's centre line
-        raw = s.pos.take(aj, axis=1)
-        raw -= s.pos.take(ai, axis=1)
-        shift, image_rate = self._image_frame()
-        dx, dy, ky, kx = self._images(raw[0], raw[1], shift[C.rep])
-        d = xp.sqrt(dx * dx + dy * dy)
+        xi = self.xi
         nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
-        touching = d < C.d0
-        active = C.perm | touching
-        new = active & ~self.active
-        xp.copyto(self.state_p, STICK, where=new)       # a new relation starts sticking
-        if self.numbers_relations:
-            self._number(new)
-        self.xi = xi = xp.where(active, self.xi, 0.0)   # an opened contact loses its history
-        self.active = active
         # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
         dvx = -(C.Ly * image_rate[C.rep]) * ky
         vel = s.vel if self.half is None else s.vel + self.half
@@ -492,6 +477,38 @@ class BatchEngine:
                 self.verdict = verdict
         self.g = _ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob)
         return out
+
+    def relations(self):
+        """The neighbour update of a force phase: neighbour lists (when due) → Lees-Edwards minimum
+        image of every candidate → distances → relations (``touching | bond``; a new relation starts
+        sticking and takes its number, an opened contact loses its ξ).
+
+        Returns
+        -------
+        tuple
+            ``(yc, dx, dy, ky, kx, d, touching, active, image_rate)``: the heights ``y − Ly/2`` of
+            the spheres (µm), per candidate the pair vector (µm, j's nearest image minus i), its
+            image periods, distance, contact and relation flags, and the rate the images move
+            with per replica (1/s; :meth:`_image_frame`).
+        """
+        s, xp = self.s, self.xp
+        self.neighbours()          # (positions at the start of the step)
+        C = self.C
+        yc = s.y - self.hy_s                            # height above the cell's centre line
+        raw = s.pos.take(C.aj, axis=1)
+        raw -= s.pos.take(C.ai, axis=1)
+        shift, image_rate = self._image_frame()
+        dx, dy, ky, kx = self._images(raw[0], raw[1], shift[C.rep])
+        d = xp.sqrt(dx * dx + dy * dy)
+        touching = d < C.d0
+        active = C.perm | touching
+        new = active & ~self.active
+        xp.copyto(self.state_p, STICK, where=new)       # a new relation starts sticking
+        if self.numbers_relations:
+            self._number(new)
+        self.xi = xp.where(active, self.xi, 0.0)        # an opened contact loses its history
+        self.active = active
+        return yc, dx, dy, ky, kx, d, touching, active, image_rate
 
     def _central(self, K, d, vn, active, parts):
         """The central term of one visit (:func:`~particleShear.engine.terms.central_term`); with
@@ -645,6 +662,19 @@ class BatchEngine:
         EngineInstability
             On a device, if the force phase's guard verdict is not sound.
         """
+        self.move_spheres(dt)
+        self.advance_cells(dt)
+
+    def move_spheres(self, dt):
+        """The first part of :meth:`move`: ξ of sticking contacts and bonds (sequential rule,
+        Appendix B.2; none without a force phase), the displacement since the lists were built, and
+        the drift ``x, y, φ += (v_x, v_y, ω)·dt``.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
         s, xp, C, g = self.s, self.xp, self.C, self.g
         vx, vy = s.vx, s.vy
         free = self.free_p
@@ -672,8 +702,25 @@ class BatchEngine:
         self.strain += abs(image_rate) * dt
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         drift(s.pos, s.phi, s.vel, dt)
+
+    def advance_cells(self, dt):
+        """The second part of :meth:`move`: strain, Lees-Edwards wrap, clock, and the step's one read
+        of per-replica flags (see there).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+
+        Raises
+        ------
+        EngineInstability
+            On a device, if the force phase's guard verdict is not sound.
+        """
+        s, xp = self.s, self.xp
+        rate_s = self._image_frame()[1][s.rep]
         s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
-        wrap(s.x, s.y, vx, self.Lx_s, self.Ly_s, self._image_frame()[0][s.rep], rate_s)
+        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, self._image_frame()[0][s.rep], rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = self.verdict

@@ -3,11 +3,12 @@
 ``CanvasPointsLinkable`` adds bonds to the friction canvas: bonds use
 the compressive law below ``d_eq`` and the tensile law above it, never break,
 carry an unbounded tangential spring and are scaled by the per-sphere
-``permanent_ratio_*`` of the adjustable sphere class.  They are pairs of the canvas's terms with
-other constants (:func:`particleShear.engine.terms.term_constants`), evaluated by the engine's
-term functions like contacts; this class adds the bookkeeping of bonds and, for a tensile law
-replaced through ``call_back_elastic_force_law_tensile``, its evaluation.  The force laws are eq. S1-5a/b of the manual; the constants are those
-of docs/parameters.md; how bonds are made and cut is described in docs/design.md.
+``permanent_ratio_*`` of the adjustable sphere class.  They are rows of the pair table whose
+constants the engine's force phase takes from :func:`particleShear.engine.terms.term_constants`
+(the tensile law, also one replaced through ``call_back_elastic_force_law_tensile``, beyond
+``d_eq``); this class adds the bookkeeping of bonds: making, listing and cutting them.  The force
+laws are eq. S1-5a/b of the manual; the constants are those of docs/parameters.md; how bonds are
+made and cut is described in docs/design.md.
 """
 __docformat__ = "numpy"
 import math
@@ -16,9 +17,7 @@ import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image
-from ..base.namespace import count_nonzero as _nz, where as _where
-from ..base.laws import call_law_vectorised, elastic_force_law_tensile
-from ..engine import laws as _engine_laws
+from ..base.namespace import count_nonzero as _nz
 from ..base.neighbours import PERMANENT, SLIP
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
@@ -195,33 +194,6 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         """
         self.cutLine((0, 0), math.pi / 2)
         self.cutLine((0, self.size_y), math.pi / 2)
-
-    # -- bond forces -------------------------------------------------------------------------------
-    # Bonds are terms of the pairs like contacts: their constants come from the engine's term_constants
-    # (the pair structure's bonds and d_eq, the spheres' permanent ratios), and the canvas's elastic, viscous
-    # and tangential terms evaluate them with the engine's functions (docs/design.md, "One step").
-    def _builtin_laws(self):
-        """Whether the built-in compressive and tensile laws are both in use."""
-        return (CanvasPointsFrictionElasticityLeesEdwards._builtin_laws(self)
-                and SphereLinkable.call_back_elastic_force_law_tensile is elastic_force_law_tensile)
-
-    def _user_law_term(self, K, g):
-        """Elastic term with laws replaced through the callbacks: the compressive callback as in the parent, and on
-        bonds stretched beyond ``d_eq`` the tensile callback ``call_back_elastic_force_law_tensile`` (built-in:
-        :func:`~particleShear.engine.laws.tensile_law`); ``(law·ratio_c, law)``."""
-        f, law = CanvasPointsFrictionElasticityLeesEdwards._user_law_term(self, K, g)
-        if g.perm is None:
-            return f, law
-        stretched = g.perm & (g.d >= K.d_eq)
-        if not _nz(stretched):
-            return f, law
-        tensile = SphereLinkable.call_back_elastic_force_law_tensile
-        if tensile is elastic_force_law_tensile:
-            f_t = _engine_laws.tensile_law(g.d, K.d_eq, K.k)
-        else:
-            f_t = call_law_vectorised(tensile, g.d, K.d_eq, K.k)
-        law = _where(stretched, f_t, law)
-        return law * K.ratio_c, law
 
     @property
     def active_terms(self):
