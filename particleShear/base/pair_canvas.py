@@ -45,8 +45,9 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         If ``size_x`` or ``size_y`` is not a finite number > 0.
     """
 
-    #: extra search distance of the candidate list, in units of the largest radius
-    neighbour_skin = 0.5
+    #: the Verlet skin of the step's neighbour lists, in units of the largest radius: the runs'
+    #: value (``run.batch.ENGINE_SKIN_FACTOR``; fewer candidates per step, a few more rebuilds)
+    neighbour_skin = 0.2
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsMass.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
