@@ -10,6 +10,8 @@ __docformat__ = "numpy"
 
 import numpy as np
 
+from ..engine.xp import to_host
+
 __all__ = ["Force_register", "SphereSelection"]
 
 
@@ -33,6 +35,33 @@ class PairBlock(dict):
             self[key] = value
             return value
         raise KeyError(key)
+
+
+class EngineForcePhase:
+    """The force phase of replica ``b`` of an engine that a register holds: the engine's record of
+    its terms (:attr:`~particleShear.engine.step.BatchEngine.terms`, fixed when the phase ends),
+    whether the ensemble has the tangential term, and the ensemble's position version at the time
+    (the pair vectors hold while the spheres have not moved).  ``block``: the register block made
+    from it (:meth:`~particleShear.engine.step.BatchEngine.register_block`) once read.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine of the phase.
+    terms : object
+        Its record of the phase's per-candidate terms.
+    b : int
+        The replica.
+    tangential : bool
+        The ensemble has the tangential term (the lists hold tangential visits and torques).
+    pos_version : int
+        The ensemble's position version of the phase (−1: moved since).
+    """
+    __slots__ = ("engine", "terms", "b", "tangential", "pos_version", "block")
+
+    def __init__(self, engine, terms, b, tangential, pos_version):
+        self.engine, self.terms, self.b, self.tangential, self.pos_version = engine, terms, b, tangential, pos_version
+        self.block = None
 
 
 def _invalidating(name):
@@ -123,7 +152,8 @@ class Force_register:
     def reset_force_register(self):
         """Clear everything (start of each force phase)."""
         self._ens = None
-        self._blocks = []
+        self._block_list = []
+        self._phase = None      # the engine force phase held (EngineForcePhase), its block made when read
         self._tot = None
         self._tot_block = None
         self._mom = None
@@ -142,10 +172,31 @@ class Force_register:
         self._m_unb = {}
 
     # -- engine side -------------------------------------------------------------------------
+    @property
+    def _blocks(self):
+        """The blocks of per-pair arrays: that of the engine force phase held (made when first read),
+        then those of standalone term calls."""
+        ph = self._phase
+        if ph is not None and ph.block is None:
+            ph.block = PairBlock(ph.engine.register_block(ph.b, tangential=ph.tangential, terms=ph.terms))
+            ph.block.pop("totals")
+            ph.block.pop("mobile")
+            ph.block["pos_version"] = ph.pos_version
+            self._block_list.insert(0, ph.block)
+        return self._block_list
+
     def _set_pairs(self, ensemble, pair):
         """Add one block of per-pair arrays (one per force phase, or per standalone term call)."""
         self._ens = ensemble
         self._blocks.append(pair)
+
+    def engine_phase(self):
+        """The engine force phase that is all this register holds (pairs and totals, no manual
+        entries, no other block), or None: what the stress evaluation reads as arrays."""
+        ph = self._phase
+        if ph is None or self._manual or len(self._block_list) != (ph.block is not None):
+            return None
+        return ph
 
     def _set_totals(self, ensemble, mobile, fx, fy, torque, block=None):
         self._ens = ensemble
@@ -172,15 +223,17 @@ class Force_register:
         bool
             Whether the engine had a force phase to give (else the register is left alone).
         """
-        spin = ensemble._torque_total() is not None
-        block = engine.register_block(b, tangential=spin)
-        if block is None:
+        t = engine.terms
+        if t is None:
             return False
-        tot, mobile = block.pop("totals"), block.pop("mobile")
-        # the register's pair vectors are those of the force phase, while the spheres have not moved
-        block["pos_version"] = ensemble._pos_version if engine.g is not None else -1
+        spin = ensemble._torque_total() is not None
+        N = engine.s.N
+        mobile = to_host(t.mob, "register")[b * N:(b + 1) * N]
+        tot = to_host(t.totals, "register")[:, b * N:(b + 1) * N]
         self.reset_force_register()
-        self._set_pairs(ensemble, PairBlock(block))
+        # the register's pair vectors are those of the force phase, while the spheres have not moved
+        self._phase = EngineForcePhase(engine, t, b, spin, ensemble._pos_version if engine.g is not None else -1)
+        self._ens = ensemble
         self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None, tot)
         return True
 

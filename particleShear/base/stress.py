@@ -183,60 +183,29 @@ def _tensor_property(k):
     return property(fget, fset, doc="2×2 tensor (Pa), nested lists; see docs/output.md (eqs. S1-16 to S1-24).")
 
 
-def _engine_block(reg):
-    """The register's single block of an engine force phase with F_j = −F_i and no manual pair
-    entries, or None (then the register is read entry by entry)."""
-    if len(reg._blocks) != 1 or reg._m_pair or reg._m_ext or reg._m_imom:
+def _engine_phase(reg):
+    """The register's engine force phase of a batch of one on the host with F_j = −F_i, when it
+    is all the register holds (else None: the register is read entry by entry)."""
+    ph = reg.engine_phase()
+    if ph is None or ph.terms.fx_j is not None or ph.engine.s.B != 1 or not ph.engine.backend.host:
         return None
-    p = reg._blocks[0]
-    if not p.get("engine") or not p.get("antisymmetric", True):
-        return None
-    return p
+    return ph
 
 
-class _BlockRows:
-    """What the engine's functions read of an engine register block that changes only with its
-    pairs and their internal/external flags (kept while the block's arrays are the same objects).
-
-    The register says per pair whether it is internal and whether each sphere receives an
-    external entry (``roles``, what the shear-stress function takes); the tensors derive this
-    from a mobility mask and the image shift by the engine's rule (``pair_roles``), and passing
-    ``shifted = ~internal`` makes that rule give exactly the register's flags (external pairs are
-    never internal; an external entry needs a mobile sphere).
-    """
-
-    def __init__(self, p):
-        self.key = (p["i"], p["internal"], p["ext_i"], p["ext_j"])
-        internal = p["internal"]
-        self.C = OneReplicaRows(p["i"], p["j"])
-        self.not_internal = ~internal
-        self.roles = (internal, p["ext_i"], p["ext_j"])
-        self.zeros = np.zeros(self.C.P)
-        self.all_active = np.ones(self.C.P, dtype=bool)
-        self.rule_mask = _UNSET   # the mask for which the engine's rule was checked, and the answer
-        self.rule_ok = False
-
-    def same(self, p):
-        k = self.key
-        return k[0] is p["i"] and k[1] is p["internal"] and k[2] is p["ext_i"] and k[3] is p["ext_j"]
-
-    def follows_mask(self, p, mob):
-        """True when the block's flags are the engine's rule for the sphere mask ``mob`` (None: all
-        mobile) with ``shifted = ~internal``: internal pairs have both spheres mobile and each
-        external entry goes to exactly the mobile spheres of an external pair."""
-        if self.rule_mask is not mob:
-            internal, i, j = p["internal"], p["i"], p["j"]
-            if mob is None:
-                ok = np.array_equal(p["ext_i"], self.not_internal) and np.array_equal(p["ext_j"], self.not_internal)
-            else:
-                mi, mj = mob[i], mob[j]
-                ok = (np.array_equal(p["ext_i"], mi & self.not_internal)
-                      and np.array_equal(p["ext_j"], mj & self.not_internal) and not (internal & ~(mi & mj)).any())
-            self.rule_mask, self.rule_ok = mob, bool(ok)
-        return self.rule_ok
-
-
-_UNSET = object()
+def _phase_arrays(ph, ens):
+    """(C, active, dx, dy, fx_i, fy_i, dF) of an engine force phase (:func:`_engine_phase`): the
+    candidates, their relations, the pair vectors of the phase (taken anew from the positions if a
+    sphere has moved since: only internal pairs, which never act through the boundary, use them),
+    the forces on i and the pair's torque ``t_i + t_j = d·F_T`` (eq. S1-3; 0 without the
+    tangential term)."""
+    t = ph.terms
+    C = t.C
+    dx, dy = t.dx, t.dy
+    if ph.pos_version != ens._pos_version:
+        pos = ens._pos
+        dx, dy = pos.take(C.aj, axis=1) - pos.take(C.ai, axis=1)
+    dF = t.tq[0] + t.tq[1] if ph.tangential else np.zeros(C.P)
+    return C, t.active, dx, dy, t.fx_i, t.fy_i, dF
 
 
 def _shear_inputs(q):
@@ -391,7 +360,6 @@ class StressTensorEvaluation:
         self.graphical_output_configuration = None
         self.toDeleteList = []
         self._t = np.zeros((len(TENSORS), 2, 2))
-        self._rows = None      # _BlockRows of the last engine block read
         self._spheres = None   # (N, rep, all-mobile mask, zero torques) of the last ensemble size
         self._cell_inputs = None   # (key, Lx, Ly, rate, V arrays) of the last evaluation
 
@@ -464,35 +432,12 @@ class StressTensorEvaluation:
         return tuple(arr[:, q] for q in range(6))
 
     # -- the engine's inputs ------------------------------------------------------------------
-    def _block_rows(self, p):
-        rows = self._rows
-        if rows is None or not rows.same(p):
-            rows = self._rows = _BlockRows(p)
-        return rows
-
     def _per_sphere(self, n):
         """(replica index, all-mobile mask, zero torques) of ``n`` spheres, kept per size."""
         s = self._spheres
         if s is None or s[0] != n:
             s = self._spheres = (n, np.zeros(n, dtype=np.intp), np.ones(n, dtype=bool), np.zeros(n))
         return s[1:]
-
-    @staticmethod
-    def _block_arrays(p, rows, ens):
-        """(active, dx, dy, fx_i, fy_i, dF) of an engine block: the pair vectors of the force phase
-        (taken anew from the positions if a sphere has moved since: only internal pairs, which never
-        act through the boundary, use them) and the pair's torque ``t_i + t_j = d·F_T`` (eq. S1-3)."""
-        active = p.get("active")
-        if active is None:
-            active = rows.all_active
-        D = p["D"]
-        if p["pos_version"] != ens._pos_version:
-            pos = ens._pos
-            D = pos.take(p["j"], axis=1) - pos.take(p["i"], axis=1)
-        ti = p.get("ti")
-        dF = rows.zeros if ti is None else ti + p["tj"]
-        Fi = p["Fi"]
-        return active, D[0], D[1], Fi[0], Fi[1], dF
 
     def _shear_from_register(self, reg, pairs=None):
         """(τ_internal, τ_surface) of the register by the engine's shear-stress function (eq. S1-25).
@@ -501,43 +446,41 @@ class StressTensorEvaluation:
         G does not depend on whether tensors are kept.  ``pairs``: the register's entries when
         already made (:func:`_entries`)."""
         cell = _cell(self)
-        p = _engine_block(reg)
-        if p is not None:
+        ph = _engine_phase(reg)
+        if ph is not None:
             ens = reg._ens
-            rows = self._block_rows(p)
-            active, _, dy, fx_i, _, dF = self._block_arrays(p, rows, ens)
+            C, active, _, dy, fx_i, _, dF = _phase_arrays(ph, ens)
+            mob = ph.terms.mob
             # y − Ly/2 of the spheres: the ensemble's own (kept per position update) when the cells agree
             yc = ens._y_centred() if ens.size_y == self.size_y else ens._a["y"] - self.size_y / 2
-            tau = _engine_shear_stresses(rows.C, 1, yc, rows.roles, active, dy, fx_i, dF, cell["V"])
+            tau = _engine_shear_stresses(C, 1, yc, pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted), active, dy,
+                                         fx_i, dF, cell["V"])
         else:
             q = OneReplicaInputs(**(_entries(reg) if pairs is None else pairs), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
         return float(tau[0][0]), float(tau[1][0])
 
     def _array_inputs(self, reg, spheres, shear_rate):
-        """The inputs of one engine force phase read from the ensemble's own arrays, or None.
+        """The inputs of the register's engine force phase (:func:`_engine_phase`) with the
+        ensemble's own sphere arrays, or None.
 
-        Applies to a register of one engine block (F_j = −F_i, no manual entries) with its totals,
-        whose flags are the engine's rule for the totals' mobility mask, and to spheres that are
-        rows of the ensemble.  The kinetic tensors sum over the spheres passed, the unbalanced-force
-        tensor over the register's (mobile) totals."""
-        p = _engine_block(reg)
-        if p is None or reg._tot is None or reg._manual:
+        Applies to a register that holds one engine force phase and its totals, and to spheres
+        that are rows of the ensemble.  The kinetic tensors sum over the spheres passed, the
+        unbalanced-force tensor over the register's (mobile) totals."""
+        ph = _engine_phase(reg)
+        if ph is None or reg._tot is None:
             return None
         ens = reg._ens
         ok, mask = self._rows_of(ens, spheres)
         if not ok:
             return None
-        rows = self._block_rows(p)
         mob, fx, fy = reg._tot
-        if not rows.follows_mask(p, mob):
-            return None
         a = ens._a
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
-        active, dx, dy, fx_i, fy_i, dF = self._block_arrays(p, rows, ens)
-        q = OneReplicaInputs(C=rows.C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
+        C, active, dx, dy, fx_i, fy_i, dF = _phase_arrays(ph, ens)
+        q = OneReplicaInputs(C=C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
                              omega=a["omega"], m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob,
-                             active=active, shifted=rows.not_internal, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
+                             active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
                              fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
                              **_cell(self, shear_rate))
         if mask is mob:

@@ -521,7 +521,7 @@ class BatchEngine:
         parts += [f_el, f_v]
         return f_el + f_v, law
 
-    def register_block(self, b, tangential=True):
+    def register_block(self, b, tangential=True, terms=None):
         """The force register's block of replica ``b``'s last force phase (:attr:`keep_terms` on),
         in the layout the documented classes' register reads (``base.register``).
 
@@ -538,6 +538,8 @@ class BatchEngine:
         tangential : bool, default True
             The replica's ensemble has the tangential term (its register lists tangential visits
             and torques, zero forces where μ = 0 and no bond).
+        terms : _TermRecord, optional
+            The record of the force phase to give (:attr:`terms` of that phase; default: the last).
 
         Returns
         -------
@@ -546,7 +548,7 @@ class BatchEngine:
             totals of the replica's spheres and under ``"mobile"`` their mobility of that force
             phase; None before a force phase that kept its terms.
         """
-        t = self.terms
+        t = self.terms if terms is None else terms
         if t is None:
             return None
         C, N = t.C, self.s.N
