@@ -39,28 +39,32 @@ class PairBlock(dict):
 
 class EngineForcePhase:
     """The force phase of replica ``b`` of an engine that a register holds: the engine's record of
-    its terms (:attr:`~particleShear.engine.step.BatchEngine.terms`, fixed when the phase ends),
-    whether the ensemble has the tangential term, and the ensemble's position version at the time
-    (the pair vectors hold while the spheres have not moved).  ``block``: the register block made
-    from it (:meth:`~particleShear.engine.step.BatchEngine.register_block`) once read.
+    its terms (:attr:`~particleShear.engine.step.BatchEngine.terms`, fixed when the phase ends; not
+    the engine, which the register does not keep alive), whether the ensemble has the tangential
+    term, and the ensemble's position version at the time (the pair vectors hold while the spheres
+    have not moved).  ``block``: the register block made from it
+    (:func:`~particleShear.engine.step.register_block`) once read.
 
     Parameters
     ----------
-    engine : BatchEngine
-        The engine of the phase.
     terms : object
-        Its record of the phase's per-candidate terms.
+        The engine's record of the phase's per-candidate terms.
+    N : int
+        Spheres per replica of the engine.
     b : int
         The replica.
     tangential : bool
         The ensemble has the tangential term (the lists hold tangential visits and torques).
     pos_version : int
         The ensemble's position version of the phase (−1: moved since).
+    one_host_replica : bool
+        The engine is a batch of one on the host (its arrays are the replica's rows, read as they are).
     """
-    __slots__ = ("engine", "terms", "b", "tangential", "pos_version", "block")
+    __slots__ = ("terms", "N", "b", "tangential", "pos_version", "one_host_replica", "block")
 
-    def __init__(self, engine, terms, b, tangential, pos_version):
-        self.engine, self.terms, self.b, self.tangential, self.pos_version = engine, terms, b, tangential, pos_version
+    def __init__(self, terms, N, b, tangential, pos_version, one_host_replica):
+        self.terms, self.N, self.b, self.tangential = terms, N, b, tangential
+        self.pos_version, self.one_host_replica = pos_version, one_host_replica
         self.block = None
 
 
@@ -178,7 +182,8 @@ class Force_register:
         then those of standalone term calls."""
         ph = self._phase
         if ph is not None and ph.block is None:
-            ph.block = PairBlock(ph.engine.register_block(ph.b, tangential=ph.tangential, terms=ph.terms))
+            from ..engine.step import register_block
+            ph.block = PairBlock(register_block(ph.terms, ph.N, ph.b, tangential=ph.tangential))
             ph.block.pop("totals")
             ph.block.pop("mobile")
             ph.block["pos_version"] = ph.pos_version
@@ -214,7 +219,7 @@ class Force_register:
         ensemble : ensemble
             The ensemble of the replica (its spheres are the lists' entries).
         engine : BatchEngine
-            The engine (:meth:`~particleShear.engine.step.BatchEngine.register_block`).
+            The engine, after a force phase with ``keep_terms`` on (its :attr:`~particleShear.engine.step.BatchEngine.terms`).
         b : int, default 0
             The replica.
 
@@ -232,7 +237,8 @@ class Force_register:
         tot = to_host(t.totals, "register")[:, b * N:(b + 1) * N]
         self.reset_force_register()
         # the register's pair vectors are those of the force phase, while the spheres have not moved
-        self._phase = EngineForcePhase(engine, t, b, spin, ensemble._pos_version if engine.g is not None else -1)
+        self._phase = EngineForcePhase(t, N, b, spin, ensemble._pos_version if engine.g is not None else -1,
+                                       engine.s.B == 1 and engine.backend.host)
         self._ens = ensemble
         self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None, tot)
         return True

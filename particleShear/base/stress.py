@@ -187,7 +187,7 @@ def _engine_phase(reg):
     """The register's engine force phase of a batch of one on the host with F_j = −F_i, when it
     is all the register holds (else None: the register is read entry by entry)."""
     ph = reg.engine_phase()
-    if ph is None or ph.terms.fx_j is not None or ph.engine.s.B != 1 or not ph.engine.backend.host:
+    if ph is None or ph.terms.fx_j is not None or not ph.one_host_replica:
         return None
     return ph
 
