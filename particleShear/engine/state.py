@@ -217,7 +217,10 @@ class PairTable:
             found = at < len(k)
             found[found] = k[at[found]] == kept[found]
             if not found.all():
-                k = np.union1d(k, kept[~found])
+                # the few kept keys merged into the sorted unique candidates: an O(n) insert (a
+                # union1d sorts the whole set anew, ≈ 60 ms of a rebuild at N = 100,000)
+                extra = np.unique(kept[~found])
+                k = np.insert(k, np.searchsorted(k, extra), extra)
         pos = np.searchsorted(old_key, k)
         pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
         had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
