@@ -716,12 +716,12 @@ class BatchEngine:
         Parameters
         ----------
         dt : float
-            Time step (s).
+            Time step (s) by which the strain and the clock advance.
 
         Raises
         ------
         EngineInstability
-            On a device, if the force phase's guard verdict is not sound.
+            On a device, when the guard verdict read with the flags is not sound.
         """
         s, xp = self.s, self.xp
         rate_s = self._image_frame()[1][s.rep]
