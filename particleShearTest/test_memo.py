@@ -162,6 +162,35 @@ class TestCanvasMemo(unittest.TestCase):
         np.testing.assert_array_equal(p["ext_i"], mi & ~internal)
         np.testing.assert_array_equal(p["ext_j"], mj & ~internal)
 
+    def test_register_lists_are_those_of_their_force_phase(self):
+        """The six lists are made when first read, from the record of the force phase: read after
+        the step's kick and movement (which change velocities, positions, ξ, states and relation
+        numbers) they are, entry by entry, the lists read at once, as 1.0.2's register, filled
+        during the force phase, keeps them until the next one."""
+        def lists(ens):
+            reg = ens.force_register
+            flat = lambda e: tuple(x._idx if hasattr(x, "_idx") else tuple(x) if isinstance(x, list) else x
+                                   for x in e)   # noqa: E731
+            return {name: [flat(e) for e in getattr(reg, name)] for name in (
+                "pair_register", "external_force_register", "internal_moment_register",
+                "external_moment_register", "total_particle_force_register", "unbalanced_moment_register")}
+        at_once, later = self.ens, _scene()
+        for _ in range(15):
+            later.mechanical_simulation_step(cool_factor=0.95, dt=1e-3)
+        later.mechanical_simulation_step_calculate_forces()
+        later.record_total_particle_forces()
+        at_once.record_total_particle_forces()
+        expected = lists(at_once)
+        xi_before = later._pairs.xi.copy()
+        later.mechanical_simulation_step_calculate_acceleration(0.95, 1e-3)
+        later.mechanical_simulation_step_calculate_movement(1e-3)
+        self.assertFalse(np.array_equal(later._pairs.xi, xi_before))     # the movement changed the history
+        got = lists(later)
+        self.assertGreater(len(expected["pair_register"]), 0)
+        self.assertGreater(len(expected["external_force_register"]), 0)
+        for name in expected:
+            self.assertEqual(got[name], expected[name], name)
+
     def test_sphere_parameters_give_each_visit_its_constants(self):
         ens = self.ens
         s = ens.sphereList[3]
