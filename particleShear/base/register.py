@@ -10,6 +10,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
+from ..engine.step import register_block
 from ..engine.xp import to_host
 
 __all__ = ["Force_register", "SphereSelection"]
@@ -182,10 +183,7 @@ class Force_register:
         then those of standalone term calls."""
         ph = self._phase
         if ph is not None and ph.block is None:
-            from ..engine.step import register_block
             ph.block = PairBlock(register_block(ph.terms, ph.N, ph.b, tangential=ph.tangential))
-            ph.block.pop("totals")
-            ph.block.pop("mobile")
             ph.block["pos_version"] = ph.pos_version
             self._block_list.insert(0, ph.block)
         return self._block_list
@@ -239,7 +237,6 @@ class Force_register:
         # the register's pair vectors are those of the force phase, while the spheres have not moved
         self._phase = EngineForcePhase(t, N, b, spin, ensemble._pos_version if engine.g is not None else -1,
                                        engine.s.B == 1 and engine.backend.host)
-        self._ens = ensemble
         self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None, tot)
         return True
 

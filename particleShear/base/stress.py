@@ -439,12 +439,13 @@ class StressTensorEvaluation:
             s = self._spheres = (n, np.zeros(n, dtype=np.intp), np.ones(n, dtype=bool), np.zeros(n))
         return s[1:]
 
-    def _shear_from_register(self, reg, pairs=None):
+    def _shear_from_register(self, reg, pairs=None, roles=None):
         """(τ_internal, τ_surface) of the register by the engine's shear-stress function (eq. S1-25).
 
         The one function of both the full and the σ_xy-only evaluation, on the same inputs, so
         G does not depend on whether tensors are kept.  ``pairs``: the register's entries when
-        already made (:func:`_entries`)."""
+        already made (:func:`_entries`); ``roles``: the internal and external flags of the
+        register's engine force phase when the tensors' inputs already hold them."""
         cell = _cell(self)
         ph = _engine_phase(reg)
         if ph is not None:
@@ -453,8 +454,9 @@ class StressTensorEvaluation:
             mob = ph.terms.mob
             # y − Ly/2 of the spheres: the ensemble's own (kept per position update) when the cells agree
             yc = ens._y_centred() if ens.size_y == self.size_y else ens._a["y"] - self.size_y / 2
-            tau = _engine_shear_stresses(C, 1, yc, pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted), active, dy,
-                                         fx_i, dF, cell["V"])
+            if roles is None:
+                roles = pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted)
+            tau = _engine_shear_stresses(C, 1, yc, roles, active, dy, fx_i, dF, cell["V"])
         else:
             q = OneReplicaInputs(**(_entries(reg) if pairs is None else pairs), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
@@ -607,7 +609,9 @@ class StressTensorEvaluation:
                            self._sphere_inputs(theSphereList, shear_rate))
         t = self._t
         t[...] = _es.evaluate_all(q)[0]
-        tau_internal, tau_surface = self._shear_from_register(reg, entries)
+        # the flags of the tensors' pair inputs (× relations, as the shear stresses take them anyway)
+        roles = q.parts[_es.love_weber].roles if entries is None else None
+        tau_internal, tau_surface = self._shear_from_register(reg, entries, roles)
         t[_ALL, 0, 1] = -tau_internal
         t[_EXT, 0, 1] = -tau_surface
 

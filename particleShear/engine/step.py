@@ -113,9 +113,8 @@ def register_block(t, N, b, tangential=True):
     Returns
     -------
     dict
-        The block's arrays (on the host), and under ``"totals"`` the (3, N) force and torque
-        totals of the replica's spheres and under ``"mobile"`` their mobility of that force
-        phase; None before a force phase that kept its terms.
+        The block's arrays (on the host); None before a force phase that kept its terms.  The
+        replica's totals and mobility the register takes from ``t.totals`` and ``t.mob`` itself.
     """
     if t is None:
         return None
@@ -137,9 +136,7 @@ def register_block(t, N, b, tangential=True):
             "D": np.array((h(t.dx), h(t.dy))),
             "visits": ([("elastic", el_i, el_j), ("viscous", v_i, v_j)], h(t.F) if tangential else None,
                        np.array((nx, ny)), np.array((-ny, nx)), h(t.d), h(C.w), h(t.touching), h(C.perm),
-                       h(t.birth), slice(None)),
-            "totals": to_host(t.totals, "register")[:, b * N:(b + 1) * N], "mobile": mob}
-
+                       h(t.birth), slice(None))}
 
 
 class BatchEngine:
