@@ -105,8 +105,6 @@ ENGINE_MODULES = [
     "particleShear.base.kernels",
     "particleShear.base.laws",
     "particleShear.base.memo",
-    "particleShear.base.memory",
-    "particleShear.base.namespace",
     "particleShear.base.neighbours",
     "particleShear.base.points",
     "particleShear.base.circles",

@@ -257,12 +257,45 @@ class TestBatchIndependence(unittest.TestCase):
         from particleShear.engine.relax import write_back
         from particleShear.engine.step import BatchEngine
         a = random_packing(3)
-        eng = BatchEngine(BatchState.from_ensembles([a]))
+        eng = BatchEngine(BatchState.of_ensemble(a))
+        eng.numbers_relations = False
         eng.step(1.0, a.dt)
-        x = a._a["x"].copy()
+        x, t = a._a["x"].copy(), a.t
         with self.assertRaisesRegex(ValueError, "numbers_relations"):
             write_back(eng, 0, a)
-        self.assertEqual(a._a["x"].tobytes(), x.tobytes())
+        self.assertEqual((a._a["x"].tobytes(), a.t), (x.tobytes(), t))
+
+    def test_write_back_needs_the_ensembles_own_state(self):
+        # a copy of the ensemble (from_ensembles) is not handed back: the engine's spheres are not
+        # the ensemble's, and nothing copies them
+        from particleShear.engine.relax import write_back
+        from particleShear.engine.step import BatchEngine
+        a, b = random_packing(3), random_packing(4)
+        eng = BatchEngine(BatchState.from_ensembles([a]))
+        eng.numbers_relations = True
+        eng.step(1.0, a.dt)
+        with self.assertRaisesRegex(ValueError, "own state"):
+            write_back(eng, 0, a)
+        both = BatchEngine(BatchState.of_ensembles([a, b]))
+        with self.assertRaisesRegex(ValueError, "own state"):
+            write_back(both, 0, b)
+
+    def test_a_batch_steps_the_ensembles_own_rows(self):
+        # of_ensembles: the batch's sphere arrays are the ensembles' rows, so a relaxed batch leaves
+        # each ensemble exactly where the engine put its replica
+        from particleShear.engine.step import BatchEngine
+        a, b = random_packing(5), random_packing(6)
+        s = BatchState.of_ensembles([a, b])
+        eng = BatchEngine(s)
+        for _ in range(5):
+            eng.step(1.0, a.dt)
+        for k, e in enumerate((a, b)):
+            rows = s.replica(k)
+            for name, src in (("x", "x"), ("yspeed", "vy"), ("omega", "omega"), ("xforce", "fx")):
+                self.assertEqual(e._a[name].tobytes(), getattr(s, src)[rows].tobytes())
+            self.assertIs(s.pairs[k], e._pairs)
+        with self.assertRaisesRegex(ValueError, "twice"):
+            BatchState.of_ensembles([a, a])
 
 
 if __name__ == "__main__":

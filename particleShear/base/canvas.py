@@ -1,20 +1,7 @@
-"""Canvases: the ensemble state arrays and the vectorised step (see docs/design.md).
+"""Canvases: the ensemble's state arrays and the documented step (docs/design.md, "The documented classes").
 
-Each class of the documented chain adds one capability:
-
-=========================================  ==============================================
-``CanvasPoints``                           state arrays, ``sphereList``, bookkeeping
-``CanvasPointsMass``                       kick, damping, force register, momenta
-``CanvasPointsNeighbors``                  pair table and the O(N) neighbour update
-``CanvasPointsShear``                      Lees-Edwards offset, plates, shear rate
-``CanvasPointsBasicElasticity``            central elastic + viscous pair term
-``CanvasPointsBasicElasticityLeesEdwards`` rate changes, boundary-aware registration
-``CanvasPointsFrictionElasticityLeesEdwards``  tangential term, torques, ξ history
-=========================================  ==============================================
-
-A step never loops over spheres or pairs in Python.  Forces of one force phase
-are collected per active pair and applied with one ``bincount`` per component
-(`_flush_pair_forces`), which also fills the force register.
+Each class adds one capability: points and ``sphereList``, mass and force register, pair table,
+Lees-Edwards shear and plates, central forces and the step, shear-rate changes, friction and spin.
 """
 __docformat__ = "numpy"
 
@@ -25,12 +12,9 @@ import numpy as np
 from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
 from .kernels import le_wrap
-from .namespace import (count_nonzero as _nz)
-from . import laws
 from ..engine.integrate import damp
 from .memo import Memo
-from .memory import tune_allocator
-from .neighbours import SLIP
+from ..engine.memory import tune_allocator
 from .points import _check_finite, _check_positive
 from .register import Force_register, SphereSelection
 from .stability import StabilityGuard
@@ -40,32 +24,18 @@ __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasP
            "CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards",
            "CanvasPointsFrictionElasticityLeesEdwards", "SphereList", "check_non_negative", "check_time_step"]
 
-_PARAMS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
-           "keep_viscosity_coefficients_constant")
-
-
-#: a sphere found farther than this many cell lengths outside the cell after a step has diverged
-#: (or was placed there by mistake): no physical step moves a sphere across a thousand cells
+#: a sphere farther than this many cell lengths outside the cell has diverged (or was misplaced)
 MAX_CELLS_OUTSIDE = 1000
 
 
 def check_time_step(dt, step=None):
-    """Raise ValueError unless the time step ``dt`` (s) is a finite real number > 0.
-
-    A zero, negative, infinite or NaN step would freeze, reverse or destroy the state
-    (NaN or infinite positions) without any error; refusing it costs one comparison.
+    """Raise ValueError unless the time step ``dt`` (s) is a finite number > 0 (not a bool).
 
     Parameters
     ----------
     dt : float
-        Time step (s).
     step : int or None
-        Current step, named in the message when given.
-
-    Raises
-    ------
-    ValueError
-        If ``dt`` is not a finite number > 0 (a bool is refused too).
+        Current step, named in the message.
     """
     if isinstance(dt, bool) or not 0.0 < dt < math.inf:
         where = "" if step is None else f" at step {step}"
@@ -73,21 +43,13 @@ def check_time_step(dt, step=None):
 
 
 def check_non_negative(name, value):
-    """Raise ValueError unless ``value`` is a finite number ≥ 0.
+    """Raise ValueError unless ``value`` is a finite number ≥ 0 (TypeError if not a real number).
 
     Parameters
     ----------
     name : str
-        Parameter name used in the message.
+        Parameter name for the message.
     value : float
-        The value to check.
-
-    Raises
-    ------
-    TypeError
-        If ``value`` is not a real number.
-    ValueError
-        If ``value`` is not finite or is negative.
     """
     _check_finite(name, value)
     if value < 0:
@@ -97,9 +59,7 @@ def check_non_negative(name, value):
 class NonNegative:
     """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu).
 
-    Only assignment is intercepted (and validated); the value lives in the instance
-    ``__dict__`` under its own name, so reading it is a plain attribute lookup
-    (a descriptor without ``__get__`` yields to the instance dictionary).
+    Only assignment is validated: without ``__get__`` a read is a plain instance-dict lookup.
     """
 
     def __set_name__(self, owner, name):
@@ -111,9 +71,7 @@ class NonNegative:
 
 
 class SphereList(list):
-    """The ensemble's spheres in index order; ``append`` moves a sphere's state into the arrays.
-
-    Spheres can only be added: removing, replacing or reordering raises ``TypeError``.
+    """The ensemble's spheres in index order; they can only be added (else ``TypeError``).
 
     Parameters
     ----------
@@ -126,28 +84,21 @@ class SphereList(list):
         self._canvas = canvas
 
     def append(self, sphere):
-        """Add a sphere: its state moves into the ensemble's arrays and its relations into the pair table.
+        """Add a sphere, moving its state into the ensemble's arrays (ValueError if already in one or invalid).
 
         Parameters
         ----------
-        sphere : object
-            A sphere (e.g. :class:`~particleShear.base.points.CircleFrictionElasticity`) not yet in an ensemble.
-
-        Raises
-        ------
-        ValueError
-            If the sphere is already in an ensemble, or its position, radius or mass is invalid.
+        sphere : Sphere
         """
         self._canvas._attach(sphere)
         list.append(self, sphere)
 
     def extend(self, spheres):
-        """Append every sphere of ``spheres`` in order (see :meth:`append`).
+        """Append every sphere of ``spheres`` in order.
 
         Parameters
         ----------
-        spheres : iterable
-            The spheres.
+        spheres : iterable of Sphere
         """
         for s in spheres:
             self.append(s)
@@ -157,53 +108,34 @@ class SphereList(list):
         return self
 
     def _forbidden(self, *args, **kwargs):
-        """Refused: spheres cannot be removed, replaced or reordered once in an ensemble.
+        """Raise TypeError: spheres cannot be removed, replaced or reordered once in an ensemble.
 
         Parameters
         ----------
-        *args
+        *args, **kwargs
             Ignored.
-        **kwargs
-            Ignored.
-
-        Raises
-        ------
-        TypeError
-            Always: spheres cannot be removed, replaced or reordered once in an ensemble.
         """
         raise TypeError("spheres cannot be removed, replaced or reordered once in an ensemble")
 
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
 
 
-_SLIP8 = np.int8(SLIP)   # compared with the int8 state array without a scalar conversion
-
-
 # ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
 _max_reduce = np.maximum.reduce
 _min_reduce = np.minimum.reduce
-#: built-in central laws, which are exactly 0 for d ≥ r_i + r_j (no masking of inactive candidates needed)
-_ZERO_BEYOND_CONTACT = (laws.elastic_force_law, laws.elastic_force_law_plateau)
 
 
 class CanvasPoints:
-    """Cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form.
-
-    Random choices use the generator set by :meth:`set_random_generator` (seeded by the run).
+    """Periodic cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form.
 
     Parameters
     ----------
     size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
+        Cell size Lx, Ly (µm), finite and > 0 (else ValueError).
     theCanvas : object or bool
         Tk canvas of the live window (False when none).
     doDrawing : bool
         Whether the spheres are drawn.
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0.
     """
 
     use_lees_edwards = False
@@ -223,7 +155,7 @@ class CanvasPoints:
         self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
         self._renderer = None
-        self._memo = Memo()   # every value kept between calls (docs/design.md, "The documented classes")
+        self._memo = Memo()   # every value kept between calls
         self._pos_version = 0
         self._params_version = 0
         self.graphical_output_configuration = Graphical_output_configuration()
@@ -236,19 +168,17 @@ class CanvasPoints:
 
     @sphereList.setter
     def sphereList(self, spheres):
-        """The spheres in index order (a :class:`SphereList`); assignable only while the ensemble is empty."""
         if len(self._sphereList):
             raise TypeError("sphereList can only be assigned while the ensemble is empty")
         for s in spheres:
             self._sphereList.append(s)
 
     def set_random_generator(self, rng):
-        """Use ``rng`` (a ``numpy.random.Generator``) for every random choice of this ensemble.
+        """Use ``rng`` for every random choice of this ensemble (the run seeds it).
 
         Parameters
         ----------
         rng : numpy.random.Generator
-            The generator (e.g. ``numpy.random.default_rng(seed)``).
         """
         self._rng = rng
 
@@ -263,9 +193,7 @@ class CanvasPoints:
         self._views()
 
     def _views(self):
-        """Per-field views ``_a[name]`` and the grouped rows the kernels gather in one call:
-        ``_pos`` (x, y), ``_coord`` (x, y, phi), ``_vel`` (xspeed, yspeed, omega), ``_frc`` (xforce,
-        yforce, torque)."""
+        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_coord``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]
         self._st = st
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
@@ -302,11 +230,7 @@ class CanvasPoints:
         self._adopt_relations(sphere)
 
     def _adopt_relations(self, sphere):
-        """Move relations made before appending (e.g. links) into the pair table.
-
-        A relation is adopted once both of its spheres are in this ensemble; the
-        partner's own relation back supplies the second history.
-        """
+        """Move relations made before appending (e.g. links) into the pair table once both spheres are in."""
         own = sphere.__dict__.get("_own_neighbors")
         if not own or not hasattr(self, "_pairs"):
             return
@@ -354,7 +278,6 @@ class CanvasPoints:
         Parameters
         ----------
         graphical_output_configuration : Graphical_output_configuration
-            The drawing options.
         """
         self.graphical_output_configuration = graphical_output_configuration
         for s in self.sphereList:
@@ -373,32 +296,19 @@ class CanvasPoints:
             a["yspeed"] -= a["yspeed"].sum() / self._n
 
     def particle_info(self):
-        """Short description of the ensemble for the output header.
-
-        Returns
-        -------
-        str
-            The description.
-        """
+        """Return a short description of the ensemble for the output header."""
         return "Points in a periodic cell"
 
     def canMove(self, theSphere):
-        """Whether the sphere is mobile (always True here; plates are added by :class:`CanvasPointsShear`).
+        """Whether ``theSphere`` is mobile: always, except plate spheres while a :class:`CanvasPointsShear` shears.
 
         Parameters
         ----------
-        theSphere : object
-            A sphere of this ensemble.
-
-        Returns
-        -------
-        bool
-            True.
+        theSphere : Sphere
         """
         return True
 
     def _mobile_mask(self):
-        """Boolean mask of mobile spheres, or None when every sphere is mobile."""
         return self._mobile()[0]
 
     def _mobile(self):
@@ -406,24 +316,22 @@ class CanvasPoints:
         return None, None
 
     def movableSphereList(self):
-        """The mobile spheres, in index order, as a list (a :class:`SphereSelection`: new on each call,
-        and recognised by the stress evaluation, which then sums over the ensemble's arrays)."""
+        """The mobile spheres in index order (a new :class:`SphereSelection`, which the stress evaluation sums fast)."""
         sel = self._mobile_selection()
         return SphereSelection(self, sel.mask, sel)
 
     def _mobile_selection(self):
-        """The selection of the mobile spheres the stress evaluation is given (kept while the same spheres are
-        mobile: building the list of spheres costs ≈ 10 % of a step at N = 10,000)."""
+        """Selection of the mobile spheres, kept while they stay the same (building it costs ≈ 10 % of a step)."""
         mob, mob_bytes = self._mobile()
         return self._memo.get("selection", (self._n, mob_bytes), lambda: SphereSelection(self, mob))
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres ``v += F·dt/m`` and reset their force.
+        """Kick mobile spheres ``v += F·dt/m`` and reset their force (plate spheres take their plate's velocity).
 
         Parameters
         ----------
         dt : float
-            Time step (s), finite and > 0.
+            Time step (s).
         """
         a = self._a
         mob = self._mobile_mask()
@@ -443,12 +351,12 @@ class CanvasPoints:
         pass
 
     def cool(self, f=0.8):
-        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` of all spheres (SLLOD-like; docs/design.md).
+        """Multiply the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` (and any spin) by ``f``.
 
         Parameters
         ----------
         f : float
-            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
+            Damping factor, 0 < f ≤ 1 (1 = no damping).
         """
         rate = getattr(self, "shear_rate", 0)
         damp(self._vel[:2], self._affine_vx(rate) if rate else None, f)
@@ -461,7 +369,7 @@ class CanvasPoints:
         self._pos_version += 1
 
     def move(self, dt=1):
-        """Drift: advance every position by velocity × ``dt``.
+        """Drift every position by velocity × ``dt`` (with pairs: their ξ rule first, and φ turns by ω·dt).
 
         Parameters
         ----------
@@ -474,8 +382,7 @@ class CanvasPoints:
         return 0.0
 
     def _y_centred(self):
-        """``y − Ly/2`` of every sphere (µm): the affine flow, the damping, the shear-rate change, the
-        drift bookkeeping and the shear stress need it."""
+        """``y − Ly/2`` of every sphere (µm)."""
         return self._pos[1] - self.size_y / 2
 
     def _affine_vx(self, rate):
@@ -483,12 +390,10 @@ class CanvasPoints:
         return self._y_centred() * rate
 
     def boundary_conditions(self):
-        """Wrap every sphere into the cell (Lees-Edwards shifted where active; docs/design.md).
+        """Wrap every sphere into the cell (Lees-Edwards shifted where active).
 
-        Raises
-        ------
-        SimulationInstabilityError
-            If a position is not finite or lies more than :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
+        Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
+        :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
         """
         a = self._a
         if self._n:
@@ -511,10 +416,7 @@ class CanvasPoints:
         self._pos_version += 1
 
     def _check_positions(self, pos=None):
-        """Raise :class:`SimulationInstabilityError` for a non-finite position or one more than
-        :data:`MAX_CELLS_OUTSIDE` cell lengths outside the cell (step, sphere and value in the message).
-
-        ``pos``: the (2, n) positions to check (default the spheres' own)."""
+        """Raise SimulationInstabilityError for a non-finite or far-outside position among ``pos`` (2, n)."""
         pos = self._pos if pos is None else pos
         x, y = pos[0], pos[1]
         Lx, Ly = self.size_x, self.size_y
@@ -524,7 +426,7 @@ class CanvasPoints:
         with np.errstate(invalid="ignore"):
             bad = ~((np.abs(x - Lx / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Lx)
                     & (np.abs(y - Ly / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Ly))
-        if not _nz(bad):
+        if not bad.any():
             return
         k = int(np.flatnonzero(bad)[0])
         step = getattr(self, "step_count", None)
@@ -539,7 +441,7 @@ class CanvasPoints:
         guard._fail(self, step, phase, getattr(self, "_last_dt", None), reason, pair=(k,))
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
-        """Place the spheres on a square grid with random jitter of ``rand_fraction`` of a spacing.
+        """Place the spheres on a square grid with random jitter.
 
         Parameters
         ----------
@@ -565,19 +467,10 @@ class CanvasPointsMass(CanvasPoints):
 
     Parameters
     ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
+    size_x, size_y, theCanvas, doDrawing
+        As for :class:`CanvasPoints`.
     m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0.
+        Default sphere mass (mg per m depth); each sphere carries its own.
     """
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
@@ -590,22 +483,19 @@ class CanvasPointsMass(CanvasPoints):
         """Clear the force register (start of a force phase)."""
         self.force_register.reset_force_register()
 
-    # Registration filters (boundary-crossing forces are external) for scripts that apply forces sphere by sphere.
+    # registration filters for scripts that apply forces sphere by sphere
     def _source_is_external(self, target, source):
         return False
 
     def record_individual_internal_force(self, target, source, force_vector):
-        """Record a pair force sphere by sphere: dropped for an immobile target, external when the source is
-        immobile or acts through the periodic boundary, internal otherwise.
+        """Record the pair force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``source`` on ``target``.
+
+        Dropped on an immobile target; external from an immobile source or through the boundary.
 
         Parameters
         ----------
-        target : object
-            The sphere the force acts on.
-        source : object
-            The sphere exerting it.
+        target, source : Sphere
         force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
         if not self.canMove(target):
             return
@@ -615,16 +505,12 @@ class CanvasPointsMass(CanvasPoints):
             self.force_register.record_individual_internal_force(target, source, force_vector)
 
     def record_individual_internal_torque(self, target, source, moment):
-        """Record a pair torque with the same filters as :meth:`record_individual_internal_force`.
+        """Record the pair torque ``moment`` (mg·µm²·s⁻² per m), filtered as :meth:`record_individual_internal_force`.
 
         Parameters
         ----------
-        target : object
-            The sphere the torque acts on.
-        source : object
-            The sphere exerting it.
+        target, source : Sphere
         moment : float
-            Torque (mg·µm²·s⁻² per m depth).
         """
         if not self.canMove(target):
             return
@@ -634,53 +520,45 @@ class CanvasPointsMass(CanvasPoints):
             self.force_register.record_individual_internal_torque(target, source, moment)
 
     def record_total_particle_force(self, target, force_vector):
-        """Record the total force of a mobile sphere (dropped for an immobile one).
+        """Record the total force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``target`` unless it is immobile.
 
         Parameters
         ----------
-        target : object
-            The sphere the force acts on.
+        target : Sphere
         force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
         if self.canMove(target):
             self.force_register.record_total_particle_force(target, force_vector)
 
     def record_external_force(self, target, force_vector):
-        """Record an external force on a mobile sphere (dropped for an immobile one).
+        """Record an external force ``(F_x, F_y)`` (mg·µm·s⁻² per m) on ``target`` unless it is immobile.
 
         Parameters
         ----------
-        target : object
-            The sphere the force acts on.
+        target : Sphere
         force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
         if self.canMove(target):
             self.force_register.record_external_force(target, force_vector)
 
     def record_external_torque(self, target, moment):
-        """Record an external torque on a mobile sphere (dropped for an immobile one).
+        """Record an external torque (mg·µm²·s⁻² per m) on ``target`` unless it is immobile.
 
         Parameters
         ----------
-        target : object
-            The sphere the torque acts on.
+        target : Sphere
         moment : float
-            Torque (mg·µm²·s⁻² per m depth).
         """
         if self.canMove(target):
             self.force_register.record_external_torque(target, moment)
 
     def record_unbalanced_moment(self, target, moment):
-        """Record the net torque of a mobile sphere (dropped for an immobile one).
+        """Record the net torque (mg·µm²·s⁻² per m) of ``target`` unless it is immobile.
 
         Parameters
         ----------
-        target : object
-            The sphere the torque acts on.
+        target : Sphere
         moment : float
-            Torque (mg·µm²·s⁻² per m depth).
         """
         if self.canMove(target):
             self.force_register.record_unbalanced_moment(target, moment)
@@ -698,17 +576,11 @@ class CanvasPointsMass(CanvasPoints):
         return "Spheres with mass"
 
     def evaluate_stress_tensors(self, StressTensorEvaluator):
-        """Evaluate every tensor (eqs. S1-16 to S1-24) for the current register, mobile spheres and shear rate.
+        """Evaluate every tensor (eqs. S1-16 to S1-24) of the register, mobile spheres and rate; return the evaluator.
 
         Parameters
         ----------
         StressTensorEvaluator : StressTensorEvaluation
-            The evaluator whose tensors are updated.
-
-        Returns
-        -------
-        StressTensorEvaluation
-            The same evaluator.
         """
         sel = self._mobile_selection()
         StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
@@ -718,7 +590,7 @@ class CanvasPointsMass(CanvasPoints):
         """Set the force of every sphere to zero."""
         self._frc[:2] = 0.0
 
-    # Momenta (raw coordinates, origin at the cell corner) — conserved in isolated scenes.
+    # momenta in raw coordinates (origin at the cell corner)
     def total_momentum(self):
         """Linear momentum ``Σ m v`` (mg·µm/s per m depth)."""
         a = self._a

@@ -1,8 +1,7 @@
 """Circles: discs with a mass and relations to their neighbours (docs/design.md, "State").
 
-:class:`Circle` (a disc of radius r, µm, and its drawing), :class:`CircleMass` (mass, forces and the
-register of 1.0.2) and :class:`CircleMassNeighbors` (the relations, views of the ensemble's pair
-table).  Handles into the ensemble's arrays once appended (:class:`~particleShear.base.points.ArrayField`).
+:class:`Circle` (radius, drawing), :class:`CircleMass` (mass, forces, 1.0.2's register) and
+:class:`CircleMassNeighbors` (relations); handles into the ensemble's arrays once appended.
 """
 __docformat__ = "numpy"
 
@@ -15,9 +14,8 @@ from .points import ArrayField, PointLeesEdwards, _check_positive, _one
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]
 
 
-
 class Circle(PointLeesEdwards):
-    """Disc of radius ``diameter/2`` (µm); the cross-section of an infinite cylinder.
+    """Disc of radius ``r = diameter/2`` (µm), the cross-section of an infinite cylinder.
 
     Parameters
     ----------
@@ -26,18 +24,18 @@ class Circle(PointLeesEdwards):
     x, y : float
         Position of the centre (µm).
     diameter : float
-        Diameter (µm, > 0); the radius ``r`` is half of it.
+        Diameter (µm, > 0).
     theCanvas : object or bool
-        Tk canvas to draw on (stored for compatibility; False when none).
+        Tk canvas, stored for compatibility (False: none).
     doDrawing : bool
-        Whether the sphere is drawn (the ensemble's renderer draws it).
+        Whether the ensemble's renderer draws the sphere.
     use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
+        Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
 
     Raises
     ------
-    ValueError
-        If ``diameter`` is not a finite number > 0, or ``x``/``y`` is not finite.
+    TypeError, ValueError
+        If ``x``, ``y`` or ``diameter`` is not a finite number, or ``diameter`` not > 0.
     """
 
     r = ArrayField(1.0, geometry=True, positive=True, param=True)
@@ -54,118 +52,82 @@ class Circle(PointLeesEdwards):
         self.graphical_output_configuration = Graphical_output_configuration()
 
     def set_graphical_output_configuration(self, graphical_output_configuration):
-        """Use these drawing options for the sphere.
+        """Use these drawing options for the sphere and its contacts.
 
         Parameters
         ----------
         graphical_output_configuration : Graphical_output_configuration
-            The options.
         """
         self.graphical_output_configuration = graphical_output_configuration
 
     def coordinates(self):
-        """Position and radius as ``[x, y, r]`` (µm).
-
-        Returns
-        -------
-        list of float
-            ``[x, y, r]``.
-        """
+        """Return ``[x, y, r]`` (µm)."""
         return [self.x, self.y, self.r]
 
     # Drawing happens in the renderer of the ensemble (layer 4); these hooks keep the API.
     def initiate_drawing(self):
-        """Kept for the 1.0.2 API: the ensemble's renderer draws the spheres (does nothing)."""
+        """Do nothing (1.0.2 API: the ensemble's renderer draws the spheres)."""
         pass
 
     def move(self, dt=1):
-        """Drift by velocity × ``dt`` (the drawing follows in the renderer).
+        """Drift by velocity × ``dt`` (s).
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         PointLeesEdwards.move(self, dt)
         self.moveDrawing(dt)
 
     def moveDrawing(self, dt):
-        """Kept for the 1.0.2 API: the ensemble's renderer moves the drawing (does nothing).
+        """Do nothing (1.0.2 API: the ensemble's renderer moves the drawing).
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         pass
 
     def deleteDrawing(self):
-        """Kept for the 1.0.2 API: the ensemble's renderer deletes the drawing (does nothing)."""
+        """Do nothing (1.0.2 API: the ensemble's renderer deletes the drawing)."""
         pass
 
     def tangential_vector(self, theSphere):
-        """Unit tangent ``t = (−n_y, n_x)`` of the contact with the other sphere.
+        """Return the unit tangent ``t = (−n_y, n_x)`` of the contact with ``theSphere``.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[t_x, t_y]``.
         """
         n = self.n(theSphere)
         return [-n[1], n[0]]
 
     def tangential_speed(self, theSphere):
-        """Slip velocity along ``t_ij`` (:func:`~particleShear.engine.terms.slip_speed`, µm/s).
-
-        ``Δv·t_ij − (r_i ω_i + r_j ω_j)``: the translational part only for a sphere without spin,
-        the slip of the two surfaces at the contact point for a spinning one
-        (:class:`CircleFrictionElasticity`).
+        """Return the slip speed ``Δv·t − (r_i ω_i + r_j ω_j)`` to ``theSphere`` (µm/s; ω = 0 without spin).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        float
-            Speed (µm/s).
         """
         return self._pairs([theSphere]).slip().item()
 
 
 class CircleMass(Circle):
-    """Disc with mass ``m`` (mg per m depth) and a force accumulator (mg·µm·s⁻² per m).
+    """Disc with mass ``m`` (mg per m depth) and a force accumulator (mg·µm·s⁻² per m depth).
 
     Parameters
     ----------
-    color : str
-        Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
-    diameter : float
-        Diameter (µm, > 0); the radius ``r`` is half of it.
+    color, x, y, diameter, theCanvas, doDrawing, use_lees_edwards
+        As for :class:`Circle`.
     m : float
         Mass (mg per m depth, > 0).
-    theCanvas : object or bool
-        Tk canvas to draw on (stored for compatibility; False when none).
-    doDrawing : bool
-        Whether the sphere is drawn (the ensemble's renderer draws it).
     force_register : Force_register or None
-        Register that records the forces; None gives the sphere a register of its own (in an
-        ensemble the ensemble's register is used).
-    use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
+        Register of the forces; None: one of its own (in an ensemble, the ensemble's is used).
 
     Raises
     ------
-    ValueError
-        If ``diameter`` or ``m`` is not a finite number > 0, or ``x``/``y`` is not finite.
+    TypeError, ValueError
+        As for :class:`Circle`, and if ``m`` is not a finite number > 0.
     """
 
     m = ArrayField(1.0, positive=True, param=True)
@@ -187,14 +149,11 @@ class CircleMass(Circle):
         self.force_register.record_total_particle_force(self, [self.xforce, self.yforce])
 
     def do_linear_acceleration(self, dt):
-        """Register the total force, kick the velocity by ``F dt / m``, reset the force.
-
-        :func:`~particleShear.engine.integrate.kick` on this sphere.
+        """Register the total force, kick the velocity by ``F dt / m`` (``dt`` in s), reset the force.
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         self.record_total_particle_force()
         vel, frc = _one(self.xspeed, self.yspeed)[:, None], _one(self.xforce, self.yforce)[:, None]
@@ -203,16 +162,15 @@ class CircleMass(Circle):
         self.xforce, self.yforce = frc[:, 0].tolist()
 
     def applyInternalForceAndRegister(self, force_vector, source, register_homolog=False):
-        """Add a pair force to the accumulator and record it as internal.
+        """Add the force ``force_vector`` (mg·µm·s⁻² per m depth) from ``source`` and record it as internal.
+
+        ``register_homolog``: also record the opposite force on ``source`` in its register.
 
         Parameters
         ----------
         force_vector : sequence of float
-            ``(F_x, F_y)`` on this sphere (mg·µm·s⁻² per m depth).
         source : CircleMass
-            The sphere exerting it.
         register_homolog : bool
-            Also record the opposite force on ``source`` in its register.
         """
         self.xforce = self.xforce + force_vector[0]
         self.yforce = self.yforce + force_vector[1]
@@ -223,32 +181,12 @@ class CircleMass(Circle):
 
 
 class CircleMassNeighbors(CircleMass):
-    """Disc with a neighbour list of relation objects (views of the ensemble's pair table).
+    """Disc with a neighbour list of relations (views of the ensemble's pair table once appended).
 
     Parameters
     ----------
-    color : str
-        Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
-    diameter : float
-        Diameter (µm, > 0); the radius ``r`` is half of it.
-    m : float
-        Mass (mg per m depth, > 0).
-    theCanvas : object or bool
-        Tk canvas to draw on (stored for compatibility; False when none).
-    doDrawing : bool
-        Whether the sphere is drawn (the ensemble's renderer draws it).
-    force_register : Force_register or None
-        Register that records the forces; None gives the sphere a register of its own (in an
-        ensemble the ensemble's register is used).
-    use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
-
-    Raises
-    ------
-    ValueError
-        If ``diameter`` or ``m`` is not a finite number > 0, or ``x``/``y`` is not finite.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register, use_lees_edwards
+        As for :class:`CircleMass` (and raising as it does).
     """
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
@@ -275,32 +213,16 @@ class CircleMassNeighbors(CircleMass):
         else:
             raise AttributeError("the neighbour list of a sphere in an ensemble is managed by the ensemble")
 
-    def set_graphical_output_configuration(self, graphical_output_configuration):
-        """Use these drawing options for the sphere and its contacts.
-
-        Parameters
-        ----------
-        graphical_output_configuration : Graphical_output_configuration
-            The options.
-        """
-        self.graphical_output_configuration = graphical_output_configuration
-
     def deleteNeighborDrawing(self):
-        """Kept for the 1.0.2 API: the renderer draws the contacts (does nothing)."""
+        """Do nothing (1.0.2 API: the renderer draws the contacts)."""
         pass
 
     def contactLineColor(self, interface_type):
-        """Colour of a contact line: the locked colour when sticking, else the slip colour.
+        """Return the colour of a contact line: the locked colour when ``"stick"``, else the slip colour.
 
         Parameters
         ----------
         interface_type : {"stick", "slip", "permanent"}
-            State of the relation.
-
-        Returns
-        -------
-        str
-            A colour of :attr:`graphical_output_configuration`.
         """
         cfg = self.graphical_output_configuration
         if interface_type == "stick":
@@ -308,21 +230,7 @@ class CircleMassNeighbors(CircleMass):
         return cfg.color_interface_slip
 
     def initiateNeighborDrawing(self):
-        """Kept for the 1.0.2 API: the renderer draws the contacts (does nothing)."""
-        pass
-
-    def moveDrawing(self, dt):
-        """Kept for the 1.0.2 API: the renderer moves the drawing (does nothing).
-
-        Parameters
-        ----------
-        dt : float
-            Time step (s).
-        """
-        pass
-
-    def deleteDrawing(self):
-        """Kept for the 1.0.2 API: the renderer deletes the drawing (does nothing)."""
+        """Do nothing (1.0.2 API: the renderer draws the contacts)."""
         pass
 
     def _relation(self, theSphere):
@@ -330,17 +238,11 @@ class CircleMassNeighbors(CircleMass):
         return None if k < 0 else self.neighbors[k]
 
     def findNeighborIndex(self, theSphere):
-        """Index of the relation pointing at ``theSphere`` in ``neighbors``, −1 if none (the last match wins).
+        """Return the index in ``neighbors`` of the (last) relation to the sphere ``theSphere``, −1 if none.
 
         Parameters
         ----------
         theSphere : CircleMassNeighbors
-            The partner (matched by identity).
-
-        Returns
-        -------
-        int
-            The index, or −1.
         """
         found = -1
         for k, rel in enumerate(self.neighbors):
@@ -352,15 +254,11 @@ class CircleMassNeighbors(CircleMass):
         return neighbor_relation(0, "stick", theSphere)
 
     def test_neighbor_relation(self, theSphere):
-        """Create or delete the relation to ``theSphere`` from the current overlap.
-
-        A relation is created when the discs overlap and dropped when they separate, unless it is
-        permanent (see docs/design.md).
+        """Create the relation to ``theSphere`` when the discs overlap, drop it when they separate (unless permanent).
 
         Parameters
         ----------
         theSphere : CircleMassNeighbors
-            The possible partner.
         """
         ens = self.__dict__.get("_ens")
         if ens is not None and theSphere.__dict__.get("_ens") is ens:

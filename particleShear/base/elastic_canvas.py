@@ -1,10 +1,4 @@
-"""Canvases with pair forces: the force, acceleration and movement phases of the documented step (docs/design.md, "The documented classes").
-
-=========================================  ==============================================
-``CanvasPointsBasicElasticity``            central elastic + viscous pair term (eqs. S1-5a/b, S1-6, S1-9)
-``CanvasPointsBasicElasticityLeesEdwards`` rate changes, boundary-aware registration
-``CanvasPointsFrictionElasticityLeesEdwards``  tangential term, torques, ξ history (eqs. S1-3, S1-7)
-=========================================  ==============================================
+"""Canvases with pair forces and the documented step (docs/design.md, "The documented classes").
 
 The phases of a step are the engine's (:mod:`particleShear.base.engine_view`); the canvas-wide
 per-term methods (``elastic_force_from_neighbors()`` …) are 1.0.2's loops over the per-sphere API.
@@ -20,27 +14,16 @@ __all__ = ["CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdward
 
 
 class CanvasPointsBasicElasticity(CanvasPointsShear):
-    """Adds the central elastic and viscous pair forces with constants ``k`` and ``nu``.
+    """Adds the central elastic and viscous pair forces (eqs. S1-5a/b, S1-9) and the step.
 
     Parameters
     ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
+    size_x, size_y, theCanvas, doDrawing, m
+        As for :class:`~particleShear.base.canvas.CanvasPointsMass`.
     k : float
-        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
+        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0 (else ValueError).
     nu : float
-        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
-    m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``/``nu`` is not a finite number ≥ 0.
+        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0 (else ValueError).
     """
 
     k = NonNegative()
@@ -59,24 +42,14 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     INTEGRATORS = ("euler", "verlet")
 
     def set_integrator(self, integrator):
-        """Choose the time integrator.
+        """Choose the time integrator (ValueError for another name).
 
-        ``"euler"`` (default) is the reference's semi-implicit Euler: kick with the
-        forces of the step, damp, drift.  ``"verlet"`` is velocity Verlet with a
-        half-kick predictor (Groot-Warren λ = 1/2): the velocity-dependent forces
-        see the velocity at the force time instead of half a step earlier, which
-        makes the viscous terms second-order accurate.  Positions and the
-        conservative forces are updated identically by both.
+        ``"euler"`` (default): the reference's semi-implicit Euler.  ``"verlet"``: velocity Verlet with a
+        half-kick predictor (Groot-Warren λ = 1/2), second-order accurate in the viscous terms.
 
         Parameters
         ----------
-        integrator : str
-            One of :attr:`INTEGRATORS` (``"euler"`` or ``"verlet"``).
-
-        Raises
-        ------
-        ValueError
-            If ``integrator`` is not one of them.
+        integrator : {"euler", "verlet"}
         """
         if integrator not in self.INTEGRATORS:
             raise ValueError(f"integrator must be one of {self.INTEGRATORS}, got {integrator!r}")
@@ -84,17 +57,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._half_kick = None
 
     def set_central_repulsion_coefficient(self, central_repulsion_coefficient=0):
-        """Set the law's repulsion coefficient c ∈ [0, 1] on the ensemble and every sphere.
+        """Set the law's repulsion coefficient c (0 linear, eq. S1-5a; 1 divergent, eq. S1-5b) on every sphere.
 
         Parameters
         ----------
         central_repulsion_coefficient : float
-            c of the force law: 0 = linear (eq. S1-5a), 1 = divergent (eq. S1-5b).
-
-        Raises
-        ------
-        ValueError
-            If the value is not finite.
+            Finite (else ValueError).
         """
         _check_finite("central_repulsion_coefficient", central_repulsion_coefficient)
         self.central_repulsion_coefficient = central_repulsion_coefficient
@@ -102,15 +70,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self._params_changed()
 
     def elastic_force_from_neighbors(self):
-        """Central elastic force of every relation (eqs. S1-5a, S1-5b), 1.0.2's loop: each sphere's
-        ``elastic_force_from_neighbors(k)`` in ``sphereList`` order (the per-sphere API, registered
-        entry by entry)."""
+        """Central elastic force of every relation (eqs. S1-5a/b): each sphere's method in ``sphereList`` order."""
         for sphere in list(self.sphereList):
             sphere.elastic_force_from_neighbors(self.k)
 
     def central_viscous_force_from_neighbors(self):
-        """Central viscous force ``ν v_n`` of every relation (eq. S1-9), 1.0.2's loop: each sphere's
-        ``central_viscous_force_from_neighbors(nu)`` in ``sphereList`` order."""
+        """Central viscous force ``ν v_n`` of every relation (eq. S1-9): each sphere's method in order."""
         for sphere in list(self.sphereList):
             sphere.central_viscous_force_from_neighbors(self.nu)
 
@@ -125,17 +90,12 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.central_viscous_force_from_neighbors()
 
     def mechanical_simulation_step_calculate_forces(self, dt=1):
-        """Clear the register, update neighbours, add every pair force (first phase of a step).
-
-        The engine's force phase on the ensemble's own state (:mod:`particleShear.base.engine_view`):
-        the forces and torques add to those already on the spheres, and the force register holds
-        the phase's terms.  Then the stability guard, if set, checks the state.  ``dt`` is
-        accepted for the 1.0.2 signature.
+        """First phase of a step: clear the register, update neighbours, add every pair force, run the guard.
 
         Parameters
         ----------
         dt : float
-            Time step (s); not used by the force phase.
+            Not used (1.0.2 signature).
         """
         self.reset_force_register()
         self._engine_force_phase()
@@ -145,43 +105,26 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
     _last_dt = None
 
     def mechanical_simulation_step_calculate_acceleration(self, cool_factor=0.97, dt=1):
-        """Kick the velocities with the forces of the step (the plates follow), then damp them (third
-        phase of a step; the engine's :meth:`~particleShear.engine.step.BatchEngine.accelerate`:
-        eqs. S1-10, S1-11).
-
-        With velocity Verlet the half kick of the mobile spheres is kept for the next force phase.
+        """Third phase of a step: kick the velocities (the plates follow), then damp (eqs. S1-10, S1-11).
 
         Parameters
         ----------
         cool_factor : float
-            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
+            Damping factor of the peculiar velocity per step, 0 < f ≤ 1 (1 = no damping).
         dt : float
-            Time step (s), finite and > 0.
-
-        Raises
-        ------
-        ValueError
-            If ``dt`` is not a finite number > 0 (before any work).
+            Time step (s), finite and > 0 (else ValueError before any work).
         """
         check_time_step(dt, self.step_count)
         self._last_dt = dt
         self._engine_accelerate(cool_factor, dt)
 
     def mechanical_simulation_step_calculate_movement(self, dt=1):
-        """ξ rule, drift, strain update, wrap, clock (last phase of a step; the engine's
-        :meth:`~particleShear.engine.step.BatchEngine.move`).
-
-        The strain advances by ``γ̇·dt`` while shearing (always in the frictional canvases).
+        """Last phase of a step: ξ rule, drift, strain ``+= γ̇·dt`` (while shearing; always if frictional), wrap, clock.
 
         Parameters
         ----------
         dt : float
-            Time step (s), finite and > 0.
-
-        Raises
-        ------
-        ValueError
-            If ``dt`` is not a finite number > 0 (before any work).
+            Time step (s), finite and > 0 (else ValueError before any work).
         """
         check_time_step(dt, self.step_count)
         self._engine_move(dt)
@@ -195,15 +138,8 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
         Parameters
         ----------
-        cool_factor : float
-            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
-        dt : float
-            Time step (s), finite and > 0.
-
-        Raises
-        ------
-        ValueError
-            If ``dt`` is not a finite number > 0 (before any work).
+        cool_factor, dt : float
+            As for :meth:`mechanical_simulation_step_calculate_acceleration`.
         """
         check_time_step(dt, self.step_count)  # before the force phase: a refused step does no work
         self.mechanical_simulation_step_calculate_forces()
@@ -212,25 +148,17 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.mechanical_simulation_step_calculate_movement(dt)
 
     def mechanical_relaxation(self, N=1000, cool_factor=0.97, dt=1, theTk=False, StressTensorEvaluator=False):
-        """N steps; optionally a window update and a stress evaluation after each.
+        """``N`` steps, each optionally followed by ``theTk.update()`` and a stress evaluation.
 
         Parameters
         ----------
         N : int
-            Number of steps.
-        cool_factor : float
-            Damping factor of the peculiar velocity per step (0 < f ≤ 1; 1 = no damping).
-        dt : float
-            Time step (s), finite and > 0.
+        cool_factor, dt : float
+            As for :meth:`mechanical_simulation_step_calculate_acceleration`.
         theTk : object or bool
-            Tk root window updated after each step (False: none).
+            Tk root window (False: none).
         StressTensorEvaluator : StressTensorEvaluation or bool
-            Evaluator updated after each step (False: none).
-
-        Raises
-        ------
-        ValueError
-            If ``dt`` is not a finite number > 0 (before any work).
+            Evaluator (False: none).
         """
         for _ in range(int(N)):
             self.mechanical_simulation_step(cool_factor, dt)
@@ -249,28 +177,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
 
 
 class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
-    """Adds shear-rate changes that keep velocities relative to the flow (docs/design.md).
-
-    Parameters
-    ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
-    k : float
-        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
-    nu : float
-        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
-    m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``/``nu`` is not a finite number ≥ 0.
-    """
+    """Adds shear-rate changes that keep velocities relative to the flow (parameters as the base class)."""
 
     def setShear(self, theShear):
         """Set the shear strain γ (the Lees-Edwards offset is ``Ly·γ``).
@@ -278,18 +185,17 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
         Parameters
         ----------
         theShear : float
-            Strain (dimensionless).
         """
         self.shear = theShear
         self._g = None
 
     def setShearInSpheres(self):
-        """Kept for the 1.0.2 API: spheres read γ from the ensemble (does nothing)."""
-        pass  # spheres read γ from the ensemble
+        """Does nothing (1.0.2 API): spheres read γ from the ensemble."""
+        pass
 
     def setShearRateInSpheres(self):
-        """Kept for the 1.0.2 API: spheres read γ̇ from the ensemble (does nothing)."""
-        pass  # spheres read γ̇ from the ensemble
+        """Does nothing (1.0.2 API): spheres read γ̇ from the ensemble."""
+        pass
 
     def adjust_sphere_speed_to_shear_rate_change(self, delta_shear_rate):
         """Add the change of the affine flow to every velocity (and −Δγ̇/2 to every spin).
@@ -297,19 +203,18 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
         Parameters
         ----------
         delta_shear_rate : float
-            Change Δγ̇ of the shear rate (1/s).
+            Δγ̇ (1/s).
         """
         a = self._a
         a["xspeed"] += self._y_centred() * delta_shear_rate
         a["omega"] -= delta_shear_rate / 2
 
     def setShearRate(self, theShearRate):
-        """Change γ̇; every sphere keeps its velocity relative to the local flow.
+        """Change γ̇ (1/s); every sphere keeps its velocity relative to the local flow.
 
         Parameters
         ----------
         theShearRate : float
-            New shear rate γ̇ (1/s).
         """
         delta = theShearRate - self.shear_rate
         if delta != 0:
@@ -318,33 +223,16 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
 
 
 class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesEdwards):
-    """Adds the tangential force (``k_t``, ``nu_t``, Coulomb ``mu``), spin and the ξ history.
+    """Adds the tangential force (eqs. S1-3, S1-7), spin and the ξ history.
 
     Parameters
     ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
-    k : float
-        Spring constant of the central force (mg·s⁻² per m depth, eq. S1-8), ≥ 0.
-    nu : float
-        Central viscosity constant (mg·s⁻¹ per m depth, eq. S1-9), ≥ 0.
-    m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-    k_t : float
-        Tangential spring constant (mg·s⁻² per m depth), ≥ 0.
-    nu_t : float
-        Tangential viscosity constant (mg·s⁻¹ per m depth), ≥ 0.
+    size_x, size_y, theCanvas, doDrawing, k, nu, m
+        As for :class:`CanvasPointsBasicElasticity`.
+    k_t, nu_t : float
+        Tangential spring (mg·s⁻² per m depth) and viscosity (mg·s⁻¹ per m depth) constants, ≥ 0.
     mu : float
-        Coulomb friction coefficient μ (dimensionless), ≥ 0.
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0, or ``k``, ``nu``, ``k_t``, ``nu_t`` or ``mu`` is not a finite number ≥ 0.
+        Coulomb friction coefficient μ, ≥ 0 (each of the three else ValueError).
     """
 
     k_t = NonNegative()
@@ -359,8 +247,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self.mu = mu
 
     def tangential_force_from_neighbors(self):
-        """Two-visit tangential force of every relation (torque split eq. S1-3), 1.0.2's loop: each
-        sphere's ``tangential_force_from_neighbors(nu_t, mu, k, k_t)`` in ``sphereList`` order."""
+        """Tangential force of every relation (eq. S1-3): each sphere's method in ``sphereList`` order."""
         for sphere in list(self.sphereList):
             sphere.tangential_force_from_neighbors(self.nu_t, self.mu, self.k, self.k_t)
 
@@ -388,13 +275,6 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         self._a["omega"] *= f
 
     def cool(self, f=0.8):
-        """Damp velocity relative to the affine flow and spin by ``f`` (docs/design.md), all three rows at once.
-
-        Parameters
-        ----------
-        f : float
-            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
-        """
         if type(self)._cool_spin is not CanvasPointsFrictionElasticityLeesEdwards._cool_spin:
             return CanvasPointsBasicElasticityLeesEdwards.cool(self, f)
         rate = getattr(self, "shear_rate", 0)

@@ -1,10 +1,9 @@
 """Elastic and frictional circles: the per-sphere force API of 1.0.2 (docs/design.md, "The documented classes").
 
-:class:`CircleBasicElasticity` (central elastic and viscous forces, eqs. S1-5a/b, S1-6, S1-9) and
-:class:`CircleFrictionElasticity` (tangential forces with the Coulomb bound and the torque split,
-eqs. S1-3, S1-7).  Each method evaluates the engine's pure functions (:mod:`particleShear.engine.terms`)
-on the pairs it is asked about, one visit per call as in 1.0.2.  ``CircleBasicElasticity`` holds the
-documented law callback ``call_back_elastic_force_law`` that the engine reads.
+Each method evaluates :mod:`particleShear.engine.terms` on the pairs it is asked about, one visit per
+call.  ``theSphere`` is the partner; ``k``, ``k_t`` the central and tangential spring constants
+(mg·s⁻² per m depth, eq. S1-8), ``nu`` a viscosity (mg·s⁻¹ per m depth, eq. S1-9), ``mu`` the friction
+coefficient; forces are in mg·µm·s⁻² per m depth.
 """
 __docformat__ = "numpy"
 import math
@@ -23,35 +22,15 @@ __all__ = ["CircleBasicElasticity", "CircleFrictionElasticity"]
 
 
 class CircleBasicElasticity(CircleMassNeighbors):
-    """Disc with central elastic and viscous contact forces (eqs. S1-5a, S1-5b; viscosity eq. S1-9).
+    """Disc with central elastic and viscous contact forces (eqs. S1-5a/b, S1-6, S1-9).
 
     The class attribute ``call_back_elastic_force_law`` (default
-    :func:`~particleShear.base.laws.elastic_force_law`) is the central force law of every sphere.
+    :func:`~particleShear.base.laws.elastic_force_law`) is the central law of every sphere; the engine reads it.
 
     Parameters
     ----------
-    color : str
-        Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
-    diameter : float
-        Diameter (µm, > 0); the radius ``r`` is half of it.
-    m : float
-        Mass (mg per m depth, > 0).
-    theCanvas : object or bool
-        Tk canvas to draw on (stored for compatibility; False when none).
-    doDrawing : bool
-        Whether the sphere is drawn (the ensemble's renderer draws it).
-    force_register : Force_register or None
-        Register that records the forces; None gives the sphere a register of its own (in an
-        ensemble the ensemble's register is used).
-    use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
-
-    Raises
-    ------
-    ValueError
-        If ``diameter`` or ``m`` is not a finite number > 0, or ``x``/``y`` is not finite.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register, use_lees_edwards
+        As for :class:`~particleShear.base.circles.CircleMass` (and raising as it does).
     """
 
     call_back_elastic_force_law = elastic_force_law
@@ -68,9 +47,9 @@ class CircleBasicElasticity(CircleMassNeighbors):
         return None
 
     def _terms(self, theSphere, d_eq=None, k=1.0, nu=0.0, k_t=0.0, nu_t=0.0, mu=0.0):
-        """:func:`~particleShear.engine.terms.term_constants` of the visit from this sphere to ``theSphere`` (a contact,
-        or a bond at ``d_eq``), with this sphere's c and permanent ratios (1 where it has none); the constants a
-        method does not take keep their defaults and do not enter its term."""
+        """:func:`~particleShear.engine.terms.term_constants` of the visit to ``theSphere`` (a contact, or a bond at
+        ``d_eq``), with this sphere's c and permanent ratios (1 where it has none); constants a method does not
+        take keep their defaults and do not enter its term."""
         bond = d_eq is not None
         return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None, _one(d_eq) if bond else None,
                               k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
@@ -84,56 +63,40 @@ class CircleBasicElasticity(CircleMassNeighbors):
         return None if law is elastic_force_law else _one(law(d.item(), K.d_law.item(), K.k, K.c))
 
     def _elastic(self, K, d):
-        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1): :func:`~particleShear.engine.terms.elastic_term`,
-        or the replaced callbacks."""
+        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1):
+        :func:`~particleShear.engine.terms.elastic_term`, or the replaced callbacks."""
         law = self._replaced_law(K, d)
         return elastic_term(K, d) if law is None else (law * K.ratio_c, law)
 
     def _apply_central(self, theSphere, p, f):
-        """Apply and register the central force ``f·n`` of the pair ``p`` (:func:`~particleShear.engine.terms.pair_forces`);
-        returns ``[F_x, F_y]``."""
+        """Apply and register the central force ``f·n`` of the pair ``p``
+        (:func:`~particleShear.engine.terms.pair_forces`); returns ``[F_x, F_y]``."""
         fx, fy = pair_forces(f, None, p.nx, p.ny, p.d, None)[:2]
         vec = [fx.item(), fy.item()]
         self.applyInternalForceAndRegister(vec, theSphere)
         return vec
 
     def get_elastic_force(self, theSphere, k=1):
-        """Scalar central elastic force of the active contact law, ``law(d, r_i + r_j, k, c)`` (negative = repulsion).
+        """Return the central force ``law(d, r_i + r_j, k, c)`` of the active contact law (negative = repulsion).
 
-        :func:`~particleShear.engine.terms.elastic_term` of the pair (eqs. S1-5a/b, cap S1-6),
-        or the replaced ``call_back_elastic_force_law``.
+        The built-in laws (eqs. S1-5a/b, S1-6) give 0 beyond contact.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         k : float
-            Spring constant (mg·s⁻² per m depth, eq. S1-8).
-
-        Returns
-        -------
-        float
-            Force (mg·µm·s⁻² per m depth); 0 beyond contact for the built-in laws.
         """
         return self._elastic(self._terms(theSphere, k=k), self._pairs([theSphere], normal=False).d)[0].item()
 
     def elastic_force(self, theSphere, k):
-        """Apply and register the central elastic force along ``n`` if the discs overlap (a bond: at any distance).
+        """Apply, register and return the central elastic force along ``n`` if the discs overlap, else ``[0, 0]``.
 
-        A contact takes the law of :meth:`get_elastic_force`, a bond of a linkable sphere that of
-        ``get_elastic_force_permanent``.
+        A bond of a linkable sphere acts at any distance, with the law of ``get_elastic_force_permanent``.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         k : float
-            Spring constant (mg·s⁻² per m depth, eq. S1-8).
-
-        Returns
-        -------
-        list of float
-            The force vector on this sphere (``[0, 0]`` for a contact without overlap).
         """
         d_eq = self._bond(theSphere)
         p = self._pairs([theSphere])
@@ -142,99 +105,60 @@ class CircleBasicElasticity(CircleMassNeighbors):
         return self._apply_central(theSphere, p, self._elastic(self._terms(theSphere, d_eq, k=k), p.d)[0])
 
     def elastic_force_from_neighbors(self, k):
-        """Apply the central elastic force of every relation (:meth:`elastic_force`, in ``neighbors`` order).
+        """Apply :meth:`elastic_force` for every relation, in ``neighbors`` order.
 
         Parameters
         ----------
         k : float
-            Spring constant (mg·s⁻² per m depth, eq. S1-8).
         """
         for rel in list(self.neighbors):
             self.elastic_force(rel.theSphere, k)
 
     def _viscous(self, theSphere, nu):
-        """The pair's :class:`_Pairs` and its :func:`~particleShear.engine.terms.viscous_term` ``ν·v_n`` (a bond's ν × its
-        ratio unless kept constant)."""
+        """The pair's ``_Pairs`` and its :func:`~particleShear.engine.terms.viscous_term` ``ν·v_n`` (a bond's ν
+        × its ratio unless kept constant)."""
         p = self._pairs([theSphere])
         vn = normal_speed(p.velocity(), p.nx, p.ny)
         return p, viscous_term(self._terms(theSphere, self._bond(theSphere), nu=nu), vn, None)
 
     def get_central_viscous_force(self, theSphere, nu):
-        """Scalar central viscous force ``ν v_n`` (eq. S1-9; a linkable sphere's bond: × ``permanent_ratio_central``
-        unless ``keep_viscosity_coefficients_constant``).
+        """Return the central viscous force ``ν v_n`` (eq. S1-9; a bond's ν × its ratio unless kept constant).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         nu : float
-            Viscosity constant (mg·s⁻¹ per m depth, eq. S1-9).
-
-        Returns
-        -------
-        float
-            Force (mg·µm·s⁻² per m depth).
         """
         return self._viscous(theSphere, nu)[1].item()
 
     def central_viscous_force(self, theSphere, nu):
-        """Apply and register the central viscous force ``ν v_n n`` (of :meth:`get_central_viscous_force`).
+        """Apply, register and return the force ``ν v_n n`` of :meth:`get_central_viscous_force`.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         nu : float
-            Viscosity constant (mg·s⁻¹ per m depth, eq. S1-9).
-
-        Returns
-        -------
-        list of float
-            The force vector on this sphere.
         """
         return self._apply_central(theSphere, *self._viscous(theSphere, nu))
 
     def central_viscous_force_from_neighbors(self, nu):
-        """Apply the central viscous force of every relation (:meth:`central_viscous_force`, in ``neighbors`` order).
+        """Apply :meth:`central_viscous_force` for every relation, in ``neighbors`` order.
 
         Parameters
         ----------
         nu : float
-            Viscosity constant (mg·s⁻¹ per m depth, eq. S1-9).
         """
         for rel in list(self.neighbors):
             self.central_viscous_force(rel.theSphere, nu)
 
 
 class CircleFrictionElasticity(CircleBasicElasticity):
-    """Disc with spin and tangential (frictional) contact forces (torque split eq. S1-3).
-
-    The moment of inertia is ``m r²/2`` (mg·µm² per m depth).
+    """Disc with spin and tangential (frictional) contact forces (eqs. S1-3, S1-7); inertia ``m r²/2``.
 
     Parameters
     ----------
-    color : str
-        Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
-    diameter : float
-        Diameter (µm, > 0); the radius ``r`` is half of it.
-    m : float
-        Mass (mg per m depth, > 0).
-    theCanvas : object or bool
-        Tk canvas to draw on (stored for compatibility; False when none).
-    doDrawing : bool
-        Whether the sphere is drawn (the ensemble's renderer draws it).
-    force_register : Force_register or None
-        Register that records the forces; None gives the sphere a register of its own (in an
-        ensemble the ensemble's register is used).
-    use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
-
-    Raises
-    ------
-    ValueError
-        If ``diameter`` or ``m`` is not a finite number > 0, or ``x``/``y`` is not finite.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register, use_lees_edwards
+        As for :class:`~particleShear.base.circles.CircleMass` (and raising as it does).
     """
 
     _spins = True
@@ -254,18 +178,14 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         self.inertia = self.m * self.r * self.r / 2
 
     def cool(self, f=0.8, shear_rate_to_rotation_rate_coefficient=0):
-        """Damp the velocity relative to the affine flow and the spin relative to the local rotation rate.
+        """Damp by ``f`` the velocity relative to the flow ``u = γ̇ (y − Ly/2)`` and ω relative to ``κ·u``.
 
-        :func:`~particleShear.engine.integrate.damp` of ``(v_x, v_y)`` relative to
-        ``u = γ̇ (y − Ly/2)`` (plain damping without Lees-Edwards) and of ω relative to ``κ·u``.
+        Without Lees-Edwards the velocity is damped plainly; κ = ``shear_rate_to_rotation_rate_coefficient``.
 
         Parameters
         ----------
         f : float
-            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
         shear_rate_to_rotation_rate_coefficient : float
-            κ: spin of the flow the rotation is damped towards, as a multiple of ``γ̇ (y − Ly/2)``
-            (0 = damp towards no rotation).
         """
         PointLeesEdwards.cool(self, f) if self.use_lees_edwards else Point.cool(self, f)
         spin = _one(self.omega)[:, None]
@@ -275,14 +195,12 @@ class CircleFrictionElasticity(CircleBasicElasticity):
     def _visit(self, theSphere, p, K, xi_ij, xi_ji=0.0, bounded=True):
         """One visit from this sphere of the tangential rule, :func:`~particleShear.engine.terms.tangential_term`.
 
-        The visit is the second visit of the engine's two-visit rule on the pair after a first one
-        that applies nothing (``k_t = ν_t = 0``), so the force, the slip decision and the reset of
-        both histories are this visit's: ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` with the
-        bound ``|μ·law|`` (bonds, and ``bounded=False``: none).
-
-        ``xi_ij``, ``xi_ji`` are the histories of this sphere's relation and of the partner's (µm).
-        Returns the visit's force along ``t_ij`` (array of 1), whether it slipped, and the (2, 1)
-        histories ``ξ_ji, ξ_ij`` after it (both 0 after a slip).
+        It is the second visit of the engine's two-visit rule after a first that applies nothing
+        (``k_t = ν_t = 0``), so the force, the slip decision and the reset of both histories are this
+        visit's: ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` within ``|μ·law|`` (bonds and
+        ``bounded=False``: no bound).  ``xi_ij``, ``xi_ji``: the histories of this sphere's relation and
+        of the partner's (µm).  Returns the force along ``t_ij`` (array of 1), whether it slipped, and the
+        (2, 1) histories ``ξ_ji, ξ_ij`` after it (both 0 after a slip).
         """
         ri, rj = p.radii()
         law = self._elastic(K, p.d)[1] if bounded else _one(0.0)
@@ -301,36 +219,22 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         return self._visit(theSphere, p, K, 0.0 if xi is None else xi, bounded=False)[0].item()
 
     def tangential_force_viscous(self, theSphere, nu):
-        """Tangential viscous force ``ν_t v_t`` if the discs overlap, else 0 (the viscous part of a visit).
+        """Return the tangential viscous force ``ν_t v_t`` (``nu`` = ν_t) if the discs overlap, else 0.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         nu : float
-            Tangential viscosity constant (mg·s⁻¹ per m depth).
-
-        Returns
-        -------
-        float
-            Force (mg·µm·s⁻² per m depth).
         """
         return self._tangential_part(theSphere, False, nu_t=nu)
 
     def tangential_force_elastic(self, theSphere, k_t):
-        """Tangential elastic force ``k_t ξ`` if the discs overlap and are related, else 0 (the elastic part of a visit).
+        """Return the tangential elastic force ``k_t ξ`` if the discs overlap and are related, else 0.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         k_t : float
-            Tangential spring constant (mg·s⁻² per m depth).
-
-        Returns
-        -------
-        float
-            Force (mg·µm·s⁻² per m depth).
         """
         rel = self._relation(theSphere)
         if rel is None or not self.d(theSphere) < self.r + theSphere.r:
@@ -338,18 +242,15 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         return self._tangential_part(theSphere, False, rel.friction_position, k_t=k_t)
 
     def distribute_tangential_couple(self, theSphere, force):
-        """Apply ``force`` along ``t_ij`` on self and the opposite on the partner, torques split by radii (eq. S1-3).
+        """Apply ``force`` along ``t_ij`` on self, the opposite on the partner, and the torques (eq. S1-3).
 
-        :func:`~particleShear.engine.terms.pair_forces` of the pair: ``±f·t`` and the torques
-        ``d·f·r_i/(r_i + r_j)`` on self and ``d·f·r_j/(r_i + r_j)`` on the partner (same sign),
-        each registered (two forces, two torques).
+        The torques ``d·f·r_i/(r_i + r_j)`` on self and ``d·f·r_j/(r_i + r_j)`` on the partner have the same
+        sign; the two forces and two torques are registered.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
         force : float
-            Tangential force (mg·µm·s⁻² per m depth).
         """
         p = self._pairs([theSphere])
         w = _one(self.r, theSphere.r)[:, None] / (self.r + theSphere.r)
@@ -368,31 +269,18 @@ class CircleFrictionElasticity(CircleBasicElasticity):
             reg.record_individual_internal_torque(theSphere, self, tj)
 
     def tangential_force(self, theSphere, nu, mu, k, k_t):
-        """One visit of the tangential routine (a contact; for a linkable sphere also a bond).
+        """One visit of the tangential routine (a contact; for a linkable sphere also a bond); return its force.
 
-        The force ``ν_t v_t·[d < r_i + r_j] + k_t ξ`` of :meth:`_visit`: a contact is limited by
-        ``μ |law(d, r_i + r_j, k, c)|`` — this visit sets the state of both directions (stick or
-        slip) and a slip resets both histories — a bond has no bound and keeps its state; half
-        of the force is applied (:meth:`distribute_tangential_couple`; docs/design.md).
+        The force ``ν_t v_t·[d < r_i + r_j] + k_t ξ`` of a contact is limited by ``μ |law(d, r_i + r_j, k, c)|``;
+        the visit sets the state of both directions (stick or slip) and a slip resets both histories.  A bond
+        has no bound and keeps its state.  Half of the force is applied (:meth:`distribute_tangential_couple`).
+        0 without a relation or, for a contact, without overlap.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-        nu : float
-            Tangential viscosity constant (mg·s⁻¹ per m depth).
-        mu : float
-            Friction coefficient μ of the Coulomb limit (dimensionless).
-        k : float
-            Spring constant (mg·s⁻² per m depth, eq. S1-8).
-        k_t : float
-            Tangential spring constant (mg·s⁻² per m depth).
-
-        Returns
-        -------
-        float
-            The limited tangential force (mg·µm·s⁻² per m depth), 0 without a relation and for a
-            contact without overlap.
+        nu, mu, k, k_t : float
+            Tangential viscosity ν_t, friction coefficient μ, spring constants k and k_t.
         """
         rel = self._relation(theSphere)
         d_eq = self._bond(theSphere)
@@ -413,29 +301,21 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         return f
 
     def tangential_force_from_neighbors(self, nu, mu, k, k_t):
-        """Apply the tangential routine to every relation (:meth:`tangential_force`, in ``neighbors`` order).
+        """Apply :meth:`tangential_force` for every relation, in ``neighbors`` order.
 
         Parameters
         ----------
-        nu : float
-            Tangential viscosity constant (mg·s⁻¹ per m depth).
-        mu : float
-            Friction coefficient μ of the Coulomb limit (dimensionless).
-        k : float
-            Spring constant (mg·s⁻² per m depth, eq. S1-8).
-        k_t : float
-            Tangential spring constant (mg·s⁻² per m depth).
+        nu, mu, k, k_t : float
         """
         for rel in list(self.neighbors):
             self.tangential_force(rel.theSphere, nu, mu, k, k_t)
 
     def do_rotational_acceleration(self, dt):
-        """Register the net torque, kick the spin by ``T dt / I``, reset the torque (:func:`~particleShear.engine.integrate.kick`).
+        """Register the net torque, kick the spin by ``T dt / I`` (``dt`` in s), reset the torque.
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         reg = self.force_register
         if hasattr(reg, "record_unbalanced_moment"):
@@ -445,17 +325,15 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         self.omega, self.torque = spin.item(), torque.item()
 
     def move(self, dt=1):
-        """Advance φ, integrate ξ of the stick and permanent relations, then drift (sequential rule, Appendix B.2).
+        """Advance φ, integrate ξ of the stick and permanent relations, then drift by ``dt`` (s).
 
-        ``ξ_ij += v_t·dt`` with the current velocities and positions (partners moved before this
-        sphere count at their new positions): the increment ``ξ̇_ij`` of
-        :func:`~particleShear.engine.integrate.xi_increments` over this sphere's relations; the
-        partner's history is integrated by the partner's own move.
+        ``ξ_ij += ξ̇_ij·dt`` (:func:`~particleShear.engine.integrate.xi_increments`) with the current
+        velocities and positions (partners moved before count at their new positions); the partner
+        integrates ``ξ_ji`` in its own move.
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         rels = [rel for rel in self.neighbors if rel.interface_type in ("stick", "permanent")]
         if rels:

@@ -1,25 +1,10 @@
-"""The documented step as the engine's phases on the ensemble's own state (docs/design.md, "One step").
+"""The documented step as the engine's phases on the ensemble's own state (docs/design.md, "The documented classes").
 
-A documented ensemble keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
-whose sphere arrays are the ensemble's own rows and whose pair list is the ensemble's pair table
-(:meth:`~particleShear.engine.state.BatchState.of_ensemble`).  The three phases of the documented
-step (``mechanical_simulation_step_calculate_forces``, ``…_acceleration``, ``…_movement``) are that
-engine's :meth:`~particleShear.engine.step.BatchEngine.force_phase`,
-:meth:`~particleShear.engine.step.BatchEngine.accelerate` and
-:meth:`~particleShear.engine.step.BatchEngine.move`; the register of a force phase is the engine's
-(:meth:`~particleShear.base.register.Force_register.set_from_engine`).
-
-What a step only reads (clock, strain, rate, μ, the plates, whether the cell is Lees-Edwards and
-whether the strain advances) is handed to the engine at every force phase, and the clock and strain
-are handed back after every movement, so the ensemble's attributes stay what scripts read and
-write.  Between steps the pair table holds the engine's relations (written back after every
-movement), so the per-sphere API, links and cuts read and edit it as before.
-
-The engine is kept under one key (the sphere block, the per-sphere parameters, the constants, the
-box, the integrator, the generator) and dropped at the one invalidation point of the ensemble
-(:meth:`EngineStep._drop_engine`: a sphere appended or moved from outside, a radius changed);
-an edit of the pair table (a link, a cut, a relation edited) makes its next force phase rebuild
-the candidates from the table.
+A canvas keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
+(:meth:`~particleShear.engine.state.BatchState.of_ensemble`) whose sphere arrays are the ensemble's
+rows and whose pairs are its pair table.  What a step reads (clock, strain, rate, μ, plates) is
+handed to the engine before each force phase; clock, strain and relations come back after each
+movement.  The engine is kept under one key and dropped at :meth:`EngineStep._drop_engine`.
 """
 __docformat__ = "numpy"
 import numpy as np
@@ -30,8 +15,7 @@ __all__ = ["EngineStep", "ForcePhaseGeometry"]
 class EngineStep:
     """Mixin of the documented canvases: the step's phases on the ensemble's engine (a batch of one).
 
-    The canvas supplies the hooks :meth:`_lees_edwards` (images offset by ``Ly·γ``) and
-    :meth:`_strain_advances` (γ advances by ``γ̇·dt`` in this step).
+    Hooks: :meth:`_lees_edwards` (images offset by ``Ly·γ``), :meth:`_strain_advances` (γ += γ̇·dt).
     """
 
     _engine = None          # the engine of the ensemble's state (None until the first phase, after a drop)
@@ -94,11 +78,6 @@ class EngineStep:
             eng.half = None if value is None else np.array([h if h is not None else np.zeros(self._n)
                                                             for h in value])
 
-    def _engine_pairs_edited(self):
-        """The pair table was edited outside a step (links, cuts, relations): the next force phase
-        rebuilds the candidates from it."""
-        self._engine_pairs = None
-
     def _hand_to_engine(self, eng):
         """What a step reads of the ensemble, into the engine's state (before a force phase)."""
         s = eng.s
@@ -125,9 +104,7 @@ class EngineStep:
             self._share_history(eng)
 
     def _share_history(self, eng):
-        """Make the engine's flat relation history the pair table's own arrays (a batch of one has
-        one segment), so what a phase writes, the table holds, and what was set on the table (a
-        relation's ξ or state), the engine reads."""
+        """Make the engine's relation history the pair table's own arrays (a batch of one has one segment)."""
         pairs = self._pairs
         eng.state_p, eng.xi, eng.active, eng.birth = pairs.state, pairs.xi, pairs.active, pairs.birth
 
@@ -145,8 +122,7 @@ class EngineStep:
         return eng
 
     def _take_relations(self, eng):
-        """The relations, states and ξ of the engine's last phase into the pair table, which then
-        holds the engine's history (the movement's ξ rule writes the table's ξ)."""
+        """The relations, states and ξ of the engine's last phase into the pair table."""
         eng.flush()
         self._share_history(eng)
         self._engine_pairs = (self._pairs, self._pairs.version)
@@ -173,9 +149,7 @@ class EngineStep:
         self._pos_version += 1
 
     def _engine_move_spheres(self, dt):
-        """The documented ``move(dt)`` of a frictional canvas: the engine's ξ rule on the relations
-        of its last force phase (none without one), then the drift of x, y, φ (no strain, wrap or
-        clock); the neighbour lists are rebuilt at the next force phase."""
+        """The documented ``move(dt)``: ξ rule, drift of x, y, φ (no strain, wrap or clock)."""
         eng = self._engine
         if eng is None:
             eng = self._step_engine()
@@ -185,8 +159,7 @@ class EngineStep:
         self._pos_version += 1
 
     def _closest_contact(self):
-        """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force
-        phase and its spheres, or None (for the stability guard)."""
+        """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last phase, or None."""
         g = self._g
         if g is None or not g.P:
             return None
@@ -198,14 +171,11 @@ class EngineStep:
 
 
 class ForcePhaseGeometry:
-    """The relations of an engine force phase as the documented canvas's ``_g`` shows them (read by
-    stability guards and tests), made when first read; valid until the movement ends the step.
+    """The relations of the last force phase as the canvas's ``_g`` (for guards and tests), made when read.
 
-    Per relation (``P`` of them, in the table's ``(i, j)`` order): ``slots``, its row of the pair
-    table; the sphere indices ``ai, aj`` and radii ``ri, rj``; the pair vector ``dx, dy`` (µm, j's
-    nearest image minus i), the distance ``d``, the contact distance ``d0 = r_i + r_j``, the unit
-    normal ``nx, ny``; the image velocity ``dvx`` (µm/s, ``−Ly·γ̇`` per period above); ``perm``
-    (a bond) and ``trans`` (a transient contact); ``active`` (all true).
+    Per relation (``P`` of them): ``slots`` (pair-table rows), ``ai, aj``, ``ri, rj`` (µm), the
+    minimum-image vector ``dx, dy``, distance ``d``, ``d0 = r_i + r_j``, unit normal ``nx, ny``, image
+    velocity ``dvx`` (µm/s), ``perm`` (bond), ``trans`` (transient contact), ``active`` (all true).
 
     Parameters
     ----------

@@ -1,18 +1,7 @@
-"""Layout of the per-sphere state block (fields × spheres) shared by the canvases and the stress tensors.
-
-Rows that are advanced or gathered together sit next to each other: (x, y, phi) are moved by
-(xspeed, yspeed, omega)·dt in one pass, and (xforce, yforce, torque) are kicked in one pass.
-"""
+"""Layout of the per-sphere state block (fields × spheres): the engine's
+(:data:`particleShear.engine.state.FIELDS`), which a batch of ensembles shares."""
 __docformat__ = "numpy"
 
-import math
+from ..engine.state import FIELDS, ROW
 
-#: per-sphere arrays and their defaults
-FIELDS = {
-    "x": 0.0, "y": 0.0, "phi": -math.pi / 2, "xspeed": 0.0, "yspeed": 0.0, "omega": 0.0,
-    "r": 1.0, "m": 1.0, "inertia": 0.5, "xforce": 0.0, "yforce": 0.0, "torque": 0.0,
-    "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
-    "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
-}
-#: row of each field in the state block ``CanvasPoints._st`` (fields × spheres)
-ROW = {name: k for k, name in enumerate(FIELDS)}
+__all__ = ["FIELDS", "ROW"]

@@ -5,57 +5,30 @@ __all__ = ["Graphical_output_configuration"]
 
 
 class Graphical_output_configuration:
-    """Colours and switches of the particle drawing; every argument is stored under its own name.
-
-    Colours are Tk/Pillow colour names (e.g. ``"grey"``, ``"darkorchid"``).  Some options
-    (``color_spheres_boundary``, ``draw_permanent_connections``, ``color_permanent_connections``,
-    the volume and boundary forces, ``force_scale`` and the speeds) are stored for
-    compatibility with particleShear 1.0.2 but the drawing does not use them: permanent links
-    are always drawn as blue centre-to-centre lines (see docs/output.md).
+    """Colours (Tk/Pillow names) and switches of the particle drawing; each argument is stored under its name.
 
     Parameters
     ----------
     draw_spheres_as : {"spheres", "dots", "none"}
-        How a sphere is drawn: its disc outline, a dot of radius 2 pixels, or not at all.
+        Disc outline, a dot of radius 2 pixels, or nothing (another value: ValueError).
     color_spheres_volume : str
         Colour of the sphere discs.
-    color_spheres_boundary : str
-        Colour of spheres touching the boundary (stored, not used).
-    draw_rotation_line : bool
-        Draw a radius marking each sphere's rotation angle φ.
-    color_rotation_line : str
-        Colour of the rotation line.
+    draw_rotation_line, color_rotation_line : bool, str
+        Draw a radius marking each sphere's angle φ, in this colour.
     draw_active_interface : bool
-        Draw the contact chord of every touching pair (locked or slip colour by its state).
-    color_interface_locked : str
-        Colour of a sticking contact.
-    color_interface_slip : str
-        Colour of a slipping contact.
-    draw_permanent_connections : bool
-        Draw permanent links (stored; links are always drawn).
-    color_permanent_connections : str
-        Colour of permanent links (stored; links are drawn in blue).
+        Draw the contact chord of every touching pair.
+    color_interface_locked, color_interface_slip : str
+        Chord colour of a sticking and of a slipping contact.
     draw_permanent_interfaces : bool
         Draw the contact chord of permanent links (in dark orange).
-    draw_volume_forces : bool
-        Draw the volume forces (stored, not used).
-    color_volume_forces : str
-        Colour of the volume forces (stored, not used).
-    draw_boundary_forces : bool
-        Draw the forces on the plate spheres (stored, not used).
-    color_boundary_forces : str
-        Colour of the boundary forces (stored, not used).
-    force_scale : float
-        Scale of drawn force arrows (stored, not used).
-    draw_speeds : bool
-        Draw the velocities (stored, not used).
-    color_speeds : str
-        Colour of the velocities (stored, not used).
 
-    Raises
-    ------
-    ValueError
-        If ``draw_spheres_as`` is not one of the three allowed values.
+    Other Parameters
+    ----------------
+    color_spheres_boundary, draw_permanent_connections, color_permanent_connections : optional
+        Stored for 1.0.2 compatibility, not used: links are always drawn as blue centre lines.
+    draw_volume_forces, color_volume_forces, draw_boundary_forces, color_boundary_forces : optional
+    force_scale, draw_speeds, color_speeds : optional
+        Stored, not used.
     """
 
     def __init__(self, draw_spheres_as="spheres", color_spheres_volume="grey",

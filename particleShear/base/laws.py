@@ -1,9 +1,7 @@
-"""Central force laws (eqs. S1-5a, S1-5b, S1-6; the plateau and tensile variants are described in docs/design.md).
+"""Central force laws: the linear and divergent blend (eqs. S1-5a, S1-5b, S1-6), plateau and tensile variants.
 
-Every law works on Python scalars and on NumPy arrays alike: the engine calls
-them once per step on whole pair arrays, the sphere API calls them on scalars.
-Sign convention: negative = repulsion, positive = attraction.  Distances in µm,
-spring constants in mg·s⁻² per m depth, forces in mg·µm·s⁻² per m depth.
+Every law takes Python scalars or NumPy arrays (the engine calls them on whole pair arrays).
+Negative = repulsion.  Distances in µm, ``k`` in mg·s⁻² per m depth, forces in mg·µm·s⁻² per m depth.
 """
 __docformat__ = "numpy"
 
@@ -30,26 +28,19 @@ def _scalar_result(value, *args):
 def elastic_force_law(d, d0, k, central_repulsion_coefficient):
     """Blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law; 0 for d > d0.
 
-    The force is ``-k (1 - c)(d0 - d) - k c d0 (d0/d - 1)``; the divergent part is capped at
-    ``d0/d = 1000`` (eq. S1-6).  The arithmetic is that of
-    :func:`particleShear.engine.laws.central_inside`, shared with the classes' vectorised step
-    and the engine.
+    ``-k (1 - c)(d0 - d) - k c d0 (d0/d - 1)``, the divergent part capped at ``d0/d = 1000``
+    (eq. S1-6), by :func:`particleShear.engine.laws.central_inside` as in the engine.
 
     Parameters
     ----------
     d : float or numpy.ndarray
-        Centre distance of the pair (µm).
+        Centre distance (µm).
     d0 : float or numpy.ndarray
         Contact distance ``r_i + r_j`` (µm).
     k : float or numpy.ndarray
-        Spring constant (mg·s⁻² per m depth, eq. S1-8).
+        Spring constant (eq. S1-8).
     central_repulsion_coefficient : float or numpy.ndarray
-        Blend ``c`` between the linear law (0, eq. S1-5a) and the divergent law (1, eq. S1-5b).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Central force (mg·µm·s⁻² per m depth); negative = repulsion; a float for scalar input.
+        Blend ``c`` of the linear (0, eq. S1-5a) and divergent (1, eq. S1-5b) laws.
     """
     c = central_repulsion_coefficient
     if np.ndim(d) == 0 and np.ndim(d0) == 0:
@@ -63,9 +54,8 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
 class PlateauConfiguration:
     """Static parameters of the plateau law, as fractions of the contact distance.
 
-    The class-attribute way of particleShear 1.0.2; a run's ``contact_law="plateau"`` with
-    ``plateau_begin``, ``plateau_end`` and ``plateau_slope`` gives the same law per run
-    (:func:`particleShear.engine.laws.plateau_law`).
+    1.0.2's class attributes; a run's ``contact_law="plateau"`` with ``plateau_begin``, ``plateau_end``
+    and ``plateau_slope`` gives the same law per run.
     """
     relative_plateau_begin = 0.3
     relative_plateau_end = 0.8
@@ -73,36 +63,20 @@ class PlateauConfiguration:
 
     @classmethod
     def values(cls):
-        """``(begin, end, slope)`` now, the parameters of :func:`~particleShear.engine.laws.plateau_law`.
-
-        Returns
-        -------
-        tuple of float
-        """
+        """Return ``(begin, end, slope)``, the parameters of :func:`~particleShear.engine.laws.plateau_law`."""
         return cls.relative_plateau_begin, cls.relative_plateau_end, cls.relative_plateau_slope
 
 
 def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_slope):
-    """Continuous distance mapping that flattens the law between begin and end.
+    """Map distances to flatten the law between ``plateau_begin`` and ``plateau_end`` (µm).
 
-    Distances above ``plateau_end`` are unchanged; between begin and end they are compressed
-    by ``relative_plateau_slope``; below ``plateau_begin`` they are scaled linearly to 0.
+    Above the end unchanged, between begin and end compressed by ``relative_plateau_slope``
+    (0 = flat), below the begin scaled linearly to 0; returns the transformed distance (µm).
 
     Parameters
     ----------
-    d : float or numpy.ndarray
-        Centre distance (µm).
-    plateau_begin : float or numpy.ndarray
-        Distance where the plateau begins (µm), smaller than ``plateau_end``.
-    plateau_end : float or numpy.ndarray
-        Distance where the plateau ends (µm).
+    d, plateau_begin, plateau_end : float or numpy.ndarray
     relative_plateau_slope : float
-        Slope of the mapping on the plateau (dimensionless, 0 = flat).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Transformed distance (µm).
     """
     pb, pe, s = plateau_begin, plateau_end, relative_plateau_slope
     if np.ndim(d) == 0 and np.ndim(pb) == 0 and np.ndim(pe) == 0:
@@ -111,27 +85,15 @@ def distance_transform_plateau(d, plateau_begin, plateau_end, relative_plateau_s
 
 
 def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
-    """Law of spongy particles: the default law evaluated on a plateau-transformed distance.
+    """Law of spongy particles: :func:`elastic_force_law` on a plateau-transformed distance; 0 for d > d0.
 
-    The plateau lies between ``PlateauConfiguration.relative_plateau_begin·d0`` and
-    ``relative_plateau_end·d0`` (see :func:`distance_transform_plateau`); 0 for ``d > d0``.
-    The arithmetic is :func:`particleShear.engine.laws.plateau_law` (the registry's ``"plateau"``).
+    The plateau lies between ``relative_plateau_begin·d0`` and ``relative_plateau_end·d0`` of
+    :class:`PlateauConfiguration` (:func:`particleShear.engine.laws.plateau_law`, the ``"plateau"`` law).
 
     Parameters
     ----------
-    d : float or numpy.ndarray
-        Centre distance of the pair (µm).
-    d0 : float or numpy.ndarray
-        Contact distance ``r_i + r_j`` (µm).
-    k : float or numpy.ndarray
-        Spring constant (mg·s⁻² per m depth, eq. S1-8).
-    central_repulsion_coefficient : float or numpy.ndarray
-        Blend ``c`` between the linear law (0, eq. S1-5a) and the divergent law (1, eq. S1-5b).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Central force (mg·µm·s⁻² per m depth); negative = repulsion; a float for scalar input.
+    d, d0, k, central_repulsion_coefficient : float or numpy.ndarray
+        As for :func:`elastic_force_law`.
     """
     c = central_repulsion_coefficient
     values = PlateauConfiguration.values()
@@ -146,9 +108,6 @@ def elastic_force_law_plateau(d, d0, k, central_repulsion_coefficient):
 def elastic_force_law_tensile(d, d0, k):
     """Linear tensile law of permanent links: ``-k (d0 - d)`` (eq. S1-5a in tension).
 
-    The arithmetic is that of :func:`particleShear.engine.laws.tensile_inside`, shared with the
-    classes' vectorised step and the engine.
-
     Parameters
     ----------
     d : float or numpy.ndarray
@@ -156,12 +115,7 @@ def elastic_force_law_tensile(d, d0, k):
     d0 : float or numpy.ndarray
         Equilibrium distance of the link (µm).
     k : float or numpy.ndarray
-        Spring constant (mg·s⁻² per m depth, eq. S1-8).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Central force (mg·µm·s⁻² per m depth); positive (attractive) for ``d > d0``.
+        Spring constant (eq. S1-8).
     """
     return _engine_laws.tensile_inside(d, d0, -k)
 
@@ -172,24 +126,14 @@ class TensileConfiguration:
 
 
 def elastic_force_law_tensile_exponential(d, d0, k):
-    """Saturating tensile law: slope k at d0, limit ``k·d0·δ`` (δ = TensileConfiguration.d_exponential).
+    """Saturating tensile law ``k d0 δ (1 - exp(-(d - d0)/(d0 δ)))``, δ = ``TensileConfiguration.d_exponential``.
 
-    The force is ``k d0 δ (1 - exp(-(d - d0)/(d0 δ)))``: a bond that weakens smoothly instead
-    of growing without bound.
+    Slope k at d0, limit ``k·d0·δ``: a bond that weakens smoothly instead of growing without bound.
 
     Parameters
     ----------
-    d : float or numpy.ndarray
-        Centre distance of the linked pair (µm).
-    d0 : float or numpy.ndarray
-        Equilibrium distance of the link (µm).
-    k : float or numpy.ndarray
-        Spring constant (mg·s⁻² per m depth, eq. S1-8).
-
-    Returns
-    -------
-    float or numpy.ndarray
-        Central force (mg·µm·s⁻² per m depth); positive (attractive) for ``d > d0``.
+    d, d0, k : float or numpy.ndarray
+        As for :func:`elastic_force_law_tensile`.
     """
     delta = TensileConfiguration.d_exponential
     return k * d0 * delta * (1 - np.exp(-(d - d0) / (d0 * delta)))

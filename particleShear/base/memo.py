@@ -1,15 +1,7 @@
 """The one cache mechanism of the canvas classes: named values kept under an explicit key.
 
-A canvas keeps a value between calls only through its :class:`Memo`: ``memo.get(name, key, compute)``
-returns the value stored under ``name`` while the stored key equals ``key`` and otherwise calls
-``compute()`` and stores its result under the new key.  The key lists everything the value is
-computed from (version counters of the canvas's state, parameters, the key of a value it derives
-from), so a cached value is by construction what recomputing it gives; :meth:`Memo.invalidate`
-drops every value at once, for the changes no counter records (relations edited in place through
-the per-sphere API, a constitution that replaces the pair table).
-
-Only values that buy at least ~10 % of a step are kept this way (docs/design.md, "Caching of the
-classes", has the measured tables); everything else is recomputed where it is used.
+The key lists everything a value is computed from (version counters, parameters), so a kept value
+is what recomputing it gives.  Only values worth ≥ ~10 % of a step are kept (docs/design.md, "The one cache").
 """
 __docformat__ = "numpy"
 
@@ -22,12 +14,8 @@ class Memo:
     Examples
     --------
     >>> m = Memo()
-    >>> m.get("sq", (3,), lambda: 3 * 3)
-    9
-    >>> m.get("sq", (3,), lambda: 0)     # same key: the kept value, compute is not called
-    9
-    >>> m.get("sq", (4,), lambda: 4 * 4)  # new key: recomputed
-    16
+    >>> m.get("sq", (3,), lambda: 3 * 3), m.get("sq", (3,), lambda: 0), m.get("sq", (4,), lambda: 16)
+    (9, 9, 16)
     """
 
     __slots__ = ("_values",)
@@ -36,22 +24,15 @@ class Memo:
         self._values = {}
 
     def get(self, name, key, compute):
-        """The value of ``name`` for ``key``: the kept one if it was computed for an equal key, else ``compute()``.
+        """Return the value of ``name`` kept for an equal ``key``, else ``compute()`` (then kept).
 
         Parameters
         ----------
         name : str
-            Which value (one entry per name).
         key : tuple
-            Everything the value depends on, compared with ``==`` (numbers, strings, bytes, tuples of them:
-            never arrays, whose ``==`` is elementwise).
+            Everything the value depends on, compared with ``==`` (never arrays).
         compute : callable
-            Called without arguments when the value must be (re)computed; its result is kept under ``key``.
-
-        Returns
-        -------
-        object
-            The value.
+            Called without arguments when the value must be (re)computed.
         """
         entry = self._values.get(name)
         if entry is not None and entry[0] == key:
@@ -65,17 +46,11 @@ class Memo:
         self._values.clear()
 
     def peek(self, name):
-        """The value kept under ``name`` (whatever its key), or None: for inspection, never for computing.
+        """Return the value kept under ``name`` (whatever its key), or None: for inspection only.
 
         Parameters
         ----------
         name : str
-            Which value.
-
-        Returns
-        -------
-        object or None
-            The value, or None when none is kept.
         """
         entry = self._values.get(name)
         return None if entry is None else entry[1]

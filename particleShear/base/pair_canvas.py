@@ -1,19 +1,8 @@
-"""Canvases with pairs: the pair table, the neighbour update and the Lees-Edwards cell (docs/design.md).
-
-=========================================  ==============================================
-``CanvasPointsNeighbors``                  pair table and the neighbour update
-``CanvasPointsShear``                      Lees-Edwards offset, plates, shear rate
-=========================================  ==============================================
-
-The pair table is the engine's :class:`~particleShear.engine.state.PairTable`, and the neighbour
-update is the engine's :meth:`~particleShear.engine.step.BatchEngine.relations` on the ensemble's
-own state (:mod:`particleShear.base.engine_view`).
-"""
+"""Canvases with pairs: the pair table, the neighbour update and the Lees-Edwards cell (docs/design.md)."""
 __docformat__ = "numpy"
 import math
 import numpy as np
 from .kernels import min_image
-from .namespace import where as _where
 from ..engine.integrate import kick, plates_follow
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
@@ -26,27 +15,15 @@ __all__ = ["CanvasPointsNeighbors", "CanvasPointsShear"]
 
 
 class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
-    """Adds the pair table and the neighbour update (relations = contacts ∪ permanent links).
+    """Adds the pair table (the engine's ``PairTable``) and the neighbour update (contacts ∪ links).
 
     Parameters
     ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
-    m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    size_x, size_y, theCanvas, doDrawing, m
+        As for :class:`~particleShear.base.canvas.CanvasPointsMass`.
     """
 
-    #: the Verlet skin of the step's neighbour lists, in units of the largest radius: the runs'
-    #: value (``run.batch.ENGINE_SKIN_FACTOR``; fewer candidates per step, a few more rebuilds)
+    #: Verlet skin of the neighbour lists in units of the largest radius (``run.batch.ENGINE_SKIN_FACTOR``)
     neighbour_skin = 0.2
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
@@ -67,24 +44,10 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         self._invalidate_neighbours()
 
     def move(self, dt=1):
-        """ξ rule (relations of the last force phase), then drift and turn: x, y, φ += (u_x, u_y, ω)·dt
-        (the engine's :meth:`~particleShear.engine.step.BatchEngine.move_spheres`).
-
-        Parameters
-        ----------
-        dt : float
-            Time step (s).
-        """
         self._engine_move_spheres(dt)
 
     def test_neighbor_relation(self):
-        """Neighbour update (docs/design.md): activate touching pairs, drop transient ones that separated.
-
-        The engine's :meth:`~particleShear.engine.step.BatchEngine.relations` on the ensemble's own
-        state: candidates within reach of the Verlet list (rebuilt when due), their minimum image,
-        the relations ``touching | bond`` (a new one sticks, with ξ = 0 and the next creation
-        number; an opened contact loses its ξ), written into the pair table.
-        """
+        """Neighbour update: activate touching pairs (sticking, ξ = 0), drop transient ones that separated."""
         eng = self._step_engine()
         self._hand_to_engine(eng)
         eng.relations()
@@ -96,14 +59,12 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         m = pt.active & ((pt.i == p) | (pt.j == p))
         slots = np.flatnonzero(m)
         slots = slots[np.argsort(pt.birth[slots], kind="stable")]
-        partners = _where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
+        partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
         cls = self._relation_view_class
         return [cls(self, p, int(q)) for q in partners]
 
     def _relations_edited(self):
-        """The one place that drops every kept value (docs/design.md, "The documented classes"): relations were changed
-        outside the step's neighbour update (the per-sphere API, a batched constitution), which no counter
-        of the memo keys records."""
+        """Drop every kept value: relations were changed outside the step (no memo key records that)."""
         self._memo.invalidate()
         self._engine_pairs = None
 
@@ -122,7 +83,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         return float(np.sqrt(dx * dx + dy * dy)[0])
 
     def _test_pair(self, p, q):
-        """Neighbour test of one pair (the scalar ``test_neighbor_relation(theSphere)`` API)."""
+        """Neighbour test of one pair (the per-sphere ``test_neighbor_relation(theSphere)``)."""
         self._relations_edited()
         a = self._a
         touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
@@ -150,19 +111,8 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 
     Parameters
     ----------
-    size_x, size_y : float
-        Cell size Lx, Ly (µm), finite and > 0.
-    theCanvas : object or bool
-        Tk canvas of the live window (False when none).
-    doDrawing : bool
-        Whether the spheres are drawn.
-    m : float
-        Default sphere mass (mg per m depth), stored as ``m`` (each sphere carries its own mass).
-
-    Raises
-    ------
-    ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0.
+    size_x, size_y, theCanvas, doDrawing, m
+        As for :class:`~particleShear.base.canvas.CanvasPointsMass`.
     """
 
     use_lees_edwards = True
@@ -175,27 +125,12 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.shear = 0
 
     def canMove(self, theSphere):
-        """During shear, spheres overlapping y = 0 or y = Ly are glued to the plates (docs/design.md).
-
-        Parameters
-        ----------
-        theSphere : object
-            A sphere of this ensemble.
-
-        Returns
-        -------
-        bool
-            True if the sphere moves freely.
-        """
         if not self.applyingShear:
             return True
         return theSphere.r < theSphere.y < self.size_y - theSphere.r
 
     def _mobile(self):
-        """(mask of the mobile spheres ``r < y < Ly − r``, its bytes) while shearing, else (None, None).
-
-        The bytes are the memo key of what is derived from the mask (the pairs' internal flags, the
-        selection of the mobile spheres), kept while the plates hold the same spheres."""
+        """(mask ``r < y < Ly − r``, its bytes: the memo key) while shearing, else (None, None)."""
         if not self.applyingShear:
             return None, None
         y = self._pos[1]
@@ -205,16 +140,6 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         return mob, mob.tobytes()
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres; immobile ones take the velocity of their plate.
-
-        Every sphere is kicked and the plate velocity then overwrites the
-        immobile ones, which gives the mobile spheres exactly the reference kick.
-
-        Parameters
-        ----------
-        dt : float
-            Time step (s), finite and > 0.
-        """
         kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
         mob = self._mobile_mask()
         if mob is not None:     # plate spheres take the velocity ±γ̇·Ly/2 of their plate and no y velocity
@@ -222,12 +147,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             plates_follow(a["xspeed"], a["yspeed"], ~mob, self._y_centred(), self.shear_rate * self.size_y / 2)
 
     def transmit_lees_edwards_parameters(self, theSphere):
-        """Copy the cell size, strain, rate and Lees-Edwards flag to a sphere.
+        """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.
 
         Parameters
         ----------
-        theSphere : object
-            The sphere that receives them.
+        theSphere : Sphere
         """
         PointLeesEdwards.transmit_lees_edwards_parameters(self, theSphere)   # the one hand-over (reads attributes only)
 

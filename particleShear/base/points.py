@@ -1,23 +1,9 @@
-"""Points: the base of the per-sphere API of layer 1 (see docs/design.md).
+"""Points, the root of the per-sphere API (docs/design.md, "The documented classes").
 
-A sphere object is a thin handle.  Before it is appended to an ensemble it
-keeps its own values; once appended, its state attributes (``x``, ``xspeed``,
-``omega``, ``xforce`` …) read and write the ensemble's arrays at its index and
-its ``neighbors`` are views of the ensemble's pair table.  The scalar methods
-here and in :mod:`.circles` and :mod:`.elastic_circles` (``d``, ``elastic_force``,
-``tangential_force`` …; the classes are re-exported here) are the documented API
-for scripts and tests; the ensembles never call them in a step.
-
-Each of them evaluates the engine's pure functions on the pairs it is asked about, as arrays
-of length 1 (or over one sphere's relations): the minimum image and wrap of
-:mod:`particleShear.engine.box`, the normals of :func:`particleShear.engine.forces.normals`,
-the kinematics, term constants, elastic, viscous and tangential terms and the force vectors of
-:mod:`particleShear.engine.terms`, and the kick, damping, ξ increments and drift of
-:mod:`particleShear.engine.integrate`.  What stays here is 1.0.2's bookkeeping: one visit per
-call, half of a tangential visit's force applied by that visit, and the register entries and
-relation states each call leaves.  The rounding is the engine's (e.g. the torque
-``d·f·(r_i/(r_i + r_j))``, the permanent ratio on the constant rather than on the force); no
-test needs 1.0.2's own order of the operations of a single pair.
+A sphere keeps its own values until appended to an ensemble, then reads and writes the ensemble's
+arrays at its index.  These scalar methods (and those of :mod:`.circles`, :mod:`.elastic_circles`,
+re-exported here) serve scripts and tests: each evaluates the engine's pure functions on arrays of
+length 1 with 1.0.2's bookkeeping (one visit per call); the documented step does not call them.
 """
 __docformat__ = "numpy"
 
@@ -36,42 +22,31 @@ __all__ = ["Point", "PointLeesEdwards", "Circle", "CircleMass", "CircleMassNeigh
 
 
 def dotProduct2(a, b):
-    """Dot product of two 2-vectors.
+    """Return ``a[0]·b[0] + a[1]·b[1]``, the dot product of two 2-vectors.
 
     Parameters
     ----------
     a, b : sequence of float
-        The vectors (their first two components are used).
-
-    Returns
-    -------
-    float
-        ``a[0]·b[0] + a[1]·b[1]``.
     """
     return a[0] * b[0] + a[1] * b[1]
 
 
 class ArrayField:
-    """Attribute stored locally before the sphere joins an ensemble, in the ensemble's array after.
-
-    A data descriptor: reading it on a sphere of an ensemble reads the ensemble's per-sphere
-    array at the sphere's index, so scripts and the vectorised step see one state.
+    """Descriptor: a sphere attribute stored locally, or in the ensemble's array once appended.
 
     Parameters
     ----------
     default : float
-        Value before the attribute is first set.
-    geometry : bool
-        Setting it changes the geometry (position, radius): the neighbour candidates are rebuilt.
-    param : bool
-        Setting it changes a constant of the step (mass, radius …): cached constants are recomputed.
+        Value before it is first set.
+    geometry, param : bool
+        Setting it rebuilds the neighbour candidates (position, radius) / the cached step constants.
     positive : bool
-        Only finite values > 0 are accepted (else finite values).
+        Accept only values > 0.
 
     Raises
     ------
-    ValueError
-        On assignment, if the value is not finite (or not > 0 when ``positive``).
+    TypeError, ValueError
+        On assigning a non-number, a value not finite, or not > 0 when ``positive``.
     """
 
     def __init__(self, default=0.0, geometry=False, param=False, positive=False):
@@ -109,14 +84,13 @@ class ArrayField:
 
 
 class EnsembleField:
-    """Lees-Edwards parameter: a per-sphere copy in the reference, the ensemble's value here once appended.
+    """Descriptor: a Lees-Edwards parameter, the ensemble's value once the sphere is appended.
 
     Parameters
     ----------
     default : float
-        Value before it is first set.
     canvas_name : str or None
-        Name of the ensemble attribute read once the sphere is in an ensemble (None: the same name).
+        Ensemble attribute read once appended (None: the same name).
     """
 
     def __init__(self, default, canvas_name=None):
@@ -159,12 +133,8 @@ def _wrapped(x, y, vx, Lx, Ly, shift, rate):
 
 
 class _Pairs:
-    """The engine's inputs for the visits from sphere ``me`` to ``spheres``, as arrays over the partners.
-
-    Image vectors and image velocities (``image``, default ``me._image``), distances, normals
-    (if ``normal``; a random direction at ``d = 0`` from the ensemble's generator, or Python's
-    for a sphere alone), velocity rows ``(vx, vy, ω)`` and radii.
-    """
+    """The engine's inputs for visits from ``me`` to ``spheres`` over the partners: images (``image``, default
+    ``me._image``), distances, normals if ``normal`` (random at ``d = 0``: the ensemble's or Python's generator)."""
 
     def __init__(self, me, spheres, normal=True, image=None):
         dx = _one(*(s.x for s in spheres)) - me.x
@@ -197,19 +167,16 @@ class _Pairs:
 
 
 class Point:
-    """A point with position (µm) and velocity (µm/s); the root of the sphere classes.
+    """A point with position ``x, y`` (µm) and velocity (µm/s); the root of the sphere classes.
 
     Parameters
     ----------
     x, y : float
-        Position of the centre (µm).
 
     Raises
     ------
-    TypeError
-        If ``x`` or ``y`` is not a real number.
-    ValueError
-        If ``x`` or ``y`` is not finite.
+    TypeError, ValueError
+        If ``x`` or ``y`` is not a finite number.
     """
 
     x = ArrayField(0.0, geometry=True)
@@ -228,30 +195,23 @@ class Point:
         self.yspeed = 0
 
     def coordinates(self):
-        """Position as ``[x, y, 0]`` (µm); circles return their radius as the third entry.
-
-        Returns
-        -------
-        list of float
-            ``[x, y, 0]``.
-        """
+        """Return ``[x, y, 0]`` (µm); circles return their radius as the third entry."""
         return [self.x, self.y, 0]
 
     #: whether the sphere spins (ω enters its slip speed, φ its drift)
     _spins = False
 
     def boundary_conditions(self, boundary_x, boundary_y):
-        """Plain periodic wrap into ``[0, boundary)`` (:func:`~particleShear.engine.box.wrap` without shift).
+        """Wrap periodically into the cell ``boundary_x × boundary_y`` (µm).
 
         Parameters
         ----------
         boundary_x, boundary_y : float
-            Cell size (µm).
         """
         self.x, self.y, _ = _wrapped(self.x, self.y, 0.0, boundary_x, boundary_y, 0.0, 0.0)
 
     def _image(self, dx, dy):
-        """Pair vectors from raw differences (µm) and the x velocities of the images (µm/s; None: no image)."""
+        """Pair vectors (µm) from raw differences, and the images' x velocities (µm/s; None here)."""
         return dx, dy, None
 
     def _pairs(self, spheres, normal=True, image=None):
@@ -259,94 +219,60 @@ class Point:
         return _Pairs(self, spheres, normal, image)
 
     def d_euclidian(self, theSphere):
-        """Euclidean distance to the other point, without periodic images (µm).
+        """Return the distance (µm) to the point or sphere ``theSphere``, without periodic images.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        float
-            Distance (µm).
         """
         return math.sqrt((theSphere.x - self.x) ** 2 + (theSphere.y - self.y) ** 2)
 
     def relative_vector(self, theSphere):
-        """Vector from this point to the other one (µm): the Lees-Edwards minimum image where used.
+        """Return ``[dx, dy]`` to ``theSphere`` (µm): the Lees-Edwards minimum image where used.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[dx, dy]`` (µm).
         """
         p = self._pairs([theSphere], normal=False)
         return [p.dx.item(), p.dy.item()]
 
     def d(self, theSphere):
-        """Distance to the other point (µm), the length of :meth:`relative_vector`.
+        """Return the distance to ``theSphere`` (µm), the length of :meth:`relative_vector`.
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        float
-            Distance (µm).
         """
         return self._pairs([theSphere], normal=False).d.item()
 
     def n(self, theSphere):
-        """Unit vector towards the other point; a random direction when the two coincide.
-
-        The random direction (:func:`~particleShear.engine.forces.normals`) comes from the
-        ensemble's random generator (the run's seed) when the point is in an ensemble.
+        """Return the unit vector towards ``theSphere``; where they coincide, a random one (the ensemble's seed).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[n_x, n_y]``, of length 1.
         """
         p = self._pairs([theSphere])
         return [p.nx.item(), p.ny.item()]
 
     def relative_position(self, theSphere):
-        """Vector to the other point as ``n·d`` (µm).
+        """Return the vector ``n·d`` to ``theSphere`` (µm).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[dx, dy]`` (µm).
         """
         n = self.n(theSphere)
         d = self.d(theSphere)
         return [n[0] * d, n[1] * d]
 
     def move(self, dt=1):
-        """Drift: advance the position by velocity × ``dt`` (:func:`~particleShear.engine.integrate.drift`).
+        """Drift: advance the position by velocity × ``dt`` (s), and φ by ω·``dt`` for a spinning sphere.
 
         Parameters
         ----------
         dt : float
-            Time step (s).
         """
         pos = _one(self.x, self.y)[:, None]
         vel = _one(self.xspeed, self.yspeed, getattr(self, "omega", 0.0))[:, None]
@@ -357,44 +283,32 @@ class Point:
         self.x, self.y = pos[:, 0].tolist()
 
     def _damp(self, f, flow):
-        """:func:`~particleShear.engine.integrate.damp` of ``(xspeed, yspeed)`` relative to the flow (None: none)."""
+        """:func:`~particleShear.engine.integrate.damp` of ``(xspeed, yspeed)`` relative to ``flow`` (None: none)."""
         vel = _one(self.xspeed, self.yspeed)[:, None]
         damp(vel, flow, f)
         self.xspeed, self.yspeed = vel[:, 0].tolist()
 
     def cool(self, f=0.8):
-        """Multiply both velocity components by ``f`` (damping).
+        """Damp: multiply the velocity by ``f`` (0 < f ≤ 1; 1 = no damping).
 
         Parameters
         ----------
         f : float
-            Factor (0 < f ≤ 1; 1 = no damping).
         """
         self._damp(f, None)
 
     def relative_speed(self, theSphere):
-        """Velocity of the other point relative to this one (µm/s); of its nearest image where Lees-Edwards is used.
-
-        :func:`~particleShear.engine.terms.relative_velocity`; an image one row up moves faster by
-        ``Ly·γ̇`` in x.
+        """Return the velocity of ``theSphere`` (its nearest image with Lees-Edwards) relative to this point (µm/s).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[v_x, v_y]``. (µm/s)
         """
         return self._pairs([theSphere], normal=False).velocity()[:, 0].tolist()
 
 
 class PointLeesEdwards(Point):
-    """Point in a Lees-Edwards cell of ``size_x × size_y`` µm with strain ``shear`` and rate ``shear_rate``.
-
-    Once the point is in an ensemble, the cell parameters are the ensemble's.
+    """Point in a Lees-Edwards cell; once in an ensemble, the cell parameters are the ensemble's.
 
     Parameters
     ----------
@@ -402,12 +316,10 @@ class PointLeesEdwards(Point):
         Position of the centre (µm).
     size_x, size_y : float
         Cell size Lx, Ly (µm).
-    shear : float
-        Shear strain γ of the cell (dimensionless); the image rows are offset by ``Ly·γ``.
-    shear_rate : float
-        Shear rate γ̇ (1/s).
+    shear, shear_rate : float
+        Strain γ (the image rows are offset by ``Ly·γ``) and rate γ̇ (1/s).
     use_lees_edwards : bool
-        Use Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
+        Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
     """
 
     size_x = EnsembleField(500)
@@ -424,12 +336,11 @@ class PointLeesEdwards(Point):
         self.shear_rate = shear_rate
 
     def boundary_conditions(self, boundary_x, boundary_y):
-        """Store the cell size, then wrap (Lees-Edwards with velocity correction, or plain).
+        """Store the cell size (µm), then wrap (Lees-Edwards with velocity correction, or plain).
 
         Parameters
         ----------
         boundary_x, boundary_y : float
-            Cell size (µm).
         """
         self.size_x = boundary_x
         self.size_y = boundary_y
@@ -439,94 +350,66 @@ class PointLeesEdwards(Point):
             Point.boundary_conditions(self, boundary_x, boundary_y)
 
     def _image(self, dx, dy):
-        """The Lees-Edwards minimum image (:meth:`_le_image`) if used, else the plain differences (see
-        :meth:`Point._image`)."""
+        """:meth:`_le_image` if Lees-Edwards is used, else :meth:`Point._image`."""
         return self._le_image(dx, dy) if self.use_lees_edwards else (dx, dy, None)
 
     def _le_image(self, dx, dy):
-        """:func:`~particleShear.engine.box.min_image` with shift ``Ly·γ``, and the image velocities ``−Ly·γ̇·k_y``."""
+        """:func:`~particleShear.engine.box.min_image` with shift ``Ly·γ``; image velocities ``−Ly·γ̇·k_y``."""
         Ly = self.size_y
         dx, dy, ky, _ = min_image(dx, dy, self.size_x, Ly, Ly * self.shear)
         return dx, dy, -(Ly * self.shear_rate) * ky
 
     def lee_edwards_closest_to_zero(self, x, y):
-        """Minimum image of a difference vector in the sheared cell.
+        """Return the minimum image ``[dx, dy]`` of the difference ``x, y`` in the sheared cell (µm).
 
-        Crossing the y boundary shifts x by ``∓Ly·γ`` (:func:`~particleShear.engine.box.min_image`).
+        Crossing the y boundary shifts x by ``∓Ly·γ``; ``-Lx/2 ≤ dx < Lx/2``, ``-Ly/2 ≤ dy < Ly/2``.
 
         Parameters
         ----------
         x, y : float
-            Difference vector (µm).
-
-        Returns
-        -------
-        list of float
-            ``[dx, dy]``, with ``-Lx/2 ≤ dx < Lx/2`` and ``-Ly/2 ≤ dy < Ly/2`` (µm).
         """
         dx, dy, _ = self._le_image(_one(x), _one(y))
         return [dx.item(), dy.item()]
 
     def lee_edwards_positive(self, x, y):
-        """Map a position into the cell, without velocity correction (:func:`~particleShear.engine.box.wrap`).
+        """Return the position ``x, y`` mapped into ``[0, Lx) × [0, Ly)`` (µm), without velocity correction.
 
         Parameters
         ----------
         x, y : float
-            Position (µm).
-
-        Returns
-        -------
-        list of float
-            ``[x, y]`` inside ``[0, Lx) × [0, Ly)`` (µm).
         """
         return _wrapped(x, y, 0.0, self.size_x, self.size_y, self.size_y * self.shear, 0.0)[:2]
 
     def lee_edwards_relative_speed(self, theSphere):
-        """Velocity of the nearest Lees-Edwards image of the other point relative to this one.
-
-        An image one row up moves faster by ``Ly·γ̇`` in x.
+        """Return the velocity of the nearest Lees-Edwards image of ``theSphere`` relative to this point (µm/s).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[v_x, v_y]``. (µm/s)
         """
         return self._pairs([theSphere], normal=False, image=self._le_image).velocity()[:, 0].tolist()
 
     def lee_edwards_boundary_conditions(self):
-        """Wrap into the cell; crossing y changes x by ∓Ly·γ and vx by ∓Ly·γ̇ (:func:`~particleShear.engine.box.wrap`)."""
+        """Wrap into the cell; crossing y changes x by ∓Ly·γ and vx by ∓Ly·γ̇ (``engine.box.wrap``)."""
         x, y, self.xspeed = _wrapped(self.x, self.y, self.xspeed, self.size_x, self.size_y,
                                      self.size_y * self.shear, self.shear_rate)
         self.x, self.y = x, y
 
     def lee_edwards_relative_vector(self, theSphere):
-        """Minimum-image vector from this point to the other one (µm).
+        """Return the minimum-image vector ``[dx, dy]`` to ``theSphere`` (µm).
 
         Parameters
         ----------
         theSphere : Point
-            The other point or sphere.
-
-        Returns
-        -------
-        list of float
-            ``[dx, dy]`` (µm).
         """
         return self.lee_edwards_closest_to_zero(theSphere.x - self.x, theSphere.y - self.y)
 
     def transmit_lees_edwards_parameters(self, theSphere):
-        """Copy the cell size, strain, rate and Lees-Edwards flag to another point.
+        """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.
 
         Parameters
         ----------
         theSphere : PointLeesEdwards
-            The point that receives them.
         """
         theSphere.size_x = self.size_x
         theSphere.size_y = self.size_y
@@ -535,12 +418,11 @@ class PointLeesEdwards(Point):
         theSphere.use_lees_edwards = self.use_lees_edwards
 
     def cool(self, f=0.8):
-        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` (SLLOD-like; see docs/design.md).
+        """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` by the factor ``f`` (SLLOD-like).
 
         Parameters
         ----------
         f : float
-            Factor applied to the peculiar velocity (0 < f ≤ 1; 1 = no damping).
         """
         self._damp(f, flow_velocity(_one(self.y), self.size_y, self.shear_rate))
 

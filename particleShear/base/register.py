@@ -1,10 +1,7 @@
-"""Force register: what the stress tensors are made of (eqs. S1-16 to S1-24; see docs/design.md).
+"""Force register: the forces and torques the stress tensors sum (eqs. S1-16 to S1-24; docs/design.md).
 
-The engine fills it with arrays once per force phase (per active pair: the
-force on each sphere, the tangential torques and the internal/external flags;
-per sphere: totals).  The six reference lists (``pair_register`` …) are built
-on demand as ``[target, source, F]`` entries for the API; manual ``record_*``
-calls (scripts without an ensemble) append to them directly.
+The engine stores a force phase as arrays; the six reference lists (``pair_register`` …) are built
+from them on demand, and manual ``record_*`` calls (scripts without an ensemble) append to them.
 """
 __docformat__ = "numpy"
 
@@ -16,16 +13,8 @@ from ..engine.xp import to_host
 __all__ = ["Force_register", "SphereSelection"]
 
 
-def _live(p, flag):
-    """Entries of a register block with ``flag`` set that are relations (engine blocks span all candidates)."""
-    m = p[flag]
-    active = p.get("active")
-    return m if active is None else m & active
-
-
 class PairBlock(dict):
-    """Register block of the engine: per-pair arrays; ``fix``, ``fiy``, ``fjx``, ``fjy`` are the rows
-    of the (2, P) force arrays ``Fi``, ``Fj``, made on first use."""
+    """Engine register block of per-pair arrays; ``fix`` … ``fjy`` are rows of ``Fi``/``Fj``, made on first use."""
 
     _ROWS = {"fix": ("Fi", 0), "fiy": ("Fi", 1), "fjx": ("Fj", 0), "fjy": ("Fj", 1)}
 
@@ -39,27 +28,18 @@ class PairBlock(dict):
 
 
 class EngineForcePhase:
-    """The force phase of replica ``b`` of an engine that a register holds: the engine's record of
-    its terms (:attr:`~particleShear.engine.step.BatchEngine.terms`, fixed when the phase ends; not
-    the engine, which the register does not keep alive), whether the ensemble has the tangential
-    term, and the ensemble's position version at the time (the pair vectors hold while the spheres
-    have not moved).  ``block``: the register block made from it
-    (:func:`~particleShear.engine.step.register_block`) once read.
+    """Force phase of replica ``b`` of an engine, held by a register (which does not keep the engine alive).
+
+    ``block``: its register block (:func:`~particleShear.engine.step.register_block`), made when read.
 
     Parameters
     ----------
     terms : object
-        The engine's record of the phase's per-candidate terms.
-    N : int
-        Spheres per replica of the engine.
-    b : int
-        The replica.
-    tangential : bool
-        The ensemble has the tangential term (the lists hold tangential visits and torques).
-    pos_version : int
-        The ensemble's position version of the phase (−1: moved since).
-    one_host_replica : bool
-        The engine is a batch of one on the host (its arrays are the replica's rows, read as they are).
+        The engine's :attr:`~particleShear.engine.step.BatchEngine.terms` of the phase.
+    N, b, pos_version : int
+        Spheres per replica; the replica; the ensemble's position version of the phase (−1: moved since).
+    tangential, one_host_replica : bool
+        The ensemble has the tangential term; the engine is a host batch of one (arrays are the replica's rows).
     """
     __slots__ = ("terms", "N", "b", "tangential", "pos_version", "one_host_replica", "block")
 
@@ -77,15 +57,8 @@ def _invalidating(name):
 
         Parameters
         ----------
-        *args
-            Positional arguments of the ``list`` method.
-        **kwargs
-            Keyword arguments of the ``list`` method.
-
-        Returns
-        -------
-        object
-            What the ``list`` method returns.
+        *args, **kwargs
+            Those of the ``list`` method.
         """
         self._valid = False   # contents no longer follow the mask: evaluated sphere by sphere
         return method(self, *args, **kwargs)
@@ -95,23 +68,19 @@ def _invalidating(name):
 
 
 class SphereSelection(list):
-    """The spheres of an ensemble picked by a boolean ``mask`` (None: all), as a list.
+    """The spheres of an ensemble picked by ``mask``, as a list in index order (``movableSphereList()``).
 
-    It is what ``movableSphereList()`` returns: a plain ``list`` of the spheres in index
-    order for every use a script makes of it, which also tells the stress evaluation
-    which rows of the ensemble's arrays it holds, so the tensors are summed with array
-    operations.  Changing it (``append``, ``remove``, ``sel[k] = …`` …) keeps it a list
-    and drops that link.
+    It also tells the stress evaluation which array rows it holds, so tensors are summed as
+    arrays; changing it (``append``, ``sel[k] = …`` …) keeps it a list and drops that link.
 
     Parameters
     ----------
     ensemble : object
-        The ensemble (a canvas of :mod:`particleShear.base.canvas`) whose ``sphereList`` is selected.
+        The ensemble (a canvas of :mod:`particleShear.base.canvas`).
     mask : numpy.ndarray of bool or None
-        Which spheres (one flag per sphere of ``sphereList``); None selects all.
+        One flag per sphere of ``sphereList``; None selects all.
     spheres : list or None
-        The spheres themselves when already known (must match ``mask``); None takes them from
-        ``ensemble.sphereList``.
+        The selected spheres when already known; None takes them from ``ensemble.sphereList``.
     """
 
     def __init__(self, ensemble, mask=None, spheres=None):
@@ -179,8 +148,7 @@ class Force_register:
     # -- engine side -------------------------------------------------------------------------
     @property
     def _blocks(self):
-        """The blocks of per-pair arrays: that of the engine force phase held (made when first read),
-        then those of standalone term calls."""
+        """The per-pair array blocks: that of the engine force phase held, made when first read."""
         ph = self._phase
         if ph is not None and ph.block is None:
             ph.block = PairBlock(register_block(ph.terms, ph.N, ph.b, tangential=ph.tangential))
@@ -188,14 +156,8 @@ class Force_register:
             self._block_list.insert(0, ph.block)
         return self._block_list
 
-    def _set_pairs(self, ensemble, pair):
-        """Add one block of per-pair arrays (one per force phase, or per standalone term call)."""
-        self._ens = ensemble
-        self._blocks.append(pair)
-
     def engine_phase(self):
-        """The engine force phase that is all this register holds (pairs and totals, no manual
-        entries, no other block), or None: what the stress evaluation reads as arrays."""
+        """The engine force phase if it is all the register holds (the stresses then read arrays), else None."""
         ph = self._phase
         if ph is None or self._manual or len(self._block_list) != (ph.block is not None):
             return None
@@ -208,23 +170,16 @@ class Force_register:
         self._mom = torque
 
     def set_from_engine(self, ensemble, engine, b=0):
-        """Hold the last force phase of replica ``b`` of ``engine`` (an engine with ``keep_terms``
-        on, e.g. on ``ensemble``'s own state): its pair block and its totals, as the classes' force
-        phase and ``record_total_particle_forces`` leave them, so the six lists are built from it.
+        """Hold the last force phase (pairs, totals) of replica ``b``; return False, changing nothing, if none.
 
         Parameters
         ----------
         ensemble : ensemble
             The ensemble of the replica (its spheres are the lists' entries).
         engine : BatchEngine
-            The engine, after a force phase with ``keep_terms`` on (its :attr:`~particleShear.engine.step.BatchEngine.terms`).
+            An engine after a force phase with ``keep_terms`` on.
         b : int, default 0
             The replica.
-
-        Returns
-        -------
-        bool
-            Whether the engine had a force phase to give (else the register is left alone).
         """
         t = engine.terms
         if t is None:
@@ -242,14 +197,12 @@ class Force_register:
 
     # -- manual API (reference signatures) ----------------------------------------------------
     def record_individual_internal_force(self, target, source, force_vector):
-        """Append an internal pair force ``[target, source, F]`` to :attr:`pair_register` (Love-Weber, eq. S1-19).
+        """Append an internal pair force to :attr:`pair_register` (Love-Weber, eq. S1-19).
 
         Parameters
         ----------
-        target : object
-            The sphere the force acts on.
-        source : object
-            The sphere exerting it.
+        target, source : object
+            The sphere acted on; the sphere exerting the force.
         force_vector : sequence of float
             ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
@@ -257,12 +210,11 @@ class Force_register:
         self._m_pair.append([target, source, list(force_vector)])
 
     def record_total_particle_force(self, target, force_vector):
-        """Set (update or append) the total force of ``target`` in :attr:`total_particle_force_register` (eq. S1-17).
+        """Set the total force of ``target`` in :attr:`total_particle_force_register` (eq. S1-17).
 
         Parameters
         ----------
         target : object
-            The sphere the force acts on.
         force_vector : sequence of float
             ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
@@ -275,7 +227,6 @@ class Force_register:
         Parameters
         ----------
         target : object
-            The sphere the force acts on.
         force_vector : sequence of float
             ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
         """
@@ -283,12 +234,11 @@ class Force_register:
         self._m_ext.append([target, list(force_vector)])
 
     def record_external_torque(self, target, moment):
-        """Append an external tangential torque to :attr:`external_moment_register` (stored, unused by the tensors).
+        """Append an external tangential torque to :attr:`external_moment_register` (unused by the tensors).
 
         Parameters
         ----------
         target : object
-            The sphere the torque acts on.
         moment : float
             Torque (mg·µm²·s⁻² per m depth).
         """
@@ -296,14 +246,12 @@ class Force_register:
         self._m_emom.append([target, moment])
 
     def record_individual_internal_torque(self, target, source, moment):
-        """Append an internal tangential torque ``[target, source, M]`` to :attr:`internal_moment_register` (eq. S1-22).
+        """Append an internal tangential torque to :attr:`internal_moment_register` (eq. S1-22).
 
         Parameters
         ----------
-        target : object
-            The sphere the torque acts on.
-        source : object
-            The sphere exerting it.
+        target, source : object
+            The sphere acted on; the sphere exerting the torque.
         moment : float
             Torque (mg·µm²·s⁻² per m depth).
         """
@@ -311,12 +259,11 @@ class Force_register:
         self._m_imom.append([target, source, moment])
 
     def record_unbalanced_moment(self, target, moment):
-        """Set (update or append) the net torque of ``target`` in :attr:`unbalanced_moment_register` (eq. S1-22).
+        """Set the net torque of ``target`` in :attr:`unbalanced_moment_register` (eq. S1-22).
 
         Parameters
         ----------
         target : object
-            The sphere the torque acts on.
         moment : float
             Torque (mg·µm²·s⁻² per m depth).
         """
@@ -340,16 +287,12 @@ class Force_register:
 
     @property
     def pair_register(self):
-        """``[target, source, [F_x, F_y]]`` per internal pair-force entry, in the reference's order (docs/design.md):
-        every central elastic visit, then every central viscous visit, then two entries per tangential
-        visit (visiting sphere, then its neighbour); visits by sphere in ``sphereList`` order and, per
-        sphere, by relation in ``neighbors`` order."""
+        """``[target, source, [F_x, F_y]]`` per internal pair force, in the reference's order (docs/design.md)."""
         return self._engine_lists()["pair"] + self._m_pair
 
     @property
     def external_force_register(self):
-        """``[target, [F_x, F_y]]`` per force from an immobile sphere or through the periodic boundary,
-        at the place of its visit in the order of :attr:`pair_register`."""
+        """``[target, [F_x, F_y]]`` per force from an immobile sphere or through the periodic boundary."""
         return self._engine_lists()["ext"] + self._m_ext
 
     @property
@@ -387,13 +330,10 @@ class Force_register:
 def _visit_entries(p, sl, out):
     """Append the reference entries of one engine register block to the lists in ``out`` (docs/design.md).
 
-    Each relation (pair k, i < j) is visited twice: from i (side 0) and from j (side 1).  Visits are
-    ordered by visiting sphere, then by the visitor's relation order (birth of the relation, then
-    partner index).  A central term gives one entry per visit, on the visiting sphere; a tangential
-    visit with scalar force F gives ``±F/2·t`` on the visitor and its neighbour (eq. S1-3 torques
-    ``d·F/2·r/(r_i + r_j)`` likewise).  Each entry goes to the internal list, the external list or
-    nowhere according to the pair's flags for its target (target immobile: dropped; source immobile
-    or the pair acting through the boundary: external).
+    Each pair is visited from i (side 0) and from j (side 1), ordered by visitor, relation birth,
+    partner.  Central terms give one entry per visit on the visitor, a tangential visit ``±F/2·t``
+    on the visitor and its neighbour (torques of eq. S1-3 likewise).  An entry on an immobile target
+    is dropped; one from an immobile source or through the boundary is external.
     """
     i_all, j_all = p["i"], p["j"]
     if not len(i_all) or "visits" not in p:
@@ -413,7 +353,6 @@ def _visit_entries(p, sl, out):
     vs = side[order]                          # 0: visit from i, 1: visit from j
     internal, ext_i, ext_j = p["internal"], p["ext_i"], p["ext_j"]
     interacting = touching if perm is None else (touching | perm)   # elastic and tangential visits happen
-
     # per (pair, side-of-target): where an entry on that target goes (1 internal, 2 external, 0 dropped)
     dest = np.zeros((2, len(i_all)), dtype=np.int8)
     dest[0][ext_i] = 2

@@ -7,19 +7,18 @@ __all__ = ["neighbor_relation", "RelationView"]
 
 
 class neighbor_relation:
-    """Directed relation of a sphere to ``theSphere``: state and tangential history ξ (µm).
+    """Directed relation of a sphere to ``theSphere``.
 
     Parameters
     ----------
     friction_position : float
-        Tangential displacement history ξ of the contact (µm): the spring extension of the
-        tangential force.
+        Tangential displacement history ξ (µm), the extension of the tangential spring.
     interface_type : {"stick", "slip", "permanent"}
-        State of the relation: a sticking or slipping transient contact, or a permanent link.
+        A sticking or slipping contact, or a permanent link.
     theSphere : object
-        The partner sphere; its ``myindex`` (0 if it has none) is copied to ``myindex``.
+        The partner; its ``myindex`` (0 if none) is copied to ``myindex``.
     graphical_line_index : int
-        Canvas item of the drawn interface line, -1 when not drawn.
+        Canvas item of the drawn interface line (-1: none).
     """
 
     def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1):
@@ -31,11 +30,7 @@ class neighbor_relation:
 
 
 class RelationView:
-    """Mixin: the relation ``owner → partner`` read from and written to the ensemble's pair table.
-
-    Views are built on demand (``sphere.neighbors``); they look the pair up by
-    its sphere indices at every access, so they stay valid across steps.
-    """
+    """Mixin: the relation ``owner → partner`` in the ensemble's pair table, looked up at every access."""
 
     def _bind(self, ensemble, owner, partner):
         d = self.__dict__
@@ -76,8 +71,7 @@ class RelationView:
 
     @property
     def interface_type(self):
-        """State ``"stick"``, ``"slip"`` or ``"permanent"``; setting it updates the pair table
-        (and the cached bond constants when the link becomes or stops being permanent)."""
+        """State ``"stick"``, ``"slip"`` or ``"permanent"``; settable (a link made or ended updates its constants)."""
         return STATE_NAMES[int(self.__dict__["_ens"]._pairs.state[self._slot()])]
 
     @interface_type.setter

@@ -1,8 +1,4 @@
-"""Blow-up detection: stop a diverging integration with a clear error instead of silent NaNs.
-
-The guard is cheap (a few reductions over arrays the step already has) and is
-run by the experiment after every force phase.  It never changes the physics.
-"""
+"""Blow-up detection: stop a diverging integration with a clear error instead of silent NaNs."""
 __docformat__ = "numpy"
 
 import math
@@ -13,22 +9,18 @@ __all__ = ["SimulationInstabilityError", "StabilityGuard"]
 
 
 class SimulationInstabilityError(RuntimeError):
-    """The integration diverged; ``step``, ``phase``, ``pair`` and ``suggested_dt`` say where and what to try.
-
-    Every argument is stored under its own name.
+    """The integration diverged; every argument is stored under its own name.
 
     Parameters
     ----------
     message : str
-        The full explanation (also the exception's text).
-    step : int or None
-        Step of the phase at which the divergence was detected.
-    phase : str or None
-        Name of the phase (e.g. pre-equilibration or shear).
+        The explanation (the exception's text).
+    step, phase : int, str or None
+        Step and phase (e.g. pre-equilibration or shear) at which it was detected.
     pair : tuple of int or None
-        The worst sphere ``(k,)`` or pair ``(i, j)`` (indices in ``sphereList``).
+        The worst sphere ``(k,)`` or pair ``(i, j)`` (``sphereList`` indices).
     suggested_dt : float or None
-        A time step (s) that is likely to be stable.
+        A time step (s) likely to be stable.
     reason : str or None
         The short cause (non-finite state, kinetic energy bound, interpenetration).
     """
@@ -43,22 +35,19 @@ class SimulationInstabilityError(RuntimeError):
 
 
 class StabilityGuard:
-    """Checks finiteness, peculiar kinetic energy and interpenetration of an ensemble.
+    """Checks finiteness, peculiar kinetic energy and interpenetration of an ensemble (never changes the physics).
 
     Parameters
     ----------
     min_distance_ratio : float
-        Smallest allowed ``d / (r_i + r_j)`` of a transient contact (default 0.05: 95 %
-        interpenetration; the divergent law is then ~400× stiffer than at contact and the
-        explicit step of the default rule starts to pump energy into the pair).
+        Smallest allowed ``d / (r_i + r_j)`` of a transient contact (0.05: the divergent law is
+        then ~400× stiffer than at contact and the explicit step starts to pump energy).
     max_kinetic_energy : float or None
         Bound on the kinetic energy relative to the affine flow (mg·µm²/s² per m); None uses
-        ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²``: the energy of compressing every sphere by its
-        radius plus twice the kinetic energy of moving every sphere at the largest plate
-        speed seen so far (a packing may lag the affine flow by up to the plate speed).
+        ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` (every sphere compressed by its radius, plus twice the
+        energy of every sphere at the largest plate speed seen).
     interval : int
-        Check every ``interval``-th step (a diverging run grows by orders of magnitude per
-        step, so a blow-up is still caught within a few steps).
+        Check every ``interval``-th step (a blow-up grows by orders of magnitude per step).
     """
 
     def __init__(self, min_distance_ratio=0.05, max_kinetic_energy=None, interval=4):
@@ -68,49 +57,36 @@ class StabilityGuard:
         self._rate_max = 0.0
 
     def suggested_dt(self, ens, dt):
-        """Time step to suggest after a failure: half the current one, at most 5 % of ``sqrt(m_min/k)``.
+        """Return the time step (s) to suggest: half ``dt``, at most 5 % of ``sqrt(m_min/k)``.
 
-    Parameters
-    ----------
-    ens : object
-        The ensemble (a canvas of :mod:`particleShear.base.canvas`); its masses and ``k``,
-        ``k_t`` are read.
-    dt : float or None
-        The current time step (s); None or 0 when unknown.
-
-    Returns
-    -------
-    float
-        Suggested time step (s).
-    """
+        Parameters
+        ----------
+        ens : canvas
+            The ensemble (masses, ``k`` and ``k_t`` are read).
+        dt : float or None
+            The current time step (s); None or 0 when unknown.
+        """
         a = ens._a
         k = max(float(getattr(ens, "k", 0) or 0), float(getattr(ens, "k_t", 0) or 0), 1e-300)
         m_min = float(a["m"].min()) if len(a["m"]) else 1.0
         return min(dt / 2, 0.05 * math.sqrt(m_min / k)) if dt else 0.05 * math.sqrt(m_min / k)
 
     def check(self, ens, step=None, phase=None, dt=None):
-        """Raise :class:`SimulationInstabilityError` if the state of ``ens`` has diverged.
+        """Raise :class:`SimulationInstabilityError` if ``ens`` has diverged (checked every ``interval``-th step).
 
-    Checked, every ``interval``-th step: finite positions and velocities, kinetic energy
-    relative to the affine flow below ``max_kinetic_energy``, and no transient contact
-    closer than ``min_distance_ratio·(r_i + r_j)``.
+        Checked: finite state, peculiar kinetic energy below the bound, no transient contact closer than
+        ``min_distance_ratio·(r_i + r_j)``.
 
-    Parameters
-    ----------
-    ens : object
-        The ensemble (a canvas of :mod:`particleShear.base.canvas`).
-    step : int or None
-        Current step; None checks unconditionally.
-    phase : str or None
-        Name of the phase, for the message.
-    dt : float or None
-        Current time step (s), for the message and the suggestion.
-
-    Raises
-    ------
-    SimulationInstabilityError
-        If the state has diverged.
-    """
+        Parameters
+        ----------
+        ens : canvas
+        step : int or None
+            Current step; None checks unconditionally.
+        phase : str or None
+            Name of the phase, for the message.
+        dt : float or None
+            Current time step (s), for the message and the suggestion.
+        """
         if step is not None and step % self.interval:
             return
         a = ens._a

@@ -1,13 +1,11 @@
-"""Stress tensors of the documented classes, computed by the engine's tensor functions.
+"""Stress tensors of the documented classes (eqs. S1-16 to S1-24; Nicot et al. with the factor 3/2).
 
-Every tensor (eqs. S1-16 to S1-24; Nicot et al. with the factor 3/2) is one function of the
-engine's registry :data:`particleShear.engine.stress.TENSORS`.  :class:`StressTensorEvaluation` is
-an adapter: it turns a :class:`~particleShear.base.register.Force_register` and a list of spheres
-into the engine's inputs (:class:`~particleShear.engine.stress.StressInputs`) for a batch of one
-replica and calls the registry; the shear stresses G needs come from the engine's shear-stress
-function (:func:`particleShear.engine.forces.shear_stresses`).  All tensors are 2×2 in Pa, index
-``[a][b]`` = (force component, lever-arm component), compression positive; forces ×1e-12 (N/m),
-lengths ×1e-6 (m), torques and inertias ×1e-18 (docs/design.md, docs/output.md).
+:class:`StressTensorEvaluation` turns a :class:`~particleShear.base.register.Force_register` and a
+list of spheres into :class:`~particleShear.engine.stress.StressInputs` of a batch of one replica
+and evaluates :data:`particleShear.engine.stress.TENSORS`; G's shear stresses come from
+:func:`particleShear.engine.forces.shear_stresses`.  Tensors are 2×2 in Pa, ``[a][b]`` = (force,
+lever-arm component), compression positive; forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and
+inertias ×1e-18 (docs/output.md).
 """
 __docformat__ = "numpy"
 
@@ -23,8 +21,7 @@ from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
 
-#: tensor attribute names in the column order of the output table (docs/output.md, "Table columns"):
-#: the names of the engine's registry
+#: tensor attribute names (the engine registry's), in the output table's column order (docs/output.md)
 TENSOR_NAMES = tuple(t.name for t in TENSORS)
 _INDEX = {t.function: k for k, t in enumerate(TENSORS)}
 _EXT = _INDEX[_es.external_forces]
@@ -41,11 +38,7 @@ _NOT_ROWS = (False, None)
 
 
 class OneReplicaRows:
-    """The pair rows of a batch of one replica, as the engine's tensor functions read them.
-
-    These are the attributes of :class:`~particleShear.engine.forces.PairConstants` that the
-    tensors and :func:`~particleShear.engine.forces.replica_sums` use: the sphere rows of each
-    pair, its replica (0) and the one replica's segment.
+    """Pair rows of a batch of one: the :class:`~particleShear.engine.forces.PairConstants` attributes tensors read.
 
     Parameters
     ----------
@@ -67,12 +60,9 @@ class OneReplicaRows:
 
 
 class OneReplicaInputs(StressInputs):
-    """:class:`~particleShear.engine.stress.StressInputs` of a batch of one replica, summed in fewer calls.
+    """:class:`~particleShear.engine.stress.StressInputs` of a batch of one, its reductions specialised.
 
-    The tensor functions are the engine's; only the reductions they call are specialised to one
-    replica, with the engine's numbers bit for bit (tested): the sum over the replica's one
-    segment is the same ``add.reduceat`` from row 0 (the engine's ``outer`` passes its four rows
-    of products in one call, each row summed on its own).  The internal flags are evaluated once per set of inputs.
+    The sums are the engine's ``add.reduceat`` from row 0, bit for bit (tested); the flags are evaluated once.
     """
 
     @staticmethod
@@ -83,21 +73,14 @@ class OneReplicaInputs(StressInputs):
         return np.add.reduceat(W, _FROM_ROW_0, axis=-1)[..., 0]
 
     def per_replica(self, weights, by_pair=True):
-        """Σ of ``weights`` over the one replica's rows (pairs or spheres): shape (1,), or (k, 1) for k rows.
-
-        The engine's :meth:`~particleShear.engine.stress.StressInputs.outer` sums its four product
-        rows through this method in one call.
+        """Σ of ``weights`` over the replica's rows: shape (1,), or (k, 1) for a (k, n) array.
 
         Parameters
         ----------
-        weights : ndarray (P,) or (N,), or (k, P) or (k, N)
-            One value per pair row (``by_pair``) or per sphere row; a 2-D array sums each row.
+        weights : ndarray (n,) or (k, n)
+            One value per pair or sphere row; a 2-D array sums each row.
         by_pair : bool
             Unused: a batch of one has one segment of either.
-
-        Returns
-        -------
-        ndarray (1,) or (k, 1)
         """
         if weights.ndim == 2:
             return self._sums(weights)[:, None]
@@ -116,19 +99,13 @@ _FROM_ROW_0 = np.zeros(1, dtype=np.intp)
 
 
 class ForcePhase(StressInputs):
-    """The engine's inputs of one force phase of the classes, in three parts.
-
-    A register and the spheres a caller passes need not describe one set of spheres: the pair
-    tensors (Love-Weber, external forces, internal torque) read the register's pair entries, the
-    tensors of sphere totals (unbalanced forces and torque, linear acceleration) the register's
-    totals, and the kinetic tensors (spin, Otsuki) the caller's spheres.  Each part is a
-    :class:`~particleShear.engine.stress.StressInputs` of a batch of one (often the same object);
-    this one hands each tensor to its part and evaluates the overall tensor (eq. S1-24) from them.
+    """The engine's inputs of one force phase, in three parts; the overall tensor (eq. S1-24) sums them.
 
     Parameters
     ----------
     pairs, totals, spheres : StressInputs
-        The parts (see above); ``pairs`` also gives the cell volume ``V``.
+        Inputs of the pair tensors (also the cell volume ``V``), of the sphere-total tensors, and
+        of the kinetic tensors (the caller's spheres, which need not be the register's).
     """
 
     def __init__(self, pairs, totals, spheres):
@@ -138,24 +115,19 @@ class ForcePhase(StressInputs):
         super().__init__(B=1, V=pairs.V, parts=parts)
 
     def tensor(self, function):
-        """``function`` evaluated on its part (the overall tensor on this object, from the parts).
+        """``function`` evaluated on its part (the overall tensor from the parts): shape (1, 2, 2).
 
         Parameters
         ----------
         function : callable
             A tensor function of :data:`~particleShear.engine.stress.TENSORS`.
-
-        Returns
-        -------
-        ndarray (1, 2, 2)
         """
         part = self.parts.get(function)
         return super().tensor(function) if part is None else part.tensor(function)
 
 
 def _cell(ev, shear_rate=None):
-    """The per-replica inputs of the cell of ``ev`` (arrays of one replica: ``Lx, Ly, V``, kept per
-    cell size, and ``rate`` when ``shear_rate`` is given)."""
+    """Cell inputs ``Lx, Ly, V`` of ``ev`` (kept per cell size), and ``rate`` if ``shear_rate`` is given."""
     key = (ev.size_x, ev.size_y)
     c = ev._cell_inputs
     if c is None or c[0] != key:
@@ -184,8 +156,7 @@ def _tensor_property(k):
 
 
 def _engine_phase(reg):
-    """The register's engine force phase of a batch of one on the host with F_j = −F_i, when it
-    is all the register holds (else None: the register is read entry by entry)."""
+    """The register's sole engine force phase if a host batch of one with F_j = −F_i, else None (read by entry)."""
     ph = reg.engine_phase()
     if ph is None or ph.terms.fx_j is not None or not ph.one_host_replica:
         return None
@@ -193,11 +164,8 @@ def _engine_phase(reg):
 
 
 def _phase_arrays(ph, ens):
-    """(C, active, dx, dy, fx_i, fy_i, dF) of an engine force phase (:func:`_engine_phase`): the
-    candidates, their relations, the pair vectors of the phase (taken anew from the positions if a
-    sphere has moved since: only internal pairs, which never act through the boundary, use them),
-    the forces on i and the pair's torque ``t_i + t_j = d·F_T`` (eq. S1-3; 0 without the
-    tangential term)."""
+    """(C, active, dx, dy, fx_i, fy_i, dF = t_i + t_j, eq. S1-3) of an engine force phase; pair vectors are
+    retaken from the positions if a sphere moved since (only internal pairs, never through the boundary, use them)."""
     t = ph.terms
     C = t.C
     dx, dy = t.dx, t.dy
@@ -209,30 +177,17 @@ def _phase_arrays(ph, ens):
 
 
 def _shear_inputs(q):
-    """The arguments of the engine's shear-stress function read from pair inputs ``q`` (mobility
-    flags from ``q.mob``), after the batch of one ``C`` and ``B``."""
+    """The engine shear-stress function's arguments after ``C, B``, from pair inputs ``q``."""
     C = q.C
     return (q.y - q.Ly[0] / 2, pair_roles(q.mob[C.ai], q.mob[C.aj], q.shifted), q.active, q.dy, q.fx_i, q.dF, q.V)
 
 
 def _entries(reg):
-    """The register's pair entries as the engine's pair inputs of a batch of one (docs/design.md).
+    """The register's pair entries (eqs. S1-16, S1-19, S1-22) as pair inputs of a batch of one.
 
-    Each entry is a row (target, source): the force on the target and the lever ``x_target −
-    x_source`` (eq. S1-19, the reference's ``pair_register``), or the force from an immobile
-    sphere or through the boundary at the target (eq. S1-16, ``external_force_register``), or an
-    internal torque (eq. S1-22, ``internal_moment_register``).  An engine block gives two entries
-    per pair, one on each sphere, with the block's flags; the manual ``record_*`` entries follow.
-    The target and the source of each entry are sphere rows of their own (rows 0 … n−1 and
-    n … 2n−1), flagged mobile where the register gives them an entry, and ``shifted`` is
-    ``~internal``: so the engine's rule (internal: both mobile, no image shift; external entry:
-    on the mobile spheres of the other pairs) reproduces the register's flags.  An internal entry
-    carries half its force, since the reference registers a contact once from each side.
-
-    Returns
-    -------
-    dict
-        ``C, x, y, mob, active, shifted, dx, dy, fx_i, fy_i, dF`` for :class:`StressInputs`.
+    Each entry (target, source) is a pair row with rows of its own (0 … n−1, n … 2n−1), mobile where
+    the register gives it an entry, ``shifted = ~internal``: so the engine's rules reproduce the
+    register's flags.  Internal entries carry half their force (the reference registers each side).
     """
     tx, ty, sx, sy, fx, fy, internal, external, active, dF = ([] for _ in range(10))
     ens = reg._ens
@@ -282,17 +237,10 @@ def _entries(reg):
 
 
 def _totals(reg):
-    """The register's sphere totals as the engine's sphere inputs of a batch of one.
+    """The register's sphere totals as sphere inputs of a batch of one (eqs. S1-17, S1-22).
 
-    Rows: the ensemble's spheres (total force summed over the mobile ones, eq. S1-17; net torque
-    of every sphere, immobile ones included, eq. S1-22 — the reference's quirk), then the manual
-    ``record_total_particle_force`` entries (mobile), then the manual ``record_unbalanced_moment``
-    entries (torque only).
-
-    Returns
-    -------
-    dict
-        ``rep, x, y, mob, fx, fy, torque`` for :class:`StressInputs`.
+    Rows: the ensemble's spheres (torque of immobile ones included: the reference's quirk), then the
+    manual totals (mobile), then the manual net torques (torque only).
     """
     x, y, fx, fy, mob, torque = ([] for _ in range(6))
     ens = reg._ens
@@ -327,22 +275,17 @@ def _totals(reg):
 
 
 class StressTensorEvaluation:
-    """Evaluates every stress tensor (eqs. S1-16 to S1-24) of a :class:`Force_register` with the engine's functions.
+    """Evaluates every stress tensor (eqs. S1-16 to S1-24) of a :class:`Force_register`.
 
-    The tensors are attributes (``overall_stress_tensor``, ``stress_tensor_LW`` …; see
-    :data:`TENSOR_NAMES`), 2×2 nested lists in Pa, recomputed by each ``evaluate_*`` call.
-    The cell volume is ``V = (size_x·1e-6)·(size_y·1e-6)`` m² per m depth.  Each tensor is the
-    function of that tensor in :data:`particleShear.engine.stress.TENSORS`, evaluated on the
-    register and the spheres passed as a batch of one replica (docs/design.md).
+    The tensors are attributes named in :data:`TENSOR_NAMES`, 2×2 nested lists in Pa; cell volume
+    ``V = (size_x·1e-6)·(size_y·1e-6)`` m² per m depth.
 
     Parameters
     ----------
-    size_x : float
-        Width Lx of the periodic cell (µm), finite and > 0.
-    size_y : float
-        Height Ly of the cell (µm), finite and > 0.
+    size_x, size_y : float
+        Width Lx and height Ly of the periodic cell (µm).
     theCanvas : object or bool
-        Tk canvas for drawing (stored for compatibility; False when none).
+        Tk canvas (stored for compatibility; False when none).
 
     Raises
     ------
@@ -378,12 +321,8 @@ class StressTensorEvaluation:
     # -- sphere lists -----------------------------------------------------------------------
     @staticmethod
     def _rows_of(ens, spheres):
-        """``(True, mask)`` when ``spheres`` are rows of ``ens``'s arrays in index order, each once
-        (``mask`` None: all of them), else ``(False, None)``: the list is then read sphere by sphere.
-
-        ``sphereList`` and the selections of ``movableSphereList()`` are recognised at once; another
-        list or tuple by one pass over its spheres' ensemble and index.
-        """
+        """``(True, mask)`` if ``spheres`` are rows of ``ens`` in index order, each once (``mask`` None: all),
+        else ``(False, None)``: then read sphere by sphere."""
         if ens is None:
             return _NOT_ROWS
         if isinstance(spheres, SphereSelection) and spheres.ensemble is ens and spheres.is_current():
@@ -440,12 +379,9 @@ class StressTensorEvaluation:
         return s[1:]
 
     def _shear_from_register(self, reg, pairs=None, roles=None):
-        """(τ_internal, τ_surface) of the register by the engine's shear-stress function (eq. S1-25).
+        """(τ_internal, τ_surface) of the register (eq. S1-25), for both the full and the σ_xy-only evaluation.
 
-        The one function of both the full and the σ_xy-only evaluation, on the same inputs, so
-        G does not depend on whether tensors are kept.  ``pairs``: the register's entries when
-        already made (:func:`_entries`); ``roles``: the internal and external flags of the
-        register's engine force phase when the tensors' inputs already hold them."""
+        ``pairs``: :func:`_entries` if already made; ``roles``: the engine phase's flags if already evaluated."""
         cell = _cell(self)
         ph = _engine_phase(reg)
         if ph is not None:
@@ -463,12 +399,8 @@ class StressTensorEvaluation:
         return float(tau[0][0]), float(tau[1][0])
 
     def _array_inputs(self, reg, spheres, shear_rate):
-        """The inputs of the register's engine force phase (:func:`_engine_phase`) with the
-        ensemble's own sphere arrays, or None.
-
-        Applies to a register that holds one engine force phase and its totals, and to spheres
-        that are rows of the ensemble.  The kinetic tensors sum over the spheres passed, the
-        unbalanced-force tensor over the register's (mobile) totals."""
+        """Inputs from the register's engine force phase, its totals and the ensemble's arrays, or None
+        unless :func:`_engine_phase` holds and ``spheres`` are rows of the ensemble."""
         ph = _engine_phase(reg)
         if ph is None or reg._tot is None:
             return None
@@ -512,8 +444,6 @@ class StressTensorEvaluation:
     def evaluate_force_stress_tensors(self, force_register):
         """Love-Weber, unbalanced-force, linear-acceleration and external-force tensors (eqs. S1-19, S1-17, S1-16).
 
-        Reads the register entry by entry (every block, manual ``record_*`` entries included).
-
         Parameters
         ----------
         force_register : Force_register
@@ -529,7 +459,7 @@ class StressTensorEvaluation:
         Parameters
         ----------
         theSphereList : list
-            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+            The spheres to sum over (in the experiment, ``movableSphereList()``).
         """
         self._store(self._sphere_inputs(theSphereList), (_es.spin_kinetic_energy,))
 
@@ -539,8 +469,6 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The current force phase: the net torque of every sphere (``unbalanced_moment_register``)
-            is summed.
         """
         self._store(self._total_inputs(force_register), (_es.unbalanced_torque,))
 
@@ -550,8 +478,6 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The current force phase: its internal tangential torques (``internal_moment_register``)
-            are summed.
         """
         self._store(self._pair_inputs(force_register), (_es.internal_torque,))
 
@@ -561,9 +487,8 @@ class StressTensorEvaluation:
         Parameters
         ----------
         force_register : Force_register
-            The forces and torques of the current force phase.
         theSphereList : list
-            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+            The spheres to sum over (in the experiment, ``movableSphereList()``).
         """
         self.evaluate_spin_kinetic_energy_stress_tensor(theSphereList)
         self.evaluate_unbalanced_torque_stress_tensor(force_register)
@@ -575,30 +500,26 @@ class StressTensorEvaluation:
         Parameters
         ----------
         theSphereList : list
-            The spheres to sum over (in the experiment, the mobile ones: ``movableSphereList()``).
+            The spheres to sum over (in the experiment, ``movableSphereList()``).
         shear_rate : float
-            Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
+            Shear rate γ̇ (1/s) of the affine flow the peculiar velocities are taken against.
         """
         self._store(self._sphere_inputs(theSphereList, shear_rate), (_es.peculiar_acceleration_otsuki,))
 
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
         """Every tensor and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24).
 
-        The xy entries of the overall and external-force tensors are ``−τ_internal`` and
-        ``−τ_surface`` of the engine's shear-stress function, the numbers
-        :meth:`evaluate_shear_stresses` gives (they equal the registry's sums to rounding, ≈ 1e-16
-        relative), so G does not depend on whether tensors are kept.
+        The xy entries of the overall and external-force tensors are those of
+        :meth:`evaluate_shear_stresses` (equal to the registry's sums to ≈ 1e-16 relative), so G
+        does not depend on whether tensors are kept.
 
         Parameters
         ----------
         force_register : Force_register
-            The current force phase: its pair entries and its sphere totals (the unbalanced-force
-            tensor sums over the register's mobile spheres).
         theSphereList : list
-            The spheres of the spin and Otsuki sums (in the experiment, the mobile ones:
-            ``movableSphereList()``).
+            The spheres of the spin and Otsuki sums (in the experiment, ``movableSphereList()``).
         shear_rate : float
-            Shear rate γ̇ of the affine flow (1/s) that the peculiar velocities are taken against.
+            Shear rate γ̇ (1/s) of the affine flow.
         """
         reg = force_register
         q = self._array_inputs(reg, theSphereList, shear_rate)
@@ -616,24 +537,15 @@ class StressTensorEvaluation:
         t[_EXT, 0, 1] = -tau_surface
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
-        """Only what G needs: σ_xy of the overall and of the external-force tensor (Pa).
+        """Only what G needs: update the xy entries of the overall and external-force tensors.
 
-        Returns ``(τ_internal, τ_surface)`` of the engine's shear-stress function, the numbers the
-        full evaluation puts into those entries, so G does not depend on whether tensors are kept.
-        Only the xy entries of the overall and external-force tensors are updated.
+        Returns ``(τ_internal, τ_surface)`` (Pa, eq. S1-25), the numbers the full evaluation stores.
 
         Parameters
         ----------
         force_register : Force_register
-            The forces and torques of the current force phase.
         theSphereList : list
-            The spheres of the evaluation (in the experiment, the mobile ones); the shear stresses do
-            not depend on them (the centrifugal tensor has no xy entry).
-
-        Returns
-        -------
-        tuple of float
-            ``(τ_internal, τ_surface)`` (Pa), eq. S1-25.
+            Unused: the shear stresses do not depend on it (the centrifugal tensor has no xy entry).
         """
         tau_internal, tau_surface = self._shear_from_register(force_register)
         self._t[_ALL, 0, 1] = -tau_internal
@@ -641,21 +553,9 @@ class StressTensorEvaluation:
         return tau_internal, tau_surface
 
     def evaluate_quasistatic_shear_stress(self):
-        """τ_internal = −σ_xy of the overall tensor (eq. S1-25).
-
-        Returns
-        -------
-        float
-            Shear stress (Pa) of the last evaluation.
-        """
+        """Return τ_internal = −σ_xy of the overall tensor of the last evaluation (Pa, eq. S1-25)."""
         return -float(self._t[_ALL, 0, 1])
 
     def evaluate_externally_applied_shear_stress(self):
-        """τ_surface = −σ_xy of the external-force tensor (eq. S1-25).
-
-        Returns
-        -------
-        float
-            Shear stress (Pa) measured from the forces on the boundary, of the last evaluation.
-        """
+        """Return τ_surface = −σ_xy of the external-force tensor of the last evaluation (Pa, eq. S1-25)."""
         return -float(self._t[_EXT, 0, 1])

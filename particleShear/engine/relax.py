@@ -6,9 +6,9 @@ and plates off, frictionless damped levels from ``dt_max`` halving down to ``dt`
 ending with the removal of the mean velocity), one frictionless block at ``dt``, one block at
 ``dt`` with the ensemble's μ.  :func:`free_relaxation` runs exactly these steps on every replica
 of a :class:`~particleShear.engine.step.BatchEngine`; :func:`remove_linear_drift` is the classes'
-``correct_linear_drift`` per replica; :func:`write_back` puts a relaxed replica back into its
-ensemble (spheres, clock, and the relations, states and ξ of its pair table) so that the
-bookkeeping that follows (crosslinking, cutting, link removal, joining isolated spheres) runs
+``correct_linear_drift`` per replica.  The engine steps the ensembles' own sphere rows and pair
+tables (:meth:`~particleShear.engine.state.BatchState.of_ensembles`), and :func:`write_back` hands
+each ensemble its clock and relations and drops its caches, so that the bookkeeping that follows (crosslinking, cutting, link removal, joining isolated spheres) runs
 through the documented classes on the contacts the engine ended with, the relations numbered
 in the order they formed, as the classes number them.
 :func:`relax_ensembles` does all of it for a list of ensembles (docs/design.md, "Batches of
@@ -162,18 +162,14 @@ def free_relaxation(engine, N, dt, dt_max, mu):
 
 
 def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
-    """Put replica ``b`` of a relaxed (or measured) engine back into its ensemble.
+    """Hand replica ``b`` of a relaxed (or measured) engine on the ensembles' own state back to its ensemble.
 
-    Positions, angles φ, velocities and forces of the spheres (nothing to copy when the state is
-    the ensemble's own rows, :meth:`~particleShear.engine.state.BatchState.of_ensemble`), the
-    clock and strain; the candidate
-    pairs of the replica become the ensemble's pair table with their relations, states, ξ and
-    ``d_eq`` (inactive transient candidates: stick, ξ = 0, as the classes leave them), so the
-    crosslinking sees the contacts of the engine's last neighbour update.  The relations keep the
-    creation numbers (the order of ``neighbors``) the engine gave them as they formed, the
-    classes' numbers, and the ensemble's counter continues from the engine's.  The ensemble's neighbour
-    list and caches are invalidated; its ``step_count`` and ``n_constitution_steps`` advance by
-    ``steps``.
+    The spheres and the pair table are the ensemble's own already (:meth:`~particleShear.engine.state.BatchState.of_ensembles`):
+    what is handed back is the clock, the strain, the plates, μ, the relations of the last step
+    (written into the table, with the creation numbers the engine gave them as they formed: the
+    order of ``neighbors``), a Verlet engine's half kick, and the bookkeeping: the ensemble's
+    neighbour list and caches are invalidated, its ``step_count`` and ``n_constitution_steps``
+    advance by ``steps``.
 
     Parameters
     ----------
@@ -195,18 +191,17 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     Raises
     ------
     ValueError
-        If the engine does not number its relations (``numbers_relations`` False).
+        If the engine's state is not the ensembles' own with ``ensemble`` as replica b, or the
+        engine does not number its relations (``numbers_relations`` False).
     """
     s = engine.s
+    if s.ensembles is None or s.ensembles[b] is not ensemble:
+        raise ValueError("write_back needs an engine on the ensemble's own state "
+                         "(BatchState.of_ensembles, of which replica b is the ensemble)")
     if not engine.numbers_relations:
         raise ValueError("write_back needs an engine with numbers_relations = True from its first step "
                          "(the creation numbers of the relations order the ensemble's neighbors)")
     rows = s.replica(b)
-    a = ensemble._a
-    if s.ensemble is not ensemble:     # a view of the ensemble (BatchState.of_ensemble) holds them already
-        for name, src in (("x", "x"), ("y", "y"), ("phi", "phi"), ("xspeed", "vx"), ("yspeed", "vy"),
-                          ("omega", "omega"), ("xforce", "fx"), ("yforce", "fy"), ("torque", "torque")):
-            a[name][...] = getattr(s, src)[rows]
     ensemble.t = float(s.t[b])
     ensemble.shear = float(s.gamma[b])
     ensemble.applyingShear = bool(s.applying_shear) and not constitution
@@ -216,8 +211,6 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
         ensemble.mu = float(s.mu[b])
 
     engine.flush()
-    if s.pairs[b] is not ensemble._pairs:      # a view's pair list is the ensemble's table itself
-        ensemble._pairs.assign(s.pairs[b])
 
     ensemble._invalidate_neighbours()
     ensemble._links_changed()
@@ -289,8 +282,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         If the ensembles differ in N, ``dt``, ``dt_max``, integrator or the settings of their
         stability guards, or a step is not usable (before any step).
     EngineInstability
-        If the stability guard of an ensemble (its interval and thresholds) finds it unstable; an
-        ensemble relaxed alone is then left as it was (:func:`untouched_on_failure`).
+        If the stability guard of an ensemble (its interval and thresholds) finds it unstable; the
+        ensembles are then left as they were (:func:`untouched_on_failure`).
     """
     ensembles = list(ensembles)
     if not ensembles:
@@ -303,9 +296,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     integrators = {getattr(e, "integrator", "euler") for e in ensembles}
     if len(integrators) != 1:
         raise ValueError(f"ensembles use the integrators {sorted(integrators)}: one engine relaxes with one")
-    # one ensemble: the engine steps its own sphere rows (nothing of them to write back)
-    state = (BatchState.of_ensemble(ensembles[0], laws=laws) if len(ensembles) == 1
-             else BatchState.from_ensembles(ensembles, laws=laws))
+    # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
+    state = BatchState.of_ensembles(ensembles, laws=laws)
     mu = state.mu.copy()
     # the guard where an ensemble has one (a script's; the builders guard the measurement only), with
     # its interval and thresholds (one set per engine)
@@ -321,11 +313,10 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
     engine.phase = "constitution"
     engine.numbers_relations = True
-    if state.ensemble is None:
+    with contextlib.ExitStack() as stack:      # their own state is stepped
+        for e in ensembles:
+            stack.enter_context(untouched_on_failure(e))
         steps = free_relaxation(engine, N, dt, dt_max, mu)
-    else:
-        with untouched_on_failure(state.ensemble):     # its own state is stepped
-            steps = free_relaxation(engine, N, dt, dt_max, mu)
     for b, e in enumerate(ensembles):
         write_back(engine, b, e, steps)
     return steps

@@ -13,12 +13,26 @@ Units: µm, s, mg per m depth (reference units, docs/parameters.md).
 """
 __docformat__ = "numpy"
 
+import math
+
 import numpy as np
 
 from .xp import get_backend
 
+#: the per-sphere fields of a documented ensemble's state block (fields × spheres) and their defaults;
+#: rows advanced or gathered together sit next to each other: (x, y, phi) are moved by
+#: (xspeed, yspeed, omega)·dt in one pass, (xforce, yforce, torque) kicked in one pass
+FIELDS = {
+    "x": 0.0, "y": 0.0, "phi": -math.pi / 2, "xspeed": 0.0, "yspeed": 0.0, "omega": 0.0,
+    "r": 1.0, "m": 1.0, "inertia": 0.5, "xforce": 0.0, "yforce": 0.0, "torque": 0.0,
+    "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
+    "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
+}
+#: row of each field in that block
+ROW = {name: k for k, name in enumerate(FIELDS)}
+
 __all__ = ["STICK", "SLIP", "PERMANENT", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
-           "uniform_parameters"]
+           "uniform_parameters", "FIELDS", "ROW"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
@@ -329,6 +343,8 @@ class BatchState:
     visit = None
     #: the ensemble whose sphere rows this state's per-sphere arrays are (:meth:`of_ensemble`), else None
     ensemble = None
+    #: the ensembles whose sphere rows this state's per-sphere arrays are (:meth:`of_ensembles`), else None
+    ensembles = None
 
     def __init__(self, B, N, backend="numpy"):
         self.backend = get_backend(backend)
@@ -359,6 +375,7 @@ class BatchState:
         state["backend"] = self.backend.name
         del state["xp"]
         state.pop("ensemble", None)      # a copy is no longer the ensemble's rows
+        state.pop("ensembles", None)
         return state
 
     def __setstate__(self, state):
@@ -394,7 +411,7 @@ class BatchState:
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
-        out.ensemble = None        # copies, no longer an ensemble's rows
+        out.ensemble = out.ensembles = None        # copies, no longer the ensembles' rows
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
@@ -480,18 +497,7 @@ class BatchState:
 
     @classmethod
     def of_ensemble(cls, ensemble, laws=None):
-        """The state of one ensemble as a batch of one whose per-sphere arrays are the ensemble's
-        own rows (no copy): what the engine's steps write, the ensemble holds.
-
-        Positions, φ, velocities, forces, radii, masses and moments of inertia are views of the
-        ensemble's state block (``ens._pos``, ``_vel``, ``_frc`` and the rows of ``_a``), and the
-        replica's pair list is the ensemble's pair table (``ens._pairs``) itself; the box, strain,
-        rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
-        by :meth:`from_ensembles`, the plates (``applying_shear``) from its ``applyingShear``.  The views stay valid while the ensemble gains no sphere (an
-        append can move its block).  An engine on this state numbers the relations as they form,
-        and :func:`~particleShear.engine.relax.write_back` afterwards gives the ensemble its clock,
-        strain and relations and drops its caches (and
-        :func:`~particleShear.engine.relax.untouched_on_failure` puts it back after a failed run).
+        """:meth:`of_ensembles` of one ensemble (the ensemble keeps its own block).
 
         Parameters
         ----------
@@ -505,14 +511,65 @@ class BatchState:
         BatchState
             B = 1 on NumPy, with :attr:`ensemble` set to ``ensemble``.
         """
-        s = cls.from_ensembles([ensemble], laws=laws)
-        a = ensemble._a
-        s.pos, s.vel, s.frc = ensemble._pos, ensemble._vel, ensemble._frc
-        s.phi, s.r, s.m, s.inertia = a["phi"], a["r"], a["m"], a["inertia"]
+        return cls.of_ensembles([ensemble], laws=laws)
+
+    @classmethod
+    def of_ensembles(cls, ensembles, laws=None):
+        """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:
+        what the engine's steps write, the ensembles hold (nothing to copy back).
+
+        The sphere rows of replica b are columns ``b·N … b·N + N − 1`` of one state block laid out as
+        the ensembles' (:data:`~particleShear.base.fields.FIELDS` × spheres); a single ensemble keeps
+        its own block, several move theirs into the joint block, of which each then holds its
+        columns as a view (an ensemble that later gains a sphere copies its block out again).
+        Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
+        block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the box, strain,
+        rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
+        by :meth:`from_ensembles`, the plates (``applying_shear``) from the first ensemble's
+        ``applyingShear``.  An engine on this state numbers the relations as they form, and
+        :func:`~particleShear.engine.relax.write_back` afterwards gives each ensemble its clock,
+        strain and relations and drops its caches (and
+        :func:`~particleShear.engine.relax.untouched_on_failure` puts one back after a failed run).
+
+        Parameters
+        ----------
+        ensembles : sequence of ensemble
+            Documented ensembles of ``particleShear.objects`` or ``particleShear.linkable`` with
+            equal N, each at most once.
+        laws : sequence, optional
+            As :meth:`from_ensembles`.
+
+        Returns
+        -------
+        BatchState
+            On NumPy, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
+
+        Raises
+        ------
+        ValueError
+            As :meth:`from_ensembles`, or if an ensemble is given twice.
+        """
+        ensembles = list(ensembles)
+        if len({id(e) for e in ensembles}) != len(ensembles):
+            raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
+        s = cls.from_ensembles(ensembles, laws=laws)
+        N = s.N
+        if len(ensembles) == 1:
+            block = ensembles[0]._st
+        else:
+            block = np.empty((ensembles[0]._st.shape[0], s.B * N))
+            for b, e in enumerate(ensembles):
+                block[:, b * N:(b + 1) * N] = e._st
+                e._block, e._cap = block[:, b * N:(b + 1) * N], N
+                e._views()
+        x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
+        s.pos, s.vel, s.frc = block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3]
+        s.phi, s.r, s.m, s.inertia = (block[ROW[name]] for name in ("phi", "r", "m", "inertia"))
         s._views()
-        s.pairs[0] = ensemble._pairs
-        s.applying_shear = bool(getattr(ensemble, "applyingShear", True))
-        s.ensemble = ensemble
+        s.pairs = [e._pairs for e in ensembles]
+        s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
+        s.ensembles = ensembles
+        s.ensemble = ensembles[0] if len(ensembles) == 1 else None
         return s
 
     @classmethod

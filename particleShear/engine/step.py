@@ -217,7 +217,7 @@ class BatchEngine:
         #: number the relations as they form (:meth:`_number`), for a write-back into ensembles (on
         #: from the start for a state that is an ensemble's own); ``next_birth``: the number the
         #: next relation of each replica gets
-        self.numbers_relations = s.ensemble is not None
+        self.numbers_relations = s.ensembles is not None
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
         self.phase = "pre-equilibration"
         self.rebuilds = np.zeros(B, dtype=np.int64)

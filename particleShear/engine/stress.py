@@ -125,7 +125,10 @@ class StressInputs:
         ndarray (B, 2, 2)
             ``out[b, a, c] = Σ_rows of b  u_a · w_c`` (unscaled).
         """
-        W = array_namespace(u[0]).stack((u[0] * w[0], u[0] * w[1], u[1] * w[0], u[1] * w[1]))
+        xp = array_namespace(u[0])
+        W = xp.empty((4, u[0].shape[0]))      # the four products written in place (no stack)
+        for r, (a, c) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
+            xp.multiply(u[a], w[c], out=W[r])
         return self.per_replica(W, by_pair).T.reshape(self.B, 2, 2)
 
     @property

@@ -2,16 +2,11 @@
 __docformat__ = "numpy"
 from .spheres import neighbor_relation_linkable, SphereLinkable, SphereLinkableAdjustableInterfaceStrength
 from .canvas import CanvasPointsLinkable, EnsembleLinkable
+from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
+from .builders import (EnsembleCompactParticlesFromModelParameters,
+                       EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters)
 
 __all__ = ["neighbor_relation_linkable", "SphereLinkable", "SphereLinkableAdjustableInterfaceStrength",
-           "CanvasPointsLinkable", "EnsembleLinkable"]
-
-try:  # compact particles and builders (filled in by their own modules)
-    from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
-    from .builders import (EnsembleCompactParticlesFromModelParameters,
-                           EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters)
-    __all__ += ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
-                "EnsembleCompactParticlesFromModelParameters",
-                "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters"]
-except ImportError:  # pragma: no cover - during development only
-    pass
+           "CanvasPointsLinkable", "EnsembleLinkable", "EnsembleCompactParticles",
+           "EnsembleCompactParticlesAdjustableInterfaceStrength", "EnsembleCompactParticlesFromModelParameters",
+           "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters"]

@@ -1,12 +1,6 @@
 """Ensemble factories from physical properties: the constitution of a crosslinked, cut gel.
 
-Both builders validate every input before any work, derive the model constants
-and time steps, relax the random packing, crosslink it, cut it into particles
-and relax again.  ``rng`` (Generator, int seed or None) drives every random
-choice; ``verbose`` logs the console messages of particleShear 1.0.2 (INFO, logger
-``particleShear.linkable.builders``).  The constants follow eq. S1-8 (spring constant),
-eq. S1-9 (viscosity) and eq. S1-14 (radii) of the manual; docs/parameters.md describes every
-parameter and docs/accuracy.md the choice of the time step.
+Constants: eq. S1-8 (spring), S1-9 (viscosity), S1-14 (radii); the time step: docs/accuracy.md.
 """
 __docformat__ = "numpy"
 import logging
@@ -27,7 +21,6 @@ __all__ = ["EnsembleCompactParticlesFromModelParameters",
 MAX_CUT_ATTEMPTS = 1000
 
 
-# -- input validation -------------------------------------------------------------------------------------
 def _number(name, value):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, got {value!r}")
@@ -70,36 +63,16 @@ def _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_sphe
              "0 <= value < 90 (degrees)")
 
 
-# -- time steps -------------------------------------------------------------------------------------------
 def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
                           anticipated_amplitude, relative_viscosity):
-    """Final step ``dt`` and coarsest relaxation step ``dt_max`` of the builders, in the order of particleShear 1.0.2.
-
-    ``dt = 0.1·τ/bf``, halved when ``mu <= 1 or rts < 1``, when ``A <= 0.05``, when
-    ``mu <= 0.1 or rts < 0.1``, when ``A <= 0.005`` and when ``A >= 0.5``;
-    ``dt_max = 0.25·τ/bf``, or ``0.125·τ/bf`` when ``(rv <= 0.1 and mu < 0.1) or rts < 0.1 or
-    rts > 5``, or ``0.04·τ/bf`` when ``(rv < 0.01 and mu < 0.01) or rts < 0.01``; then ``dt`` is
-    capped at ``dt_max`` and, for ``rv > 1``, ``dt_max`` is divided by ``rv``.
+    """Return ``(dt, dt_max)`` (s), the builders' final and coarsest step, chosen as in particleShear 1.0.2.
 
     Parameters
     ----------
-    time_constant : float
-        Model time constant τ = sqrt(m/k) (s).
-    bimodal_factor : float
-        Ratio bf of the large to the small radius.
-    mu : float
-        Coulomb friction coefficient μ.
-    relative_transversal_link_strength : float
-        rts = k_t/k.
-    anticipated_amplitude : float
-        Strain amplitude A the ensemble is built for.
-    relative_viscosity : float
-        rv in ν = rv·√(m k) (eq. S1-9).
-
-    Returns
-    -------
-    tuple of float
-        ``(dt, dt_max)`` in s.
+    time_constant, bimodal_factor, mu : float
+        τ = sqrt(m/k) (s), large/small radius ratio bf, Coulomb coefficient μ.
+    relative_transversal_link_strength, anticipated_amplitude, relative_viscosity : float
+        rts = k_t/k, strain amplitude A, rv (eq. S1-9).
     """
     tau, bf, rts, A, rv = (time_constant, bimodal_factor, relative_transversal_link_strength,
                            anticipated_amplitude, relative_viscosity)
@@ -126,7 +99,6 @@ def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversa
     return dt, dt_max
 
 
-# -- shared constitution steps ----------------------------------------------------------------------------
 def _avoid_flag(avoid, doCutByTriangulation, cut_lines, verbose):
     """Height checks only make sense when cutting can produce separate particles (first step of the builders)."""
     if avoid and ((doCutByTriangulation and cut_lines <= 1) or (not doCutByTriangulation and cut_lines <= 0)):
@@ -146,7 +118,7 @@ def _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness):
 
 
 def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose):
-    """Crosslink all contacts, cut into particles, re-cut while a particle spans > 0.9·Ly (at most MAX_CUT_ATTEMPTS)."""
+    """Crosslink all contacts and cut; re-cut while a particle spans > 0.9·Ly (at most MAX_CUT_ATTEMPTS)."""
     ens.makeAllLinksPermanent()
     if cut_top_bottom:
         ens.cutTopBottomEdge()
@@ -171,21 +143,15 @@ def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut
 
 
 class Relaxation:
-    """One relaxation of a constitution: ``ensemble.free_pre_equilibration(N)`` at its current settings.
+    """Request to run ``ensemble.free_pre_equilibration(N)`` in the engine, yielded by a constitution.
 
-    A constitution written as a generator (:func:`adjustable_interface_constitution`) yields one
-    request per relaxation block and resumes once it is done.  Whoever drives the generator runs
-    it: :func:`relax_constitution` one request at a time (:meth:`run`), or a batch's driver for
-    all its replicas at once; both relax in the engine (:func:`particleShear.engine.relax.relax_ensembles`;
-    docs/design.md, "Runs").  The relaxation reads the ensemble's ``dt``, ``dt_max`` and ``mu`` when
-    it is run, so requests with equal :attr:`key` run the same steps (the replicas' μ may differ).
+    Run by :meth:`run` or by a batch's driver; ``dt``, ``dt_max``, ``mu`` are read then (docs/design.md, "Runs").
 
     Parameters
     ----------
     ensemble : EnsembleCompactParticles
-        The ensemble to relax.
     N : int
-        Steps per level and per final block of ``free_pre_equilibration`` (>= 0).
+        Steps per level and per final block, >= 0.
     """
     __slots__ = ("ensemble", "N")
 
@@ -195,13 +161,12 @@ class Relaxation:
 
     @property
     def key(self):
-        """``(N, dt, dt_max)``: requests with equal keys run the same number of steps of the same lengths."""
+        """``(N, dt, dt_max)``: requests with equal keys run the same steps."""
         e = self.ensemble
         return (self.N, float(e.dt), float(e.dt_max))
 
     def run(self):
-        """Relax this ensemble alone in the engine (a batch of one): the steps of
-        ``ensemble.free_pre_equilibration(N)`` (:func:`particleShear.engine.relax.relax_ensembles`)."""
+        """Relax this ensemble alone in the engine (:func:`particleShear.engine.relax.relax_ensembles`)."""
         from ..engine.relax import relax_ensembles
         relax_ensembles([self.ensemble], self.N)
 
@@ -215,22 +180,13 @@ MAX_RELAXATIONS = 10000
 
 
 def relax_constitution(steps):
-    """Drive a constitution generator, running each of its :class:`Relaxation` requests (:meth:`Relaxation.run`).
+    """Run every :class:`Relaxation` a constitution yields and return the generator's value.
 
     Parameters
     ----------
     steps : generator
-        A constitution such as :func:`adjustable_interface_constitution`.
-
-    Returns
-    -------
-    object
-        What the generator returns (the constituted ensemble).
-
-    Raises
-    ------
-    RuntimeError
-        If the generator yields more than :data:`MAX_RELAXATIONS` requests.
+        A constitution such as :func:`adjustable_interface_constitution` (RuntimeError after
+        :data:`MAX_RELAXATIONS` requests).
     """
     try:
         request = next(steps)
@@ -249,7 +205,6 @@ def _free_mu0(ens, n, mu):
     ens.mu = mu
 
 
-# -- builders ---------------------------------------------------------------------------------------------
 def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         size_x=500, size_y=500, N=100, packing_fraction=1, mu=1, Young_modulus_spheres=10000, density=50,
         bimodal_factor=1.4, cut_lines=5, do_permanent_links=True, theTk=False, do_pre_equilibration=True,
@@ -261,94 +216,52 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
         rng=None, verbose=False):
     """Relaxed, crosslinked and cut ensemble with reinforced transient interfaces; the main factory.
 
-    The factory of ``doParticleShearSimulation``: it validates every input, derives the model
-    constants (:class:`~particleShear.objects.model.particle_shear_model_parameters` with
-    ``bimodal_factor=1``) and the time steps (:func:`time_steps_from_model`), sets
-    ``k = k_model·irc``, ``k_t = k_model·rts·irt``, ``ν = rv·k_model·τ`` and ``ν_t = ν·rts``
-    (times ``irc`` / ``irt`` unless ``keep_viscosity_coefficients_constant``), with bonds scaled
-    back by ``1/irc`` and ``1/irt``; then it relaxes the random packing, crosslinks it, cuts it
-    into particles, removes links, joins isolated spheres and relaxes again (docs/design.md).
+    The factory of ``doParticleShearSimulation`` (same parameter names: docs/parameters.md).  From
+    :class:`~particleShear.objects.model.particle_shear_model_parameters` (``bimodal_factor=1``) it
+    sets ``k = k_model·irc``, ``k_t = k_model·rts·irt``, ``ν = rv·k_model·τ``, ``ν_t = ν·rts`` (times
+    irc, irt unless ``keep_viscosity_coefficients_constant``; bonds scaled back by 1/irc, 1/irt) and
+    the steps of :func:`time_steps_from_model`, then runs :func:`adjustable_interface_constitution`.
 
     Parameters
     ----------
-    size_x, size_y : float, optional
-        Width and height of the periodic cell (µm), > 0.
-    N : int, optional
-        Number of spheres, >= 2.
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
-    Young_modulus_spheres : float, optional
-        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
-    density : float, optional
-        Density of the sphere material (kg/m³), > 0.
-    bimodal_factor : float, optional
-        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
-    cut_lines : int, optional
-        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
-        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
-    do_permanent_links : bool, optional
-        Crosslink all contacts after the relaxation and cut the gel into particles (False:
-        frictional spheres only).
-    theTk : object, optional
-        Accepted for compatibility with particleShear 1.0.2; not used.
-    do_pre_equilibration : bool, optional
-        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
-    relative_viscosity : float, optional
-        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
-    central_repulsion_coefficient : float, optional
-        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
-    anticipated_amplitude : float, optional
-        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
-        length of the relaxation.
-    relative_transversal_link_strength : float, optional
-        rts = k_t/k = ν_t/ν, >= 0.
+    size_x, size_y, N, packing_fraction, bimodal_factor : optional
+        Cell (µm, > 0), number of spheres (>= 2), nominal area fraction φ (eq. S1-14, > 0), large/small
+        radius ratio (> 0).
+    mu, Young_modulus_spheres, density : float, optional
+        Coulomb coefficient μ of transient contacts (>= 0), Young modulus (Pa; eq. S1-8), density (kg/m³).
+    relative_viscosity, relative_transversal_link_strength : float, optional
+        rv in ν = rv·√(m k) (eq. S1-9) and rts = k_t/k = ν_t/ν, >= 0.
+    central_repulsion_coefficient, anticipated_amplitude : float, optional
+        c of the central law (1: divergent, eq. S1-5b; 0: linear, eq. S1-5a); strain amplitude A (> 0),
+        which selects the time step and the length of the relaxation.
+    interface_reenforcement_central, interface_reenforcement_tangential, keep_viscosity_coefficients_constant
+        irc, irt (> 0): factors on k, k_t of transient contacts relative to bonds; True: ν, ν_t not scaled.
+    do_pre_equilibration, do_permanent_links : bool, optional
+        Relax the random packing; crosslink and cut it afterwards (False: frictional spheres only).
+    cut_lines, doCutByTriangulation : optional
+        Number of Voronoi particles (<= 1: uncut) or, with False, of random straight cuts (0: uncut).
     avoid_horizontal_angle_degree : float, optional
-        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
-        lines that are redrawn.
-    avoid_height_spanning_particles : bool, optional
-        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
-        ignored when the cut cannot produce separate particles.
-    interface_reenforcement_central : float, optional
-        irc, factor on k (and ν) of transient contacts relative to bonds, > 0.
-    interface_reenforcement_tangential : float, optional
-        irt, the same for k_t (and ν_t), > 0.
-    keep_viscosity_coefficients_constant : bool, optional
-        True: the viscosities are not scaled by the reinforcement factors.
-    cut_top_bottom : bool, optional
-        Cut every bond through the y-periodic boundary (wall-slip emulation).
-    doCutByTriangulation : bool, optional
-        Particles by periodic Voronoi cells (False: random straight lines).
-    remove_link_fraction : float, optional
-        Target fraction (0 … 1) of non-essential links to remove after cutting.
-    edge_fuzziness : float, optional
-        Random roughening of the Voronoi borders in units of the largest radius, >= 0.
-    doDrawing : bool, optional
-        Whether the ensemble draws its spheres (no window is opened here).
-    do_debug : bool, optional
-        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
-    rng : numpy.random.Generator, int or None, optional
-        Random generator or seed driving every random choice (placement, cutting, link removal);
-        None draws fresh entropy.
-    verbose : bool, optional
-        Log the progress messages (INFO) of particleShear 1.0.2.
+        Line cuts: half-width (degrees, in [0, 90)) of the redrawn band of near-horizontal lines.
+    avoid_height_spanning_particles, cut_top_bottom : bool, optional
+        Re-cut while a particle is taller than 0.9·size_y; cut every bond through the y boundary.
+    remove_link_fraction, edge_fuzziness : float, optional
+        Fraction (0 … 1) of non-essential links removed; roughening of Voronoi borders (units of r_max).
+    theTk, doDrawing, do_debug : optional
+        Unused (1.0.2 compatibility); draw the spheres (no window); ten times shorter relaxations.
+    rng, verbose : optional
+        Generator or seed of every random choice (None: fresh entropy); log 1.0.2's messages (INFO, module logger).
 
     Returns
     -------
     EnsembleCompactParticlesAdjustableInterfaceStrength
-        The ensemble; its ``dt`` / ``dt_max`` (s) are the steps the experiment should use and its
-        ``model`` holds the model constants.
+        The ensemble; ``dt``, ``dt_max`` (s) are the steps to use, ``model`` the model constants.
 
     Raises
     ------
-    TypeError
-        If a numeric parameter is not a real number.
-    ValueError
-        If a parameter is out of its range (the message names it, its value and the allowed range),
-        before any work.
+    TypeError, ValueError
+        If a parameter is not a real number or out of range (named in the message), before any work.
     RuntimeError
-        If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
+        If no cut without a height-spanning particle is found in :data:`MAX_CUT_ATTEMPTS` attempts.
     """
     arguments = dict(locals())     # every parameter, as passed (nothing else is defined yet)
     return relax_constitution(adjustable_interface_constitution(**arguments))
@@ -363,31 +276,17 @@ def adjustable_interface_constitution(
         interface_reenforcement_tangential=1, keep_viscosity_coefficients_constant=True, cut_top_bottom=True,
         doCutByTriangulation=True, remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, do_debug=False,
         rng=None, verbose=False):
-    """The constitution of :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters`
-    as a generator of its relaxations.
+    """Constitution of :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters` as a generator.
 
-    The same validation, placement, crosslinking, cutting, link removal and joining of isolated
-    spheres as the builder (every bookkeeping step through the documented classes), but each of
-    its ``free_pre_equilibration`` blocks is yielded as a :class:`Relaxation` request; the
-    generator resumes when the caller has run it and returns the ensemble (``StopIteration.value``).
-    :func:`relax_constitution` runs the requests one by one (that is the builder);
-    ``particleShear.run.batch`` runs those of all replicas of a batch together in the engine
-    (docs/design.md, "Runs").
+    Each ``free_pre_equilibration`` block is yielded as a :class:`Relaxation` for the caller to run
+    (:func:`relax_constitution`, or ``particleShear.run.batch`` for all replicas; docs/design.md,
+    "Runs"); the ensemble is returned (``StopIteration.value``).  Invalid inputs raise as in the
+    builder, on the first ``next()``.
 
     Yields
     ------
     Relaxation
-        The next relaxation block (the ensemble's ``dt``, ``dt_max`` and ``mu`` are set for it).
-
-    Returns
-    -------
-    EnsembleCompactParticlesAdjustableInterfaceStrength
-        The constituted ensemble, as the builder returns it.
-
-    Raises
-    ------
-    TypeError, ValueError, RuntimeError
-        As the builder, on the first ``next()`` (before any work).
+        The next block (the ensemble's ``dt``, ``dt_max`` and ``mu`` set for it).
     """
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
@@ -494,81 +393,17 @@ def EnsembleCompactParticlesFromModelParameters(
         relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
         avoid_height_spanning_particles=False, doCutByTriangulation=True, doDrawing=True, do_debug=False,
         rng=None, verbose=False):
-    """Legacy factory: no reinforcement, top/bottom always cut, a short final relaxation.
+    """Legacy factory of ``Simulation_dermal_filler_rheology``; returns an :class:`EnsembleCompactParticles`.
 
-    The factory of ``Simulation_dermal_filler_rheology``: the same time steps and constants as
-    :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters` with
-    ``irc = irt = 1``, bonds through the y-periodic boundary always cut, no edge fuzziness, no
-    link removal and a final relaxation of 25 steps per level.
+    The main builder (same parameters, checks and errors) with ``irc = irt = 1``, bonds through the y
+    boundary always cut, no edge fuzziness or link removal, and a final relaxation of 25 steps per level.
 
     Parameters
     ----------
-    size_x, size_y : float, optional
-        Width and height of the periodic cell (µm), > 0.
-    N : int, optional
-        Number of spheres, >= 2.
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0 (bonds are not limited).
-    Young_modulus_spheres : float, optional
-        Young modulus E of the sphere material (Pa), > 0; k = π E/8 (eq. S1-8).
-    density : float, optional
-        Density of the sphere material (kg/m³), > 0.
-    bimodal_factor : float, optional
-        Ratio of the large to the small radius, > 0 (spheres large or small with probability 1/2).
-    cut_lines : int, optional
-        Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts;
-        integer >= 0 (<= 1 resp. 0: an uncut bulk gel).
-    do_permanent_links : bool, optional
-        Crosslink all contacts after the relaxation and cut the gel into particles (False:
-        frictional spheres only).
-    theTk : object, optional
-        Accepted for compatibility with particleShear 1.0.2; not used.
-    do_pre_equilibration : bool, optional
-        Relax the random packing (frictionless, damped, multi-level) before crosslinking.
-    relative_viscosity : float, optional
-        rv in ν = rv·√(m k) (eq. S1-9), >= 0.
-    central_repulsion_coefficient : float, optional
-        c of the central law: 1 = divergent law eq. S1-5b, 0 = linear law eq. S1-5a.
-    anticipated_amplitude : float, optional
-        Strain amplitude A the ensemble is built for, > 0; it selects the time step and the
-        length of the relaxation.
-    relative_transversal_link_strength : float, optional
-        rts = k_t/k = ν_t/ν, >= 0.
-    avoid_horizontal_angle_degree : float, optional
-        Line mode only: half-width (degrees, 0 <= value < 90) of the band of near-horizontal cut
-        lines that are redrawn.
-    avoid_height_spanning_particles : bool, optional
-        Re-cut (with fresh random seeds or lines) while a particle is taller than 0.9·size_y;
-        ignored when the cut cannot produce separate particles.
-    doCutByTriangulation : bool, optional
-        Particles by periodic Voronoi cells (False: random straight lines).
-    doDrawing : bool, optional
-        Whether the ensemble draws its spheres (no window is opened here).
-    do_debug : bool, optional
-        Ten times shorter relaxations (for tests; the ensemble is less relaxed).
-    rng : numpy.random.Generator, int or None, optional
-        Random generator or seed driving every random choice (placement, cutting, link removal);
-        None draws fresh entropy.
-    verbose : bool, optional
-        Log the progress messages (INFO) of particleShear 1.0.2.
-
-    Returns
-    -------
-    EnsembleCompactParticles
-        The ensemble; its ``dt`` / ``dt_max`` (s) are the steps the experiment should use and its
-        ``model`` holds the model constants.
-
-    Raises
-    ------
-    TypeError
-        If a numeric parameter is not a real number.
-    ValueError
-        If a parameter is out of its range (the message names it, its value and the allowed range),
-        before any work.
-    RuntimeError
-        If no cut without a height-spanning particle is found in ``MAX_CUT_ATTEMPTS`` attempts.
+    size_x, size_y, N, packing_fraction, bimodal_factor, mu, Young_modulus_spheres, density, cut_lines
+    relative_viscosity, relative_transversal_link_strength, central_repulsion_coefficient, doDrawing
+    anticipated_amplitude, do_pre_equilibration, do_debug, do_permanent_links, doCutByTriangulation
+    avoid_horizontal_angle_degree, avoid_height_spanning_particles, theTk, rng, verbose
     """
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,

@@ -1,15 +1,4 @@
-"""Ensembles with permanent links (crosslinks): bonds, cutting along lines, bond forces.
-
-``CanvasPointsLinkable`` adds bonds to the friction canvas: bonds use
-the compressive law below ``d_eq`` and the tensile law above it, never break,
-carry an unbounded tangential spring and are scaled by the per-sphere
-``permanent_ratio_*`` of the adjustable sphere class.  They are rows of the pair table whose
-constants the engine's force phase takes from :func:`particleShear.engine.terms.term_constants`
-(the tensile law, also one replaced through ``call_back_elastic_force_law_tensile``, beyond
-``d_eq``); this class adds the bookkeeping of bonds: making, listing and cutting them.  The force
-laws are eq. S1-5a/b of the manual; the constants are those of docs/parameters.md; how bonds are
-made and cut is described in docs/design.md.
-"""
+"""Ensembles with permanent links (bonds, rows of the pair table): making, listing and cutting them."""
 __docformat__ = "numpy"
 import math
 
@@ -17,7 +6,6 @@ import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image
-from ..base.namespace import count_nonzero as _nz
 from ..base.neighbours import PERMANENT, SLIP
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
@@ -27,36 +15,14 @@ __all__ = ["CanvasPointsLinkable", "EnsembleLinkable"]
 
 
 class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
-    """Friction canvas whose relations can be made permanent (crosslinks).
-
-    Bonds are made by :meth:`makeAllLinksPermanent` and cut by :meth:`cutLine` and its variants;
-    the bond forces are added to the contact forces of the friction canvas in every step.
+    """Friction canvas whose relations can be made permanent (crosslinks), with bond forces in every step.
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic Lees-Edwards cell (µm), > 0.
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    size_x, size_y, theCanvas, doDrawing, k, nu, k_t, nu_t, mu
+        As for :class:`~particleShear.objects.ensembles.EnsembleFrictionLeesEdwards` (ValueError when out of range).
     m : float, optional
-        Nominal sphere mass stored on the ensemble (mg per metre of depth).
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+        Nominal sphere mass stored on the ensemble (mg per m depth).
     """
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1, k_t=1, nu_t=0.01,
@@ -65,12 +31,11 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                                                            k_t, nu_t, mu)
         self._relation_view_class = LinkableRelationView
 
-    # -- bond bookkeeping (arrays) -------------------------------------------------------------------
     def _link_pairs(self, i, j):
         """Make pairs (i, j) permanent: ``d_eq = r_i + r_j``, ξ = 0; creates missing relations."""
         i = np.atleast_1d(np.asarray(i, dtype=np.intp))
         j = np.atleast_1d(np.asarray(j, dtype=np.intp))
-        if _nz(i == j):
+        if (i == j).any():
             k = int(np.flatnonzero(i == j)[0])
             raise ValueError(f"cannot link sphere {int(i[k])} to itself")
         if not len(i):
@@ -79,7 +44,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         slots = pt.ensure(i, j)
         r = self._a["r"]
         newly = ~pt.active[slots]
-        if _nz(newly):
+        if newly.any():
             pt.birth[slots[newly]] = pt.next_births(int(newly.sum()))
         pt.active[slots] = True
         pt.state[slots] = PERMANENT
@@ -105,18 +70,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._cut_slots(slots[slots >= 0])
 
     def permanent_pairs(self, physical_neighbors_only=False):
-        """Sphere indices (i, j), i < j, of the bonds.
+        """Sphere indices ``(i, j)``, i < j, of the bonds (two integer arrays, copies).
 
         Parameters
         ----------
         physical_neighbors_only : bool, optional
-            Only bonds that do not wrap through the periodic boundary (raw coordinate differences
-            below half the cell size in x and in y).
-
-        Returns
-        -------
-        tuple of numpy.ndarray
-            ``(i, j)``, two integer arrays of equal length (copies).
+            Only bonds not wrapping through the periodic boundary (raw differences below half the cell).
         """
         pt = self._pairs
         m = pt.state == PERMANENT
@@ -133,25 +92,18 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                 & (np.abs(a["y"][i] - a["y"][j]) < self.size_y / 2))
 
     def makeAllLinksPermanent(self):
-        """Bond every current relation (the contacts of the last neighbour update).
-
-        Each bond gets ``d_eq = r_i + r_j`` (not the current, compressed distance) and ξ = 0; bonds
-        through the periodic boundary are made like any other (docs/design.md).  Runs a
-        neighbour update first if no relation exists yet.
-        """
+        """Bond every current relation (updating the neighbours if none exists): ``d_eq = r_i + r_j``, ξ = 0."""
         pt = self._pairs
-        if self._g is None and not _nz(pt.active):
+        if self._g is None and not pt.active.any():
             self.test_neighbor_relation()
         m = np.flatnonzero(pt.active)
         self._link_pairs(pt.i[m], pt.j[m])
 
     def cutLine(self, point, angle):
-        """Cut every bond crossed by an infinite, non-periodic line.
+        """Cut (to slipping contacts) every bond crossed by the infinite, non-periodic line.
 
-        With the normal ``n = (cos angle, sin angle)`` and ``b = n·point``, the bond i–j is cut
-        when ``(n·x_i − b)·(n·(x_i + Δ_ij) − b) <= 0`` (from either end), ``Δ_ij`` being the
-        Lees-Edwards minimum-image separation.  Cut bonds become slipping contacts (ξ = 0,
-        ``d_eq`` = 0).
+        With ``n = (cos angle, sin angle)``, ``b = n·point``: bond i–j is cut when
+        ``(n·x_i − b)·(n·(x_i + Δ_ij) − b) <= 0`` from either end (``Δ_ij``: Lees-Edwards minimum image).
 
         Parameters
         ----------
@@ -179,19 +131,13 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         self._cut_slots(slots[cut])
 
     def cutRandomLine(self):
-        """Cut along a line through a random integer point of the cell with a uniform random normal angle.
-
-        Draws from the ensemble's random generator (x, y, then the angle).
-        """
+        """Cut along a line through a random integer point, uniform random normal angle (draws x, y, angle)."""
         rng = self._rng
         point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
         self.cutLine(point, 2 * math.pi * rng.random())
 
     def cutTopBottomEdge(self):
-        """Cut every bond crossing y = 0 or y = size_y through the periodic image.
-
-        This emulates wall slip at the plates (``cut_top_bottom`` of the builders).
-        """
+        """Cut every bond crossing y = 0 or y = size_y (wall slip, ``cut_top_bottom`` of the builders)."""
         self.cutLine((0, 0), math.pi / 2)
         self.cutLine((0, self.size_y), math.pi / 2)
 
@@ -205,41 +151,12 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
 
 
 class EnsembleLinkable(RandomBimodalSpheres, CanvasPointsLinkable):
-    """N random bimodal linkable spheres (``N = 0`` for hand-built scenes, as in the unit tests).
+    """N random bimodal linkable spheres (``N = 0`` for hand-built scenes).
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor, k_t, nu_t, mu
+        As for :class:`~particleShear.objects.ensembles.EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,

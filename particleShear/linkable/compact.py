@@ -1,12 +1,7 @@
-"""Ensembles of compact particles: crosslinked spheres cut into particles.
+"""Compact particles: crosslinked spheres cut into particles, the connected components of the bond graph.
 
-A *particle* is a connected component of the graph of permanent links (by
-default only *physical* links, i.e. links that do not wrap through the
-periodic boundary).  Components are found with array operations (min-label
-propagation with pointer jumping over the bond arrays); ``particles`` is kept,
-as in particleShear 1.0.2, as a list of lists of sphere objects.  The constitution
-protocol that uses these methods (relax, crosslink, cut, remove links, join isolated
-spheres, relax again) is described in docs/design.md and docs/parameters.md.
+``physical_neighbors_only``: count only physical bonds, which do not wrap through the periodic
+boundary.  ``particles`` is, as in 1.0.2, a list of lists of spheres.
 """
 __docformat__ = "numpy"
 import math
@@ -25,19 +20,13 @@ __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterf
 
 
 def component_labels(n, i, j):
-    """Connected components of an undirected graph, by min-label propagation with pointer jumping.
+    """Label each of ``n`` nodes with the smallest node of its component (min-label propagation, pointer jumping).
 
     Parameters
     ----------
     n : int
-        Number of nodes (0 … n−1).
     i, j : array_like of int
-        End nodes of the edges (equal lengths; an edge may be listed twice or in either order).
-
-    Returns
-    -------
-    numpy.ndarray of int
-        Per node, the label of its component: the smallest node index of the component.
+        End nodes of the edges.
     """
     lab = np.arange(n, dtype=np.intp)
     i = np.asarray(i, dtype=np.intp)
@@ -66,56 +55,17 @@ def component_labels(n, i, j):
 class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     """Random bimodal linkable spheres that are crosslinked and cut into compact particles.
 
-    ``dt`` / ``dt_max`` (s) are the final and the coarsest step of the multi-level
-    relaxation :meth:`free_pre_equilibration`.  ``rng`` (an addition to 1.0.2) is set before
-    the spheres are drawn so that whole builds are reproducible.
-
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
-    dt : float, optional
-        Final (finest) time step of :meth:`free_pre_equilibration` (s), > 0 when relaxing.
-    dt_max : float, optional
-        Coarsest time step of the multi-level relaxation (s).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor, k_t, nu_t, mu
+        As for :class:`~particleShear.objects.ensembles.EnsembleFrictionLeesEdwards` (ValueError when out of range).
+    dt, dt_max : float, optional
+        Final and coarsest step of :meth:`free_pre_equilibration` (s).
     theTkSimulation : object or False, optional
-        Tk window of the live drawing, False for none (stored only).
     avoid_horizontal_angle_degree : float, optional
-        Half-width (degrees, 0 <= value < 90) of the band of near-horizontal line directions that
-        :meth:`cutRandomLine` redraws; 0 accepts every direction.
+        Half-width (degrees, in [0, 90)) of the band of near-horizontal lines :meth:`cutRandomLine` redraws.
     rng : numpy.random.Generator, int or None, optional
-        Random generator or seed for every random choice of the ensemble (sphere placement,
-        cutting, link removal), set before the spheres are drawn; None keeps the ensemble's own
-        unseeded generator.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+        Generator or seed of every random choice (None: the ensemble's own).
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
@@ -145,18 +95,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                               self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
 
     def particle_info(self, reference=False):
-        """Description of the spheres for the header of the output file (radii in µm, masses in mg).
+        """Description of the spheres for the output file's header (exactly the text of 1.0.2 if ``reference``).
 
         Parameters
         ----------
         reference : bool, optional
-            True: the text of particleShear 1.0.2 exactly (its typos and its radius ratio of
-            0.8/1.2 included); False: the corrected text with the actual radii and masses.
-
-        Returns
-        -------
-        str
-            The description.
         """
         return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles\n\t"
                 + self._sphere_info(reference))
@@ -173,27 +116,21 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return ("Spheres with bimodal distribution, equal probability, \n\tr1=" + str(r1) + " r2="
                 + str(self.r_max) + "\n\tmasses m1=" + m1 + "mg m2=" + m2 + "mg")
 
-    # -- relaxation ----------------------------------------------------------------------------------
     def free_pre_equilibration(self, N=25):
-        """Frictionless damped multi-level relaxation, then N frictionless and N frictional steps at ``dt``.
+        """Damped frictionless multi-level relaxation, then N frictionless and N frictional steps at ``dt``.
 
-        Starting at ``dt_max`` with damping factor 0.5, N frictionless steps are run per level
-        while the level step exceeds ``dt``; each level halves the step, moves the damping factor
-        half-way to 1 and removes the mean velocity.  Then N steps at ``dt`` without friction
-        and N steps with friction follow, both undamped.  Shear is off throughout; the
-        ensemble's ``mu`` is restored afterwards.  Run by the engine on this ensemble alone
-        (:func:`particleShear.engine.relax.relax_ensembles`, the relaxation of every
-        constitution), the result written back.
+        From ``dt_max`` with damping 0.5, N steps per level while the step exceeds ``dt``, each level halving
+        the step, moving the damping half-way to 1 and removing the mean velocity (docs/design.md, "Runs").
 
         Parameters
         ----------
         N : int, optional
-            Number of steps per level and per final block, >= 0.
+            Steps per level and per final block.
 
         Raises
         ------
         ValueError
-            If the ensemble's ``dt`` is not > 0, or ``N`` < 0 (before any step).
+            If ``dt`` is not > 0 or ``N`` < 0 (before any step).
         """
         from ..engine.relax import relax_ensembles
         N = int(N)
@@ -203,7 +140,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
             raise ValueError(f"N={N!r} is out of range for free_pre_equilibration: allowed >= 0")
         relax_ensembles([self], N)
 
-    # -- particles -----------------------------------------------------------------------------------
     def _labels(self, physical_neighbors_only=True):
         i, j = self.permanent_pairs(physical_neighbors_only)
         return component_labels(self._n, i, j)
@@ -216,17 +152,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return [[sl[k] for k in grp] for grp in np.split(order, cuts)] if self._n else []
 
     def identify_particles(self, physical_neighbors_only=True):
-        """Set and return ``particles``: the connected components of the permanent-link graph.
+        """Set and return ``particles``, ordered by lowest sphere index (spheres in index order).
 
         Parameters
         ----------
         physical_neighbors_only : bool, optional
-            Count only bonds that do not wrap through the periodic boundary.
-
-        Returns
-        -------
-        list of list of SphereLinkable
-            One list per particle, ordered by the lowest sphere index (spheres in index order).
         """
         self.particles = self._particles_from_labels(self._labels(physical_neighbors_only))
         return self.particles
@@ -241,16 +171,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return top[roots] - bottom[roots]
 
     def maximal_particle_height(self):
-        """Height of the tallest particle: the largest ``max(y + r) − min(y − r)`` (raw coordinates).
-
-        Particles are the components of the physical bonds; ``particles`` is set as by
-        :meth:`identify_particles`.
-
-        Returns
-        -------
-        float
-            The height (µm); 0 for an empty ensemble.
-        """
+        """Height ``max(y + r) − min(y − r)`` of the tallest particle (µm; 0 if empty); sets ``particles``."""
         lab = self._labels(True)
         self.particles = self._particles_from_labels(lab)
         if not self._n:
@@ -264,17 +185,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return d["_idx"]
 
     def findParticle(self, theSphere):
-        """The particle of ``particles`` that contains ``theSphere``.
+        """The particle of ``particles`` that contains ``theSphere``, or False.
 
         Parameters
         ----------
         theSphere : SphereLinkable
-            The sphere looked for.
-
-        Returns
-        -------
-        list of SphereLinkable or False
-            The particle, or False if no particle of ``particles`` contains the sphere.
         """
         for particle in self.particles:
             for s in particle:
@@ -285,20 +200,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     def addParticleFromSphere(self, theSphere, physical_neighbors_only=True):
         """Grow the particle of ``theSphere`` breadth-first, append it to ``particles`` and return it.
 
-        Every generation uses ``physical_neighbors_only`` (particleShear 1.0.2 ignores it
-        beyond the first generation).
-
         Parameters
         ----------
         theSphere : SphereLinkable
-            A sphere of this ensemble.
         physical_neighbors_only : bool, optional
-            Follow only bonds that do not wrap through the periodic boundary.
-
-        Returns
-        -------
-        list of SphereLinkable
-            The particle, in breadth-first order from ``theSphere``.
+            Physical bonds only (in every generation, unlike 1.0.2).
 
         Raises
         ------
@@ -322,20 +228,12 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return particle
 
     def permanentConnectionBetweenSpheres(self, theSphere1, theSphere2, physical_neighbors_only=True):
-        """How two spheres are connected by bonds.
+        """``"direct"`` (bonded), ``"indirect"`` (same particle), ``"no_connection"``; False if identical or foreign.
 
         Parameters
         ----------
         theSphere1, theSphere2 : SphereLinkable
-            The two spheres.
         physical_neighbors_only : bool, optional
-            Count only bonds that do not wrap through the periodic boundary.
-
-        Returns
-        -------
-        str or False
-            ``"direct"`` (bonded to each other), ``"indirect"`` (same particle),
-            ``"no_connection"``, or False if the spheres are identical or not both of this ensemble.
         """
         p, q = self._index_of(theSphere1), self._index_of(theSphere2)
         if p is None or q is None or p == q:
@@ -348,48 +246,24 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return "indirect" if lab[p] == lab[q] else "no_connection"
 
     def n_permanent_connections(self, physical_neighbors_only=True):
-        """Number of bonds, each pair counted once.
+        """Number of bonds, each pair once (a float, as in 1.0.2).
 
         Parameters
         ----------
         physical_neighbors_only : bool, optional
-            Count only bonds that do not wrap through the periodic boundary.
-
-        Returns
-        -------
-        float
-            The number (a float, as in particleShear 1.0.2).
         """
         return float(len(self.permanent_pairs(physical_neighbors_only)[0]))
 
     def remove_non_essential_links(self, max_fraction_to_remove, physical_neighbors_only=True, max_trials=1000):
-        """Cut random links whose spheres stay connected otherwise, up to a fraction of the links.
-
-        A link is non-essential when its two spheres stay in the same particle without it, so
-        removing it never splits a particle.  Sampling is sphere-first (a uniform random sphere,
-        then a uniform random bonded partner), as in particleShear 1.0.2, so links are not
-        sampled uniformly; a trial whose link is essential re-establishes it.  Stops after
-        ``max_trials`` consecutive failures.  Sets and returns ``removed_fraction`` (0 without
-        links).
+        """Cut random links that do not split a particle (sphere-first, as 1.0.2); set and return ``removed_fraction``.
 
         Parameters
         ----------
         max_fraction_to_remove : float
-            Target fraction of the links to remove, >= 0.
+            Target fraction of the links, >= 0 (ValueError if negative).
         physical_neighbors_only : bool, optional
-            Count and remove only bonds that do not wrap through the periodic boundary.
         max_trials : int, optional
-            Consecutive unsuccessful trials after which the removal stops.
-
-        Returns
-        -------
-        float
-            The fraction of the links removed.
-
-        Raises
-        ------
-        ValueError
-            If ``max_fraction_to_remove`` is negative.
+            Consecutive failed trials after which the removal stops.
         """
         check_non_negative("max_fraction_to_remove", max_fraction_to_remove)
         i, j = self.permanent_pairs(physical_neighbors_only)
@@ -420,16 +294,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return self.removed_fraction
 
     def join_isolated_spheres(self, physical_neighbors_only=True):
-        """Bond each sphere without a bond to a random partner among its non-permanent relations.
-
-        Spheres are visited in index order; a sphere without any relation stays free.  This avoids
-        free single spheres inside the gel (the bond may cross a cut).
+        """Bond each unbonded sphere (index order) to a random partner among its relations (may cross a cut).
 
         Parameters
         ----------
         physical_neighbors_only : bool, optional
-            A sphere counts as bonded only through bonds that do not wrap through the periodic
-            boundary.
         """
         pt = self._pairs
         i, j = self.permanent_pairs(physical_neighbors_only)
@@ -451,25 +320,18 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
             if not physical_neighbors_only or self._physical(np.array([p]), np.array([q]))[0]:
                 bonded[p] = bonded[q] = True
 
-    # -- cutting ---------------------------------------------------------------------------------------
     def cutByTriangulationPoints(self, triangulation_points, edge_fuzziness=0):
-        """Cut every bond between spheres whose nearest seed point differs (a periodic Voronoi cut).
+        """Periodic Voronoi cut: cut every bond between spheres with different nearest seeds.
 
-        The distance of a sphere to a seed is the Lees-Edwards minimum-image distance plus
-        ``edge_fuzziness · U · r_max`` (U uniform, drawn per (sphere, seed) even when the fuzziness
-        is 0); ties go to the lower seed index.  Sets ``doCutByTriangulation`` and ``sphere_seed``.
+        Distance: Lees-Edwards minimum image plus ``edge_fuzziness·U·r_max`` (U uniform, drawn per sphere
+        and seed even at 0); ties go to the lower seed.  Sets ``doCutByTriangulation``, ``sphere_seed``.
 
         Parameters
         ----------
         triangulation_points : array_like of float
-            Seed points, shape (n, 2), in µm.
+            Seed points, shape (n, 2) (µm).
         edge_fuzziness : float, optional
-            Roughness of the particle edges in units of the largest sphere radius, >= 0.
-
-        Raises
-        ------
-        ValueError
-            If ``edge_fuzziness`` is negative.
+            Edge roughness in units of the largest radius (ValueError if negative).
         """
         check_non_negative("edge_fuzziness", edge_fuzziness)
         pts = np.asarray(triangulation_points, dtype=float).reshape(-1, 2)
@@ -488,22 +350,13 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.sphere_seed = seed
 
     def cutByTriangulation(self, n_points=5, edge_fuzziness=0):
-        """Periodic Voronoi cut into ``n_points`` particles around uniform random seed points.
-
-        The seeds are drawn from the ensemble's random generator and kept in
-        ``triangulation_points``; ``n_points <= 1`` cuts nothing (a bulk gel).
+        """Periodic Voronoi cut around ``n_points`` random seeds (kept in ``triangulation_points``; <= 1: none).
 
         Parameters
         ----------
         n_points : int, optional
-            Number of seed points, i.e. of particles (``cut_lines`` of the builders).
         edge_fuzziness : float, optional
-            Roughness of the particle edges in units of the largest sphere radius, >= 0.
-
-        Raises
-        ------
-        ValueError
-            If ``edge_fuzziness`` is negative.
+            As for :meth:`cutByTriangulationPoints`.
         """
         n_points = int(n_points)
         pts = self._rng.random((max(n_points, 0), 2)) * np.array([self.size_x, self.size_y])
@@ -511,18 +364,12 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.cutByTriangulationPoints(pts, edge_fuzziness)
 
     def angle_OK(self, angle):
-        """Whether a cut line with this normal angle is accepted (not near-horizontal).
+        """False if the normal ``angle`` lies within ``avoid_horizontal_angle_degree`` of ±y.
 
         Parameters
         ----------
         angle : float
-            Angle of the line's normal to the x axis (rad), in [0, 2π).
-
-        Returns
-        -------
-        bool
-            False if the normal lies within ``avoid_horizontal_angle_degree`` of ±y, True otherwise
-            (always True when ``avoid_horizontal_angle_degree`` is 0).
+            Angle of the cut line's normal to the x axis (rad), in [0, 2π).
         """
         a = self.avoid_horizontal_angle_degree
         if not a > 0:
@@ -532,11 +379,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                     or (3 * math.pi / 2 - w <= angle <= 3 * math.pi / 2 + w))
 
     def cutRandomLine(self):
-        """Cut along an infinite line through a random integer point; near-horizontal lines are redrawn.
-
-        The angle is redrawn while :meth:`angle_OK` rejects it (bounded: the avoided band is
-        narrower than all directions, ``avoid_horizontal_angle_degree < 90``).
-        """
+        """Cut along a line through a random integer point, redrawing angles :meth:`angle_OK` rejects."""
         rng = self._rng
         point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
         angle = 2 * math.pi * rng.random()
@@ -546,65 +389,16 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
 
 
 class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticles):
-    """Compact-particle ensemble whose bonds are scaled by ``permanent_ratio_*`` relative to transient contacts.
-
-    The spheres are :class:`~particleShear.linkable.spheres.SphereLinkableAdjustableInterfaceStrength`;
-    the builders pass ``1/interface_reenforcement_*`` as the ratios.
+    """Compact-particle ensemble of :class:`~particleShear.linkable.spheres.SphereLinkableAdjustableInterfaceStrength`.
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
-    dt : float, optional
-        Final (finest) time step of :meth:`free_pre_equilibration` (s), > 0 when relaxing.
-    dt_max : float, optional
-        Coarsest time step of the multi-level relaxation (s).
-    theTkSimulation : object or False, optional
-        Tk window of the live drawing, False for none (stored only).
-    avoid_horizontal_angle_degree : float, optional
-        Half-width (degrees, 0 <= value < 90) of the band of near-horizontal line directions that
-        :meth:`cutRandomLine` redraws; 0 accepts every direction.
-    permanent_ratio_central : float, optional
-        Factor of the central elastic force of bonds (and of their viscous force unless
-        ``keep_viscosity_coefficients_constant``), >= 0.
-    permanent_ratio_tangential : float, optional
-        Factor of the tangential spring of bonds (and of their tangential viscosity unless
-        ``keep_viscosity_coefficients_constant``), >= 0.
-    keep_viscosity_coefficients_constant : bool, optional
-        True: the viscous forces of bonds are not scaled by the ratios.
-    rng : numpy.random.Generator, int or None, optional
-        Random generator or seed for every random choice of the ensemble (sphere placement,
-        cutting, link removal), set before the spheres are drawn; None keeps the ensemble's own
-        unseeded generator.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor, k_t, nu_t, mu
+        As for :class:`EnsembleCompactParticles`.
+    dt, dt_max, theTkSimulation, avoid_horizontal_angle_degree, rng
+        Likewise.
+    permanent_ratio_central, permanent_ratio_tangential, keep_viscosity_coefficients_constant
+        As for the sphere class.
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,

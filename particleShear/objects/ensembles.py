@@ -1,11 +1,4 @@
-"""Concrete non-crosslinkable ensembles with random bimodal spheres.
-
-The spheres are placed at random integer positions (µm) without an overlap check; the heavy
-initial overlaps are relaxed by the frictionless pre-equilibration of the experiment or the
-builders.  Radii follow eq. S1-14, masses scale with the disc area.  Every random draw comes from
-the ensemble's ``numpy.random.Generator`` (``set_random_generator``), so one seed fixes the
-ensemble.  Units: docs/design.md.
-"""
+"""Concrete non-crosslinkable ensembles of random bimodal spheres (lengths µm, masses mg per m depth)."""
 __docformat__ = "numpy"
 import math
 
@@ -27,11 +20,10 @@ def _check_count(N):
 
 
 class RandomBimodalSpheres:
-    """Mixin: N spheres of radius ``r_b/√bf`` or ``r_b·√bf`` (probability 1/2 each) at random integer positions.
+    """Mixin: N spheres of radius ``r_b/√bf`` or ``r_b·√bf`` (probability 1/2) at random integer positions.
 
-    ``r_b`` is :func:`~particleShear.objects.model.r_estimate` with the bimodal factors (eq. S1-14);
-    masses follow ``adjust_m(m, r, r_b)`` (mass proportional to the disc area); every draw comes
-    from the ensemble's ``numpy.random.Generator`` (``set_random_generator``).
+    ``r_b``: :func:`~particleShear.objects.model.r_estimate`; masses ``adjust_m(m, r, r_b)``; no overlap
+    check.  Every draw comes from the ensemble's ``numpy.random.Generator`` (one seed fixes the ensemble).
     """
 
     def _init_bimodal(self, N, packing_fraction, bimodal_factor):
@@ -45,19 +37,11 @@ class RandomBimodalSpheres:
         self.r_max = 0
 
     def random_radius_bimodal(self, r):
-        """Small or large radius with equal probability: ``r·(lower + (upper − lower)·U{0,1})``.
-
-        Draws one integer from the ensemble's random generator.
+        """Return ``r/√bf`` or ``r·√bf`` (µm) with equal probability (one draw of the ensemble's generator).
 
         Parameters
         ----------
         r : float
-            Bimodal mean radius ``r_b`` (µm).
-
-        Returns
-        -------
-        float
-            ``r/√bf`` or ``r·√bf`` (µm).
         """
         return r * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(self._rng.integers(0, 2)))
 
@@ -81,50 +65,18 @@ class RandomBimodalSpheres:
             self.sphereList.append(s)
 
     def particle_info(self):
-        """Description of the spheres for the header of the output file (radii in µm).
-
-        Returns
-        -------
-        str
-            The text, with the small radius ``r1`` and the large radius ``r2``.
-        """
+        """Description of the spheres (radii ``r1``, ``r2`` in µm) for the header of the output file."""
         return ("Spheres with, bimodal distribution, equal probability, \n\tr1="
                 + str(self.r_max / self.bimodal_upper * self.bimodal_lower) + "r2=" + str(self.r_max))
 
 
 class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
-    """Legacy ensemble: plain periodic cell (no shear offset), frictional spheres, central forces only.
-
-    particleShear 1.0.2 emulates periodicity with boundary replicas; here the minimum
-    image does it, and boundary-crossing pairs are registered as external forces.
+    """Legacy ensemble: periodic cell (minimum image) without shear offset, frictional spheres, central forces.
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor
+        As for :class:`EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
     use_lees_edwards = False
@@ -151,37 +103,8 @@ class EnsembleFriction(Ensemble):
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor, k_t, nu_t, mu
+        As for :class:`EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
     k_t = NonNegative()
@@ -197,8 +120,8 @@ class EnsembleFriction(Ensemble):
         self.mu = mu
 
 
-# EnsembleFriction takes the tangential machinery of the friction canvas (it is not on that branch
-# of the documented chain); its strain still advances only while shearing, as in its base class.
+# EnsembleFriction takes the tangential machinery of the friction canvas (not on its branch of the
+# documented chain); its strain still advances only while shearing, as in its base class.
 for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
     if not _name.startswith("__") and _name not in ("_strain_advances", "k_t", "nu_t", "mu"):
         setattr(EnsembleFriction, _name, _value)
@@ -206,35 +129,12 @@ del _name, _value
 
 
 class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesEdwards):
-    """Frictionless Lees-Edwards ensemble (buildable here; particleShear 1.0.2 crashes for N > 0).
+    """Frictionless Lees-Edwards ensemble (constructible, unlike in 1.0.2 for N > 0).
 
     Parameters
     ----------
-    size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
-    N : int
-        Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
-    m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+    size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m, bimodal_factor
+        As for :class:`EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
@@ -249,41 +149,25 @@ class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesE
 
 
 class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElasticityLeesEdwards):
-    """Frictional spheres under Lees-Edwards boundary conditions.
+    """Frictional spheres under Lees-Edwards boundary conditions (ValueError when a parameter is out of range).
 
     Parameters
     ----------
     size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
+        Periodic cell (µm), > 0.
     N : int
         Number of spheres, >= 0 (0 for hand-built scenes).
-    packing_fraction : float, optional
-        Nominal (uncompressed) area fraction φ of the spheres, > 0; sets the radii (eq. S1-14).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the spheres are drawn on ``theCanvas``.
-    k : float, optional
-        Central spring constant (mg·s⁻² per metre of depth), >= 0 (eq. S1-8).
-    nu : float, optional
-        Central viscosity constant ν (mg·s⁻¹ per metre of depth), >= 0 (eq. S1-9).
+    packing_fraction, bimodal_factor : float, optional
+        Nominal area fraction φ (eq. S1-14) and large/small radius ratio bf, > 0.
+    theCanvas, doDrawing : optional
+        Tk canvas of the live drawing (False: none) and whether the spheres are drawn on it.
+    k, nu, k_t, nu_t : float, optional
+        Central and tangential spring (mg·s⁻²) and viscosity (mg·s⁻¹) constants per m depth, >= 0
+        (eq. S1-8, S1-9).
     m : float, optional
-        Mass of a sphere of the bimodal mean radius (mg per metre of depth); each sphere's mass
-        scales with its area.
-    bimodal_factor : float, optional
-        Ratio bf of the large to the small radius, > 0; radii ``r_b/√bf`` or ``r_b·√bf`` with
-        probability 1/2 each.
-    k_t : float, optional
-        Tangential spring constant (mg·s⁻² per metre of depth), >= 0.
-    nu_t : float, optional
-        Tangential viscosity constant (mg·s⁻¹ per metre of depth), >= 0.
+        Mass of a sphere of the mean radius (mg per m depth); masses scale with the area.
     mu : float, optional
         Coulomb friction coefficient μ of transient contacts, >= 0.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,

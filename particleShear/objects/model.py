@@ -1,101 +1,66 @@
-"""Model constants from physical properties: radius, mass, spring constant, time constant.
+"""Model constants from physical properties (µm, mg per m depth, mg·s⁻² per m depth, Pa, kg/m³).
 
-Units are those of the engine (docs/design.md): lengths in µm (1 canvas pixel = 1 µm), masses in mg
-per metre of cylinder depth, spring constants in mg·s⁻² per metre of depth; the Young modulus is in Pa
-and the density in kg/m³.  The spring constant is eq. S1-8 of the manual, the radii eq. S1-14.
+Spring constant: eq. S1-8; radii: eq. S1-14.
 """
 __docformat__ = "numpy"
 import math
 
-from ..base.points import _check_finite, _check_positive
+from ..base.points import _check_positive
 
 __all__ = ["r_estimate", "adjust_m", "particle_shear_model_parameters"]
 
 
 def r_estimate(size_x, size_y, packing_fraction, N, bimodal_upper=1.2, bimodal_lower=0.8):
-    """Mean radius of N discs whose expected total area fills ``packing_fraction · size_x · size_y`` (eq. S1-14).
-
-    Each disc has radius ``r·bimodal_upper`` or ``r·bimodal_lower`` with probability 1/2, so
-    ``r = sqrt(size_x·size_y·packing_fraction / (N·π) · 2 / (bimodal_upper² + bimodal_lower²))``.
-    The ensembles call it with ``bimodal_upper = √bf`` and ``bimodal_lower = 1/√bf`` for the
-    bimodal factor ``bf`` (the large/small radius ratio).
+    """Mean radius r (µm) of N discs that fill ``packing_fraction·size_x·size_y`` on average (eq. S1-14).
 
     Parameters
     ----------
     size_x, size_y : float
-        Width and height of the periodic cell (µm), > 0.
+        Cell size (µm), > 0.
     packing_fraction : float
-        Nominal (uncompressed) area fraction φ of the discs, > 0 (typically 1-2).
+        Nominal area fraction φ, > 0.
     N : int
         Number of discs, >= 1.
     bimodal_upper, bimodal_lower : float, optional
-        Factors of the large and the small radius relative to the returned radius (dimensionless).
-
-    Returns
-    -------
-    float
-        The radius ``r`` (µm).
+        Radii ``r·bimodal_upper``, ``r·bimodal_lower`` (probability 1/2 each); the ensembles pass √bf, 1/√bf.
     """
     return math.sqrt(size_x * size_y * packing_fraction / N / math.pi
                      / (bimodal_upper ** 2 + bimodal_lower ** 2) * 2)
 
 
 def adjust_m(m, r_actual, r_mean):
-    """Mass of a disc of radius ``r_actual`` when a disc of radius ``r_mean`` has mass ``m``.
-
-    The mass scales with the disc area: ``m · r_actual² / r_mean²`` (the multiplication order
-    reproduces the masses of particleShear 1.0.2 bit for bit).
+    """Mass ``m·r_actual²/r_mean²`` of a disc of radius ``r_actual`` when one of ``r_mean`` has mass ``m``.
 
     Parameters
     ----------
     m : float
-        Mass of a disc of radius ``r_mean`` (mg per metre of depth).
-    r_actual : float
-        Radius of the disc whose mass is wanted (µm).
-    r_mean : float
-        Radius of the reference disc (µm), > 0.
-
-    Returns
-    -------
-    float
-        The mass (mg per metre of depth).
+        Mass of the reference disc (mg per m depth).
+    r_actual, r_mean : float
+        Radius of the disc and of the reference disc (µm), ``r_mean`` > 0.
     """
     return m * r_actual * r_actual / r_mean / r_mean  # this order reproduces the reference masses exactly
 
 
 class particle_shear_model_parameters:
-    """Radius, mass, spring constant and time constant of the model, from the physical properties.
+    """Radius, mass, spring constant and time constant of the model (docs/parameters.md).
 
-    The builders derive every constant of an ensemble from these (see docs/parameters.md).  The
-    inputs are stored under their own names; the derived attributes are
-
-    * ``size_x_m``, ``size_y_m``: the cell size in m;
-    * ``r``: :func:`r_estimate` with ``bimodal_upper = √bimodal_factor``, ``bimodal_lower = 1/√bimodal_factor``
-      (µm), and ``r_m`` the same in m;
-    * ``m = π · r_m² · density · 1e6``: the mass of a disc of radius ``r`` (mg per metre of depth);
-    * ``k = π/8 · Young_modulus_spheres · 1e6``: the contact spring constant of two parallel
-      cylinders (eq. S1-8; mg·s⁻² per metre of depth);
-    * ``time_constant = sqrt(m/k) / sqrt(max(bimodal_factor, 1/bimodal_factor))`` (s).
+    Inputs are stored under their own names (ValueError when out of range); derived: ``size_x_m``,
+    ``size_y_m`` (m); ``r`` (:func:`r_estimate` with √bimodal_factor, 1/√bimodal_factor; µm) and
+    ``r_m`` (m); ``m = π·r_m²·density·1e6``; ``k = π/8·Young_modulus_spheres·1e6`` (eq. S1-8);
+    ``time_constant = sqrt(m/k)/sqrt(max(bimodal_factor, 1/bimodal_factor))`` (s).
 
     Parameters
     ----------
     size_x, size_y : float, optional
-        Width and height of the periodic cell (µm), > 0.
+        Cell size (µm), > 0.
     N : int, optional
         Number of spheres, >= 1.
     packing_fraction : float, optional
-        Nominal area fraction φ of the spheres (eq. S1-14), > 0.
-    Young_modulus_spheres : float, optional
-        Young modulus E of the sphere material (Pa), > 0.
-    density : float, optional
-        Density of the sphere material (kg/m³), > 0.
+        Nominal area fraction φ (eq. S1-14), > 0.
+    Young_modulus_spheres, density : float, optional
+        Young modulus E (Pa) and density (kg/m³) of the sphere material, > 0.
     bimodal_factor : float, optional
-        Ratio of the large to the small radius, > 0 (the builders pass 1).
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of its range (the message names it and its value).
+        Large/small radius ratio, > 0 (the builders pass 1).
     """
 
     def __init__(self, size_x=500, size_y=500, N=100, packing_fraction=1, Young_modulus_spheres=10000,

@@ -1,10 +1,4 @@
-"""Concrete non-crosslinkable spheres: frictionless or frictional, with or without Lees-Edwards geometry.
-
-These are the sphere classes of particleShear 1.0.2 (public API).  The ensembles create them; a
-sphere created alone keeps its own state and computes its pair forces with the engine's terms
-evaluated on the pair (base/points.py).
-Lengths are in µm, masses in mg per metre of depth (docs/design.md).
-"""
+"""Concrete non-crosslinkable spheres of particleShear 1.0.2 (lengths µm, masses mg per m depth)."""
 __docformat__ = "numpy"
 from ..base.points import CircleBasicElasticity, CircleFrictionElasticity
 
@@ -12,29 +6,21 @@ __all__ = ["Sphere", "SphereLeesEdwards", "SphereFriction", "SphereFrictionLeesE
 
 
 class Sphere(CircleBasicElasticity):
-    """Frictionless sphere without Lees-Edwards geometry (legacy).
-
-    Central elastic and viscous contact forces only (eq. S1-5a/b).
+    """Frictionless sphere without Lees-Edwards geometry (legacy): central contact forces (eq. S1-5a/b).
 
     Parameters
     ----------
     color : str
-        Fill colour of the disc in drawings (a Tk/Pillow colour name).
-    x, y : float
-        Initial position of the centre (µm).
-    diameter : float
-        Diameter of the disc (µm), > 0.
+        Fill colour in drawings (a Tk/Pillow colour name).
+    x, y, diameter : float
+        Centre and diameter (µm).
     m : float, optional
-        Mass (mg per metre of depth); the moment of inertia is ``m·r²/2``.
+        Mass; moment of inertia ``m·r²/2``.
     my_index : int, optional
-        Index of the sphere in its ensemble (its creation index).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the sphere draws itself on ``theCanvas``.
+    theCanvas, doDrawing : optional
+        Tk canvas of the live drawing (False: none) and whether the sphere draws itself on it.
     force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble, for the stress tensors); None creates a
-        private ``Force_register``.
+        Receiver of the recorded forces (the ensemble); None: a private ``Force_register``.
     """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
@@ -44,32 +30,16 @@ class Sphere(CircleBasicElasticity):
 
 
 class SphereLeesEdwards(CircleBasicElasticity):
-    """Frictionless sphere in a Lees-Edwards cell of ``size_x × size_y`` µm.
-
-    (The NameError of particleShear 1.0.2 on construction is fixed; the index keeps its 1.0.2
-    spelling ``myindex``.)
+    """Frictionless sphere in a Lees-Edwards cell (constructible, unlike in 1.0.2).
 
     Parameters
     ----------
-    color : str
-        Fill colour of the disc in drawings (a Tk/Pillow colour name).
-    x, y : float
-        Initial position of the centre (µm).
-    diameter : float
-        Diameter of the disc (µm), > 0.
-    m : float, optional
-        Mass (mg per metre of depth); the moment of inertia is ``m·r²/2``.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register
+        As for :class:`Sphere`.
     myindex : int, optional
-        Index of the sphere in its ensemble (its creation index).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the sphere draws itself on ``theCanvas``.
-    force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble, for the stress tensors); None creates a
-        private ``Force_register``.
+        Index in the ensemble (the 1.0.2 spelling).
     size_x, size_y : float, optional
-        Width and height of the Lees-Edwards cell (µm).
+        Lees-Edwards cell (µm).
     """
 
     def __init__(self, color, x, y, diameter, m=1, myindex=1, theCanvas=False, doDrawing=False,
@@ -82,29 +52,12 @@ class SphereLeesEdwards(CircleBasicElasticity):
 
 
 class SphereFriction(CircleFrictionElasticity):
-    """Frictional sphere without Lees-Edwards geometry (legacy).
-
-    Central and tangential (Coulomb friction) contact forces.
+    """Frictional sphere without Lees-Edwards geometry (legacy): central and tangential (Coulomb) forces.
 
     Parameters
     ----------
-    color : str
-        Fill colour of the disc in drawings (a Tk/Pillow colour name).
-    x, y : float
-        Initial position of the centre (µm).
-    diameter : float
-        Diameter of the disc (µm), > 0.
-    m : float, optional
-        Mass (mg per metre of depth); the moment of inertia is ``m·r²/2``.
-    my_index : int, optional
-        Index of the sphere in its ensemble (its creation index).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the sphere draws itself on ``theCanvas``.
-    force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble, for the stress tensors); None creates a
-        private ``Force_register``.
+    color, x, y, diameter, m, my_index, theCanvas, doDrawing, force_register
+        As for :class:`Sphere`.
     """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
@@ -114,31 +67,14 @@ class SphereFriction(CircleFrictionElasticity):
 
 
 class SphereFrictionLeesEdwards(CircleFrictionElasticity):
-    """Frictional sphere in a Lees-Edwards cell of ``size_x × size_y`` µm.
-
-    Central and tangential (Coulomb friction) contact forces; the sphere used by the simulations.
+    """Frictional sphere in a Lees-Edwards cell: the sphere of the simulations.
 
     Parameters
     ----------
-    color : str
-        Fill colour of the disc in drawings (a Tk/Pillow colour name).
-    x, y : float
-        Initial position of the centre (µm).
-    diameter : float
-        Diameter of the disc (µm), > 0.
-    m : float, optional
-        Mass (mg per metre of depth); the moment of inertia is ``m·r²/2``.
-    my_index : int, optional
-        Index of the sphere in its ensemble (its creation index).
-    theCanvas : tkinter.Canvas or False, optional
-        Canvas of the live drawing, False for none.
-    doDrawing : bool, optional
-        Whether the sphere draws itself on ``theCanvas``.
-    force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble, for the stress tensors); None creates a
-        private ``Force_register``.
+    color, x, y, diameter, m, my_index, theCanvas, doDrawing, force_register
+        As for :class:`Sphere`.
     size_x, size_y : float, optional
-        Width and height of the Lees-Edwards cell (µm).
+        Lees-Edwards cell (µm).
     """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
