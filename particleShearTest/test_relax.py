@@ -297,6 +297,51 @@ class TestBatchIndependence(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "twice"):
             BatchState.of_ensembles([a, a])
 
+    def test_a_refused_batch_leaves_the_ensembles_stepping_as_before(self):
+        # a batch refused before any step (guards that differ, an unusable skin) leaves each ensemble
+        # to step on exactly as its twin that was never batched, also one that kept the documented
+        # step's engine on its block (the blocks a batch moves drop what was cached on them)
+        from particleShear.base.stability import StabilityGuard
+        for refuse in ("guards", "skin"):
+            with self.subTest(refuse=refuse):
+                a, b, twin = random_packing(3), random_packing(4), random_packing(3)
+                for e in (a, twin):
+                    e.mechanical_simulation_step(1, e.dt)
+                if refuse == "guards":
+                    a.stability_guard, b.stability_guard = StabilityGuard(interval=4), StabilityGuard(interval=8)
+                with self.assertRaises(ValueError):
+                    relax_ensembles([a, b], 2, **({"skin_factor": -1.0} if refuse == "skin" else {}))
+                a.stability_guard = None
+                for _ in range(3):
+                    for e in (a, twin):
+                        e.mechanical_simulation_step(1, e.dt)
+                self.assertEqual(a._st.tobytes(), twin._st.tobytes())
+
+    def test_a_failed_batch_leaves_every_ensemble_as_it_was(self):
+        # the batch steps the ensembles' own rows: when one replica's guard stops it (a bound on the
+        # kinetic energy no moving packing meets), every ensemble of the batch is put back, and a
+        # retry gives the relaxation of ensembles that never failed
+        from particleShear.base.stability import StabilityGuard
+        from particleShear.engine.step import EngineInstability
+        a, b = random_packing(7), random_packing(8)
+        ra, rb = random_packing(7), random_packing(8)
+        n = len(a.sphereList)
+        before = [(e._block[:, :n].copy(), e._pairs.copy(), e.t, e.step_count) for e in (a, b)]
+        b.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=4)
+        with self.assertRaises(EngineInstability):
+            relax_ensembles([a, b], 6)
+        for e, (block, pt, t, steps) in zip((a, b), before):
+            self.assertEqual(e._block[:, :n].tobytes(), block.tobytes())
+            for name in ("key", "state", "xi", "active", "birth"):
+                self.assertEqual(getattr(e._pairs, name).tobytes(), getattr(pt, name).tobytes(), name)
+            self.assertEqual((e.t, e.step_count), (t, steps))
+        b.stability_guard = None
+        relax_ensembles([a, b], 6)
+        relax_ensembles([ra, rb], 6)
+        for e, r in ((a, ra), (b, rb)):
+            self.assertEqual(e._block[:, :n].tobytes(), r._block[:, :n].tobytes())
+            self.assertEqual(e._pairs.key.tobytes(), r._pairs.key.tobytes())
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -38,8 +38,9 @@ class EngineStep:
         """The ensemble's engine, made anew when its key changed (the half kick is carried over)."""
         key = self._engine_view_key()
         eng = self._engine
-        if eng is not None and len(key) == len(self._engine_key) and all(
-                a is b or a == b for a, b in zip(key, self._engine_key)):
+        old = self._engine_key
+        if eng is not None and len(key) == len(old) and key[0] is old[0] and all(
+                a is b or a == b for a, b in zip(key[1:], old[1:])):      # the sphere block by identity
             return eng
         from ..engine.state import BatchState
         from ..engine.step import BatchEngine

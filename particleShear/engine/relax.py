@@ -296,9 +296,6 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     integrators = {getattr(e, "integrator", "euler") for e in ensembles}
     if len(integrators) != 1:
         raise ValueError(f"ensembles use the integrators {sorted(integrators)}: one engine relaxes with one")
-    # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
-    state = BatchState.of_ensembles(ensembles, laws=laws)
-    mu = state.mu.copy()
     # the guard where an ensemble has one (a script's; the builders guard the measurement only), with
     # its interval and thresholds (one set per engine)
     guards = [getattr(e, "stability_guard", None) for e in ensembles]
@@ -308,15 +305,17 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         raise ValueError(f"the ensembles' stability guards differ ({sorted(settings, key=str)}): one engine "
                          "relaxes with one guard")
     interval, ratio, ke = settings.pop() if settings else (4, 0.05, None)
-    engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
-                         guard=[g is not None for g in guards])
-    engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
-    engine.phase = "constitution"
-    engine.numbers_relations = True
-    with contextlib.ExitStack() as stack:      # their own state is stepped
+    with contextlib.ExitStack() as stack:      # their own state is stepped: put back on any failure
         for e in ensembles:
             stack.enter_context(untouched_on_failure(e))
-        steps = free_relaxation(engine, N, dt, dt_max, mu)
+        # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
+        state = BatchState.of_ensembles(ensembles, laws=laws)
+        engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
+                             guard=[g is not None for g in guards])
+        engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
+        engine.phase = "constitution"
+        engine.numbers_relations = True
+        steps = free_relaxation(engine, N, dt, dt_max, state.mu.copy())
     for b, e in enumerate(ensembles):
         write_back(engine, b, e, steps)
     return steps

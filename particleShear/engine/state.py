@@ -562,6 +562,7 @@ class BatchState:
                 block[:, b * N:(b + 1) * N] = e._st
                 e._block, e._cap = block[:, b * N:(b + 1) * N], N
                 e._views()
+                e._invalidate_neighbours()      # caches of the old block (the documented step's engine)
         x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
         s.pos, s.vel, s.frc = block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3]
         s.phi, s.r, s.m, s.inertia = (block[ROW[name]] for name in ("phi", "r", "m", "inertia"))
