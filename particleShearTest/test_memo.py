@@ -1,7 +1,7 @@
 """The one cache mechanism of the canvas classes (particleShear.base.memo) and what the canvases keep in it.
 
 A kept value must be what recomputing it gives: the memo's contract (same key: the kept value; new key
-or an invalidation: recomputed), and, on a sheared crosslinked scene, every value the canvas keeps
+or a drop: recomputed), and, on a sheared crosslinked scene, every value the canvas keeps
 compared with the same value computed from the ensemble's state by its definition.
 """
 import math
@@ -34,14 +34,15 @@ class TestMemo(unittest.TestCase):
         self.assertEqual(m.get("b", (1,), lambda: "B"), "B")
         self.assertEqual(m.get("a", (1,), lambda: "other"), "A")
 
-    def test_invalidate_drops_every_value(self):
+    def test_drop_forgets_one_value(self):
         m = Memo()
         m.get("a", (1,), lambda: 1)
         m.get("b", (1,), lambda: 2)
-        m.invalidate()
+        self.assertEqual(m.drop("a"), 1)
         self.assertIsNone(m.peek("a"))
+        self.assertIsNone(m.drop("a"))
         self.assertEqual(m.get("a", (1,), lambda: 10), 10)
-        self.assertEqual(m.get("b", (1,), lambda: 20), 20)
+        self.assertEqual(m.get("b", (1,), lambda: 20), 2)
 
     def test_bytes_keys_compare_by_content(self):
         m = Memo()

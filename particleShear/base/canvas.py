@@ -196,6 +196,7 @@ class CanvasPoints:
         """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_coord``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]
         self._st = st
+        self._block_version = getattr(self, "_block_version", 0) + 1     # a key of what depends on the block
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
         x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
         self._pos = st[x:x + 2]

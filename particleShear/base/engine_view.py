@@ -18,8 +18,6 @@ class EngineStep:
     Hooks: :meth:`_lees_edwards` (images offset by ``Ly·γ``), :meth:`_strain_advances` (γ += γ̇·dt).
     """
 
-    _engine = None          # the engine of the ensemble's state (None until the first phase, after a drop)
-    _engine_key = None
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
     _engine_half = None     # the Verlet half kick while no engine is kept
 
@@ -29,19 +27,22 @@ class EngineStep:
     def _strain_advances(self):
         return bool(getattr(self, "applyingShear", False))
 
+    @property
+    def _engine(self):
+        """The engine kept in the canvas's memo (None before the first phase and after a drop)."""
+        return self._memo.peek("engine")
+
     def _engine_view_key(self):
-        return (self._st, self._params_version, self._rng, float(getattr(self, "k", 0.0)),
+        return (self._block_version, self._params_version, self._rng, float(getattr(self, "k", 0.0)),
                 float(getattr(self, "nu", 0.0)), float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)),
                 float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"))
 
     def _step_engine(self):
-        """The ensemble's engine, made anew when its key changed (the half kick is carried over)."""
-        key = self._engine_view_key()
-        eng = self._engine
-        old = self._engine_key
-        if eng is not None and len(key) == len(old) and key[0] is old[0] and all(
-                a is b or a == b for a, b in zip(key[1:], old[1:])):      # the sphere block by identity
-            return eng
+        """The ensemble's engine, kept in the memo under :meth:`_engine_view_key`."""
+        return self._memo.get("engine", self._engine_view_key(), self._new_engine)
+
+    def _new_engine(self):
+        """A new engine on the ensemble's state (the half kick of the one it replaces carried over)."""
         from ..engine.state import BatchState
         from ..engine.step import BatchEngine
         half = self._half_kick
@@ -52,16 +53,15 @@ class EngineStep:
         eng.keep_terms = True      # the force register of every force phase
         if integrator == "verlet" and half is not None and len(half[0]) == self._n:
             eng.half = np.array([h if h is not None else np.zeros(self._n) for h in half])
-        self._engine, self._engine_key = eng, key
         self._engine_pairs = (self._pairs, self._pairs.version)
         return eng
 
     def _drop_engine(self):
         """Forget the engine (the one invalidation point; its Verlet half kick is kept)."""
-        eng = self._engine
+        eng = self._memo.drop("engine")
         if eng is not None:
             self._engine_half = None if eng.half is None else tuple(np.array(h) for h in eng.half)
-            self._engine = self._engine_key = self._engine_pairs = None
+            self._engine_pairs = None
 
     @property
     def _half_kick(self):

@@ -9,7 +9,7 @@ __all__ = ["Memo"]
 
 
 class Memo:
-    """Named values, each kept under an explicit key until the key changes or :meth:`invalidate`.
+    """Named values, each kept under an explicit key until the key changes or :meth:`drop`.
 
     Examples
     --------
@@ -30,7 +30,8 @@ class Memo:
         ----------
         name : str
         key : tuple
-            Everything the value depends on, compared with ``==`` (never arrays).
+            Everything the value depends on, compared with ``==`` (numbers, strings, version
+            counters, objects compared by identity; never arrays).
         compute : callable
             Called without arguments when the value must be (re)computed.
         """
@@ -41,9 +42,15 @@ class Memo:
         self._values[name] = (key, value)
         return value
 
-    def invalidate(self):
-        """Drop every value: the next :meth:`get` of each name recomputes it."""
-        self._values.clear()
+    def drop(self, name):
+        """Forget the value of ``name``; return it (None if none was kept).
+
+        Parameters
+        ----------
+        name : str
+        """
+        entry = self._values.pop(name, None)
+        return None if entry is None else entry[1]
 
     def peek(self, name):
         """Return the value kept under ``name`` (whatever its key), or None: for inspection only.

@@ -64,8 +64,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         return [cls(self, p, int(q)) for q in partners]
 
     def _relations_edited(self):
-        """Drop every kept value: relations were changed outside the step (no memo key records that)."""
-        self._memo.invalidate()
+        """Relations were changed outside the step: the next force phase takes the candidates from the table."""
         self._engine_pairs = None
 
     def _drop_relations_of(self, p):
