@@ -136,10 +136,24 @@ def documented_vs_protocol(n_blocks, block=50):
     return median_us(doc), median_us(prot)
 
 
+def _le_closest(dx, dy, Lx, Ly, shear):
+    """The reference's scalar Lees-Edwards minimum image: periods removed one at a time (y first, which
+    moves x by ``Ly·γ``); differences of positions inside the cell need at most a few passes."""
+    for _ in range(4):
+        if dy > Ly / 2:
+            dy, dx = dy - Ly, dx - Ly * shear
+        elif dy < -Ly / 2:
+            dy, dx = dy + Ly, dx + Ly * shear
+        if dx > Lx / 2:
+            dx -= Lx
+        elif dx < -Lx / 2:
+            dx += Lx
+    return dx, dy
+
+
 def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
     """The reference's O(N²) pure-Python neighbour update: every ordered pair, LE minimum image,
     linear search of the relation list by index."""
-    from particleShear.base.points import _le_closest   # here: build() and the step loops import without it
     n = len(xs)
     for i in range(n):
         rel = relations[i]

@@ -227,7 +227,8 @@ class PairConstants:
         rows ``spheres`` (``ai`` or ``aj``): the per-replica constants of each candidate's replica and the
         visiting sphere's own c, permanent ratios and kept viscosities, gathered at once."""
         rep = s.xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
-        own = s.visit_rows()[:, spheres]
+        # the visiting sphere's own values; where a replica's spheres share them, its values directly
+        own = s.per_replica_parameters(self.rep) if s.visit is None else s.visit[:, spheres]
         return term_constants(self.d0, self.perm, d_eq, rep[0], own[0], rep[1], rep[2], rep[3], rep[4], own[1], own[2],
                               own[3])
 

@@ -615,14 +615,20 @@ class BatchState:
             out.visit = xp.concatenate([st.visit_rows() for st in states], axis=1)
         return out
 
-    def per_replica_parameters(self):
-        """The per-replica parameters ``c, prc, prt, keep`` on every sphere row: a (4, B·N) array.
+    def per_replica_parameters(self, rep=None):
+        """The per-replica parameters ``c, prc, prt, keep`` on every sphere row (or on the rows of
+        the replica index ``rep``, e.g. a batch's candidates).
+
+        Parameters
+        ----------
+        rep : ndarray of int, optional
+            The replica of each row (default: :attr:`rep`, the sphere rows).
 
         Returns
         -------
-        ndarray (4, B·N)
+        ndarray (4, len(rep))
         """
-        return self.xp.stack([getattr(self, name) for name in _PER_REPLICA])[:, self.rep]
+        return self.xp.stack([getattr(self, name) for name in _PER_REPLICA])[:, self.rep if rep is None else rep]
 
     def visit_rows(self):
         """The parameters of :data:`PER_SPHERE_PARAMETERS` of every sphere: :attr:`visit`, or the

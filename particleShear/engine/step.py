@@ -618,7 +618,9 @@ class BatchEngine:
         if self.C is None:
             return
         mu = to_host(s.mu, "state") if not isinstance(s.mu, np.ndarray) else s.mu
-        free = (mu == 0) & ~np.array([bool((p.state == PERMANENT).any()) for p in s.pairs], dtype=bool)
+        free = mu == 0
+        for b in np.flatnonzero(free):          # (only the replicas without friction are looked at)
+            free[b] = not (s.pairs[b].state == PERMANENT).any()
         if not free.any():
             self.free_p = None
         elif free.all():
