@@ -1,0 +1,74 @@
+"""Where the documented step loop spends its time, phase by phase, for one or more trees (not a test).
+
+The loop of README.md ("Scripts of particleShear 1.0.2 …") on the ``bench_step.build(150, seed=2)``
+scene: ``setShearRate``, ``mechanical_simulation_step_calculate_forces``,
+``record_total_particle_forces``, ``ev.evaluate_stress_tensors(ens.force_register,
+ens.movableSphereList(), ens.shear_rate)`` (every tensor), acceleration, movement.  Each call is
+timed on its own; the figure of a phase is the first quartile of its block means (30 blocks of 20
+steps after 100 warm-up steps), so the steps that rebuild the neighbour lists are included.  Each
+tree runs in its own process (``PYTHONPATH`` set to the tree, one thread, pinned to one CPU where
+``taskset`` exists); compare trees within one run of the script.
+
+Usage: python benchmarks/bench_phases.py [TREE ...]   (default: this tree)
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PHASES = ("rate", "forces", "totals", "tensors", "acceleration", "movement")
+
+WORKER = r'''
+import json, math, sys, time
+tree = sys.argv[1]
+sys.path[:0] = [tree, sys.argv[2]]
+import particleShear
+assert particleShear.__file__.startswith(tree), particleShear.__file__
+import bench_step
+from particleShear import StressTensorEvaluation
+ens = bench_step.build(150, seed=2)
+ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+bench_step.documented_steps(ens, ev, 100)
+w, cool, dt = 2 * math.pi * bench_step.F_EXC, 0.99969060716623, bench_step.DT
+names = %r
+means = {n: [] for n in names}
+for _ in range(30):
+    acc = dict.fromkeys(names, 0.0)
+    for _ in range(20):
+        t = [time.perf_counter()]
+        ens.setShearRate(bench_step.AMPLITUDE * w * math.cos(w * ens.t)); t.append(time.perf_counter())
+        ens.mechanical_simulation_step_calculate_forces(); t.append(time.perf_counter())
+        ens.record_total_particle_forces(); t.append(time.perf_counter())
+        ev.evaluate_stress_tensors(ens.force_register, ens.movableSphereList(), ens.shear_rate); t.append(time.perf_counter())
+        ens.mechanical_simulation_step_calculate_acceleration(cool, dt); t.append(time.perf_counter())
+        ens.mechanical_simulation_step_calculate_movement(dt); t.append(time.perf_counter())
+        for k, n in enumerate(names):
+            acc[n] += t[k + 1] - t[k]
+    for n in names:
+        means[n].append(acc[n] / 20 * 1e6)
+print(json.dumps({n: sorted(v)[len(v) // 4] for n, v in means.items()}))
+''' % (PHASES,)
+
+
+def main():
+    trees = [os.path.abspath(t) for t in sys.argv[1:]] or [os.path.dirname(HERE)]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    pin = ["taskset", "-c", "0"] if shutil.which("taskset") else []
+    rows = {}
+    for tree in trees:
+        p = subprocess.run(pin + [sys.executable, "-c", WORKER, tree, HERE], capture_output=True, text=True, env=env)
+        if p.returncode:
+            sys.exit(f"{tree}: {p.stderr[-2000:]}")
+        rows[tree] = json.loads(p.stdout.strip().splitlines()[-1])
+    print("documented step loop, N = 150, µs per step by phase (first quartile of 30 block means of 20 steps)")
+    print("| phase | " + " | ".join(trees) + " |")
+    print("|---|" + "---|" * len(trees))
+    for n in PHASES + ("sum",):
+        print(f"| {n} | " + " | ".join(f"{(sum(rows[t].values()) if n == 'sum' else rows[t][n]):.1f}"
+                                      for t in trees) + " |")
+
+
+if __name__ == "__main__":
+    main()
