@@ -62,7 +62,7 @@ class OneReplicaRows:
 class OneReplicaInputs(StressInputs):
     """:class:`~particleShear.engine.stress.StressInputs` of a batch of one, its reductions specialised.
 
-    The sums are the engine's ``add.reduceat`` from row 0, bit for bit (tested); the flags are evaluated once.
+    The sums are the engine's ``add.reduceat`` from row 0, bit for bit (tested).
     """
 
     @staticmethod
@@ -85,14 +85,6 @@ class OneReplicaInputs(StressInputs):
         if weights.ndim == 2:
             return self._sums(weights)[:, None]
         return self._sums(weights[None])
-
-    @property
-    def roles(self):
-        """The engine's internal and external flags (eqs. S1-16, S1-19), evaluated once."""
-        v = self.__dict__.get("_roles")
-        if v is None:
-            v = self._roles = StressInputs.roles.fget(self)
-        return v
 
 
 _FROM_ROW_0 = np.zeros(1, dtype=np.intp)

@@ -19,6 +19,7 @@ from .xp import array_namespace
 __all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
 
 _ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
+_EYE = np.eye(2)
 
 
 class StressInputs:
@@ -58,11 +59,13 @@ class StressInputs:
         Parameters
         ----------
         function : callable
-            A tensor function of :data:`TENSORS` (``function(q) -> (B, 2, 2)``).
+            A tensor function of :data:`TENSORS` (``function(q) -> (B, 2, 2)``), or another
+            function of the inputs that several tensors read (the pairs' roles).
 
         Returns
         -------
-        ndarray (B, 2, 2)
+        object
+            Its value ((B, 2, 2) for a tensor).
         """
         memo = self.__dict__.setdefault("_tensors", {})
         if function not in memo:
@@ -133,15 +136,30 @@ class StressInputs:
 
     @property
     def roles(self):
-        """``(internal, ext_i, ext_j)`` of the relations (:func:`~particleShear.engine.forces.pair_roles`)."""
-        C = self.C
-        internal, ext_i, ext_j = pair_roles(self.mob[C.ai], self.mob[C.aj], self.shifted)
-        return internal & self.active, ext_i & self.active, ext_j & self.active
+        """``(internal, ext_i, ext_j)`` of the relations (:func:`~particleShear.engine.forces.pair_roles`), once per phase."""
+        return self.tensor(_roles)
 
     @property
     def internal(self):
         """Pairs counted as internal: both spheres mobile, no image shift, a relation (eq. S1-19)."""
         return self.roles[0]
+
+
+def _roles(q):
+    """The pairs' roles of :attr:`StressInputs.roles`."""
+    C = q.C
+    internal, ext_i, ext_j = pair_roles(q.mob[C.ai], q.mob[C.aj], q.shifted)
+    return internal & q.active, ext_i & q.active, ext_j & q.active
+
+
+def _x_centred(q):
+    """``x − Lx/2`` of every sphere (µm): lever arms from the cell centre."""
+    return q.x - (q.Lx / 2)[q.rep]
+
+
+def _y_centred(q):
+    """``y − Ly/2`` of every sphere (µm)."""
+    return q.y - (q.Ly / 2)[q.rep]
 
 
 def love_weber(q):
@@ -178,14 +196,14 @@ def external_forces(q):
     """
     C = q.C
     _, ei, ej = q.roles
-    cx, cy = (q.Lx / 2)[C.rep], (q.Ly / 2)[C.rep]
-    lever_x = (q.x[C.ai] - cx) * ei - (q.x[C.aj] - cx) * ej     # F on j is −F on i
-    lever_y = (q.y[C.ai] - cy) * ei - (q.y[C.aj] - cy) * ej
+    xc, yc = q.tensor(_x_centred), q.tensor(_y_centred)
+    lever_x = xc[C.ai] * ei - xc[C.aj] * ej     # F on j is −F on i
+    lever_y = yc[C.ai] * ei - yc[C.aj] * ej
     S = q.outer((q.fx_i, q.fy_i), (lever_x, lever_y))
     if q.fx_j is not None:
         # j's visit has a force of its own (spheres with parameters of their own): −F_j at j, i.e.
         # F_i ⊗ lever + (F_i − F_j) ⊗ (x_j − c), exactly S where F_j = F_i
-        S = S + q.outer((q.fx_i - q.fx_j, q.fy_i - q.fy_j), ((q.x[C.aj] - cx) * ej, (q.y[C.aj] - cy) * ej))
+        S = S + q.outer((q.fx_i - q.fx_j, q.fy_i - q.fy_j), (xc[C.aj] * ej, yc[C.aj] * ej))
     return -S * (1e-18 / q.V)[:, None, None]
 
 
@@ -203,8 +221,8 @@ def unbalanced_forces(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     w = q.mob
-    cx, cy = (q.Lx / 2)[q.rep], (q.Ly / 2)[q.rep]
-    return q.outer((q.fx * w, q.fy * w), (q.x - cx, q.y - cy), by_pair=False) * (1e-18 / q.V)[:, None, None]
+    S = q.outer((q.fx * w, q.fy * w), (q.tensor(_x_centred), q.tensor(_y_centred)), by_pair=False)
+    return S * (1e-18 / q.V)[:, None, None]
 
 
 def linear_acceleration(q):
@@ -271,7 +289,7 @@ def spin_kinetic_energy(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     k = q.per_replica(q.inertia * q.omega * q.omega * q.mob, by_pair=False) * 1e-18 / 2
-    return -(k / q.V)[:, None, None] * array_namespace(k).eye(2)
+    return -(k / q.V)[:, None, None] * array_namespace(k).asarray(_EYE)
 
 
 def peculiar_acceleration_otsuki(q):
@@ -288,7 +306,7 @@ def peculiar_acceleration_otsuki(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * (q.y - (q.Ly / 2)[q.rep]))
+    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * q.tensor(_y_centred))
     py = q.m * 1e-12 * q.vy
     w = q.mob / (q.m * 1e-6)
     return -q.outer((px * w, py * w), (px, py), by_pair=False) / q.V[:, None, None]
