@@ -7,12 +7,12 @@ ending with the removal of the mean velocity), one frictionless block at ``dt``,
 ``dt`` with the ensemble's μ.  :func:`free_relaxation` runs exactly these steps on every replica
 of a :class:`~particleShear.engine.step.BatchEngine`; :func:`remove_linear_drift` is the classes'
 ``correct_linear_drift`` per replica.  The engine steps the ensembles' own sphere rows and pair
-tables (:meth:`~particleShear.engine.state.BatchState.of_ensembles`), and :func:`write_back` hands
-each ensemble its clock and relations and drops its caches, so that the bookkeeping that follows (crosslinking, cutting, link removal, joining isolated spheres) runs
-through the documented classes on the contacts the engine ended with, the relations numbered
-in the order they formed, as the classes number them.
-:func:`relax_ensembles` does all of it for a list of ensembles (docs/design.md, "Batches of
-replicas", "Constitution of a batch").
+tables (:meth:`~particleShear.engine.state.BatchState.of_ensembles`), and :func:`write_back`
+hands each ensemble its clock and relations and drops its caches, so that the bookkeeping that
+follows (crosslinking, cutting, link removal, joining isolated spheres) runs through the
+documented classes on the contacts the engine ended with, the relations numbered in the order
+they formed, as the classes number them.  :func:`relax_ensembles` does all of it for a list of
+ensembles (docs/design.md, "Runs").
 
 A replica's relaxation does not depend on its batch (every operation of the step is per
 replica, see :mod:`.step`; the drift is removed per replica), so a run constituted in a batch
@@ -162,14 +162,14 @@ def free_relaxation(engine, N, dt, dt_max, mu):
 
 
 def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
-    """Hand replica ``b`` of a relaxed (or measured) engine on the ensembles' own state back to its ensemble.
+    """Hand replica ``b`` of a relaxed (or measured) engine on the ensembles' state back to its ensemble.
 
-    The spheres and the pair table are the ensemble's own already (:meth:`~particleShear.engine.state.BatchState.of_ensembles`):
-    what is handed back is the clock, the strain, the plates, μ, the relations of the last step
-    (written into the table, with the creation numbers the engine gave them as they formed: the
-    order of ``neighbors``), a Verlet engine's half kick, and the bookkeeping: the ensemble's
-    neighbour list and caches are invalidated, its ``step_count`` and ``n_constitution_steps``
-    advance by ``steps``.
+    The spheres and the pair table are the ensemble's own already
+    (:meth:`~particleShear.engine.state.BatchState.of_ensembles`): what is handed back is the
+    clock, the strain, the plates, μ, the relations of the last step (written into the table,
+    with the creation numbers the engine gave them as they formed: the order of ``neighbors``), a
+    Verlet engine's half kick, and the bookkeeping: the ensemble's neighbour list and caches are
+    invalidated, its ``step_count`` and ``n_constitution_steps`` advance by ``steps``.
 
     Parameters
     ----------

@@ -136,7 +136,8 @@ class StressInputs:
 
     @property
     def roles(self):
-        """``(internal, ext_i, ext_j)`` of the relations (:func:`~particleShear.engine.forces.pair_roles`), once per phase."""
+        """``(internal, ext_i, ext_j)`` of the relations (:func:`~particleShear.engine.forces.pair_roles`),
+        evaluated once per force phase."""
         return self.tensor(_roles)
 
     @property
