@@ -8,9 +8,11 @@ in µs and as a fraction of the enabled step.  With ``--baseline REV`` the whole
 tree is also timed against the step of git revision REV (its package loaded under another name)
 on the same scene, alternating blocks: what the deleted caches cost together.
 
-The caches deleted from the classes (each buying < 10 % of a step at N = 150 and at N = 10,000)
-were measured by this script at commit 89efadd, which disabled each by an instance-level patch of
-the method that kept it; docs/design.md ("The one cache") has both tables.
+The memo holds the selection of the mobile spheres and the canvas's step engine
+(docs/design.md, "The one cache"); only the selection is timed here: the engine also carries the
+step's state from one phase to the next (the force phase's record that the acceleration and the
+movement read, Verlet's half kick), so making it anew at every ``get`` would change the step, not
+only its cost.
 
 The step is what a run does: ``setShearRate``, the force phase, the register totals, the σ_xy-only
 evaluation on every other step (what the experiment samples), the acceleration and the movement —
@@ -90,12 +92,7 @@ class BypassMemo(Memo):
 
 
 ENTRIES = {
-    "pair_structure": "pair structure (indices, radii, levers, images, bonds)",
-    "internal_flags": "internal/external flags of the pairs",
-    "pair_structure+internal_flags": "the structure and the flags",
     "selection": "selection of the mobile spheres (the list)",
-    "term_constants": "constants of the force terms (laws, bonds, viscosities, Coulomb offset), at every get",
-    "term_constants@phase": "the same, computed once per force phase instead of kept",
 }
 
 

@@ -6,7 +6,7 @@ scene: ``setShearRate``, ``mechanical_simulation_step_calculate_forces``,
 ens.movableSphereList(), ens.shear_rate)`` (every tensor), acceleration, movement.  Each call is
 timed on its own; the figure of a phase is the first quartile of its block means (30 blocks of 20
 steps after 100 warm-up steps), so the steps that rebuild the neighbour lists are included.  Each
-tree runs in its own process (``PYTHONPATH`` set to the tree, one thread, pinned to one CPU where
+tree runs in its own process (the tree first on ``sys.path``, one thread, pinned to one CPU where
 ``taskset`` exists); compare trees within one run of the script.
 
 Usage: python benchmarks/bench_phases.py [TREE ...]   (default: this tree)

@@ -178,7 +178,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     b : int
         Replica index (0 … B−1).
     ensemble : ensemble of ``particleShear.linkable``
-        The ensemble the replica was copied from (same N).
+        The ensemble that is replica ``b`` of the engine's state (``state.ensembles[b]``).
     steps : int, optional
         Steps the replica was advanced (bookkeeping of the classes).
     constitution : bool, default True

@@ -1,10 +1,11 @@
 """Projected size and cost of a sweep, from the time-step rule and documented per-step costs.
 
 The number of protocol steps of a run is exact (the rule of ``time_steps_from_model`` and
-``protocol_steps``: ``τ`` cancels, so no ensemble is built).  Wall times use the per-step costs
-measured on the project's 2-core CI-class machine (docs/performance.md): 285 µs per step at
+``protocol_steps``: ``τ`` cancels, so no ensemble is built).  Wall times use static per-step costs
+measured by ``benchmarks/bench_step.py`` on a quiet 2-core CI-class machine: 285 µs per step at
 N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extrapolated with the
-nearest slope), plus constitution 0.53 s · (N/150)^0.7.  Disk: the text format writes about
+nearest slope), plus constitution 0.53 s · (N/150)^0.7; a loaded machine measures up to 2× more
+(docs/performance.md), which is why ``--dry-run`` calibrates on the machine at hand.  Disk: the text format writes about
 723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md).
 """
 __docformat__ = "numpy"
@@ -15,7 +16,7 @@ from ..simulation.experiment import protocol_steps
 
 __all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "estimate_point_cost", "format_cost"]
 
-_STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step), docs/performance.md
+_STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step), bench_step.py, quiet
 _CONSTITUTION_S = 0.53                                            # s at N = 150
 _BYTES_PER_STEP = 723
 _HEADER_BYTES = 4000
