@@ -128,15 +128,15 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             return True
         return theSphere.r < theSphere.y < self.size_y - theSphere.r
 
-    def _mobile(self):
-        """(mask ``r < y < Ly − r``, its bytes: the memo key) while shearing, else (None, None)."""
+    def _mobile_mask(self):
+        """The mask ``r < y < Ly − r`` while shearing, else None."""
         if not self.applyingShear:
-            return None, None
+            return None
         y = self._pos[1]
         r = self._a["r"]
         mob = r < y
         mob &= y < self.size_y - r
-        return mob, mob.tobytes()
+        return mob
 
     def do_linear_acceleration(self, dt):
         kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
