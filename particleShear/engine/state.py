@@ -341,10 +341,14 @@ class BatchState:
 
     #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
     visit = None
-    #: the ensemble whose sphere rows this state's per-sphere arrays are (:meth:`of_ensemble`), else None
-    ensemble = None
     #: the ensembles whose sphere rows this state's per-sphere arrays are (:meth:`of_ensembles`), else None
     ensembles = None
+
+    @property
+    def ensemble(self):
+        """The ensemble of a batch of one on its own rows (:meth:`of_ensemble`), else None."""
+        e = self.ensembles
+        return e[0] if e is not None and len(e) == 1 else None
 
     def __init__(self, B, N, backend="numpy"):
         self.backend = get_backend(backend)
@@ -374,8 +378,7 @@ class BatchState:
         state = dict(self.__dict__)
         state["backend"] = self.backend.name
         del state["xp"]
-        state.pop("ensemble", None)      # a copy is no longer the ensemble's rows
-        state.pop("ensembles", None)
+        state.pop("ensembles", None)      # a copy is no longer the ensembles' rows
         return state
 
     def __setstate__(self, state):
@@ -411,7 +414,7 @@ class BatchState:
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
-        out.ensemble = out.ensembles = None        # copies, no longer the ensembles' rows
+        out.ensembles = None        # copies, no longer the ensembles' rows
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
@@ -519,7 +522,7 @@ class BatchState:
         what the engine's steps write, the ensembles hold (nothing to copy back).
 
         The sphere rows of replica b are columns ``b·N … b·N + N − 1`` of one state block laid out as
-        the ensembles' (:data:`~particleShear.base.fields.FIELDS` × spheres); a single ensemble keeps
+        the ensembles' (:data:`FIELDS` × spheres); a single ensemble keeps
         its own block, several move theirs into the joint block, of which each then holds its
         columns as a view (an ensemble that later gains a sphere copies its block out again).
         Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
@@ -570,7 +573,6 @@ class BatchState:
         s.pairs = [e._pairs for e in ensembles]
         s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
         s.ensembles = ensembles
-        s.ensemble = ensembles[0] if len(ensembles) == 1 else None
         return s
 
     @classmethod

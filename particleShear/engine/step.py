@@ -511,15 +511,16 @@ class BatchEngine:
         if self.keep_terms:
             self.terms = _TermRecord(C, parts, F, dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
                                      fx_j, fy_j, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
-        if sample == "tensors":
-            q = StressInputs(C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia,
-                             Lx=s.Lx, Ly=s.Ly, rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted,
-                             dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, fx_j=fx_j, fy_j=fy_j, dF=dF, fx=s.fx, fy=s.fy,
-                             torque=s.torque)
-            # the tensors' roles of the pairs (the same flags, already with the relations) serve both
-            out = shear_stresses(C, s.B, yc, q.roles, active, dy, fx_i, dF, self.V, fx_j) + (evaluate_all(q),)
-        elif sample:
-            out = shear_stresses(C, s.B, yc, pair_roles(mob[ai], mob[aj], shifted), active, dy, fx_i, dF, self.V, fx_j)
+        if sample:
+            q = None if sample != "tensors" else StressInputs(
+                C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,
+                rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i,
+                fx_j=fx_j, fy_j=fy_j, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
+            # with tensors, their roles of the pairs (the same flags, already with the relations) serve both
+            roles = pair_roles(mob[ai], mob[aj], shifted) if q is None else q.roles
+            out = shear_stresses(C, s.B, yc, roles, active, dy, fx_i, dF, self.V, fx_j)
+            if q is not None:
+                out = out + (evaluate_all(q),)
         self.verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)
