@@ -295,9 +295,41 @@ class TestStressRegistry(unittest.TestCase):
                     else np.max(np.abs(ref[:, k])) + 1e-300
                 self.assertGreater(np.max(np.abs(ref[:, k])), 0.0)
                 self.assertLessEqual(np.max(np.abs(tens[:, k] - ref[:, k])), 1e-12 * scale)
-        # the fast shear stresses G uses are the xy entries of the overall and external tensors
-        np.testing.assert_allclose(got["stress_internal"][:, 0], -tens[:, 8, 0, 1], rtol=0, atol=1e-13 * p)
-        np.testing.assert_allclose(got["stress_surface"][:, 0], -tens[:, 2, 0, 1], rtol=0, atol=1e-13 * p)
+        # the shear stresses G uses are the xy entries of the overall and external tensors bit for bit:
+        # the same row sums in the one formula (engine.forces.shear_from_sums)
+        np.testing.assert_array_equal(got["stress_internal"][:, 0], -tens[:, 8, 0, 1])
+        np.testing.assert_array_equal(got["stress_surface"][:, 0], -tens[:, 2, 0, 1])
+
+    def test_shear_stresses_are_the_tensors_xy_entries_with_sphere_parameters(self):
+        """Spheres with parameters of their own (j's visit has its own central force, F_j ≠ F_i): the
+        shear stresses of a step without tensors are the xy entries of the tensors of the same step,
+        bit for bit, and each replica of a batch of two has the tensors of its single run."""
+        def scene(seed):
+            _, ens, sc = constituted(seed, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
+            for s in ens.sphereList[::3]:
+                s.permanent_ratio_central = 2.0
+                s.permanent_ratio_tangential = 3.0
+            ens.setShearRate(300.0)
+            return ens, sc
+        runs = {}
+        for sample in (True, "tensors"):
+            engines = [BatchEngine(BatchState.from_ensembles([scene(seed)[0]]), guard=False) for seed in (3, 4)]
+            batch = BatchEngine(BatchState.from_ensembles([scene(seed)[0] for seed in (3, 4)]), guard=False)
+            dt = scene(3)[1]["dt"]
+            runs[sample] = [[e.step(0.999, dt, sample=sample) for _ in range(20)] for e in engines + [batch]]
+            self.assertIsNotNone(batch.C.Kj)
+        for k in range(20):
+            for b in range(2):
+                for r in range(2):      # τ_internal, τ_surface: single run, with or without tensors, batch
+                    tau = runs[True][b][k][r][0]
+                    self.assertEqual(runs["tensors"][b][k][r][0], tau)
+                    self.assertEqual(runs["tensors"][2][k][r][b], tau)
+                    self.assertEqual(runs[True][2][k][r][b], tau)
+                T = runs["tensors"][b][k][2][0]
+                self.assertEqual(T.tobytes(), runs["tensors"][2][k][2][b].tobytes())
+                self.assertEqual(-T[8, 0, 1], runs[True][b][k][0][0])
+                self.assertEqual(-T[2, 0, 1], runs[True][b][k][1][0])
+        self.assertNotEqual(runs[True][0][-1][1][0], 0.0)
 
     def test_registry_matches_output_columns(self):
         from particleShear.engine.stress import TENSORS

@@ -314,11 +314,10 @@ class TestOutputFile(unittest.TestCase):
         np.testing.assert_allclose(lw, ext + lin, rtol=0, atol=1e-12 * scale)
         np.testing.assert_array_equal(lin, unb)
         np.testing.assert_allclose(overall[:, 1], overall[:, 2], rtol=0, atol=1e-12 * scale)
-        # the shear-stress columns are the tensors' xy entries; the engine sums them in another order
-        # (its fast path for G), equal to rounding: 1e-12 of the pressure scale
-        np.testing.assert_allclose(-overall[:, 1], col["shear_stress_internal_stress-tensor"], rtol=0,
-                                   atol=1e-12 * scale)
-        np.testing.assert_allclose(-ext[:, 1], col["stress_measured_at_surface"], rtol=0, atol=1e-12 * scale)
+        # the shear-stress columns are the tensors' xy entries, bit for bit (the same row sums in the one
+        # formula of engine.forces.shear_from_sums)
+        np.testing.assert_array_equal(-overall[:, 1], col["shear_stress_internal_stress-tensor"])
+        np.testing.assert_array_equal(-ext[:, 1], col["stress_measured_at_surface"])
 
     def test_next_number_and_reference_header_switch(self):
         sim = Simulation_interlocking_rheology(self.dir.name, cut_lines=3, N=30, amplitude=0.2, mu=0.01,

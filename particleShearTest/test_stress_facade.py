@@ -18,6 +18,7 @@ import numpy as np
 
 from particleShear import StressTensorEvaluation
 from particleShear.base.register import Force_register
+from particleShear.base.stress import ForcePhase
 from particleShear.engine import stress as es
 from particleShear.engine.state import BatchState
 from particleShear.engine.step import BatchEngine
@@ -83,7 +84,7 @@ class TestOneReplicaReductions(unittest.TestCase):
         ev = StressTensorEvaluation(ens.size_x, ens.size_y)
         q = ev._array_inputs(ens.force_register, ens.movableSphereList(), ens.shear_rate)
         self.assertIsNotNone(q)   # the array path applies to the ensemble's own register
-        part = q.parts[es.love_weber]
+        part = q.pairs if isinstance(q, ForcePhase) else q
         fields = {k: v for k, v in part.__dict__.items() if not k.startswith("_")}
         plain = es.StressInputs(**fields)   # the engine's reductions on the same inputs
         fast = es.evaluate_all(q)

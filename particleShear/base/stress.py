@@ -27,10 +27,9 @@ _INDEX = {t.function: k for k, t in enumerate(TENSORS)}
 _EXT = _INDEX[_es.external_forces]
 _ALL = _INDEX[_es.overall]
 
-#: which part of a force phase each tensor reads (the overall tensor adds up parts of the others)
-_PAIR_TENSORS = (_es.love_weber, _es.external_forces, _es.internal_torque)
-_TOTAL_TENSORS = (_es.unbalanced_forces, _es.linear_acceleration, _es.unbalanced_torque)
-_SPHERE_TENSORS = (_es.spin_kinetic_energy, _es.peculiar_acceleration_otsuki)
+#: which part of a force phase each row function reads: the pairs, the sphere totals or the kinetic state
+_TOTAL_ROWS = frozenset(r for t in TENSORS if t.function in (_es.unbalanced_forces, _es.unbalanced_torque)
+                        for r in t.rows)
 
 _ENS_OF = attrgetter("_ens")
 _IDX_OF = attrgetter("_idx")
@@ -91,31 +90,47 @@ _FROM_ROW_0 = np.zeros(1, dtype=np.intp)
 
 
 class ForcePhase(StressInputs):
-    """The engine's inputs of one force phase, in three parts; the overall tensor (eq. S1-24) sums them.
+    """The inputs of one force phase in three parts, each row function summed on its own part.
 
     Parameters
     ----------
     pairs, totals, spheres : StressInputs
-        Inputs of the pair tensors (also the cell volume ``V``), of the sphere-total tensors, and
-        of the kinetic tensors (the caller's spheres, which need not be the register's).
+        Inputs of the pair rows (also the cell volume ``V``), of the sphere-total rows, and of the
+        kinetic rows (the caller's spheres, which need not be the register's).
     """
 
     def __init__(self, pairs, totals, spheres):
-        parts = {f: pairs for f in _PAIR_TENSORS}
-        parts.update((f, totals) for f in _TOTAL_TENSORS)
-        parts.update((f, spheres) for f in _SPHERE_TENSORS)
-        super().__init__(B=1, V=pairs.V, parts=parts)
+        super().__init__(B=1, V=pairs.V, pairs=pairs, totals=totals, spheres=spheres)
 
-    def tensor(self, function):
-        """``function`` evaluated on its part (the overall tensor from the parts): shape (1, 2, 2).
+    def _part(self, rows):
+        if rows.by_pair:
+            return self.pairs
+        return self.totals if rows in _TOTAL_ROWS else self.spheres
+
+    def sums(self, rows):
+        """The sums of ``rows`` on its part: shape (k, 1).
 
         Parameters
         ----------
-        function : callable
-            A tensor function of :data:`~particleShear.engine.stress.TENSORS`.
+        rows : callable
+            A row function of :data:`~particleShear.engine.stress.ROWS`.
         """
-        part = self.parts.get(function)
-        return super().tensor(function) if part is None else part.tensor(function)
+        return self._part(rows).sums(rows)
+
+    def reduce(self, groups):
+        """Sum ``groups`` part by part (one reduction per kind of rows and part).
+
+        Parameters
+        ----------
+        groups : iterable of callable
+            Row functions of :data:`~particleShear.engine.stress.ROWS`.
+        """
+        parts = {}
+        for g in groups:
+            part = self._part(g)
+            parts.setdefault(id(part), (part, []))[1].append(g)
+        for part, gs in parts.values():
+            part.reduce(gs)
 
 
 def _cell(ev, shear_rate=None):
@@ -370,10 +385,8 @@ class StressTensorEvaluation:
             s = self._spheres = (n, np.zeros(n, dtype=np.intp), np.ones(n, dtype=bool), np.zeros(n))
         return s[1:]
 
-    def _shear_from_register(self, reg, pairs=None, roles=None):
-        """(τ_internal, τ_surface) of the register (eq. S1-25), for both the full and the σ_xy-only evaluation.
-
-        ``pairs``: :func:`_entries` if already made; ``roles``: the engine phase's flags if already evaluated."""
+    def _shear_from_register(self, reg):
+        """(τ_internal, τ_surface) of the register (eq. S1-25): the σ_xy-only evaluation."""
         cell = _cell(self)
         ph = _engine_phase(reg)
         if ph is not None:
@@ -382,11 +395,10 @@ class StressTensorEvaluation:
             mob = ph.terms.mob
             # y − Ly/2 of the spheres: the ensemble's own (kept per position update) when the cells agree
             yc = ens._y_centred() if ens.size_y == self.size_y else ens._a["y"] - self.size_y / 2
-            if roles is None:
-                roles = pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted)
+            roles = pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted)
             tau = _engine_shear_stresses(C, 1, yc, roles, active, dy, fx_i, dF, cell["V"])
         else:
-            q = OneReplicaInputs(**(_entries(reg) if pairs is None else pairs), **cell)
+            q = OneReplicaInputs(**_entries(reg), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
         return float(tau[0][0]), float(tau[1][0])
 
@@ -409,8 +421,8 @@ class StressTensorEvaluation:
                              active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
                              fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
                              **_cell(self, shear_rate))
-        if mask is mob:
-            return ForcePhase(q, q, q)
+        if mask is mob or (mask is not None and mob is not None and np.array_equal(mask, mob)):
+            return q
         return ForcePhase(q, q, _with_mobile(q, everyone if mask is None else mask))
 
     def _sphere_inputs(self, theSphereList, shear_rate=0.0):
@@ -420,8 +432,8 @@ class StressTensorEvaluation:
         return OneReplicaInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy,
                                 y=y, mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
 
-    def _pair_inputs(self, reg, entries=None):
-        return OneReplicaInputs(**(_entries(reg) if entries is None else entries), **_cell(self))
+    def _pair_inputs(self, reg):
+        return OneReplicaInputs(**_entries(reg), **_cell(self))
 
     def _total_inputs(self, reg):
         return OneReplicaInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
@@ -501,9 +513,9 @@ class StressTensorEvaluation:
     def evaluate_stress_tensors(self, force_register, theSphereList, shear_rate):
         """Every tensor and the overall tensor ``σ = σ_LW + σ_Tint + σ_cen`` (eq. S1-24).
 
-        The xy entries of the overall and external-force tensors are those of
-        :meth:`evaluate_shear_stresses` (equal to the registry's sums to ≈ 1e-16 relative), so G
-        does not depend on whether tensors are kept.
+        The xy entries of the overall and external-force tensors are the shear stresses of
+        :meth:`evaluate_shear_stresses` bit for bit (the same sums in the same formula), so G does
+        not depend on whether tensors are kept.
 
         Parameters
         ----------
@@ -515,18 +527,9 @@ class StressTensorEvaluation:
         """
         reg = force_register
         q = self._array_inputs(reg, theSphereList, shear_rate)
-        entries = None
         if q is None:
-            entries = _entries(reg)
-            q = ForcePhase(self._pair_inputs(reg, entries), self._total_inputs(reg),
-                           self._sphere_inputs(theSphereList, shear_rate))
-        t = self._t
-        t[...] = _es.evaluate_all(q)[0]
-        # the flags of the tensors' pair inputs (× relations, as the shear stresses take them anyway)
-        roles = q.parts[_es.love_weber].roles if entries is None else None
-        tau_internal, tau_surface = self._shear_from_register(reg, entries, roles)
-        t[_ALL, 0, 1] = -tau_internal
-        t[_EXT, 0, 1] = -tau_surface
+            q = ForcePhase(self._pair_inputs(reg), self._total_inputs(reg), self._sphere_inputs(theSphereList, shear_rate))
+        self._t[...] = _es.evaluate_all(q)[0]
 
     def evaluate_shear_stresses(self, force_register, theSphereList):
         """Only what G needs: update the xy entries of the overall and external-force tensors.

@@ -25,7 +25,7 @@ from . import laws
 from .terms import TermConstants, term_constants
 
 __all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "pair_roles",
-           "shear_stresses"]
+           "shear_from_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -486,17 +486,43 @@ def shear_stresses(C, B, yc, roles, active, dy, fx_i, dF, V, fx_j=None):
     internal, ext_i, ext_j = roles
     internal = internal & active
     ext_j = ext_j & active
+    lever_j = yc[C.aj] * ext_j
     lever = yc[C.ai] * (ext_i & active)
-    lever -= yc[C.aj] * ext_j
+    lever -= lever_j
     fx_lw, f_lever = fx_i, fx_i * lever
     if fx_j is not None:
         # F_i at i and −F_j at j: F_i·lever + (F_i − F_j)·(y_j − Ly/2), so a pair with F_j = F_i gives
         # the same number as without fx_j (a batch's replica equals its single run)
         fx_lw = (fx_i + fx_j) * 0.5
-        f_lever = f_lever + (fx_i - fx_j) * (yc[C.aj] * ext_j)
-    # three per-replica sums in one reduction: Σ F_x,i·D_y (= −Σ F_x,i (y_i − y_j)), Σ d·F_T, Σ F_x·lever
-    sums = replica_sums(C, xp.stack((fx_lw * dy * internal, dF * internal, f_lever)))
-    lw, tint, surf = sums[0], sums[1], sums[2]
+        f_lever += (fx_i - fx_j) * lever_j
+    # the rows of the tensors' xy entries (engine.stress), the same products: Σ F_x,i·D_y (= −Σ F_x,i
+    # (y_i − y_j)), Σ d·F_T, Σ F_x·lever, in one reduction
+    sums = replica_sums(C, xp.stack((fx_lw * internal * dy, dF * internal, f_lever)))
+    return shear_from_sums(sums[0], sums[1], sums[2], V)
+
+
+def shear_from_sums(lw, tint, surf, V):
+    """τ_internal and τ_surface (Pa, eq. S1-25) from per-replica sums of the pair rows.
+
+    The one formula of the shear stresses: :func:`shear_stresses` and the tensors' xy entries
+    (:mod:`particleShear.engine.stress`) both finish with it.
+
+    Parameters
+    ----------
+    lw : ndarray (B,)
+        Σ_internal F_x,i·D_y (mg·µm²·s⁻² per m depth).
+    tint : ndarray (B,)
+        Σ_internal d·F_T (same unit).
+    surf : ndarray (B,)
+        Σ_external F_x·(y_target − Ly/2) (same unit).
+    V : ndarray (B,)
+        Cell area of each replica (m²).
+
+    Returns
+    -------
+    tau_internal, tau_surface : ndarray (B,)
+        ``−σ_xy`` of the overall and of the external-force tensor (Pa).
+    """
     sigma_all = -lw * (CF_CL / V) - tint * (CT / V) / 2
     sigma_ext = -surf * (CF_CL / V)
     return -sigma_all, -sigma_ext

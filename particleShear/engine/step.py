@@ -35,10 +35,14 @@ from .terms import (central_term, elastic_term, normal_speed, pair_forces, relat
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK
-from .stress import StressInputs, evaluate_all
+from .stress import TENSORS, StressInputs, evaluate_all, external_forces, overall
 from .xp import to_host
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks", "register_block"]
+
+#: the tensors whose xy entries are −τ_internal and −τ_surface (TENSORS' order)
+_OVERALL = [t.function for t in TENSORS].index(overall)
+_EXTERNAL = [t.function for t in TENSORS].index(external_forces)
 
 
 class EngineInstability(RuntimeError):
@@ -516,11 +520,12 @@ class BatchEngine:
                 C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,
                 rate=s.rate, V=self.V, mob=mob, active=active, shifted=shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i,
                 fx_j=fx_j, fy_j=fy_j, dF=dF, fx=s.fx, fy=s.fy, torque=s.torque)
-            # with tensors, their roles of the pairs (the same flags, already with the relations) serve both
-            roles = pair_roles(mob[ai], mob[aj], shifted) if q is None else q.roles
-            out = shear_stresses(C, s.B, yc, roles, active, dy, fx_i, dF, self.V, fx_j)
-            if q is not None:
-                out = out + (evaluate_all(q),)
+            if q is None:
+                out = shear_stresses(C, s.B, yc, pair_roles(mob[ai], mob[aj], shifted), active, dy, fx_i, dF,
+                                     self.V, fx_j)
+            else:       # the tensors' xy entries are the shear stresses, bit for bit (engine.stress)
+                T = evaluate_all(q)
+                out = (-T[:, _OVERALL, 0, 1], -T[:, _EXTERNAL, 0, 1], T)
         self.verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)

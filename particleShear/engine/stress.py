@@ -2,10 +2,13 @@
 
 Each function takes the :class:`StressInputs` of one force phase of a batch and returns a
 ``(B, 2, 2)`` array (Pa; index ``[b, a, c]``: replica, force component, position component).
-Sums run per replica over its own rows (one reduction over each replica's segment), so a replica's
-tensors do not depend on its batch.  Units as in the reference: forces ×1e-12 (N per m depth),
-lengths ×1e-6 (m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from
-the cell centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
+A tensor reads per-replica sums of rows of products (its *rows*: :func:`pair_rows` and
+:func:`sphere_rows` functions); :func:`evaluate_all` sums the rows of every tensor in two
+reductions, one over the pairs and one over the spheres.  Each row is summed per replica over
+its own segment, so a tensor's numbers do not depend on which other rows, tensors or replicas
+are summed with it.  Units as in the reference: forces ×1e-12 (N per m depth), lengths ×1e-6
+(m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from the cell
+centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
 """
 __docformat__ = "numpy"
 
@@ -13,10 +16,10 @@ import collections
 
 import numpy as np
 
-from .forces import pair_roles, replica_sums
+from .forces import pair_roles, replica_sums, shear_from_sums
 from .xp import array_namespace
 
-__all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all"]
+__all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all", "pair_rows", "sphere_rows"]
 
 _ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
 _EYE = np.eye(2)
@@ -108,31 +111,47 @@ class StressInputs:
                 out = W.reshape(W.shape[0], self.B, n).sum(axis=2)
         return out if weights.ndim == 2 else out[0]
 
-    def outer(self, u, w, by_pair=True):
-        """(B, 2, 2) array of the per-replica sums of ``u_a · w_c`` (u, w: pairs of rows).
-
-        The four products are summed in one reduction over their stacked rows (each row on its
-        own, so the same numbers as four separate sums).
+    def sums(self, rows):
+        """Per-replica sums of the rows of ``rows`` (a :func:`pair_rows` or :func:`sphere_rows`
+        function), (k, B), evaluated once per force phase.
 
         Parameters
         ----------
-        u : tuple of two ndarray
-            x and y components of the first factor (force components; per pair or per sphere).
-        w : tuple of two ndarray
-            x and y components of the second factor (lever arms), same length as ``u``.
-        by_pair : bool
-            True: the rows are candidate pairs; False: spheres.
+        rows : callable
+            ``rows(self) -> (k, P)`` or ``(k, B·N)`` array.
 
         Returns
         -------
-        ndarray (B, 2, 2)
-            ``out[b, a, c] = Σ_rows of b  u_a · w_c`` (unscaled).
+        ndarray (k, B)
+            ``out[r, b]`` = Σ over replica b's rows of row r (the unit of the rows).
         """
-        xp = array_namespace(u[0])
-        W = xp.empty((4, u[0].shape[0]))      # the four products written in place (no stack)
-        for r, (a, c) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
-            xp.multiply(u[a], w[c], out=W[r])
-        return self.per_replica(W, by_pair).T.reshape(self.B, 2, 2)
+        memo = self.__dict__.setdefault("_row_sums", {})
+        if rows not in memo:
+            self.reduce((rows,))
+        return memo[rows]
+
+    def reduce(self, groups):
+        """Sum the rows of every function of ``groups`` not summed yet: the pair rows in one
+        reduction, the sphere rows in another (each row over each replica's own segment, so the
+        same numbers as a reduction of its own).
+
+        Parameters
+        ----------
+        groups : iterable of callable
+            :func:`pair_rows` and :func:`sphere_rows` functions.
+        """
+        memo = self.__dict__.setdefault("_row_sums", {})
+        for by_pair in (True, False):
+            todo = [g for g in groups if g.by_pair is by_pair and g not in memo]
+            if not todo:
+                continue
+            blocks = [g(self) for g in todo]
+            W = blocks[0] if len(blocks) == 1 else array_namespace(blocks[0]).concatenate(blocks)
+            S = self.per_replica(W, by_pair)
+            k = 0
+            for g, b in zip(todo, blocks):
+                memo[g] = S[k:k + len(b)]
+                k += len(b)
 
     @property
     def roles(self):
@@ -163,6 +182,112 @@ def _y_centred(q):
     return q.y - (q.Ly / 2)[q.rep]
 
 
+def pair_rows(function):
+    """Mark a row function as rows over the candidate pairs (see :meth:`StressInputs.reduce`).
+
+    Parameters
+    ----------
+    function : callable
+        ``function(q) -> (k, P)``: k rows of products, one value per candidate pair of the batch.
+
+    Returns
+    -------
+    callable
+        ``function``, with ``by_pair = True``.
+    """
+    function.by_pair = True
+    return function
+
+
+def sphere_rows(function):
+    """Mark a row function as rows over the spheres (see :meth:`StressInputs.reduce`).
+
+    Parameters
+    ----------
+    function : callable
+        ``function(q) -> (k, B·N)``: k rows of products, one value per sphere of the batch.
+
+    Returns
+    -------
+    callable
+        ``function``, with ``by_pair = False``.
+    """
+    function.by_pair = False
+    return function
+
+
+def _outer_rows(ux, uy, wx, wy):
+    """(4, n) rows ``u_a·w_c`` in the order (x, x), (x, y), (y, x), (y, y): a 2×2 tensor per row sum."""
+    xp = array_namespace(ux)
+    W = xp.empty((4, ux.shape[0]))
+    for r, (u, w) in enumerate(((ux, wx), (ux, wy), (uy, wx), (uy, wy))):
+        xp.multiply(u, w, out=W[r])
+    return W
+
+
+def _as_tensors(S, q):
+    """(B, 2, 2) tensors from the (4, B) sums of :func:`_outer_rows`."""
+    return S.T.reshape(q.B, 2, 2)
+
+
+@pair_rows
+def _love_weber_rows(q):
+    """F ⊗ D of the internal pairs (D = x_j − x_i, the minimum-image pair vector); F the mean of the two
+    visits' forces where spheres have parameters of their own (1.0.2 registers each visit with half)."""
+    w = q.internal
+    fx, fy = (q.fx_i, q.fy_i) if q.fx_j is None else ((q.fx_i + q.fx_j) * 0.5, (q.fy_i + q.fy_j) * 0.5)
+    return _outer_rows(fx * w, fy * w, q.dx, q.dy)
+
+
+@pair_rows
+def _external_rows(q):
+    """F ⊗ (x_target − c) of the external entries: F_i at i, −F_j at j (eq. S1-16)."""
+    C = q.C
+    _, ei, ej = q.roles
+    xc, yc = q.tensor(_x_centred), q.tensor(_y_centred)
+    xj, yj = xc[C.aj] * ej, yc[C.aj] * ej
+    W = _outer_rows(q.fx_i, q.fy_i, xc[C.ai] * ei - xj, yc[C.ai] * ei - yj)
+    if q.fx_j is not None:
+        # j's visit has a force of its own: F_i ⊗ lever + (F_i − F_j) ⊗ (x_j − c), exactly the rows
+        # above where F_j = F_i (a batch's replica equals its single run)
+        W += _outer_rows(q.fx_i - q.fx_j, q.fy_i - q.fy_j, xj, yj)
+    return W
+
+
+@pair_rows
+def _internal_torque_rows(q):
+    """d·F_T of the internal pairs (the pair's two torques sum to d·F_T)."""
+    return (q.dF * q.internal)[None]
+
+
+@sphere_rows
+def _unbalanced_rows(q):
+    """F_total ⊗ (x − c) of the mobile spheres."""
+    w = q.mob
+    return _outer_rows(q.fx * w, q.fy * w, q.tensor(_x_centred), q.tensor(_y_centred))
+
+
+@sphere_rows
+def _torque_rows(q):
+    """The net torque of every sphere, immobile ones included."""
+    return q.torque[None]
+
+
+@sphere_rows
+def _spin_rows(q):
+    """I ω² of the mobile spheres."""
+    return (q.inertia * q.omega * q.omega * q.mob)[None]
+
+
+@sphere_rows
+def _otsuki_rows(q):
+    """P ⊗ P / m of the mobile spheres, P = m (v_x − γ̇ (y − Ly/2), v_y) (units of eq. S1-21 ×1e-18)."""
+    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * q.tensor(_y_centred))
+    py = q.m * 1e-12 * q.vy
+    w = q.mob / (q.m * 1e-6)
+    return _outer_rows(px * w, py * w, px, py)
+
+
 def love_weber(q):
     """σ_LW = (1/V) Σ_internal F_i ⊗ (x_i − x_j) (eq. S1-19); ``x_i − x_j = −D`` for an unshifted pair.
 
@@ -176,14 +301,15 @@ def love_weber(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    w = q.internal
-    fx, fy = (q.fx_i, q.fy_i) if q.fx_j is None else ((q.fx_i + q.fx_j) * 0.5, (q.fy_i + q.fy_j) * 0.5)
-    return q.outer((fx * w, fy * w), (-q.dx, -q.dy)) * (1e-18 / q.V)[:, None, None]
+    return -_as_tensors(q.sums(_love_weber_rows), q) * (1e-18 / q.V)[:, None, None]
 
 
 def external_forces(q):
     """σ_ext = −(1/V) Σ_external F ⊗ (x_target − c) (eq. S1-16): a mobile sphere of a pair through
     the boundary or with an immobile partner receives the pair force at its own centre.
+
+    Its xy entry is −τ_surface of :func:`~particleShear.engine.forces.shear_stresses`, bit for bit
+    (the same rows, the same sums).
 
     Parameters
     ----------
@@ -195,17 +321,7 @@ def external_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    C = q.C
-    _, ei, ej = q.roles
-    xc, yc = q.tensor(_x_centred), q.tensor(_y_centred)
-    lever_x = xc[C.ai] * ei - xc[C.aj] * ej     # F on j is −F on i
-    lever_y = yc[C.ai] * ei - yc[C.aj] * ej
-    S = q.outer((q.fx_i, q.fy_i), (lever_x, lever_y))
-    if q.fx_j is not None:
-        # j's visit has a force of its own (spheres with parameters of their own): −F_j at j, i.e.
-        # F_i ⊗ lever + (F_i − F_j) ⊗ (x_j − c), exactly S where F_j = F_i
-        S = S + q.outer((q.fx_i - q.fx_j, q.fy_i - q.fy_j), (xc[C.aj] * ej, yc[C.aj] * ej))
-    return -S * (1e-18 / q.V)[:, None, None]
+    return -_as_tensors(q.sums(_external_rows), q) * (1e-18 / q.V)[:, None, None]
 
 
 def unbalanced_forces(q):
@@ -221,9 +337,7 @@ def unbalanced_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    w = q.mob
-    S = q.outer((q.fx * w, q.fy * w), (q.tensor(_x_centred), q.tensor(_y_centred)), by_pair=False)
-    return S * (1e-18 / q.V)[:, None, None]
+    return _as_tensors(q.sums(_unbalanced_rows), q) * (1e-18 / q.V)[:, None, None]
 
 
 def linear_acceleration(q):
@@ -255,8 +369,8 @@ def unbalanced_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    rot = array_namespace(q.torque).asarray(_ROT)
-    return q.per_replica(q.torque, by_pair=False)[:, None, None] * 1e-18 / q.V[:, None, None] * rot
+    S = q.sums(_torque_rows)[0]
+    return S[:, None, None] * 1e-18 / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
 def internal_torque(q):
@@ -272,8 +386,8 @@ def internal_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    rot = array_namespace(q.dF).asarray(_ROT)
-    return q.per_replica(q.dF * q.internal)[:, None, None] * 1e-18 / q.V[:, None, None] * rot
+    S = q.sums(_internal_torque_rows)[0]
+    return S[:, None, None] * 1e-18 / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
 def spin_kinetic_energy(q):
@@ -289,7 +403,7 @@ def spin_kinetic_energy(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    k = q.per_replica(q.inertia * q.omega * q.omega * q.mob, by_pair=False) * 1e-18 / 2
+    k = q.sums(_spin_rows)[0] * 1e-18 / 2
     return -(k / q.V)[:, None, None] * array_namespace(k).asarray(_EYE)
 
 
@@ -307,14 +421,13 @@ def peculiar_acceleration_otsuki(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * q.tensor(_y_centred))
-    py = q.m * 1e-12 * q.vy
-    w = q.mob / (q.m * 1e-6)
-    return -q.outer((px * w, py * w), (px, py), by_pair=False) / q.V[:, None, None]
+    return -_as_tensors(q.sums(_otsuki_rows), q) / q.V[:, None, None]
 
 
 def overall(q):
-    """σ = σ_LW + σ_Tint + σ_cen (eq. S1-24).
+    """σ = σ_LW + σ_Tint + σ_cen (eq. S1-24); its xy entry is −τ_internal of
+    :func:`~particleShear.engine.forces.shear_stresses`, bit for bit (the same sums in the same
+    formula), so G does not depend on whether tensors are kept.
 
     Parameters
     ----------
@@ -326,24 +439,37 @@ def overall(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return q.tensor(love_weber) + q.tensor(internal_torque) + q.tensor(spin_kinetic_energy)
+    out = q.tensor(love_weber) + q.tensor(internal_torque) + q.tensor(spin_kinetic_energy)
+    tau_internal, _ = shear_from_sums(q.sums(_love_weber_rows)[1], q.sums(_internal_torque_rows)[0],
+                                      q.sums(_external_rows)[1], q.V)
+    out[:, 0, 1] = -tau_internal
+    return out
 
 
-#: one registry entry per tensor: name (StressTensorEvaluation attribute), output-column stem, equation
-Tensor = collections.namedtuple("Tensor", "name stem equation function")
+#: one registry entry per tensor: name (StressTensorEvaluation attribute), output-column stem, equation,
+#: function, and the row functions it sums (:func:`pair_rows`, :func:`sphere_rows`)
+Tensor = collections.namedtuple("Tensor", "name stem equation function rows")
 TENSORS = (
-    Tensor("stress_tensor_LW", "stress_tensor_Love_Weber", "S1-19", love_weber),
+    Tensor("stress_tensor_LW", "stress_tensor_Love_Weber", "S1-19", love_weber, (_love_weber_rows,)),
     Tensor("stress_tensor_linear_acceleration_otsuki", "stress_tensor_peculiar_acceleration_otsuki", "Otsuki",
-           peculiar_acceleration_otsuki),
-    Tensor("stress_tensor_with_external_forces", "stress_tensor_from_external_forces", "S1-16", external_forces),
-    Tensor("stress_tensor_linear_acceleration", "stress_tensor_linear_acceleration", "S1-17", linear_acceleration),
+           peculiar_acceleration_otsuki, (_otsuki_rows,)),
+    Tensor("stress_tensor_with_external_forces", "stress_tensor_from_external_forces", "S1-16", external_forces,
+           (_external_rows,)),
+    Tensor("stress_tensor_linear_acceleration", "stress_tensor_linear_acceleration", "S1-17", linear_acceleration,
+           (_unbalanced_rows,)),
     Tensor("stress_tensor_unbalanced_forces", "stress_tensor_unbalanced_linear_forces", "S1-17",
-           unbalanced_forces),
-    Tensor("stress_tensor_unbalanced_torque", "stress_tensor_tangential_torque", "S1-22", unbalanced_torque),
-    Tensor("stress_tensor_internal_torque", "stress_tensor_internal_tangential_torque", "S1-22", internal_torque),
-    Tensor("stress_tensor_spin_kinetic_energy", "stress_tensor_centrifugal", "S1-21", spin_kinetic_energy),
-    Tensor("overall_stress_tensor", "stress_tensor_overall", "S1-24", overall),
+           unbalanced_forces, (_unbalanced_rows,)),
+    Tensor("stress_tensor_unbalanced_torque", "stress_tensor_tangential_torque", "S1-22", unbalanced_torque,
+           (_torque_rows,)),
+    Tensor("stress_tensor_internal_torque", "stress_tensor_internal_tangential_torque", "S1-22", internal_torque,
+           (_internal_torque_rows,)),
+    Tensor("stress_tensor_spin_kinetic_energy", "stress_tensor_centrifugal", "S1-21", spin_kinetic_energy,
+           (_spin_rows,)),
+    Tensor("overall_stress_tensor", "stress_tensor_overall", "S1-24", overall,
+           (_love_weber_rows, _internal_torque_rows, _spin_rows, _external_rows)),
 )
+#: every row function of :data:`TENSORS`, once
+ROWS = tuple(dict.fromkeys(r for t in TENSORS for r in t.rows))
 
 
 def evaluate_all(q):
@@ -359,5 +485,6 @@ def evaluate_all(q):
     ndarray (B, 9, 2, 2)
         ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
     """
+    q.reduce(ROWS)
     tensors = [q.tensor(t.function) for t in TENSORS]
     return array_namespace(tensors[0]).stack(tensors, axis=1)
