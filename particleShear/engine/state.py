@@ -65,6 +65,11 @@ def _key(i, j):
     return (np.asarray(i, dtype=np.int64) << 32) | np.asarray(j, dtype=np.int64)
 
 
+def _increasing(k, strict=True):
+    """True if the 1-D array ``k`` is sorted (strictly: also without repeats); O(n), no sort."""
+    return len(k) < 2 or bool((k[1:] > k[:-1]).all() if strict else (k[1:] >= k[:-1]).all())
+
+
 class PairTable:
     """Candidate pairs of one ensemble (one replica): sphere indices ``i < j`` in canonical ``(i, j)``
     order and their history, as a structure of arrays.
@@ -220,9 +225,11 @@ class PairTable:
             out of its reach ended).
         """
         old_key = self.key
-        k = np.sort(_key(np.minimum(i, j), np.maximum(i, j)))
-        if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
-            k = np.unique(k)
+        k = _key(np.minimum(i, j), np.maximum(i, j))
+        if not _increasing(k):          # (a search's pairs come sorted and unique: no sort)
+            k = np.sort(k)
+            if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
+                k = np.unique(k)
         # rows to keep that the new candidates miss (e.g. bonds stretched beyond the search reach)
         bond = self.state == PERMANENT
         kept = old_key if keep_existing else old_key[(self.active | bond) if keep_relations else bond]
@@ -233,7 +240,9 @@ class PairTable:
             if not found.all():
                 # the few kept keys merged into the sorted unique candidates: an O(n) insert (a
                 # union1d sorts the whole set anew, ≈ 60 ms of a rebuild at N = 100,000)
-                extra = np.unique(kept[~found])
+                extra = kept[~found]
+                extra = extra[np.r_[True, extra[1:] != extra[:-1]]] if _increasing(extra, strict=False) \
+                    else np.unique(extra)     # (the table's keys are sorted: no sort)
                 k = np.insert(k, np.searchsorted(k, extra), extra)
         pos = np.searchsorted(old_key, k)
         pos_c = np.minimum(pos, max(len(old_key) - 1, 0))

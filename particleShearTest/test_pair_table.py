@@ -1,0 +1,88 @@
+"""``PairTable.replace``: the candidate set of a rebuild, against a reference made with Python sets.
+
+The new table holds, in ``(i, j)`` order with ``i < j``, each pair of the given candidates once
+(whatever their order, orientation or repeats) plus the rows the rebuild keeps (bonds; with
+``keep_relations`` also relations; with ``keep_existing`` every row); a row present before carries
+its state, ξ, ``d_eq``, relation flag and creation number, a new row starts empty.  A sorted
+candidate list (what the searches return) and the same pairs shuffled, reversed and repeated give
+the same table.
+"""
+import unittest
+
+import numpy as np
+
+from particleShear.engine.state import PERMANENT, SLIP, STICK, PairTable
+
+
+def table(rng, n_spheres=40, n_pairs=120):
+    """A table of random distinct pairs with random history (some bonds, some relations)."""
+    pairs = set()
+    while len(pairs) < n_pairs:
+        i, j = rng.integers(0, n_spheres, 2)
+        if i != j:
+            pairs.add((min(i, j), max(i, j)))
+    i, j = np.array(sorted(pairs)).T
+    n = len(i)
+    return PairTable(i, j, state=rng.choice([STICK, SLIP, PERMANENT], n), xi=rng.normal(size=(2, n)),
+                     d_eq=rng.random(n), active=rng.random(n) < 0.5, birth=rng.integers(1, 100, n))
+
+
+def reference(old, i, j, keep_existing, keep_relations):
+    """The rows of the replaced table as {(i, j): (state, ξ_ij, ξ_ji, d_eq, active, birth)}."""
+    before = {(a, b): (old.state[k], old.xi[0, k], old.xi[1, k], old.d_eq[k], old.active[k], old.birth[k])
+              for k, (a, b) in enumerate(zip(old.i.tolist(), old.j.tolist()))}
+    keys = {(min(a, b), max(a, b)) for a, b in zip(i.tolist(), j.tolist())}
+    for k, key in enumerate(zip(old.i.tolist(), old.j.tolist())):
+        bond = old.state[k] == PERMANENT
+        if keep_existing or bond or (keep_relations and old.active[k]):
+            keys.add(key)
+    empty = (STICK, 0.0, 0.0, 0.0, False, 0)
+    return {key: before.get(key, empty) for key in sorted(keys)}
+
+
+def rows(t):
+    return {(a, b): (t.state[k], t.xi[0, k], t.xi[1, k], t.d_eq[k], t.active[k], t.birth[k])
+            for k, (a, b) in enumerate(zip(t.i.tolist(), t.j.tolist()))}
+
+
+class TestReplace(unittest.TestCase):
+    def check(self, seed, keep_existing, keep_relations):
+        rng = np.random.default_rng(seed)
+        old = table(rng)
+        # new candidates: some old pairs, some new ones
+        new = set(zip(old.i[rng.random(len(old)) < 0.6].tolist(), old.j[rng.random(len(old)) < 0.6].tolist()))
+        new = {(a, b) for a, b in new if a < b}
+        while len(new) < 150:
+            a, b = rng.integers(0, 40, 2)
+            if a != b:
+                new.add((min(a, b), max(a, b)))
+        i, j = np.array(sorted(new)).T
+        expected = reference(old, i, j, keep_existing, keep_relations)
+        # the sorted list of a search, and the same pairs shuffled, either orientation, repeated
+        order = rng.permutation(np.r_[np.arange(len(i)), rng.integers(0, len(i), 30)])
+        flip = rng.random(len(order)) < 0.5
+        si, sj = np.where(flip, j[order], i[order]), np.where(flip, i[order], j[order])
+        for name, (ci, cj) in (("sorted", (i, j)), ("shuffled", (si, sj))):
+            with self.subTest(seed=seed, input=name, keep_existing=keep_existing, keep_relations=keep_relations):
+                t = table(np.random.default_rng(seed))
+                t.replace(ci, cj, keep_existing=keep_existing, keep_relations=keep_relations)
+                self.assertEqual(list(zip(t.i.tolist(), t.j.tolist())), list(expected))
+                self.assertEqual(rows(t), expected)
+                self.assertTrue((np.diff(t.key) > 0).all())        # sorted, each pair once
+
+    def test_against_sets(self):
+        for seed in range(6):
+            for keep_existing, keep_relations in ((False, False), (False, True), (True, True)):
+                self.check(seed, keep_existing, keep_relations)
+
+    def test_kept_bonds_beyond_the_candidates(self):
+        rng = np.random.default_rng(7)
+        old = table(rng)
+        t = table(np.random.default_rng(7))
+        t.replace(np.array([0]), np.array([1]), keep_relations=False)   # almost nothing found: bonds kept
+        self.assertEqual(rows(t), reference(old, np.array([0]), np.array([1]), False, False))
+        self.assertEqual(int((t.state == PERMANENT).sum()), int((old.state == PERMANENT).sum()))
+
+
+if __name__ == "__main__":
+    unittest.main()
