@@ -13,7 +13,9 @@ the working tree's and times, in one run and in alternating blocks on the same s
   (``saveData=True, saveStressTensorData=True``), each revision once per repetition.
 
 It also checks that both revisions give the same tensors to 1e-12 of the pressure scale and the
-same shear stresses to 1e-12 relative on the measured phase.
+same shear stresses to 1e-12 relative on the measured phase.  The baseline's ``base/stress.py``
+runs on this tree's engine, so it must use the engine's row-sum tensor registry
+(``engine.stress.ROWS``); to compare whole trees use ``bench_phases.py``.
 
 Usage: python benchmarks/bench_stress_facade.py [--baseline REV] [--blocks K] [--runs R]
 """

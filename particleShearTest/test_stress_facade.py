@@ -76,6 +76,35 @@ class TestClassesEqualEngine(unittest.TestCase):
         self.assertNotEqual(ev.stress_tensor_with_external_forces[0][1], 0.0)
 
 
+class TestAnyListOfSpheres(unittest.TestCase):
+    def test_reordered_list_keeps_the_shear_stresses(self):
+        """A list of the ensemble's mobile spheres in another order (summed sphere by sphere): the xy
+        entries are still G's shear stresses bit for bit, the force tensors those of the ordered
+        selection bit for bit, the kinetic tensors the same sums in another order (1e-12 of their
+        scale)."""
+        for plates in (True, False):
+            ens, _ = sheared(4, plates)
+            ens.mechanical_simulation_step_calculate_forces()
+            ens.record_total_particle_forces()
+            sel = ens.movableSphereList()
+            ordered, shuffled = StressTensorEvaluation(ens.size_x, ens.size_y), StressTensorEvaluation(ens.size_x, ens.size_y)
+            ordered.evaluate_stress_tensors(ens.force_register, sel, ens.shear_rate)
+            others = list(sel)[::-1]
+            shuffled.evaluate_stress_tensors(ens.force_register, others, ens.shear_rate)
+            tau = shuffled.evaluate_shear_stresses(ens.force_register, others)
+            with self.subTest(plates=plates):
+                self.assertEqual(shuffled.evaluate_quasistatic_shear_stress(), tau[0])
+                self.assertEqual(shuffled.evaluate_externally_applied_shear_stress(), tau[1])
+                self.assertNotEqual(tau[1], 0.0)
+                for k, t in enumerate(es.TENSORS):
+                    a, b = ordered.tensors[k], shuffled.tensors[k]
+                    if t.name in KINETIC:
+                        self.assertGreater(np.abs(a).max(), 0.0)
+                        self.assertLessEqual(np.abs(a - b).max(), 1e-12 * np.abs(a).max(), t.name)
+                    elif t.name != "overall_stress_tensor":     # (its spin part is kinetic)
+                        self.assertEqual(a.tobytes(), b.tobytes(), t.name)
+
+
 class TestOneReplicaReductions(unittest.TestCase):
     def test_bit_for_bit_with_the_engine_inputs(self):
         ens, _ = sheared(5, True)

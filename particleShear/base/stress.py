@@ -2,8 +2,9 @@
 
 :class:`StressTensorEvaluation` turns a :class:`~particleShear.base.register.Force_register` and a
 list of spheres into :class:`~particleShear.engine.stress.StressInputs` of a batch of one replica
-and evaluates :data:`particleShear.engine.stress.TENSORS`; G's shear stresses come from
-:func:`particleShear.engine.forces.shear_stresses`.  Tensors are 2×2 in Pa, ``[a][b]`` = (force,
+and evaluates :data:`particleShear.engine.stress.TENSORS`; G's shear stresses are
+:func:`particleShear.engine.forces.shear_stresses` alone, or the xy entries of the full evaluation
+(the same sums, :func:`~particleShear.engine.forces.shear_from_sums`).  Tensors are 2×2 in Pa, ``[a][b]`` = (force,
 lever-arm component), compression positive; forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and
 inertias ×1e-18 (docs/output.md).
 """
@@ -26,10 +27,6 @@ TENSOR_NAMES = tuple(t.name for t in TENSORS)
 _INDEX = {t.function: k for k, t in enumerate(TENSORS)}
 _EXT = _INDEX[_es.external_forces]
 _ALL = _INDEX[_es.overall]
-
-#: which part of a force phase each row function reads: the pairs, the sphere totals or the kinetic state
-_TOTAL_ROWS = frozenset(r for t in TENSORS if t.function in (_es.unbalanced_forces, _es.unbalanced_torque)
-                        for r in t.rows)
 
 _ENS_OF = attrgetter("_ens")
 _IDX_OF = attrgetter("_idx")
@@ -105,7 +102,7 @@ class ForcePhase(StressInputs):
     def _part(self, rows):
         if rows.by_pair:
             return self.pairs
-        return self.totals if rows in _TOTAL_ROWS else self.spheres
+        return self.spheres if rows in _es.KINETIC_ROWS else self.totals
 
     def sums(self, rows):
         """The sums of ``rows`` on its part: shape (k, 1).
@@ -404,14 +401,12 @@ class StressTensorEvaluation:
 
     def _array_inputs(self, reg, spheres, shear_rate):
         """Inputs from the register's engine force phase, its totals and the ensemble's arrays, or None
-        unless :func:`_engine_phase` holds and ``spheres`` are rows of the ensemble."""
+        unless :func:`_engine_phase` holds; the kinetic part is the phase's own rows when ``spheres``
+        are its mobile spheres, else their rows of the ensemble, else their values read one by one."""
         ph = _engine_phase(reg)
         if ph is None or reg._tot is None:
             return None
         ens = reg._ens
-        ok, mask = self._rows_of(ens, spheres)
-        if not ok:
-            return None
         mob, fx, fy = reg._tot
         a = ens._a
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
@@ -421,6 +416,9 @@ class StressTensorEvaluation:
                              active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
                              fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
                              **_cell(self, shear_rate))
+        ok, mask = self._rows_of(ens, spheres)
+        if not ok:
+            return ForcePhase(q, q, self._sphere_inputs(spheres, shear_rate))
         if mask is mob or (mask is not None and mob is not None and np.array_equal(mask, mob)):
             return q
         return ForcePhase(q, q, _with_mobile(q, everyone if mask is None else mask))

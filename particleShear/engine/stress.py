@@ -16,10 +16,10 @@ import collections
 
 import numpy as np
 
-from .forces import pair_roles, replica_sums, shear_from_sums
+from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums
 from .xp import array_namespace
 
-__all__ = ["StressInputs", "Tensor", "TENSORS", "evaluate_all", "pair_rows", "sphere_rows"]
+__all__ = ["StressInputs", "Tensor", "TENSORS", "ROWS", "KINETIC_ROWS", "evaluate_all", "pair_rows", "sphere_rows"]
 
 _ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
 _EYE = np.eye(2)
@@ -141,6 +141,7 @@ class StressInputs:
             :func:`pair_rows` and :func:`sphere_rows` functions.
         """
         memo = self.__dict__.setdefault("_row_sums", {})
+        groups = tuple(groups)
         for by_pair in (True, False):
             todo = [g for g in groups if g.by_pair is by_pair and g not in memo]
             if not todo:
@@ -232,11 +233,12 @@ def _as_tensors(S, q):
 
 @pair_rows
 def _love_weber_rows(q):
-    """F ⊗ D of the internal pairs (D = x_j − x_i, the minimum-image pair vector); F the mean of the two
-    visits' forces where spheres have parameters of their own (1.0.2 registers each visit with half)."""
+    """F ⊗ (x_i − x_j) = −F ⊗ D of the internal pairs (D = x_j − x_i, the minimum-image pair vector); F the
+    mean of the two visits' forces where spheres have parameters of their own (1.0.2 registers each
+    visit with half)."""
     w = q.internal
     fx, fy = (q.fx_i, q.fy_i) if q.fx_j is None else ((q.fx_i + q.fx_j) * 0.5, (q.fy_i + q.fy_j) * 0.5)
-    return _outer_rows(fx * w, fy * w, q.dx, q.dy)
+    return _outer_rows(fx * w, fy * w, -q.dx, -q.dy)
 
 
 @pair_rows
@@ -281,7 +283,8 @@ def _spin_rows(q):
 
 @sphere_rows
 def _otsuki_rows(q):
-    """P ⊗ P / m of the mobile spheres, P = m (v_x − γ̇ (y − Ly/2), v_y) (units of eq. S1-21 ×1e-18)."""
+    """P ⊗ P / m of the mobile spheres, P = m (v_x − γ̇ (y − Ly/2), v_y), already in SI (J per m depth:
+    P in kg·m/s, m in kg), unlike the other rows, which are in the model's units."""
     px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * q.tensor(_y_centred))
     py = q.m * 1e-12 * q.vy
     w = q.mob / (q.m * 1e-6)
@@ -301,7 +304,7 @@ def love_weber(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return -_as_tensors(q.sums(_love_weber_rows), q) * (1e-18 / q.V)[:, None, None]
+    return _as_tensors(q.sums(_love_weber_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
 def external_forces(q):
@@ -321,7 +324,7 @@ def external_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return -_as_tensors(q.sums(_external_rows), q) * (1e-18 / q.V)[:, None, None]
+    return -_as_tensors(q.sums(_external_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
 def unbalanced_forces(q):
@@ -337,7 +340,7 @@ def unbalanced_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return _as_tensors(q.sums(_unbalanced_rows), q) * (1e-18 / q.V)[:, None, None]
+    return _as_tensors(q.sums(_unbalanced_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
 def linear_acceleration(q):
@@ -370,7 +373,7 @@ def unbalanced_torque(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     S = q.sums(_torque_rows)[0]
-    return S[:, None, None] * 1e-18 / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
+    return S[:, None, None] * CT / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
 def internal_torque(q):
@@ -387,7 +390,7 @@ def internal_torque(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     S = q.sums(_internal_torque_rows)[0]
-    return S[:, None, None] * 1e-18 / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
+    return S[:, None, None] * CT / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
 def spin_kinetic_energy(q):
@@ -440,7 +443,8 @@ def overall(q):
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
     out = q.tensor(love_weber) + q.tensor(internal_torque) + q.tensor(spin_kinetic_energy)
-    tau_internal, _ = shear_from_sums(q.sums(_love_weber_rows)[1], q.sums(_internal_torque_rows)[0],
+    # Σ F_x,i·D_y is minus the Love-Weber row's sum (the same products with the sign of D flipped: exact)
+    tau_internal, _ = shear_from_sums(-q.sums(_love_weber_rows)[1], q.sums(_internal_torque_rows)[0],
                                       q.sums(_external_rows)[1], q.V)
     out[:, 0, 1] = -tau_internal
     return out
@@ -470,6 +474,10 @@ TENSORS = (
 )
 #: every row function of :data:`TENSORS`, once
 ROWS = tuple(dict.fromkeys(r for t in TENSORS for r in t.rows))
+#: the sphere rows of the spheres' motion (I, ω, m, v: a caller's list of spheres in
+#: :class:`~particleShear.base.stress.StressTensorEvaluation`); the other sphere rows read the force
+#: phase's totals
+KINETIC_ROWS = (_spin_rows, _otsuki_rows)
 
 
 def evaluate_all(q):
