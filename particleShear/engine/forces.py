@@ -111,7 +111,8 @@ class PairConstants:
         f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
         f[2] = f[0] + f[1]                        # d0 = r_i + r_j
         f[3:5] = f[0:2] / f[2]                    # w_i, w_j = r/d0
-        f[5:7] = xp.stack((s.Lx, s.Ly))[:, self.rep]
+        f[5] = s.Lx[self.rep]
+        f[6] = s.Ly[self.rep]
         f[7:9] = f[6:4:-1] / 2                    # hy, hx
 
     @property

@@ -65,6 +65,18 @@ def _key(i, j):
     return (np.asarray(i, dtype=np.int64) << 32) | np.asarray(j, dtype=np.int64)
 
 
+def _merge(k, extra):
+    """The sorted union of the sorted arrays ``k`` and ``extra`` that share no value: one pass, no sort
+    (``np.insert`` at the sorted positions, without its overhead on small arrays)."""
+    at = np.searchsorted(k, extra) + np.arange(len(extra))
+    out = np.empty(len(k) + len(extra), dtype=k.dtype)
+    rest = np.ones(len(out), dtype=bool)
+    rest[at] = False
+    out[at] = extra
+    out[rest] = k
+    return out
+
+
 def _increasing(k, strict=True):
     """True if the 1-D array ``k`` is sorted (strictly: also without repeats); O(n), no sort."""
     return len(k) < 2 or bool((k[1:] > k[:-1]).all() if strict else (k[1:] >= k[:-1]).all())
@@ -241,9 +253,11 @@ class PairTable:
                 # the few kept keys merged into the sorted unique candidates: an O(n) insert (a
                 # union1d sorts the whole set anew, ≈ 60 ms of a rebuild at N = 100,000)
                 extra = kept[~found]
-                extra = extra[np.r_[True, extra[1:] != extra[:-1]]] if _increasing(extra, strict=False) \
-                    else np.unique(extra)     # (the table's keys are sorted: no sort)
-                k = np.insert(k, np.searchsorted(k, extra), extra)
+                if _increasing(extra, strict=False):     # (the table's keys are sorted: no sort)
+                    extra = extra[np.concatenate(((True,), extra[1:] != extra[:-1]))]
+                else:
+                    extra = np.unique(extra)
+                k = _merge(k, extra)
         pos = np.searchsorted(old_key, k)
         pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
         had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)

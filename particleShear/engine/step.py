@@ -321,13 +321,16 @@ class BatchEngine:
         self.C.set_visits(s)
         self._frictionless()
 
-    def _image_frame(self):
-        """``(Ly·γ, γ̇)`` of the images of each replica (B,): the Lees-Edwards offset and the rate
-        the images move with, 0 for a plain periodic replica (:attr:`lees_edwards`)."""
+    def _image_shift(self):
+        """The Lees-Edwards offset ``Ly·γ`` of the images of each replica (B,), 0 for a plain periodic
+        replica (:attr:`lees_edwards`)."""
         s = self.s
-        if self.lees_edwards is None:
-            return s.Ly * s.gamma, s.rate
-        return s.Ly * s.gamma * self.lees_edwards, s.rate * self.lees_edwards
+        return s.Ly * s.gamma if self.lees_edwards is None else s.Ly * s.gamma * self.lees_edwards
+
+    def _image_rate(self):
+        """The rate γ̇ the images of each replica move with (B,), 0 for a plain periodic replica."""
+        s = self.s
+        return s.rate if self.lees_edwards is None else s.rate * self.lees_edwards
 
     def _images(self, raw_x, raw_y, shift_p):
         """Minimum image of the candidates, reusing the period counts of the last step while they
@@ -547,7 +550,7 @@ class BatchEngine:
             ``(yc, dx, dy, ky, kx, d, touching, active, image_rate)``: the heights ``y − Ly/2`` of
             the spheres (µm), per candidate the pair vector (µm, j's nearest image minus i), its
             image periods, distance, contact and relation flags, and the rate the images move
-            with per replica (1/s; :meth:`_image_frame`).
+            with per replica (1/s; :meth:`_image_shift`, :meth:`_image_rate`).
         """
         s, xp = self.s, self.xp
         self.neighbours()          # (positions at the start of the step)
@@ -555,7 +558,7 @@ class BatchEngine:
         yc = s.y - self.hy_s                            # height above the cell's centre line
         raw = s.pos.take(C.aj, axis=1)
         raw -= s.pos.take(C.ai, axis=1)
-        shift, image_rate = self._image_frame()
+        shift, image_rate = self._image_shift(), self._image_rate()
         dx, dy, ky, kx = self._images(raw[0], raw[1], shift[C.rep])
         d = xp.sqrt(dx * dx + dy * dy)
         touching = d < C.d0
@@ -704,7 +707,7 @@ class BatchEngine:
             xi[0] += inc_ij * kd
             xi[1] += inc_ji * kd
         # drift, strain, wrap, clock (the displacement relative to the flow the images follow)
-        image_rate = self._image_frame()[1]
+        image_rate = self._image_rate()
         rate_s = image_rate[s.rep]
         u = self.u
         u[0] += (vx - (s.y - self.hy_s if g is None else g.yc) * rate_s) * dt
@@ -729,9 +732,9 @@ class BatchEngine:
             On a device, when the guard verdict read with the flags is not sound.
         """
         s, xp = self.s, self.xp
-        rate_s = self._image_frame()[1][s.rep]
+        rate_s = self._image_rate()[s.rep]
         s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
-        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, self._image_frame()[0][s.rep], rate_s)
+        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, self._image_shift()[s.rep], rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = self.verdict
