@@ -87,7 +87,8 @@ class TestAnyListOfSpheres(unittest.TestCase):
             ens.mechanical_simulation_step_calculate_forces()
             ens.record_total_particle_forces()
             sel = ens.movableSphereList()
-            ordered, shuffled = StressTensorEvaluation(ens.size_x, ens.size_y), StressTensorEvaluation(ens.size_x, ens.size_y)
+            ordered = StressTensorEvaluation(ens.size_x, ens.size_y)
+            shuffled = StressTensorEvaluation(ens.size_x, ens.size_y)
             ordered.evaluate_stress_tensors(ens.force_register, sel, ens.shear_rate)
             others = list(sel)[::-1]
             shuffled.evaluate_stress_tensors(ens.force_register, others, ens.shear_rate)

@@ -4,9 +4,9 @@
 list of spheres into :class:`~particleShear.engine.stress.StressInputs` of a batch of one replica
 and evaluates :data:`particleShear.engine.stress.TENSORS`; G's shear stresses are
 :func:`particleShear.engine.forces.shear_stresses` alone, or the xy entries of the full evaluation
-(the same sums, :func:`~particleShear.engine.forces.shear_from_sums`).  Tensors are 2×2 in Pa, ``[a][b]`` = (force,
-lever-arm component), compression positive; forces ×1e-12 (N/m), lengths ×1e-6 (m), torques and
-inertias ×1e-18 (docs/output.md).
+(the same sums, :func:`~particleShear.engine.forces.shear_from_sums`).  Tensors are 2×2 in Pa,
+``[a][b]`` = (force, lever-arm component), compression positive; forces ×1e-12 (N/m), lengths ×1e-6
+(m), torques and inertias ×1e-18 (docs/output.md).
 """
 __docformat__ = "numpy"
 
@@ -25,8 +25,7 @@ __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
 #: tensor attribute names (the engine registry's), in the output table's column order (docs/output.md)
 TENSOR_NAMES = tuple(t.name for t in TENSORS)
 _INDEX = {t.function: k for k, t in enumerate(TENSORS)}
-_EXT = _INDEX[_es.external_forces]
-_ALL = _INDEX[_es.overall]
+_EXT, _ALL = _es.EXTERNAL, _es.OVERALL
 
 _ENS_OF = attrgetter("_ens")
 _IDX_OF = attrgetter("_idx")
@@ -526,7 +525,8 @@ class StressTensorEvaluation:
         reg = force_register
         q = self._array_inputs(reg, theSphereList, shear_rate)
         if q is None:
-            q = ForcePhase(self._pair_inputs(reg), self._total_inputs(reg), self._sphere_inputs(theSphereList, shear_rate))
+            q = ForcePhase(self._pair_inputs(reg), self._total_inputs(reg),
+                           self._sphere_inputs(theSphereList, shear_rate))
         self._t[...] = _es.evaluate_all(q)[0]
 
     def evaluate_shear_stresses(self, force_register, theSphereList):

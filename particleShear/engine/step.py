@@ -35,14 +35,10 @@ from .terms import (central_term, elastic_term, normal_speed, pair_forces, relat
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK
-from .stress import TENSORS, StressInputs, evaluate_all, external_forces, overall
+from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks", "register_block"]
-
-#: the tensors whose xy entries are −τ_internal and −τ_surface (TENSORS' order)
-_OVERALL = [t.function for t in TENSORS].index(overall)
-_EXTERNAL = [t.function for t in TENSORS].index(external_forces)
 
 
 class EngineInstability(RuntimeError):
@@ -528,7 +524,7 @@ class BatchEngine:
                                      self.V, fx_j)
             else:       # the tensors' xy entries are the shear stresses, bit for bit (engine.stress)
                 T = evaluate_all(q)
-                out = (-T[:, _OVERALL, 0, 1], -T[:, _EXTERNAL, 0, 1], T)
+                out = (-T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T)
         self.verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)

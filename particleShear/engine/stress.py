@@ -19,7 +19,8 @@ import numpy as np
 from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums
 from .xp import array_namespace
 
-__all__ = ["StressInputs", "Tensor", "TENSORS", "ROWS", "KINETIC_ROWS", "evaluate_all", "pair_rows", "sphere_rows"]
+__all__ = ["StressInputs", "Tensor", "TENSORS", "OVERALL", "EXTERNAL", "ROWS", "KINETIC_ROWS", "evaluate_all",
+           "pair_rows", "sphere_rows"]
 
 _ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
 _EYE = np.eye(2)
@@ -472,6 +473,9 @@ TENSORS = (
     Tensor("overall_stress_tensor", "stress_tensor_overall", "S1-24", overall,
            (_love_weber_rows, _internal_torque_rows, _spin_rows, _external_rows)),
 )
+#: the positions in :data:`TENSORS` of the tensors whose xy entries are −τ_internal and −τ_surface
+#: (:func:`~particleShear.engine.forces.shear_from_sums`)
+OVERALL, EXTERNAL = ([t.function for t in TENSORS].index(f) for f in (overall, external_forces))
 #: every row function of :data:`TENSORS`, once
 ROWS = tuple(dict.fromkeys(r for t in TENSORS for r in t.rows))
 #: the sphere rows of the spheres' motion (I, ω, m, v: a caller's list of spheres in
