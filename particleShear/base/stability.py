@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 
+from ..engine.guard import INTERPENETRATION, KINETIC_ENERGY, NON_FINITE, verdict
+
 __all__ = ["SimulationInstabilityError", "StabilityGuard"]
 
 
@@ -37,6 +39,9 @@ class SimulationInstabilityError(RuntimeError):
 class StabilityGuard:
     """Checks finiteness, peculiar kinetic energy and interpenetration of an ensemble (never changes the physics).
 
+    The rule is the engine's guard, :func:`particleShear.engine.guard.verdict`, on the ensemble as a
+    batch of one; this class names the sphere or pair at fault and suggests a time step.
+
     Parameters
     ----------
     min_distance_ratio : float
@@ -45,7 +50,7 @@ class StabilityGuard:
     max_kinetic_energy : float or None
         Bound on the kinetic energy relative to the affine flow (mg·µm²/s² per m); None uses
         ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` (every sphere compressed by its radius, plus twice the
-        energy of every sphere at the largest plate speed seen).
+        energy of every sphere at the largest plate speed seen; k taken as 1 where it is 0).
     interval : int
         Check every ``interval``-th step (a blow-up grows by orders of magnitude per step).
     """
@@ -90,36 +95,30 @@ class StabilityGuard:
         if step is not None and step % self.interval:
             return
         a = ens._a
-        if not len(a["x"]):
+        n = len(a["x"])
+        if not n:
             return
-        x, y, vx, vy, om = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]
-        total = x.sum() + y.sum() + vx.sum() + vy.sum() + om.sum()
-        if not math.isfinite(total):
-            bad = np.flatnonzero(~(np.isfinite(x) & np.isfinite(y) & np.isfinite(vx) & np.isfinite(vy)
-                                   & np.isfinite(om)))
-            if len(bad):
-                k = int(bad[0])
-                state = (f" of sphere {k}: (x, y) = ({float(x[k])!r}, {float(y[k])!r}) µm, (vx, vy) = "
-                         f"({float(vx[k])!r}, {float(vy[k])!r}) µm/s, ω = {float(om[k])!r} rad/s")
-            else:  # the sum overflowed although every value is finite
-                k, state = int(np.argmax(np.abs(vx) + np.abs(vy))), " (sums overflow)"
-            self._fail(ens, step, phase, dt, "non-finite state" + state, pair=(k,))
-        rate = getattr(ens, "shear_rate", 0) or 0
+        rate = float(getattr(ens, "shear_rate", 0) or 0)
         self._rate_max = max(self._rate_max, abs(rate))
-        u = vx - rate * (y - ens.size_y / 2) if rate else vx
-        ke = 0.5 * float(a["m"] @ (u * u + vy * vy) + a["inertia"] @ (om * om))
-        bound = self.max_kinetic_energy
-        if bound is None:
-            r = a["r"]
-            plate = self._rate_max * ens.size_y / 2
-            bound = (len(r) * float(getattr(ens, "k", 1.0) or 1.0) * float(r.mean()) ** 2
-                     + float(a["m"].sum()) * plate * plate)
-        if ke > bound:
+        closest = ens._closest_contact() if hasattr(ens, "_closest_contact") else None
+        x, y, vx, vy, om = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]
+        code, ke, bound = (float(v[0]) for v in verdict(
+            1, x, y, vx, vy, om, a["m"], a["inertia"], a["r"], np.array([float(getattr(ens, "k", 0) or 0)]),
+            np.array([rate]), np.array([float(ens.size_y)]), np.array([self._rate_max]),
+            np.array([math.inf if closest is None else closest[0]]), self.min_distance_ratio,
+            self.max_kinetic_energy))
+        if code == NON_FINITE:
+            k = int(np.flatnonzero(~(np.isfinite(x) & np.isfinite(y) & np.isfinite(vx) & np.isfinite(vy)
+                                     & np.isfinite(om)))[0])
+            self._fail(ens, step, phase, dt, f"non-finite state of sphere {k}: (x, y) = ({float(x[k])!r}, "
+                       f"{float(y[k])!r}) µm, (vx, vy) = ({float(vx[k])!r}, {float(vy[k])!r}) µm/s, "
+                       f"ω = {float(om[k])!r} rad/s", pair=(k,))
+        if code == KINETIC_ENERGY:
+            u = vx - rate * (y - ens.size_y / 2)
             worst = int(np.argmax(a["m"] * (u * u + vy * vy)))
             self._fail(ens, step, phase, dt, f"kinetic energy {ke:.3g} exceeds the bound {bound:.3g}",
                        pair=(worst,))
-        closest = ens._closest_contact() if hasattr(ens, "_closest_contact") else None
-        if closest is not None and closest[0] < self.min_distance_ratio:
+        if code == INTERPENETRATION:
             ratio, i, j = closest
             self._fail(ens, step, phase, dt, f"spheres {i} and {j} interpenetrate (d/(r_i+r_j) = {ratio:.3g})",
                        pair=(i, j))

@@ -28,6 +28,7 @@ import numpy as np
 
 from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
+from .guard import KINETIC_ENERGY, NON_FINITE, closest_transient, verdict as guard_verdict
 from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses, splice_arrays
 from .callbacks import force_phase_laws
 from .terms import (central_term, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
@@ -746,31 +747,15 @@ class BatchEngine:
         self.g = self.verdict = None
 
     def _check(self, d, active):
-        """The stability guard's verdict (see the class docstring), on the state's backend.
+        """The stability guard's verdict (:func:`~particleShear.engine.guard.verdict`), on the state's backend.
 
         Returns ``(code, ke, bound, closest)``, arrays (B,): ``code`` 0 for a sound (or unguarded)
         replica, 1 non-finite state, 2 kinetic energy above its bound, 3 interpenetration."""
         s, xp = self.s, self.xp
-        B, N = s.B, s.N
         self.rate_max = xp.maximum(self.rate_max, abs(s.rate))
-        state = xp.stack((s.x, s.y, s.vx, s.vy, s.omega)).reshape(5, B, N)
-        finite = xp.isfinite(state).all(axis=(0, 2))
-        u = s.vx - (s.y - self.hy_s) * s.rate[s.rep]
-        ke = 0.5 * (s.m * (u * u + s.vy * s.vy) + s.inertia * s.omega * s.omega).reshape(B, N).sum(axis=1)
-        plate = self.rate_max * s.Ly / 2
-        bound = N * s.k * xp.square(s.r.reshape(B, N).mean(axis=1)) + s.m.reshape(B, N).sum(axis=1) * plate * plate
-        if self.max_kinetic_energy is not None:
-            bound = xp.full(B, float(self.max_kinetic_energy))
-        C = self.C
-        ratio = xp.where(active & C.trans, d / C.d0, math.inf)
-        # closest transient contact of each replica: one reduction over its own (contiguous) segment
-        if C.replica_sum is not None:       # a device: the padded gather (inf for a replica without pairs)
-            closest = C.replica_sum.minimum(ratio)
-        else:
-            closest = xp.full(B, math.inf)
-            if C.P:
-                closest[C.seg_rep_b] = xp.minimum.reduceat(ratio, C.seg_starts_b)
-        code = xp.where(~finite, 1, xp.where(ke > bound, 2, xp.where(closest < self.min_distance_ratio, 3, 0)))
+        closest = closest_transient(self.C, d, active)
+        code, ke, bound = guard_verdict(s.B, s.x, s.y, s.vx, s.vy, s.omega, s.m, s.inertia, s.r, s.k, s.rate,
+                                        s.Ly, self.rate_max, closest, self.min_distance_ratio, self.max_kinetic_energy)
         return code * self.guard_dev, ke, bound, closest
 
     def _report(self, verdict, step):
@@ -781,9 +766,9 @@ class BatchEngine:
             return
         b = int(bad[0])
         ke, bound, closest = (to_host(a, "guard") for a in verdict[1:])
-        if code[b] == 1:
+        if code[b] == NON_FINITE:
             reason = "non-finite state"
-        elif code[b] == 2:
+        elif code[b] == KINETIC_ENERGY:
             reason = f"kinetic energy {ke[b]:.3g} exceeds the bound {bound[b]:.3g}"
         else:
             reason = f"two spheres interpenetrate to d/(r_i + r_j) = {closest[b]:.3g}"

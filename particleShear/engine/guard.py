@@ -1,0 +1,101 @@
+"""The stability guard's rule, written once for the engine and the documented classes.
+
+A replica is *sound* while its state is finite, its kinetic energy relative to the affine flow
+stays below a bound, and no transient contact has closed to less than a fraction of its contact
+distance (the divergent law, eq. S1-5b, is then hundreds of times stiffer than at contact and the
+explicit step starts to pump energy).  :meth:`~particleShear.engine.step.BatchEngine._check`
+applies the rule to every replica of a batch; :class:`~particleShear.base.stability.StabilityGuard`
+applies it to an ensemble of the documented classes (a batch of one) and names the sphere or
+pair at fault.  Neither changes the physics.
+
+Units: µm, s, mg per m depth; energies in mg·µm²·s⁻² per m depth.
+"""
+__docformat__ = "numpy"
+
+import math
+
+from .xp import array_namespace
+
+__all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "verdict", "closest_transient"]
+
+#: verdict codes, in the order they are tested (the first that holds is reported)
+SOUND, NON_FINITE, KINETIC_ENERGY, INTERPENETRATION = 0, 1, 2, 3
+
+
+def verdict(B, x, y, vx, vy, omega, m, inertia, r, k, rate, Ly, rate_max, closest, min_distance_ratio=0.05,
+            max_kinetic_energy=None):
+    """The guard's verdict of each replica: ``(code, ke, bound)``, arrays (B,).
+
+    ``ke = ½ Σ (m |u|² + I ω²)`` with the peculiar velocity ``u = (v_x − γ̇ (y − L_y/2), v_y)``;
+    ``bound = N·k'·r_mean² + Σ m (γ̇_max·L_y/2)²`` — every sphere compressed by its mean radius,
+    plus twice the energy of every sphere at the fastest plate speed seen — with ``k' = k`` for
+    ``k > 0`` and 1 otherwise (a replica without springs is not failed for any motion), or
+    ``max_kinetic_energy`` where given.  ``code`` is :data:`NON_FINITE` if a position, velocity
+    or spin is not finite, else :data:`KINETIC_ENERGY` if ``ke > bound``, else
+    :data:`INTERPENETRATION` if ``closest < min_distance_ratio``, else :data:`SOUND`.
+
+    Parameters
+    ----------
+    B : int
+        Number of replicas; the sphere arrays hold B rows of N spheres each.
+    x, y, vx, vy, omega : array (B·N,)
+        Positions (µm), velocities (µm/s) and spins (rad/s).
+    m, inertia, r : array (B·N,)
+        Masses, moments of inertia and radii.
+    k : array (B,)
+        Spring constant of each replica (eq. S1-8).
+    rate, Ly : array (B,)
+        Shear rate γ̇ (1/s) and cell height (µm) of each replica.
+    rate_max : array (B,)
+        Largest ``|γ̇|`` seen so far (1/s).
+    closest : array (B,)
+        Smallest ``d/(r_i + r_j)`` of a transient contact (:func:`closest_transient`; inf: none).
+    min_distance_ratio : float
+        Smallest allowed ``closest``.
+    max_kinetic_energy : float or None
+        A fixed bound instead of the default one.
+
+    Returns
+    -------
+    tuple of arrays (B,)
+        ``(code, ke, bound)``.
+    """
+    xp = array_namespace(x)
+    N = len(x) // B
+    state = xp.stack((x, y, vx, vy, omega)).reshape(5, B, N)
+    finite = xp.isfinite(state).all(axis=(0, 2))
+    u = vx - (y - xp.repeat(Ly / 2, N)) * xp.repeat(rate, N)
+    ke = 0.5 * (m * (u * u + vy * vy) + inertia * omega * omega).reshape(B, N).sum(axis=1)
+    if max_kinetic_energy is None:
+        plate = rate_max * Ly / 2
+        bound = N * xp.where(k > 0, k, 1.0) * xp.square(r.reshape(B, N).mean(axis=1)) \
+            + m.reshape(B, N).sum(axis=1) * plate * plate
+    else:
+        bound = xp.full(B, float(max_kinetic_energy))
+    code = xp.where(~finite, NON_FINITE, xp.where(ke > bound, KINETIC_ENERGY,
+                                                  xp.where(closest < min_distance_ratio, INTERPENETRATION, SOUND)))
+    return code, ke, bound
+
+
+def closest_transient(C, d, active):
+    """Smallest ``d/(r_i + r_j)`` of a transient contact (no bond) of each replica: array (B,), inf where none.
+
+    One reduction over each replica's own contiguous segment of candidates.
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (``d0``, ``trans``, the segments).
+    d : array (P,)
+        Distance of each candidate (µm).
+    active : array of bool (P,)
+        Relations (touching or bonded).
+    """
+    xp = array_namespace(d)
+    ratio = xp.where(active & C.trans, d / C.d0, math.inf)
+    if C.replica_sum is not None:       # a device: the padded gather (inf for a replica without pairs)
+        return C.replica_sum.minimum(ratio)
+    closest = xp.full(C.B, math.inf)
+    if C.P:
+        closest[C.seg_rep_b] = xp.minimum.reduceat(ratio, C.seg_starts_b)
+    return closest
