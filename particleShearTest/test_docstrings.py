@@ -29,6 +29,7 @@ import particleShear
 #: Modules whose public API is fully documented (checked; a failure is a defect).
 DOCUMENTED_MODULES = [
     "particleShear",
+    "particleShear.checks",
     "particleShear.analysis",
     "particleShear.analysis.curves",
     "particleShear.analysis.demodulation",

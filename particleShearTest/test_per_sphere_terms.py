@@ -40,7 +40,7 @@ import unittest
 
 import numpy as np
 
-from particleShear import (CircleBasicElasticity, Force_register, SphereLinkable, SphereLinkableAdjustableInterfaceStrength,
+from particleShear import (CircleBasicElasticity, EnsembleLinkable, Force_register, SphereLinkable, SphereLinkableAdjustableInterfaceStrength,
                            elastic_force_law_plateau, elastic_force_law_tensile_exponential)
 from particleShear.engine.box import flow_velocity, min_image, wrap
 from particleShear.engine.integrate import damp, kick, xi_increments
@@ -509,6 +509,26 @@ class EnsembleForcePhaseTest(unittest.TestCase):
             self._scenes()
         finally:
             CircleBasicElasticity.call_back_elastic_force_law, SphereLinkable.call_back_elastic_force_law_tensile = saved
+
+    def test_routing_of_a_visit(self):
+        """The per-sphere filters route a visit's entry by the step's rule (``pair_roles``): dropped on an
+        immobile target, external from an immobile source or when the visit's minimum image removes a
+        period — also at exactly Δx = +Lx/2, where the raw and image distances are equal — else internal."""
+        ens = EnsembleLinkable(200.0, 200.0, 0, k=1, nu=0.01, k_t=1, nu_t=0.01, mu=0.1)
+        for q, (x, y) in enumerate(((20.0, 100.0), (120.0, 100.0), (90.0, 100.0), (130.0, 5.0), (20.0, 150.0))):
+            ens.sphereList.append(SphereLinkable("grey", x, y, 20, 1, q, force_register=ens, size_x=200.0, size_y=200.0))
+        s = ens.sphereList
+        ens.applyingShear = True          # sphere 3 (y = 5 < r) is a plate sphere
+        for target, source, where in ((0, 2, 1), (2, 0, 1), (0, 1, 2), (1, 0, 1), (1, 3, 2), (3, 1, 0),
+                                      (2, 4, 1), (4, 0, 1)):
+            with self.subTest(target=target, source=source):
+                self.assertEqual(ens._entry_of(s[target], s[source]), where)
+        ens.applyingShear = False
+        ens.shear = 0.25                  # the rows above and below are offset by Ly·γ = 50 µm
+        s[0].y = 60.0                     # Δy = 90 < Ly/2: the same row
+        self.assertEqual(ens._entry_of(s[0], s[4]), 1)
+        s[0].y = 40.0                     # Δy = 110: the image one row down
+        self.assertEqual(ens._entry_of(s[0], s[4]), 2)
 
     def _scenes(self):
         for name, spec in SCENES.items():

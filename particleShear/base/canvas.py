@@ -12,10 +12,12 @@ import numpy as np
 from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
 from .kernels import le_wrap
-from ..engine.integrate import damp
+from ..engine.box import flow_velocity
+from ..engine.forces import pair_roles
+from ..engine.integrate import damp, drift, kick, remove_mean_velocity
 from .memo import Memo
 from ..engine.memory import tune_allocator
-from .points import _check_finite, _check_positive
+from ..checks import finite as _check_finite, non_negative as check_non_negative, positive as _check_positive
 from .register import Force_register, SphereSelection
 from .stability import StabilityGuard
 
@@ -40,20 +42,6 @@ def check_time_step(dt, step=None):
     if isinstance(dt, bool) or not 0.0 < dt < math.inf:
         where = "" if step is None else f" at step {step}"
         raise ValueError(f"dt={dt!r} is out of range{where}: allowed a finite time step > 0 (s)")
-
-
-def check_non_negative(name, value):
-    """Raise ValueError unless ``value`` is a finite number ≥ 0 (TypeError if not a real number).
-
-    Parameters
-    ----------
-    name : str
-        Parameter name for the message.
-    value : float
-    """
-    _check_finite(name, value)
-    if value < 0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
 
 
 class NonNegative:
@@ -291,10 +279,7 @@ class CanvasPoints:
 
     def correct_linear_drift(self):
         """Subtract the unweighted mean velocity from all spheres."""
-        a = self._a
-        if self._n:
-            a["xspeed"] -= a["xspeed"].sum() / self._n
-            a["yspeed"] -= a["yspeed"].sum() / self._n
+        remove_mean_velocity(self._vel[:2], 1)
 
     def particle_info(self):
         """Return a short description of the ensemble for the output header."""
@@ -329,22 +314,17 @@ class CanvasPoints:
         dt : float
             Time step (s).
         """
-        a = self._a
         mob = self._mobile_mask()
-        fx, fy, m = a["xforce"], a["yforce"], a["m"]
         if mob is None:
-            a["xspeed"] += fx * dt / m
-            a["yspeed"] += fy * dt / m
-            fx[:] = 0.0
-            fy[:] = 0.0
-        else:
-            a["xspeed"][mob] += fx[mob] * dt / m[mob]
-            a["yspeed"][mob] += fy[mob] * dt / m[mob]
-            fx[mob] = 0.0
-            fy[mob] = 0.0
+            kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
+            return
+        vel, frc = self._vel[:2, mob], self._frc[:2, mob]
+        kick(vel, frc, self._a["m"][mob], dt)
+        self._vel[:2, mob] = vel
+        self._frc[:2, mob] = frc
 
-    def _cool_spin(self, f):
-        pass
+    #: the velocity rows a damping step scales: (vx, vy), and ω where spheres spin
+    _damped_rows = 2
 
     def cool(self, f=0.8):
         """Multiply the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` (and any spin) by ``f``.
@@ -355,13 +335,10 @@ class CanvasPoints:
             Damping factor, 0 < f ≤ 1 (1 = no damping).
         """
         rate = getattr(self, "shear_rate", 0)
-        damp(self._vel[:2], self._affine_vx(rate) if rate else None, f)
-        self._cool_spin(f)
+        damp(self._vel[:self._damped_rows], self._affine_vx(rate) if rate else None, f)
 
     def _drift(self, dt):
-        a = self._a
-        a["x"] += a["xspeed"] * dt
-        a["y"] += a["yspeed"] * dt
+        drift(self._pos, None, self._vel, dt)
         self._pos_version += 1
 
     def move(self, dt=1):
@@ -383,7 +360,7 @@ class CanvasPoints:
 
     def _affine_vx(self, rate):
         """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s)."""
-        return self._y_centred() * rate
+        return flow_velocity(self._pos[1], self.size_y, rate)
 
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active).
@@ -480,8 +457,16 @@ class CanvasPointsMass(CanvasPoints):
         self.force_register.reset_force_register()
 
     # registration filters for scripts that apply forces sphere by sphere
-    def _source_is_external(self, target, source):
+    def _through_boundary(self, target, source):
+        """Whether the pair acts through the periodic boundary (its minimum image removes a period)."""
         return False
+
+    def _entry_of(self, target, source):
+        """Where an entry of ``source`` on ``target`` goes: 0 nowhere (immobile target), 1 internal,
+        2 external (:func:`~particleShear.engine.forces.pair_roles`, the rule of the step)."""
+        internal, external, _ = pair_roles(self.canMove(target), self.canMove(source),
+                                           np.bool_(self._through_boundary(target, source)))
+        return 1 if internal else 2 if external else 0
 
     def record_individual_internal_force(self, target, source, force_vector):
         """Record the pair force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``source`` on ``target``.
@@ -493,12 +478,11 @@ class CanvasPointsMass(CanvasPoints):
         target, source : Sphere
         force_vector : sequence of float
         """
-        if not self.canMove(target):
-            return
-        if not self.canMove(source) or self._source_is_external(target, source):
-            self.force_register.record_external_force(target, force_vector)
-        else:
+        where = self._entry_of(target, source)
+        if where == 1:
             self.force_register.record_individual_internal_force(target, source, force_vector)
+        elif where == 2:
+            self.force_register.record_external_force(target, force_vector)
 
     def record_individual_internal_torque(self, target, source, moment):
         """Record the pair torque ``moment`` (mg·µm²·s⁻² per m), filtered as :meth:`record_individual_internal_force`.
@@ -508,12 +492,11 @@ class CanvasPointsMass(CanvasPoints):
         target, source : Sphere
         moment : float
         """
-        if not self.canMove(target):
-            return
-        if not self.canMove(source) or self._source_is_external(target, source):
-            self.force_register.record_external_torque(target, moment)
-        else:
+        where = self._entry_of(target, source)
+        if where == 1:
             self.force_register.record_individual_internal_torque(target, source, moment)
+        elif where == 2:
+            self.force_register.record_external_torque(target, moment)
 
     def record_total_particle_force(self, target, force_vector):
         """Record the total force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``target`` unless it is immobile.

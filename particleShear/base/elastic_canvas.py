@@ -4,7 +4,7 @@ The phases of a step are the engine's (:mod:`particleShear.base.engine_view`); t
 per-term methods (``elastic_force_from_neighbors()`` …) are 1.0.2's loops over the per-sphere API.
 """
 __docformat__ = "numpy"
-from ..engine.integrate import damp
+from ..engine.integrate import kick, shift_flow
 from .points import _check_finite
 
 from .canvas import NonNegative, check_time_step
@@ -206,8 +206,7 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
             Δγ̇ (1/s).
         """
         a = self._a
-        a["xspeed"] += self._y_centred() * delta_shear_rate
-        a["omega"] -= delta_shear_rate / 2
+        shift_flow(a["xspeed"], a["omega"], self._y_centred(), delta_shear_rate)
 
     def setShearRate(self, theShearRate):
         """Change γ̇ (1/s); every sphere keeps its velocity relative to the local flow.
@@ -267,18 +266,9 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
         dt : float
             Time step (s).
         """
-        a = self._a
-        a["omega"] += a["torque"] * dt / a["inertia"]
-        a["torque"][:] = 0.0
+        kick(self._vel[2:], self._frc[2:], self._a["inertia"], dt)
 
-    def _cool_spin(self, f):
-        self._a["omega"] *= f
-
-    def cool(self, f=0.8):
-        if type(self)._cool_spin is not CanvasPointsFrictionElasticityLeesEdwards._cool_spin:
-            return CanvasPointsBasicElasticityLeesEdwards.cool(self, f)
-        rate = getattr(self, "shear_rate", 0)
-        damp(self._vel, self._affine_vx(rate) if rate else None, f)
+    _damped_rows = 3
 
     def _strain_advances(self):
         return True

@@ -14,7 +14,6 @@ __all__ = [
     "elastic_force_law", "elastic_force_law_plateau", "distance_transform_plateau",
     "PlateauConfiguration", "elastic_force_law_tensile",
     "elastic_force_law_tensile_exponential", "TensileConfiguration",
-    "call_law_vectorised",
 ]
 
 
@@ -145,6 +144,3 @@ _callbacks.register_callback(elastic_force_law_plateau, "plateau", lambda: dict(
     ("plateau_begin", "plateau_end", "plateau_slope"), PlateauConfiguration.values())))
 _callbacks.register_callback(elastic_force_law_tensile, "tensile")
 elastic_force_law_tensile_exponential.accepts_arrays = True
-
-#: evaluate a (possibly user-supplied, scalar-only) law on pair arrays (:func:`particleShear.engine.callbacks.call_law`)
-call_law_vectorised = _callbacks.call_law

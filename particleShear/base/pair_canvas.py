@@ -1,9 +1,9 @@
 """Canvases with pairs: the pair table, the neighbour update and the Lees-Edwards cell (docs/design.md)."""
 __docformat__ = "numpy"
-import math
 import numpy as np
+from ..engine import box as _box
 from .kernels import min_image
-from ..engine.integrate import kick, plates_follow
+from ..engine.integrate import kick, mobile_mask, plates_follow
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
 
@@ -124,19 +124,11 @@ class CanvasPointsShear(CanvasPointsNeighbors):
         self.shear = 0
 
     def canMove(self, theSphere):
-        if not self.applyingShear:
-            return True
-        return theSphere.r < theSphere.y < self.size_y - theSphere.r
+        return not self.applyingShear or bool(mobile_mask(theSphere.r, theSphere.y, self.size_y))
 
     def _mobile_mask(self):
         """The mask ``r < y < Ly − r`` while shearing, else None."""
-        if not self.applyingShear:
-            return None
-        y = self._pos[1]
-        r = self._a["r"]
-        mob = r < y
-        mob &= y < self.size_y - r
-        return mob
+        return mobile_mask(self._a["r"], self._pos[1], self.size_y) if self.applyingShear else None
 
     def do_linear_acceleration(self, dt):
         kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
@@ -157,7 +149,8 @@ class CanvasPointsShear(CanvasPointsNeighbors):
     def _le_shift(self):
         return self.size_y * self.shear if self.use_lees_edwards else 0.0
 
-    def _source_is_external(self, target, source):
-        dx = source.x - target.x
-        dy = source.y - target.y
-        return math.sqrt(dx ** 2 + dy ** 2) != target.d(source)
+    def _through_boundary(self, target, source):
+        # the visit's own image from target to source, as the per-sphere terms take it (MODEL_SPEC 3.5)
+        ky, kx = _box.min_image(np.array([source.x - target.x]), np.array([source.y - target.y]), self.size_x,
+                                self.size_y, self._le_shift())[2:]
+        return bool(ky[0] != 0 or kx[0] != 0)

@@ -12,6 +12,7 @@ import random as _random
 
 import numpy as np
 
+from ..checks import finite as _check_finite, positive as _check_positive
 from ..engine.box import flow_velocity, min_image, wrap
 from ..engine.forces import normals
 from ..engine.integrate import damp, drift
@@ -70,7 +71,7 @@ class ArrayField:
     def __set__(self, obj, value):
         if self.positive:
             _check_positive(self.name, value)
-        else:
+        elif not isinstance(value, (bool, np.bool_)):     # a flag (kept viscosities) is stored as 0 or 1
             _check_finite(self.name, value)
         ens = obj.__dict__.get("_ens")
         if ens is None:
@@ -425,21 +426,6 @@ class PointLeesEdwards(Point):
         f : float
         """
         self._damp(f, flow_velocity(_one(self.y), self.size_y, self.shear_rate))
-
-
-def _check_finite(name, value):
-    try:
-        ok = math.isfinite(value)
-    except TypeError:
-        raise TypeError(f"{name} must be a real number, got {value!r}") from None
-    if not ok:
-        raise ValueError(f"{name} must be finite, got {value!r}")
-
-
-def _check_positive(name, value):
-    _check_finite(name, value)
-    if not value > 0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
 
 
 # the circles subclass PointLeesEdwards: imported after it, re-exported here

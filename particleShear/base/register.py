@@ -101,12 +101,6 @@ class SphereSelection(list):
             return len(self) == n
         return len(self.mask) == n
 
-    def indices(self):
-        """Indices of the selected spheres in ``sphereList``."""
-        if self.mask is None:
-            return np.arange(len(self))
-        return np.flatnonzero(self.mask)
-
     def copy(self):
         """A shallow copy: a selection with the same mask while still current, else a plain list."""
         return SphereSelection(self.ensemble, self.mask, self) if self._valid else list(self)

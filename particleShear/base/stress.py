@@ -14,6 +14,7 @@ from operator import attrgetter
 
 import numpy as np
 
+from ..checks import positive
 from ..engine import stress as _es
 from ..engine.forces import pair_roles, shear_stresses as _engine_shear_stresses
 from ..engine.stress import TENSORS, StressInputs
@@ -167,7 +168,7 @@ def _engine_phase(reg):
 
 
 def _phase_arrays(ph, ens):
-    """(C, active, dx, dy, fx_i, fy_i, dF = t_i + t_j, eq. S1-3) of an engine force phase; pair vectors are
+    """(C, active, dx, dy, fx_i, fy_i, dF = d·F_T, eq. S1-3) of an engine force phase; pair vectors are
     retaken from the positions if a sphere moved since (only internal pairs, never through the boundary, use them)."""
     t = ph.terms
     C = t.C
@@ -175,8 +176,7 @@ def _phase_arrays(ph, ens):
     if ph.pos_version != ens._pos_version:
         pos = ens._pos
         dx, dy = pos.take(C.aj, axis=1) - pos.take(C.ai, axis=1)
-    dF = t.tq[0] + t.tq[1] if ph.tangential else np.zeros(C.P)
-    return C, t.active, dx, dy, t.fx_i, t.fy_i, dF
+    return C, t.active, dx, dy, t.fx_i, t.fy_i, t.dF
 
 
 def _shear_inputs(q):
@@ -293,13 +293,12 @@ class StressTensorEvaluation:
     Raises
     ------
     ValueError
-        If ``size_x`` or ``size_y`` is not a finite number > 0.
+        If ``size_x`` or ``size_y`` is not a finite number > 0 (TypeError: not a real number).
     """
 
     def __init__(self, size_x, size_y, theCanvas=False):
-        for name, v in (("size_x", size_x), ("size_y", size_y)):
-            if not (isinstance(v, (int, float, np.number)) and np.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        positive("size_x", size_x)
+        positive("size_y", size_y)
         self.size_x = size_x
         self.size_y = size_y
         self.theCanvas = theCanvas

@@ -16,7 +16,8 @@ __docformat__ = "numpy"
 
 from .xp import array_namespace
 
-__all__ = ["kick", "half_kick", "plates_follow", "damp", "xi_increments", "drift"]
+__all__ = ["kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
+           "xi_increments", "drift"]
 
 
 def kick(vel, frc, weights, dt):
@@ -68,6 +69,28 @@ def half_kick(frc, weights, dt, mobile=None):
     return h
 
 
+def mobile_mask(r, y, Ly):
+    """Which spheres move freely while the plates are on: ``r < y < Ly − r`` (docs/design.md).
+
+    A sphere overlapping ``y = 0`` or ``y = Ly`` is glued to its plate (:func:`plates_follow`); the
+    same rule decides which pair forces count as external (eq. S1-16).
+
+    Parameters
+    ----------
+    r, y : ndarray (n,) or float
+        Radii and heights (µm).
+    Ly : ndarray (n,) or float
+        Cell height of each sphere's replica (µm).
+
+    Returns
+    -------
+    ndarray of bool (n,) or bool
+    """
+    mob = r < y
+    mob &= y < Ly - r
+    return mob
+
+
 def plates_follow(vx, vy, immobile, yc, plate_speed):
     """Immobile (plate) spheres take the velocity of their plate and no y velocity (docs/design.md).
 
@@ -114,6 +137,47 @@ def damp(vel, flow, cool):
     vel[0] -= flow
     vel *= cool
     vel[0] += flow
+
+
+def shift_flow(vx, omega, yc, delta):
+    """A change ``Δγ̇`` of the shear rate without a velocity shock: ``v_x += (y − Ly/2)·Δγ̇``, ``ω −= Δγ̇/2``.
+
+    Every sphere keeps its velocity relative to the affine flow and its spin relative to the
+    flow's rotation rate ``−γ̇/2`` (docs/design.md).  In place.
+
+    Parameters
+    ----------
+    vx, omega : ndarray (n,)
+        x velocities (µm/s) and spins (rad/s).
+    yc : ndarray (n,)
+        Heights above the cell's centre line, ``y − Ly/2`` (µm).
+    delta : ndarray (n,) or float
+        Change of the shear rate of each sphere's replica (1/s).
+    """
+    vx += yc * delta
+    omega -= delta / 2
+
+
+def remove_mean_velocity(vel, B):
+    """Subtract each replica's unweighted mean velocity from its spheres (``correct_linear_drift``).
+
+    ``v ← v − Σ v / N`` per row over the N spheres of each replica (its contiguous columns).  The
+    definition of the classes is the unweighted mean: with unequal masses the mean momentum is
+    not removed exactly.  In place.
+
+    Parameters
+    ----------
+    vel : ndarray (k, B·N)
+        Velocity rows (µm/s).
+    B : int
+        Number of replicas.
+    """
+    k, n = vel.shape
+    if not n:
+        return
+    N = n // B
+    xp = array_namespace(vel)
+    vel -= xp.repeat(vel.reshape(k, B, N).sum(axis=2) / N, N, axis=1)
 
 
 def xi_increments(Vi, Vj, dvx, nx, ny, ri, rj, Rx, Ry, unit, dvx_ji=None):

@@ -30,6 +30,8 @@ import numbers
 
 import numpy as np
 
+from ..checks import integer
+from .integrate import remove_mean_velocity
 from .state import BatchState
 from .step import BatchEngine
 from .xp import to_host
@@ -86,25 +88,15 @@ def relaxation_levels(dt, dt_max):
 
 
 def remove_linear_drift(state):
-    """Subtract each replica's unweighted mean velocity from its spheres (``correct_linear_drift``).
-
-    ``v_x ← v_x − Σ v_x / N`` and ``v_y ← v_y − Σ v_y / N`` over the N spheres of each replica,
-    with the sums of the classes (each replica's contiguous rows), so the mean velocity of every
-    replica becomes zero to rounding.  The classes' definition is the unweighted mean: with
-    unequal masses the mean momentum is not removed exactly.
+    """Subtract each replica's unweighted mean velocity from its spheres (``correct_linear_drift``):
+    :func:`~particleShear.engine.integrate.remove_mean_velocity` of the batch's (vx, vy) rows.
 
     Parameters
     ----------
     state : BatchState
         The batch; its velocities are changed in place.
     """
-    N = state.N
-    if not N:
-        return
-    for b in range(state.B):
-        rows = state.replica(b)
-        state.vx[rows] -= state.vx[rows].sum() / N
-        state.vy[rows] -= state.vy[rows].sum() / N
+    remove_mean_velocity(state.vel[:2], state.B)
 
 
 def _steps(engine, n, cool, dt):
@@ -143,9 +135,7 @@ def free_relaxation(engine, N, dt, dt_max, mu):
     ValueError
         If ``N`` is negative, ``dt`` is not > 0 or ``dt_max`` is not finite (before any step).
     """
-    N = int(N)
-    if N < 0:
-        raise ValueError(f"N={N!r} is out of range: allowed integers >= 0")
+    N = integer("N", N, 0)
     levels = relaxation_levels(dt, dt_max)
     s = engine.s
     mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
@@ -286,6 +276,7 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         ensembles are then left as they were (:func:`untouched_on_failure`).
     """
     ensembles = list(ensembles)
+    N = integer("N", N, 0)
     if not ensembles:
         return 0
     dts = {(float(e.dt), float(e.dt_max)) for e in ensembles}

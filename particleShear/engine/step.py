@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from .box import min_image, wrap
-from .integrate import damp, drift, half_kick, kick, plates_follow, xi_increments
+from .integrate import damp, drift, half_kick, kick, mobile_mask, plates_follow, shift_flow, xi_increments
 from .guard import KINETIC_ENERGY, NON_FINITE, closest_transient, verdict as guard_verdict
 from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses, splice_arrays
 from .callbacks import force_phase_laws
@@ -70,7 +70,7 @@ class _TermRecord:
     """The per-candidate terms of the last force phase that the force register reads
     (:func:`register_block`; kept only with :attr:`BatchEngine.keep_terms`)."""
     __slots__ = ("C", "parts", "F", "dx", "dy", "nx", "ny", "d", "touching", "active", "shifted", "mob",
-                 "fx_i", "fy_i", "fx_j", "fy_j", "tq", "birth", "totals")
+                 "fx_i", "fy_i", "fx_j", "fy_j", "dF", "tq", "birth", "totals")
 
     def __init__(self, *values):
         for name, value in zip(self.__slots__, values):
@@ -387,7 +387,7 @@ class BatchEngine:
         s = self.s
         if not s.applying_shear:
             return self.xp.ones(len(s.y), bool)
-        return (s.r < s.y) & (s.y < self.Ly_s - s.r)
+        return mobile_mask(s.r, s.y, self.Ly_s)
 
     # -- the step --------------------------------------------------------------------------------
     def set_rate(self, rate):
@@ -402,10 +402,7 @@ class BatchEngine:
             New shear rate γ̇ of each replica (1/s).
         """
         s = self.s
-        delta = rate - s.rate
-        d_s = delta[s.rep]
-        s.vx += (s.y - self.hy_s) * d_s
-        s.omega -= d_s / 2
+        shift_flow(s.vx, s.omega, s.y - self.hy_s, (rate - s.rate)[s.rep])
         s.rate = self.xp.array(rate, dtype=float)
 
     def set_mu(self, mu):
@@ -514,7 +511,7 @@ class BatchEngine:
         shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
         if self.keep_terms:
             self.terms = _TermRecord(C, parts, F, dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
-                                     fx_j, fy_j, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
+                                     fx_j, fy_j, dF, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(
                 C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,

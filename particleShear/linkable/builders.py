@@ -4,11 +4,10 @@ Constants: eq. S1-8 (spring), S1-9 (viscosity), S1-14 (radii); the time step: do
 """
 __docformat__ = "numpy"
 import logging
-import math
-import numbers
 
 import numpy as np
 
+from ..checks import finite, in_range, integer, non_negative, positive
 from ..objects.model import particle_shear_model_parameters
 from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
 
@@ -21,46 +20,23 @@ __all__ = ["EnsembleCompactParticlesFromModelParameters",
 MAX_CUT_ATTEMPTS = 1000
 
 
-def _number(name, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return value
-
-
-def _require(name, value, ok, allowed):
-    _number(name, value)
-    if not ok(value):
-        raise ValueError(f"{name}={value!r} is out of range: allowed {allowed}")
-
-
-def _require_int(name, value, minimum):
-    _number(name, value)
-    if int(value) != value or value < minimum:
-        raise ValueError(f"{name}={value!r} is out of range: allowed integers >= {minimum}")
-
-
 def _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
                      relative_transversal_link_strength, avoid_horizontal_angle_degree):
-    pos = (lambda v: v > 0, "> 0")
-    nonneg = (lambda v: v >= 0, ">= 0")
-    _require("size_x", size_x, *pos)
-    _require("size_y", size_y, *pos)
-    _require_int("N", N, 2)
-    _require("packing_fraction", packing_fraction, *pos)
-    _require("mu", mu, *nonneg)
-    _require("Young_modulus_spheres", Young_modulus_spheres, *pos)
-    _require("density", density, *pos)
-    _require("bimodal_factor", bimodal_factor, *pos)
-    _require_int("cut_lines", cut_lines, 0)
-    _require("relative_viscosity", relative_viscosity, *nonneg)
-    _number("central_repulsion_coefficient", central_repulsion_coefficient)
-    _require("anticipated_amplitude", anticipated_amplitude, *pos)
-    _require("relative_transversal_link_strength", relative_transversal_link_strength, *nonneg)
-    _require("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, lambda v: 0 <= v < 90,
-             "0 <= value < 90 (degrees)")
+    positive("size_x", size_x)
+    positive("size_y", size_y)
+    integer("N", N, 2)
+    positive("packing_fraction", packing_fraction)
+    non_negative("mu", mu)
+    positive("Young_modulus_spheres", Young_modulus_spheres)
+    positive("density", density)
+    positive("bimodal_factor", bimodal_factor)
+    integer("cut_lines", cut_lines, 0)
+    non_negative("relative_viscosity", relative_viscosity)
+    finite("central_repulsion_coefficient", central_repulsion_coefficient)
+    positive("anticipated_amplitude", anticipated_amplitude)
+    non_negative("relative_transversal_link_strength", relative_transversal_link_strength)
+    in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)
 
 
 def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
@@ -291,10 +267,10 @@ def adjustable_interface_constitution(
     _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
                      cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
                      relative_transversal_link_strength, avoid_horizontal_angle_degree)
-    _require("interface_reenforcement_central", interface_reenforcement_central, lambda v: v > 0, "> 0")
-    _require("interface_reenforcement_tangential", interface_reenforcement_tangential, lambda v: v > 0, "> 0")
-    _require("remove_link_fraction", remove_link_fraction, lambda v: 0 <= v <= 1, "0 <= value <= 1")
-    _require("edge_fuzziness", edge_fuzziness, lambda v: v >= 0, ">= 0")
+    positive("interface_reenforcement_central", interface_reenforcement_central)
+    positive("interface_reenforcement_tangential", interface_reenforcement_tangential)
+    in_range("remove_link_fraction", remove_link_fraction, 0, 1)
+    non_negative("edge_fuzziness", edge_fuzziness)
 
     N, cut_lines = int(N), int(cut_lines)
     R = 10 if do_debug else 1

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..base.canvas import check_non_negative
+from ..checks import in_range
 from ..base.kernels import min_image
 from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
@@ -133,11 +134,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
             If ``dt`` is not > 0 or ``N`` < 0 (before any step).
         """
         from ..engine.relax import relax_ensembles
-        N = int(N)
-        if not self.dt > 0:
-            raise ValueError(f"dt must be > 0 for free_pre_equilibration, got {self.dt!r}")
-        if N < 0:
-            raise ValueError(f"N={N!r} is out of range for free_pre_equilibration: allowed >= 0")
         relax_ensembles([self], N)
 
     def _labels(self, physical_neighbors_only=True):
@@ -431,10 +427,7 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
 
 
 def _check_angle(a):
-    check_non_negative("avoid_horizontal_angle_degree", a)
-    if not a < 90:
-        raise ValueError(f"avoid_horizontal_angle_degree must be in [0, 90) degrees, got {a!r} "
-                         "(90 or more rejects every line direction)")
+    in_range("avoid_horizontal_angle_degree", a, 0, 90, hi_open=True)   # 90 or more rejects every direction
 
 
 def _adjacency(n, i, j):

@@ -7,7 +7,8 @@ it never breaks and its tangential spring has no Coulomb bound.
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
 from ..engine import callbacks as _engine_callbacks
-from ..base.points import ArrayField, _check_finite, _one
+from ..base.points import ArrayField, _one
+from ..checks import non_negative
 from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
 
@@ -227,11 +228,8 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
                  permanent_ratio_tangential=1, keep_viscosity_coefficients_constant=True):
         SphereLinkable.__init__(self, color, x, y, diameter, m, my_index, theCanvas, doDrawing, force_register,
                                 size_x, size_y)
-        _check_finite("permanent_ratio_central", permanent_ratio_central)
-        _check_finite("permanent_ratio_tangential", permanent_ratio_tangential)
-        if permanent_ratio_central < 0 or permanent_ratio_tangential < 0:
-            raise ValueError("permanent ratios must be >= 0, got "
-                             f"{permanent_ratio_central!r}, {permanent_ratio_tangential!r}")
+        non_negative("permanent_ratio_central", permanent_ratio_central)
+        non_negative("permanent_ratio_tangential", permanent_ratio_tangential)
         self.permanent_ratio_central = permanent_ratio_central
         self.permanent_ratio_tangential = permanent_ratio_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant

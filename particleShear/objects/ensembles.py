@@ -6,17 +6,12 @@ import numpy as np
 
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                            CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
-from ..base.points import _check_positive
+from ..checks import integer, positive as _check_positive
 from .model import adjust_m, r_estimate
 from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
 
 __all__ = ["Ensemble", "EnsembleFriction", "EnsembleLeesEdwards", "EnsembleFrictionLeesEdwards",
            "RandomBimodalSpheres"]
-
-
-def _check_count(N):
-    if int(N) != N or N < 0:
-        raise ValueError(f"N must be a non-negative integer, got {N!r}")
 
 
 class RandomBimodalSpheres:
@@ -27,7 +22,7 @@ class RandomBimodalSpheres:
     """
 
     def _init_bimodal(self, N, packing_fraction, bimodal_factor):
-        _check_count(N)
+        integer("N", N, 0)
         _check_positive("packing_fraction", packing_fraction)
         _check_positive("bimodal_factor", bimodal_factor)
         self.bimodal_upper = math.sqrt(bimodal_factor)

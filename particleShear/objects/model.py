@@ -5,7 +5,7 @@ Spring constant: eq. S1-8; radii: eq. S1-14.
 __docformat__ = "numpy"
 import math
 
-from ..base.points import _check_positive
+from ..checks import integer, positive as _check_positive
 
 __all__ = ["r_estimate", "adjust_m", "particle_shear_model_parameters"]
 
@@ -67,8 +67,7 @@ class particle_shear_model_parameters:
                  density=50, bimodal_factor=1):
         _check_positive("size_x", size_x)
         _check_positive("size_y", size_y)
-        if int(N) != N or N < 1:
-            raise ValueError(f"N must be a positive integer, got {N!r}")
+        integer("N", N, 1)
         _check_positive("packing_fraction", packing_fraction)
         _check_positive("Young_modulus_spheres", Young_modulus_spheres)
         _check_positive("density", density)

@@ -26,6 +26,7 @@ import tempfile
 
 import numpy as np
 
+from ..checks import as_float as _as_float, finite as _real, in_range, integer as _int, real_type, show_value
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters, r_estimate
 from ..simulation.formats import check_output_format
@@ -89,98 +90,14 @@ MEMORY_FRACTION = 0.8
 
 
 # -- single values ---------------------------------------------------------------------------------
-#: integers with more digits than this are abbreviated in messages (:func:`show_value`)
-SHOW_DIGITS = 20
-
-
-def show_value(v):
-    """``repr(v)``, with an integer of more than :data:`SHOW_DIGITS` digits abbreviated to one short word.
-
-    A power of ten reads ``10**400``, any other such integer ``123456…(401 digits)`` (no conversion
-    to text of the whole number, so integers beyond Python's digit limit are shown too); used for
-    every value a validation message quotes, so a message stays one readable line.
-
-    Parameters
-    ----------
-    v : object
-        The value to show.
-
-    Returns
-    -------
-    str
-    """
-    if isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_)):
-        i = int(v)
-        a = abs(i)
-        if a >= 10 ** SHOW_DIGITS:
-            n = int(math.log10(a)) + 1          # number of digits, corrected where log10 rounds
-            if 10 ** (n - 1) > a:
-                n -= 1
-            elif 10 ** n <= a:
-                n += 1
-            sign = "-" if i < 0 else ""
-            if a == 10 ** (n - 1):
-                return f"{sign}10**{n - 1}"
-            return f"{sign}{a // 10 ** (n - 6)}…({n} digits)"
-    return repr(v)
-
-
-def _real_type(name, v):
-    """TypeError unless ``v`` is a real number (not a bool)."""
-    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
-        raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
-
-
-def _as_float(v):
-    """``float(v)``, or None when ``v`` (an integer or a rational beyond ~1.8e308) has no finite float."""
-    try:
-        return float(v)
-    except OverflowError:
-        return None
-
-
-def _real(name, v):
-    _real_type(name, v)
-    x = _as_float(v)
-    if x is None or not math.isfinite(x):
-        raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
-    return x
-
-
 def _range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
-    """Check ``v`` against its limits, compared exactly before any conversion (a huge integer included)."""
-    _real_type(name, v)
-    if not isinstance(v, numbers.Integral):
-        x = _as_float(v)
-        if x is None or not math.isfinite(x):
-            raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
+    """:func:`~particleShear.checks.in_range` with the run's limits of ``name`` (:data:`UPPER`, :data:`LOWER`)."""
+    real_type(name, v)
     if hi is None and name in UPPER:
         hi = UPPER[name]
     if name in LOWER and (lo is None or LOWER[name] > lo):
         lo, lo_open = LOWER[name], False
-    if hi is None and _as_float(v) is None:
-        hi = sys.float_info.max   # an integer without a finite float: beyond every unbounded range
-    w = v if isinstance(v, numbers.Integral) else float(v)   # int/float comparisons are exact in Python
-    bad = ((lo is not None and (w <= lo if lo_open else w < lo))
-           or (hi is not None and (w >= hi if hi_open else w > hi)))
-    if bad:
-        left = "" if lo is None else (f"{lo:g} < " if lo_open else f"{lo:g} <= ")
-        right = "" if hi is None else (f" < {hi:g}" if hi_open else f" <= {hi:g}")
-        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {left}value{right}")
-    return float(v)
-
-
-def _int(name, v, lo, hi=None):
-    _real_type(name, v)
-    if isinstance(v, numbers.Integral):
-        ok = lo <= v and (hi is None or v <= hi)
-    else:
-        x = _real(name, v)
-        ok = x.is_integer() and x >= lo and (hi is None or x <= hi)
-    if not ok:
-        allowed = f"integers >= {lo}" if hi is None else f"integers {lo} <= value <= {hi:,}"
-        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {allowed}")
-    return int(v)
+    return in_range(name, v, lo, hi, lo_open, hi_open)
 
 
 def _bool(name, v):

@@ -1,0 +1,178 @@
+"""Checks of single parameter values, written once for every layer.
+
+Each check raises ``TypeError`` for a value that is not a real number (a bool is not one) and
+``ValueError`` for one out of range, with one message form: ``name=value is out of range: allowed
+…`` (a huge integer abbreviated: :func:`show_value`).  Integers of any size are compared exactly,
+never converted to float first.  The run's own limits (the tables of
+:mod:`particleShear.run.validation`) are applied there on top of these checks.
+"""
+__docformat__ = "numpy"
+
+import math
+import numbers
+import sys
+
+import numpy as np
+
+__all__ = ["SHOW_DIGITS", "show_value", "real_type", "as_float", "finite", "in_range", "positive", "non_negative",
+           "integer"]
+
+#: integers with more digits than this are abbreviated in messages (:func:`show_value`)
+SHOW_DIGITS = 20
+
+
+def show_value(v):
+    """``repr(v)``, with an integer of more than :data:`SHOW_DIGITS` digits abbreviated to one short word.
+
+    A power of ten reads ``10**400``, any other such integer ``123456…(401 digits)`` (no conversion
+    to text of the whole number, so integers beyond Python's digit limit are shown too); used for
+    every value a validation message quotes, so a message stays one readable line.
+
+    Parameters
+    ----------
+    v : object
+        The value to show.
+
+    Returns
+    -------
+    str
+    """
+    if isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_)):
+        i = int(v)
+        a = abs(i)
+        if a >= 10 ** SHOW_DIGITS:
+            n = int(math.log10(a)) + 1          # number of digits, corrected where log10 rounds
+            if 10 ** (n - 1) > a:
+                n -= 1
+            elif 10 ** n <= a:
+                n += 1
+            sign = "-" if i < 0 else ""
+            if a == 10 ** (n - 1):
+                return f"{sign}10**{n - 1}"
+            return f"{sign}{a // 10 ** (n - 6)}…({n} digits)"
+    return repr(v)
+
+
+def real_type(name, v):
+    """Raise TypeError unless ``v`` is a real number (not a bool).
+
+    Parameters
+    ----------
+    name : str
+        The parameter, named in the message.
+    v : object
+    """
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
+
+
+def as_float(v):
+    """``float(v)``, or None when ``v`` (an integer or a rational beyond ~1.8e308) has no finite float.
+
+    Parameters
+    ----------
+    v : numbers.Real
+    """
+    try:
+        return float(v)
+    except OverflowError:
+        return None
+
+
+def finite(name, v):
+    """Return ``float(v)``; raise unless ``v`` is a finite real number.
+
+    Parameters
+    ----------
+    name : str
+        The parameter, named in the message.
+    v : object
+    """
+    if type(v) is float and v - v == 0.0:      # the common case, without the type checks
+        return v
+    real_type(name, v)
+    x = as_float(v)
+    if x is None or not math.isfinite(x):
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
+    return x
+
+
+def in_range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
+    """Return ``float(v)``; raise unless ``v`` is a finite real number within the limits.
+
+    The limits are compared exactly before any conversion (a huge integer included).
+
+    Parameters
+    ----------
+    name : str
+        The parameter, named in the message.
+    v : object
+    lo, hi : float or None
+        Lower and upper limit (None: none).
+    lo_open, hi_open : bool
+        The limit itself is excluded.
+    """
+    real_type(name, v)
+    if not isinstance(v, numbers.Integral):
+        x = as_float(v)
+        if x is None or not math.isfinite(x):
+            raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
+    if hi is None and as_float(v) is None:
+        hi = sys.float_info.max   # an integer without a finite float: beyond every unbounded range
+    w = v if isinstance(v, numbers.Integral) else float(v)   # int/float comparisons are exact in Python
+    bad = ((lo is not None and (w <= lo if lo_open else w < lo))
+           or (hi is not None and (w >= hi if hi_open else w > hi)))
+    if bad:
+        left = "" if lo is None else (f"{lo:g} < " if lo_open else f"{lo:g} <= ")
+        right = "" if hi is None else (f" < {hi:g}" if hi_open else f" <= {hi:g}")
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {left}value{right}")
+    return float(v)
+
+
+def positive(name, v):
+    """Return ``float(v)``; raise unless ``v`` is a finite real number > 0.
+
+    Parameters
+    ----------
+    name : str
+    v : object
+    """
+    if type(v) is float and 0.0 < v < math.inf:
+        return v
+    return in_range(name, v, lo=0, lo_open=True)
+
+
+def non_negative(name, v):
+    """Return ``float(v)``; raise unless ``v`` is a finite real number ≥ 0.
+
+    Parameters
+    ----------
+    name : str
+    v : object
+    """
+    if type(v) is float and 0.0 <= v < math.inf:
+        return v
+    return in_range(name, v, lo=0)
+
+
+def integer(name, v, lo, hi=None):
+    """Return ``int(v)``; raise unless ``v`` is an integral real number in ``[lo, hi]``.
+
+    Parameters
+    ----------
+    name : str
+    v : object
+        An int, or a float with an integral value.
+    lo : int
+    hi : int or None
+    """
+    real_type(name, v)
+    if isinstance(v, numbers.Integral):
+        ok = lo <= v and (hi is None or v <= hi)
+    else:
+        x = finite(name, v)
+        ok = x.is_integer() and x >= lo and (hi is None or x <= hi)
+    if not ok:
+        allowed = f"integers >= {lo}" if hi is None else f"integers {lo} <= value <= {hi:,}"
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {allowed}")
+    return int(v)
