@@ -10,6 +10,13 @@
   increments equal the reference's visit formula written from scratch — the j→i visit with the
   normal from j to i *after* i moved, ``(v_i − v_j + image)·t_ji − (r_i ω_i + r_j ω_j)`` — to a
   few ulps of the velocity scale;
+* ``mobile_mask``: a sphere is mobile exactly when it overlaps neither plate, ``r < y < Ly − r``
+  (strict: touching a plate is overlapping it);
+* ``shift_flow``: after a change of rate every velocity relative to the new flow and every spin
+  relative to the new rotation rate ``−γ̇/2`` is what it was relative to the old ones (to rounding
+  of one product and one addition);
+* ``remove_mean_velocity``: each replica's mean velocity becomes 0 (to rounding), its own sums
+  only — the definition ``v − Σ v/N`` per replica evaluated here replica by replica, exactly;
 * the documented classes and the engine call these functions (one implementation).
 """
 import unittest
@@ -17,7 +24,8 @@ import unittest
 import numpy as np
 
 from particleShear.engine import integrate
-from particleShear.engine.integrate import damp, drift, kick, plates_follow, xi_increments
+from particleShear.engine.integrate import (damp, drift, kick, mobile_mask, plates_follow, remove_mean_velocity, shift_flow,
+                                           xi_increments)
 
 
 def _unit(rx, ry):
@@ -137,12 +145,47 @@ class TestDrift(unittest.TestCase):
         np.testing.assert_array_equal(phi, [1.0, 3.0])
 
 
+class TestFlowAndPlates(unittest.TestCase):
+    def test_mobile_exactly_between_the_plates(self):
+        Ly = 100.0
+        r = np.array([5.0, 5.0, 5.0, 5.0, 5.0, 20.0])
+        y = np.array([5.0, 5.000001, 94.999999, 95.0, 50.0, 15.0])
+        np.testing.assert_array_equal(mobile_mask(r, y, Ly), [False, True, True, False, True, False])
+        self.assertIs(bool(mobile_mask(5.0, 50.0, Ly)), True)
+
+    def test_rate_change_keeps_the_peculiar_velocities(self):
+        rng = np.random.default_rng(4)
+        n, Ly = 50, 200.0
+        y = rng.uniform(0, Ly, n)
+        yc = y - Ly / 2
+        vx, omega = rng.normal(size=n) * 10, rng.normal(size=n)
+        old, new = 3.0, -7.5
+        u0, w0 = vx - old * yc, omega + old / 2
+        shift_flow(vx, omega, yc, new - old)
+        scale = 1e-14 * (np.abs(vx).max() + abs(new) * Ly)
+        np.testing.assert_allclose(vx - new * yc, u0, rtol=0, atol=scale)
+        np.testing.assert_allclose(omega + new / 2, w0, rtol=0, atol=1e-14 * (np.abs(omega).max() + abs(new)))
+
+    def test_mean_velocity_removed_per_replica(self):
+        rng = np.random.default_rng(5)
+        B, N = 4, 37
+        vel = rng.normal(size=(2, B * N)) + np.repeat(rng.normal(size=(2, B)) * 5, N, axis=1)
+        want = vel.copy()
+        for b in range(B):
+            rows = slice(b * N, (b + 1) * N)
+            for k in range(2):
+                want[k, rows] -= want[k, rows].sum() / N
+        remove_mean_velocity(vel, B)
+        np.testing.assert_array_equal(vel, want)
+        self.assertLess(np.abs(vel.reshape(2, B, N).mean(axis=2)).max(), 1e-14 * 5)
+
+
 class TestOneImplementation(unittest.TestCase):
     def test_engine_and_classes_call_these_functions(self):
         import inspect
         from particleShear.base import canvas, elastic_canvas, pair_canvas
         from particleShear.engine import step
-        for name in ("kick", "damp", "plates_follow", "xi_increments"):
+        for name in ("kick", "damp", "plates_follow", "xi_increments", "mobile_mask", "shift_flow"):
             self.assertIs(getattr(step, name), getattr(integrate, name), name)
             # the documented canvases (three modules) use the engine's function wherever they use one
             # (the ξ rule only through the engine's movement: engine_view)

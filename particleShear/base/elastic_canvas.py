@@ -5,6 +5,7 @@ per-term methods (``elastic_force_from_neighbors()`` …) are 1.0.2's loops over
 """
 __docformat__ = "numpy"
 from ..engine.integrate import kick, shift_flow
+from ..engine.step import BatchEngine
 from .points import _check_finite
 
 from .canvas import NonNegative, check_time_step
@@ -39,7 +40,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         self.phase = ""
         self.step_count = 0
 
-    INTEGRATORS = ("euler", "verlet")
+    INTEGRATORS = BatchEngine.INTEGRATORS
 
     def set_integrator(self, integrator):
         """Choose the time integrator (ValueError for another name).

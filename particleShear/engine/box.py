@@ -13,7 +13,7 @@ import contextlib
 
 from .xp import backend_of
 
-__all__ = ["min_image", "wrap", "flow_velocity", "MAX_PASSES"]
+__all__ = ["min_image", "wrap", "flow_velocity", "inside_half_cell", "MAX_PASSES"]
 
 #: one-period passes of :func:`min_image` and :func:`wrap` before the rest is folded in closed form
 #: (floor): a protocol needs at most one or two, so ordinary states keep the exact subtractions of the
@@ -213,3 +213,23 @@ def flow_velocity(y, Ly, rate):
         The flow's x velocity (µm/s).
     """
     return (y - Ly / 2) * rate
+
+
+def inside_half_cell(dx, dy, Lx, Ly):
+    """Whether raw coordinate differences stay below half the cell in x and in y.
+
+    A bond whose raw differences do so does not cross the periodic boundary: it is *physical*
+    (``physical_neighbors_only`` of the compact particles).
+
+    Parameters
+    ----------
+    dx, dy : ndarray or float
+        Raw differences of the two spheres' coordinates (µm).
+    Lx, Ly : float
+        Box lengths (µm).
+
+    Returns
+    -------
+    ndarray of bool or bool
+    """
+    return (abs(dx) < Lx / 2) & (abs(dy) < Ly / 2)

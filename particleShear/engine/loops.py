@@ -9,20 +9,59 @@ step) call :meth:`~.step.BatchEngine.step` and, after the steps, the observers
 __docformat__ = "numpy"
 
 import math
+import numbers
 
 import numpy as np
 
 from .observers import check_observers, notify
 from .xp import to_host
 
-__all__ = ["pre_equilibrate", "protocol", "pre_equilibration_blocks"]
+__all__ = ["pre_equilibrate", "protocol", "pre_equilibration_blocks", "relaxation_levels", "MAX_LEVELS"]
+
+
+#: most coarse levels of one relaxation (halving a finite step reaches any dt > 0 in fewer)
+MAX_LEVELS = 2100
+
+
+def relaxation_levels(dt, dt_max):
+    """Coarse levels of ``free_pre_equilibration``: ``(level_dt, cool)`` from ``dt_max`` halving while above ``dt``.
+
+    The damping factor starts at 0.5 and moves halfway to 1 at every halving (the classes'
+    rule, repeated halving of ``dt_max``).
+
+    Parameters
+    ----------
+    dt : float
+        Final time step (s), > 0.
+    dt_max : float
+        Step of the first level (s), finite.
+
+    Returns
+    -------
+    list of tuple
+        ``(level_dt, cool)`` per level; empty when ``dt_max <= dt``.
+
+    Raises
+    ------
+    ValueError
+        If ``dt`` is not a finite number > 0 or ``dt_max`` is not finite.
+    """
+    if isinstance(dt, bool) or not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt={dt!r} is out of range: allowed a finite number > 0 (free_pre_equilibration)")
+    if not math.isfinite(dt_max):
+        raise ValueError(f"dt_max={dt_max!r} is out of range: allowed a finite number (free_pre_equilibration)")
+    levels = []
+    level_dt, cf = dt_max, 0.5
+    while level_dt > dt and len(levels) < MAX_LEVELS:
+        levels.append((level_dt, cf))
+        level_dt /= 2
+        cf = (1 + cf) / 2
+    return levels
 
 
 def pre_equilibration_blocks(N, dt, dt_max):
-    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)`` from ``dt_max`` halving down to ``dt``.
-
-    Each level runs ``int(N/2)`` steps; its damping factor starts at 0.5 and moves halfway
-    to 1 at every halving.
+    """Coarse levels of the pre-equilibration: ``(steps, dt, cool)``, :func:`relaxation_levels` with
+    ``int(N/2)`` steps each.
 
     Parameters
     ----------
@@ -38,13 +77,7 @@ def pre_equilibration_blocks(N, dt, dt_max):
     list of tuple
         ``(steps, level_dt, cool)`` per level; empty when ``dt_max ≤ dt``.
     """
-    blocks = []
-    level_dt, cf = dt_max, 0.5
-    while level_dt > dt:
-        blocks.append((int(N / 2), level_dt, cf))
-        level_dt = level_dt / 2
-        cf = (1 + cf) / 2
-    return blocks
+    return [(int(N / 2), level_dt, cf) for level_dt, cf in relaxation_levels(dt, dt_max)]
 
 
 def _quiet(*args):

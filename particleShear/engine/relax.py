@@ -25,22 +25,18 @@ Units: µm, s, mg per m depth (docs/parameters.md).
 __docformat__ = "numpy"
 
 import contextlib
-import math
-import numbers
 
 import numpy as np
 
 from ..checks import integer
 from .integrate import remove_mean_velocity
+from .loops import relaxation_levels
 from .state import BatchState
 from .step import BatchEngine
 from .xp import to_host
 
 __all__ = ["free_relaxation", "remove_linear_drift", "write_back", "relax_ensembles", "relaxation_levels",
            "untouched_on_failure"]
-
-#: most coarse levels of one relaxation (halving a finite step reaches any dt > 0 in fewer)
-MAX_LEVELS = 2100
 
 #: Verlet skin of the relaxation engine, in units of each replica's largest radius.  The
 #: contacts of every step are exact for any skin (the list is rebuilt before a pair can have
@@ -49,42 +45,6 @@ MAX_LEVELS = 2100
 #: rebuilds cost less than that (measured: a batch of 32 default constitutions takes ~40 % less
 #: CPU time than at 0.5).
 RELAX_SKIN = 0.2
-
-
-def relaxation_levels(dt, dt_max):
-    """Coarse levels of ``free_pre_equilibration``: ``(level_dt, cool)`` from ``dt_max`` halving while above ``dt``.
-
-    The damping factor starts at 0.5 and moves halfway to 1 at every halving (the classes'
-    rule, repeated halving of ``dt_max``).
-
-    Parameters
-    ----------
-    dt : float
-        Final time step (s), > 0.
-    dt_max : float
-        Step of the first level (s), finite.
-
-    Returns
-    -------
-    list of tuple
-        ``(level_dt, cool)`` per level; empty when ``dt_max <= dt``.
-
-    Raises
-    ------
-    ValueError
-        If ``dt`` is not a finite number > 0 or ``dt_max`` is not finite.
-    """
-    if isinstance(dt, bool) or not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt={dt!r} is out of range: allowed a finite number > 0 (free_pre_equilibration)")
-    if not math.isfinite(dt_max):
-        raise ValueError(f"dt_max={dt_max!r} is out of range: allowed a finite number (free_pre_equilibration)")
-    levels = []
-    level_dt, cf = dt_max, 0.5
-    while level_dt > dt and len(levels) < MAX_LEVELS:
-        levels.append((level_dt, cf))
-        level_dt /= 2
-        cf = (1 + cf) / 2
-    return levels
 
 
 def remove_linear_drift(state):

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
 from ..base.kernels import min_image
+from ..engine.box import inside_half_cell
 from ..base.neighbours import PERMANENT, SLIP
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
@@ -88,8 +89,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
     def _physical(self, i, j):
         """Bonds that do not cross the periodic boundary (raw coordinate differences below L/2)."""
         a = self._a
-        return ((np.abs(a["x"][i] - a["x"][j]) < self.size_x / 2)
-                & (np.abs(a["y"][i] - a["y"][j]) < self.size_y / 2))
+        return inside_half_cell(a["x"][i] - a["x"][j], a["y"][i] - a["y"][j], self.size_x, self.size_y)
 
     def makeAllLinksPermanent(self):
         """Bond every current relation (updating the neighbours if none exists): ``d_eq = r_i + r_j``, ξ = 0."""

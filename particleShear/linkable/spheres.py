@@ -7,6 +7,7 @@ it never breaks and its tangential spring has no Coulomb bound.
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
 from ..engine import callbacks as _engine_callbacks
+from ..engine.box import inside_half_cell
 from ..base.points import ArrayField, _one
 from ..checks import non_negative
 from ..base.relations import RelationView, neighbor_relation
@@ -131,7 +132,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
             theSphere.cut_permanent_link(self, do_backlink=False)
 
     def _is_physical(self, theSphere):
-        return (abs(self.x - theSphere.x) < self.size_x / 2) and (abs(self.y - theSphere.y) < self.size_y / 2)
+        return bool(inside_half_cell(self.x - theSphere.x, self.y - theSphere.y, self.size_x, self.size_y))
 
     def permanentlyConnectedSpheres(self, physical_neighbors_only=True):
         """Partners bonded to this sphere (list, in relation-list order).

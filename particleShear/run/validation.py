@@ -27,6 +27,7 @@ import tempfile
 import numpy as np
 
 from ..checks import as_float as _as_float, finite as _real, in_range, integer as _int, real_type, show_value
+from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters, r_estimate
 from ..simulation.formats import check_output_format
@@ -41,8 +42,8 @@ __all__ = ["validate_run", "validate_simulation_parameters", "validate_series", 
 IMAGE_FILE_TYPES = ("jpg", "png", "ps", "svg")
 #: accepted ``renderer`` values (None = "auto")
 RENDERERS = ("auto", "tk", "pillow", "none")
-#: accepted ``integrator`` values
-INTEGRATORS = ("euler", "verlet")
+#: accepted ``integrator`` values (the engine's)
+INTEGRATORS = BatchEngine.INTEGRATORS
 
 #: cell of every run (µm)
 CELL = 500.0

@@ -18,6 +18,7 @@ import warnings
 import numpy as np
 
 from ..base.stress import StressTensorEvaluation
+from ..engine.loops import relaxation_levels
 from ..engine.relax import untouched_on_failure
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
@@ -264,12 +265,8 @@ class OscillatoryShearExperiment:
         ens.applyingShear = False
         mu = getattr(ens, "mu", 0)
         N = int(20 * (2 - math.log10(mu))) if mu > 0 else 10
-        level_dt = self.dt_max
-        cf = 0.5
-        while level_dt > self.dt:
+        for level_dt, cf in relaxation_levels(self.dt, self.dt_max):
             ens.mechanical_relaxation(N, cf, level_dt)
-            level_dt = level_dt / 2
-            cf = (1 + cf) / 2
             ens.correct_linear_drift()
         ens.mechanical_relaxation(N, 1, self.dt)
 
