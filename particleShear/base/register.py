@@ -8,6 +8,7 @@ __docformat__ = "numpy"
 import numpy as np
 
 from ..engine.step import register_block
+from ..engine.terms import pair_forces
 from ..engine.xp import to_host
 
 __all__ = ["Force_register", "SphereSelection"]
@@ -332,7 +333,7 @@ def _visit_entries(p, sl, out):
     i_all, j_all = p["i"], p["j"]
     if not len(i_all) or "visits" not in p:
         return
-    parts, F, n, t, d, w2, touching, perm, birth, slots = p["visits"]
+    parts, F, n, _, d, w2, touching, perm, birth, slots = p["visits"]
     active = p.get("active")
     ks = np.arange(len(i_all)) if active is None else np.flatnonzero(active)
     if not len(ks):
@@ -362,7 +363,7 @@ def _visit_entries(p, sl, out):
         elif dd == 2:
             out["ext" if kind == "F" else "emom"].append([sl[target], value])
 
-    nx, ny, tx, ty = n[0].tolist(), n[1].tolist(), t[0].tolist(), t[1].tolist()
+    nx, ny = n[0].tolist(), n[1].tolist()
     ii, jj = i_all.tolist(), j_all.tolist()
     visits = list(zip(vk.tolist(), vs.tolist()))
     inter = interacting.tolist()
@@ -380,17 +381,19 @@ def _visit_entries(p, sl, out):
                 emit("F", k, 1, jj[k], ii[k], [-nx[k] * f, -ny[k] * f])
     if F is None:
         return
-    F = np.broadcast_to(F, (2, len(i_all))).tolist()
-    d = d.tolist()
-    wi, wj = w2[0].tolist(), w2[1].tolist()
+    # each visit applies half its force: +F/2·t_ij on i, −F/2·t_ij on j, torques d·F/2·r/(r_i + r_j) (eq. S1-3)
+    F = np.broadcast_to(F, (2, len(i_all)))
+    halves = []
+    for side in (0, 1):
+        fx, fy, _, tq = pair_forces(0.0, F[side] * 0.5, n[0], n[1], d, w2)
+        halves.append((fx.tolist(), fy.tolist(), tq[0].tolist(), tq[1].tolist()))
     for k, s in visits:
         if not inter[k]:
             continue   # transient relation beyond contact: no tangential force
-        h = F[s][k] * 0.5
-        fi = [tx[k] * h, ty[k] * h]        # +F/2·t_ij on i
-        fj = [-tx[k] * h, -ty[k] * h]      # −F/2·t_ij on j
-        mi = d[k] * h * wi[k]
-        mj = d[k] * h * wj[k]
+        fx, fy, ti, tj = halves[s]
+        fi = [fx[k], fy[k]]
+        fj = [-fx[k], -fy[k]]
+        mi, mj = ti[k], tj[k]
         if s == 0:   # visit from i: the entry on i, then on its neighbour j
             emit("F", k, 0, ii[k], jj[k], fi)
             emit("F", k, 1, jj[k], ii[k], fj)
