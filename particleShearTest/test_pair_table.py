@@ -6,6 +6,10 @@ The new table holds, in ``(i, j)`` order with ``i < j``, each pair of the given 
 its state, ξ, ``d_eq``, relation flag and creation number, a new row starts empty.  A sorted
 candidate list (what the searches return) and the same pairs shuffled, reversed and repeated give
 the same table.
+
+The relation edits of the documented classes: ``open_relations`` numbers the rows that were no
+relation in the order given and leaves the others as they are; ``close_relations`` ends transient
+relations (ξ = 0) and never a bond; ``relations_of`` lists a sphere's relations by creation number.
 """
 import unittest
 
@@ -83,6 +87,33 @@ class TestReplace(unittest.TestCase):
         self.assertEqual(rows(t), reference(old, np.array([0]), np.array([1]), False, False))
         self.assertEqual(int((t.state == PERMANENT).sum()), int((old.state == PERMANENT).sum()))
 
+
+
+class TestRelationEdits(unittest.TestCase):
+    def test_open_close_and_order(self):
+        rng = np.random.default_rng(7)
+        t = table(rng)
+        before = t.copy()
+        t._births = 1000
+        slots = rng.permutation(len(t.i))[:30]
+        new = t.open_relations(slots)
+        was_off = ~before.active[slots]
+        np.testing.assert_array_equal(new, slots[was_off])                    # in the order given
+        np.testing.assert_array_equal(t.birth[new], 1000 + np.arange(len(new)))
+        kept = slots[~was_off]
+        np.testing.assert_array_equal(t.birth[kept], before.birth[kept])      # relations keep their number
+        self.assertTrue(t.active[slots].all())
+        t.close_relations(slots)
+        bond = t.state[slots] == PERMANENT
+        np.testing.assert_array_equal(t.active[slots], bond)
+        self.assertTrue((t.xi[:, slots[~bond]] == 0).all())
+        np.testing.assert_array_equal(t.xi[:, slots[bond]], before.xi[:, slots[bond]])
+        for p in range(40):
+            rows = t.relations_of(p)
+            want = sorted((int(t.birth[k]), k) for k in range(len(t.i)) if t.active[k] and p in (t.i[k], t.j[k]))
+            self.assertEqual(rows.tolist(), [k for _, k in want])
+            only = t.relations_of(p, bonds=False)
+            self.assertEqual(only.tolist(), [k for _, k in want if t.state[k] != PERMANENT])
 
 if __name__ == "__main__":
     unittest.main()

@@ -234,9 +234,7 @@ class CanvasPoints:
             q = partner.__dict__["_idx"]
             pt = self._pairs
             slot = int(pt.ensure(p, q)[0])
-            if not pt.active[slot]:
-                pt.active[slot] = True
-                pt.birth[slot] = pt.next_births(1)[0]
+            pt.open_relations(slot)
             pt.state[slot] = STATE_CODES[rel.interface_type]
             pt.d_eq[slot] = getattr(rel, "equilibrium_distance", 0)
             (pt.xi_ij if p < q else pt.xi_ji)[slot] = rel.friction_position

@@ -56,9 +56,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
     # -- views and scalar helpers for the API ------------------------------------------------------
     def _relations_of(self, p):
         pt = self._pairs
-        m = pt.active & ((pt.i == p) | (pt.j == p))
-        slots = np.flatnonzero(m)
-        slots = slots[np.argsort(pt.birth[slots], kind="stable")]
+        slots = pt.relations_of(p)
         partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
         cls = self._relation_view_class
         return [cls(self, p, int(q)) for q in partners]
@@ -69,11 +67,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
 
     def _drop_relations_of(self, p):
         self._relations_edited()
-        pt = self._pairs
-        m = pt.active & ((pt.i == p) | (pt.j == p)) & (pt.state != PERMANENT)
-        pt.active[m] = False
-        pt.xi_ij[m] = 0.0
-        pt.xi_ji[m] = 0.0
+        self._pairs.close_relations(self._pairs.relations_of(p))
 
     def _pair_d(self, p, q):
         a = self._a
@@ -88,16 +82,12 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
         pt = self._pairs
         s = int(pt.find(p, q))
-        if touching:
-            s = int(pt.ensure(p, q)[0])
-            if not pt.active[s]:
-                pt.active[s] = True
-                pt.state[s] = STICK
-                pt.xi_ij[s] = pt.xi_ji[s] = 0.0
-                pt.birth[s] = pt.next_births(1)[0]
-        elif s >= 0 and pt.active[s] and pt.state[s] != PERMANENT:
-            pt.active[s] = False
-            pt.xi_ij[s] = pt.xi_ji[s] = 0.0
+        if touching:      # a new relation starts sticking, without history (as in the step)
+            new = pt.open_relations(pt.ensure(p, q))
+            pt.state[new] = STICK
+            pt.xi[:, new] = 0.0
+        elif s >= 0:
+            pt.close_relations(s)
 
     def contact_pairs(self):
         """Sphere indices (i, j), i < j, of the current relations (contacts and links)."""

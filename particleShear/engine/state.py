@@ -218,6 +218,56 @@ class PairTable:
         self._births += n
         return b
 
+    def open_relations(self, slots):
+        """Make the pairs at ``slots`` relations; those that were none get the next creation numbers in order.
+
+        Parameters
+        ----------
+        slots : ndarray of int
+            Rows of the table.
+
+        Returns
+        -------
+        ndarray of int
+            The rows that became relations now (their state and ξ are the caller's to set).
+        """
+        slots = np.atleast_1d(slots)
+        new = slots[~self.active[slots]]
+        if len(new):
+            self.birth[new] = self.next_births(len(new))
+            self.active[new] = True
+        return new
+
+    def close_relations(self, slots):
+        """End the relations at ``slots`` that are not bonds: no longer active, both histories ξ = 0.
+
+        Parameters
+        ----------
+        slots : ndarray of int or of bool
+            Rows (or a mask of rows) of the table.
+        """
+        m = np.zeros(len(self.i), bool)
+        m[slots] = True
+        m &= self.active & (self.state != PERMANENT)
+        self.active[m] = False
+        self.xi[:, m] = 0.0
+
+    def relations_of(self, p, bonds=True):
+        """Rows of the relations of sphere ``p`` in creation order (the order of its ``neighbors``).
+
+        Parameters
+        ----------
+        p : int
+            Sphere index.
+        bonds : bool
+            Include the bonds (False: the transient relations only).
+        """
+        m = self.active & ((self.i == p) | (self.j == p))
+        if not bonds:
+            m &= self.state != PERMANENT
+        slots = np.flatnonzero(m)
+        return slots[np.argsort(self.birth[slots], kind="stable")]
+
     def replace(self, i, j, keep_existing=False, keep_relations=True):
         """Make (i, j) the candidate set, keeping the history of the pairs present before.
 

@@ -44,10 +44,7 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         pt = self._pairs
         slots = pt.ensure(i, j)
         r = self._a["r"]
-        newly = ~pt.active[slots]
-        if newly.any():
-            pt.birth[slots[newly]] = pt.next_births(int(newly.sum()))
-        pt.active[slots] = True
+        pt.open_relations(slots)
         pt.state[slots] = PERMANENT
         pt.d_eq[slots] = r[pt.i[slots]] + r[pt.j[slots]]
         pt.xi_ij[slots] = 0.0

@@ -305,11 +305,9 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         for p in np.flatnonzero(~bonded):
             if bonded[p]:
                 continue
-            m = pt.active & (pt.state != PERMANENT) & ((pt.i == p) | (pt.j == p))
-            slots = np.flatnonzero(m)
+            slots = pt.relations_of(p, bonds=False)          # relation-list order
             if not len(slots):
                 continue
-            slots = slots[np.argsort(pt.birth[slots], kind="stable")]  # relation-list order
             s = slots[int(rng.integers(0, len(slots)))]
             q = int(pt.j[s] if pt.i[s] == p else pt.i[s])
             self._link_pairs([p], [q])
