@@ -6,8 +6,6 @@
   The two force phases use the same laws with the operations in another order, so the forces
   agree to ≈ 1e-15 relative; the tensors to 1e-12 of the pressure scale (the spin and Otsuki
   terms, three orders smaller, on their own scale), as in ``test_engine.py``.
-* The classes' batch-of-one reductions (``OneReplicaInputs``) give the engine's numbers bit for
-  bit on the same inputs.
 * A register filled only by the manual ``record_*`` calls (no ensemble) gives every tensor of
   its definition (eq. S1-16 … S1-24), summed here entry by entry.
 """
@@ -18,7 +16,6 @@ import numpy as np
 
 from particleShear import StressTensorEvaluation
 from particleShear.base.register import Force_register
-from particleShear.base.stress import ForcePhase
 from particleShear.engine import stress as es
 from particleShear.engine.state import BatchState
 from particleShear.engine.step import BatchEngine
@@ -104,23 +101,6 @@ class TestAnyListOfSpheres(unittest.TestCase):
                         self.assertLessEqual(np.abs(a - b).max(), 1e-12 * np.abs(a).max(), t.name)
                     elif t.name != "overall_stress_tensor":     # (its spin part is kinetic)
                         self.assertEqual(a.tobytes(), b.tobytes(), t.name)
-
-
-class TestOneReplicaReductions(unittest.TestCase):
-    def test_bit_for_bit_with_the_engine_inputs(self):
-        ens, _ = sheared(5, True)
-        ens.mechanical_simulation_step_calculate_forces()
-        ens.record_total_particle_forces()
-        ev = StressTensorEvaluation(ens.size_x, ens.size_y)
-        q = ev._array_inputs(ens.force_register, ens.movableSphereList(), ens.shear_rate)
-        self.assertIsNotNone(q)   # the array path applies to the ensemble's own register
-        part = q.pairs if isinstance(q, ForcePhase) else q
-        fields = {k: v for k, v in part.__dict__.items() if not k.startswith("_")}
-        plain = es.StressInputs(**fields)   # the engine's reductions on the same inputs
-        fast = es.evaluate_all(q)
-        ref = es.evaluate_all(plain)
-        self.assertTrue(np.array_equal(fast, ref), fast - ref)
-        self.assertTrue(np.all(np.abs(ref[0, :, 0, 0]) + np.abs(ref[0, :, 0, 1]) > 0))
 
 
 class Point:

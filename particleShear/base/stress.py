@@ -54,36 +54,12 @@ class OneReplicaRows:
         self.backend = get_backend("numpy")   # the classes step NumPy arrays
         self.replica_sum = None                 # ordered reduceat per segment, as the engine on NumPy
 
-
-class OneReplicaInputs(StressInputs):
-    """:class:`~particleShear.engine.stress.StressInputs` of a batch of one, its reductions specialised.
-
-    The sums are the engine's ``add.reduceat`` from row 0, bit for bit (tested).
-    """
-
-    @staticmethod
-    def _sums(W):
-        """``add.reduceat`` of the rows of ``W`` (k, n) from column 0: shape (k,), zeros when n = 0."""
-        if not W.shape[-1]:
-            return np.zeros(W.shape[:-1])
-        return np.add.reduceat(W, _FROM_ROW_0, axis=-1)[..., 0]
-
-    def per_replica(self, weights, by_pair=True):
-        """Σ of ``weights`` over the replica's rows: shape (1,), or (k, 1) for a (k, n) array.
-
-        Parameters
-        ----------
-        weights : ndarray (n,) or (k, n)
-            One value per pair or sphere row; a 2-D array sums each row.
-        by_pair : bool
-            Unused: a batch of one has one segment of either.
-        """
-        if weights.ndim == 2:
-            return self._sums(weights)[:, None]
-        return self._sums(weights[None])
+    @classmethod
+    def none(cls):
+        """No pair rows (inputs of sphere rows only)."""
+        return cls(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
 
 
-_FROM_ROW_0 = np.zeros(1, dtype=np.intp)
 
 
 class ForcePhase(StressInputs):
@@ -393,7 +369,7 @@ class StressTensorEvaluation:
             roles = pair_roles(mob[C.ai], mob[C.aj], ph.terms.shifted)
             tau = _engine_shear_stresses(C, 1, yc, roles, active, dy, fx_i, dF, cell["V"])
         else:
-            q = OneReplicaInputs(**_entries(reg), **cell)
+            q = StressInputs(**_entries(reg), **cell)
             tau = _engine_shear_stresses(q.C, 1, *_shear_inputs(q))
         return float(tau[0][0]), float(tau[1][0])
 
@@ -409,7 +385,7 @@ class StressTensorEvaluation:
         a = ens._a
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
         C, active, dx, dy, fx_i, fy_i, dF = _phase_arrays(ph, ens)
-        q = OneReplicaInputs(C=C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
+        q = StressInputs(C=C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
                              omega=a["omega"], m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob,
                              active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
                              fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
@@ -425,15 +401,14 @@ class StressTensorEvaluation:
         """The spheres of a list as the engine's sphere inputs of a batch of one (all counted)."""
         inertia, omega, m, vx, vy, y = self._sphere_values(theSphereList)
         n = len(m)
-        return OneReplicaInputs(rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m, vx=vx, vy=vy,
-                                y=y, mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
+        return StressInputs(C=OneReplicaRows.none(), rep=np.zeros(n, dtype=np.intp), inertia=inertia, omega=omega, m=m,
+                            vx=vx, vy=vy, y=y, mob=np.ones(n, dtype=bool), **_cell(self, shear_rate))
 
     def _pair_inputs(self, reg):
-        return OneReplicaInputs(**_entries(reg), **_cell(self))
+        return StressInputs(**_entries(reg), **_cell(self))
 
     def _total_inputs(self, reg):
-        return OneReplicaInputs(C=OneReplicaRows(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)),
-                                **_totals(reg), **_cell(self))
+        return StressInputs(C=OneReplicaRows.none(), **_totals(reg), **_cell(self))
 
     def _store(self, q, functions):
         """Evaluate ``functions`` of the registry on ``q`` into the tensor attributes."""
