@@ -173,9 +173,9 @@ def legacy_neighbour_loop(xs, ys, rs, L, shear, relations):
 
 
 def numpy_all_pairs_step(x, y, r, L, shift):
-    from particleShear.base.kernels import min_image
+    from particleShear.engine.box import min_image
     i, j = np.triu_indices(len(x), 1)
-    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], L, L, shift)
+    dx, dy = min_image(x[j] - x[i], y[j] - y[i], L, L, shift)[:2]
     d = np.sqrt(dx * dx + dy * dy)
     return int(np.count_nonzero(d < r[i] + r[j]))
 

@@ -1,4 +1,4 @@
-"""The Lees-Edwards box is written once (particleShear.engine.box) and the classes' kernels are adapters.
+"""The Lees-Edwards box is written once (particleShear.engine.box).
 
 * every finite coordinate, however large, ends inside the half-open cell (wrap) or the half-open
   intervals ``[−L/2, L/2)`` (minimum image): the closed-form fold is clipped against rounding;
@@ -6,9 +6,8 @@
   a NaN height stays NaN and is moved by no period;
 * the device form of the box (every pass, then the fold) gives NumPy's numbers, for ordinary,
   huge, infinite and NaN coordinates;
-* the adapters of ``particleShear.base.kernels`` keep their conventions: the image velocity
-  correction ``−Ly·γ̇·ky`` (None when nothing wrapped in y), int period counts with
-  ``raw − counts·periods = separation``, ``passes`` as an ignored hint;
+* the period counts of the minimum image: −1, 0 or +1 for differences of positions inside the
+  cell, with ``raw − counts·periods = separation`` in the reference's order of subtraction;
 * the random normals at ``d = 0`` (``engine.forces.normals``) are drawn from the replica's
   generator, one uniform ``u`` per pair in pair order, ``n = (cos 2πu, sin 2πu)``.
 """
@@ -16,7 +15,6 @@ import unittest
 
 import numpy as np
 
-from particleShear.base import kernels
 from particleShear.engine import box
 from particleShear.engine import xp as xpmod
 from particleShearTest.test_backend import STANDIN, standin_registered
@@ -39,20 +37,15 @@ class TestEveryFiniteCoordinateEndsInside(unittest.TestCase):
 
     def test_wrap(self):
         v = huge_values(20000, 1)
-        for name, wrap in (("engine", box.wrap), ("classes", kernels.le_wrap)):
-            with self.subTest(name):
-                x, y, vx = v.copy(), v[::-1].copy(), np.zeros(len(v))
-                wrap(x, y, vx, L, L, 123.4, 0.3)
-                self.assertTrue(inside(x, 0.0, L).all() and inside(y, 0.0, L).all(),
-                                (x[~inside(x, 0.0, L)][:3], y[~inside(y, 0.0, L)][:3]))
+        x, y, vx = v.copy(), v[::-1].copy(), np.zeros(len(v))
+        box.wrap(x, y, vx, L, L, 123.4, 0.3)
+        self.assertTrue(inside(x, 0.0, L).all() and inside(y, 0.0, L).all(),
+                        (x[~inside(x, 0.0, L)][:3], y[~inside(y, 0.0, L)][:3]))
 
     def test_minimum_image(self):
         v = huge_values(20000, 2)
-        for name, fn in (("engine", lambda a, b: box.min_image(a, b, L, L, 123.4)[:2]),
-                         ("classes", lambda a, b: kernels.min_image(a, b, L, L, 123.4)[:2])):
-            with self.subTest(name):
-                dx, dy = fn(v, v[::-1])
-                self.assertTrue(inside(dx, -L / 2, L / 2).all() and inside(dy, -L / 2, L / 2).all())
+        dx, dy = box.min_image(v, v[::-1], L, L, 123.4)[:2]
+        self.assertTrue(inside(dx, -L / 2, L / 2).all() and inside(dy, -L / 2, L / 2).all())
 
     def test_exact_where_representable(self):
         # 10⁹ periods of 512 µm (a power of two): k·L is exact, so the fold must give the remainder exactly
@@ -67,18 +60,16 @@ class TestCrossingsAreExact(unittest.TestCase):
 
     def test_one_crossing(self):
         Ly, Lx, gamma, rate = 400.0, 500.0, 0.3, 2.5
-        for name, wrap in (("engine", box.wrap), ("classes", kernels.le_wrap)):
-            with self.subTest(name):
-                x, y, vx = np.array([200.0, 200.0, 50.0]), np.array([401.0, -1.0, 7.0]), np.array([3.0, 3.0, 3.0])
-                wrap(x, y, vx, Lx, Ly, Ly * gamma, rate)
-                np.testing.assert_array_equal(y, [1.0, 399.0, 7.0])
-                np.testing.assert_array_equal(x, [200.0 - Ly * gamma, 200.0 + Ly * gamma, 50.0])
-                np.testing.assert_array_equal(vx, [3.0 - Ly * rate, 3.0 + Ly * rate, 3.0])
+        x, y, vx = np.array([200.0, 200.0, 50.0]), np.array([401.0, -1.0, 7.0]), np.array([3.0, 3.0, 3.0])
+        box.wrap(x, y, vx, Lx, Ly, Ly * gamma, rate)
+        np.testing.assert_array_equal(y, [1.0, 399.0, 7.0])
+        np.testing.assert_array_equal(x, [200.0 - Ly * gamma, 200.0 + Ly * gamma, 50.0])
+        np.testing.assert_array_equal(vx, [3.0 - Ly * rate, 3.0 + Ly * rate, 3.0])
 
     def test_nan_height_moves_no_period(self):
         # the NaN sphere is not moved by a period (its vx, (y' − y)·γ̇, is NaN); the other one wraps as alone
         x, y, vx = np.array([10.0, 20.0]), np.array([np.nan, 510.0]), np.array([1.0, 1.0])
-        moved = kernels.le_wrap(x, y, vx, L, L, 100.0, 0.5)
+        moved = box.wrap(x, y, vx, L, L, 100.0, 0.5)
         self.assertTrue(moved)
         self.assertTrue(np.isnan(y[0]))
         self.assertEqual(x[0], 10.0)
@@ -87,7 +78,7 @@ class TestCrossingsAreExact(unittest.TestCase):
     def test_hair_below_zero_ends_inside(self):
         # y + Ly rounds onto Ly: the reference's sequential loops would leave y = Ly, outside [0, Ly)
         x, y, vx = np.array([10.0]), np.array([-1e-14]), np.array([0.0])
-        kernels.le_wrap(x, y, vx, L, L, 0.0, 0.0)
+        box.wrap(x, y, vx, L, L, 0.0, 0.0)
         self.assertTrue(inside(y, 0.0, L).all(), y)
 
 
@@ -119,35 +110,22 @@ class TestDeviceFormGivesNumPysNumbers(unittest.TestCase):
                 np.testing.assert_array_equal(xpmod.to_host(g, "state"), w)
 
 
-class TestClassAdapters(unittest.TestCase):
-    """``base.kernels`` keeps its conventions over the engine's arithmetic."""
+class TestCountsAndNormals(unittest.TestCase):
+    """The period counts of the minimum image and the random normals at ``d = 0``."""
 
-    def test_image_velocity_and_counts(self):
+    def test_period_counts(self):
         rng = np.random.default_rng(8)
         x = rng.uniform(0, L, 300)
         y = rng.uniform(0, L, 300)
         i, j = np.triu_indices(300, 1)
         rx, ry = x[j] - x[i], y[j] - y[i]          # differences of positions inside the cell
-        shift, rate = 0.37 * L, 1.7
-        dx, dy, dvx, ky, kx = kernels.min_image(rx, ry, L, L, shift, rate, counts=True)
-        self.assertEqual((ky.dtype, kx.dtype), (np.int8, np.int8))
+        shift = 0.37 * L
+        dx, dy, ky, kx = box.min_image(rx, ry, L, L, shift)
         self.assertTrue(set(np.unique(ky)) <= {-1, 0, 1} and set(np.unique(kx)) <= {-1, 0, 1})
+        self.assertTrue((ky != 0).any() and (kx != 0).any())
         # the separation is the raw difference less the periods counted, subtracted in the reference's order
         np.testing.assert_array_equal(dy, ry - L * ky)
         np.testing.assert_array_equal(dx, (rx - shift * ky) - L * kx)
-        np.testing.assert_array_equal(dvx, -(L * rate) * ky)
-        # the old fixed-passes hint changes nothing
-        for passes in ((1, 2), (1, 10 ** 6)):
-            again = kernels.min_image(rx, ry, L, L, shift, rate, passes=passes, counts=True)
-            for a, b in zip(again, (dx, dy, dvx, ky, kx)):
-                np.testing.assert_array_equal(a, b)
-        # nothing wraps in y, or γ̇ = 0: no velocity correction
-        self.assertIsNone(kernels.min_image(np.array([300.0]), np.array([10.0]), L, L, shift, rate)[2])
-        self.assertIsNone(kernels.min_image(rx, ry, L, L, shift, 0.0)[2])
-        # several periods (or a non-finite difference): no counts, the caller recomputes the images
-        for far in (2.2 * L, np.inf):
-            out = kernels.min_image(np.array([1.0, 2.0]), np.array([far, 3.0]), L, L, shift, rate, counts=True)
-            self.assertEqual(out[3:], (None, None))
 
     def test_random_normals_follow_the_generator(self):
         from particleShear.engine.forces import normals

@@ -103,7 +103,6 @@ ENGINE_MODULES = [
     "particleShear.base.engine_view",
     "particleShear.base.fields",
     "particleShear.base.graphics",
-    "particleShear.base.kernels",
     "particleShear.base.laws",
     "particleShear.base.memo",
     "particleShear.base.neighbours",

@@ -28,7 +28,7 @@ from unittest import mock
 import numpy as np
 
 from particleShear import EnsembleLinkable, SphereLinkable, doParticleShearSimulation
-from particleShear.base.kernels import le_wrap, min_image
+from particleShear.engine.box import min_image, wrap as le_wrap
 from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
 from particleShear.linkable.builders import EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
 from particleShear.run import validation
@@ -71,16 +71,6 @@ def reference_min_image(dx, dy, Lx, Ly, shift):
     return dx, dy
 
 
-def best_time(fn, repeat=3):
-    """Shortest wall time (s) of ``repeat`` calls of ``fn``."""
-    best = math.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
-
-
 def defaults(**changes):
     """The full argument dict of ``doParticleShearSimulation`` (defaults) with ``changes``."""
     p = {k: v.default for k, v in inspect.signature(doParticleShearSimulation).parameters.items()}
@@ -98,8 +88,7 @@ class TestWrapIsConstantTime(unittest.TestCase):
             x, y, vx = np.array([1e300, 10.0]), np.array([20.0, -1e300]), np.zeros(2)
             le_wrap(x, y, vx, L, L, 100.0, 0.2)
             return x, y
-        self.assertLess(best_time(wrap), 1e-3)  # measured ~0.1 ms
-        x, y = wrap()
+        x, y = wrap()        # inside after one call: folded, not moved one period per pass (1e300 − 500 == 1e300)
         self.assertTrue(np.all((x >= 0) & (x < L)) and np.all((y >= 0) & (y < L)), (x, y))
 
     def test_closed_form_is_exact_where_it_can_be(self):
@@ -114,9 +103,7 @@ class TestWrapIsConstantTime(unittest.TestCase):
 
     def test_non_finite_coordinates_end_non_finite(self):
         x, y, vx = np.array([np.inf, 1.0, np.nan]), np.array([1.0, -np.inf, 2.0]), np.zeros(3)
-        t = time.perf_counter()
         le_wrap(x, y, vx, L, L, 50.0, 0.1)
-        self.assertLess(time.perf_counter() - t, 0.1)
         self.assertTrue(np.isnan(x[0]) and np.isnan(y[1]) and np.isnan(x[2]))
 
     def test_ordinary_coordinates_bit_identical_to_reference_loop(self):
@@ -141,25 +128,23 @@ class TestWrapIsConstantTime(unittest.TestCase):
         dy = rng.uniform(-2 * L, 2 * L, 500)
         for shift in (0.0, 100.0, 900.0):
             with self.subTest(shift=shift):
-                gx, gy, _ = min_image(dx, dy, L, L, shift)
+                gx, gy = min_image(dx, dy, L, L, shift)[:2]
                 wx, wy = reference_min_image(dx, dy, L, L, shift)
                 np.testing.assert_array_equal(gx, wx)
                 np.testing.assert_array_equal(gy, wy)
-        # a huge difference or a huge Lees-Edwards shift (strain 10⁶) costs no more than an ordinary one
+        # a huge difference or a huge Lees-Edwards shift (strain 10⁶) is folded at once: inside after one call
         big = np.array([1e300, 3.0])
-        self.assertLess(best_time(lambda: min_image(big, big, L, L, 5e8)), 1e-3)
-        for dy, passes in ((np.array([-1e300, -260.0]), None), (np.array([100.0, -260.0]), (1, 10 ** 6))):
-            # passes = (1, n), the old fixed-passes hint for in-cell differences, is accepted and ignored
-            gx, gy, _ = min_image(big, dy, L, L, 5e8, passes=passes)
+        for dy in (np.array([-1e300, -260.0]), np.array([100.0, -260.0])):
+            gx, gy = min_image(big, dy, L, L, 5e8)[:2]
             self.assertTrue(np.all((gx >= -L / 2) & (gx < L / 2)) and np.all((gy >= -L / 2) & (gy < L / 2)))
         # in-cell differences with a shift of 10⁶ cells: exact where representable (3 + 5e8 ≡ 3 mod 500)
-        gx, gy, _ = min_image(np.array([3.0]), np.array([-260.0]), L, L, 5e8, passes=(1, 10 ** 6))
+        gx, gy = min_image(np.array([3.0]), np.array([-260.0]), L, L, 5e8)[:2]
         self.assertEqual((gx[0], gy[0]), (3.0, 240.0))
 
 
 class TestEngineBoxIsConstantTime(unittest.TestCase):
-    """The engine's wrap and minimum image (particleShear.engine.box, which the classes' kernels above
-    call) end at once for any coordinate and equal the reference loop for ordinary ones."""
+    """The engine's wrap and minimum image (particleShear.engine.box) end at once for any coordinate, on
+    arrays of box sizes per element, and equal the reference loop for ordinary ones."""
 
     def test_huge_and_infinite_coordinates(self):
         from particleShear.engine.box import min_image as engine_min_image, wrap as engine_wrap
@@ -169,12 +154,10 @@ class TestEngineBoxIsConstantTime(unittest.TestCase):
             x, y, vx = np.array([1e300, 10.0, np.inf]), np.array([20.0, -1e300, 3.0]), np.zeros(3)
             engine_wrap(x, y, vx, Ls, Ls, np.full(3, 100.0), np.full(3, 0.2))
             return x, y
-        self.assertLess(best_time(wrap), 1e-3)
         x, y = wrap()
         self.assertTrue(np.all((x[:2] >= 0) & (x[:2] < L)) and np.all((y[:2] >= 0) & (y[:2] < L)), (x, y))
         self.assertTrue(np.isnan(x[2]))  # infinite: NaN, which the stability guard reports
         big = np.array([1e300, 3.0])
-        self.assertLess(best_time(lambda: engine_min_image(big, big, L, L, 5e8)), 1e-3)
         gx, gy, _, _ = engine_min_image(big, np.array([-1e300, -260.0]), L, L, 5e8)
         self.assertTrue(np.all((gx >= -L / 2) & (gx < L / 2)) and np.all((gy >= -L / 2) & (gy < L / 2)))
 

@@ -11,8 +11,7 @@ import numpy as np
 
 from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
-from .kernels import le_wrap
-from ..engine.box import flow_velocity
+from ..engine.box import flow_velocity, wrap
 from ..engine.forces import pair_roles
 from ..engine.integrate import damp, drift, kick, remove_mean_velocity
 from .memo import Memo
@@ -382,8 +381,8 @@ class CanvasPoints:
         if not inside:
             self._check_positions()
         if not inside:
-            le_wrap(a["x"], a["y"], a["xspeed"], self.size_x, self.size_y, self._le_shift(),
-                    getattr(self, "shear_rate", 0) if self.use_lees_edwards else 0.0)
+            wrap(a["x"], a["y"], a["xspeed"], float(self.size_x), float(self.size_y), float(self._le_shift()),
+                 float(getattr(self, "shear_rate", 0)) if self.use_lees_edwards else 0.0)
         self._pos_version += 1
 
     def _check_positions(self, pos=None):

@@ -2,7 +2,6 @@
 __docformat__ = "numpy"
 import numpy as np
 from ..engine import box as _box
-from .kernels import min_image
 from ..engine.integrate import kick, mobile_mask, plates_follow
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
@@ -71,8 +70,8 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
 
     def _pair_d(self, p, q):
         a = self._a
-        dx, dy, _ = min_image(np.array([a["x"][q] - a["x"][p]]), np.array([a["y"][q] - a["y"][p]]),
-                              self.size_x, self.size_y, self._le_shift())
+        dx, dy = _box.min_image(np.array([a["x"][q] - a["x"][p]]), np.array([a["y"][q] - a["y"][p]]),
+                                self.size_x, self.size_y, self._le_shift())[:2]
         return float(np.sqrt(dx * dx + dy * dy)[0])
 
     def _test_pair(self, p, q):

@@ -85,8 +85,8 @@ def min_image(dx, dy, Lx, Ly, shift):
     :data:`MAX_PASSES` passes; what is still outside then is folded in closed form and clipped
     into the interval against rounding, so the cost does not grow with the size of a separation
     and the result is inside the intervals for any finite input.  A NaN stays NaN (count 0); an
-    infinite difference becomes NaN.  This is the one minimum image of the package: the
-    documented classes call it through :func:`particleShear.base.kernels.min_image`.
+    infinite difference becomes NaN.  This is the one minimum image of the package (the
+    engine, the documented classes, the per-sphere API, cuts and drawings call it).
     """
     be = backend_of(dx, dy)
     xp = be.xp
@@ -156,8 +156,8 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     one becomes NaN, which the stability guard reports.  Unlike the reference's sequential
     loops (first every ``y ≥ Ly`` pass, then every ``y < 0`` pass), each pass tests both sides,
     so a coordinate a hair below 0 that rounds onto ``L`` ends at 0, inside the half-open cell.
-    This is the one wrap of the package: the documented classes call it through
-    :func:`particleShear.base.kernels.le_wrap`.
+    This is the one wrap of the package (the engine, the documented classes and the per-sphere API
+    call it).
     """
     be = backend_of(x, y)
     xp = be.xp

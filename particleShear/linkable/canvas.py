@@ -5,8 +5,7 @@ import math
 import numpy as np
 
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
-from ..base.kernels import min_image
-from ..engine.box import inside_half_cell
+from ..engine.box import inside_half_cell, min_image
 from ..base.neighbours import PERMANENT, SLIP
 from ..objects.ensembles import RandomBimodalSpheres
 from .spheres import LinkableRelationView, SphereLinkable
@@ -119,8 +118,8 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         b = nu[0] * point[0] + nu[1] * point[1]
         xi, yi, xj, yj = a["x"][i], a["y"][i], a["x"][j], a["y"][j]
         shift = self._le_shift()
-        dx, dy, _ = min_image(xj - xi, yj - yi, self.size_x, self.size_y, shift)
-        ex, ey, _ = min_image(xi - xj, yi - yj, self.size_x, self.size_y, shift)
+        dx, dy = min_image(xj - xi, yj - yi, self.size_x, self.size_y, shift)[:2]
+        ex, ey = min_image(xi - xj, yi - yj, self.size_x, self.size_y, shift)[:2]
         si = nu[0] * xi + nu[1] * yi - b
         sj = nu[0] * xj + nu[1] * yj - b
         cut = (si * (nu[0] * (xi + dx) + nu[1] * (yi + dy) - b) <= 0) | \

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..base.canvas import check_non_negative
 from ..checks import in_range
-from ..base.kernels import min_image
+from ..engine.box import min_image
 from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
 from .canvas import CanvasPointsLinkable
@@ -333,8 +333,8 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         if not len(pts) or not self._n:
             return
         a = self._a
-        dx, dy, _ = min_image(pts[None, :, 0] - a["x"][:, None], pts[None, :, 1] - a["y"][:, None],
-                              self.size_x, self.size_y, self._le_shift())
+        dx, dy = min_image(pts[None, :, 0] - a["x"][:, None], pts[None, :, 1] - a["y"][:, None],
+                           self.size_x, self.size_y, self._le_shift())[:2]
         dist = np.sqrt(dx * dx + dy * dy)
         dist = dist + edge_fuzziness * self._rng.random(dist.shape) * self.r_max  # drawn even at 0
         seed = np.argmin(dist, axis=1)

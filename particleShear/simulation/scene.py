@@ -12,7 +12,7 @@ import os
 
 import numpy as np
 
-from ..base.kernels import min_image
+from ..engine.box import min_image
 from ..base.neighbours import PERMANENT, SLIP
 
 __all__ = ["scene_geometry", "PARTICLE_COLOURS", "particle_labels", "sphere_fills", "CAPTION_HEIGHT", "periodic_offsets",
@@ -50,7 +50,7 @@ def scene_geometry(ens):
         return out
     i, j, st = pt.i[act], pt.j[act], pt.state[act]
     shift = ens._le_shift() if hasattr(ens, "_le_shift") else 0.0
-    dx, dy, _ = min_image(x[j] - x[i], y[j] - y[i], ens.size_x, ens.size_y, shift)
+    dx, dy = min_image(x[j] - x[i], y[j] - y[i], ens.size_x, ens.size_y, shift)[:2]
     d = np.sqrt(dx * dx + dy * dy)
     ok = d > 0
     nx = np.where(ok, dx / np.where(ok, d, 1), 1.0)
@@ -148,7 +148,7 @@ def periodic_offsets(size_x, size_y, shift):
     """(dx, dy) of the 3 × 4 Lees-Edwards images of the cell that can overlap it (µm).
 
     The image above (``y + Ly``) is moved by ``+shift = Ly·γ`` in x, the one below by ``−shift``
-    (the convention of :func:`particleShear.base.kernels.min_image`).  Drawing every disc and
+    (the convention of :func:`particleShear.engine.box.min_image`).  Drawing every disc and
     segment at these offsets (clipped to the cell) shows a disc crossing an edge on both sides.
 
     Parameters
