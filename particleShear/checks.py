@@ -19,6 +19,7 @@ __all__ = ["SHOW_DIGITS", "show_value", "real_type", "as_float", "finite", "in_r
 
 #: integers with more digits than this are abbreviated in messages (:func:`show_value`)
 SHOW_DIGITS = 20
+_MAX = sys.float_info.max
 
 
 def show_value(v):
@@ -51,6 +52,11 @@ def show_value(v):
                 return f"{sign}10**{n - 1}"
             return f"{sign}{a // 10 ** (n - 6)}…({n} digits)"
     return repr(v)
+
+
+def _scalar(v):
+    """A 0-d array's value (NumPy's reductions return them), else ``v``."""
+    return v.item() if isinstance(v, np.ndarray) and v.ndim == 0 else v
 
 
 def real_type(name, v):
@@ -87,9 +93,13 @@ def finite(name, v):
     name : str
         The parameter, named in the message.
     v : object
+        A real number, or a 0-d array of one.
     """
-    if type(v) is float and v - v == 0.0:      # the common case, without the type checks
-        return v
+    if isinstance(v, float) and v - v == 0.0:      # the common cases (float, numpy.float64) at once
+        return float(v)
+    if type(v) is int and -_MAX <= v <= _MAX:      # (int/float comparisons are exact)
+        return float(v)
+    v = _scalar(v)
     real_type(name, v)
     x = as_float(v)
     if x is None or not math.isfinite(x):
@@ -112,13 +122,17 @@ def in_range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
     lo_open, hi_open : bool
         The limit itself is excluded.
     """
+    v = _scalar(v)
     real_type(name, v)
     if not isinstance(v, numbers.Integral):
         x = as_float(v)
         if x is None or not math.isfinite(x):
             raise ValueError(f"{name}={show_value(v)} is out of range: allowed a finite number")
-    if hi is None and as_float(v) is None:
-        hi = sys.float_info.max   # an integer without a finite float: beyond every unbounded range
+    if as_float(v) is None:       # an integer without a finite float: beyond every unbounded side
+        if v > 0 and hi is None:
+            hi = _MAX
+        elif v < 0 and lo is None:
+            lo = -_MAX
     w = v if isinstance(v, numbers.Integral) else float(v)   # int/float comparisons are exact in Python
     bad = ((lo is not None and (w <= lo if lo_open else w < lo))
            or (hi is not None and (w >= hi if hi_open else w > hi)))
@@ -137,8 +151,8 @@ def positive(name, v):
     name : str
     v : object
     """
-    if type(v) is float and 0.0 < v < math.inf:
-        return v
+    if isinstance(v, (float, int)) and not isinstance(v, bool) and 0 < v <= _MAX:
+        return float(v)
     return in_range(name, v, lo=0, lo_open=True)
 
 
@@ -150,8 +164,8 @@ def non_negative(name, v):
     name : str
     v : object
     """
-    if type(v) is float and 0.0 <= v < math.inf:
-        return v
+    if isinstance(v, (float, int)) and not isinstance(v, bool) and 0 <= v <= _MAX:
+        return float(v)
     return in_range(name, v, lo=0)
 
 
@@ -166,6 +180,7 @@ def integer(name, v, lo, hi=None):
     lo : int
     hi : int or None
     """
+    v = _scalar(v)
     real_type(name, v)
     if isinstance(v, numbers.Integral):
         ok = lo <= v and (hi is None or v <= hi)

@@ -79,8 +79,9 @@ def defaults(**changes):
     return p
 
 
-class TestWrapIsConstantTime(unittest.TestCase):
-    """The wrap never loops over the size of a coordinate, and ordinary coordinates are unchanged."""
+class TestWrapAndMinimumImageOfScalarCells(unittest.TestCase):
+    """With one box for all elements: a coordinate of any size ends inside after one call (it is
+    folded, never moved one period per pass), and ordinary coordinates give the reference loop's bits."""
 
     def test_huge_coordinate_wraps_at_once(self):
         # 1e300 / 500 periods: the one-period loop would never end (1e300 − 500 == 1e300)

@@ -43,6 +43,8 @@ class ArrayField:
         Setting it rebuilds the neighbour candidates (position, radius) / the cached step constants.
     positive : bool
         Accept only values > 0.
+    flag : bool
+        A yes/no setting stored as 1 or 0: True and False are accepted too.
 
     Raises
     ------
@@ -50,11 +52,12 @@ class ArrayField:
         On assigning a non-number, a value not finite, or not > 0 when ``positive``.
     """
 
-    def __init__(self, default=0.0, geometry=False, param=False, positive=False):
+    def __init__(self, default=0.0, geometry=False, param=False, positive=False, flag=False):
         self.default = default
         self.geometry = geometry
         self.param = param
         self.positive = positive
+        self.flag = flag
 
     def __set_name__(self, owner, name):
         self.name = name
@@ -71,7 +74,7 @@ class ArrayField:
     def __set__(self, obj, value):
         if self.positive:
             _check_positive(self.name, value)
-        elif not isinstance(value, (bool, np.bool_)):     # a flag (kept viscosities) is stored as 0 or 1
+        elif not (self.flag and isinstance(value, (bool, np.bool_))):
             _check_finite(self.name, value)
         ens = obj.__dict__.get("_ens")
         if ens is None:

@@ -103,8 +103,8 @@ class StabilityGuard:
         closest = ens._closest_contact() if hasattr(ens, "_closest_contact") else None
         x, y, vx, vy, om = a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]
         code, ke, bound = (float(v[0]) for v in verdict(
-            1, x, y, vx, vy, om, a["m"], a["inertia"], a["r"], np.array([float(getattr(ens, "k", 0) or 0)]),
-            np.array([rate]), np.array([float(ens.size_y)]), np.array([self._rate_max]),
+            1, x, y - ens.size_y / 2, vx, vy, om, rate, a["m"], a["inertia"], a["r"],
+            np.array([float(getattr(ens, "k", 0) or 0)]), np.array([float(ens.size_y)]), np.array([self._rate_max]),
             np.array([math.inf if closest is None else closest[0]]), self.min_distance_ratio,
             self.max_kinetic_energy))
         if code == NON_FINITE:

@@ -22,7 +22,7 @@ __all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "verdict
 SOUND, NON_FINITE, KINETIC_ENERGY, INTERPENETRATION = 0, 1, 2, 3
 
 
-def verdict(B, x, y, vx, vy, omega, m, inertia, r, k, rate, Ly, rate_max, closest, min_distance_ratio=0.05,
+def verdict(B, x, yc, vx, vy, omega, rate_s, m, inertia, r, k, Ly, rate_max, closest, min_distance_ratio=0.05,
             max_kinetic_energy=None):
     """The guard's verdict of each replica: ``(code, ke, bound)``, arrays (B,).
 
@@ -38,14 +38,16 @@ def verdict(B, x, y, vx, vy, omega, m, inertia, r, k, rate, Ly, rate_max, closes
     ----------
     B : int
         Number of replicas; the sphere arrays hold B rows of N spheres each.
-    x, y, vx, vy, omega : array (B·N,)
-        Positions (µm), velocities (µm/s) and spins (rad/s).
+    x, yc, vx, vy, omega : array (B·N,)
+        x and the height above the centre line ``y − Ly/2`` (µm), velocities (µm/s) and spins (rad/s).
+    rate_s : array (B·N,) or float
+        Shear rate γ̇ of each sphere's replica (1/s).
     m, inertia, r : array (B·N,)
         Masses, moments of inertia and radii.
     k : array (B,)
         Spring constant of each replica (eq. S1-8).
-    rate, Ly : array (B,)
-        Shear rate γ̇ (1/s) and cell height (µm) of each replica.
+    Ly : array (B,)
+        Cell height of each replica (µm).
     rate_max : array (B,)
         Largest ``|γ̇|`` seen so far (1/s).
     closest : array (B,)
@@ -62,9 +64,9 @@ def verdict(B, x, y, vx, vy, omega, m, inertia, r, k, rate, Ly, rate_max, closes
     """
     xp = array_namespace(x)
     N = len(x) // B
-    state = xp.stack((x, y, vx, vy, omega)).reshape(5, B, N)
+    state = xp.stack((x, yc, vx, vy, omega)).reshape(5, B, N)
     finite = xp.isfinite(state).all(axis=(0, 2))
-    u = vx - (y - xp.repeat(Ly / 2, N)) * xp.repeat(rate, N)
+    u = vx - yc * rate_s
     ke = 0.5 * (m * (u * u + vy * vy) + inertia * omega * omega).reshape(B, N).sum(axis=1)
     if max_kinetic_energy is None:
         plate = rate_max * Ly / 2

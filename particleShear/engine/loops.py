@@ -9,10 +9,10 @@ step) call :meth:`~.step.BatchEngine.step` and, after the steps, the observers
 __docformat__ = "numpy"
 
 import math
-import numbers
 
 import numpy as np
 
+from ..checks import finite, positive
 from .observers import check_observers, notify
 from .xp import to_host
 
@@ -24,10 +24,11 @@ MAX_LEVELS = 2100
 
 
 def relaxation_levels(dt, dt_max):
-    """Coarse levels of ``free_pre_equilibration``: ``(level_dt, cool)`` from ``dt_max`` halving while above ``dt``.
+    """Coarse levels of a relaxation: ``(level_dt, cool)`` from ``dt_max`` halving while above ``dt``.
 
     The damping factor starts at 0.5 and moves halfway to 1 at every halving (the classes'
-    rule, repeated halving of ``dt_max``).
+    rule, repeated halving of ``dt_max``); the levels of ``free_pre_equilibration`` and of the
+    measurement's pre-equilibration (:func:`pre_equilibration_blocks`).
 
     Parameters
     ----------
@@ -44,12 +45,10 @@ def relaxation_levels(dt, dt_max):
     Raises
     ------
     ValueError
-        If ``dt`` is not a finite number > 0 or ``dt_max`` is not finite.
+        If ``dt`` is not a finite number > 0 or ``dt_max`` is not finite (TypeError: not a real
+        number).
     """
-    if isinstance(dt, bool) or not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt={dt!r} is out of range: allowed a finite number > 0 (free_pre_equilibration)")
-    if not math.isfinite(dt_max):
-        raise ValueError(f"dt_max={dt_max!r} is out of range: allowed a finite number (free_pre_equilibration)")
+    dt, dt_max = positive("dt", dt), finite("dt_max", dt_max)
     levels = []
     level_dt, cf = dt_max, 0.5
     while level_dt > dt and len(levels) < MAX_LEVELS:
@@ -76,6 +75,11 @@ def pre_equilibration_blocks(N, dt, dt_max):
     -------
     list of tuple
         ``(steps, level_dt, cool)`` per level; empty when ``dt_max ≤ dt``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`relaxation_levels`.
     """
     return [(int(N / 2), level_dt, cf) for level_dt, cf in relaxation_levels(dt, dt_max)]
 

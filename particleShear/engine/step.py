@@ -153,9 +153,10 @@ class BatchEngine:
         Steps between the checks of the stability guard.
     guard : bool or array of bool (B,)
         Check every ``check_interval`` steps, for each replica where it is true, what
-        :class:`~particleShear.base.stability.StabilityGuard` checks: a finite state, the kinetic
-        energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²`` and no transient
-        contact closer than 5 % of its contact distance; raise :class:`EngineInstability` otherwise.
+        :class:`~particleShear.base.stability.StabilityGuard` checks (:func:`~.guard.verdict`): a
+        finite state, the kinetic energy relative to the flow below ``N·k·r_mean² + Σ m (γ̇_max·Ly/2)²``
+        (k taken as 1 where it is 0) and no transient contact closer than 5 % of its contact
+        distance; raise :class:`EngineInstability` otherwise.
     integrator : {"euler", "verlet"}
         ``"euler"``: the reference's semi-implicit Euler.  ``"verlet"``: velocity Verlet with a
         half-kick predictor — the velocity-dependent terms of a force phase see the velocities
@@ -751,8 +752,9 @@ class BatchEngine:
         s, xp = self.s, self.xp
         self.rate_max = xp.maximum(self.rate_max, abs(s.rate))
         closest = closest_transient(self.C, d, active)
-        code, ke, bound = guard_verdict(s.B, s.x, s.y, s.vx, s.vy, s.omega, s.m, s.inertia, s.r, s.k, s.rate,
-                                        s.Ly, self.rate_max, closest, self.min_distance_ratio, self.max_kinetic_energy)
+        code, ke, bound = guard_verdict(s.B, s.x, s.y - self.hy_s, s.vx, s.vy, s.omega, s.rate[s.rep], s.m, s.inertia,
+                                        s.r, s.k, s.Ly, self.rate_max, closest, self.min_distance_ratio,
+                                        self.max_kinetic_energy)
         return code * self.guard_dev, ke, bound, closest
 
     def _report(self, verdict, step):

@@ -70,7 +70,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
     call_back_elastic_force_law_tensile = elastic_force_law_tensile
     permanent_ratio_central = ArrayField(1.0, param=True)
     permanent_ratio_tangential = ArrayField(1.0, param=True)
-    keep_viscosity_coefficients_constant = ArrayField(1.0, param=True)
+    keep_viscosity_coefficients_constant = ArrayField(1.0, param=True, flag=True)
 
     def _new_relation(self, theSphere):
         return neighbor_relation_linkable(0, "stick", theSphere)

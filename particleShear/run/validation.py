@@ -21,12 +21,11 @@ import itertools
 import math
 import numbers
 import os
-import sys
 import tempfile
 
 import numpy as np
 
-from ..checks import as_float as _as_float, finite as _real, in_range, integer as _int, real_type, show_value
+from ..checks import as_float as _as_float, in_range, integer as _int, real_type, show_value
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters, r_estimate
