@@ -21,7 +21,6 @@ import re
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 from unittest import mock
 
@@ -208,10 +207,8 @@ class TestLowLevelStep(unittest.TestCase):
 
     def test_sphere_far_outside_the_cell(self):
         ens = two_spheres(x=1e9)
-        t = time.perf_counter()
         with self.assertRaises(SimulationInstabilityError) as cm:
             ens.mechanical_simulation_step(1.0, 0.01)
-        self.assertLess(time.perf_counter() - t, 1.0)
         e = cm.exception
         self.assertEqual(e.pair, (0,))
         self.assertEqual(e.step, 0)
@@ -228,11 +225,10 @@ class TestLowLevelStep(unittest.TestCase):
 
     def test_huge_time_step_stops_instead_of_hanging(self):
         ens = two_spheres()
-        t = time.perf_counter()
         with self.assertRaises(SimulationInstabilityError) as cm, np.errstate(all="ignore"):
             for _ in range(3):
                 ens.mechanical_simulation_step(1.0, 1e300)
-        self.assertLess(time.perf_counter() - t, 1.0)
+        self.assertIn(cm.exception.step, (0, 1, 2))      # stopped within the steps asked for, not later
         self.assertIn("not finite", str(cm.exception))
 
     def test_guard_names_the_non_finite_value(self):
@@ -262,13 +258,11 @@ def no_simulation_work():
 
 
 class TestRefusedBeforeWork(unittest.TestCase):
-    """Each case ends, in < 1 s and before the ensemble is built, with an error naming its parameter."""
+    """Each case ends before the ensemble is built with an error naming its parameter."""
 
     def assertRefused(self, name, kw, error=ValueError, message=None):
-        t = time.perf_counter()
         with no_simulation_work(), self.assertRaises(error) as cm:
             doParticleShearSimulation(**dict(QUIET, **kw))
-        self.assertLess(time.perf_counter() - t, 1.0)
         self.assertRegex(str(cm.exception), rf"(?<![\w-]){re.escape(name)}=")
         if message:
             self.assertRegex(str(cm.exception), message)
@@ -390,10 +384,11 @@ class TestResolutionAndConstitution(unittest.TestCase):
 class TestInstabilityEndsQuickly(unittest.TestCase):
 
     def test_time_step_factor_1000(self):
-        t = time.perf_counter()
         with self.assertRaises(SimulationInstabilityError) as cm:
             doParticleShearSimulation(time_step_factor=1000, seed=1, **QUIET)
-        self.assertLess(time.perf_counter() - t, 30.0)  # measured 0.7 s
+        # stopped at the first checks of the pre-equilibration (every 4th step), not after the protocol
+        self.assertEqual(cm.exception.phase, "pre-equilibration")
+        self.assertLessEqual(cm.exception.step, 8)
         self.assertIn("try dt <=", str(cm.exception))
 
 
@@ -407,10 +402,8 @@ class TestSeriesRefusedBeforeJobs(unittest.TestCase):
                  ("N", dict(N=10 ** 9)), ("renderer", dict(renderer="bogus"))]
         for name, kw in cases:
             with self.subTest(name=name):
-                t = time.perf_counter()
                 with self.assertRaisesRegex(ValueError, rf"\b{name}="):
                     doParticleShearSimulationSeries(executor=executor, **kw)
-                self.assertLess(time.perf_counter() - t, 1.0)
 
 
 class TestCommandLine(unittest.TestCase):
