@@ -9,6 +9,8 @@ movement.  The engine is kept under one key and dropped at :meth:`EngineStep._dr
 __docformat__ = "numpy"
 import numpy as np
 
+from ..engine.guard import transient_ratios
+
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
 
 
@@ -160,15 +162,15 @@ class EngineStep:
         self._pos_version += 1
 
     def _closest_contact(self):
-        """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last phase, or None."""
-        g = self._g
-        if g is None or not g.P:
+        """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force phase
+        (:func:`~particleShear.engine.guard.transient_ratios`, inf without one), or None without candidates."""
+        eng = self._engine
+        g = None if eng is None else eng.g
+        if g is None or not eng.C.P:
             return None
-        ratio = g.d / g.d0
-        if g.trans is not None:
-            ratio = np.where(g.trans, ratio, np.inf)
+        ratio = transient_ratios(eng.C, np.sqrt(g.dx * g.dx + g.dy * g.dy), g.active)
         k = int(np.argmin(ratio))
-        return float(ratio[k]), int(g.ai[k]), int(g.aj[k])
+        return float(ratio[k]), int(eng.C.ai[k]), int(eng.C.aj[k])
 
 
 class ForcePhaseGeometry:

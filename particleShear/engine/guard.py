@@ -16,7 +16,8 @@ import math
 
 from .xp import array_namespace
 
-__all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "verdict", "closest_transient"]
+__all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "verdict", "transient_ratios",
+           "closest_transient"]
 
 #: verdict codes, in the order they are tested (the first that holds is reported)
 SOUND, NON_FINITE, KINETIC_ENERGY, INTERPENETRATION = 0, 1, 2, 3
@@ -79,6 +80,22 @@ def verdict(B, x, yc, vx, vy, omega, rate_s, m, inertia, r, k, Ly, rate_max, clo
     return code, ke, bound
 
 
+def transient_ratios(C, d, active):
+    """``d/(r_i + r_j)`` of each transient contact (a relation that is no bond), inf for the other candidates.
+
+    Parameters
+    ----------
+    C : PairConstants
+        The candidates (``d0``, ``trans``).
+    d : array (P,)
+        Distance of each candidate (µm).
+    active : array of bool (P,)
+        Relations (touching or bonded).
+    """
+    xp = array_namespace(d)
+    return xp.where(active & C.trans, d / C.d0, math.inf)
+
+
 def closest_transient(C, d, active):
     """Smallest ``d/(r_i + r_j)`` of a transient contact (no bond) of each replica: array (B,), inf where none.
 
@@ -94,7 +111,7 @@ def closest_transient(C, d, active):
         Relations (touching or bonded).
     """
     xp = array_namespace(d)
-    ratio = xp.where(active & C.trans, d / C.d0, math.inf)
+    ratio = transient_ratios(C, d, active)
     if C.replica_sum is not None:       # a device: the padded gather (inf for a replica without pairs)
         return C.replica_sum.minimum(ratio)
     closest = xp.full(C.B, math.inf)
