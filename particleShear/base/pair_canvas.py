@@ -68,10 +68,13 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         self._relations_edited()
         self._pairs.close_relations(self._pairs.relations_of(p))
 
+    def _image(self, dx, dy):
+        """``(dx, dy, ky, kx)`` of one raw difference (µm): its minimum image and the periods removed."""
+        return _box.min_image(np.array([dx]), np.array([dy]), self.size_x, self.size_y, self._le_shift())
+
     def _pair_d(self, p, q):
         a = self._a
-        dx, dy = _box.min_image(np.array([a["x"][q] - a["x"][p]]), np.array([a["y"][q] - a["y"][p]]),
-                                self.size_x, self.size_y, self._le_shift())[:2]
+        dx, dy = self._image(a["x"][q] - a["x"][p], a["y"][q] - a["y"][p])[:2]
         return float(np.sqrt(dx * dx + dy * dy)[0])
 
     def _test_pair(self, p, q):
@@ -140,6 +143,5 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 
     def _through_boundary(self, target, source):
         # the visit's own image from target to source, as the per-sphere terms take it (MODEL_SPEC 3.5)
-        ky, kx = _box.min_image(np.array([source.x - target.x]), np.array([source.y - target.y]), self.size_x,
-                                self.size_y, self._le_shift())[2:]
+        ky, kx = self._image(source.x - target.x, source.y - target.y)[2:]
         return bool(ky[0] != 0 or kx[0] != 0)

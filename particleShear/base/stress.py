@@ -60,8 +60,6 @@ class OneReplicaRows:
         return cls(np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
 
 
-
-
 class ForcePhase(StressInputs):
     """The inputs of one force phase in three parts, each row function summed on its own part.
 
@@ -386,10 +384,10 @@ class StressTensorEvaluation:
         rep, everyone, no_torque = self._per_sphere(len(a["x"]))
         C, active, dx, dy, fx_i, fy_i, dF = _phase_arrays(ph, ens)
         q = StressInputs(C=C, rep=rep, x=a["x"], y=a["y"], vx=a["xspeed"], vy=a["yspeed"],
-                             omega=a["omega"], m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob,
-                             active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
-                             fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
-                             **_cell(self, shear_rate))
+                         omega=a["omega"], m=a["m"], inertia=a["inertia"], mob=everyone if mob is None else mob,
+                         active=active, shifted=ph.terms.shifted, dx=dx, dy=dy, fx_i=fx_i, fy_i=fy_i, dF=dF,
+                         fx=fx, fy=fy, torque=no_torque if reg._mom is None else reg._mom,
+                         **_cell(self, shear_rate))
         ok, mask = self._rows_of(ens, spheres)
         if not ok:
             return ForcePhase(q, q, self._sphere_inputs(spheres, shear_rate))
