@@ -159,6 +159,14 @@ def _shear_inputs(q):
     return (q.y - q.Ly[0] / 2, pair_roles(q.mob[C.ai], q.mob[C.aj], q.shifted), q.active, q.dy, q.fx_i, q.dF, q.V)
 
 
+def _stack(columns, kinds):
+    """Concatenate each column of the row blocks ``columns`` (a list of tuples of arrays), or zeros of
+    ``kinds`` (one dtype per column) when there are no blocks."""
+    if not columns:
+        return [np.zeros(0, dtype=k) for k in kinds]
+    return [np.concatenate(c) for c in zip(*columns)]
+
+
 def _entries(reg):
     """The register's pair entries (eqs. S1-16, S1-19, S1-22) as pair inputs of a batch of one.
 
@@ -166,45 +174,25 @@ def _entries(reg):
     the register gives it an entry, ``shifted = ~internal``: so the engine's rules reproduce the
     register's flags.  Internal entries carry half their force (the reference registers each side).
     """
-    tx, ty, sx, sy, fx, fy, internal, external, active, dF = ([] for _ in range(10))
-    ens = reg._ens
+    cols = []     # (tx, ty, sx, sy, fx, fy, dF, internal, external, active) of each block of entries
     for p in reg._blocks:
         i, j = p["i"], p["j"]
         if not len(i):
             continue
-        x, y = ens._a["x"], ens._a["y"]
+        x, y = reg._ens._a["x"], reg._ens._a["y"]
         act = p.get("active")
         act = np.ones(len(i), dtype=bool) if act is None else act
         for t, s, F, ext, torque in ((i, j, p["Fi"], p["ext_i"], p.get("ti")), (j, i, p["Fj"], p["ext_j"], p.get("tj"))):
-            tx.append(x[t])
-            ty.append(y[t])
-            sx.append(x[s])
-            sy.append(y[s])
-            fx.append(F[0])
-            fy.append(F[1])
-            internal.append(p["internal"])
-            external.append(ext)
-            active.append(act)
-            dF.append(np.zeros(len(i)) if torque is None else torque)
+            cols.append((x[t], y[t], x[s], y[s], F[0], F[1], np.zeros(len(i)) if torque is None else torque,
+                         p["internal"], ext, act))
     manual = ([(t, s, f, 0.0, True) for t, s, f in reg._m_pair]
               + [(t, t, f, 0.0, False) for t, f in reg._m_ext]
               + [(t, s, (0.0, 0.0), m, True) for t, s, m in reg._m_imom])
     if manual:
-        rows = np.array([(t.x, t.y, s.x, s.y, f[0], f[1], m) for t, s, f, m, _ in manual], dtype=float).T
-        tx.append(rows[0])
-        ty.append(rows[1])
-        sx.append(rows[2])
-        sy.append(rows[3])
-        fx.append(rows[4])
-        fy.append(rows[5])
-        dF.append(rows[6])
+        rows = np.array([(t.x, t.y, s.x, s.y, f[0], f[1], m) for t, s, f, m, _ in manual], dtype=float)
         flag = np.array([e[4] for e in manual], dtype=bool)
-        internal.append(flag)
-        external.append(~flag)
-        active.append(np.ones(len(manual), dtype=bool))
-    cat = (lambda parts, dtype=float: np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
-    tx, ty, sx, sy, fx, fy, dF = map(cat, (tx, ty, sx, sy, fx, fy, dF))
-    internal, external, active = (cat(f, bool) for f in (internal, external, active))
+        cols.append((*rows.T, flag, ~flag, np.ones(len(manual), dtype=bool)))
+    tx, ty, sx, sy, fx, fy, dF, internal, external, active = _stack(cols, (float,) * 7 + (bool,) * 3)
     n = len(tx)
     half = np.where(internal, 0.5, 1.0)   # × ½ is exact
     return dict(C=OneReplicaRows(np.arange(n), np.arange(n, 2 * n)), rep=np.zeros(2 * n, dtype=np.intp),
@@ -219,36 +207,21 @@ def _totals(reg):
     Rows: the ensemble's spheres (torque of immobile ones included: the reference's quirk), then the
     manual totals (mobile), then the manual net torques (torque only).
     """
-    x, y, fx, fy, mob, torque = ([] for _ in range(6))
-    ens = reg._ens
+    cols = []     # (x, y, fx, fy, torque, mob) of each block of rows
     if reg._tot is not None or reg._mom is not None:
-        a = ens._a
+        a = reg._ens._a
         n = len(a["x"])
-        x.append(a["x"])
-        y.append(a["y"])
-        if reg._tot is not None:
-            mask, tfx, tfy = reg._tot
-            fx.append(tfx)
-            fy.append(tfy)
-            mob.append(np.ones(n, dtype=bool) if mask is None else mask)
-        else:
-            fx.append(np.zeros(n))
-            fy.append(np.zeros(n))
-            mob.append(np.zeros(n, dtype=bool))
-        torque.append(np.zeros(n) if reg._mom is None else reg._mom)
+        zero = np.zeros(n)
+        mask, tfx, tfy = reg._tot if reg._tot is not None else (np.zeros(n, dtype=bool), zero, zero)
+        cols.append((a["x"], a["y"], tfx, tfy, zero if reg._mom is None else reg._mom,
+                     np.ones(n, dtype=bool) if mask is None else mask))
     manual = ([(t, f, 0.0, True) for t, f in reg._m_tot.values()]
               + [(t, (0.0, 0.0), m, False) for t, m in reg._m_unb.values()])
     if manual:
-        rows = np.array([(t.x, t.y, f[0], f[1], m) for t, f, m, _ in manual], dtype=float).T
-        x.append(rows[0])
-        y.append(rows[1])
-        fx.append(rows[2])
-        fy.append(rows[3])
-        torque.append(rows[4])
-        mob.append(np.array([e[3] for e in manual], dtype=bool))
-    cat = (lambda parts, dtype=float: np.concatenate(parts) if parts else np.zeros(0, dtype=dtype))
-    x, y, fx, fy, torque = map(cat, (x, y, fx, fy, torque))
-    return dict(rep=np.zeros(len(x), dtype=np.intp), x=x, y=y, mob=cat(mob, bool), fx=fx, fy=fy, torque=torque)
+        rows = np.array([(t.x, t.y, f[0], f[1], m) for t, f, m, _ in manual], dtype=float)
+        cols.append((*rows.T, np.array([e[3] for e in manual], dtype=bool)))
+    x, y, fx, fy, torque, mob = _stack(cols, (float,) * 5 + (bool,))
+    return dict(rep=np.zeros(len(x), dtype=np.intp), x=x, y=y, mob=mob, fx=fx, fy=fy, torque=torque)
 
 
 class StressTensorEvaluation:
