@@ -124,7 +124,6 @@ class Force_register:
         self._block_list = []
         self._phase = None      # the engine force phase held (EngineForcePhase), its block made when read
         self._tot = None
-        self._tot_block = None
         self._mom = None
         self._lists = None
         if getattr(self, "_manual", True):
@@ -147,7 +146,6 @@ class Force_register:
         ph = self._phase
         if ph is not None and ph.block is None:
             ph.block = PairBlock(register_block(ph.terms, ph.N, ph.b, tangential=ph.tangential))
-            ph.block["pos_version"] = ph.pos_version
             self._block_list.insert(0, ph.block)
         return self._block_list
 
@@ -161,7 +159,6 @@ class Force_register:
     def _set_totals(self, ensemble, mobile, fx, fy, torque, block=None):
         self._ens = ensemble
         self._tot = (mobile, fx, fy)
-        self._tot_block = np.array((fx, fy)) if block is None else block
         self._mom = torque
 
     def set_from_engine(self, ensemble, engine, b=0):
