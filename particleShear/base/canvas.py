@@ -44,10 +44,7 @@ def check_time_step(dt, step=None):
 
 
 class NonNegative:
-    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu).
-
-    Only assignment is validated: without ``__get__`` a read is a plain instance-dict lookup.
-    """
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu); only assignment is checked."""
 
     def __set_name__(self, owner, name):
         self.name = name
@@ -135,7 +132,6 @@ class CanvasPoints:
         self.size_x = size_x
         self.size_y = size_y
         self.doDrawing = doDrawing
-        self._cap = 0
         self._n = 0
         self._set_capacity(0)
         self._sphereList = SphereList(self)
@@ -180,14 +176,13 @@ class CanvasPoints:
         self._views()
 
     def _views(self):
-        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_coord``, ``_vel``, ``_frc``."""
+        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]
         self._st = st
         self._block_version = getattr(self, "_block_version", 0) + 1     # a key of what depends on the block
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
         x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
         self._pos = st[x:x + 2]
-        self._coord = st[x:x + 3]   # x, y, phi: advanced by (xspeed, yspeed, omega)·dt in one pass
         self._vel = st[vx:vx + 3]
         self._frc = st[fx:fx + 3]
 
@@ -214,7 +209,7 @@ class CanvasPoints:
         for name in FIELDS:
             d.pop("_v_" + name, None)
         self._params_changed()
-        self._spheres_changed()
+        self._invalidate_neighbours()
         self._adopt_relations(sphere)
 
     def _adopt_relations(self, sphere):
@@ -242,9 +237,6 @@ class CanvasPoints:
                 (pt.xi_ji if p < q else pt.xi_ij)[slot] = back[-1].friction_position
         sphere.__dict__["_own_neighbors"] = pending
         self._links_changed()
-
-    def _spheres_changed(self):
-        self._invalidate_neighbours()
 
     def _invalidate_neighbours(self):
         self._pos_version += 1
@@ -297,11 +289,9 @@ class CanvasPoints:
 
     def movableSphereList(self):
         """The mobile spheres in index order (a new :class:`SphereSelection`, which the stress evaluation sums fast)."""
-        return self._mobile_selection()
-
-    def _mobile_selection(self):
-        """A new selection of the mobile spheres (not kept: keeping it bought ≈ 5 % of a step, under a cache's 10 %)."""
         return SphereSelection(self, self._mobile_mask())
+
+    _mobile_selection = movableSphereList
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres ``v += F·dt/m`` and reset their force (plate spheres take their plate's velocity).
@@ -311,14 +301,7 @@ class CanvasPoints:
         dt : float
             Time step (s).
         """
-        mob = self._mobile_mask()
-        if mob is None:
-            kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
-            return
-        vel, frc = self._vel[:2, mob], self._frc[:2, mob]
-        kick(vel, frc, self._a["m"][mob], dt)
-        self._vel[:2, mob] = vel
-        self._frc[:2, mob] = frc
+        kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
 
     #: the velocity rows a damping step scales: (vx, vy), and ω where spheres spin
     _damped_rows = 2
@@ -332,11 +315,7 @@ class CanvasPoints:
             Damping factor, 0 < f ≤ 1 (1 = no damping).
         """
         rate = getattr(self, "shear_rate", 0)
-        damp(self._vel[:self._damped_rows], self._affine_vx(rate) if rate else None, f)
-
-    def _drift(self, dt):
-        drift(self._pos, None, self._vel, dt)
-        self._pos_version += 1
+        damp(self._vel[:self._damped_rows], flow_velocity(self._pos[1], self.size_y, rate) if rate else None, f)
 
     def move(self, dt=1):
         """Drift every position by velocity × ``dt`` (with pairs: their ξ rule first, and φ turns by ω·dt).
@@ -346,7 +325,8 @@ class CanvasPoints:
         dt : float
             Time step (s).
         """
-        self._drift(dt)
+        drift(self._pos, None, self._vel, dt)
+        self._pos_version += 1
 
     def _le_shift(self):
         return 0.0
@@ -355,17 +335,12 @@ class CanvasPoints:
         """``y − Ly/2`` of every sphere (µm)."""
         return self._pos[1] - self.size_y / 2
 
-    def _affine_vx(self, rate):
-        """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s)."""
-        return flow_velocity(self._pos[1], self.size_y, rate)
-
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active).
 
         Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
         :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
         """
-        a = self._a
         if self._n:
             pos = self._pos
             Lx, Ly = self.size_x, self.size_y
@@ -380,7 +355,7 @@ class CanvasPoints:
             inside = True
         if not inside:
             self._check_positions()
-        if not inside:
+            a = self._a
             wrap(a["x"], a["y"], a["xspeed"], float(self.size_x), float(self.size_y), float(self._le_shift()),
                  float(getattr(self, "shear_rate", 0)) if self.use_lees_edwards else 0.0)
         self._pos_version += 1

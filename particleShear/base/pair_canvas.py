@@ -39,9 +39,6 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
         self._engine_pairs = None       # the step's engine rebuilds its candidates from the table
 
-    def _spheres_changed(self):
-        self._invalidate_neighbours()
-
     def move(self, dt=1):
         self._engine_move_spheres(dt)
 
@@ -72,16 +69,12 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         """``(dx, dy, ky, kx)`` of one raw difference (µm): its minimum image and the periods removed."""
         return _box.min_image(np.array([dx]), np.array([dy]), self.size_x, self.size_y, self._le_shift())
 
-    def _pair_d(self, p, q):
-        a = self._a
-        dx, dy = self._image(a["x"][q] - a["x"][p], a["y"][q] - a["y"][p])[:2]
-        return float(np.sqrt(dx * dx + dy * dy)[0])
-
     def _test_pair(self, p, q):
         """Neighbour test of one pair (the per-sphere ``test_neighbor_relation(theSphere)``)."""
         self._relations_edited()
         a = self._a
-        touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
+        dx, dy = self._image(a["x"][q] - a["x"][p], a["y"][q] - a["y"][p])[:2]
+        touching = float(np.sqrt(dx * dx + dy * dy)[0]) < a["r"][p] + a["r"][q]
         pt = self._pairs
         s = int(pt.find(p, q))
         if touching:      # a new relation starts sticking, without history (as in the step)
@@ -110,7 +103,6 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsNeighbors.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
-        self.t = 0
         self.applyingShear = False
         self.shear_rate = 0
         self.shear = 0
