@@ -29,11 +29,7 @@ class SimulationInstabilityError(RuntimeError):
 
     def __init__(self, message, step=None, phase=None, pair=None, suggested_dt=None, reason=None):
         RuntimeError.__init__(self, message)
-        self.step = step
-        self.phase = phase
-        self.pair = pair
-        self.suggested_dt = suggested_dt
-        self.reason = reason
+        vars(self).update(step=step, phase=phase, pair=pair, suggested_dt=suggested_dt, reason=reason)
 
 
 class StabilityGuard:
@@ -78,9 +74,6 @@ class StabilityGuard:
 
     def check(self, ens, step=None, phase=None, dt=None):
         """Raise :class:`SimulationInstabilityError` if ``ens`` has diverged (checked every ``interval``-th step).
-
-        Checked: finite state, peculiar kinetic energy below the bound, no transient contact closer than
-        ``min_distance_ratio·(r_i + r_j)``.
 
         Parameters
         ----------
