@@ -407,6 +407,41 @@ class CanvasPoints:
         self._invalidate_neighbours()
 
 
+def _register_filter(name, what):
+    """The ``record_*`` method ``name`` of :class:`CanvasPointsMass`, documented as recording ``what``
+    (``{}``: the quantity).
+
+    It calls the force register's method ``name`` for a mobile target only; a pair entry (``record_individual_*``)
+    is internal, external (``record_external_*``) or dropped as the step routes it (:meth:`CanvasPointsMass._entry_of`).
+    """
+    value = "force_vector" if name.endswith("force") else "moment"
+    pair = name.startswith("record_individual")
+    if pair:
+        external = "record_external_" + ("force" if value == "force_vector" else "torque")
+
+        def method(self, target, source, value):
+            where = self._entry_of(target, source)
+            if where == 1:
+                getattr(self.force_register, name)(target, source, value)
+            elif where == 2:
+                getattr(self.force_register, external)(target, value)
+    else:
+        def method(self, target, value):
+            if self.canMove(target):
+                getattr(self.force_register, name)(target, value)
+    code = method.__code__     # the value parameter under its documented name (keyword calls work as documented)
+    method.__code__ = code.replace(co_varnames=tuple(value if v == "value" else v for v in code.co_varnames))
+    method.__name__ = name
+    method.__qualname__ = "CanvasPointsMass." + name
+    quantity, kind = (("force ``(F_x, F_y)`` (mg·µm·s⁻² per m)", "sequence of float") if value == "force_vector"
+                      else ("torque (mg·µm²·s⁻² per m)", "float"))
+    rule = (".\n\nDropped on an immobile target; external from an immobile source or through the boundary." if pair
+            else " unless it is immobile.")
+    method.__doc__ = (f"Record {what.format(quantity)} ``target``{rule}\n\nParameters\n----------\n"
+                      f"{'target, source' if pair else 'target'} : Sphere\n{value} : {kind}\n")
+    return method
+
+
 class CanvasPointsMass(CanvasPoints):
     """Adds the clock ``t`` (s), the force register and momentum bookkeeping.
 
@@ -440,79 +475,14 @@ class CanvasPointsMass(CanvasPoints):
                                            np.bool_(self._through_boundary(target, source)))
         return 1 if internal else 2 if external else 0
 
-    def record_individual_internal_force(self, target, source, force_vector):
-        """Record the pair force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``source`` on ``target``.
-
-        Dropped on an immobile target; external from an immobile source or through the boundary.
-
-        Parameters
-        ----------
-        target, source : Sphere
-        force_vector : sequence of float
-        """
-        where = self._entry_of(target, source)
-        if where == 1:
-            self.force_register.record_individual_internal_force(target, source, force_vector)
-        elif where == 2:
-            self.force_register.record_external_force(target, force_vector)
-
-    def record_individual_internal_torque(self, target, source, moment):
-        """Record the pair torque ``moment`` (mg·µm²·s⁻² per m), filtered as :meth:`record_individual_internal_force`.
-
-        Parameters
-        ----------
-        target, source : Sphere
-        moment : float
-        """
-        where = self._entry_of(target, source)
-        if where == 1:
-            self.force_register.record_individual_internal_torque(target, source, moment)
-        elif where == 2:
-            self.force_register.record_external_torque(target, moment)
-
-    def record_total_particle_force(self, target, force_vector):
-        """Record the total force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        force_vector : sequence of float
-        """
-        if self.canMove(target):
-            self.force_register.record_total_particle_force(target, force_vector)
-
-    def record_external_force(self, target, force_vector):
-        """Record an external force ``(F_x, F_y)`` (mg·µm·s⁻² per m) on ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        force_vector : sequence of float
-        """
-        if self.canMove(target):
-            self.force_register.record_external_force(target, force_vector)
-
-    def record_external_torque(self, target, moment):
-        """Record an external torque (mg·µm²·s⁻² per m) on ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        moment : float
-        """
-        if self.canMove(target):
-            self.force_register.record_external_torque(target, moment)
-
-    def record_unbalanced_moment(self, target, moment):
-        """Record the net torque (mg·µm²·s⁻² per m) of ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        moment : float
-        """
-        if self.canMove(target):
-            self.force_register.record_unbalanced_moment(target, moment)
+    for _name, _what in (("record_individual_internal_force", "the pair {} of ``source`` on"),
+                         ("record_individual_internal_torque", "the pair {} of ``source`` on"),
+                         ("record_total_particle_force", "the total {} of"),
+                         ("record_external_force", "an external {} on"),
+                         ("record_external_torque", "an external {} on"),
+                         ("record_unbalanced_moment", "the net {} of")):
+        locals()[_name] = _register_filter(_name, _what)
+    del _name, _what
 
     def _torque_total(self):
         return None
