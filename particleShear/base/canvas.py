@@ -153,8 +153,7 @@ class CanvasPoints:
     def sphereList(self, spheres):
         if len(self._sphereList):
             raise TypeError("sphereList can only be assigned while the ensemble is empty")
-        for s in spheres:
-            self._sphereList.append(s)
+        self._sphereList.extend(spheres)
 
     def set_random_generator(self, rng):
         """Use ``rng`` for every random choice of this ensemble (the run seeds it).
@@ -204,8 +203,7 @@ class CanvasPoints:
         self._n = n + 1
         self._views()
         d = sphere.__dict__
-        d["_ens"] = self
-        d["_idx"] = n
+        d.update(_ens=self, _idx=n)
         for name in FIELDS:
             d.pop("_v_" + name, None)
         self._params_changed()
@@ -341,18 +339,17 @@ class CanvasPoints:
         Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
         :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
         """
-        if self._n:
-            pos = self._pos
-            Lx, Ly = self.size_x, self.size_y
-            if _min_reduce(pos, axis=None) < 0:
-                inside = False
-            elif Lx == Ly:
-                inside = _max_reduce(pos, axis=None) < Lx
-            else:
-                hi = _max_reduce(pos, axis=1)
-                inside = hi[0] < Lx and hi[1] < Ly
-        else:
+        pos = self._pos
+        Lx, Ly = self.size_x, self.size_y
+        if not self._n:
             inside = True
+        elif _min_reduce(pos, axis=None) < 0:
+            inside = False
+        elif Lx == Ly:
+            inside = _max_reduce(pos, axis=None) < Lx
+        else:
+            hi = _max_reduce(pos, axis=1)
+            inside = hi[0] < Lx and hi[1] < Ly
         if not inside:
             self._check_positions()
             a = self._a
@@ -374,8 +371,6 @@ class CanvasPoints:
         if not bad.any():
             return
         k = int(np.flatnonzero(bad)[0])
-        step = getattr(self, "step_count", None)
-        phase = getattr(self, "phase", "")
         what = ("is not finite" if not (math.isfinite(x[k]) and math.isfinite(y[k]))
                 else f"is more than {MAX_CELLS_OUTSIDE} cell lengths outside the {Lx:g} x {Ly:g} µm cell")
         a = self._a
@@ -383,7 +378,8 @@ class CanvasPoints:
                   f"({float(a['xspeed'][k])!r}, {float(a['yspeed'][k])!r}) µm/s): a diverging step or a sphere "
                   "placed outside the cell")
         guard = getattr(self, "stability_guard", None) or StabilityGuard()
-        guard._fail(self, step, phase, getattr(self, "_last_dt", None), reason, pair=(k,))
+        guard._fail(self, getattr(self, "step_count", None), getattr(self, "phase", ""),
+                    getattr(self, "_last_dt", None), reason, pair=(k,))
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
         """Place the spheres on a square grid with random jitter.
@@ -408,11 +404,10 @@ class CanvasPoints:
 
 
 def _register_filter(name, what):
-    """The ``record_*`` method ``name`` of :class:`CanvasPointsMass`, documented as recording ``what``
-    (``{}``: the quantity).
+    """The ``record_*`` method ``name`` of :class:`CanvasPointsMass`, documented as recording ``what`` ({}: quantity).
 
-    It calls the force register's method ``name`` for a mobile target only; a pair entry (``record_individual_*``)
-    is internal, external (``record_external_*``) or dropped as the step routes it (:meth:`CanvasPointsMass._entry_of`).
+    It calls the register's method ``name`` for a mobile target; a pair entry (``record_individual_*``) is routed as
+    the step routes it (:meth:`CanvasPointsMass._entry_of`): internal, external (``record_external_*``) or dropped.
     """
     value = "force_vector" if name.endswith("force") else "moment"
     pair = name.startswith("record_individual")

@@ -54,8 +54,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         pt = self._pairs
         slots = pt.relations_of(p)
         partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
-        cls = self._relation_view_class
-        return [cls(self, p, int(q)) for q in partners]
+        return [self._relation_view_class(self, p, int(q)) for q in partners]
 
     def _relations_edited(self):
         """Relations were changed outside the step: the next force phase takes the candidates from the table."""
@@ -121,14 +120,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             a = self._a
             plates_follow(a["xspeed"], a["yspeed"], ~mob, self._y_centred(), self.shear_rate * self.size_y / 2)
 
-    def transmit_lees_edwards_parameters(self, theSphere):
-        """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.
-
-        Parameters
-        ----------
-        theSphere : Sphere
-        """
-        PointLeesEdwards.transmit_lees_edwards_parameters(self, theSphere)   # the one hand-over (reads attributes only)
+    transmit_lees_edwards_parameters = PointLeesEdwards.transmit_lees_edwards_parameters   # reads attributes only
 
     def _le_shift(self):
         return self.size_y * self.shear if self.use_lees_edwards else 0.0
