@@ -88,8 +88,7 @@ class StabilityGuard:
         if step is not None and step % self.interval:
             return
         a = ens._a
-        n = len(a["x"])
-        if not n:
+        if not len(a["x"]):
             return
         rate = float(getattr(ens, "shear_rate", 0) or 0)
         self._rate_max = max(self._rate_max, abs(rate))
