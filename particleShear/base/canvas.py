@@ -44,10 +44,7 @@ def check_time_step(dt, step=None):
 
 
 class NonNegative:
-    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu).
-
-    Only assignment is validated: without ``__get__`` a read is a plain instance-dict lookup.
-    """
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu); only assignment is checked."""
 
     def __set_name__(self, owner, name):
         self.name = name
@@ -135,7 +132,6 @@ class CanvasPoints:
         self.size_x = size_x
         self.size_y = size_y
         self.doDrawing = doDrawing
-        self._cap = 0
         self._n = 0
         self._set_capacity(0)
         self._sphereList = SphereList(self)
@@ -157,8 +153,7 @@ class CanvasPoints:
     def sphereList(self, spheres):
         if len(self._sphereList):
             raise TypeError("sphereList can only be assigned while the ensemble is empty")
-        for s in spheres:
-            self._sphereList.append(s)
+        self._sphereList.extend(spheres)
 
     def set_random_generator(self, rng):
         """Use ``rng`` for every random choice of this ensemble (the run seeds it).
@@ -180,14 +175,13 @@ class CanvasPoints:
         self._views()
 
     def _views(self):
-        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_coord``, ``_vel``, ``_frc``."""
+        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]
         self._st = st
         self._block_version = getattr(self, "_block_version", 0) + 1     # a key of what depends on the block
         self._a = {name: st[k] for k, name in enumerate(FIELDS)}
         x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
         self._pos = st[x:x + 2]
-        self._coord = st[x:x + 3]   # x, y, phi: advanced by (xspeed, yspeed, omega)·dt in one pass
         self._vel = st[vx:vx + 3]
         self._frc = st[fx:fx + 3]
 
@@ -209,12 +203,11 @@ class CanvasPoints:
         self._n = n + 1
         self._views()
         d = sphere.__dict__
-        d["_ens"] = self
-        d["_idx"] = n
+        d.update(_ens=self, _idx=n)
         for name in FIELDS:
             d.pop("_v_" + name, None)
         self._params_changed()
-        self._spheres_changed()
+        self._invalidate_neighbours()
         self._adopt_relations(sphere)
 
     def _adopt_relations(self, sphere):
@@ -242,9 +235,6 @@ class CanvasPoints:
                 (pt.xi_ji if p < q else pt.xi_ij)[slot] = back[-1].friction_position
         sphere.__dict__["_own_neighbors"] = pending
         self._links_changed()
-
-    def _spheres_changed(self):
-        self._invalidate_neighbours()
 
     def _invalidate_neighbours(self):
         self._pos_version += 1
@@ -297,11 +287,9 @@ class CanvasPoints:
 
     def movableSphereList(self):
         """The mobile spheres in index order (a new :class:`SphereSelection`, which the stress evaluation sums fast)."""
-        return self._mobile_selection()
-
-    def _mobile_selection(self):
-        """A new selection of the mobile spheres (not kept: keeping it bought ≈ 5 % of a step, under a cache's 10 %)."""
         return SphereSelection(self, self._mobile_mask())
+
+    _mobile_selection = movableSphereList
 
     def do_linear_acceleration(self, dt):
         """Kick mobile spheres ``v += F·dt/m`` and reset their force (plate spheres take their plate's velocity).
@@ -311,14 +299,7 @@ class CanvasPoints:
         dt : float
             Time step (s).
         """
-        mob = self._mobile_mask()
-        if mob is None:
-            kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
-            return
-        vel, frc = self._vel[:2, mob], self._frc[:2, mob]
-        kick(vel, frc, self._a["m"][mob], dt)
-        self._vel[:2, mob] = vel
-        self._frc[:2, mob] = frc
+        kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
 
     #: the velocity rows a damping step scales: (vx, vy), and ω where spheres spin
     _damped_rows = 2
@@ -332,11 +313,7 @@ class CanvasPoints:
             Damping factor, 0 < f ≤ 1 (1 = no damping).
         """
         rate = getattr(self, "shear_rate", 0)
-        damp(self._vel[:self._damped_rows], self._affine_vx(rate) if rate else None, f)
-
-    def _drift(self, dt):
-        drift(self._pos, None, self._vel, dt)
-        self._pos_version += 1
+        damp(self._vel[:self._damped_rows], flow_velocity(self._pos[1], self.size_y, rate) if rate else None, f)
 
     def move(self, dt=1):
         """Drift every position by velocity × ``dt`` (with pairs: their ξ rule first, and φ turns by ω·dt).
@@ -346,7 +323,8 @@ class CanvasPoints:
         dt : float
             Time step (s).
         """
-        self._drift(dt)
+        drift(self._pos, None, self._vel, dt)
+        self._pos_version += 1
 
     def _le_shift(self):
         return 0.0
@@ -355,32 +333,26 @@ class CanvasPoints:
         """``y − Ly/2`` of every sphere (µm)."""
         return self._pos[1] - self.size_y / 2
 
-    def _affine_vx(self, rate):
-        """Velocity ``γ̇ (y − Ly/2)`` of the shear flow at every sphere (µm/s)."""
-        return flow_velocity(self._pos[1], self.size_y, rate)
-
     def boundary_conditions(self):
         """Wrap every sphere into the cell (Lees-Edwards shifted where active).
 
         Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
         :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
         """
-        a = self._a
-        if self._n:
-            pos = self._pos
-            Lx, Ly = self.size_x, self.size_y
-            if _min_reduce(pos, axis=None) < 0:
-                inside = False
-            elif Lx == Ly:
-                inside = _max_reduce(pos, axis=None) < Lx
-            else:
-                hi = _max_reduce(pos, axis=1)
-                inside = hi[0] < Lx and hi[1] < Ly
-        else:
+        pos = self._pos
+        Lx, Ly = self.size_x, self.size_y
+        if not self._n:
             inside = True
+        elif _min_reduce(pos, axis=None) < 0:
+            inside = False
+        elif Lx == Ly:
+            inside = _max_reduce(pos, axis=None) < Lx
+        else:
+            hi = _max_reduce(pos, axis=1)
+            inside = hi[0] < Lx and hi[1] < Ly
         if not inside:
             self._check_positions()
-        if not inside:
+            a = self._a
             wrap(a["x"], a["y"], a["xspeed"], float(self.size_x), float(self.size_y), float(self._le_shift()),
                  float(getattr(self, "shear_rate", 0)) if self.use_lees_edwards else 0.0)
         self._pos_version += 1
@@ -399,8 +371,6 @@ class CanvasPoints:
         if not bad.any():
             return
         k = int(np.flatnonzero(bad)[0])
-        step = getattr(self, "step_count", None)
-        phase = getattr(self, "phase", "")
         what = ("is not finite" if not (math.isfinite(x[k]) and math.isfinite(y[k]))
                 else f"is more than {MAX_CELLS_OUTSIDE} cell lengths outside the {Lx:g} x {Ly:g} µm cell")
         a = self._a
@@ -408,7 +378,8 @@ class CanvasPoints:
                   f"({float(a['xspeed'][k])!r}, {float(a['yspeed'][k])!r}) µm/s): a diverging step or a sphere "
                   "placed outside the cell")
         guard = getattr(self, "stability_guard", None) or StabilityGuard()
-        guard._fail(self, step, phase, getattr(self, "_last_dt", None), reason, pair=(k,))
+        guard._fail(self, getattr(self, "step_count", None), getattr(self, "phase", ""),
+                    getattr(self, "_last_dt", None), reason, pair=(k,))
 
     def regular_sphere_distribution(self, rand_fraction=0.5):
         """Place the spheres on a square grid with random jitter.
@@ -430,6 +401,40 @@ class CanvasPoints:
         a["x"][:] = ((k % cols) + 0.5 + jitter[0] * 1.0) * sx % self.size_x
         a["y"][:] = ((k // cols) + 0.5 + jitter[1] * 1.0) * sy % self.size_y
         self._invalidate_neighbours()
+
+
+def _register_filter(name, what):
+    """The ``record_*`` method ``name`` of :class:`CanvasPointsMass`, documented as recording ``what`` ({}: quantity).
+
+    It calls the register's method ``name`` for a mobile target; a pair entry (``record_individual_*``) is routed as
+    the step routes it (:meth:`CanvasPointsMass._entry_of`): internal, external (``record_external_*``) or dropped.
+    """
+    value = "force_vector" if name.endswith("force") else "moment"
+    pair = name.startswith("record_individual")
+    if pair:
+        external = "record_external_" + ("force" if value == "force_vector" else "torque")
+
+        def method(self, target, source, value):
+            where = self._entry_of(target, source)
+            if where == 1:
+                getattr(self.force_register, name)(target, source, value)
+            elif where == 2:
+                getattr(self.force_register, external)(target, value)
+    else:
+        def method(self, target, value):
+            if self.canMove(target):
+                getattr(self.force_register, name)(target, value)
+    code = method.__code__     # the value parameter under its documented name (keyword calls work as documented)
+    method.__code__ = code.replace(co_varnames=tuple(value if v == "value" else v for v in code.co_varnames))
+    method.__name__ = name
+    method.__qualname__ = "CanvasPointsMass." + name
+    quantity, kind = (("force ``(F_x, F_y)`` (mg·µm·s⁻² per m)", "sequence of float") if value == "force_vector"
+                      else ("torque (mg·µm²·s⁻² per m)", "float"))
+    rule = (".\n\nDropped on an immobile target; external from an immobile source or through the boundary." if pair
+            else " unless it is immobile.")
+    method.__doc__ = (f"Record {what.format(quantity)} ``target``{rule}\n\nParameters\n----------\n"
+                      f"{'target, source' if pair else 'target'} : Sphere\n{value} : {kind}\n")
+    return method
 
 
 class CanvasPointsMass(CanvasPoints):
@@ -465,79 +470,14 @@ class CanvasPointsMass(CanvasPoints):
                                            np.bool_(self._through_boundary(target, source)))
         return 1 if internal else 2 if external else 0
 
-    def record_individual_internal_force(self, target, source, force_vector):
-        """Record the pair force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``source`` on ``target``.
-
-        Dropped on an immobile target; external from an immobile source or through the boundary.
-
-        Parameters
-        ----------
-        target, source : Sphere
-        force_vector : sequence of float
-        """
-        where = self._entry_of(target, source)
-        if where == 1:
-            self.force_register.record_individual_internal_force(target, source, force_vector)
-        elif where == 2:
-            self.force_register.record_external_force(target, force_vector)
-
-    def record_individual_internal_torque(self, target, source, moment):
-        """Record the pair torque ``moment`` (mg·µm²·s⁻² per m), filtered as :meth:`record_individual_internal_force`.
-
-        Parameters
-        ----------
-        target, source : Sphere
-        moment : float
-        """
-        where = self._entry_of(target, source)
-        if where == 1:
-            self.force_register.record_individual_internal_torque(target, source, moment)
-        elif where == 2:
-            self.force_register.record_external_torque(target, moment)
-
-    def record_total_particle_force(self, target, force_vector):
-        """Record the total force ``(F_x, F_y)`` (mg·µm·s⁻² per m) of ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        force_vector : sequence of float
-        """
-        if self.canMove(target):
-            self.force_register.record_total_particle_force(target, force_vector)
-
-    def record_external_force(self, target, force_vector):
-        """Record an external force ``(F_x, F_y)`` (mg·µm·s⁻² per m) on ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        force_vector : sequence of float
-        """
-        if self.canMove(target):
-            self.force_register.record_external_force(target, force_vector)
-
-    def record_external_torque(self, target, moment):
-        """Record an external torque (mg·µm²·s⁻² per m) on ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        moment : float
-        """
-        if self.canMove(target):
-            self.force_register.record_external_torque(target, moment)
-
-    def record_unbalanced_moment(self, target, moment):
-        """Record the net torque (mg·µm²·s⁻² per m) of ``target`` unless it is immobile.
-
-        Parameters
-        ----------
-        target : Sphere
-        moment : float
-        """
-        if self.canMove(target):
-            self.force_register.record_unbalanced_moment(target, moment)
+    for _name, _what in (("record_individual_internal_force", "the pair {} of ``source`` on"),
+                         ("record_individual_internal_torque", "the pair {} of ``source`` on"),
+                         ("record_total_particle_force", "the total {} of"),
+                         ("record_external_force", "an external {} on"),
+                         ("record_external_torque", "an external {} on"),
+                         ("record_unbalanced_moment", "the net {} of")):
+        locals()[_name] = _register_filter(_name, _what)
+    del _name, _what
 
     def _torque_total(self):
         return None

@@ -192,11 +192,9 @@ class CanvasPointsBasicElasticityLeesEdwards(CanvasPointsBasicElasticity):
 
     def setShearInSpheres(self):
         """Does nothing (1.0.2 API): spheres read γ from the ensemble."""
-        pass
 
     def setShearRateInSpheres(self):
         """Does nothing (1.0.2 API): spheres read γ̇ from the ensemble."""
-        pass
 
     def adjust_sphere_speed_to_shear_rate_change(self, delta_shear_rate):
         """Add the change of the affine flow to every velocity (and −Δγ̇/2 to every spin).

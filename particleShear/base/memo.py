@@ -49,8 +49,7 @@ class Memo:
         ----------
         name : str
         """
-        entry = self._values.pop(name, None)
-        return None if entry is None else entry[1]
+        return self._values.pop(name, (None, None))[1]
 
     def peek(self, name):
         """Return the value kept under ``name`` (whatever its key), or None: for inspection only.
@@ -59,5 +58,4 @@ class Memo:
         ----------
         name : str
         """
-        entry = self._values.get(name)
-        return None if entry is None else entry[1]
+        return self._values.get(name, (None, None))[1]

@@ -39,9 +39,6 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
         self._engine_pairs = None       # the step's engine rebuilds its candidates from the table
 
-    def _spheres_changed(self):
-        self._invalidate_neighbours()
-
     def move(self, dt=1):
         self._engine_move_spheres(dt)
 
@@ -57,8 +54,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         pt = self._pairs
         slots = pt.relations_of(p)
         partners = np.where(pt.i[slots] == p, pt.j[slots], pt.i[slots])
-        cls = self._relation_view_class
-        return [cls(self, p, int(q)) for q in partners]
+        return [self._relation_view_class(self, p, int(q)) for q in partners]
 
     def _relations_edited(self):
         """Relations were changed outside the step: the next force phase takes the candidates from the table."""
@@ -72,16 +68,12 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         """``(dx, dy, ky, kx)`` of one raw difference (µm): its minimum image and the periods removed."""
         return _box.min_image(np.array([dx]), np.array([dy]), self.size_x, self.size_y, self._le_shift())
 
-    def _pair_d(self, p, q):
-        a = self._a
-        dx, dy = self._image(a["x"][q] - a["x"][p], a["y"][q] - a["y"][p])[:2]
-        return float(np.sqrt(dx * dx + dy * dy)[0])
-
     def _test_pair(self, p, q):
         """Neighbour test of one pair (the per-sphere ``test_neighbor_relation(theSphere)``)."""
         self._relations_edited()
         a = self._a
-        touching = self._pair_d(p, q) < a["r"][p] + a["r"][q]
+        dx, dy = self._image(a["x"][q] - a["x"][p], a["y"][q] - a["y"][p])[:2]
+        touching = float(np.sqrt(dx * dx + dy * dy)[0]) < a["r"][p] + a["r"][q]
         pt = self._pairs
         s = int(pt.find(p, q))
         if touching:      # a new relation starts sticking, without history (as in the step)
@@ -110,7 +102,6 @@ class CanvasPointsShear(CanvasPointsNeighbors):
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsNeighbors.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
-        self.t = 0
         self.applyingShear = False
         self.shear_rate = 0
         self.shear = 0
@@ -129,14 +120,7 @@ class CanvasPointsShear(CanvasPointsNeighbors):
             a = self._a
             plates_follow(a["xspeed"], a["yspeed"], ~mob, self._y_centred(), self.shear_rate * self.size_y / 2)
 
-    def transmit_lees_edwards_parameters(self, theSphere):
-        """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.
-
-        Parameters
-        ----------
-        theSphere : Sphere
-        """
-        PointLeesEdwards.transmit_lees_edwards_parameters(self, theSphere)   # the one hand-over (reads attributes only)
+    transmit_lees_edwards_parameters = PointLeesEdwards.transmit_lees_edwards_parameters   # reads attributes only
 
     def _le_shift(self):
         return self.size_y * self.shear if self.use_lees_edwards else 0.0

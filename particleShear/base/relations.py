@@ -33,12 +33,8 @@ class RelationView:
     """Mixin: the relation ``owner → partner`` in the ensemble's pair table, looked up at every access."""
 
     def _bind(self, ensemble, owner, partner):
-        d = self.__dict__
-        d["_ens"] = ensemble
-        d["_owner"] = owner
-        d["_partner"] = partner
-        d["graphical_line_index"] = -1
-        d["linking_line_index"] = -1
+        self.__dict__.update(_ens=ensemble, _owner=owner, _partner=partner, graphical_line_index=-1,
+                             linking_line_index=-1)
 
     def _slot(self):
         ens = self.__dict__["_ens"]

@@ -29,11 +29,7 @@ class SimulationInstabilityError(RuntimeError):
 
     def __init__(self, message, step=None, phase=None, pair=None, suggested_dt=None, reason=None):
         RuntimeError.__init__(self, message)
-        self.step = step
-        self.phase = phase
-        self.pair = pair
-        self.suggested_dt = suggested_dt
-        self.reason = reason
+        vars(self).update(step=step, phase=phase, pair=pair, suggested_dt=suggested_dt, reason=reason)
 
 
 class StabilityGuard:
@@ -79,9 +75,6 @@ class StabilityGuard:
     def check(self, ens, step=None, phase=None, dt=None):
         """Raise :class:`SimulationInstabilityError` if ``ens`` has diverged (checked every ``interval``-th step).
 
-        Checked: finite state, peculiar kinetic energy below the bound, no transient contact closer than
-        ``min_distance_ratio·(r_i + r_j)``.
-
         Parameters
         ----------
         ens : canvas
@@ -95,8 +88,7 @@ class StabilityGuard:
         if step is not None and step % self.interval:
             return
         a = ens._a
-        n = len(a["x"])
-        if not n:
+        if not len(a["x"]):
             return
         rate = float(getattr(ens, "shear_rate", 0) or 0)
         self._rate_max = max(self._rate_max, abs(rate))
