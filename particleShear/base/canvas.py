@@ -6,6 +6,7 @@ Lees-Edwards shear and plates, central forces and the step, shear-rate changes, 
 __docformat__ = "numpy"
 
 import math
+from operator import attrgetter
 
 import numpy as np
 
@@ -409,23 +410,36 @@ def _register_filter(name, what):
     It calls the register's method ``name`` for a mobile target; a pair entry (``record_individual_*``) is routed as
     the step routes it (:meth:`CanvasPointsMass._entry_of`): internal, external (``record_external_*``) or dropped.
     """
-    value = "force_vector" if name.endswith("force") else "moment"
+    force = name.endswith("force")
     pair = name.startswith("record_individual")
-    if pair:
-        external = "record_external_" + ("force" if value == "force_vector" else "torque")
+    register = attrgetter(name)
+    external = attrgetter("record_external_" + ("force" if force else "torque"))
 
-        def method(self, target, source, value):
-            where = self._entry_of(target, source)
-            if where == 1:
-                getattr(self.force_register, name)(target, source, value)
-            elif where == 2:
-                getattr(self.force_register, external)(target, value)
+    def route(self, target, source, value):
+        where = self._entry_of(target, source)
+        if where == 1:
+            register(self.force_register)(target, source, value)
+        elif where == 2:
+            external(self.force_register)(target, value)
+
+    def filtered(self, target, value):
+        if self.canMove(target):
+            register(self.force_register)(target, value)
+
+    # the value parameter under its documented name (keyword calls work as documented)
+    if pair and force:
+        def method(self, target, source, force_vector):
+            route(self, target, source, force_vector)
+    elif pair:
+        def method(self, target, source, moment):
+            route(self, target, source, moment)
+    elif force:
+        def method(self, target, force_vector):
+            filtered(self, target, force_vector)
     else:
-        def method(self, target, value):
-            if self.canMove(target):
-                getattr(self.force_register, name)(target, value)
-    code = method.__code__     # the value parameter under its documented name (keyword calls work as documented)
-    method.__code__ = code.replace(co_varnames=tuple(value if v == "value" else v for v in code.co_varnames))
+        def method(self, target, moment):
+            filtered(self, target, moment)
+    value = "force_vector" if force else "moment"
     method.__name__ = name
     method.__qualname__ = "CanvasPointsMass." + name
     quantity, kind = (("force ``(F_x, F_y)`` (mg·µm·s⁻² per m)", "sequence of float") if value == "force_vector"
@@ -486,7 +500,7 @@ class CanvasPointsMass(CanvasPoints):
         """Store the accumulated force of every mobile sphere (and torques, where spin exists)."""
         tot = self._frc.copy()
         self.force_register._set_totals(self, self._mobile_mask(), tot[0], tot[1],
-                                        tot[2] if self._torque_total() is not None else None, tot)
+                                        tot[2] if self._torque_total() is not None else None)
 
     def particle_info(self):
         return "Spheres with mass"

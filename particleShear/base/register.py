@@ -156,7 +156,7 @@ class Force_register:
             return None
         return ph
 
-    def _set_totals(self, ensemble, mobile, fx, fy, torque, block=None):
+    def _set_totals(self, ensemble, mobile, fx, fy, torque):
         self._ens = ensemble
         self._tot = (mobile, fx, fy)
         self._mom = torque
@@ -184,7 +184,7 @@ class Force_register:
         # the register's pair vectors are those of the force phase, while the spheres have not moved
         self._phase = EngineForcePhase(t, N, b, spin, ensemble._pos_version if engine.g is not None else -1,
                                        engine.s.B == 1 and engine.backend.host)
-        self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None, tot)
+        self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None)
         return True
 
     # -- manual API (reference signatures) ----------------------------------------------------
