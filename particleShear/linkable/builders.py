@@ -45,16 +45,9 @@ def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversa
     tau, bf, rts, A, rv = (time_constant, bimodal_factor, relative_transversal_link_strength,
                            anticipated_amplitude, relative_viscosity)
     dt = 0.1 * tau / bf
-    if mu <= 1 or rts < 1:
-        dt = dt / 2
-    if A <= 0.05:
-        dt = dt / 2
-    if mu <= 0.1 or rts < 0.1:
-        dt = dt / 2
-    if A <= 0.005:
-        dt = dt / 2
-    if A >= 0.5:
-        dt = dt / 2
+    for halve in (mu <= 1 or rts < 1, A <= 0.05, mu <= 0.1 or rts < 0.1, A <= 0.005, A >= 0.5):
+        if halve:
+            dt = dt / 2
     dt_max = 0.25 * tau / bf
     if (rv <= 0.1 and mu < 0.1) or rts < 0.1 or rts > 5:
         dt_max = 0.125 * tau / bf
@@ -298,10 +291,9 @@ def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus
         ens.dt = dt
         ens.dt_max = dt_max
         yield Relaxation(ens, int(200 / R) if prc == 1 else int(100 / R))
-        if A <= 0.01 and prc == 1:
-            yield Relaxation(ens, int(200 / R))
-        if A <= 0.001 and prc == 1:
-            yield Relaxation(ens, int(200 / R))
+        for threshold in (0.01, 0.001):
+            if A <= threshold and prc == 1:
+                yield Relaxation(ens, int(200 / R))
 
     if do_permanent_links:
         _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose)

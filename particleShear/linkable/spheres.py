@@ -131,9 +131,6 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         if do_backlink:
             theSphere.cut_permanent_link(self, do_backlink=False)
 
-    def _is_physical(self, theSphere):
-        return bool(inside_half_cell(self.x - theSphere.x, self.y - theSphere.y, self.size_x, self.size_y))
-
     def permanentlyConnectedSpheres(self, physical_neighbors_only=True):
         """Partners bonded to this sphere (list, in relation-list order).
 
@@ -146,7 +143,8 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         for rel in self.neighbors:
             if rel.interface_type == "permanent":
                 s = rel.theSphere
-                if not physical_neighbors_only or self._is_physical(s):
+                if not physical_neighbors_only or inside_half_cell(self.x - s.x, self.y - s.y, self.size_x,
+                                                                   self.size_y):
                     out.append(s)
         return out
 
