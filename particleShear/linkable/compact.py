@@ -73,7 +73,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1, dt=1, dt_max=10, theTkSimulation=False,
                  avoid_horizontal_angle_degree=0, rng=None):
         CanvasPointsLinkable.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m, k_t, nu_t, mu)
-        in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)  # 90: none left
+        in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         if rng is not None:
             self.set_random_generator(np.random.default_rng(rng))
@@ -139,7 +139,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return component_labels(self._n, i, j)
 
     def _particles_from_labels(self, lab):
-        """Lists of spheres per component, ordered by the lowest sphere index (spheres in index order)."""
         order = np.argsort(lab, kind="stable")
         cuts = np.flatnonzero(np.diff(lab[order])) + 1
         sl = self.sphereList

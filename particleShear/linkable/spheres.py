@@ -21,13 +21,10 @@ class neighbor_relation_linkable(neighbor_relation):
 
     Parameters
     ----------
-    friction_position : float
-        Tangential displacement ξ (µm).
-    interface_type : str
-        ``"stick"``, ``"slip"`` or ``"permanent"``.
-    theSphere : Sphere
-    graphical_line_index, linking_line_index : int, optional
-        Canvas items of the drawn contact and bond lines (-1: none).
+    friction_position, interface_type, theSphere, graphical_line_index
+        As for :class:`~particleShear.base.relations.neighbor_relation`.
+    linking_line_index : int, optional
+        Canvas item of the drawn bond line (-1: none).
     """
 
     def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1,
@@ -71,6 +68,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
     permanent_ratio_central = ArrayField(1.0, param=True)
     permanent_ratio_tangential = ArrayField(1.0, param=True)
     keep_viscosity_coefficients_constant = ArrayField(1.0, param=True, flag=True)
+    _bond_colour = None   # colour of a bond's line (None: the locked colour)
 
     def _new_relation(self, theSphere):
         return neighbor_relation_linkable(0, "stick", theSphere)
@@ -197,13 +195,16 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return self._tangential_part(theSphere, True, self._relation(theSphere).friction_position, k_t=k_t)
 
     def contactLineColor(self, interface_type):
-        """Colour of the line drawn for a relation: locked for stick contacts and bonds, else slip.
+        """Colour of the line drawn for a relation: locked for stick contacts, slip for slipping ones; for bonds
+        locked, or dark orange in :class:`SphereLinkableAdjustableInterfaceStrength`.
 
         Parameters
         ----------
         interface_type : str
         """
         cfg = self.graphical_output_configuration
+        if interface_type == "permanent" and self._bond_colour:
+            return self._bond_colour
         if interface_type in ("stick", "permanent"):
             return cfg.color_interface_locked
         return cfg.color_interface_slip
@@ -222,6 +223,8 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
     keep_viscosity_coefficients_constant : bool, optional
     """
 
+    _bond_colour = "darkorange"
+
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
                  force_register=None, size_x=500, size_y=500, permanent_ratio_central=1,
                  permanent_ratio_tangential=1, keep_viscosity_coefficients_constant=True):
@@ -232,20 +235,6 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
         self.permanent_ratio_central = permanent_ratio_central
         self.permanent_ratio_tangential = permanent_ratio_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
-
-    def contactLineColor(self, interface_type):
-        """Colour of the line drawn for a relation: locked (stick), dark orange (bond) or slip.
-
-        Parameters
-        ----------
-        interface_type : str
-        """
-        cfg = self.graphical_output_configuration
-        if interface_type == "stick":
-            return cfg.color_interface_locked
-        if interface_type == "permanent":
-            return "darkorange"
-        return cfg.color_interface_slip
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
