@@ -173,7 +173,9 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
 
     def _index_of(self, theSphere):
         d = theSphere.__dict__
-        return d["_idx"] if d.get("_ens") is self else None
+        if d.get("_ens") is not self:
+            return None
+        return d["_idx"]
 
     def findParticle(self, theSphere):
         """The particle of ``particles`` that contains ``theSphere``, or False.

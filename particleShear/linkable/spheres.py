@@ -10,7 +10,7 @@ from ..engine import callbacks as _engine_callbacks
 from ..engine.box import inside_half_cell
 from ..base.points import ArrayField, _one
 from ..checks import non_negative
-from ..base.relations import RelationView, neighbor_relation
+from ..base.relations import RelationView, _BaseRelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
 
 __all__ = ["neighbor_relation_linkable", "SphereLinkable", "SphereLinkableAdjustableInterfaceStrength"]
@@ -43,8 +43,7 @@ class LinkableRelationView(RelationView, neighbor_relation_linkable):
     owner, partner : int
     """
 
-    def __init__(self, ensemble, owner, partner):
-        self._bind(ensemble, owner, partner)
+    __init__ = _BaseRelationView.__init__
 
 
 def _same_ensemble(a, b):
