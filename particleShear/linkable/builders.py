@@ -20,23 +20,15 @@ __all__ = ["EnsembleCompactParticlesFromModelParameters",
 MAX_CUT_ATTEMPTS = 1000
 
 
-def _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
-                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
-                     relative_transversal_link_strength, avoid_horizontal_angle_degree):
-    positive("size_x", size_x)
-    positive("size_y", size_y)
-    integer("N", N, 2)
-    positive("packing_fraction", packing_fraction)
-    non_negative("mu", mu)
-    positive("Young_modulus_spheres", Young_modulus_spheres)
-    positive("density", density)
-    positive("bimodal_factor", bimodal_factor)
-    integer("cut_lines", cut_lines, 0)
-    non_negative("relative_viscosity", relative_viscosity)
-    finite("central_repulsion_coefficient", central_repulsion_coefficient)
-    positive("anticipated_amplitude", anticipated_amplitude)
-    non_negative("relative_transversal_link_strength", relative_transversal_link_strength)
-    in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)
+#: the builders' checks, in order: (check, parameter, limits...) (particleShear.checks)
+_CHECKS = ((positive, "size_x"), (positive, "size_y"), (integer, "N", 2), (positive, "packing_fraction"),
+           (non_negative, "mu"), (positive, "Young_modulus_spheres"), (positive, "density"),
+           (positive, "bimodal_factor"), (integer, "cut_lines", 0), (non_negative, "relative_viscosity"),
+           (finite, "central_repulsion_coefficient"), (positive, "anticipated_amplitude"),
+           (non_negative, "relative_transversal_link_strength"),
+           (in_range, "avoid_horizontal_angle_degree", 0, 90, False, True),
+           (positive, "interface_reenforcement_central"), (positive, "interface_reenforcement_tangential"),
+           (in_range, "remove_link_fraction", 0, 1), (non_negative, "edge_fuzziness"))
 
 
 def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
@@ -53,16 +45,9 @@ def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversa
     tau, bf, rts, A, rv = (time_constant, bimodal_factor, relative_transversal_link_strength,
                            anticipated_amplitude, relative_viscosity)
     dt = 0.1 * tau / bf
-    if mu <= 1 or rts < 1:
-        dt = dt / 2
-    if A <= 0.05:
-        dt = dt / 2
-    if mu <= 0.1 or rts < 0.1:
-        dt = dt / 2
-    if A <= 0.005:
-        dt = dt / 2
-    if A >= 0.5:
-        dt = dt / 2
+    for halve in (mu <= 1 or rts < 1, A <= 0.05, mu <= 0.1 or rts < 0.1, A <= 0.005, A >= 0.5):
+        if halve:
+            dt = dt / 2
     dt_max = 0.25 * tau / bf
     if (rv <= 0.1 and mu < 0.1) or rts < 0.1 or rts > 5:
         dt_max = 0.125 * tau / bf
@@ -75,47 +60,30 @@ def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversa
     return dt, dt_max
 
 
-def _avoid_flag(avoid, doCutByTriangulation, cut_lines, verbose):
-    """Height checks only make sense when cutting can produce separate particles (first step of the builders)."""
-    if avoid and ((doCutByTriangulation and cut_lines <= 1) or (not doCutByTriangulation and cut_lines <= 0)):
-        if verbose:
-            logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines=" + str(cut_lines)
-                  + " the gel is not cut into separate particles")
-        return False
-    return avoid
-
-
-def _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness):
-    if doCutByTriangulation:
-        ens.cutByTriangulation(cut_lines, edge_fuzziness)
-    else:
-        for _ in range(int(cut_lines)):
-            ens.cutRandomLine()
-
-
 def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose):
     """Crosslink all contacts and cut; re-cut while a particle spans > 0.9·Ly (at most MAX_CUT_ATTEMPTS)."""
-    ens.makeAllLinksPermanent()
-    if cut_top_bottom:
-        ens.cutTopBottomEdge()
-    _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness)
-    if not avoid:
-        return
-    h = ens.maximal_particle_height()
-    attempts = 1
-    while h > 0.9 * ens.size_y:
+    attempts = 0
+    while True:
+        ens.makeAllLinksPermanent()
+        if cut_top_bottom:
+            ens.cutTopBottomEdge()
+        if doCutByTriangulation:
+            ens.cutByTriangulation(cut_lines, edge_fuzziness)
+        else:
+            for _ in range(int(cut_lines)):
+                ens.cutRandomLine()
+        attempts += 1
+        if not avoid:
+            return
+        h = ens.maximal_particle_height()
+        if not h > 0.9 * ens.size_y:
+            return
         if attempts >= MAX_CUT_ATTEMPTS:
             raise RuntimeError(f"no cut without a height-spanning particle found in {attempts} attempts "
                                f"(cut_lines={cut_lines}); use more cuts or avoid_height_spanning_particles=False")
         if verbose:
             logging.getLogger(__name__).info("Height spanning particle (height " + str(h) + "), cutting again")
         ens.particles = []
-        ens.makeAllLinksPermanent()
-        if cut_top_bottom:
-            ens.cutTopBottomEdge()
-        _cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness)
-        h = ens.maximal_particle_height()
-        attempts += 1
 
 
 class Relaxation:
@@ -239,8 +207,7 @@ def EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters(
     RuntimeError
         If no cut without a height-spanning particle is found in :data:`MAX_CUT_ATTEMPTS` attempts.
     """
-    arguments = dict(locals())     # every parameter, as passed (nothing else is defined yet)
-    return relax_constitution(adjustable_interface_constitution(**arguments))
+    return relax_constitution(adjustable_interface_constitution(**locals()))   # every parameter, as passed
 
 
 def adjustable_interface_constitution(
@@ -264,21 +231,33 @@ def adjustable_interface_constitution(
     Relaxation
         The next block (the ensemble's ``dt``, ``dt_max`` and ``mu`` set for it).
     """
-    _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
-                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
-                     relative_transversal_link_strength, avoid_horizontal_angle_degree)
-    positive("interface_reenforcement_central", interface_reenforcement_central)
-    positive("interface_reenforcement_tangential", interface_reenforcement_tangential)
-    in_range("remove_link_fraction", remove_link_fraction, 0, 1)
-    non_negative("edge_fuzziness", edge_fuzziness)
+    return (yield from _constitution(False, **locals()))
 
+
+def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
+                  cut_lines, do_permanent_links, theTk, do_pre_equilibration, relative_viscosity,
+                  central_repulsion_coefficient, anticipated_amplitude, relative_transversal_link_strength,
+                  avoid_horizontal_angle_degree, avoid_height_spanning_particles, doCutByTriangulation, doDrawing,
+                  do_debug, rng, verbose, interface_reenforcement_central=1, interface_reenforcement_tangential=1,
+                  keep_viscosity_coefficients_constant=True, cut_top_bottom=True, remove_link_fraction=0,
+                  edge_fuzziness=0):
+    """Both builders' constitution; ``legacy``: that of :func:`EnsembleCompactParticlesFromModelParameters`
+    (the parameters it lacks at their defaults, no halved step when dense, 25 steps per level after the cut)."""
+    arguments = locals()
+    for check, name, *limits in _CHECKS:
+        check(name, arguments[name], *limits)
     N, cut_lines = int(N), int(cut_lines)
     R = 10 if do_debug else 1
     irc, irt = interface_reenforcement_central, interface_reenforcement_tangential
     rv, rts, A, bf = relative_viscosity, relative_transversal_link_strength, anticipated_amplitude, bimodal_factor
     prc = 1 / irc
     prt = 1 / irt
-    avoid = _avoid_flag(avoid_height_spanning_particles, doCutByTriangulation, cut_lines, verbose)
+    avoid = avoid_height_spanning_particles
+    if avoid and cut_lines <= (1 if doCutByTriangulation else 0):   # no separate particles: no height to check
+        if verbose:
+            logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines="
+                                             + str(cut_lines) + " the gel is not cut into separate particles")
+        avoid = False
 
     model = particle_shear_model_parameters(size_x, size_y, N, packing_fraction, Young_modulus_spheres, density,
                                             bimodal_factor=1)
@@ -291,10 +270,10 @@ def adjustable_interface_constitution(
     if not keep_viscosity_coefficients_constant:
         nu_ens = nu_ens * irc
         nu_t_ens = nu_t_ens * irt
-    ens = EnsembleCompactParticlesAdjustableInterfaceStrength(
-        size_x, size_y, N, packing_fraction, False, doDrawing, k_ens, nu_ens, model.m, bf, k_t_ens, nu_t_ens, mu,
-        dt, dt_max, False, avoid_horizontal_angle_degree, prc, prt, keep_viscosity_coefficients_constant,
-        rng=np.random.default_rng(rng))
+    cls, extra = ((EnsembleCompactParticles, ()) if legacy else (EnsembleCompactParticlesAdjustableInterfaceStrength,
+                                                                 (prc, prt, keep_viscosity_coefficients_constant)))
+    ens = cls(size_x, size_y, N, packing_fraction, False, doDrawing, k_ens, nu_ens, model.m, bf, k_t_ens, nu_t_ens,
+              mu, dt, dt_max, False, avoid_horizontal_angle_degree, *extra, rng=np.random.default_rng(rng))
     ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
     ens.avoid_height_spanning_particles = avoid
     ens.model = model
@@ -303,7 +282,7 @@ def adjustable_interface_constitution(
     if do_pre_equilibration:
         ens.dt = dt
         ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
-        if packing_fraction > 2:
+        if packing_fraction > 2 and not legacy:
             ens.dt_max = ens.dt_max / 2
         n1 = int(300 / R) if prc == 1 else int(100 / R)
         yield Relaxation(ens, n1)
@@ -312,23 +291,26 @@ def adjustable_interface_constitution(
         ens.dt = dt
         ens.dt_max = dt_max
         yield Relaxation(ens, int(200 / R) if prc == 1 else int(100 / R))
-        if A <= 0.01 and prc == 1:
-            yield Relaxation(ens, int(200 / R))
-        if A <= 0.001 and prc == 1:
-            yield Relaxation(ens, int(200 / R))
+        for threshold in (0.01, 0.001):
+            if A <= threshold and prc == 1:
+                yield Relaxation(ens, int(200 / R))
 
     if do_permanent_links:
         _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose)
-        if cut_top_bottom:
+        if cut_top_bottom and not legacy:
             ens.cut_top_bottom = True
         if remove_link_fraction > 0:
             ens.remove_non_essential_links(remove_link_fraction, True)
             if verbose:
-                logging.getLogger(__name__).info("Actual fraction of removed non-essential links: " + str(ens.removed_fraction))
+                logging.getLogger(__name__).info("Actual fraction of removed non-essential links: "
+                                                 + str(ens.removed_fraction))
         ens.join_isolated_spheres()
         ens.dt_max = min(2 * ens.dt, ens.dt_max)
         if rts > 5:
             ens.dt_max = ens.dt_max / 2
+        if legacy:
+            yield Relaxation(ens, 25)   # free_pre_equilibration() with its default N
+            return ens
         yield Relaxation(ens, int(300 / R))
         n = int(150 / R)
         if A < 0.1:
@@ -381,44 +363,4 @@ def EnsembleCompactParticlesFromModelParameters(
     anticipated_amplitude, do_pre_equilibration, do_debug, do_permanent_links, doCutByTriangulation
     avoid_horizontal_angle_degree, avoid_height_spanning_particles, theTk, rng, verbose
     """
-    _validate_common(size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
-                     cut_lines, relative_viscosity, central_repulsion_coefficient, anticipated_amplitude,
-                     relative_transversal_link_strength, avoid_horizontal_angle_degree)
-    N, cut_lines = int(N), int(cut_lines)
-    R = 10 if do_debug else 1
-    rv, rts, A, bf = relative_viscosity, relative_transversal_link_strength, anticipated_amplitude, bimodal_factor
-    avoid = _avoid_flag(avoid_height_spanning_particles, doCutByTriangulation, cut_lines, verbose)
-
-    model = particle_shear_model_parameters(size_x, size_y, N, packing_fraction, Young_modulus_spheres, density,
-                                            bimodal_factor=1)
-    tau, k = model.time_constant, model.k
-    dt, dt_max = time_steps_from_model(tau, bf, mu, rts, A, rv)
-    ens = EnsembleCompactParticles(size_x, size_y, N, packing_fraction, False, doDrawing, k, rv * k * tau,
-                                   model.m, bf, k * rts, rv * k * tau * rts, mu, dt, dt_max, False,
-                                   avoid_horizontal_angle_degree, rng=np.random.default_rng(rng))
-    ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
-    ens.avoid_height_spanning_particles = avoid
-    ens.model = model
-
-    if do_pre_equilibration:
-        ens.dt = dt
-        ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
-        Relaxation(ens, int(300 / R)).run()
-        if A <= 0.01 or rts < 0.1:
-            Relaxation(ens, int(300 / R)).run()
-        ens.dt = dt
-        ens.dt_max = dt_max
-        Relaxation(ens, int(200 / R)).run()
-        if A <= 0.01:
-            Relaxation(ens, int(200 / R)).run()
-        if A <= 0.001:
-            Relaxation(ens, int(200 / R)).run()
-
-    if do_permanent_links:
-        _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, 0, True, avoid, verbose)
-        ens.join_isolated_spheres()
-        ens.dt_max = min(2 * ens.dt, ens.dt_max)
-        if rts > 5:
-            ens.dt_max = ens.dt_max / 2
-        Relaxation(ens, 25).run()   # free_pre_equilibration() with its default N
-    return ens
+    return relax_constitution(_constitution(True, **locals()))

@@ -44,22 +44,20 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         slots = pt.ensure(i, j)
         r = self._a["r"]
         pt.open_relations(slots)
-        pt.state[slots] = PERMANENT
-        pt.d_eq[slots] = r[pt.i[slots]] + r[pt.j[slots]]
+        self._set_bonds(slots, PERMANENT, r[pt.i[slots]] + r[pt.j[slots]])
+
+    def _set_bonds(self, slots, state, d_eq):
+        """Pairs ``slots`` to ``state`` with ``d_eq`` and ξ = 0; drops the cached bond constants and grid."""
+        pt = self._pairs
+        pt.state[slots] = state
+        pt.d_eq[slots] = d_eq
         pt.xi_ij[slots] = 0.0
         pt.xi_ji[slots] = 0.0
         self._links_changed()
         self._g = None
 
     def _cut_slots(self, slots):
-        pt = self._pairs
-        slots = slots[pt.state[slots] == PERMANENT]
-        pt.state[slots] = SLIP
-        pt.xi_ij[slots] = 0.0
-        pt.xi_ji[slots] = 0.0
-        pt.d_eq[slots] = 0.0
-        self._links_changed()
-        self._g = None
+        self._set_bonds(slots[self._pairs.state[slots] == PERMANENT], SLIP, 0.0)
 
     def _cut_pairs(self, i, j):
         """Cut bonds (i, j): state slip, ξ = 0, ``d_eq`` = 0; the contact stays while touching."""

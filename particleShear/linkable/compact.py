@@ -13,8 +13,8 @@ from ..checks import in_range
 from ..engine.box import min_image
 from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
-from .canvas import CanvasPointsLinkable
-from .spheres import SphereLinkable, SphereLinkableAdjustableInterfaceStrength
+from .canvas import CanvasPointsLinkable, EnsembleLinkable
+from .spheres import SphereLinkableAdjustableInterfaceStrength
 
 __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
            "component_labels"]
@@ -73,7 +73,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1, dt=1, dt_max=10, theTkSimulation=False,
                  avoid_horizontal_angle_degree=0, rng=None):
         CanvasPointsLinkable.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m, k_t, nu_t, mu)
-        _check_angle(avoid_horizontal_angle_degree)
+        in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         if rng is not None:
             self.set_random_generator(np.random.default_rng(rng))
@@ -91,9 +91,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.n_constitution_steps = 0
         self._create_spheres(N, m)
 
-    def _new_sphere(self, x, y, r, m, index):
-        return SphereLinkable(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
-                              self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
+    _new_sphere = EnsembleLinkable._new_sphere
 
     def particle_info(self, reference=False):
         """Description of the spheres for the output file's header (exactly the text of 1.0.2 if ``reference``).
@@ -141,7 +139,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return component_labels(self._n, i, j)
 
     def _particles_from_labels(self, lab):
-        """Lists of spheres per component, ordered by the lowest sphere index (spheres in index order)."""
         order = np.argsort(lab, kind="stable")
         cuts = np.flatnonzero(np.diff(lab[order])) + 1
         sl = self.sphereList
@@ -399,9 +396,8 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1, dt=1, dt_max=10, theTkSimulation=False,
                  avoid_horizontal_angle_degree=0, permanent_ratio_central=1, permanent_ratio_tangential=1,
                  keep_viscosity_coefficients_constant=True, rng=None):
-        for name, v in (("permanent_ratio_central", permanent_ratio_central),
-                        ("permanent_ratio_tangential", permanent_ratio_tangential)):
-            check_non_negative(name, v)
+        check_non_negative("permanent_ratio_central", permanent_ratio_central)
+        check_non_negative("permanent_ratio_tangential", permanent_ratio_tangential)
         self.permanent_ratio_central = permanent_ratio_central
         self.permanent_ratio_tangential = permanent_ratio_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
@@ -417,15 +413,9 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
             self.permanent_ratio_tangential, self.keep_viscosity_coefficients_constant)
 
     def particle_info(self, reference=False):
-        if reference:
-            return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
-                    "adjustment ofstrength between permament and temporary interfaces\n\t" + self._sphere_info(True))
-        return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, "
-                "adjustment of strength between permanent and temporary interfaces\n\t" + self._sphere_info())
-
-
-def _check_angle(a):
-    in_range("avoid_horizontal_angle_degree", a, 0, 90, hi_open=True)   # 90 or more rejects every direction
+        adjustment = "ofstrength between permament" if reference else "of strength between permanent"   # 1.0.2's typos
+        return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, adjustment "
+                + adjustment + " and temporary interfaces\n\t" + self._sphere_info(reference))
 
 
 def _adjacency(n, i, j):

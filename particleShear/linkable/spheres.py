@@ -10,7 +10,7 @@ from ..engine import callbacks as _engine_callbacks
 from ..engine.box import inside_half_cell
 from ..base.points import ArrayField, _one
 from ..checks import non_negative
-from ..base.relations import RelationView, neighbor_relation
+from ..base.relations import RelationView, _BaseRelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
 
 __all__ = ["neighbor_relation_linkable", "SphereLinkable", "SphereLinkableAdjustableInterfaceStrength"]
@@ -21,13 +21,10 @@ class neighbor_relation_linkable(neighbor_relation):
 
     Parameters
     ----------
-    friction_position : float
-        Tangential displacement ξ (µm).
-    interface_type : str
-        ``"stick"``, ``"slip"`` or ``"permanent"``.
-    theSphere : Sphere
-    graphical_line_index, linking_line_index : int, optional
-        Canvas items of the drawn contact and bond lines (-1: none).
+    friction_position, interface_type, theSphere, graphical_line_index
+        As for :class:`~particleShear.base.relations.neighbor_relation`.
+    linking_line_index : int, optional
+        Canvas item of the drawn bond line (-1: none).
     """
 
     def __init__(self, friction_position, interface_type, theSphere, graphical_line_index=-1,
@@ -46,8 +43,7 @@ class LinkableRelationView(RelationView, neighbor_relation_linkable):
     owner, partner : int
     """
 
-    def __init__(self, ensemble, owner, partner):
-        self._bind(ensemble, owner, partner)
+    __init__ = _BaseRelationView.__init__
 
 
 def _same_ensemble(a, b):
@@ -71,6 +67,7 @@ class SphereLinkable(SphereFrictionLeesEdwards):
     permanent_ratio_central = ArrayField(1.0, param=True)
     permanent_ratio_tangential = ArrayField(1.0, param=True)
     keep_viscosity_coefficients_constant = ArrayField(1.0, param=True, flag=True)
+    _bond_colour = None   # colour of a bond's line (None: the locked colour)
 
     def _new_relation(self, theSphere):
         return neighbor_relation_linkable(0, "stick", theSphere)
@@ -131,9 +128,6 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         if do_backlink:
             theSphere.cut_permanent_link(self, do_backlink=False)
 
-    def _is_physical(self, theSphere):
-        return bool(inside_half_cell(self.x - theSphere.x, self.y - theSphere.y, self.size_x, self.size_y))
-
     def permanentlyConnectedSpheres(self, physical_neighbors_only=True):
         """Partners bonded to this sphere (list, in relation-list order).
 
@@ -146,7 +140,8 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         for rel in self.neighbors:
             if rel.interface_type == "permanent":
                 s = rel.theSphere
-                if not physical_neighbors_only or self._is_physical(s):
+                if not physical_neighbors_only or inside_half_cell(self.x - s.x, self.y - s.y, self.size_x,
+                                                                   self.size_y):
                     out.append(s)
         return out
 
@@ -199,13 +194,16 @@ class SphereLinkable(SphereFrictionLeesEdwards):
         return self._tangential_part(theSphere, True, self._relation(theSphere).friction_position, k_t=k_t)
 
     def contactLineColor(self, interface_type):
-        """Colour of the line drawn for a relation: locked for stick contacts and bonds, else slip.
+        """Colour of the line drawn for a relation: locked for stick contacts, slip for slipping ones; for bonds
+        locked, or dark orange in :class:`SphereLinkableAdjustableInterfaceStrength`.
 
         Parameters
         ----------
         interface_type : str
         """
         cfg = self.graphical_output_configuration
+        if interface_type == "permanent" and self._bond_colour:
+            return self._bond_colour
         if interface_type in ("stick", "permanent"):
             return cfg.color_interface_locked
         return cfg.color_interface_slip
@@ -224,6 +222,8 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
     keep_viscosity_coefficients_constant : bool, optional
     """
 
+    _bond_colour = "darkorange"
+
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
                  force_register=None, size_x=500, size_y=500, permanent_ratio_central=1,
                  permanent_ratio_tangential=1, keep_viscosity_coefficients_constant=True):
@@ -234,20 +234,6 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
         self.permanent_ratio_central = permanent_ratio_central
         self.permanent_ratio_tangential = permanent_ratio_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
-
-    def contactLineColor(self, interface_type):
-        """Colour of the line drawn for a relation: locked (stick), dark orange (bond) or slip.
-
-        Parameters
-        ----------
-        interface_type : str
-        """
-        cfg = self.graphical_output_configuration
-        if interface_type == "stick":
-            return cfg.color_interface_locked
-        if interface_type == "permanent":
-            return "darkorange"
-        return cfg.color_interface_slip
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
