@@ -9,7 +9,7 @@ from ..engine.integrate import kick
 from .register import Force_register
 from .relations import neighbor_relation
 
-from .points import ArrayField, PointLeesEdwards, _check_positive, _one
+from .points import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
 
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]
 
@@ -67,15 +67,8 @@ class Circle(PointLeesEdwards):
     # Drawing happens in the renderer of the ensemble (layer 4); these hooks keep the API.
     def initiate_drawing(self):
         """Do nothing (1.0.2 API: the ensemble's renderer draws the spheres)."""
-        pass
 
     def move(self, dt=1):
-        """Drift by velocity × ``dt`` (s).
-
-        Parameters
-        ----------
-        dt : float
-        """
         PointLeesEdwards.move(self, dt)
         self.moveDrawing(dt)
 
@@ -86,30 +79,14 @@ class Circle(PointLeesEdwards):
         ----------
         dt : float
         """
-        pass
 
     def deleteDrawing(self):
         """Do nothing (1.0.2 API: the ensemble's renderer deletes the drawing)."""
-        pass
 
-    def tangential_vector(self, theSphere):
-        """Return the unit tangent ``t = (−n_y, n_x)`` of the contact with ``theSphere``.
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        n = self.n(theSphere)
-        return [-n[1], n[0]]
-
-    def tangential_speed(self, theSphere):
-        """Return the slip speed ``Δv·t − (r_i ω_i + r_j ω_j)`` to ``theSphere`` (µm/s; ω = 0 without spin).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self._pairs([theSphere]).slip().item()
+    tangential_vector = _pair_query("Return the unit tangent ``t = (−n_y, n_x)`` of the contact with "
+                                    "``theSphere``.", lambda p: [-p.ny.item(), p.nx.item()], normal=True)
+    tangential_speed = _pair_query("Return the slip speed ``Δv·t − (r_i ω_i + r_j ω_j)`` to ``theSphere`` (µm/s; ω = 0 "
+                                   "without spin).", lambda p: p.slip().item(), normal=True)
 
 
 class CircleMass(Circle):
@@ -137,12 +114,10 @@ class CircleMass(Circle):
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):
         Circle.__init__(self, color, x, y, diameter, theCanvas, doDrawing, use_lees_edwards)
-        _check_positive("m", m)
         self.m = m
         # a register of its own unless one is given (1.0.2 shared one mutable default register among all spheres)
         self.force_register = Force_register() if force_register is None else force_register
-        self.xforce = 0
-        self.yforce = 0
+        self.xforce, self.yforce = 0, 0
 
     def record_total_particle_force(self):
         """Record the accumulated force ``(xforce, yforce)`` as this sphere's total in the register."""
@@ -215,7 +190,6 @@ class CircleMassNeighbors(CircleMass):
 
     def deleteNeighborDrawing(self):
         """Do nothing (1.0.2 API: the renderer draws the contacts)."""
-        pass
 
     def contactLineColor(self, interface_type):
         """Return the colour of a contact line: the locked colour when ``"stick"``, else the slip colour.
@@ -225,13 +199,10 @@ class CircleMassNeighbors(CircleMass):
         interface_type : {"stick", "slip", "permanent"}
         """
         cfg = self.graphical_output_configuration
-        if interface_type == "stick":
-            return cfg.color_interface_locked
-        return cfg.color_interface_slip
+        return cfg.color_interface_locked if interface_type == "stick" else cfg.color_interface_slip
 
     def initiateNeighborDrawing(self):
         """Do nothing (1.0.2 API: the renderer draws the contacts)."""
-        pass
 
     def _relation(self, theSphere):
         k = self.findNeighborIndex(theSphere)
@@ -244,11 +215,7 @@ class CircleMassNeighbors(CircleMass):
         ----------
         theSphere : CircleMassNeighbors
         """
-        found = -1
-        for k, rel in enumerate(self.neighbors):
-            if rel.theSphere is theSphere:
-                found = k
-        return found
+        return max((k for k, rel in enumerate(self.neighbors) if rel.theSphere is theSphere), default=-1)
 
     def _new_relation(self, theSphere):
         return neighbor_relation(0, "stick", theSphere)
