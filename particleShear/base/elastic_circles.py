@@ -51,9 +51,10 @@ class CircleBasicElasticity(CircleMassNeighbors):
         ``d_eq``), with this sphere's c and permanent ratios (1 where it has none); constants a method does not
         take keep their defaults and do not enter its term."""
         bond = d_eq is not None
-        return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None, _one(d_eq) if bond else None,
-                              k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
-                              getattr(self, "permanent_ratio_central", 1.0), getattr(self, "permanent_ratio_tangential", 1.0),
+        return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None,
+                              _one(d_eq) if bond else None, k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
+                              getattr(self, "permanent_ratio_central", 1.0),
+                              getattr(self, "permanent_ratio_tangential", 1.0),
                               getattr(self, "keep_viscosity_coefficients_constant", 1.0))
 
     def _replaced_law(self, K, d):
@@ -173,8 +174,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
                                        force_register, use_lees_edwards)
         self.phi = -math.pi / 2
         self.rotation_line = None
-        self.omega = 0
-        self.torque = 0
+        self.omega, self.torque = 0, 0
         self.inertia = self.m * self.r * self.r / 2
 
     def cool(self, f=0.8, shear_rate_to_rotation_rate_coefficient=0):
@@ -189,19 +189,16 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         """
         PointLeesEdwards.cool(self, f) if self.use_lees_edwards else Point.cool(self, f)
         spin = _one(self.omega)[:, None]
-        damp(spin, flow_velocity(_one(self.y), self.size_y, self.shear_rate) * shear_rate_to_rotation_rate_coefficient, f)
+        kappa_u = flow_velocity(_one(self.y), self.size_y, self.shear_rate) * shear_rate_to_rotation_rate_coefficient
+        damp(spin, kappa_u, f)
         self.omega = spin.item()
 
     def _visit(self, theSphere, p, K, xi_ij, xi_ji=0.0, bounded=True):
-        """One visit from this sphere of the tangential rule, :func:`~particleShear.engine.terms.tangential_term`.
-
-        It is the second visit of the engine's two-visit rule after a first that applies nothing
-        (``k_t = ν_t = 0``), so the force, the slip decision and the reset of both histories are this
-        visit's: ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` within ``|μ·law|`` (bonds and
-        ``bounded=False``: no bound).  ``xi_ij``, ``xi_ji``: the histories of this sphere's relation and
-        of the partner's (µm).  Returns the force along ``t_ij`` (array of 1), whether it slipped, and the
-        (2, 1) histories ``ξ_ji, ξ_ij`` after it (both 0 after a slip).
-        """
+        """One visit of :func:`~particleShear.engine.terms.tangential_term`, the engine's second after a first that
+        applies nothing (``k_t = ν_t = 0``): ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` within ``|μ·law|`` (no
+        bound for bonds and ``bounded=False``).  ``xi_ij``, ``xi_ji``: the histories of this sphere's relation and
+        the partner's (µm).  Returns the force along ``t_ij`` (array of 1), whether it slipped, and the (2, 1)
+        ``ξ_ji, ξ_ij`` after it (both 0 after a slip)."""
         ri, rj = p.radii()
         law = self._elastic(K, p.d)[1] if bounded else _one(0.0)
         first = _with(K, k_t=0.0, nu_t=0.0, fc_inf=K.fc_inf if bounded else math.inf)
@@ -261,12 +258,9 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         ti, tj = tq[:, 0].tolist()
         self.torque = self.torque + ti
         theSphere.torque = theSphere.torque + tj
-        reg = self.force_register
-        if hasattr(reg, "record_individual_internal_torque"):
-            reg.record_individual_internal_torque(self, theSphere, ti)
-        reg = theSphere.force_register
-        if hasattr(reg, "record_individual_internal_torque"):
-            reg.record_individual_internal_torque(theSphere, self, tj)
+        for a, b, t in ((self, theSphere, ti), (theSphere, self, tj)):
+            if hasattr(a.force_register, "record_individual_internal_torque"):
+                a.force_register.record_individual_internal_torque(a, b, t)
 
     def tangential_force(self, theSphere, nu, mu, k, k_t):
         """One visit of the tangential routine (a contact; for a linkable sphere also a bond); return its force.
