@@ -21,16 +21,14 @@ class Circle(PointLeesEdwards):
     ----------
     color : str
         Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
+    x, y, use_lees_edwards
+        As for :class:`~particleShear.base.points.PointLeesEdwards`.
     diameter : float
         Diameter (µm, > 0).
     theCanvas : object or bool
         Tk canvas, stored for compatibility (False: none).
     doDrawing : bool
         Whether the ensemble's renderer draws the sphere.
-    use_lees_edwards : bool
-        Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
 
     Raises
     ------

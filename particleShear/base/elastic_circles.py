@@ -172,7 +172,6 @@ class CircleFrictionElasticity(CircleBasicElasticity):
                  force_register=None, use_lees_edwards=False):
         CircleBasicElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
                                        force_register, use_lees_edwards)
-        self.phi = -math.pi / 2
         self.rotation_line = None
         self.omega, self.torque = 0, 0
         self.inertia = self.m * self.r * self.r / 2

@@ -347,14 +347,8 @@ class PointLeesEdwards(Point):
                                      self.size_y * self.shear, self.shear_rate)
         self.x, self.y = x, y
 
-    def lee_edwards_relative_vector(self, theSphere):
-        """Return the minimum-image vector ``[dx, dy]`` to ``theSphere`` (µm).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self.lee_edwards_closest_to_zero(theSphere.x - self.x, theSphere.y - self.y)
+    lee_edwards_relative_vector = _pair_query("Return the minimum-image vector ``[dx, dy]`` to ``theSphere`` (µm).",
+                                              lambda p: [p.dx.item(), p.dy.item()], lees_edwards=True)
 
     def transmit_lees_edwards_parameters(self, theSphere):
         """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.

@@ -2,8 +2,6 @@
 __docformat__ = "numpy"
 import math
 
-import numpy as np
-
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                            CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
 from ..checks import integer, positive as _check_positive

@@ -10,17 +10,10 @@ class Sphere(CircleBasicElasticity):
 
     Parameters
     ----------
-    color : str
-        Fill colour in drawings (a Tk/Pillow colour name).
-    x, y, diameter : float
-        Centre and diameter (µm).
-    m : float, optional
-        Mass; moment of inertia ``m·r²/2``.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register
+        As for :class:`~particleShear.base.circles.CircleMass` (and raising as it does).
     my_index : int, optional
-    theCanvas, doDrawing : optional
-        Tk canvas of the live drawing (False: none) and whether the sphere draws itself on it.
-    force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble); None: a private ``Force_register``.
+        Index in the ensemble (stored as ``myindex``).
     """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
