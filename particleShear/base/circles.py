@@ -137,13 +137,12 @@ class CircleMass(Circle):
     def applyInternalForceAndRegister(self, force_vector, source, register_homolog=False):
         """Add the force ``force_vector`` (mg·µm·s⁻² per m depth) from ``source`` and record it as internal.
 
-        ``register_homolog``: also record the opposite force on ``source`` in its register.
-
         Parameters
         ----------
         force_vector : sequence of float
         source : CircleMass
         register_homolog : bool
+            Also record the opposite force on ``source`` in its register.
         """
         self.xforce = self.xforce + force_vector[0]
         self.yforce = self.yforce + force_vector[1]
@@ -162,18 +161,12 @@ class CircleMassNeighbors(CircleMass):
         As for :class:`CircleMass` (and raising as it does).
     """
 
-    def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
-                 force_register=None, use_lees_edwards=False):
-        CircleMass.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing, force_register,
-                            use_lees_edwards)
-        self.__dict__["_own_neighbors"] = []
-
     @property
     def neighbors(self):
         """Relations of this sphere in creation order (views when in an ensemble)."""
         ens = self.__dict__.get("_ens")
         if ens is None:
-            return self.__dict__["_own_neighbors"]
+            return self.__dict__.setdefault("_own_neighbors", [])
         return ens._relations_of(self.__dict__["_idx"])
 
     @neighbors.setter

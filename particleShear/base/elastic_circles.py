@@ -34,13 +34,7 @@ class CircleBasicElasticity(CircleMassNeighbors):
     """
 
     call_back_elastic_force_law = elastic_force_law
-    central_repulsion_coefficient = ArrayField(0.0, param=True)
-
-    def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
-                 force_register=None, use_lees_edwards=False):
-        CircleMassNeighbors.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
-                                     force_register, use_lees_edwards)
-        self.central_repulsion_coefficient = 0
+    central_repulsion_coefficient = ArrayField(0, param=True)
 
     def _bond(self, theSphere):
         """Equilibrium distance (µm) of the bond to ``theSphere``; None: a contact (these spheres have no bonds)."""

@@ -23,11 +23,8 @@ class RandomBimodalSpheres:
         integer("N", N, 0)
         _check_positive("packing_fraction", packing_fraction)
         _check_positive("bimodal_factor", bimodal_factor)
-        self.bimodal_upper = math.sqrt(bimodal_factor)
-        self.bimodal_lower = math.sqrt(1 / bimodal_factor)
-        self.N = N
-        self.packing_fraction = packing_fraction
-        self.r_max = 0
+        self.bimodal_upper, self.bimodal_lower = math.sqrt(bimodal_factor), math.sqrt(1 / bimodal_factor)
+        self.N, self.packing_fraction, self.r_max = N, packing_fraction, 0
 
     def random_radius_bimodal(self, r):
         """Return ``r/√bf`` or ``r·√bf`` (µm) with equal probability (one draw of the ensemble's generator).
@@ -108,9 +105,7 @@ class EnsembleFriction(Ensemble):
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
         Ensemble.__init__(self, size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m,
                           bimodal_factor)
-        self.k_t = k_t
-        self.nu_t = nu_t
-        self.mu = mu
+        self.k_t, self.nu_t, self.mu = k_t, nu_t, mu
 
 
 # EnsembleFriction takes the tangential machinery of the friction canvas (not on its branch of the

@@ -39,9 +39,7 @@ class SphereLeesEdwards(CircleBasicElasticity):
                  force_register=None, size_x=500, size_y=500):
         CircleBasicElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing, force_register,
                                        use_lees_edwards=True)
-        self.myindex = myindex
-        self.size_x = size_x
-        self.size_y = size_y
+        self.myindex, self.size_x, self.size_y = myindex, size_x, size_y
 
 
 class SphereFriction(CircleFrictionElasticity):
@@ -74,6 +72,4 @@ class SphereFrictionLeesEdwards(CircleFrictionElasticity):
                  force_register=None, size_x=500, size_y=500):
         CircleFrictionElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
                                           force_register, use_lees_edwards=True)
-        self.myindex = my_index
-        self.size_x = size_x
-        self.size_y = size_y
+        self.myindex, self.size_x, self.size_y = my_index, size_x, size_y
