@@ -43,9 +43,7 @@ class Circle(PointLeesEdwards):
         _check_positive("diameter", diameter)
         self.theCanvas = theCanvas
         self.r = diameter / 2
-        self.doDrawing = doDrawing
-        self.shape = None
-        self.color = color
+        self.doDrawing, self.shape, self.color = doDrawing, None, color
         from .graphics import Graphical_output_configuration
         self.graphical_output_configuration = Graphical_output_configuration()
 
@@ -59,10 +57,8 @@ class Circle(PointLeesEdwards):
         self.graphical_output_configuration = graphical_output_configuration
 
     def coordinates(self):
-        """Return ``[x, y, r]`` (µm)."""
         return [self.x, self.y, self.r]
 
-    # Drawing happens in the renderer of the ensemble (layer 4); these hooks keep the API.
     def initiate_drawing(self):
         """Do nothing (1.0.2 API: the ensemble's renderer draws the spheres)."""
 
@@ -106,16 +102,14 @@ class CircleMass(Circle):
     """
 
     m = ArrayField(1.0, positive=True, param=True)
-    xforce = ArrayField(0.0)
-    yforce = ArrayField(0.0)
+    xforce = ArrayField(0)
+    yforce = ArrayField(0)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):
         Circle.__init__(self, color, x, y, diameter, theCanvas, doDrawing, use_lees_edwards)
         self.m = m
-        # a register of its own unless one is given (1.0.2 shared one mutable default register among all spheres)
         self.force_register = Force_register() if force_register is None else force_register
-        self.xforce, self.yforce = 0, 0
 
     def record_total_particle_force(self):
         """Record the accumulated force ``(xforce, yforce)`` as this sphere's total in the register."""

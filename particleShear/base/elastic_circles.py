@@ -6,6 +6,7 @@ call.  ``theSphere`` is the partner; ``k``, ``k_t`` the central and tangential s
 coefficient; forces are in mg·µm·s⁻² per m depth.
 """
 __docformat__ = "numpy"
+import inspect
 import math
 
 import numpy as np
@@ -19,6 +20,14 @@ from .circles import Circle, CircleMassNeighbors
 from .points import ArrayField, Point, PointLeesEdwards, _one, _with
 
 __all__ = ["CircleBasicElasticity", "CircleFrictionElasticity"]
+
+
+def _for_every_relation(method):
+    """Document ``<visit>_from_neighbors(self, *constants)``, which applies ``<visit>`` for every relation."""
+    constants = ", ".join(list(inspect.signature(method).parameters)[1:])
+    method.__doc__ = (f"Apply :meth:`{method.__name__[:-len('_from_neighbors')]}` for every relation, in "
+                      f"``neighbors`` order.\n\n        Parameters\n        ----------\n        {constants} : float\n")
+    return method
 
 
 class CircleBasicElasticity(CircleMassNeighbors):
@@ -99,13 +108,8 @@ class CircleBasicElasticity(CircleMassNeighbors):
             return [0, 0]
         return self._apply_central(theSphere, p, self._elastic(self._terms(theSphere, d_eq, k=k), p.d)[0])
 
+    @_for_every_relation
     def elastic_force_from_neighbors(self, k):
-        """Apply :meth:`elastic_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        k : float
-        """
         for rel in list(self.neighbors):
             self.elastic_force(rel.theSphere, k)
 
@@ -136,13 +140,8 @@ class CircleBasicElasticity(CircleMassNeighbors):
         """
         return self._apply_central(theSphere, *self._viscous(theSphere, nu))
 
+    @_for_every_relation
     def central_viscous_force_from_neighbors(self, nu):
-        """Apply :meth:`central_viscous_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        nu : float
-        """
         for rel in list(self.neighbors):
             self.central_viscous_force(rel.theSphere, nu)
 
@@ -158,8 +157,8 @@ class CircleFrictionElasticity(CircleBasicElasticity):
 
     _spins = True
     phi = ArrayField(-math.pi / 2)
-    omega = ArrayField(0.0)
-    torque = ArrayField(0.0)
+    omega = ArrayField(0)
+    torque = ArrayField(0)
     inertia = ArrayField(0.5, positive=True, param=True)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
@@ -167,7 +166,6 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         CircleBasicElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
                                        force_register, use_lees_edwards)
         self.rotation_line = None
-        self.omega, self.torque = 0, 0
         self.inertia = self.m * self.r * self.r / 2
 
     def cool(self, f=0.8, shear_rate_to_rotation_rate_coefficient=0):
@@ -287,13 +285,8 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         self.distribute_tangential_couple(theSphere, f / 2)
         return f
 
+    @_for_every_relation
     def tangential_force_from_neighbors(self, nu, mu, k, k_t):
-        """Apply :meth:`tangential_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        nu, mu, k, k_t : float
-        """
         for rel in list(self.neighbors):
             self.tangential_force(rel.theSphere, nu, mu, k, k_t)
 

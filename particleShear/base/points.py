@@ -136,7 +136,8 @@ class _Pairs:
     def rows(self, s):
         """Velocity rows ``(vx, vy, ω)`` of spheres ``s`` (µm/s, rad/s; ω = 0 unless the visitor spins)."""
         spin = self.me._spins
-        return np.array([[p.xspeed for p in s], [p.yspeed for p in s], [p.omega if spin else 0.0 for p in s]], dtype=float)
+        return np.array([[p.xspeed for p in s], [p.yspeed for p in s], [p.omega if spin else 0.0 for p in s]],
+                        dtype=float)
 
     def velocity(self):
         """:func:`~particleShear.engine.terms.relative_velocity` of the partners' images (µm/s), (2, P)."""

@@ -35,9 +35,6 @@ class RandomBimodalSpheres:
         """
         return r * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(self._rng.integers(0, 2)))
 
-    def _new_sphere(self, x, y, r, m, index):
-        raise NotImplementedError
-
     def _create_spheres(self, N, m):
         """Draw and append N spheres; one block of draws per quantity, in index order."""
         if N == 0:
@@ -147,15 +144,10 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
         Number of spheres, >= 0 (0 for hand-built scenes).
     packing_fraction, bimodal_factor : float, optional
         Nominal area fraction φ (eq. S1-14) and large/small radius ratio bf, > 0.
-    theCanvas, doDrawing : optional
-        Tk canvas of the live drawing (False: none) and whether the spheres are drawn on it.
-    k, nu, k_t, nu_t : float, optional
-        Central and tangential spring (mg·s⁻²) and viscosity (mg·s⁻¹) constants per m depth, >= 0
-        (eq. S1-8, S1-9).
+    theCanvas, doDrawing, k, nu, k_t, nu_t, mu : optional
+        As for :class:`~particleShear.base.elastic_canvas.CanvasPointsFrictionElasticityLeesEdwards`.
     m : float, optional
         Mass of a sphere of the mean radius (mg per m depth); masses scale with the area.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,

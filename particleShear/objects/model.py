@@ -73,8 +73,7 @@ class particle_shear_model_parameters:
             else:
                 _check_positive(name, value)
         vars(self).update(inputs)
-        self.size_x_m = size_x / 1e6
-        self.size_y_m = size_y / 1e6
+        self.size_x_m, self.size_y_m = size_x / 1e6, size_y / 1e6
         self.r = r_estimate(size_x, size_y, packing_fraction, N, bimodal_upper=math.sqrt(bimodal_factor),
                             bimodal_lower=1 / math.sqrt(bimodal_factor))
         self.r_m = self.r / 1e6
