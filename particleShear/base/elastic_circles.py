@@ -67,14 +67,12 @@ class CircleBasicElasticity(CircleMassNeighbors):
         return None if law is elastic_force_law else _one(law(d.item(), K.d_law.item(), K.k, K.c))
 
     def _elastic(self, K, d):
-        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1):
-        :func:`~particleShear.engine.terms.elastic_term`, or the replaced callbacks."""
+        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1), built in or replaced."""
         law = self._replaced_law(K, d)
         return elastic_term(K, d) if law is None else (law * K.ratio_c, law)
 
     def _apply_central(self, theSphere, p, f):
-        """Apply and register the central force ``f·n`` of the pair ``p``
-        (:func:`~particleShear.engine.terms.pair_forces`); returns ``[F_x, F_y]``."""
+        """Apply and register the central force ``f·n`` of the pair ``p``; return ``[F_x, F_y]``."""
         fx, fy = pair_forces(f, None, p.nx, p.ny, p.d, None)[:2]
         vec = [fx.item(), fy.item()]
         self.applyInternalForceAndRegister(vec, theSphere)
@@ -114,8 +112,7 @@ class CircleBasicElasticity(CircleMassNeighbors):
             self.elastic_force(rel.theSphere, k)
 
     def _viscous(self, theSphere, nu):
-        """The pair's ``_Pairs`` and its :func:`~particleShear.engine.terms.viscous_term` ``ν·v_n`` (a bond's ν
-        × its ratio unless kept constant)."""
+        """The pair's ``_Pairs`` and its viscous term ``ν·v_n`` (a bond's ν × its ratio unless kept constant)."""
         p = self._pairs([theSphere])
         vn = normal_speed(p.velocity(), p.nx, p.ny)
         return p, viscous_term(self._terms(theSphere, self._bond(theSphere), nu=nu), vn, None)
@@ -318,8 +315,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         rels = [rel for rel in self.neighbors if rel.interface_type in ("stick", "permanent")]
         if rels:
             p = self._pairs([rel.theSphere for rel in rels])
-            ri, rj = p.radii()
-            inc = xi_increments(p.rows([self]), p.rows(p.spheres), p.dvx, p.nx, p.ny, ri, rj, -p.dx, -p.dy,
+            inc = xi_increments(p.rows([self]), p.rows(p.spheres), p.dvx, p.nx, p.ny, *p.radii(), -p.dx, -p.dy,
                                 lambda Rx, Ry: (-p.nx, -p.ny))[0]
             for rel, step in zip(rels, (inc * dt).tolist()):
                 rel.friction_position = rel.friction_position + step

@@ -154,9 +154,8 @@ class _Pairs:
 
 
 class _pair_query:
-    """A method ``(self, theSphere)`` that returns ``value(p)`` of the :class:`_Pairs` ``p`` of the sphere with
-    ``theSphere`` (normals if ``normal``; the Lees-Edwards image if ``lees_edwards``, else the sphere's), documented
-    by ``summary``; it takes the name it is assigned to in the class body."""
+    """A method ``(self, theSphere)``, named where assigned and documented by ``summary``: ``value(p)`` of the
+    :class:`_Pairs` ``p`` with ``theSphere`` (normals if ``normal``; the Lees-Edwards image if ``lees_edwards``)."""
 
     def __init__(self, summary, value, normal=False, lees_edwards=False):
         self.args = summary, value, normal, lees_edwards

@@ -72,8 +72,7 @@ class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
                  nu=0.01, m=1, bimodal_factor=1.4):
         CanvasPointsBasicElasticity.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
-        self.record_type = "internal"
-        self.spheres_boundary = []
+        self.record_type, self.spheres_boundary = "internal", []
         self._create_spheres(N, m)
 
     def _new_sphere(self, x, y, r, m, index):
@@ -105,8 +104,7 @@ class EnsembleFriction(Ensemble):
         self.k_t, self.nu_t, self.mu = k_t, nu_t, mu
 
 
-# EnsembleFriction takes the tangential machinery of the friction canvas (not on its branch of the
-# documented chain); its strain still advances only while shearing, as in its base class.
+# EnsembleFriction takes the friction canvas's tangential machinery; its strain advances as in its base class
 for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
     if not _name.startswith("__") and _name not in ("_strain_advances", "k_t", "nu_t", "mu"):
         setattr(EnsembleFriction, _name, _value)
