@@ -9,7 +9,7 @@ from ..engine.integrate import kick
 from .register import Force_register
 from .relations import neighbor_relation
 
-from .points import ArrayField, PointLeesEdwards, _check_positive, _one
+from .points import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
 
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]
 
@@ -21,16 +21,14 @@ class Circle(PointLeesEdwards):
     ----------
     color : str
         Drawing colour (Tk/Pillow colour name).
-    x, y : float
-        Position of the centre (µm).
+    x, y, use_lees_edwards
+        As for :class:`~particleShear.base.points.PointLeesEdwards`.
     diameter : float
         Diameter (µm, > 0).
     theCanvas : object or bool
         Tk canvas, stored for compatibility (False: none).
     doDrawing : bool
         Whether the ensemble's renderer draws the sphere.
-    use_lees_edwards : bool
-        Lees-Edwards minimum images and wrapping (True) or a plain periodic cell (False).
 
     Raises
     ------
@@ -45,9 +43,7 @@ class Circle(PointLeesEdwards):
         _check_positive("diameter", diameter)
         self.theCanvas = theCanvas
         self.r = diameter / 2
-        self.doDrawing = doDrawing
-        self.shape = None
-        self.color = color
+        self.doDrawing, self.shape, self.color = doDrawing, None, color
         from .graphics import Graphical_output_configuration
         self.graphical_output_configuration = Graphical_output_configuration()
 
@@ -61,21 +57,12 @@ class Circle(PointLeesEdwards):
         self.graphical_output_configuration = graphical_output_configuration
 
     def coordinates(self):
-        """Return ``[x, y, r]`` (µm)."""
         return [self.x, self.y, self.r]
 
-    # Drawing happens in the renderer of the ensemble (layer 4); these hooks keep the API.
     def initiate_drawing(self):
         """Do nothing (1.0.2 API: the ensemble's renderer draws the spheres)."""
-        pass
 
     def move(self, dt=1):
-        """Drift by velocity × ``dt`` (s).
-
-        Parameters
-        ----------
-        dt : float
-        """
         PointLeesEdwards.move(self, dt)
         self.moveDrawing(dt)
 
@@ -86,30 +73,14 @@ class Circle(PointLeesEdwards):
         ----------
         dt : float
         """
-        pass
 
     def deleteDrawing(self):
         """Do nothing (1.0.2 API: the ensemble's renderer deletes the drawing)."""
-        pass
 
-    def tangential_vector(self, theSphere):
-        """Return the unit tangent ``t = (−n_y, n_x)`` of the contact with ``theSphere``.
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        n = self.n(theSphere)
-        return [-n[1], n[0]]
-
-    def tangential_speed(self, theSphere):
-        """Return the slip speed ``Δv·t − (r_i ω_i + r_j ω_j)`` to ``theSphere`` (µm/s; ω = 0 without spin).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self._pairs([theSphere]).slip().item()
+    tangential_vector = _pair_query("Return the unit tangent ``t = (−n_y, n_x)`` of the contact with "
+                                    "``theSphere``.", lambda p: [-p.ny.item(), p.nx.item()], normal=True)
+    tangential_speed = _pair_query("Return the slip speed ``Δv·t − (r_i ω_i + r_j ω_j)`` to ``theSphere`` (µm/s; ω = 0 "
+                                   "without spin).", lambda p: p.slip().item(), normal=True)
 
 
 class CircleMass(Circle):
@@ -131,18 +102,14 @@ class CircleMass(Circle):
     """
 
     m = ArrayField(1.0, positive=True, param=True)
-    xforce = ArrayField(0.0)
-    yforce = ArrayField(0.0)
+    xforce = ArrayField(0)
+    yforce = ArrayField(0)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):
         Circle.__init__(self, color, x, y, diameter, theCanvas, doDrawing, use_lees_edwards)
-        _check_positive("m", m)
         self.m = m
-        # a register of its own unless one is given (1.0.2 shared one mutable default register among all spheres)
         self.force_register = Force_register() if force_register is None else force_register
-        self.xforce = 0
-        self.yforce = 0
 
     def record_total_particle_force(self):
         """Record the accumulated force ``(xforce, yforce)`` as this sphere's total in the register."""
@@ -164,13 +131,12 @@ class CircleMass(Circle):
     def applyInternalForceAndRegister(self, force_vector, source, register_homolog=False):
         """Add the force ``force_vector`` (mg·µm·s⁻² per m depth) from ``source`` and record it as internal.
 
-        ``register_homolog``: also record the opposite force on ``source`` in its register.
-
         Parameters
         ----------
         force_vector : sequence of float
         source : CircleMass
         register_homolog : bool
+            Also record the opposite force on ``source`` in its register.
         """
         self.xforce = self.xforce + force_vector[0]
         self.yforce = self.yforce + force_vector[1]
@@ -189,18 +155,12 @@ class CircleMassNeighbors(CircleMass):
         As for :class:`CircleMass` (and raising as it does).
     """
 
-    def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
-                 force_register=None, use_lees_edwards=False):
-        CircleMass.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing, force_register,
-                            use_lees_edwards)
-        self.__dict__["_own_neighbors"] = []
-
     @property
     def neighbors(self):
         """Relations of this sphere in creation order (views when in an ensemble)."""
         ens = self.__dict__.get("_ens")
         if ens is None:
-            return self.__dict__["_own_neighbors"]
+            return self.__dict__.setdefault("_own_neighbors", [])
         return ens._relations_of(self.__dict__["_idx"])
 
     @neighbors.setter
@@ -215,7 +175,6 @@ class CircleMassNeighbors(CircleMass):
 
     def deleteNeighborDrawing(self):
         """Do nothing (1.0.2 API: the renderer draws the contacts)."""
-        pass
 
     def contactLineColor(self, interface_type):
         """Return the colour of a contact line: the locked colour when ``"stick"``, else the slip colour.
@@ -225,13 +184,10 @@ class CircleMassNeighbors(CircleMass):
         interface_type : {"stick", "slip", "permanent"}
         """
         cfg = self.graphical_output_configuration
-        if interface_type == "stick":
-            return cfg.color_interface_locked
-        return cfg.color_interface_slip
+        return cfg.color_interface_locked if interface_type == "stick" else cfg.color_interface_slip
 
     def initiateNeighborDrawing(self):
         """Do nothing (1.0.2 API: the renderer draws the contacts)."""
-        pass
 
     def _relation(self, theSphere):
         k = self.findNeighborIndex(theSphere)
@@ -244,11 +200,7 @@ class CircleMassNeighbors(CircleMass):
         ----------
         theSphere : CircleMassNeighbors
         """
-        found = -1
-        for k, rel in enumerate(self.neighbors):
-            if rel.theSphere is theSphere:
-                found = k
-        return found
+        return max((k for k, rel in enumerate(self.neighbors) if rel.theSphere is theSphere), default=-1)
 
     def _new_relation(self, theSphere):
         return neighbor_relation(0, "stick", theSphere)

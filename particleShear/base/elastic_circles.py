@@ -6,6 +6,7 @@ call.  ``theSphere`` is the partner; ``k``, ``k_t`` the central and tangential s
 coefficient; forces are in mg·µm·s⁻² per m depth.
 """
 __docformat__ = "numpy"
+import inspect
 import math
 
 import numpy as np
@@ -21,6 +22,14 @@ from .points import ArrayField, Point, PointLeesEdwards, _one, _with
 __all__ = ["CircleBasicElasticity", "CircleFrictionElasticity"]
 
 
+def _for_every_relation(method):
+    """Document ``<visit>_from_neighbors(self, *constants)``, which applies ``<visit>`` for every relation."""
+    constants = ", ".join(list(inspect.signature(method).parameters)[1:])
+    method.__doc__ = (f"Apply :meth:`{method.__name__[:-len('_from_neighbors')]}` for every relation, in "
+                      f"``neighbors`` order.\n\n        Parameters\n        ----------\n        {constants} : float\n")
+    return method
+
+
 class CircleBasicElasticity(CircleMassNeighbors):
     """Disc with central elastic and viscous contact forces (eqs. S1-5a/b, S1-6, S1-9).
 
@@ -34,13 +43,7 @@ class CircleBasicElasticity(CircleMassNeighbors):
     """
 
     call_back_elastic_force_law = elastic_force_law
-    central_repulsion_coefficient = ArrayField(0.0, param=True)
-
-    def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
-                 force_register=None, use_lees_edwards=False):
-        CircleMassNeighbors.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
-                                     force_register, use_lees_edwards)
-        self.central_repulsion_coefficient = 0
+    central_repulsion_coefficient = ArrayField(0, param=True)
 
     def _bond(self, theSphere):
         """Equilibrium distance (µm) of the bond to ``theSphere``; None: a contact (these spheres have no bonds)."""
@@ -51,9 +54,10 @@ class CircleBasicElasticity(CircleMassNeighbors):
         ``d_eq``), with this sphere's c and permanent ratios (1 where it has none); constants a method does not
         take keep their defaults and do not enter its term."""
         bond = d_eq is not None
-        return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None, _one(d_eq) if bond else None,
-                              k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
-                              getattr(self, "permanent_ratio_central", 1.0), getattr(self, "permanent_ratio_tangential", 1.0),
+        return term_constants(_one(self.r + theSphere.r), np.array([True]) if bond else None,
+                              _one(d_eq) if bond else None, k, self.central_repulsion_coefficient, nu, k_t, nu_t, mu,
+                              getattr(self, "permanent_ratio_central", 1.0),
+                              getattr(self, "permanent_ratio_tangential", 1.0),
                               getattr(self, "keep_viscosity_coefficients_constant", 1.0))
 
     def _replaced_law(self, K, d):
@@ -63,14 +67,12 @@ class CircleBasicElasticity(CircleMassNeighbors):
         return None if law is elastic_force_law else _one(law(d.item(), K.d_law.item(), K.k, K.c))
 
     def _elastic(self, K, d):
-        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1):
-        :func:`~particleShear.engine.terms.elastic_term`, or the replaced callbacks."""
+        """``(law·ratio_c, law)`` of the pair at distance ``d`` (arrays of 1), built in or replaced."""
         law = self._replaced_law(K, d)
         return elastic_term(K, d) if law is None else (law * K.ratio_c, law)
 
     def _apply_central(self, theSphere, p, f):
-        """Apply and register the central force ``f·n`` of the pair ``p``
-        (:func:`~particleShear.engine.terms.pair_forces`); returns ``[F_x, F_y]``."""
+        """Apply and register the central force ``f·n`` of the pair ``p``; return ``[F_x, F_y]``."""
         fx, fy = pair_forces(f, None, p.nx, p.ny, p.d, None)[:2]
         vec = [fx.item(), fy.item()]
         self.applyInternalForceAndRegister(vec, theSphere)
@@ -104,19 +106,13 @@ class CircleBasicElasticity(CircleMassNeighbors):
             return [0, 0]
         return self._apply_central(theSphere, p, self._elastic(self._terms(theSphere, d_eq, k=k), p.d)[0])
 
+    @_for_every_relation
     def elastic_force_from_neighbors(self, k):
-        """Apply :meth:`elastic_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        k : float
-        """
         for rel in list(self.neighbors):
             self.elastic_force(rel.theSphere, k)
 
     def _viscous(self, theSphere, nu):
-        """The pair's ``_Pairs`` and its :func:`~particleShear.engine.terms.viscous_term` ``ν·v_n`` (a bond's ν
-        × its ratio unless kept constant)."""
+        """The pair's ``_Pairs`` and its viscous term ``ν·v_n`` (a bond's ν × its ratio unless kept constant)."""
         p = self._pairs([theSphere])
         vn = normal_speed(p.velocity(), p.nx, p.ny)
         return p, viscous_term(self._terms(theSphere, self._bond(theSphere), nu=nu), vn, None)
@@ -141,13 +137,8 @@ class CircleBasicElasticity(CircleMassNeighbors):
         """
         return self._apply_central(theSphere, *self._viscous(theSphere, nu))
 
+    @_for_every_relation
     def central_viscous_force_from_neighbors(self, nu):
-        """Apply :meth:`central_viscous_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        nu : float
-        """
         for rel in list(self.neighbors):
             self.central_viscous_force(rel.theSphere, nu)
 
@@ -163,18 +154,15 @@ class CircleFrictionElasticity(CircleBasicElasticity):
 
     _spins = True
     phi = ArrayField(-math.pi / 2)
-    omega = ArrayField(0.0)
-    torque = ArrayField(0.0)
+    omega = ArrayField(0)
+    torque = ArrayField(0)
     inertia = ArrayField(0.5, positive=True, param=True)
 
     def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
                  force_register=None, use_lees_edwards=False):
         CircleBasicElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
                                        force_register, use_lees_edwards)
-        self.phi = -math.pi / 2
         self.rotation_line = None
-        self.omega = 0
-        self.torque = 0
         self.inertia = self.m * self.r * self.r / 2
 
     def cool(self, f=0.8, shear_rate_to_rotation_rate_coefficient=0):
@@ -189,19 +177,16 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         """
         PointLeesEdwards.cool(self, f) if self.use_lees_edwards else Point.cool(self, f)
         spin = _one(self.omega)[:, None]
-        damp(spin, flow_velocity(_one(self.y), self.size_y, self.shear_rate) * shear_rate_to_rotation_rate_coefficient, f)
+        kappa_u = flow_velocity(_one(self.y), self.size_y, self.shear_rate) * shear_rate_to_rotation_rate_coefficient
+        damp(spin, kappa_u, f)
         self.omega = spin.item()
 
     def _visit(self, theSphere, p, K, xi_ij, xi_ji=0.0, bounded=True):
-        """One visit from this sphere of the tangential rule, :func:`~particleShear.engine.terms.tangential_term`.
-
-        It is the second visit of the engine's two-visit rule after a first that applies nothing
-        (``k_t = ν_t = 0``), so the force, the slip decision and the reset of both histories are this
-        visit's: ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` within ``|μ·law|`` (bonds and
-        ``bounded=False``: no bound).  ``xi_ij``, ``xi_ji``: the histories of this sphere's relation and
-        of the partner's (µm).  Returns the force along ``t_ij`` (array of 1), whether it slipped, and the
-        (2, 1) histories ``ξ_ji, ξ_ij`` after it (both 0 after a slip).
-        """
+        """One visit of :func:`~particleShear.engine.terms.tangential_term`, the engine's second after a first that
+        applies nothing (``k_t = ν_t = 0``): ``clamp(ν_t v_t·[d < r_i + r_j] + k_t ξ_ij)`` within ``|μ·law|`` (no
+        bound for bonds and ``bounded=False``).  ``xi_ij``, ``xi_ji``: the histories of this sphere's relation and
+        the partner's (µm).  Returns the force along ``t_ij`` (array of 1), whether it slipped, and the (2, 1)
+        ``ξ_ji, ξ_ij`` after it (both 0 after a slip)."""
         ri, rj = p.radii()
         law = self._elastic(K, p.d)[1] if bounded else _one(0.0)
         first = _with(K, k_t=0.0, nu_t=0.0, fc_inf=K.fc_inf if bounded else math.inf)
@@ -261,12 +246,9 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         ti, tj = tq[:, 0].tolist()
         self.torque = self.torque + ti
         theSphere.torque = theSphere.torque + tj
-        reg = self.force_register
-        if hasattr(reg, "record_individual_internal_torque"):
-            reg.record_individual_internal_torque(self, theSphere, ti)
-        reg = theSphere.force_register
-        if hasattr(reg, "record_individual_internal_torque"):
-            reg.record_individual_internal_torque(theSphere, self, tj)
+        for a, b, t in ((self, theSphere, ti), (theSphere, self, tj)):
+            if hasattr(a.force_register, "record_individual_internal_torque"):
+                a.force_register.record_individual_internal_torque(a, b, t)
 
     def tangential_force(self, theSphere, nu, mu, k, k_t):
         """One visit of the tangential routine (a contact; for a linkable sphere also a bond); return its force.
@@ -300,13 +282,8 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         self.distribute_tangential_couple(theSphere, f / 2)
         return f
 
+    @_for_every_relation
     def tangential_force_from_neighbors(self, nu, mu, k, k_t):
-        """Apply :meth:`tangential_force` for every relation, in ``neighbors`` order.
-
-        Parameters
-        ----------
-        nu, mu, k, k_t : float
-        """
         for rel in list(self.neighbors):
             self.tangential_force(rel.theSphere, nu, mu, k, k_t)
 
@@ -338,8 +315,7 @@ class CircleFrictionElasticity(CircleBasicElasticity):
         rels = [rel for rel in self.neighbors if rel.interface_type in ("stick", "permanent")]
         if rels:
             p = self._pairs([rel.theSphere for rel in rels])
-            ri, rj = p.radii()
-            inc = xi_increments(p.rows([self]), p.rows(p.spheres), p.dvx, p.nx, p.ny, ri, rj, -p.dx, -p.dy,
+            inc = xi_increments(p.rows([self]), p.rows(p.spheres), p.dvx, p.nx, p.ny, *p.radii(), -p.dx, -p.dy,
                                 lambda Rx, Ry: (-p.nx, -p.ny))[0]
             for rel, step in zip(rels, (inc * dt).tolist()):
                 rel.friction_position = rel.friction_position + step

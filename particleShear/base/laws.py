@@ -19,9 +19,7 @@ __all__ = [
 
 def _scalar_result(value, *args):
     """Return a Python float when every argument was a scalar."""
-    if all(np.ndim(a) == 0 for a in args):
-        return float(value)
-    return value
+    return float(value) if all(np.ndim(a) == 0 for a in args) else value
 
 
 def elastic_force_law(d, d0, k, central_repulsion_coefficient):

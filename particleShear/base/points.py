@@ -53,15 +53,10 @@ class ArrayField:
     """
 
     def __init__(self, default=0.0, geometry=False, param=False, positive=False, flag=False):
-        self.default = default
-        self.geometry = geometry
-        self.param = param
-        self.positive = positive
-        self.flag = flag
+        self.default, self.geometry, self.param, self.positive, self.flag = default, geometry, param, positive, flag
 
     def __set_name__(self, owner, name):
-        self.name = name
-        self.key = "_v_" + name
+        self.name, self.key = name, "_v_" + name
 
     def __get__(self, obj, objtype=None):
         if obj is None:
@@ -87,32 +82,20 @@ class ArrayField:
             ens._params_changed()
 
 
-class EnsembleField:
-    """Descriptor: a Lees-Edwards parameter, the ensemble's value once the sphere is appended.
+class EnsembleField(ArrayField):
+    """Descriptor: a Lees-Edwards parameter, the ensemble's attribute of that name once the sphere is appended.
 
     Parameters
     ----------
     default : float
-    canvas_name : str or None
-        Ensemble attribute read once appended (None: the same name).
     """
-
-    def __init__(self, default, canvas_name=None):
-        self.default = default
-        self.canvas_name = canvas_name
-
-    def __set_name__(self, owner, name):
-        self.name = name
-        self.key = "_v_" + name
-        if self.canvas_name is None:
-            self.canvas_name = name
 
     def __get__(self, obj, objtype=None):
         if obj is None:
             return self
         ens = obj.__dict__.get("_ens")
-        if ens is not None and hasattr(ens, self.canvas_name):
-            return getattr(ens, self.canvas_name)
+        if ens is not None and hasattr(ens, self.name):
+            return getattr(ens, self.name)
         return obj.__dict__.get(self.key, self.default)
 
     def __set__(self, obj, value):
@@ -153,7 +136,8 @@ class _Pairs:
     def rows(self, s):
         """Velocity rows ``(vx, vy, ω)`` of spheres ``s`` (µm/s, rad/s; ω = 0 unless the visitor spins)."""
         spin = self.me._spins
-        return np.array([[p.xspeed for p in s], [p.yspeed for p in s], [p.omega if spin else 0.0 for p in s]], dtype=float)
+        return np.array([[p.xspeed for p in s], [p.yspeed for p in s], [p.omega if spin else 0.0 for p in s]],
+                        dtype=float)
 
     def velocity(self):
         """:func:`~particleShear.engine.terms.relative_velocity` of the partners' images (µm/s), (2, P)."""
@@ -165,9 +149,26 @@ class _Pairs:
 
     def slip(self):
         """:func:`~particleShear.engine.terms.slip_speed` of the pairs (µm/s), with the spins if the visitor spins."""
-        ri, rj = self.radii()
         Vi, Vj = self.rows([self.me]), self.rows(self.spheres)
-        return slip_speed(relative_velocity(Vi, Vj, self.dvx), self.nx, self.ny, ri, rj, Vi[2], Vj[2])
+        return slip_speed(relative_velocity(Vi, Vj, self.dvx), self.nx, self.ny, *self.radii(), Vi[2], Vj[2])
+
+
+class _pair_query:
+    """A method ``(self, theSphere)``, named where assigned and documented by ``summary``: ``value(p)`` of the
+    :class:`_Pairs` ``p`` with ``theSphere`` (normals if ``normal``; the Lees-Edwards image if ``lees_edwards``)."""
+
+    def __init__(self, summary, value, normal=False, lees_edwards=False):
+        self.args = summary, value, normal, lees_edwards
+
+    def __set_name__(self, owner, name):
+        summary, value, normal, lees_edwards = self.args
+
+        def query(self, theSphere):
+            return value(self._pairs([theSphere], normal, self._le_image if lees_edwards else None))
+
+        query.__name__, query.__qualname__, query.__module__ = name, f"{owner.__qualname__}.{name}", owner.__module__
+        query.__doc__ = summary + "\n\n        Parameters\n        ----------\n        theSphere : Point\n        "
+        setattr(owner, name, query)
 
 
 class Point:
@@ -189,14 +190,8 @@ class Point:
     yspeed = ArrayField(0.0)
 
     def __init__(self, x, y):
-        self.__dict__["_ens"] = None
-        self.__dict__["_idx"] = -1
-        _check_finite("x", x)
-        _check_finite("y", y)
-        self.x = x
-        self.y = y
-        self.xspeed = 0
-        self.yspeed = 0
+        self.__dict__.update(_ens=None, _idx=-1)
+        self.x, self.y, self.xspeed, self.yspeed = x, y, 0, 0
 
     def coordinates(self):
         """Return ``[x, y, 0]`` (µm); circles return their radius as the third entry."""
@@ -231,45 +226,16 @@ class Point:
         """
         return math.sqrt((theSphere.x - self.x) ** 2 + (theSphere.y - self.y) ** 2)
 
-    def relative_vector(self, theSphere):
-        """Return ``[dx, dy]`` to ``theSphere`` (µm): the Lees-Edwards minimum image where used.
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        p = self._pairs([theSphere], normal=False)
-        return [p.dx.item(), p.dy.item()]
-
-    def d(self, theSphere):
-        """Return the distance to ``theSphere`` (µm), the length of :meth:`relative_vector`.
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self._pairs([theSphere], normal=False).d.item()
-
-    def n(self, theSphere):
-        """Return the unit vector towards ``theSphere``; where they coincide, a random one (the ensemble's seed).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        p = self._pairs([theSphere])
-        return [p.nx.item(), p.ny.item()]
-
-    def relative_position(self, theSphere):
-        """Return the vector ``n·d`` to ``theSphere`` (µm).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        n = self.n(theSphere)
-        d = self.d(theSphere)
-        return [n[0] * d, n[1] * d]
+    relative_vector = _pair_query("Return ``[dx, dy]`` to ``theSphere`` (µm): the Lees-Edwards minimum image where "
+                                  "used.", lambda p: [p.dx.item(), p.dy.item()])
+    d = _pair_query("Return the distance to ``theSphere`` (µm), the length of :meth:`relative_vector`.",
+                    lambda p: p.d.item())
+    n = _pair_query("Return the unit vector towards ``theSphere``; where they coincide, a random one (the ensemble's "
+                    "seed).", lambda p: [p.nx.item(), p.ny.item()], normal=True)
+    relative_position = _pair_query("Return the vector ``n·d`` to ``theSphere`` (µm).",
+                                    lambda p: [p.nx.item() * p.d.item(), p.ny.item() * p.d.item()], normal=True)
+    relative_speed = _pair_query("Return the velocity of ``theSphere`` (its nearest image with Lees-Edwards) relative "
+                                 "to this point (µm/s).", lambda p: p.velocity()[:, 0].tolist())
 
     def move(self, dt=1):
         """Drift: advance the position by velocity × ``dt`` (s), and φ by ω·``dt`` for a spinning sphere.
@@ -301,15 +267,6 @@ class Point:
         """
         self._damp(f, None)
 
-    def relative_speed(self, theSphere):
-        """Return the velocity of ``theSphere`` (its nearest image with Lees-Edwards) relative to this point (µm/s).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self._pairs([theSphere], normal=False).velocity()[:, 0].tolist()
-
 
 class PointLeesEdwards(Point):
     """Point in a Lees-Edwards cell; once in an ensemble, the cell parameters are the ensemble's.
@@ -334,10 +291,7 @@ class PointLeesEdwards(Point):
     def __init__(self, x, y, size_x=500, size_y=500, shear=0, shear_rate=0, use_lees_edwards=True):
         Point.__init__(self, x, y)
         self.use_lees_edwards = use_lees_edwards
-        self.size_x = size_x
-        self.size_y = size_y
-        self.shear = shear
-        self.shear_rate = shear_rate
+        self.size_x, self.size_y, self.shear, self.shear_rate = size_x, size_y, shear, shear_rate
 
     def boundary_conditions(self, boundary_x, boundary_y):
         """Store the cell size (µm), then wrap (Lees-Edwards with velocity correction, or plain).
@@ -346,8 +300,7 @@ class PointLeesEdwards(Point):
         ----------
         boundary_x, boundary_y : float
         """
-        self.size_x = boundary_x
-        self.size_y = boundary_y
+        self.size_x, self.size_y = boundary_x, boundary_y
         if self.use_lees_edwards:
             self.lee_edwards_boundary_conditions()
         else:
@@ -384,14 +337,9 @@ class PointLeesEdwards(Point):
         """
         return _wrapped(x, y, 0.0, self.size_x, self.size_y, self.size_y * self.shear, 0.0)[:2]
 
-    def lee_edwards_relative_speed(self, theSphere):
-        """Return the velocity of the nearest Lees-Edwards image of ``theSphere`` relative to this point (µm/s).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self._pairs([theSphere], normal=False, image=self._le_image).velocity()[:, 0].tolist()
+    lee_edwards_relative_speed = _pair_query("Return the velocity of the nearest Lees-Edwards image of ``theSphere`` "
+                                             "relative to this point (µm/s).",
+                                             lambda p: p.velocity()[:, 0].tolist(), lees_edwards=True)
 
     def lee_edwards_boundary_conditions(self):
         """Wrap into the cell; crossing y changes x by ∓Ly·γ and vx by ∓Ly·γ̇ (``engine.box.wrap``)."""
@@ -399,14 +347,8 @@ class PointLeesEdwards(Point):
                                      self.size_y * self.shear, self.shear_rate)
         self.x, self.y = x, y
 
-    def lee_edwards_relative_vector(self, theSphere):
-        """Return the minimum-image vector ``[dx, dy]`` to ``theSphere`` (µm).
-
-        Parameters
-        ----------
-        theSphere : Point
-        """
-        return self.lee_edwards_closest_to_zero(theSphere.x - self.x, theSphere.y - self.y)
+    lee_edwards_relative_vector = _pair_query("Return the minimum-image vector ``[dx, dy]`` to ``theSphere`` (µm).",
+                                              lambda p: [p.dx.item(), p.dy.item()], lees_edwards=True)
 
     def transmit_lees_edwards_parameters(self, theSphere):
         """Copy the cell size, strain, rate and Lees-Edwards flag to ``theSphere``.
@@ -415,11 +357,8 @@ class PointLeesEdwards(Point):
         ----------
         theSphere : PointLeesEdwards
         """
-        theSphere.size_x = self.size_x
-        theSphere.size_y = self.size_y
-        theSphere.shear = self.shear
-        theSphere.shear_rate = self.shear_rate
-        theSphere.use_lees_edwards = self.use_lees_edwards
+        for name in ("size_x", "size_y", "shear", "shear_rate", "use_lees_edwards"):
+            setattr(theSphere, name, getattr(self, name))
 
     def cool(self, f=0.8):
         """Damp the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` by the factor ``f`` (SLLOD-like).

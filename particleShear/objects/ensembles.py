@@ -2,8 +2,6 @@
 __docformat__ = "numpy"
 import math
 
-import numpy as np
-
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                            CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
 from ..checks import integer, positive as _check_positive
@@ -25,11 +23,8 @@ class RandomBimodalSpheres:
         integer("N", N, 0)
         _check_positive("packing_fraction", packing_fraction)
         _check_positive("bimodal_factor", bimodal_factor)
-        self.bimodal_upper = math.sqrt(bimodal_factor)
-        self.bimodal_lower = math.sqrt(1 / bimodal_factor)
-        self.N = N
-        self.packing_fraction = packing_fraction
-        self.r_max = 0
+        self.bimodal_upper, self.bimodal_lower = math.sqrt(bimodal_factor), math.sqrt(1 / bimodal_factor)
+        self.N, self.packing_fraction, self.r_max = N, packing_fraction, 0
 
     def random_radius_bimodal(self, r):
         """Return ``r/√bf`` or ``r·√bf`` (µm) with equal probability (one draw of the ensemble's generator).
@@ -39,9 +34,6 @@ class RandomBimodalSpheres:
         r : float
         """
         return r * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(self._rng.integers(0, 2)))
-
-    def _new_sphere(self, x, y, r, m, index):
-        raise NotImplementedError
 
     def _create_spheres(self, N, m):
         """Draw and append N spheres; one block of draws per quantity, in index order."""
@@ -80,8 +72,7 @@ class Ensemble(RandomBimodalSpheres, CanvasPointsBasicElasticity):
                  nu=0.01, m=1, bimodal_factor=1.4):
         CanvasPointsBasicElasticity.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
-        self.record_type = "internal"
-        self.spheres_boundary = []
+        self.record_type, self.spheres_boundary = "internal", []
         self._create_spheres(N, m)
 
     def _new_sphere(self, x, y, r, m, index):
@@ -110,13 +101,10 @@ class EnsembleFriction(Ensemble):
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
         Ensemble.__init__(self, size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m,
                           bimodal_factor)
-        self.k_t = k_t
-        self.nu_t = nu_t
-        self.mu = mu
+        self.k_t, self.nu_t, self.mu = k_t, nu_t, mu
 
 
-# EnsembleFriction takes the tangential machinery of the friction canvas (not on its branch of the
-# documented chain); its strain still advances only while shearing, as in its base class.
+# EnsembleFriction takes the friction canvas's tangential machinery; its strain advances as in its base class
 for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
     if not _name.startswith("__") and _name not in ("_strain_advances", "k_t", "nu_t", "mu"):
         setattr(EnsembleFriction, _name, _value)
@@ -154,15 +142,10 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
         Number of spheres, >= 0 (0 for hand-built scenes).
     packing_fraction, bimodal_factor : float, optional
         Nominal area fraction φ (eq. S1-14) and large/small radius ratio bf, > 0.
-    theCanvas, doDrawing : optional
-        Tk canvas of the live drawing (False: none) and whether the spheres are drawn on it.
-    k, nu, k_t, nu_t : float, optional
-        Central and tangential spring (mg·s⁻²) and viscosity (mg·s⁻¹) constants per m depth, >= 0
-        (eq. S1-8, S1-9).
+    theCanvas, doDrawing, k, nu, k_t, nu_t, mu : optional
+        As for :class:`~particleShear.base.elastic_canvas.CanvasPointsFrictionElasticityLeesEdwards`.
     m : float, optional
         Mass of a sphere of the mean radius (mg per m depth); masses scale with the area.
-    mu : float, optional
-        Coulomb friction coefficient μ of transient contacts, >= 0.
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,

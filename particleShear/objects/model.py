@@ -65,22 +65,15 @@ class particle_shear_model_parameters:
 
     def __init__(self, size_x=500, size_y=500, N=100, packing_fraction=1, Young_modulus_spheres=10000,
                  density=50, bimodal_factor=1):
-        _check_positive("size_x", size_x)
-        _check_positive("size_y", size_y)
-        integer("N", N, 1)
-        _check_positive("packing_fraction", packing_fraction)
-        _check_positive("Young_modulus_spheres", Young_modulus_spheres)
-        _check_positive("density", density)
-        _check_positive("bimodal_factor", bimodal_factor)
-        self.bimodal_factor = bimodal_factor
-        self.size_x = size_x
-        self.size_y = size_y
-        self.N = N
-        self.packing_fraction = packing_fraction
-        self.Young_modulus_spheres = Young_modulus_spheres
-        self.density = density
-        self.size_x_m = size_x / 1e6
-        self.size_y_m = size_y / 1e6
+        inputs = dict(size_x=size_x, size_y=size_y, N=N, packing_fraction=packing_fraction,
+                      Young_modulus_spheres=Young_modulus_spheres, density=density, bimodal_factor=bimodal_factor)
+        for name, value in inputs.items():
+            if name == "N":
+                integer(name, value, 1)
+            else:
+                _check_positive(name, value)
+        vars(self).update(inputs)
+        self.size_x_m, self.size_y_m = size_x / 1e6, size_y / 1e6
         self.r = r_estimate(size_x, size_y, packing_fraction, N, bimodal_upper=math.sqrt(bimodal_factor),
                             bimodal_lower=1 / math.sqrt(bimodal_factor))
         self.r_m = self.r / 1e6

@@ -10,17 +10,10 @@ class Sphere(CircleBasicElasticity):
 
     Parameters
     ----------
-    color : str
-        Fill colour in drawings (a Tk/Pillow colour name).
-    x, y, diameter : float
-        Centre and diameter (µm).
-    m : float, optional
-        Mass; moment of inertia ``m·r²/2``.
+    color, x, y, diameter, m, theCanvas, doDrawing, force_register
+        As for :class:`~particleShear.base.circles.CircleMass` (and raising as it does).
     my_index : int, optional
-    theCanvas, doDrawing : optional
-        Tk canvas of the live drawing (False: none) and whether the sphere draws itself on it.
-    force_register : object or None, optional
-        Receiver of the recorded forces (the ensemble); None: a private ``Force_register``.
+        Index in the ensemble (stored as ``myindex``).
     """
 
     def __init__(self, color, x, y, diameter, m=1, my_index=1, theCanvas=False, doDrawing=False,
@@ -46,9 +39,7 @@ class SphereLeesEdwards(CircleBasicElasticity):
                  force_register=None, size_x=500, size_y=500):
         CircleBasicElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing, force_register,
                                        use_lees_edwards=True)
-        self.myindex = myindex
-        self.size_x = size_x
-        self.size_y = size_y
+        self.myindex, self.size_x, self.size_y = myindex, size_x, size_y
 
 
 class SphereFriction(CircleFrictionElasticity):
@@ -81,6 +72,4 @@ class SphereFrictionLeesEdwards(CircleFrictionElasticity):
                  force_register=None, size_x=500, size_y=500):
         CircleFrictionElasticity.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing,
                                           force_register, use_lees_edwards=True)
-        self.myindex = my_index
-        self.size_x = size_x
-        self.size_y = size_y
+        self.myindex, self.size_x, self.size_y = my_index, size_x, size_y
