@@ -142,10 +142,15 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
         Number of spheres, >= 0 (0 for hand-built scenes).
     packing_fraction, bimodal_factor : float, optional
         Nominal area fraction φ (eq. S1-14) and large/small radius ratio bf, > 0.
-    theCanvas, doDrawing, k, nu, k_t, nu_t, mu : optional
-        As for :class:`~particleShear.base.elastic_canvas.CanvasPointsFrictionElasticityLeesEdwards`.
+    theCanvas, doDrawing : optional
+        Tk canvas of the live drawing (False: none) and whether the spheres are drawn on it.
+    k, nu, k_t, nu_t : float, optional
+        Central and tangential spring (mg·s⁻²) and viscosity (mg·s⁻¹) constants per m depth, >= 0
+        (eq. S1-8, S1-9).
     m : float, optional
         Mass of a sphere of the mean radius (mg per m depth); masses scale with the area.
+    mu : float, optional
+        Coulomb friction coefficient μ of transient contacts, >= 0.
     """
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
