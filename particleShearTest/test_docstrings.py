@@ -125,6 +125,7 @@ ENGINE_MODULES = [
     "particleShear.engine",
     "particleShear.engine.box",
     "particleShear.engine.forces",
+    "particleShear.engine.graph",
     "particleShear.engine.guard",
     "particleShear.engine.integrate",
     "particleShear.engine.laws",

@@ -18,7 +18,7 @@ from ..engine.integrate import damp, drift, kick, remove_mean_velocity
 from .memo import Memo
 from ..engine.memory import tune_allocator
 from ..checks import finite as _check_finite, non_negative as check_non_negative, positive as _check_positive
-from .register import Force_register, SphereSelection
+from .register import Force_register, SphereSelection, record_method
 from .stability import StabilityGuard
 
 
@@ -422,33 +422,15 @@ def _register_filter(name, what):
         elif where == 2:
             external(self.force_register)(target, value)
 
-    def filtered(self, target, value):
+    def filtered(self, target, source, value):
         if self.canMove(target):
             register(self.force_register)(target, value)
 
-    # the value parameter under its documented name (keyword calls work as documented)
-    if pair and force:
-        def method(self, target, source, force_vector):
-            route(self, target, source, force_vector)
-    elif pair:
-        def method(self, target, source, moment):
-            route(self, target, source, moment)
-    elif force:
-        def method(self, target, force_vector):
-            filtered(self, target, force_vector)
-    else:
-        def method(self, target, moment):
-            filtered(self, target, moment)
-    value = "force_vector" if force else "moment"
-    method.__name__ = name
-    method.__qualname__ = "CanvasPointsMass." + name
-    quantity, kind = (("force ``(F_x, F_y)`` (mg·µm·s⁻² per m)", "sequence of float") if value == "force_vector"
-                      else ("torque (mg·µm²·s⁻² per m)", "float"))
+    quantity = "force ``(F_x, F_y)`` (mg·µm·s⁻² per m)" if force else "torque (mg·µm²·s⁻² per m)"
     rule = (".\n\nDropped on an immobile target; external from an immobile source or through the boundary." if pair
             else " unless it is immobile.")
-    method.__doc__ = (f"Record {what.format(quantity)} ``target``{rule}\n\nParameters\n----------\n"
-                      f"{'target, source' if pair else 'target'} : Sphere\n{value} : {kind}\n")
-    return method
+    return record_method(name, "CanvasPointsMass", route if pair else filtered,
+                         f"Record {what.format(quantity)} ``target``{rule}")
 
 
 class CanvasPointsMass(CanvasPoints):

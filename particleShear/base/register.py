@@ -112,6 +112,65 @@ class SphereSelection(list):
     del _name
 
 
+def record_method(name, owner, body, summary):
+    """A ``record_*`` method of 1.0.2's signature that calls ``body(self, target, source, value)``.
+
+    The signature is ``(self, target, source, value)`` for a pair entry (``record_individual_*``), else
+    ``(self, target, value)`` (``body`` then gets ``source = None``), with the value named
+    ``force_vector`` for a force (a name ending in ``force``) and ``moment`` for a torque, so keyword
+    calls work as documented.
+
+    Parameters
+    ----------
+    name, owner : str
+        The method's name and its class's name.
+    body : callable
+        ``body(self, target, source, value)``: what the method does.
+    summary : str
+        The docstring's first paragraph; the parameters' section is added.
+
+    Returns
+    -------
+    function
+        The method, named and documented.
+    """
+    pair, force = name.startswith("record_individual"), name.endswith("force")
+    if pair and force:
+        def method(self, target, source, force_vector):
+            body(self, target, source, force_vector)
+    elif pair:
+        def method(self, target, source, moment):
+            body(self, target, source, moment)
+    elif force:
+        def method(self, target, force_vector):
+            body(self, target, None, force_vector)
+    else:
+        def method(self, target, moment):
+            body(self, target, None, moment)
+    method.__name__, method.__qualname__ = name, f"{owner}.{name}"
+    targets = ("target, source : Sphere\n    The sphere acted on; the sphere exerting the force or torque.\n" if pair
+               else "target : Sphere\n    The sphere acted on.\n")
+    value = ("force_vector : sequence of float\n    ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).\n" if force
+             else "moment : float\n    Torque (mg·µm²·s⁻² per m depth).\n")
+    method.__doc__ = f"{summary}\n\nParameters\n----------\n{targets}{value}"
+    return method
+
+
+def _manual_entry(name, store):
+    """What the register's manual ``record_*`` method ``name`` does: an entry ``[target, (source,) value]``
+    appended to the list ``store`` (the total force and the net torque: set per target in the dict)."""
+    force = name.endswith("force")
+
+    def body(self, target, source, value):
+        self._manual = True
+        entry = [target] + ([] if source is None else [source]) + [list(value) if force else value]
+        if store in ("_m_tot", "_m_unb"):
+            getattr(self, store)[id(target)] = entry
+        else:
+            getattr(self, store).append(entry)
+    return body
+
+
 class Force_register:
     """Per-step record of internal pair forces, external forces and torques."""
 
@@ -126,18 +185,10 @@ class Force_register:
         self._tot = None
         self._mom = None
         self._lists = None
-        if getattr(self, "_manual", True):
-            self._clear_manual()
-
-    def _clear_manual(self):
-        """Empty the lists that the manual ``record_*`` calls fill (only when something was recorded)."""
-        self._manual = False
-        self._m_pair = []
-        self._m_ext = []
-        self._m_imom = []
-        self._m_emom = []
-        self._m_tot = {}
-        self._m_unb = {}
+        if getattr(self, "_manual", True):     # the lists of the manual record_* calls, emptied once used
+            self._manual = False
+            self._m_pair, self._m_ext, self._m_imom, self._m_emom = [], [], [], []
+            self._m_tot, self._m_unb = {}, {}
 
     # -- engine side -------------------------------------------------------------------------
     @property
@@ -188,84 +239,23 @@ class Force_register:
         return True
 
     # -- manual API (reference signatures) ----------------------------------------------------
-    def record_individual_internal_force(self, target, source, force_vector):
-        """Append an internal pair force to :attr:`pair_register` (Love-Weber, eq. S1-19).
-
-        Parameters
-        ----------
-        target, source : object
-            The sphere acted on; the sphere exerting the force.
-        force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_pair.append([target, source, list(force_vector)])
-
-    def record_total_particle_force(self, target, force_vector):
-        """Set the total force of ``target`` in :attr:`total_particle_force_register` (eq. S1-17).
-
-        Parameters
-        ----------
-        target : object
-        force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_tot[id(target)] = [target, list(force_vector)]
-
-    def record_external_force(self, target, force_vector):
-        """Append a force from a plate sphere or through the boundary to :attr:`external_force_register` (eq. S1-16).
-
-        Parameters
-        ----------
-        target : object
-        force_vector : sequence of float
-            ``(F_x, F_y)`` (mg·µm·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_ext.append([target, list(force_vector)])
-
-    def record_external_torque(self, target, moment):
-        """Append an external tangential torque to :attr:`external_moment_register` (unused by the tensors).
-
-        Parameters
-        ----------
-        target : object
-        moment : float
-            Torque (mg·µm²·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_emom.append([target, moment])
-
-    def record_individual_internal_torque(self, target, source, moment):
-        """Append an internal tangential torque to :attr:`internal_moment_register` (eq. S1-22).
-
-        Parameters
-        ----------
-        target, source : object
-            The sphere acted on; the sphere exerting the torque.
-        moment : float
-            Torque (mg·µm²·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_imom.append([target, source, moment])
-
-    def record_unbalanced_moment(self, target, moment):
-        """Set the net torque of ``target`` in :attr:`unbalanced_moment_register` (eq. S1-22).
-
-        Parameters
-        ----------
-        target : object
-        moment : float
-            Torque (mg·µm²·s⁻² per m depth).
-        """
-        self._manual = True
-        self._m_unb[id(target)] = [target, moment]
+    for _name, _store, _doc in (
+            ("record_individual_internal_force", "_m_pair", "Append an internal pair force to "
+             ":attr:`pair_register` (Love-Weber, eq. S1-19)."),
+            ("record_total_particle_force", "_m_tot", "Set the total force of ``target`` in "
+             ":attr:`total_particle_force_register` (eq. S1-17)."),
+            ("record_external_force", "_m_ext", "Append a force from a plate sphere or through the boundary "
+             "to :attr:`external_force_register` (eq. S1-16)."),
+            ("record_external_torque", "_m_emom", "Append an external tangential torque to "
+             ":attr:`external_moment_register` (unused by the tensors)."),
+            ("record_individual_internal_torque", "_m_imom", "Append an internal tangential torque to "
+             ":attr:`internal_moment_register` (eq. S1-22)."),
+            ("record_unbalanced_moment", "_m_unb", "Set the net torque of ``target`` in "
+             ":attr:`unbalanced_moment_register` (eq. S1-22).")):
+        locals()[_name] = record_method(_name, "Force_register", _manual_entry(_name, _store), _doc)
+    del _name, _store, _doc
 
     # -- reference lists, built on demand ---------------------------------------------------------
-    def _spheres(self):
-        return self._ens.sphereList
-
     def _engine_lists(self):
         """The engine part of the six reference lists, built once per force phase when first read."""
         cache = self.__dict__.get("_lists")
@@ -273,7 +263,7 @@ class Force_register:
             return cache[2]
         out = {"pair": [], "ext": [], "imom": [], "emom": []}
         for p in self._blocks:
-            _visit_entries(p, self._spheres(), out)
+            _visit_entries(p, self._ens.sphereList, out)
         self._lists = (self._blocks, len(self._blocks), out)
         return out
 
@@ -303,7 +293,7 @@ class Force_register:
         out = []
         if self._tot is not None:
             mobile, fx, fy = self._tot
-            sl = self._spheres()
+            sl = self._ens.sphereList
             idx = range(len(fx)) if mobile is None else np.flatnonzero(mobile).tolist()
             fx, fy = fx.tolist(), fy.tolist()
             out = [[sl[k], [fx[k], fy[k]]] for k in idx]
@@ -314,7 +304,7 @@ class Force_register:
         """``[sphere, T]``: the net torque of every sphere, immobile ones included (reference quirk)."""
         out = []
         if self._mom is not None:
-            sl = self._spheres()
+            sl = self._ens.sphereList
             out = [[sl[k], t] for k, t in enumerate(self._mom.tolist())]
         return out + list(self._m_unb.values())
 

@@ -30,9 +30,17 @@ class neighbor_relation:
 
 
 class RelationView:
-    """Mixin: the relation ``owner → partner`` in the ensemble's pair table, looked up at every access."""
+    """Mixin: the relation ``owner → partner`` in the ensemble's pair table, looked up at every access.
 
-    def _bind(self, ensemble, owner, partner):
+    Parameters
+    ----------
+    ensemble : object
+        The ensemble (a canvas with a pair table).
+    owner, partner : int
+        Indices of the sphere holding the relation and of its partner.
+    """
+
+    def __init__(self, ensemble, owner, partner):
         self.__dict__.update(_ens=ensemble, _owner=owner, _partner=partner, graphical_line_index=-1,
                              linking_line_index=-1)
 
@@ -96,7 +104,4 @@ class RelationView:
 
 
 class _BaseRelationView(RelationView, neighbor_relation):
-    """View of a relation for non-linkable ensembles."""
-
-    def __init__(self, ensemble, owner, partner):
-        self._bind(ensemble, owner, partner)
+    """View of a relation for non-linkable ensembles (:class:`RelationView`'s parameters)."""

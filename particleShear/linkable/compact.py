@@ -11,46 +11,14 @@ import numpy as np
 from ..base.canvas import check_non_negative
 from ..checks import in_range
 from ..engine.box import min_image
+from ..engine.graph import adjacency, component_labels, connected_without_edge
 from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
-from .canvas import CanvasPointsLinkable, EnsembleLinkable
-from .spheres import SphereLinkableAdjustableInterfaceStrength
+from .canvas import CanvasPointsLinkable
+from .spheres import SphereLinkable, SphereLinkableAdjustableInterfaceStrength
 
 __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
            "component_labels"]
-
-
-def component_labels(n, i, j):
-    """Label each of ``n`` nodes with the smallest node of its component (min-label propagation, pointer jumping).
-
-    Parameters
-    ----------
-    n : int
-    i, j : array_like of int
-        End nodes of the edges.
-    """
-    lab = np.arange(n, dtype=np.intp)
-    i = np.asarray(i, dtype=np.intp)
-    j = np.asarray(j, dtype=np.intp)
-    if not len(i):
-        return lab
-    while True:
-        li, lj = lab[i], lab[j]
-        m = np.minimum(li, lj)
-        new = lab.copy()
-        # hook both the nodes and their current labels (roots) onto the smaller label
-        np.minimum.at(new, li, m)
-        np.minimum.at(new, lj, m)
-        np.minimum.at(new, i, m)
-        np.minimum.at(new, j, m)
-        while True:  # pointer jumping: every node points at its root
-            nn = new[new]
-            if np.array_equal(nn, new):
-                break
-            new = nn
-        if np.array_equal(new, lab):
-            return lab
-        lab = new
 
 
 class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
@@ -91,7 +59,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.n_constitution_steps = 0
         self._create_spheres(N, m)
 
-    _new_sphere = EnsembleLinkable._new_sphere
+    sphere_class = SphereLinkable
 
     def particle_info(self, reference=False):
         """Description of the spheres for the output file's header (exactly the text of 1.0.2 if ``reference``).
@@ -208,7 +176,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         if p is None:
             raise ValueError("theSphere is not a sphere of this ensemble")
         i, j = self.permanent_pairs(physical_neighbors_only)
-        adj = _adjacency(self._n, i, j)
+        adj = adjacency(self._n, i, j)
         seen = {p}
         order = [p]
         for q in order:  # breadth-first: the list grows while being traversed
@@ -264,7 +232,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         if n_links == 0:
             self.removed_fraction = 0
             return 0
-        adj = _adjacency(self._n, i, j)
+        adj = adjacency(self._n, i, j)
         rng = self._rng
         failures = successes = 0
         target = max_fraction_to_remove * n_links
@@ -275,7 +243,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
             if not cand:
                 continue
             q = sorted(cand)[int(rng.integers(0, len(cand)))]
-            if _connected_without_edge(adj, p, q):
+            if connected_without_edge(adj, p, q):
                 adj[p].discard(q)
                 adj[q].discard(p)
                 self._cut_pairs([p], [q])
@@ -416,33 +384,3 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
         adjustment = "ofstrength between permament" if reference else "of strength between permanent"   # 1.0.2's typos
         return ("Frictional spheres under Lees-Edwards boundary conditions, organized in fixed particles, adjustment "
                 + adjustment + " and temporary interfaces\n\t" + self._sphere_info(reference))
-
-
-def _adjacency(n, i, j):
-    """Neighbour sets per node of the undirected graph with edges i–j."""
-    adj = [set() for _ in range(n)]
-    for p, q in zip(i.tolist(), j.tolist()):
-        adj[p].add(q)
-        adj[q].add(p)
-    return adj
-
-
-def _connected_without_edge(adj, p, q):
-    """Is q reachable from p without the edge p–q? Bidirectional breadth-first search, early exit."""
-    front_a, seen_a = [p], {p}
-    front_b, seen_b = [q], {q}
-    while front_a and front_b:
-        if len(front_a) > len(front_b):
-            front_a, seen_a, front_b, seen_b = front_b, seen_b, front_a, seen_a
-        nxt = []
-        for u in front_a:
-            for w in adj[u]:
-                if (u == p and w == q) or (u == q and w == p):
-                    continue
-                if w in seen_b:
-                    return True
-                if w not in seen_a:
-                    seen_a.add(w)
-                    nxt.append(w)
-        front_a = nxt
-    return False

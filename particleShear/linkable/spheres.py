@@ -10,7 +10,7 @@ from ..engine import callbacks as _engine_callbacks
 from ..engine.box import inside_half_cell
 from ..base.points import ArrayField, _one
 from ..checks import non_negative
-from ..base.relations import RelationView, _BaseRelationView, neighbor_relation
+from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards
 
 __all__ = ["neighbor_relation_linkable", "SphereLinkable", "SphereLinkableAdjustableInterfaceStrength"]
@@ -42,8 +42,6 @@ class LinkableRelationView(RelationView, neighbor_relation_linkable):
     ensemble : CanvasPointsLinkable
     owner, partner : int
     """
-
-    __init__ = _BaseRelationView.__init__
 
 
 def _same_ensemble(a, b):

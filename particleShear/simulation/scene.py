@@ -13,6 +13,7 @@ import os
 import numpy as np
 
 from ..engine.box import min_image
+from ..engine.graph import component_labels
 from ..base.neighbours import PERMANENT, SLIP
 
 __all__ = ["scene_geometry", "PARTICLE_COLOURS", "particle_labels", "sphere_fills", "CAPTION_HEIGHT", "periodic_offsets",
@@ -97,7 +98,6 @@ def particle_labels(ens):
     numpy.ndarray of int
         Shape (n,): the particle id of each sphere, or −1.
     """
-    from ..linkable.compact import component_labels
     n = len(ens._a["x"])
     pt = getattr(ens, "_pairs", None)
     if pt is None or not len(pt.i):
