@@ -115,5 +115,17 @@ class TestRelationEdits(unittest.TestCase):
             only = t.relations_of(p, bonds=False)
             self.assertEqual(only.tolist(), [k for _, k in want if t.state[k] != PERMANENT])
 
+    def test_relations_with_a_sphere_outside_the_ensemble(self):
+        """A relation of an ensemble's sphere to a sphere of no ensemble lives on the outside sphere's own
+        list, for every ensemble-built sphere (1.0.2: ``establish_permanent_link`` makes the back-link)."""
+        from particleShear import EnsembleLinkable, SphereLinkable
+        ens = EnsembleLinkable(100, 100, 2)
+        inside = ens.sphereList[0]
+        outside = SphereLinkable("red", inside.x + 1.0, inside.y, 2 * inside.r)
+        self.assertIsNone(inside.test_neighbor_relation(outside))
+        self.assertIsNone(inside.establish_permanent_link(outside))
+        self.assertEqual([(r.theSphere is inside, r.interface_type) for r in outside.neighbors],
+                         [(True, "permanent")])
+
 if __name__ == "__main__":
     unittest.main()

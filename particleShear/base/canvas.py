@@ -293,7 +293,7 @@ class CanvasPoints:
     _mobile_selection = movableSphereList
 
     def do_linear_acceleration(self, dt):
-        """Kick mobile spheres ``v += F·dt/m`` and reset their force (plate spheres take their plate's velocity).
+        """Kick every sphere ``v += F·dt/m`` and reset its force (all move: :class:`CanvasPointsShear` has plates).
 
         Parameters
         ----------

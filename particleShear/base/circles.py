@@ -155,12 +155,18 @@ class CircleMassNeighbors(CircleMass):
         As for :class:`CircleMass` (and raising as it does).
     """
 
+    def __init__(self, color, x, y, diameter, m=1, theCanvas=False, doDrawing=False,
+                 force_register=None, use_lees_edwards=False):
+        CircleMass.__init__(self, color, x, y, diameter, m, theCanvas, doDrawing, force_register,
+                            use_lees_edwards)
+        self.__dict__["_own_neighbors"] = []
+
     @property
     def neighbors(self):
         """Relations of this sphere in creation order (views when in an ensemble)."""
         ens = self.__dict__.get("_ens")
         if ens is None:
-            return self.__dict__.setdefault("_own_neighbors", [])
+            return self.__dict__["_own_neighbors"]
         return ens._relations_of(self.__dict__["_idx"])
 
     @neighbors.setter

@@ -159,11 +159,11 @@ def record_method(name, owner, body, summary):
 def _manual_entry(name, store):
     """What the register's manual ``record_*`` method ``name`` does: an entry ``[target, (source,) value]``
     appended to the list ``store`` (the total force and the net torque: set per target in the dict)."""
-    force = name.endswith("force")
+    force, pair = name.endswith("force"), name.startswith("record_individual")
 
     def body(self, target, source, value):
         self._manual = True
-        entry = [target] + ([] if source is None else [source]) + [list(value) if force else value]
+        entry = [target] + ([source] if pair else []) + [list(value) if force else value]
         if store in ("_m_tot", "_m_unb"):
             getattr(self, store)[id(target)] = entry
         else:

@@ -153,10 +153,12 @@ class EnsembleLinkable(RandomBimodalSpheres, CanvasPointsLinkable):
         As for :class:`~particleShear.objects.ensembles.EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
-    sphere_class = SphereLinkable
-
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
         CanvasPointsLinkable.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m, k_t, nu_t, mu)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereLinkable(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
+                              self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)

@@ -14,8 +14,8 @@ from ..engine.box import min_image
 from ..engine.graph import adjacency, component_labels, connected_without_edge
 from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
-from .canvas import CanvasPointsLinkable
-from .spheres import SphereLinkable, SphereLinkableAdjustableInterfaceStrength
+from .canvas import CanvasPointsLinkable, EnsembleLinkable
+from .spheres import SphereLinkableAdjustableInterfaceStrength
 
 __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
            "component_labels"]
@@ -59,7 +59,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.n_constitution_steps = 0
         self._create_spheres(N, m)
 
-    sphere_class = SphereLinkable
+    _new_sphere = EnsembleLinkable._new_sphere
 
     def particle_info(self, reference=False):
         """Description of the spheres for the output file's header (exactly the text of 1.0.2 if ``reference``).

@@ -26,13 +26,6 @@ class RandomBimodalSpheres:
         self.bimodal_upper, self.bimodal_lower = math.sqrt(bimodal_factor), math.sqrt(1 / bimodal_factor)
         self.N, self.packing_fraction, self.r_max = N, packing_fraction, 0
 
-    #: the class of the spheres :meth:`_create_spheres` makes (a sphere of the Lees-Edwards cell: it takes the cell size)
-    sphere_class = None
-
-    def _new_sphere(self, x, y, r, m, index):
-        return self.sphere_class(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
-                                 self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
-
     def random_radius_bimodal(self, r):
         """Return ``r/√bf`` or ``r·√bf`` (µm) with equal probability (one draw of the ensemble's generator).
 
@@ -127,13 +120,15 @@ class EnsembleLeesEdwards(RandomBimodalSpheres, CanvasPointsBasicElasticityLeesE
         As for :class:`EnsembleFrictionLeesEdwards` (ValueError when out of range).
     """
 
-    sphere_class = SphereLeesEdwards
-
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4):
         CanvasPointsBasicElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereLeesEdwards(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r, m, index,
+                                 self.theCanvas, self.doDrawing, self, self.size_x, self.size_y)
 
 
 class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElasticityLeesEdwards):
@@ -158,14 +153,17 @@ class EnsembleFrictionLeesEdwards(RandomBimodalSpheres, CanvasPointsFrictionElas
         Coulomb friction coefficient μ of transient contacts, >= 0.
     """
 
-    sphere_class = SphereFrictionLeesEdwards
-
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
         CanvasPointsFrictionElasticityLeesEdwards.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m,
                                                            k_t, nu_t, mu)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         self._create_spheres(N, m)
+
+    def _new_sphere(self, x, y, r, m, index):
+        return SphereFrictionLeesEdwards(self.graphical_output_configuration.color_spheres_volume, x, y, 2 * r,
+                                         m, index, self.theCanvas, self.doDrawing, self, self.size_x,
+                                         self.size_y)
 
     def particle_info(self):
         return "Frictional spheres under Lees-Edwards boundary conditions\n\t" + \
