@@ -490,15 +490,18 @@ def shear_stresses(C, B, yc, roles, active, dy, fx_i, dF, V, fx_j=None):
     lever_j = yc[C.aj] * ext_j
     lever = yc[C.ai] * (ext_i & active)
     lever -= lever_j
-    fx_lw, f_lever = fx_i, fx_i * lever
+    # the rows of the tensors' xy entries (engine.stress), the same products: Σ F_x,i·D_y (= −Σ F_x,i
+    # (y_i − y_j)), Σ d·F_T, Σ F_x·lever, in one reduction
+    rows = xp.empty((3, fx_i.shape[0]))
+    fx_lw = fx_i if fx_j is None else (fx_i + fx_j) * 0.5
+    xp.multiply(fx_lw * internal, dy, out=rows[0])
+    xp.multiply(dF, internal, out=rows[1])
+    xp.multiply(fx_i, lever, out=rows[2])
     if fx_j is not None:
         # F_i at i and −F_j at j: F_i·lever + (F_i − F_j)·(y_j − Ly/2), so a pair with F_j = F_i gives
         # the same number as without fx_j (a batch's replica equals its single run)
-        fx_lw = (fx_i + fx_j) * 0.5
-        f_lever += (fx_i - fx_j) * lever_j
-    # the rows of the tensors' xy entries (engine.stress), the same products: Σ F_x,i·D_y (= −Σ F_x,i
-    # (y_i − y_j)), Σ d·F_T, Σ F_x·lever, in one reduction
-    sums = replica_sums(C, xp.stack((fx_lw * internal * dy, dF * internal, f_lever)))
+        rows[2] += (fx_i - fx_j) * lever_j
+    sums = replica_sums(C, rows)
     return shear_from_sums(sums[0], sums[1], sums[2], V)
 
 
