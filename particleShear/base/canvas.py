@@ -12,7 +12,7 @@ import numpy as np
 
 from .fields import FIELDS, ROW
 from .graphics import Graphical_output_configuration
-from ..engine.box import flow_velocity, wrap
+from ..engine.box import flow_velocity, inside_cell, wrap
 from ..engine.forces import pair_roles
 from ..engine.integrate import damp, drift, kick, remove_mean_velocity
 from .memo import Memo
@@ -340,20 +340,9 @@ class CanvasPoints:
         Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
         :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
         """
-        pos = self._pos
-        Lx, Ly = self.size_x, self.size_y
-        if not self._n:
-            inside = True
-        elif _min_reduce(pos, axis=None) < 0:
-            inside = False
-        elif Lx == Ly:
-            inside = _max_reduce(pos, axis=None) < Lx
-        else:
-            hi = _max_reduce(pos, axis=1)
-            inside = hi[0] < Lx and hi[1] < Ly
-        if not inside:
+        a = self._a
+        if not inside_cell(a["x"], a["y"], self.size_x, self.size_y):
             self._check_positions()
-            a = self._a
             wrap(a["x"], a["y"], a["xspeed"], float(self.size_x), float(self.size_y), float(self._le_shift()),
                  float(getattr(self, "shear_rate", 0)) if self.use_lees_edwards else 0.0)
         self._pos_version += 1

@@ -11,9 +11,9 @@ __docformat__ = "numpy"
 
 import contextlib
 
-from .xp import backend_of
+from .xp import array_namespace, backend_of
 
-__all__ = ["min_image", "wrap", "flow_velocity", "inside_half_cell", "MAX_PASSES"]
+__all__ = ["min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cell", "MAX_PASSES"]
 
 #: one-period passes of :func:`min_image` and :func:`wrap` before the rest is folded in closed form
 #: (floor): a protocol needs at most one or two, so ordinary states keep the exact subtractions of the
@@ -121,9 +121,27 @@ def min_image(dx, dy, Lx, Ly, shift):
     return dx, dy, ky_total, kx_total
 
 
-def _inside(v, L, xp):
-    """Whether every coordinate of v lies in ``[0, L)`` (False for a NaN: then the passes decide)."""
-    return bool(xp.minimum.reduce(v, initial=xp.inf) >= 0) and bool((v < L).all())
+def inside_cell(x, y, Lx, Ly):
+    """Whether every position lies in the cell ``[0, Lx) × [0, Ly)`` (host arrays; False for a NaN).
+
+    The test before a wrap: with every sphere inside, :func:`wrap` has nothing to do.
+
+    Parameters
+    ----------
+    x, y : ndarray (n,)
+        Positions (µm).
+    Lx, Ly : ndarray (n,) or float
+        Box lengths of each sphere's replica (µm).
+
+    Returns
+    -------
+    bool
+    """
+    xp = array_namespace(x)
+    for v, L in ((y, Ly), (x, Lx)):
+        if not (xp.minimum.reduce(v, initial=xp.inf) >= 0 and (v < L).all()):
+            return False
+    return True
 
 
 def wrap(x, y, vx, Lx, Ly, shift, rate):
@@ -166,7 +184,7 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     """
     be = backend_of(x, y)
     xp = be.xp
-    if be.host and _inside(y, Ly, xp) and _inside(x, Lx, xp):
+    if be.host and inside_cell(x, y, Lx, Ly):
         return False          # the common step: nothing crossed (three reductions per axis, not five)
     moved = False if be.host else None
     y0 = None if be.host else y.copy()   # heights before the wrap, for the velocity correction
