@@ -5,6 +5,8 @@ from them on demand, and manual ``record_*`` calls (scripts without an ensemble)
 """
 __docformat__ = "numpy"
 
+import itertools
+
 import numpy as np
 
 from ..engine.step import register_block
@@ -87,7 +89,7 @@ class SphereSelection(list):
     def __init__(self, ensemble, mask=None, spheres=None):
         if spheres is None:
             sl = ensemble.sphereList
-            spheres = sl if mask is None else [sl[k] for k in np.flatnonzero(mask).tolist()]
+            spheres = sl if mask is None else itertools.compress(sl, mask.tolist())
         list.__init__(self, spheres)
         self.ensemble = ensemble
         self.mask = mask

@@ -13,17 +13,16 @@ centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
 __docformat__ = "numpy"
 
 import collections
+import functools
 
 import numpy as np
 
-from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums
+from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums, spread
 from .xp import array_namespace
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "OVERALL", "EXTERNAL", "ROWS", "KINETIC_ROWS", "evaluate_all",
            "pair_rows", "sphere_rows"]
 
-_ROT = np.array([[0.0, -0.5], [0.5, 0.0]])
-_EYE = np.eye(2)
 
 
 class StressInputs:
@@ -176,12 +175,12 @@ def _roles(q):
 
 def _x_centred(q):
     """``x − Lx/2`` of every sphere (µm): lever arms from the cell centre."""
-    return q.x - (q.Lx / 2)[q.rep]
+    return q.x - spread(q.Lx / 2, q.rep, q.B)
 
 
 def _y_centred(q):
     """``y − Ly/2`` of every sphere (µm)."""
-    return q.y - (q.Ly / 2)[q.rep]
+    return q.y - spread(q.Ly / 2, q.rep, q.B)
 
 
 def pair_rows(function):
@@ -225,11 +224,6 @@ def _outer_rows(ux, uy, wx, wy):
     for r, (u, w) in enumerate(((ux, wx), (ux, wy), (uy, wx), (uy, wy))):
         xp.multiply(u, w, out=W[r])
     return W
-
-
-def _as_tensors(S, q):
-    """(B, 2, 2) tensors from the (4, B) sums of :func:`_outer_rows`."""
-    return S.T.reshape(q.B, 2, 2)
 
 
 @pair_rows
@@ -286,12 +280,119 @@ def _spin_rows(q):
 def _otsuki_rows(q):
     """P ⊗ P / m of the mobile spheres, P = m (v_x − γ̇ (y − Ly/2), v_y), already in SI (J per m depth:
     P in kg·m/s, m in kg), unlike the other rows, which are in the model's units."""
-    px = q.m * 1e-12 * (q.vx - q.rate[q.rep] * q.tensor(_y_centred))
+    px = q.m * 1e-12 * (q.vx - spread(q.rate, q.rep, q.B) * q.tensor(_y_centred))
     py = q.m * 1e-12 * q.vy
     w = q.mob / (q.m * 1e-6)
     return _outer_rows(px * w, py * w, px, py)
 
 
+class Linear(collections.namedtuple("Linear", "rows index coef scale per_volume")):
+    """A tensor as a linear map of the per-replica sums of one row function (:func:`linear_tensor`).
+
+    Entry ``e`` of the tensor, in the order (xx, xy, yx, yy), is
+    ``(sums[index[e]] · (coef[e] · scale)) / (V if per_volume else 1)``; an entry whose index is
+    None is 0.  ``coef`` holds ±1 and ±½ only, so ``coef · scale`` is exact and each entry is the
+    sum times one factor, then divided by V: the same rounding as the definition written out.
+
+    Attributes
+    ----------
+    rows : callable
+        A :func:`pair_rows` or :func:`sphere_rows` function.
+    index : tuple of (int or None)
+        Per entry, the row of ``rows`` whose sum it takes (4 items).
+    coef : tuple of float
+        Per entry, ±1 or ±½ (4 items).
+    scale : float or callable
+        The unit factor, or ``scale(q) -> (B,)`` per replica (as ``CF_CL / V``).
+    per_volume : bool
+        Divide by the cell volume V (m² per m depth).
+    """
+
+
+def linear_tensor(rows, index, coef, scale, per_volume=False):
+    """Make a tensor function of :data:`TENSORS` from its :class:`Linear` map (a decorator).
+
+    The decorated function gives the name and the docstring (the definition, its equation); its
+    body is not run.  The returned function evaluates the map on its own; :func:`evaluate_all`
+    evaluates the maps of every such tensor of the registry together (one gather, one product,
+    one division for all of them), with the same numbers.
+
+    Parameters
+    ----------
+    rows, index, coef, scale, per_volume
+        The fields of :class:`Linear`.
+
+    Returns
+    -------
+    callable
+        A decorator: ``function -> tensor function`` with the attribute ``linear``.
+    """
+    spec = Linear(rows, tuple(index), tuple(float(c) for c in coef), scale, bool(per_volume))
+
+    def decorate(function):
+        @functools.wraps(function)
+        def tensor(q):
+            return _LinearMaps((spec,))(q)[:, 0]
+        tensor.linear = spec
+        return tensor
+    return decorate
+
+
+class _LinearMaps:
+    """The :class:`Linear` maps of several tensors evaluated at once: ``(q) -> (B, n, 2, 2)``.
+
+    The sums of the maps' row functions are stacked (with one row of zeros for the zero entries),
+    gathered to the n·4 entries, multiplied by ``coef · scale`` and divided by V or 1 (exact).
+
+    Parameters
+    ----------
+    specs : sequence of Linear
+        The maps, in the order of the result's second axis.
+    """
+
+    def __init__(self, specs):
+        self.specs = tuple(specs)
+        self.rows = tuple(dict.fromkeys(s.rows for s in self.specs))
+        self.coef = np.array([s.coef for s in self.specs])                   # (n, 4)
+        # the constant scales, and the columns of each per-replica one (a function of q)
+        self.const = np.array([1.0 if callable(s.scale) else float(s.scale) for s in self.specs])
+        self.varying = [(f, [k for k, s in enumerate(self.specs) if s.scale is f])
+                        for f in dict.fromkeys(s.scale for s in self.specs if callable(s.scale))]
+        self.per_volume = [k for k, s in enumerate(self.specs) if s.per_volume]
+        self._index = None                                                   # the gather, once the row counts are known
+
+    def _gather(self, sizes):
+        base = dict(zip(self.rows, np.cumsum((0,) + sizes[:-1])))
+        zero = sum(sizes)
+        return np.array([zero if e is None else base[s.rows] + e for s in self.specs for e in s.index])
+
+    def __call__(self, q):
+        xp = array_namespace(q.V)
+        sums = [q.sums(r) for r in self.rows]
+        if self._index is None:
+            self._index = self._gather(tuple(len(S) for S in sums))
+        B, n = q.B, len(self.specs)
+        A = xp.concatenate(sums + [xp.zeros((1, B))])
+        scale = xp.empty((B, n, 1))
+        scale[:, :, 0] = xp.asarray(self.const)
+        for f, cols in self.varying:
+            scale[:, cols, 0] = q.tensor(f)[:, None]
+        T = A[xp.asarray(self._index)].T.reshape(B, n, 4) * (xp.asarray(self.coef) * scale)
+        if self.per_volume:
+            cols = xp.asarray(self.per_volume)
+            T[:, cols] /= q.V[:, None, None]
+        return T.reshape(B, n, 2, 2)
+
+
+def _force_per_volume(q):
+    """``CF_CL / V`` per replica: forces ×1e-12 and lever arms ×1e-6 over the volume (1/m² per m depth)."""
+    return CF_CL / q.V
+
+
+_DIAGONAL, _FULL = (0, None, None, 0), (0, 1, 2, 3)
+
+
+@linear_tensor(_love_weber_rows, _FULL, (1, 1, 1, 1), _force_per_volume)
 def love_weber(q):
     """σ_LW = (1/V) Σ_internal F_i ⊗ (x_i − x_j) (eq. S1-19); ``x_i − x_j = −D`` for an unshifted pair.
 
@@ -305,9 +406,9 @@ def love_weber(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return _as_tensors(q.sums(_love_weber_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
+@linear_tensor(_external_rows, _FULL, (-1, -1, -1, -1), _force_per_volume)
 def external_forces(q):
     """σ_ext = −(1/V) Σ_external F ⊗ (x_target − c) (eq. S1-16): a mobile sphere of a pair through
     the boundary or with an immobile partner receives the pair force at its own centre.
@@ -325,9 +426,9 @@ def external_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return -_as_tensors(q.sums(_external_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
+@linear_tensor(_unbalanced_rows, _FULL, (1, 1, 1, 1), _force_per_volume)
 def unbalanced_forces(q):
     """σ_unb = (1/V) Σ_mobile F_total ⊗ (x − c) (eq. S1-17).
 
@@ -341,9 +442,9 @@ def unbalanced_forces(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return _as_tensors(q.sums(_unbalanced_rows), q) * (CF_CL / q.V)[:, None, None]
 
 
+@linear_tensor(_unbalanced_rows, _FULL, (1, 1, 1, 1), _force_per_volume)
 def linear_acceleration(q):
     """σ_linacc = σ_unb (m·a = F_total; gravity neglected, eq. S1-17).
 
@@ -357,9 +458,9 @@ def linear_acceleration(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return q.tensor(unbalanced_forces)
 
 
+@linear_tensor(_torque_rows, (None, 0, 0, None), (0, -0.5, 0.5, 0), CT, per_volume=True)
 def unbalanced_torque(q):
     """σ_T = (1/V) Σ_all spheres T·[[0, −½], [½, 0]] (eq. S1-22; immobile spheres included, reference quirk).
 
@@ -373,10 +474,9 @@ def unbalanced_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    S = q.sums(_torque_rows)[0]
-    return S[:, None, None] * CT / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
+@linear_tensor(_internal_torque_rows, (None, 0, 0, None), (0, -0.5, 0.5, 0), CT, per_volume=True)
 def internal_torque(q):
     """σ_Tint = (1/V) Σ_internal d·F_T·[[0, −½], [½, 0]] (eq. S1-22): the pair's two torques sum to d·F_T.
 
@@ -390,12 +490,11 @@ def internal_torque(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    S = q.sums(_internal_torque_rows)[0]
-    return S[:, None, None] * CT / q.V[:, None, None] * array_namespace(S).asarray(_ROT)
 
 
+@linear_tensor(_spin_rows, _DIAGONAL, (-0.5, 0, 0, -0.5), 1e-18, per_volume=True)
 def spin_kinetic_energy(q):
-    """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21).
+    """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21; inertias and ω² ×1e-18).
 
     Parameters
     ----------
@@ -407,10 +506,9 @@ def spin_kinetic_energy(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    k = q.sums(_spin_rows)[0] * 1e-18 / 2
-    return -(k / q.V)[:, None, None] * array_namespace(k).asarray(_EYE)
 
 
+@linear_tensor(_otsuki_rows, _FULL, (-1, -1, -1, -1), 1.0, per_volume=True)
 def peculiar_acceleration_otsuki(q):
     """σ_ot = −(1/V) Σ_mobile P ⊗ P / m with P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa; for
     comparison only).
@@ -425,7 +523,6 @@ def peculiar_acceleration_otsuki(q):
     ndarray (B, 2, 2)
         The tensor of each replica (Pa; ``[b, force component, position component]``).
     """
-    return -_as_tensors(q.sums(_otsuki_rows), q) / q.V[:, None, None]
 
 
 def overall(q):
@@ -484,8 +581,16 @@ ROWS = tuple(dict.fromkeys(r for t in TENSORS for r in t.rows))
 KINETIC_ROWS = (_spin_rows, _otsuki_rows)
 
 
+#: the tensors of :data:`TENSORS` that are :class:`Linear` maps, evaluated together by :func:`evaluate_all`
+_LINEAR = tuple(k for k, t in enumerate(TENSORS) if hasattr(t.function, "linear"))
+_LINEAR_MAPS = _LinearMaps([TENSORS[k].function.linear for k in _LINEAR])
+
+
 def evaluate_all(q):
     """(B, 9, 2, 2) array of every tensor of :data:`TENSORS`, in registry order.
+
+    The :class:`Linear` tensors are evaluated together (the same numbers as each on its own), then
+    the others (the overall tensor, which adds three of them) one by one.
 
     Parameters
     ----------
@@ -498,5 +603,13 @@ def evaluate_all(q):
         ``out[b, t]`` is tensor ``TENSORS[t]`` of replica b (Pa).
     """
     q.reduce(ROWS)
-    tensors = [q.tensor(t.function) for t in TENSORS]
-    return array_namespace(tensors[0]).stack(tensors, axis=1)
+    xp = array_namespace(q.V)
+    out = xp.empty((q.B, len(TENSORS), 2, 2))
+    out[:, _LINEAR] = linear = _LINEAR_MAPS(q)
+    memo = q.__dict__.setdefault("_tensors", {})
+    for n, k in enumerate(_LINEAR):
+        memo.setdefault(TENSORS[k].function, linear[:, n])
+    for k, t in enumerate(TENSORS):
+        if k not in _LINEAR:
+            out[:, k] = q.tensor(t.function)
+    return out
