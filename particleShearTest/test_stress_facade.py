@@ -73,6 +73,40 @@ class TestClassesEqualEngine(unittest.TestCase):
         self.assertNotEqual(ev.stress_tensor_with_external_forces[0][1], 0.0)
 
 
+class TestLinearMaps(unittest.TestCase):
+    def test_tensors_together_equal_each_on_its_own(self):
+        """``evaluate_all`` evaluates the linear tensors together (one gather, product and division):
+        each is bit for bit the tensor its own function gives on fresh inputs of the same force phase
+        (the overall tensor, the sum of three of them, too),
+        for both replicas of a batch of two; the torque and spin tensors have their fixed pattern
+        (antisymmetric, isotropic)."""
+        ens = [sheared(seed, True)[0] for seed in (5, 6)]
+        engine = BatchEngine(BatchState.from_ensembles(ens), guard=False)
+        captured = []
+        real = es.evaluate_all
+        from particleShear.engine import step as step_module
+        step_module.evaluate_all = lambda q: captured.append(q) or real(q)
+        try:
+            T = engine.force_phase(sample="tensors")[2]      # (the state stays that of the inputs)
+        finally:
+            step_module.evaluate_all = real
+        q = captured[0]
+        fresh = es.StressInputs(**{k: v for k, v in q.__dict__.items() if not k.startswith("_")})
+        for k, t in enumerate(es.TENSORS):
+            alone = t.function(fresh)
+            with self.subTest(tensor=t.name):
+                self.assertEqual(alone.shape, (2, 2, 2))
+                np.testing.assert_array_equal(T[:, k], alone)
+                self.assertTrue(np.all(np.isfinite(alone)))
+        for name in ("stress_tensor_unbalanced_torque", "stress_tensor_internal_torque"):
+            A = T[:, [t.name for t in es.TENSORS].index(name)]
+            np.testing.assert_array_equal(A[:, 0, 1], -A[:, 1, 0])
+            np.testing.assert_array_equal(A[:, 0, 0], 0.0)
+        S = T[:, [t.name for t in es.TENSORS].index("stress_tensor_spin_kinetic_energy")]
+        np.testing.assert_array_equal(S[:, 0, 0], S[:, 1, 1])
+        self.assertTrue(np.all(S[:, 0, 0] <= 0.0))
+
+
 class TestAnyListOfSpheres(unittest.TestCase):
     def test_reordered_list_keeps_the_shear_stresses(self):
         """A list of the ensemble's mobile spheres in another order (summed sphere by sphere): the xy
