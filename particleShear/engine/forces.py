@@ -20,6 +20,7 @@ __docformat__ = "numpy"
 import numpy as np
 
 from .box import min_image
+from .state import spread
 from .xp import SegmentSum, array_namespace, to_host
 from . import laws
 from .terms import TermConstants, term_constants
@@ -111,8 +112,8 @@ class PairConstants:
         f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
         f[2] = f[0] + f[1]                        # d0 = r_i + r_j
         f[3:5] = f[0:2] / f[2]                    # w_i, w_j = r/d0
-        f[5] = s.Lx[self.rep]
-        f[6] = s.Ly[self.rep]
+        f[5] = spread(s.Lx, self.rep, s.B)
+        f[6] = spread(s.Ly, self.rep, s.B)
         f[7:9] = f[6:4:-1] / 2                    # hy, hx
 
     @property
@@ -217,19 +218,40 @@ class PairConstants:
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
-        K = self._visit(s, self.ai, d_eq)        # the visit from i
+        K = self._visit(s, self.ai, d_eq, rows=True)        # the visit from i
         self.k = K.k
         self.c = K.c
         for name in self.TERM_ROWS:
             setattr(self, name, getattr(K, name))
 
-    def _visit(self, s, spheres, d_eq):
+    def _visit(self, s, spheres, d_eq, rows=False):
         """The :class:`~particleShear.engine.terms.TermConstants` of the candidates as seen from the sphere
         rows ``spheres`` (``ai`` or ``aj``): the per-replica constants of each candidate's replica and the
-        visiting sphere's own c, permanent ratios and kept viscosities, gathered at once."""
-        rep = s.xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))[:, self.rep]
+        visiting sphere's own c, permanent ratios and kept viscosities, gathered at once.
+
+        Parameters
+        ----------
+        s : BatchState
+            The batch (its per-replica constants and ``visit`` rows).
+        spheres : ndarray of int (P,)
+            The visiting sphere's row of each candidate.
+        d_eq : ndarray (P,)
+            Equilibrium distance of each candidate (µm; read on bonds).
+        rows : bool, default False
+            The constants are only written into the rows of the blocks: in a batch of one its
+            per-replica values are not gathered (:func:`~particleShear.engine.state.spread`, (1,)
+            arrays that broadcast to the same numbers).  Otherwise every constant that is not a
+            number is an array over the candidates.
+
+        Returns
+        -------
+        TermConstants
+        """
+        per_replica = s.xp.stack((s.k, s.nu, s.k_t, s.nu_t, s.mu))
+        rep = spread(per_replica, self.rep, s.B) if rows else per_replica[:, self.rep]
         # the visiting sphere's own values; where a replica's spheres share them, its values directly
-        own = s.per_replica_parameters(self.rep) if s.visit is None else s.visit[:, spheres]
+        own = (s.per_replica_parameters(self.rep) if rows else s.per_replica_parameters()[:, spheres]) \
+            if s.visit is None else s.visit[:, spheres]
         return term_constants(self.d0, self.perm, d_eq, rep[0], own[0], rep[1], rep[2], rep[3], rep[4], own[1], own[2],
                               own[3])
 

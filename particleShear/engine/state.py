@@ -32,7 +32,7 @@ FIELDS = {
 ROW = {name: k for k, name in enumerate(FIELDS)}
 
 __all__ = ["STICK", "SLIP", "PERMANENT", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
-           "uniform_parameters", "FIELDS", "ROW"]
+           "uniform_parameters", "spread", "FIELDS", "ROW"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
@@ -59,6 +59,28 @@ def uniform_parameters(ensemble):
     """
     a, n = ensemble._a, len(ensemble.sphereList)
     return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
+
+
+def spread(values, rep, B):
+    """Per-replica values onto the rows of the spheres or candidates: ``values[..., rep]``.
+
+    For a batch of one, ``values`` itself: its (…, 1) columns broadcast to the same numbers
+    without a gather (for arithmetic with, or assignment to, arrays over the rows).
+
+    Parameters
+    ----------
+    values : ndarray (…, B)
+        One value per replica along the last axis (any unit).
+    rep : ndarray of int (R,)
+        The replica of each row.
+    B : int
+        Replicas of the batch.
+
+    Returns
+    -------
+    ndarray (…, R), or ``values`` (…, 1) when ``B == 1``
+    """
+    return values if B == 1 else values[..., rep]
 
 
 def _key(i, j):
@@ -692,7 +714,7 @@ class BatchState:
 
     def per_replica_parameters(self, rep=None):
         """The per-replica parameters ``c, prc, prt, keep`` on every sphere row (or on the rows of
-        the replica index ``rep``, e.g. a batch's candidates).
+        the replica index ``rep``, e.g. a batch's candidates, through :func:`spread`).
 
         Parameters
         ----------
@@ -701,9 +723,11 @@ class BatchState:
 
         Returns
         -------
-        ndarray (4, len(rep))
+        ndarray (4, B·N) or (4, len(rep))
+            For a given ``rep`` in a batch of one, (4, 1): the values, which broadcast to its rows.
         """
-        return self.xp.stack([getattr(self, name) for name in _PER_REPLICA])[:, self.rep if rep is None else rep]
+        values = self.xp.stack([getattr(self, name) for name in _PER_REPLICA])
+        return values[:, self.rep] if rep is None else spread(values, rep, self.B)
 
     def visit_rows(self):
         """The parameters of :data:`PER_SPHERE_PARAMETERS` of every sphere: :attr:`visit`, or the

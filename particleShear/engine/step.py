@@ -35,7 +35,7 @@ from .terms import (central_term, elastic_term, normal_speed, pair_forces, relat
                     tangential_term, viscous_term)
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .state import PERMANENT, SLIP, STICK
+from .state import PERMANENT, SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 
@@ -64,12 +64,6 @@ class EngineInstability(RuntimeError):
         self.replica = replica
         self.step = step
         self.phase = phase
-
-
-def _spread(values, rep, B):
-    """``values[rep]``: per-replica values onto the rows of the spheres or candidates (``rep``); for a
-    batch of one the (1,) array itself, which broadcasts to the same numbers without a gather."""
-    return values if B == 1 else values[rep]
 
 
 class _TermRecord:
@@ -409,7 +403,7 @@ class BatchEngine:
             New shear rate γ̇ of each replica (1/s).
         """
         s = self.s
-        shift_flow(s.vx, s.omega, s.y - self.hy_s, _spread(rate - s.rate, s.rep, s.B))
+        shift_flow(s.vx, s.omega, s.y - self.hy_s, spread(rate - s.rate, s.rep, s.B))
         s.rate = self.xp.array(rate, dtype=float)
 
     def set_mu(self, mu):
@@ -493,7 +487,7 @@ class BatchEngine:
         xi = self.xi
         nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
         # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
-        dvx = -(C.Ly * _spread(image_rate, C.rep, s.B)) * ky
+        dvx = -(C.Ly * spread(image_rate, C.rep, s.B)) * ky
         vel = s.vel if self.half is None else s.vel + self.half
         Vi = vel.take(ai, axis=1)
         Vj = vel.take(aj, axis=1)
@@ -560,7 +554,7 @@ class BatchEngine:
         raw = s.pos.take(C.aj, axis=1)
         raw -= s.pos.take(C.ai, axis=1)
         shift, image_rate = self._image_shift(), self._image_rate()
-        dx, dy, ky, kx = self._images(raw[0], raw[1], _spread(shift, C.rep, s.B))
+        dx, dy, ky, kx = self._images(raw[0], raw[1], spread(shift, C.rep, s.B))
         d = xp.sqrt(dx * dx + dy * dy)
         touching = d < C.d0
         active = C.perm | touching
@@ -656,7 +650,7 @@ class BatchEngine:
         mob, yc = (self.mobile(), s.y - self.hy_s) if g is None else (g.mob, g.yc)
         if self.integrator == "verlet":
             self.half = half_kick(s.frc, self.mmi, dt, mob)
-        rate_s = _spread(s.rate, s.rep, s.B)
+        rate_s = spread(s.rate, s.rep, s.B)
         kick(s.vel, s.frc, self.mmi, dt)                    # (F_x/m, F_y/m, T/I)·dt
         if s.applying_shear:        # (without the plates every sphere is mobile)
             plates_follow(s.vx, s.vy, ~mob, yc, rate_s * self.Ly_s / 2)
@@ -710,7 +704,7 @@ class BatchEngine:
             xi[1] += inc_ji * kd
         # drift, strain, wrap, clock (the displacement relative to the flow the images follow)
         image_rate = self._image_rate()
-        rate_s = _spread(image_rate, s.rep, s.B)
+        rate_s = spread(image_rate, s.rep, s.B)
         u = self.u
         u[0] += (vx - (s.y - self.hy_s if g is None else g.yc) * rate_s) * dt
         u[1] += vy * dt
@@ -735,9 +729,9 @@ class BatchEngine:
             On a device, when the guard verdict read with the flags is not sound.
         """
         s, xp = self.s, self.xp
-        rate_s = _spread(self._image_rate(), s.rep, s.B)
+        rate_s = spread(self._image_rate(), s.rep, s.B)
         s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
-        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, _spread(self._image_shift(), s.rep, s.B), rate_s)
+        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, spread(self._image_shift(), s.rep, s.B), rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = self.verdict
