@@ -99,6 +99,35 @@ def _merge(k, extra):
     return out
 
 
+#: keys (both arrays) from which :func:`_positions` merges instead of searching (measured crossover
+#: ≈ 2,000: 10 µs either way)
+_MERGE_MIN = 2000
+
+
+def _positions(a, v):
+    """``np.searchsorted(a, v)`` (left side) of the sorted array ``v`` in the sorted array ``a``, by one merge.
+
+    A stable sort of ``v`` followed by ``a`` merges two sorted runs (O(n) in NumPy's timsort, about
+    a third of the binary searches' time at 35,000 keys); ``v[m]`` lands after the m elements of
+    ``v`` before it and the elements of ``a`` below it, so its place in the merge less m is its
+    position in ``a``.  Below :data:`_MERGE_MIN` keys in all the binary searches are faster.
+
+    Parameters
+    ----------
+    a, v : ndarray of int (n,), (m,)
+        Sorted keys (repeats allowed).
+
+    Returns
+    -------
+    ndarray of intp (m,)
+        Index of the first element of ``a`` not below each ``v[m]``.
+    """
+    if len(a) + len(v) < _MERGE_MIN:
+        return np.searchsorted(a, v)
+    order = np.argsort(np.concatenate((v, a)), kind="stable")
+    return np.flatnonzero(order < len(v)) - np.arange(len(v))
+
+
 def _increasing(k, strict=True):
     """True if the 1-D array ``k`` is sorted (strictly: also without repeats); O(n), no sort."""
     return len(k) < 2 or bool((k[1:] > k[:-1]).all() if strict else (k[1:] >= k[:-1]).all())
@@ -318,7 +347,7 @@ class PairTable:
         bond = self.state == PERMANENT
         kept = old_key if keep_existing else old_key[(self.active | bond) if keep_relations else bond]
         if len(kept):
-            at = np.searchsorted(k, kept)
+            at = _positions(k, kept)
             found = at < len(k)
             found[found] = k[at[found]] == kept[found]
             if not found.all():
@@ -330,7 +359,7 @@ class PairTable:
                 else:
                     extra = np.unique(extra)
                 k = _merge(k, extra)
-        pos = np.searchsorted(old_key, k)
+        pos = _positions(old_key, k)
         pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
         had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
         src = pos_c[had]
