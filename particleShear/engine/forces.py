@@ -38,7 +38,8 @@ class PairConstants:
 
     Built from the per-replica lists and the per-replica constants of the state; ``rep`` is
     each pair's replica, ``ai``/``aj`` the global sphere rows.  The bond-dependent constants are
-    added by :meth:`set_bonds`.
+    added by :meth:`set_bonds` (until then their rows of :attr:`f` hold no defined value: the block
+    is allocated without a fill, ≈ 0.2 ms of a rebuild at N = 10,000).
 
     The constants are stored in three stacked blocks of P columns, one per kind: :attr:`f`
     (floats, rows :data:`FLOAT_ROWS`), :attr:`i` (sphere and replica indices, :data:`INT_ROWS`,
@@ -106,15 +107,13 @@ class PairConstants:
         i_host[0] = rep
         i_host[1] = np.concatenate([p.i for p in pairs]) + rep * N
         i_host[2] = np.concatenate([p.j for p in pairs]) + rep * N
-        self._blocks(xp.zeros((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
+        self._blocks(xp.empty((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
         self._index(s, offsets)
         f = self.f
         f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
         f[2] = f[0] + f[1]                        # d0 = r_i + r_j
         f[3:5] = f[0:2] / f[2]                    # w_i, w_j = r/d0
-        f[5] = spread(s.Lx, self.rep, s.B)
-        f[6] = spread(s.Ly, self.rep, s.B)
-        f[7:9] = f[6:4:-1] / 2                    # hy, hx
+        f[5:9] = spread(s.xp.stack((s.Lx, s.Ly, s.Ly / 2, s.Lx / 2)), self.rep, s.B)     # Lx, Ly, hy, hx
 
     @property
     def w(self):
