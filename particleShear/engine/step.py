@@ -35,7 +35,7 @@ from .terms import (central_term, elastic_term, normal_speed, pair_forces, relat
                     tangential_term, viscous_term)
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .state import PERMANENT, SLIP, STICK
+from .state import PERMANENT, SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 
