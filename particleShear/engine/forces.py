@@ -26,7 +26,7 @@ from . import laws
 from .terms import TermConstants, term_constants
 
 __all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "pair_roles",
-           "shear_from_sums", "shear_stresses", "spread"]
+           "shear_from_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
 CF_CL = 1e-18
@@ -439,27 +439,6 @@ def replica_sums(C, W):
     if C.P:
         out[:, C.seg_rep_b] = xp.add.reduceat(W, C.seg_starts_b, axis=1)
     return out
-
-
-def spread(values, rep, B):
-    """``values[rep]``: per-replica values onto the rows of the spheres or candidates (``rep``); for a
-    batch of one the (1,) array itself, which broadcasts to the same numbers without a gather.
-
-    Parameters
-    ----------
-    values : ndarray (B,)
-        One value per replica.
-    rep : ndarray of int
-        The replica of each row.
-    B : int
-        Replicas.
-
-    Returns
-    -------
-    ndarray
-        ``values[rep]``, or ``values`` itself when ``B == 1``.
-    """
-    return values if B == 1 else values[rep]
 
 
 def pair_roles(mob_i, mob_j, shifted):

@@ -17,7 +17,8 @@ import functools
 
 import numpy as np
 
-from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums, spread
+from .forces import CF_CL, CT, pair_roles, replica_sums, shear_from_sums
+from .state import spread
 from .xp import array_namespace
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "OVERALL", "EXTERNAL", "ROWS", "KINETIC_ROWS", "evaluate_all",
