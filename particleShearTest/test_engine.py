@@ -368,6 +368,32 @@ class TestStateOfOneEnsemble(unittest.TestCase):
         self.assertIsNone(pickle.loads(pickle.dumps(view)).ensemble)
 
 
+    def test_documented_steps_keep_their_state_through_appends(self):
+        """The documented step fits the ensemble's state block to its spheres (contiguous (2|3, N) rows
+        for the engine); a sphere appended between steps keeps its numbers, the old spheres theirs, and
+        the next step runs on all of them."""
+        from particleShear import SphereLinkable
+        _, ens, sc = constituted(19, theMu=0.05, do_permanent_links=True, cut_lines=1)
+        ens.setShearRate(200.0)
+        for _ in range(5):
+            ens.mechanical_simulation_step(0.99, sc["dt"])
+        for name in ("_pos", "_vel", "_frc"):
+            self.assertTrue(getattr(ens, name).flags["C_CONTIGUOUS"], name)
+        before = {name: ens._a[name].copy() for name in ("x", "y", "xspeed", "yspeed", "omega", "r", "m")}
+        r = float(np.median(ens._a["r"]))
+        new = SphereLinkable("grey", 0.5 * ens.size_x, 0.5 * ens.size_y, 2 * r, float(np.median(ens._a["m"])),
+                             len(ens.sphereList), force_register=ens, size_x=ens.size_x, size_y=ens.size_y)
+        ens.sphereList.append(new)
+        for name, old in before.items():
+            self.assertEqual(ens._a[name][:-1].tobytes(), old.tobytes(), name)
+        self.assertEqual((ens._a["x"][-1], ens._a["y"][-1]), (new.x, new.y))
+        ens.mechanical_simulation_step(0.99, sc["dt"])
+        for name in ("_pos", "_vel", "_frc"):
+            self.assertTrue(getattr(ens, name).flags["C_CONTIGUOUS"], name)
+        self.assertTrue(np.all(np.isfinite(ens._pos)))
+        self.assertEqual(ens._engine.s.N, len(ens.sphereList))
+
+
 class TestPhasesOneByOne(unittest.TestCase):
     """A script's ``pre_equilibrate`` then ``run_protocol`` is the measurement of
     ``oscillatory_shear_experiment`` bit for bit: the same loops of the engine on the ensemble's own
