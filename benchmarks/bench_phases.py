@@ -9,6 +9,11 @@ steps after 100 warm-up steps), so the steps that rebuild the neighbour lists ar
 tree runs in its own process (the tree first on ``sys.path``, one thread, pinned to one CPU where
 ``taskset`` exists); compare trees within one run of the script.
 
+For comparison it also times the engine's own step without the documented view around it:
+``BatchEngine.step(cool, dt, sample=…)`` on a copy of the same scene (``BatchState.from_ensembles``,
+plates on), with no stresses, the two shear stresses and every tensor (``sample=False``, ``True``,
+``"tensors"``), the same statistics; "n/a" where the tree's engine cannot.
+
 Usage: python benchmarks/bench_phases.py [TREE ...]   (default: this tree)
 """
 import json
@@ -19,6 +24,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PHASES = ("rate", "forces", "totals", "tensors", "acceleration", "movement")
+#: the engine's own step on a copy of the scene: (row label, ``sample``)
+ENGINE = (("engine step alone, no stresses", False), ("engine step alone, shear stresses", True),
+          ("engine step alone, every tensor", "tensors"))
 
 WORKER = r'''
 import json, math, sys, time
@@ -48,8 +56,28 @@ for _ in range(30):
             acc[n] += t[k + 1] - t[k]
     for n in names:
         means[n].append(acc[n] / 20 * 1e6)
-print(json.dumps({n: sorted(v)[len(v) // 4] for n, v in means.items()}))
-''' % (PHASES,)
+out = {n: sorted(v)[len(v) // 4] for n, v in means.items()}
+try:
+    import numpy as np
+    from particleShear.engine.state import BatchState
+    from particleShear.engine.step import BatchEngine
+    eng = BatchEngine(BatchState.from_ensembles([bench_step.build(150, seed=2)]), guard=False)
+    eng.s.applying_shear = True
+    for label, sample in ENGINE:
+        eng.step(cool, dt, sample=sample)           # (raises where the tree's engine lacks the mode)
+    blocks = {label: [] for label, _ in ENGINE}
+    for _ in range(30):
+        for label, sample in ENGINE:
+            t0 = time.perf_counter()
+            for _ in range(20):
+                eng.set_rate(np.array([bench_step.AMPLITUDE * w * math.cos(w * float(eng.s.t[0]))]))
+                eng.step(cool, dt, sample=sample)
+            blocks[label].append((time.perf_counter() - t0) / 20 * 1e6)
+    out.update({label: sorted(v)[len(v) // 4] for label, v in blocks.items()})
+except Exception:
+    pass
+print(json.dumps(out))
+'''.replace("%r", repr(PHASES)).replace("ENGINE", repr(ENGINE))
 
 
 def main():
@@ -66,8 +94,10 @@ def main():
     print("| phase | " + " | ".join(trees) + " |")
     print("|---|" + "---|" * len(trees))
     for n in PHASES + ("sum",):
-        print(f"| {n} | " + " | ".join(f"{(sum(rows[t].values()) if n == 'sum' else rows[t][n]):.1f}"
+        print(f"| {n} | " + " | ".join(f"{(sum(rows[t][p] for p in PHASES) if n == 'sum' else rows[t][n]):.1f}"
                                       for t in trees) + " |")
+    for label, _ in ENGINE:
+        print(f"| {label} | " + " | ".join(f"{rows[t][label]:.1f}" if label in rows[t] else "n/a" for t in trees) + " |")
 
 
 if __name__ == "__main__":
