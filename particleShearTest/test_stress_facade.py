@@ -79,7 +79,7 @@ class TestLinearMaps(unittest.TestCase):
         each is bit for bit the tensor its own function gives on fresh inputs of the same force phase
         (the overall tensor, the sum of three of them, too),
         for both replicas of a batch of two; the torque and spin tensors have their fixed pattern
-        (antisymmetric, isotropic)."""
+        (antisymmetric, isotropic), their zero entries the sign of ``value · 0``."""
         ens = [sheared(seed, True)[0] for seed in (5, 6)]
         engine = BatchEngine(BatchState.from_ensembles(ens), guard=False)
         captured = []
@@ -98,13 +98,18 @@ class TestLinearMaps(unittest.TestCase):
                 self.assertEqual(alone.shape, (2, 2, 2))
                 np.testing.assert_array_equal(T[:, k], alone)
                 self.assertTrue(np.all(np.isfinite(alone)))
+        # the fixed patterns, with the zero entries as the definitions give them (value · 0: the sign of
+        # the value), which the text output writes ("-0.0")
         for name in ("stress_tensor_unbalanced_torque", "stress_tensor_internal_torque"):
             A = T[:, [t.name for t in es.TENSORS].index(name)]
             np.testing.assert_array_equal(A[:, 0, 1], -A[:, 1, 0])
             np.testing.assert_array_equal(A[:, 0, 0], 0.0)
+            np.testing.assert_array_equal(np.signbit(A[:, 0, 0]), np.signbit(A[:, 1, 0]))
+            np.testing.assert_array_equal(np.signbit(A[:, 1, 1]), np.signbit(A[:, 1, 0]))
         S = T[:, [t.name for t in es.TENSORS].index("stress_tensor_spin_kinetic_energy")]
         np.testing.assert_array_equal(S[:, 0, 0], S[:, 1, 1])
-        self.assertTrue(np.all(S[:, 0, 0] <= 0.0))
+        self.assertTrue(np.all(S[:, 0, 0] < 0.0))
+        self.assertTrue(np.all(np.signbit(S[:, 0, 1])) and np.all(np.signbit(S[:, 1, 0])))
 
 
 class TestAnyListOfSpheres(unittest.TestCase):

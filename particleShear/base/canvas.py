@@ -175,6 +175,12 @@ class CanvasPoints:
         self._cap = cap
         self._views()
 
+    def _fit_block(self):
+        """Drop the spare columns of the state block (kept for appends), so that the grouped rows
+        ``_pos``, ``_vel``, ``_frc`` are contiguous (an engine's (2|3, N) arrays); a no-op when fitted."""
+        if self._cap != self._n:
+            self._set_capacity(self._n)
+
     def _views(self):
         """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]

@@ -13,7 +13,7 @@ import contextlib
 
 from .xp import array_namespace, backend_of
 
-__all__ = ["min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cell", "MAX_PASSES"]
+__all__ = ["min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cell", "in_intervals", "MAX_PASSES"]
 
 #: one-period passes of :func:`min_image` and :func:`wrap` before the rest is folded in closed form
 #: (floor): a protocol needs at most one or two, so ordinary states keep the exact subtractions of the
@@ -24,6 +24,27 @@ MAX_PASSES = 4
 def _count(v, half, minus_half):
     """−1, 0 or +1 per element as float: a period to subtract (``v ≥ half``) or to add (``v < −half``)."""
     return (v >= half).astype(float) - (v < minus_half)
+
+
+def in_intervals(dx, dy, Lx, Ly):
+    """Where a separation lies in ``[−Lx/2, Lx/2) × [−Ly/2, Ly/2)``, the intervals of :func:`min_image`.
+
+    The complement of :func:`_count`'s rule on both axes: there :func:`min_image` removes no
+    period and returns the separation unchanged.
+
+    Parameters
+    ----------
+    dx, dy : ndarray
+        Separations (µm).
+    Lx, Ly : float or ndarray
+        Box lengths (µm).
+
+    Returns
+    -------
+    ndarray of bool
+    """
+    hx, hy = Lx / 2, Ly / 2
+    return (dx < hx) & (dx >= -hx) & (dy < hy) & (dy >= -hy)
 
 
 def _accumulate(total, k):
@@ -84,8 +105,9 @@ def min_image(dx, dy, Lx, Ly, shift):
     to its loop, which differs from ``dx − k·Lx`` by an ulp when ``|k| ≥ 2``), for at most
     :data:`MAX_PASSES` passes; what is still outside then is folded in closed form and clipped
     into the interval against rounding, so the cost does not grow with the size of a separation
-    and the result is inside the intervals for any finite input.  A NaN stays NaN (count 0); an
-    infinite difference becomes NaN.  This is the one minimum image of the package (the
+    and the result is inside the intervals for any finite input.  A separation already inside
+    both (:func:`in_intervals`) is returned unchanged where the offset is finite.  A NaN stays NaN
+    (count 0); an infinite difference becomes NaN.  This is the one minimum image of the package (the
     engine, the documented classes, the per-sphere API, cuts and drawings call it).
     """
     be = backend_of(dx, dy)

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from .box import min_image
+from .box import in_intervals, min_image
 from .xp import array_namespace
 
 __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
@@ -98,9 +98,8 @@ def _near(i, j, x, y, r, Lx, Ly, shift, skin):
     """
     xp = array_namespace(x)
     dx, dy = x[j] - x[i], y[j] - y[i]
-    hx, hy = Lx / 2, Ly / 2
     if math.isfinite(shift):      # (a shift that is not finite makes every x it moves NaN)
-        moved = xp.flatnonzero(~((dx < hx) & (dx >= -hx) & (dy < hy) & (dy >= -hy)))
+        moved = xp.flatnonzero(~in_intervals(dx, dy, Lx, Ly))
     else:
         moved = slice(None)
     dx[moved], dy[moved], _, _ = min_image(dx[moved], dy[moved], Lx, Ly, shift)

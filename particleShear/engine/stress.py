@@ -291,18 +291,19 @@ class Linear(collections.namedtuple("Linear", "rows index coef scale per_volume"
     """A tensor as a linear map of the per-replica sums of one row function (:func:`linear_tensor`).
 
     Entry ``e`` of the tensor, in the order (xx, xy, yx, yy), is
-    ``(sums[index[e]] · (coef[e] · scale)) / (V if per_volume else 1)``; an entry whose index is
-    None is 0.  ``coef`` holds ±1 and ±½ only, so ``coef · scale`` is exact and each entry is the
-    sum times one factor, then divided by V: the same rounding as the definition written out.
+    ``(sums[index[e]] · (coef[e] · scale)) / (V if per_volume else 1)``.  ``coef`` holds ±1, ±½ and
+    ±0 only, so ``coef · scale`` is exact and each entry is the sum times one factor, then divided by
+    V: the same rounding as the definition written out, down to the sign of a zero entry (a sum
+    times ±0: the sign of the sum, or NaN, as ``value · 0`` in the definition).
 
     Attributes
     ----------
     rows : callable
         A :func:`pair_rows` or :func:`sphere_rows` function.
-    index : tuple of (int or None)
+    index : tuple of int
         Per entry, the row of ``rows`` whose sum it takes (4 items).
     coef : tuple of float
-        Per entry, ±1 or ±½ (4 items).
+        Per entry, ±1, ±½ or ±0 (4 items).
     scale : float or callable
         The unit factor, or ``scale(q) -> (B,)`` per replica (as ``CF_CL / V``).
     per_volume : bool
@@ -342,8 +343,7 @@ def linear_tensor(rows, index, coef, scale, per_volume=False):
 class _LinearMaps:
     """The :class:`Linear` maps of several tensors evaluated at once: ``(q) -> (B, n, 2, 2)``.
 
-    The sums of the maps' row functions are stacked (with one row of zeros for the zero entries),
-    gathered to the n·4 entries, multiplied by ``coef · scale`` and divided by V or 1 (exact).
+    The sums of the maps' row functions are stacked, gathered to the n·4 entries, multiplied by ``coef · scale`` and divided by V or 1 (exact).
 
     Parameters
     ----------
@@ -364,8 +364,7 @@ class _LinearMaps:
 
     def _gather(self, sizes):
         base = dict(zip(self.rows, np.cumsum((0,) + sizes[:-1])))
-        zero = sum(sizes)
-        return np.array([zero if e is None else base[s.rows] + e for s in self.specs for e in s.index])
+        return np.array([base[s.rows] + e for s in self.specs for e in s.index])
 
     def __call__(self, q):
         xp = array_namespace(q.V)
@@ -373,7 +372,7 @@ class _LinearMaps:
         if self._index is None:
             self._index = self._gather(tuple(len(S) for S in sums))
         B, n = q.B, len(self.specs)
-        A = xp.concatenate(sums + [xp.zeros((1, B))])
+        A = xp.concatenate(sums)
         scale = xp.empty((B, n, 1))
         scale[:, :, 0] = xp.asarray(self.const)
         for f, cols in self.varying:
@@ -390,7 +389,7 @@ def _force_per_volume(q):
     return CF_CL / q.V
 
 
-_DIAGONAL, _FULL = (0, None, None, 0), (0, 1, 2, 3)
+_FULL = (0, 1, 2, 3)
 
 
 @linear_tensor(_love_weber_rows, _FULL, (1, 1, 1, 1), _force_per_volume)
@@ -461,7 +460,7 @@ def linear_acceleration(q):
     """
 
 
-@linear_tensor(_torque_rows, (None, 0, 0, None), (0, -0.5, 0.5, 0), CT, per_volume=True)
+@linear_tensor(_torque_rows, (0, 0, 0, 0), (0.0, -0.5, 0.5, 0.0), CT, per_volume=True)
 def unbalanced_torque(q):
     """σ_T = (1/V) Σ_all spheres T·[[0, −½], [½, 0]] (eq. S1-22; immobile spheres included, reference quirk).
 
@@ -477,7 +476,7 @@ def unbalanced_torque(q):
     """
 
 
-@linear_tensor(_internal_torque_rows, (None, 0, 0, None), (0, -0.5, 0.5, 0), CT, per_volume=True)
+@linear_tensor(_internal_torque_rows, (0, 0, 0, 0), (0.0, -0.5, 0.5, 0.0), CT, per_volume=True)
 def internal_torque(q):
     """σ_Tint = (1/V) Σ_internal d·F_T·[[0, −½], [½, 0]] (eq. S1-22): the pair's two torques sum to d·F_T.
 
@@ -493,7 +492,7 @@ def internal_torque(q):
     """
 
 
-@linear_tensor(_spin_rows, _DIAGONAL, (-0.5, 0, 0, -0.5), 1e-18, per_volume=True)
+@linear_tensor(_spin_rows, (0, 0, 0, 0), (-0.5, -0.0, -0.0, -0.5), 1e-18, per_volume=True)
 def spin_kinetic_energy(q):
     """σ_cen = −(1/V) Σ_mobile I ω²/2 · 1 (eq. S1-21; inertias and ω² ×1e-18).
 
