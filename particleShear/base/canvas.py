@@ -176,8 +176,7 @@ class CanvasPoints:
         self._views()
 
     def _fit_block(self):
-        """Drop the spare columns of the state block (kept for appends), so that the grouped rows
-        ``_pos``, ``_vel``, ``_frc`` are contiguous (an engine's (2|3, N) arrays); a no-op when fitted."""
+        """Drop the state block's spare columns (kept for appends): contiguous ``_pos``, ``_vel``, ``_frc`` rows."""
         if self._cap != self._n:
             self._set_capacity(self._n)
 

@@ -40,9 +40,8 @@ class EngineStep:
                 float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"))
 
     def _step_engine(self):
-        """The ensemble's engine, kept in the memo under :meth:`_engine_view_key` (the state block
-        fitted first, as :meth:`~particleShear.engine.state.BatchState.of_ensembles` fits it, so the
-        key holds the block the engine is made on)."""
+        """The ensemble's engine, kept in the memo under :meth:`_engine_view_key` (the block fitted
+        first, as ``BatchState.of_ensembles`` fits it: the key holds the block the engine is made on)."""
         self._fit_block()
         return self._memo.get("engine", self._engine_view_key(), self._new_engine)
 

@@ -89,14 +89,10 @@ class SphereSelection(list):
     def __init__(self, ensemble, mask=None, spheres=None):
         if spheres is None:
             sl = ensemble.sphereList
-            if mask is None:
-                spheres = sl
-            else:
-                flags = np.asarray(mask, dtype=bool).ravel()
-                if flags[len(sl):].any():
-                    raise IndexError(f"mask selects sphere {int(np.flatnonzero(flags)[-1])} of an ensemble of "
-                                     f"{len(sl)} spheres")
-                spheres = itertools.compress(sl, flags.tolist())
+            flags = None if mask is None else np.asarray(mask, dtype=bool).ravel()
+            if flags is not None and flags[len(sl):].any():
+                raise IndexError(f"mask selects sphere {int(np.flatnonzero(flags)[-1])} of {len(sl)} spheres")
+            spheres = sl if flags is None else itertools.compress(sl, flags.tolist())
         list.__init__(self, spheres)
         self.ensemble = ensemble
         self.mask = mask
