@@ -40,7 +40,7 @@ ens = bench_step.build(150, seed=2)
 ev = StressTensorEvaluation(ens.size_x, ens.size_y)
 bench_step.documented_steps(ens, ev, 100)
 w, cool, dt = 2 * math.pi * bench_step.F_EXC, 0.99969060716623, bench_step.DT
-names = %r
+names, engine_rows = json.loads(sys.argv[3])
 means = {n: [] for n in names}
 for _ in range(30):
     acc = dict.fromkeys(names, 0.0)
@@ -63,11 +63,11 @@ try:
     from particleShear.engine.step import BatchEngine
     eng = BatchEngine(BatchState.from_ensembles([bench_step.build(150, seed=2)]), guard=False)
     eng.s.applying_shear = True
-    for label, sample in ENGINE:
+    for label, sample in engine_rows:
         eng.step(cool, dt, sample=sample)           # (raises where the tree's engine lacks the mode)
-    blocks = {label: [] for label, _ in ENGINE}
+    blocks = {label: [] for label, _ in engine_rows}
     for _ in range(30):
-        for label, sample in ENGINE:
+        for label, sample in engine_rows:
             t0 = time.perf_counter()
             for _ in range(20):
                 eng.set_rate(np.array([bench_step.AMPLITUDE * w * math.cos(w * float(eng.s.t[0]))]))
@@ -77,7 +77,7 @@ try:
 except Exception as exc:      # a tree whose engine lacks a mode: its rows print n/a, with the reason
     out["engine"] = repr(exc)
 print(json.dumps(out))
-'''.replace("%r", repr(PHASES)).replace("ENGINE", repr(ENGINE))
+'''
 
 
 def main():
@@ -86,7 +86,8 @@ def main():
     pin = ["taskset", "-c", "0"] if shutil.which("taskset") else []
     rows = {}
     for tree in trees:
-        p = subprocess.run(pin + [sys.executable, "-c", WORKER, tree, HERE], capture_output=True, text=True, env=env)
+        p = subprocess.run(pin + [sys.executable, "-c", WORKER, tree, HERE, json.dumps([PHASES, ENGINE])],
+                           capture_output=True, text=True, env=env)
         if p.returncode:
             sys.exit(f"{tree}: {p.stderr[-2000:]}")
         rows[tree] = json.loads(p.stdout.strip().splitlines()[-1])
