@@ -23,6 +23,7 @@ import inspect
 import json
 import math
 import re
+import signal
 import sys
 import time
 
@@ -459,9 +460,34 @@ def _json_row(res):
     return json.dumps({k: clean(v) for k, v in res.to_dict().items()}, default=str)
 
 
+class RunTerminated(KeyboardInterrupt):
+    """SIGTERM during a single run of the CLI: handled as Ctrl-C (temporary files removed), exit 143."""
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts():
+    """Within: SIGTERM raises :class:`RunTerminated`, so every cleanup that Ctrl-C runs also runs for it.
+
+    Without it the default action ends the process at once and an output file being written
+    stays behind as its hidden ``.part`` file.  Outside the main thread SIGTERM is left alone.
+    """
+    def stop(signum, frame):
+        raise RunTerminated(f"signal {signum}")
+
+    try:
+        previous = signal.signal(signal.SIGTERM, stop)
+    except ValueError:
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv=None):
     """Entry point; returns the process exit status (0 ok, 1 output not written or run unstable,
-    2 invalid parameters, 130 interrupted).
+    2 invalid parameters, 130 interrupted, 143 terminated by SIGTERM).
 
     ``particleShear run ...`` (or flags only) runs one simulation, ``particleShear plot DIR ...``
     dispatches to :func:`particleShear.plot.cli_main`, ``particleShear sweep SPEC --out DIR ...`` to
@@ -529,15 +555,17 @@ def main(argv=None):
     # with --json, stdout holds the JSON only: the run's console messages go to stderr
     quiet_stdout = contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext()
     try:
-        with quiet_stdout:
+        with quiet_stdout, _sigterm_interrupts():
             res = doParticleShearSimulation(**kw, return_result=True)
     except KeyboardInterrupt as exc:  # one line, no traceback; the run removed its temporary files
         if progress is not None:
             progress.finish()
         phase, step, total = getattr(exc, "position", ("set-up", 0, 0))
         where = f"at step {step} of {total} ({phase})" if total else f"during {phase}"
-        print(f"particleShear: interrupted {where}; no file written", file=sys.stderr)
-        return 130
+        terminated = isinstance(exc, RunTerminated)
+        print(f"particleShear: {'terminated (SIGTERM)' if terminated else 'interrupted'} {where}; no file written",
+              file=sys.stderr)
+        return 143 if terminated else 130
     except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
         print(f"particleShear: {exc}", file=sys.stderr)
         return 2

@@ -117,7 +117,8 @@ def write_protocol_file(sim, result):
     """Write ``result`` into a new numbered file beside the oscillatory ones; set its ``output_path``.
 
     A failure does not lose the result: the partial file and sidecar are removed, the exception
-    is kept in ``result.write_error`` and ``output_path`` stays None.
+    is kept in ``result.write_error`` and ``output_path`` stays None.  An interruption (Ctrl-C,
+    SIGTERM under the CLI) removes them too and is raised again: the file is complete or absent.
 
     Parameters
     ----------
@@ -147,7 +148,9 @@ def write_protocol_file(sim, result):
                           sidecar_path(out.path))
         out.commit()
         result.output_path = out.path
-    except Exception as exc:  # noqa: BLE001 - a failed write keeps the result (docs/output.md)
+    except BaseException as exc:  # noqa: BLE001 - complete or absent, Ctrl-C and SIGTERM included
         if out is not None:
             out.abort()
-        result.write_error = exc
+        if not isinstance(exc, Exception):
+            raise                  # KeyboardInterrupt, SystemExit, a terminating signal: after the cleanup
+        result.write_error = exc   # a failed write keeps the result (docs/output.md)
