@@ -14,16 +14,41 @@ import sys
 
 import numpy as np
 
-__all__ = ["SHOW_DIGITS", "show_value", "real_type", "as_float", "finite", "in_range", "positive", "non_negative",
+__all__ = ["SHOW_DIGITS", "MESSAGE_VALUE_LIMIT", "cut_text", "show_value", "real_type", "as_float", "finite", "in_range", "positive", "non_negative",
            "integer"]
 
 #: integers with more digits than this are abbreviated in messages (:func:`show_value`)
 SHOW_DIGITS = 20
 _MAX = sys.float_info.max
 
+#: the most characters of one value that a message shows (:func:`cut_text`)
+MESSAGE_VALUE_LIMIT = 200
+
+
+def cut_text(text, limit=MESSAGE_VALUE_LIMIT):
+    """``text`` if it has at most ``limit`` characters, else its head, how much is left out, and its tail.
+
+    Parameters
+    ----------
+    text : str
+        A value as a message writes it.
+    limit : int, default :data:`MESSAGE_VALUE_LIMIT`
+        The most characters shown (the count of those left out comes on top).
+
+    Returns
+    -------
+    str
+        ``text``, or its first ``limit - 50`` characters, ``…(N characters)…`` and its last 20.
+    """
+    if len(text) <= limit:
+        return text
+    head, tail = text[:limit - 50], text[-20:]
+    return f"{head}…({len(text) - len(head) - len(tail):,} characters)…{tail}"
+
 
 def show_value(v):
-    """``repr(v)``, with an integer of more than :data:`SHOW_DIGITS` digits abbreviated to one short word.
+    """``repr(v)``, with an integer of more than :data:`SHOW_DIGITS` digits abbreviated to one short word,
+    and any value longer than :data:`MESSAGE_VALUE_LIMIT` characters cut (:func:`cut_text`).
 
     A power of ten reads ``10**400``, any other such integer ``123456…(401 digits)`` (no conversion
     to text of the whole number, so integers beyond Python's digit limit are shown too); used for
@@ -51,7 +76,10 @@ def show_value(v):
             if a == 10 ** (n - 1):
                 return f"{sign}10**{n - 1}"
             return f"{sign}{a // 10 ** (n - 6)}…({n} digits)"
-    return repr(v)
+    if isinstance(v, str) and len(v) > 2 * MESSAGE_VALUE_LIMIT:   # no repr of a 50 MB string
+        head, tail = v[:MESSAGE_VALUE_LIMIT - 50], v[-20:]
+        return f"{repr(head)[:-1]}…({len(v) - len(head) - len(tail):,} characters)…{repr(tail)[1:]}"
+    return cut_text(repr(v))
 
 
 def _scalar(v):

@@ -27,7 +27,7 @@ import signal
 import sys
 import time
 
-from .guard import SuggestingParser
+from .guard import SuggestingParser, shorten_values
 from .validation import IMAGE_FILE_TYPES
 
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
@@ -256,7 +256,7 @@ def cli_message(text, typed=None):
     if not PARAMETER_FLAGS:
         _flags_for_messages()
     typed = typed or {}
-    text = " ".join(str(text).split())
+    text = " ".join(shorten_values(text).split())
     for name in sorted(PARAMETER_FLAGS, key=len, reverse=True):
         for value in ("True", "False"):
             setting = f"{name}={value}"

@@ -22,8 +22,11 @@ import argparse
 import difflib
 import functools
 import inspect
+import re
 
-__all__ = ["UnknownParameterError", "PARAMETER_ALIASES", "PARAMETER_HINTS", "close_names", "unknown_name_message", "resolve_names",
+from ..checks import MESSAGE_VALUE_LIMIT, cut_text
+
+__all__ = ["shorten_values", "UnknownParameterError", "PARAMETER_ALIASES", "PARAMETER_HINTS", "close_names", "unknown_name_message", "resolve_names",
            "checked_keywords", "SuggestingParser"]
 
 #: documented aliases of parameters of ``doParticleShearSimulation`` (alias → parameter); the
@@ -72,6 +75,34 @@ def _norm(name):
     return name.lower().replace("_", "").replace("-", "")
 
 
+# a name= then a quoted literal as repr writes it or a list (of numbers or of lists), or a run of non-blanks
+_LONG_VALUE = re.compile(r"""[^\s'"\[]*(?:'(?:[^'\\\n]|\\.)*'|"(?:[^"\\\n]|\\.)*"|\[(?:[^\[\]\n]|\[[^\[\]\n]*\])*\])|\S+""")
+
+
+def shorten_values(text, limit=MESSAGE_VALUE_LIMIT):
+    """``text`` with every value longer than ``limit`` characters cut (:func:`particleShear.checks.cut_text`).
+
+    A value is a quoted literal (as ``repr`` writes it) or a bracketed list (lists in it included),
+    with the name and ``=`` written before it, or else a run of non-blank characters.  Applied by
+    the commands to every message they print: a 50 MB string in a SPEC is named, not echoed.
+
+    Parameters
+    ----------
+    text : str or Exception
+        The message.
+    limit : int, default :data:`particleShear.checks.MESSAGE_VALUE_LIMIT`
+        The most characters shown of one value.
+
+    Returns
+    -------
+    str
+    """
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    return _LONG_VALUE.sub(lambda m: cut_text(m.group(0), limit), text)
+
+
 def close_names(name, allowed, n=3, hints=None):
     """The allowed names closest to ``name``, best first.
 
@@ -105,6 +136,10 @@ def close_names(name, allowed, n=3, hints=None):
     for a in allowed:
         by_norm.setdefault(_norm(a), []).append(a)
     out += by_norm.get(key, [])
+    # a ratio >= 0.6 needs len(key) <= 7/3 of the other's length: longer names cannot be close
+    # (and difflib's time grows with the product of the lengths: a 5 MB key would take hours)
+    if len(key) > 7 * max((len(k) for k in by_norm), default=0) // 3 + 1:
+        return list(dict.fromkeys(out))[:n]
     scored = [(difflib.SequenceMatcher(None, key, k).ratio(), k) for k in by_norm]
     best = max((r for r, _ in scored), default=0.0)
     # the close spellings: ratio >= 0.6, and within 0.1 of the best (a clear winner stands alone)

@@ -7,7 +7,7 @@ import signal
 import sys
 
 from ..messages import console_messages
-from ..run.guard import SuggestingParser
+from ..run.guard import SuggestingParser, shorten_values
 
 _log = logging.getLogger(__name__)
 
@@ -148,7 +148,7 @@ def _main(args):
         sweep = Sweep(args.spec, args.out, task_index=args.task_index, task_count=args.task_count,
                       backend=args.backend, extend=args.extend)
     except (ValueError, TypeError) as exc:
-        print(f"particleShear sweep: invalid input: {exc}", file=sys.stderr)
+        print(f"particleShear sweep: invalid input: {shorten_values(exc)}", file=sys.stderr)
         return 2
     workers = args.workers or os.cpu_count() or 1
     try:
@@ -163,7 +163,7 @@ def _main(args):
             return _dry_run(args, sweep, workers)
         return _run(args, sweep, workers)
     except ValueError as exc:   # a table or record that cannot be used: refused before any run
-        print(f"particleShear sweep: invalid input: {exc}", file=sys.stderr)
+        print(f"particleShear sweep: invalid input: {shorten_values(exc)}", file=sys.stderr)
         return 2
     except FolderBusyError as exc:
         print(f"particleShear sweep: {exc}", file=sys.stderr)

@@ -33,6 +33,8 @@ import math
 import numbers
 import os
 
+from ..checks import cut_text, show_value
+
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
 
@@ -288,11 +290,16 @@ def load_spec(path):
     if not os.path.isfile(path):
         raise ValueError(f"SPEC={path!r} is invalid: no such file")
     if path.endswith(".toml"):
-        doc = _read_toml(path)
+        try:
+            doc = _read_toml(path)
+        except RecursionError:
+            raise ValueError(_too_deep(path)) from None
     elif path.endswith(".json"):
         with open(path, encoding="utf-8") as fh:
             try:
                 doc = json.load(fh)
+            except RecursionError:
+                raise ValueError(_too_deep(path)) from None
             except json.JSONDecodeError as exc:
                 raise ValueError(f"SPEC={path!r} is not valid JSON: {exc}; JSON booleans are lowercase true/false, "
                                  "strings need double quotes, no trailing commas, null is not a value a "
@@ -302,15 +309,53 @@ def load_spec(path):
     return parse_spec(doc, source=path)
 
 
+#: the most levels of tables and lists in a SPEC: the document, [[zip]], a table, a list of steps'
+#: lists and a list of steps reach 5
+MAX_SPEC_DEPTH = 8
+
+#: the longest string a SPEC value may be (a path's limit, PATH_MAX on Linux; every other string
+#: parameter is a short name)
+MAX_SPEC_STRING = 4096
+
+
+def _too_deep(source, where=""):
+    return (f"SPEC {source!r} is invalid: {where or 'its values'} nest tables or lists deeper than "
+            f"{MAX_SPEC_DEPTH} levels: allowed tables of values, lists and lists of lists")
+
+
+def _check_depth(doc, source):
+    """Refuse a SPEC nested deeper than :data:`MAX_SPEC_DEPTH` (iteratively: no recursion to overflow)."""
+    todo = [(doc, 1, "SPEC")]
+    while todo:
+        v, depth, where = todo.pop()
+        if depth > MAX_SPEC_DEPTH:
+            raise ValueError(_too_deep(source, cut_text(where)))
+        if isinstance(v, dict):
+            todo.extend((x, depth + 1, f"{where}.{k}" if where != "SPEC" else str(k)) for k, x in v.items())
+        elif isinstance(v, (list, tuple)):
+            todo.extend((x, depth + 1, f"{where}[{i}]") for i, x in enumerate(v) if isinstance(x, (dict, list, tuple)))
+
+
+def _name_source(exc, source):
+    """``exc`` with its message starting ``SPEC 'source':`` unless it names the SPEC already; in place."""
+    msg = str(exc)
+    if source and f"SPEC {source!r}" not in msg and f"SPEC={source!r}" not in msg and exc.args:
+        exc.args = (f"SPEC {source!r}: {msg}",) + tuple(exc.args[1:])
+    return exc
+
+
 def _scalar(where, v, name=None):
     from ..run.rheometer import LIST_PARAMETERS
     if name in LIST_PARAMETERS:   # a list is one value of these (the steps of a one-packing sweep)
         if not isinstance(v, list) or not v:
-            raise ValueError(f"{where}={v!r} is invalid: allowed a non-empty list of numbers (one value of {name})")
+            raise ValueError(f"{where}={show_value(v)} is invalid: allowed a non-empty list of numbers (one value of {name})")
         return [_scalar(f"{where}[{i}]", x) for i, x in enumerate(v)]
+    if isinstance(v, str) and len(v) > MAX_SPEC_STRING:
+        raise ValueError(f"{where}={show_value(v)} is invalid: allowed a string of at most {MAX_SPEC_STRING:,} "
+                         f"characters (got {len(v):,})")
     ok = isinstance(v, (bool, str, numbers.Integral)) or (isinstance(v, numbers.Real) and math.isfinite(v))
     if not ok:
-        raise ValueError(f"{where}={v!r} is invalid: allowed a bool, a finite number or a string")
+        raise ValueError(f"{where}={show_value(v)} is invalid: allowed a bool, a finite number or a string")
     return v
 
 
@@ -322,7 +367,7 @@ def _known(where, name, known):
                                         "itself", name=name)
         near = close_names(name, list(known) + list(PARAMETER_ALIASES))
         guess = f"did you mean {' or '.join(near)}?" if near else "no parameter name is close"
-        raise UnknownParameterError(f"{where}.{name} is not a parameter of doParticleShearSimulation: {guess} "
+        raise UnknownParameterError(f"{where}.{cut_text(str(name))} is not a parameter of doParticleShearSimulation: {guess} "
                                     f"(the parameters: {RUN_PARAMETERS_DOC}; aliases: "
                                     f"{', '.join(f'{a} = {t}' for a, t in PARAMETER_ALIASES.items())})",
                                     name=name, suggestions=near)
@@ -330,7 +375,7 @@ def _known(where, name, known):
 
 def _values(where, v, name=None):
     if not isinstance(v, list) or not v:
-        raise ValueError(f"{where}={v!r} is invalid: allowed a non-empty list of values")
+        raise ValueError(f"{where}={show_value(v)} is invalid: allowed a non-empty list of values")
     return [_scalar(f"{where}[{i}]", x, name) for i, x in enumerate(v)]
 
 
@@ -364,11 +409,19 @@ def parse_spec(doc, source=""):
     parsed SPEC holds the parameter names, so the runs and their ids are those of the same SPEC
     written with ``theAmplitude`` and ``theMu``.
     """
+    try:
+        _check_depth(doc, source)
+        return _parse_spec(doc, source)
+    except (ValueError, TypeError) as exc:
+        raise _name_source(exc, source) from None
+
+
+def _parse_spec(doc, source):
     if not isinstance(doc, dict):
         raise ValueError(f"SPEC {source!r} is invalid: allowed a table of the tables {SPEC_TABLES}")
     for table in doc:
         if table not in SPEC_TABLES:
-            raise ValueError(f"SPEC table [{table}] is unknown: allowed {', '.join(SPEC_TABLES)}")
+            raise ValueError(f"SPEC table [{cut_text(str(table))}] is unknown: allowed {', '.join(SPEC_TABLES)}")
     from ..run.guard import PARAMETER_ALIASES
     known = sweep_parameter_defaults(protocols=True)
     seen = {}
@@ -552,7 +605,8 @@ def _validated_points(spec):
         try:
             validate_run(dict(params, root_folder=os.curdir))   # the sweep makes DIR: not required yet
         except (ValueError, TypeError) as exc:
-            raise type(exc)(f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)) from None
+            msg = f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)
+            raise _name_source(type(exc)(msg), spec.source) from None
         # a one-packing sweep is constituted for its first value: its row says so (and its id is the
         # id of the same call to doParticleShearSimulation)
         points.append(normalize_protocol(params) if "protocol" in params else params)
