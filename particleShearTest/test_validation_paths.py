@@ -181,7 +181,9 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
                 json.dump({"parameters": dict(TINY, N=BIG), "seeds": {"root": 1}}, fh)
             with no_work(), self.assertRaises(ValueError) as cm:
                 expand_runs(load_spec(path))
-        self.assertEqual(str(cm.exception), "point 0 (fixed parameters): " + api_error(dict(TINY, N=BIG))[1])
+        # the same message as the API's, after the file and the point (issue 43: every error names the file)
+        self.assertEqual(str(cm.exception),
+                         f"SPEC {path!r}: point 0 (fixed parameters): " + api_error(dict(TINY, N=BIG))[1])
 
     def test_the_command_line_refuses_alike_naming_the_flags(self):
         for name, value, argv, extra in BAD:
