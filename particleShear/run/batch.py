@@ -578,6 +578,13 @@ def _guarded(phase, engine, *args, dt, **kwargs):
     try:
         return phase(engine, *args, **kwargs)
     except EngineInstability as e:
+        if e.step == 0 and e.phase == "pre-equilibration":   # the state the constitution left (its step ignores time_step_factor)
+            raise SimulationInstabilityError(
+                f"{e}: the packing diverged during the constitution (before the measurement's first step), whose "
+                "time step time_step_factor does not change; relative_viscosity, relative_transversal_link_strength "
+                "or interface_reenforcement_central/_tangential are beyond what the time-step rule integrates "
+                "stably: use smaller values (docs/parameters.md, Limits)", step=e.step, phase=e.phase,
+                pair=(e.replica,), suggested_dt=None, reason=str(e)) from e
         raise SimulationInstabilityError(
             f"{e} (time step {dt:.3g} s, try dt <= {dt / 2:.3g} s)", step=e.step, phase=e.phase,
             pair=(e.replica,), suggested_dt=dt / 2, reason=str(e)) from e

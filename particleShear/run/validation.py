@@ -68,11 +68,22 @@ SEED_LIMIT = 2 ** 128
 #: upper limits (and lower limits > 0) of single physical parameters: far beyond any material, yet
 #: small enough that products of them (k·τ, m·v², …) stay finite double-precision numbers
 UPPER = {"theAmplitude": 100.0, "theMu": 1e6, "Young_modulus_spheres": 1e12, "packing_fraction": 10.0,
-         "density": 1e6, "bimodal_factor": 100.0, "relative_viscosity": 1e6,
-         "relative_transversal_link_strength": 1e6, "interface_reenforcement_central": 1e6,
+         "density": 1e6, "bimodal_factor": 100.0, "relative_viscosity": 3.0,
+         "relative_transversal_link_strength": 30.0, "interface_reenforcement_central": 50.0,
          "interface_reenforcement_tangential": 1e6, "edge_fuzziness": 1e3, "relative_y_scale_force": 1e300}
+# relative_viscosity, relative_transversal_link_strength and interface_reenforcement_central: the
+# largest values the time-step rule integrates stably (benchmarks/stable_ranges.py, 2 seeds, N = 40,
+# the others at their defaults: rv 3.65, rts 39, irc 60 run; 4.5, 49, 75 diverge in the constitution,
+# whose step time_step_factor does not change), rounded down.  Their combinations: STIFF_VISCOUS.
 LOWER = {"Young_modulus_spheres": 1e-6, "density": 1e-6, "bimodal_factor": 1e-2,
          "interface_reenforcement_central": 1e-6, "interface_reenforcement_tangential": 1e-6}
+
+#: bounds on the products of the stiffness and viscosity factors that the time-step rule integrates
+#: stably (measured as :data:`UPPER`'s): rv·max(1, rts) (rv 3 with rts 1.2 diverges at 3.6; rts 39 at
+#: rv 0.1 runs: 3.9) and, where the viscosities follow the reinforcement, rv·irc (irc 60 at rv 0.1
+#: runs: 6; rv 1 with irc 5 and rv 2 with irc 2.5 run; rv 3 with irc 50 diverges)
+STIFF_VISCOUS = {"relative_viscosity*max(1,relative_transversal_link_strength)": 3.5,
+                 "relative_viscosity*interface_reenforcement_central": 5.0}
 
 #: memory of one sphere in a running ensemble, bytes (state rows, pair table, relations; measured
 #: 6–9 kB peak per sphere at N = 2,000–20,000 with tracemalloc, rounded up)
@@ -98,6 +109,23 @@ def _range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
     if name in LOWER and (lo is None or LOWER[name] > lo):
         lo, lo_open = LOWER[name], False
     return in_range(name, v, lo, hi, lo_open, hi_open)
+
+
+def _check_stiff_viscous(p):
+    """Refuse combinations of viscosity and stiffness factors past :data:`STIFF_VISCOUS` (they diverge)."""
+    rv, rts = float(p["relative_viscosity"]), float(p["relative_transversal_link_strength"])
+    irc = float(p["interface_reenforcement_central"])
+    (name_t, bound_t), (name_c, bound_c) = STIFF_VISCOUS.items()
+    if rv * max(1.0, rts) > bound_t:
+        raise ValueError(f"relative_viscosity={show_value(p['relative_viscosity'])} with relative_transversal_link_"
+                         f"strength={show_value(p['relative_transversal_link_strength'])} is out of range: allowed "
+                         f"{name_t} <= {bound_t:g} (the time-step rule diverges beyond; docs/parameters.md, Limits)")
+    if not p["keep_viscosity_coefficients_constant"] and rv * irc > bound_c:
+        raise ValueError(f"relative_viscosity={show_value(p['relative_viscosity'])} with interface_reenforcement_"
+                         f"central={show_value(p['interface_reenforcement_central'])} is out of range: allowed "
+                         f"{name_c} <= {bound_c:g} while the viscosities follow the reinforcement "
+                         "(keep_viscosity_coefficients_constant=False; the time-step rule diverges beyond; "
+                         "docs/parameters.md, Limits)")
 
 
 def _bool(name, v):
@@ -505,6 +533,7 @@ def validate_run(params):
     _range("avoid_horizontal_angle_degree", p["avoid_horizontal_angle_degree"], 0, 90, hi_open=True)
     _range("interface_reenforcement_central", p["interface_reenforcement_central"], 0, lo_open=True)
     _range("interface_reenforcement_tangential", p["interface_reenforcement_tangential"], 0, lo_open=True)
+    _check_stiff_viscous(p)
     if not isinstance(p["imageFileType"], str) or p["imageFileType"] not in IMAGE_FILE_TYPES:
         raise ValueError(f"imageFileType={show_value(p['imageFileType'])} is invalid: allowed one of "
                          f"{IMAGE_FILE_TYPES}")
