@@ -234,7 +234,8 @@ class TestNoAbbreviations(unittest.TestCase):
 
     def test_run_flags(self):
         for argv, right in ((["--amplitud", "0.1"], "--amplitude"), (["--amplitud=0.1"], "--amplitude"),
-                            (["--amp", "0.1"], "--amplitude"), (["--periode", "3"], "--periods")):
+                            (["--amp", "0.1"], "--amplitude"), (["--periode", "3"], "--periods"),
+                            (["--n", "40"], "--N"), (["--pre_periods", "1"], "--pre-periods")):
             with self.subTest(argv=argv):
                 rc, err = run_cli(argv)
                 self.assertEqual(rc, 2)

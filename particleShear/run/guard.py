@@ -320,7 +320,8 @@ class SuggestingParser(argparse.ArgumentParser):
     def flag_suggestions(self, token):
         """The closest flags of this parser to ``token`` (one per option; best first).
 
-        Flags that ``token`` abbreviates come first (shortest first), then the close spellings
+        Flags equal to ``token`` but for case, underscores and hyphens come first (``--n`` → ``--N``),
+        then flags that ``token`` abbreviates (shortest first), then the close spellings
         (:func:`close_names`).
 
         Parameters
@@ -335,8 +336,9 @@ class SuggestingParser(argparse.ArgumentParser):
         flag = token.split("=", 1)[0]
         strings = self._option_string_actions
         out, seen = [], set()
+        same = [s for s in strings if _norm(s) == _norm(flag)]      # --n → --N, --save_data → --save-data
         prefixed = sorted((s for s in strings if len(flag) > 2 and s.startswith(flag)), key=len)
-        for match in prefixed + close_names(flag, list(strings), n=6):
+        for match in same + prefixed + close_names(flag, list(strings), n=6):
             action = strings[match]
             if id(action) not in seen:
                 seen.add(id(action))
