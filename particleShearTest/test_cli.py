@@ -13,6 +13,7 @@ import logging
 import os
 import subprocess
 import sys
+import tempfile
 import unittest
 from unittest import mock
 
@@ -216,6 +217,34 @@ class TestRunAndJson(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         json.loads(out)
         self.assertIn("G''(by surface force)", err)   # the messages went to stderr
+
+
+class TestSaveFolder(unittest.TestCase):
+    """``--save DIR`` makes DIR (and its parents) as ``sweep --out`` does, after every other check."""
+
+    def test_a_missing_folder_is_made_and_holds_the_file(self):
+        with tempfile.TemporaryDirectory() as d:
+            target = os.path.join(d, "new", "runs")
+            rc, out, err = run_main([*TINY, "--save", target])
+            self.assertEqual(rc, 0, err)
+            self.assertEqual(sorted(f.rsplit(".", 1)[1] for f in os.listdir(target)), ["json", "txt"])
+
+    def test_a_refused_run_makes_no_folder(self):
+        with tempfile.TemporaryDirectory() as d:
+            target = os.path.join(d, "new")
+            rc, _, err = run_main([*TINY, "--N", "5", "--save", target])
+            self.assertEqual(rc, 2, err)
+            self.assertFalse(os.path.exists(target))
+
+    def test_a_folder_that_cannot_be_made_is_one_line(self):
+        with tempfile.TemporaryDirectory() as d:
+            blocker = os.path.join(d, "a_file")
+            open(blocker, "w").close()
+            rc, _, err = run_main([*TINY, "--save", os.path.join(blocker, "sub")])
+            self.assertEqual(rc, 2)
+            self.assertEqual(err.count("\n"), 1, err)
+            self.assertIn("--save=", err)
+            self.assertIn("cannot be made", err)
 
 
 class TestMessagesThroughLogging(unittest.TestCase):

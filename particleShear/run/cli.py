@@ -22,6 +22,7 @@ import contextlib
 import inspect
 import json
 import math
+import os
 import re
 import signal
 import sys
@@ -353,7 +354,8 @@ def build_parser():
     p = _Parser(prog="particleShear",
                 description="2D soft-particle oscillatory shear rheology: G' and G'' of one run. Commands: "
                             "run (default; the flags below), sweep SPEC --out DIR (particleShear sweep --help), "
-                            "plot DIR (particleShear plot --help). Flags follow the parameters of "
+                            "analyse DIR (particleShear analyse --help), plot DIR (particleShear plot --help). "
+                            "Flags follow the parameters of "
                             "doParticleShearSimulation (its docstring and docs/parameters.md); headless by default.")
     p.add_argument("--version", action="version", version=f"particleShear {__version__}")
     groups = {True: p.add_argument_group("parameters of doParticleShearSimulation (reference order)"),
@@ -374,12 +376,13 @@ def build_parser():
         else:
             # choices are shown, and refused by the API's validation (validate_run) with its message
             metavar = ("{" + ",".join(choices) + "}" if choices else "DIR" if name == "root_folder" else
-                       {int: "INT", float: "FLOAT"}.get(cli_type, "STR"))
+                       {int: "INT", float: "FLOAT", float_list: "X,Y,..."}.get(cli_type, "STR"))
             group.add_argument(*strings, dest=name, action=_Store, type=_float if cli_type is float else cli_type,
                                default=None, metavar=metavar, help=help_text)
     c = p.add_argument_group("command line")
     c.add_argument("--save", metavar="DIR", default=None, action=_Store,
-                   help="write the output file into DIR (must exist): --root-folder DIR --save-data")
+                   help="write the output file into DIR (made with its parents if missing): --root-folder DIR "
+                        "--save-data")
     c.add_argument("--images", nargs="?", const="jpg", default=None, choices=IMAGE_FILE_TYPES, action=_Store,
                    help="with --save: save ~200 snapshots of type jpg (default), png, ps or svg: "
                         "--save-output-images --image-file-type TYPE")
@@ -536,14 +539,24 @@ def main(argv=None):
         return 2
     # before any work: the run's parameters (the API's validation, its messages with the flags),
     # then the --plot target
+    # --save DIR is made (with its parents) as `sweep --out` makes its folder: after every other
+    # parameter is valid, so a refused run leaves nothing behind
+    make_save = bool(args.save) and not os.path.exists(args.save)
     try:
-        validate_run(kw)
+        validate_run(dict(kw, root_folder=os.curdir) if make_save else kw)
     except ImportError as exc:  # an optional extra (e.g. --output-format parquet without pyarrow)
         print(f"particleShear: {exc}", file=sys.stderr)
         return 2
     except (ValueError, TypeError) as exc:
         print(f"particleShear: invalid parameter: {cli_message(exc, typed)}", file=sys.stderr)
         return 2
+    if make_save:
+        try:
+            os.makedirs(args.save, exist_ok=True)
+        except OSError as exc:
+            print(f"particleShear: invalid parameter: --save={args.save!r}: the folder cannot be made: "
+                  f"{exc.strerror or exc}", file=sys.stderr)
+            return 2
     if args.plot:
         from ..plot import check_figure_path
         try:
