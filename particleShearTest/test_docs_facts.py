@@ -124,3 +124,21 @@ class TestDocsFacts(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestCitation(unittest.TestCase):
+    """CITATION.cff names the version this code is, and the README points to it."""
+
+    def test_version_and_readme(self):
+        from particleShear import __version__
+        with open(os.path.join(ROOT, "CITATION.cff"), encoding="utf-8") as fh:
+            text = fh.read()
+        self.assertIn("cff-version: 1.2.0", text)
+        top = [line for line in text.splitlines() if line.startswith("version:")]
+        self.assertEqual(top, [f"version: {__version__}"])
+        with open(os.path.join(ROOT, "pyproject.toml"), encoding="utf-8") as fh:
+            self.assertIn(f'version = "{__version__}"', fh.read())
+        with open(PAGES[0], encoding="utf-8") as fh:
+            readme = fh.read()
+        self.assertIn("## How to cite", readme)
+        self.assertIn("CITATION.cff", readme)
