@@ -530,8 +530,8 @@ class Sweep:
                 self._say(stream, progress, "repaired: " + note)
             foreign = foreign_entries(os.path.join(self.out_dir, "runs"))
             if foreign:
-                shown = ", ".join(repr(n) for n in foreign[:5]) + (f" and {len(foreign) - 5} more"
-                                                                   if len(foreign) > 5 else "")
+                shown = ", ".join(repr(n) for n in foreign[:10]) + (f" and {len(foreign) - 10} more"
+                                                                   if len(foreign) > 10 else "")
                 self._say(stream, progress, f"left alone in {os.path.join(self.out_dir, 'runs')}: {shown} (not "
                                             "made by a sweep; a sweep removes only its own scratch folders)")
             if self.spec is not None:
