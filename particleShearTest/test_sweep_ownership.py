@@ -338,6 +338,21 @@ class TestResumeVerifiesEveryRun(unittest.TestCase):
         self.assertEqual(ran, [b["run_id"]])
         self.assertIn(f"is the file of run {a['run_id']}", err.getvalue())
 
+    def test_an_npz_file_of_another_run_is_refused_by_its_embedded_header(self):
+        spec = dict(SPEC, parameters=dict(TINY, output_format="npz"), grid={"theAmplitude": [0.2, 0.1]}, zip=[])
+        out = os.path.join(self.tmp, "npz")
+        a, b = run_sweep(spec, out, workers=1, progress=False)
+        fb = os.path.join(out, b["output_path"])
+        shutil.copyfile(os.path.join(out, a["output_path"]), fb)
+        os.remove(os.path.splitext(fb)[0] + ".json")
+        from particleShear.simulation.formats import run_file_identity
+        self.assertEqual(run_file_identity(fb)["run_id"], a["run_id"])
+        err = io.StringIO()
+        ran = [o.row["run_id"] for o in Sweep(spec, out).as_completed(workers=1, stream=err)]
+        self.assertEqual(ran, [b["run_id"]])
+        self.assertIn(f"is the file of run {a['run_id']} (its header says)", err.getvalue())
+        self.assertEqual(run_file_identity(fb), {"run_id": b["run_id"], "seed_entropy": "7", "spawn_key": "[1]"})
+
     def test_a_duplicated_row_counts_once_and_is_set_aside(self):
         out = self._copy("dup")
         path = os.path.join(out, "results.csv")

@@ -302,7 +302,7 @@ class Sweep:
         full = os.path.join(self.out_dir, name)   # always in DIR, never elsewhere
         from ..simulation.output import sidecar_path
         side = sidecar_path(full)
-        for p in (full, side):
+        for p in (full, side, full + ".json"):
             if os.path.islink(p):
                 return f"{os.path.basename(p)} is a symbolic link (to {os.readlink(p)}), not a file of this sweep"
         if not os.path.isfile(full):
@@ -316,8 +316,6 @@ class Sweep:
             header = run_file_identity(full)
         except ValueError as exc:
             return str(exc)
-        if not os.path.isfile(side):
-            return f"its file {name} has no sidecar {os.path.basename(side)}: it cannot be verified"
         if meta.get("run_id") not in (None, row.get("run_id")):
             return f"its file {name} is the file of run {meta.get('run_id')} (its sidecar says)"
         if header.get("run_id") not in (None, row.get("run_id")):
@@ -328,6 +326,8 @@ class Sweep:
             for key, want in seed.items():
                 if header.get(key) not in (None, want):
                     return f"its file {name} has the seed of another run ({key} {header[key]}, not {want})"
+        if not (os.path.isfile(side) or os.path.isfile(full + ".json")):   # <stem>.json, or an older <file>.json
+            return f"its file {name} has no sidecar {os.path.basename(side)}: it cannot be verified"
         return None
 
     def _classify(self, retry_failed=False):
