@@ -608,6 +608,57 @@ def verify_run(path):
     return meta
 
 
+_PROVENANCE = {key: re.compile(r"\n\t" + label + r": ([^\n]*)\n")
+               for key, label in (("run_id", "Run id"), ("seed_entropy", "Seed entropy"),
+                                  ("spawn_key", "Seed spawn key"))}
+
+
+def run_file_identity(path):
+    """The run a run file says it is, from its own header: what a resume checks without the sidecar.
+
+    Reads a few kB: the start of a text file, the ``header`` member of an npz, the footer of a
+    Parquet file.  The provenance lines of block 1 (docs/output.md) give the run id, the seed
+    entropy and the spawn key.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.txt``, ``.txt.gz``, ``.npz`` or ``.parquet`` run file (verified first with :func:`verify_run`).
+
+    Returns
+    -------
+    dict
+        ``{"run_id": str, "seed_entropy": str, "spawn_key": str}`` as the header writes them
+        (``"[3]"`` for spawn key 3); a key is absent when the header has no such line (a file
+        without provenance lines).
+
+    Raises
+    ------
+    RunFileError
+        (a ``ValueError``) naming the file when its header cannot be read.
+    """
+    path = os.fspath(path)
+    fmt = format_of(path)
+    try:
+        if fmt in ("text", "text.gz"):
+            opener = gzip.open if fmt == "text.gz" else open
+            with opener(path, "rb") as fh:
+                header = _split_text(fh.read(_HEAD_CHARS).decode("utf-8", errors="replace"))[0]
+        elif fmt == "npz":
+            with zipfile.ZipFile(path) as zf, zf.open("header.npy") as fh:
+                header, _ = _embedded(path, str(np.lib.format.read_array(fh, allow_pickle=False)))
+        else:
+            _, pq = _pyarrow()
+            kv = pq.ParquetFile(path).metadata.metadata or {}
+            header, _ = _embedded(path, kv[_PARQUET_KEY].decode("utf-8"))
+    except (RunFileError, ImportError, MemoryError):
+        raise
+    except Exception as exc:  # KeyError (no header member), zip/gzip/Arrow errors
+        raise _bad(path, f"its header cannot be read ({type(exc).__name__}: {exc})") from exc
+    found = {key: rx.search(header) for key, rx in _PROVENANCE.items()}
+    return {key: m.group(1).strip() for key, m in found.items() if m}
+
+
 def _check_file(path, fmt):
     """``(sidecar content, size)``: the file exists, is not empty and has the size its sidecar records."""
     try:

@@ -31,13 +31,13 @@ import sys
 import numpy as np
 
 from .cost import estimate_cost, estimate_point_cost, format_cost
-from .locks import FolderBusyError, ScratchOwner, folder_lock
+from .locks import FolderBusyError, ScratchOwner, folder_lock, foreign_entries, refuse_links
 from .pool import pool_context, run_jobs
 from .progress import SweepProgress
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
 from .schema import typed_row, write_schema
-from .table import (TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
+from .table import (REJECTED_SUFFIX, TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
                     remove_dead_temporaries, row_problem, sort_table, table_columns, task_table_name,
                     write_parquet, write_table)
 from .tasks import execute_batch, execute_run
@@ -259,6 +259,18 @@ class Sweep:
             return []
         return sorted(os.path.join(self.out_dir, e) for e in os.listdir(self.out_dir) if _TABLE_NAME.match(e))
 
+    def _written_paths(self):
+        """Every fixed path a sweep writes, replaces or cleans in ``DIR``: none may be a symbolic link."""
+        from .schema import SCHEMA_NAME
+        out = self.out_dir
+        tables = {self.table_path, os.path.join(out, TABLE_NAME)} | set(self._tables())
+        paths = [os.path.join(out, "runs"), os.path.join(out, RECORD_NAME), os.path.join(out, RECORD_NAME + ".lock"),
+                 os.path.join(out, SCHEMA_NAME), os.path.join(out, "results.parquet"),
+                 os.path.join(out, ".results.parquet.part")]
+        for t in sorted(tables):
+            paths += [t, t + ".lock", t + REJECTED_SUFFIX]
+        return paths
+
     def _run_of(self, row):
         """The run of this sweep that ``row`` claims to be (by its spawn key and id), or None."""
         rid = row.get("run_id")
@@ -276,24 +288,46 @@ class Sweep:
         run = self.runs[k]                 # made again (not kept): memory stays that of the points
         return run if run.run_id == rid else None
 
-    def _file_problem(self, row):
-        """Why the file of an ok row cannot be trusted (None when it is there and complete)."""
+    def _file_problem(self, row, run=None):
+        """Why the file of an ok row cannot be trusted (None when it is this run's, there and complete).
+
+        The file and its sidecar must be regular files in ``DIR`` (not symbolic links), the
+        sidecar must be there, and both the sidecar and the file's own header must name this run
+        (run id, seed): a file copied from another run is refused with or without its sidecar.
+        """
         path = row.get("output_path") or ""
         if not path:
             return "its row names no file"
-        full = os.path.join(self.out_dir, os.path.basename(path))   # always in DIR, never elsewhere
+        name = os.path.basename(path)
+        full = os.path.join(self.out_dir, name)   # always in DIR, never elsewhere
+        from ..simulation.output import sidecar_path
+        side = sidecar_path(full)
+        for p in (full, side, full + ".json"):
+            if os.path.islink(p):
+                return f"{os.path.basename(p)} is a symbolic link (to {os.readlink(p)}), not a file of this sweep"
         if not os.path.isfile(full):
-            return f"its file {os.path.basename(path)} is missing"
+            return f"its file {name} is missing"
         try:
-            from ..simulation.formats import verify_run
+            from ..simulation.formats import run_file_identity, verify_run
         except ImportError:  # pragma: no cover - formats without verification
-            return None if os.path.getsize(full) > 0 else f"its file {os.path.basename(path)} is empty"
+            return None if os.path.getsize(full) > 0 else f"its file {name} is empty"
         try:
             meta = verify_run(full)
+            header = run_file_identity(full)
         except ValueError as exc:
             return str(exc)
         if meta.get("run_id") not in (None, row.get("run_id")):
-            return f"its file {os.path.basename(path)} is the file of run {meta.get('run_id')}"
+            return f"its file {name} is the file of run {meta.get('run_id')} (its sidecar says)"
+        if header.get("run_id") not in (None, row.get("run_id")):
+            return f"its file {name} is the file of run {header['run_id']} (its header says)"
+        if run is not None:
+            seed = {"seed_entropy": str(run.seed_entropy),
+                    "spawn_key": "[" + ",".join(str(int(k)) for k in run.spawn_key) + "]"}
+            for key, want in seed.items():
+                if header.get(key) not in (None, want):
+                    return f"its file {name} has the seed of another run ({key} {header[key]}, not {want})"
+        if not (os.path.isfile(side) or os.path.isfile(full + ".json")):   # <stem>.json, or an older <file>.json
+            return f"its file {name} has no sidecar {os.path.basename(side)}: it cannot be verified"
         return None
 
     def _classify(self, retry_failed=False):
@@ -313,7 +347,7 @@ class Sweep:
                 rid = run.run_id
                 problem = row_problem(row, run)
                 if problem is None and row["status"] == "ok" and run.parameters.get("saveData"):
-                    problem = self._file_problem(row)
+                    problem = self._file_problem(row, run)
                 if problem is not None:
                     if row.get("status") == "ok" or rid not in distrust:
                         distrust[rid] = (run, problem)
@@ -489,10 +523,17 @@ class Sweep:
             raise ValueError(f"batch_size={batch_size!r} (--batch-size) is invalid: allowed an integer >= 1")
         stream = stream if stream is not None else sys.stderr
         os.makedirs(self.out_dir, exist_ok=True)
+        refuse_links(self._written_paths())
         with folder_lock(self.table_path):
             remove_dead_temporaries(self.out_dir)
             for note in self._check_tables(self.table_path):
                 self._say(stream, progress, "repaired: " + note)
+            foreign = foreign_entries(os.path.join(self.out_dir, "runs"))
+            if foreign:
+                shown = ", ".join(repr(n) for n in foreign[:10]) + (f" and {len(foreign) - 10} more"
+                                                                   if len(foreign) > 10 else "")
+                self._say(stream, progress, f"left alone in {os.path.join(self.out_dir, 'runs')}: {shown} (not "
+                                            "made by a sweep; a sweep removes only its own scratch folders)")
             if self.spec is not None:
                 self._record()
             write_schema(self.out_dir, self.columns)
@@ -503,10 +544,14 @@ class Sweep:
             retried = {row.get("run_id") for row in rows if row.get("status") == "failed"
                        and row.get("run_id") not in done and self._run_of(row) is not None}
             stale = [row for row in rows if row.get("run_id") in distrust]
-            if stale or retried:   # rows of runs that run again: distrusted ones set aside, retried failures go
-                reject_lines(self.table_path, [row_line(row, self.columns) for row in stale])
-                write_table(self.table_path, [r for r in rows if r.get("run_id") not in distrust
-                                              and r.get("run_id") not in retried], self.columns)
+            kept, dupes = self._unique_rows([r for r in rows if r.get("run_id") not in distrust
+                                             and r.get("run_id") not in retried], done)
+            if stale or retried or dupes:   # distrusted rows and duplicates set aside, retried failures go
+                reject_lines(self.table_path, [row_line(row, self.columns) for row in stale + dupes])
+                write_table(self.table_path, kept, self.columns)
+            if dupes:
+                self._say(stream, progress, f"repaired: moved {len(dupes)} duplicate row(s) (same run id and step) "
+                                            f"of {self.table_path} to {self.table_path + REJECTED_SUFFIX}")
             mine = self.my_runs()
             n_mine = len(mine)
             n_todo = n_mine - sum(1 for run, _ in done.values() if self._mine(run))
@@ -526,6 +571,25 @@ class Sweep:
                 if show is not None and hasattr(show, "close"):
                     show.close()
             self._finish()
+
+    def _unique_rows(self, rows, done):
+        """``(kept, duplicates)``: one row per run id and step (``sweep_position``), in table order.
+
+        Of the rows sharing a run id and step, the one that counts (the finished row in ``done``)
+        is kept, else the first; rows of no run of this sweep are duplicates only when equal.
+        """
+        chosen = set()
+        for _, row in done.values():
+            chosen.update(row_line(r, self.columns) for r in (row if isinstance(row, list) else [row]))
+        lines = [row_line(r, self.columns) for r in rows]
+        keys = [(r.get("run_id"), r.get("sweep_position")) if self._run_of(r) is not None else ("", line)
+                for r, line in zip(rows, lines)]
+        best = {}
+        for j, (key, line) in enumerate(zip(keys, lines)):
+            if key not in best or (line in chosen and lines[best[key]] not in chosen):
+                best[key] = j
+        keep = set(best.values())
+        return [r for j, r in enumerate(rows) if j in keep], [r for j, r in enumerate(rows) if j not in keep]
 
     def _pending_cost(self, done, workers):
         if isinstance(self.runs, SweepRuns):
@@ -666,6 +730,7 @@ class Sweep:
         if not tables:
             raise ValueError(f"out_dir={self.out_dir!r} (--out) holds no results table to merge")
         self.kept_tables = []
+        refuse_links(self._written_paths())
         with folder_lock(path):
             self._check_tables(path)
             write_schema(self.out_dir, self.columns)

@@ -61,7 +61,9 @@ def publish(run_dir, out_dir, produced, run_id):
         src = os.path.join(run_dir, e)
         if e == head + SIDECAR_SUFFIX:               # the sidecar names its file: the published name
             _rename_in_sidecar(src, os.path.basename(new_head + base[len(head):]))
-        if os.path.isdir(src) and os.path.isdir(target):
+        if os.path.islink(target):
+            os.remove(target)                          # the link, never what it points to
+        elif os.path.isdir(src) and os.path.isdir(target):
             shutil.rmtree(target)
         os.replace(src, target)
         if e == base:
