@@ -168,10 +168,14 @@ class _NumberColumn(_Column):
     def add(self, texts, base, problems):
         n = len(texts)
         empty = np.fromiter((not t for t in texts), dtype=bool, count=n)
+        intform = np.zeros(n, dtype=bool)
         if self.kind == "float":
             try:
                 values = np.array([t or "nan" for t in texts], dtype=np.float64)
                 exact = [not t or repr(x) == t for t, x in zip(texts, values.tolist())]
+                for i, ok in enumerate(exact):     # "8000" in a float column: an integer's spelling
+                    if not ok and texts[i].isdigit() and str(int(values[i])) == texts[i]:
+                        exact[i] = intform[i] = True
             except (ValueError, OverflowError):      # a cell that is no float: one by one
                 got = []
                 for t in texts:
@@ -205,16 +209,18 @@ class _NumberColumn(_Column):
                 v = None
             empty[i] = v is None
             values[i] = (np.nan if self.kind == "float" else 0) if v is None else v
-        self.chunks.append((values, empty))
+        self.chunks.append((values, empty, intform))
 
     def finish(self, keep=None):
         values = np.concatenate([c[0] for c in self.chunks]) if self.chunks else np.zeros(0, self.dtype)
         empty = np.concatenate([c[1] for c in self.chunks]) if self.chunks else np.zeros(0, bool)
+        intform = np.concatenate([c[2] for c in self.chunks]) if self.chunks else np.zeros(0, bool)
         self.chunks = []
         self._remap_odd(keep)
         if keep is not None:
-            values, empty = values[keep], empty[keep]
+            values, empty, intform = values[keep], empty[keep], intform[keep]
         self.values, self.empty = values, empty
+        self.intform = intform if intform.any() else None
 
     def text(self, i):
         t = self.odd.get(i)
@@ -223,7 +229,9 @@ class _NumberColumn(_Column):
         if self.empty[i]:
             return ""
         v = self.values[i]
-        return repr(float(v)) if self.kind == "float" else str(int(v))
+        if self.kind != "float" or (self.intform is not None and self.intform[i]):
+            return str(int(v))
+        return repr(float(v))
 
     def typed(self, i):
         return None if self.empty[i] else (float(self.values[i]) if self.kind == "float" else int(self.values[i]))
@@ -719,8 +727,8 @@ def _dedupe(cols, header, lines):
     if step is not None:
         step_values = [c for c in step.chunks]
     if isinstance(step, _NumberColumn):
-        values = np.concatenate([v for v, _ in step_values])
-        empty = np.concatenate([e for _, e in step_values])
+        values = np.concatenate([c[0] for c in step_values])
+        empty = np.concatenate([c[1] for c in step_values])
         step_key = np.where(empty, -1, values).tolist()
         for i, t in step.odd.items():
             step_key[i] = t
