@@ -333,6 +333,13 @@ class TableRow(collections.abc.MutableMapping):
     Behaves as the dict of strings that ``csv.DictReader`` gives (``row["theMu"]``,
     ``row.get(...)``, ``dict(row)``, ``row["x"] = "..."``) at the cost of a few references: the
     text comes from the table's typed columns; a value set or deleted is kept in the row only.
+
+    Parameters
+    ----------
+    table : ResultsTable
+        The table.
+    i : int
+        The row's index in it.
     """
     __slots__ = ("_table", "_i", "_over")
 
@@ -388,7 +395,13 @@ _DELETED = object()
 
 
 class TableRows(collections.abc.Sequence):
-    """The rows of a table as a sequence of :class:`TableRow`, each made once, when first accessed."""
+    """The rows of a table as a sequence of :class:`TableRow`, each made once, when first accessed.
+
+    Parameters
+    ----------
+    table : ResultsTable
+        The table.
+    """
 
     def __init__(self, table):
         self._table = table
@@ -432,6 +445,23 @@ class TableRows(collections.abc.Sequence):
 
 class ResultsTable:
     """A results table read by :func:`read_table`: typed columns, notes, lines set aside.
+
+    Made by :func:`read_table`, not by hand.
+
+    Parameters
+    ----------
+    path : str
+        The file read.
+    columns : list of str
+        The header.
+    schema : dict
+        The schema applied.
+    cols : list
+        One typed column store per column.
+    lines : numpy.ndarray
+        Line number of each row.
+    set_aside, duplicates, problems : list of tuple
+        As the attributes.
 
     Attributes
     ----------
@@ -587,7 +617,9 @@ def _lines(numbers, shown=10):
 
 def _schema_for(path, header, schema):
     from .schema import SCHEMA_NAME, column_spec, read_schema
-    if schema is None:
+    if schema == "package":
+        schema = {"columns": []}
+    elif schema is None:
         schema_path = os.path.join(os.path.dirname(path) or ".", SCHEMA_NAME)
         if os.path.isfile(schema_path):
             schema = read_schema(schema_path)
@@ -604,10 +636,11 @@ def read_table(path, *, schema=None, invalid="raise", dedupe=True, label="result
     ----------
     path : str or os.PathLike
         The CSV file.
-    schema : dict, optional
+    schema : dict or "package", optional
         ``{"columns": [entry, ...]}`` as :func:`~particleShear.sweep.schema.results_schema`
         (default: ``results.schema.json`` beside the table when present, else the
-        package's entry of each column).  Columns it does not name get the package's entry.
+        package's entry of each column; ``"package"``: the package's entries, whatever file is
+        beside the table — what the sweep uses).  Columns it does not name get the package's entry.
     invalid : {"raise", "keep"}, optional
         What a cell that is not a value of its column's type does: ``"raise"`` (default) a
         ``ValueError`` naming file, line and column; ``"keep"``: the row is kept with the cell's

@@ -230,7 +230,7 @@ def check_table(path, columns):
         return notes
     with open(path, "rb") as fh:
         bom = fh.read(3) == b"\xef\xbb\xbf"
-    table = read_table(path, invalid="keep")
+    table = read_table(path, schema="package", invalid="keep")
     check_table_header(path, columns)
     aside = {k for k, _ in table.set_aside} | {k for k, _ in table.duplicates}
     if bom or aside:
@@ -434,7 +434,7 @@ def read_rows(path):
     with open(path, "rb") as fh:
         if b"\n" not in fh.read(1 << 16) and fh.read(1) == b"":
             return []                               # empty, or a torn header alone
-    return read_table(path, invalid="keep").rows()
+    return read_table(path, schema="package", invalid="keep").rows()
 
 
 @contextlib.contextmanager
