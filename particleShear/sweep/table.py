@@ -292,13 +292,17 @@ def check_table_header(path, columns):
     """
     if not os.path.exists(path) or os.path.getsize(path) == 0:
         return
-    with open(path, newline="", encoding="utf-8-sig", errors="replace") as fh:
-        header = next(csv.reader(fh), [])
+    header = _header_of(path)
     if header != list(columns):
         missing = [c for c in columns if c not in header]
         unknown = [c for c in header if c not in columns]
-        what = "; ".join(x for x in (f"missing {missing}" if missing else "",
-                                     f"unknown {unknown}" if unknown else "",
+
+        def names(a):                               # at most 10 names, each cut to 40 characters
+            shown = [n if len(n) <= 40 else n[:40] + "..." for n in a[:10]]
+            return f"{shown}" + (f" and {len(a) - 10} more" if len(a) > 10 else "")
+
+        what = "; ".join(x for x in (f"missing {names(missing)}" if missing else "",
+                                     f"unknown {names(unknown)}" if unknown else "",
                                      "columns in another order" if not (missing or unknown) else "") if x)
         raise ValueError(f"results table {path!r} does not have this sweep's columns ({what}): repair it, or use "
                          "another --out DIR")
@@ -387,9 +391,7 @@ def append_row(path, row, columns, *, checked=False):
     if not checked:
         repair_table(path)
         if os.path.exists(path) and os.path.getsize(path) > 0:
-            with open(path, "rb") as fh:
-                first = fh.readline().decode("utf-8", errors="replace").lstrip("\ufeff")
-            if next(csv.reader([first]), None) != list(columns):
+            if _header_of(path) != list(columns):
                 raise ValueError(f"results table {os.fspath(path)!r} has other columns than this sweep: use another "
                                  "--out DIR")
     rows = row if isinstance(row, list) else [row]
@@ -586,6 +588,11 @@ def write_parquet(csv_path):
 
 
 def _header_of(path):
+    """The header line's names (undecodable bytes replaced); a line that is not CSV is no header: []."""
     with open(path, "rb") as fh:
         first = fh.readline().decode("utf-8", errors="replace").lstrip("\ufeff")
-    return next(csv.reader([first]), [])
+    csv.field_size_limit(max(csv.field_size_limit(), len(first) + 1))
+    try:
+        return next(csv.reader([first]), [])
+    except csv.Error:
+        return []
