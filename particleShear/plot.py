@@ -24,11 +24,11 @@ the plate bands (the value :func:`doParticleShearSimulation` returns), "internal
 of the overall stress tensor (eq. S1-24).
 """
 __docformat__ = "numpy"
-import csv
 import logging
 import math
 import os
 import sys
+import warnings
 
 from .messages import console_messages
 from .run.guard import SuggestingParser
@@ -320,7 +320,11 @@ def _float(v):
 
 
 def read_sweep_table(folder_or_csv):
-    """Rows of a sweep's ``results.csv`` as dicts of strings (csv module; no pandas needed).
+    """Rows of a sweep's ``results.csv`` as mappings column → text (no pandas needed).
+
+    Read by the package's one table reader (:func:`particleShear.sweep.reader.read_table`): lines
+    that are not rows (a torn last line) and duplicate rows are left out (said in the result's
+    ``notes``), a cell that is not a value of its column's type is refused.
 
     Parameters
     ----------
@@ -329,21 +333,23 @@ def read_sweep_table(folder_or_csv):
 
     Returns
     -------
-    list of dict
-        One ``{column: text}`` dict per row, in file order.
+    particleShear.sweep.reader.TableRows
+        A sequence of one ``{column: text}`` mapping per row, in file order; ``.notes``: what was
+        left out.
 
     Raises
     ------
     ValueError
-        If there is no such CSV file.
+        If there is no such CSV file, or it cannot be read (naming the file; a bad cell also its
+        line and column).
     """
+    from .sweep.reader import read_table
     path = str(folder_or_csv)
     if os.path.isdir(path):
         path = os.path.join(path, "results.csv")
     if not os.path.isfile(path):
         raise ValueError(f"folder_or_csv={folder_or_csv!r} is invalid: no results.csv there")
-    with open(path, newline="", encoding="utf-8") as fh:
-        return list(csv.DictReader(fh))
+    return read_table(path).rows()
 
 
 def group_of(row):
@@ -520,6 +526,8 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS} (CLI --estimator)")
     rows = read_sweep_table(folder_or_csv)
+    for note in rows.notes:
+        warnings.warn(note, UserWarning, stacklevel=2)
     if rows and all(r.get("protocol") == "steady" for r in rows):   # a flow curve (docs/protocols.md)
         from .rheometer_plot import plot_flow_curve_sweep
         return plot_flow_curve_sweep(folder_or_csv, estimator, path, n_boot=n_boot, confidence=confidence,

@@ -63,6 +63,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep.series",
     "particleShear.sweep.spec",
     "particleShear.sweep.table",
+    "particleShear.sweep.reader",
     "particleShear.sweep.tasks",
     "particleShear.plot",
     "particleShear.sweep_plot",

@@ -320,7 +320,7 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     if not groups:
         raise ValueError(f"folder={folder!r} has no rows with status 'ok' and finite {estimator} moduli "
                          f"({len(rows)} row(s) in results.csv)")
-    notes = []
+    notes = list(getattr(rows, "notes", []))
     if skipped:
         notes.append(f"left out {skipped} row(s) with status ok but a missing or non-finite amplitude or "
                      f"{estimator} modulus")

@@ -623,7 +623,7 @@ class Sweep:
             done = []
             for task, (row, result) in zip(job, outcomes):
                 rows = row if isinstance(row, list) else [row]
-                append_row(self.table_path, rows, self.columns)
+                append_row(self.table_path, rows, self.columns, checked=True)   # checked when opened
                 run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
                     self._run_of({"run_id": task["run_id"]})
                 outcome = SweepOutcome(run, rows[0], result, rows)

@@ -25,13 +25,11 @@ protocol does not produce) gets pandas' nullable dtype for ints and
 bools (``Int64``, ``boolean``); floats are NaN where empty.
 """
 __docformat__ = "numpy"
-import csv
 import inspect
-import io
 import json
-import math
 import os
 import re
+import warnings
 
 __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "results_schema", "column_spec", "write_schema",
            "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
@@ -452,33 +450,16 @@ def arrow_table(rows, schema):
     return pa.Table.from_arrays(cols, schema=sch)
 
 
-def _frame(rows, schema):
-    import numpy as np
-    import pandas as pd
-    data = {}
-    for c in schema["columns"]:
-        name, kind = c["name"], c["type"]
-        values = [r.get(name) for r in rows]
-        missing = any(v is None for v in values)
-        if kind == "float":
-            data[name] = pd.Series(np.array([math.nan if v is None else v for v in values], dtype=np.float64))
-        elif kind == "int":
-            data[name] = pd.Series(values, dtype="Int64" if c.get("nullable") or missing else np.int64)
-        elif kind == "bool":
-            data[name] = pd.Series(values, dtype="boolean" if c.get("nullable") or missing else bool)
-        elif kind == "string":
-            data[name] = pd.Series(values, dtype=str)
-        else:
-            data[name] = pd.Series(values, dtype=object)
-    return pd.DataFrame(data, columns=[c["name"] for c in schema["columns"]])
-
-
 def load_results(folder_or_csv, as_frame=None):
     """A sweep's results table, typed by its schema: a pandas DataFrame, or a list of typed dicts.
 
-    Reads ``DIR/results.csv`` and applies ``DIR/results.schema.json`` (the package's schema of
-    the table's columns when the file is absent).  Every row is kept, ``ok`` and ``failed``, in
-    the table's order (SPEC order once a sweep has finished).
+    Reads ``DIR/results.csv`` with the package's one table reader
+    (:func:`~particleShear.sweep.reader.read_table`) and applies ``DIR/results.schema.json`` (the
+    package's schema of the table's columns when the file is absent).  Every row is kept, ``ok``
+    and ``failed``, in the table's order (SPEC order once a sweep has finished), except lines
+    that are not rows (a torn last line, another number of fields) and duplicate rows (same
+    ``run_id`` and step): those are left out with a ``UserWarning`` each (also in the
+    DataFrame's ``attrs["notes"]``).
 
     Parameters
     ----------
@@ -498,11 +479,13 @@ def load_results(folder_or_csv, as_frame=None):
     Raises
     ------
     ValueError
-        When there is no table, the table cannot be read, a cell is not a value of its column's
-        type, or ``as_frame`` is not None, True or False.
+        When there is no table, the table cannot be read (naming the file), a cell is not a value
+        of its column's type (naming the file, the line and the column), or ``as_frame`` is not
+        None, True or False.
     ImportError
         When ``as_frame=True`` and pandas is not installed.
     """
+    from .reader import read_table
     from .table import TABLE_NAME
     if as_frame not in (None, True, False):
         raise ValueError(f"as_frame={as_frame!r} is invalid: allowed None, True or False")
@@ -511,30 +494,16 @@ def load_results(folder_or_csv, as_frame=None):
         path = os.path.join(path, TABLE_NAME)
     if not os.path.isfile(path):
         raise ValueError(f"folder_or_csv={os.fspath(folder_or_csv)!r} is invalid: no results table there")
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        text = fh.read()
-    if text and not text.endswith("\n"):
-        text = text[:text.rfind("\n") + 1]        # a torn last line (killed writer) is no row
-    reader = csv.reader(io.StringIO(text))
-    header = next(reader, [])
-    schema_path = os.path.join(os.path.dirname(path) or ".", SCHEMA_NAME)
-    known = read_schema(schema_path) if os.path.isfile(schema_path) else {"columns": []}
-    by_name = {c["name"]: c for c in known["columns"]}
-    schema = {"columns": [by_name.get(c) or column_spec(c) for c in header]}
-    rows = []
-    for k, fields in enumerate(reader, start=2):
-        if len(fields) != len(header):
-            raise ValueError(f"results table {path!r}, line {k}: {len(fields)} fields, the header has "
-                             f"{len(header)}: repair it (a sweep over the folder does)")
-        try:
-            rows.append(typed_row(dict(zip(header, fields)), schema))
-        except ValueError as exc:
-            raise ValueError(f"results table {path!r}, line {k}: {exc}") from None
+    table = read_table(path)
+    for note in table.notes:
+        warnings.warn(note, UserWarning, stacklevel=2)
     if as_frame is False:
-        return rows
+        return table.typed_rows()
     try:
-        return _frame(rows, schema)
+        frame = table.to_frame()
     except ImportError:
         if as_frame:
             raise
-        return rows
+        return table.typed_rows()
+    frame.attrs["notes"] = list(table.notes)
+    return frame

@@ -15,7 +15,12 @@ written in one append; every other run has one row.
 
 Rows are appended by one writer (the sweep's driving process) with a single ``os.write`` of
 complete lines on an ``O_APPEND`` descriptor followed by ``fsync``, so a killed sweep leaves at
-most one torn last line, which :func:`read_rows` drops and :func:`repair_table` cuts off.
+most one torn last line.  Every table is read by :func:`~particleShear.sweep.reader.read_table`
+(the one reader of the package: torn lines set aside, cells checked against the schema, no
+field-size limit, duplicate rows removed); the sweep repairs its table once, when it opens it
+(:func:`check_table`), and then only appends (:func:`append_row`: one write, no read of the table).
+A cell that starts with ``=``, ``+``, ``-``, ``@`` and is not a number is written with a leading
+``'`` (:func:`~particleShear.sweep.reader.escape_cell`), which the reader removes.
 """
 __docformat__ = "numpy"
 import contextlib
@@ -29,9 +34,10 @@ import socket
 
 import numpy as np
 
+from .reader import escape_cell, read_table
 from ..analysis.measures import MEASURE_COLUMNS
 from ..simulation.provenance import identity_parameters, same_input
-from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema, typed_row
+from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
            "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
@@ -108,6 +114,10 @@ def _cell(v):
 def row_line(row, columns):
     """One CSV line (with newline) of ``row`` in ``columns`` order; a missing value is empty.
 
+    A text that a spreadsheet would evaluate (it starts with ``=``, ``+``, ``-``, ``@``, a tab, a
+    carriage return or ``'`` and is not a number) is written with a leading ``'``
+    (:func:`~particleShear.sweep.reader.escape_cell`; the reader removes it).
+
     Parameters
     ----------
     row : dict
@@ -120,12 +130,15 @@ def row_line(row, columns):
     str
     """
     buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerow([_cell(row.get(c)) for c in columns])
+    csv.writer(buf, lineterminator="\n").writerow([escape_cell(_cell(row.get(c))) for c in columns])
     return buf.getvalue()
 
 
 def repair_table(path):
-    """Cut a torn last line (no trailing newline) left by a killed writer.
+    """Cut a torn last line (no trailing newline) left by a killed writer; it is kept in ``<table>.rejected``.
+
+    Reads only the end of the file (backwards from the end to the last newline), so its cost does
+    not grow with the table.
 
     Parameters
     ----------
@@ -137,26 +150,58 @@ def repair_table(path):
     bool
         True when the file was cut.
     """
+    path = os.fspath(path)
     if not os.path.exists(path):
         return False
     with open(path, "rb+") as fh:
-        data = fh.read()
-        if not data or data.endswith(b"\n"):
+        end = fh.seek(0, os.SEEK_END)
+        if end == 0:
             return False
-        fh.truncate(data.rfind(b"\n") + 1)
+        fh.seek(end - 1)
+        if fh.read(1) == b"\n":
+            return False
+        pos, cut = end, 0
+        while pos > 0:                              # find the last newline, block by block from the end
+            step = min(65536, pos)
+            pos -= step
+            fh.seek(pos)
+            block = fh.read(step)
+            k = block.rfind(b"\n")
+            if k >= 0:
+                cut = pos + k + 1
+                break
+        fh.seek(cut)
+        torn = fh.read()
+        if cut > 0:                                 # a torn header alone (cut == 0) is no line worth keeping
+            _reject_bytes(path, [torn + b"\n"])
+        fh.truncate(cut)
         fh.flush()
         os.fsync(fh.fileno())
     return True
 
 
+def _reject_bytes(path, lines):
+    """Append raw ``lines`` (bytes, each ending with a newline) to ``<table>.rejected``, fsynced."""
+    if not lines:
+        return
+    with open(os.fspath(path) + REJECTED_SUFFIX, "ab") as fh:
+        fh.writelines(lines)
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
 def check_table(path, columns):
     """Check a table before any work: repair what can be repaired, refuse what cannot.
 
+    The table is read by the package's one reader (:func:`~particleShear.sweep.reader.read_table`).
     Repaired (and said in the returned notes): a UTF-8 byte-order mark before the header (an
     editor's), a torn last line (a killed writer), lines that are not rows of the table (another
-    number of fields) — those are moved, unchanged, to ``<table>.rejected``, so nothing is lost.
-    Refused: a header that is not this sweep's columns (other package version, parameter set,
-    edited by hand).
+    number of fields, a quote left open, bytes that are not UTF-8) and duplicate rows (same
+    ``run_id`` and step; the first ``ok`` row is kept) — those lines are moved, unchanged, to
+    ``<table>.rejected``, so nothing is lost.  Cells that are not values of their column's type
+    stay: the sweep runs their run again (:func:`row_problem`).  Refused: a header that is not
+    this sweep's columns (other package version, parameter set, edited by hand), a header that is
+    not UTF-8 text.
 
     Parameters
     ----------
@@ -173,41 +218,41 @@ def check_table(path, columns):
     Raises
     ------
     ValueError
-        When the header differs from ``columns``, naming the missing and unknown columns.
+        When the header differs from ``columns``, naming the missing and unknown columns, or the
+        table cannot be read (naming the file).
     """
     notes = []
     if not os.path.exists(path) or os.path.getsize(path) == 0:
         return notes
     if repair_table(path):
-        notes.append(f"cut a torn last line of {path}")
+        notes.append(f"cut a torn last line of {path} (kept in {path + REJECTED_SUFFIX})")
+    if os.path.getsize(path) == 0:
+        return notes
     with open(path, "rb") as fh:
-        data = fh.read()
-    bom = data.startswith(b"\xef\xbb\xbf")
-    try:
-        text = data[3:].decode("utf-8") if bom else data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"results table {path!r} is not UTF-8 text ({exc}): repair it or use another --out DIR") \
-            from None
-    lines = [line + "\n" for line in text.split("\n")]   # rows end with "\n" only (csv.writer)
-    if lines and lines[-1] == "\n":
-        lines.pop()                                       # text ends with "\n": no line after it
+        bom = fh.read(3) == b"\xef\xbb\xbf"
+    table = read_table(path, schema="package", invalid="keep")
     check_table_header(path, columns)
-    header = list(columns)
-    good, bad = [lines[0]], []
-    for line in lines[1:]:
-        try:
-            fields = next(csv.reader([line]), [])
-        except csv.Error:
-            fields = []
-        (good if len(fields) == len(header) else bad).append(line)
-    if bom or bad:
-        if bad:
-            reject_lines(path, bad)
-            notes.append(f"moved {len(bad)} line(s) that are not rows of {path} to {path + REJECTED_SUFFIX}")
+    aside = {k for k, _ in table.set_aside} | {k for k, _ in table.duplicates}
+    if bom or aside:
+        bad = []
+        with open(path, "rb") as src, atomic_text(path) as out:
+            for k, raw in enumerate(src, start=1):
+                if k == 1 and raw.startswith(b"\xef\xbb\xbf"):
+                    raw = raw[3:]
+                if k in aside:
+                    bad.append(raw)
+                else:
+                    out.buffer.write(raw)
+            _reject_bytes(path, bad)
+        other = len(table.set_aside)
+        if other:
+            notes.append(f"moved {other} line(s) that are not rows of {path} to {path + REJECTED_SUFFIX}")
+        if table.duplicates:
+            notes.append(f"moved {len(table.duplicates)} duplicate row(s) of {path} (same run_id and step; "
+                         f"line(s) {', '.join(str(k) for k, _ in table.duplicates[:10])}) to "
+                         f"{path + REJECTED_SUFFIX}")
         if bom:
             notes.append(f"removed a UTF-8 byte-order mark from {path}")
-        with atomic_text(path) as fh:
-            fh.writelines(good)
     return notes
 
 
@@ -247,13 +292,17 @@ def check_table_header(path, columns):
     """
     if not os.path.exists(path) or os.path.getsize(path) == 0:
         return
-    with open(path, newline="", encoding="utf-8-sig", errors="replace") as fh:
-        header = next(csv.reader(fh), [])
+    header = _header_of(path)
     if header != list(columns):
         missing = [c for c in columns if c not in header]
         unknown = [c for c in header if c not in columns]
-        what = "; ".join(x for x in (f"missing {missing}" if missing else "",
-                                     f"unknown {unknown}" if unknown else "",
+
+        def names(a):                               # at most 10 names, each cut to 40 characters
+            shown = [n if len(n) <= 40 else n[:40] + "..." for n in a[:10]]
+            return f"{shown}" + (f" and {len(a) - 10} more" if len(a) > 10 else "")
+
+        what = "; ".join(x for x in (f"missing {names(missing)}" if missing else "",
+                                     f"unknown {names(unknown)}" if unknown else "",
                                      "columns in another order" if not (missing or unknown) else "") if x)
         raise ValueError(f"results table {path!r} does not have this sweep's columns ({what}): repair it, or use "
                          "another --out DIR")
@@ -314,36 +363,43 @@ def row_problem(row, run):
     return None
 
 
-def append_row(path, row, columns):
+def append_row(path, row, columns, *, checked=False):
     """Append ``row`` to the table at ``path`` (header first when new) in one write; flushed and fsynced.
+
+    The cost does not depend on the table's length: nothing of the table is read but its last
+    byte and its header line (and not even those when ``checked``).
 
     Parameters
     ----------
     path : str or os.PathLike
-        The table (created when absent); a torn last line is cut first (:func:`repair_table`).
+        The table (created when absent).
     row : dict or list of dict
         Column name → value (see :func:`row_line`); a list: the rows of one run (the steps of a
         one-packing sweep), appended together.
     columns : sequence of str
         The table's columns; must equal the existing header.
+    checked : bool, optional
+        True when the caller has checked the table (:func:`check_table`) and is its only writer
+        (the sweep, under the table's lock): the row is only written.  False (default): a torn last
+        line is cut first (:func:`repair_table`) and the header line is compared with ``columns``.
 
     Raises
     ------
     ValueError
         When an existing table has other columns (another package version or parameter set).
     """
-    repair_table(path)
-    new = not os.path.exists(path) or os.path.getsize(path) == 0
-    if not new:
-        with open(path, newline="", encoding="utf-8") as fh:
-            header = next(csv.reader(fh), None)
-        if header != list(columns):
-            raise ValueError(f"results table {path!r} has other columns than this sweep: use another --out DIR")
+    if not checked:
+        repair_table(path)
+        if os.path.exists(path) and os.path.getsize(path) > 0:
+            if _header_of(path) != list(columns):
+                raise ValueError(f"results table {os.fspath(path)!r} has other columns than this sweep: use another "
+                                 "--out DIR")
     rows = row if isinstance(row, list) else [row]
-    text = (row_line({c: c for c in columns}, columns) if new else "") + "".join(row_line(r, columns) for r in rows)
+    body = "".join(row_line(r, columns) for r in rows)
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
     try:
-        data = text.encode("utf-8")
+        new = os.fstat(fd).st_size == 0
+        data = ((row_line({c: c for c in columns}, columns) if new else "") + body).encode("utf-8")
         while data:  # one write in practice; bounded by the length of the line
             n = os.write(fd, data)
             data = data[n:]
@@ -353,7 +409,11 @@ def append_row(path, row, columns):
 
 
 def read_rows(path):
-    """Rows of a table as a list of dicts of strings (a torn last line is ignored); [] when absent.
+    """Rows of a table (:func:`~particleShear.sweep.reader.read_table`, cells kept as text); [] when absent.
+
+    Lines that are not rows (a torn last line, another number of fields) are skipped, duplicate
+    rows (same ``run_id`` and step) removed; a cell that is not a value of its column's type keeps
+    its text (:func:`row_problem` judges it).
 
     Parameters
     ----------
@@ -362,19 +422,21 @@ def read_rows(path):
 
     Returns
     -------
-    list of dict
+    TableRows
+        A sequence of mappings column → text (as ``csv.DictReader`` rows), made on access from the
+        table's typed columns; [] when the file is absent or has no complete line.
+
+    Raises
+    ------
+    ValueError
+        Naming the file, when its header cannot be read.
     """
     if not os.path.exists(path):
         return []
-    with open(path, newline="", encoding="utf-8-sig", errors="replace") as fh:
-        text = fh.read()
-    if text and not text.endswith("\n"):
-        text = text[:text.rfind("\n") + 1]
-    try:
-        return list(csv.DictReader(io.StringIO(text)))
-    except csv.Error as exc:
-        raise ValueError(f"results table {os.fspath(path)!r} cannot be read as CSV ({exc}): repair it, or use "
-                         "another --out DIR") from None
+    with open(path, "rb") as fh:
+        if b"\n" not in fh.read(1 << 16) and fh.read(1) == b"":
+            return []                               # empty, or a torn header alone
+    return read_table(path, schema="package", invalid="keep").rows()
 
 
 @contextlib.contextmanager
@@ -516,12 +578,21 @@ def write_parquet(csv_path):
         return None
     if not os.path.exists(csv_path):
         return None
-    with open(csv_path, newline="", encoding="utf-8-sig") as fh:
-        header = next(csv.reader(fh), [])
-    schema = results_schema(header)
-    table = arrow_table([typed_row(r, schema) for r in read_rows(csv_path)], schema)
+    read = read_table(csv_path, schema=results_schema(_header_of(csv_path)), invalid="keep")
+    table = arrow_table(read.typed_rows(), read.schema)
     out = os.path.splitext(csv_path)[0] + ".parquet"
     tmp = os.path.join(os.path.dirname(out) or ".", "." + os.path.basename(out) + ".part")
     pq.write_table(table, tmp)
     os.replace(tmp, out)
     return out
+
+
+def _header_of(path):
+    """The header line's names (undecodable bytes replaced); a line that is not CSV is no header: []."""
+    with open(path, "rb") as fh:
+        first = fh.readline().decode("utf-8", errors="replace").lstrip("\ufeff")
+    csv.field_size_limit(max(csv.field_size_limit(), len(first) + 1))
+    try:
+        return next(csv.reader([first]), [])
+    except csv.Error:
+        return []
