@@ -543,15 +543,12 @@ class Sweep:
             rows = read_rows(self.table_path)
             retried = {row.get("run_id") for row in rows if row.get("status") == "failed"
                        and row.get("run_id") not in done and self._run_of(row) is not None}
+            # duplicate rows (same run id and step) were set aside by _check_tables (table.check_table)
             stale = [row for row in rows if row.get("run_id") in distrust]
-            kept, dupes = self._unique_rows([r for r in rows if r.get("run_id") not in distrust
-                                             and r.get("run_id") not in retried], done)
-            if stale or retried or dupes:   # distrusted rows and duplicates set aside, retried failures go
-                reject_lines(self.table_path, [row_line(row, self.columns) for row in stale + dupes])
-                write_table(self.table_path, kept, self.columns)
-            if dupes:
-                self._say(stream, progress, f"repaired: moved {len(dupes)} duplicate row(s) (same run id and step) "
-                                            f"of {self.table_path} to {self.table_path + REJECTED_SUFFIX}")
+            if stale or retried:   # distrusted rows set aside, retried failures go
+                reject_lines(self.table_path, [row_line(row, self.columns) for row in stale])
+                write_table(self.table_path, [r for r in rows if r.get("run_id") not in distrust
+                                              and r.get("run_id") not in retried], self.columns)
             mine = self.my_runs()
             n_mine = len(mine)
             n_todo = n_mine - sum(1 for run, _ in done.values() if self._mine(run))
@@ -571,25 +568,6 @@ class Sweep:
                 if show is not None and hasattr(show, "close"):
                     show.close()
             self._finish()
-
-    def _unique_rows(self, rows, done):
-        """``(kept, duplicates)``: one row per run id and step (``sweep_position``), in table order.
-
-        Of the rows sharing a run id and step, the one that counts (the finished row in ``done``)
-        is kept, else the first; rows of no run of this sweep are duplicates only when equal.
-        """
-        chosen = set()
-        for _, row in done.values():
-            chosen.update(row_line(r, self.columns) for r in (row if isinstance(row, list) else [row]))
-        lines = [row_line(r, self.columns) for r in rows]
-        keys = [(r.get("run_id"), r.get("sweep_position")) if self._run_of(r) is not None else ("", line)
-                for r, line in zip(rows, lines)]
-        best = {}
-        for j, (key, line) in enumerate(zip(keys, lines)):
-            if key not in best or (line in chosen and lines[best[key]] not in chosen):
-                best[key] = j
-        keep = set(best.values())
-        return [r for j, r in enumerate(rows) if j in keep], [r for j, r in enumerate(rows) if j not in keep]
 
     def _pending_cost(self, done, workers):
         if isinstance(self.runs, SweepRuns):
