@@ -40,10 +40,10 @@ _STAGING = re.compile(r"^\.analysis\.(?P<host>.+)-(?P<pid>\d+)-[0-9a-f]{8}\.part
 class PublishInterrupted(Exception):
     """SIGINT or SIGTERM arrived while the set was published: it was published whole, then this is raised.
 
-    Attributes
+    Parameters
     ----------
     signum : int
-        The signal.
+        The signal (also the attribute ``signum``).
     """
 
     def __init__(self, signum):
