@@ -482,9 +482,12 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     x-axis) or ± one standard error (otherwise); the legend says which.  The number of seeds per
     point is in the panel titles (or beside the points); fewer than 3 warn.  A mean ≤ 0 cannot be
     drawn on the log axis: it is marked at the panel's lower edge, listed in a note and warned about.
-    Details: :mod:`particleShear.sweep_plot`.  A steady-shear sweep (every row of protocol
-    "steady") gives its flow curve instead
-    (:func:`particleShear.rheometer_plot.plot_flow_curve_sweep`, ``DIR/flow_curve.png``).
+    Details: :mod:`particleShear.sweep_plot`.  A step of a one-packing sweep is a point at its own
+    amplitude or frequency, and the protocol splits panels
+    (:func:`particleShear.analysis.grouping.measured_row`).  A steady-shear sweep (every row of
+    protocol "steady") gives its flow curve instead
+    (:func:`particleShear.rheometer_plot.plot_flow_curve_sweep`, ``DIR/flow_curve.png``); a folder
+    of relaxation or creep runs only is refused, naming ``analyse``, which summarises them.
 
     Parameters
     ----------
@@ -536,6 +539,11 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
         from .rheometer_plot import plot_flow_curve_sweep
         return plot_flow_curve_sweep(folder_or_csv, estimator, path, n_boot=n_boot, confidence=confidence,
                                      bootstrap_seed=bootstrap_seed)
+    from .analysis.grouping import MODULI_PROTOCOLS, row_protocol
+    if rows and not any(row_protocol(r) in MODULI_PROTOCOLS for r in rows):
+        found = sorted({row_protocol(r) for r in rows})
+        raise ValueError(f"folder_or_csv={str(folder_or_csv)!r} holds runs of protocol(s) {found}, no G′ and G″ to "
+                         "plot: particleShear analyse DIR summarises them (analysis_protocols.csv)")
     try:
         table = sweep_panels(rows, estimator, x=x, split=split, n_boot=n_boot, confidence=confidence,
                              bootstrap_seed=bootstrap_seed, max_panels=max_panels)

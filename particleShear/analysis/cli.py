@@ -21,10 +21,22 @@ other groups of the folder.  Writes, atomically:
 ``DIR/analysis.schema.json``
     Column → type, unit, description.
 ``DIR/analysis.png``, ``DIR/analysis.pdf``
-    With matplotlib (extra ``[plot]``): :func:`particleShear.analysis.figure.plot_analysis`.
+    With matplotlib (extra ``[plot]``) and without ``--no-figure``:
+    :func:`particleShear.analysis.figure.plot_analysis`, at most
+    :data:`~particleShear.analysis.figure.MAX_FIGURE_PANELS` groups drawn, the others named.
+``DIR/analysis_protocols.csv``, ``DIR/analysis_protocols.schema.json``
+    When the folder holds steady, relaxation or creep runs:
+    :func:`particleShear.analysis.protocol_summary.protocol_summaries`.
 
-Exit status: 0 written, 2 invalid input (no results.csv, no usable rows, a bad flag value), with a
-one-line message on stderr.
+Rows are read as what they measured (:func:`particleShear.analysis.grouping.measured_row`): a step
+of a one-packing sweep at its own amplitude or frequency, an empty ``protocol`` cell as
+"oscillatory"; the protocol and the parameters it reads are grouping columns like the others.
+The files are checked before any work and published as one set
+(:mod:`particleShear.analysis.outputs`).
+
+Exit status: 0 written, 2 invalid input (no results.csv, no usable rows, a bad flag value, an
+unwritable folder, a directory or read-only file at an output), 3 another analysis kept the
+folder's lock, 130 interrupted, 143 terminated, with a one-line message on stderr.
 """
 __docformat__ = "numpy"
 import io
