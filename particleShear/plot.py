@@ -101,8 +101,8 @@ def check_figure_path(path, name="path"):
 def save_figure(fig, path, dpi=150):
     """Write ``fig`` to ``path`` atomically; the format follows the extension (.png, .pdf, .svg, .eps).
 
-    The figure is written to a temporary file in the same folder and renamed, so the file is
-    complete or absent.
+    The figure is written to a temporary file of a name unique to the call in the same folder
+    and renamed, so the file is complete or absent (also when several processes write it at once).
 
     Parameters
     ----------
@@ -123,9 +123,14 @@ def save_figure(fig, path, dpi=150):
     ValueError
         If the extension of ``path`` is none of .png, .pdf, .svg, .eps.
     """
+    import secrets
+    import socket
     fmt = _figure_format("path", path)
     folder = os.path.dirname(os.path.abspath(str(path)))
-    tmp = os.path.join(folder, "." + os.path.basename(str(path)) + ".part")
+    # a name of its own per call (as sweep.table.atomic_text): two processes writing the same figure never
+    # share a temporary
+    tmp = os.path.join(folder, f".{os.path.basename(str(path))}.{socket.gethostname()}-{os.getpid()}-"
+                               f"{secrets.token_hex(4)}.part")
     try:
         fig.savefig(tmp, format=fmt, dpi=dpi)
         os.replace(tmp, path)
@@ -389,9 +394,14 @@ def ok_moduli(rows, estimator="surface"):
     -------
     kept : list of tuple
         ``(row, amplitude, G′, G″)`` for each row that counts, in input order (floats; Pa).
+        ``row`` is the row as :func:`particleShear.analysis.grouping.measured_row` rewrites it:
+        a step of a one-packing sweep carries its own amplitude (``sweep_amplitude``) or
+        frequency (``sweep_relative_frequency``) in ``theAmplitude`` / ``relative_frequency``, an
+        empty ``protocol`` cell reads as "oscillatory".
     skipped : int
         Rows with status ``ok`` left out because the amplitude or a modulus is missing or not
-        finite (rows of any other status are not counted).
+        finite (rows of any other status, and rows of the steady, relaxation and creep protocols,
+        which hold no moduli, are not counted).
 
     Raises
     ------
@@ -400,10 +410,12 @@ def ok_moduli(rows, estimator="surface"):
     """
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS}")
+    from .analysis.grouping import MODULI_PROTOCOLS, measured_row, row_protocol
     kept, skipped = [], 0
     for row in rows:
-        if str(row.get("status", "")).strip() != "ok":
+        if str(row.get("status", "")).strip() != "ok" or row_protocol(row) not in MODULI_PROTOCOLS:
             continue
+        row = measured_row(row)
         gp, gpp = _float(row.get("Gp_" + estimator)), _float(row.get("Gpp_" + estimator))
         A = _float(row.get("theAmplitude"))
         if not (math.isfinite(gp) and math.isfinite(gpp) and math.isfinite(A)):
@@ -476,9 +488,12 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     x-axis) or ± one standard error (otherwise); the legend says which.  The number of seeds per
     point is in the panel titles (or beside the points); fewer than 3 warn.  A mean ≤ 0 cannot be
     drawn on the log axis: it is marked at the panel's lower edge, listed in a note and warned about.
-    Details: :mod:`particleShear.sweep_plot`.  A steady-shear sweep (every row of protocol
-    "steady") gives its flow curve instead
-    (:func:`particleShear.rheometer_plot.plot_flow_curve_sweep`, ``DIR/flow_curve.png``).
+    Details: :mod:`particleShear.sweep_plot`.  A step of a one-packing sweep is a point at its own
+    amplitude or frequency, and the protocol splits panels
+    (:func:`particleShear.analysis.grouping.measured_row`).  A steady-shear sweep (every row of
+    protocol "steady") gives its flow curve instead
+    (:func:`particleShear.rheometer_plot.plot_flow_curve_sweep`, ``DIR/flow_curve.png``); a folder
+    of relaxation or creep runs only is refused, naming ``analyse``, which summarises them.
 
     Parameters
     ----------
@@ -532,6 +547,11 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
         from .rheometer_plot import plot_flow_curve_sweep
         return plot_flow_curve_sweep(folder_or_csv, estimator, path, n_boot=n_boot, confidence=confidence,
                                      bootstrap_seed=bootstrap_seed)
+    from .analysis.grouping import MODULI_PROTOCOLS, row_protocol
+    if rows and not any(row_protocol(r) in MODULI_PROTOCOLS for r in rows):
+        found = sorted({row_protocol(r) for r in rows})
+        raise ValueError(f"folder_or_csv={str(folder_or_csv)!r} holds runs of protocol(s) {found}, no G′ and G″ to "
+                         "plot: particleShear analyse DIR summarises them (analysis_protocols.csv)")
     try:
         table = sweep_panels(rows, estimator, x=x, split=split, n_boot=n_boot, confidence=confidence,
                              bootstrap_seed=bootstrap_seed, max_panels=max_panels)

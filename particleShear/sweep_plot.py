@@ -25,6 +25,12 @@ parameter columns whose value differs between those rows:
 
 What is left at one point of one curve are the repetitions (seeds) of one parameter set.
 
+Rows are read as :func:`particleShear.analysis.grouping.measured_row` rewrites them: a step of a
+one-packing sweep (protocol ``amplitude_sweep`` or ``frequency_sweep``) is a point at its own
+amplitude or frequency, and in a table of several protocols the protocol and the parameters it
+reads are parameter columns like the others (they split panels); rows of the steady, relaxation
+and creep protocols hold no moduli and are not drawn here.
+
 Intervals
 ---------
 With the amplitude on the x-axis each curve's points carry the percentile bootstrap interval of
@@ -85,7 +91,8 @@ def _value(text):
 
 
 def _show(v):
-    return f"{v:g}" if isinstance(v, float) else str(v)
+    from .analysis.grouping import short_value
+    return f"{v:g}" if isinstance(v, float) else short_value(v)
 
 
 def _sort_key(v):
@@ -95,12 +102,15 @@ def _sort_key(v):
 def _parameter_columns(header):
     from .simulation.provenance import IDENTITY_EXCLUDED
     from .sweep.spec import sweep_parameter_defaults
-    return [c for c in sweep_parameter_defaults() if c in header and c not in IDENTITY_EXCLUDED]
+    # the protocol parameters too: in a table of several protocols the protocol (and what it reads) splits
+    # panels; rows are read as particleShear.analysis.grouping.measured_row rewrites them
+    return [c for c in sweep_parameter_defaults(protocols=True) if c in header and c not in IDENTITY_EXCLUDED]
 
 
 def _check_settings(n_boot, confidence, bootstrap_seed, max_panels):
-    if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or n_boot < 1:
-        raise ValueError(f"n_boot={n_boot!r} is out of range: allowed an integer >= 1")
+    from .analysis.sweep import N_BOOT_MAX
+    if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or not 1 <= n_boot <= N_BOOT_MAX:
+        raise ValueError(f"n_boot={n_boot!r} is out of range: allowed an integer >= 1 and <= {N_BOOT_MAX}")
     if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real) or not 0 < confidence < 1:
         raise ValueError(f"confidence={confidence!r} is out of range: allowed a number in (0, 1)")
     if bootstrap_seed is not None and (isinstance(bootstrap_seed, bool) or not isinstance(

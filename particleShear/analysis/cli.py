@@ -21,10 +21,22 @@ other groups of the folder.  Writes, atomically:
 ``DIR/analysis.schema.json``
     Column → type, unit, description.
 ``DIR/analysis.png``, ``DIR/analysis.pdf``
-    With matplotlib (extra ``[plot]``): :func:`particleShear.analysis.figure.plot_analysis`.
+    With matplotlib (extra ``[plot]``) and without ``--no-figure``:
+    :func:`particleShear.analysis.figure.plot_analysis`, at most
+    :data:`~particleShear.analysis.figure.MAX_FIGURE_PANELS` groups drawn, the others named.
+``DIR/analysis_protocols.csv``, ``DIR/analysis_protocols.schema.json``
+    When the folder holds steady, relaxation or creep runs:
+    :func:`particleShear.analysis.protocol_summary.protocol_summaries`.
 
-Exit status: 0 written, 2 invalid input (no results.csv, no usable rows, a bad flag value), with a
-one-line message on stderr.
+Rows are read as what they measured (:func:`particleShear.analysis.grouping.measured_row`): a step
+of a one-packing sweep at its own amplitude or frequency, an empty ``protocol`` cell as
+"oscillatory"; the protocol and the parameters it reads are grouping columns like the others.
+The files are checked before any work and published as one set
+(:mod:`particleShear.analysis.outputs`).
+
+Exit status: 0 written, 2 invalid input (no results.csv, no usable rows, a bad flag value, an
+unwritable folder, a directory or read-only file at an output), 3 another analysis kept the
+folder's lock, 130 interrupted, 143 terminated, with a one-line message on stderr.
 """
 __docformat__ = "numpy"
 import io
@@ -40,11 +52,15 @@ __all__ = [
     "OUTPUT_ONLY",
     "ANALYSIS_NAME",
     "FIGURE_NAME",
+    "PROTOCOLS_NAME",
+    "PROTOCOLS_SCHEMA_NAME",
     "SCHEMA_NAME",
+    "SET_NAMES",
     "analyse_folder",
     "analysis_columns",
     "build_parser",
     "group_runs",
+    "grouping_columns",
     "main",
 ]
 
@@ -54,6 +70,12 @@ ANALYSIS_NAME = "analysis.csv"
 SCHEMA_NAME = "analysis.schema.json"
 #: the figure's file stem (``.png`` and ``.pdf``)
 FIGURE_NAME = "analysis"
+#: the summaries of the steady, relaxation and creep runs, and their schema
+PROTOCOLS_NAME = "analysis_protocols.csv"
+PROTOCOLS_SCHEMA_NAME = "analysis_protocols.schema.json"
+#: every file of an analysis's set (published together, :mod:`particleShear.analysis.outputs`)
+SET_NAMES = (ANALYSIS_NAME, SCHEMA_NAME, FIGURE_NAME + ".png", FIGURE_NAME + ".pdf", PROTOCOLS_NAME,
+             PROTOCOLS_SCHEMA_NAME)
 
 _PROG = "particleShear analyse"
 _AMPLITUDE = "theAmplitude"
@@ -99,9 +121,11 @@ def build_parser():
     -------
     particleShear.run.guard.SuggestingParser
         Positional ``DIR``; options ``--estimator {surface,internal}``, ``--json``, ``--n-boot N``,
-        ``--confidence C``, ``--seed S`` (values checked by :func:`main`).
+        ``--confidence C``, ``--seed S`` (values checked by :func:`main`), ``--no-figure``.
     """
     from ..plot import ESTIMATORS
+    from .figure import MAX_FIGURE_PANELS
+    from .sweep import N_BOOT_MAX
     p = _Parser(prog=_PROG, description="Characteristics of a sweep folder's amplitude sweeps (plateau, linear "
                                         "limits, flow point, the R package's four points) with bootstrap intervals "
                                         "over the seeds. Reads DIR/results.csv, writes DIR/analysis.csv, "
@@ -110,10 +134,14 @@ def build_parser():
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
                    help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
     p.add_argument("--json", action="store_true", help="print the rows of analysis.csv as JSON on stdout (NaN: null)")
-    p.add_argument("--n-boot", metavar="N", default="2000", help="bootstrap replicates, integer >= 1 (default 2000)")
+    p.add_argument("--n-boot", metavar="N", default="2000",
+                   help=f"bootstrap replicates, integer 1 ... {N_BOOT_MAX} (default 2000)")
     p.add_argument("--confidence", metavar="C", default="0.95", help="interval level in (0, 1) (default 0.95)")
     p.add_argument("--seed", metavar="S", default=None,
                    help="seed of the bootstrap, integer >= 0 (default: fresh entropy, intervals not reproducible)")
+    p.add_argument("--no-figure", dest="figure", action="store_false",
+                   help=f"write no analysis.png/.pdf (the figure draws at most {MAX_FIGURE_PANELS} groups, the others "
+                        "named in one line)")
     return p
 
 
@@ -127,14 +155,21 @@ def _number_flag(flag, text, kind):
         if not 0 < value < 1:
             raise _UsageError(f"{flag}={text!r} is out of range: allowed a number in (0, 1)")
         return value
+    from .sweep import N_BOOT_MAX
     low = 1 if kind == "n_boot" else 0
+    allowed = f"allowed an integer >= {low}" + (f" and <= {N_BOOT_MAX} (n_boot)" if kind == "n_boot" else "")
     try:
         value = int(text)
     except ValueError:
-        raise _UsageError(f"{flag}={text!r} is invalid: allowed an integer >= {low}") from None
-    if value < low:
-        raise _UsageError(f"{flag}={text!r} is out of range: allowed an integer >= {low}")
+        raise _UsageError(f"{flag}={_short(text)!r} is invalid: {allowed}") from None
+    if value < low or (kind == "n_boot" and value > N_BOOT_MAX):
+        raise _UsageError(f"{flag}={_short(text)!r} is out of range: {allowed}")
     return value
+
+
+def _short(text):
+    from .grouping import short_value
+    return short_value(text, 40)
 
 
 def _sort_key(text):
@@ -144,8 +179,36 @@ def _sort_key(text):
         return (1, 0.0, str(text))
 
 
+def grouping_columns(header):
+    """The parameter columns of a table that split groups (module docstring).
+
+    Parameters
+    ----------
+    header : list of str
+        The table's columns.
+
+    Returns
+    -------
+    list of str
+        The parameters of :func:`particleShear.sweep.spec.sweep_parameter_defaults` (protocol
+        parameters included) in the header, less ``theAmplitude``, the inputs that change neither
+        the physics nor the output and :data:`OUTPUT_ONLY`.
+    """
+    from ..simulation.provenance import IDENTITY_EXCLUDED
+    from ..sweep.spec import sweep_parameter_defaults
+    return [c for c in sweep_parameter_defaults(protocols=True) if c in header and c != _AMPLITUDE
+            and c not in IDENTITY_EXCLUDED and c not in OUTPUT_ONLY]
+
+
 def group_runs(rows, estimator="surface"):
     """The runs of a sweep table grouped by their parameters except the amplitude.
+
+    Rows are read as :func:`particleShear.analysis.grouping.measured_row` rewrites them: a step
+    of a one-packing sweep is a run at its own amplitude (``sweep_amplitude``) or frequency
+    (``sweep_relative_frequency``); an empty ``protocol`` cell is "oscillatory"; the protocol
+    and the parameters it reads split groups.  Rows of the steady, relaxation and creep
+    protocols hold no moduli and are not grouped here
+    (:func:`particleShear.analysis.protocol_summary.protocol_summaries`).
 
     Parameters
     ----------
@@ -160,7 +223,7 @@ def group_runs(rows, estimator="surface"):
     groups : list of dict
         One per group, sorted by its parameter values (numbers numerically): ``"parameters"``
         (``{name: text}`` of every grouping column), ``"amplitude"``, ``"Gp"``, ``"Gpp"`` (lists of
-        floats, one per run).
+        floats, one per run or step).
     varying : list of str
         The grouping columns whose value differs between groups (header order).
     skipped : int
@@ -172,14 +235,11 @@ def group_runs(rows, estimator="surface"):
         If ``estimator`` is not one of the two, or the table has no ``theAmplitude`` column.
     """
     from ..plot import ok_moduli
-    from ..simulation.provenance import IDENTITY_EXCLUDED
-    from ..sweep.spec import sweep_parameter_defaults
     kept, skipped = ok_moduli(rows, estimator)
     header = list(rows[0]) if rows else []
     if rows and _AMPLITUDE not in header:
         raise ValueError(f"results.csv has no {_AMPLITUDE} column: not a sweep table")
-    names = [c for c in sweep_parameter_defaults() if c in header and c != _AMPLITUDE and c not in IDENTITY_EXCLUDED
-             and c not in OUTPUT_ONLY]
+    names = grouping_columns(header)
     cells = {}
     # runs in a fixed order (amplitude, run id), not the order they finished in: the bootstrap draws
     # the same resamples from the same seed however the table was written
@@ -224,7 +284,16 @@ def analysis_columns(varying):
 
 
 def _label(parameters, varying):
-    return ", ".join(f"{n}={parameters[n]}" for n in varying) or "all runs"
+    from .grouping import short_value
+    return ", ".join(f"{n}={short_value(parameters[n])}" for n in varying) or "all runs"
+
+
+def _stream_label(parameters):
+    """The text a group's bootstrap stream is derived from: its parameters, less the protocol
+    columns an oscillatory run does not have (its stream is that of a table without protocols)."""
+    from ..run.rheometer import PROTOCOL_DEFAULTS
+    return "\x1f".join(f"{k}={v}" for k, v in sorted(parameters.items())
+                        if not (k in PROTOCOL_DEFAULTS and v in ("", "oscillatory")))
 
 
 def _summarise(group, n_boot, confidence, rng):
@@ -235,7 +304,10 @@ def _summarise(group, n_boot, confidence, rng):
     notes = []
     n_amp = len(set(group["amplitude"]))
     if n_amp < 2:
-        return None, [f"{n_amp} amplitude only: no characteristics"]
+        why = f"{n_amp} amplitude only: no characteristics"
+        if group["parameters"].get("protocol") == "frequency_sweep":
+            why += " (a step of a frequency sweep: particleShear plot DIR draws G′, G″ against the frequency)"
+        return None, [why]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
         s = sweep_summary(group["amplitude"], group["Gp"], group["Gpp"], n_boot=n_boot, confidence=confidence,
@@ -275,8 +347,55 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
     return row
 
 
-def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, seed=None, figure=True):
+def _check_settings(estimator, n_boot, confidence, seed, figure, max_figure_panels):
+    """The arguments of :func:`analyse_folder`, before any work (ValueError naming the parameter and its flag)."""
+    import numbers
+
+    from ..plot import ESTIMATORS
+    from .figure import MAX_FIGURE_PANELS
+    from .sweep import N_BOOT_MAX
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS} (CLI --estimator)")
+    if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or not 1 <= n_boot <= N_BOOT_MAX:
+        raise ValueError(f"n_boot={n_boot!r} is out of range: allowed an integer >= 1 and <= {N_BOOT_MAX} "
+                         "(CLI --n-boot)")
+    if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real) or not 0 < confidence < 1:
+        raise ValueError(f"confidence={confidence!r} is out of range: allowed a number in (0, 1) (CLI --confidence)")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
+        raise ValueError(f"seed={seed!r} is out of range: allowed None or an integer >= 0 (CLI --seed)")
+    if not isinstance(figure, bool):
+        raise ValueError(f"figure={figure!r} is invalid: allowed True or False (CLI --no-figure)")
+    if isinstance(max_figure_panels, bool) or not isinstance(max_figure_panels, numbers.Integral) \
+            or not 1 <= max_figure_panels <= MAX_FIGURE_PANELS:
+        raise ValueError(f"max_figure_panels={max_figure_panels!r} is out of range: allowed an integer >= 1 and "
+                         f"<= {MAX_FIGURE_PANELS}")
+
+
+def _write_csv(path, columns, rows):
+    from ..sweep.table import atomic_text, row_line
+    with atomic_text(path) as fh:
+        fh.write(row_line({c: c for c in columns}, list(columns)))
+        for r in rows:
+            fh.write(row_line({k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                               for k, v in r.items()}, list(columns)))
+
+
+def _write_schema(path, name, description, columns, generation, settings):
+    from ..sweep.table import atomic_text
+    schema = {"file": name, "description": description, "empty_cell": "undefined value (NaN)",
+              "generation": generation, "settings": settings,
+              "columns": {c: {"type": t, "unit": u, "description": d} for c, (t, u, d) in columns.items()}}
+    with atomic_text(path) as fh:
+        json.dump(schema, fh, indent=1, ensure_ascii=False)
+        fh.write("\n")
+
+
+def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, seed=None, figure=True,
+                   max_figure_panels=None):
     """Analyse a sweep folder: write ``analysis.csv``, ``analysis.schema.json`` and the figure.
+
+    Every argument and the folder are checked before any work; the files are written into a
+    staging folder and published as one set (:mod:`particleShear.analysis.outputs`).
 
     Parameters
     ----------
@@ -285,80 +404,127 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     estimator : {"surface", "internal"}, optional
         Which moduli (default "surface").
     n_boot : int, optional
-        Bootstrap replicates, >= 1 (default 2000).
+        Bootstrap replicates, 1 ... :data:`particleShear.analysis.sweep.N_BOOT_MAX` (100,000;
+        default 2000).
     confidence : float, optional
         Level of the intervals, in (0, 1) (default 0.95).
     seed : int or None, optional
-        Seed of the bootstrap (>= 0): one generator drives the groups in table order; None
-        (default) draws fresh entropy.
+        Seed of the bootstrap (>= 0): each group's stream is derived from it and the group's
+        parameters; None (default) draws fresh entropy.
     figure : bool, optional
-        Write ``analysis.png`` and ``analysis.pdf`` when matplotlib is installed (default True).
+        Write ``analysis.png`` and ``analysis.pdf`` when matplotlib is installed (default True;
+        CLI ``--no-figure``).  The figure draws the first ``max_figure_panels`` groups and names
+        the others in one line.
+    max_figure_panels : int, optional
+        Most panels of the figure, 1 ... :data:`particleShear.analysis.figure.MAX_FIGURE_PANELS`
+        (24, the default).
 
     Returns
     -------
     dict
         ``"rows"`` (the rows of ``analysis.csv``, numbers as floats/ints, NaN where undefined),
-        ``"columns"`` (:func:`analysis_columns`), ``"written"`` (paths), ``"notes"`` (messages
-        about the folder: rows left out, no figure without matplotlib).
+        ``"columns"`` (:func:`analysis_columns`), ``"protocol_rows"`` and ``"protocol_columns"``
+        (``analysis_protocols.csv``, :mod:`particleShear.analysis.protocol_summary`; empty
+        without steady, relaxation or creep rows), ``"written"`` (paths), ``"removed"`` (files
+        of an earlier set that this one does not hold), ``"notes"`` (messages about the folder:
+        rows left out, groups not drawn, no figure without matplotlib).
 
     Raises
     ------
     ValueError
-        No ``results.csv``, no row with status ``ok`` and finite moduli, or an invalid argument.
+        An invalid argument, no ``results.csv``, no row with status ``ok`` and finite moduli or
+        protocol summary, an unwritable folder, a directory or read-only file in the place of
+        an output — all before the bootstrap.
+    particleShear.sweep.locks.FolderBusyError
+        Another analysis of the folder held its lock for a minute.
+    particleShear.analysis.outputs.PublishInterrupted
+        SIGINT or SIGTERM during the publication, which completed first.
     """
     import os
+    import shutil
 
     import numpy as np
 
     from ..plot import _has_matplotlib, read_sweep_table
-    from ..sweep.table import atomic_text, row_line
+    from .figure import MAX_FIGURE_PANELS, not_drawn_line
+    from .grouping import SUMMARY_PROTOCOLS, row_protocol
+    from .outputs import check_targets, make_staging, publish
+    from .protocol_summary import protocol_summaries, summary_columns
+    if max_figure_panels is None:
+        max_figure_panels = MAX_FIGURE_PANELS
+    _check_settings(estimator, n_boot, confidence, seed, figure, max_figure_panels)
     folder = os.fspath(folder)
     if not os.path.isfile(os.path.join(folder, "results.csv")):
         raise ValueError(f"folder={folder!r} is invalid: no results.csv there")
+    check_targets(folder, SET_NAMES)
     rows = read_sweep_table(folder)
     groups, varying, skipped = group_runs(rows, estimator)
-    if not groups:
+    header = list(rows[0]) if rows else []
+    protocol_rows, protocol_varying = protocol_summaries(rows, grouping_columns(header) + (
+        [_AMPLITUDE] if _AMPLITUDE in header else []), estimator, n_boot, confidence, seed)
+    if not groups and not protocol_rows:
         raise ValueError(f"folder={folder!r} has no rows with status 'ok' and finite {estimator} moduli "
                          f"({len(rows)} row(s) in results.csv)")
     notes = list(getattr(rows, "notes", []))
     if skipped:
         notes.append(f"left out {skipped} row(s) with status ok but a missing or non-finite amplitude or "
                      f"{estimator} modulus")
-    out_rows, panels = [], []
-    for g in groups:
-        # each group its own stream, from the seed and the group's parameters: a group's intervals do not
-        # depend on which other groups the folder holds
-        label = "\x1f".join(f"{k}={v}" for k, v in sorted(g["parameters"].items()))
-        rng = np.random.default_rng(None if seed is None else [int(seed), zlib.crc32(label.encode("utf-8"))])
-        summary, group_notes = _summarise(g, n_boot, confidence, rng)
-        out_rows.append(_row(g, varying, summary, group_notes, estimator, n_boot, confidence, seed))
-        panels.append((out_rows[-1]["group"], summary, group_notes))
-    columns = analysis_columns(varying)
-    path = os.path.join(folder, ANALYSIS_NAME)
-    with atomic_text(path) as fh:
-        fh.write(row_line({c: c for c in columns}, list(columns)))
-        for r in out_rows:
-            fh.write(row_line({k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-                               for k, v in r.items()}, list(columns)))
-    schema = {"file": ANALYSIS_NAME, "description": "characteristics of the amplitude sweeps of a sweep folder "
-                                                    "(python -m particleShear analyse; docs/analysis.md)",
-              "empty_cell": "undefined value (NaN)",
-              "columns": {c: {"type": t, "unit": u, "description": d} for c, (t, u, d) in columns.items()}}
-    schema_path = os.path.join(folder, SCHEMA_NAME)
-    with atomic_text(schema_path) as fh:
-        json.dump(schema, fh, indent=1, ensure_ascii=False)
-        fh.write("\n")
-    written = [path, schema_path]
-    if figure:
-        if _has_matplotlib():
-            from ..plot import save_figure
-            from .figure import plot_analysis
-            fig = plot_analysis(panels, estimator=estimator)
-            for ext in (".png", ".pdf"):
-                written.append(save_figure(fig, os.path.join(folder, FIGURE_NAME + ext)))
-        else:
-            notes.append('no figure: matplotlib is not installed (pip install "particleShear[plot]")')
-    return {"rows": out_rows, "columns": columns, "written": written, "notes": notes}
+    if any(row_protocol(r) in SUMMARY_PROTOCOLS for r in rows) and not groups:
+        notes.append("no oscillatory runs or sweep steps: the steady, relaxation and creep runs are summarised in "
+                     f"{PROTOCOLS_NAME}")
+    if rows and all(row_protocol(r) == "steady" for r in rows):
+        notes.append("the flow curve with its fit is drawn by: particleShear plot DIR (flow_curve.png)")
+    generation = f"{os.getpid()}-{np.random.default_rng().integers(1 << 62):x}"
+    settings = {"estimator": estimator, "n_boot": n_boot, "confidence": confidence, "bootstrap_seed": seed}
+    staging = make_staging(folder)
+    try:
+        out_rows, panels, names = [], [], []
+        for g in groups:
+            # each group its own stream, from the seed and the group's parameters: a group's intervals do not
+            # depend on which other groups the folder holds
+            label = _stream_label(g["parameters"])
+            rng = np.random.default_rng(None if seed is None else [int(seed), zlib.crc32(label.encode("utf-8"))])
+            summary, group_notes = _summarise(g, n_boot, confidence, rng)
+            out_rows.append(_row(g, varying, summary, group_notes, estimator, n_boot, confidence, seed))
+            panels.append((out_rows[-1]["group"], summary, group_notes))
+        columns = analysis_columns(varying)
+        if groups:
+            _write_csv(os.path.join(staging, ANALYSIS_NAME), columns, out_rows)
+            _write_schema(os.path.join(staging, SCHEMA_NAME), ANALYSIS_NAME,
+                          "characteristics of the amplitude sweeps of a sweep folder (python -m particleShear "
+                          "analyse; docs/analysis.md)", columns, generation, settings)
+            names += [ANALYSIS_NAME, SCHEMA_NAME]
+        p_columns = summary_columns(protocol_varying)
+        if protocol_rows:
+            _write_csv(os.path.join(staging, PROTOCOLS_NAME), p_columns, protocol_rows)
+            _write_schema(os.path.join(staging, PROTOCOLS_SCHEMA_NAME), PROTOCOLS_NAME,
+                          "summaries of the steady (Herschel-Bulkley fit of the flow curve), relaxation and creep "
+                          "runs of a sweep folder (python -m particleShear analyse; docs/analysis.md)", p_columns,
+                          generation, settings)
+            names += [PROTOCOLS_NAME, PROTOCOLS_SCHEMA_NAME]
+        if figure and panels:
+            if _has_matplotlib():
+                from ..plot import save_figure
+                from .figure import plot_analysis
+                fig = plot_analysis(panels, estimator=estimator, max_panels=max_figure_panels)
+                for ext in (".png", ".pdf"):
+                    key = "Description" if ext == ".png" else "Subject"
+                    fig.savefig(os.path.join(staging, FIGURE_NAME + ext), format=ext[1:], dpi=150,
+                                metadata={key: f"particleShear analyse, generation {generation}"})
+                    names.append(FIGURE_NAME + ext)
+                if len(panels) > max_figure_panels:
+                    notes.append(f"figure: the first {max_figure_panels} of {len(panels)} groups drawn; not drawn: "
+                                 + not_drawn_line([t for t, _, _ in panels[max_figure_panels:]]))
+            else:
+                notes.append('no figure: matplotlib is not installed (pip install "particleShear[plot]")')
+        removed = publish(folder, staging, names, SET_NAMES)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    if removed:
+        notes.append("removed " + ", ".join(os.path.basename(p) for p in removed) + " of an earlier analysis "
+                     "(not part of this one)")
+    return {"rows": out_rows, "columns": columns, "protocol_rows": protocol_rows, "protocol_columns": p_columns,
+            "written": [os.path.join(folder, n) for n in names], "removed": removed, "notes": notes}
 
 
 def _json_rows(rows, columns):
@@ -388,9 +554,31 @@ def _human(rows):
     return buf.getvalue()
 
 
+def _stop_on_sigterm(signum, frame):
+    raise _Terminated(signum)
+
+
+class _Terminated(Exception):
+    """SIGTERM during an analysis (status 143)."""
+
+
+def _human_protocols(rows):
+    """A short table of the protocol summaries: group, quantity, runs, value [interval] unit."""
+    head = ["group", "quantity", "runs", "value [interval]", "unit"]
+    body = [[r["group"], r["quantity"], str(r["n_runs"]),
+             f"{_fmt(r['value'])} [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]", r["unit"]] for r in rows]
+    widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
+    buf = io.StringIO()
+    for line in [head] + body:
+        buf.write("  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() + "\n")
+    for note in dict.fromkeys(f"note: {r['group']}: {r['note']}" for r in rows if r["note"]):
+        buf.write(note + "\n")
+    return buf.getvalue()
+
+
 def main(argv=None):
     """``python -m particleShear analyse DIR [--estimator surface|internal] [--json] [--n-boot N]
-    [--confidence C] [--seed S]``.
+    [--confidence C] [--seed S] [--no-figure]``.
 
     Parameters
     ----------
@@ -400,8 +588,12 @@ def main(argv=None):
     Returns
     -------
     int
-        Exit status: 0 written, 2 invalid input (message on stderr).
+        Exit status: 0 written; 2 invalid input, an unwritable folder or output (message on
+        stderr, before any work); 3 another analysis of the folder kept its lock; 130
+        interrupted (Ctrl-C), 143 terminated (SIGTERM) — the earlier files or the new set are
+        on disk, never a mix, and one line says which.
     """
+    import signal
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         args = build_parser().parse_args(argv)
@@ -411,19 +603,47 @@ def main(argv=None):
     except _UsageError as exc:
         print(f"{_PROG}: invalid parameter: {exc}", file=sys.stderr)
         return 2
+    from ..sweep.locks import FolderBusyError
+    from .outputs import PublishInterrupted
+    try:
+        previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
+    except ValueError:   # not the main thread: leave SIGTERM alone
+        previous = None
     try:
         result = analyse_folder(args.folder, estimator=args.estimator, n_boot=n_boot, confidence=confidence,
-                                seed=seed)
+                                seed=seed, figure=args.figure)
     except ValueError as exc:
         print(f"{_PROG}: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    except FolderBusyError:
+        print(f"{_PROG}: another analysis of {args.folder!r} kept its lock (analysis.lock) for a minute: nothing "
+              "written; try again", file=sys.stderr)
+        return 3
+    except PublishInterrupted as exc:
+        print(f"{_PROG}: interrupted: the new analysis files were written whole before stopping", file=sys.stderr)
+        return 143 if exc.signum == signal.SIGTERM else 130
+    except (KeyboardInterrupt, _Terminated) as exc:
+        print(f"{_PROG}: {'interrupted' if isinstance(exc, KeyboardInterrupt) else 'terminated'}: nothing written, "
+              "the files of an earlier analysis are kept as they were", file=sys.stderr)
+        return 130 if isinstance(exc, KeyboardInterrupt) else 143
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     for note in result["notes"]:
         print(f"{_PROG}: {note}", file=sys.stderr)
     if args.json:
-        print(_json_rows(result["rows"], result["columns"]))
+        if result["protocol_rows"]:
+            print(json.dumps({"analysis": json.loads(_json_rows(result["rows"], result["columns"])),
+                              "protocols": json.loads(_json_rows(result["protocol_rows"],
+                                                                 result["protocol_columns"]))},
+                             ensure_ascii=False))
+        else:
+            print(_json_rows(result["rows"], result["columns"]))
     else:
-        sys.stdout.write(_human(result["rows"]))
+        if result["rows"]:
+            sys.stdout.write(_human(result["rows"]))
+        if result["protocol_rows"]:
+            sys.stdout.write(_human_protocols(result["protocol_rows"]))
         for w in result["written"]:
             print(f"wrote {w}")
     return 0
-

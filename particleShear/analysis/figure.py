@@ -14,7 +14,11 @@ import math
 
 import numpy as np
 
-__all__ = ["MARKERS", "plot_analysis"]
+__all__ = ["MARKERS", "MAX_FIGURE_PANELS", "not_drawn_line", "plot_analysis"]
+
+#: most panels of the figure: the first groups (in table order) are drawn, the others named in one line
+#: (a figure of thousands of panels would take gigabytes and hours; every group is a row of the table)
+MAX_FIGURE_PANELS = 24
 
 #: characteristic → (marker, short label, legend text, label offset in points)
 MARKERS = {
@@ -110,8 +114,35 @@ def _panel(ax, title, s, notes):
     return said
 
 
-def plot_analysis(panels, estimator="surface", path=None):
+def not_drawn_line(titles, limit=200):
+    """One line naming the groups a figure leaves out, at most about ``limit`` characters of names.
+
+    Parameters
+    ----------
+    titles : sequence of str
+        The groups not drawn.
+    limit : int, optional
+        Characters of names shown; the rest are counted (default 200).
+
+    Returns
+    -------
+    str
+    """
+    shown, size = [], 0
+    for t in titles:
+        if shown and size + len(t) > limit:
+            break
+        shown.append(t if len(t) <= limit else t[:limit - 1] + "…")
+        size += len(t) + 2
+    rest = len(titles) - len(shown)
+    return "; ".join(shown) + (f"; … and {rest} more" if rest else "")
+
+
+def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_PANELS):
     """One panel per group: mean G′, G″ with bootstrap bands and the characteristic points.
+
+    At most ``max_panels`` panels are drawn (the first groups); a line at the foot of the figure
+    names the others (:func:`not_drawn_line`).
 
     Parameters
     ----------
@@ -123,6 +154,8 @@ def plot_analysis(panels, estimator="surface", path=None):
         Named in the figure's title (default "surface").
     path : str or os.PathLike, optional
         Also write the figure there (.png, .pdf, .svg or .eps), atomically.
+    max_panels : int, optional
+        Most panels drawn, 1 ... :data:`MAX_FIGURE_PANELS` (default).
 
     Returns
     -------
@@ -131,7 +164,7 @@ def plot_analysis(panels, estimator="surface", path=None):
     Raises
     ------
     ValueError
-        For no panels.
+        For no panels, or ``max_panels`` out of range.
     ImportError
         Without matplotlib (names the ``[plot]`` extra).
     """
@@ -139,6 +172,11 @@ def plot_analysis(panels, estimator="surface", path=None):
     panels = list(panels)
     if not panels:
         raise ValueError("panels=[] is invalid: allowed at least one (title, summary, notes)")
+    if isinstance(max_panels, bool) or not isinstance(max_panels, int) or not 1 <= max_panels <= MAX_FIGURE_PANELS:
+        raise ValueError(f"max_panels={max_panels!r} is out of range: allowed an integer >= 1 and <= "
+                         f"{MAX_FIGURE_PANELS}")
+    left_out = [t for t, _, _ in panels[max_panels:]]
+    panels = panels[:max_panels]
     n = len(panels)
     ncols = min(n, 3)
     nrows = math.ceil(n / ncols)
@@ -162,6 +200,11 @@ def plot_analysis(panels, estimator="surface", path=None):
         ax.set_axis_off()
     what = f"{confidence:.0%} bootstrap intervals over seeds" if confidence is not None else "no summary"
     fig.suptitle(f"{estimator} estimator: mean G′, G″ and {what}", fontsize="medium")
+    if left_out:
+        import textwrap
+        line = (f"{len(left_out)} more group(s) not drawn (the first {n} are; every group is a row of "
+                f"analysis.csv): {not_drawn_line(left_out)}")
+        fig.supxlabel("\n".join(textwrap.wrap(line, 160)), fontsize="x-small", color="0.3")
     if handles:
         try:
             fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=legend_cols,

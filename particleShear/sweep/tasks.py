@@ -186,6 +186,10 @@ def _finish_run(task, result, wall_time_s):
             tail = os.path.basename(image_folder)[len(os.path.basename(run_file_stem(produced))):]
             result.image_folder = run_file_stem(result.output_path) + tail
     rows = result.rows() if hasattr(result, "steps") else [result.to_dict()]   # a protocol run: its rows
+    if "protocol" in task["parameters"]:   # a table with protocol columns: an oscillatory row says so too
+        for row in rows:
+            if row.get("protocol") in (None, ""):
+                row["protocol"] = task["parameters"]["protocol"] or "oscillatory"
     err = getattr(result, "write_error", None)
     for row in rows:
         if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
