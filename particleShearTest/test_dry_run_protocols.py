@@ -139,6 +139,13 @@ class TestCli(unittest.TestCase):
                 self.assertEqual(main([path, "--out", os.path.join(d, "o"), "--dry-run"]), 0)
         self.assertIn("calibration stopped", out.getvalue())
         self.assertNotIn("calibrated here", out.getvalue())
+        out = io.StringIO()
+        with tempfile.TemporaryDirectory() as d:
+            path = _write(d, "c.json", spec)
+            with mock.patch.object(C, "measure_calibration", side_effect=RuntimeError("a calibration run failed: X")), \
+                    mock.patch.dict(os.environ, {"PARTICLESHEAR_CACHE_DIR": d}), contextlib.redirect_stdout(out):
+                self.assertEqual(main([path, "--out", os.path.join(d, "o"), "--dry-run"]), 0)
+        self.assertIn("calibration failed", out.getvalue())
 
     def test_interrupted_sweep_names_its_table_only_when_it_exists(self):
         from particleShear.sweep.cli import main

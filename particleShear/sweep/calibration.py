@@ -190,7 +190,7 @@ def _assemble(p, replicas, budget_s, items, why=None):
 
 def _default_run(kw):
     from ..run.api import doParticleShearSimulation
-    return doParticleShearSimulation(**kw, return_result=True)
+    return doParticleShearSimulation(**dict(kw, return_result=True))
 
 
 def _default_batch(kws):
@@ -221,7 +221,7 @@ def _measure_bounded(p, steps, repeats, replicas, budget_s):
     """:func:`_measure_items` in a child process, ended at ``budget_s`` wall seconds whatever it is doing."""
     import multiprocessing as mp
     ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-    items, why = [], None
+    items, why, failed = [], None, None
     with tempfile.TemporaryDirectory(prefix="particleShear-calibration-") as root:
         parent, child = ctx.Pipe(duplex=False)
         proc = ctx.Process(target=_child, args=(child, p, steps, repeats, replicas, root, budget_s), daemon=True)
@@ -247,7 +247,7 @@ def _measure_bounded(p, steps, repeats, replicas, budget_s):
                 if kind == "done":
                     break
                 if kind == "error":
-                    why = f"a calibration run failed ({value})"
+                    why, failed = f"a calibration run failed ({value})", value
                     break
                 items.append((kind, value))
         finally:
@@ -258,6 +258,8 @@ def _measure_bounded(p, steps, repeats, replicas, budget_s):
                     proc.kill()
             proc.join(5)
             parent.close()
+    if failed and not any(kind == "pair" for kind, _ in items):
+        raise RuntimeError(f"a calibration run failed: {failed}")
     if not any(kind == "steps" for kind, _ in items):
         items.append(("steps", run_steps(_shortened(p, int(steps), ""))))
     return _assemble(p, replicas, budget_s, items, why)
@@ -313,6 +315,8 @@ def measure_calibration(p, steps=400, repeats=3, replicas=4, timer=time.perf_cou
     ------
     ValueError
         For ``steps < 8``, ``repeats < 1``, ``replicas < 2`` or ``budget_s <= 0``.
+    RuntimeError
+        When the first calibration run fails in the child process (its error named).
     """
     if int(steps) < 8:
         raise ValueError(f"steps={steps!r} is invalid: allowed an integer >= 8")

@@ -205,7 +205,12 @@ def _dry_run(args, sweep, workers):
     todo = sweep._point_counts(sweep._classify()[0].values())
     p = representative_point(points, counts)
     proto = p.get("protocol") or "oscillatory"
-    cal, cached = load_or_measure(p, refresh=args.calibrate)
+    try:
+        cal, cached = load_or_measure(p, refresh=args.calibrate)
+    except RuntimeError as exc:
+        _log.info(f"calibration failed on the point (N={p['N']}, protocol {proto}): {exc}; no calibrated "
+                  "projection (the static model above stands)")
+        return 0
     if cal is None:
         _log.info(f"calibration stopped: no shortened run of the point (N={p['N']}, protocol {proto}) finished "
                   f"within the {CALIBRATION_BUDGET_S:g} s budget; no calibrated projection (the static model above "
