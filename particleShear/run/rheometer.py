@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
-           "normalize_protocol", "protocol_steps", "measure_rheometer"]
+           "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
 PROTOCOLS = ("oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", "frequency_sweep")
 
@@ -111,8 +111,10 @@ def check_protocol(p):
         An unknown protocol (the closest name suggested), a missing or non-positive rate, strain,
         time or stress, a sweep list that is empty or not monotonic, a rate or ramp the time step
         cannot resolve (more than :data:`MAX_STRAIN_PER_STEP` strain per step), a controller
-        response time shorter than 10 steps, or options of the drawing with a protocol other
-        than "oscillatory".
+        response time shorter than 10 steps, a step of a sweep that its time step cannot resolve
+        (:func:`check_sweep_resolution`), a protocol of more than
+        :data:`~particleShear.run.validation.MAX_TOTAL_STEPS` steps (naming the parameter to
+        shorten), or options of the drawing with a protocol other than "oscillatory".
     """
     proto = p.get("protocol", "oscillatory")
     if proto not in PROTOCOLS:
@@ -160,12 +162,78 @@ def check_protocol(p):
         if T < 10 * dtr:
             raise ValueError(f"creep_response_time={T!r} is out of range: the controller needs >= 10 steps per "
                              f"response time, allowed >= {10 * dtr:.4g} (flag --creep-response-time)")
+    if proto.endswith("sweep"):
+        check_sweep_resolution(q, steps)
     total = sum(steps["segments"]) if proto.endswith("sweep") else steps["steps"]
-    from .validation import MAX_TOTAL_STEPS
+    from .validation import MAX_TOTAL_STEPS, _protocol_room
     if total > MAX_TOTAL_STEPS:
-        raise ValueError(f"protocol={proto!r} needs {total:.3g} steps, more than the limit of {MAX_TOTAL_STEPS:.0e}: "
-                         "shorten total_strain, hold_time or the sweep")
+        name, allowed = _protocol_room(q, steps, MAX_TOTAL_STEPS)
+        raise ValueError(f"{name}={_shown(q[name])} is out of range: protocol={proto!r} needs {total:.3g} steps, more "
+                         f"than the limit of {MAX_TOTAL_STEPS:.0e}; allowed {allowed} (flag --{name.replace('_', '-')})")
     return steps
+
+
+def _shown(v):
+    """A value for a message: a long list cut to its first and last values."""
+    from ..checks import show_value
+    if isinstance(v, (list, tuple)) and len(v) > 6:
+        return f"[{', '.join(f'{x:g}' for x in v[:3])}, ..., {v[-1]:g}] ({len(v)} values)"
+    return show_value(v)
+
+
+def check_sweep_resolution(q, steps=None):
+    """Check every step of a one-packing sweep as the single oscillatory run is checked.
+
+    Each step ``j`` (amplitude ``A_j``, relative frequency ``f_j``) has its own time step (the
+    time-step rule depends on the amplitude) and must resolve its excitation period with at
+    least :data:`~particleShear.run.validation.MIN_STEPS_PER_PERIOD` steps at the reference time
+    step, and with at least
+    :data:`~particleShear.run.validation.MIN_STEPS_PER_PERIOD_COARSENED` at the coarsened one
+    (``time_step_factor``), the two rules of the oscillatory run's first step.
+
+    Parameters
+    ----------
+    q : dict
+        The arguments of the run (:func:`normalize_protocol`: a sweep's list as floats).
+    steps : dict, optional
+        :func:`protocol_steps` of ``q`` (computed when None).
+
+    Raises
+    ------
+    ValueError
+        Naming the step's value (``sweep_frequencies[j]`` or ``sweep_amplitudes[j]``), its steps
+        per period, the limit, the allowed range and the CLI flag.
+    """
+    from .validation import MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED
+    proto = q["protocol"]
+    steps = protocol_steps(q) if steps is None else steps
+    factor = float(q["time_step_factor"])
+    n = len(steps["dts"])
+    freqs = q["sweep_frequencies"] if proto == "frequency_sweep" else [float(q["relative_frequency"])] * n
+    for j, (fr, dtr) in enumerate(zip(freqs, steps["dts"])):
+        spp = 1.0 / (fr * dtr / factor)        # steps per period at the reference time step
+        if spp >= MIN_STEPS_PER_PERIOD and spp / factor >= MIN_STEPS_PER_PERIOD_COARSENED:
+            continue
+        if proto == "frequency_sweep":
+            name, value, flag = f"sweep_frequencies[{j}]", fr, "--sweep-frequencies"
+        else:
+            name, value, flag = f"sweep_amplitudes[{j}]", q["sweep_amplitudes"][j], "--sweep-amplitudes"
+        if spp < MIN_STEPS_PER_PERIOD:
+            if proto == "frequency_sweep":
+                allowed = (f"every value of sweep_frequencies <= {fr * spp / MIN_STEPS_PER_PERIOD:.4g} "
+                           f"(flag {flag})")
+            else:
+                rf_max = min(1.0 / (MIN_STEPS_PER_PERIOD * d / factor) for d in steps["dts"])
+                allowed = (f"relative_frequency <= {rf_max:.4g} for every amplitude of this sweep "
+                           "(flag --relative-frequency)")
+            raise ValueError(
+                f"{name}={value:g} is out of range: this step of protocol={proto!r} (relative frequency {fr:g}, "
+                f"dt = {dtr / factor:.3g} τ at the reference time step) would resolve an excitation period with "
+                f"{spp:.3g} steps, fewer than {MIN_STEPS_PER_PERIOD}; allowed {allowed}")
+        raise ValueError(
+            f"time_step_factor={q['time_step_factor']!r} is out of range: it leaves {spp / factor:.3g} steps per "
+            f"excitation period at {name}={value:g}, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed "
+            f"time_step_factor <= {spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} (flag --time-step-factor)")
 
 
 def normalize_protocol(p):

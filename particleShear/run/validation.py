@@ -98,6 +98,14 @@ OUTPUT_TEXT_BUFFER_BYTES = 1_024 * 3_500
 CUT_BYTES_PER_SPHERE_AND_SEED = 8 * 8
 #: fraction of the available memory a run may plan to use
 MEMORY_FRACTION = 0.8
+#: recording per protocol step of the other protocols (docs/protocols.md): the engine's record of 5 series
+#: (6 with N1 for "steady"), 8 bytes each, and as much again for the run's series, its analysis and its
+#: file's columns (tracemalloc, growth of the protocol's peak per step: 76 B for creep at 5,600 → 22,400
+#: steps); a sweep's steps keep the oscillatory record and its demodulation and join the steps' records
+#: (185 B per step of a frequency sweep at 2,518 → 5,542 steps); rounded up.  The whole record is held
+#: until the run ends.
+PROTOCOL_RECORD_BYTES_PER_STEP = {"steady": 2 * 6 * 8, "relaxation": 2 * 5 * 8, "creep": 2 * 5 * 8,
+                                  "amplitude_sweep": 200, "frequency_sweep": 200}
 
 
 # -- single values ---------------------------------------------------------------------------------
@@ -295,8 +303,10 @@ def estimate_run_cost(p):
 
     Uses the model constants (eq. S1-8), the time-step rule and the constitution schedule of
     the builder, the protocol length ``(pre + periods + post)/f/dt`` and what is kept or saved.
-    The protocol step count is the run's own (``int`` of ``protocol_steps``); pre-equilibration
-    and constitution counts are upper bounds.
+    The protocol step count is the run's own (``int`` of ``protocol_steps``; for another protocol
+    than "oscillatory" its own steps, a sweep's summed over its steps, and their record at
+    :data:`PROTOCOL_RECORD_BYTES_PER_STEP`); pre-equilibration and constitution counts are upper
+    bounds.
 
     Parameters
     ----------
@@ -309,8 +319,9 @@ def estimate_run_cost(p):
     dict
         ``dt`` (s, protocol time step), ``f`` (Hz), ``steps_per_period`` (at the reference time
         step), ``protocol_steps``, ``pre_equilibration_steps``, ``constitution_steps``,
-        ``total_steps`` and ``memory``: bytes per item ("ensemble", "recording", "cutting",
-        "output_text") and their "total".
+        ``total_steps``, ``memory``: bytes per item ("ensemble", "recording", "cutting",
+        "output_text") and their "total", ``protocol`` and ``protocol_detail`` (the steps of
+        :func:`~particleShear.run.rheometer.protocol_steps`; None for "oscillatory").
     """
     N = int(p["N"])
     bf, A, mu = float(p["bimodal_factor"]), float(p["theAmplitude"]), float(p["theMu"])
@@ -325,6 +336,12 @@ def estimate_run_cost(p):
     dt = dt_ref * factor
     n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
     protocol = n_periods * steps_per_period / factor
+    proto = p.get("protocol", "oscillatory")
+    detail = None
+    if proto != "oscillatory":   # the protocol's own steps (a sweep: every step's), not the oscillation's
+        from .rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps
+        detail = protocol_steps(normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p}))
+        protocol = float(sum(detail["segments"]) if "segments" in detail else detail["steps"])
     # fixed-plate pre-equilibration: N/2 steps per halving level from dt_max down to dt, then 3N steps,
     # N = 25·F with the adjustment factor of the simulation, bounded here by its largest value:
     # F ≤ 1.5·2·2 (μ) · 2 (rv) = 24, times (1 − (log10 A + 2))·2 at small amplitudes
@@ -340,14 +357,16 @@ def estimate_run_cost(p):
     cut = int(p["cut_lines"]) if (p.get("do_permanent_links", True) and p.get("doCutByTriangulation", True)) else 0
     memory = {
         "ensemble": N * BYTES_PER_SPHERE,
-        "recording": protocol * (RECORD_BYTES_PER_STEP + (TENSOR_BYTES_PER_STEP if tensors else 0)),
+        "recording": protocol * (PROTOCOL_RECORD_BYTES_PER_STEP[proto] if detail is not None else
+                                 RECORD_BYTES_PER_STEP + (TENSOR_BYTES_PER_STEP if tensors else 0)),
         "cutting": float(N) * cut * CUT_BYTES_PER_SPHERE_AND_SEED,
-        "output_text": OUTPUT_TEXT_BUFFER_BYTES if tensors else 0.0,
+        "output_text": OUTPUT_TEXT_BUFFER_BYTES if tensors and detail is None else 0.0,
     }
     memory["total"] = sum(memory.values())
     return {"dt": dt, "f": f, "steps_per_period": steps_per_period, "protocol_steps": protocol,
             "pre_equilibration_steps": pre, "constitution_steps": constitution,
-            "total_steps": protocol + pre + constitution, "memory": memory}
+            "total_steps": protocol + pre + constitution, "memory": memory, "protocol": proto,
+            "protocol_detail": detail}
 
 
 def _protocol_culprit(p, cost, steps_ok):
@@ -356,6 +375,8 @@ def _protocol_culprit(p, cost, steps_ok):
     ``time_step_factor`` when the run would fit at factor 1, ``relative_frequency`` when it would fit
     at the default 0.025, else the largest of pre_periods / periods / post_periods.
     """
+    if cost.get("protocol_detail") is not None:
+        return _protocol_room(p, cost["protocol_detail"], steps_ok)
     factor = float(p.get("time_step_factor", 1.0))
     spp = cost["steps_per_period"]
     n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
@@ -367,6 +388,31 @@ def _protocol_culprit(p, cost, steps_ok):
     name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
     room = max(0.0, steps_ok * factor / spp - (n_periods - float(p[name])))
     return name, f"{name} <= {room:.4g}"
+
+
+def _protocol_room(p, detail, steps_ok):
+    """(name, allowed) of the parameter of another protocol than "oscillatory" that makes it longer
+    than ``steps_ok`` steps: ``total_strain`` (steady), ``hold_time`` (relaxation, creep), the
+    largest of pre_periods / periods / post_periods (sweeps)."""
+    proto = p["protocol"]
+    dtr = detail["dt_over_tau"]
+    if proto == "steady":
+        name, room = "total_strain", steps_ok * float(p["relative_rate"]) * dtr
+    elif proto == "creep":
+        name, room = "hold_time", steps_ok * dtr
+    elif proto == "relaxation":
+        name, room = "hold_time", (steps_ok - 1 - detail["ramp"]) * dtr
+        if room <= 0:
+            name, room = "ramp_time", (steps_ok - 1) * dtr
+    else:
+        n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
+        per_period = sum(detail["segments"]) / n_periods      # steps of one period of every step
+        name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
+        room = steps_ok / max(per_period, 1e-300) - (n_periods - float(p[name]))
+        if room <= 0:
+            name = "sweep_amplitudes" if proto == "amplitude_sweep" else "sweep_frequencies"
+            return name, "fewer or shorter steps"
+    return name, f"{name} <= {max(room, 0.0):.4g}"
 
 
 def _check_constitution(p):
@@ -421,6 +467,11 @@ def _check_cost(p):
     if cost["total_steps"] > MAX_TOTAL_STEPS:
         other = cost["total_steps"] - cost["protocol_steps"]
         name, allowed = _protocol_culprit(p, cost, MAX_TOTAL_STEPS - other)
+        if cost.get("protocol_detail") is not None:
+            from .rheometer import _shown
+            raise ValueError(
+                f"{name}={_shown(p[name])} is out of range: the run would take {cost['total_steps']:.3g} steps, "
+                f"more than the limit of {MAX_TOTAL_STEPS:.0e}; allowed {allowed} (flag --{name.replace('_', '-')})")
         raise ValueError(
             f"{name}={show_value(p[name])} is out of range: the run would take {cost['total_steps']:.3g} steps, "
             f"more than the limit of {MAX_TOTAL_STEPS:.0e} ({spp / factor:.4g} steps per excitation period); "
@@ -449,8 +500,15 @@ def _check_cost(p):
     fixed = mem["ensemble"] + mem["cutting"] + mem["output_text"]  # the streamed output's buffer does not grow
     name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - fixed) / per_step))
     hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
-    raise ValueError(f"{name}={show_value(p[name])} is out of range: recording {cost['protocol_steps']:.3g} "
-                     f"protocol steps {need}; allowed {allowed} on this machine{hint}")
+    what, flag = "protocol steps", ""
+    if cost.get("protocol_detail") is not None:
+        from .rheometer import _shown
+        what = f"protocol steps of protocol={p['protocol']!r} ({per_step:.3g} B per step)"
+        flag, name_value = f" (flag --{name.replace('_', '-')})", _shown(p[name])
+    else:
+        name_value = show_value(p[name])
+    raise ValueError(f"{name}={name_value} is out of range: recording {cost['protocol_steps']:.3g} "
+                     f"{what} {need}; allowed {allowed} on this machine{hint}{flag}")
 
 
 # -- the whole call --------------------------------------------------------------------------------

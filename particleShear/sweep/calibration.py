@@ -22,14 +22,18 @@ import time
 from .cost import _step_seconds, run_steps
 
 __all__ = ["cache_path", "calibration_key", "measure_calibration", "load_or_measure", "project_cost",
-           "format_projection", "representative_point", "MIN_SPREAD"]
+           "format_projection", "representative_point", "MIN_SPREAD", "CALIBRATION_BUDGET_S"]
 
 #: smallest relative half-width of the printed range (the scatter of a shared machine between runs)
 MIN_SPREAD = 0.3
+#: wall-clock budget (s) of one calibration, whatever the SPEC: with the SPEC's own checks, a dry run
+#: stays under a minute
+CALIBRATION_BUDGET_S = 40.0
 #: parameters of a point that decide its calibration (the rest does not change the cost per step)
 _KEY_PARAMETERS = ("N", "bimodal_factor", "packing_fraction", "theMu", "do_permanent_links", "cut_lines",
                    "saveData", "saveStressTensorData", "file_format", "integrator", "backend",
-                   "relative_transversal_link_strength", "theAmplitude", "relative_viscosity", "time_step_factor")
+                   "relative_transversal_link_strength", "theAmplitude", "relative_viscosity", "time_step_factor",
+                   "protocol")
 
 
 def cache_path():
@@ -104,20 +108,180 @@ def representative_point(points, counts):
 
 
 def _shortened(p, steps, root):
-    per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
-    return dict(p, pre_periods=0, post_periods=0, periods=min(float(p["periods"]), steps / per_period),
-                doDrawing=False, plotStress=False, saveOutputImages=False, root_folder=root, verbose=False)
+    """``p`` with its protocol cut to about ``steps`` steps (never longer than its own), output to ``root``.
+
+    "oscillatory": no baseline periods and at most ``steps`` steps of excitation; "steady": the
+    strain of ``steps`` steps at its rate; "relaxation": the ramp kept (its rate is bounded),
+    the hold cut; "creep": the hold cut; sweeps: the first two values of the list, no baseline
+    periods, the excitation periods cut so that both steps together take about ``steps`` steps.
+    """
+    proto = p.get("protocol") or "oscillatory"
+    view = dict(doDrawing=False, plotStress=False, saveOutputImages=False, root_folder=root, verbose=False)
+    if proto == "oscillatory":
+        per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
+        return dict(p, pre_periods=0, post_periods=0, periods=min(float(p["periods"]), steps / per_period), **view)
+    from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps
+    q = normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p})
+    st = protocol_steps(q)
+    dtr = st["dt_over_tau"]
+    if proto == "steady":
+        rate = float(q["relative_rate"])
+        return dict(p, total_strain=min(float(q["total_strain"]), steps * rate * dtr), **view)
+    if proto == "creep":
+        return dict(p, hold_time=min(float(q["hold_time"]), steps * dtr), **view)
+    if proto == "relaxation":
+        return dict(p, hold_time=min(float(q["hold_time"]), max(steps - 1 - st["ramp"], 1) * dtr), **view)
+    key = "sweep_amplitudes" if proto == "amplitude_sweep" else "sweep_frequencies"
+    q2 = normalize_protocol(dict(q, **{key: q[key][:2]}, pre_periods=0, post_periods=0, periods=1))
+    per_period = max(1, sum(protocol_steps(q2)["segments"]))
+    return dict(p, **{key: list(q[key][:2])}, pre_periods=0, post_periods=0,
+                periods=min(float(p["periods"]), steps / per_period), **view)
 
 
-def measure_calibration(p, steps=400, repeats=3, replicas=4, timer=time.perf_counter, run=None, batch=None):
-    """Time a representative point here: cost per step, fixed cost per run, batch ratio.
+def _measure_items(p, steps, repeats, replicas, timer, run, batch, root, deadline):
+    """The calibration's measurements, one at a time: ``("pair", (per_step, fixed, single))`` per
+    repeat and one ``("batch", seconds)`` after the first pair; stops early (``("stopped", why)``)
+    when the next one would end after ``deadline`` (predicted from the ones measured)."""
+    short, long_ = _shortened(p, int(steps) // 4, root), _shortened(p, int(steps), root)
+    s_short, s_long = run_steps(short), run_steps(long_)
+    yield "steps", s_long
+    plan = [("pair", 0), ("batch", None)] + [("pair", k) for k in range(1, int(repeats))]
+    pair_s = None
+    for kind, k in plan:
+        if pair_s is not None:
+            need = pair_s if kind == "pair" else int(replicas) * pair_s
+            if timer() + need > deadline:
+                yield "stopped", f"the next {kind} would pass the budget"
+                return
+        if kind == "batch":
+            t0 = timer()
+            batch([dict(long_, seed=100 + b) for b in range(int(replicas))])
+            yield "batch", timer() - t0
+            continue
+        times = []
+        t_pair = timer()
+        for kw in (short, long_):
+            t0 = timer()
+            result = run(dict(kw, seed=k))
+            times.append(timer() - t0)
+        pair_s = timer() - t_pair
+        protocol_s = (getattr(result, "timings", None) or {}).get("protocol")
+        if protocol_s:   # the run timed its own protocol: the cost per step without the noise of a difference
+            c = float(protocol_s) / max(s_long, 1)
+        else:
+            c = max((times[1] - times[0]) / max(s_long - s_short, 1), 0.0)
+        yield "pair", (c, max(times[1] - c * s_long, 0.0), times[1])
 
-    Runs ``p`` (its output written to a temporary folder) with the protocol cut to ``steps//4``
-    and to ``steps`` steps, ``repeats`` times each, then one batch of ``replicas`` runs of the
-    longer schedule.  The cost per step is the longer run's own protocol timing
-    (``result.timings["protocol"]``) when ``run`` returns a result with one, else the difference
-    of the two runs' wall times over their difference in steps; the fixed cost is the rest of
-    the longer run's wall time.
+
+def _assemble(p, replicas, budget_s, items, why=None):
+    """The calibration dict of the measurements ``items`` (``why``: why it stopped early, or None)."""
+    pairs = [v for kind, v in items if kind == "pair"]
+    if not pairs:
+        return None
+    steps = next(v for kind, v in items if kind == "steps")
+    batch_s = next((v for kind, v in items if kind == "batch"), None)
+    why = why or next((v for kind, v in items if kind == "stopped"), None)
+    return {"N": int(p["N"]), "protocol": p.get("protocol") or "oscillatory", "steps": int(steps),
+            "per_step_s": [c for c, _, _ in pairs], "fixed_s": [f for _, f, _ in pairs],
+            "single_s": [t for _, _, t in pairs], "replicas": int(replicas),
+            "batch_s": None if batch_s is None else float(batch_s), "budget_s": float(budget_s),
+            "complete": why is None, "stopped": why or ""}
+
+
+def _default_run(kw):
+    from ..run.api import doParticleShearSimulation
+    return doParticleShearSimulation(**dict(kw, return_result=True))
+
+
+def _default_batch(kws):
+    from ..run.batch import run_batch
+    return run_batch(kws)
+
+
+def _child(conn, p, steps, repeats, replicas, root, budget_s):
+    """A calibration process: every measurement sent to ``conn`` as it is made, then ``("done", None)``."""
+    import warnings
+    warnings.simplefilter("ignore")
+    try:
+        deadline = time.perf_counter() + budget_s
+        for item in _measure_items(p, steps, repeats, replicas, time.perf_counter, _default_run, _default_batch,
+                                   root, deadline):
+            conn.send(item)
+        conn.send(("done", None))
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent, which keeps what was measured
+        try:
+            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        except Exception:   # noqa: BLE001
+            pass
+    finally:
+        conn.close()
+
+
+def _measure_bounded(p, steps, repeats, replicas, budget_s):
+    """:func:`_measure_items` in a child process, ended at ``budget_s`` wall seconds whatever it is doing."""
+    import multiprocessing as mp
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    items, why, failed = [], None, None
+    with tempfile.TemporaryDirectory(prefix="particleShear-calibration-") as root:
+        parent, child = ctx.Pipe(duplex=False)
+        proc = ctx.Process(target=_child, args=(child, p, steps, repeats, replicas, root, budget_s), daemon=True)
+        t_end = time.perf_counter() + budget_s
+        proc.start()
+        child.close()
+        try:
+            while True:
+                left = t_end - time.perf_counter()
+                if left <= 0:
+                    why = f"the {budget_s:g} s budget ran out"
+                    break
+                if not parent.poll(min(left, 0.5)):
+                    if not proc.is_alive() and not parent.poll(0):
+                        why = "the calibration process ended"
+                        break
+                    continue
+                try:
+                    kind, value = parent.recv()
+                except EOFError:
+                    why = why or "the calibration process ended"
+                    break
+                if kind == "done":
+                    break
+                if kind == "error":
+                    why, failed = f"a calibration run failed ({value})", value
+                    break
+                items.append((kind, value))
+        finally:
+            if proc.is_alive():
+                proc.terminate()
+                proc.join(5)
+                if proc.is_alive():
+                    proc.kill()
+            proc.join(5)
+            parent.close()
+    if failed and not any(kind == "pair" for kind, _ in items):
+        raise RuntimeError(f"a calibration run failed: {failed}")
+    if not any(kind == "steps" for kind, _ in items):
+        items.append(("steps", run_steps(_shortened(p, int(steps), ""))))
+    return _assemble(p, replicas, budget_s, items, why)
+
+
+def measure_calibration(p, steps=400, repeats=3, replicas=4, timer=time.perf_counter, run=None, batch=None,
+                        budget_s=None):
+    """Time a representative point here: cost per step, fixed cost per run, batch ratio; bounded in time.
+
+    Runs ``p`` (its output written to a temporary folder) with its protocol cut to about
+    ``steps//4`` and ``steps`` steps (every protocol: oscillation periods, a steady run's strain,
+    a relaxation's or creep's hold, a sweep's list and periods; :func:`_shortened`), then one
+    batch of ``replicas`` runs of the longer schedule, then the other ``repeats - 1`` pairs.
+    The cost per step is the longer run's own protocol timing (``result.timings["protocol"]``)
+    when ``run`` returns a result with one, else the difference of the two runs' wall times over
+    their difference in steps; the fixed cost is the rest of the longer run's wall time.
+
+    The calibration takes at most ``budget_s`` seconds whatever the point: a measurement that
+    the ones before it predict to end past the budget is not started, and with the default
+    ``run`` and ``batch`` the measurements run in a child process that is ended when the budget
+    runs out (a first run longer than the budget included).  What was measured by then is the
+    calibration (``complete`` False, ``stopped`` says why); nothing measured gives None.
 
     Parameters
     ----------
@@ -135,18 +299,24 @@ def measure_calibration(p, steps=400, repeats=3, replicas=4, timer=time.perf_cou
         ``run(kwargs)`` runs one simulation (default ``doParticleShearSimulation(**kwargs)``).
     batch : callable, optional
         ``batch(list_of_kwargs)`` runs a batch (default ``particleShear.run.batch.run_batch``).
+    budget_s : float, optional
+        Wall-clock budget in seconds (default :data:`CALIBRATION_BUDGET_S`; > 0).
 
     Returns
     -------
-    dict
-        ``N``, ``steps`` (of the longer run), ``per_step_s`` and ``fixed_s`` (one sample per
-        repeat), ``single_s`` (the longer runs' wall times), ``replicas`` and ``batch_s`` (the
-        batch's wall time).
+    dict or None
+        ``N``, ``protocol``, ``steps`` (of the longer run), ``per_step_s`` and ``fixed_s`` (one
+        sample per finished repeat), ``single_s`` (the longer runs' wall times), ``replicas``,
+        ``batch_s`` (the batch's wall time; None when not measured), ``budget_s``, ``complete``
+        and ``stopped`` (why it stopped early, else ""); None when not one pair of runs finished
+        within the budget.
 
     Raises
     ------
     ValueError
-        For ``steps < 8``, ``repeats < 1`` or ``replicas < 2``.
+        For ``steps < 8``, ``repeats < 1``, ``replicas < 2`` or ``budget_s <= 0``.
+    RuntimeError
+        When the first calibration run fails in the child process (its error named).
     """
     if int(steps) < 8:
         raise ValueError(f"steps={steps!r} is invalid: allowed an integer >= 8")
@@ -154,36 +324,16 @@ def measure_calibration(p, steps=400, repeats=3, replicas=4, timer=time.perf_cou
         raise ValueError(f"repeats={repeats!r} is invalid: allowed an integer >= 1")
     if int(replicas) < 2:
         raise ValueError(f"replicas={replicas!r} is invalid: allowed an integer >= 2")
-    if run is None:
-        from ..run.api import doParticleShearSimulation
-
-        def run(kw):
-            return doParticleShearSimulation(**kw, return_result=True)
-    if batch is None:
-        from ..run.batch import run_batch as batch
-    per_step, fixed, single = [], [], []
+    budget_s = CALIBRATION_BUDGET_S if budget_s is None else float(budget_s)
+    if not (math.isfinite(budget_s) and budget_s > 0):
+        raise ValueError(f"budget_s={budget_s!r} is invalid: allowed a number of seconds > 0")
+    if run is None and batch is None:
+        return _measure_bounded(p, steps, repeats, replicas, budget_s)
+    run = run or _default_run
+    batch = batch or _default_batch
     with tempfile.TemporaryDirectory(prefix="particleShear-calibration-") as root:
-        short, long_ = _shortened(p, int(steps) // 4, root), _shortened(p, int(steps), root)
-        s_short, s_long = run_steps(short), run_steps(long_)
-        for k in range(int(repeats)):
-            times = []
-            for kw in (short, long_):
-                t0 = timer()
-                result = run(dict(kw, seed=k))
-                times.append(timer() - t0)
-            protocol_s = (getattr(result, "timings", None) or {}).get("protocol")
-            if protocol_s:   # the run timed its own protocol: the cost per step without the noise of a difference
-                c = float(protocol_s) / max(s_long, 1)
-            else:
-                c = max((times[1] - times[0]) / max(s_long - s_short, 1), 0.0)
-            per_step.append(c)
-            fixed.append(max(times[1] - c * s_long, 0.0))
-            single.append(times[1])
-        t0 = timer()
-        batch([dict(long_, seed=100 + b) for b in range(int(replicas))])
-        batch_s = timer() - t0
-    return {"N": int(p["N"]), "steps": int(s_long), "per_step_s": per_step, "fixed_s": fixed,
-            "single_s": single, "replicas": int(replicas), "batch_s": float(batch_s)}
+        items = list(_measure_items(p, steps, repeats, replicas, timer, run, batch, root, timer() + budget_s))
+    return _assemble(p, replicas, budget_s, items)
 
 
 def load_or_measure(p, steps=400, repeats=3, replicas=4, path=None, host=None, version=None, refresh=False,
@@ -207,8 +357,9 @@ def load_or_measure(p, steps=400, repeats=3, replicas=4, path=None, host=None, v
 
     Returns
     -------
-    tuple of (dict, bool)
-        The calibration and whether it came from the cache.
+    tuple of (dict or None, bool)
+        The calibration (None when not one pair of runs finished within the budget of
+        :func:`measure_calibration`; not cached) and whether it came from the cache.
     """
     path = path or cache_path()
     key = calibration_key(p, steps, replicas, host=host, version=version)
@@ -221,6 +372,8 @@ def load_or_measure(p, steps=400, repeats=3, replicas=4, path=None, host=None, v
     if not refresh and isinstance(cache, dict) and isinstance(cache.get(key), dict):
         return cache[key], True
     cal = measure_calibration(p, steps=steps, repeats=repeats, replicas=replicas, **measure)
+    if cal is None:      # nothing measured within the budget: nothing to keep
+        return None, False
     cache = cache if isinstance(cache, dict) else {}
     cache[key] = cal
     try:
@@ -237,7 +390,7 @@ def load_or_measure(p, steps=400, repeats=3, replicas=4, path=None, host=None, v
 def _batch_fraction(cal, b):
     """Per-run cost of a batch of ``b`` runs / a single run: a fixed share ``c0`` and a per-replica share ``c1``."""
     single = sorted(cal["single_s"])[len(cal["single_s"]) // 2]
-    if b <= 1 or single <= 0:
+    if b <= 1 or single <= 0 or cal.get("batch_s") is None:   # no batch measured: a run costs a single run
         return 1.0
     r = cal["batch_s"] / (cal["replicas"] * single)          # measured fraction at the calibrated size
     c1 = min(max((cal["replicas"] * r - 1) / (cal["replicas"] - 1), 0.05), 1.0)

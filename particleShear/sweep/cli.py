@@ -169,17 +169,25 @@ def _main(args):
         print(f"particleShear sweep: {exc}", file=sys.stderr)
         return 3
     except KeyboardInterrupt:
-        print(f"\nparticleShear sweep: interrupted; the rows in {sweep.table_path} are kept; run the same command "
-              "again to resume", file=sys.stderr)
+        print(f"\nparticleShear sweep: interrupted; {_kept(sweep, args)}", file=sys.stderr)
         return 130
     except SweepTerminated:
-        print(f"particleShear sweep: terminated; the rows in {sweep.table_path} are kept; run the same command "
-              "again to resume", file=sys.stderr)
+        print(f"particleShear sweep: terminated; {_kept(sweep, args)}", file=sys.stderr)
         return 143
     except OSError as exc:   # the sweep folder itself cannot be written (a full disk, permissions)
-        print(f"particleShear sweep: cannot write the sweep folder {sweep.out_dir}: {exc}; the rows written so "
-              "far are kept; free the space and run the same command again to resume", file=sys.stderr)
+        kept = "the rows written so far are kept; " if os.path.isfile(sweep.table_path) else ""
+        print(f"particleShear sweep: cannot write the sweep folder {sweep.out_dir}: {exc}; {kept}free the space "
+              "and run the same command again to resume", file=sys.stderr)
         return 4
+
+
+def _kept(sweep, args):
+    """What an interrupted sweep leaves: its table when there is one, else that nothing was written."""
+    if args.dry_run:
+        return "dry run: nothing was written"
+    if os.path.isfile(sweep.table_path):
+        return f"the rows in {sweep.table_path} are kept; run the same command again to resume"
+    return "no run finished, no table written; run the same command again to start"
 
 
 def _dry_run(args, sweep, workers):
@@ -190,18 +198,36 @@ def _dry_run(args, sweep, workers):
     _log.info("still to run: " + format_cost(todo_c) + " [static model]")
     if args.no_calibrate or not hasattr(sweep.runs, "points"):
         return 0
-    from .calibration import cache_path, format_projection, load_or_measure, project_cost, representative_point
+    from .calibration import (CALIBRATION_BUDGET_S, cache_path, format_projection, load_or_measure, project_cost,
+                              representative_point)
     points = sweep.runs.points
     counts = sweep._point_counts()
     todo = sweep._point_counts(sweep._classify()[0].values())
     p = representative_point(points, counts)
-    cal, cached = load_or_measure(p, refresh=args.calibrate)
+    proto = p.get("protocol") or "oscillatory"
+    try:
+        cal, cached = load_or_measure(p, refresh=args.calibrate)
+    except RuntimeError as exc:
+        _log.info(f"calibration failed on the point (N={p['N']}, protocol {proto}): {exc}; no calibrated "
+                  "projection (the static model above stands)")
+        return 0
+    if cal is None:
+        _log.info(f"calibration stopped: no shortened run of the point (N={p['N']}, protocol {proto}) finished "
+                  f"within the {CALIBRATION_BUDGET_S:g} s budget; no calibrated projection (the static model above "
+                  "stands; a run here takes longer than that)")
+        return 0
     how = "cached calibration" if cached else "calibration"
     med = {k: sorted(cal[k])[len(cal[k]) // 2] for k in ("per_step_s", "fixed_s", "single_s")}
-    _log.info(f"{how} (point N={p['N']}, {cal['steps']} steps, {len(cal['per_step_s'])} samples): "
-              f"{1e6 * med['per_step_s']:.0f} us per step, {med['fixed_s']:.2f} s fixed per run; batch of "
-              f"{cal['replicas']}: {cal['batch_s'] / (cal['replicas'] * med['single_s']):.2f} of a single run "
-              f"per run (cache {cache_path()})")
+    if cal.get("batch_s") is not None:
+        batch = (f"batch of {cal['replicas']}: {cal['batch_s'] / (cal['replicas'] * med['single_s']):.2f} of a "
+                 "single run per run")
+    else:
+        batch = "no batch measured (a batch counts as single runs)"
+    partial = "" if cal.get("complete", True) else \
+        f"; partial, stopped at the {cal.get('budget_s', CALIBRATION_BUDGET_S):g} s budget: {cal.get('stopped')}"
+    _log.info(f"{how} (point N={p['N']}, protocol {proto}, shortened to {cal['steps']:,} protocol steps, "
+              f"{len(cal['per_step_s'])} samples{partial}): {1e6 * med['per_step_s']:.0f} us per step, "
+              f"{med['fixed_s']:.2f} s fixed per run; {batch} (cache {cache_path()})")
     for label, c in (("all runs:   ", counts), ("still to run: ", todo)):
         _log.info(label + format_projection(project_cost(points, c, cal, workers=workers,
                                                          batch_size=args.batch_size), workers, args.batch_size))
@@ -218,6 +244,11 @@ def _run(args, sweep, workers):
                                     batch_size=args.batch_size):
             pass
     rows = sweep.rows()
-    n_failed = sum(r["status"] == "failed" for r in rows)
-    _log.info(f"{len(rows)} of {len(sweep.my_runs())} runs finished ({n_failed} failed); table: {sweep.table_path}")
+    status = {}                     # one status per run: a one-packing sweep writes a row per step
+    for r in rows:
+        status[r["run_id"]] = "failed" if r["status"] == "failed" else status.get(r["run_id"], r["status"])
+    n_failed = sum(v == "failed" for v in status.values())
+    shown = f", {len(rows)} rows" if len(rows) != len(status) else ""
+    _log.info(f"{len(status)} of {len(sweep.my_runs())} runs finished ({n_failed} failed){shown}; table: "
+              f"{sweep.table_path}")
     return 1 if (n_failed and not args.keep_going) else 0

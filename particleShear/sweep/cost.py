@@ -6,7 +6,8 @@ measured by ``benchmarks/bench_step.py`` on a quiet 2-core CI-class machine: 285
 N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extrapolated with the
 nearest slope), plus constitution 0.53 s · (N/150)^0.7; a loaded machine measures up to 2× more
 (docs/performance.md), which is why ``--dry-run`` calibrates on the machine at hand.  Disk: the text format writes about
-723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md).
+723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md); the file of another
+protocol about 110 bytes per step.  Every protocol counts its own steps (:func:`run_steps`).
 """
 __docformat__ = "numpy"
 import math
@@ -20,10 +21,11 @@ _STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step
 _CONSTITUTION_S = 0.53                                            # s at N = 150
 _BYTES_PER_STEP = 723
 _HEADER_BYTES = 4000
+_PROTOCOL_BYTES_PER_STEP = 110   # another protocol's text file: 103 B per row (creep), 105 (steady, N1), measured
 
 
 def run_steps(p):
-    """Protocol steps (pre + excitation + post periods) of a run with parameters ``p``.
+    """Protocol steps of a run with parameters ``p``: its own protocol's.
 
     Parameters
     ----------
@@ -31,13 +33,23 @@ def run_steps(p):
         Complete parameters of ``doParticleShearSimulation`` (``bimodal_factor``, ``theMu``,
         ``relative_transversal_link_strength``, ``theAmplitude``, ``relative_viscosity``,
         ``periods``, ``pre_periods``, ``post_periods``, ``relative_frequency``; optional
-        ``time_step_factor``, default 1).
+        ``time_step_factor``, default 1; optional ``protocol`` and its parameters,
+        docs/protocols.md).
 
     Returns
     -------
     int
-        ``int((periods + pre + post)/f / dt)`` with the time step of the model's rule.
+        "oscillatory" (the default): ``int((periods + pre + post)/f / dt)`` with the time step
+        of the model's rule; another protocol: its steps
+        (:func:`particleShear.run.rheometer.protocol_steps`: a steady run's strain over its
+        rate, a hold's time, the sum over a sweep's steps).
     """
+    proto = p.get("protocol") or "oscillatory"
+    if proto != "oscillatory":
+        from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol
+        from ..run.rheometer import protocol_steps as steps_of
+        st = steps_of(normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p}))
+        return int(sum(st["segments"])) if "segments" in st else int(st["steps"])
     dt, _ = time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"],
                                   p["theAmplitude"], p["relative_viscosity"])
     dt *= float(p.get("time_step_factor", 1.0))
@@ -84,10 +96,13 @@ def run_bytes(p):
     Returns
     -------
     int
-        ≈ 4 kB header plus 723 bytes per protocol step with the tensor table.
+        ≈ 4 kB header plus 723 bytes per protocol step with the tensor table; another protocol
+        than "oscillatory" (its own file, docs/protocols.md): ≈ 4 kB plus 110 bytes per step.
     """
     if not p.get("saveData"):
         return 0
+    if (p.get("protocol") or "oscillatory") != "oscillatory":
+        return _HEADER_BYTES + _PROTOCOL_BYTES_PER_STEP * run_steps(p)
     return _HEADER_BYTES + (_BYTES_PER_STEP * run_steps(p) if p.get("saveStressTensorData", True) else 0)
 
 
