@@ -285,7 +285,11 @@ def analysis_columns(varying):
 
 def _label(parameters, varying):
     from .grouping import short_value
-    return ", ".join(f"{n}={short_value(parameters[n])}" for n in varying) or "all runs"
+    shown = ", ".join(f"{n}={short_value(parameters[n])}" for n in varying if parameters.get(n, "") != "")
+    if shown:
+        return shown
+    protocol = parameters.get("protocol", "")      # a mixed table: its oscillatory rows say so
+    return f"protocol={protocol}" if protocol not in ("", None) else "all runs"
 
 
 def _stream_label(parameters):

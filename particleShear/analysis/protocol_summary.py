@@ -143,7 +143,9 @@ def protocol_summaries(rows, names, estimator="surface", n_boot=2000, confidence
     for key in keys:
         params = dict(key)
         proto = row_protocol(params)
-        label = ", ".join(f"{n}={short_value(params[n])}" for n in varying if n in params) or f"protocol={proto}"
+        # a protocol's parameters only (the cells another protocol's rows fill are empty here)
+        label = ", ".join(f"{n}={short_value(params[n])}" for n in varying if params.get(n, "") != "") \
+            or f"protocol={proto}"
         stream = "\x1f".join(f"{k}={v}" for k, v in sorted(params.items()) if v != "")
         rng = np.random.default_rng(None if seed is None else [int(seed), zlib.crc32(stream.encode("utf-8"))])
         base = {"group": label, "protocol": proto, "estimator": estimator, "confidence": confidence,
