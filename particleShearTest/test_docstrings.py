@@ -72,6 +72,7 @@ DOCUMENTED_MODULES = [
     "particleShear.sweep_plot",
     "particleShear.rheometer_plot",
     "particleShear.messages",
+    "particleShear.signals",
     "particleShear.run",
     "particleShear.run.api",
     "particleShear.run.result",

@@ -508,7 +508,6 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
             names += [PROTOCOLS_NAME, PROTOCOLS_SCHEMA_NAME]
         if figure and panels:
             if _has_matplotlib():
-                from ..plot import save_figure
                 from .figure import plot_analysis
                 fig = plot_analysis(panels, estimator=estimator, max_panels=max_figure_panels)
                 for ext in (".png", ".pdf"):
@@ -558,12 +557,8 @@ def _human(rows):
     return buf.getvalue()
 
 
-def _stop_on_sigterm(signum, frame):
-    raise _Terminated(signum)
-
-
-class _Terminated(Exception):
-    """SIGTERM during an analysis (status 143)."""
+class _Terminated(BaseException):
+    """SIGTERM during an analysis (status 143); a BaseException, so no ``except Exception`` swallows it."""
 
 
 def _human_protocols(rows):
@@ -609,13 +604,11 @@ def main(argv=None):
         return 2
     from ..sweep.locks import FolderBusyError
     from .outputs import PublishInterrupted
+    from ..signals import sigterm_raises
     try:
-        previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
-    except ValueError:   # not the main thread: leave SIGTERM alone
-        previous = None
-    try:
-        result = analyse_folder(args.folder, estimator=args.estimator, n_boot=n_boot, confidence=confidence,
-                                seed=seed, figure=args.figure)
+        with sigterm_raises(_Terminated):
+            result = analyse_folder(args.folder, estimator=args.estimator, n_boot=n_boot, confidence=confidence,
+                                    seed=seed, figure=args.figure)
     except ValueError as exc:
         print(f"{_PROG}: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
@@ -630,9 +623,6 @@ def main(argv=None):
         print(f"{_PROG}: {'interrupted' if isinstance(exc, KeyboardInterrupt) else 'terminated'}: nothing written, "
               "the files of an earlier analysis are kept as they were", file=sys.stderr)
         return 130 if isinstance(exc, KeyboardInterrupt) else 143
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
     for note in result["notes"]:
         print(f"{_PROG}: {note}", file=sys.stderr)
     if args.json:

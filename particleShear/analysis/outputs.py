@@ -27,6 +27,8 @@ import signal
 import socket
 import stat
 
+from ..signals import process_gone
+
 __all__ = ["LOCK_NAME", "LOCK_WAIT_S", "PublishInterrupted", "check_targets", "make_staging", "publish",
            "remove_dead_staging"]
 
@@ -130,13 +132,8 @@ def remove_dead_staging(folder):
         m = _STAGING.match(name)
         if not m or m.group("host") != host:
             continue
-        try:
-            os.kill(int(m.group("pid")), 0)
+        if not process_gone(m.group("pid")):
             continue                     # alive (or another user's): leave it
-        except ProcessLookupError:
-            pass
-        except (PermissionError, OverflowError, ValueError):
-            continue
         shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
         removed.append(name)
     return removed

@@ -24,11 +24,11 @@ import json
 import math
 import os
 import re
-import signal
 import sys
 import time
 
 from .guard import SuggestingParser, shorten_values
+from ..signals import sigterm_raises
 from .validation import IMAGE_FILE_TYPES
 
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
@@ -467,27 +467,6 @@ class RunTerminated(KeyboardInterrupt):
     """SIGTERM during a single run of the CLI: handled as Ctrl-C (temporary files removed), exit 143."""
 
 
-@contextlib.contextmanager
-def _sigterm_interrupts():
-    """Within: SIGTERM raises :class:`RunTerminated`, so every cleanup that Ctrl-C runs also runs for it.
-
-    Without it the default action ends the process at once and an output file being written
-    stays behind as its hidden ``.part`` file.  Outside the main thread SIGTERM is left alone.
-    """
-    def stop(signum, frame):
-        raise RunTerminated(f"signal {signum}")
-
-    try:
-        previous = signal.signal(signal.SIGTERM, stop)
-    except ValueError:
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
 def main(argv=None):
     """Entry point; returns the process exit status (0 ok, 1 output not written or run unstable,
     2 invalid parameters, 130 interrupted, 143 terminated by SIGTERM).
@@ -568,7 +547,7 @@ def main(argv=None):
     # with --json, stdout holds the JSON only: the run's console messages go to stderr
     quiet_stdout = contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext()
     try:
-        with quiet_stdout, _sigterm_interrupts():
+        with quiet_stdout, sigterm_raises(RunTerminated):
             res = doParticleShearSimulation(**kw, return_result=True)
     except KeyboardInterrupt as exc:  # one line, no traceback; the run removed its temporary files
         if progress is not None:

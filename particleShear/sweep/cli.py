@@ -3,11 +3,11 @@ __docformat__ = "numpy"
 import contextlib
 import logging
 import os
-import signal
 import sys
 
 from ..messages import console_messages
 from ..run.guard import SuggestingParser, shorten_values
+from ..signals import sigterm_raises
 
 _log = logging.getLogger(__name__)
 
@@ -79,7 +79,7 @@ def main(argv=None):
         (Ctrl-C), 143 terminated (SIGTERM).
     """
     args = build_parser().parse_args(argv)
-    with console_messages(stream=sys.stdout), _sigterm_stops():
+    with console_messages(stream=sys.stdout), _sigterm_stops_the_sweep():
         return _main(args)
 
 
@@ -88,23 +88,10 @@ EXIT_STATUS = {"ok": 0, "runs failed": 1, "invalid input": 2, "folder busy": 3, 
                "interrupted": 130, "terminated": 143}
 
 
-@contextlib.contextmanager
-def _sigterm_stops():
+def _sigterm_stops_the_sweep():
     """SIGTERM (a scheduler's walltime, ``kill``) stops the sweep at once: workers killed, rows kept, 143."""
     from .pool import SweepTerminated
-
-    def stop(signum, frame):
-        raise SweepTerminated(f"signal {signum}")
-
-    try:
-        previous = signal.signal(signal.SIGTERM, stop)
-    except ValueError:   # not the main thread: leave SIGTERM alone
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    return sigterm_raises(SweepTerminated)
 
 
 def _check_scheduler(address):

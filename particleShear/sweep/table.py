@@ -35,6 +35,7 @@ import socket
 import numpy as np
 
 from .reader import escape_cell, read_table
+from ..signals import process_gone
 from ..analysis.measures import MEASURE_COLUMNS
 from ..simulation.provenance import identity_parameters, same_input
 from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema
@@ -494,13 +495,8 @@ def remove_dead_temporaries(folder):
         m = re.search(r"-(\d+)-[0-9a-f]{8}\.part$", name)
         if not (name.startswith(".") and m and name[:m.start()].endswith("." + host)):
             continue
-        try:
-            os.kill(int(m.group(1)), 0)
+        if not process_gone(m.group(1)):
             continue                              # alive (or another user's): leave it
-        except ProcessLookupError:
-            pass
-        except (PermissionError, OverflowError, ValueError):
-            continue
         with contextlib.suppress(OSError):
             os.remove(os.path.join(folder, name))
             removed.append(name)

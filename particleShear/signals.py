@@ -1,0 +1,57 @@
+"""Signals of the commands: SIGTERM turned into an exception, and whether a process of this host lives.
+
+A scheduler's walltime or ``kill`` sends SIGTERM, whose default action ends the process at once:
+temporary files and half-published sets would stay behind.  Each command (a run, a sweep,
+``analyse``) therefore turns SIGTERM into an exception of its own within its work
+(:func:`sigterm_raises`), so the cleanup that Ctrl-C runs also runs for it.
+"""
+__docformat__ = "numpy"
+import contextlib
+import os
+import signal
+
+__all__ = ["sigterm_raises", "process_gone"]
+
+
+@contextlib.contextmanager
+def sigterm_raises(exc_type):
+    """Within the block SIGTERM raises ``exc_type("signal 15")``; outside the main thread it is left alone.
+
+    Parameters
+    ----------
+    exc_type : type
+        The exception raised (best a ``BaseException`` that no ``except Exception`` swallows).
+    """
+    def stop(signum, frame):
+        raise exc_type(f"signal {signum}")
+
+    try:
+        previous = signal.signal(signal.SIGTERM, stop)
+    except ValueError:   # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def process_gone(pid):
+    """True when no process ``pid`` exists on this host (one that may not be signalled counts as alive).
+
+    Parameters
+    ----------
+    pid : int or str
+        The process id (as written in a temporary name).
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return True
+    except (PermissionError, OverflowError, ValueError):
+        return False
+    return False
