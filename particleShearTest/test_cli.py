@@ -219,6 +219,27 @@ class TestRunAndJson(unittest.TestCase):
         self.assertIn("G''(by surface force)", err)   # the messages went to stderr
 
 
+class TestProtocolJson(unittest.TestCase):
+    """``--json`` of a protocol run is one object, as the help says: the row, or a sweep's rows in one object."""
+
+    PROTO = ["--N", "30", "--cut-lines", "0", "--relative-frequency", "0.2", "--seed", "2", "--quiet", "--json"]
+
+    def test_creep_is_its_row(self):
+        rc, out, err = run_main([*self.PROTO, "--protocol", "creep", "--creep-stress", "20", "--hold-time", "5"])
+        self.assertEqual(rc, 0, err)
+        row = json.loads(out)
+        self.assertIsInstance(row, dict)
+        self.assertEqual((row["protocol"], row["status"]), ("creep", "ok"))
+
+    def test_a_sweep_is_one_object_with_a_row_per_step(self):
+        rc, out, err = run_main([*self.PROTO, "--protocol", "amplitude_sweep", "--sweep-amplitudes", "0.05,0.1"])
+        self.assertEqual(rc, 0, err)
+        obj = json.loads(out)
+        self.assertEqual(obj["protocol"], "amplitude_sweep")
+        self.assertEqual([r["sweep_amplitude"] for r in obj["rows"]], [0.05, 0.1])
+        self.assertEqual({r["run_id"] for r in obj["rows"]}, {obj["run_id"]})
+
+
 class TestSaveFolder(unittest.TestCase):
     """``--save DIR`` makes DIR (and its parents) as ``sweep --out`` does, after every other check."""
 

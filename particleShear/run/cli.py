@@ -394,7 +394,8 @@ def build_parser():
                         "needs particleShear[plot])")
     c.add_argument("--json", action="store_true",
                    help="print the result row (SimulationResult.to_dict(), the row of a sweep's results.csv) "
-                        "as one JSON object on stdout, and nothing else there")
+                        "as one JSON object on stdout, and nothing else there; an amplitude or frequency "
+                        "sweep: one object {protocol, run_id, rows: [one row per step]}")
     c.add_argument("--quiet", dest="progress", action=_StoreConst, const=False, default=None,
                    help="no progress line (same as --no-progress)")
     return p
@@ -458,8 +459,11 @@ def _json_row(res):
         if isinstance(v, (list, tuple)):
             return [clean(x) for x in v]
         return v
-    if not hasattr(res, "to_dict"):      # a RheometerResult: its table rows
-        return json.dumps([{k: clean(v) for k, v in row.items()} for row in res.rows()], default=str)
+    if not hasattr(res, "to_dict"):      # a RheometerResult: its table row, or a sweep's rows in one object
+        rows = [{k: clean(v) for k, v in row.items()} for row in res.rows()]
+        if len(rows) == 1:
+            return json.dumps(rows[0], default=str)
+        return json.dumps({"protocol": res.protocol, "run_id": rows[0].get("run_id"), "rows": rows}, default=str)
     return json.dumps({k: clean(v) for k, v in res.to_dict().items()}, default=str)
 
 
