@@ -231,6 +231,15 @@ class TestProtocolJson(unittest.TestCase):
         self.assertIsInstance(row, dict)
         self.assertEqual((row["protocol"], row["status"]), ("creep", "ok"))
 
+    def test_the_summary_carries_the_schema_units(self):
+        argv = [a for a in self.PROTO if a != "--json"]
+        rc, out, err = run_main([*argv, "--protocol", "creep", "--creep-stress", "20", "--hold-time", "5"])
+        self.assertEqual(rc, 0, err)
+        self.assertRegex(out, r"creep_stress = 20 Pa\b")
+        self.assertRegex(out, r"creep_rate = [-+0-9.e]+ 1/s\b")
+        self.assertRegex(out, r"creep_viscosity = [-+0-9.einf]+ Pa·s")
+        self.assertRegex(out, r"strain_plateau = [-+0-9.e]+  ")     # dimensionless: no unit
+
     def test_a_sweep_is_one_object_with_a_row_per_step(self):
         rc, out, err = run_main([*self.PROTO, "--protocol", "amplitude_sweep", "--sweep-amplitudes", "0.05,0.1"])
         self.assertEqual(rc, 0, err)

@@ -581,8 +581,14 @@ def main(argv=None):
     if args.json:
         print(_json_row(res))
     elif not hasattr(res, "G_internal"):     # another protocol than "oscillatory" (docs/protocols.md)
+        from ..sweep.schema import column_spec
+
+        def unit(name):   # the unit of the results.csv column of the same name (docs/protocols.md)
+            u = column_spec(name).get("unit") or ""
+            return "" if u in ("", "1") else " " + u
+
         def shown(items):
-            return "  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
+            return "  ".join(f"{k} = {v:.6g}{unit(k)}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
         for st in res.steps:
             print(shown((k, st[k]) for k in ("position", "amplitude", "relative_frequency", "Gp_surface",
                                              "Gp_surface_se", "Gpp_surface", "Gpp_surface_se", "Gp_internal",
