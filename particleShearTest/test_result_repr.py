@@ -94,3 +94,47 @@ class TestHtmlRepr(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestRheometerRepr(unittest.TestCase):
+    """``repr(RheometerResult)`` and its HTML: every summary number with its standard error and the
+    unit of its results-table column, the run's identity; no records dumped; the HTML escaped."""
+
+    @classmethod
+    def setUpClass(cls):
+        from particleShear import doParticleShearSimulation
+        small = dict(N=30, cut_lines=0, relative_frequency=0.2, seed=2, return_result=True, verbose=False,
+                     doDrawing=False, plotStress=False)
+        cls.creep = doParticleShearSimulation(**small, protocol="creep", creep_stress=20.0, hold_time=5.0)
+        cls.sweep = doParticleShearSimulation(**small, protocol="amplitude_sweep", sweep_amplitudes=[0.05, 0.1])
+
+    def test_summary_numbers_units_and_identity(self):
+        text = repr(self.creep)
+        self.assertTrue(text.startswith("RheometerResult(protocol=creep, N=30"))
+        self.assertIn(f"run_id={self.creep.run_id}", text)
+        s = self.creep.summary
+        m = re.search(r"creep_rate: ([-+0-9.e]+) ± ([-+0-9.e]+) 1/s", text)
+        self.assertIsNotNone(m, text)
+        self.assertAlmostEqual(float(m.group(1)), s["creep_rate"], delta=abs(s["creep_rate"]) * 1e-3)
+        self.assertAlmostEqual(float(m.group(2)), s["creep_rate_se"], delta=abs(s["creep_rate_se"]) * 0.05)
+        self.assertRegex(text, r"creep_viscosity: [-+0-9.einf]+ Pa·s")
+        self.assertNotIn("array(", text)
+        self.assertLess(len(text.splitlines()), 20)
+
+    def test_sweep_has_a_line_per_step_and_estimator(self):
+        text = repr(self.sweep)
+        lines = [ln for ln in text.splitlines() if ln.startswith("  A = ")]
+        self.assertEqual(len(lines), 4)
+        g = self.sweep.steps[1]["Gp_surface"]
+        value, _ = numbers_after("G′", lines[2])
+        self.assertAlmostEqual(value, g, delta=abs(g) * 1e-3)
+
+    def test_html_is_escaped(self):
+        self.creep.run_id, keep = "<b>x</b>", self.creep.run_id
+        try:
+            html = self.creep._repr_html_()
+        finally:
+            self.creep.run_id = keep
+        self.assertIn("&lt;b&gt;x&lt;/b&gt;", html)
+        self.assertNotIn("<b>", html)
+        self.assertIn("<td>1/s</td>", html)

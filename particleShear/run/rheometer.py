@@ -459,10 +459,75 @@ class RheometerResult:
         from ..rheometer_plot import plot_rheometer_result
         return plot_rheometer_result(self, path)
 
+    def _summary(self):
+        """(run fields, rows) of :meth:`__repr__` and :meth:`_repr_html_`.
+
+        Fields: ``(label, text)`` of protocol, N, μ, seed and run id.  Rows ``(name, value text,
+        unit)``: the summary's numbers with their standard errors (``name_se``) where finite, and
+        the units of the results-table columns of the same names; for sweeps one row per step
+        (G′, G″ of both estimators in Pa).
+        """
+        from ..sweep.schema import column_spec
+        p = self.parameters or {}
+        seed = "None" if self.seed is None else str(self.seed)
+        if self.spawn_key:
+            seed += " spawn " + ",".join(str(k) for k in self.spawn_key)
+        fields = [("protocol", self.protocol), ("N", str(p.get("N", "?"))), ("μ", str(p.get("theMu", "?"))),
+                  ("seed", seed), ("run_id", self.run_id or "–")]
+
+        def num(v, se=None):
+            text = f"{v:.4g}" if isinstance(v, (float, int)) and not isinstance(v, bool) else str(v)
+            if isinstance(se, float) and math.isfinite(se):
+                text += f" ± {se:.2g}"
+            return text
+
+        rows = []
+        if self.steps:
+            for st in self.steps:
+                label = (f"A = {st.get('amplitude', float('nan')):.4g}" if self.protocol == "amplitude_sweep"
+                         else f"f·τ = {st.get('relative_frequency', float('nan')):.4g}")
+                for est in ("surface", "internal"):
+                    rows.append((f"{label} ({est})",
+                                 f"G′ = {num(st.get('Gp_' + est, float('nan')), st.get('Gp_' + est + '_se'))}, "
+                                 f"G″ = {num(st.get('Gpp_' + est, float('nan')), st.get('Gpp_' + est + '_se'))}",
+                                 "Pa"))
+        else:
+            for name, v in self.summary.items():
+                if name.endswith("_se"):
+                    continue
+                unit = column_spec(name).get("unit") or ""
+                rows.append((name, num(v, self.summary.get(name + "_se")), "" if unit == "1" else unit))
+        return fields, rows
+
     def __repr__(self):
-        main = ", ".join(f"{v:.4g}" if isinstance(v, float) else repr(v) for v in
-                         (self.values if not self.steps else [len(self.steps)]))
-        return f"RheometerResult(protocol={self.protocol!r}, {'steps' if self.steps else 'values'}=[{main}])"
+        """A short summary: protocol, N, μ, seed, run id, then each summary number with its standard
+        error and unit (sweeps: G′, G″ of both estimators per step) — not the records.
+
+        Returns
+        -------
+        str
+        """
+        fields, rows = self._summary()
+        lines = ["RheometerResult(" + ", ".join(f"{k}={v}" for k, v in fields)]
+        lines += [f"  {name}: {text}" + (f" {unit}" if unit else "") for name, text, unit in rows]
+        return "\n".join(lines) + ")"
+
+    def _repr_html_(self):
+        """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
+
+        Returns
+        -------
+        str
+        """
+        import html
+        esc = html.escape
+        fields, rows = self._summary()
+        cap = ", ".join(f"{esc(k)} = {esc(v)}" for k, v in fields)
+        out = ["<table>", f"<caption>RheometerResult: {cap}</caption>",
+               "<tr><th>quantity</th><th>value</th><th>unit</th></tr>"]
+        out += [f"<tr><td>{esc(name)}</td><td>{esc(text)}</td><td>{esc(unit)}</td></tr>" for name, text, unit in rows]
+        out.append("</table>")
+        return "\n".join(out)
 
 
 def _concatenated(records):
