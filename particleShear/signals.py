@@ -10,7 +10,7 @@ import contextlib
 import os
 import signal
 
-__all__ = ["sigterm_raises", "process_gone"]
+__all__ = ["sigterm_raises", "signals_held", "process_gone"]
 
 
 @contextlib.contextmanager
@@ -34,6 +34,36 @@ def sigterm_raises(exc_type):
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def signals_held():
+    """Within the block SIGINT and SIGTERM are recorded, not acted on (main thread only); yields their list.
+
+    For a few renames that must all happen (``analyse`` publishing its set): the caller acts on
+    the signals afterwards.
+
+    Yields
+    ------
+    list of int
+        The signals that arrived, in order.
+    """
+    got = []
+
+    def hold(signum, frame):
+        got.append(signum)
+
+    previous = {}
+    try:
+        for s in (signal.SIGINT, signal.SIGTERM):
+            previous[s] = signal.signal(s, hold)
+    except ValueError:       # not the main thread: signals go to the main thread anyway
+        pass
+    try:
+        yield got
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
 
 
 def process_gone(pid):

@@ -8,6 +8,7 @@ constitution left) says so instead of advising a smaller time step that cannot h
 import math
 import unittest
 import warnings
+from unittest import mock
 
 from particleShear import doParticleShearSimulation
 from particleShear.base.stability import SimulationInstabilityError
@@ -34,16 +35,20 @@ class TestRangesThatRun(unittest.TestCase):
                  dict(interface_reenforcement_central=UPPER["interface_reenforcement_central"] * 1.01),
                  dict(relative_viscosity=3.0, relative_transversal_link_strength=1.2),      # 3.6 > 3.5
                  dict(relative_viscosity=1.0, interface_reenforcement_central=5.5)]         # 5.5 > 5
+        def no_work(*a, **k):
+            raise AssertionError("a run was started")
         for kw in cases:
-            with self.subTest(kw=kw), self.assertRaisesRegex(ValueError, "out of range"):
-                doParticleShearSimulation(**dict(TINY, N=10 ** 6), **kw)   # refused before the build
+            with self.subTest(kw=kw), mock.patch("particleShear.run.api.measure_batch", no_work), \
+                    self.assertRaisesRegex(ValueError, "out of range"):
+                doParticleShearSimulation(**TINY, **kw)
 
     def test_kept_viscosities_lift_the_reinforcement_product(self):
         # with the viscosities kept constant rv·irc is not a viscosity: only the single ranges apply
         bound = STIFF_VISCOUS["relative_viscosity*interface_reenforcement_central"]
         kw = dict(relative_viscosity=1.0, interface_reenforcement_central=bound * 2)
-        with self.assertRaises(ValueError):
-            doParticleShearSimulation(**dict(TINY, N=10 ** 6), **kw)
+        with mock.patch("particleShear.run.api.measure_batch", side_effect=AssertionError("a run was started")), \
+                self.assertRaisesRegex(ValueError, "out of range"):
+            doParticleShearSimulation(**TINY, **kw)
         from particleShear.run.validation import _check_stiff_viscous
         _check_stiff_viscous(dict(kw, relative_transversal_link_strength=1.0, keep_viscosity_coefficients_constant=True))
 

@@ -18,16 +18,15 @@ holds for root) — such a file is never replaced, the analysis refuses with one
 folders of dead processes of this host are removed by the next analysis.
 """
 __docformat__ = "numpy"
-import contextlib
 import os
 import re
 import secrets
 import shutil
-import signal
 import socket
 import stat
 
-from ..signals import process_gone
+from ..signals import process_gone, signals_held
+from ..simulation.output import fsync_folder
 
 __all__ = ["LOCK_NAME", "LOCK_WAIT_S", "PublishInterrupted", "check_targets", "make_staging", "publish",
            "remove_dead_staging"]
@@ -139,27 +138,6 @@ def remove_dead_staging(folder):
     return removed
 
 
-@contextlib.contextmanager
-def _signals_held():
-    """SIGINT and SIGTERM recorded, not acted on, in the block (main thread only); yields the list of them."""
-    got = []
-
-    def hold(signum, frame):
-        got.append(signum)
-
-    previous = {}
-    try:
-        for s in (signal.SIGINT, signal.SIGTERM):
-            previous[s] = signal.signal(s, hold)
-    except ValueError:       # not the main thread: signals go to the main thread anyway
-        pass
-    try:
-        yield got
-    finally:
-        for s, h in previous.items():
-            signal.signal(s, h)
-
-
 def publish(folder, staging, names, every_name):
     """Move the files ``names`` of ``staging`` into ``folder`` as one set; remove the set's other files.
 
@@ -192,7 +170,7 @@ def publish(folder, staging, names, every_name):
     removed = []
     with folder_lock(os.path.join(folder, LOCK_NAME), wait_s=LOCK_WAIT_S):
         check_targets(folder, every_name)
-        with _signals_held() as got:
+        with signals_held() as got:
             for name in names:
                 os.replace(os.path.join(staging, name), os.path.join(folder, name))
             for name in every_name:
@@ -200,12 +178,7 @@ def publish(folder, staging, names, every_name):
                 if name not in names and os.path.lexists(path):
                     os.remove(path)
                     removed.append(path)
-            with contextlib.suppress(OSError):      # the renames on disk before we say so
-                fd = os.open(folder, os.O_RDONLY)
-                try:
-                    os.fsync(fd)
-                finally:
-                    os.close(fd)
+            fsync_folder(folder)                    # the renames on disk before we say so
     if got:
         raise PublishInterrupted(got[0])
     return removed

@@ -79,9 +79,10 @@ LOWER = {"Young_modulus_spheres": 1e-6, "density": 1e-6, "bimodal_factor": 1e-2,
          "interface_reenforcement_central": 1e-6, "interface_reenforcement_tangential": 1e-6}
 
 #: bounds on the products of the stiffness and viscosity factors that the time-step rule integrates
-#: stably (measured as :data:`UPPER`'s): rv·max(1, rts) (rv 3 with rts 1.2 diverges at 3.6; rts 39 at
-#: rv 0.1 runs: 3.9) and, where the viscosities follow the reinforcement, rv·irc (irc 60 at rv 0.1
-#: runs: 6; rv 1 with irc 5 and rv 2 with irc 2.5 run; rv 3 with irc 50 diverges)
+#: stably (measured as :data:`UPPER`'s): rv·max(1, rts) (rv alone runs to 3.65, rts 39 at rv 0.1
+#: runs: 3.9; rv 0.5 with rts 10 runs: 5; rv 3 with rts 30 diverges; 3.5 keeps below the single
+#: limits) and, where the viscosities follow the reinforcement, rv·irc (irc 60 at rv 0.1 runs: 6;
+#: rv 1 with irc 5 and rv 2 with irc 2.5 run; rv 3 with irc 50 diverges)
 STIFF_VISCOUS = {"relative_viscosity*max(1,relative_transversal_link_strength)": 3.5,
                  "relative_viscosity*interface_reenforcement_central": 5.0}
 

@@ -43,7 +43,7 @@ FORMAT_SUFFIXES = {"text": ".txt", "text.gz": ".txt.gz", "npz": ".npz", "parquet
 #: suffix of a run's JSON sidecar, which replaces the run file's suffix (``x.txt`` → ``x.json``)
 SIDECAR_SUFFIX = ".json"
 
-__all__ = ["TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "format_of", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
+__all__ = ["fsync_folder", "TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "format_of", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
            "probe_writable", "iter_table_text", "iter_text_rows", "experiment_description_text",
            "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
 
@@ -149,8 +149,14 @@ def _quietly(action):
         pass
 
 
-def _fsync_folder(folder):
-    """Make a rename in ``folder`` durable (no-op where folders cannot be opened, e.g. Windows)."""
+def fsync_folder(folder):
+    """Make a rename in ``folder`` durable (no-op where folders cannot be opened, e.g. Windows).
+
+    Parameters
+    ----------
+    folder : str
+        The folder whose entries were renamed.
+    """
     try:
         fd = os.open(folder, os.O_RDONLY)
     except OSError:
@@ -318,7 +324,7 @@ class AtomicOutputFile:
                 _quietly(lambda f=final: os.remove(f))
             raise
         _quietly(self._fh.close)  # flushed and synced: nothing left that can fail
-        _fsync_folder(self.folder)
+        fsync_folder(self.folder)
         return self.path
 
     def abort(self):

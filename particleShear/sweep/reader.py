@@ -48,14 +48,14 @@ import sys
 
 import numpy as np
 
+from ..checks import cut_text
+
 __all__ = ["read_table", "ResultsTable", "escape_cell", "unescape_cell", "TableRow", "TableRows"]
 
 #: first characters that make a spreadsheet evaluate a cell (and the escape character itself)
 _FORMULA_STARTS = "=+-@\t\r'"
 #: rows parsed before their cells are converted to columns (bounds the text held at once)
 _CHUNK = 8192
-#: longest cell text shown in a message
-_SHOWN = 200
 
 
 def _is_number(text):
@@ -110,10 +110,6 @@ def unescape_cell(text):
     if len(text) > 1 and text[0] == "'" and text[1] in _FORMULA_STARTS:
         return text[1:]
     return text
-
-
-def _shown(text):
-    return text if len(text) <= _SHOWN else text[:_SHOWN] + f"... ({len(text)} characters)"
 
 
 def _allow_fields(size):
@@ -689,7 +685,7 @@ def read_table(path, *, schema=None, invalid="raise", dedupe=True, label="result
         if not header or any(not h for h in header) or len(set(header)) != len(header) \
                 or any(not h.isprintable() for h in header):
             raise ValueError(f"{where} has no valid header line (line 1: empty, repeated or unprintable column "
-                             f"names: {_shown(header_text.strip())!r})")
+                             f"names: {cut_text(header_text.strip())!r})")
         schema = _schema_for(path, header, schema)
         kinds = [c["type"] for c in schema["columns"]]
         cols = [_column(name, kind) for name, kind in zip(header, kinds)]
@@ -703,8 +699,8 @@ def read_table(path, *, schema=None, invalid="raise", dedupe=True, label="result
             pending.clear()
             if problems and invalid == "raise":
                 i, name, text, why_ = min(problems)
-                raise ValueError(f"{where}, line {lines[i]}: column {name}={_shown(text)!r} is not of type "
-                                 f"{schema['columns'][header.index(name)]['type']} ({_shown(why_)}): correct or "
+                raise ValueError(f"{where}, line {lines[i]}: column {name}={cut_text(text)!r} is not of type "
+                                 f"{schema['columns'][header.index(name)]['type']} ({cut_text(why_)}): correct or "
                                  "remove that row") from None
 
         k = 1
