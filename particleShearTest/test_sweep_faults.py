@@ -22,6 +22,7 @@ from unittest import mock
 
 import numpy as np
 
+from particleShearTest.sweep_copies import CopiesOfOneSweep
 from particleShear import doParticleShearSimulationSeries
 from particleShear.sweep import Sweep, expand_runs, parse_spec, run_sweep
 from particleShear.sweep.cli import main as sweep_main
@@ -382,21 +383,8 @@ class TestOneFolderOneSpec(unittest.TestCase):
                 Sweep(base, d)
 
 
-class TestVerifiedResume(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.tmp = tempfile.mkdtemp(prefix="ps_resume_")
-        cls.ref = os.path.join(cls.tmp, "ref")
-        cls.rows = run_sweep(SPEC, cls.ref, workers=2, progress=False)
-
-    @classmethod
-    def tearDownClass(cls):
-        shutil.rmtree(cls.tmp, ignore_errors=True)
-
-    def _copy(self, name):
-        out = os.path.join(self.tmp, name)
-        shutil.copytree(self.ref, out)
-        return out
+class TestVerifiedResume(CopiesOfOneSweep, unittest.TestCase):
+    SPEC = SPEC
 
     def _resume(self, out):
         err = io.StringIO()

@@ -26,6 +26,7 @@ import time
 import unittest
 
 from particleShear.sweep import Sweep, run_sweep
+from particleShearTest.sweep_copies import CopiesOfOneSweep
 from particleShear.sweep.locks import SCRATCH_MARKER, ScratchOwner, foreign_entries, remove_dead_scratch
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -259,24 +260,14 @@ class TestSymlinkedRunFiles(unittest.TestCase):
             self.assertEqual(len(_rows(os.path.join(out, "results.csv"))), 2)
 
 
-class TestResumeVerifiesEveryRun(unittest.TestCase):
+class TestResumeVerifiesEveryRun(CopiesOfOneSweep, unittest.TestCase):
     """Why 3: copy run A's ``.txt`` over run B's and delete B's ``.json``."""
+    SPEC = SPEC
 
     @classmethod
     def setUpClass(cls):
-        cls.tmp = tempfile.mkdtemp(prefix="ps_verify_")
+        super().setUpClass()
         cls.spec = _write_spec(cls.tmp, SPEC)
-        cls.ref = os.path.join(cls.tmp, "ref")
-        cls.rows = run_sweep(SPEC, cls.ref, workers=2, progress=False)
-
-    @classmethod
-    def tearDownClass(cls):
-        shutil.rmtree(cls.tmp, ignore_errors=True)
-
-    def _copy(self, name):
-        out = os.path.join(self.tmp, name)
-        shutil.copytree(self.ref, out)
-        return out
 
     def _files(self, out, row):
         txt = os.path.join(out, row["output_path"])
