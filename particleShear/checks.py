@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 __all__ = ["SHOW_DIGITS", "MESSAGE_VALUE_LIMIT", "cut_text", "show_value", "real_type", "as_float", "finite", "in_range", "positive", "non_negative",
-           "integer"]
+           "integer", "range_text"]
 
 #: integers with more digits than this are abbreviated in messages (:func:`show_value`)
 SHOW_DIGITS = 20
@@ -165,10 +165,32 @@ def in_range(name, v, lo=None, hi=None, lo_open=False, hi_open=False):
     bad = ((lo is not None and (w <= lo if lo_open else w < lo))
            or (hi is not None and (w >= hi if hi_open else w > hi)))
     if bad:
-        left = "" if lo is None else (f"{lo:g} < " if lo_open else f"{lo:g} <= ")
-        right = "" if hi is None else (f" < {hi:g}" if hi_open else f" <= {hi:g}")
-        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {left}value{right}")
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {range_text(lo, hi, lo_open, hi_open)}")
     return float(v)
+
+
+def range_text(lo=None, hi=None, lo_open=False, hi_open=False, integers=False):
+    """The allowed range as every range message states it (the one wording of a range).
+
+    Parameters
+    ----------
+    lo, hi : float or int or None
+        Lower and upper limit (None: none), in the parameter's own unit.
+    lo_open, hi_open : bool
+        The limit itself is excluded.
+    integers : bool
+        Only integers are allowed (limits written with thousands separators).
+
+    Returns
+    -------
+    str
+        ``"0 < value <= 100"``, ``"integers 11 <= value <= 1,000,000"``, ``"0 <= value"``.
+    """
+    def num(x):
+        return f"{x:,}" if integers else f"{x:g}"
+    left = "" if lo is None else f"{num(lo)} {'<' if lo_open else '<='} "
+    right = "" if hi is None else f" {'<' if hi_open else '<='} {num(hi)}"
+    return f"{'integers ' if integers else ''}{left}value{right}"
 
 
 def positive(name, v):
@@ -197,7 +219,7 @@ def non_negative(name, v):
     return in_range(name, v, lo=0)
 
 
-def integer(name, v, lo, hi=None):
+def integer(name, v, lo, hi=None, why=""):
     """Return ``int(v)``; raise unless ``v`` is an integral real number in ``[lo, hi]``.
 
     Parameters
@@ -207,6 +229,9 @@ def integer(name, v, lo, hi=None):
         An int, or a float with an integral value.
     lo : int
     hi : int or None
+    why : str
+        Appended to the message after the range (what sets a limit that depends on other
+        parameters, e.g. ``" for packing_fraction=1.5 …"``).
     """
     v = _scalar(v)
     real_type(name, v)
@@ -216,6 +241,5 @@ def integer(name, v, lo, hi=None):
         x = finite(name, v)
         ok = x.is_integer() and x >= lo and (hi is None or x <= hi)
     if not ok:
-        allowed = f"integers >= {lo}" if hi is None else f"integers {lo} <= value <= {hi:,}"
-        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {allowed}")
+        raise ValueError(f"{name}={show_value(v)} is out of range: allowed {range_text(lo, hi, integers=True)}{why}")
     return int(v)

@@ -336,7 +336,7 @@ class TestResolutionAndConstitution(unittest.TestCase):
             validation.validate_simulation_parameters(defaults(N=3, cut_lines=0))
         msg = str(cm.exception)
         self.assertIn("N=3", msg)
-        n_min = int(re.search(r"allowed N >= (\d+)", msg).group(1))
+        n_min = int(re.search(r"allowed integers (\d+) <= value", msg).group(1))
         validation.validate_simulation_parameters(defaults(N=n_min, cut_lines=0))
         with self.assertRaises(ValueError):
             validation.validate_simulation_parameters(defaults(N=n_min - 1, cut_lines=0))
@@ -353,7 +353,7 @@ class TestResolutionAndConstitution(unittest.TestCase):
                 with self.assertRaises(ValueError) as cm:
                     validation.validate_simulation_parameters(defaults(N=100, cut_lines=60,
                                                                        doCutByTriangulation=triangulation))
-                cut_max = int(re.search(r"allowed cut_lines <= (\d+)", str(cm.exception)).group(1))
+                cut_max = int(re.search(r"allowed integers 0 <= value <= (\d+)", str(cm.exception)).group(1))
                 pieces = cut_max if triangulation else 1 + cut_max * (cut_max + 1) // 2
                 self.assertGreaterEqual(100 / pieces, 3)
                 validation.validate_simulation_parameters(defaults(N=100, cut_lines=cut_max,
@@ -366,9 +366,9 @@ class TestResolutionAndConstitution(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d, \
                 mock.patch.object(validation, "available_memory", return_value=100 * 2 ** 20):
             # 100 MiB: N = 20,000 spheres need ~200 MB
-            with self.assertRaisesRegex(ValueError, r"N=20000 .*allowed N <= ([\d,]+)") as cm:
+            with self.assertRaisesRegex(ValueError, r"N=20000 .*allowed integers 2 <= value <= ([\d,]+)") as cm:
                 validation.validate_simulation_parameters(defaults(N=20000, cut_lines=0))
-            n_ok = int(re.search(r"allowed N <= ([\d,]+)", str(cm.exception)).group(1).replace(",", ""))
+            n_ok = int(re.search(r"allowed integers 2 <= value <= ([\d,]+)", str(cm.exception)).group(1).replace(",", ""))
             self.assertLessEqual(n_ok * validation.BYTES_PER_SPHERE, 0.8 * 100 * 2 ** 20)
             # a saved tensor table of 1,000 periods (2.2 M steps, ~8 GB of text)
             kw = dict(saveData=True, root_folder=d, periods=1000)

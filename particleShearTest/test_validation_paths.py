@@ -25,6 +25,9 @@ from particleShear.run.validation import MAX_N, show_value, validate_run
 from particleShear.sweep import expand_runs, load_spec, parse_spec
 
 BIG = 10 ** 400
+#: what sets the lower limit of N at the default packing (one range rule, one message)
+N_WHY = (" for packing_fraction=1.5 and bimodal_factor=1.4: the largest spheres must be smaller than a quarter "
+         "of the 500 µm cell for each pair to interact through one image only (or a smaller packing_fraction)")
 
 #: a quick run (no crosslinks, 30 spheres, one period; well under a second)
 TINY = dict(N=30, cut_lines=0, do_permanent_links=False, relative_frequency=0.25, pre_periods=0.5, periods=1,
@@ -116,7 +119,7 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
 
     def test_huge_integers_are_out_of_range_naming_the_limits(self):
         self.assertEqual(api_error(dict(TINY, N=BIG))[1],
-                         "N=10**400 is out of range: allowed integers 2 <= value <= 1,000,000")
+                         "N=10**400 is out of range: allowed integers 11 <= value <= 1,000,000" + N_WHY)
         self.assertEqual(api_error(dict(TINY, theAmplitude=BIG))[1],
                          "theAmplitude=10**400 is out of range: allowed 0 < value <= 100")
         self.assertEqual(api_error(dict(TINY, cut_lines=BIG))[1],
@@ -126,6 +129,23 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
         kind, message = api_error(dict(TINY, periods=BIG))
         self.assertEqual((kind, message), (ValueError, "periods=10**400 is out of range: allowed 0 < value <= "
                                                        "1.79769e+308"))
+
+    def test_one_range_statement_per_parameter(self):
+        # below the cell's minimum, negative, zero or huge: the same rule, the same allowed range
+        for n in (5, -5, 0, 10, BIG):
+            with self.subTest(N=show_value(n)):
+                self.assertEqual(api_error(dict(TINY, N=n))[1], f"N={show_value(n)} is out of range: allowed "
+                                 "integers 11 <= value <= 1,000,000" + N_WHY)
+        self.assertIsNone(validate_run(dict(TINY, N=11, verbose=False)) and None)   # the lower limit is allowed
+        # a looser packing allows fewer spheres: the limit follows, the wording does not change
+        self.assertEqual(api_error(dict(TINY, N=1, packing_fraction=0.1))[1],
+                         "N=1 is out of range: allowed integers 2 <= value <= 1,000,000")
+        # cut_lines: above what N can hold or negative, one statement
+        kw = dict(TINY, do_permanent_links=True, doCutByTriangulation=True)
+        messages = {api_error(dict(kw, cut_lines=c))[1].split(" is ", 1)[1] for c in (-1, 11, BIG)}
+        self.assertEqual(messages, {"out of range: allowed integers 0 <= value <= 10 for N=30: each particle "
+                                    "(Voronoi cell) must hold at least 3 spheres (more with a larger N; cut_lines=0: "
+                                    "bulk gel)"})
 
     def test_show_value(self):
         self.assertEqual(show_value(BIG), "10**400")
@@ -141,7 +161,9 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
     def test_the_series_refuses_alike_before_any_run(self):
         for name, value, _, extra in BAD:
             with self.subTest(name=name, value=show_value(value)), no_work():
-                kind, message = api_error(dict(TINY, verbose=False, **extra, **{name: value}))
+                # the series' first run is crosslinked (its cut_lines limit is the one of linked runs)
+                kind, message = api_error(dict(TINY, verbose=False, **dict(extra, do_permanent_links=True),
+                                               **{name: value}))
                 with self.assertRaises(kind) as cm:
                     doParticleShearSimulationSeries(**series_kwargs(name, value, extra))
                 self.assertEqual(str(cm.exception), message)
@@ -204,7 +226,10 @@ class TestEveryPathRefusesAlike(unittest.TestCase):
     def test_cli_flags_in_the_message(self):
         rc, _, err = run_main(TINY_ARGV + ["--N", str(BIG)])
         self.assertEqual((rc, err), (2, "particleShear: invalid parameter: --N=10**400 is out of range: "
-                                        "allowed integers 2 <= value <= 1,000,000\n"))
+                                        "allowed integers 11 <= value <= 1,000,000 for --packing-fraction=1.5 and "
+                                        "--bimodal-factor=1.4: the largest spheres must be smaller than a quarter of "
+                                        "the 500 µm cell for each pair to interact through one image only (or a "
+                                        "smaller --packing-fraction)\n"))
 
 
 class TestPlotTargetOfTheCommandLine(unittest.TestCase):

@@ -25,10 +25,10 @@ import tempfile
 
 import numpy as np
 
-from ..checks import as_float as _as_float, in_range, integer as _int, real_type, show_value
+from ..checks import as_float as _as_float, in_range, integer as _int, range_text, real_type, show_value
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
-from ..objects.model import particle_shear_model_parameters, r_estimate
+from ..objects.model import particle_shear_model_parameters
 from ..simulation.formats import check_output_format
 from .batch import check_backend, check_run_backend
 
@@ -417,35 +417,35 @@ def _protocol_room(p, detail, steps_ok):
 
 
 def _check_constitution(p):
-    """Ensemble large enough for the cell (minimum image) and for the number of particles."""
-    N, phi, bf = int(p["N"]), float(p["packing_fraction"]), float(p["bimodal_factor"])
-    up, low = math.sqrt(bf), math.sqrt(1 / bf)
-    r_large = r_estimate(CELL, CELL, phi, N, up, low) * max(up, low)
-    if 2 * r_large >= CELL / 2:
-        # r_large² = L²·φ·2·max(bf, 1/bf) / (N π (bf + 1/bf)) < L²/16
-        n_min = math.floor(32 * phi * max(bf, 1 / bf) / (math.pi * (bf + 1 / bf))) + 1
-        raise ValueError(
-            f"N={show_value(p['N'])} is too small for packing_fraction={show_value(p['packing_fraction'])} and "
-            f"bimodal_factor={show_value(p['bimodal_factor'])}: the largest spheres (radius {r_large:.3g} µm) must be "
-            f"smaller than a quarter of the {CELL:g} µm cell for each pair to interact through one image "
-            f"only; allowed N >= {n_min} (or a smaller packing_fraction)")
-    cut = int(p["cut_lines"])
-    if not p["do_permanent_links"] or cut <= 1:
-        return
-    if p["doCutByTriangulation"]:
-        pieces, kind = cut, "particles (Voronoi cells)"
-        cut_max = N // MIN_SPHERES_PER_PARTICLE
-    else:
-        # an arrangement of L lines cuts the plane into at most 1 + L(L+1)/2 pieces
-        pieces, kind = 1 + cut * (cut + 1) // 2, "pieces of the straight cuts (at most 1 + L(L+1)/2)"
-        cut_max = int((math.sqrt(1 + 8 * (N / MIN_SPHERES_PER_PARTICLE - 1)) - 1) / 2) if N >= 6 else 0
-    if N < MIN_SPHERES_PER_PARTICLE * pieces:
-        raise ValueError(
-            f"cut_lines={show_value(p['cut_lines'])} is too many for N={show_value(p['N'])}: {show_value(pieces)} "
-            f"{kind} would hold fewer than {MIN_SPHERES_PER_PARTICLE} spheres each; allowed cut_lines <= {cut_max} "
-            f"for N={show_value(p['N'])}, "
-            f"or N >= {show_value(MIN_SPHERES_PER_PARTICLE * pieces)} for cut_lines={show_value(p['cut_lines'])}, "
-            "or cut_lines=0 (bulk gel)")
+    """``N`` and ``cut_lines`` within their ranges, the lower limit of ``N`` set by the cell and the
+    upper limit of ``cut_lines`` by ``N``: one range rule per parameter, one message.
+
+    ``N`` is at least 2, and large enough that the largest spheres are smaller than a quarter of
+    the cell (minimum image: every pair interacts through one image only); ``cut_lines`` is at
+    most :data:`MAX_N`, and with permanent links few enough that each particle holds at least
+    :data:`MIN_SPHERES_PER_PARTICLE` spheres.  ``packing_fraction`` and ``bimodal_factor`` are
+    checked before.
+    """
+    phi, bf = float(p["packing_fraction"]), float(p["bimodal_factor"])
+    # r_large² = L²·φ·2·max(bf, 1/bf) / (N π (bf + 1/bf)) < L²/16  ⇔  N > 32 φ max(bf, 1/bf) / (π (bf + 1/bf))
+    n_min = max(2, math.floor(32 * phi * max(bf, 1 / bf) / (math.pi * (bf + 1 / bf))) + 1)
+    why = "" if n_min == 2 else (
+        f" for packing_fraction={show_value(p['packing_fraction'])} and bimodal_factor={show_value(p['bimodal_factor'])}: "
+        f"the largest spheres must be smaller than a quarter of the {CELL:g} µm cell for each pair to interact "
+        "through one image only (or a smaller packing_fraction)")
+    N = _int("N", p["N"], n_min, MAX_N, why=why)
+    cut_max, why = MAX_N, ""      # never more particles (or cuts) than a run has spheres
+    if p["do_permanent_links"]:
+        if p["doCutByTriangulation"]:
+            kind = "particle (Voronoi cell)"
+            cut_max = max(1, N // MIN_SPHERES_PER_PARTICLE)
+        else:
+            # an arrangement of L lines cuts the plane into at most 1 + L(L+1)/2 pieces
+            kind = "piece of the straight cuts (at most 1 + L(L+1)/2 pieces)"
+            cut_max = max(1, int((math.sqrt(1 + 8 * (N / MIN_SPHERES_PER_PARTICLE - 1)) - 1) / 2) if N >= 6 else 1)
+        why = (f" for N={show_value(p['N'])}: each {kind} must hold at least {MIN_SPHERES_PER_PARTICLE} spheres "
+               "(more with a larger N; cut_lines=0: bulk gel)")
+    _int("cut_lines", p["cut_lines"], 0, cut_max, why=why)
 
 
 def _check_cost(p):
@@ -491,12 +491,13 @@ def _check_cost(p):
             f"{MEMORY_FRACTION:.0%} of the {_bytes(avail)} of memory available")
     if item == "ensemble":
         allowed = int(budget / BYTES_PER_SPHERE)
-        raise ValueError(f"N={show_value(p['N'])} is out of range: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per "
-                         f"sphere); allowed N <= {allowed:,} on this machine")
+        raise ValueError(f"N={show_value(p['N'])} is out of range: allowed {range_text(2, allowed, integers=True)} "
+                         f"on this machine: the ensemble {need} ({_bytes(BYTES_PER_SPHERE)} per sphere)")
     if item == "cutting":
         allowed = int(budget / (int(p["N"]) * CUT_BYTES_PER_SPHERE_AND_SEED))
-        raise ValueError(f"cut_lines={show_value(p['cut_lines'])} is out of range: the Voronoi cut {need}; allowed "
-                         f"cut_lines <= {allowed:,} for N={show_value(p['N'])} on this machine")
+        raise ValueError(f"cut_lines={show_value(p['cut_lines'])} is out of range: allowed "
+                         f"{range_text(0, allowed, integers=True)} for N={show_value(p['N'])} on this machine: the "
+                         f"Voronoi cut {need}")
     per_step = mem["recording"] / max(cost["protocol_steps"], 1.0)
     fixed = mem["ensemble"] + mem["cutting"] + mem["output_text"]  # the streamed output's buffer does not grow
     name, allowed = _protocol_culprit(p, cost, max(0.0, (budget - fixed) / per_step))
@@ -580,12 +581,11 @@ def validate_run(params):
         _bool(name, p[name])
     _range("theAmplitude", p["theAmplitude"], 0, lo_open=True)
     _range("theMu", p["theMu"], 0)
-    _int("cut_lines", p["cut_lines"], 0, MAX_N)   # never more particles (or cuts) than a run has spheres
     _range("Young_modulus_spheres", p["Young_modulus_spheres"], 0, lo_open=True)
-    _int("N", p["N"], 2, MAX_N)
     _range("packing_fraction", p["packing_fraction"], 0, lo_open=True)
     _range("density", p["density"], 0, lo_open=True)
     _range("bimodal_factor", p["bimodal_factor"], 0, lo_open=True)
+    _check_constitution(p)    # N and cut_lines: ranges that depend on the cell and on N
     _range("relative_viscosity", p["relative_viscosity"], 0)
     _range("relative_transversal_link_strength", p["relative_transversal_link_strength"], 0)
     _range("relative_frequency", p["relative_frequency"], 0, lo_open=True)
@@ -617,7 +617,6 @@ def validate_run(params):
     from .rheometer import check_protocol, normalize_protocol
     check_protocol(p)             # the protocol's own parameters and steps (docs/protocols.md)
     p = normalize_protocol(p)     # a sweep is constituted for its first value
-    _check_constitution(p)
     cost = _check_cost(p)
     if wants:
         check_folder_writable("root_folder", root)
