@@ -31,7 +31,7 @@ import sys
 import warnings
 
 from .messages import console_messages
-from .run.guard import SuggestingParser
+from .run.guard import SuggestingParser, command_line_names
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
            "check_figure_path", "align_zeros"]
@@ -599,6 +599,10 @@ def build_parser():
     return p
 
 
+#: plot_sweep's arguments whose command-line names differ (:func:`~particleShear.run.guard.command_line_names`)
+_CLI_ALIASES = {"folder_or_csv": "folder", "path": "output"}
+
+
 def cli_main(argv=None):
     """``python -m particleShear plot DIR [--estimator internal] [--output FILE] [--x NAME] [--no-split]``.
 
@@ -615,7 +619,8 @@ def cli_main(argv=None):
         Exit status: 0 written, 1 matplotlib missing, 2 invalid input (message on stderr).
     """
     import warnings
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -625,8 +630,8 @@ def cli_main(argv=None):
     except ImportError as exc:
         print(f"particleShear plot: {exc}", file=sys.stderr)
         return 1
-    except ValueError as exc:
-        print(f"particleShear plot: {exc}", file=sys.stderr)
+    except ValueError as exc:   # named as the user typed it: DIR, --x, --output
+        print(f"particleShear plot: {command_line_names(exc, parser, _CLI_ALIASES)}", file=sys.stderr)
         return 2
     folder = args.folder if os.path.isdir(args.folder) else os.path.dirname(os.path.abspath(args.folder))
     written = [args.output] if args.output else [os.path.join(folder, fig.get_label() + e) for e in (".png", ".pdf")]

@@ -171,7 +171,7 @@ class BadInput(unittest.TestCase):
 
     def test_exit_2_with_one_line(self):
         with tempfile.TemporaryDirectory() as d:
-            self.check(["analyse", d], r"no results\.csv")
+            self.check(["analyse", d], r"^particleShear analyse: DIR '.*' is invalid: no results\.csv")
             write_results(d, groups={}, extra=True)
             self.check(["analyse", d], r"no rows with status 'ok'")
             write_results(d)

@@ -373,10 +373,18 @@ class TestSweepPlot(unittest.TestCase):
             with mock.patch("sys.stdout"):
                 self.assertEqual(main(["plot", d, "--estimator", "internal"]), 0)
             self.assertTrue(os.path.isfile(os.path.join(d, "G_vs_amplitude.pdf")))
-            with mock.patch("sys.stderr"):
+            err = io.StringIO()
+            with mock.patch("sys.stderr", err):
                 self.assertEqual(main(["plot", os.path.join(d, "nothing_here")]), 2)
+                self.assertEqual(main(["plot", d, "--x", "amplitud"]), 2)
                 with self.assertRaises(SystemExit):
                     main(["plot", d, "--estimator", "bogus"])
+            # the names the user typed (DIR, --x), never plot_sweep's (folder_or_csv, x)
+            lines = err.getvalue().splitlines()
+            self.assertTrue(lines[0].startswith("particleShear plot: DIR '"), lines[0])
+            self.assertTrue(lines[1].startswith("particleShear plot: DIR '"), lines[1])
+            self.assertIn(": --x='amplitud' is invalid", lines[1])
+            self.assertNotIn("folder_or_csv", err.getvalue())
         runs, _ = self.frequency_runs(seeds=2)
         with tempfile.TemporaryDirectory() as d:
             write_table(d, runs)

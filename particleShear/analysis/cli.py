@@ -594,8 +594,9 @@ def main(argv=None):
     """
     import signal
     argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser()
     try:
-        args = build_parser().parse_args(argv)
+        args = parser.parse_args(argv)
         n_boot = _number_flag("--n-boot", args.n_boot, "n_boot")
         confidence = _number_flag("--confidence", args.confidence, "confidence")
         seed = None if args.seed is None else _number_flag("--seed", args.seed, "seed")
@@ -609,8 +610,10 @@ def main(argv=None):
         with sigterm_raises(_Terminated):
             result = analyse_folder(args.folder, estimator=args.estimator, n_boot=n_boot, confidence=confidence,
                                     seed=seed, figure=args.figure)
-    except ValueError as exc:
-        print(f"{_PROG}: {' '.join(str(exc).split())}", file=sys.stderr)
+    except ValueError as exc:   # named as the user typed it: DIR, --seed, --n-boot
+        from ..run.guard import command_line_names
+        text = command_line_names(exc, parser, {"folder_or_csv": "folder", "bootstrap_seed": "seed"})
+        print(f"{_PROG}: {' '.join(text.split())}", file=sys.stderr)
         return 2
     except FolderBusyError:
         print(f"{_PROG}: another analysis of {args.folder!r} kept its lock (analysis.lock) for a minute: nothing "

@@ -26,7 +26,7 @@ import re
 
 from ..checks import MESSAGE_VALUE_LIMIT, cut_text
 
-__all__ = ["shorten_values", "UnknownParameterError", "PARAMETER_ALIASES", "PARAMETER_HINTS", "close_names", "unknown_name_message", "resolve_names",
+__all__ = ["shorten_values", "command_line_names", "UnknownParameterError", "PARAMETER_ALIASES", "PARAMETER_HINTS", "close_names", "unknown_name_message", "resolve_names",
            "checked_keywords", "SuggestingParser"]
 
 #: documented aliases of parameters of ``doParticleShearSimulation`` (alias → parameter); the
@@ -101,6 +101,43 @@ def shorten_values(text, limit=MESSAGE_VALUE_LIMIT):
     if len(text) <= limit:
         return text
     return _LONG_VALUE.sub(lambda m: cut_text(m.group(0), limit), text)
+
+
+def command_line_names(text, parser, aliases=None):
+    """``text`` with every ``name=value`` of a Python argument written as the command line names it.
+
+    A command's message comes from the function it calls, whose arguments have Python names
+    (``folder_or_csv='x' is invalid``); the command shows the names its user typed: an option as
+    ``--x=value``, a positional argument as its metavar (``DIR 'x' is invalid``).
+
+    Parameters
+    ----------
+    text : str or Exception
+        The message.
+    parser : argparse.ArgumentParser
+        The command's parser: each argument's ``dest`` is replaced by its last option string
+        (``--no-split`` for ``split``) or, positional, by its metavar.
+    aliases : dict of str to str, optional
+        Python argument name → the parser's ``dest`` where they differ
+        (``{"folder_or_csv": "folder", "path": "output"}``).
+
+    Returns
+    -------
+    str
+    """
+    shown = {}
+    for action in parser._actions:
+        if action.dest in ("help", argparse.SUPPRESS):
+            continue
+        shown[action.dest] = (action.option_strings[-1] + "=") if action.option_strings else \
+            f"{action.metavar or action.dest.upper()} "
+    for name, dest in (aliases or {}).items():
+        if dest in shown:
+            shown[name] = shown[dest]
+    text = str(text)
+    for name in sorted(shown, key=len, reverse=True):
+        text = re.sub(rf"(?<![\w.-]){re.escape(name)}=", lambda m, s=shown[name]: s, text)
+    return text
 
 
 def close_names(name, allowed, n=3, hints=None):
