@@ -114,6 +114,33 @@ class TestMeasurement(unittest.TestCase):
         self.assertAlmostEqual(cal["batch_s"] / (4 * cal["single_s"][0]), 0.5)
         self.assertEqual(len(cal["per_step_s"]), 2)
 
+    def test_no_warning_about_values_the_user_did_not_set(self):
+        # the user's point measures 3 periods (no warning); the calibration shortens it to a
+        # fraction of a period, which validate_run warns about: the user never set those values
+        import warnings
+        from particleShear.run.validation import validate_run
+        from particleShear.run.batch import _signature_defaults
+        p = dict(_signature_defaults(), **dict(BASE, periods=3, relative_frequency=0.01), cut_lines=0)
+        clock = FakeClock()
+
+        def run(kw):
+            validate_run(kw)
+            clock.t += 0.3 + 1e-3 * run_steps(kw)
+
+        def batch(kws):
+            for kw in kws:
+                validate_run(kw)
+            clock.t += 1.0
+
+        self.assertLess(C._shortened(p, 400, "")["periods"], 1)     # the calibration's own value
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            validate_run(dict(C._shortened(p, 400, ""), root_folder=""))
+            self.assertEqual(len(caught), 1)                        # a warning the user would not expect
+            caught.clear()
+            C.measure_calibration(p, steps=400, repeats=2, replicas=2, timer=clock, run=run, batch=batch)
+        self.assertEqual([str(w.message) for w in caught], [])
+
     def test_bad_arguments(self):
         for kw in ({"steps": 4}, {"repeats": 0}, {"replicas": 1}):
             with self.assertRaises(ValueError) as cm:

@@ -18,6 +18,7 @@ import os
 import socket
 import tempfile
 import time
+import warnings
 
 from .cost import _step_seconds, run_steps
 
@@ -138,10 +139,27 @@ def _shortened(p, steps, root):
                 periods=min(float(p["periods"]), steps / per_period), **view)
 
 
+def _calibration_runs(run):
+    """``run`` with the :class:`~particleShear.analysis.measures.MeasurementWarning` of its arguments silenced.
+
+    The calibration's runs are shortened by the calibration (:func:`_shortened`: a fraction of
+    a period, no baseline): a warning about those values would name values the user never set.
+    The user's own values were checked, and warned about, when the sweep was expanded.
+    """
+    from ..analysis.measures import MeasurementWarning
+
+    def quiet(arg):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeasurementWarning)
+            return run(arg)
+    return quiet
+
+
 def _measure_items(p, steps, repeats, replicas, timer, run, batch, root, deadline):
     """The calibration's measurements, one at a time: ``("pair", (per_step, fixed, single))`` per
     repeat and one ``("batch", seconds)`` after the first pair; stops early (``("stopped", why)``)
     when the next one would end after ``deadline`` (predicted from the ones measured)."""
+    run, batch = _calibration_runs(run), _calibration_runs(batch)
     short, long_ = _shortened(p, int(steps) // 4, root), _shortened(p, int(steps), root)
     s_short, s_long = run_steps(short), run_steps(long_)
     yield "steps", s_long
