@@ -300,7 +300,9 @@ class _Parser(SuggestingParser):
 class ProgressLine:
     """Progress callback writing one self-overwriting line to a stream (default stderr).
 
-    The estimate of the remaining time of a phase is ``elapsed · (total − step)/step``.
+    The remaining time of a phase is estimated from the steps after its first report
+    (:class:`~particleShear.sweep.progress.RemainingTime`: the first step's start-up is not a
+    rate); the first report of a phase shows none.
 
     Parameters
     ----------
@@ -309,33 +311,43 @@ class ProgressLine:
         boundary and at most one every ``log_interval`` s, without carriage returns.
     """
 
-    def __init__(self, stream=None):
+    def __init__(self, stream=None, clock=time.perf_counter):
+        from ..sweep.progress import RemainingTime
         self.stream = stream if stream is not None else sys.stderr
-        self.t0 = time.perf_counter()
+        self.clock = clock
+        self.t0 = clock()
+        self._remaining = RemainingTime()
         self._width = 0
         self._tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self._last_phase = None
+        self._estimated = False   # a line with an estimate was written in this phase (no terminal)
         self._last_line = 0.0
         #: without a terminal, a line is written at phase boundaries and at most every ``log_interval`` s
         self.log_interval = 5.0
 
     def __call__(self, phase, step, total, elapsed):
+        if phase != self._last_phase:
+            self._remaining.reset()
+            self._estimated = False
+        remaining = self._remaining.update(step, total, elapsed) if total else None
+        now = self.clock()
         if total and step:
-            remaining = elapsed * (total - step) / step
-            text = (f"[{phase}] step {step}/{total}  elapsed {elapsed:6.1f} s  remaining ~{remaining:6.1f} s  "
-                    f"(total {time.perf_counter() - self.t0:6.1f} s)")
+            left = "remaining ~   –  " if remaining is None else f"remaining ~{remaining:6.1f} s"
+            text = (f"[{phase}] step {step}/{total}  elapsed {elapsed:6.1f} s  {left}  "
+                    f"(total {now - self.t0:6.1f} s)")
         elif total:
             text = f"[{phase}] done in {elapsed:.1f} s"
         else:
-            text = f"[{phase}] running (total {time.perf_counter() - self.t0:6.1f} s)"
+            text = f"[{phase}] running (total {now - self.t0:6.1f} s)"
         if self._tty:
             pad = max(0, self._width - len(text))
             self.stream.write("\r" + text + " " * pad)
             self._width = len(text)
-        elif (phase != self._last_phase or step == total
-              or time.perf_counter() - self._last_line >= self.log_interval):
-            self.stream.write(text + "\n")  # no carriage returns in logs
-            self._last_line = time.perf_counter()
+        elif (phase != self._last_phase or step == total or now - self._last_line >= self.log_interval
+              or (remaining is not None and not self._estimated)):
+            self.stream.write(text + "\n")  # no carriage returns in logs; the first estimate gets its line
+            self._last_line = now
+            self._estimated = self._estimated or remaining is not None
         self._last_phase = phase
         self.stream.flush()
 

@@ -557,7 +557,9 @@ class Sweep:
                 stream.write(f"[sweep] {n_mine} runs in this share, {n_mine - n_todo} already finished; "
                              f"to run: {format_cost(c)}\n")
                 stream.flush()
-                show = SweepProgress(n_mine, n_mine - n_todo, stream)
+                show = SweepProgress(n_mine, n_mine - n_todo, stream,
+                                     workers=None if executor is not None else min(workers or os.cpu_count() or 1,
+                                                                                    max(n_todo, 1)))
             else:
                 show = progress if callable(progress) else None
             try:
