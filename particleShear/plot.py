@@ -34,7 +34,8 @@ from .messages import console_messages
 from .run.guard import SuggestingParser, command_line_names
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
-           "check_figure_path", "align_zeros"]
+           "check_figure_path", "align_zeros", "fit_title", "dodge_factors", "place_labels", "is_flagged",
+           "FLAGGED_LABEL", "made_by"]
 
 _INSTALL_HINT = 'particleShear.plot needs matplotlib: pip install "particleShear[plot]"'
 
@@ -54,6 +55,192 @@ def _figure(width, height):
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+#: legend entry of the points drawn hollow because a run of theirs has a flagged verdict
+FLAGGED_LABEL = "flagged (see verdict)"
+
+
+def is_flagged(row):
+    """Whether a results row's ``verdict`` column flags it (``"flagged: name, …"``).
+
+    Tables written before the verdict column have none: their rows are not flagged.
+
+    Parameters
+    ----------
+    row : mapping
+        A row of ``results.csv``.
+
+    Returns
+    -------
+    bool
+    """
+    return str(row.get("verdict") or "").strip().lower().startswith("flagged")
+
+
+def made_by(N=None, seeds=None, estimator=None, rate=None, amplitude=None, stress=None):
+    """The "what made it" line of a figure's title: N, seeds, estimator, rate, γ₀ or σ₀.
+
+    Each argument is a value (written), a (low, high) pair (written as a range), or None (left
+    out: it varies across the figure and is on an axis, a panel or the legend).
+
+    Parameters
+    ----------
+    N : int or tuple, optional
+        Spheres per run.
+    seeds : int or tuple, optional
+        Seeds (repetitions) per point.
+    estimator : str, optional
+        "surface" (plate forces) or "internal" (overall stress tensor).
+    rate : str, optional
+        The rate, already written with its name and unit (``"f·τ = 0.025"``, ``"γ̇·τ = 1e-3"``).
+    amplitude : float or tuple, optional
+        Strain amplitude or step strain γ₀ (–).
+    stress : float, optional
+        Imposed stress σ₀ (Pa).
+
+    Returns
+    -------
+    str
+    """
+    def show(v, unit=""):
+        if isinstance(v, tuple):
+            lo, hi = v
+            return f"{lo:g}{unit}" if lo == hi else f"{lo:g}–{hi:g}{unit}"
+        return f"{v:g}{unit}"
+    parts = []
+    if N is not None:
+        parts.append(f"N = {show(N)}")
+    if seeds is not None:
+        one = seeds == 1 or seeds == (1, 1)
+        parts.append(f"{show(seeds)} seed{'' if one else 's'}{' per point' if isinstance(seeds, tuple) else ''}")
+    if estimator is not None:
+        parts.append(f"{estimator} estimator")
+    if rate is not None:
+        parts.append(rate)
+    if amplitude is not None:
+        parts.append(f"γ₀ = {show(amplitude)}")
+    if stress is not None:
+        parts.append(f"σ₀ = {show(stress, ' Pa')}")
+    return ", ".join(parts)
+
+
+def fit_title(fig, text, fontsize="medium", **kw):
+    """Set ``text`` as the figure's title, wrapped so that every line fits the figure's width.
+
+    The text is broken at ``"; "``, then ``", "``, then spaces, and each line's width is measured
+    with the figure's renderer (not estimated from a character count), so no title is clipped
+    however few panels the figure has.  With constrained layout the panels move down to make room.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    text : str
+        The title (explicit newlines are kept).
+    fontsize : str or float, optional
+    **kw
+        Passed to ``fig.suptitle``.
+
+    Returns
+    -------
+    matplotlib.text.Text
+    """
+    renderer = fig.canvas.get_renderer()
+    room = 0.96 * fig.bbox.width
+    title = fig.suptitle("", fontsize=fontsize, **kw)
+
+    def width(line):
+        title.set_text(line)
+        return title.get_window_extent(renderer).width
+
+    lines = []
+    for paragraph in str(text).split("\n"):
+        current = ""
+        tokens = [t for t in paragraph.replace("; ", ";\0").replace(", ", ",\0").replace(" ", " \0").split("\0")]
+        for tok in tokens:
+            trial = current + (" " if current and current.endswith((";", ",")) else "") + tok
+            if current and width(trial.rstrip()) > room:
+                lines.append(current.rstrip())
+                current = tok
+            else:
+                current = trial
+        lines.append(current.rstrip())
+    title.set_text("\n".join(lines))
+    return title
+
+
+def dodge_factors(n, xs):
+    """Multiplicative offsets that set ``n`` series at the same x side by side on a log x axis.
+
+    Series k of n is drawn at ``x · factor[k]``: centred on the true x, a step of 6 % of the
+    smallest gap between neighbouring x values (in log x; a 4 % step where there is one x), so
+    that markers and error bars do not overlap and never cross into the next x value.
+
+    Parameters
+    ----------
+    n : int
+        Number of series.
+    xs : array_like
+        The x values (> 0) the series share.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``n`` factors, 1 for a single series.
+    """
+    import numpy as np
+    u = np.unique(np.log10(np.asarray(xs, dtype=float)))
+    step = 0.06 * float(np.min(np.diff(u))) if len(u) > 1 else 0.04
+    step = min(step, 0.9 / max(n, 1) * (float(np.min(np.diff(u))) if len(u) > 1 else 1.0))
+    return 10.0 ** (step * (np.arange(n) - (n - 1) / 2))
+
+
+def place_labels(ax, items, fontsize="x-small", gid="mark-label"):
+    """Label points without overlap: each label at the first of 8 offsets whose box meets no other.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    items : sequence of tuple
+        ``(text, x, y)`` in data coordinates, in order of priority (the first labels are placed first).
+    fontsize : str or float, optional
+    gid : str, optional
+        The gid of the labels.
+
+    Returns
+    -------
+    list of matplotlib.text.Annotation
+        The labels, each at the first offset whose box meets no label placed before and lies in
+        the panel; else at the first free one; else the first in the panel.  Call it after the
+        figure's layout is done (``fig.canvas.draw()``): the labels are left out of the layout.
+    """
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    offsets = [(5, 6), (5, -12), (-5, 6), (-5, -12), (10, 16), (10, -22), (-10, 16), (-10, -22), (0, 26),
+               (0, -32), (16, 0), (-16, 0)]
+    frame = ax.get_window_extent(renderer)
+    placed, boxes = [], []
+    for text, x, y in items:
+        best = None
+        for dx, dy in offsets:
+            a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", fontsize=fontsize,
+                            ha="left" if dx >= 0 else "right", zorder=6, gid=gid)
+            a.set_in_layout(False)     # placed after the layout: it must not move the panels
+            box = a.get_window_extent(renderer)
+            inside = (box.x0 >= frame.x0 and box.x1 <= frame.x1 and box.y0 >= frame.y0 and box.y1 <= frame.y1)
+            free = not any(box.overlaps(b) for b in boxes)
+            score = 2 * free + inside
+            if best is None or score > best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (score, a, box)
+            else:
+                a.remove()
+            if score == 3:
+                break
+        boxes.append(best[2])
+        placed.append(best[1])
+    return placed
 
 
 def _figure_format(name, path):

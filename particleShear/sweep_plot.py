@@ -46,7 +46,8 @@ import warnings
 
 import numpy as np
 
-from .plot import ESTIMATORS, _figure, _float, group_of, ok_moduli
+from .plot import (ESTIMATORS, FLAGGED_LABEL, _figure, _float, dodge_factors, fit_title, group_of, is_flagged,
+                   made_by, ok_moduli)
 
 __all__ = ["sweep_panels", "draw_sweep", "figure_stem", "X_ALIASES", "MIN_SEEDS", "MAX_PANELS"]
 
@@ -182,11 +183,13 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
     -------
     dict
         ``"x"`` (the x column), ``"x_label"``, ``"log_x"`` (all x > 0), ``"estimator"``,
-        ``"interval"`` ("bootstrap" or "se"), ``"interval_label"`` (legend text), ``"split_by"``
+        ``"made"`` (``N``, ``relative_frequency``, ``theAmplitude`` where one value holds for every
+        point), ``"interval"`` ("bootstrap" or "se"), ``"interval_label"`` (legend text), ``"split_by"``
         (the parameters besides the material that split the panels), ``"varying"`` (every varying
         parameter column), ``"skipped"`` (``ok`` rows left out for a missing value), ``"panels"``: a
         list of ``{"material", "split": {name: value}, "title", "curves"}``, each curve
-        ``{"mu", "label", "x", "n", "Gp", "Gp_low", "Gp_high", "Gpp", "Gpp_low", "Gpp_high"}`` with
+        ``{"mu", "label", "x", "n", "flagged", "Gp", "Gp_low", "Gp_high", "Gpp", "Gpp_low", "Gpp_high"}``
+        (``flagged``: runs of the point whose ``verdict`` is "flagged: …") with
         NumPy arrays ordered by x (moduli and interval ends in Pa; ``mu`` None when μ is the x-axis).
 
     Raises
@@ -227,7 +230,7 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
             key = (None,) + key
         mu = _value(row.get(colour, 0.0)) if colour else None
         cells.setdefault((material, key), {}).setdefault(mu, {}).setdefault(_float(row.get(xname)), []).append(
-            (gp, gpp))
+            (gp, gpp, is_flagged(row)))
     if not cells:
         raise ValueError(f"x={xname!r}: no row with status 'ok' has a finite value in that column")
     if len(cells) > max_panels:
@@ -247,10 +250,11 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
             pts = cells[(material, key)][mu]
             xs = np.array(sorted(pts))
             c = {"mu": mu, "label": "" if mu is None else f"μ={_show(mu)}", "x": xs,
-                 "n": np.array([len(pts[v]) for v in xs])}
+                 "n": np.array([len(pts[v]) for v in xs]),
+                 "flagged": np.array([sum(p[2] for p in pts[v]) for v in xs])}
             if kind == "bootstrap":
                 from .analysis.sweep import sweep_summary
-                long = [(v, gp, gpp) for v in xs for gp, gpp in pts[v]]
+                long = [(v, gp, gpp) for v in xs for gp, gpp, _ in pts[v]]
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", UserWarning)   # one seed: said by draw_sweep's warning
                     s = sweep_summary([t[0] for t in long], [t[1] for t in long], [t[2] for t in long],
@@ -265,7 +269,12 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
             curves.append(c)
         panels.append({"material": material, "split": split_values, "title": title, "curves": curves})
     all_x = [v for p in panels for c in p["curves"] for v in c["x"]]
-    return {"x": xname, "x_label": _X_LABELS.get(xname, xname), "log_x": min(all_x) > 0, "estimator": estimator,
+    made = {}      # what made the figure, where one value holds for every point (else it is on an axis or panel)
+    for col in ("N", _FREQUENCY, _AMPLITUDE):
+        values = {_value(r.get(col, "")) for r, *_ in kept}
+        if col != xname and col not in split_by and len(values) == 1 and isinstance(next(iter(values)), float):
+            made[col] = next(iter(values))
+    return {"x": xname, "made": made, "x_label": _X_LABELS.get(xname, xname), "log_x": min(all_x) > 0, "estimator": estimator,
             "interval": kind, "interval_label": _interval_label(kind, n_boot, confidence, bootstrap_seed, why),
             "split_by": split_by, "varying": varying, "skipped": skipped, "panels": panels}
 
@@ -312,27 +321,61 @@ def draw_sweep(table):
     mus = sorted({c["mu"] for p in panels for c in p["curves"]}, key=_sort_key)
     colours = {mu: f"C{k % 10}" for k, mu in enumerate(mus)}
     handles, nonpositive, few, total = {}, [], [], 0
+    # one lower edge for all panels (they share y): a third of the smallest positive mean or bar end;
+    # a bar whose lower end is at or below it (an interval reaching <= 0) is cut there and marked
+    positive = [v for p in panels for c in p["curves"] for k in ("Gp", "Gpp", "Gp_low", "Gpp_low")
+                for v in np.ravel(c[k]) if np.isfinite(v) and v > 0]
+    means = [v for p in panels for c in p["curves"] for k in ("Gp", "Gpp") for v in np.ravel(c[k])
+             if np.isfinite(v) and v > 0]
+    floor = min(positive) / 3 if positive else 1.0
+    if means and floor < min(means) / 1e3:      # a bar end far below every mean: cut it (marked), keep the data legible
+        floor = min(means) / 1e3
+    cut_any, flagged_any = False, False
     for ax, panel in zip(axes, panels):
         edge = blended_transform_factory(ax.transData, ax.transAxes)
         n_panel = sorted({int(n) for c in panel["curves"] for n in c["n"]})
+        panel_x = [v for c in panel["curves"] for v in c["x"]]
+        if table["log_x"]:     # series at the same x side by side (dodge_factors), x ticks at the true values
+            shift = {id(c): c["x"] * f for c, f in zip(panel["curves"], dodge_factors(len(panel["curves"]), panel_x))}
+        else:
+            span = (max(panel_x) - min(panel_x)) or 1.0
+            m = len(panel["curves"])
+            shift = {id(c): c["x"] + 0.015 * span * (k - (m - 1) / 2) for k, c in enumerate(panel["curves"])}
         for c in panel["curves"]:
             col = colours[c["mu"]]
+            xd = shift[id(c)]
             for name, sym, marker, ls, mfc in (("Gp", "G′", "o", "-", col), ("Gpp", "G″", "s", "--", "white")):
                 mean, low, high = c[name], c[name + "_low"], c[name + "_high"]
                 pos = mean > 0
                 y = np.where(pos, mean, np.nan)
-                err = np.vstack([np.where(pos, mean - low, np.nan), np.where(pos, high - mean, np.nan)])
+                cut = pos & ~(low > floor)
+                err = np.vstack([np.where(pos, mean - np.where(cut, floor, low), np.nan),
+                                 np.where(pos, high - mean, np.nan)])
                 label = f"{sym} {c['label']}".strip()
-                cont = ax.errorbar(c["x"], y, yerr=err, color=col, marker=marker, mfc=mfc, ls=ls, capsize=3,
+                cont = ax.errorbar(xd, y, yerr=err, color=col, marker=marker, mfc=mfc, ls=ls, capsize=3,
                                    label=label)
                 handles.setdefault(label, cont)
+                if cut.any():
+                    cut_any = True
+                    ax.plot(xd[cut], np.full(int(cut.sum()), floor), ls="none", marker=7, ms=7, color=col,
+                            clip_on=False, gid="interval-cut")
+                fl = pos & (c["flagged"] > 0)
+                if fl.any():
+                    flagged_any = True
+                    ax.plot(xd[fl], mean[fl], ls="none", marker="o", ms=13, mfc="none", mec="k", mew=1.2,
+                            zorder=4, gid="flagged")
                 if not pos.all():
-                    ax.plot(c["x"][~pos], np.zeros(int((~pos).sum())), transform=edge, ls="none", clip_on=False,
+                    ax.plot(xd[~pos], np.zeros(int((~pos).sum())), transform=edge, ls="none", clip_on=False,
                             marker="v", ms=8, color=col, mfc=col if name == "Gp" else "white", gid="nonpositive")
+                    if (c["flagged"][~pos] > 0).any():
+                        flagged_any = True
+                        ax.plot(xd[~pos & (c["flagged"] > 0)], np.zeros(int((~pos & (c["flagged"] > 0)).sum())),
+                                transform=edge, ls="none", clip_on=False, marker="o", ms=13, mfc="none", mec="k",
+                                mew=1.2, gid="flagged")
                     for v, m in zip(c["x"][~pos], mean[~pos]):
                         nonpositive.append(f"{panel['title']} {c['label']}: {sym} = {m:.3g} Pa at {symbol} = {v:g}")
             if len(n_panel) > 1:
-                for v, n, gp in zip(c["x"], c["n"], c["Gp"]):
+                for v, n, gp in zip(xd, c["n"], c["Gp"]):
                     if gp > 0:
                         ax.annotate(f"n={n}", (v, gp), xytext=(3, 4), textcoords="offset points", fontsize=6,
                                     color=col)
@@ -343,6 +386,7 @@ def draw_sweep(table):
                  else f"n = {n_panel[0]}–{n_panel[-1]} seeds per point (beside the points)")
         ax.set_title(f"{panel['title']}\n{seeds}", fontsize="medium")
         ax.set_yscale("log", nonpositive="clip")
+        ax.set_ylim(bottom=floor)
         if table["log_x"]:
             ax.set_xscale("log")
         xs = sorted({float(v) for c in panel["curves"] for v in c["x"]})
@@ -354,12 +398,24 @@ def draw_sweep(table):
         ax.grid(True, which="both", color="0.9", lw=0.6)
     if nonpositive:
         handles["mean ≤ 0: not on the log axis,\nmarked at the lower edge"] = Line2D([], [], ls="none", marker="v", ms=8, color="0.3")
+    if cut_any:
+        handles["interval reaches below the axis\n(≤ 0): bar cut at ▼"] = Line2D([], [], ls="none", marker=7, ms=7,
+                                                                                   color="0.3")
+    if flagged_any:
+        handles[FLAGGED_LABEL + ":\n≥ 1 run of the point flagged"] = Line2D([], [], ls="none", marker="o", ms=13,
+                                                                          mfc="none", mec="k", mew=1.2)
+    if any(len(p["curves"]) > 1 for p in panels):
+        handles["series at one x drawn side by side\n(ticks at the measured values)"] = Line2D([], [], ls="none")
     legend_ax.legend(list(handles.values()), list(handles.keys()), loc="upper left", fontsize="small",
                      title=table["interval_label"], title_fontsize="x-small", frameon=False)
     split = ", ".join(["material (do_permanent_links, cut_lines)"] + [s for s in table["split_by"]
                                                                      if s != "cut_lines"])
-    fig.suptitle(f"G′, G″ ({table['estimator']}) against {table['x_label']}; panels by {split}; colour: μ (theMu)",
-                 fontsize="medium")
+    made = table.get("made", {})
+    ns = [int(n) for p in panels for c in p["curves"] for n in c["n"]]
+    rate = f"f·τ = {made[_FREQUENCY]:g}" if _FREQUENCY in made else None
+    line = made_by(N=int(made["N"]) if "N" in made else None, seeds=(min(ns), max(ns)),
+                   estimator=table["estimator"], rate=rate, amplitude=made.get(_AMPLITUDE))
+    fit_title(fig, f"G′, G″ against {table['x_label']}: {line}; panels by {split}; colour: μ (theMu)")
     notes = []
     if nonpositive:
         notes.append("mean ≤ 0, marked at the lower edge:\n" + "\n".join("  " + s for s in nonpositive))

@@ -193,16 +193,20 @@ class TestSweepPlot(unittest.TestCase):
             for which, c in (("G′", col[0]), ("G″", col[1])):
                 cont = containers(ax)[f"{which} μ={mu:g}"]
                 data_line = cont.lines[0]
-                np.testing.assert_allclose(data_line.get_xdata(), self.AMPS)
+                # drawn side by side with the other μ (plot.dodge_factors): one factor, well within the gap
+                ratio = np.asarray(data_line.get_xdata(), float) / np.array(self.AMPS)
+                np.testing.assert_allclose(ratio, ratio[0], rtol=1e-12)
+                self.assertLess(abs(math.log10(ratio[0])), 0.1)
                 seeds = [expected[(name, mu, A)][:, c] for A in self.AMPS]
                 np.testing.assert_allclose(data_line.get_ydata(), [v.mean() for v in seeds], rtol=1e-12)
                 # a bootstrap mean of resampled seeds lies between the smallest and largest seed; the
                 # Student widening moves it from the mean by at most √(3/2)·t₂/z, so the interval lies in
                 # mean ± that factor × the seeds' spread, and it holds the mean
                 low, high = bar_ends(cont)
+                cut = low <= ax.get_ylim()[0] * (1 + 1e-12)    # an end below the panel's edge, drawn cut there
                 mean = np.array([v.mean() for v in seeds])
                 widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
-                self.assertTrue(np.all(low >= mean + widen * (np.array([v.min() for v in seeds]) - mean) - 1e-9))
+                self.assertTrue(np.all(cut | (low >= mean + widen * (np.array([v.min() for v in seeds]) - mean) - 1e-9)))
                 self.assertTrue(np.all(high <= mean + widen * (np.array([v.max() for v in seeds]) - mean) + 1e-9))
                 self.assertTrue(np.all((low <= data_line.get_ydata()) & (data_line.get_ydata() <= high)))
         legend = fig.axes[-1].get_legend()
@@ -246,9 +250,12 @@ class TestSweepPlot(unittest.TestCase):
             # the percentile ends are the seeds' extremes, widened from the mean by √(3/2)·t₂/z (Student width)
             mean = v.mean(axis=1)
             widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
-            np.testing.assert_allclose(low, mean + widen * (v.min(axis=1) - mean), rtol=1e-12)
+            # an end below the panel's lower edge (≤ 0 included) is drawn cut at the edge
+            edge = panel_axes(fig)[0].get_ylim()[0]
+            expect_low = np.maximum(mean + widen * (v.min(axis=1) - mean), edge)
+            np.testing.assert_allclose(low, expect_low, rtol=1e-12)
             np.testing.assert_allclose(high, mean + widen * (v.max(axis=1) - mean), rtol=1e-12)
-            np.testing.assert_allclose(np.c_[low, high], ci, rtol=1e-12)
+            np.testing.assert_allclose(np.c_[np.maximum(ci[:, 0], edge), ci[:, 1]], np.c_[low, high], rtol=1e-12)
 
     def frequency_runs(self, amplitudes=(0.1,), seeds=3, extra=None):
         rng = np.random.default_rng(2)
