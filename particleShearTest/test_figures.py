@@ -26,14 +26,14 @@ def texts_outside(fig, tolerance=1.0):
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     box = fig.bbox
-    # tick labels are drawn only for the ticks inside the view (Axis._update_ticks); the others
-    # exist, positioned, but are never drawn
+    # tick labels are drawn only for the ticks inside the view (Axis._update_ticks) of an axes that is
+    # on; the others exist, positioned, but are never drawn
     ticks, drawn = set(), set()
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
             for tick in axis.get_major_ticks() + axis.get_minor_ticks():
                 ticks.update((id(tick.label1), id(tick.label2)))
-            for tick in axis._update_ticks():
+            for tick in (axis._update_ticks() if ax.axison and ax.get_visible() else []):   # axes off: none
                 drawn.update((id(tick.label1), id(tick.label2)))
     out = []
     for t in fig.findobj(Text):

@@ -234,7 +234,7 @@ def group_runs(rows, estimator="surface"):
     ValueError
         If ``estimator`` is not one of the two, or the table has no ``theAmplitude`` column.
     """
-    from ..plot import ok_moduli
+    from ..plot import is_flagged, ok_moduli
     kept, skipped = ok_moduli(rows, estimator)
     header = list(rows[0]) if rows else []
     if rows and _AMPLITUDE not in header:
@@ -245,13 +245,26 @@ def group_runs(rows, estimator="surface"):
     # the same resamples from the same seed however the table was written
     for row, A, gp, gpp in sorted(kept, key=lambda k: (k[1], str(k[0].get("run_id", "")))):
         key = tuple(str(row.get(c, "")) for c in names)
-        d = cells.setdefault(key, {"parameters": dict(zip(names, key)), "amplitude": [], "Gp": [], "Gpp": []})
+        d = cells.setdefault(key, {"parameters": dict(zip(names, key)), "amplitude": [], "Gp": [], "Gpp": [],
+                                   "flagged": []})
         d["amplitude"].append(A)
         d["Gp"].append(gp)
         d["Gpp"].append(gpp)
+        d["flagged"].append(is_flagged(row))    # verdict "flagged: …" (False in tables without the column)
     keys = sorted(cells, key=lambda k: [_sort_key(v) for v in k])
     varying = [c for i, c in enumerate(names) if len({k[i] for k in keys}) > 1]
     return [cells[k] for k in keys], varying, skipped
+
+
+def _made(rows, columns):
+    """``{column: value}`` of the columns that hold one number in every ``ok`` row (for a figure's title)."""
+    from ..plot import _float
+    made = {}
+    for c in columns:
+        values = {_float(r.get(c)) for r in rows if r.get("status") == "ok" and c in r}
+        if len(values) == 1 and all(v == v for v in values):
+            made[c] = values.pop()
+    return made
 
 
 def analysis_columns(varying):
@@ -490,7 +503,8 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
             rng = np.random.default_rng(None if seed is None else [int(seed), zlib.crc32(label.encode("utf-8"))])
             summary, group_notes = _summarise(g, n_boot, confidence, rng)
             out_rows.append(_row(g, varying, summary, group_notes, estimator, n_boot, confidence, seed))
-            panels.append((out_rows[-1]["group"], summary, group_notes))
+            flagged = sorted({A for A, fl in zip(g["amplitude"], g["flagged"]) if fl})
+            panels.append((out_rows[-1]["group"], summary, group_notes, flagged))
         columns = analysis_columns(varying)
         if groups:
             _write_csv(os.path.join(staging, ANALYSIS_NAME), columns, out_rows)
@@ -509,7 +523,8 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
         if figure and panels:
             if _has_matplotlib():
                 from .figure import plot_analysis
-                fig = plot_analysis(panels, estimator=estimator, max_panels=max_figure_panels)
+                fig = plot_analysis(panels, estimator=estimator, max_panels=max_figure_panels,
+                                    made=_made(rows, ("N", "relative_frequency")))
                 for ext in (".png", ".pdf"):
                     key = "Description" if ext == ".png" else "Subject"
                     fig.savefig(os.path.join(staging, FIGURE_NAME + ext), format=ext[1:], dpi=150,

@@ -14,11 +14,15 @@ import math
 
 import numpy as np
 
-__all__ = ["MARKERS", "MAX_FIGURE_PANELS", "not_drawn_line", "plot_analysis"]
+__all__ = ["MARKERS", "MAX_FIGURE_PANELS", "MIN_AMPLITUDES_FOR_LIMITS", "not_drawn_line", "plot_analysis"]
 
 #: most panels of the figure: the first groups (in table order) are drawn, the others named in one line
 #: (a figure of thousands of panels would take gigabytes and hours; every group is a row of the table)
 MAX_FIGURE_PANELS = 24
+
+#: fewest amplitudes of a curve on which the linear limits and the yield point are drawn: below,
+#: a "plateau" and a departure from it are the same two or three points
+MIN_AMPLITUDES_FOR_LIMITS = 4
 
 #: characteristic → (marker, short label, legend text, label offset in points)
 MARKERS = {
@@ -50,8 +54,13 @@ def _seeds_text(n_seeds):
     return f"{lo} seed{'s' if lo != 1 else ''} per amplitude" if lo == hi else f"{lo}–{hi} seeds per amplitude"
 
 
-def _panel(ax, title, s, notes):
-    """Draw one group's panel; returns the notes drawn into it."""
+def _panel(ax, title, s, notes, flagged=()):
+    """Draw one group's panel; returns (the notes drawn into it, the point labels to place).
+
+    The labels of the characteristic points are not drawn here: :func:`plot_analysis` places them
+    after the layout, without overlap (:func:`particleShear.plot.place_labels`).
+    """
+    from ..plot import FLAGGED_LABEL
     A = np.asarray(s.amplitudes, float)
     said = list(notes)
     positive = [v for arr in (s.Gp_mean, s.Gpp_mean, s.Gp_ci.ravel(), s.Gpp_ci.ravel()) for v in np.ravel(arr)
@@ -69,6 +78,10 @@ def _panel(ax, title, s, notes):
                         label=f"{key}: {s.confidence:.0%} bootstrap interval of the mean (Student-t width)")
         ax.plot(A[ok], mean[ok], color=colour, ls=style, marker=marker, mfc=mfc, ms=4, lw=1.3,
                 label=f"{key} mean over seeds")
+        ring = ok & np.isin(A, np.asarray(list(flagged), float))
+        if ring.any():     # a run of the point has a flagged verdict: ringed, never hidden
+            ax.plot(A[ring], mean[ring], ls="none", marker="o", ms=10, mfc="none", mec="k", mew=1.1, zorder=4,
+                    gid="flagged", label=FLAGGED_LABEL + ": ≥ 1 run at the amplitude")
         if (~ok).any():
             ax.plot(A[~ok], np.full((~ok).sum(), floor), ls="none", marker="v", ms=8, color=colour, mfc="none",
                     clip_on=False, label=f"{key} mean <= 0 (not on the log axis)")
@@ -86,8 +99,15 @@ def _panel(ax, title, s, notes):
         strain, gp, _ = s.points[name]
         ci = s.points_ci[name]
         marks.append((name, strain, gp, (ci[0, 0], ci[0, 1]), (ci[1, 0], ci[1, 1])))
+    labels = []
+    short_curve = len(A) < MIN_AMPLITUDES_FOR_LIMITS
+    if short_curve:
+        said.append(f"{len(A)} amplitudes: no linear limits or yield drawn (they need >= "
+                    f"{MIN_AMPLITUDES_FOR_LIMITS})")
     for name, x, y, xci, yci in marks:
         marker, short, legend, offset = MARKERS[name]
+        if short_curve and name in ("linear_limit_5", "linear_limit_10", "yield"):
+            continue
         if not (math.isfinite(x) and math.isfinite(y) and x > 0 and y > 0):
             continue
         xerr = None
@@ -98,7 +118,7 @@ def _panel(ax, title, s, notes):
             yerr = [[max(y - yci[0], 0)], [max(yci[1] - y, 0)]]
         ax.errorbar([x], [y], xerr=xerr, yerr=yerr, ls="none", marker=marker, ms=8, color="k", mfc="gold",
                     ecolor="0.3", elinewidth=0.8, capsize=2, zorder=5, label=legend)
-        ax.annotate(short, (x, y), xytext=offset, textcoords="offset points", fontsize="x-small", zorder=6)
+        labels.append((short, x, y))
     if clipped:
         said.append("interval ends <= 0 drawn at the lower edge")
     ax.set_xscale("log")
@@ -111,7 +131,7 @@ def _panel(ax, title, s, notes):
         import textwrap
         ax.set_xlabel(ax.get_xlabel() + "\n" + "\n".join(textwrap.fill("note: " + n, 70) for n in said),
                       fontsize="small")
-    return said
+    return said, labels
 
 
 def not_drawn_line(titles, limit=200):
@@ -138,7 +158,7 @@ def not_drawn_line(titles, limit=200):
     return "; ".join(shown) + (f"; … and {rest} more" if rest else "")
 
 
-def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_PANELS):
+def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_PANELS, made=None):
     """One panel per group: mean G′, G″ with bootstrap bands and the characteristic points.
 
     At most ``max_panels`` panels are drawn (the first groups); a line at the foot of the figure
@@ -147,15 +167,19 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
     Parameters
     ----------
     panels : sequence of tuple
-        ``(title, summary, notes)`` per group: a text, a
+        ``(title, summary, notes)`` or ``(title, summary, notes, flagged)`` per group: a text, a
         :class:`~particleShear.analysis.sweep.SweepSummary` (None for a group that could not be
-        summarised: the panel says so) and a list of notes to print in the panel.
+        summarised: the panel says so), a list of notes to print in the panel and the amplitudes
+        at which a run has a flagged verdict (ringed, with a legend entry; default none).
     estimator : {"surface", "internal"}, optional
         Named in the figure's title (default "surface").
     path : str or os.PathLike, optional
         Also write the figure there (.png, .pdf, .svg or .eps), atomically.
     max_panels : int, optional
         Most panels drawn, 1 ... :data:`MAX_FIGURE_PANELS` (default).
+    made : dict, optional
+        ``N`` and ``relative_frequency`` where one value holds for every run: named in the title
+        with the seeds and the estimator (:func:`particleShear.plot.made_by`).
 
     Returns
     -------
@@ -175,7 +199,8 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
     if isinstance(max_panels, bool) or not isinstance(max_panels, int) or not 1 <= max_panels <= MAX_FIGURE_PANELS:
         raise ValueError(f"max_panels={max_panels!r} is out of range: allowed an integer >= 1 and <= "
                          f"{MAX_FIGURE_PANELS}")
-    left_out = [t for t, _, _ in panels[max_panels:]]
+    panels = [tuple(p) + ((),) * (4 - len(p)) for p in panels]     # (title, summary, notes, flagged)
+    left_out = [p[0] for p in panels[max_panels:]]
     panels = panels[:max_panels]
     n = len(panels)
     ncols = min(n, 3)
@@ -185,7 +210,8 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     handles = {}
     confidence = None
-    for ax, (title, summary, notes) in zip(axes, panels):
+    to_label, seeds = [], []
+    for ax, (title, summary, notes, flagged) in zip(axes, panels):
         if summary is None:
             ax.text(0.5, 0.5, "not summarised:\n" + "\n".join(notes), ha="center", va="center",
                     transform=ax.transAxes, fontsize="small", color="C3")
@@ -193,13 +219,20 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
             ax.set_axis_off()
             continue
         confidence = summary.confidence
-        _panel(ax, title, summary, notes)
+        seeds += [int(n) for n in np.ravel(summary.n_seeds)]
+        _, labels = _panel(ax, title, summary, notes, flagged)
+        to_label.append((ax, labels))
         for h, label in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(label, h)
     for ax in axes[n:]:
         ax.set_axis_off()
+    from ..plot import fit_title, made_by, place_labels
     what = f"{confidence:.0%} bootstrap intervals over seeds" if confidence is not None else "no summary"
-    fig.suptitle(f"{estimator} estimator: mean G′, G″ and {what}", fontsize="medium")
+    made = made or {}
+    rate = f"f·τ = {made['relative_frequency']:g}" if "relative_frequency" in made else None
+    line = made_by(N=int(made["N"]) if "N" in made else None, seeds=(min(seeds), max(seeds)) if seeds else None,
+                   estimator=estimator, rate=rate)
+    fit_title(fig, f"Mean G′, G″ against the strain amplitude: {line}; {what}")
     if left_out:
         import textwrap
         line = (f"{len(left_out)} more group(s) not drawn (the first {n} are; every group is a row of "
@@ -212,6 +245,9 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
         except (ValueError, TypeError):   # matplotlib < 3.7: no "outside" locations
             fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=legend_cols, fontsize="x-small",
                        frameon=False, bbox_to_anchor=(0.5, 0.0))
+    fig.canvas.draw()        # the layout first: the labels are placed in the panels' final frames
+    for ax, labels in to_label:
+        place_labels(ax, labels)
     if path is not None:
         save_figure(fig, path)
     return fig
