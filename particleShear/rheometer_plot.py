@@ -31,7 +31,7 @@ plot_rheometer_result
 __docformat__ = "numpy"
 import numpy as np
 
-from .plot import _figure, check_figure_path, save_figure
+from .plot import _figure, check_figure_path, fit_title, made_by, save_figure
 
 __all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps", "plot_steady_run",
            "plot_rheometer_result", "plot_flow_curve_sweep"]
@@ -53,13 +53,15 @@ def _note(ax, dropped, what):
                 transform=ax.transAxes, ha="left", va="bottom", fontsize="small", gid="dropped-note")
 
 
-def _finish(fig, path):
+def _finish(fig, path, title=None):
+    if title:
+        fit_title(fig, title)
     if path is not None:
         save_figure(fig, path)
     return fig
 
 
-def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None):
+def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None, *, title=None):
     """Flow curve: σ (Pa) and η = σ/γ̇ (Pa·s) against γ̇ (1/s), both log–log.
 
     Parameters
@@ -76,6 +78,9 @@ def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None):
         σ_y as a dashed horizontal line on the σ panel.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
@@ -115,10 +120,10 @@ def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None):
     ax_s.set_ylabel("stress σ (Pa)")
     ax_e.set_ylabel("viscosity η = σ/γ̇ (Pa·s)")
     _note(ax_s, int((~keep).sum()), "(γ̇, σ)")
-    return _finish(fig, path)
+    return _finish(fig, path, title)
 
 
-def plot_relaxation(t, G, G_err=None, plateau=None, path=None):
+def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
     """Stress relaxation: G(t) (Pa) against t (s), log x; log y when all G > 0, else linear y.
 
     Parameters
@@ -133,6 +138,9 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None):
         (value, error) of the plateau modulus in Pa, drawn as a horizontal band.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
@@ -168,10 +176,10 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None):
     ax.set_ylabel("relaxation modulus G(t) (Pa)")
     ax.legend(fontsize="small")
     _note(ax, int((~keep).sum()), "t")
-    return _finish(fig, path)
+    return _finish(fig, path, title)
 
 
-def plot_creep(t, J, path=None):
+def plot_creep(t, J, path=None, *, title=None):
     """Creep: compliance J(t) = γ(t)/σ₀ (1/Pa) against t (s), log–log on the positive points.
 
     Parameters
@@ -182,6 +190,9 @@ def plot_creep(t, J, path=None):
         Creep compliance in 1/Pa, same length as ``t``.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
@@ -206,10 +217,14 @@ def plot_creep(t, J, path=None):
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("creep compliance J(t) (1/Pa)")
     _note(ax, int((~keep).sum()), "(t, J)")
-    return _finish(fig, path)
+    return _finish(fig, path, title)
 
 
-_SWEEP_NAMES = {"one_packing": "one packing (amplitude after amplitude)", "independent": "independent packings"}
+#: legend names of the two series, by the swept quantity (the legend says what was swept)
+_SWEEP_NAMES = {"amplitude": {"one_packing": "one packing (amplitude after amplitude)",
+                              "independent": "independent packings"},
+                "relative_frequency": {"one_packing": "one packing (frequency after frequency)",
+                                       "independent": "independent packings"}}
 
 
 def _sweep(name, data, x="amplitude"):
@@ -228,18 +243,22 @@ def _sweep(name, data, x="amplitude"):
     return out
 
 
-def plot_amplitude_sweeps(one_packing, independent=None, path=None, *, x="amplitude"):
+def plot_amplitude_sweeps(one_packing, independent=None, path=None, *, x="amplitude", title=None):
     """G′ (filled markers) and G″ (open markers) in Pa against the strain amplitude, log–log.
 
     Parameters
     ----------
     one_packing : mapping
-        One packing swept amplitude after amplitude: keys "amplitude", "Gp", "Gpp" (Pa) and
-        optional "Gp_err", "Gpp_err" (standard errors, Pa).
+        One packing swept step after step (amplitude after amplitude, or frequency after
+        frequency): keys ``x``, "Gp", "Gpp" (Pa) and optional "Gp_err", "Gpp_err" (standard
+        errors, Pa).
     independent : mapping, optional
         A fresh packing per amplitude, same keys.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
     x : {"amplitude", "relative_frequency"}, default "amplitude"
         Keyword-only.  The abscissa's key: the strain amplitude γ₀, or the relative frequency
         f·τ of a frequency sweep.
@@ -270,17 +289,17 @@ def plot_amplitude_sweeps(one_packing, independent=None, path=None, *, x="amplit
             dropped += int((~keep).sum())
             err = d[k + "_err"]
             ax.errorbar(d["amplitude"][keep], d[k][keep], yerr=None if err is None else err[keep], fmt="o-",
-                        color=colour, mfc=face, label=f"{_SWEEP_NAMES[key]}: {'G′' if k == 'Gp' else 'G″'}")
+                        color=colour, mfc=face, label=f"{_SWEEP_NAMES[x][key]}: {'G′' if k == 'Gp' else 'G″'}")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("strain amplitude γ₀" if x == "amplitude" else "relative frequency f·τ")
     ax.set_ylabel("G′, G″ (Pa)")
     ax.legend(fontsize="small")
     _note(ax, dropped, "G′/G″")
-    return _finish(fig, path)
+    return _finish(fig, path, title)
 
 
-def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=None):
+def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=None, *, title=None):
     """One steady-shear run: the shear stress σ (Pa) against the strain γ, linear axes.
 
     Parameters
@@ -295,6 +314,9 @@ def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=Non
         Strain at the detected end of the start-up transient (a vertical line).
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
@@ -325,7 +347,40 @@ def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=Non
     ax.set_xlabel("strain γ")
     ax.set_ylabel("shear stress σ (Pa)")
     ax.legend(fontsize="small")
-    return _finish(fig, path)
+    return _finish(fig, path, title)
+
+
+#: what each protocol's title names besides N, the seed and the estimator
+_PROTOCOL_TITLES = {"steady": "steady shear", "relaxation": "stress relaxation", "creep": "creep",
+                    "amplitude_sweep": "amplitude sweep (one packing)", "frequency_sweep": "frequency sweep (one packing)"}
+
+
+def _result_title(result):
+    """The title of a protocol run's figure: the protocol, then N, seeds, estimator, rate, γ₀ or σ₀."""
+    p = result.parameters or {}
+
+    def num(name):
+        try:
+            v = float(p[name])
+        except (KeyError, TypeError, ValueError):
+            return None
+        return v if np.isfinite(v) else None
+    proto = result.protocol
+    N = num("N")
+    kw = {"N": int(N) if N is not None else None, "seeds": 1, "estimator": "surface"}
+    if proto == "steady" and num("relative_rate") is not None:
+        kw["rate"] = f"γ̇·τ = {num('relative_rate'):g}"
+    if proto in ("relaxation", "frequency_sweep") and num("theAmplitude") is not None:
+        kw["amplitude"] = num("theAmplitude")
+    if proto == "relaxation" and num("ramp_time") is not None:
+        kw["rate"] = f"ramp time {num('ramp_time'):g} τ"
+    if proto == "creep" and num("creep_stress") is not None:
+        kw["stress"] = num("creep_stress")
+    if proto == "amplitude_sweep" and num("relative_frequency") is not None:
+        kw["rate"] = f"f·τ = {num('relative_frequency'):g}"
+    seed = getattr(result, "seed", None)
+    tail = f" (seed {seed})" if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) else ""
+    return f"{_PROTOCOL_TITLES.get(proto, proto)}: {made_by(**kw)}{tail}"
 
 
 def plot_rheometer_result(result, path=None):
@@ -343,6 +398,9 @@ def plot_rheometer_result(result, path=None):
         results table has the steps only, enough for the sweeps).
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
+    title : str, optional
+        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
+        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
@@ -354,6 +412,7 @@ def plot_rheometer_result(result, path=None):
         A result without the data its figure needs, or a bad ``path``.
     """
     proto, summ = result.protocol, result.summary
+    title = _result_title(result)
     if proto in ("amplitude_sweep", "frequency_sweep"):
         x = "amplitude" if proto == "amplitude_sweep" else "relative_frequency"
         st = result.steps
@@ -362,14 +421,14 @@ def plot_rheometer_result(result, path=None):
             errs = [s.get(f"{k}_surface_se") for s in st]
             if all(e is not None and np.isfinite(e) for e in errs):
                 data[k + "_err"] = errs
-        return plot_amplitude_sweeps(data, path=path, x=x)
+        return plot_amplitude_sweeps(data, path=path, x=x, title=title)
     if proto == "steady":
         if "strain" not in result.series:
             raise ValueError("plot needs the recorded series of the run (a result of this session or read_run "
                              "of its file, not one rebuilt from a results table)")
         return plot_steady_run(result.series["strain"], result.series["stress_surface"],
                                (summ["stress_surface"], summ["stress_surface_se"]), summ.get("strain_transient"),
-                               path)
+                               path, title=title)
     name = "G_surface" if proto == "relaxation" else "J"
     if name not in result.curves:
         raise ValueError(f"plot needs the curve {name!r} of the run (a result of this session, not one rebuilt "
@@ -377,8 +436,8 @@ def plot_rheometer_result(result, path=None):
     t, y, err = result.curves[name]
     if proto == "relaxation":
         plateau = (summ["G_plateau_surface"], summ["G_plateau_surface_se"])
-        return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path)
-    return plot_creep(t, y, path)
+        return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path, title=title)
+    return plot_creep(t, y, path, title=title)
 
 
 def plot_flow_curve_sweep(folder_or_csv, estimator="surface", path=None, n_boot=2000, confidence=0.95,
@@ -428,12 +487,15 @@ def plot_flow_curve_sweep(folder_or_csv, estimator="surface", path=None, n_boot=
         sem = np.where(have > 1, np.nanstd(stress, axis=1, ddof=1) / np.sqrt(np.maximum(have, 1)), 0.0)
     keep = have > 0
     fc = fit_flow_curve(table, estimator, n_boot=n_boot, confidence=confidence, rng=bootstrap_seed)
-    fig = plot_flow_curve(rate[keep], mean[keep], np.nan_to_num(sem[keep]), fit=fc.fit,
-                          path=path if path not in (None, False) else None)
+    if path not in (None, False):
+        check_figure_path(path, "path")
+    fig = plot_flow_curve(rate[keep], mean[keep], np.nan_to_num(sem[keep]), fit=fc.fit)
     lo, hi = fc.intervals["sigma_y"]
     fig.axes[0].set_title(f"{estimator} stress, {stress.shape[1]} seed(s); σ_y {100 * confidence:g} % interval "
                           f"[{lo:.3g}, {hi:.3g}] Pa", fontsize="small")
     fig.set_label("flow_curve")
+    if path not in (None, False):      # written with its title
+        save_figure(fig, path)
     if path is None:
         folder = src if os.path.isdir(src) else os.path.dirname(os.path.abspath(src))
         for ext in (".png", ".pdf"):

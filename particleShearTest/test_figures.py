@@ -200,5 +200,45 @@ class TestAnalysisFigure(unittest.TestCase):
             self.assertIn(part, title)
 
 
+@unittest.skipUnless(HAVE_MPL, "matplotlib not installed (extra [plot])")
+class TestProtocolFigures(unittest.TestCase):
+    @staticmethod
+    def sweep_result(protocol, **parameters):
+        import types
+        x = "amplitude" if protocol == "amplitude_sweep" else "relative_frequency"
+        steps = [{x: v, "Gp_surface": 300.0 - 50 * k, "Gpp_surface": 60.0 + 10 * k, "Gp_surface_se": 5.0,
+                  "Gpp_surface_se": 3.0} for k, v in enumerate((0.01, 0.03, 0.1))]
+        return types.SimpleNamespace(protocol=protocol, summary={}, steps=steps, seed=7,
+                                     parameters=dict(N=40, theAmplitude=0.1, relative_frequency=0.025, **parameters))
+
+    def test_titles_and_legends_say_what_made_them(self):
+        from particleShear.rheometer_plot import plot_rheometer_result
+        cases = {"amplitude_sweep": ("amplitude after amplitude", ("N = 40", "1 seed", "surface estimator",
+                                                                     "f·τ = 0.025", "seed 7")),
+                 "frequency_sweep": ("frequency after frequency", ("N = 40", "1 seed", "surface estimator",
+                                                                     "γ₀ = 0.1"))}
+        for protocol, (legend, parts) in cases.items():
+            with self.subTest(protocol=protocol):
+                fig = plot_rheometer_result(self.sweep_result(protocol))
+                title = " ".join(fig._suptitle.get_text().split())
+                for part in parts:
+                    self.assertIn(part, title)
+                labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+                self.assertTrue(all(legend in t for t in labels), labels)
+                self.assertEqual(texts_outside(fig), [])
+
+    def test_protocol_titles_name_rate_strain_or_stress(self):
+        import types
+        from particleShear.rheometer_plot import _result_title
+        r = types.SimpleNamespace(protocol="creep", seed=None, parameters=dict(N=150, creep_stress=50.0))
+        self.assertEqual(_result_title(r), "creep: N = 150, 1 seed, surface estimator, σ₀ = 50 Pa")
+        r = types.SimpleNamespace(protocol="steady", seed=3, parameters=dict(N=150, relative_rate=0.01))
+        self.assertEqual(_result_title(r), "steady shear: N = 150, 1 seed, surface estimator, γ̇·τ = 0.01 (seed 3)")
+        r = types.SimpleNamespace(protocol="relaxation", seed=None, parameters=dict(N=150, theAmplitude=0.01,
+                                                                                   ramp_time=1.0))
+        self.assertEqual(_result_title(r), "stress relaxation: N = 150, 1 seed, surface estimator, ramp time 1 τ, "
+                                           "γ₀ = 0.01")
+
+
 if __name__ == "__main__":
     unittest.main()
