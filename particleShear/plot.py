@@ -464,7 +464,9 @@ def _lissajous_bowditch(result, elastic, viscous, text):
                   fontsize="small", transform=text.transAxes)
         return
     rate = np.asarray(s.get("strain_rate", np.zeros(len(s["t"]))))
-    lines = ["LAOS of the measured periods", ""]
+    lines = ["LAOS of the measured periods", "(± standard error over the periods)", ""]
+    spread = _laos_period_spread(result, w)
+    signs = {}
     for est, color in (("surface", "C0"), ("internal", "C1")):
         key = "stress_" + est
         try:
@@ -480,9 +482,17 @@ def _lissajous_bowditch(result, elastic, viscous, text):
         if np.any(rate[w]):
             viscous.plot(rate[w], stress, color=color, lw=0.5, alpha=0.35)
         viscous.plot(c["strain_rate"], c["viscous_stress"], color=color, lw=1.8, label=f"σ″ {est}")
-        lines += [f"{est}:", f"  G_M = {m.G_M:.4g} Pa,  G_L = {m.G_L:.4g} Pa,  S = {m.S:.3g}",
-                  f"  η_M = {m.eta_M:.4g} Pa·s,  η_L = {m.eta_L:.4g} Pa·s,  T = {m.T:.3g}",
-                  f"  I₃/I₁ = {m.I3_I1:.3g},  Q = {m.Q:.3g}", ""]
+        se = spread.get(est, {})
+        signs[est] = (np.sign(m.S), np.sign(m.T))
+        lines += [f"{est}:", f"  G_M = {m.G_M:.4g} Pa,  G_L = {m.G_L:.4g} Pa",
+                  f"  S = {_with_error(m.S, se.get('S'))}",
+                  f"  η_M = {m.eta_M:.4g} Pa·s,  η_L = {m.eta_L:.4g} Pa·s",
+                  f"  T = {_with_error(m.T, se.get('T'))}",
+                  f"  I₃/I₁ = {_with_error(m.I3_I1, se.get('I3_I1'))}", ""]
+    if len(signs) == 2:
+        differ = [name for k, name in enumerate(("S", "T")) if signs["surface"][k] * signs["internal"][k] < 0]
+        if differ:
+            lines += [f"{' and '.join(differ)}: surface and internal", "  differ in sign: not resolved", ""]
     elastic.set_xlabel("strain γ (–)")
     elastic.set_ylabel("elastic stress σ′ (Pa)")
     elastic.set_title("elastic Lissajous–Bowditch (thin: measured τ)", fontsize="medium")
@@ -495,6 +505,47 @@ def _lissajous_bowditch(result, elastic, viscous, text):
     text.axis("off")
     text.text(0.0, 1.0, "\n".join(lines), va="top", ha="left", fontsize="x-small", family="monospace",
               transform=text.transAxes)
+
+
+def _with_error(v, se):
+    """``v ± se`` with the error to 2 significant figures and the value to the same decimal; ``v`` to 2
+    figures with "(1 period: no error)" when there is no error."""
+    if se is None or not math.isfinite(se) or se <= 0:
+        return f"{v:.2g} (no error: < 2 periods)" if se is None else f"{v:.2g}"
+    digits = min(4, max(0, 1 - int(math.floor(math.log10(se)))))
+    return f"{v:.{digits}f} ± {se:.{digits}f}"
+
+
+def _laos_period_spread(result, window):
+    """Standard errors of S, T and I₃/I₁ over the measured periods, per estimator (empty: < 2 periods).
+
+    Each whole measured period gets its own LAOS measures (:func:`particleShear.analysis.laos.laos`,
+    5 harmonics, as :meth:`SimulationResult.laos`); the error is their standard deviation over √n.
+    """
+    import numpy as np
+    from .analysis.laos import laos
+    s = result.series
+    t, strain = np.asarray(s["t"]), np.asarray(s["strain"])
+    f = float(result.f)
+    pre = float(result.parameters.get("pre_periods", 0))
+    k = np.floor(t * f - pre + 1e-9).astype(int)
+    ids = [j for j in np.unique(k[window]) if np.sum(window & (k == j)) >= 8]
+    out = {}
+    if len(ids) < 2:
+        return out
+    for est in ("surface", "internal"):
+        values = {"S": [], "T": [], "I3_I1": []}
+        for j in ids:
+            idx = np.flatnonzero(window & (k == j))
+            sel = np.arange(idx[0], min(idx[-1] + 2, len(t)))   # and the next period's first sample: one whole period
+            try:
+                m = laos(t[sel], strain[sel], np.asarray(s["stress_" + est])[sel], f, n_max=5)
+            except (ValueError, KeyError):
+                continue
+            for name in values:
+                values[name].append(float(getattr(m, name)))
+        out[est] = {name: float(np.std(v, ddof=1) / math.sqrt(len(v))) for name, v in values.items() if len(v) >= 2}
+    return out
 
 
 # ---------------------------------------------------------------------------------------------

@@ -11,6 +11,7 @@
 """
 import importlib.util
 import os
+import sys
 import tempfile
 import unittest
 import warnings
@@ -18,6 +19,7 @@ import warnings
 import numpy as np
 
 HAVE_MPL = importlib.util.find_spec("matplotlib") is not None
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # test_plot's synthetic run
 
 
 def texts_outside(fig, tolerance=1.0):
@@ -198,6 +200,22 @@ class TestAnalysisFigure(unittest.TestCase):
         title = " ".join(fig._suptitle.get_text().split())
         for part in ("N = 40", "3 seeds", "internal estimator", "f·τ = 0.025"):
             self.assertIn(part, title)
+
+
+@unittest.skipUnless(HAVE_MPL, "matplotlib not installed (extra [plot])")
+class TestLaosBox(unittest.TestCase):
+    def test_ratios_carry_their_spread_over_periods(self):
+        from particleShear.plot import _with_error, plot_result
+        from test_plot import synthetic_result
+        self.assertEqual(_with_error(0.1234, 0.0123), "0.123 ± 0.012")
+        self.assertEqual(_with_error(-0.16, 0.29), "-0.16 ± 0.29")
+        self.assertEqual(_with_error(0.1234, None), "0.12 (no error: < 2 periods)")
+        fig = plot_result(synthetic_result(P=5, f=2.0))
+        text = fig.axes[-1].texts[0].get_text()
+        for line in text.splitlines():
+            if line.strip().startswith(("S =", "T =")):
+                self.assertIn("±", line)            # every S and T with its error over the periods
+        self.assertEqual(texts_outside(fig), [])
 
 
 @unittest.skipUnless(HAVE_MPL, "matplotlib not installed (extra [plot])")
