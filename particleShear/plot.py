@@ -444,6 +444,14 @@ def plot_result(result, path=None):
     lj.legend(loc="upper left", fontsize="x-small", framealpha=0.85)
     _lissajous_bowditch(result, fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1]),
                         fig.add_subplot(grid[1, 2]))
+    p = result.parameters
+    N = p.get("N")
+    seed = getattr(result, "seed", None)
+    rate = f"f·τ = {float(p['relative_frequency']):g}" if "relative_frequency" in p else None
+    line = made_by(N=int(N) if N is not None else None, seeds=1, rate=rate,
+                   amplitude=float(A) if isinstance(A, (int, float)) else None)
+    fit_title(fig, f"One oscillatory run: {line}{'' if seed is None else f' (seed {seed})'}; "
+                   "surface (plate forces) and internal (stress tensor) estimators")
     if path is not None:
         save_figure(fig, path)
     return fig
@@ -508,8 +516,8 @@ def _lissajous_bowditch(result, elastic, viscous, text):
 
 
 def _with_error(v, se):
-    """``v ± se`` with the error to 2 significant figures and the value to the same decimal; ``v`` to 2
-    figures with "(1 period: no error)" when there is no error."""
+    """``v ± se``, the error to 2 significant figures (at most 4 decimals) and the value to the same
+    decimal; ``v`` to 2 figures, with "(no error: < 2 periods)" when ``se`` is None."""
     if se is None or not math.isfinite(se) or se <= 0:
         return f"{v:.2g} (no error: < 2 periods)" if se is None else f"{v:.2g}"
     digits = min(4, max(0, 1 - int(math.floor(math.log10(se)))))
