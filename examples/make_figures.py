@@ -15,6 +15,7 @@ Usage (from the repository root, ~6 min of one core: 45 runs of ~8 s)::
 import argparse
 import csv
 import glob
+import json
 import os
 import shutil
 import tempfile
@@ -32,7 +33,7 @@ SMALL = dict(N=40, pre_periods=0.5, periods=3, post_periods=0.5, doDrawing=False
 #: ~4.5× narrower than 2 for the same spread, bars that separate the materials — within ~6 min of one core
 SEEDS = 5
 COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal",
-           "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "spawn_key"]
+           "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "N", "relative_frequency", "spawn_key"]
 
 
 def trace_and_snapshot(out, work):
@@ -60,7 +61,8 @@ def small_sweep(out, work, workers):
             p = r.parameters
             ok = all(np.isfinite(r.G_surface)) and all(np.isfinite(r.G_internal))
             w.writerow([k, "ok" if ok else "error", "", *r.G_surface, *r.G_internal, p["theAmplitude"], p["theMu"],
-                        p["do_permanent_links"], p["cut_lines"], r.spawn_key[0]])
+                        p["do_permanent_links"], p["cut_lines"], p["N"], p["relative_frequency"],
+                        json.dumps([int(k) for k in r.spawn_key])])
     return replot_sweep(out)
 
 

@@ -133,7 +133,9 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
     G : array_like
         Relaxation modulus G(t) = (σ(t) − σ_res)/γ₀ in Pa, same length as ``t``.
     G_err : array_like, optional
-        Standard errors of ``G`` in Pa (error bars).
+        Error bars of ``G`` in Pa: for the curves of a run, the within-bin spread of
+        :func:`~particleShear.analysis.rheometry.log_grid` (std/√n of correlated samples: a
+        spread, not an independent error; 0 for a bin of one sample), said in the legend.
     plateau : tuple of float, optional
         (value, error) of the plateau modulus in Pa, drawn as a horizontal band.
     path : str or os.PathLike, optional
@@ -162,7 +164,9 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
     keep = t > 0
     fig = _figure(6.0, 4.0)
     ax = fig.subplots()
-    ax.errorbar(t[keep], G[keep], yerr=None if err is None else err[keep], fmt="o", label="G(t)")
+    ax.errorbar(t[keep], G[keep], yerr=None if err is None else err[keep], fmt="o",
+                label="G(t)" if err is None else "G(t): log-time bin means; bars: the samples' spread\n"
+                "in the bin (std/√n of correlated samples, 0 for one)")
     if plateau is not None:
         v, e = plateau
         ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"plateau {v:.3g} ± {e:.3g} Pa", gid="plateau")
