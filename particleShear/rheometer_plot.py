@@ -123,7 +123,7 @@ def plot_flow_curve(rate, stress, stress_err=None, fit=None, path=None, *, title
     return _finish(fig, path, title)
 
 
-def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
+def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ramp=None):
     """Stress relaxation: G(t) (Pa) against t (s), log x; log y when all G > 0, else linear y.
 
     Parameters
@@ -138,6 +138,11 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
         spread, not an independent error; 0 for a bin of one sample), said in the legend.
     plateau : tuple of float, optional
         (value, error) of the plateau modulus in Pa, drawn as a horizontal band.
+    ramp : float, optional
+        Keyword-only.  Duration of the strain ramp in s, drawn as a dotted vertical line: before
+        about this time G(t) is the packing's release from the ramp, after it the stress waves
+        of the stopped plates ring down (an oscillation of G about the plateau over a few tens of
+        ramp times), then the plateau.
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
     title : str, optional
@@ -170,15 +175,18 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None):
     if plateau is not None:
         v, e = plateau
         ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"plateau {v:.3g} ± {e:.3g} Pa", gid="plateau")
+    if ramp is not None and np.isfinite(ramp) and ramp > 0:
+        ax.axvline(float(ramp), color="0.3", ls=":", lw=1, gid="ramp",
+                   label=f"ramp duration {float(ramp):.3g} s: the release, then stress\nwaves ring down before the plateau")
     ax.set_xscale("log")
     if np.all(G[keep] > 0):
         ax.set_yscale("log")
     else:
         ax.text(0.98, 0.98, "linear G axis: some G ≤ 0", transform=ax.transAxes, ha="right", va="top",
                 fontsize="small", gid="linear-note")
-    ax.set_xlabel("time t (s)")
+    ax.set_xlabel("time after the strain step t (s)")
     ax.set_ylabel("relaxation modulus G(t) (Pa)")
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(0.0, -0.16), frameon=False)   # below: off the data
     _note(ax, int((~keep).sum()), "t")
     return _finish(fig, path, title)
 
@@ -440,7 +448,8 @@ def plot_rheometer_result(result, path=None):
     t, y, err = result.curves[name]
     if proto == "relaxation":
         plateau = (summ["G_plateau_surface"], summ["G_plateau_surface_se"])
-        return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path, title=title)
+        return plot_relaxation(t, y, err, plateau if all(np.isfinite(plateau)) else None, path, title=title,
+                               ramp=summ.get("ramp_time_s"))
     return plot_creep(t, y, path, title=title)
 
 
