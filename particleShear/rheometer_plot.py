@@ -410,13 +410,11 @@ def plot_rheometer_result(result, path=None):
         results table has the steps only, enough for the sweeps).
     path : str or os.PathLike, optional
         Write the figure there (.png, .pdf, .svg, .eps).
-    title : str, optional
-        Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
-        :func:`particleShear.plot.made_by`), fitted to the figure's width.
 
     Returns
     -------
     matplotlib.figure.Figure
+        Titled with the protocol, N, the seed, the estimator and the rate, γ₀ or σ₀.
 
     Raises
     ------

@@ -308,7 +308,10 @@ class ProgressLine:
     ----------
     stream : file-like, optional
         Where the line goes (default ``sys.stderr``); without a terminal, one line per phase
-        boundary and at most one every ``log_interval`` s, without carriage returns.
+        boundary, one with the phase's first estimate, and at most one every ``log_interval`` s,
+        without carriage returns.
+    clock : callable, optional
+        Seconds (default ``time.perf_counter``; tests pass a fake clock).
     """
 
     def __init__(self, stream=None, clock=time.perf_counter):
