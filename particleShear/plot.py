@@ -516,7 +516,8 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     confidence : float, optional
         Level of the bootstrap intervals, in (0, 1) (default 0.95).
     bootstrap_seed : int or None, optional
-        Seed of the resampling, >= 0 (default 0: the figure is reproducible); None: fresh entropy.
+        Seed of the resampling, >= 0 (default 0, :data:`particleShear.analysis.sweep.DEFAULT_SEED`, as
+        ``analyse``'s: the figure is reproducible); None: fresh entropy.
     max_panels : int, optional
         More panels than this are refused with a ValueError naming the parameters (default 12).
 

@@ -46,6 +46,7 @@ import warnings
 
 import numpy as np
 
+from .analysis.sweep import DEFAULT_SEED
 from .plot import ESTIMATORS, _figure, _float, group_of, ok_moduli
 
 __all__ = ["sweep_panels", "draw_sweep", "figure_stem", "X_ALIASES", "MIN_SEEDS", "MAX_PANELS"]
@@ -153,8 +154,8 @@ def _mean_se(values):
     return m, m - se, m + se
 
 
-def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, confidence=0.95, bootstrap_seed=0,
-                 max_panels=MAX_PANELS):
+def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, confidence=0.95,
+                 bootstrap_seed=DEFAULT_SEED, max_panels=MAX_PANELS):
     """The numbers of the sweep figure: panels, curves per μ, points per x value (module docstring).
 
     Parameters
@@ -174,7 +175,8 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
     confidence : float, optional
         Level of the bootstrap intervals, in (0, 1) (default 0.95).
     bootstrap_seed : int or None, optional
-        Seed of the resampling, >= 0 (default 0: reproducible); None draws fresh entropy.
+        Seed of the resampling, >= 0 (default 0, :data:`particleShear.analysis.sweep.DEFAULT_SEED`, as
+        ``analyse``'s: reproducible); None draws fresh entropy.
     max_panels : int, optional
         Refuse a split into more panels than this (default :data:`MAX_PANELS`).
 
