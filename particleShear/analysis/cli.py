@@ -599,9 +599,11 @@ class _Terminated(BaseException):
 
 def _human_protocols(rows):
     """A short table of the protocol summaries: group, quantity, runs, value [interval] unit."""
-    head = ["group", "quantity", "runs", "value [interval]", "unit"]
+    head = ["group", "quantity", "runs", "value [interval]", "unit", "flag"]
     body = [[r["group"], r["quantity"], str(r["n_runs"]),
-             f"{_fmt(r['value'])} [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]", r["unit"]] for r in rows]
+             f"{_fmt(r['value'])} [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]"
+             if math.isfinite(r["value"]) and math.isfinite(r["ci_low"]) else _fmt(r["value"]),
+             r["unit"], r.get("flag", "ok")] for r in rows]
     widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
     buf = io.StringIO()
     for line in [head] + body:
