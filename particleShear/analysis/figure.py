@@ -88,6 +88,10 @@ def _panel(ax, title, s, notes):
         marks.append((name, strain, gp, (ci[0, 0], ci[0, 1]), (ci[1, 0], ci[1, 1])))
     for name, x, y, xci, yci in marks:
         marker, short, legend, offset = MARKERS[name]
+        flag = s.flags.get(name, s.flags.get(name + "_strain", "ok"))
+        if flag in ("lower_bound", "upper_bound"):      # a bound is not a point of the curve: said, not drawn
+            said.append(f"{short}: {'>' if flag == 'lower_bound' else '<'} {x:g} (beyond the measured amplitudes)")
+            continue
         if not (math.isfinite(x) and math.isfinite(y) and x > 0 and y > 0):
             continue
         xerr = None
