@@ -10,7 +10,6 @@ import csv
 import importlib.util
 import io
 import json
-import math
 import os
 import signal
 import stat
