@@ -10,6 +10,9 @@ The truths used here:
 * the bootstrap of a mean over resampled seeds: identical seeds give a zero-width interval; two
   seeds a, b give replicate means a, (a+b)/2, b with probabilities ¼, ½, ¼, so the 2.5 % and 97.5 %
   percentiles are a and b;
+* a percentile interval computed on the log of positive replicates and exponentiated is positive,
+  and its ends are the geometric interpolation of the neighbouring order statistics; with the
+  Student widening on the log scale the ends of two seeds a, b are m·(a/m)^w, m·(b/m)^w;
 * coverage: for n normal seeds the percentile interval is about x̄ ± z·σ̂/√n with the ddof = 0
   deviation σ̂, i.e. it covers the true mean with probability P(|T_{n−1}| < z·√((n−1)/n)) (Student
   t), 0.904 for n = 10 and 95 %; the measured coverage over M independent sweeps is binomial.
@@ -215,6 +218,22 @@ class Bootstrap(unittest.TestCase):
         self.assertGreater(s.plateau_ci[0], 0)
         self.assertTrue((s.Gp_ci >= 0).all() and (s.Gpp_ci >= 0).all())
         self.assertTrue((s.Gp_ci[:, 0] <= s.Gp_mean).all() and (s.Gp_mean <= s.Gp_ci[:, 1]).all())
+
+    def test_modulus_interval_on_the_log_scale(self):
+        from particleShear.analysis.sweep import modulus_interval
+        # order statistics 10, 100, 1000, 10000 at confidence 0.5: the 25 % and 75 % points sit at positions 0.75
+        # and 2.25, interpolated in log: 10^1.75 and 10^3.25 (linear interpolation would give 77.5 and 3250)
+        lo, hi = modulus_interval([1000.0, 10.0, 10000.0, 100.0], 500.0, 0.5)
+        self.assertAlmostEqual(lo, 10 ** 1.75, delta=1e-9 * lo)
+        self.assertAlmostEqual(hi, 10 ** 3.25, delta=1e-9 * hi)
+        # an end on a replicate <= 0 (log −∞) is 0, never negative; NaN replicates are left out
+        self.assertEqual(modulus_interval([-5.0, -1.0, 50.0, 60.0, math.nan], 20.0, 0.5)[0], 0.0)
+        for estimate in (0.0, -3.0, math.nan):
+            self.assertTrue(all(math.isnan(v) for v in modulus_interval([1.0, 2.0], estimate, 0.9)))
+        with self.assertRaisesRegex(ValueError, r"confidence=1.5 is out of range: allowed a number in \(0, 1\)"):
+            modulus_interval([1.0, 2.0], 1.5, 1.5)
+        with self.assertRaisesRegex(ValueError, r"samples is invalid: allowed a 1-D sequence"):
+            modulus_interval([[1.0, 2.0]], 1.5, 0.9)
 
     def test_no_interval_without_an_estimate(self):
         rng = np.random.default_rng(3)

@@ -426,8 +426,27 @@ def modulus_interval(samples, estimate, confidence):
     tuple of float
         ``(low, high)`` in Pa with ``0 <= low <= high``, or ``(nan, nan)`` when ``estimate`` is not
         finite and > 0 or no replicate is finite.
+
+    Raises
+    ------
+    ValueError
+        ``samples`` not 1-D real numbers, or ``confidence`` not in (0, 1).
+
+    Examples
+    --------
+    >>> modulus_interval([-50.0, 10.0, 100.0, 1000.0], 265.0, 0.5)   # never below 0
+    (0.0, 177.82794100389225)
     """
-    s = np.asarray(samples, dtype=float).ravel()
+    try:
+        s = np.asarray(samples, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"samples is invalid: allowed a 1-D sequence of real numbers, got "
+                         f"{type(samples).__name__}") from None
+    if s.ndim != 1:
+        raise ValueError(f"samples is invalid: allowed a 1-D sequence of real numbers, got shape {s.shape}")
+    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, numbers.Real) \
+            or not (0 < confidence < 1):
+        raise ValueError(f"confidence={confidence!r} is out of range: allowed a number in (0, 1)")
     s = np.sort(s[np.isfinite(s)])
     if not (math.isfinite(estimate) and estimate > 0) or len(s) == 0:
         return math.nan, math.nan
