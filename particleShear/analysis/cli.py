@@ -89,6 +89,9 @@ _HEAD_COLUMNS = {
                           "for one group)")),
     "estimator": ("str", "", "the moduli used: surface (plate forces) or internal (overall stress tensor)"),
     "n_runs": ("int", "1", "runs (rows with status ok and finite moduli) of the group"),
+    "n_flagged": ("int", "1", "runs of the group whose verdict is flagged (counted in n_runs; docs/analysis.md "
+                              "\"Verdicts\")"),
+    "n_failed": ("int", "1", "rows of the group's parameters whose status is not ok (not in n_runs)"),
     "n_amplitudes": ("int", "1", "distinct strain amplitudes of the group"),
     "amplitude_min": ("float", "1", "smallest strain amplitude"),
     "amplitude_max": ("float", "1", "largest strain amplitude"),
@@ -223,7 +226,8 @@ def group_runs(rows, estimator="surface"):
     groups : list of dict
         One per group, sorted by its parameter values (numbers numerically): ``"parameters"``
         (``{name: text}`` of every grouping column), ``"amplitude"``, ``"Gp"``, ``"Gpp"`` (lists of
-        floats, one per run or step).
+        floats, one per run or step), ``"n_flagged"`` (runs of the group whose verdict is flagged),
+        ``"n_failed"`` (rows of its parameters whose status is not ok), ``"flags"`` (check → count).
     varying : list of str
         The grouping columns whose value differs between groups (header order).
     skipped : int
@@ -249,9 +253,25 @@ def group_runs(rows, estimator="surface"):
         d["amplitude"].append(A)
         d["Gp"].append(gp)
         d["Gpp"].append(gpp)
+    _count_verdicts(rows, names, cells)
     keys = sorted(cells, key=lambda k: [_sort_key(v) for v in k])
     varying = [c for i, c in enumerate(names) if len({k[i] for k in keys}) > 1]
     return [cells[k] for k in keys], varying, skipped
+
+
+def _count_verdicts(rows, names, cells):
+    """Each group's ``n_flagged``, ``n_failed`` and ``flags`` (check → count) over every row of its
+    parameters, whatever its status (:func:`particleShear.analysis.verdicts.verdict_counts`)."""
+    from .grouping import MODULI_PROTOCOLS, measured_row, row_protocol
+    from .verdicts import verdict_counts
+    members = {}
+    for row in rows:
+        if row_protocol(row) not in MODULI_PROTOCOLS:
+            continue
+        row = measured_row(row)
+        members.setdefault(tuple(str(row.get(c, "")) for c in names), []).append(row)
+    for key, d in cells.items():
+        d["n_failed"], d["n_flagged"], d["flags"] = verdict_counts(members.get(key, []))
 
 
 def analysis_columns(varying):
@@ -335,8 +355,9 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
     from .sweep import CHARACTERISTICS
     row = {"group": _label(group["parameters"], varying)}
     row.update({n: group["parameters"][n] for n in varying})
-    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "confidence": confidence,
-                "n_boot": n_boot, "bootstrap_seed": seed})
+    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "n_flagged": group.get("n_flagged", 0),
+                "n_failed": group.get("n_failed", 0), "confidence": confidence, "n_boot": n_boot,
+                "bootstrap_seed": seed})
     if summary is not None:
         row.update(summary.to_dict())
     else:
@@ -347,7 +368,10 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
             for suffix in ("", "_ci_low", "_ci_high"):
                 row[name + suffix] = math.nan
             row[name + "_defined"] = 0.0
-    row["note"] = "; ".join(notes)
+    from .verdicts import counts_note
+    counted = counts_note(len(group["amplitude"]), group.get("n_failed", 0), group.get("n_flagged", 0),
+                          group.get("flags", {}))
+    row["note"] = "; ".join(([counted] if counted else []) + list(notes))
     return row
 
 
@@ -545,7 +569,7 @@ def _human(rows):
     shown = (("plateau", "plateau (Pa)"), ("linear_limit_5", "linear limit 5 %"), ("flow_point", "flow point"),
              ("yield_strain", "yield strain"))
     head = ["group", "runs"] + [t for _, t in shown]
-    body = [[r["group"], str(r["n_runs"])] +
+    body = [[r["group"], _runs_text(r)] +
             [f"{_fmt(r[n])} [{_fmt(r[n + '_ci_low'])}, {_fmt(r[n + '_ci_high'])}]" for n, _ in shown] for r in rows]
     widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
     buf = io.StringIO()
@@ -555,6 +579,12 @@ def _human(rows):
         if r["note"]:
             buf.write(f"note: {r['group']}: {r['note']}\n")
     return buf.getvalue()
+
+
+def _runs_text(r):
+    """``12`` or ``12 (2 flagged, 1 failed)``: a group's runs with its verdict counts."""
+    extra = [f"{r[k]} {k[2:]}" for k in ("n_flagged", "n_failed") if r.get(k)]
+    return str(r["n_runs"]) + (f" ({', '.join(extra)})" if extra else "")
 
 
 class _Terminated(BaseException):

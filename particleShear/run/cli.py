@@ -589,12 +589,14 @@ def main(argv=None):
 
         def shown(items):
             return "  ".join(f"{k} = {v:.6g}{unit(k)}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
+        from ..analysis.verdicts import CHECKS, verdict_lines
         for st in res.steps:
             print(shown((k, st[k]) for k in ("position", "amplitude", "relative_frequency", "Gp_surface",
                                              "Gp_surface_se", "Gpp_surface", "Gpp_surface_se", "Gp_internal",
-                                             "Gpp_internal")))
+                                             "Gpp_internal", "verdict")))
         if res.summary:
-            print(shown(res.summary.items()))
+            print(shown((k, v) for k, v in res.summary.items() if k not in CHECKS and k != "verdict"))
+            print("\n".join(verdict_lines(res.summary, res.protocol)))
         print(f"protocol = {res.protocol}; seed entropy = {res.seed}; tau = {res.tau:.6g} s; wall time "
               + ", ".join(f"{k} {v:.2f} s" for k, v in res.timings.items()))
         if res.output_path:
@@ -602,6 +604,8 @@ def main(argv=None):
     else:
         print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
         print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
+        from ..analysis.verdicts import verdict_lines
+        print("\n".join(verdict_lines(res.measures)))
         t = res.timings
         print("seed entropy = " + str(res.seed) + "; wall time " + ", ".join(
             f"{k} {t[k]:.2f} s" for k in ("constitution", "pre_equilibration", "protocol", "output", "total")

@@ -43,6 +43,8 @@ COLUMN_TYPES = ("float", "int", "bool", "string", "bigint", "int_list", "float_l
 RUN_COLUMNS = ("repetition", "frequency_Hz", "omega", "dt", "N_steps")
 
 _G = "{} modulus G{} from the {} (Pa); empty for a failed run"
+_CHECK = ("check {0}: True when it passes, False when it fails, empty when it cannot be judged (rule: "
+          "particleShear.analysis.verdicts.CHECKS['{0}'], docs/analysis.md \"Verdicts\")")
 _SE = "standard error of {} over the measured excitation periods (Pa); NaN with fewer than 2 periods"
 #: column -> (type, unit, description, nullable) of every column that is not a parameter
 _FIXED = {
@@ -66,6 +68,12 @@ _FIXED = {
     "T_surface": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, surface stress", True),
     "S_internal": ("float", "1", "Ewoldt-Hosoi-McKinley stiffening ratio S, internal stress", True),
     "T_internal": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, internal stress", True),
+    "linear_response": ("bool", "", _CHECK.format("linear_response"), True),
+    "estimators_agree": ("bool", "", _CHECK.format("estimators_agree"), True),
+    "moduli_positive": ("bool", "", _CHECK.format("moduli_positive"), True),
+    "excitation_resolved": ("bool", "", _CHECK.format("excitation_resolved"), True),
+    "verdict": ("string", "", "'ok' when no check of the run failed, else 'flagged: ' and the failed checks' names "
+                "(docs/analysis.md, \"Verdicts\"); empty for a failed run", True),
     "repetition": ("int", "", "index of the run among the repetitions of its parameter point (0-based; "
                    "SweepRun.repetition)", False),
     "frequency_Hz": ("float", "Hz", "excitation frequency f; empty for a failed run", True),
@@ -126,6 +134,12 @@ _PROTOCOL_FIXED = {
     "strain_plateau_se": ("float", "1", "standard error of strain_plateau by block averaging" + _P.format("'creep'")),
     "stress_tracking": ("float", "1", "(mean plate stress over the second half of the hold − σ₀)/σ₀"
                         + _P.format("'creep'")),
+    "plateau_reached": ("bool", "", _CHECK.format("plateau_reached") + _P.format("'steady' or 'relaxation'")),
+    "strain_sufficient": ("bool", "", _CHECK.format("strain_sufficient") + _P.format("'steady'")),
+    "stress_held": ("bool", "", _CHECK.format("stress_held") + _P.format("'creep'")),
+    "rate_unsaturated": ("bool", "", _CHECK.format("rate_unsaturated") + _P.format("'creep'")),
+    "hold_sufficient": ("bool", "", _CHECK.format("hold_sufficient") + _P.format("'creep'")),
+    "strain_above_noise": ("bool", "", _CHECK.format("strain_above_noise") + _P.format("'relaxation'")),
 }
 #: the protocol columns, in table order
 PROTOCOL_COLUMNS = tuple(_PROTOCOL_FIXED)
