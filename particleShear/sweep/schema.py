@@ -466,8 +466,9 @@ def load_results(folder_or_csv, as_frame=None):
     folder_or_csv : str or os.PathLike
         The sweep folder, or a results table (``.csv``) itself (its schema is looked for beside it).
     as_frame : bool, optional
-        True: a DataFrame (needs pandas); False: a list of dicts; None (default): a DataFrame when
-        pandas is installed, else the list.
+        True: a DataFrame (needs pandas, the extra ``[tables]``); False: a list of dicts; None
+        (default): a DataFrame when pandas is installed, else the list.  Code that indexes the
+        result as a DataFrame should pass True, so a missing pandas is an error saying so.
 
     Returns
     -------
@@ -483,12 +484,20 @@ def load_results(folder_or_csv, as_frame=None):
         of its column's type (naming the file, the line and the column), or ``as_frame`` is not
         None, True or False.
     ImportError
-        When ``as_frame=True`` and pandas is not installed.
+        When ``as_frame=True`` and pandas is not installed (naming the extra ``[tables]``), before
+        the table is read.
     """
     from .reader import read_table
     from .table import TABLE_NAME
     if as_frame not in (None, True, False):
         raise ValueError(f"as_frame={as_frame!r} is invalid: allowed None, True or False")
+    if as_frame:
+        try:
+            import pandas  # noqa: F401  (checked before the table is read)
+        except ImportError:
+            raise ImportError("load_results(as_frame=True) needs pandas: pip install \"particleShear[tables]\" "
+                              "(from this source, see README 'Install'), or pass as_frame=False for a list of "
+                              "typed dicts") from None
     path = os.fspath(folder_or_csv)
     if os.path.isdir(path):
         path = os.path.join(path, TABLE_NAME)
