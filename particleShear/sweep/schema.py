@@ -51,8 +51,8 @@ _FIXED = {
     "error": ("string", "", "exception type and message of a failed run; empty when ok", False),
     "Gp_surface": ("float", "Pa", _G.format("storage", "′", "plate (surface) forces"), True),
     "Gpp_surface": ("float", "Pa", _G.format("loss", "″", "plate (surface) forces"), True),
-    "Gp_internal": ("float", "Pa", _G.format("storage", "′", "overall stress tensor (internal, eq. S1-24)"), True),
-    "Gpp_internal": ("float", "Pa", _G.format("loss", "″", "overall stress tensor (internal, eq. S1-24)"), True),
+    "Gp_internal": ("float", "Pa", _G.format("storage", "′", "internal estimator (stress tensor, eq. S1-24)"), True),
+    "Gpp_internal": ("float", "Pa", _G.format("loss", "″", "internal estimator (stress tensor, eq. S1-24)"), True),
     "Gp_surface_se": ("float", "Pa", _SE.format("Gp_surface"), True),
     "Gpp_surface_se": ("float", "Pa", _SE.format("Gpp_surface"), True),
     "Gp_internal_se": ("float", "Pa", _SE.format("Gp_internal"), True),
@@ -93,7 +93,7 @@ _PROTOCOL_FIXED = {
     "stress_surface": ("float", "Pa", "steady shear stress from the plate forces (mean after the transient)"
                        + _P.format("'steady'")),
     "stress_surface_se": ("float", "Pa", "standard error of stress_surface by block averaging" + _P.format("'steady'")),
-    "stress_internal": ("float", "Pa", "steady shear stress of the overall stress tensor (eq. S1-24)"
+    "stress_internal": ("float", "Pa", "steady shear stress of the internal estimator (stress tensor, eq. S1-24)"
                         + _P.format("'steady'")),
     "stress_internal_se": ("float", "Pa", "standard error of stress_internal by block averaging"
                            + _P.format("'steady'")),
@@ -114,7 +114,7 @@ _PROTOCOL_FIXED = {
                           + _P.format("'relaxation'")),
     "G_plateau_surface_se": ("float", "Pa", "standard error of G_plateau_surface by block averaging"
                              + _P.format("'relaxation'")),
-    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), overall stress tensor" + _P.format("'relaxation'")),
+    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), internal estimator" + _P.format("'relaxation'")),
     "G_plateau_internal_se": ("float", "Pa", "standard error of G_plateau_internal by block averaging"
                               + _P.format("'relaxation'")),
     "creep_rate": ("float", "1/s", "final creep rate dγ/dt over the last 20 % of the hold" + _P.format("'creep'")),
