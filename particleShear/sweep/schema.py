@@ -493,7 +493,7 @@ def load_results(folder_or_csv, as_frame=None):
         raise ValueError(f"as_frame={as_frame!r} is invalid: allowed None, True or False")
     if as_frame:
         try:
-            import pandas  # noqa: F401  (checked before the table is read)
+            __import__("pandas")            # checked before the table is read
         except ImportError:
             raise ImportError("load_results(as_frame=True) needs pandas: pip install \"particleShear[tables]\" "
                               "(from this source, see README 'Install'), or pass as_frame=False for a list of "
