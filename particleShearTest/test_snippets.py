@@ -22,9 +22,14 @@ def documents():
     return [d for d in [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md")) if d.exists()]
 
 
+def document_blocks_from_text(text):
+    """The code of every ```python block of a Markdown text, in order."""
+    return [m.group(1) for m in _FENCE.finditer(text)]
+
+
 def document_blocks(doc):
     """The code of every ```python block of ``doc``, in document order."""
-    return [m.group(1) for m in _FENCE.finditer(pathlib.Path(doc).read_text(encoding="utf-8"))]
+    return document_blocks_from_text(pathlib.Path(doc).read_text(encoding="utf-8"))
 
 
 def snippet_blocks():
@@ -46,6 +51,25 @@ def _headless_env():
     return env
 
 
+def run_block(code, folder, env):
+    """Run one block as pasted into ``folder`` by a fresh interpreter, warnings as errors."""
+    return subprocess.run([sys.executable, "-W", "error", "-c", code], cwd=folder, env=env, capture_output=True,
+                          text=True, timeout=900, stdin=subprocess.DEVNULL)
+
+
+class TestHarness(unittest.TestCase):
+    """The harness itself: blocks share their folder, and a block that warns fails."""
+
+    def test_blocks_share_one_folder_and_warnings_fail(self):
+        env = _headless_env()
+        with tempfile.TemporaryDirectory() as folder:
+            self.assertEqual(run_block("open('made_by_block_0.txt', 'w').write('x')", folder, env).returncode, 0)
+            self.assertEqual(run_block("assert open('made_by_block_0.txt').read() == 'x'", folder, env).returncode, 0)
+            self.assertNotEqual(run_block("import warnings; warnings.warn('w', UserWarning)", folder, env).returncode, 0)
+        blocks = document_blocks_from_text("text\n```python\nprint(1)\n```\n```bash\nls\n```\n```python\nprint(2)\n```\n")
+        self.assertEqual(blocks, ["print(1)\n", "print(2)\n"])
+
+
 @unittest.skipUnless((ROOT / "README.md").exists(), "documents not shipped with this installation")
 class TestDocumentSnippets(unittest.TestCase):
     def test_blocks_found(self):
@@ -61,9 +85,7 @@ class TestDocumentSnippets(unittest.TestCase):
             with tempfile.TemporaryDirectory() as folder:
                 for k, code in enumerate(blocks):
                     with self.subTest(document=name, block=k):
-                        proc = subprocess.run([sys.executable, "-W", "error", "-c", code], cwd=folder, env=env,
-                                              capture_output=True, text=True, timeout=900,
-                                              stdin=subprocess.DEVNULL)
+                        proc = run_block(code, folder, env)
                         self.assertEqual(proc.returncode, 0,
                                          f"{name} block {k} (pasted after blocks 0..{k - 1} in the same folder) "
                                          f"failed:\n{code}\n--- stderr ---\n{proc.stderr[-3000:]}")
