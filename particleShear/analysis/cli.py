@@ -135,7 +135,7 @@ def build_parser():
                                         "DIR/analysis.schema.json and (with matplotlib) DIR/analysis.png and .pdf.")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
-                   help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
+                   help="moduli from the plate forces (surface, default) or the stress tensor (internal)")
     p.add_argument("--json", action="store_true", help="print the rows of analysis.csv as JSON on stdout (NaN: null)")
     p.add_argument("--n-boot", metavar="N", default="2000",
                    help=f"bootstrap replicates, integer 1 ... {N_BOOT_MAX} (default 2000)")

@@ -2,7 +2,7 @@
 
 ``particleShear [run] [FLAGS]`` runs one :func:`~particleShear.doParticleShearSimulation`,
 headless by default (no windows unless ``--draw``), with a progress line on stderr, and prints G′
-and G″ from both estimators (overall stress tensor and surface forces) on stdout, or with
+and G″ from both estimators (internal and surface) on stdout, or with
 ``--json`` the result row (:meth:`~particleShear.SimulationResult.to_dict`) as JSON and nothing
 else.  ``particleShear sweep SPEC --out DIR`` runs a sweep (docs/sweeps.md), ``particleShear plot
 DIR`` plots one.
@@ -602,8 +602,8 @@ def main(argv=None):
         if res.output_path:
             print("output file: " + res.output_path)
     else:
-        print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
-        print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
+        print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (internal estimator)")
+        print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface estimator)")
         from ..analysis.verdicts import verdict_lines
         print("\n".join(verdict_lines(res.measures)))
         t = res.timings
