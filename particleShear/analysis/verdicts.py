@@ -38,7 +38,7 @@ __all__ = ["CHECKS", "PROTOCOL_CHECKS", "VERDICT_COLUMNS", "LINEAR_I3_I1", "AGRE
            "STEADY_MIN_STRAIN", "CREEP_TRACKING_TOLERANCE", "CREEP_MIN_RESPONSE_TIMES", "RATE_LIMIT_FRACTION",
            "RELAXATION_SIGNAL_MIN", "verdict", "failed_checks", "baseline_noise", "oscillatory_checks",
            "plateau_check", "steady_checks", "creep_checks", "relaxation_checks", "verdict_lines", "is_flagged",
-           "verdict_counts", "counts_note"]
+           "verdict_counts", "counts_note", "agreement_spread", "signal_to_noise"]
 
 #: largest I₃/I₁ (internal stress) of a linear response: the default scene gives 0.01–0.07 over seeds
 #: at γ₀ = 0.01 and 0.2 (noise and slip events), 0.05–0.13 at γ₀ = 1.  A weak test: in this model G′
@@ -224,28 +224,69 @@ def oscillatory_checks(moduli, measures, strain_amplitude, noise):
     dict
         :data:`PROTOCOL_CHECKS` ["oscillatory"] → True, False or None.
     """
-    g = {e: (float(a), float(b)) for e, (a, b) in moduli.items()
-         if a is not None and b is not None and math.isfinite(a) and math.isfinite(b)}
+    g = _finite_moduli(moduli)
     out = {"steady_state": _judged(measures.get("steady_state"))}
     ratio = measures.get("I3_I1_internal")
     if ratio is None or not math.isfinite(ratio):
         ratio = measures.get("I3_I1_surface")
     out["linear_response"] = None if ratio is None or not math.isfinite(ratio) else bool(ratio <= LINEAR_I3_I1)
-    if len(g) == 2:
-        (a1, b1), (a2, b2) = g["surface"], g["internal"]
-        scale = max(math.hypot(a1, b1), math.hypot(a2, b2))
-        out["estimators_agree"] = (bool(max(abs(a1 - a2), abs(b1 - b2)) <= AGREEMENT_TOLERANCE * scale)
-                                   if scale > 0 else None)
-    else:
-        out["estimators_agree"] = None
+    spread = agreement_spread(g)
+    out["estimators_agree"] = None if not math.isfinite(spread) else bool(spread <= AGREEMENT_TOLERANCE)
     out["moduli_positive"] = bool(all(a >= 0 and b >= 0 for a, b in g.values())) if g else None
+    snr = signal_to_noise(g, strain_amplitude, noise)
+    out["excitation_resolved"] = None if math.isnan(snr) else bool(snr >= SIGNAL_TO_NOISE_MIN)
+    return out
+
+
+def _finite_moduli(moduli):
+    return {e: (float(a), float(b)) for e, (a, b) in moduli.items()
+            if a is not None and b is not None and math.isfinite(a) and math.isfinite(b)}
+
+
+def agreement_spread(moduli):
+    """max(|G′_s − G′_i|, |G″_s − G″_i|) / max(|G*_s|, |G*_i|), the quantity ``estimators_agree`` bounds.
+
+    Parameters
+    ----------
+    moduli : dict
+        "surface" and "internal" → (G′, G″) in Pa.
+
+    Returns
+    -------
+    float
+        Dimensionless; NaN unless both estimators have finite moduli, not both zero.
+    """
+    g = _finite_moduli(moduli)
+    if len(g) < 2 or "surface" not in g or "internal" not in g:
+        return math.nan
+    (a1, b1), (a2, b2) = g["surface"], g["internal"]
+    scale = max(math.hypot(a1, b1), math.hypot(a2, b2))
+    return max(abs(a1 - a2), abs(b1 - b2)) / scale if scale > 0 else math.nan
+
+
+def signal_to_noise(moduli, strain_amplitude, noise):
+    """The smaller over the estimators of |G*|·γ₀ / baseline noise, the quantity ``excitation_resolved`` bounds.
+
+    Parameters
+    ----------
+    moduli : dict
+        Estimator → (G′, G″) in Pa.
+    strain_amplitude : float
+        γ₀.
+    noise : dict
+        Estimator → :func:`baseline_noise` (Pa).
+
+    Returns
+    -------
+    float
+        Dimensionless; inf for a noiseless baseline, NaN when no estimator has a baseline.
+    """
     snr = []
-    for est, (a, b) in g.items():
+    for est, (a, b) in _finite_moduli(moduli).items():
         n = noise.get(est, math.nan)
         if n is not None and math.isfinite(n):
             snr.append(math.hypot(a, b) * float(strain_amplitude) / n if n > 0 else math.inf)
-    out["excitation_resolved"] = bool(min(snr) >= SIGNAL_TO_NOISE_MIN) if snr else None
-    return out
+    return min(snr) if snr else math.nan
 
 
 def plateau_check(t, y, fraction=PLATEAU_FRACTION):
