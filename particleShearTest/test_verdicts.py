@@ -219,3 +219,36 @@ class TestAnalyseCounts(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestFolderOfAnEarlierVersion(unittest.TestCase):
+    """A results table written before the verdict columns existed resumes: nothing re-runs, the new
+    columns are added empty (its rows were not judged), every cell of the old rows is kept."""
+
+    def test_resume_adds_the_columns(self):
+        from particleShear.analysis.measures import MEASURE_COLUMNS
+        from particleShear.sweep import run_sweep
+        spec = {"parameters": dict(N=30, relative_frequency=0.5, pre_periods=0.5, periods=1, post_periods=0.5,
+                                   doDrawing=False, plotStress=False),
+                "grid": {"theAmplitude": [0.2, 0.1]}, "seeds": {"root": 7, "repetitions": 1}}
+        new = [c for c in vd.VERDICT_COLUMNS if c in MEASURE_COLUMNS]
+        with tempfile.TemporaryDirectory() as d, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run_sweep(spec, d, workers=1, progress=False)
+            path = os.path.join(d, "results.csv")
+            with open(path, newline="", encoding="utf-8") as fh:
+                rows = list(csv.DictReader(fh))
+            old_columns = [c for c in rows[0] if c not in new]
+            with open(path, "w", newline="", encoding="utf-8") as fh:      # the table as the earlier version wrote it
+                w = csv.DictWriter(fh, old_columns, lineterminator="\n", extrasaction="ignore")
+                w.writeheader()
+                w.writerows(rows)
+            again = run_sweep(spec, d, workers=1, progress=False)
+            self.assertEqual(sorted(r["run_id"] for r in again), sorted(r["run_id"] for r in rows))
+            with open(path, newline="", encoding="utf-8") as fh:
+                after = list(csv.DictReader(fh))
+            self.assertEqual(len(after), len(rows))                           # nothing ran again
+            self.assertEqual(list(after[0]), list(rows[0]))                   # this version's header
+            for a, b in zip(after, rows):
+                self.assertEqual({c: a[c] for c in old_columns}, {c: b[c] for c in old_columns})
+                self.assertEqual({a[c] for c in new}, {""})                   # not evaluated then
