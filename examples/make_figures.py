@@ -1,4 +1,4 @@
-"""Make the README's three pictures in docs/figures/ at 150 dpi (needs ``pip install "particleShear[plot]"``).
+"""Make the README's three pictures at 150 dpi (needs ``pip install ".[plot]"`` from this source).
 
 1. ``trace.png``: one run's strain and stress traces and its Lissajous loop (``result.plot``).
 2. ``sweep.png``: G′ and G″ against strain amplitude of a small real sweep (crosslinked,
@@ -6,10 +6,14 @@
    in the sweep runner's column layout and plotted by ``particleShear.plot.plot_sweep``.
 3. ``snapshot.png``: a captioned snapshot of that first run at the strain maximum.
 
+They are written to ``./particleShear-figures`` by default, never over the tracked files; to
+regenerate the README's pictures, name their folder explicitly.
+
 Usage (from the repository root, ~1–2 min on 2 cores)::
 
-    python examples/make_figures.py [--out docs/figures] [--workers 2]
-    python examples/make_figures.py --replot-sweep      # redraw sweep.png from the saved CSV
+    python examples/make_figures.py [--out DIR] [--workers 2]     # DIR default ./particleShear-figures
+    python examples/make_figures.py --out docs/figures             # regenerate the README's pictures
+    python examples/make_figures.py --out DIR --replot-sweep       # redraw sweep.png from DIR/sweep_results.csv
 """
 import argparse
 import csv
@@ -25,7 +29,7 @@ from particleShear.plot import plot_sweep, save_figure
 
 #: resolution of the raster figures (dots per inch)
 DPI = 150
-SMALL = dict(N=40, pre_periods=0.5, periods=2, post_periods=0.5, doDrawing=False, plotStress=False)
+SMALL = dict(N=40, pre_periods=0.5, periods=3, post_periods=0.5, doDrawing=False, plotStress=False)
 COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal",
            "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "spawn_key"]
 
@@ -67,7 +71,9 @@ def replot_sweep(out):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", default=os.path.join("docs", "figures"))
+    ap.add_argument("--out", default="particleShear-figures",
+                    help="folder of the pictures (created; default ./particleShear-figures); "
+                         "--out docs/figures regenerates the README's pictures")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--replot-sweep", action="store_true", help="only redraw sweep.png from OUT/sweep_results.csv")
     args = ap.parse_args(argv)

@@ -231,8 +231,8 @@ def plot_result(result, path=None):
     ax.axvspan(pre + P, periods[-1] if len(t) else pre + P, color="0.92")
     ax.axvline(pre, color="0.4", ls=":", lw=1)
     ax.axvline(pre + P, color="0.4", ls=":", lw=1)
-    ax.plot(periods, tau_s, color="C0", lw=1, label="τ surface (plate forces)")
-    ax.plot(periods, tau_i, color="C1", lw=1, label="τ internal (stress tensor)")
+    ax.plot(periods, tau_s, color="C0", lw=1, label="surface (plate forces)")
+    ax.plot(periods, tau_i, color="C1", lw=1, label="internal (stress tensor)")
     ax.set_xlabel("time t·f (periods)")
     ax.set_ylabel("shear stress τ (Pa)")
     ax2 = ax.twinx()
@@ -588,7 +588,7 @@ def build_parser():
                                      "DIR/G_vs_amplitude.png and .pdf, or G_vs_frequency.*).")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv (or the CSV file)")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
-                   help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
+                   help="moduli from the plate forces (surface, default) or the stress tensor (internal)")
     p.add_argument("--output", metavar="FILE", default=None,
                    help="write this file instead of DIR/G_vs_amplitude.png and .pdf")
     p.add_argument("--x", metavar="NAME", default=None,

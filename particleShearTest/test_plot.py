@@ -113,8 +113,8 @@ class TestResultPlot(unittest.TestCase):
         self.assertEqual(loop.get_xlabel(), "strain γ (–)")
         self.assertEqual(loop.get_ylabel(), "shear stress τ (Pa)")
         lines = {ln.get_label(): ln for ln in trace.get_lines() + strain_axis.get_lines()}
-        np.testing.assert_array_equal(lines["τ surface (plate forces)"].get_ydata(), res.series["stress_surface"])
-        np.testing.assert_array_equal(lines["τ internal (stress tensor)"].get_ydata(), res.series["stress_internal"])
+        np.testing.assert_array_equal(lines["surface (plate forces)"].get_ydata(), res.series["stress_surface"])
+        np.testing.assert_array_equal(lines["internal (stress tensor)"].get_ydata(), res.series["stress_internal"])
         np.testing.assert_array_equal(lines["strain γ"].get_ydata(), res.series["strain"])
         # time in periods: x = t·f
         np.testing.assert_allclose(lines["strain γ"].get_xdata(), res.series["t"] * res.f, rtol=1e-12)

@@ -94,6 +94,9 @@ _HEAD_COLUMNS = {
                           "for one group)")),
     "estimator": ("str", "", "the moduli used: surface (plate forces) or internal (overall stress tensor)"),
     "n_runs": ("int", "1", "runs (rows with status ok and finite moduli) of the group"),
+    "n_flagged": ("int", "1", "runs of the group whose verdict is flagged (counted in n_runs; docs/analysis.md "
+                              "\"Verdicts\")"),
+    "n_failed": ("int", "1", "rows of the group's parameters whose status is not ok (not in n_runs)"),
     "n_amplitudes": ("int", "1", "distinct strain amplitudes of the group"),
     "amplitude_min": ("float", "1", "smallest strain amplitude"),
     "amplitude_max": ("float", "1", "largest strain amplitude"),
@@ -138,7 +141,7 @@ def build_parser():
                                         "DIR/analysis.schema.json and (with matplotlib) DIR/analysis.png and .pdf.")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
-                   help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
+                   help="moduli from the plate forces (surface, default) or the stress tensor (internal)")
     p.add_argument("--json", action="store_true", help="print the rows of analysis.csv as JSON on stdout (NaN: null)")
     p.add_argument("--n-boot", metavar="N", default="2000",
                    help=f"bootstrap replicates, integer 1 ... {N_BOOT_MAX} (default 2000)")
@@ -230,7 +233,8 @@ def group_runs(rows, estimator="surface"):
     groups : list of dict
         One per group, sorted by its parameter values (numbers numerically): ``"parameters"``
         (``{name: text}`` of every grouping column), ``"amplitude"``, ``"Gp"``, ``"Gpp"`` (lists of
-        floats, one per run or step).
+        floats, one per run or step), ``"n_flagged"`` (runs of the group whose verdict is flagged),
+        ``"n_failed"`` (rows of its parameters whose status is not ok), ``"flags"`` (check → count).
     varying : list of str
         The grouping columns whose value differs between groups (header order).
     skipped : int
@@ -256,9 +260,25 @@ def group_runs(rows, estimator="surface"):
         d["amplitude"].append(A)
         d["Gp"].append(gp)
         d["Gpp"].append(gpp)
+    _count_verdicts(rows, names, cells)
     keys = sorted(cells, key=lambda k: [_sort_key(v) for v in k])
     varying = [c for i, c in enumerate(names) if len({k[i] for k in keys}) > 1]
     return [cells[k] for k in keys], varying, skipped
+
+
+def _count_verdicts(rows, names, cells):
+    """Each group's ``n_flagged``, ``n_failed`` and ``flags`` (check → count) over every row of its
+    parameters, whatever its status (:func:`particleShear.analysis.verdicts.verdict_counts`)."""
+    from .grouping import MODULI_PROTOCOLS, measured_row, row_protocol
+    from .verdicts import verdict_counts
+    members = {}
+    for row in rows:
+        if row_protocol(row) not in MODULI_PROTOCOLS:
+            continue
+        row = measured_row(row)
+        members.setdefault(tuple(str(row.get(c, "")) for c in names), []).append(row)
+    for key, d in cells.items():
+        d["n_failed"], d["n_flagged"], d["flags"] = verdict_counts(members.get(key, []))
 
 
 def analysis_columns(varying):
@@ -347,8 +367,9 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
     from .sweep import CHARACTERISTICS
     row = {"group": _label(group["parameters"], varying)}
     row.update({n: group["parameters"][n] for n in varying})
-    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "confidence": confidence,
-                "n_boot": n_boot, "bootstrap_seed": seed})
+    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "n_flagged": group.get("n_flagged", 0),
+                "n_failed": group.get("n_failed", 0), "confidence": confidence, "n_boot": n_boot,
+                "bootstrap_seed": seed})
     if summary is not None:
         row.update(summary.to_dict())
     else:
@@ -360,7 +381,10 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
                 row[name + suffix] = math.nan
             row[name + "_defined"] = 0.0
             row[name + "_flag"] = "too_few_amplitudes"
-    row["note"] = "; ".join(notes)
+    from .verdicts import counts_note
+    counted = counts_note(len(group["amplitude"]), group.get("n_failed", 0), group.get("n_flagged", 0),
+                          group.get("flags", {}))
+    row["note"] = "; ".join(([counted] if counted else []) + list(notes))
     return row
 
 
@@ -576,7 +600,7 @@ def _human(rows):
     shown = (("plateau", "plateau (Pa)"), ("linear_limit_5", "linear limit 5 %"), ("flow_point", "flow point"),
              ("yield_strain", "yield strain"))
     head = ["group", "runs"] + [t for _, t in shown]
-    body = [[r["group"], str(r["n_runs"])] +
+    body = [[r["group"], _runs_text(r)] +
             [_with_interval(r, n) for n, _ in shown] for r in rows]
     widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
     buf = io.StringIO()
@@ -591,6 +615,12 @@ def _human(rows):
         if r["note"]:
             buf.write(f"note: {r['group']}: {r['note']}\n")
     return buf.getvalue()
+
+
+def _runs_text(r):
+    """``12`` or ``12 (2 flagged, 1 failed)``: a group's runs with its verdict counts."""
+    extra = [f"{r[k]} {k[2:]}" for k in ("n_flagged", "n_failed") if r.get(k)]
+    return str(r["n_runs"]) + (f" ({', '.join(extra)})" if extra else "")
 
 
 class _Terminated(BaseException):

@@ -29,6 +29,7 @@ import zlib
 import numpy as np
 
 from .grouping import SUMMARY_PROTOCOLS, measured_row, row_protocol, short_value
+from .verdicts import counts_note, verdict_counts
 
 __all__ = ["COLUMNS", "FLAGS", "QUANTITIES", "protocol_summaries", "summary_columns"]
 
@@ -55,6 +56,8 @@ COLUMNS = {
     "unit": ("str", "", "unit of value, ci_low, ci_high"),
     "estimator": ("str", "", "the stress used: surface (plate forces) or internal (overall stress tensor)"),
     "n_runs": ("int", "1", "finished runs (status ok, finite value) of the group that count"),
+    "n_flagged": ("int", "1", "runs of the group (status ok) whose verdict is flagged (docs/analysis.md \"Verdicts\")"),
+    "n_failed": ("int", "1", "runs of the group whose status is not ok"),
     "n_rates": ("int", "1", "distinct rates with a finished run (steady groups; empty otherwise)"),
     "value": ("float", "", "the mean over the runs, or the fitted parameter (unit: column unit; empty: undefined)"),
     "ci_low": ("float", "", "lower end of the bootstrap percentile interval (level: confidence)"),
@@ -170,33 +173,46 @@ def protocol_summaries(rows, names, estimator="surface", n_boot=2000, confidence
         base.update({n: params.get(n, "") for n in varying if n != "protocol"})
         group = cells[key]
         ok = [r for r in group if str(r.get("status", "")).strip() == "ok"]
+        n_failed, n_flagged, flags = verdict_counts(group)
+        base.update(n_flagged=n_flagged, n_failed=n_failed)
+        first = len(out)
         if proto == "steady":
             out.extend(_steady(group, ok, base, estimator, n_boot, confidence, rng, fit_flow_curve))
-            continue
-        for pattern, unit in QUANTITIES[proto].items():
-            name = pattern.format(est=estimator)
-            values = [_float(r.get(name)) for r in ok]
-            finite = [v for v in values if math.isfinite(v)]
-            notes = []
-            if len(finite) < len(group):
-                notes.append(f"{len(group) - len(finite)} of {len(group)} run(s) left out (not ok, or "
-                             f"{name} not finite)")
-            row = dict(base, quantity=name, unit=unit, n_runs=len(finite), n_rates=None, flag="ok")
-            modulus = pattern.startswith("G_")
-            if finite:
-                row["value"], row["ci_low"], row["ci_high"] = _mean_interval(finite, n_boot, confidence, rng,
-                                                                             modulus=modulus)
-                if len(finite) == 1:
-                    notes.append("one run: degenerate interval")
-                if modulus and not row["value"] > 0:
-                    row["flag"] = "non_positive"
-                    notes.append(f"mean {name} <= 0: no interval")
-            else:
-                row["value"] = row["ci_low"] = row["ci_high"] = math.nan
-                row["flag"] = "undefined"
-            row["note"] = "; ".join(notes)
-            out.append(row)
+        else:
+            out.extend(_quantities(proto, group, ok, base, estimator, n_boot, confidence, rng))
+        counted = counts_note(len(ok), n_failed, n_flagged, flags)
+        for row in out[first:]:
+            row["note"] = "; ".join(x for x in (counted, row["note"]) if x)
     return out, varying
+
+
+def _quantities(proto, group, ok, base, estimator, n_boot, confidence, rng):
+    """The rows of one relaxation or creep group: the mean of each quantity with its interval."""
+    out = []
+    for pattern, unit in QUANTITIES[proto].items():
+        name = pattern.format(est=estimator)
+        values = [_float(r.get(name)) for r in ok]
+        finite = [v for v in values if math.isfinite(v)]
+        notes = []
+        if len(finite) < len(group):
+            notes.append(f"{len(group) - len(finite)} of {len(group)} run(s) left out (not ok, or "
+                         f"{name} not finite)")
+        row = dict(base, quantity=name, unit=unit, n_runs=len(finite), n_rates=None, flag="ok")
+        modulus = pattern.startswith("G_")
+        if finite:
+            row["value"], row["ci_low"], row["ci_high"] = _mean_interval(finite, n_boot, confidence, rng,
+                                                                         modulus=modulus)
+            if len(finite) == 1:
+                notes.append("one run: degenerate interval")
+            if modulus and not row["value"] > 0:
+                row["flag"] = "non_positive"
+                notes.append(f"mean {name} <= 0: no interval")
+        else:
+            row["value"] = row["ci_low"] = row["ci_high"] = math.nan
+            row["flag"] = "undefined"
+        row["note"] = "; ".join(notes)
+        out.append(row)
+    return out
 
 
 def _steady(group, ok, base, estimator, n_boot, confidence, rng, fit_flow_curve):
