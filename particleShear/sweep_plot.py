@@ -34,8 +34,9 @@ and creep protocols hold no moduli and are not drawn here.
 Intervals
 ---------
 With the amplitude on the x-axis each curve's points carry the percentile bootstrap interval of
-:func:`particleShear.analysis.sweep.sweep_summary` (seeds resampled within each amplitude; 95 %, a
-fixed resampling seed, so the figure is reproducible); otherwise — or when a curve has a single
+:func:`particleShear.analysis.sweep.sweep_summary` (seeds resampled within each amplitude, widened to
+Student-t width on the log scale, so never below 0; 95 %; the resampling seed
+:data:`particleShear.analysis.sweep.DEFAULT_SEED`, as ``analyse``'s, so the figure is reproducible); otherwise — or when a curve has a single
 amplitude, which the bootstrap summary does not take — mean ± one standard error ``s/√n``
 (``ddof = 1``; zero for one seed).  The legend says which.
 """
