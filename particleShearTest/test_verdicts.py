@@ -76,9 +76,10 @@ class TestRulesOnConstructedRecords(unittest.TestCase):
 
     def test_excitation_against_the_baseline_noise(self):
         # stress amplitude |G*|·γ0 = 102 Pa; baseline noise σn: SNR = 102/σn
-        for noise, passes in ((102.0 / 50, True), (102.0 / 3, False)):
+        for snr, passes in ((10 * vd.SIGNAL_TO_NOISE_MIN, True), (vd.SIGNAL_TO_NOISE_MIN / 3, False)):
+            noise = math.hypot(1000.0, 200.0) * 0.1 / snr
             m = measures_of(*record(noise=noise, seed=3))
-            self.assertIs(m["excitation_resolved"], passes, noise)
+            self.assertIs(m["excitation_resolved"], passes, snr)
 
     def test_no_baseline_leaves_the_excitation_unjudged_and_unflagged(self):
         s, f, g0 = record(pre=0.0)
@@ -115,7 +116,8 @@ class TestOscillatoryRuns(unittest.TestCase):
             warnings.simplefilter("ignore")
             cls.default = doParticleShearSimulation(seed=1, **QUIET)
             cls.disagree = doParticleShearSimulation(N=50, relative_frequency=0.1, theAmplitude=0.01, seed=3, **QUIET)
-            cls.tiny = doParticleShearSimulation(N=50, theAmplitude=1e-9, pre_periods=0.5, post_periods=0, seed=1,
+            # issue 44's case; seed 5 is one whose baseline noise drowns the excitation (SNR 0.15)
+            cls.tiny = doParticleShearSimulation(N=50, theAmplitude=1e-9, pre_periods=0.5, post_periods=0, seed=5,
                                                  **QUIET)
 
     def test_default_run_passes_every_judged_check(self):
