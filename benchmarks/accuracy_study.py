@@ -32,11 +32,13 @@ to a plain call (checked at start-up, see ``_self_check``).
 Usage::
 
     python benchmarks/accuracy_study.py [--quick] [--out DIR] [--workers 2]
-    python benchmarks/accuracy_study.py --replot      # redraw accuracy.png from the saved JSON
+    python benchmarks/accuracy_study.py --out docs/accuracy_data            # regenerate docs/accuracy.md's data
+    python benchmarks/accuracy_study.py --out docs/accuracy_data --replot   # redraw its accuracy.png from the JSON
 
 ``--quick`` (< 3 min on 2 cores) uses N = 45 scenes, four factors and fewer seeds; the full
 study (~15–25 min on 2 cores) is what ``docs/accuracy.md`` reports.  Output in ``DIR``
-(default ``docs/accuracy_data``): ``accuracy_results.json``, ``convergence.csv``,
+(default ``./accuracy-study``, a scratch folder: the tracked ``docs/accuracy_data`` is written only
+when named with ``--out``): ``accuracy_results.json``, ``convergence.csv``,
 ``statistics.csv``, ``stability.csv``, ``accuracy_tables.md`` and ``accuracy.png``.
 """
 import os
@@ -527,7 +529,9 @@ def _self_check():
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="small scenes, < 3 min on 2 cores")
-    ap.add_argument("--out", default=os.path.join("docs", "accuracy_data"), help="output folder")
+    ap.add_argument("--out", default="accuracy-study",
+                    help="output folder (created; default ./accuracy-study); --out docs/accuracy_data "
+                         "regenerates the data of docs/accuracy.md")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1, help="seed of the convergence and bisection runs")
     ap.add_argument("--replot", action="store_true",
@@ -564,7 +568,7 @@ def main(argv=None):
         b["dt0"] = next((p["dt0"] for p in b["probes"] if p["dt0"]), None)
     results = dict(
         config=dict(command="python benchmarks/accuracy_study.py" + (" --quick" if args.quick else "")
-                    + (f" --out {args.out}" if args.out != os.path.join("docs", "accuracy_data") else ""),
+                    + f" --out {args.out}",
                     quick=args.quick, seed=args.seed, N_conv=N_conv, workers=args.workers,
                     machine=f"{platform.machine()}, {os.cpu_count()} CPUs, Python {platform.python_version()}, "
                             f"NumPy {np.__version__}",

@@ -1,4 +1,4 @@
-"""Make the README's three pictures in docs/figures/ at 150 dpi (needs ``pip install "particleShear[plot]"``).
+"""Make the README's three pictures at 150 dpi (needs ``pip install ".[plot]"`` from this source).
 
 1. ``trace.png``: one run's strain and stress traces and its Lissajous loop (``result.plot``).
 2. ``sweep.png``: G′ and G″ against strain amplitude of a small real sweep (crosslinked,
@@ -7,10 +7,14 @@
    ``particleShear.plot.plot_sweep``.
 3. ``snapshot.png``: a captioned snapshot of that first run at the strain maximum.
 
+They are written to ``./particleShear-figures`` by default, never over the tracked files; to
+regenerate the README's pictures, name their folder explicitly.
+
 Usage (from the repository root, ~6 min of one core: 45 runs of ~8 s)::
 
-    python examples/make_figures.py [--out docs/figures] [--workers 2]
-    python examples/make_figures.py --replot-sweep      # redraw sweep.png from the saved CSV
+    python examples/make_figures.py [--out DIR] [--workers 2]     # DIR default ./particleShear-figures
+    python examples/make_figures.py --out docs/figures             # regenerate the README's pictures
+    python examples/make_figures.py --out DIR --replot-sweep       # redraw sweep.png from DIR/sweep_results.csv
 """
 import argparse
 import csv
@@ -33,7 +37,7 @@ SMALL = dict(N=40, pre_periods=0.5, periods=3, post_periods=0.5, doDrawing=False
 #: ~4.5× narrower than 2 for the same spread, bars that separate the materials — within ~6 min of one core
 SEEDS = 5
 COLUMNS = ["run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal",
-           "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "N", "relative_frequency", "spawn_key"]
+           "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "N", "relative_frequency", "verdict", "spawn_key"]
 
 
 def trace_and_snapshot(out, work):
@@ -62,7 +66,7 @@ def small_sweep(out, work, workers):
             ok = all(np.isfinite(r.G_surface)) and all(np.isfinite(r.G_internal))
             w.writerow([k, "ok" if ok else "error", "", *r.G_surface, *r.G_internal, p["theAmplitude"], p["theMu"],
                         p["do_permanent_links"], p["cut_lines"], p["N"], p["relative_frequency"],
-                        json.dumps([int(k) for k in r.spawn_key])])
+                        getattr(r, "verdict", "") or "", json.dumps([int(k) for k in r.spawn_key])])
     return replot_sweep(out)
 
 
@@ -74,7 +78,9 @@ def replot_sweep(out):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", default=os.path.join("docs", "figures"))
+    ap.add_argument("--out", default="particleShear-figures",
+                    help="folder of the pictures (created; default ./particleShear-figures); "
+                         "--out docs/figures regenerates the README's pictures")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--replot-sweep", action="store_true", help="only redraw sweep.png from OUT/sweep_results.csv")
     args = ap.parse_args(argv)

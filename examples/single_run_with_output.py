@@ -13,7 +13,7 @@ def main():
     os.makedirs(folder, exist_ok=True)
     result = doParticleShearSimulation(root_folder=folder, doDrawing=False, plotStress=False, saveData=True,
                                        seed=1, verbose=False, return_result=True)
-    print("G', G'' from the overall stress tensor (Pa):", result.G_internal)
+    print("G', G'' of the internal estimator (Pa):", result.G_internal)
     print("G', G'' from the surface forces (Pa):      ", result.G_surface)
     print("output file:", result.output_path)
     print("wall time per phase (s):", {k: round(v, 2) for k, v in result.timings.items()})

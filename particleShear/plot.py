@@ -31,6 +31,7 @@ import sys
 import warnings
 
 from .messages import console_messages
+from .analysis.verdicts import is_flagged  # noqa: F401 - re-exported: the one rule of a flagged row
 from .run.guard import SuggestingParser, command_line_names
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
@@ -58,24 +59,8 @@ def _figure(width, height):
 
 
 #: legend entry of the points drawn hollow because a run of theirs has a flagged verdict
+#: (:func:`particleShear.analysis.verdicts.is_flagged`, re-exported here for the figures)
 FLAGGED_LABEL = "flagged (see verdict)"
-
-
-def is_flagged(row):
-    """Whether a results row's ``verdict`` column flags it (``"flagged: name, …"``).
-
-    Tables written before the verdict column have none: their rows are not flagged.
-
-    Parameters
-    ----------
-    row : mapping
-        A row of ``results.csv``.
-
-    Returns
-    -------
-    bool
-    """
-    return str(row.get("verdict") or "").strip().lower().startswith("flagged")
 
 
 def made_by(N=None, seeds=None, estimator=None, rate=None, amplitude=None, stress=None):
@@ -418,8 +403,8 @@ def plot_result(result, path=None):
     ax.axvspan(pre + P, periods[-1] if len(t) else pre + P, color="0.92")
     ax.axvline(pre, color="0.4", ls=":", lw=1)
     ax.axvline(pre + P, color="0.4", ls=":", lw=1)
-    ax.plot(periods, tau_s, color="C0", lw=1, label="τ surface (plate forces)")
-    ax.plot(periods, tau_i, color="C1", lw=1, label="τ internal (stress tensor)")
+    ax.plot(periods, tau_s, color="C0", lw=1, label="surface (plate forces)")
+    ax.plot(periods, tau_i, color="C1", lw=1, label="internal (stress tensor)")
     ax.set_xlabel("time t·f (periods)")
     ax.set_ylabel("shear stress τ (Pa)")
     ax2 = ax.twinx()
@@ -762,7 +747,8 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
     confidence : float, optional
         Level of the bootstrap intervals, in (0, 1) (default 0.95).
     bootstrap_seed : int or None, optional
-        Seed of the resampling, >= 0 (default 0: the figure is reproducible); None: fresh entropy.
+        Seed of the resampling, >= 0 (default 0, :data:`particleShear.analysis.sweep.DEFAULT_SEED`, as
+        ``analyse``'s: the figure is reproducible); None: fresh entropy.
     max_panels : int, optional
         More panels than this are refused with a ValueError naming the parameters (default 12).
 
@@ -833,7 +819,7 @@ def build_parser():
                                      "DIR/G_vs_amplitude.png and .pdf, or G_vs_frequency.*).")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv (or the CSV file)")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
-                   help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
+                   help="moduli from the plate forces (surface, default) or the stress tensor (internal)")
     p.add_argument("--output", metavar="FILE", default=None,
                    help="write this file instead of DIR/G_vs_amplitude.png and .pdf")
     p.add_argument("--x", metavar="NAME", default=None,

@@ -34,8 +34,9 @@ and creep protocols hold no moduli and are not drawn here.
 Intervals
 ---------
 With the amplitude on the x-axis each curve's points carry the percentile bootstrap interval of
-:func:`particleShear.analysis.sweep.sweep_summary` (seeds resampled within each amplitude; 95 %, a
-fixed resampling seed, so the figure is reproducible); otherwise — or when a curve has a single
+:func:`particleShear.analysis.sweep.sweep_summary` (seeds resampled within each amplitude, widened to
+Student-t width on the log scale, so never below 0; 95 %; the resampling seed
+:data:`particleShear.analysis.sweep.DEFAULT_SEED`, as ``analyse``'s, so the figure is reproducible); otherwise — or when a curve has a single
 amplitude, which the bootstrap summary does not take — mean ± one standard error ``s/√n``
 (``ddof = 1``; zero for one seed).  The legend says which.
 """
@@ -46,6 +47,7 @@ import warnings
 
 import numpy as np
 
+from .analysis.sweep import DEFAULT_SEED
 from .plot import (ESTIMATORS, FLAGGED_LABEL, _figure, _float, dodge_factors, fit_title, group_of, is_flagged,
                    made_by, ok_moduli)
 
@@ -154,8 +156,8 @@ def _mean_se(values):
     return m, m - se, m + se
 
 
-def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, confidence=0.95, bootstrap_seed=0,
-                 max_panels=MAX_PANELS):
+def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, confidence=0.95,
+                 bootstrap_seed=DEFAULT_SEED, max_panels=MAX_PANELS):
     """The numbers of the sweep figure: panels, curves per μ, points per x value (module docstring).
 
     Parameters
@@ -175,7 +177,8 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
     confidence : float, optional
         Level of the bootstrap intervals, in (0, 1) (default 0.95).
     bootstrap_seed : int or None, optional
-        Seed of the resampling, >= 0 (default 0: reproducible); None draws fresh entropy.
+        Seed of the resampling, >= 0 (default 0, :data:`particleShear.analysis.sweep.DEFAULT_SEED`, as
+        ``analyse``'s: reproducible); None draws fresh entropy.
     max_panels : int, optional
         Refuse a split into more panels than this (default :data:`MAX_PANELS`).
 

@@ -150,14 +150,72 @@ class Synthetic(unittest.TestCase):
             with open(os.path.join(d, "results.csv"), "w", newline="", encoding="utf-8") as fh:
                 fh.write(row_line({c: c for c in cols}, cols))
                 fh.writelines(row_line(dict(base, theAmplitude=A, run_id=f"r{k}", status="ok", Gp_surface=gp,
-                                           Gpp_surface=gpp, Gp_internal=gp, Gpp_internal=gpp), cols) for k, (A, gp, gpp) in enumerate([(0.01, 100.0, 10.0), (0.1, 60.0, 30.0), (1.0, -5.0, 40.0)] * 2))
+                                           Gpp_surface=gpp, Gp_internal=gp, Gpp_internal=gpp), cols) for k, (A, gp, gpp) in enumerate([(0.01, 100.0, 10.0), (0.03, 90.0, 20.0), (0.1, 60.0, 30.0), (1.0, -5.0, 40.0)] * 2))
             rc, out, err = run(["analyse", d, "--seed", "0", "--n-boot", "20"])
             self.assertEqual(rc, 0, err)
             row = read_analysis(d)[0]
             self.assertEqual(row["group"], "all runs")
             self.assertIn("mean G′ <= 0 at amplitude(s) [1]", row["note"])
             self.assertEqual(row["flow_point"], "")            # no log across a negative mean: empty = undefined
+            self.assertEqual(row["flow_point_flag"], "undefined")
+            self.assertEqual((row["flow_point_ci_low"], row["flow_point_ci_high"]), ("", ""))   # none without a value
             self.assertIn("mean G′ <= 0", out)
+
+    def write_rows(self, d, points):
+        cols = table_columns()
+        base = dict(sweep_parameter_defaults())
+        with open(os.path.join(d, "results.csv"), "w", newline="", encoding="utf-8") as fh:
+            fh.write(row_line({c: c for c in cols}, cols))
+            fh.writelines(row_line(dict(base, theAmplitude=A, run_id=f"r{k}", status="ok", Gp_surface=gp,
+                                        Gpp_surface=gpp, Gp_internal=gp, Gpp_internal=gpp), cols)
+                          for k, (A, gp, gpp) in enumerate(points))
+
+    def test_censored_flow_point_is_a_bound(self):
+        # G′ > G″ at every amplitude up to 0.2: the flow point lies beyond 0.2 — '> 0.2', no interval, a flag
+        with tempfile.TemporaryDirectory() as d:
+            self.write_rows(d, [(A, 100.0 * f, 10.0 * f) for A in (0.01, 0.03, 0.1, 0.2) for f in (0.9, 1.0, 1.1)])
+            rc, out, err = run(["analyse", d, "--n-boot", "50", "--no-figure"])
+            self.assertEqual(rc, 0, err)
+            row = read_analysis(d)[0]
+            self.assertEqual((float(row["flow_point"]), row["flow_point_flag"]), (0.2, "lower_bound"))
+            self.assertEqual((row["flow_point_ci_low"], row["flow_point_ci_high"]), ("", ""))
+            self.assertIn("> 0.2", out)
+            self.assertNotIn("0.2 [0.2, 0.2]", out)
+            with open(os.path.join(d, "analysis.schema.json"), encoding="utf-8") as fh:
+                self.assertEqual(json.load(fh)["columns"]["flow_point_flag"]["type"], "str")
+
+    def test_fewer_than_four_amplitudes_refuse_the_points(self):
+        with tempfile.TemporaryDirectory() as d:
+            self.write_rows(d, [(A, 100.0 / A * f, 10.0 * f) for A in (0.01, 1.0) for f in (0.9, 1.1)])
+            rc, out, err = run(["analyse", d, "--n-boot", "50", "--no-figure"])
+            self.assertEqual(rc, 0, err)
+            row = read_analysis(d)[0]
+            self.assertIn("2 amplitudes: the characteristic points", row["note"])
+            self.assertIn("need >= 4", out)
+            for name in CHARACTERISTICS:
+                if name != "plateau":
+                    self.assertEqual((row[name], row[name + "_flag"]), ("", "too_few_amplitudes"), name)
+            self.assertEqual(row["plateau_flag"], "ok")
+            self.assertTrue(0 <= float(row["plateau_ci_low"]) <= float(row["plateau"]) <= float(row["plateau_ci_high"]))
+
+    def test_same_call_same_numbers_with_the_default_seed(self):
+        from particleShear.analysis.sweep import DEFAULT_SEED
+        from particleShear.plot import plot_sweep
+        import inspect
+        with tempfile.TemporaryDirectory() as d:
+            self.write_rows(d, [(A, 100.0 / (1 + A) * f, 30.0 * A * f) for A in (0.01, 0.1, 0.3, 1.0, 3.0)
+                                for f in (0.8, 1.0, 1.3)])
+            first = run(["analyse", d, "--n-boot", "100", "--no-figure"])
+            one = read_analysis(d)
+            second = run(["analyse", d, "--n-boot", "100", "--no-figure"])
+            self.assertEqual(first[1], second[1])              # the same printed numbers
+            self.assertEqual(one, read_analysis(d))
+            self.assertEqual(one[0]["bootstrap_seed"], str(DEFAULT_SEED))   # recorded
+            self.assertIn(f"seed {DEFAULT_SEED}", first[1])
+            other = run(["analyse", d, "--n-boot", "100", "--no-figure", "--seed", "5"])
+            self.assertNotEqual(one[0]["plateau_ci_low"], read_analysis(d)[0]["plateau_ci_low"])   # --seed overrides
+            self.assertIn("seed 5", other[1])
+        self.assertEqual(inspect.signature(plot_sweep).parameters["bootstrap_seed"].default, DEFAULT_SEED)
 
 
 class BadInput(unittest.TestCase):

@@ -10,7 +10,6 @@ import csv
 import importlib.util
 import io
 import json
-import math
 import os
 import signal
 import stat
@@ -192,9 +191,25 @@ class OnePackingSweeps(unittest.TestCase):
             self.assertEqual((sy["n_runs"], sy["n_rates"]), ("8", "4"))
             self.assertAlmostEqual(float(sy["value"]), 3.0, delta=0.1)
             self.assertAlmostEqual(float(got["steady", "n"]["value"]), 0.5, delta=0.05)
+            self.assertEqual({r["flag"] for r in table}, {"ok"})        # a proper fit, positive moduli
             with open(os.path.join(d, "analysis_protocols.schema.json"), encoding="utf-8") as fh:
                 self.assertEqual(list(json.load(fh)["columns"]), list(table[0]))
             self.assertIn("no oscillatory runs or sweep steps", err)
+
+    def test_degenerate_flow_curve_fit_is_flagged(self):
+        # a stress that grows as the rate cubed: the Herschel-Bulkley fit puts n on its bound 2 — flagged, with why
+        with tempfile.TemporaryDirectory() as d:
+            rows = [dict(run_id=f"s{rate}-{s}", protocol="steady", relative_rate=rate, repetition=s,
+                         strain_rate=rate * 10, stress_surface=1.0 + (rate * 10) ** 3 * (1 + 0.01 * s),
+                         stress_internal=1.0) for s in range(2) for rate in (0.01, 0.02, 0.04, 0.08, 0.16)]
+            write_table(d, rows)
+            rc, out, err = run(["analyse", d, "--n-boot", "40"])
+            self.assertEqual(rc, 0, err)
+            table = read_csv(os.path.join(d, "analysis_protocols.csv"))
+            self.assertEqual({r["flag"] for r in table}, {"degenerate_fit"})
+            self.assertIn("on its upper bound 2", table[0]["note"])
+            self.assertIn("degenerate_fit", out)
+            self.assertIn("degenerate Herschel-Bulkley fit", out)
 
 
 class RealMixedSweep(unittest.TestCase):

@@ -34,6 +34,7 @@ DOCUMENTED_MODULES = [
     "particleShear.analysis.curves",
     "particleShear.analysis.demodulation",
     "particleShear.analysis.measures",
+    "particleShear.analysis.verdicts",
     "particleShear.analysis.sweep",
     "particleShear.analysis.flow_curve",
     "particleShear.analysis.grouping",

@@ -29,6 +29,22 @@ class TestFit(unittest.TestCase):
             clamped += hb.sigma_y == 0.0
         self.assertGreater(clamped, 0)      # the constraint σ_y >= 0 was exercised
 
+    def test_degenerate_fits_say_why(self):
+        # inside the bounds: no reason; σ_y = 0 exactly (a power law); n on its upper bound 2 (a cubic rises faster
+        # than any law with n <= 2); n -> 0 (a stress that does not depend on the rate: σ_y and K trade off)
+        from particleShear.analysis.flow_curve import N_LOW
+        self.assertEqual(herschel_bulkley_fit(RATE, 5.0 + 2.0 * RATE ** 0.5).degenerate, ())
+        power = herschel_bulkley_fit(RATE, 2.0 * RATE ** 0.7)
+        self.assertEqual(power.sigma_y, 0.0)
+        self.assertEqual(len(power.degenerate), 1)
+        self.assertIn("sigma_y on its bound 0", power.degenerate[0])
+        steep = herschel_bulkley_fit(RATE, 1.0 + RATE ** 3)
+        self.assertEqual(steep.n, 2.0)
+        self.assertTrue(any("on its upper bound 2" in r for r in steep.degenerate), steep.degenerate)
+        flat = herschel_bulkley_fit(RATE, 10.0 + 0.001 * np.log(RATE / 1e-3))   # slope d ln σ / d ln γ̇ ~ 1e-4
+        self.assertLess(flat.n, N_LOW)
+        self.assertTrue(any("at its lower bound 0" in r for r in flat.degenerate), flat.degenerate)
+
     def test_minimum_against_independent_grid(self):
         # independent evaluation: unconstrained lstsq on a fine n grid never beats the fit
         rng = np.random.default_rng(5)

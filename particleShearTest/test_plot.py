@@ -113,8 +113,8 @@ class TestResultPlot(unittest.TestCase):
         self.assertEqual(loop.get_xlabel(), "strain γ (–)")
         self.assertEqual(loop.get_ylabel(), "shear stress τ (Pa)")
         lines = {ln.get_label(): ln for ln in trace.get_lines() + strain_axis.get_lines()}
-        np.testing.assert_array_equal(lines["τ surface (plate forces)"].get_ydata(), res.series["stress_surface"])
-        np.testing.assert_array_equal(lines["τ internal (stress tensor)"].get_ydata(), res.series["stress_internal"])
+        np.testing.assert_array_equal(lines["surface (plate forces)"].get_ydata(), res.series["stress_surface"])
+        np.testing.assert_array_equal(lines["internal (stress tensor)"].get_ydata(), res.series["stress_internal"])
         np.testing.assert_array_equal(lines["strain γ"].get_ydata(), res.series["strain"])
         # time in periods: x = t·f
         np.testing.assert_allclose(lines["strain γ"].get_xdata(), res.series["t"] * res.f, rtol=1e-12)
@@ -200,14 +200,18 @@ class TestSweepPlot(unittest.TestCase):
                 seeds = [expected[(name, mu, A)][:, c] for A in self.AMPS]
                 np.testing.assert_allclose(data_line.get_ydata(), [v.mean() for v in seeds], rtol=1e-12)
                 # a bootstrap mean of resampled seeds lies between the smallest and largest seed; the
-                # Student widening moves it from the mean by at most √(3/2)·t₂/z, so the interval lies in
-                # mean ± that factor × the seeds' spread, and it holds the mean
+                # Student widening moves its log from the log of the mean by at most √(3/2)·t₂/z times, so the
+                # interval lies in mean·(extreme/mean)^that factor, is positive, and holds the mean
                 low, high = bar_ends(cont)
                 cut = low <= ax.get_ylim()[0] * (1 + 1e-12)    # an end below the panel's edge, drawn cut there
                 mean = np.array([v.mean() for v in seeds])
+                self.assertTrue(all((v > 0).all() for v in seeds))
                 widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
-                self.assertTrue(np.all(cut | (low >= mean + widen * (np.array([v.min() for v in seeds]) - mean) - 1e-9)))
-                self.assertTrue(np.all(high <= mean + widen * (np.array([v.max() for v in seeds]) - mean) + 1e-9))
+                lo_bound = mean * (np.array([v.min() for v in seeds]) / mean) ** widen
+                hi_bound = mean * (np.array([v.max() for v in seeds]) / mean) ** widen
+                self.assertTrue(np.all(cut | (low >= lo_bound * (1 - 1e-12))))
+                self.assertTrue(np.all(high <= hi_bound * (1 + 1e-12)))
+                self.assertTrue(np.all(low > 0))
                 self.assertTrue(np.all((low <= data_line.get_ydata()) & (data_line.get_ydata() <= high)))
         legend = fig.axes[-1].get_legend()
         self.assertIn("95 % bootstrap interval", legend.get_title().get_text())
@@ -247,15 +251,15 @@ class TestSweepPlot(unittest.TestCase):
         for label, values, ci in (("G′ μ=0.01", gp, ref.Gp_ci), ("G″ μ=0.01", gpp, ref.Gpp_ci)):
             v = np.array(values).reshape(2, 3)
             low, high = bar_ends(conts[label])
-            # the percentile ends are the seeds' extremes, widened from the mean by √(3/2)·t₂/z (Student width)
+            # the percentile ends are the seeds' extremes, widened from the mean by √(3/2)·t₂/z (Student width) on
+            # the log scale: mean·(extreme/mean)^w, positive however far the widening reaches
             mean = v.mean(axis=1)
+            self.assertTrue((v > 0).all())
             widen = math.sqrt(1.5) * t_critical(2, 0.05) / 1.959963984540054
-            # an end below the panel's lower edge (≤ 0 included) is drawn cut at the edge
-            edge = panel_axes(fig)[0].get_ylim()[0]
-            expect_low = np.maximum(mean + widen * (v.min(axis=1) - mean), edge)
-            np.testing.assert_allclose(low, expect_low, rtol=1e-12)
-            np.testing.assert_allclose(high, mean + widen * (v.max(axis=1) - mean), rtol=1e-12)
-            np.testing.assert_allclose(np.c_[np.maximum(ci[:, 0], edge), ci[:, 1]], np.c_[low, high], rtol=1e-12)
+            np.testing.assert_allclose(low, mean * (v.min(axis=1) / mean) ** widen, rtol=1e-12)
+            np.testing.assert_allclose(high, mean * (v.max(axis=1) / mean) ** widen, rtol=1e-12)
+            self.assertTrue((low > 0).all())
+            np.testing.assert_allclose(np.c_[low, high], ci, rtol=1e-12)
 
     def frequency_runs(self, amplitudes=(0.1,), seeds=3, extra=None):
         rng = np.random.default_rng(2)

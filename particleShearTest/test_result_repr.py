@@ -77,7 +77,9 @@ class TestHtmlRepr(unittest.TestCase):
         res = noisy_result()
         h = res._repr_html_()
         self.assertTrue(h.startswith("<table>") and h.rstrip().endswith("</table>"))
-        self.assertEqual(h.count("<tr>"), 3)              # header + surface + internal
+        # header + surface + internal, then the verdict and one row per failed or unjudged check
+        self.assertEqual(h.count("<tr>"), 3 + len(res._verdict_lines()))
+        self.assertIn("verdict: ", h)
         for fragment in ("surface", "internal", "G′ (Pa)", "G″ (Pa)", "0123456789ab", "±"):
             self.assertIn(fragment, h)
         self.assertNotIn("Young_modulus_spheres", h)

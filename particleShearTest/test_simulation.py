@@ -499,8 +499,8 @@ class TestRunLayer(unittest.TestCase):
             rc = cli_main(["--N", "20", "--no-permanent-links", "--cut-lines", "0", "--relative-frequency", "0.2",
                            "--pre-periods", "0.5", "--periods", "1", "--post-periods", "0.5", "--seed", "3"])
         self.assertEqual(rc, 0)
-        self.assertIn("(overall stress tensor)", out.getvalue())
-        self.assertIn("(surface forces)", out.getvalue())
+        self.assertIn("(internal estimator)", out.getvalue())
+        self.assertIn("(surface estimator)", out.getvalue())
         self.assertIn("[protocol]", err.getvalue())
         self.assertIn("remaining", err.getvalue())
         err = io.StringIO()

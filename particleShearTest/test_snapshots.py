@@ -224,7 +224,7 @@ class TestStressWindowTicks(unittest.TestCase):
         self.assertAlmostEqual(texts["100"][1], 250 - 100 * fs)     # 100 Pa at y = H/2 − τ·scale
         self.assertAlmostEqual(texts["\u03b3 = +0.2"][1], 250 - 30)  # strain A drawn 30 px above the axis
         self.assertIn((250.0, 0, 250.0, 500), w.canvas.lines)        # excitation start t_on = 1 ms
-        for label in ("\u03c4 internal (stress tensor)", "\u03c4 surface (plate forces)", "strain \u03b3"):
+        for label in ("internal (stress tensor)", "surface (plate forces)", "strain \u03b3"):
             self.assertIn(label, texts)
 
 

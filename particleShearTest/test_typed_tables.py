@@ -275,6 +275,12 @@ class TestTypedTables(unittest.TestCase):
                          [(r["N"], r["N_steps"], r["Gp_surface"]) for r in self.rows])
         with self.assertRaisesRegex(ValueError, "as_frame='yes' is invalid"):
             load_results(self.out, as_frame="yes")
+        # a DataFrame asked for without pandas: an ImportError naming the extra, before the table is read
+        with mock.patch.dict(sys.modules, {"pandas": None}):
+            with self.assertRaisesRegex(ImportError, r"as_frame=True\) needs pandas: pip install .*particleShear\[tables\]"):
+                load_results(self.out, as_frame=True)
+            with self.assertRaisesRegex(ImportError, r"particleShear\[tables\]"):
+                load_results(os.path.join(self.tmp, "nowhere"), as_frame=True)     # checked before the folder
         with self.assertRaisesRegex(ValueError, "no results table"):
             load_results(os.path.join(self.tmp, "nowhere"))
 

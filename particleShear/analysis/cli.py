@@ -10,13 +10,17 @@ saved, the backend) do not split groups; the runs of one group are its seeds), a
 group with :func:`particleShear.analysis.sweep.sweep_summary`.  The runs of a group are taken in
 the order (amplitude, run id) and each group's bootstrap stream is derived from ``--seed`` and the
 group's parameters, so the intervals depend neither on the order the runs finished in nor on the
-other groups of the folder.  Writes, atomically:
+other groups of the folder; without ``--seed`` the seed is
+:data:`particleShear.analysis.sweep.DEFAULT_SEED` (0, as ``plot``'s), so the same call gives the same
+numbers, and ``bootstrap_seed`` records it.  Writes, atomically:
 
 ``DIR/analysis.csv``
     One row per group: ``group`` (a label), the parameters that differ between groups, the
     estimator, the bootstrap settings, ``n_runs``, ``n_amplitudes``, … and every characteristic of
-    :data:`particleShear.analysis.sweep.CHARACTERISTICS` with ``_ci_low``, ``_ci_high`` and
-    ``_defined``; ``note`` says what deserves a look (one seed, non-positive means, rows left out).
+    :data:`particleShear.analysis.sweep.CHARACTERISTICS` with ``_ci_low``, ``_ci_high``,
+    ``_defined`` and ``_flag`` (:data:`particleShear.analysis.sweep.FLAGS`: a censored point is a bound,
+    printed ``> 0.2``, with no interval); ``note`` says what deserves a look (one seed, non-positive
+    means, fewer than 4 amplitudes, rows left out).
     An empty cell is an undefined value.
 ``DIR/analysis.schema.json``
     Column → type, unit, description.
@@ -47,6 +51,7 @@ import warnings
 import zlib
 
 from ..run.guard import SuggestingParser
+from .sweep import DEFAULT_SEED
 
 __all__ = [
     "OUTPUT_ONLY",
@@ -89,6 +94,9 @@ _HEAD_COLUMNS = {
                           "for one group)")),
     "estimator": ("str", "", "the moduli used: surface (plate forces) or internal (overall stress tensor)"),
     "n_runs": ("int", "1", "runs (rows with status ok and finite moduli) of the group"),
+    "n_flagged": ("int", "1", "runs of the group whose verdict is flagged (counted in n_runs; docs/analysis.md "
+                              "\"Verdicts\")"),
+    "n_failed": ("int", "1", "rows of the group's parameters whose status is not ok (not in n_runs)"),
     "n_amplitudes": ("int", "1", "distinct strain amplitudes of the group"),
     "amplitude_min": ("float", "1", "smallest strain amplitude"),
     "amplitude_max": ("float", "1", "largest strain amplitude"),
@@ -96,7 +104,8 @@ _HEAD_COLUMNS = {
     "n_seeds_max": ("int", "1", "most runs (seeds) at one amplitude"),
     "confidence": ("float", "1", "level of the bootstrap percentile intervals"),
     "n_boot": ("int", "1", "bootstrap replicates (seeds resampled with replacement within each amplitude)"),
-    "bootstrap_seed": ("int", "1", "--seed of the bootstrap (empty: fresh entropy, not reproducible)"),
+    "bootstrap_seed": ("int", "1", ("--seed of the bootstrap (default 0, analysis.sweep.DEFAULT_SEED; empty: fresh "
+                                    "entropy, analyse_folder(seed=None) only)")),
 }
 _NOTE = ("note", ("str", "", ("what deserves a look: one seed at some amplitude (degenerate intervals), "
                               "non-positive means (no log-log characteristics there)")))
@@ -132,13 +141,14 @@ def build_parser():
                                         "DIR/analysis.schema.json and (with matplotlib) DIR/analysis.png and .pdf.")
     p.add_argument("folder", metavar="DIR", help="sweep folder containing results.csv")
     p.add_argument("--estimator", choices=ESTIMATORS, default="surface",
-                   help="moduli from the plate forces (surface, default) or the overall stress tensor (internal)")
+                   help="moduli from the plate forces (surface, default) or the stress tensor (internal)")
     p.add_argument("--json", action="store_true", help="print the rows of analysis.csv as JSON on stdout (NaN: null)")
     p.add_argument("--n-boot", metavar="N", default="2000",
                    help=f"bootstrap replicates, integer 1 ... {N_BOOT_MAX} (default 2000)")
     p.add_argument("--confidence", metavar="C", default="0.95", help="interval level in (0, 1) (default 0.95)")
-    p.add_argument("--seed", metavar="S", default=None,
-                   help="seed of the bootstrap, integer >= 0 (default: fresh entropy, intervals not reproducible)")
+    p.add_argument("--seed", metavar="S", default=str(DEFAULT_SEED),
+                   help=f"seed of the bootstrap, integer >= 0 (default {DEFAULT_SEED}, as plot's: the same call prints "
+                        "the same intervals)")
     p.add_argument("--no-figure", dest="figure", action="store_false",
                    help=f"write no analysis.png/.pdf (the figure draws at most {MAX_FIGURE_PANELS} groups, the others "
                         "named in one line)")
@@ -223,7 +233,8 @@ def group_runs(rows, estimator="surface"):
     groups : list of dict
         One per group, sorted by its parameter values (numbers numerically): ``"parameters"``
         (``{name: text}`` of every grouping column), ``"amplitude"``, ``"Gp"``, ``"Gpp"`` (lists of
-        floats, one per run or step).
+        floats, one per run or step), ``"n_flagged"`` (runs of the group whose verdict is flagged),
+        ``"n_failed"`` (rows of its parameters whose status is not ok), ``"flags"`` (check → count).
     varying : list of str
         The grouping columns whose value differs between groups (header order).
     skipped : int
@@ -251,6 +262,7 @@ def group_runs(rows, estimator="surface"):
         d["Gp"].append(gp)
         d["Gpp"].append(gpp)
         d["flagged"].append(is_flagged(row))    # verdict "flagged: …" (False in tables without the column)
+    _count_verdicts(rows, names, cells)
     keys = sorted(cells, key=lambda k: [_sort_key(v) for v in k])
     varying = [c for i, c in enumerate(names) if len({k[i] for k in keys}) > 1]
     return [cells[k] for k in keys], varying, skipped
@@ -267,6 +279,21 @@ def _made(rows, columns):
     return made
 
 
+def _count_verdicts(rows, names, cells):
+    """Each group's ``n_flagged``, ``n_failed`` and ``flags`` (check → count) over every row of its
+    parameters, whatever its status (:func:`particleShear.analysis.verdicts.verdict_counts`)."""
+    from .grouping import MODULI_PROTOCOLS, measured_row, row_protocol
+    from .verdicts import verdict_counts
+    members = {}
+    for row in rows:
+        if row_protocol(row) not in MODULI_PROTOCOLS:
+            continue
+        row = measured_row(row)
+        members.setdefault(tuple(str(row.get(c, "")) for c in names), []).append(row)
+    for key, d in cells.items():
+        d["n_failed"], d["n_flagged"], d["flags"] = verdict_counts(members.get(key, []))
+
+
 def analysis_columns(varying):
     """Columns of ``analysis.csv`` with (type, unit, description), in table order.
 
@@ -280,7 +307,7 @@ def analysis_columns(varying):
     dict
         ``{column: (type, unit, description)}``; type one of "str", "int", "float".
     """
-    from .sweep import CHARACTERISTICS
+    from .sweep import CHARACTERISTICS, FLAGS
     cols = {"group": _HEAD_COLUMNS["group"]}
     for name in varying:
         cols[name] = ("str", "", (f"parameter {name} of doParticleShearSimulation (docs/parameters.md), as in "
@@ -292,6 +319,8 @@ def analysis_columns(varying):
         cols[name + "_ci_low"] = ("float", unit, f"lower end of {q} of {name}")
         cols[name + "_ci_high"] = ("float", unit, f"upper end of {q} of {name}")
         cols[name + "_defined"] = ("float", "1", f"fraction of the bootstrap replicates in which {name} is defined")
+        cols[name + "_flag"] = ("str", "", f"what {name} is: one of {', '.join(FLAGS)} (analysis.sweep.FLAGS, "
+                                           "docs/analysis.md)")
     cols[_NOTE[0]] = _NOTE[1]
     return cols
 
@@ -317,7 +346,7 @@ def _summarise(group, n_boot, confidence, rng):
     """(SweepSummary or None, notes) of one group."""
     import numpy as np
 
-    from .sweep import sweep_summary
+    from .sweep import MIN_POINT_AMPLITUDES, sweep_summary
     notes = []
     n_amp = len(set(group["amplitude"]))
     if n_amp < 2:
@@ -330,13 +359,16 @@ def _summarise(group, n_boot, confidence, rng):
         s = sweep_summary(group["amplitude"], group["Gp"], group["Gpp"], n_boot=n_boot, confidence=confidence,
                           rng=rng)
     single = s.amplitudes[s.n_seeds == 1]
+    if n_amp < MIN_POINT_AMPLITUDES:
+        notes.append(f"{n_amp} amplitudes: the characteristic points (linear limits, flow point, the R package's "
+                     f"points) need >= {MIN_POINT_AMPLITUDES}; only the plateau and the mean curves are given")
     if len(caught) and len(single):
         notes.append(f"one seed at amplitude(s) {_floats(single)}: degenerate intervals there")
     for what, mean in (("G′", s.Gp_mean), ("G″", s.Gpp_mean)):
         bad = s.amplitudes[np.asarray(mean) <= 0]
         if len(bad):
-            notes.append(f"mean {what} <= 0 at amplitude(s) {_floats(bad)}: not on the log axes, no log-log "
-                         "characteristics across them")
+            notes.append(f"mean {what} <= 0 at amplitude(s) {_floats(bad)}: not on the log axes, no interval and "
+                         "no log-log characteristics there")
     return s, notes
 
 
@@ -348,8 +380,9 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
     from .sweep import CHARACTERISTICS
     row = {"group": _label(group["parameters"], varying)}
     row.update({n: group["parameters"][n] for n in varying})
-    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "confidence": confidence,
-                "n_boot": n_boot, "bootstrap_seed": seed})
+    row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "n_flagged": group.get("n_flagged", 0),
+                "n_failed": group.get("n_failed", 0), "confidence": confidence, "n_boot": n_boot,
+                "bootstrap_seed": seed})
     if summary is not None:
         row.update(summary.to_dict())
     else:
@@ -360,7 +393,11 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
             for suffix in ("", "_ci_low", "_ci_high"):
                 row[name + suffix] = math.nan
             row[name + "_defined"] = 0.0
-    row["note"] = "; ".join(notes)
+            row[name + "_flag"] = "too_few_amplitudes"
+    from .verdicts import counts_note
+    counted = counts_note(len(group["amplitude"]), group.get("n_failed", 0), group.get("n_flagged", 0),
+                          group.get("flags", {}))
+    row["note"] = "; ".join(([counted] if counted else []) + list(notes))
     return row
 
 
@@ -407,7 +444,7 @@ def _write_schema(path, name, description, columns, generation, settings):
         fh.write("\n")
 
 
-def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, seed=None, figure=True,
+def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, seed=DEFAULT_SEED, figure=True,
                    max_figure_panels=None):
     """Analyse a sweep folder: write ``analysis.csv``, ``analysis.schema.json`` and the figure.
 
@@ -427,7 +464,8 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
         Level of the intervals, in (0, 1) (default 0.95).
     seed : int or None, optional
         Seed of the bootstrap (>= 0): each group's stream is derived from it and the group's
-        parameters; None (default) draws fresh entropy.
+        parameters; default 0 (:data:`particleShear.analysis.sweep.DEFAULT_SEED`, as ``plot``'s), so
+        the same call gives the same intervals; None draws fresh entropy (not reproducible).
     figure : bool, optional
         Write ``analysis.png`` and ``analysis.pdf`` when matplotlib is installed (default True;
         CLI ``--no-figure``).  The figure draws the first ``max_figure_panels`` groups and names
@@ -555,21 +593,49 @@ def _fmt(v):
     return "–" if not (isinstance(v, (int, float)) and math.isfinite(v)) else f"{v:.4g}"
 
 
+def _with_interval(row, name):
+    """``value [low, high]`` of a characteristic as its flag says (:data:`particleShear.analysis.sweep.FLAGS`):
+    a censored point as a bound (``> 0.2``), an open interval end as a bound, no interval without an estimate."""
+    v, lo, hi, flag = row[name], row[name + "_ci_low"], row[name + "_ci_high"], row.get(name + "_flag", "ok")
+    if flag == "lower_bound":
+        return f"> {_fmt(v)}"
+    if flag == "upper_bound":
+        return f"< {_fmt(v)}"
+    if flag in ("too_few_amplitudes", "undefined") or not math.isfinite(v):
+        return "–"
+    if flag == "non_positive":
+        return f"{_fmt(v)} (<= 0, no interval)"
+    low = ("< " if flag in ("open_below", "open_both") else "") + _fmt(lo)
+    high = ("> " if flag in ("open_above", "open_both") else "") + _fmt(hi)
+    return f"{_fmt(v)} [{low}, {high}]"
+
+
 def _human(rows):
     """A short table: group, runs, plateau, linear limit 5 %, flow point, yield strain with intervals."""
     shown = (("plateau", "plateau (Pa)"), ("linear_limit_5", "linear limit 5 %"), ("flow_point", "flow point"),
              ("yield_strain", "yield strain"))
     head = ["group", "runs"] + [t for _, t in shown]
-    body = [[r["group"], str(r["n_runs"])] +
-            [f"{_fmt(r[n])} [{_fmt(r[n + '_ci_low'])}, {_fmt(r[n + '_ci_high'])}]" for n, _ in shown] for r in rows]
+    body = [[r["group"], _runs_text(r)] +
+            [_with_interval(r, n) for n, _ in shown] for r in rows]
     widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
     buf = io.StringIO()
     for line in [head] + body:
         buf.write("  ".join(x.ljust(w) for x, w in zip(line, widths)).rstrip() + "\n")
+    if rows:
+        r = rows[0]
+        seed = "fresh entropy (not reproducible)" if r["bootstrap_seed"] is None else f"seed {r['bootstrap_seed']}"
+        buf.write(f"intervals: {100 * r['confidence']:g} % bootstrap, {r['n_boot']} replicates, {seed}; "
+                  "> x / < x: the point lies beyond the measured amplitudes (a bound)\n")
     for r in rows:
         if r["note"]:
             buf.write(f"note: {r['group']}: {r['note']}\n")
     return buf.getvalue()
+
+
+def _runs_text(r):
+    """``12`` or ``12 (2 flagged, 1 failed)``: a group's runs with its verdict counts."""
+    extra = [f"{r[k]} {k[2:]}" for k in ("n_flagged", "n_failed") if r.get(k)]
+    return str(r["n_runs"]) + (f" ({', '.join(extra)})" if extra else "")
 
 
 class _Terminated(BaseException):
@@ -578,9 +644,11 @@ class _Terminated(BaseException):
 
 def _human_protocols(rows):
     """A short table of the protocol summaries: group, quantity, runs, value [interval] unit."""
-    head = ["group", "quantity", "runs", "value [interval]", "unit"]
+    head = ["group", "quantity", "runs", "value [interval]", "unit", "flag"]
     body = [[r["group"], r["quantity"], str(r["n_runs"]),
-             f"{_fmt(r['value'])} [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]", r["unit"]] for r in rows]
+             f"{_fmt(r['value'])} [{_fmt(r['ci_low'])}, {_fmt(r['ci_high'])}]"
+             if math.isfinite(r["value"]) and math.isfinite(r["ci_low"]) else _fmt(r["value"]),
+             r["unit"], r.get("flag", "ok")] for r in rows]
     widths = [max(len(x[i]) for x in [head] + body) for i in range(len(head))]
     buf = io.StringIO()
     for line in [head] + body:
@@ -614,7 +682,7 @@ def main(argv=None):
         args = parser.parse_args(argv)
         n_boot = _number_flag("--n-boot", args.n_boot, "n_boot")
         confidence = _number_flag("--confidence", args.confidence, "confidence")
-        seed = None if args.seed is None else _number_flag("--seed", args.seed, "seed")
+        seed = _number_flag("--seed", args.seed, "seed")
     except _UsageError as exc:
         print(f"{_PROG}: invalid parameter: {exc}", file=sys.stderr)
         return 2

@@ -14,15 +14,11 @@ import math
 
 import numpy as np
 
-__all__ = ["MARKERS", "MAX_FIGURE_PANELS", "MIN_AMPLITUDES_FOR_LIMITS", "not_drawn_line", "plot_analysis"]
+__all__ = ["MARKERS", "MAX_FIGURE_PANELS", "not_drawn_line", "plot_analysis"]
 
 #: most panels of the figure: the first groups (in table order) are drawn, the others named in one line
 #: (a figure of thousands of panels would take gigabytes and hours; every group is a row of the table)
 MAX_FIGURE_PANELS = 24
-
-#: fewest amplitudes of a curve on which the linear limits and the yield point are drawn: below,
-#: a "plateau" and a departure from it are the same two or three points
-MIN_AMPLITUDES_FOR_LIMITS = 4
 
 #: characteristic → (marker, short label, legend text, label offset in points)
 MARKERS = {
@@ -100,13 +96,11 @@ def _panel(ax, title, s, notes, flagged=()):
         ci = s.points_ci[name]
         marks.append((name, strain, gp, (ci[0, 0], ci[0, 1]), (ci[1, 0], ci[1, 1])))
     labels = []
-    short_curve = len(A) < MIN_AMPLITUDES_FOR_LIMITS
-    if short_curve:
-        said.append(f"{len(A)} amplitudes: no linear limits or yield drawn (they need >= "
-                    f"{MIN_AMPLITUDES_FOR_LIMITS})")
     for name, x, y, xci, yci in marks:
         marker, short, legend, offset = MARKERS[name]
-        if short_curve and name in ("linear_limit_5", "linear_limit_10", "yield"):
+        flag = s.flags.get(name, s.flags.get(name + "_strain", "ok"))
+        if flag in ("lower_bound", "upper_bound"):      # a bound is not a point of the curve: said, not drawn
+            said.append(f"{short}: {'>' if flag == 'lower_bound' else '<'} {x:g} (beyond the measured amplitudes)")
             continue
         if not (math.isfinite(x) and math.isfinite(y) and x > 0 and y > 0):
             continue

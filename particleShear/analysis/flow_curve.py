@@ -17,6 +17,10 @@ under σ_y ≥ 0, K ≥ 0; the residual sum of squares of that solution is then 
 grid of :data:`N_GRID` points in (0, 2] and a golden-section refinement between the neighbours of
 the best grid point.
 
+A fit with a parameter on a bound of the law — σ_y = 0, n = 2, or n below the first grid point
+2/:data:`N_GRID` — is degenerate: the law does not describe the data there, or σ_y and K trade off
+(:attr:`HerschelBulkley.degenerate` gives the reasons; ``analyse`` flags the rows ``degenerate_fit``).
+
 NumPy only (no SciPy).
 """
 __docformat__ = "numpy"
@@ -29,12 +33,15 @@ import numpy as np
 
 from .sweep import _check_resampling, _percentile_interval, _vector
 
-__all__ = ["FlowCurveFit", "HerschelBulkley", "N_GRID", "fit_flow_curve", "flow_curve_table", "herschel_bulkley_bootstrap",
+__all__ = ["FlowCurveFit", "HerschelBulkley", "N_GRID", "N_LOW", "fit_flow_curve", "flow_curve_table", "herschel_bulkley_bootstrap",
            "herschel_bulkley_fit"]
 
 #: number of flow indices n = 2k/N_GRID (k = 1 … N_GRID) of the coarse search
 N_GRID = 41
 _N_MAX = 2.0
+#: flow index below which a fit counts as on its lower bound n → 0 (the first grid point 2/N_GRID ≈ 0.049):
+#: the stress then hardly depends on the rate and σ_y and K are not separately determined
+N_LOW = _N_MAX / N_GRID
 _N_MIN = 1e-3                 # lower end of the refinement below the first grid point
 _GOLDEN_STEPS = 60            # bracket width 2·2/41 · 0.618^60 ≈ 3e-14
 _INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
@@ -63,6 +70,28 @@ class HerschelBulkley:
     K: float
     n: float
     rss: float
+
+    @property
+    def degenerate(self):
+        """Why the fit is degenerate — a parameter on a bound of the law; empty when none is.
+
+        Returns
+        -------
+        tuple of str
+            One reason per parameter on a bound: σ_y = 0 (no yield stress resolved), n = 2 (the
+            stress curves upward more steeply than the law allows), n < :data:`N_LOW` (the stress
+            hardly depends on the rate: σ_y and K trade off).
+        """
+        out = []
+        if self.sigma_y <= 0:
+            out.append("sigma_y on its bound 0: no yield stress resolved (a power law fits as well)")
+        if self.n >= _N_MAX * (1 - 1e-9):
+            out.append(f"n = {self.n:.3g} on its upper bound {_N_MAX:g}: the stress rises more steeply than the law "
+                       "allows (K and sigma_y not meaningful)")
+        elif self.n < N_LOW:
+            out.append(f"n = {self.n:.3g} below {N_LOW:.3g}, at its lower bound 0: the stress hardly depends on the "
+                       "rate (sigma_y and K trade off)")
+        return tuple(out)
 
     def stress(self, rate):
         """Shear stress of the law at the given shear rates.
@@ -114,6 +143,11 @@ class FlowCurveFit:
         Confidence level of the intervals.
     n_seeds : int
         Number of seeds (columns of the stress table).
+
+    Notes
+    -----
+    ``degenerate`` (the reasons of :attr:`HerschelBulkley.degenerate` of ``fit``) is empty for a
+    fit whose parameters are inside the bounds of the law.
     """
 
     fit: HerschelBulkley
@@ -126,6 +160,11 @@ class FlowCurveFit:
     def yield_stress(self):
         """The fitted yield stress σ_y (Pa), ``fit.sigma_y``."""
         return self.fit.sigma_y
+
+    @property
+    def degenerate(self):
+        """Why the point fit is degenerate (:attr:`HerschelBulkley.degenerate`); empty when it is not."""
+        return self.fit.degenerate
 
 
 # ---------------------------------------------------------------------------------------------

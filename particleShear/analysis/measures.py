@@ -11,7 +11,7 @@ import numpy as np
 
 from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
 
-__all__ = ["MEASURE_COLUMNS", "MEASURE_N_MAX", "MeasurementWarning", "empty_measures", "run_measures", "measured_window", "warn_few_periods"]
+__all__ = ["MEASURE_COLUMNS", "NON_NUMERIC_MEASURES", "MEASURE_N_MAX", "MeasurementWarning", "empty_measures", "run_measures", "measured_window", "warn_few_periods"]
 
 #: highest harmonic order of the table's LAOS ratios: G_M and η_M weight order n by n, and orders above
 #: 5 of a run at N <= 150 are at its noise level (their S, T change sign with the order kept)
@@ -19,7 +19,11 @@ MEASURE_N_MAX = 5
 
 #: columns of the results table after the four moduli, in order (units in docs/analysis.md)
 MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_internal_se", "steady_state",
-                   "I3_I1_surface", "I3_I1_internal", "S_surface", "T_surface", "S_internal", "T_internal")
+                   "I3_I1_surface", "I3_I1_internal", "S_surface", "T_surface", "S_internal", "T_internal",
+                   "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved", "verdict")
+#: the measure columns that are not numbers: checks (bool or None) and the verdict (str or None)
+NON_NUMERIC_MEASURES = ("steady_state", "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved",
+                "verdict")
 
 
 class MeasurementWarning(UserWarning):
@@ -74,17 +78,17 @@ def measured_window(t, f, pre_periods, periods):
 
 
 def empty_measures():
-    """The measures of a run that has none: NaN, ``steady_state`` None.
+    """The measures of a run that has none: NaN, the checks and ``verdict`` None.
 
     Returns
     -------
     dict
     """
-    return {c: (None if c == "steady_state" else math.nan) for c in MEASURE_COLUMNS}
+    return {c: (None if c in NON_NUMERIC_MEASURES else math.nan) for c in MEASURE_COLUMNS}
 
 
-def run_measures(series, f, strain_amplitude, pre_periods, periods):
-    """The standard errors, steady-state flag and LAOS measures of one run (:data:`MEASURE_COLUMNS`).
+def run_measures(series, f, strain_amplitude, pre_periods, periods, moduli=None):
+    """The standard errors, steady-state flag, LAOS measures and verdict of one run (:data:`MEASURE_COLUMNS`).
 
     * ``G*_se`` — standard error of the mean over the whole excitation periods of the
       package's demodulation window, each demodulated alone
@@ -97,6 +101,9 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
       Ewoldt–Hosoi–McKinley stiffening and thickening ratios over the ``"oscillatory_measurement"``
       samples (:func:`~particleShear.analysis.laos.laos` with orders up to :data:`MEASURE_N_MAX`); NaN
       when that span is shorter than a period.
+    * ``linear_response``, ``estimators_agree``, ``moduli_positive``, ``excitation_resolved``
+      and ``verdict`` — the run's checks and verdict
+      (:func:`~particleShear.analysis.verdicts.oscillatory_checks`; docs/analysis.md, "Verdicts").
 
     Parameters
     ----------
@@ -108,24 +115,30 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
         γ₀ (dimensionless).
     pre_periods, periods : float
         The protocol's baseline periods before the excitation and excitation periods.
+    moduli : dict, optional
+        Estimator → (G′, G″) in Pa, the run's reported moduli; without them the checks that
+        compare moduli are not judged (None).
 
     Returns
     -------
     dict
-        Column → value (float; ``steady_state`` bool or None).
+        Column → value (float; checks bool or None; ``verdict`` str).
     """
     from .laos import laos
     from .periods import FALSE_ALARM, period_moduli
+    from .verdicts import baseline_noise, oscillatory_checks, verdict
     row = empty_measures()
     if not series or "t" not in series or len(series["t"]) == 0 or not f:
         return row
     t = np.asarray(series["t"], dtype=float)
     flags = []
+    noise = {}
     window = measured_window(t, f, pre_periods, periods)
     for est, (_col, key) in ESTIMATOR_COLUMNS.items():
         if key not in series:
             continue
         stress = np.asarray(series[key], dtype=float)
+        noise[est] = baseline_noise(t, stress, f, pre_periods)
         try:
             # each estimator at half the run's false-alarm level: the run's flag errs with <= 5 %
             pm = period_moduli(t, stress, f, strain_amplitude, pre_periods, periods, false_alarm=FALSE_ALARM / 2)
@@ -142,4 +155,7 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods):
         row[f"I3_I1_{est}"], row[f"S_{est}"], row[f"T_{est}"] = float(m.I3_I1), float(m.S), float(m.T)
     known = [x for x in flags if x is not None]
     row["steady_state"] = None if not known or len(known) < len(flags) else all(known)
+    checks = oscillatory_checks(moduli or {}, row, strain_amplitude, noise)
+    row.update(checks)
+    row["verdict"] = verdict(checks)
     return row

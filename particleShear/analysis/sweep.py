@@ -21,6 +21,13 @@ low_strain_plateau, softening, soft_plateau, yield
     strain and the G′ and G″ there; in the flat names ``<point>_strain``, ``<point>_Gp``,
     ``<point>_Gpp``.
 
+Every characteristic carries a flag (:data:`FLAGS`): a point beyond the measured amplitudes is a
+bound (``lower_bound``: the flow point is larger than the largest amplitude), never a number with a
+zero-width interval; the points that need a curve are refused below :data:`MIN_POINT_AMPLITUDES`
+amplitudes; an interval is given only beside an estimate.  Moduli intervals (Pa) never go below 0:
+the Student widening of the bootstrap means is done on their logarithm, and a modulus whose point
+estimate is <= 0 gets no interval (flag ``non_positive``).
+
 NumPy only (no pandas, no SciPy).
 """
 __docformat__ = "numpy"
@@ -34,13 +41,39 @@ import numpy as np
 
 from .curves import CURVE_POINTS
 
-__all__ = ["CHARACTERISTICS", "CURVE_COLUMNS", "N_BOOT_MAX", "POINT_NAMES", "SCALAR_NAMES", "SweepSummary",
-           "sweep_summary"]
+__all__ = ["CHARACTERISTICS", "CURVE_COLUMNS", "DEFAULT_SEED", "FLAGS", "MIN_POINT_AMPLITUDES", "MODULUS_NAMES",
+           "N_BOOT_MAX", "POINT_NAMES", "SCALAR_NAMES", "SweepSummary", "modulus_interval", "sweep_summary"]
 
 #: most bootstrap replicates (``n_boot``, CLI ``--n-boot``) of the analyses: 100,000 replicates put
 #: the percentile ends of a 95 % interval within about 0.1 % of their limit, and keep the arrays of
 #: one group (replicates × amplitudes, replicates × seeds) to a few tens of MB
 N_BOOT_MAX = 100_000
+
+#: seed of the bootstrap of ``python -m particleShear analyse`` and ``plot`` when none is given (``--seed``
+#: overrides): the same call prints the same intervals
+DEFAULT_SEED = 0
+
+#: fewest distinct amplitudes for the characteristics read off the shape of the curve (linear limits,
+#: flow point, the R package's four points): one amplitude sets the plateau, a second confirms it, and a
+#: transition needs two more to be bracketed; with fewer only the plateau and the mean curves are given
+MIN_POINT_AMPLITUDES = 4
+
+#: flag of a characteristic (column ``<name>_flag`` of analysis.csv) → meaning
+FLAGS = {
+    "ok": "an estimate with its interval",
+    "lower_bound": ("censored: the point lies beyond the largest amplitude; the value is that amplitude, a lower "
+                    "bound (printed '> value'), no interval"),
+    "upper_bound": ("censored: the point lies below the smallest amplitude; the value is that amplitude, an upper "
+                    "bound (printed '< value'), no interval"),
+    "open_above": ("an estimate whose interval reaches beyond the largest amplitude (more than (1 - confidence)/2 "
+                   "of the replicates censored there): ci_high is that amplitude, a lower bound of the true end"),
+    "open_below": ("an estimate whose interval reaches below the smallest amplitude: ci_low is that amplitude, an "
+                   "upper bound of the true end"),
+    "open_both": "open_above and open_below at once",
+    "too_few_amplitudes": f"not computed: the sweep has fewer than {MIN_POINT_AMPLITUDES} distinct amplitudes",
+    "undefined": "no value and no interval (no such point on the mean curve, or a log of a non-positive mean)",
+    "non_positive": "a modulus whose point estimate is <= 0: the value, no interval (a modulus interval is >= 0)",
+}
 
 #: the characteristics that are one number each
 SCALAR_NAMES = ("plateau", "linear_limit_5", "linear_limit_10", "flow_point")
@@ -62,6 +95,11 @@ for _p in POINT_NAMES:
         CHARACTERISTICS[f"{_p}_{_part}"] = (_unit, (f"{_what} of the {_POINT_TEXT[_p]} of the R package's "
                                                     "stress curve (curves.stress_curve_points) on the mean curve"))
 del _p, _part, _unit, _what
+
+#: the characteristics that are moduli (Pa): their intervals are >= 0 (:func:`modulus_interval`)
+MODULUS_NAMES = tuple(name for name, (unit, _) in CHARACTERISTICS.items() if unit == "Pa")
+#: the characteristics that are strains read off the curve, and may be censored by the measured range
+_CENSORABLE = ("linear_limit_5", "linear_limit_10", "flow_point", "yield_strain")
 
 #: columns of :meth:`SweepSummary.curve_rows`: name → (unit, description)
 CURVE_COLUMNS = {
@@ -88,7 +126,9 @@ class SweepSummary:
 
     Made by :func:`sweep_summary`.  Arrays are read-only, mappings are read-only views.  An
     interval is ``(low, high)``, the percentile interval of the bootstrap replicates that define
-    the quantity (NaN, NaN when none does); ``defined_fraction`` says how many did.
+    the quantity; (NaN, NaN) when none does, when the point estimate is undefined or a bound, or for
+    a modulus whose estimate is <= 0; ``defined_fraction`` says how many replicates defined it and
+    ``flags`` what the value is (:data:`FLAGS`).
 
     Parameters
     ----------
@@ -99,20 +139,22 @@ class SweepSummary:
     Gp_mean, Gpp_mean : numpy.ndarray
         Mean G′ and G″ over the runs at each amplitude (Pa), shape (n,).
     Gp_ci, Gpp_ci : numpy.ndarray
-        Percentile bootstrap interval of each mean (Pa), shape (n, 2).
+        Percentile bootstrap interval of each mean (Pa), shape (n, 2), >= 0; NaN where the mean is
+        <= 0 (:func:`modulus_interval`).
     plateau : float
         Mean G′ at the smallest amplitude (Pa).
     plateau_ci : tuple of float
         Its interval.
     linear_limit_5, linear_limit_10 : float
-        Amplitude where the mean G′ first falls 5 % (10 %) below the plateau; NaN if it never
-        does, or if the plateau or the G′ just past the limit is not positive (no log-log
-        interpolation).
+        Amplitude where the mean G′ first falls 5 % (10 %) below the plateau; the largest
+        amplitude if it never does (flag ``lower_bound``); NaN if the plateau or the G′ just past
+        the limit is not positive (no log-log interpolation).
     linear_limit_5_ci, linear_limit_10_ci : tuple of float
         Their intervals.
     flow_point : float
-        Amplitude where mean G′ = mean G″ (log-log interpolation); NaN if G′ never exceeds G″, or
-        the bracketing means are not positive.
+        Amplitude where mean G′ = mean G″ (log-log interpolation); the largest amplitude if G′ > G″
+        there (flag ``lower_bound``), the smallest if G′ never exceeds G″ (flag ``upper_bound``);
+        NaN if the bracketing means are not positive.
     flow_point_ci : tuple of float
         Its interval.
     points : mapping
@@ -123,7 +165,9 @@ class SweepSummary:
         ``{name: array of shape (3, 2)}``: rows strain, G′, G″; columns low, high.
     defined_fraction : mapping
         Flat name of :data:`CHARACTERISTICS` → fraction of the bootstrap replicates in which it
-        is finite.
+        is finite (a censored replicate counts, at the end of the measured range).
+    flags : mapping
+        Flat name of :data:`CHARACTERISTICS` → a key of :data:`FLAGS`.
     confidence : float
         Confidence level of the intervals.
     n_boot : int
@@ -147,6 +191,7 @@ class SweepSummary:
     points: types.MappingProxyType
     points_ci: types.MappingProxyType
     defined_fraction: types.MappingProxyType
+    flags: types.MappingProxyType
     confidence: float
     n_boot: int
 
@@ -185,7 +230,8 @@ class SweepSummary:
             ``n_runs``, ``n_amplitudes``, ``amplitude_min``, ``amplitude_max``, ``n_seeds_min``,
             ``n_seeds_max``, ``confidence``, ``n_boot``, then for each name of
             :data:`CHARACTERISTICS`: ``name``, ``name_ci_low``, ``name_ci_high``,
-            ``name_defined`` (fraction of replicates).  Python floats and ints; NaN where undefined.
+            ``name_defined`` (fraction of replicates), ``name_flag`` (a key of :data:`FLAGS`).  Python
+            floats, ints and str; NaN where undefined.
         """
         out = {"n_runs": int(self.n_seeds.sum()), "n_amplitudes": len(self.amplitudes),
                "amplitude_min": float(self.amplitudes[0]), "amplitude_max": float(self.amplitudes[-1]),
@@ -197,6 +243,7 @@ class SweepSummary:
             out[name + "_ci_low"] = float(lo)
             out[name + "_ci_high"] = float(hi)
             out[name + "_defined"] = float(self.defined_fraction[name])
+            out[name + "_flag"] = self.flags[name]
         return out
 
     def curve_rows(self):
@@ -280,12 +327,14 @@ def _check_resampling(n_boot, confidence, rng):
 # ---------------------------------------------------------------------------------------------
 def _linear_limits(A, Gp, fraction):
     """Amplitude where each row of ``Gp`` (shape (B, n), amplitudes ``A`` ascending) first falls to
-    ``(1 - fraction)`` × its first value, log-log interpolated; NaN where it never does or a log is
-    not defined."""
+    ``(1 - fraction)`` × its first value, log-log interpolated, and whether it is censored: rows with a
+    positive plateau that never fall that far get the largest amplitude and ``True``; NaN where a log
+    is not defined."""
     plateau = Gp[:, 0]
     target = (1.0 - fraction) * plateau
     below = Gp[:, 1:] <= target[:, None]
     found = below.any(axis=1) & (plateau > 0)
+    censored = ~below.any(axis=1) & (plateau > 0)
     j = np.argmax(below, axis=1) + 1               # first amplitude at or below the target
     rows = np.arange(len(Gp))
     g0, g1 = Gp[rows, j - 1], Gp[rows, j]           # g0 > target >= g1
@@ -297,33 +346,49 @@ def _linear_limits(A, Gp, fraction):
         lg0, lg1, lt = np.log(g0[ok]), np.log(g1[ok]), np.log(target[ok])
         t = (lt - lg0) / (lg1 - lg0)                # in (0, 1]: lg1 <= lt < lg0
         out[r] = np.exp(u[jj - 1] + t * (u[jj] - u[jj - 1]))
-    return out
+    out[censored] = A[-1]
+    return out, censored
 
 
 def _curve_characteristics(A, Gp, Gpp, guesses=(0.01, 0.1)):
-    """Flat characteristics (order of :data:`CHARACTERISTICS`) of each row of ``Gp``/``Gpp`` (shape (B, n));
-    ``guesses`` = (guess_softening_strain, guess_soft_plateau_strain) of the R rules."""
+    """Flat characteristics (order of :data:`CHARACTERISTICS`) of each row of ``Gp``/``Gpp`` (shape (B, n),
+    amplitudes ``A`` ascending) and their censoring (int8, same shape: +1 beyond the largest amplitude, −1
+    below the smallest, 0 not censored); ``guesses`` = (guess_softening_strain, guess_soft_plateau_strain)
+    of the R rules.  A censored strain is the end of the range; the G′, G″ of a censored yield point NaN."""
     from .curves import stress_curve_points, yield_point
     B = len(Gp)
-    out = np.full((B, len(CHARACTERISTICS)), np.nan)
-    out[:, 0] = Gp[:, 0]
-    out[:, 1] = _linear_limits(A, Gp, 0.05)
-    out[:, 2] = _linear_limits(A, Gp, 0.10)
+    names = list(CHARACTERISTICS)
+    col = {name: i for i, name in enumerate(names)}
+    out = np.full((B, len(names)), np.nan)
+    censor = np.zeros((B, len(names)), dtype=np.int8)
+    out[:, col["plateau"]] = Gp[:, 0]
+    for name, frac in (("linear_limit_5", 0.05), ("linear_limit_10", 0.10)):
+        out[:, col[name]], above = _linear_limits(A, Gp, frac)
+        censor[above, col[name]] = 1
+    # the crossing read from above (curves.yield_point): G′ > G″ at the largest amplitude → beyond the range;
+    # G′ > G″ nowhere → below it
+    cross_above = Gp[:, -1] > Gpp[:, -1]
+    cross_below = ~(Gp > Gpp).any(axis=1)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)   # logs of non-positive means: NaN, said by the docs
         for b in range(B):
             gp, gpp = Gp[b], Gpp[b]
             try:
-                out[b, 3] = yield_point(A, gp, gpp, interpolation="log")
+                out[b, col["flow_point"]] = yield_point(A, gp, gpp, interpolation="log")
             except (ValueError, ZeroDivisionError):        # a log of a non-positive mean
                 pass
             try:
                 pts = stress_curve_points(A, gp, gpp, *guesses)
             except (ValueError, ZeroDivisionError):
                 continue
-            out[b, 4:] = [float(x) for name in POINT_NAMES for x in pts[name]]
+            out[b, col["low_strain_plateau_strain"]:] = [float(x) for name in POINT_NAMES for x in pts[name]]
     out[~np.isfinite(out)] = np.nan
-    return out
+    for name in ("flow_point", "yield_strain"):
+        out[cross_above, col[name]], censor[cross_above, col[name]] = A[-1], 1
+        out[cross_below, col[name]], censor[cross_below, col[name]] = A[0], -1
+    out[cross_above | cross_below, col["yield_Gp"]] = np.nan
+    out[cross_above | cross_below, col["yield_Gpp"]] = np.nan
+    return out, censor
 
 
 def _percentile_interval(samples, confidence):
@@ -337,6 +402,109 @@ def _percentile_interval(samples, confidence):
     if some.any():
         ci[some] = np.nanpercentile(samples[:, some], [q, 100.0 - q], axis=0).T
     return ci, frac
+
+
+def modulus_interval(samples, estimate, confidence):
+    """Percentile interval of the bootstrap replicates of a modulus, computed on their logarithm.
+
+    The ``(1 ± confidence)/2`` percentiles of log(replicate) over the finite replicates (linear
+    interpolation between order statistics), exponentiated: the interval is >= 0 by construction.
+    A replicate <= 0 has log −∞: an interval end that falls on one is 0.  A modulus whose estimate
+    is not > 0 has no interval (a log-scale interval of it does not exist; flag ``non_positive``).
+
+    Parameters
+    ----------
+    samples : array_like
+        Bootstrap replicates of the modulus (Pa), 1-D; NaN entries are left out.
+    estimate : float
+        The point estimate (Pa).
+    confidence : float
+        Level, in (0, 1).
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)`` in Pa with ``0 <= low <= high``, or ``(nan, nan)`` when ``estimate`` is not
+        finite and > 0 or no replicate is finite.
+
+    Raises
+    ------
+    ValueError
+        ``samples`` not 1-D real numbers, or ``confidence`` not in (0, 1).
+
+    Examples
+    --------
+    >>> modulus_interval([-50.0, 10.0, 100.0, 1000.0], 265.0, 0.5)   # never below 0
+    (0.0, 177.82794100389225)
+    """
+    try:
+        s = np.asarray(samples, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"samples is invalid: allowed a 1-D sequence of real numbers, got "
+                         f"{type(samples).__name__}") from None
+    if s.ndim != 1:
+        raise ValueError(f"samples is invalid: allowed a 1-D sequence of real numbers, got shape {s.shape}")
+    if isinstance(confidence, (bool, np.bool_)) or not isinstance(confidence, numbers.Real) \
+            or not (0 < confidence < 1):
+        raise ValueError(f"confidence={confidence!r} is out of range: allowed a number in (0, 1)")
+    s = np.sort(s[np.isfinite(s)])
+    if not (math.isfinite(estimate) and estimate > 0) or len(s) == 0:
+        return math.nan, math.nan
+    q = 0.5 * (1.0 - confidence)
+    ends = []
+    for p in (q, 1.0 - q):
+        h = (len(s) - 1) * p
+        i = int(math.floor(h))
+        j = min(i + 1, len(s) - 1)
+        if s[i] <= 0:                                # the end falls on a replicate with log −∞
+            ends.append(0.0)
+        elif s[i] == s[j]:
+            ends.append(float(s[i]))
+        else:
+            li, lj = math.log(s[i]), math.log(s[j])    # s[j] >= s[i] > 0
+            ends.append(float(math.exp(li + (h - i) * (lj - li))))
+    return ends[0], ends[1]
+
+
+def _characteristic_intervals(point, point_censor, reps, reps_censor, A, confidence):
+    """Interval, flag of each characteristic: ``ci`` (m, 2), ``flags`` list of keys of :data:`FLAGS` (rules
+    in :data:`FLAGS`; an interval only beside an estimate, moduli by :func:`modulus_interval`)."""
+    q = 0.5 * (1.0 - confidence)
+    ci, _ = _percentile_interval(reps, confidence)
+    flags = []
+    for j, name in enumerate(CHARACTERISTICS):
+        v, c = point[j], int(point_censor[j])
+        if c:
+            flags.append("lower_bound" if c > 0 else "upper_bound")
+            ci[j] = np.nan
+        elif not math.isfinite(v):
+            flags.append("undefined")
+            ci[j] = np.nan
+        elif name in MODULUS_NAMES:
+            ci[j] = modulus_interval(reps[:, j], v, confidence)
+            flags.append("ok" if v > 0 else "non_positive")
+        elif name in _CENSORABLE:
+            above = float(np.mean(reps_censor[:, j] > 0))
+            below = float(np.mean(reps_censor[:, j] < 0))
+            if above > q:
+                ci[j, 1] = A[-1]
+            if below > q:
+                ci[j, 0] = A[0]
+            flags.append("open_both" if above > q and below > q else "open_above" if above > q
+                         else "open_below" if below > q else "ok")
+        else:
+            flags.append("ok")
+    return ci, flags
+
+
+def _widen_log(boot, mean, factor):
+    """Replicate means ``boot`` (B, n) moved away from ``mean`` (n,) by ``factor`` (n,) on the log scale where
+    the mean is > 0 (a replicate <= 0 there becomes 0), linearly where it is not."""
+    linear = mean + factor * (boot - mean)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        logscale = mean * np.exp(factor * (np.log(boot) - np.log(mean)))
+    logscale = np.where(boot > 0, logscale, 0.0)
+    return np.where(mean > 0, logscale, linear)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -373,15 +541,26 @@ def sweep_summary(amplitude, Gp, Gpp, n_boot=2000, confidence=0.95, rng=None, st
     Student, quantiles: about 72 % instead of 95 % for 4 normal seeds, 88 % for 8).  With
     ``student=True`` (default) each replicate mean is therefore moved away from the sample mean by
     the factor ``√(n/(n−1))·t_{n−1}/z`` of its amplitude's n runs before the characteristics are
-    extracted, which makes the interval of a mean the Student-t interval and carries that width
-    into every characteristic (docs/analysis.md gives the measured coverage).
+    extracted — on the log scale where the mean is > 0 (``mean·(replicate/mean)^factor``, so a
+    widened modulus stays positive), linearly where it is not — which makes the interval of a
+    mean the Student-t interval of its logarithm and carries that width into every characteristic
+    (docs/analysis.md gives the measured coverage, ``benchmarks/interval_coverage.py``).
+
+    Moduli intervals (the mean curves, the plateau, the G′ and G″ of the points) are
+    :func:`modulus_interval`: >= 0, none for an estimate <= 0.  A strain beyond the measured
+    amplitudes is reported as a bound, with no interval (flags ``lower_bound``, ``upper_bound``);
+    an estimate whose replicates are censored in more than ``(1 − confidence)/2`` of the cases
+    gets the range end as that end of its interval (``open_above``, ``open_below``).  An interval
+    is given only beside an estimate.  With fewer than :data:`MIN_POINT_AMPLITUDES` distinct
+    amplitudes only the plateau and the mean curves are computed (the other characteristics are
+    NaN with the flag ``too_few_amplitudes``, and a ``UserWarning`` says so).
 
     With one run at an amplitude the replicates cannot vary there: its interval has zero width and
     the intervals of the characteristics understate the uncertainty (with one run everywhere, all
     intervals collapse to the point estimate).  A ``UserWarning`` says so.
 
     Log-log quantities (linear limits, flow point) need positive means at the bracketing
-    amplitudes; where a mean is zero or negative they are NaN (no error).
+    amplitudes; where a mean is zero or negative they are NaN (no error, flag ``undefined``).
 
     Parameters
     ----------
@@ -422,8 +601,8 @@ def sweep_summary(amplitude, Gp, Gpp, n_boot=2000, confidence=0.95, rng=None, st
     >>> A = np.repeat([0.01, 0.1, 1.0, 10.0], 3)
     >>> x = A / 1.0
     >>> s = sweep_summary(A, 1000 / (1 + x**2), 500 * x / (1 + x**2), n_boot=200, rng=1)
-    >>> round(s.flow_point, 6)
-    2.0
+    >>> round(s.flow_point, 6), s.flags["flow_point"]
+    (2.0, 'ok')
     """
     A, gp, gpp, n_boot, confidence, gen = _check(amplitude, Gp, Gpp, n_boot, confidence, rng)
     amps, inverse = np.unique(A, return_inverse=True)
@@ -443,21 +622,33 @@ def sweep_summary(amplitude, Gp, Gpp, n_boot=2000, confidence=0.95, rng=None, st
         gpp_boot[:, i] = gpp_s[idx].mean(axis=1)
     if student:
         widen = _student_factor(counts, confidence)
-        gp_boot = gp_mean + widen * (gp_boot - gp_mean)
-        gpp_boot = gpp_mean + widen * (gpp_boot - gpp_mean)
+        gp_boot = _widen_log(gp_boot, gp_mean, widen)
+        gpp_boot = _widen_log(gpp_boot, gpp_mean, widen)
     single = amps[counts == 1]
     if len(single):
         what = "every amplitude has" if len(single) == n else f"amplitude(s) {[float(a) for a in single]} have"
         warnings.warn(f"sweep_summary: {what} one run only: the bootstrap intervals there have zero width and the "
                       "intervals of the characteristics understate the uncertainty", UserWarning, stacklevel=2)
-    gp_ci, _ = _percentile_interval(gp_boot, confidence)
-    gpp_ci, _ = _percentile_interval(gpp_boot, confidence)
-    guesses = (guess_softening_strain, guess_soft_plateau_strain)
-    point = _curve_characteristics(amps, gp_mean[None, :], gpp_mean[None, :], guesses)[0]
-    reps = _curve_characteristics(amps, gp_boot, gpp_boot, guesses)
-    ci, frac = _percentile_interval(reps, confidence)
+    gp_ci = np.array([modulus_interval(gp_boot[:, i], gp_mean[i], confidence) for i in range(n)])
+    gpp_ci = np.array([modulus_interval(gpp_boot[:, i], gpp_mean[i], confidence) for i in range(n)])
     names = list(CHARACTERISTICS)
     k = {name: i for i, name in enumerate(names)}
+    if n >= MIN_POINT_AMPLITUDES:
+        guesses = (guess_softening_strain, guess_soft_plateau_strain)
+        point, point_censor = _curve_characteristics(amps, gp_mean[None, :], gpp_mean[None, :], guesses)
+        reps, reps_censor = _curve_characteristics(amps, gp_boot, gpp_boot, guesses)
+    else:     # the plateau only: the other characteristics need the shape of the curve
+        warnings.warn(f"sweep_summary: {n} distinct amplitudes: the linear limits, the flow point and the R "
+                      f"package's points need >= {MIN_POINT_AMPLITUDES} and are not computed (only the plateau "
+                      "and the mean curves)", UserWarning, stacklevel=2)
+        point, reps = np.full((1, len(names)), np.nan), np.full((n_boot, len(names)), np.nan)
+        point[0, k["plateau"]], reps[:, k["plateau"]] = gp_mean[0], gp_boot[:, 0]
+        point_censor, reps_censor = np.zeros(point.shape, np.int8), np.zeros(reps.shape, np.int8)
+    point, point_censor = point[0], point_censor[0]
+    _, frac = _percentile_interval(reps, confidence)
+    ci, flag_list = _characteristic_intervals(point, point_censor, reps, reps_censor, amps, confidence)
+    if n < MIN_POINT_AMPLITUDES:
+        flag_list = [f if name == "plateau" else "too_few_amplitudes" for name, f in zip(names, flag_list)]
 
     def scalar(name):
         return float(point[k[name]]), (float(ci[k[name], 0]), float(ci[k[name], 1]))
@@ -477,7 +668,7 @@ def sweep_summary(amplitude, Gp, Gpp, n_boot=2000, confidence=0.95, rng=None, st
         flow_point=values["flow_point"][0], flow_point_ci=values["flow_point"][1],
         points=types.MappingProxyType(points), points_ci=types.MappingProxyType(points_ci),
         defined_fraction=types.MappingProxyType({name: float(frac[i]) for i, name in enumerate(names)}),
-        confidence=confidence, n_boot=n_boot)
+        flags=types.MappingProxyType(dict(zip(names, flag_list))), confidence=confidence, n_boot=n_boot)
 
 
 def _frozen_int(a):

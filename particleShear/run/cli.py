@@ -2,7 +2,7 @@
 
 ``particleShear [run] [FLAGS]`` runs one :func:`~particleShear.doParticleShearSimulation`,
 headless by default (no windows unless ``--draw``), with a progress line on stderr, and prints G′
-and G″ from both estimators (overall stress tensor and surface forces) on stdout, or with
+and G″ from both estimators (internal and surface) on stdout, or with
 ``--json`` the result row (:meth:`~particleShear.SimulationResult.to_dict`) as JSON and nothing
 else.  ``particleShear sweep SPEC --out DIR`` runs a sweep (docs/sweeps.md), ``particleShear plot
 DIR`` plots one.
@@ -604,19 +604,23 @@ def main(argv=None):
 
         def shown(items):
             return "  ".join(f"{k} = {v:.6g}{unit(k)}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
+        from ..analysis.verdicts import CHECKS, verdict_lines
         for st in res.steps:
             print(shown((k, st[k]) for k in ("position", "amplitude", "relative_frequency", "Gp_surface",
                                              "Gp_surface_se", "Gpp_surface", "Gpp_surface_se", "Gp_internal",
-                                             "Gpp_internal")))
+                                             "Gpp_internal", "verdict")))
         if res.summary:
-            print(shown(res.summary.items()))
+            print(shown((k, v) for k, v in res.summary.items() if k not in CHECKS and k != "verdict"))
+            print("\n".join(verdict_lines(res.summary, res.protocol)))
         print(f"protocol = {res.protocol}; seed entropy = {res.seed}; tau = {res.tau:.6g} s; wall time "
               + ", ".join(f"{k} {v:.2f} s" for k, v in res.timings.items()))
         if res.output_path:
             print("output file: " + res.output_path)
     else:
-        print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (overall stress tensor)")
-        print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface forces)")
+        print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (internal estimator)")
+        print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface estimator)")
+        from ..analysis.verdicts import verdict_lines
+        print("\n".join(verdict_lines(res.measures)))
         t = res.timings
         print("seed entropy = " + str(res.seed) + "; wall time " + ", ".join(
             f"{k} {t[k]:.2f} s" for k in ("constitution", "pre_equilibration", "protocol", "output", "total")

@@ -140,7 +140,16 @@ class SimulationResult:
         for name, g1, s1, g2, s2 in rows:
             lines.append(f"  {name + ':':<9} G′ = {self._modulus_text(g1, s1)} Pa, "
                          f"G″ = {self._modulus_text(g2, s2)} Pa")
+        lines += ["  " + line for line in self._verdict_lines()]
         return "\n".join(lines) + ")"
+
+    def _verdict_lines(self):
+        """:func:`~particleShear.analysis.verdicts.verdict_lines` of the run; none when its measures fail."""
+        from ..analysis.verdicts import verdict_lines
+        try:
+            return verdict_lines(self.measures)
+        except Exception:  # noqa: BLE001 - a repr never fails
+            return []
 
     def _repr_html_(self):
         """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
@@ -158,6 +167,7 @@ class SimulationResult:
         for name, g1, s1, g2, s2 in rows:
             out.append(f"<tr><td>{esc(name)}</td><td>{esc(self._modulus_text(g1, s1))}</td>"
                        f"<td>{esc(self._modulus_text(g2, s2))}</td></tr>")
+        out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
 
@@ -172,7 +182,8 @@ class SimulationResult:
             p = self.parameters or {}
             try:
                 self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0),
-                                              p.get("pre_periods", 0), p.get("periods", 0))
+                                              p.get("pre_periods", 0), p.get("periods", 0),
+                                              moduli={"surface": self.G_surface, "internal": self.G_internal})
             except Exception as exc:  # noqa: BLE001 - a measure must never turn a finished run into a failure
                 warnings.warn(f"the measures of run {self.run_id or '?'} could not be evaluated "
                               f"({type(exc).__name__}: {exc}); they are left empty", RuntimeWarning, stacklevel=2)
@@ -188,6 +199,12 @@ class SimulationResult:
     def G_internal_se(self):
         """(se G′, se G″) in Pa of the internal estimator: standard error over the measured periods."""
         return self.measures["Gp_internal_se"], self.measures["Gpp_internal_se"]
+
+    @property
+    def verdict(self):
+        """``"ok"`` when no check of the run failed, else ``"flagged: …"`` naming the failed checks
+        (:mod:`particleShear.analysis.verdicts`; docs/analysis.md, "Verdicts")."""
+        return self.measures["verdict"]
 
     @property
     def steady_state(self):

@@ -356,6 +356,16 @@ class RheometerResult:
         self.write_error = None
 
     @property
+    def verdict(self):
+        """``"ok"`` or ``"flagged: …"`` (:mod:`particleShear.analysis.verdicts`); a sweep's is that of its
+        steps together (None when not judged)."""
+        if not self.steps:
+            return self.summary.get("verdict")
+        from ..analysis.verdicts import PROTOCOL_CHECKS, verdict
+        names = PROTOCOL_CHECKS[self.protocol]
+        return verdict({n: (False if any(st.get(n) is False for st in self.steps) else None) for n in names})
+
+    @property
     def values(self):
         """The main numbers of the protocol (see the class docstring)."""
         s = self.summary
@@ -390,7 +400,7 @@ class RheometerResult:
         params.update({k: v for k, v in self.parameters.items() if k in params})
         base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
                 "repetition": int(getattr(self, "repetition", 0)), "dt": float(self.dt)}
-        base.update({k: v for k, v in self.summary.items() if k in PROTOCOL_COLUMNS})
+        base.update({k: v for k, v in self.summary.items() if k in PROTOCOL_COLUMNS or k == "verdict"})
         if self.protocol in ("steady", "relaxation", "creep"):
             base["N_steps"] = int(len(self.series["t"])) if "t" in self.series else None
         base.update(params)
@@ -435,7 +445,8 @@ class RheometerResult:
         moduli = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") + tuple(MEASURE_COLUMNS)
         steps = [{inverse.get(c, c): r.get(c) for c in tuple(STEP_COLUMNS.values()) + moduli}
                  for r in rows] if proto in ("amplitude_sweep", "frequency_sweep") else []
-        summary = {} if steps else {c: first[c] for c in PROTOCOL_COLUMNS if first.get(c) is not None}
+        summary = {} if steps else {c: first[c] for c in PROTOCOL_COLUMNS + ("verdict",)
+                                    if first.get(c) is not None}
         dt = float(first["dt"])
         res = cls(proto, dict(parameters), seed, tuple(spawn_key), first["run_id"], dt / _dt_over_tau(parameters), dt,
                   {}, summary, {}, steps, {"total": float(first.get("wall_time_s") or 0.0)})
@@ -492,8 +503,9 @@ class RheometerResult:
                                  f"G″ = {num(st.get('Gpp_' + est, float('nan')), st.get('Gpp_' + est + '_se'))}",
                                  "Pa"))
         else:
+            from ..analysis.verdicts import CHECKS
             for name, v in self.summary.items():
-                if name.endswith("_se"):
+                if name.endswith("_se") or name in CHECKS or name == "verdict":
                     continue
                 unit = column_spec(name).get("unit") or ""
                 rows.append((name, num(v, self.summary.get(name + "_se")), "" if unit == "1" else unit))
@@ -510,7 +522,15 @@ class RheometerResult:
         fields, rows = self._summary()
         lines = ["RheometerResult(" + ", ".join(f"{k}={v}" for k, v in fields)]
         lines += [f"  {name}: {text}" + (f" {unit}" if unit else "") for name, text, unit in rows]
+        lines += ["  " + line for line in self._verdict_lines()]
         return "\n".join(lines) + ")"
+
+    def _verdict_lines(self):
+        """The verdict of the run (:func:`~particleShear.analysis.verdicts.verdict_lines`); a sweep's per step."""
+        from ..analysis.verdicts import verdict_lines
+        if not self.steps:
+            return verdict_lines(self.summary, self.protocol) if "verdict" in self.summary else []
+        return [f"step {st.get('position', j)}: {st.get('verdict') or 'not judged'}" for j, st in enumerate(self.steps)]
 
     def _repr_html_(self):
         """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
@@ -526,6 +546,7 @@ class RheometerResult:
         out = ["<table>", f"<caption>RheometerResult: {cap}</caption>",
                "<tr><th>quantity</th><th>value</th><th>unit</th></tr>"]
         out += [f"<tr><td>{esc(name)}</td><td>{esc(text)}</td><td>{esc(unit)}</td></tr>" for name, text, unit in rows]
+        out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
 
@@ -619,7 +640,7 @@ def measure_rheometer(runs):
         if sweep_recs is None:
             n = steps[b]["steps"]
             series = {key: np.ascontiguousarray(v[:n, col]) for key, v in recs.items()}
-            summary, curves = analyse_record(proto, kw, series, tau, steps[b])
+            summary, curves = analyse_record(proto, kw, series, tau, steps[b], MAX_STRAIN_PER_STEP)
             sweep = []
         else:
             segments = [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ..analysis import verdicts as vd
 from ..analysis.rheometry import final_rate, log_grid, plateau, steady_state
 
 __all__ = ["analyse_record", "analyse_sweep"]
@@ -17,7 +18,7 @@ __all__ = ["analyse_record", "analyse_sweep"]
 _EST = (("surface", "stress_surface"), ("internal", "stress_internal"))
 
 
-def analyse_record(protocol, kw, series, tau, steps):
+def analyse_record(protocol, kw, series, tau, steps, rate_limit=math.inf):
     """Scalars and log-grid curves of one replica's record (steady, relaxation, creep).
 
     Parameters
@@ -32,11 +33,14 @@ def analyse_record(protocol, kw, series, tau, steps):
         Model time constant (s).
     steps : dict
         :func:`particleShear.run.rheometer.protocol_steps` of the run.
+    rate_limit : float, default inf
+        The creep controller's largest strain per step (its rate limit times dt).
 
     Returns
     -------
     summary : dict
-        Column → float (units in docs/protocols.md).
+        Column → float (units in docs/protocols.md), the protocol's checks (bool or None) and
+        ``verdict`` (:mod:`particleShear.analysis.verdicts`).
     curves : dict
         ``name -> (t, y, y_sem)``.
     """
@@ -55,6 +59,7 @@ def analyse_record(protocol, kw, series, tau, steps):
         keep = np.isfinite(n1) & (t >= out["t_transient"])
         ba = plateau(t[keep], n1[keep], 1.0) if keep.sum() >= 2 else None
         out["N1"], out["N1_se"] = (ba.mean, ba.sem) if ba else (math.nan, math.nan)
+        checks = vd.steady_checks(t, {key: series[key] for _, key in _EST}, kw["total_strain"])
     elif protocol == "relaxation":
         g0 = kw["theAmplitude"]
         n_ramp = steps["ramp"] + 1          # the first hold sample: step 0 at rest, then the ramp
@@ -69,6 +74,8 @@ def analyse_record(protocol, kw, series, tau, steps):
             out[f"G_plateau_{est}"], out[f"G_plateau_{est}_se"] = ba.mean, ba.sem
             tm, gm, gs, _ = log_grid(th, G)
             curves[f"G_{est}"] = (tm, gm, gs)
+        checks = vd.relaxation_checks(th, {est: (series[key][n_ramp:] - series[key][0]) / g0 for est, key in _EST},
+                                      g0, {est: float(series[key][0]) for est, key in _EST})
     elif protocol == "creep":
         s0 = kw["creep_stress"]
         gam = series["strain"] - series["strain"][0]
@@ -84,6 +91,13 @@ def analyse_record(protocol, kw, series, tau, steps):
         out["stress_tracking"] = float((series["stress_surface"][half].mean() - s0) / s0)
         tm, jm, js, _ = log_grid(t, gam / s0)
         curves["J"] = (tm, jm, js)
+        dt = float(t[1] - t[0]) if len(t) >= 2 else math.nan
+        checks = vd.creep_checks(t, series["strain_rate"], out["stress_tracking"], rate_limit / dt,
+                                 kw["hold_time"], kw["creep_response_time"])
+    else:
+        return out, curves
+    out.update(checks)
+    out["verdict"] = vd.verdict(checks)
     return out, curves
 
 
@@ -114,6 +128,7 @@ def analyse_sweep(kw, segments, tau):
             SA, SB, Gp, Gpp = demodulation(rec["t"], rec[key], f, A, pre, periods, post,
                                            correct_drift_sign=kw["correct_drift_sign"])
             row[f"Gp_{est}"], row[f"Gpp_{est}"] = Gp, Gpp
-        row.update(run_measures(rec, f, A, pre, periods))
+        row.update(run_measures(rec, f, A, pre, periods,
+                                moduli={est: (row[f"Gp_{est}"], row[f"Gpp_{est}"]) for est, _ in _EST}))
         rows.append(row)
     return rows

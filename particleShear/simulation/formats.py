@@ -391,7 +391,8 @@ class RunData(dict):
         try:
             import pandas as pd
         except ImportError as exc:
-            raise ImportError("RunData.to_dataframe needs pandas: pip install pandas") from exc
+            raise ImportError("RunData.to_dataframe needs pandas: pip install \"particleShear[tables]\" (from this "
+                              "source, see README 'Install')") from exc
         df = pd.DataFrame(dict(self))
         df.attrs["header"] = self.header
         df.attrs["metadata"] = self.metadata

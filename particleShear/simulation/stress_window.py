@@ -111,8 +111,8 @@ class StressPlotWindow:
         for t in (t_on, t_off):
             if t is not None:
                 c.create_line(t * x_scale, 0, t * x_scale, H, fill="grey", dash=(2, 4))
-        for k, (col, label) in enumerate((("red", "\u03c4 internal (stress tensor)"),
-                                          ("blue", "\u03c4 surface (plate forces)"), ("green", "strain \u03b3"))):
+        for k, (col, label) in enumerate((("red", "internal (stress tensor)"),
+                                          ("blue", "surface (plate forces)"), ("green", "strain \u03b3"))):
             y = 24 + 16 * k
             c.create_line(200, y, 220, y, fill=col, width=3)
             c.create_text(226, y, text=label, anchor="w")

@@ -43,6 +43,8 @@ COLUMN_TYPES = ("float", "int", "bool", "string", "bigint", "int_list", "float_l
 RUN_COLUMNS = ("repetition", "frequency_Hz", "omega", "dt", "N_steps")
 
 _G = "{} modulus G{} from the {} (Pa); empty for a failed run"
+_CHECK = ("check {0}: True when it passes, False when it fails, empty when it cannot be judged (rule: "
+          "particleShear.analysis.verdicts.CHECKS['{0}'], docs/analysis.md \"Verdicts\")")
 _SE = "standard error of {} over the measured excitation periods (Pa); NaN with fewer than 2 periods"
 #: column -> (type, unit, description, nullable) of every column that is not a parameter
 _FIXED = {
@@ -51,8 +53,8 @@ _FIXED = {
     "error": ("string", "", "exception type and message of a failed run; empty when ok", False),
     "Gp_surface": ("float", "Pa", _G.format("storage", "′", "plate (surface) forces"), True),
     "Gpp_surface": ("float", "Pa", _G.format("loss", "″", "plate (surface) forces"), True),
-    "Gp_internal": ("float", "Pa", _G.format("storage", "′", "overall stress tensor (internal, eq. S1-24)"), True),
-    "Gpp_internal": ("float", "Pa", _G.format("loss", "″", "overall stress tensor (internal, eq. S1-24)"), True),
+    "Gp_internal": ("float", "Pa", _G.format("storage", "′", "internal estimator (stress tensor, eq. S1-24)"), True),
+    "Gpp_internal": ("float", "Pa", _G.format("loss", "″", "internal estimator (stress tensor, eq. S1-24)"), True),
     "Gp_surface_se": ("float", "Pa", _SE.format("Gp_surface"), True),
     "Gpp_surface_se": ("float", "Pa", _SE.format("Gpp_surface"), True),
     "Gp_internal_se": ("float", "Pa", _SE.format("Gp_internal"), True),
@@ -66,6 +68,12 @@ _FIXED = {
     "T_surface": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, surface stress", True),
     "S_internal": ("float", "1", "Ewoldt-Hosoi-McKinley stiffening ratio S, internal stress", True),
     "T_internal": ("float", "1", "Ewoldt-Hosoi-McKinley thickening ratio T, internal stress", True),
+    "linear_response": ("bool", "", _CHECK.format("linear_response"), True),
+    "estimators_agree": ("bool", "", _CHECK.format("estimators_agree"), True),
+    "moduli_positive": ("bool", "", _CHECK.format("moduli_positive"), True),
+    "excitation_resolved": ("bool", "", _CHECK.format("excitation_resolved"), True),
+    "verdict": ("string", "", "'ok' when no check of the run failed, else 'flagged: ' and the failed checks' names "
+                "(docs/analysis.md, \"Verdicts\"); empty for a failed run", True),
     "repetition": ("int", "", "index of the run among the repetitions of its parameter point (0-based; "
                    "SweepRun.repetition)", False),
     "frequency_Hz": ("float", "Hz", "excitation frequency f; empty for a failed run", True),
@@ -93,7 +101,7 @@ _PROTOCOL_FIXED = {
     "stress_surface": ("float", "Pa", "steady shear stress from the plate forces (mean after the transient)"
                        + _P.format("'steady'")),
     "stress_surface_se": ("float", "Pa", "standard error of stress_surface by block averaging" + _P.format("'steady'")),
-    "stress_internal": ("float", "Pa", "steady shear stress of the overall stress tensor (eq. S1-24)"
+    "stress_internal": ("float", "Pa", "steady shear stress of the internal estimator (stress tensor, eq. S1-24)"
                         + _P.format("'steady'")),
     "stress_internal_se": ("float", "Pa", "standard error of stress_internal by block averaging"
                            + _P.format("'steady'")),
@@ -114,7 +122,7 @@ _PROTOCOL_FIXED = {
                           + _P.format("'relaxation'")),
     "G_plateau_surface_se": ("float", "Pa", "standard error of G_plateau_surface by block averaging"
                              + _P.format("'relaxation'")),
-    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), overall stress tensor" + _P.format("'relaxation'")),
+    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), internal estimator" + _P.format("'relaxation'")),
     "G_plateau_internal_se": ("float", "Pa", "standard error of G_plateau_internal by block averaging"
                               + _P.format("'relaxation'")),
     "creep_rate": ("float", "1/s", "final creep rate dγ/dt over the last 20 % of the hold" + _P.format("'creep'")),
@@ -126,6 +134,12 @@ _PROTOCOL_FIXED = {
     "strain_plateau_se": ("float", "1", "standard error of strain_plateau by block averaging" + _P.format("'creep'")),
     "stress_tracking": ("float", "1", "(mean plate stress over the second half of the hold − σ₀)/σ₀"
                         + _P.format("'creep'")),
+    "plateau_reached": ("bool", "", _CHECK.format("plateau_reached") + _P.format("'steady' or 'relaxation'")),
+    "strain_sufficient": ("bool", "", _CHECK.format("strain_sufficient") + _P.format("'steady'")),
+    "stress_held": ("bool", "", _CHECK.format("stress_held") + _P.format("'creep'")),
+    "rate_unsaturated": ("bool", "", _CHECK.format("rate_unsaturated") + _P.format("'creep'")),
+    "hold_sufficient": ("bool", "", _CHECK.format("hold_sufficient") + _P.format("'creep'")),
+    "strain_above_noise": ("bool", "", _CHECK.format("strain_above_noise") + _P.format("'relaxation'")),
 }
 #: the protocol columns, in table order
 PROTOCOL_COLUMNS = tuple(_PROTOCOL_FIXED)
@@ -466,8 +480,9 @@ def load_results(folder_or_csv, as_frame=None):
     folder_or_csv : str or os.PathLike
         The sweep folder, or a results table (``.csv``) itself (its schema is looked for beside it).
     as_frame : bool, optional
-        True: a DataFrame (needs pandas); False: a list of dicts; None (default): a DataFrame when
-        pandas is installed, else the list.
+        True: a DataFrame (needs pandas, the extra ``[tables]``); False: a list of dicts; None
+        (default): a DataFrame when pandas is installed, else the list.  Code that indexes the
+        result as a DataFrame should pass True, so a missing pandas is an error saying so.
 
     Returns
     -------
@@ -483,12 +498,20 @@ def load_results(folder_or_csv, as_frame=None):
         of its column's type (naming the file, the line and the column), or ``as_frame`` is not
         None, True or False.
     ImportError
-        When ``as_frame=True`` and pandas is not installed.
+        When ``as_frame=True`` and pandas is not installed (naming the extra ``[tables]``), before
+        the table is read.
     """
     from .reader import read_table
     from .table import TABLE_NAME
     if as_frame not in (None, True, False):
         raise ValueError(f"as_frame={as_frame!r} is invalid: allowed None, True or False")
+    if as_frame:
+        try:
+            __import__("pandas")            # checked before the table is read
+        except ImportError:
+            raise ImportError("load_results(as_frame=True) needs pandas: pip install \"particleShear[tables]\" "
+                              "(from this source, see README 'Install'), or pass as_frame=False for a list of "
+                              "typed dicts") from None
     path = os.fspath(folder_or_csv)
     if os.path.isdir(path):
         path = os.path.join(path, TABLE_NAME)

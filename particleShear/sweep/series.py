@@ -39,7 +39,7 @@ def _result_from_rows(rows, run, out_dir):
         res = RheometerResult.from_rows(rows, run.parameters, run.seed_entropy, run.spawn_key, path)
         res.repetition = run.repetition
         return res
-    from ..analysis.measures import MEASURE_COLUMNS
+    from ..analysis.measures import NON_NUMERIC_MEASURES, MEASURE_COLUMNS
     g = tuple(_number(row.get(c)) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
     result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
                               parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
@@ -47,7 +47,7 @@ def _result_from_rows(rows, run, out_dir):
                               output_path=path,
                               dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
                               N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
-    result._measures = {c: (row.get(c) if c == "steady_state" else _number(row.get(c))) for c in MEASURE_COLUMNS}
+    result._measures = {c: (row.get(c) if c in NON_NUMERIC_MEASURES else _number(row.get(c))) for c in MEASURE_COLUMNS}
     return result
 
 

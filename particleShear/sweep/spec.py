@@ -174,14 +174,17 @@ class SweepSpec:
 
 
 def _read_toml(path):
+    """The tables of the TOML file ``path``: the one reader of TOML in the package (``tomllib``, or
+    ``tomli`` on Python < 3.11)."""
     try:
         import tomllib
     except ModuleNotFoundError:  # Python < 3.11
         try:
             import tomli as tomllib
         except ModuleNotFoundError:
-            raise ValueError(f"SPEC={path!r}: reading TOML needs Python >= 3.11 or the package 'tomli'; "
-                             "install tomli or write the SPEC as JSON (same tables)") from None
+            raise ValueError(f"SPEC={path!r}: reading TOML needs Python >= 3.11 or the package 'tomli' (a "
+                             "dependency of particleShear on Python < 3.11: pip install 'tomli>=1.1'); "
+                             "or write the SPEC as JSON (same tables)") from None
     with open(path, "rb") as fh:
         try:
             return tomllib.load(fh)
@@ -274,7 +277,7 @@ def load_spec(path):
     Parameters
     ----------
     path : str or os.PathLike
-        The SPEC file: ``.toml`` (needs Python ≥ 3.11 or tomli) or ``.json``, same tables.
+        The SPEC file: ``.toml`` (``tomllib``; ``tomli`` on Python < 3.11, a dependency there) or ``.json``, same tables.
 
 
     Returns

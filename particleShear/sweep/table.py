@@ -231,6 +231,10 @@ def check_table(path, columns):
         return notes
     with open(path, "rb") as fh:
         bom = fh.read(3) == b"\xef\xbb\xbf"
+    added = add_result_columns(path, columns)
+    if added:
+        notes.append(f"added the column(s) {added} of this version to {path} (empty in its earlier rows: not "
+                     "evaluated when they ran)")
     table = read_table(path, schema="package", invalid="keep")
     check_table_header(path, columns)
     aside = {k for k, _ in table.set_aside} | {k for k, _ in table.duplicates}
@@ -274,6 +278,52 @@ def reject_lines(path, lines):
         fh.writelines(lines)
         fh.flush()
         os.fsync(fh.fileno())
+
+
+#: columns a newer version may add to a table of an older one: what a run measured, never what it
+#: was asked (a missing parameter would change what the run is)
+ADDABLE_COLUMNS = frozenset(MEASURE_COLUMNS) | frozenset(PROTOCOL_COLUMNS)
+
+
+def add_result_columns(path, columns):
+    """Give a table of an earlier version this version's result columns, empty in its rows.
+
+    Only when the header is ``columns`` less some of :data:`ADDABLE_COLUMNS` (measures, checks,
+    protocol outputs), in the same order: the rows keep every cell, the new columns are empty
+    ("not evaluated"), and the file is replaced atomically.  Any other difference is left for
+    :func:`check_table_header` to refuse.
+
+    Parameters
+    ----------
+    path : str
+        The table.
+    columns : sequence of str
+        This sweep's columns.
+
+    Returns
+    -------
+    list of str
+        The columns added (empty when nothing was done).
+    """
+    header = _header_of(path)
+    columns = list(columns)
+    missing = [c for c in columns if c not in header]
+    if not header or not missing or any(c not in ADDABLE_COLUMNS for c in missing) \
+            or [c for c in columns if c in header] != header:
+        return []
+    where = [header.index(c) if c in header else None for c in columns]
+    csv.field_size_limit(max(csv.field_size_limit(), os.path.getsize(path) + 1))
+    try:
+        with open(path, newline="", encoding="utf-8", errors="strict") as src, atomic_text(path) as out:
+            w = csv.writer(out, lineterminator="\n")
+            for k, cells in enumerate(csv.reader(src)):
+                if k == 0:
+                    w.writerow(columns)
+                else:   # a line that is no row keeps its cells (check_table sets it aside next)
+                    w.writerow(cells if len(cells) != len(header) else ["" if i is None else cells[i] for i in where])
+    except (UnicodeDecodeError, csv.Error):
+        return []       # the file is left as it was (atomic_text); check_table says what is wrong with it
+    return missing
 
 
 def check_table_header(path, columns):
