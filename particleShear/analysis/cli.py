@@ -570,7 +570,7 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
                     names.append(FIGURE_NAME + ext)
                 if len(panels) > max_figure_panels:
                     notes.append(f"figure: the first {max_figure_panels} of {len(panels)} groups drawn; not drawn: "
-                                 + not_drawn_line([t for t, _, _ in panels[max_figure_panels:]]))
+                                 + not_drawn_line([p[0] for p in panels[max_figure_panels:]]))
             else:
                 notes.append('no figure: matplotlib is not installed (pip install "particleShear[plot]")')
         removed = publish(folder, staging, names, SET_NAMES)
