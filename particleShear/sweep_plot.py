@@ -402,8 +402,8 @@ def draw_sweep(table):
     if nonpositive:
         handles["mean ≤ 0: not on the log axis,\nmarked at the lower edge"] = Line2D([], [], ls="none", marker="v", ms=8, color="0.3")
     if cut_any:
-        handles["interval reaches below the axis\n(≤ 0): bar cut at ▼"] = Line2D([], [], ls="none", marker=7, ms=7,
-                                                                                   color="0.3")
+        handles["interval reaches below the axis (≤ 0, or\n1000× below the smallest mean): bar cut at ▼"] = Line2D(
+            [], [], ls="none", marker=7, ms=7, color="0.3")
     if flagged_any:
         handles[FLAGGED_LABEL + ":\n≥ 1 run of the point flagged"] = Line2D([], [], ls="none", marker="o", ms=13,
                                                                           mfc="none", mec="k", mew=1.2)
