@@ -148,6 +148,10 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ra
     title : str, optional
         Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
         :func:`particleShear.plot.made_by`), fitted to the figure's width.
+    is_steady : bool, default True
+        Keyword-only.  False when the run failed ``plateau_reached``
+        (:mod:`particleShear.analysis.verdicts`): the band is then hatched and labelled the mean
+        after the transient, "not steady", never a steady stress.
 
     Returns
     -------
@@ -311,7 +315,7 @@ def plot_amplitude_sweeps(one_packing, independent=None, path=None, *, x="amplit
     return _finish(fig, path, title)
 
 
-def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=None, *, title=None):
+def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=None, *, title=None, is_steady=True):
     """One steady-shear run: the shear stress σ (Pa) against the strain γ, linear axes.
 
     Parameters
@@ -353,7 +357,11 @@ def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=Non
     ax.plot(g, s, "-", lw=0.8, label="σ (plate)")
     if steady is not None:
         v, e = steady
-        ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"steady {v:.3g} ± {e:.3g} Pa", gid="steady")
+        if is_steady:
+            ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"steady {v:.3g} ± {e:.3g} Pa", gid="steady")
+        else:
+            ax.axhspan(v - e, v + e, alpha=0.3, facecolor="none", edgecolor="tab:red", hatch="//",
+                       label=f"mean after transient {v:.3g} ± {e:.3g} Pa: not steady (no plateau)", gid="steady")
     if strain_transient is not None:
         ax.axvline(strain_transient, color="k", ls=":", label="end of transient", gid="transient")
     ax.set_xlabel("strain γ")
@@ -414,7 +422,8 @@ def plot_rheometer_result(result, path=None):
     Returns
     -------
     matplotlib.figure.Figure
-        Titled with the protocol, N, the seed, the estimator and the rate, γ₀ or σ₀.
+        Titled with the protocol, N, the seed, the estimator and the rate, γ₀ or σ₀, and the verdict
+        when the run is flagged.
 
     Raises
     ------
@@ -423,6 +432,9 @@ def plot_rheometer_result(result, path=None):
     """
     proto, summ = result.protocol, result.summary
     title = _result_title(result)
+    verdict = getattr(result, "verdict", None)
+    if verdict and verdict != "ok":
+        title += f"; {verdict}"           # flags are drawn, never hidden (docs/analysis.md, "Verdicts")
     if proto in ("amplitude_sweep", "frequency_sweep"):
         x = "amplitude" if proto == "amplitude_sweep" else "relative_frequency"
         st = result.steps
@@ -438,7 +450,7 @@ def plot_rheometer_result(result, path=None):
                              "of its file, not one rebuilt from a results table)")
         return plot_steady_run(result.series["strain"], result.series["stress_surface"],
                                (summ["stress_surface"], summ["stress_surface_se"]), summ.get("strain_transient"),
-                               path, title=title)
+                               path, title=title, is_steady=summ.get("plateau_reached") is not False)
     name = "G_surface" if proto == "relaxation" else "J"
     if name not in result.curves:
         raise ValueError(f"plot needs the curve {name!r} of the run (a result of this session, not one rebuilt "

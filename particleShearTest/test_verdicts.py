@@ -6,6 +6,7 @@ baseline noise of a known level), then on real runs of the model: the default ru
 check; the cases of issue 44 fail the check that names what is wrong with them.
 """
 import csv
+import importlib.util
 import math
 import os
 import tempfile
@@ -164,6 +165,17 @@ class TestProtocolRuns(unittest.TestCase):
         rising = self.run_(protocol="steady", cut_lines=0, total_strain=1.0)
         self.assertIs(rising.summary["plateau_reached"], False)
         self.assertIn("failed plateau_reached", repr(rising))
+        if importlib.util.find_spec("matplotlib") is not None:     # the flag is drawn, never hidden
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+            for res, steady in ((ok, True), (rising, False)):
+                fig = res.plot()
+                labels = fig.axes[0].get_legend_handles_labels()[1]
+                self.assertEqual(any(lb.startswith("steady ") for lb in labels), steady)
+                self.assertEqual(any("not steady" in lb for lb in labels), not steady)
+                self.assertEqual("flagged" in " ".join(t.get_text() for t in fig.texts), not steady)
+                plt.close(fig)
         short = self.run_(protocol="steady", total_strain=0.5)
         self.assertIs(short.summary["strain_sufficient"], False)
         self.assertEqual(short.rows()[0]["verdict"], short.summary["verdict"])
