@@ -42,6 +42,8 @@ DOCUMENTED_MODULES = [
     "particleShear.analysis.protocol_summary",
     "particleShear.analysis.cli",
     "particleShear.analysis.figure",
+    "particleShear.experiment",
+    "particleShear.experiment.tables",
     "particleShear.simulation",
     "particleShear.simulation.drawing",
     "particleShear.simulation.scene",
