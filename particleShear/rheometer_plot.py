@@ -148,10 +148,6 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ra
     title : str, optional
         Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
         :func:`particleShear.plot.made_by`), fitted to the figure's width.
-    is_steady : bool, default True
-        Keyword-only.  False when the run failed ``plateau_reached``
-        (:mod:`particleShear.analysis.verdicts`): the band is then hatched and labelled the mean
-        after the transient, "not steady", never a steady stress.
 
     Returns
     -------
@@ -333,6 +329,10 @@ def plot_steady_run(strain, stress, steady=None, strain_transient=None, path=Non
     title : str, optional
         Keyword-only.  The figure's title: what made it (N, seeds, estimator, rate, γ₀ or σ₀;
         :func:`particleShear.plot.made_by`), fitted to the figure's width.
+    is_steady : bool, default True
+        Keyword-only.  False when the run failed ``plateau_reached``
+        (:mod:`particleShear.analysis.verdicts`): the band is then hatched and labelled the mean
+        after the transient, "not steady", never a steady stress.
 
     Returns
     -------
