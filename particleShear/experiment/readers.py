@@ -319,7 +319,7 @@ def _build(path, names, unit_cells, rows, *, header_line, units_line, kind, colu
                              f"({QUANTITIES[q][1]}): give it, e.g. units={{{name!r}: {hint!r}}}")
         conv = _unit_factor(q, unit)
         if conv is None:
-            raise ValueError(f"{_where(path, units_line or header_line, name)}: unit {unit!r} (from {whence}) is not "
+            raise ValueError(f"{_where(path, units_line or header_line, name)}: unit {_norm_unit(unit)!r} (from {whence}) is not "
                              f"known for {q} ({QUANTITIES[q][1]}): allowed {sorted(UNITS[_DIMENSION[q]])}; give "
                              f"the right one, e.g. units={{{name!r}: {sorted(UNITS[_DIMENSION[q]])[0]!r}}}")
         q2, factor, offset = conv
