@@ -44,6 +44,8 @@ DOCUMENTED_MODULES = [
     "particleShear.analysis.figure",
     "particleShear.experiment",
     "particleShear.experiment.tables",
+    "particleShear.experiment.readers",
+    "particleShear.experiment.measured",
     "particleShear.simulation",
     "particleShear.simulation.drawing",
     "particleShear.simulation.scene",

@@ -658,9 +658,19 @@ def _human_protocols(rows):
     return buf.getvalue()
 
 
+def _measured_files(argv):
+    """Whether the command line names files, not a sweep folder: a positional argument that is an existing file
+    other than a sweep's ``results.csv`` (read by :func:`particleShear.experiment.measured.main`)."""
+    import os
+    return any(not a.startswith("-") and os.path.isfile(a) and os.path.basename(a) != "results.csv" for a in argv)
+
+
 def main(argv=None):
     """``python -m particleShear analyse DIR [--estimator surface|internal] [--json] [--n-boot N]
     [--confidence C] [--seed S] [--no-figure]``.
+
+    A command line whose paths are measured rheometer files (not a folder) is handed to
+    :func:`particleShear.experiment.measured.main` (``analyse FILE… [--out DIR]``).
 
     Parameters
     ----------
@@ -677,6 +687,9 @@ def main(argv=None):
     """
     import signal
     argv = sys.argv[1:] if argv is None else list(argv)
+    if _measured_files(argv):       # particleShear analyse FILE…: measured rheometer files
+        from ..experiment.measured import main as measured_main
+        return measured_main(argv)
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
