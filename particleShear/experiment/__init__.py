@@ -5,6 +5,7 @@ exported simulated) rheometer test; readers turn files into it, writers turn it 
 into the files rheologists' tools open, and :mod:`~particleShear.experiment.calibration` ranks a
 simulated campaign against a measured amplitude sweep.
 """
+__docformat__ = "numpy"
 from .tables import KINDS, QUANTITIES, MeasuredTest
 
 __all__ = ["KINDS", "QUANTITIES", "MeasuredTest"]

@@ -203,7 +203,7 @@ def _interval(samples, confidence):
 class Calibration:
     """The ranking of a campaign's grid points against a measured amplitude sweep (:func:`calibrate`).
 
-    Attributes
+    Parameters
     ----------
     rows : list of dict
         One per grid point, best first; columns :data:`RANKING_COLUMNS` plus the varying parameters.
@@ -255,7 +255,17 @@ class Calibration:
         return path
 
     def table_text(self, limit=20):
-        """The ranking as printed text: the assumptions, then one line per grid point (best first)."""
+        """The ranking as printed text: one line per grid point (best first), the notes, the assumptions.
+
+        Parameters
+        ----------
+        limit : int, optional
+            Most grid points shown (default 20).
+
+        Returns
+        -------
+        str
+        """
         conf = int(round(100 * self.settings["confidence"]))
         lines = [f"calibration against {self.measured['replicates']} measured replicate(s), "
                  f"{self.settings['estimator']} estimator, {conf} % bootstrap intervals ({self.settings['n_boot']})"]
@@ -434,6 +444,11 @@ def main(argv=None):
     """``particleShear calibrate MEASURED… DIR [--estimator] [--n-boot] [--seed] [--out OUT]``.
 
     Prints the ranking, writes ``calibration.csv`` and (with matplotlib) ``calibration.png``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``calibrate``.
 
     Returns
     -------

@@ -97,7 +97,17 @@ class MeasuredTest:
         return name in self.columns
 
     def unit(self, name):
-        """The SI unit of a column (:data:`QUANTITIES`)."""
+        """The SI unit of a column (:data:`QUANTITIES`).
+
+        Parameters
+        ----------
+        name : str
+            A quantity name.
+
+        Returns
+        -------
+        str
+        """
         return QUANTITIES[name][0]
 
     def __repr__(self):
