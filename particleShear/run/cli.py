@@ -369,7 +369,9 @@ def build_parser():
     p = _Parser(prog="particleShear",
                 description="2D soft-particle oscillatory shear rheology: G' and G'' of one run. Commands: "
                             "run (default; the flags below), sweep SPEC --out DIR (particleShear sweep --help), "
-                            "analyse DIR (particleShear analyse --help), plot DIR (particleShear plot --help). "
+                            "analyse DIR (particleShear analyse --help), plot DIR (particleShear plot --help), "
+                            "export DIR --format reptate|pyrheo (particleShear export --help), calibrate MEASURED "
+                            "DIR (particleShear calibrate --help). "
                             "Flags follow the parameters of "
                             "doParticleShearSimulation (its docstring and docs/parameters.md); headless by default.")
     p.add_argument("--version", action="version", version=f"particleShear {__version__}")
@@ -513,11 +515,17 @@ def main(argv=None):
     if argv[:1] in (["analyse"], ["analyze"]):  # python -m particleShear analyse DIR (particleShear.analysis.cli)
         from ..analysis.cli import main as analyse_main
         return analyse_main(argv[1:])
+    if argv[:1] == ["export"]:  # particleShear export DIR --format reptate|pyrheo (particleShear.experiment.writers)
+        from ..experiment.writers import main as export_main
+        return export_main(argv[1:])
+    if argv[:1] == ["calibrate"]:  # particleShear calibrate MEASURED DIR (particleShear.experiment.calibration)
+        from ..experiment.calibration import main as calibrate_main
+        return calibrate_main(argv[1:])
     if argv[:1] == ["run"]:
         argv = argv[1:]
     elif argv and not argv[0].startswith("-"):
         print(f"particleShear: invalid parameter: unknown command {argv[0]!r}: allowed run (default), sweep, plot, "
-              "analyse",
+              "analyse, export, calibrate",
               file=sys.stderr)
         return 2
     args = build_parser().parse_args(argv)
