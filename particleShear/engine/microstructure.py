@@ -123,29 +123,34 @@ def _pair_vectors(pos, Lx, Ly, shift):
     return np.array((ux, uy))
 
 
-def d2min(pos0, disp, Lx, Ly, gamma0, cutoff):
+def d2min(pos0, disp, Lx, Ly, gamma0, cutoff, dgamma=0.0):
     """D²_min of every sphere: the residual of the best local affine map (Falk & Langer 1998).
 
     For sphere i with the neighbours j within ``cutoff`` at the reference snapshot (minimum image
-    at strain ``gamma0``), separations ``d⁰_ij`` and, after the displacements, ``d¹_ij = d⁰_ij +
-    u_j − u_i``:  ``D²_min(i) = min_J (1/n_i) Σ_j |d¹_ij − J d⁰_ij|²`` with J the 2 × 2 map
-    ``X Y⁻¹`` (``X = Σ d¹ d⁰ᵀ``, ``Y = Σ d⁰ d⁰ᵀ``).  Falk & Langer sum over the neighbours; the
-    mean over them used here does not grow with the cutoff.  Zero for any affine map of the
-    neighbourhood, rigid translations and rotations included.
+    at strain ``gamma0``), separations ``d⁰_ij`` and, after the motion, ``d¹_ij = d⁰_ij + u_j − u_i
+    + Δγ·(d⁰_ij,y, 0)``:  ``D²_min(i) = min_J (1/n_i) Σ_j |d¹_ij − J d⁰_ij|²`` with J the 2 × 2 map
+    ``X Y⁻¹`` (``X = Σ d¹ d⁰ᵀ``, ``Y = Σ d⁰ d⁰ᵀ``).  The shear of the cell acts on the pair vector
+    itself, so a neighbour seen through the sheared boundary (an image ``k·Ly`` away) moves with
+    its image, as in the unwrapped packing.  Falk & Langer sum over the neighbours; the mean over
+    them used here does not grow with the cutoff.  Zero for any affine map of the neighbourhood,
+    rigid translations and rotations included.
 
     Parameters
     ----------
     pos0 : ndarray (2, n)
         Wrapped positions at the reference snapshot (µm).
     disp : ndarray (2, n)
-        Displacements to the current snapshot (µm), affine part included or not (an affine part
-        changes J, not the residual).
+        Displacements to the current snapshot less the cell's shear ``Δγ·(y − Ly/2)`` (µm): the
+        non-affine displacements of :func:`non_affine_displacement`, or any displacement field
+        when ``dgamma`` is 0.
     Lx, Ly : float
         Cell lengths (µm).
     gamma0 : float
         Strain at the reference snapshot.
     cutoff : float
         Neighbour radius (µm), > 0.
+    dgamma : float, default 0
+        Strain change Δγ of the cell between the snapshots.
 
     Returns
     -------
@@ -159,6 +164,7 @@ def d2min(pos0, disp, Lx, Ly, gamma0, cutoff):
     w = (r2 < cutoff * cutoff).astype(float)
     np.fill_diagonal(w, 0.0)
     d1 = d0 + (disp[:, None, :] - disp[:, :, None])
+    d1[0] += dgamma * d0[1]
     X = np.einsum("ij,aij,bij->iab", w, d1, d0)
     Y = np.einsum("ij,aij,bij->iab", w, d0, d0)
     det = Y[:, 0, 0] * Y[:, 1, 1] - Y[:, 0, 1] * Y[:, 1, 0]
@@ -219,7 +225,20 @@ def rattler_free(i, j, n, min_contacts=MIN_CONTACTS):
 
 
 def contact_keys(i, j, n):
-    """Sorted integer keys ``min·n + max`` of contacts (one per unordered pair)."""
+    """Sorted integer keys ``min·n + max`` of contacts (one per unordered pair).
+
+    Parameters
+    ----------
+    i, j : array_like of int (c,)
+        The contacts' sphere indices (0 … n−1).
+    n : int
+        Number of spheres.
+
+    Returns
+    -------
+    ndarray of int64
+        The distinct keys, increasing.
+    """
     i, j = np.asarray(i, np.int64), np.asarray(j, np.int64)
     return np.unique(np.minimum(i, j) * n + np.maximum(i, j))
 
@@ -386,9 +405,8 @@ class Stroboscope:
         u2 = u[0] ** 2 + u[1] ** 2
         both = a["mobile"] & b["mobile"]
         r = a["r"]
-        # the total displacement (affine part included) for D²_min: its affine part changes J only
-        disp = u + np.array(((b["gamma"] - a["gamma"]) * (a["pos"][1] - a["Ly"] / 2), np.zeros_like(u[0])))
-        D2 = d2min(a["pos"], disp, a["Lx"], a["Ly"], a["gamma"], self.cutoff * float(r.mean()))
+        D2 = d2min(a["pos"], u, a["Lx"], a["Ly"], a["gamma"], self.cutoff * float(r.mean()),
+                   dgamma=b["gamma"] - a["gamma"])
         made, broken = contact_changes(a["keys"], b["keys"])
         m = max(int(both.sum()), 1)
         return {"u": u, "msd": float(u2[both].sum() / m), "moved": float((u2[both] > (self.threshold * r[both]) ** 2).sum() / m),
