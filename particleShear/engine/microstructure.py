@@ -27,6 +27,7 @@ Units: lengths µm, squared lengths µm², forces mg·µm·s⁻² per m depth (t
 __docformat__ = "numpy"
 
 import math
+import time
 
 import numpy as np
 
@@ -349,6 +350,9 @@ class Stroboscope:
         self.replicas = None if replicas is None else [int(b) for b in replicas]
         self.snaps = {}           # replica -> list of snapshot dicts
         self.cycles = {}          # replica -> list of per-cycle dicts
+        #: wall time spent taking the snapshots and computing the measures (s; the cost of the observer
+        #: beside its per-step check, benchmarks/stroboscopic_cost.py)
+        self.seconds = 0.0
 
     def observe(self, engine, phase, step, total):
         """Take the snapshot due after ``step`` of the protocol (nothing otherwise).
@@ -365,6 +369,7 @@ class Stroboscope:
         # (a protocol of a whole number of periods may end one step short of its last snapshot)
         if phase != "protocol" or not (step in self._due or (step == total and total + 1 in self._due)):
             return
+        t0 = time.perf_counter()
         s = engine.s
         B, N = s.B, s.N
         pos = to_host(s.pos, "microstructure")
@@ -398,6 +403,7 @@ class Stroboscope:
             if snaps:
                 self.cycles.setdefault(b, []).append(self._cycle(snaps[-1], snap))
             snaps.append(snap)
+        self.seconds += time.perf_counter() - t0
 
     def _cycle(self, a, b):
         """The per-cycle measures between snapshots ``a`` and ``b`` of one replica."""
@@ -430,7 +436,8 @@ class Stroboscope:
             "gamma", "Z", "rattler_fraction", "contacts", "force_pdf" (n_c + 1, bins), "positions"
             (n_c + 1, 2, N) (µm, wrapped), "contact_i", "contact_j", "normal_force" (lists of
             arrays per snapshot); "force_bins", "r_mean" (µm), "Lx", "Ly" (µm) and the settings
-            "threshold", "cutoff" (mean radii), "min_contacts".  None when the replica was not watched.
+            "threshold", "cutoff" (mean radii), "min_contacts"; "seconds": the observer's wall time
+            (s, of the whole batch).  None when the replica was not watched.
         """
         snaps = self.snaps.get(b)
         if snaps is None:
@@ -453,5 +460,5 @@ class Stroboscope:
                 "normal_force": [sn["fn"] for sn in snaps], "radius": snaps[0]["r"].copy(),
                 "force_bins": FORCE_BINS.copy(), "r_mean": float(snaps[0]["r"].mean()),
                 "Lx": snaps[0]["Lx"], "Ly": snaps[0]["Ly"], "threshold": self.threshold, "cutoff": self.cutoff,
-                "min_contacts": self.min_contacts}
+                "min_contacts": self.min_contacts, "seconds": self.seconds}
 
