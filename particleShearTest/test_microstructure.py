@@ -198,6 +198,17 @@ class TestOnset(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "amplitude"):
             irreversibility_onset([0.0], [1.0])
 
+    def test_onset_beside_the_sweep_summary(self):
+        from particleShear.analysis.microstructure import onset_summary
+        A = np.repeat([0.002, 0.005, 0.02, 0.05, 0.2], 3)
+        Gp = 100 / (1 + (A / 0.05) ** 2) * np.tile([0.95, 1.0, 1.05], 5)
+        Gpp = 10 + 0 * A
+        out = onset_summary(A, Gp, Gpp, (A / 0.1) ** 2, n_boot=50)
+        self.assertAlmostEqual(out["onset"]["onset"], 0.01, delta=1e-12)
+        for name in ("flow_point", "softening_strain", "linear_limit_10"):
+            self.assertEqual(len(out[name]), 3)
+        self.assertTrue(0.05 < out["flow_point"][0] < 0.2)     # G′ = 10 between these amplitudes
+
     def test_micro_measures_without_observer_are_nan(self):
         self.assertTrue(all(math.isnan(v) for v in micro_measures(None).values()))
 

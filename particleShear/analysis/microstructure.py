@@ -172,11 +172,8 @@ def onset_summary(amplitude, Gp, Gpp, irr, threshold=ONSET_THRESHOLD, n_boot=200
     summ = sweep_summary(amplitude, Gp, Gpp, n_boot=n_boot, confidence=confidence, rng=rng)
     out = {"onset": onset, "summary": summ}
     for name in ("flow_point", "softening_strain", "linear_limit_10"):
-        try:
-            v = summ.value(name)
-            out[name] = tuple(float(x) for x in (v if isinstance(v, tuple) else (v, math.nan, math.nan)))[:3]
-        except (KeyError, ValueError, TypeError, AttributeError):
-            out[name] = (math.nan, math.nan, math.nan)
+        v, (low, high) = summ.value(name)
+        out[name] = (float(v), float(low), float(high))
     return out
 
 
