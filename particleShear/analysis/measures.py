@@ -80,13 +80,14 @@ def measured_window(t, f, pre_periods, periods):
 
 
 def empty_measures():
-    """The measures of a run that has none: NaN, the checks and ``verdict`` None.
+    """The measures of a run that has none: NaN, the checks, ``verdict`` and the microstructure
+    columns (not evaluated without the stroboscopic observer) None.
 
     Returns
     -------
     dict
     """
-    return {c: (None if c in NON_NUMERIC_MEASURES else math.nan) for c in MEASURE_COLUMNS}
+    return {c: (None if c in NON_NUMERIC_MEASURES or c in MICRO_COLUMNS else math.nan) for c in MEASURE_COLUMNS}
 
 
 def run_measures(series, f, strain_amplitude, pre_periods, periods, moduli=None):

@@ -40,17 +40,20 @@ def micro_measures(micro, transient=TRANSIENT_CYCLES):
     Parameters
     ----------
     micro : dict or None
-        ``result.microstructure``; None gives NaN in every column.
+        ``result.microstructure``; None (a run without the observer) gives None in every column
+        (empty in the table: not evaluated).
     transient : int, default :data:`TRANSIENT_CYCLES`
         Cycles left out.
 
     Returns
     -------
     dict
-        Column → float (dimensionless; NaN when not evaluated).
+        Column → float (dimensionless; NaN where the observer saw no cycle); None without the observer.
     """
+    if micro is None:
+        return {c: None for c in MICRO_COLUMNS}
     row = {c: math.nan for c in MICRO_COLUMNS}
-    if not micro or not len(micro["msd"]):
+    if not len(micro["msd"]):
         return row
     n = len(micro["msd"])
     k = transient if n > transient else n - 1
