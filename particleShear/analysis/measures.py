@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
+from .microstructure import MICRO_COLUMNS
 
 __all__ = ["MEASURE_COLUMNS", "NON_NUMERIC_MEASURES", "MEASURE_N_MAX", "MeasurementWarning", "empty_measures", "run_measures", "measured_window", "warn_few_periods"]
 
@@ -17,10 +18,11 @@ __all__ = ["MEASURE_COLUMNS", "NON_NUMERIC_MEASURES", "MEASURE_N_MAX", "Measurem
 #: 5 of a run at N <= 150 are at its noise level (their S, T change sign with the order kept)
 MEASURE_N_MAX = 5
 
-#: columns of the results table after the four moduli, in order (units in docs/analysis.md)
+#: columns of the results table after the four moduli, in order (units in docs/analysis.md); the last,
+#: :data:`~particleShear.analysis.microstructure.MICRO_COLUMNS`, are empty unless the run was stroboscopic
 MEASURE_COLUMNS = ("Gp_surface_se", "Gpp_surface_se", "Gp_internal_se", "Gpp_internal_se", "steady_state",
                    "I3_I1_surface", "I3_I1_internal", "S_surface", "T_surface", "S_internal", "T_internal",
-                   "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved", "verdict")
+                   "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved", "verdict") + MICRO_COLUMNS
 #: the measure columns that are not numbers: checks (bool or None) and the verdict (str or None)
 NON_NUMERIC_MEASURES = ("steady_state", "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved",
                 "verdict")
@@ -78,13 +80,14 @@ def measured_window(t, f, pre_periods, periods):
 
 
 def empty_measures():
-    """The measures of a run that has none: NaN, the checks and ``verdict`` None.
+    """The measures of a run that has none: NaN, the checks, ``verdict`` and the microstructure
+    columns (not evaluated without the stroboscopic observer) None.
 
     Returns
     -------
     dict
     """
-    return {c: (None if c in NON_NUMERIC_MEASURES else math.nan) for c in MEASURE_COLUMNS}
+    return {c: (None if c in NON_NUMERIC_MEASURES or c in MICRO_COLUMNS else math.nan) for c in MEASURE_COLUMNS}
 
 
 def run_measures(series, f, strain_amplitude, pre_periods, periods, moduli=None):

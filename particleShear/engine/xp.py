@@ -44,6 +44,7 @@ REASONS = {
     "state": "copies of the state between host and device: at set-up (radii, boxes, skins) or when inspected",
     "scalar law": "a force law callback that accepts only numbers, evaluated pair by pair on the host",
     "register": "the last force phase's terms, for the force register of a documented ensemble",
+    "microstructure": "positions, strain and contact forces at a snapshot of the stroboscopic observer (once per period)",
 }
 
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))

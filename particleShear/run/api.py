@@ -114,7 +114,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1,
                               protocol="oscillatory", relative_rate=0.01, total_strain=2.0, ramp_time=1.0,
                               hold_time=200.0, creep_stress=None, creep_modulus=None, creep_response_time=5.0,
-                              sweep_amplitudes=None, sweep_frequencies=None):
+                              sweep_amplitudes=None, sweep_frequencies=None, stroboscopic=False):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -320,6 +320,15 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     sweep_frequencies : list of float or None, default None
         Keyword-only.  ``protocol="frequency_sweep"`` (required there): the relative frequencies
         f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first.
+    stroboscopic : bool, default False
+        Keyword-only.  Watch the oscillatory protocol with the stroboscopic observer
+        (:class:`particleShear.engine.microstructure.Stroboscope`): a snapshot at the start of every
+        shear period; per cycle the non-affine displacement, D²_min, contacts made and broken, Z
+        without rattlers and P(f/⟨f⟩) in ``result.microstructure`` and the per-run columns
+        ``irreversibility``, ``moved_fraction``, ``Z_rattler_free``, ``rattler_fraction``,
+        ``contact_change_rate`` in ``result.measures`` (docs/microstructure.md).  It only reads the
+        state: G′ and G″ are those of the run without it, bit for bit; off, nothing is computed.
+        Not part of the run identity.  CLI ``--stroboscopic``.
 
     Returns
     -------
@@ -377,7 +386,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                    plateau_slope=plateau_slope, protocol=protocol, relative_rate=relative_rate,
                    total_strain=total_strain, ramp_time=ramp_time, hold_time=hold_time, creep_stress=creep_stress,
                    creep_modulus=creep_modulus, creep_response_time=creep_response_time,
-                   sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies)
+                   sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies,
+                   stroboscopic=stroboscopic)
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))

@@ -53,7 +53,7 @@ PER_REPLICA_PARAMETERS = frozenset((
     "root_folder", "saveData", "saveStressTensorData", "saveOutputImages", "imageFileType", "doDrawing",
     "plotStress", "relative_y_scale_force", "verbose", "progress", "reference_header", "correct_drift_sign",
     "renderer", "stability_guard", "plateau_begin", "plateau_end", "plateau_slope",
-    "relative_rate", "total_strain", "creep_stress", "creep_modulus", "sweep_amplitudes",
+    "relative_rate", "total_strain", "creep_stress", "creep_modulus", "sweep_amplitudes", "stroboscopic",
 ))
 
 #: parameters that fix the step schedule: N, the model constants behind τ, the protocol and the integrator
@@ -285,7 +285,8 @@ def measure_batch(runs):
             image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
             N_steps=info["N_steps"], damping_factor=info["damping_factor"],
             removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
-            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error")))
+            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
+            microstructure=getattr(run, "microstructure", None)))
         results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
     return results
 
@@ -453,13 +454,25 @@ def _measure(sessions, sched, where):
         t0 = time.perf_counter()
         say, report = _console(sims, order, "protocol", where)
         keep = [bool(sessions[b].exp.keep_tensor_history) for b in order]
+        strobe = _stroboscope(sessions, order, dt, f, pre_p, periods)
         out = _guarded(protocol, engine, dt, f, [sessions[b].exp.amplitude for b in order], cool, pre_p, periods,
-                       post, any(keep), say, report, observers(engine, order), dt=dt)
+                       post, any(keep), say, report, observers(engine, order) + ([strobe] if strobe else []), dt=dt)
         for col, b in enumerate(order):
+            sessions[b].microstructure = strobe.replica(col) if strobe else None
             rec[b] = replica_record(out, col, keep[col])
             timings[b]["protocol"] = (time.perf_counter() - t0) / len(order)
         del out
     return rec, timings
+
+
+def _stroboscope(sessions, order, dt, f, pre, periods):
+    """The stroboscopic observer of the replicas (columns of ``order``) whose run asks for it
+    (``stroboscopic=True``), or None when none does (then nothing is computed)."""
+    want = [col for col, b in enumerate(order) if (sessions[b].sim.parameters or {}).get("stroboscopic")]
+    if not want:
+        return None
+    from ..engine.microstructure import Stroboscope
+    return Stroboscope(dt, f, pre, periods, replicas=want)
 
 
 def replica_record(out, col, keep):

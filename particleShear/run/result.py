@@ -64,6 +64,10 @@ class SimulationResult:
         (:func:`~particleShear.simulation.provenance.run_identity`).
     write_error : Exception or None, default None
         Why writing the output failed after the run (the moduli are valid); None when written.
+    microstructure : dict or None, default None
+        The per-cycle arrays of the stroboscopic observer (a run with ``stroboscopic=True``;
+        :meth:`particleShear.engine.microstructure.Stroboscope.replica`, docs/microstructure.md);
+        None for a run without it.
 
     Attributes
     ----------
@@ -91,6 +95,7 @@ class SimulationResult:
     series: dict = dataclasses.field(default_factory=dict, repr=False)
     run_id: str = ""
     write_error: object = None
+    microstructure: object = dataclasses.field(default=None, repr=False, compare=False)
     _measures: dict = dataclasses.field(default=None, init=False, repr=False, compare=False)
 
     @property
@@ -184,6 +189,9 @@ class SimulationResult:
                 self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0),
                                               p.get("pre_periods", 0), p.get("periods", 0),
                                               moduli={"surface": self.G_surface, "internal": self.G_internal})
+                if self.microstructure is not None:
+                    from ..analysis.microstructure import micro_measures
+                    self._measures.update(micro_measures(self.microstructure))
             except Exception as exc:  # noqa: BLE001 - a measure must never turn a finished run into a failure
                 warnings.warn(f"the measures of run {self.run_id or '?'} could not be evaluated "
                               f"({type(exc).__name__}: {exc}); they are left empty", RuntimeWarning, stacklevel=2)

@@ -249,6 +249,7 @@ def _check_keyword_options(p):
     if not isinstance(integrator, str) or integrator not in INTEGRATORS:
         raise ValueError(f"integrator={integrator!r} is out of range: allowed one of {INTEGRATORS}")
     _bool("stability_guard", p["stability_guard"])
+    _bool("stroboscopic", p.get("stroboscopic", False))
     _bool("saveOutputMovie", p["saveOutputMovie"])
     check_output_format(p["output_format"])
     _bool("strict_io", p["strict_io"])

@@ -24,7 +24,7 @@ __all__ = ["run_identity", "identity_parameters", "same_input", "header_number",
 
 #: inputs that change neither the physics nor what is written: left out of the run identity
 IDENTITY_EXCLUDED = frozenset({"seed", "root_folder", "return_result", "verbose", "progress", "strict_io",
-                               "renderer", "plotStress", "doDrawing"})
+                               "renderer", "plotStress", "doDrawing", "stroboscopic"})
 
 
 def package_version():

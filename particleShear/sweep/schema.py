@@ -74,6 +74,17 @@ _FIXED = {
     "excitation_resolved": ("bool", "", _CHECK.format("excitation_resolved"), True),
     "verdict": ("string", "", "'ok' when no check of the run failed, else 'flagged: ' and the failed checks' names "
                 "(docs/analysis.md, \"Verdicts\"); empty for a failed run", True),
+    "irreversibility": ("float", "1", "mean squared non-affine displacement per excitation cycle between stroboscopic "
+                        "snapshots after the transient cycle, / mean radius²; empty unless stroboscopic "
+                        "(docs/microstructure.md)", True),
+    "moved_fraction": ("float", "1", "mean fraction of spheres whose non-affine displacement per cycle exceeds "
+                       "0.1 of their radius, after the transient; empty unless stroboscopic", True),
+    "Z_rattler_free": ("float", "1", "contacts per sphere with rattlers (< 3 contacts, iteratively) removed, at the "
+                       "snapshots after the transient; empty unless stroboscopic", True),
+    "rattler_fraction": ("float", "1", "fraction of spheres that are rattlers at the snapshots after the transient; "
+                         "empty unless stroboscopic", True),
+    "contact_change_rate": ("float", "1/cycle", "contacts made + broken per cycle per contact, after the transient; "
+                            "empty unless stroboscopic", True),
     "repetition": ("int", "", "index of the run among the repetitions of its parameter point (0-based; "
                    "SweepRun.repetition)", False),
     "frequency_Hz": ("float", "Hz", "excitation frequency f; empty for a failed run", True),

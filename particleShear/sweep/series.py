@@ -47,7 +47,10 @@ def _result_from_rows(rows, run, out_dir):
                               output_path=path,
                               dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
                               N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
-    result._measures = {c: (row.get(c) if c in NON_NUMERIC_MEASURES else _number(row.get(c))) for c in MEASURE_COLUMNS}
+    from ..analysis.microstructure import MICRO_COLUMNS
+    # (an empty microstructure cell stays None: not evaluated, as the run without the observer reports it)
+    result._measures = {c: (row.get(c) if c in NON_NUMERIC_MEASURES or (c in MICRO_COLUMNS and row.get(c) is None)
+                            else _number(row.get(c))) for c in MEASURE_COLUMNS}
     return result
 
 

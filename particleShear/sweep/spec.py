@@ -43,6 +43,9 @@ SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
 _SEED_KEYS = ("root", "repetitions")
 #: arguments a SPEC may not set: the sweep chooses them
 _RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
+#: keyword options of a run that are not parameters of a sweep (no table column): the stroboscopic
+#: observer only reads a run (its columns are measure columns, empty where it was off)
+_NOT_SWEPT = ("stroboscopic",)
 #: most parameter points of one SPEC: each is validated before any work (≈ 0.1 ms a point)
 MAX_POINTS = 10_000
 #: most runs of one SPEC (points × repetitions); runs are enumerated lazily, never held all at once
@@ -55,7 +58,7 @@ def _defaults(protocols):
     from ..run.rheometer import PROTOCOL_DEFAULTS
     sig = inspect.signature(doParticleShearSimulation)
     return tuple((name, p.default) for name, p in sig.parameters.items()
-                 if name not in _RESERVED and (protocols or name not in PROTOCOL_DEFAULTS)
+                 if name not in _RESERVED and name not in _NOT_SWEPT and (protocols or name not in PROTOCOL_DEFAULTS)
                  and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
 
 
