@@ -30,6 +30,7 @@ import particleShear
 DOCUMENTED_MODULES = [
     "particleShear",
     "particleShear.checks",
+    "particleShear.parameters",
     "particleShear.analysis",
     "particleShear.analysis.curves",
     "particleShear.analysis.demodulation",

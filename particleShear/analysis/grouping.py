@@ -13,7 +13,7 @@ say what the row measured:
 * ``theAmplitude`` of an ``amplitude_sweep`` row is its ``sweep_amplitude``, ``relative_frequency``
   of a ``frequency_sweep`` row its ``sweep_relative_frequency``;
 * the protocol parameters the row's protocol does not read
-  (:data:`particleShear.simulation.provenance._PROTOCOL_READS`, the rule of the run identity) are
+  (their role in :mod:`particleShear.parameters`, the rule of the run identity) are
   empty, so that a default ``relative_rate`` never splits two oscillatory groups.
 
 Grouping the rewritten rows by their parameter columns then keeps apart what differs — the
@@ -64,8 +64,7 @@ def measured_row(row):
         oscillatory), the step's amplitude or frequency in ``theAmplitude`` /
         ``relative_frequency``, the protocol parameters its protocol does not read empty.
     """
-    from ..run.rheometer import PROTOCOL_DEFAULTS
-    from ..simulation.provenance import _PROTOCOL_READS
+    from ..parameters import names, protocol_parameters
     proto = row_protocol(row)
     q = dict(row)
     if "protocol" in q or proto != "oscillatory":
@@ -73,8 +72,8 @@ def measured_row(row):
     if proto in _STEP_VALUE:
         column, step = _STEP_VALUE[proto]
         q[column] = row.get(step, "")
-    reads = _PROTOCOL_READS.get(proto, ())
-    for name in PROTOCOL_DEFAULTS:
+    reads = protocol_parameters(proto)
+    for name in names("protocol"):
         if name != "protocol" and name in q and name not in reads:
             q[name] = ""
     return q

@@ -9,7 +9,6 @@ every call (per process) or returned directly with ``return_result=True``.
 ``concurrent.futures.Executor`` (a ``ProcessPoolExecutor`` by default) with per-run seeds
 ``numpy.random.SeedSequence(seed).spawn(n)`` and returns the results in iteration order.
 """
-import inspect
 
 import numpy as np
 
@@ -132,12 +131,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         it must be an existing, writable folder when ``saveData`` or ``saveOutputImages`` is
         True (probed with an empty temporary file before any work).
     theAmplitude : float, default 0.2
-        Strain amplitude A, dimensionless (0.2 = 20 %); allowed 0 < A <= 100.  Also the
+        Strain amplitude A, dimensionless (0.2 = 20 %); allowed 0 < value <= 100.  Also the
         builder's anticipated amplitude (time step, relaxation length).  Python alias:
         ``amplitude=`` (the same run and run id; not together with ``theAmplitude``).
     theMu : float, default 0.01
-        Coulomb friction coefficient μ of transient contacts, dimensionless; allowed
-        0 <= μ <= 1e6 (permanent links are not limited by friction).  Python alias: ``mu=``
+        Coulomb friction coefficient μ of transient contacts, dimensionless; allowed 0 <= value <= 1e+06 (permanent links are not limited by friction).  Python alias: ``mu=``
         (the same run and run id; not together with ``theMu``).
     do_permanent_links : bool, default True
         Crosslink all contacts after relaxation; False: frictional spheres only.
@@ -146,34 +144,33 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         <= 1 (triangulation) or 0 (lines) is an uncut bulk gel.  Allowed: an integer 0 ... 1e6 that
         leaves >= 3 spheres per particle on average (triangulation: cut_lines <= N/3).
     Young_modulus_spheres : float, default 8000
-        Young modulus E of the sphere material in Pa; allowed 1e-6 ... 1e12.  Contact stiffness
+        Young modulus E of the sphere material in Pa; allowed 1e-06 <= value <= 1e+12.  Contact stiffness
         k = π E/8 (eq. S1-8).
     N : int, default 150
         Number of spheres; allowed an integer from N_min (11 at the default packing fraction and
         bimodal factor: the largest sphere must be smaller than a quarter of the cell) to 1e6.
     packing_fraction : float, default 1.5
         Nominal (uncompressed) area fraction φ that defines the radii (eq. S1-14), dimensionless;
-        allowed 0 < φ <= 10.
+        allowed 0 < value <= 10.
     density : float, default 50
-        Material density in kg/m³; allowed 1e-6 ... 1e6 (the manual's table says 1000, the
+        Material density in kg/m³; allowed 1e-06 <= value <= 1e+06 (the manual's table says 1000, the
         reference code default is 50).
     bimodal_factor : float, default 1.4
-        Ratio of large to small radius (50/50 random), dimensionless; allowed 0.01 ... 100.
+        Ratio of large to small radius (50/50 random), dimensionless; allowed 0.01 <= value <= 100.
     relative_viscosity : float, default 0.1
-        rv in the contact damping ν = rv·√(m k) (eq. S1-9), dimensionless; allowed 0 ... 1e6.
+        rv in the contact damping ν = rv·√(m k) (eq. S1-9), dimensionless; allowed 0 <= value <= 3.
     relative_transversal_link_strength : float, default 1
-        k_t/k and ν_t/ν, dimensionless; allowed 0 ... 1e6.
+        k_t/k and ν_t/ν, dimensionless; allowed 0 <= value <= 30.
     relative_frequency : float, default 0.025
         f·τ: excitation frequency in units of the characteristic frequency 1/τ, dimensionless;
-        allowed > 0 with >= 100 steps per excitation period (<= 0.56 at the defaults).
+        allowed 0 < value, with >= 100 steps per excitation period (<= 0.56 at the defaults).
     avoid_horizontal_angle_degree : float, default 15
         Line-cut mode only: half-width in degrees of the forbidden band around horizontal cut
-        lines; allowed 0 <= a < 90.
+        lines; allowed 0 <= value < 90.
     interface_reenforcement_central : float, default 1
-        Factor on k of transient contacts relative to permanent links, dimensionless; allowed
-        1e-6 ... 1e6.
+        Factor on k of transient contacts relative to permanent links, dimensionless; allowed 1e-06 <= value <= 50.
     interface_reenforcement_tangential : float, default 1
-        The same factor for k_t, dimensionless; allowed 1e-6 ... 1e6.
+        The same factor for k_t, dimensionless; allowed 1e-06 <= value <= 1e+06.
     keep_viscosity_coefficients_constant : bool, default False
         False: the contact viscosities follow the reinforcement factors; True: they stay.
     avoid_height_spanning_particles : bool, default True
@@ -186,13 +183,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     imageFileType : {"jpg", "png", "ps", "svg"}, default "jpg"
         Snapshot format; "ps" is vector Encapsulated PostScript (extension .ps), "svg" vector SVG.
     remove_link_fraction : float, default 0
-        Target fraction of non-essential permanent links removed at random; allowed 0 ... 1.
+        Target fraction of non-essential permanent links removed at random; allowed 0 <= value <= 1.
     edge_fuzziness : float, default 0
-        Random roughening of the Voronoi borders in units of the largest radius; allowed
-        0 ... 1000.
+        Random roughening of the Voronoi borders in units of the largest radius; allowed 0 <= value <= 1000.
     central_repulsion_coefficient : float, default 1
         c of the central force law, dimensionless (1 = divergent repulsion eq. S1-5b, 0 =
-        linear eq. S1-5a); allowed 0 ... 1.
+        linear eq. S1-5a); allowed 0 <= value <= 1.
     doCutByTriangulation : bool, default True
         Cut into particles by periodic Voronoi cells; False: by random straight lines.
     doDrawing : bool, default True
@@ -205,19 +201,17 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         Live stress/strain window (needs a display and ``doDrawing``); without a display, and
         with ``saveData``, it is saved as ``<output file>_stress.png`` (needs particleShear[plot]).
     relative_y_scale_force : float, default 1e8
-        Vertical scale of the live stress window only, dimensionless; allowed |value| <= 1e300.
+        Vertical scale of the live stress window only, dimensionless; allowed -1e+300 <= value <= 1e+300.
     pre_periods : float, default 2
-        Baseline before the excitation, in excitation periods (drift reference); allowed >= 0
-        within the step and memory limits.
+        Baseline before the excitation, in excitation periods (drift reference); allowed 0 <= value, within the step and memory limits.
     periods : float, default 3
-        Excitation periods (the first is skipped in the demodulation when >= 2); allowed > 0
-        within the step and memory limits.
+        Excitation periods (the first is skipped in the demodulation when >= 2); allowed 0 < value, within the step and memory limits.
     post_periods : float, default 1
-        Recovery after the excitation, in excitation periods; allowed >= 0 within the step and
+        Recovery after the excitation, in excitation periods; allowed 0 <= value, within the step and
         memory limits.
     cool_factor : float, default 0.5
         Fraction of the peculiar velocity left after one excitation period (damping),
-        dimensionless; allowed 0 < c <= 1.
+        dimensionless; allowed 0 < value <= 1.
     seed : None, int, numpy.random.SeedSequence or numpy.random.Generator, default None
         Drives every random choice; one seed gives a bit-identical run.  Allowed None (fresh
         entropy, recorded in the result), an integer >= 0, a SeedSequence or a Generator.
@@ -473,8 +467,8 @@ def _series_worker(kwargs):
 
 def _run_options():
     """The keyword-only options of doParticleShearSimulation (what ``**options`` of a series may name)."""
-    return [n for n, par in inspect.signature(doParticleShearSimulation).parameters.items()
-            if par.kind is par.KEYWORD_ONLY]
+    from ..parameters import PARAMETERS
+    return [p.name for p in PARAMETERS if p.keyword_only]
 
 
 #: names a series user may mean by a name of doParticleShearSimulation (the series takes lists)
@@ -607,8 +601,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     from their rows (moduli, parameters, seed, output path; no per-step series).
     """
     check_batch_size(batch_size)
-    keyword_only = [n for n, par in inspect.signature(doParticleShearSimulation).parameters.items()
-                    if par.kind is par.KEYWORD_ONLY and n not in ("return_result", "verbose", "backend")]
+    from ..parameters import PARAMETERS
+    keyword_only = [p.name for p in PARAMETERS if p.keyword_only and p.name not in ("return_result", "verbose", "backend")]
     for name in options:
         if name not in keyword_only:
             raise TypeError(f"{name}={options[name]!r} is invalid for doParticleShearSimulationSeries: allowed the "

@@ -29,6 +29,9 @@ import time
 import numpy as np
 
 from ..linkable.builders import time_steps_from_model
+from ..parameters import PARAMETERS
+from ..parameters import defaults as _defaults
+from ..parameters import names as _names
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
@@ -45,32 +48,19 @@ _log = logging.getLogger(__name__)
 ENGINE_SKIN_FACTOR = 0.2
 
 #: parameters a replica may choose on its own (everything else must agree within a batch)
-PER_REPLICA_PARAMETERS = frozenset((
-    "seed", "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "remove_link_fraction",
-    "edge_fuzziness", "interface_reenforcement_central", "interface_reenforcement_tangential",
-    "relative_transversal_link_strength", "central_repulsion_coefficient", "avoid_horizontal_angle_degree",
-    "avoid_height_spanning_particles", "cut_top_bottom", "doCutByTriangulation", "keep_viscosity_coefficients_constant",
-    "root_folder", "saveData", "saveStressTensorData", "saveOutputImages", "imageFileType", "doDrawing",
-    "plotStress", "relative_y_scale_force", "verbose", "progress", "reference_header", "correct_drift_sign",
-    "renderer", "stability_guard", "plateau_begin", "plateau_end", "plateau_slope",
-    "relative_rate", "total_strain", "creep_stress", "creep_modulus", "sweep_amplitudes", "stroboscopic",
-))
+PER_REPLICA_PARAMETERS = frozenset(_names(batch="replica"))
 
-#: parameters that fix the step schedule: N, the model constants behind τ, the protocol and the integrator
-SCHEDULE_PARAMETERS = ("N", "packing_fraction", "Young_modulus_spheres", "density", "bimodal_factor",
-                       "relative_viscosity", "relative_frequency", "pre_periods", "periods", "post_periods",
-                       "cool_factor", "time_step_factor", "integrator")
+#: parameters that fix the step schedule: N, the model constants behind τ, the protocol's periods and
+#: the integrator (batch class "schedule" of :mod:`particleShear.parameters`)
+SCHEDULE_PARAMETERS = _names(batch="schedule")
 
 #: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
 BACKENDS = ("numpy", "cupy")
 
-def _signature_defaults():
-    """Defaults of every keyword of ``doParticleShearSimulation`` (read from its signature)."""
-    import inspect
 
-    from .api import doParticleShearSimulation
-    return {name: p.default for name, p in inspect.signature(doParticleShearSimulation).parameters.items()
-            if p.default is not inspect.Parameter.empty}
+def _signature_defaults():
+    """Defaults of every keyword of ``doParticleShearSimulation`` (the parameter table's)."""
+    return _defaults()
 
 
 def check_backend(backend):
@@ -604,11 +594,4 @@ def _guarded(phase, engine, *args, dt, **kwargs):
 
 
 #: the arguments a SimulationResult lists in ``parameters`` (the reference's, in its order)
-_REFERENCE_ARGUMENTS = (
-    "root_folder", "theAmplitude", "theMu", "do_permanent_links", "cut_lines", "Young_modulus_spheres", "N",
-    "packing_fraction", "density", "bimodal_factor", "relative_viscosity", "relative_transversal_link_strength",
-    "relative_frequency", "avoid_horizontal_angle_degree", "interface_reenforcement_central",
-    "interface_reenforcement_tangential", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",
-    "cut_top_bottom", "saveOutputImages", "imageFileType", "remove_link_fraction", "edge_fuzziness",
-    "central_repulsion_coefficient", "doCutByTriangulation", "doDrawing", "saveData", "saveStressTensorData",
-    "plotStress", "relative_y_scale_force", "pre_periods", "periods", "post_periods", "cool_factor", "seed")
+_REFERENCE_ARGUMENTS = tuple(p.name for p in PARAMETERS if not p.keyword_only)

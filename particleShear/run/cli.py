@@ -73,8 +73,7 @@ def float_list(text):
 
 
 float_list.__name__ = "comma-separated float list"   # argparse names the type in its message
-_CLI_TYPES = {"seed": int, "progress": bool, "creep_stress": float, "creep_modulus": float,
-              "sweep_amplitudes": float_list, "sweep_frequencies": float_list}
+_CLI_TYPES = {"seed": int, "progress": bool}
 
 
 def flag_name(name):
@@ -137,17 +136,11 @@ def parameter_docs(func=None):
     return out
 
 
-def _choices(type_text):
-    if not type_text.startswith("{"):
-        return None
-    return tuple(re.findall(r'"([^"]*)"', type_text[:type_text.index("}")]))
-
-
-def _cli_type(name, type_text, default):
-    if name in _CLI_TYPES:
-        return _CLI_TYPES[name]
-    first = re.split(r"[ ,]", type_text, maxsplit=1)[0]
-    return {"bool": bool, "int": int, "float": float, "str": str}.get(first, type(default))
+def _cli_type(par):
+    """The argparse type of a parameter of the table: its kind's, or the command line's own."""
+    if par.name in _CLI_TYPES:
+        return _CLI_TYPES[par.name]
+    return {"bool": bool, "int": int, "float": float, "str": str, "float_list": float_list}.get(par.kind, str)
 
 
 def _float(text):
@@ -208,18 +201,16 @@ class _Bool(argparse.BooleanOptionalAction):
 
 
 def _flags():
-    """``{parameter: (option strings, kind, choices, CLI type, default)}`` in signature order."""
-    from .api import doParticleShearSimulation
-    sig = inspect.signature(doParticleShearSimulation)
-    docs = parameter_docs(doParticleShearSimulation)
+    """``{parameter: (option strings, CLI type, choices, default)}`` in signature order, from the
+    parameter table (:mod:`particleShear.parameters`)."""
+    from ..parameters import PARAMETERS
     out = {}
-    for name, par in sig.parameters.items():
-        if name in NOT_FLAGS:
+    for par in PARAMETERS:
+        if par.name in NOT_FLAGS:
             continue
-        type_text = docs.get(name, ("", ""))[0]
-        derived = flag_name(name)
-        strings = [_ALIASES[name], derived] if name in _ALIASES and _ALIASES[name] != derived else [derived]
-        out[name] = (strings, _cli_type(name, type_text, par.default), _choices(type_text), par.default)
+        derived = flag_name(par.name)
+        strings = [_ALIASES[par.name], derived] if par.name in _ALIASES and _ALIASES[par.name] != derived else [derived]
+        out[par.name] = (strings, _cli_type(par), par.choices, par.default)
     return out
 
 
@@ -364,8 +355,7 @@ class ProgressLine:
 def build_parser():
     """The parser of ``particleShear [run]``: one flag per parameter of ``doParticleShearSimulation``."""
     from .. import __version__
-    from .api import doParticleShearSimulation
-    docs = parameter_docs(doParticleShearSimulation)
+    from ..parameters import BY_NAME
     p = _Parser(prog="particleShear",
                 description="2D soft-particle oscillatory shear rheology: G' and G'' of one run. Commands: "
                             "run (default; the flags below), sweep SPEC --out DIR (particleShear sweep --help), "
@@ -377,12 +367,12 @@ def build_parser():
     p.add_argument("--version", action="version", version=f"particleShear {__version__}")
     groups = {True: p.add_argument_group("parameters of doParticleShearSimulation (reference order)"),
               False: p.add_argument_group("keyword-only options of doParticleShearSimulation")}
-    from inspect import Parameter, signature
-    kinds = {n: par.kind for n, par in signature(doParticleShearSimulation).parameters.items()}
     for name, (strings, cli_type, choices, default) in _flags().items():
-        group = groups[kinds[name] != Parameter.KEYWORD_ONLY]
-        # the Python keyword aliases (``amplitude=``) are the flags' own names here: not repeated
-        desc = re.sub(r"\s*Python alias: .*$", "", _CLI_HELP.get(name) or docs.get(name, ("", ""))[1])
+        par = BY_NAME[name]
+        group = groups[not par.keyword_only]
+        desc = _CLI_HELP.get(name) or par.doc
+        if par.has_range:
+            desc += f"; allowed {par.range_text()}"
         shown = _CLI_DEFAULTS.get(name, _default_text(default))
         help_text = _help(cli_message(desc)) + f" [default: {shown}]"
         if cli_type is bool:
@@ -435,13 +425,13 @@ def api_kwargs(args):
     ValueError
         Naming the flags, for combinations the API cannot express.
     """
-    from .api import doParticleShearSimulation
+    from ..parameters import PARAMETERS
     kw = {}
-    for name, par in inspect.signature(doParticleShearSimulation).parameters.items():
-        if name in NOT_FLAGS:
+    for par in PARAMETERS:
+        if par.name in NOT_FLAGS:
             continue
-        value = getattr(args, name, None)
-        kw[name] = par.default if value is None else value
+        value = getattr(args, par.name, None)
+        kw[par.name] = par.default if value is None else value
     given = {n for n in kw if getattr(args, n, None) is not None}
     images = getattr(args, "images", None)
     save = getattr(args, "save", None)

@@ -32,18 +32,19 @@ import time
 
 import numpy as np
 
+from ..parameters import BY_NAME, PARAMETERS
+
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
-PROTOCOLS = ("oscillatory", "steady", "relaxation", "creep", "amplitude_sweep", "frequency_sweep")
+PROTOCOLS = BY_NAME["protocol"].choices
 
-#: the keyword-only parameters of the protocols and their defaults (as in doParticleShearSimulation)
-PROTOCOL_DEFAULTS = {"protocol": "oscillatory", "relative_rate": 0.01, "total_strain": 2.0, "ramp_time": 1.0,
-                     "hold_time": 200.0, "creep_stress": None, "creep_modulus": None, "creep_response_time": 5.0,
-                     "sweep_amplitudes": None, "sweep_frequencies": None}
+#: the protocol's selector and the protocols' own parameters with their defaults (roles "protocol" of
+#: :mod:`particleShear.parameters`)
+PROTOCOL_DEFAULTS = {p.name: p.default for p in PARAMETERS if p.base_role == "protocol"}
 
 #: the protocol parameters whose value is a list (one value of a sweep is a whole list)
-LIST_PARAMETERS = ("sweep_amplitudes", "sweep_frequencies")
+LIST_PARAMETERS = tuple(p.name for p in PARAMETERS if p.kind == "float_list")
 
 #: key of a sweep step (``RheometerResult.steps``) -> its column in a results table (the other keys,
 #: the moduli and measures, are columns of the same name)

@@ -29,6 +29,8 @@ from ..checks import as_float as _as_float, in_range, integer as _int, range_tex
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters
+from ..parameters import BY_NAME, PARAMETERS
+from ..parameters import defaults as _defaults
 from ..simulation.formats import check_output_format
 from .batch import check_backend, check_run_backend
 
@@ -38,9 +40,9 @@ __all__ = ["validate_run", "validate_simulation_parameters", "validate_series", 
            "MAX_SERIES_RUNS", "SEED_LIMIT", "contact_law_spec"]
 
 #: accepted ``imageFileType`` values (the reference silently wrote PostScript for anything else)
-IMAGE_FILE_TYPES = ("jpg", "png", "ps", "svg")
+IMAGE_FILE_TYPES = BY_NAME["imageFileType"].choices
 #: accepted ``renderer`` values (None = "auto")
-RENDERERS = ("auto", "tk", "pillow", "none")
+RENDERERS = BY_NAME["renderer"].choices
 #: accepted ``integrator`` values (the engine's)
 INTEGRATORS = BatchEngine.INTEGRATORS
 
@@ -65,18 +67,14 @@ MAX_SERIES_RUNS = 100_000
 #: integer seeds are below this bound (the 128 bits of entropy numpy draws for a fresh SeedSequence)
 SEED_LIMIT = 2 ** 128
 
-#: upper limits (and lower limits > 0) of single physical parameters: far beyond any material, yet
-#: small enough that products of them (k·τ, m·v², …) stay finite double-precision numbers
-UPPER = {"theAmplitude": 100.0, "theMu": 1e6, "Young_modulus_spheres": 1e12, "packing_fraction": 10.0,
-         "density": 1e6, "bimodal_factor": 100.0, "relative_viscosity": 3.0,
-         "relative_transversal_link_strength": 30.0, "interface_reenforcement_central": 50.0,
-         "interface_reenforcement_tangential": 1e6, "edge_fuzziness": 1e3, "relative_y_scale_force": 1e300}
-# relative_viscosity, relative_transversal_link_strength and interface_reenforcement_central: the
-# largest values the time-step rule integrates stably (benchmarks/stable_ranges.py, 2 seeds, N = 40,
-# the others at their defaults: rv 3.65, rts 39, irc 60 run; 4.5, 49, 75 diverge in the constitution,
-# whose step time_step_factor does not change), rounded down.  Their combinations: STIFF_VISCOUS.
-LOWER = {"Young_modulus_spheres": 1e-6, "density": 1e-6, "bimodal_factor": 1e-2,
-         "interface_reenforcement_central": 1e-6, "interface_reenforcement_tangential": 1e-6}
+#: upper and lower limits of the single parameters, from the parameter table
+#: (:mod:`particleShear.parameters`, where each limit's reason is stated): the physical ones far
+#: beyond any material yet small enough that products of them (k·τ, m·v², …) stay finite double
+#: numbers; relative_viscosity, relative_transversal_link_strength and
+#: interface_reenforcement_central the largest values the time-step rule integrates stably
+#: (benchmarks/stable_ranges.py).  Their combinations: STIFF_VISCOUS.
+UPPER = {p.name: p.high for p in PARAMETERS if p.high is not None}
+LOWER = {p.name: p.low for p in PARAMETERS if p.low is not None}
 
 #: bounds on the products of the stiffness and viscosity factors that the time-step rule integrates
 #: stably (measured as :data:`UPPER`'s): rv·max(1, rts) (rv alone runs to 3.65, rts 39 at rv 0.1
@@ -564,8 +562,7 @@ def validate_run(params):
     particleShear.analysis.measures.MeasurementWarning
         When ``periods`` measures fewer than 2 whole excitation periods (no standard error).
     """
-    from .batch import _signature_defaults
-    defaults = _signature_defaults()
+    defaults = _defaults()
     unknown = sorted(set(params) - set(defaults))
     if unknown:
         from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
@@ -576,35 +573,17 @@ def validate_run(params):
                                     name=unknown[0], suggestions=near[unknown[0]])
     p = dict(defaults, **params)
     _check_keyword_options(p)
-    for name in ("do_permanent_links", "keep_viscosity_coefficients_constant", "avoid_height_spanning_particles",
-                 "cut_top_bottom", "saveOutputImages", "doCutByTriangulation", "doDrawing", "saveData",
-                 "saveStressTensorData", "plotStress"):
-        _bool(name, p[name])
-    _range("theAmplitude", p["theAmplitude"], 0, lo_open=True)
-    _range("theMu", p["theMu"], 0)
-    _range("Young_modulus_spheres", p["Young_modulus_spheres"], 0, lo_open=True)
-    _range("packing_fraction", p["packing_fraction"], 0, lo_open=True)
-    _range("density", p["density"], 0, lo_open=True)
-    _range("bimodal_factor", p["bimodal_factor"], 0, lo_open=True)
+    for par in PARAMETERS:          # the 1.0.2 booleans (the options' types: _check_keyword_options)
+        if par.kind == "bool" and not par.keyword_only:
+            _bool(par.name, p[par.name])
+    for par in PARAMETERS:          # every single value with a range or a set of choices in the table
+        if par.has_range:
+            in_range(par.name, p[par.name], par.low, par.high, par.low_open, par.high_open)
+        elif par.choices and not par.keyword_only and (not isinstance(p[par.name], str)
+                                                        or p[par.name] not in par.choices):
+            raise ValueError(f"{par.name}={show_value(p[par.name])} is invalid: allowed one of {par.choices}")
     _check_constitution(p)    # N and cut_lines: ranges that depend on the cell and on N
-    _range("relative_viscosity", p["relative_viscosity"], 0)
-    _range("relative_transversal_link_strength", p["relative_transversal_link_strength"], 0)
-    _range("relative_frequency", p["relative_frequency"], 0, lo_open=True)
-    _range("avoid_horizontal_angle_degree", p["avoid_horizontal_angle_degree"], 0, 90, hi_open=True)
-    _range("interface_reenforcement_central", p["interface_reenforcement_central"], 0, lo_open=True)
-    _range("interface_reenforcement_tangential", p["interface_reenforcement_tangential"], 0, lo_open=True)
     _check_stiff_viscous(p)
-    if not isinstance(p["imageFileType"], str) or p["imageFileType"] not in IMAGE_FILE_TYPES:
-        raise ValueError(f"imageFileType={show_value(p['imageFileType'])} is invalid: allowed one of "
-                         f"{IMAGE_FILE_TYPES}")
-    _range("remove_link_fraction", p["remove_link_fraction"], 0, 1)
-    _range("edge_fuzziness", p["edge_fuzziness"], 0)
-    _range("central_repulsion_coefficient", p["central_repulsion_coefficient"], 0, 1)
-    _range("relative_y_scale_force", p["relative_y_scale_force"], -UPPER["relative_y_scale_force"])
-    _range("pre_periods", p["pre_periods"], 0)
-    _range("periods", p["periods"], 0, lo_open=True)
-    _range("post_periods", p["post_periods"], 0)
-    _range("cool_factor", p["cool_factor"], 0, 1, lo_open=True)
     root = p["root_folder"]
     if not isinstance(root, (str, os.PathLike)):
         raise TypeError(f"root_folder={show_value(root)} is invalid: allowed a path string")

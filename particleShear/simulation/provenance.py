@@ -19,12 +19,15 @@ import re
 
 import numpy as np
 
+from ..parameters import identity_excluded
+from ..parameters import names as _names
+
 __all__ = ["run_identity", "identity_parameters", "same_input", "header_number", "positional_numbers_in_call",
            "json_safe", "provenance_lines", "IDENTITY_EXCLUDED", "package_version"]
 
-#: inputs that change neither the physics nor what is written: left out of the run identity
-IDENTITY_EXCLUDED = frozenset({"seed", "root_folder", "return_result", "verbose", "progress", "strict_io",
-                               "renderer", "plotStress", "doDrawing", "stroboscopic"})
+#: the parameters no run identity holds: what a run shows, what the caller chooses for the call and
+#: the observers (roles "display", "call", "observer" of :mod:`particleShear.parameters`)
+IDENTITY_EXCLUDED = frozenset(_names("display") + _names("call") + _names("observer"))
 
 
 def package_version():
@@ -84,10 +87,10 @@ def _identity_value(value):
 def identity_parameters(parameters):
     """The inputs that make a run what it is, in the form the run identity hashes them.
 
-    Keys of :data:`IDENTITY_EXCLUDED` are left out, and so are ``contact_law="linear"`` and the
-    plateau parameters of a run of another law than "plateau" (they change nothing of such a run,
-    and a run of the default law keeps the id it had before the law was a parameter); every real
-    number is a float (``N = 30`` and
+    The names :func:`particleShear.parameters.identity_excluded` gives are left out (those of
+    :data:`IDENTITY_EXCLUDED`, the parameters of the laws and protocols the run does not use, and
+    ``contact_law`` and ``protocol`` at their defaults: they change nothing of such a run, and a run
+    keeps the id it had before the law or the protocol was a parameter); every real number is a float (``N = 30`` and
     ``N = 30.0``, ``0.2`` and ``numpy.float64(0.2)`` are the same input), bools stay bools.  This
     is the one rule of "the same run": :func:`run_identity` hashes it, a sweep compares a results
     row and matches the runs of an extended folder with it.
@@ -101,28 +104,8 @@ def identity_parameters(parameters):
     -------
     dict
     """
-    law = parameters.get("contact_law", "linear")
-    unused = (() if law == "plateau" else _PLATEAU) + (("contact_law",) if law == "linear" else ())
-    unused += _protocol_unused(parameters.get("protocol", "oscillatory"))
-    return {k: _identity_value(v) for k, v in parameters.items() if k not in IDENTITY_EXCLUDED and k not in unused}
-
-
-#: the parameters of the plateau law (``contact_law="plateau"``)
-_PLATEAU = ("plateau_begin", "plateau_end", "plateau_slope")
-
-#: the parameters each protocol reads (docs/protocols.md); the others change nothing of its runs
-_PROTOCOL_READS = {"oscillatory": (), "steady": ("protocol", "relative_rate", "total_strain"),
-                   "relaxation": ("protocol", "ramp_time", "hold_time"),
-                   "creep": ("protocol", "hold_time", "creep_stress", "creep_modulus", "creep_response_time"),
-                   "amplitude_sweep": ("protocol", "sweep_amplitudes"),
-                   "frequency_sweep": ("protocol", "sweep_frequencies")}
-
-
-def _protocol_unused(protocol):
-    """The protocol parameters a run of ``protocol`` does not read (left out of its identity, so an
-    oscillatory run keeps the id it had before the protocols were parameters)."""
-    every = {k for v in _PROTOCOL_READS.values() for k in v}
-    return tuple(sorted(every - set(_PROTOCOL_READS.get(protocol, ()))))
+    unused = identity_excluded(parameters)
+    return {k: _identity_value(v) for k, v in parameters.items() if k not in unused}
 
 
 def same_input(text, value):

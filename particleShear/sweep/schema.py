@@ -25,10 +25,8 @@ protocol does not produce) gets pandas' nullable dtype for ints and
 bools (``Int64``, ``boolean``); floats are NaN where empty.
 """
 __docformat__ = "numpy"
-import inspect
 import json
 import os
-import re
 import warnings
 
 __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "results_schema", "column_spec", "write_schema",
@@ -155,33 +153,6 @@ _PROTOCOL_FIXED = {
 #: the protocol columns, in table order
 PROTOCOL_COLUMNS = tuple(_PROTOCOL_FIXED)
 _FIXED.update({k: v + (True,) for k, v in _PROTOCOL_FIXED.items()})
-#: parameters that are integers (validation: ``cut_lines``, ``N``); other numbers are floats
-_INT_PARAMETERS = ("cut_lines", "N")
-#: units of the numeric parameters that have one (docs/parameters.md); the other numbers are dimensionless
-_PARAMETER_UNITS = {"Young_modulus_spheres": "Pa", "density": "kg/m³", "avoid_horizontal_angle_degree": "degree",
-                    "edge_fuzziness": "largest radius", "pre_periods": "excitation periods",
-                    "periods": "excitation periods", "post_periods": "excitation periods",
-                    "plateau_begin": "contact distance", "plateau_end": "contact distance",
-                    "ramp_time": "τ", "hold_time": "τ", "creep_response_time": "τ", "creep_stress": "Pa",
-                    "creep_modulus": "Pa"}
-_parameter_cache = {}
-
-
-def _parameter_descriptions():
-    """Parameter name -> first sentence of its entry in the docstring of ``doParticleShearSimulation``."""
-    if "doc" not in _parameter_cache:
-        from ..run.api import doParticleShearSimulation
-        doc = inspect.getdoc(doParticleShearSimulation) or ""   # empty under python -OO
-        found = {}
-        for m in re.finditer(r"^(\w+) : [^\n]*\n((?:    [^\n]*\n?)+)", doc, flags=re.M):
-            text = " ".join(line.strip() for line in m.group(2).splitlines())
-            text = re.sub(r"^Keyword-only\.\s*", "", text)
-            found[m.group(1)] = re.split(r"(?<!\beq)(?<!e\.g)\.\s+(?=[A-Z(`])", text + " ", maxsplit=1)[0].strip() \
-                .rstrip(".")
-        _parameter_cache["doc"] = found
-    return _parameter_cache["doc"]
-
-
 def column_spec(name):
     """The schema entry of one column of a results table (a parameter or a fixed column).
 
@@ -208,25 +179,19 @@ def _column_spec(name):
     if name in _FIXED:
         kind, unit, text, nullable = _FIXED[name]
         return {"name": name, "type": kind, "unit": unit, "description": text, "nullable": nullable}
-    from ..run.rheometer import LIST_PARAMETERS
+    from ..parameters import BY_NAME
     from .spec import sweep_parameter_defaults
-    defaults = sweep_parameter_defaults(protocols=True)
-    if name not in defaults:
+    if name not in sweep_parameter_defaults(protocols=True):
         return {"name": name, "type": "string", "unit": "", "description": "", "nullable": True}
-    d = defaults[name]
-    if name in LIST_PARAMETERS:
-        kind, unit = "float_list", "1"
-    elif isinstance(d, bool):
-        kind, unit = "bool", ""
-    elif isinstance(d, str):
-        kind, unit = "string", ""
-    else:
-        kind = "int" if name in _INT_PARAMETERS else "float"
-        unit = _PARAMETER_UNITS.get(name, "" if kind == "int" else "1")
-    text = _parameter_descriptions().get(name, "")
+    par = BY_NAME[name]
+    kind = {"float_list": "float_list", "bool": "bool", "int": "int", "float": "float"}.get(par.kind, "string")
+    unit = par.unit if kind in ("float", "int", "float_list") else ""
+    text = par.doc
+    if par.has_range:
+        text += f"; allowed {par.range_text()}"
     return {"name": name, "type": kind, "unit": unit,
             "description": f"parameter {name} of doParticleShearSimulation: {text}" if text else
-            f"parameter {name} of doParticleShearSimulation", "nullable": d is None}
+            f"parameter {name} of doParticleShearSimulation", "nullable": par.nullable}
 
 
 def results_schema(columns=None):

@@ -26,7 +26,6 @@ fastest.  Every run is validated before any starts (docs/sweeps.md).
 __docformat__ = "numpy"
 import dataclasses
 import functools
-import inspect
 import itertools
 import json
 import math
@@ -54,12 +53,9 @@ MAX_RUNS = 10 ** 8
 
 @functools.lru_cache(maxsize=2)
 def _defaults(protocols):
-    from ..run.api import doParticleShearSimulation
-    from ..run.rheometer import PROTOCOL_DEFAULTS
-    sig = inspect.signature(doParticleShearSimulation)
-    return tuple((name, p.default) for name, p in sig.parameters.items()
-                 if name not in _RESERVED and name not in _NOT_SWEPT and (protocols or name not in PROTOCOL_DEFAULTS)
-                 and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))
+    from ..parameters import PARAMETERS
+    return tuple((p.name, p.default) for p in PARAMETERS
+                 if p.name not in _RESERVED and p.name not in _NOT_SWEPT and (protocols or p.base_role != "protocol"))
 
 
 def sweep_parameter_defaults(protocols=False):
@@ -91,8 +87,8 @@ def uses_protocols(names):
     -------
     bool
     """
-    from ..run.rheometer import PROTOCOL_DEFAULTS
-    return any(n in PROTOCOL_DEFAULTS for n in names)
+    from ..parameters import BY_NAME
+    return any(n in BY_NAME and BY_NAME[n].base_role == "protocol" for n in names)
 
 
 def _spec_keys(spec):

@@ -37,6 +37,7 @@ import numpy as np
 from .reader import escape_cell, read_table
 from ..signals import process_gone
 from ..analysis.measures import MEASURE_COLUMNS
+from ..parameters import BY_NAME, identity_excluded
 from ..simulation.provenance import identity_parameters, same_input
 from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema
 
@@ -233,8 +234,8 @@ def check_table(path, columns):
         bom = fh.read(3) == b"\xef\xbb\xbf"
     added = add_result_columns(path, columns)
     if added:
-        notes.append(f"added the column(s) {added} of this version to {path} (empty in its earlier rows: not "
-                     "evaluated when they ran)")
+        notes.append(f"added the column(s) {added} of this version to {path} (results empty in its earlier rows: "
+                     "not evaluated when they ran; parameters at their defaults)")
     table = read_table(path, schema="package", invalid="keep")
     check_table_header(path, columns)
     aside = {k for k, _ in table.set_aside} | {k for k, _ in table.duplicates}
@@ -280,17 +281,19 @@ def reject_lines(path, lines):
         os.fsync(fh.fileno())
 
 
-#: columns a newer version may add to a table of an older one: what a run measured, never what it
-#: was asked (a missing parameter would change what the run is)
-ADDABLE_COLUMNS = frozenset(MEASURE_COLUMNS) | frozenset(PROTOCOL_COLUMNS)
+#: columns a newer version may add to a table of an older one: what a run measured, and the
+#: parameters whose default leaves a run's identity unchanged (those of laws and protocols the run
+#: does not use, options, parameters added after 2.0.0: particleShear.parameters.identity_excluded)
+ADDABLE_COLUMNS = frozenset(MEASURE_COLUMNS) | frozenset(PROTOCOL_COLUMNS) | identity_excluded({})
 
 
 def add_result_columns(path, columns):
-    """Give a table of an earlier version this version's result columns, empty in its rows.
+    """Give a table of an earlier version this version's new columns: results empty, parameters at their default.
 
     Only when the header is ``columns`` less some of :data:`ADDABLE_COLUMNS` (measures, checks,
-    protocol outputs), in the same order: the rows keep every cell, the new columns are empty
-    ("not evaluated"), and the file is replaced atomically.  Any other difference is left for
+    protocol outputs, parameters whose default changes no run id), in the same order: the rows
+    keep every cell, a new result column is empty ("not evaluated"), a new parameter column holds
+    the parameter's default (what the run used), and the file is replaced atomically.  Any other difference is left for
     :func:`check_table_header` to refuse.
 
     Parameters
@@ -312,6 +315,8 @@ def add_result_columns(path, columns):
             or [c for c in columns if c in header] != header:
         return []
     where = [header.index(c) if c in header else None for c in columns]
+    fill = [escape_cell(_cell(BY_NAME[c].default)) if i is None and c in BY_NAME else ""
+            for c, i in zip(columns, where)]
     csv.field_size_limit(max(csv.field_size_limit(), os.path.getsize(path) + 1))
     try:
         with open(path, newline="", encoding="utf-8", errors="strict") as src, atomic_text(path) as out:
@@ -320,7 +325,8 @@ def add_result_columns(path, columns):
                 if k == 0:
                     w.writerow(columns)
                 else:   # a line that is no row keeps its cells (check_table sets it aside next)
-                    w.writerow(cells if len(cells) != len(header) else ["" if i is None else cells[i] for i in where])
+                    w.writerow(cells if len(cells) != len(header) else
+                               [f if i is None else cells[i] for i, f in zip(where, fill)])
     except (UnicodeDecodeError, csv.Error):
         return []       # the file is left as it was (atomic_text); check_table says what is wrong with it
     return missing

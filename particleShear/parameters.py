@@ -1,0 +1,290 @@
+"""The parameters of a run as data: one table, read by everything that needs them.
+
+Each :class:`Parameter` of :data:`PARAMETERS` holds a keyword of
+:func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order): its default,
+type, unit, allowed range, role and a one-line description.  The signature and the docstring of
+``doParticleShearSimulation`` keep particleShear 1.0.2's order, names and defaults; the suite checks
+them against this table, never the other way round (particleShearTest/test_parameter_table.py).
+What is derived from it: the range checks of the validation (:mod:`particleShear.run.validation`),
+the command line's types, choices and help (:mod:`particleShear.run.cli`), the results table's
+parameter columns, types and units (:mod:`particleShear.sweep.schema`), the SPEC keys
+(:mod:`particleShear.sweep.spec`), the run identity (:mod:`particleShear.simulation.provenance`),
+the batch grouping (:mod:`particleShear.run.batch`) and the protocols' parameters
+(:mod:`particleShear.run.rheometer`).
+
+Roles
+-----
+``model``
+    The physics of the packing and of its excitation (in the run identity).
+``law``, ``law:<name>``
+    The contact law's selector (``contact_law``) and the parameters of law ``<name>`` (in the run
+    identity only when that law is selected; the selector only when it is not the default).
+``protocol``, ``protocol:<a>,<b>``
+    The protocol's selector and the parameters the protocols ``<a>``, ``<b>`` read (in the run
+    identity only for those protocols; the selector only when it is not "oscillatory").
+``numerics``
+    How the measurement is integrated and evaluated (in the identity).
+``output``
+    What a run writes (in the identity: the row names the file).
+``display``, ``call``, ``observer``
+    What a run shows, what the caller chooses for this call (folder, seed, return type, error
+    policy) and observers that only read a run: not in the identity.
+
+Batch classes (``batch``): ``schedule`` parameters fix the step schedule (runs share a batch only
+with equal values), ``replica`` parameters may differ between the replicas of one batch, ``shared``
+ones must be equal within a batch.
+"""
+__docformat__ = "numpy"
+import dataclasses
+import math
+
+__all__ = ["Parameter", "PARAMETERS", "BY_NAME", "ROLES", "KINDS", "defaults", "names", "law_parameters",
+           "protocol_parameters", "identity_excluded"]
+
+#: the roles of a parameter (module docstring); ``law:<name>`` and ``protocol:<a>,<b>`` carry names
+ROLES = ("model", "law", "protocol", "numerics", "output", "display", "call", "observer")
+#: the value types: ``float``, ``int``, ``bool``, ``str`` (with ``choices``), ``float_list``, ``seed``
+#: (None, an integer, a SeedSequence or a Generator), ``path``, ``callable``
+KINDS = ("float", "int", "bool", "str", "float_list", "seed", "path", "callable")
+
+
+@dataclasses.dataclass(frozen=True)
+class Parameter:
+    """One keyword of ``doParticleShearSimulation`` (module docstring).
+
+    Parameters
+    ----------
+    name : str
+        The keyword (1.0.2's name).
+    default : object
+        Its default.
+    kind : str
+        One of :data:`KINDS`.
+    unit : str, default ""
+        Unit of a number ("1" dimensionless, "" for the other kinds and the integers).
+    low, high : float or None, default None
+        Allowed range of a number (None: no limit here; limits that depend on other parameters —
+        ``N``, ``cut_lines``, the steps per period — are the validation's).
+    low_open, high_open : bool, default False
+        The limit itself is excluded.
+    choices : tuple of str or None, default None
+        The allowed values of a ``str`` parameter.
+    role : str, default "model"
+        One of :data:`ROLES`, with ``:<names>`` for a law's or a protocol's own parameters.
+    batch : {"replica", "schedule", "shared"}, default "replica"
+        How runs that differ in it share a batch (module docstring).
+    keyword_only : bool, default False
+        Keyword-only in the signature (the options added after 1.0.2).
+    nullable : bool, default False
+        None is a value (its default, meaning "derived" or "required by its protocol").
+    doc : str, default ""
+        One line: what it is, with units.
+    since : str, default ""
+        The version that added it ("" for the parameters of 2.0.0).  A parameter added later is
+        in a run's identity only when it differs from its default, so the runs of a folder written
+        before it existed keep their ids (and a missing column of it means its default).
+    """
+
+    name: str
+    default: object
+    kind: str
+    unit: str = ""
+    low: object = None
+    high: object = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: object = None
+    role: str = "model"
+    batch: str = "replica"
+    keyword_only: bool = False
+    nullable: bool = False
+    doc: str = ""
+    since: str = ""
+
+    @property
+    def base_role(self):
+        """The role without its names (``"protocol:creep"`` → ``"protocol"``)."""
+        return self.role.partition(":")[0]
+
+    @property
+    def role_names(self):
+        """The names after the role's colon (``"protocol:relaxation,creep"`` → ``("relaxation", "creep")``)."""
+        return tuple(n for n in self.role.partition(":")[2].split(",") if n)
+
+    @property
+    def has_range(self):
+        """True when the table states a range (``low`` or ``high``)."""
+        return self.low is not None or self.high is not None
+
+    def range_text(self):
+        """The allowed range in the one wording of every range message (:func:`particleShear.checks.range_text`)."""
+        from .checks import range_text
+        return range_text(self.low, self.high, self.low_open, self.high_open)
+
+
+#: every keyword of ``doParticleShearSimulation``, in signature order
+PARAMETERS = (
+    Parameter('root_folder', '', 'path', role='call', doc='Output folder (path) of the text file and of the image folder'),
+    Parameter('theAmplitude', 0.2, 'float', unit='1', low=0, high=100, low_open=True, doc='Strain amplitude A, dimensionless (0.2 = 20 %)'),
+    Parameter('theMu', 0.01, 'float', unit='1', low=0, high=1000000.0, doc='Coulomb friction coefficient μ of transient contacts, dimensionless'),
+    Parameter('do_permanent_links', True, 'bool', doc='Crosslink all contacts after relaxation; False: frictional spheres only'),
+    Parameter('cut_lines', 5, 'int', doc='Triangulation: number of particles (Voronoi seeds); line mode: number of straight cuts; <= 1 (triangulation) or 0 (lines) is an uncut bulk gel'),
+    Parameter('Young_modulus_spheres', 8000, 'float', unit='Pa', low=1e-06, high=1000000000000.0, batch='schedule', doc='Young modulus E of the sphere material in Pa'),
+    Parameter('N', 150, 'int', batch='schedule', doc='Number of spheres; allowed an integer from N_min (11 at the default packing fraction and bimodal factor: the largest sphere must be smaller than a quarter of the cell) to 1e6'),
+    Parameter('packing_fraction', 1.5, 'float', unit='1', low=0, high=10, low_open=True, batch='schedule', doc='Nominal (uncompressed) area fraction φ that defines the radii (eq. S1-14), dimensionless'),
+    Parameter('density', 50, 'float', unit='kg/m³', low=1e-06, high=1000000.0, batch='schedule', doc='Material density in kg/m³'),
+    Parameter('bimodal_factor', 1.4, 'float', unit='1', low=0.01, high=100, batch='schedule', doc='Ratio of large to small radius (50/50 random), dimensionless'),
+    Parameter('relative_viscosity', 0.1, 'float', unit='1', low=0, high=3.0, batch='schedule', doc='rv in the contact damping ν = rv·√(m k) (eq. S1-9), dimensionless'),
+    Parameter('relative_transversal_link_strength', 1, 'float', unit='1', low=0, high=30.0, doc='k_t/k and ν_t/ν, dimensionless'),
+    Parameter('relative_frequency', 0.025, 'float', unit='1', low=0, low_open=True, batch='schedule', doc='f·τ: excitation frequency in units of the characteristic frequency 1/τ, dimensionless'),
+    Parameter('avoid_horizontal_angle_degree', 15, 'float', unit='degree', low=0, high=90, high_open=True, doc='Line-cut mode only: half-width in degrees of the forbidden band around horizontal cut lines'),
+    Parameter('interface_reenforcement_central', 1, 'float', unit='1', low=1e-06, high=50.0, doc='Factor on k of transient contacts relative to permanent links, dimensionless'),
+    Parameter('interface_reenforcement_tangential', 1, 'float', unit='1', low=1e-06, high=1000000.0, doc='The same factor for k_t, dimensionless'),
+    Parameter('keep_viscosity_coefficients_constant', False, 'bool', doc='False: the contact viscosities follow the reinforcement factors; True: they stay'),
+    Parameter('avoid_height_spanning_particles', True, 'bool', doc='Cut again while a particle is taller than 0.9 of the cell height'),
+    Parameter('cut_top_bottom', False, 'bool', doc='Cut every link through the y-periodic boundary (emulates wall slip)'),
+    Parameter('saveOutputImages', False, 'bool', role='output', doc='Save about 200 captioned snapshots of the protocol into an image folder beside the output file (needs ``root_folder``; works with or without ``doDrawing``)'),
+    Parameter('imageFileType', 'jpg', 'str', choices=('jpg', 'png', 'ps', 'svg'), role='output', doc='Snapshot format; "ps" is vector Encapsulated PostScript (extension .ps), "svg" vector SVG'),
+    Parameter('remove_link_fraction', 0, 'float', unit='1', low=0, high=1, doc='Target fraction of non-essential permanent links removed at random'),
+    Parameter('edge_fuzziness', 0, 'float', unit='largest radius', low=0, high=1000.0, doc='Random roughening of the Voronoi borders in units of the largest radius'),
+    Parameter('central_repulsion_coefficient', 1, 'float', unit='1', low=0, high=1, doc='c of the central force law, dimensionless (1 = divergent repulsion eq. S1-5b, 0 = linear eq. S1-5a)'),
+    Parameter('doCutByTriangulation', True, 'bool', doc='Cut into particles by periodic Voronoi cells; False: by random straight lines'),
+    Parameter('doDrawing', True, 'bool', role='display', doc='Draw: the live particle window when a display exists (snapshots do not need it)'),
+    Parameter('saveData', False, 'bool', role='output', doc='Write the output file of the run (format ``output_format``; docs/output.md)'),
+    Parameter('saveStressTensorData', True, 'bool', role='output', doc='With ``saveData``: also write the 42-column per-step table of the stress tensors'),
+    Parameter('plotStress', True, 'bool', role='display', doc='Live stress/strain window (needs a display and ``doDrawing``); without a display, and with ``saveData``, it is saved as ``<output file>_stress.png`` (needs particleShear[plot])'),
+    Parameter('relative_y_scale_force', 100000000.0, 'float', unit='1', low=-1e+300, high=1e+300, role='output', doc='Vertical scale of the live stress window only, dimensionless'),
+    Parameter('pre_periods', 2, 'float', unit='excitation periods', low=0, batch='schedule', doc='Baseline before the excitation, in excitation periods (drift reference)'),
+    Parameter('periods', 3, 'float', unit='excitation periods', low=0, low_open=True, batch='schedule', doc='Excitation periods (the first is skipped in the demodulation when >= 2)'),
+    Parameter('post_periods', 1, 'float', unit='excitation periods', low=0, batch='schedule', doc='Recovery after the excitation, in excitation periods'),
+    Parameter('cool_factor', 0.5, 'float', unit='1', low=0, high=1, low_open=True, batch='schedule', doc='Fraction of the peculiar velocity left after one excitation period (damping), dimensionless'),
+    Parameter('seed', None, 'seed', role='call', nullable=True, doc='Drives every random choice; one seed gives a bit-identical run'),
+    Parameter('return_result', False, 'bool', role='call', batch='shared', keyword_only=True, doc='Return the :class:`SimulationResult` instead of ``[G′_surface, G″_surface]``'),
+    Parameter('verbose', True, 'bool', role='display', keyword_only=True, doc='Show the reference\'s console messages: INFO messages of the logger "particleShear" on stdout during the call (see :mod:`particleShear.messages`)'),
+    Parameter('progress', None, 'callable', role='display', keyword_only=True, nullable=True, doc='``progress(phase, step, total, elapsed_s)``, called at most ~10 times per second, for the phases "constitution", "pre-equilibration" and "protocol"'),
+    Parameter('correct_drift_sign', False, 'bool', role='numerics', keyword_only=True, doc="Demodulate with the mathematically correct drift correction (default: the reference's sign; docs/output.md)"),
+    Parameter('reference_header', False, 'bool', role='output', keyword_only=True, doc="Reproduce the two defects of the reference's output header (docs/output.md)"),
+    Parameter('renderer', 'auto', 'str', choices=('auto', 'tk', 'pillow', 'none'), role='display', keyword_only=True, doc='Drawing backend: "auto" (Tk when a display exists, else Pillow for the snapshots), "tk", "pillow" or "none"; also set by the environment variable PARTICLESHEAR_RENDERER'),
+    Parameter('time_step_factor', 1.0, 'float', unit='1', role='numerics', batch='schedule', keyword_only=True, doc='Multiplies the time step (and the coarsest relaxation step) of the measurement: plate pre-equilibration and protocol (1 = the reference rule)'),
+    Parameter('integrator', 'euler', 'str', choices=('euler', 'verlet'), role='numerics', batch='schedule', keyword_only=True, doc="Time integrator of the measurement: the reference's semi-implicit Euler, or velocity Verlet with a half-kick predictor for the velocity-dependent forces"),
+    Parameter('stability_guard', True, 'bool', role='numerics', keyword_only=True, doc='Stop a diverging measurement with ``SimulationInstabilityError`` (step, phase, worst pair, suggested time step) instead of returning NaN moduli'),
+    Parameter('saveOutputMovie', False, 'bool', role='output', batch='shared', keyword_only=True, doc='Also write the snapshots as the animated GIF ``movie.gif`` in the image folder (needs ``saveOutputImages``): 80 ms a frame, each snapshot scaled down to 320 px wide (kept as it is when narrower); every snapshot is a frame (201 by default) until 400 are kept, then every second kept frame is dropped and only every second later snapshot is kept, so a movie has fewer than 400 frames'),
+    Parameter('output_format', 'text', 'str', choices=('text', 'text.gz', 'npz', 'parquet'), role='output', batch='shared', keyword_only=True, doc='File format of ``saveData``: the reference text, the same gzip-compressed, NumPy .npz, or Parquet (needs particleShear[parquet]); read any with :func:`particleShear.read_run` (docs/output.md)'),
+    Parameter('strict_io', False, 'bool', role='call', batch='shared', keyword_only=True, doc='Raise the ``OSError`` of a failed write after the run; False: return the result with ``write_error`` set (``last_result`` holds it either way)'),
+    Parameter('backend', 'numpy', 'str', choices=('numpy', 'cupy'), role='numerics', batch='shared', keyword_only=True, doc='Array library of the measurement: "numpy", or "cupy" to measure on a CUDA GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for bit)'),
+    Parameter('contact_law', 'linear', 'str', choices=('linear', 'plateau'), role='law', batch='shared', keyword_only=True, doc='Central contact law, a name of the registry :data:`particleShear.engine.laws.LAWS` (laws added with ``register_law`` are allowed too): "linear" the blend of eqs'),
+    Parameter('plateau_begin', 0.3, 'float', unit='contact distance', role='law:plateau', keyword_only=True, doc='Begin of the plateau of ``contact_law="plateau"``, a fraction of the contact distance; allowed 0 < plateau_begin < plateau_end'),
+    Parameter('plateau_end', 0.8, 'float', unit='contact distance', role='law:plateau', keyword_only=True, doc='End of the plateau, a fraction of the contact distance; allowed plateau_begin < plateau_end <= 1'),
+    Parameter('plateau_slope', 0.1, 'float', unit='1', role='law:plateau', keyword_only=True, doc="Slope of the force on the plateau relative to the law's (0 flat, 1 no plateau); allowed 0 ... 1"),
+    Parameter('protocol', 'oscillatory', 'str', choices=('oscillatory', 'steady', 'relaxation', 'creep', 'amplitude_sweep', 'frequency_sweep'), role='protocol', batch='shared', keyword_only=True, doc="What the rheometer does after the pre-equilibration (docs/protocols.md): the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude`` and hold; a constant applied stress; or, on one packing, the oscillation at each of ``sweep_amplitudes`` or ``sweep_frequencies`` in turn"),
+    Parameter('relative_rate', 0.01, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: shear rate γ̇·τ, dimensionless like ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant); allowed > 0 with at most 0.005 strain per time step'),
+    Parameter('total_strain', 2.0, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: strain sheared in all; allowed 0 < value <= 1e6'),
+    Parameter('ramp_time', 1.0, 'float', unit='τ', role='protocol:relaxation', batch='shared', keyword_only=True, doc='``protocol="relaxation"``: duration of the strain ramp to γ₀, in units of τ; allowed > 0 with at most 0.005 strain per time step'),
+    Parameter('hold_time', 200.0, 'float', unit='τ', role='protocol:relaxation,creep', batch='shared', keyword_only=True, doc='``protocol="relaxation"`` and ``"creep"``: duration of the hold, in units of τ; allowed 0 < value <= 1e9 within the step limit'),
+    Parameter('creep_stress', None, 'float', unit='Pa', role='protocol:creep', keyword_only=True, nullable=True, doc='``protocol="creep"`` (required there): applied shear stress σ₀ in Pa, > 0'),
+    Parameter('creep_modulus', None, 'float', unit='Pa', role='protocol:creep', keyword_only=True, nullable=True, doc='``protocol="creep"``: modulus scale G_c (Pa) of the stress controller; None: Young_modulus_spheres/8 (docs/protocols.md)'),
+    Parameter('creep_response_time', 5.0, 'float', unit='τ', role='protocol:creep', batch='shared', keyword_only=True, doc='``protocol="creep"``: response time T_c of the stress controller in units of τ; allowed >= 10 time steps'),
+    Parameter('sweep_amplitudes', None, 'float_list', unit='1', role='protocol:amplitude_sweep', keyword_only=True, nullable=True, doc='``protocol="amplitude_sweep"`` (required there): the strain amplitudes, in the order run, strictly increasing or strictly decreasing, each 0 < A <= 100; ``theAmplitude`` is set to the first'),
+    Parameter('sweep_frequencies', None, 'float_list', unit='1', role='protocol:frequency_sweep', batch='shared', keyword_only=True, nullable=True, doc='``protocol="frequency_sweep"`` (required there): the relative frequencies f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first'),
+    Parameter('stroboscopic', False, 'bool', role='observer', keyword_only=True, doc='Watch the oscillatory protocol with the stroboscopic observer (:class:`particleShear.engine.microstructure.Stroboscope`): a snapshot at the start of every shear period; per cycle the non-affine displacement, D²_min, contacts made and broken, Z without rattlers and P(f/⟨f⟩) in ``result.microstructure`` and the per-run columns ``irreversibility``, ``moved_fraction``, ``Z_rattler_free``, ``rattler_fraction``, ``contact_change_rate`` in ``result.measures`` (docs/microstructure.md)'),
+)
+
+#: name → :class:`Parameter`
+BY_NAME = {p.name: p for p in PARAMETERS}
+
+
+def _check_table():
+    for p in PARAMETERS:
+        assert p.kind in KINDS and p.base_role in ROLES and p.batch in ("replica", "schedule", "shared"), p
+        assert p.kind != "str" or p.choices, p
+        assert not p.has_range or all(x is None or math.isfinite(x) for x in (p.low, p.high)), p
+
+
+_check_table()
+
+
+def defaults():
+    """``{name: default}`` of every parameter, signature order.
+
+    Returns
+    -------
+    dict
+    """
+    return {p.name: p.default for p in PARAMETERS}
+
+
+def names(role=None, batch=None):
+    """The names of the parameters of a (base) role and/or batch class, signature order.
+
+    Parameters
+    ----------
+    role : str, optional
+        A base role (:data:`ROLES`) or a full role (``"law:plateau"``).
+    batch : str, optional
+        ``"replica"``, ``"schedule"`` or ``"shared"``.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(p.name for p in PARAMETERS
+                 if (role is None or p.role == role or p.base_role == role)
+                 and (batch is None or p.batch == batch))
+
+
+def law_parameters(law):
+    """The parameters of contact law ``law`` (role ``law:<law>``), signature order.
+
+    Parameters
+    ----------
+    law : str
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(p.name for p in PARAMETERS if p.base_role == "law" and law in p.role_names)
+
+
+def protocol_parameters(protocol):
+    """The parameters protocol ``protocol`` reads (role ``protocol:…`` naming it), signature order.
+
+    Parameters
+    ----------
+    protocol : str
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(p.name for p in PARAMETERS if p.base_role == "protocol" and protocol in p.role_names)
+
+
+def identity_excluded(parameters):
+    """The names a run's identity leaves out: display, call and observer parameters; the parameters
+    of the laws and protocols the run does not use; a selector, and a parameter added after 2.0.0
+    (``since``), at its default (so a run keeps the id it had before the law, the protocol or the
+    parameter existed).
+
+    Parameters
+    ----------
+    parameters : dict
+        The run's inputs (``contact_law`` and ``protocol`` read; defaults when absent).
+
+    Returns
+    -------
+    frozenset of str
+    """
+    out = set()
+    for p in PARAMETERS:
+        base = p.base_role
+        if base in ("display", "call", "observer"):
+            out.add(p.name)
+        elif p.role_names:
+            chosen = parameters.get("contact_law" if base == "law" else "protocol", BY_NAME[
+                "contact_law" if base == "law" else "protocol"].default)
+            if chosen not in p.role_names:
+                out.add(p.name)
+        elif (base in ("law", "protocol") or p.since) and parameters.get(p.name, p.default) == p.default:
+            out.add(p.name)
+    return frozenset(out)
