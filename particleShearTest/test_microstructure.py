@@ -213,5 +213,53 @@ class TestOnset(unittest.TestCase):
         self.assertTrue(all(v is None for v in micro_measures(None).values()))
 
 
+class TestSweepSpec(unittest.TestCase):
+    """``stroboscopic`` in a SPEC: an output option, the run ids of the same SPEC without it."""
+
+    BASE = dict(N=30, relative_frequency=0.5, pre_periods=0.5, periods=3, post_periods=0.5, doDrawing=False,
+                plotStress=False, saveData=False)
+
+    def _ids(self, doc):
+        from particleShear.sweep import expand_runs, parse_spec
+        return [r.run_id for r in expand_runs(parse_spec(doc))]
+
+    def test_run_ids_unchanged_in_parameters_grid_and_zip(self):
+        seeds = {"root": 3, "repetitions": 2}
+        plain = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3]}, "seeds": seeds}
+        fixed = {"parameters": dict(self.BASE, stroboscopic=True), "grid": {"theAmplitude": [0.02, 0.3]},
+                 "seeds": seeds}
+        grid = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3], "stroboscopic": [True]},
+                "seeds": seeds}
+        zipped = {"parameters": dict(self.BASE), "zip": [{"theAmplitude": [0.02, 0.3], "stroboscopic": [False, True]}],
+                  "seeds": seeds}
+        ids = self._ids(plain)
+        self.assertEqual(len(set(ids)), 4)
+        for doc in (fixed, grid, zipped):
+            self.assertEqual(self._ids(doc), ids)
+        with self.assertRaisesRegex((ValueError, TypeError), "stroboscopic='yes'"):
+            self._ids({"parameters": dict(self.BASE, stroboscopic="yes"), "seeds": seeds})
+
+    def test_sweep_fills_the_columns_and_does_not_split_groups(self):
+        import tempfile
+        from particleShear.analysis.cli import grouping_columns
+        from particleShear.sweep import run_sweep
+        from particleShear.sweep.schema import load_results
+        doc = {"parameters": dict(self.BASE), "zip": [{"theAmplitude": [0.02, 0.3], "stroboscopic": [False, True]}],
+               "seeds": {"root": 3, "repetitions": 1}}
+        plain = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3]},
+                 "seeds": {"root": 3, "repetitions": 1}}
+        with tempfile.TemporaryDirectory() as out:
+            run_sweep(doc, out, workers=1, progress=False)
+            rows = load_results(out, as_frame=False)
+            header = list(rows[0])
+        self.assertEqual([r["run_id"] for r in rows], self._ids(plain))
+        self.assertEqual([r["status"] for r in rows], ["ok", "ok"])
+        self.assertTrue(all(rows[0][c] is None for c in MICRO_COLUMNS))      # off: not evaluated
+        self.assertTrue(all(rows[1][c] is not None and math.isfinite(rows[1][c]) for c in MICRO_COLUMNS))
+        self.assertGreater(rows[1]["irreversibility"], 0.0)
+        self.assertIn("stroboscopic", header)
+        self.assertNotIn("stroboscopic", grouping_columns(header))           # one analysis group
+
+
 if __name__ == "__main__":
     unittest.main()
