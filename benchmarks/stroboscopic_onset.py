@@ -9,7 +9,8 @@ docs/microstructure.md ("Finding") is the output of
 
     python benchmarks/stroboscopic_onset.py --N 40 --seeds 16 --periods 4
 
-(≈ 2–4 min on one core).
+(6.7 min on one shared core; run from the repository root with ``PYTHONPATH=.`` so the
+working tree is the package imported).
 """
 import argparse
 import csv
