@@ -149,6 +149,7 @@ ENGINE_MODULES = [
     "particleShear.engine.neighbours",
     "particleShear.engine.observers",
     "particleShear.engine.microstructure",
+    "particleShear.simulation.microstructure_pictures",
     "particleShear.engine.relax",
     "particleShear.engine.state",
     "particleShear.engine.step",

@@ -4,13 +4,14 @@ Geometry tests are exact statements (affine maps, rigid motions, a hand-built co
 to rounding; the run tests use N = 40 spheres and 3 shear periods.
 """
 import math
+import os
 import unittest
 
 import numpy as np
 
 from particleShear import doParticleShearSimulation
 from particleShear.analysis.microstructure import MICRO_COLUMNS, irreversibility_onset, micro_measures
-from particleShear.engine.box import wrap
+from particleShear.engine.box import min_image, wrap
 from particleShear.engine.microstructure import (Stroboscope, contact_changes, contact_keys, d2min, force_histogram,
                                                  non_affine_displacement, rattler_free, snapshot_steps)
 
@@ -177,6 +178,86 @@ class TestStroboscopicRuns(unittest.TestCase):
         for key in ("msd", "d2min", "made", "broken", "Z", "force_pdf", "positions"):
             np.testing.assert_array_equal(a[key], b[key])
 
+    # -- pictures (docs/microstructure.md, "Pictures") ---------------------------------------------
+    def test_pictures_one_per_cycle_and_a_gif_of_the_cycles(self):
+        import tempfile
+        from PIL import Image
+        n_c = len(self.large.microstructure["msd"])
+        with tempfile.TemporaryDirectory() as d:
+            made = self.large.microstructure_pictures(d)
+            self.assertEqual([os.path.basename(p) for p in made["pictures"]],
+                             [f"cycle_{c:03d}.png" for c in range(1, n_c + 1)])
+            self.assertTrue(all(os.path.getsize(p) > 0 for p in made["pictures"]))
+            with Image.open(made["gif"]) as gif:
+                self.assertEqual(gif.n_frames, n_c)
+            made = self.large.microstructure_pictures(os.path.join(d, "na"), colour_by="non_affine", gif=False)
+            self.assertEqual(len(made["pictures"]), n_c)
+            self.assertIsNone(made["gif"])
+
+    def test_thickest_chain_is_the_largest_normal_force(self):
+        import tempfile
+        from PIL import Image
+        from particleShear.simulation.microstructure_pictures import CHAIN_COLOUR, picture_primitives
+        m, cycle = self.large.microstructure, 1
+        discs, segs = picture_primitives(m, cycle)
+        fn = m["normal_force"][cycle + 1]
+        widest = max(segs, key=lambda sg: sg[4])
+        self.assertEqual(widest[5], int(np.argmax(fn)))
+        # widths proportional to the forces, and a segment joins the centres of the pair in contact
+        ratios = [w / fn[k] for *_, w, k in segs]
+        self.assertLess(max(ratios) / min(ratios) - 1, 1e-12)
+        pos = m["positions"][cycle + 1]
+        Lx, Ly = m["Lx"], m["Ly"]
+        for x1, y1, x2, y2, w, k in segs:
+            i, j = m["contact_i"][cycle + 1][k], m["contact_j"][cycle + 1][k]
+            self.assertAlmostEqual(math.hypot(x2 - x1, y2 - y1),
+                                   float(np.hypot(*min_image(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Lx, Ly,
+                                                             m["shift"][cycle + 1])[:2])), places=9)
+        # in the written picture, the middle of the widest segment (an image inside the cell) is chain-coloured
+        k_max = widest[5]
+        mid = [((a + c) / 2, (b + d) / 2) for a, b, c, d, _, k in segs if k == k_max]
+        mx, my = next(p for p in mid if 0 < p[0] < Lx and 0 < p[1] < Ly)
+        with tempfile.TemporaryDirectory() as d:
+            path = self.large.microstructure_pictures(d, gif=False)["pictures"][cycle]
+            with Image.open(path) as img:
+                scale = img.width / Lx
+                px = img.convert("RGB").getpixel((int(mx * scale), int(my * scale)))
+        self.assertEqual("#%02x%02x%02x" % px, CHAIN_COLOUR)
+
+    def test_sphere_of_the_largest_d2min_has_the_top_colour(self):
+        from particleShear.simulation.microstructure_pictures import NAN_FILL, VIRIDIS, picture_primitives
+        m = self.large.microstructure
+        q = np.where(np.isfinite(m["d2min"]), m["d2min"], -np.inf)
+        cycle, i = np.unravel_index(int(np.argmax(q)), q.shape)
+        discs, _ = picture_primitives(m, int(cycle))
+        x, y = m["positions"][cycle + 1][:, i]
+        fill = next(f for X, Y, r, f in discs if abs(X - x) < 1e-9 and abs(Y - y) < 1e-9)
+        self.assertEqual(fill, VIRIDIS[-1])
+        undefined = ~np.isfinite(m["d2min"][cycle])          # neighbours on a line: the NaN fill
+        self.assertEqual(NAN_FILL in [f for X, Y, r, f in discs], bool(undefined.any()))
+
+    def test_pictures_bad_input_names_the_parameter(self):
+        import io
+        import tempfile
+        from contextlib import redirect_stderr
+        from particleShear.run.cli import main
+        from particleShear.simulation.microstructure_pictures import picture_primitives
+        with tempfile.TemporaryDirectory() as d:
+            with self.assertRaisesRegex(ValueError, "stroboscopic=True"):
+                self.off.microstructure_pictures(d)
+            with self.assertRaisesRegex(ValueError, "colour_by='x' is invalid"):
+                self.large.microstructure_pictures(d, colour_by="x")
+            with self.assertRaisesRegex(ValueError, r"cycle=3 is out of range: allowed an integer 0 <= cycle <= 2"):
+                picture_primitives(self.large.microstructure, 3)
+            with self.assertRaisesRegex(ValueError, "scale=0 is out of range"):
+                self.large.microstructure_pictures(d, scale=0)
+            err = io.StringIO()
+            with redirect_stderr(err):
+                rc = main(["--N", "30", "--periods", "0.5", "--stroboscopic-pictures", d, "--quiet"])
+            self.assertEqual(rc, 2)
+            self.assertIn("--stroboscopic-pictures with --periods 0.5 is invalid", err.getvalue())
+            self.assertEqual(os.listdir(d), [])
+
 
 class TestOnset(unittest.TestCase):
 
@@ -211,6 +292,54 @@ class TestOnset(unittest.TestCase):
 
     def test_micro_measures_without_observer_are_nan(self):
         self.assertTrue(all(v is None for v in micro_measures(None).values()))
+
+
+class TestSweepSpec(unittest.TestCase):
+    """``stroboscopic`` in a SPEC: an output option, the run ids of the same SPEC without it."""
+
+    BASE = dict(N=30, relative_frequency=0.5, pre_periods=0.5, periods=3, post_periods=0.5, doDrawing=False,
+                plotStress=False, saveData=False)
+
+    def _ids(self, doc):
+        from particleShear.sweep import expand_runs, parse_spec
+        return [r.run_id for r in expand_runs(parse_spec(doc))]
+
+    def test_run_ids_unchanged_in_parameters_grid_and_zip(self):
+        seeds = {"root": 3, "repetitions": 2}
+        plain = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3]}, "seeds": seeds}
+        fixed = {"parameters": dict(self.BASE, stroboscopic=True), "grid": {"theAmplitude": [0.02, 0.3]},
+                 "seeds": seeds}
+        grid = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3], "stroboscopic": [True]},
+                "seeds": seeds}
+        zipped = {"parameters": dict(self.BASE), "zip": [{"theAmplitude": [0.02, 0.3], "stroboscopic": [False, True]}],
+                  "seeds": seeds}
+        ids = self._ids(plain)
+        self.assertEqual(len(set(ids)), 4)
+        for doc in (fixed, grid, zipped):
+            self.assertEqual(self._ids(doc), ids)
+        with self.assertRaisesRegex((ValueError, TypeError), "stroboscopic='yes'"):
+            self._ids({"parameters": dict(self.BASE, stroboscopic="yes"), "seeds": seeds})
+
+    def test_sweep_fills_the_columns_and_does_not_split_groups(self):
+        import tempfile
+        from particleShear.analysis.cli import grouping_columns
+        from particleShear.sweep import run_sweep
+        from particleShear.sweep.schema import load_results
+        doc = {"parameters": dict(self.BASE), "zip": [{"theAmplitude": [0.02, 0.3], "stroboscopic": [False, True]}],
+               "seeds": {"root": 3, "repetitions": 1}}
+        plain = {"parameters": dict(self.BASE), "grid": {"theAmplitude": [0.02, 0.3]},
+                 "seeds": {"root": 3, "repetitions": 1}}
+        with tempfile.TemporaryDirectory() as out:
+            run_sweep(doc, out, workers=1, progress=False)
+            rows = load_results(out, as_frame=False)
+            header = list(rows[0])
+        self.assertEqual([r["run_id"] for r in rows], self._ids(plain))
+        self.assertEqual([r["status"] for r in rows], ["ok", "ok"])
+        self.assertTrue(all(rows[0][c] is None for c in MICRO_COLUMNS))      # off: not evaluated
+        self.assertTrue(all(rows[1][c] is not None and math.isfinite(rows[1][c]) for c in MICRO_COLUMNS))
+        self.assertGreater(rows[1]["irreversibility"], 0.0)
+        self.assertIn("stroboscopic", header)
+        self.assertNotIn("stroboscopic", grouping_columns(header))           # one analysis group
 
 
 if __name__ == "__main__":

@@ -394,7 +394,8 @@ class Stroboscope:
             sel = touching & (rep == b)
             ci, cj = ai[sel] - b * N, aj[sel] - b * N
             Z, rattlers = rattler_free(ci, cj, N, self.min_contacts)
-            snap = {"step": step, "pos": pos[:, rows].copy(), "gamma": float(gamma[b]), "Lx": float(Lx[b]),
+            snap = {"step": step, "pos": pos[:, rows].copy(), "gamma": float(gamma[b]), "shift": float(shift[b]),
+                    "Lx": float(Lx[b]),
                     "Ly": float(Ly[b]), "r": r[rows], "mobile": mob[rows].copy(), "i": ci, "j": cj,
                     "fn": fn[sel], "keys": contact_keys(ci, cj, N), "Z": Z,
                     "rattler_fraction": float(rattlers.mean()) if N else math.nan,
@@ -451,6 +452,7 @@ class Stroboscope:
                 "d2min_mean": col("d2min_mean"),
                 "non_affine": np.array([c["u"] for c in cyc]).reshape(len(cyc), 2, N),
                 "step": np.array([sn["step"] for sn in snaps]), "gamma": np.array([sn["gamma"] for sn in snaps]),
+                "shift": np.array([sn["shift"] for sn in snaps]),
                 "Z": np.array([sn["Z"] for sn in snaps]),
                 "rattler_fraction": np.array([sn["rattler_fraction"] for sn in snaps]),
                 "contacts": np.array([len(sn["keys"]) for sn in snaps]),

@@ -399,6 +399,10 @@ def build_parser():
     c.add_argument("--plot", metavar="FILE", default=None,
                    help="write the strain/stress trace and Lissajous loop to FILE (.png/.pdf/.svg/.eps; "
                         "needs particleShear[plot])")
+    c.add_argument("--stroboscopic-pictures", metavar="DIR", default=None, action=_Store,
+                   help="watch the run with the stroboscopic observer (--stroboscopic) and write one picture per "
+                        "excitation cycle into DIR (force chains, spheres coloured by D2_min; Pillow) and "
+                        "DIR/cycles.gif (docs/microstructure.md)")
     c.add_argument("--json", action="store_true",
                    help="print the result row (SimulationResult.to_dict(), the row of a sweep's results.csv) "
                         "as one JSON object on stdout, and nothing else there; an amplitude or frequency "
@@ -455,6 +459,20 @@ def api_kwargs(args):
     kw["progress"] = ProgressLine() if getattr(args, "progress", None) in (None, True) else None
     if images and not kw["root_folder"]:
         raise ValueError("--images needs --save DIR")
+    pictures = getattr(args, "stroboscopic_pictures", None)
+    if pictures is not None:
+        if not str(pictures).strip():
+            raise ValueError("--stroboscopic-pictures='' is invalid: allowed a folder name")
+        if "stroboscopic" in given and not kw["stroboscopic"]:
+            raise ValueError("--stroboscopic-pictures needs the stroboscopic observer: drop --no-stroboscopic")
+        if kw.get("protocol", "oscillatory") != "oscillatory":
+            raise ValueError(f"--stroboscopic-pictures with --protocol {kw['protocol']} is invalid: allowed only "
+                             "the oscillatory protocol (the observer watches its periods)")
+        periods = kw.get("periods")
+        if isinstance(periods, (int, float)) and not isinstance(periods, bool) and periods < 1:
+            raise ValueError(f"--stroboscopic-pictures with --periods {periods:g} is invalid: allowed --periods >= 1 "
+                             "(one picture per complete period)")
+        kw["stroboscopic"] = True
     return kw
 
 
@@ -637,6 +655,14 @@ def main(argv=None):
             print(f"particleShear: --plot: {exc}", file=sys.stderr)
             return 1
         print("plot: " + args.plot, file=info)
+    if args.stroboscopic_pictures is not None:
+        try:
+            made = res.microstructure_pictures(args.stroboscopic_pictures)
+        except (OSError, ValueError) as exc:
+            print(f"particleShear: --stroboscopic-pictures: {exc}", file=sys.stderr)
+            return 1
+        print(f"pictures: {len(made['pictures'])} cycles and {os.path.basename(made['gif'])} in "
+              f"{args.stroboscopic_pictures}", file=info)
     return 0
 
 

@@ -273,6 +273,36 @@ class SimulationResult:
         from ..plot import plot_result
         return plot_result(self, path)
 
+    def microstructure_pictures(self, folder, colour_by="d2min", gif=True, **options):
+        """One picture per excitation cycle (force chains, spheres coloured by D²_min) and a GIF.
+
+        See :func:`particleShear.simulation.microstructure_pictures.microstructure_pictures` (Pillow
+        only; docs/microstructure.md, "Pictures").
+
+        Parameters
+        ----------
+        folder : str or os.PathLike
+            Output folder (made when missing).
+        colour_by : {"d2min", "non_affine"}, default "d2min"
+            What fills the spheres.
+        gif : bool, default True
+            Also write ``folder/cycles.gif``.
+        **options
+            ``scale`` (pixels per µm), ``decades``, ``frame_duration_ms``.
+
+        Returns
+        -------
+        dict
+            ``"pictures"`` (PNG paths, one per cycle) and ``"gif"`` (path or None).
+
+        Raises
+        ------
+        ValueError
+            A run without ``stroboscopic=True``, or an option out of range.
+        """
+        from ..simulation.microstructure_pictures import microstructure_pictures
+        return microstructure_pictures(self, folder, colour_by=colour_by, gif=gif, **options)
+
     def to_dict(self):
         """The row of this run in a sweep's results table (docs/sweeps.md), as a dict.
 

@@ -7,6 +7,7 @@ __docformat__ = "numpy"
 from .evaluation import EvaluationHandler, EvaluationHandlerPlotter, demodulation  # noqa: F401
 from .experiment import OscillatoryShearExperiment
 from .formats import OUTPUT_FORMATS, RunData, RunFileError, read_run, verify_run
+from .microstructure_pictures import microstructure_pictures
 from .provenance import run_identity
 from .simulations import (OscillatorySimulation, OscillatorySimulationFragmentation,
                           Simulation_dermal_filler_rheology, Simulation_interlocking_rheology)
@@ -14,4 +15,4 @@ from .simulations import (OscillatorySimulation, OscillatorySimulationFragmentat
 __all__ = ["EvaluationHandler", "EvaluationHandlerPlotter", "OscillatoryShearExperiment", "OscillatorySimulation",
            "OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology",
            "Simulation_interlocking_rheology", "read_run", "verify_run", "RunData", "RunFileError", "OUTPUT_FORMATS",
-           "run_identity"]
+           "run_identity", "microstructure_pictures"]

@@ -17,6 +17,9 @@
 
 ``amplitude`` and ``mu`` are accepted as aliases of ``theAmplitude`` and ``theMu`` (the same
 runs, the same run ids); an unknown key is refused with the closest parameter names.
+``stroboscopic = true`` (in any table) watches the runs with the stroboscopic observer
+(docs/microstructure.md): an output option, so the run ids are those of the same SPEC without it
+and it does not split the groups of ``particleShear analyse``.
 
 Run ``k = repetition · n_points + point`` gets ``numpy.random.SeedSequence(root, spawn_key=(k,))``,
 i.e. ``SeedSequence(root).spawn(n)[k]``: adding repetitions keeps the ids of the earlier ones.
@@ -42,9 +45,12 @@ SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
 _SEED_KEYS = ("root", "repetitions")
 #: arguments a SPEC may not set: the sweep chooses them
 _RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
-#: keyword options of a run that are not parameters of a sweep (no table column): the stroboscopic
-#: observer only reads a run (its columns are measure columns, empty where it was off)
-_NOT_SWEPT = ("stroboscopic",)
+#: keyword options of a run that are not parameters of a sweep by default (no table column unless a
+#: SPEC sets them) and not part of the run identity, with their defaults: the stroboscopic observer
+#: only reads a run (its columns are measure columns, empty where it was off).  A SPEC may set them
+#: in [parameters], [grid] or [[zip]]; a SPEC that does gets a column of that name and the run ids
+#: of the same SPEC without it.
+_NOT_SWEPT = {"stroboscopic": False}
 #: most parameter points of one SPEC: each is validated before any work (≈ 0.1 ms a point)
 MAX_POINTS = 10_000
 #: most runs of one SPEC (points × repetitions); runs are enumerated lazily, never held all at once
@@ -425,7 +431,7 @@ def _parse_spec(doc, source):
         if table not in SPEC_TABLES:
             raise ValueError(f"SPEC table [{cut_text(str(table))}] is unknown: allowed {', '.join(SPEC_TABLES)}")
     from ..run.guard import PARAMETER_ALIASES
-    known = sweep_parameter_defaults(protocols=True)
+    known = dict(sweep_parameter_defaults(protocols=True), **_NOT_SWEPT)
     seen = {}
 
     def claim(name, where):
