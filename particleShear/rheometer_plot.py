@@ -134,8 +134,9 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ra
         Relaxation modulus G(t) = (σ(t) − σ_res)/γ₀ in Pa, same length as ``t``.
     G_err : array_like, optional
         Error bars of ``G`` in Pa: for the curves of a run, the within-bin spread of
-        :func:`~particleShear.analysis.rheometry.log_grid` (std/√n of correlated samples: a
-        spread, not an independent error; 0 for a bin of one sample), said in the legend.
+        :func:`~particleShear.analysis.rheometry.log_grid` about the bin's trend (std/√n of
+        correlated samples: a spread, not an independent error; NaN, drawn without a bar, for a
+        bin of fewer than 3 samples), said in the legend.
     plateau : tuple of float, optional
         (value, error) of the plateau modulus in Pa, drawn as a horizontal band.
     ramp : float, optional
@@ -161,7 +162,12 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ra
     """
     t = _series("t", t)
     G = _series("G", G, len(t))
-    err = None if G_err is None else _series("G_err", G_err, len(t))
+    err = None
+    if G_err is not None:     # NaN: a bin without a spread (fewer than 3 samples), drawn without a bar
+        err = np.asarray(G_err, dtype=float).reshape(-1)
+        if len(err) != len(t) or np.any(np.isinf(err)) or np.any(err < 0):
+            raise ValueError(f"G_err is invalid: allowed {len(t)} numbers >= 0 or NaN (no spread), one per time")
+        err = np.nan_to_num(err, nan=0.0)
     if plateau is not None:
         plateau = _series("plateau", plateau, 2)
     if path is not None:
@@ -170,8 +176,8 @@ def plot_relaxation(t, G, G_err=None, plateau=None, path=None, *, title=None, ra
     fig = _figure(6.0, 4.0)
     ax = fig.subplots()
     ax.errorbar(t[keep], G[keep], yerr=None if err is None else err[keep], fmt="o",
-                label="G(t)" if err is None else "G(t): log-time bin means; bars: the samples' spread\n"
-                "in the bin (std/√n of correlated samples, 0 for one)")
+                label="G(t)" if err is None else "G(t): log-time bin means; bars: the samples' spread about\n"
+                "the bin's trend (std/√n; none for fewer than 3 samples)")
     if plateau is not None:
         v, e = plateau
         ax.axhspan(v - e, v + e, alpha=0.3, color="grey", label=f"plateau {v:.3g} ± {e:.3g} Pa", gid="plateau")

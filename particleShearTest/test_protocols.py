@@ -153,6 +153,25 @@ class TestRheometryStatistics(unittest.TestCase):
         np.testing.assert_allclose(ym, tm ** -0.5, rtol=0.01)
         self.assertEqual(count.sum(), 100000)
 
+    def test_log_grid_spread_is_scatter_not_the_curves_fall(self):
+        # a steeply falling curve without noise: the spread about each bin's trend in log t is only the
+        # curvature left in a tenth of a decade (< 1 % of the value), at most half of std/√n
+        t = np.linspace(1e-3, 10, 20000)
+        y = np.exp(-t)
+        tm, ym, sem, count = log_grid(t, y)
+        many = count >= 3
+        self.assertTrue(np.all(sem[many] < 1e-2 * np.abs(ym[many])))
+        k = np.floor(np.log10(t / t[0]) * 10 + 1e-12).astype(int)
+        naive = np.array([y[k == b].std(ddof=1) / np.sqrt((k == b).sum()) for b in np.unique(k)])
+        self.assertTrue(np.all(sem[many] <= 0.5 * naive[many]))
+        self.assertTrue(np.all(np.isnan(sem[~many])))           # no spread from fewer than 3 samples
+        # white noise of σ = 0.01 on a flat curve: sem ≈ σ/√count (the residual's n − 2 degrees of freedom)
+        y = 1.0 + np.random.default_rng(5).normal(scale=0.01, size=t.size)
+        _, _, sem, count = log_grid(t, y)
+        big = count >= 200
+        ratio = sem[big] * np.sqrt(count[big]) / 0.01
+        self.assertLess(abs(np.mean(ratio) - 1), 0.1)
+
     def test_final_rate_of_a_ramp(self):
         t = np.linspace(0, 10, 5000)
         y = 3.0 * t + np.random.default_rng(4).normal(scale=0.01, size=t.size)

@@ -158,8 +158,9 @@ def log_grid(t, y, n_per_decade=10, t_min=None):
     """Bin averages of ``y`` on log-spaced bins of ``t`` > 0 (empty bins dropped).
 
     Bin edges ``t_min·10^(k/n_per_decade)``; each bin gives the geometric mean of its times, the
-    mean of its values and their standard error ``std/√count`` (the within-bin scatter: the
-    samples of a bin are correlated, so read it as a spread, not an independent error).
+    mean of its values and the standard error of its samples about the bin's own linear trend in
+    log t (the within-bin scatter with the curve's fall across the bin removed; the samples of a
+    bin are correlated, so read it as a spread, not an independent error).
 
     Parameters
     ----------
@@ -173,7 +174,8 @@ def log_grid(t, y, n_per_decade=10, t_min=None):
     Returns
     -------
     t_mid, y_mean, y_sem : ndarray (m,)
-        Geometric-mean time, mean and standard error of each non-empty bin (sem 0 for one sample).
+        Geometric-mean time, mean, and the standard error of the bin's samples about its own
+        linear trend in log t (NaN for bins of fewer than 3 samples: no spread to tell).
     count : ndarray of int (m,)
         Samples per bin.
 
@@ -201,9 +203,16 @@ def log_grid(t, y, n_per_decade=10, t_min=None):
     k = np.floor(np.log10(tt / t_min) * n_per_decade + 1e-12).astype(int)
     bins, inv, count = np.unique(k, return_inverse=True, return_counts=True)
     mean = np.bincount(inv, a) / count
+    # the spread about each bin's own linear trend in log t: a curve that falls steeply across a
+    # bin (G(t) right after the ramp) is a trend, not scatter; fewer than 3 samples have no spread
+    x = np.log(tt)
+    dx = x - (np.bincount(inv, x) / count)[inv]
     dev = a - mean[inv]
-    var = np.bincount(inv, dev * dev) / np.maximum(count - 1, 1)
-    sem = np.where(count > 1, np.sqrt(var / count), 0.0)
+    sxx = np.bincount(inv, dx * dx)
+    slope = np.where(sxx > 0, np.bincount(inv, dx * dev) / np.where(sxx > 0, sxx, 1.0), 0.0)
+    res = dev - slope[inv] * dx
+    var = np.bincount(inv, res * res) / np.maximum(count - 2, 1)
+    sem = np.where(count > 2, np.sqrt(var / count), np.nan)
     t_mid = np.exp(np.bincount(inv, np.log(tt)) / count)
     return t_mid, mean, sem, count
 
