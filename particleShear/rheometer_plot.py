@@ -520,8 +520,10 @@ def plot_flow_curve_sweep(folder_or_csv, estimator="surface", path=None, n_boot=
         check_figure_path(path, "path")
     fig = plot_flow_curve(rate[keep], mean[keep], np.nan_to_num(sem[keep]), fit=fc.fit)
     lo, hi = fc.intervals["sigma_y"]
-    fig.axes[0].set_title(f"{estimator} stress, {stress.shape[1]} seed(s); σ_y {100 * confidence:g} % interval "
-                          f"[{lo:.3g}, {hi:.3g}] Pa", fontsize="small")
+    Ns = sorted({int(r["N"]) for r in table if r.get("N") is not None and str(r.get("status")) == "ok"})
+    N = (Ns[0] if len(Ns) == 1 else (Ns[0], Ns[-1])) if Ns else None
+    fig.axes[0].set_title(f"flow curve: {made_by(N=N, seeds=stress.shape[1], estimator=estimator)}; σ_y "
+                          f"{100 * confidence:g} % interval [{lo:.3g}, {hi:.3g}] Pa", fontsize="small")
     fig.set_label("flow_curve")
     if path not in (None, False):      # written with its title
         save_figure(fig, path)
