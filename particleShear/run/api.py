@@ -13,7 +13,7 @@ every call (per process) or returned directly with ``return_result=True``.
 import numpy as np
 
 from ..messages import console_messages
-from ..parameters import EXTRA
+from ..parameters import BY_NAME, EXTRA
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, validate_run, validate_series
@@ -94,6 +94,10 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     theSimulation.stability_guard = bool(stability_guard)
 
     return theSimulation
+
+
+#: the defaults of the contact laws' parameters outside the signature (``**law_parameters``)
+_EXTRA_DEFAULTS = {name: BY_NAME[name].default for name in EXTRA}
 
 
 @checked_keywords(aliases=PARAMETER_ALIASES, hints=PARAMETER_HINTS, extra=EXTRA)
@@ -391,7 +395,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                    total_strain=total_strain, ramp_time=ramp_time, hold_time=hold_time, creep_stress=creep_stress,
                    creep_modulus=creep_modulus, creep_response_time=creep_response_time,
                    sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies,
-                   stroboscopic=stroboscopic, **law_parameters)
+                   stroboscopic=stroboscopic, **dict(_EXTRA_DEFAULTS, **law_parameters))
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
