@@ -1,8 +1,7 @@
 """The plateau law of spongy particles: the linear law of a plateau-transformed distance.
 
 ``linear(dp, d0, k, c)`` with ``dp`` the distance flattened between ``plateau_begin·d0`` and
-``plateau_end·d0`` by the factor ``plateau_slope`` (the manual's ``elastic_force_law_plateau``;
-MODEL_SPEC §2.12).  The arithmetic is :func:`particleShear.engine.laws.plateau_law` (shared with
+``plateau_end·d0`` by the factor ``plateau_slope`` (the manual's ``elastic_force_law_plateau``).  The arithmetic is :func:`particleShear.engine.laws.plateau_law` (shared with
 the documented callback ``elastic_force_law_plateau``), evaluated by the engine from constants
 prepared once per candidate set.  Its parameters are keywords of ``doParticleShearSimulation``'s
 signature (``SIGNATURE``), as in 2.0.0.
@@ -25,7 +24,7 @@ PARAMETERS = (
 
 
 def plateau(d, d0, r_i, r_j, k, c, plateau_begin, plateau_end, plateau_slope):
-    """Linear law of the plateau-transformed distance (MODEL_SPEC §2.12): :func:`~particleShear.engine.laws.plateau_law`.
+    """Linear law of the plateau-transformed distance (the manual's plateau law): :func:`~particleShear.engine.laws.plateau_law`.
 
     Parameters
     ----------
