@@ -1,8 +1,11 @@
 """The parameters of a run as data: one table, read by everything that needs them.
 
 Each :class:`Parameter` of :data:`PARAMETERS` holds a keyword of
-:func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order): its default,
-type, unit, allowed range, role and a one-line description.  The signature and the docstring of
+:func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order, then the contact
+laws' parameters outside the signature, :data:`EXTRA`): its default, type, unit, allowed range,
+role and a one-line description.  The contact laws declare their parameters in their own files
+(:mod:`particleShear.engine.contact_laws`); the table is the base entries written here composed
+with every discovered law's (the plateau law's after ``contact_law``, as in the signature).  The signature and the docstring of
 ``doParticleShearSimulation`` keep particleShear 1.0.2's order, names and defaults; the suite checks
 them against this table, never the other way round (particleShearTest/test_parameter_table.py).
 What is derived from it: the range checks of the validation (:mod:`particleShear.run.validation`),

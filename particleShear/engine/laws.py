@@ -1,20 +1,22 @@
-"""The contact laws, written once, and their registry: the one place to add a law.
+"""The arithmetic of the package's laws, written once, and the law registry.
 
-A *central law* is a pure function ``law(d, d0, k, c, *parameters)`` of arrays (centre distance
-``d`` and contact distance ``d0`` in µm, spring constant ``k``, repulsion coefficient ``c``, and
-the law's own parameters, one value per pair or one number): the central force on i along
-``n_ij`` as if the pair were in contact (negative = repulsion, mg·µm·s⁻² per m depth).  The
-caller applies the cut-off: 0 beyond contact for a contact, the tensile law beyond ``d_eq`` for
-a bond.  A *tensile law* ``law(d, d_eq, k)`` is the force of a stretched bond (positive attracts).
-:func:`register_law` adds a law under a name (:data:`LAWS`); ``contact_law=<name>`` of a run
-selects it (docs/design.md, "Adding a contact law").  Built in:
+A *central law* is a pure function of arrays: the central force on i along ``n_ij`` as if the
+pair were in contact (negative = repulsion, mg·µm·s⁻² per m depth).  The laws of the laws folder
+(:mod:`particleShear.engine.contact_laws`, one file each: ``linear``, ``plateau``, ``hertz``) take
+``(d, d0, r_i, r_j, k, c, *parameters)`` (centre distance, contact distance and radii in µm,
+spring constant ``k``, repulsion coefficient ``c``, the law's own parameters, one value per pair or
+one number); a law :func:`register_law` adds at run time may take ``(d, d0, k, c, *parameters)``.
+The caller applies the cut-off: 0 beyond contact for a contact, the tensile law beyond ``d_eq``
+for a bond.  A *tensile law* ``law(d, d_eq, k)`` is the force of a stretched bond (positive
+attracts).  :data:`LAWS` holds the laws by name; ``contact_law=<name>`` of a run selects one
+(docs/design.md, "Adding a contact law").  Written here, shared by the laws' files and the
+documented callbacks of :mod:`particleShear.base.laws`:
 
-* ``"linear"`` (:func:`linear_law`): the blend of the linear (eq. S1-5a) and divergent (eq.
-  S1-5b) law with the cap of eq. S1-6 — the default;
-* ``"plateau"`` (:func:`plateau_law`): the same law of a plateau-transformed distance
-  (:func:`plateau_distance`), the spongy particles of the manual (parameters ``plateau_begin``,
-  ``plateau_end``, ``plateau_slope``: 0.3, 0.8, 0.1);
-* ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``): the linear tensile law of bonds.
+* :func:`linear_law`: the blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law with the
+  cap of eq. S1-6 — the law of ``contact_laws/linear.py``, the default;
+* :func:`plateau_law`: the same law of a plateau-transformed distance (:func:`plateau_distance`),
+  the spongy particles of the manual — the law of ``contact_laws/plateau.py``;
+* ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``, registered here): the linear tensile law of bonds.
 
 The documented callbacks of particleShear 1.0.2 (``CircleBasicElasticity.call_back_elastic_force_law``,
 ``SphereLinkable.call_back_elastic_force_law_tensile``) keep working: the engine looks them up
