@@ -133,5 +133,29 @@ class TestHertzRuns(unittest.TestCase):
         self.assertIn("--hertz-scale=0.0 is out of range: allowed 0 < value <= 1000", err)
 
 
+class TestUserLawByModulePath(unittest.TestCase):
+    """``contact_law="package.module:function"``: a law outside the package, imported where it is used."""
+
+    def test_module_function_runs_as_its_law(self):
+        import pathlib
+        import sys
+        import tempfile
+        import warnings
+        tmp = tempfile.mkdtemp(prefix="ps_userlaw_")
+        pathlib.Path(tmp, "ps_user_law_45.py").write_text(
+            "from particleShear.engine.contact_laws.hertz import hertz as _h\n"
+            "def doubled(d, d0, r_i, r_j, k, c):\n"
+            "    return _h(d, d0, r_i, r_j, k, c, 0.1)\n", encoding="utf-8")
+        sys.path.insert(0, tmp)
+        self.addCleanup(sys.path.remove, tmp)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            user = doParticleShearSimulation(**QUICK, contact_law="ps_user_law_45:doubled", return_result=True)
+            ref = doParticleShearSimulation(**QUICK, contact_law="hertz", hertz_scale=0.1, return_result=True)
+        self.assertEqual(user.G, ref.G)          # the same force law
+        with self.assertRaisesRegex(ValueError, "contact_law='no_such_module_45:f' is invalid: cannot import it"):
+            doParticleShearSimulation(**QUICK, contact_law="no_such_module_45:f")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -561,8 +561,17 @@ def _import_law(spec, what):
     if isinstance(own, ContactLaw) and own.function is function:
         LAWS[spec] = own
         return own
-    return register_law(spec, function, getattr(module, "PARAMETERS", None), radii=True,
-                        check=getattr(module, "check", None), replace=True)
+    if not callable(function):
+        raise ValueError(f"{what}={spec!r} is invalid: {attr!r} of {module_name} is not callable")
+    declared = tuple(getattr(module, "PARAMETERS", ()) or ())
+    parameters = {p.name: p.default for p in declared}
+    try:
+        function.accepts_arrays = True
+    except (AttributeError, TypeError):
+        pass
+    LAWS[spec] = law = ContactLaw(spec, function, parameters, "central", getattr(module, "check", None),
+                                  radii=True, declared=declared)
+    return law
 
 
 def law_values(law, given=None):
