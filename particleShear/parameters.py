@@ -1,8 +1,11 @@
 """The parameters of a run as data: one table, read by everything that needs them.
 
 Each :class:`Parameter` of :data:`PARAMETERS` holds a keyword of
-:func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order): its default,
-type, unit, allowed range, role and a one-line description.  The signature and the docstring of
+:func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order, then the contact
+laws' parameters outside the signature, :data:`EXTRA`): its default, type, unit, allowed range,
+role and a one-line description.  The contact laws declare their parameters in their own files
+(:mod:`particleShear.engine.contact_laws`); the table is the base entries written here composed
+with every discovered law's (the plateau law's after ``contact_law``, as in the signature).  The signature and the docstring of
 ``doParticleShearSimulation`` keep particleShear 1.0.2's order, names and defaults; the suite checks
 them against this table, never the other way round (particleShearTest/test_parameter_table.py).
 What is derived from it: the range checks of the validation (:mod:`particleShear.run.validation`),
@@ -38,92 +41,17 @@ __docformat__ = "numpy"
 import dataclasses
 import math
 
-__all__ = ["Parameter", "PARAMETERS", "BY_NAME", "ROLES", "KINDS", "defaults", "names", "law_parameters",
+from .engine.contact_laws import declared_parameters
+from .parameter_entry import KINDS, ROLES, Parameter
+
+__all__ = ["Parameter", "PARAMETERS", "SIGNATURE", "EXTRA", "BY_NAME", "ROLES", "KINDS", "defaults", "names", "law_parameters",
            "protocol_parameters", "identity_excluded"]
 
-#: the roles of a parameter (module docstring); ``law:<name>`` and ``protocol:<a>,<b>`` carry names
-ROLES = ("model", "law", "protocol", "numerics", "output", "display", "call", "observer")
-#: the value types: ``float``, ``int``, ``bool``, ``str`` (with ``choices``), ``float_list``, ``seed``
-#: (None, an integer, a SeedSequence or a Generator), ``path``, ``callable``
-KINDS = ("float", "int", "bool", "str", "float_list", "seed", "path", "callable")
+#: the contact laws of the laws folder: name → (their declared parameters, in the signature or not)
+_LAWS = declared_parameters()
 
-
-@dataclasses.dataclass(frozen=True)
-class Parameter:
-    """One keyword of ``doParticleShearSimulation`` (module docstring).
-
-    Parameters
-    ----------
-    name : str
-        The keyword (1.0.2's name).
-    default : object
-        Its default.
-    kind : str
-        One of :data:`KINDS`.
-    unit : str, default ""
-        Unit of a number ("1" dimensionless, "" for the other kinds and the integers).
-    low, high : float or None, default None
-        Allowed range of a number (None: no limit here; limits that depend on other parameters —
-        ``N``, ``cut_lines``, the steps per period — are the validation's).
-    low_open, high_open : bool, default False
-        The limit itself is excluded.
-    choices : tuple of str or None, default None
-        The allowed values of a ``str`` parameter.
-    role : str, default "model"
-        One of :data:`ROLES`, with ``:<names>`` for a law's or a protocol's own parameters.
-    batch : {"replica", "schedule", "shared"}, default "replica"
-        How runs that differ in it share a batch (module docstring).
-    keyword_only : bool, default False
-        Keyword-only in the signature (the options added after 1.0.2).
-    nullable : bool, default False
-        None is a value (its default, meaning "derived" or "required by its protocol").
-    doc : str, default ""
-        One line: what it is, with units.
-    since : str, default ""
-        The version that added it ("" for the parameters of 2.0.0).  A parameter added later is
-        in a run's identity only when it differs from its default, so the runs of a folder written
-        before it existed keep their ids (and a missing column of it means its default).
-    """
-
-    name: str
-    default: object
-    kind: str
-    unit: str = ""
-    low: object = None
-    high: object = None
-    low_open: bool = False
-    high_open: bool = False
-    choices: object = None
-    role: str = "model"
-    batch: str = "replica"
-    keyword_only: bool = False
-    nullable: bool = False
-    doc: str = ""
-    since: str = ""
-
-    @property
-    def base_role(self):
-        """The role without its names (``"protocol:creep"`` → ``"protocol"``)."""
-        return self.role.partition(":")[0]
-
-    @property
-    def role_names(self):
-        """The names after the role's colon (``"protocol:relaxation,creep"`` → ``("relaxation", "creep")``)."""
-        return tuple(n for n in self.role.partition(":")[2].split(",") if n)
-
-    @property
-    def has_range(self):
-        """True when the table states a range (``low`` or ``high``)."""
-        return self.low is not None or self.high is not None
-
-    def range_text(self):
-        """The allowed range in the one wording of every range message (:func:`particleShear.checks.range_text`)."""
-        from .checks import range_text
-        return range_text(self.low, self.high, self.low_open, self.high_open)
-
-
-#: every keyword of ``doParticleShearSimulation``, in signature order
-PARAMETERS = (
+#: the entries written here; the laws' parameters are composed into :data:`PARAMETERS` below
+_BASE = (
     Parameter('root_folder', '', 'path', role='call', doc='Output folder (path) of the text file and of the image folder'),
     Parameter('theAmplitude', 0.2, 'float', unit='1', low=0, high=100, low_open=True, doc='Strain amplitude A, dimensionless (0.2 = 20 %)'),
     Parameter('theMu', 0.01, 'float', unit='1', low=0, high=1000000.0, doc='Coulomb friction coefficient μ of transient contacts, dimensionless'),
@@ -172,10 +100,7 @@ PARAMETERS = (
     Parameter('output_format', 'text', 'str', choices=('text', 'text.gz', 'npz', 'parquet'), role='output', batch='shared', keyword_only=True, doc='File format of ``saveData``: the reference text, the same gzip-compressed, NumPy .npz, or Parquet (needs particleShear[parquet]); read any with :func:`particleShear.read_run` (docs/output.md)'),
     Parameter('strict_io', False, 'bool', role='call', batch='shared', keyword_only=True, doc='Raise the ``OSError`` of a failed write after the run; False: return the result with ``write_error`` set (``last_result`` holds it either way)'),
     Parameter('backend', 'numpy', 'str', choices=('numpy', 'cupy'), role='numerics', batch='shared', keyword_only=True, doc='Array library of the measurement: "numpy", or "cupy" to measure on a CUDA GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for bit)'),
-    Parameter('contact_law', 'linear', 'str', choices=('linear', 'plateau'), role='law', batch='shared', keyword_only=True, doc='Central contact law, a name of the registry :data:`particleShear.engine.laws.LAWS` (laws added with ``register_law`` are allowed too): "linear" the blend of eqs'),
-    Parameter('plateau_begin', 0.3, 'float', unit='contact distance', role='law:plateau', keyword_only=True, doc='Begin of the plateau of ``contact_law="plateau"``, a fraction of the contact distance; allowed 0 < plateau_begin < plateau_end'),
-    Parameter('plateau_end', 0.8, 'float', unit='contact distance', role='law:plateau', keyword_only=True, doc='End of the plateau, a fraction of the contact distance; allowed plateau_begin < plateau_end <= 1'),
-    Parameter('plateau_slope', 0.1, 'float', unit='1', role='law:plateau', keyword_only=True, doc="Slope of the force on the plateau relative to the law's (0 flat, 1 no plateau); allowed 0 ... 1"),
+    Parameter('contact_law', 'linear', 'str', choices=tuple(_LAWS), role='law', batch='shared', keyword_only=True, doc='Central contact law, a law of the folder particleShear/engine/contact_laws (its parameters follow it in this table), a law added with ``register_law``, or ``"package.module:function"``: "linear" the blend of eqs'),
     Parameter('protocol', 'oscillatory', 'str', choices=('oscillatory', 'steady', 'relaxation', 'creep', 'amplitude_sweep', 'frequency_sweep'), role='protocol', batch='shared', keyword_only=True, doc="What the rheometer does after the pre-equilibration (docs/protocols.md): the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude`` and hold; a constant applied stress; or, on one packing, the oscillation at each of ``sweep_amplitudes`` or ``sweep_frequencies`` in turn"),
     Parameter('relative_rate', 0.01, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: shear rate γ̇·τ, dimensionless like ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant); allowed > 0 with at most 0.005 strain per time step'),
     Parameter('total_strain', 2.0, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: strain sheared in all; allowed 0 < value <= 1e6'),
@@ -188,6 +113,27 @@ PARAMETERS = (
     Parameter('sweep_frequencies', None, 'float_list', unit='1', role='protocol:frequency_sweep', batch='shared', keyword_only=True, nullable=True, doc='``protocol="frequency_sweep"`` (required there): the relative frequencies f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first'),
     Parameter('stroboscopic', False, 'bool', role='observer', keyword_only=True, doc='Watch the oscillatory protocol with the stroboscopic observer (:class:`particleShear.engine.microstructure.Stroboscope`): a snapshot at the start of every shear period; per cycle the non-affine displacement, D²_min, contacts made and broken, Z without rattlers and P(f/⟨f⟩) in ``result.microstructure`` and the per-run columns ``irreversibility``, ``moved_fraction``, ``Z_rattler_free``, ``rattler_fraction``, ``contact_change_rate`` in ``result.measures`` (docs/microstructure.md)'),
 )
+
+
+
+def _compose(base, laws):
+    """The base entries with every law's parameters: those of a law in the signature (the plateau
+    law) right after ``contact_law``, the others (``extra``) after the base entries."""
+    signature = [p for params, in_signature in laws.values() if in_signature for p in params]
+    extra = [dataclasses.replace(p, keyword_only=True, extra=True)
+             for params, in_signature in laws.values() if not in_signature for p in params]
+    at = [p.name for p in base].index("contact_law") + 1
+    return tuple(base[:at]) + tuple(dataclasses.replace(p, keyword_only=True) for p in signature) \
+        + tuple(base[at:]) + tuple(extra)
+
+
+#: every parameter of a run: the keywords of ``doParticleShearSimulation`` in signature order, then the
+#: parameters of the contact laws that are not in its signature (``extra``: its ``**law_parameters``)
+PARAMETERS = _compose(_BASE, _LAWS)
+#: the keywords of ``doParticleShearSimulation``'s signature, in its order
+SIGNATURE = tuple(p for p in PARAMETERS if not p.extra)
+#: the parameters of contact laws outside the signature (taken by ``**law_parameters``)
+EXTRA = tuple(p.name for p in PARAMETERS if p.extra)
 
 #: name → :class:`Parameter`
 BY_NAME = {p.name: p for p in PARAMETERS}

@@ -30,7 +30,12 @@ import particleShear
 DOCUMENTED_MODULES = [
     "particleShear",
     "particleShear.checks",
+    "particleShear.parameter_entry",
     "particleShear.parameters",
+    "particleShear.engine.contact_laws",
+    "particleShear.engine.contact_laws.linear",
+    "particleShear.engine.contact_laws.plateau",
+    "particleShear.engine.contact_laws.hertz",
     "particleShear.analysis",
     "particleShear.analysis.curves",
     "particleShear.analysis.demodulation",

@@ -22,8 +22,12 @@ PACKAGE = pathlib.Path(P.__file__).resolve().parent
 class TestSignatureAndDocstring(unittest.TestCase):
     def test_signature_is_the_table(self):
         sig = inspect.signature(doParticleShearSimulation)
-        self.assertEqual(list(sig.parameters), [p.name for p in P.PARAMETERS])
-        for p in P.PARAMETERS:
+        named = [n for n, par in sig.parameters.items() if par.kind is not par.VAR_KEYWORD]
+        self.assertEqual(named, [p.name for p in P.SIGNATURE])
+        # the contact laws' other parameters: the table's ``extra`` ones, after the signature's
+        self.assertEqual(list(P.PARAMETERS), list(P.SIGNATURE) + [P.BY_NAME[n] for n in P.EXTRA])
+        self.assertIn("hertz_scale", P.EXTRA)
+        for p in P.SIGNATURE:
             par = sig.parameters[p.name]
             with self.subTest(name=p.name):
                 self.assertEqual(par.default, p.default)
@@ -35,8 +39,8 @@ class TestSignatureAndDocstring(unittest.TestCase):
 
     def test_docstring_documents_the_table(self):
         docs = parameter_docs(doParticleShearSimulation)
-        self.assertEqual([n for n in docs if n in P.BY_NAME], [p.name for p in P.PARAMETERS])
-        for p in P.PARAMETERS:
+        self.assertEqual([n for n in docs if n in P.BY_NAME], [p.name for p in P.SIGNATURE])
+        for p in P.SIGNATURE:
             type_text, text = docs[p.name]
             with self.subTest(name=p.name):
                 self.assertIn("default", type_text)
@@ -80,8 +84,9 @@ class TestDerived(unittest.TestCase):
         self.assertEqual(P.BY_NAME["integrator"].choices, tuple(BatchEngine.INTEGRATORS))
         self.assertEqual(P.BY_NAME["backend"].choices, tuple(BACKENDS))
         self.assertEqual(P.BY_NAME["output_format"].choices, tuple(OUTPUT_FORMATS))
-        central = {n for n, law in LAWS.items() if law.kind == "central" and n in ("linear", "plateau")}
-        self.assertEqual(set(P.BY_NAME["contact_law"].choices), central)      # the shipped central laws
+        from particleShear.engine.contact_laws import MODULES
+        self.assertEqual(P.BY_NAME["contact_law"].choices, tuple(MODULES))     # the laws of the laws folder
+        self.assertEqual(P.BY_NAME["contact_law"].choices[:3], ("linear", "plateau", "hertz"))
         for law in P.BY_NAME["contact_law"].choices:       # each law's parameters are the table's
             self.assertEqual(tuple(LAWS[law].parameters or ()), P.law_parameters(law))
 
@@ -201,10 +206,14 @@ class TestFolderOf200(unittest.TestCase):
             warnings.simplefilter("ignore")
             rows = run_sweep(self.spec, str(self.folder), workers=1, progress=False)
         after = self.rows()
-        self.assertEqual(list(after[0]), header)
+        # the parameters of laws added since 2.0.0 (hertz_scale) are added as columns at their defaults
+        self.assertEqual([c for c in after[0] if c not in P.EXTRA], header)
+        self.assertEqual(set(after[0]) - set(header), set(P.EXTRA))
         self.assertEqual(len(after), len(before))                 # nothing ran again
         self.assertEqual(sorted(r["run_id"] for r in rows), sorted(r["run_id"] for r in before))
         for a, b in zip(after, before):
             self.assertEqual({c: a[c] for c in kept}, {c: b[c] for c in kept})
             self.assertEqual(a["plateau_slope"], repr(P.BY_NAME["plateau_slope"].default))
             self.assertEqual(a["verdict"], "")
+            for name in P.EXTRA:
+                self.assertEqual(a[name], repr(P.BY_NAME[name].default))

@@ -72,7 +72,8 @@ def reference_min_image(dx, dy, Lx, Ly, shift):
 
 def defaults(**changes):
     """The full argument dict of ``doParticleShearSimulation`` (defaults) with ``changes``."""
-    p = {k: v.default for k, v in inspect.signature(doParticleShearSimulation).parameters.items()}
+    p = {k: v.default for k, v in inspect.signature(doParticleShearSimulation).parameters.items()
+         if v.kind is not v.VAR_KEYWORD}
     p.update(QUIET)
     p.update(changes)
     return p

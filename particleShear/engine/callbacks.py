@@ -18,7 +18,7 @@ import weakref
 
 import numpy as np
 
-from .laws import LAWS, law_values
+from .contact_laws import LAWS, get_law, law_values
 from .xp import array_namespace, to_host
 
 __all__ = ["register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks", "hold_callbacks"]
@@ -230,10 +230,10 @@ def force_phase_laws(s, C):
         return None, None           # the default: both laws from the prepared constants
     central = None
     if s.law is not None:
-        law = LAWS[s.law]
+        law = get_law(s.law)
         if law.name != "linear" or law.parameters:
             central = _prepared(law, C, (law.name, id(s.law_params)),
-                                lambda: (C.d_law, C.k, C.c) + tuple(s.law_params[:, C.rep]))
+                                lambda: _law_arguments(law, C) + tuple(s.law_params[:, C.rep]))
     elif not builtin_c:
         found = callback_law(compressive)
         if found is None:
@@ -241,7 +241,7 @@ def force_phase_laws(s, C):
             central = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
         elif found[0].name != "linear":
             law, values = found
-            central = _prepared(law, C, (law.name, values), lambda: (C.d_law, C.k, C.c) + values)
+            central = _prepared(law, C, (law.name, values), lambda: _law_arguments(law, C) + values)
     tensile = None
     if not builtin_t:
         found = callback_law(stretched)
@@ -251,10 +251,16 @@ def force_phase_laws(s, C):
     return central, tensile
 
 
+def _law_arguments(law, C):
+    """The arguments of a central law after ``d`` and before its own parameters, per candidate:
+    ``(d0, r_i, r_j, k, c)`` for a law of the laws folder (``law.radii``), else ``(d0, k, c)``."""
+    return (C.d_law, C.ri, C.rj, C.k, C.c) if law.radii else (C.d_law, C.k, C.c)
+
+
 def _prepared(law, C, key, arguments):
     """``law`` as a function of ``d`` on the candidates ``C``: ``inside(d, *constants)`` with the
     constants kept with ``C`` under ``key`` when the law is prepared, else ``function(d, *arguments())``
-    (``arguments()``: ``(d0, k, c, *parameters)`` per candidate)."""
+    (``arguments()``: :func:`_law_arguments` and the law's parameters, per candidate)."""
     if law.prepared is None:
         args = _cached(C, key, arguments)
         return lambda d: law.function(d, *args)

@@ -275,7 +275,7 @@ class PairConstants:
 class VisitConstants(TermConstants):
     """The :class:`~particleShear.engine.terms.TermConstants` of one visit of a batch's candidates,
     with what the laws of a force phase read besides them (:func:`~particleShear.engine.callbacks.force_phase_laws`):
-    the candidates' bonds and replicas, and a place for their prepared law arguments.
+    the candidates' bonds, replicas and radii, and a place for their prepared law arguments.
 
     Parameters
     ----------
@@ -287,7 +287,7 @@ class VisitConstants(TermConstants):
 
     def __init__(self, K, C):
         TermConstants.__init__(self, **{name: getattr(K, name) for name in TermConstants.__slots__})
-        self.perm, self.rep = C.perm, C.rep
+        self.perm, self.rep, self.ri, self.rj = C.perm, C.rep, C.ri, C.rj
 
 
 def splice_arrays(old, new, segments):

@@ -1,20 +1,22 @@
-"""The contact laws, written once, and their registry: the one place to add a law.
+"""The arithmetic of the package's laws, written once, and the law registry.
 
-A *central law* is a pure function ``law(d, d0, k, c, *parameters)`` of arrays (centre distance
-``d`` and contact distance ``d0`` in µm, spring constant ``k``, repulsion coefficient ``c``, and
-the law's own parameters, one value per pair or one number): the central force on i along
-``n_ij`` as if the pair were in contact (negative = repulsion, mg·µm·s⁻² per m depth).  The
-caller applies the cut-off: 0 beyond contact for a contact, the tensile law beyond ``d_eq`` for
-a bond.  A *tensile law* ``law(d, d_eq, k)`` is the force of a stretched bond (positive attracts).
-:func:`register_law` adds a law under a name (:data:`LAWS`); ``contact_law=<name>`` of a run
-selects it (docs/design.md, "Adding a contact law").  Built in:
+A *central law* is a pure function of arrays: the central force on i along ``n_ij`` as if the
+pair were in contact (negative = repulsion, mg·µm·s⁻² per m depth).  The laws of the laws folder
+(:mod:`particleShear.engine.contact_laws`, one file each: ``linear``, ``plateau``, ``hertz``) take
+``(d, d0, r_i, r_j, k, c, *parameters)`` (centre distance, contact distance and radii in µm,
+spring constant ``k``, repulsion coefficient ``c``, the law's own parameters, one value per pair or
+one number); a law :func:`register_law` adds at run time may take ``(d, d0, k, c, *parameters)``.
+The caller applies the cut-off: 0 beyond contact for a contact, the tensile law beyond ``d_eq``
+for a bond.  A *tensile law* ``law(d, d_eq, k)`` is the force of a stretched bond (positive
+attracts).  :data:`LAWS` holds the laws by name; ``contact_law=<name>`` of a run selects one
+(docs/design.md, "Adding a contact law").  Written here, shared by the laws' files and the
+documented callbacks of :mod:`particleShear.base.laws`:
 
-* ``"linear"`` (:func:`linear_law`): the blend of the linear (eq. S1-5a) and divergent (eq.
-  S1-5b) law with the cap of eq. S1-6 — the default;
-* ``"plateau"`` (:func:`plateau_law`): the same law of a plateau-transformed distance
-  (:func:`plateau_distance`), the spongy particles of the manual (parameters ``plateau_begin``,
-  ``plateau_end``, ``plateau_slope``: 0.3, 0.8, 0.1);
-* ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``): the linear tensile law of bonds.
+* :func:`linear_law`: the blend of the linear (eq. S1-5a) and divergent (eq. S1-5b) law with the
+  cap of eq. S1-6 — the law of ``contact_laws/linear.py``, the default;
+* :func:`plateau_law`: the same law of a plateau-transformed distance (:func:`plateau_distance`),
+  the spongy particles of the manual — the law of ``contact_laws/plateau.py``;
+* ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``, registered here): the linear tensile law of bonds.
 
 The documented callbacks of particleShear 1.0.2 (``CircleBasicElasticity.call_back_elastic_force_law``,
 ``SphereLinkable.call_back_elastic_force_law_tensile``) keep working: the engine looks them up
@@ -33,9 +35,11 @@ mg·µm·s⁻² per m depth; negative = repulsion.
 __docformat__ = "numpy"
 
 import difflib
+import importlib
 import math
 import numbers
 
+from ..checks import in_range
 from .xp import array_namespace
 
 __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", "central_inside",
@@ -365,30 +369,33 @@ class ContactLaw:
     name : str
         The name a run selects it by (``contact_law=name``).
     function : callable
-        ``function(d, d0, k, c, *parameters)`` (kind ``"central"``) or ``function(d, d_eq, k)``
-        (kind ``"tensile"``), on arrays; see the module docstring.
+        ``function(d, d0, r_i, r_j, k, c, *parameters)`` (kind ``"central"``, ``radii`` True: the
+        form of the laws folder), ``function(d, d0, k, c, *parameters)`` (``radii`` False: the
+        form of :func:`register_law` before the laws folder) or ``function(d, d_eq, k)`` (kind
+        ``"tensile"``), on arrays; see the module docstring.
     parameters : dict
         Parameter name → default, in the order ``function`` takes them.
     kind : {"central", "tensile"}
         Compressive law of contacts and bonds, or tensile law of stretched bonds.
     check : callable or None
         ``check(**values)`` raises ValueError for values the law does not allow; None: any
-        finite numbers.
+        finite numbers (within the declared ranges).
     prepared : tuple or None
-        ``(constants, inside)`` with ``function(d, d0, k, c, *p) == inside(d, *constants(d0, k,
-        c, *p))``: the engine keeps the constants per candidate set; None: it calls ``function``.
+        ``(constants, inside)`` with ``function(d, *a) == inside(d, *constants(*a))`` (``a`` the
+        arguments after ``d``): the engine keeps the constants per candidate set; None: it calls
+        ``function``.
+    radii : bool, default False
+        ``function`` takes the radii ``r_i, r_j`` (µm) after ``d0``.
+    declared : tuple of Parameter, default ()
+        The parameters as declared in the law's file (:class:`particleShear.parameter_entry.Parameter`:
+        unit, range, one-line doc); empty for a law registered with a plain dict.
     """
 
-    __slots__ = ("name", "function", "parameters", "kind", "check", "prepared")
+    __slots__ = ("name", "function", "parameters", "kind", "check", "prepared", "radii", "declared")
 
-    def __init__(self, name, function, parameters, kind, check, prepared=None):
+    def __init__(self, name, function, parameters, kind, check, prepared=None, radii=False, declared=()):
         self.name, self.function, self.parameters, self.kind, self.check = name, function, parameters, kind, check
-        self.prepared = prepared
-
-    @property
-    def description(self):
-        """First line of the law function's docstring (its equation), str."""
-        return ((self.function.__doc__ or "").strip().splitlines() or [""])[0]
+        self.prepared, self.radii, self.declared = prepared, bool(radii), tuple(declared)
 
     def __repr__(self):
         return f"ContactLaw({self.name!r}, {self.kind}, parameters={self.parameters!r})"
@@ -396,13 +403,18 @@ class ContactLaw:
 
 #: the registered laws, name → :class:`ContactLaw` (add one with :func:`register_law`)
 LAWS = {}
-_BUILT_IN = ("linear", "plateau", "tensile")
+#: the laws that cannot be replaced: the tensile law and the laws of the laws folder (added on discovery)
+_BUILT_IN = {"tensile"}
 
 
-def register_law(name, function, parameters=None, kind="central", check=None, replace=False, prepared=None):
+def register_law(name, function, parameters=None, kind="central", check=None, replace=False, prepared=None,
+                 radii=False, built_in=False):
     """Add a contact law to :data:`LAWS`, the one place the engine and the run layer read laws from.
 
-    The function must accept arrays (the engine calls it once per force phase on all candidate
+    The laws folder (:mod:`particleShear.engine.contact_laws`) calls it in each law's file (with
+    the declared parameters, ``radii=True``, ``built_in=True``); a script may call it at run time
+    (the law is then known in this process only, not in spawn workers: a law for those is a file
+    of the laws folder or ``contact_law="package.module:function"``).  The function must accept arrays (the engine calls it once per force phase on all candidate
     pairs, values beyond contact are discarded); it is marked ``accepts_arrays``.
 
     Parameters
@@ -410,11 +422,13 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
     name : str
         Name of the law (a run selects it with ``contact_law=name``).
     function : callable
-        ``function(d, d0, k, c, *parameters)`` for kind ``"central"``: the force as if in
-        contact (mg·µm·s⁻² per m depth, negative repels); ``function(d, d_eq, k)`` for kind
-        ``"tensile"``.
-    parameters : dict, optional
-        Parameter name → default value, in the order of the function's extra arguments.
+        ``function(d, d0, k, c, *parameters)`` for kind ``"central"`` (``function(d, d0, r_i,
+        r_j, k, c, *parameters)`` with ``radii``): the force as if in contact (mg·µm·s⁻² per m
+        depth, negative repels); ``function(d, d_eq, k)`` for kind ``"tensile"``.
+    parameters : dict or tuple of Parameter, optional
+        Parameter name → default value, or the declared parameters
+        (:class:`particleShear.parameter_entry.Parameter`), in the order of the function's extra
+        arguments.
     kind : {"central", "tensile"}, default "central"
         Which law it is.
     check : callable, optional
@@ -424,6 +438,10 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
     prepared : tuple, optional
         ``(constants, inside)``: the law split into per-pair constants and a function of them
         (:class:`ContactLaw`), so that the engine computes the constants once per candidate set.
+    radii : bool, default False
+        The function takes the radii ``r_i, r_j`` (µm) after ``d0``.
+    built_in : bool, default False
+        A law of the laws folder (it cannot be replaced or unregistered).
 
     Returns
     -------
@@ -438,11 +456,15 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
         raise ValueError(f"name={name!r} is invalid: allowed a non-empty identifier")
     if name in LAWS and (not replace or name in _BUILT_IN):
         raise ValueError(f"name={name!r} is invalid: a law of that name is registered (replace=True replaces "
-                         f"one that is not built in: {', '.join(_BUILT_IN)})")
+                         f"one that is not built in: {', '.join(sorted(_BUILT_IN))})")
     if not callable(function):
         raise ValueError(f"function={function!r} is invalid: allowed a callable")
     if kind not in ("central", "tensile"):
         raise ValueError(f"kind={kind!r} is invalid: allowed 'central' or 'tensile'")
+    declared = ()
+    if parameters and not isinstance(parameters, dict):
+        declared = tuple(parameters)
+        parameters = {p.name: p.default for p in declared}
     parameters = dict(parameters or {})
     for p, v in parameters.items():
         if isinstance(v, bool) or not isinstance(v, numbers.Real):
@@ -451,7 +473,9 @@ def register_law(name, function, parameters=None, kind="central", check=None, re
         function.accepts_arrays = True
     except (AttributeError, TypeError):
         pass
-    LAWS[name] = law = ContactLaw(name, function, parameters, kind, check, prepared)
+    LAWS[name] = law = ContactLaw(name, function, parameters, kind, check, prepared, radii, declared)
+    if built_in:
+        _BUILT_IN.add(name)
     return law
 
 
@@ -511,12 +535,43 @@ def get_law(name, kind="central", what="contact_law"):
         For an unknown name: naming ``what``, the value, the allowed names and the closest one.
     """
     law = LAWS.get(name) if isinstance(name, str) else None
+    if law is None and kind == "central" and isinstance(name, str) and ":" in name:
+        law = _import_law(name, what)
     if law is not None and law.kind == kind:
         return law
     names = law_names(kind)
     close = difflib.get_close_matches(str(name), names, n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ValueError(f"{what}={name!r} is invalid: allowed {', '.join(repr(n) for n in names)}{hint}")
+
+
+def _import_law(spec, what):
+    """Register the law ``"package.module:function"`` under that name (imported where it is used,
+    spawn workers included): the module's ``LAW`` (a :class:`ContactLaw` it registered) when the
+    function is its function, else ``function(d, d0, r_i, r_j, k, c, *parameters)`` with the
+    module's ``PARAMETERS`` (declared parameters; none when absent)."""
+    module_name, _, attr = spec.partition(":")
+    try:
+        module = importlib.import_module(module_name)
+        function = getattr(module, attr)
+    except (ImportError, AttributeError) as e:
+        raise ValueError(f"{what}={spec!r} is invalid: cannot import it ({e}); allowed a registered law or "
+                         "'package.module:function'") from None
+    own = getattr(module, "LAW", None)
+    if isinstance(own, ContactLaw) and own.function is function:
+        LAWS[spec] = own
+        return own
+    if not callable(function):
+        raise ValueError(f"{what}={spec!r} is invalid: {attr!r} of {module_name} is not callable")
+    declared = tuple(getattr(module, "PARAMETERS", ()) or ())
+    parameters = {p.name: p.default for p in declared}
+    try:
+        function.accepts_arrays = True
+    except (AttributeError, TypeError):
+        pass
+    LAWS[spec] = law = ContactLaw(spec, function, parameters, "central", getattr(module, "check", None),
+                                  radii=True, declared=declared)
+    return law
 
 
 def law_values(law, given=None):
@@ -545,12 +600,12 @@ def law_values(law, given=None):
     for p, v in values.items():
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
             raise ValueError(f"{p}={v!r} is invalid: allowed a finite number")
+    for p in law.declared:
+        if p.has_range:
+            in_range(p.name, values[p.name], p.low, p.high, p.low_open, p.high_open)
     if law.check is not None:
         law.check(**values)
     return tuple(float(v) for v in values.values())
 
 
-register_law("linear", linear_law)
-register_law("plateau", plateau_law, {"plateau_begin": 0.3, "plateau_end": 0.8, "plateau_slope": 0.1},
-             check=check_plateau, prepared=(plateau_constants, plateau_inside))
 register_law("tensile", tensile_law, kind="tensile")

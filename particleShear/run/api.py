@@ -13,6 +13,7 @@ every call (per process) or returned directly with ``return_result=True``.
 import numpy as np
 
 from ..messages import console_messages
+from ..parameters import BY_NAME, EXTRA
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, validate_run, validate_series
@@ -95,7 +96,11 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     return theSimulation
 
 
-@checked_keywords(aliases=PARAMETER_ALIASES, hints=PARAMETER_HINTS)
+#: the defaults of the contact laws' parameters outside the signature (``**law_parameters``)
+_EXTRA_DEFAULTS = {name: BY_NAME[name].default for name in EXTRA}
+
+
+@checked_keywords(aliases=PARAMETER_ALIASES, hints=PARAMETER_HINTS, extra=EXTRA)
 def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_permanent_links=True, cut_lines=5,
                               Young_modulus_spheres=8000, N=150, packing_fraction=1.5, density=50,
                               bimodal_factor=1.4, relative_viscosity=0.1, relative_transversal_link_strength=1,
@@ -113,7 +118,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1,
                               protocol="oscillatory", relative_rate=0.01, total_strain=2.0, ramp_time=1.0,
                               hold_time=200.0, creep_stress=None, creep_modulus=None, creep_response_time=5.0,
-                              sweep_amplitudes=None, sweep_frequencies=None, stroboscopic=False):
+                              sweep_amplitudes=None, sweep_frequencies=None, stroboscopic=False,
+                              **law_parameters):
     """Build a crosslinked, cut soft-particle ensemble, shear it sinusoidally and return its moduli.
 
     The run follows the reference (particleShear 1.0.2): N bimodal spheres are relaxed in a
@@ -265,13 +271,15 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         so that a run in a batched series (``doParticleShearSimulationSeries(..., batch_size=B)``)
         is bit-identical to it and a drawn run to the same run headless (the drawing observes the
         engine's loops).
-    contact_law : {"linear", "plateau"}, default "linear"
-        Keyword-only.  Central contact law, a name of the registry
-        :data:`particleShear.engine.laws.LAWS` (laws added with ``register_law`` are allowed too):
-        "linear" the blend of eqs. S1-5a/b with the cap S1-6 (or the law assigned to
+    contact_law : {"linear", "plateau", "hertz"}, default "linear"
+        Keyword-only.  Central contact law, a law of the folder particleShear/engine/contact_laws
+        (its parameters follow it in the parameter table), a law added with ``register_law``, or
+        ``"package.module:function"`` (imported where it is used): "linear" the blend of eqs.
+        S1-5a/b with the cap S1-6 (or the law assigned to
         ``CircleBasicElasticity.call_back_elastic_force_law``, the class-attribute way of 1.0.2),
         "plateau" the same law of a plateau-transformed distance (spongy particles, the manual's
-        ``elastic_force_law_plateau``; docs/parameters.md).
+        ``elastic_force_law_plateau``), "hertz" the Hertz force of two spheres of unequal radii
+        (eq. H-1, parameter ``hertz_scale``; docs/parameters.md, docs/design.md).
     plateau_begin : float, default 0.3
         Keyword-only.  Begin of the plateau of ``contact_law="plateau"``, a fraction of the
         contact distance; allowed 0 < plateau_begin < plateau_end.
@@ -323,6 +331,12 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         ``contact_change_rate`` in ``result.measures`` (docs/microstructure.md).  It only reads the
         state: G′ and G″ are those of the run without it, bit for bit; off, nothing is computed.
         Not part of the run identity.  CLI ``--stroboscopic``.
+    **law_parameters
+        Keyword-only.  The parameters of the contact laws that are not in this signature: those
+        of ``hertz`` (``hertz_scale``, float, default 0.05, allowed 0 < value <= 1000) and of a law
+        file saved into particleShear/engine/contact_laws, as each law's file declares them
+        (:data:`particleShear.parameters.EXTRA`; each checked against its declared range, in
+        the run identity only when its law is selected; CLI ``--hertz-scale`` etc.).
 
     Returns
     -------
@@ -381,7 +395,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                    total_strain=total_strain, ramp_time=ramp_time, hold_time=hold_time, creep_stress=creep_stress,
                    creep_modulus=creep_modulus, creep_response_time=creep_response_time,
                    sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies,
-                   stroboscopic=stroboscopic)
+                   stroboscopic=stroboscopic, **dict(_EXTRA_DEFAULTS, **law_parameters))
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))

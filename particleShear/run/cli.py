@@ -371,6 +371,8 @@ def build_parser():
         par = BY_NAME[name]
         group = groups[not par.keyword_only]
         desc = _CLI_HELP.get(name) or par.doc
+        if par.extra and par.unit:       # a law's own parameter (its file's declaration): its unit
+            desc += "; unit: " + ("dimensionless" if par.unit == "1" else par.unit)
         if par.has_range:
             desc += f"; allowed {par.range_text()}"
         shown = _CLI_DEFAULTS.get(name, _default_text(default))

@@ -26,6 +26,7 @@ import tempfile
 import numpy as np
 
 from ..checks import as_float as _as_float, in_range, integer as _int, range_text, real_type, show_value
+from ..engine import contact_laws
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters
@@ -259,15 +260,16 @@ def contact_law_spec(p):
     """The central law of one run as the engine takes it: None for "linear", else ``(name, values)``.
 
     "linear" is the documented callback ``CircleBasicElasticity.call_back_elastic_force_law``
-    (the built-in linear law unless replaced: the class-attribute way of 1.0.2); another name of
-    :data:`particleShear.engine.laws.LAWS` is that law with its parameters (the plateau law's are
-    ``plateau_begin``, ``plateau_end``, ``plateau_slope``; a registered law's other parameters
-    take their defaults).  The plateau parameters are checked whatever the law.
+    (the built-in linear law unless replaced: the class-attribute way of 1.0.2); another law of
+    the laws folder (:mod:`particleShear.engine.contact_laws`), of :func:`register_law` or
+    ``"package.module:function"`` is that law with its parameters (given, else their declared
+    defaults).  The parameters of every law of the laws folder are checked whatever the law
+    (types, declared ranges, the law's own check), as the plateau parameters were in 2.0.0.
 
     Parameters
     ----------
     p : dict
-        Arguments of the run (``contact_law`` and the ``plateau_*`` ones; missing ones take
+        Arguments of the run (``contact_law`` and the laws' parameters; missing ones take
         their defaults).
 
     Returns
@@ -278,23 +280,26 @@ def contact_law_spec(p):
     Raises
     ------
     TypeError
-        For a plateau parameter that is not a real number.
+        For a law parameter that is not a real number.
     ValueError
         For an unknown law (naming ``contact_law``, the allowed names and the closest one) or a
-        plateau parameter out of range (naming it, its value and the range).
+        law parameter out of range (naming it, its value and the range).
     """
-    from ..engine import laws
-    given = {}
-    for name, default in laws.LAWS["plateau"].parameters.items():
-        v = p.get(name, default)
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
-            raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
-        given[name] = float(v)
-    laws.check_plateau(**given)
-    law = laws.get_law(p.get("contact_law", "linear"))
+    def given(law):
+        out = {}
+        for name, default in law.parameters.items():
+            v = p.get(name, default)
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+                raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
+            out[name] = float(v)
+        return out
+
+    for name in contact_laws.MODULES:
+        contact_laws.law_values(contact_laws.LAWS[name], given(contact_laws.LAWS[name]))
+    law = contact_laws.get_law(p.get("contact_law", "linear"))
     if law.name == "linear":
         return None
-    return law.name, laws.law_values(law, given)
+    return law.name, contact_laws.law_values(law, given(law))
 
 
 # -- cost ------------------------------------------------------------------------------------------

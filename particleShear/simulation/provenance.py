@@ -19,6 +19,7 @@ import re
 
 import numpy as np
 
+from ..engine.contact_laws import get_law
 from ..parameters import identity_excluded
 from ..parameters import names as _names
 
@@ -259,7 +260,6 @@ def _law_text(spec):
     """``linear`` or e.g. ``plateau (plateau_begin 0.3, plateau_end 0.8, plateau_slope 0.1)``."""
     if spec is None:
         return "linear"
-    from ..engine.laws import LAWS
     name, values = spec
-    pairs = ", ".join(f"{p} {header_number(v)}" for p, v in zip(LAWS[name].parameters, values))
+    pairs = ", ".join(f"{p} {header_number(v)}" for p, v in zip(get_law(name).parameters, values))
     return name + (f" ({pairs})" if pairs else "")
