@@ -385,11 +385,6 @@ class ContactLaw:
         self.name, self.function, self.parameters, self.kind, self.check = name, function, parameters, kind, check
         self.prepared = prepared
 
-    @property
-    def description(self):
-        """First line of the law function's docstring (its equation), str."""
-        return ((self.function.__doc__ or "").strip().splitlines() or [""])[0]
-
     def __repr__(self):
         return f"ContactLaw({self.name!r}, {self.kind}, parameters={self.parameters!r})"
 

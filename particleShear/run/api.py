@@ -13,6 +13,7 @@ import inspect
 
 import numpy as np
 
+from ..hooks import entry
 from ..messages import console_messages
 from ..simulation.provenance import run_identity
 from ..simulation.simulations import Simulation_interlocking_rheology
@@ -467,10 +468,6 @@ def series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_con
     return jobs
 
 
-def _series_worker(kwargs):
-    return doParticleShearSimulation(**kwargs, return_result=True)
-
-
 def _run_options():
     """The keyword-only options of doParticleShearSimulation (what ``**options`` of a series may name)."""
     return [n for n, par in inspect.signature(doParticleShearSimulation).parameters.items()
@@ -650,7 +647,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         validate_run(kw)
     if not all_kwargs:
         return []
-    from ..sweep.series import run_series
+    run_series = entry("run_series")
     per_repetition = len(jobs) // int(N_repetitions)
     return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size,
                       repetitions=[k // per_repetition for k in range(len(jobs))])

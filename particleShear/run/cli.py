@@ -27,6 +27,7 @@ import re
 import sys
 import time
 
+from .._version import __version__
 from .guard import SuggestingParser, shorten_values
 from ..signals import sigterm_raises
 from .validation import IMAGE_FILE_TYPES
@@ -363,7 +364,6 @@ class ProgressLine:
 
 def build_parser():
     """The parser of ``particleShear [run]``: one flag per parameter of ``doParticleShearSimulation``."""
-    from .. import __version__
     from .api import doParticleShearSimulation
     docs = parameter_docs(doParticleShearSimulation)
     p = _Parser(prog="particleShear",

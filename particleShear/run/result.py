@@ -9,6 +9,9 @@ import math
 
 import numpy as np
 
+from .._version import __version__
+from ..hooks import entry
+
 __all__ = ["SimulationResult"]
 
 
@@ -270,8 +273,7 @@ class SimulationResult:
         -------
         matplotlib.figure.Figure
         """
-        from ..plot import plot_result
-        return plot_result(self, path)
+        return entry("plot_result")(self, path)
 
     def to_dict(self):
         """The row of this run in a sweep's results table (docs/sweeps.md), as a dict.
@@ -289,7 +291,6 @@ class SimulationResult:
         -------
         dict
         """
-        from .. import __version__
         from ..sweep.spec import sweep_parameter_defaults
         from ..simulation.provenance import run_identity
         params = sweep_parameter_defaults()

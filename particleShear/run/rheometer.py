@@ -32,6 +32,9 @@ import time
 
 import numpy as np
 
+from .._version import __version__
+from ..hooks import entry
+
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
@@ -392,7 +395,6 @@ class RheometerResult:
         -------
         list of dict
         """
-        from .. import __version__
         from ..simulation.provenance import run_identity
         from ..sweep.schema import PROTOCOL_COLUMNS
         from ..sweep.spec import sweep_parameter_defaults
@@ -467,8 +469,7 @@ class RheometerResult:
         -------
         matplotlib.figure.Figure
         """
-        from ..rheometer_plot import plot_rheometer_result
-        return plot_rheometer_result(self, path)
+        return entry("plot_rheometer_result")(self, path)
 
     def _summary(self):
         """(run fields, rows) of :meth:`__repr__` and :meth:`_repr_html_`.

@@ -19,6 +19,8 @@ import re
 
 import numpy as np
 
+from .._version import __version__
+
 __all__ = ["run_identity", "identity_parameters", "same_input", "header_number", "positional_numbers_in_call",
            "json_safe", "provenance_lines", "IDENTITY_EXCLUDED", "package_version"]
 
@@ -29,7 +31,6 @@ IDENTITY_EXCLUDED = frozenset({"seed", "root_folder", "return_result", "verbose"
 
 def package_version():
     """The installed particleShear version (``particleShear.__version__``)."""
-    from .. import __version__
     return __version__
 
 

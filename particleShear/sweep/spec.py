@@ -170,11 +170,6 @@ class SweepSpec:
             n *= len(next(iter(group.values())))
         return n
 
-    @property
-    def n_runs(self):
-        """Number of runs: ``n_points · repetitions``."""
-        return self.n_points * self.repetitions
-
 
 def _read_toml(path):
     """The tables of the TOML file ``path``: the one reader of TOML in the package (``tomllib``, or
