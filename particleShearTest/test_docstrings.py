@@ -30,6 +30,9 @@ import particleShear
 DOCUMENTED_MODULES = [
     "particleShear",
     "particleShear.checks",
+    "particleShear._version",
+    "particleShear.hooks",
+    "particleShear.layers",
     "particleShear.analysis",
     "particleShear.analysis.curves",
     "particleShear.analysis.demodulation",
@@ -60,6 +63,7 @@ DOCUMENTED_MODULES = [
     "particleShear.simulation.observers",
     "particleShear.simulation.output",
     "particleShear.simulation.provenance",
+    "particleShear.simulation.driver",
     "particleShear.simulation.simulations",
     "particleShear.simulation.fragmentation",
     "particleShear.sweep",

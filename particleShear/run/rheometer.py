@@ -34,6 +34,7 @@ import numpy as np
 
 from .._version import __version__
 from ..hooks import entry
+from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
 
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
@@ -566,7 +567,7 @@ def measure_rheometer(runs):
 
     The constitution and pre-equilibration are those of the oscillatory runs
     (:func:`~particleShear.run.batch.build_sessions`, ``_constitute``,
-    :func:`~particleShear.run.batch.pre_equilibrated`); every replica then runs its rate
+    :func:`~particleShear.simulation.driver.pre_equilibrated`); every replica then runs its rate
     schedule in one engine.  Replicas may differ in rate, strain, stress, γ₀ and amplitude list;
     the batch runs the longest and cuts each record at the replica's own length.
 
@@ -582,7 +583,7 @@ def measure_rheometer(runs):
     from ..engine import rheometer as eng
     from ..engine.step import protocol as oscillatory
     from ..simulation.provenance import run_identity
-    from .batch import _console, _constitute, _guarded, build_sessions, pre_equilibrated
+    from .batch import build_sessions
     from .rheometer_analysis import analyse_record, analyse_sweep
     from .rheometer_files import write_protocol_file
 
