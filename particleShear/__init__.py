@@ -16,7 +16,7 @@ from .objects import __all__ as _objects_all  # noqa: E402
 from .linkable import *  # noqa: F401,F403,E402
 from .linkable import __all__ as _linkable_all  # noqa: E402
 
-__version__ = "2.0.0"
+from ._version import __version__  # noqa: E402
 __all__ = list(_base_all) + list(_objects_all) + list(_linkable_all)
 
 from .simulation import *  # noqa: F401,F403,E402

@@ -14,8 +14,6 @@ plot_sweep
     G′ and G″ (log axes) from a sweep folder's ``results.csv`` against the amplitude or frequency,
     one panel per material and per value of any other varying parameter, colour by μ, means over
     seeds with bootstrap intervals (amplitude) or standard errors (:mod:`particleShear.sweep_plot`).
-sweep_groups
-    Mean and standard error over seeds per (material, μ) and amplitude (a table, no figure).
 cli_main
     ``python -m particleShear plot DIR [--estimator internal] [--x NAME] [--no-split]``.
 
@@ -30,11 +28,13 @@ import os
 import sys
 import warnings
 
+import numpy as np
+
 from .messages import console_messages
 from .analysis.verdicts import is_flagged  # noqa: F401 - re-exported: the one rule of a flagged row
 from .run.guard import SuggestingParser, command_line_names
 
-__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "sweep_groups", "cli_main", "save_figure",
+__all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "cli_main", "save_figure",
            "check_figure_path", "align_zeros", "fit_title", "dodge_factors", "place_labels", "is_flagged",
            "FLAGGED_LABEL", "made_by"]
 
@@ -173,7 +173,6 @@ def dodge_factors(n, xs):
     numpy.ndarray
         ``n`` factors, 1 for a single series.
     """
-    import numpy as np
     u = np.unique(np.log10(np.asarray(xs, dtype=float)))
     step = 0.06 * float(np.min(np.diff(u))) if len(u) > 1 else 0.04
     step = min(step, 0.9 / max(n, 1) * (float(np.min(np.diff(u))) if len(u) > 1 else 1.0))
@@ -380,7 +379,6 @@ def plot_result(result, path=None):
         Axes in order: trace, Lissajous loop, the trace's strain axis, elastic and viscous
         Lissajous–Bowditch curves.
     """
-    import numpy as np
     s = result.series
     for key in ("t", "strain", "stress_surface", "stress_internal"):
         if key not in s:
@@ -444,7 +442,6 @@ def plot_result(result, path=None):
 
 def _lissajous_bowditch(result, elastic, viscous, text):
     """Elastic σ′(γ) and viscous σ″(γ̇) curves of both estimators, and a table of their LAOS ratios."""
-    import numpy as np
     from .analysis.measures import measured_window
     s = result.series
     try:
@@ -515,7 +512,6 @@ def _laos_period_spread(result, window):
     Each whole measured period gets its own LAOS measures (:func:`particleShear.analysis.laos.laos`,
     5 harmonics, as :meth:`SimulationResult.laos`); the error is their standard deviation over √n.
     """
-    import numpy as np
     from .analysis.laos import laos
     s = result.series
     t, strain = np.asarray(s["t"]), np.asarray(s["strain"])
@@ -654,55 +650,6 @@ def ok_moduli(rows, estimator="surface"):
             continue
         kept.append((row, A, gp, gpp))
     return kept, skipped
-
-
-def sweep_groups(rows, estimator="surface"):
-    """Mean and standard error over seeds of G′ and G″ per (group, μ) and amplitude.
-
-    Only rows with ``status == "ok"`` and finite moduli count.  The standard error is
-    ``s/√n`` with the sample standard deviation ``s`` (ddof = 1); 0 for a single seed.
-    Rows that differ in any other parameter (a frequency, N, ...) fall into the same cell, as if
-    they were seeds; :func:`particleShear.sweep_plot.sweep_panels` keeps them apart.
-
-    Parameters
-    ----------
-    rows : iterable of dict
-        Rows of ``results.csv`` (as :func:`read_sweep_table` returns them).
-    estimator : {"surface", "internal"}, optional
-        Which moduli to average: ``Gp_surface``/``Gpp_surface`` (plate forces, default) or
-        ``Gp_internal``/``Gpp_internal`` (overall stress tensor, eq. S1-24).
-
-    Returns
-    -------
-    dict
-        ``{(group, mu): {"A": [...], "Gp": [...], "Gp_err": [...], "Gpp": [...], "Gpp_err": [...],
-        "n": [...]}}`` with amplitudes ascending; moduli in Pa.
-
-    Raises
-    ------
-    ValueError
-        If ``estimator`` is not "surface" or "internal".
-    """
-    cells = {}
-    for row, A, gp, gpp in ok_moduli(rows, estimator)[0]:
-        key = (group_of(row), _float(row.get("theMu", 0)))
-        cells.setdefault(key, {}).setdefault(A, []).append((gp, gpp))
-    out = {}
-    for key in sorted(cells, key=lambda k: (k[0], k[1])):
-        d = {"A": [], "Gp": [], "Gp_err": [], "Gpp": [], "Gpp_err": [], "n": []}
-        for A in sorted(cells[key]):
-            vals = cells[key][A]
-            n = len(vals)
-            d["A"].append(A)
-            d["n"].append(n)
-            for i, name in ((0, "Gp"), (1, "Gpp")):
-                xs = [v[i] for v in vals]
-                m = sum(xs) / n
-                sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1)) if n > 1 else 0.0
-                d[name].append(m)
-                d[name + "_err"].append(sd / math.sqrt(n))
-        out[key] = d
-    return out
 
 
 def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=True, n_boot=2000, confidence=0.95,

@@ -50,6 +50,8 @@ import sys
 import warnings
 import zlib
 
+import numpy as np
+
 from ..run.guard import SuggestingParser
 from .sweep import DEFAULT_SEED
 
@@ -344,7 +346,6 @@ def _stream_label(parameters):
 
 def _summarise(group, n_boot, confidence, rng):
     """(SweepSummary or None, notes) of one group."""
-    import numpy as np
 
     from .sweep import MIN_POINT_AMPLITUDES, sweep_summary
     notes = []
@@ -498,7 +499,6 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     import os
     import shutil
 
-    import numpy as np
 
     from ..plot import _has_matplotlib, read_sweep_table
     from .figure import MAX_FIGURE_PANELS, not_drawn_line

@@ -20,6 +20,7 @@ Grouping the rewritten rows by their parameter columns then keeps apart what dif
 protocol and the parameters it reads split groups — and pools only seeds.
 """
 __docformat__ = "numpy"
+from ..parameters import names, protocol_parameters
 
 __all__ = ["MODULI_PROTOCOLS", "SUMMARY_PROTOCOLS", "row_protocol", "measured_row", "short_value"]
 
@@ -64,7 +65,6 @@ def measured_row(row):
         oscillatory), the step's amplitude or frequency in ``theAmplitude`` /
         ``relative_frequency``, the protocol parameters its protocol does not read empty.
     """
-    from ..parameters import names, protocol_parameters
     proto = row_protocol(row)
     q = dict(row)
     if "protocol" in q or proto != "oscillatory":

@@ -1,7 +1,7 @@
-"""Candidate pairs of a batch: their constants, geometry, the scatter and the shear stresses.
+"""Candidate pairs of a batch: their constants, normals, the scatter and the shear stresses.
 
 Each function is a pure function of arrays: the per-candidate constants (:class:`PairConstants`,
-whose term constants come from :func:`.terms.term_constants`), the geometry of the candidates, the
+whose term constants come from :func:`.terms.term_constants`), the normals of the candidates, the
 scatter of pair forces to spheres and the two shear stresses G′/G″ need.  The force terms
 themselves are in :mod:`.terms`.  Equations: reference manual eq.
 S1-3 (torque split), S1-5/S1-6 (laws), S1-16 (external-force tensor), S1-19 (Love-Weber),
@@ -19,13 +19,12 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from .box import min_image
 from .state import spread
 from .xp import SegmentSum, array_namespace, to_host
 from . import laws
 from .terms import TermConstants, term_constants
 
-__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "geometry", "scatter", "replica_sums", "pair_roles",
+__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "scatter", "replica_sums", "pair_roles",
            "shear_from_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
@@ -306,33 +305,6 @@ def splice_arrays(old, new, segments):
     """
     xp = array_namespace(old, new)
     return xp.concatenate([(new if from_new else old)[..., lo:hi] for from_new, lo, hi in segments], axis=-1)
-
-
-def geometry(C, x, y, shift_p):
-    """Minimum-image pair vectors ``D = x_j − x_i``, distances and image counts of the candidates.
-
-    Parameters
-    ----------
-    C : PairConstants
-        The candidates (sphere rows ``ai``, ``aj`` and box of each).
-    x, y : ndarray (B·N,)
-        Sphere positions (µm).
-    shift_p : ndarray (P,) or float
-        Lees-Edwards offset ``Ly·γ`` of each candidate's replica (µm).
-
-    Returns
-    -------
-    dx, dy : ndarray (P,)
-        Minimum-image separation (µm).
-    d : ndarray (P,)
-        Centre distance (µm).
-    ky, kx : ndarray (P,)
-        Numbers of y and x periods removed (see :func:`~particleShear.engine.box.min_image`).
-    """
-    ai, aj = C.ai, C.aj
-    dx, dy, ky, kx = min_image(x[aj] - x[ai], y[aj] - y[ai], C.Lx, C.Ly, shift_p)
-    d = array_namespace(dx).sqrt(dx * dx + dy * dy)
-    return dx, dy, d, ky, kx
 
 
 def normals(dx, dy, d, rep, rng):

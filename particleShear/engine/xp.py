@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["Backend", "get_backend", "register_backend", "unregister_backend", "backend_names", "array_namespace",
+__all__ = ["Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
            "backend_of", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
@@ -130,16 +130,6 @@ def _cupy_backend():
 
 _FACTORIES = {"numpy": _numpy_backend, "cupy": _cupy_backend}
 _MADE = {}
-
-
-def backend_names():
-    """Names accepted by :func:`get_backend`, in registration order.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(_FACTORIES)
 
 
 def register_backend(name, factory):

@@ -12,6 +12,7 @@ every call (per process) or returned directly with ``return_result=True``.
 
 import numpy as np
 
+from ..hooks import entry
 from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA
 from ..simulation.provenance import run_identity
@@ -20,6 +21,7 @@ from .validation import check_seed, validate_run, validate_series
 from .batch import check_batch_size, measure_batch
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
+from ..parameters import PARAMETERS
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -475,13 +477,8 @@ def series_jobs(amplitudes, mu, cut_lines, do_bulk_control, do_uncrosslinked_con
     return jobs
 
 
-def _series_worker(kwargs):
-    return doParticleShearSimulation(**kwargs, return_result=True)
-
-
 def _run_options():
     """The keyword-only options of doParticleShearSimulation (what ``**options`` of a series may name)."""
-    from ..parameters import PARAMETERS
     return [p.name for p in PARAMETERS if p.keyword_only]
 
 
@@ -615,7 +612,6 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     from their rows (moduli, parameters, seed, output path; no per-step series).
     """
     check_batch_size(batch_size)
-    from ..parameters import PARAMETERS
     keyword_only = [p.name for p in PARAMETERS if p.keyword_only and p.name not in ("return_result", "verbose", "backend")]
     for name in options:
         if name not in keyword_only:
@@ -658,7 +654,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         validate_run(kw)
     if not all_kwargs:
         return []
-    from ..sweep.series import run_series
+    run_series = entry("run_series")
     per_repetition = len(jobs) // int(N_repetitions)
     return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size,
                       repetitions=[k // per_repetition for k in range(len(jobs))])

@@ -27,9 +27,11 @@ import re
 import sys
 import time
 
+from .._version import __version__
 from .guard import SuggestingParser, shorten_values
 from ..signals import sigterm_raises
 from .validation import IMAGE_FILE_TYPES
+from ..parameters import BY_NAME, PARAMETERS
 
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
@@ -203,7 +205,6 @@ class _Bool(argparse.BooleanOptionalAction):
 def _flags():
     """``{parameter: (option strings, CLI type, choices, default)}`` in signature order, from the
     parameter table (:mod:`particleShear.parameters`)."""
-    from ..parameters import PARAMETERS
     out = {}
     for par in PARAMETERS:
         if par.name in NOT_FLAGS:
@@ -354,8 +355,6 @@ class ProgressLine:
 
 def build_parser():
     """The parser of ``particleShear [run]``: one flag per parameter of ``doParticleShearSimulation``."""
-    from .. import __version__
-    from ..parameters import BY_NAME
     p = _Parser(prog="particleShear",
                 description="2D soft-particle oscillatory shear rheology: G' and G'' of one run. Commands: "
                             "run (default; the flags below), sweep SPEC --out DIR (particleShear sweep --help), "
@@ -431,7 +430,6 @@ def api_kwargs(args):
     ValueError
         Naming the flags, for combinations the API cannot express.
     """
-    from ..parameters import PARAMETERS
     kw = {}
     for par in PARAMETERS:
         if par.name in NOT_FLAGS:

@@ -9,6 +9,10 @@ import math
 
 import numpy as np
 
+from .._version import __version__
+from ..hooks import entry
+from ..simulation.microstructure_pictures import microstructure_pictures
+
 __all__ = ["SimulationResult"]
 
 
@@ -270,8 +274,7 @@ class SimulationResult:
         -------
         matplotlib.figure.Figure
         """
-        from ..plot import plot_result
-        return plot_result(self, path)
+        return entry("plot_result")(self, path)
 
     def microstructure_pictures(self, folder, colour_by="d2min", gif=True, **options):
         """One picture per excitation cycle (force chains, spheres coloured by D²_min) and a GIF.
@@ -300,7 +303,6 @@ class SimulationResult:
         ValueError
             A run without ``stroboscopic=True``, or an option out of range.
         """
-        from ..simulation.microstructure_pictures import microstructure_pictures
         return microstructure_pictures(self, folder, colour_by=colour_by, gif=gif, **options)
 
     def to_dict(self):
@@ -319,7 +321,6 @@ class SimulationResult:
         -------
         dict
         """
-        from .. import __version__
         from ..sweep.spec import sweep_parameter_defaults
         from ..simulation.provenance import run_identity
         params = sweep_parameter_defaults()

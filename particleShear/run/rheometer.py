@@ -33,6 +33,9 @@ import time
 import numpy as np
 
 from ..parameters import BY_NAME, PARAMETERS
+from .._version import __version__
+from ..hooks import entry
+from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
 
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
@@ -393,7 +396,6 @@ class RheometerResult:
         -------
         list of dict
         """
-        from .. import __version__
         from ..simulation.provenance import run_identity
         from ..sweep.schema import PROTOCOL_COLUMNS
         from ..sweep.spec import sweep_parameter_defaults
@@ -468,8 +470,7 @@ class RheometerResult:
         -------
         matplotlib.figure.Figure
         """
-        from ..rheometer_plot import plot_rheometer_result
-        return plot_rheometer_result(self, path)
+        return entry("plot_rheometer_result")(self, path)
 
     def _summary(self):
         """(run fields, rows) of :meth:`__repr__` and :meth:`_repr_html_`.
@@ -566,7 +567,7 @@ def measure_rheometer(runs):
 
     The constitution and pre-equilibration are those of the oscillatory runs
     (:func:`~particleShear.run.batch.build_sessions`, ``_constitute``,
-    :func:`~particleShear.run.batch.pre_equilibrated`); every replica then runs its rate
+    :func:`~particleShear.simulation.driver.pre_equilibrated`); every replica then runs its rate
     schedule in one engine.  Replicas may differ in rate, strain, stress, γ₀ and amplitude list;
     the batch runs the longest and cuts each record at the replica's own length.
 
@@ -582,7 +583,7 @@ def measure_rheometer(runs):
     from ..engine import rheometer as eng
     from ..engine.step import protocol as oscillatory
     from ..simulation.provenance import run_identity
-    from .batch import _console, _constitute, _guarded, build_sessions, pre_equilibrated
+    from .batch import build_sessions
     from .rheometer_analysis import analyse_record, analyse_sweep
     from .rheometer_files import write_protocol_file
 

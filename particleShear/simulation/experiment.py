@@ -22,6 +22,13 @@ from ..engine.loops import relaxation_levels
 from ..engine.relax import untouched_on_failure
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
+from .drawing import IMAGE_EXTENSIONS
+from .driver import ENGINE_SKIN_FACTOR, _guarded, replica_record
+from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
+from .observers import LiveDrawing, SnapshotWriter, StressWindow, ReplicaScene
+from ..engine.relax import write_back
+from ..engine.state import BatchState
+from ..engine.step import pre_equilibrate, protocol, BatchEngine
 
 _log = logging.getLogger(__name__)
 
@@ -251,8 +258,6 @@ class OscillatoryShearExperiment:
 
     def _pre_equilibrate_in(self, engine, N, cool_factor, observers):
         """The pre-equilibration in ``engine`` (timed, guarded, reported); returns the steps run."""
-        from ..engine.step import pre_equilibrate
-        from ..run.batch import _guarded
         t0 = time.perf_counter()
         steps = _guarded(pre_equilibrate, engine, N, self.dt, self.dt_max, cool_factor, self._say,
                          self._reporter("pre-equilibration"), observers, dt=self.dt)
@@ -283,7 +288,6 @@ class OscillatoryShearExperiment:
         -------
         str
         """
-        from .drawing import IMAGE_EXTENSIONS
         ext = IMAGE_EXTENSIONS.get(self.imageFileType, IMAGE_EXTENSIONS["ps"])[0]
         return os.path.join(str(self.imageOutputFolder), str(self.imageBaseFileName) + f"{index:07d}" + ext)
 
@@ -338,7 +342,6 @@ class OscillatoryShearExperiment:
         -------
         list of Observer
         """
-        from .observers import LiveDrawing, SnapshotWriter, StressWindow
         out = []
         r = self.renderer
         if live and r is not None and r.live:
@@ -434,8 +437,6 @@ class OscillatoryShearExperiment:
 
     def _protocol_in(self, engine, cool_factor, observers, n_steps=None):
         """The protocol in ``engine`` (timed, guarded, reported); returns the replica's record."""
-        from ..engine.step import protocol
-        from ..run.batch import _guarded, replica_record
         keep = self._keeps_tensors()
         t0 = time.perf_counter()
         out = _guarded(protocol, engine, self.dt, self.f, [self.amplitude], cool_factor, self.baseline_pre_periods,
@@ -530,9 +531,6 @@ class OscillatoryShearExperiment:
         -------
         BatchEngine
         """
-        from ..engine.state import BatchState
-        from ..engine.step import BatchEngine
-        from ..run.batch import ENGINE_SKIN_FACTOR
         ens = self.theEnsemble
         guard = getattr(ens, "stability_guard", None)
         integrator = getattr(ens, "integrator", "euler")
@@ -549,7 +547,6 @@ class OscillatoryShearExperiment:
         return engine
 
     def _scene(self, engine):
-        from .observers import ReplicaScene
         scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
         scene.bind(engine, 0)
         return scene
@@ -567,7 +564,6 @@ class OscillatoryShearExperiment:
         """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble, and
         its last force phase into the ensemble's force register (the six lists, the totals), as the
         documented step loop leaves them."""
-        from ..engine.relax import write_back
         ens = self.theEnsemble
         if engine.phase == "protocol":
             ens.step_count = 0        # the protocol's steps, as the documented loop counts them
@@ -633,7 +629,6 @@ class OscillatoryShearExperiment:
     def _record(self, record):
         """The recording of a replica's record: :attr:`plotter` (series, tensor history when kept,
         first and last tensors), :attr:`theEvaluator` (the tensors of the last step), :attr:`N_steps`."""
-        from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
         n = len(record["t"])
         T_total = (self.periods + self.baseline_pre_periods + self.baseline_post_periods) / self.f
         if self.theEvaluator is None:         # a prepared recording (prepare_recording) is filled

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..engine.box import min_image
 from .scene import _ascii, _font, periodic_offsets, scale_bar_length
+from .drawing import PillowRenderer
 
 __all__ = ["microstructure_pictures", "picture_primitives", "colour_of", "COLOUR_BY", "CHAIN_COLOUR", "NAN_FILL",
            "VIRIDIS"]
@@ -269,7 +270,6 @@ def microstructure_pictures(result, folder, colour_by="d2min", gif=True, scale=N
         scale = 480.0 / float(micro["Lx"])
     vmax, fmax, max_width = _scales(micro, colour_by, None, None, None)
     os.makedirs(folder, exist_ok=True)
-    from .drawing import PillowRenderer
     movie = PillowRenderer()
     n_c = len(micro["msd"])
     movie.movie_max_frames = n_c + 1

@@ -45,7 +45,7 @@ SIDECAR_SUFFIX = ".json"
 
 __all__ = ["fsync_folder", "TABLE_COLUMNS", "FORMAT_SUFFIXES", "AtomicOutputFile", "run_file_stem", "format_of", "sidecar_path", "reserve_numbered_path", "remove_stale_parts", "number_is_free",
            "probe_writable", "iter_table_text", "iter_text_rows", "experiment_description_text",
-           "output_summary_text", "table_text", "NO_TENSOR_DATA_TEXT"]
+           "output_summary_text", "NO_TENSOR_DATA_TEXT"]
 
 #: output-table column name stems of the nine tensors, in the order of TENSOR_NAMES
 _TENSOR_COLUMN_STEMS = (
@@ -760,7 +760,7 @@ def iter_text_rows(names, blocks, chunk_rows=CHUNK_ROWS):
 
 
 def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
-    """The text of :func:`table_text` in pieces of ``chunk_rows`` lines (:func:`iter_text_rows`).
+    """The text of the 42-column table in pieces of ``chunk_rows`` lines (:func:`iter_text_rows`).
 
     Parameters
     ----------
@@ -779,23 +779,3 @@ def iter_table_text(scalars, tensors, chunk_rows=CHUNK_ROWS):
     n = len(scalars)
     return iter_text_rows(TABLE_COLUMNS, (np.arange(n), scalars, tensors.reshape(n, 36)), chunk_rows)
 
-
-def table_text(scalars, tensors):
-    """The header line and the data lines of the 42-column table, each data line preceded by "\\n".
-
-    Writers use :func:`iter_table_text` instead (bounded memory).
-
-    Parameters
-    ----------
-    scalars : numpy.ndarray
-        Shape (n, 5): t (s), strain (–), strain rate (1/s), τ_surface and τ_internal (Pa).
-    tensors : numpy.ndarray
-        Shape (n, 9, 2, 2): the nine stress tensors of each step (Pa).
-
-    Returns
-    -------
-    str
-        The text starting with a newline (after "Detailed stress tensor data") and without a
-        trailing newline.
-    """
-    return "".join(iter_table_text(scalars, tensors))

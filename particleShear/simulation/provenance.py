@@ -22,6 +22,7 @@ import numpy as np
 from ..engine.contact_laws import get_law
 from ..parameters import identity_excluded
 from ..parameters import names as _names
+from .._version import __version__
 
 __all__ = ["run_identity", "identity_parameters", "same_input", "header_number", "positional_numbers_in_call",
            "json_safe", "provenance_lines", "IDENTITY_EXCLUDED", "package_version"]
@@ -33,7 +34,6 @@ IDENTITY_EXCLUDED = frozenset(_names("display") + _names("call") + _names("obser
 
 def package_version():
     """The installed particleShear version (``particleShear.__version__``)."""
-    from .. import __version__
     return __version__
 
 

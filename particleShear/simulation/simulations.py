@@ -20,6 +20,7 @@ from collections import namedtuple
 from ..linkable.builders import relax_constitution
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
+from .driver import measure_sessions
 from .experiment import OscillatoryShearExperiment
 from .formats import FORMAT_SUFFIXES, check_output_format, table_rows, text_stream, write_run
 from .output import (IMAGE_FOLDER_SUFFIX, REFERENCE_IMAGE_FOLDER_SUFFIX, number_is_free, output_summary_text,
@@ -525,7 +526,6 @@ class OscillatorySimulation:
             For an unusable ``root_folder``, ``periods`` ≤ 0, ``cool_factor`` outside (0, 1] or an
             unknown output format — before any work.
         """
-        from ..run.batch import measure_sessions
         run = RunSession(self, cool_factor, periods, plotStress)
         try:
             relax_constitution(run.constitution())

@@ -20,6 +20,7 @@ import tempfile
 import time
 import warnings
 
+from .._version import __version__
 from .cost import _step_seconds, run_steps
 
 __all__ = ["cache_path", "calibration_key", "measure_calibration", "load_or_measure", "project_cost",
@@ -77,7 +78,7 @@ def calibration_key(p, steps, replicas, host=None, version=None):
     if host is None:
         host = socket.gethostname()
     if version is None:
-        from .. import __version__ as version
+        version = __version__
     config = {k: repr(p.get(k)) for k in _KEY_PARAMETERS}
     config.update(steps=int(steps), replicas=int(replicas))
     digest = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]

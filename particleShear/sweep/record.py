@@ -20,6 +20,8 @@ import hashlib
 import json
 import os
 
+from .._version import __version__
+
 __all__ = ["RECORD_NAME", "canonical_spec", "spec_hash", "spec_changes", "read_record", "write_record",
            "extended_runs", "check_record"]
 
@@ -161,7 +163,6 @@ def write_record(out_dir, segments, docs):
         The same SPECs as documents of their tables with the original value types (from which
         an earlier segment's runs are rebuilt when the folder is extended).
     """
-    from .. import __version__
     rec = {"format": _FORMAT, "package_version": __version__,
            "segments": [{"spec": c, "sha256": spec_hash(c), "doc": d} for c, d in zip(segments, docs)]}
     from .table import atomic_text

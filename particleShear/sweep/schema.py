@@ -28,6 +28,7 @@ __docformat__ = "numpy"
 import json
 import os
 import warnings
+from ..parameters import BY_NAME
 
 __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "results_schema", "column_spec", "write_schema",
            "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
@@ -179,7 +180,6 @@ def _column_spec(name):
     if name in _FIXED:
         kind, unit, text, nullable = _FIXED[name]
         return {"name": name, "type": kind, "unit": unit, "description": text, "nullable": nullable}
-    from ..parameters import BY_NAME
     from .spec import sweep_parameter_defaults
     if name not in sweep_parameter_defaults(protocols=True):
         return {"name": name, "type": "string", "unit": "", "description": "", "nullable": True}

@@ -36,6 +36,7 @@ import numbers
 import os
 
 from ..checks import cut_text, show_value
+from ..parameters import BY_NAME, PARAMETERS
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
@@ -59,7 +60,6 @@ MAX_RUNS = 10 ** 8
 
 @functools.lru_cache(maxsize=2)
 def _defaults(protocols):
-    from ..parameters import PARAMETERS
     return tuple((p.name, p.default) for p in PARAMETERS
                  if p.name not in _RESERVED and p.name not in _NOT_SWEPT and (protocols or p.base_role != "protocol"))
 
@@ -93,7 +93,6 @@ def uses_protocols(names):
     -------
     bool
     """
-    from ..parameters import BY_NAME
     return any(n in BY_NAME and BY_NAME[n].base_role == "protocol" for n in names)
 
 
@@ -171,11 +170,6 @@ class SweepSpec:
         for group in self.zips:
             n *= len(next(iter(group.values())))
         return n
-
-    @property
-    def n_runs(self):
-        """Number of runs: ``n_points · repetitions``."""
-        return self.n_points * self.repetitions
 
 
 def _read_toml(path):

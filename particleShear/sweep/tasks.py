@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from .._version import __version__
 from ..simulation.output import SIDECAR_SUFFIX, run_file_stem
 from .table import atomic_text
 
@@ -112,7 +113,6 @@ def failed_row(task, exc, wall):
     -------
     dict
     """
-    from .. import __version__
     row = {"run_id": task["run_id"], "status": "failed", "error": error_text(exc),
            "repetition": int(task.get("repetition", 0))}
     row.update(task["parameters"])
