@@ -44,8 +44,8 @@ import math
 from .engine.contact_laws import declared_parameters
 from .parameter_entry import KINDS, ROLES, Parameter
 
-__all__ = ["Parameter", "PARAMETERS", "SIGNATURE", "EXTRA", "BY_NAME", "ROLES", "KINDS", "defaults", "names", "law_parameters",
-           "protocol_parameters", "identity_excluded"]
+__all__ = ["Parameter", "PARAMETERS", "SIGNATURE", "EXTRA", "BY_NAME", "ROLES", "KINDS", "defaults", "names",
+           "law_parameters", "SPEC_RESERVED", "spec_defaults", "protocol_parameters", "identity_excluded"]
 
 #: the contact laws of the laws folder: name → (their declared parameters, in the signature or not)
 _LAWS = declared_parameters()
@@ -176,6 +176,30 @@ def names(role=None, batch=None):
     return tuple(p.name for p in PARAMETERS
                  if (role is None or p.role == role or p.base_role == role)
                  and (batch is None or p.batch == batch))
+
+
+#: arguments a sweep SPEC may not set: the sweep chooses them (its folder, its seeds, the result
+#: type, its console)
+SPEC_RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
+
+
+def spec_defaults(protocols=False):
+    """Every parameter that is a sweep's table column, with its default (dict, signature order).
+
+    The parameters less :data:`SPEC_RESERVED` and the observers (a SPEC may set those, but they
+    are columns only where it does); the protocols' own parameters only with ``protocols``.
+
+    Parameters
+    ----------
+    protocols : bool, default False
+        With the protocols' selector and parameters (role ``protocol…``).
+
+    Returns
+    -------
+    dict
+    """
+    return {p.name: p.default for p in PARAMETERS
+            if p.name not in SPEC_RESERVED and p.base_role != "observer" and (protocols or p.base_role != "protocol")}
 
 
 def law_parameters(law):

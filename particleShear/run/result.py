@@ -11,6 +11,7 @@ import numpy as np
 
 from .._version import __version__
 from ..hooks import entry
+from ..parameters import spec_defaults
 from ..simulation.microstructure_pictures import microstructure_pictures
 
 __all__ = ["SimulationResult"]
@@ -321,9 +322,8 @@ class SimulationResult:
         -------
         dict
         """
-        from ..sweep.spec import sweep_parameter_defaults
         from ..simulation.provenance import run_identity
-        params = sweep_parameter_defaults()
+        params = spec_defaults()
         params.update({k: v for k, v in self.parameters.items() if k in params})
         row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
                "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),

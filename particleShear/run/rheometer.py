@@ -32,7 +32,7 @@ import time
 
 import numpy as np
 
-from ..parameters import BY_NAME, PARAMETERS
+from ..parameters import BY_NAME, PARAMETERS, spec_defaults
 from .._version import __version__
 from ..hooks import entry
 from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
@@ -398,8 +398,7 @@ class RheometerResult:
         """
         from ..simulation.provenance import run_identity
         from ..sweep.schema import PROTOCOL_COLUMNS
-        from ..sweep.spec import sweep_parameter_defaults
-        params = sweep_parameter_defaults(protocols=True)
+        params = spec_defaults(protocols=True)
         params.update({k: v for k, v in self.parameters.items() if k in params})
         base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
                 "repetition": int(getattr(self, "repetition", 0)), "dt": float(self.dt)}

@@ -36,7 +36,7 @@ import numbers
 import os
 
 from ..checks import cut_text, show_value
-from ..parameters import BY_NAME, PARAMETERS
+from ..parameters import BY_NAME, PARAMETERS, SPEC_RESERVED, spec_defaults
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
@@ -45,13 +45,13 @@ __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "exp
 SPEC_TABLES = ("parameters", "grid", "zip", "seeds")
 _SEED_KEYS = ("root", "repetitions")
 #: arguments a SPEC may not set: the sweep chooses them
-_RESERVED = ("root_folder", "seed", "return_result", "verbose", "progress")
+_RESERVED = SPEC_RESERVED
 #: keyword options of a run that are not parameters of a sweep by default (no table column unless a
 #: SPEC sets them) and not part of the run identity, with their defaults: the stroboscopic observer
 #: only reads a run (its columns are measure columns, empty where it was off).  A SPEC may set them
 #: in [parameters], [grid] or [[zip]]; a SPEC that does gets a column of that name and the run ids
 #: of the same SPEC without it.
-_NOT_SWEPT = {"stroboscopic": False}
+_NOT_SWEPT = {p.name: p.default for p in PARAMETERS if p.base_role == "observer"}
 #: most parameter points of one SPEC: each is validated before any work (≈ 0.1 ms a point)
 MAX_POINTS = 10_000
 #: most runs of one SPEC (points × repetitions); runs are enumerated lazily, never held all at once
@@ -60,8 +60,7 @@ MAX_RUNS = 10 ** 8
 
 @functools.lru_cache(maxsize=2)
 def _defaults(protocols):
-    return tuple((p.name, p.default) for p in PARAMETERS
-                 if p.name not in _RESERVED and p.name not in _NOT_SWEPT and (protocols or p.base_role != "protocol"))
+    return tuple(spec_defaults(protocols).items())
 
 
 def sweep_parameter_defaults(protocols=False):
