@@ -8,7 +8,9 @@ temporary files and half-published sets would stay behind.  Each command (a run,
 __docformat__ = "numpy"
 import contextlib
 import os
+import re
 import signal
+import socket
 
 __all__ = ["sigterm_raises", "signals_held", "process_gone"]
 
@@ -85,3 +87,36 @@ def process_gone(pid):
     except (PermissionError, OverflowError, ValueError):
         return False
     return False
+
+
+def dead_leftovers(folder, stem=None):
+    """The names in ``folder`` of temporary files or folders that dead processes of this host left.
+
+    A temporary name is ``<stem>.<host>-<pid>-<8 hex digits>.part``, ``stem`` hidden (a leading
+    "."): the package's ``.part`` files and staging folders.  It is left over when its host is
+    this one and no process ``pid`` exists here (:func:`process_gone`; a live process, or another
+    user's, keeps it).
+
+    Parameters
+    ----------
+    folder : str
+        The folder (an unreadable one has none).
+    stem : str, optional
+        The one stem to look for (``".analysis"``); None: any hidden stem (``".results.csv"``, …).
+
+    Returns
+    -------
+    list of str
+        The names, not removed: the caller removes them (a file or a folder).
+    """
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    pattern = re.compile(r"^(?P<stem>\..*)\." + re.escape(socket.gethostname()) + r"-(?P<pid>\d+)-[0-9a-f]{8}\.part$")
+    out = []
+    for name in names:
+        m = pattern.match(name)
+        if m and (stem is None or m.group("stem") == stem) and process_gone(m.group("pid")):
+            out.append(name)
+    return out

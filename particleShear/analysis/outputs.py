@@ -19,13 +19,12 @@ folders of dead processes of this host are removed by the next analysis.
 """
 __docformat__ = "numpy"
 import os
-import re
 import secrets
 import shutil
 import socket
 import stat
 
-from ..signals import process_gone, signals_held
+from ..signals import dead_leftovers, signals_held
 from ..simulation.output import fsync_folder
 
 __all__ = ["LOCK_NAME", "LOCK_WAIT_S", "PublishInterrupted", "check_targets", "make_staging", "publish",
@@ -35,7 +34,6 @@ __all__ = ["LOCK_NAME", "LOCK_WAIT_S", "PublishInterrupted", "check_targets", "m
 LOCK_NAME = "analysis"
 #: seconds an analysis waits for another one of the folder to finish publishing
 LOCK_WAIT_S = 60.0
-_STAGING = re.compile(r"^\.analysis\.(?P<host>.+)-(?P<pid>\d+)-[0-9a-f]{8}\.part$")
 
 
 class PublishInterrupted(Exception):
@@ -122,17 +120,7 @@ def remove_dead_staging(folder):
     list of str
     """
     removed = []
-    try:
-        names = os.listdir(folder)
-    except OSError:
-        return removed
-    host = socket.gethostname()
-    for name in names:
-        m = _STAGING.match(name)
-        if not m or m.group("host") != host:
-            continue
-        if not process_gone(m.group("pid")):
-            continue                     # alive (or another user's): leave it
+    for name in dead_leftovers(folder, ".analysis"):
         shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
         removed.append(name)
     return removed

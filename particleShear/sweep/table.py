@@ -35,7 +35,7 @@ import socket
 import numpy as np
 
 from .reader import escape_cell, read_table
-from ..signals import process_gone
+from ..signals import dead_leftovers
 from ..analysis.measures import MEASURE_COLUMNS
 from ..parameters import BY_NAME, identity_excluded
 from ..simulation.provenance import identity_parameters, same_input
@@ -540,19 +540,8 @@ def remove_dead_temporaries(folder):
     list of str
         The names removed.
     """
-    import re
-    host = socket.gethostname()
     removed = []
-    try:
-        names = os.listdir(folder)
-    except OSError:
-        return removed
-    for name in names:
-        m = re.search(r"-(\d+)-[0-9a-f]{8}\.part$", name)
-        if not (name.startswith(".") and m and name[:m.start()].endswith("." + host)):
-            continue
-        if not process_gone(m.group(1)):
-            continue                              # alive (or another user's): leave it
+    for name in dead_leftovers(folder):
         with contextlib.suppress(OSError):
             os.remove(os.path.join(folder, name))
             removed.append(name)
