@@ -33,6 +33,11 @@ import numpy as np
 from .messages import console_messages
 from .analysis.verdicts import is_flagged  # noqa: F401 - re-exported: the one rule of a flagged row
 from .run.guard import SuggestingParser, command_line_names
+from .analysis.grouping import MODULI_PROTOCOLS, measured_row, row_protocol
+from .analysis.laos import laos
+from .analysis.measures import measured_window
+from .run.validation import check_folder_writable
+from .sweep.reader import read_table
 
 __all__ = ["plot_result", "plot_sweep", "read_sweep_table", "ok_moduli", "cli_main", "save_figure",
            "check_figure_path", "align_zeros", "fit_title", "dodge_factors", "place_labels", "is_flagged",
@@ -261,7 +266,6 @@ def check_figure_path(path, name="path"):
     ImportError
         Without matplotlib (the message names ``name`` and the extra to install).
     """
-    from .run.validation import check_folder_writable
     _figure_format(name, path)
     check_folder_writable(f"{name} folder", os.path.dirname(os.path.abspath(str(path))))
     if not _has_matplotlib():
@@ -442,7 +446,6 @@ def plot_result(result, path=None):
 
 def _lissajous_bowditch(result, elastic, viscous, text):
     """Elastic σ′(γ) and viscous σ″(γ̇) curves of both estimators, and a table of their LAOS ratios."""
-    from .analysis.measures import measured_window
     s = result.series
     try:
         w = measured_window(s["t"], result.f, result.parameters.get("pre_periods", 0),
@@ -512,7 +515,6 @@ def _laos_period_spread(result, window):
     Each whole measured period gets its own LAOS measures (:func:`particleShear.analysis.laos.laos`,
     5 harmonics, as :meth:`SimulationResult.laos`); the error is their standard deviation over √n.
     """
-    from .analysis.laos import laos
     s = result.series
     t, strain = np.asarray(s["t"]), np.asarray(s["strain"])
     f = float(result.f)
@@ -575,7 +577,6 @@ def read_sweep_table(folder_or_csv):
         If there is no such CSV file, or it cannot be read (naming the file; a bad cell also its
         line and column).
     """
-    from .sweep.reader import read_table
     path = str(folder_or_csv)
     if os.path.isdir(path):
         path = os.path.join(path, "results.csv")
@@ -637,7 +638,6 @@ def ok_moduli(rows, estimator="surface"):
     """
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS}")
-    from .analysis.grouping import MODULI_PROTOCOLS, measured_row, row_protocol
     kept, skipped = [], 0
     for row in rows:
         if str(row.get("status", "")).strip() != "ok" or row_protocol(row) not in MODULI_PROTOCOLS:
@@ -726,7 +726,6 @@ def plot_sweep(folder_or_csv, estimator="surface", path=None, *, x=None, split=T
         from .rheometer_plot import plot_flow_curve_sweep
         return plot_flow_curve_sweep(folder_or_csv, estimator, path, n_boot=n_boot, confidence=confidence,
                                      bootstrap_seed=bootstrap_seed)
-    from .analysis.grouping import MODULI_PROTOCOLS, row_protocol
     if rows and not any(row_protocol(r) in MODULI_PROTOCOLS for r in rows):
         found = sorted({row_protocol(r) for r in rows})
         raise ValueError(f"folder_or_csv={str(folder_or_csv)!r} holds runs of protocol(s) {found}, no G′ and G″ to "

@@ -32,6 +32,9 @@ __docformat__ = "numpy"
 import numpy as np
 
 from .plot import _figure, check_figure_path, fit_title, made_by, save_figure
+from .analysis.flow_curve import fit_flow_curve, flow_curve_table
+from .analysis.sweep import _vector
+from .sweep.schema import load_results
 
 __all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_sweeps", "plot_steady_run",
            "plot_rheometer_result", "plot_flow_curve_sweep"]
@@ -39,7 +42,6 @@ __all__ = ["plot_flow_curve", "plot_relaxation", "plot_creep", "plot_amplitude_s
 
 def _series(name, values, n=None):
     """``values`` as a 1-d finite float array (of length ``n`` if given); ValueError naming ``name``."""
-    from .analysis.sweep import _vector
     a = _vector(name, values)
     if n is not None and len(a) != n:
         raise ValueError(f"{name} is invalid: length {len(a)}, must equal the length {n} of the data")
@@ -501,8 +503,6 @@ def plot_flow_curve_sweep(folder_or_csv, estimator="surface", path=None, n_boot=
     import os
     import warnings
 
-    from .analysis.flow_curve import fit_flow_curve, flow_curve_table
-    from .sweep.schema import load_results
     src = os.fspath(folder_or_csv)
     table = load_results(src, as_frame=False)
     rate, stress = flow_curve_table(table, estimator)

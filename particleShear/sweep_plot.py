@@ -47,9 +47,12 @@ import warnings
 
 import numpy as np
 
-from .analysis.sweep import DEFAULT_SEED
+from .analysis.sweep import DEFAULT_SEED, N_BOOT_MAX, sweep_summary
 from .plot import (ESTIMATORS, FLAGGED_LABEL, _figure, _float, dodge_factors, fit_title, group_of, is_flagged,
                    made_by, ok_moduli)
+from .analysis.grouping import short_value
+from .simulation.provenance import IDENTITY_EXCLUDED
+from .sweep.spec import sweep_parameter_defaults
 
 __all__ = ["sweep_panels", "draw_sweep", "figure_stem", "X_ALIASES", "MIN_SEEDS", "MAX_PANELS"]
 
@@ -94,7 +97,6 @@ def _value(text):
 
 
 def _show(v):
-    from .analysis.grouping import short_value
     return f"{v:g}" if isinstance(v, float) else short_value(v)
 
 
@@ -103,15 +105,12 @@ def _sort_key(v):
 
 
 def _parameter_columns(header):
-    from .simulation.provenance import IDENTITY_EXCLUDED
-    from .sweep.spec import sweep_parameter_defaults
     # the protocol parameters too: in a table of several protocols the protocol (and what it reads) splits
     # panels; rows are read as particleShear.analysis.grouping.measured_row rewrites them
     return [c for c in sweep_parameter_defaults(protocols=True) if c in header and c not in IDENTITY_EXCLUDED]
 
 
 def _check_settings(n_boot, confidence, bootstrap_seed, max_panels):
-    from .analysis.sweep import N_BOOT_MAX
     if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or not 1 <= n_boot <= N_BOOT_MAX:
         raise ValueError(f"n_boot={n_boot!r} is out of range: allowed an integer >= 1 and <= {N_BOOT_MAX}")
     if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real) or not 0 < confidence < 1:
@@ -256,7 +255,6 @@ def sweep_panels(rows, estimator="surface", x=None, split=True, n_boot=2000, con
                  "n": np.array([len(pts[v]) for v in xs]),
                  "flagged": np.array([sum(p[2] for p in pts[v]) for v in xs])}
             if kind == "bootstrap":
-                from .analysis.sweep import sweep_summary
                 long = [(v, gp, gpp) for v in xs for gp, gpp, _ in pts[v]]
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", UserWarning)   # one seed: said by draw_sweep's warning

@@ -52,8 +52,21 @@ import zlib
 
 import numpy as np
 
-from ..run.guard import SuggestingParser
-from .sweep import DEFAULT_SEED
+from ..run.guard import SuggestingParser, command_line_names
+from .sweep import CHARACTERISTICS, DEFAULT_SEED, FLAGS, MIN_POINT_AMPLITUDES, N_BOOT_MAX, sweep_summary
+from ..experiment.measured import main as measured_main
+from ..plot import ESTIMATORS, _float, _has_matplotlib, is_flagged, ok_moduli, read_sweep_table
+from ..run.rheometer import PROTOCOL_DEFAULTS
+from ..signals import sigterm_raises
+from ..simulation.provenance import IDENTITY_EXCLUDED
+from ..sweep.locks import FolderBusyError
+from ..sweep.spec import sweep_parameter_defaults
+from ..sweep.table import atomic_text, row_line
+from .figure import MAX_FIGURE_PANELS, not_drawn_line, plot_analysis
+from .grouping import MODULI_PROTOCOLS, SUMMARY_PROTOCOLS, measured_row, row_protocol, short_value
+from .outputs import PublishInterrupted, check_targets, make_staging, publish
+from .protocol_summary import protocol_summaries, summary_columns
+from .verdicts import counts_note, verdict_counts
 
 __all__ = [
     "OUTPUT_ONLY",
@@ -134,9 +147,6 @@ def build_parser():
         Positional ``DIR``; options ``--estimator {surface,internal}``, ``--json``, ``--n-boot N``,
         ``--confidence C``, ``--seed S`` (values checked by :func:`main`), ``--no-figure``.
     """
-    from ..plot import ESTIMATORS
-    from .figure import MAX_FIGURE_PANELS
-    from .sweep import N_BOOT_MAX
     p = _Parser(prog=_PROG, description="Characteristics of a sweep folder's amplitude sweeps (plateau, linear "
                                         "limits, flow point, the R package's four points) with bootstrap intervals "
                                         "over the seeds. Reads DIR/results.csv, writes DIR/analysis.csv, "
@@ -167,7 +177,6 @@ def _number_flag(flag, text, kind):
         if not 0 < value < 1:
             raise _UsageError(f"{flag}={text!r} is out of range: allowed a number in (0, 1)")
         return value
-    from .sweep import N_BOOT_MAX
     low = 1 if kind == "n_boot" else 0
     allowed = f"allowed an integer >= {low}" + (f" and <= {N_BOOT_MAX} (n_boot)" if kind == "n_boot" else "")
     try:
@@ -180,7 +189,6 @@ def _number_flag(flag, text, kind):
 
 
 def _short(text):
-    from .grouping import short_value
     return short_value(text, 40)
 
 
@@ -206,8 +214,6 @@ def grouping_columns(header):
         parameters included) in the header, less ``theAmplitude``, the inputs that change neither
         the physics nor the output and :data:`OUTPUT_ONLY`.
     """
-    from ..simulation.provenance import IDENTITY_EXCLUDED
-    from ..sweep.spec import sweep_parameter_defaults
     return [c for c in sweep_parameter_defaults(protocols=True) if c in header and c != _AMPLITUDE
             and c not in IDENTITY_EXCLUDED and c not in OUTPUT_ONLY]
 
@@ -247,7 +253,6 @@ def group_runs(rows, estimator="surface"):
     ValueError
         If ``estimator`` is not one of the two, or the table has no ``theAmplitude`` column.
     """
-    from ..plot import is_flagged, ok_moduli
     kept, skipped = ok_moduli(rows, estimator)
     header = list(rows[0]) if rows else []
     if rows and _AMPLITUDE not in header:
@@ -272,7 +277,6 @@ def group_runs(rows, estimator="surface"):
 
 def _made(rows, columns):
     """``{column: value}`` of the columns that hold one number in every ``ok`` row (for a figure's title)."""
-    from ..plot import _float
     made = {}
     for c in columns:
         values = {_float(r.get(c)) for r in rows if r.get("status") == "ok" and c in r}
@@ -284,8 +288,6 @@ def _made(rows, columns):
 def _count_verdicts(rows, names, cells):
     """Each group's ``n_flagged``, ``n_failed`` and ``flags`` (check → count) over every row of its
     parameters, whatever its status (:func:`particleShear.analysis.verdicts.verdict_counts`)."""
-    from .grouping import MODULI_PROTOCOLS, measured_row, row_protocol
-    from .verdicts import verdict_counts
     members = {}
     for row in rows:
         if row_protocol(row) not in MODULI_PROTOCOLS:
@@ -309,7 +311,6 @@ def analysis_columns(varying):
     dict
         ``{column: (type, unit, description)}``; type one of "str", "int", "float".
     """
-    from .sweep import CHARACTERISTICS, FLAGS
     cols = {"group": _HEAD_COLUMNS["group"]}
     for name in varying:
         cols[name] = ("str", "", (f"parameter {name} of doParticleShearSimulation (docs/parameters.md), as in "
@@ -328,7 +329,6 @@ def analysis_columns(varying):
 
 
 def _label(parameters, varying):
-    from .grouping import short_value
     shown = ", ".join(f"{n}={short_value(parameters[n])}" for n in varying if parameters.get(n, "") != "")
     if shown:
         return shown
@@ -339,7 +339,6 @@ def _label(parameters, varying):
 def _stream_label(parameters):
     """The text a group's bootstrap stream is derived from: its parameters, less the protocol
     columns an oscillatory run does not have (its stream is that of a table without protocols)."""
-    from ..run.rheometer import PROTOCOL_DEFAULTS
     return "\x1f".join(f"{k}={v}" for k, v in sorted(parameters.items())
                         if not (k in PROTOCOL_DEFAULTS and v in ("", "oscillatory")))
 
@@ -347,7 +346,6 @@ def _stream_label(parameters):
 def _summarise(group, n_boot, confidence, rng):
     """(SweepSummary or None, notes) of one group."""
 
-    from .sweep import MIN_POINT_AMPLITUDES, sweep_summary
     notes = []
     n_amp = len(set(group["amplitude"]))
     if n_amp < 2:
@@ -378,7 +376,6 @@ def _floats(a):
 
 
 def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
-    from .sweep import CHARACTERISTICS
     row = {"group": _label(group["parameters"], varying)}
     row.update({n: group["parameters"][n] for n in varying})
     row.update({"estimator": estimator, "n_runs": len(group["amplitude"]), "n_flagged": group.get("n_flagged", 0),
@@ -395,7 +392,6 @@ def _row(group, varying, summary, notes, estimator, n_boot, confidence, seed):
                 row[name + suffix] = math.nan
             row[name + "_defined"] = 0.0
             row[name + "_flag"] = "too_few_amplitudes"
-    from .verdicts import counts_note
     counted = counts_note(len(group["amplitude"]), group.get("n_failed", 0), group.get("n_flagged", 0),
                           group.get("flags", {}))
     row["note"] = "; ".join(([counted] if counted else []) + list(notes))
@@ -406,9 +402,6 @@ def _check_settings(estimator, n_boot, confidence, seed, figure, max_figure_pane
     """The arguments of :func:`analyse_folder`, before any work (ValueError naming the parameter and its flag)."""
     import numbers
 
-    from ..plot import ESTIMATORS
-    from .figure import MAX_FIGURE_PANELS
-    from .sweep import N_BOOT_MAX
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of {ESTIMATORS} (CLI --estimator)")
     if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or not 1 <= n_boot <= N_BOOT_MAX:
@@ -427,7 +420,6 @@ def _check_settings(estimator, n_boot, confidence, seed, figure, max_figure_pane
 
 
 def _write_csv(path, columns, rows):
-    from ..sweep.table import atomic_text, row_line
     with atomic_text(path) as fh:
         fh.write(row_line({c: c for c in columns}, list(columns)))
         for r in rows:
@@ -436,7 +428,6 @@ def _write_csv(path, columns, rows):
 
 
 def _write_schema(path, name, description, columns, generation, settings):
-    from ..sweep.table import atomic_text
     schema = {"file": name, "description": description, "empty_cell": "undefined value (NaN)",
               "generation": generation, "settings": settings,
               "columns": {c: {"type": t, "unit": u, "description": d} for c, (t, u, d) in columns.items()}}
@@ -500,11 +491,6 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     import shutil
 
 
-    from ..plot import _has_matplotlib, read_sweep_table
-    from .figure import MAX_FIGURE_PANELS, not_drawn_line
-    from .grouping import SUMMARY_PROTOCOLS, row_protocol
-    from .outputs import check_targets, make_staging, publish
-    from .protocol_summary import protocol_summaries, summary_columns
     if max_figure_panels is None:
         max_figure_panels = MAX_FIGURE_PANELS
     _check_settings(estimator, n_boot, confidence, seed, figure, max_figure_panels)
@@ -560,7 +546,6 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
             names += [PROTOCOLS_NAME, PROTOCOLS_SCHEMA_NAME]
         if figure and panels:
             if _has_matplotlib():
-                from .figure import plot_analysis
                 fig = plot_analysis(panels, estimator=estimator, max_panels=max_figure_panels,
                                     made=_made(rows, ("N", "relative_frequency")))
                 for ext in (".png", ".pdf"):
@@ -688,7 +673,6 @@ def main(argv=None):
     import signal
     argv = sys.argv[1:] if argv is None else list(argv)
     if _measured_files(argv):       # particleShear analyse FILE…: measured rheometer files
-        from ..experiment.measured import main as measured_main
         return measured_main(argv)
     parser = build_parser()
     try:
@@ -699,15 +683,11 @@ def main(argv=None):
     except _UsageError as exc:
         print(f"{_PROG}: invalid parameter: {exc}", file=sys.stderr)
         return 2
-    from ..sweep.locks import FolderBusyError
-    from .outputs import PublishInterrupted
-    from ..signals import sigterm_raises
     try:
         with sigterm_raises(_Terminated):
             result = analyse_folder(args.folder, estimator=args.estimator, n_boot=n_boot, confidence=confidence,
                                     seed=seed, figure=args.figure)
     except ValueError as exc:   # named as the user typed it: DIR, --seed, --n-boot
-        from ..run.guard import command_line_names
         text = command_line_names(exc, parser, {"folder_or_csv": "folder", "bootstrap_seed": "seed"})
         print(f"{_PROG}: {' '.join(text.split())}", file=sys.stderr)
         return 2

@@ -13,6 +13,7 @@ import math
 import numbers
 
 import numpy as np
+from ..simulation.formats import read_run
 
 __all__ = ["demodulate", "jump_corrected", "measurement_periods", "evaluate_run", "PHASES",
            "ESTIMATOR_COLUMNS"]
@@ -188,7 +189,6 @@ def measurement_periods(t, f, pre_periods, periods):
 def _protocol_of(run):
     """(series dict with 't' and both stresses, f, γ₀, pre, periods) of a result, RunData or path."""
     if isinstance(run, (str, bytes)) or hasattr(run, "__fspath__"):
-        from ..simulation.formats import read_run
         run = read_run(run)
     if hasattr(run, "strain_amplitude") and hasattr(run, "header"):       # RunData
         series = {"t": run["t"]} if "t" in run else {}

@@ -13,6 +13,7 @@ __docformat__ = "numpy"
 import math
 
 import numpy as np
+from ..plot import FLAGGED_LABEL, _figure, fit_title, made_by, place_labels, save_figure
 
 __all__ = ["MARKERS", "MAX_FIGURE_PANELS", "not_drawn_line", "plot_analysis"]
 
@@ -56,7 +57,6 @@ def _panel(ax, title, s, notes, flagged=()):
     The labels of the characteristic points are not drawn here: :func:`plot_analysis` places them
     after the layout, without overlap (:func:`particleShear.plot.place_labels`).
     """
-    from ..plot import FLAGGED_LABEL
     A = np.asarray(s.amplitudes, float)
     said = list(notes)
     positive = [v for arr in (s.Gp_mean, s.Gpp_mean, s.Gp_ci.ravel(), s.Gpp_ci.ravel()) for v in np.ravel(arr)
@@ -186,7 +186,6 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
     ImportError
         Without matplotlib (names the ``[plot]`` extra).
     """
-    from ..plot import _figure, save_figure
     panels = list(panels)
     if not panels:
         raise ValueError("panels=[] is invalid: allowed at least one (title, summary, notes)")
@@ -220,7 +219,6 @@ def plot_analysis(panels, estimator="surface", path=None, max_panels=MAX_FIGURE_
             handles.setdefault(label, h)
     for ax in axes[n:]:
         ax.set_axis_off()
-    from ..plot import fit_title, made_by, place_labels
     what = f"{confidence:.0%} bootstrap intervals over seeds" if confidence is not None else "no summary"
     made = made or {}
     rate = f"f·τ = {made['relative_frequency']:g}" if "relative_frequency" in made else None

@@ -11,6 +11,9 @@ import numpy as np
 
 from .demodulation import ESTIMATOR_COLUMNS, measurement_periods
 from .microstructure import MICRO_COLUMNS
+from .laos import laos
+from .periods import FALSE_ALARM, measured_period_count, period_moduli
+from .verdicts import baseline_noise, oscillatory_checks, verdict
 
 __all__ = ["MEASURE_COLUMNS", "NON_NUMERIC_MEASURES", "MEASURE_N_MAX", "MeasurementWarning", "empty_measures", "run_measures", "measured_window", "warn_few_periods"]
 
@@ -48,7 +51,6 @@ def warn_few_periods(periods):
     bool
         True when it warned.
     """
-    from .periods import measured_period_count
     n = measured_period_count(0, periods)
     if n >= 2:
         return False
@@ -127,9 +129,6 @@ def run_measures(series, f, strain_amplitude, pre_periods, periods, moduli=None)
     dict
         Column → value (float; checks bool or None; ``verdict`` str).
     """
-    from .laos import laos
-    from .periods import FALSE_ALARM, period_moduli
-    from .verdicts import baseline_noise, oscillatory_checks, verdict
     row = empty_measures()
     if not series or "t" not in series or len(series["t"]) == 0 or not f:
         return row

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from ..engine.microstructure import TRANSIENT_CYCLES, irreversibility
+from .sweep import sweep_summary
 
 __all__ = ["MICRO_COLUMNS", "ONSET_THRESHOLD", "micro_measures", "irreversibility_onset", "onset_summary",
            "onset_figure"]
@@ -170,7 +171,6 @@ def onset_summary(amplitude, Gp, Gpp, irr, threshold=ONSET_THRESHOLD, n_boot=200
         "linear_limit_10": ``(estimate, low, high)`` from
         :func:`~particleShear.analysis.sweep.sweep_summary`; "summary": the SweepSummary.
     """
-    from .sweep import sweep_summary
     onset = irreversibility_onset(amplitude, irr, threshold, n_boot, confidence, rng)
     summ = sweep_summary(amplitude, Gp, Gpp, n_boot=n_boot, confidence=confidence, rng=rng)
     out = {"onset": onset, "summary": summ}

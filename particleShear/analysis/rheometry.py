@@ -16,6 +16,7 @@ import collections
 import math
 
 import numpy as np
+from .sweep import _vector
 
 __all__ = ["BlockAverage", "SteadyState", "block_average", "transient_end", "steady_state", "log_grid", "plateau",
            "final_rate"]
@@ -26,7 +27,6 @@ SteadyState = collections.namedtuple("SteadyState", "mean sem t_transient i_tran
 
 def _series(name, x):
     """``x`` as a finite 1-D float array (the sweep analysis's check; ValueError naming ``name``)."""
-    from .sweep import _vector
     return _vector(name, x)
 
 

@@ -39,7 +39,8 @@ import warnings
 
 import numpy as np
 
-from .curves import CURVE_POINTS
+from .curves import CURVE_POINTS, stress_curve_points, yield_point
+from .periods import t_critical
 
 __all__ = ["CHARACTERISTICS", "CURVE_COLUMNS", "DEFAULT_SEED", "FLAGS", "MIN_POINT_AMPLITUDES", "MODULUS_NAMES",
            "N_BOOT_MAX", "POINT_NAMES", "SCALAR_NAMES", "SweepSummary", "modulus_interval", "sweep_summary"]
@@ -355,7 +356,6 @@ def _curve_characteristics(A, Gp, Gpp, guesses=(0.01, 0.1)):
     amplitudes ``A`` ascending) and their censoring (int8, same shape: +1 beyond the largest amplitude, −1
     below the smallest, 0 not censored); ``guesses`` = (guess_softening_strain, guess_soft_plateau_strain)
     of the R rules.  A censored strain is the end of the range; the G′, G″ of a censored yield point NaN."""
-    from .curves import stress_curve_points, yield_point
     B = len(Gp)
     names = list(CHARACTERISTICS)
     col = {name: i for i, name in enumerate(names)}
@@ -518,7 +518,6 @@ def _student_factor(count, confidence):
     mean the exact t interval for normal runs (1 for n = 1: nothing to widen).
     """
     from statistics import NormalDist
-    from .periods import t_critical
     alpha = 1.0 - confidence
     z = NormalDist().inv_cdf(1.0 - alpha / 2.0)
     return np.array([1.0 if c < 2 else math.sqrt(c / (c - 1.0)) * t_critical(int(c) - 1, alpha) / z

@@ -32,6 +32,8 @@ __docformat__ = "numpy"
 import math
 
 import numpy as np
+from .periods import t_critical
+from .rheometry import final_rate, plateau as plateau_mean
 
 __all__ = ["CHECKS", "PROTOCOL_CHECKS", "VERDICT_COLUMNS", "LINEAR_I3_I1", "AGREEMENT_TOLERANCE",
            "SIGNAL_TO_NOISE_MIN", "PLATEAU_FRACTION", "PLATEAU_RELATIVE_CHANGE", "PLATEAU_FALSE_ALARM",
@@ -311,8 +313,6 @@ def plateau_check(t, y, fraction=PLATEAU_FRACTION):
     bool or None
         None for fewer than 10 finite samples in the window.
     """
-    from .periods import t_critical
-    from .rheometry import final_rate
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(t) & np.isfinite(y)
@@ -405,7 +405,6 @@ def relaxation_checks(t_hold, G, strain, residual_stress):
     dict
         ``plateau_reached`` (every estimator), ``strain_above_noise`` (every estimator).
     """
-    from .rheometry import plateau as plateau_mean
     flags = [plateau_check(t_hold, g) for g in G.values()]
     plat = None if any(f is None for f in flags) or not flags else all(flags)
     above = []

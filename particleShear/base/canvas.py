@@ -20,6 +20,7 @@ from ..engine.memory import tune_allocator
 from ..checks import finite as _check_finite, non_negative as check_non_negative, positive as _check_positive
 from .register import Force_register, SphereSelection, record_method
 from .stability import StabilityGuard
+from .neighbours import STATE_CODES
 
 
 __all__ = ["CanvasPoints", "CanvasPointsMass", "CanvasPointsNeighbors", "CanvasPointsShear",
@@ -221,7 +222,6 @@ class CanvasPoints:
         own = sphere.__dict__.get("_own_neighbors")
         if not own or not hasattr(self, "_pairs"):
             return
-        from .neighbours import STATE_CODES
         p = sphere.__dict__["_idx"]
         pending = []
         for rel in own:

@@ -10,6 +10,7 @@ from .register import Force_register
 from .relations import neighbor_relation
 
 from .points import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
+from .graphics import Graphical_output_configuration
 
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]
 
@@ -44,7 +45,6 @@ class Circle(PointLeesEdwards):
         self.theCanvas = theCanvas
         self.r = diameter / 2
         self.doDrawing, self.shape, self.color = doDrawing, None, color
-        from .graphics import Graphical_output_configuration
         self.graphical_output_configuration = Graphical_output_configuration()
 
     def set_graphical_output_configuration(self, graphical_output_configuration):

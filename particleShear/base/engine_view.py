@@ -10,6 +10,8 @@ __docformat__ = "numpy"
 import numpy as np
 
 from ..engine.guard import transient_ratios
+from ..engine.state import BatchState
+from ..engine.step import BatchEngine
 
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
 
@@ -47,8 +49,6 @@ class EngineStep:
 
     def _new_engine(self):
         """A new engine on the ensemble's state (the half kick of the one it replaces carried over)."""
-        from ..engine.state import BatchState
-        from ..engine.step import BatchEngine
         half = self._half_kick
         self._drop_engine()
         integrator = getattr(self, "integrator", "euler")

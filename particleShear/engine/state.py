@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from .xp import get_backend
+from .xp import get_backend, to_host
 
 #: the per-sphere fields of a documented ensemble's state block (fields × spheres) and their defaults;
 #: rows advanced or gathered together sit next to each other: (x, y, phi) are moved by
@@ -527,7 +527,6 @@ class BatchState:
         target = get_backend(backend)
         if target is self.backend:
             return self
-        from .xp import to_host
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp

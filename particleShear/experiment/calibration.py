@@ -47,6 +47,10 @@ import sys
 import numpy as np
 
 from .tables import MeasuredTest
+from ..analysis.sweep import N_BOOT_MAX, _student_factor, _widen_log
+from ..run.guard import SuggestingParser
+from ..sweep.table import write_table
+from .readers import read_rheometer
 
 __all__ = ["ASSUMPTIONS", "RANKING_COLUMNS", "Calibration", "calibrate", "measured_curve", "main"]
 
@@ -86,7 +90,6 @@ RANKING_COLUMNS = {
 # checks and curves
 # ---------------------------------------------------------------------------------------------
 def _check(measured, estimator, n_boot, confidence, seed):
-    from ..analysis.sweep import N_BOOT_MAX
     if estimator not in ("surface", "internal"):
         raise ValueError(f"estimator={estimator!r} is invalid: allowed one of ('surface', 'internal')")
     if isinstance(n_boot, bool) or not isinstance(n_boot, (int, np.integer)) or not 1 <= n_boot <= N_BOOT_MAX:
@@ -175,7 +178,6 @@ def _mismatch_and_scale(m, s):
 
 def _boot_means(values_per_x, n_boot, rng, confidence):
     """Bootstrap means (B, n) of the runs at each x, Student-widened as sweep_summary widens them."""
-    from ..analysis.sweep import _student_factor, _widen_log
     means = np.array([np.mean(v) for v in values_per_x])
     boot = np.empty((n_boot, len(values_per_x)))
     for j, v in enumerate(values_per_x):
@@ -247,7 +249,6 @@ class Calibration:
         -------
         str
         """
-        from ..sweep.table import write_table
         path = os.fspath(path)
         write_table(path, self.rows, self.columns())
         return path
@@ -318,7 +319,6 @@ def calibrate(measured, sweep_dir, estimator="surface", n_boot=1000, seed=0, con
     # measured replicates: resampled whole, their means Student-widened per grid amplitude
     m_mean = reps.mean(axis=0)
     if R > 1:
-        from ..analysis.sweep import _student_factor, _widen_log
         idx = rng.integers(0, R, size=(n_boot, R))
         m_boot = reps[idx].mean(axis=1)                         # (B, 2, ng)
         factor = _student_factor([R] * reps.shape[2], confidence)
@@ -396,7 +396,6 @@ def calibrate(measured, sweep_dir, estimator="surface", n_boot=1000, seed=0, con
 # ---------------------------------------------------------------------------------------------
 def _read_measured(path):
     """The amplitude sweeps of a measured file (:func:`particleShear.experiment.readers.read_rheometer`)."""
-    from .readers import read_rheometer
     got = read_rheometer(path)
     tests = [got] if isinstance(got, MeasuredTest) else list(got)
     sweeps = [t for t in tests if t.kind == "amplitude_sweep"]
@@ -407,7 +406,6 @@ def _read_measured(path):
 
 def build_parser():
     """Parser of ``particleShear calibrate``."""
-    from ..run.guard import SuggestingParser
     p = SuggestingParser(prog="particleShear calibrate",
                          description="Rank the grid points of a simulated campaign (sweep folder DIR) by how well "
                                      "their normalised amplitude sweeps (G'/G'_p, G''/G'_p against the strain "

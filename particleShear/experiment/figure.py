@@ -16,6 +16,8 @@ import math
 import numpy as np
 
 from .tables import MeasuredTest
+from ..analysis.sweep import sweep_summary
+from ..plot import _figure, _has_matplotlib, check_figure_path, fit_title, save_figure
 
 __all__ = ["plot_comparison", "plot_calibration"]
 
@@ -30,7 +32,6 @@ _SCALED = ("Gp", "Gpp", "stress", "G")
 
 
 def _need_matplotlib():
-    from ..plot import _has_matplotlib
     if not _has_matplotlib():
         raise ImportError('particleShear.experiment.figure needs matplotlib: pip install "particleShear[plot]"')
 
@@ -107,10 +108,8 @@ def plot_comparison(measured=(), simulated=(), scale=1.0, path=None, title=None,
     if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
         raise ValueError(f"scale={scale!r} is invalid: allowed a finite number > 0")
     if path is not None:
-        from ..plot import check_figure_path
         check_figure_path(path)
     _need_matplotlib()
-    from ..plot import _figure, fit_title, save_figure
     kinds = [k for k in _PANELS if any(t.kind == k for t in tests)]
     fig = _figure(max(6.5, 4.6 * len(kinds)), 4.4)
     axes = fig.subplots(1, len(kinds), squeeze=False)[0]
@@ -154,7 +153,6 @@ def _sweep_band(reps, y, factor, n_boot, seed):
     """Mean and sweep_summary interval of G′ or G″ of replicate amplitude sweeps (pooled per amplitude)."""
     import warnings
 
-    from ..analysis.sweep import sweep_summary
     A = np.concatenate([t["strain_amplitude"] for t in reps])
     gp = np.concatenate([t["Gp"] * factor for t in reps])
     gpp = np.concatenate([t["Gpp"] * factor for t in reps])

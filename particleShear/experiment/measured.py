@@ -30,6 +30,13 @@ import sys
 import warnings
 
 import numpy as np
+from ..analysis.flow_curve import herschel_bulkley_bootstrap
+from ..analysis.laos import laos
+from ..analysis.rheometry import final_rate, plateau
+from ..analysis.sweep import CHARACTERISTICS, sweep_summary
+from ..sweep.table import atomic_text, row_line
+from .readers import read_rheometer
+from .tables import KINDS
 
 __all__ = ["ANALYSIS_COLUMNS", "amplitude_sweep_summary", "analyse_files", "analyse_tests", "creep_summary",
            "flow_curve_fit", "frequency_sweep_table", "main", "measured_laos", "relaxation_summary"]
@@ -107,7 +114,6 @@ def amplitude_sweep_summary(tests, n_boot=2000, confidence=0.95, rng=0, rtol=0.0
     ValueError
         A test of another kind, or as ``sweep_summary``.
     """
-    from ..analysis.sweep import sweep_summary
     tests = _tests_of(tests, "amplitude_sweep")
     rtol = _check_rtol(rtol)
     A = np.concatenate([t["strain_amplitude"] for t in tests])
@@ -176,7 +182,6 @@ def measured_laos(test, f=None, n_max=15):
     ValueError
         Not a laos test, no frequency known, or as ``laos``.
     """
-    from ..analysis.laos import laos
     test = _tests_of(test, "laos")[0]
     if f is None:
         if "omega" in test.meta:
@@ -210,7 +215,6 @@ def flow_curve_fit(tests, n_boot=2000, confidence=0.95, rng=0, rtol=0.02):
     particleShear.analysis.flow_curve.FlowCurveFit
         σ_y (Pa), K (Pa·sⁿ), n with intervals.
     """
-    from ..analysis.flow_curve import herschel_bulkley_bootstrap
     tests = _tests_of(tests, "flow_curve")
     rtol = _check_rtol(rtol)
     rates = _pool(np.concatenate([t["shear_rate"] for t in tests]), rtol)
@@ -243,7 +247,6 @@ def relaxation_summary(test, fraction=0.2):
         ``G_plateau`` and ``G_plateau_se`` (Pa; blocked mean and standard error), ``G_initial``
         (Pa, G at the first time), ``t_first``, ``t_last`` (s), ``n_points``.
     """
-    from ..analysis.rheometry import plateau
     test = _tests_of(test, "relaxation")[0]
     t, G = test["time"], test["G"]
     ba = plateau(t, G, fraction)
@@ -270,7 +273,6 @@ def creep_summary(test, fraction=0.2):
         ``strain_plateau``, ``strain_plateau_se`` (1, :func:`~particleShear.analysis.rheometry.plateau`),
         ``compliance_final`` (1/Pa, last strain / stress; NaN without a stress), ``stress`` (Pa).
     """
-    from ..analysis.rheometry import final_rate, plateau
     test = _tests_of(test, "creep")[0]
     t, g = test["time"], test["strain"]
     s0 = float(test.meta.get("stress", math.nan))
@@ -293,7 +295,6 @@ def _row(tests, quantity, value, unit, lo=math.nan, hi=math.nan, flag="ok"):
 
 def _analyse_group(tests, n_boot, confidence, seed):
     """Rows and notes of one group of tests of one kind."""
-    from ..analysis.sweep import CHARACTERISTICS
     kind, rows, notes = tests[0].kind, [], []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UserWarning)
@@ -397,7 +398,6 @@ def analyse_tests(tests, pool=False, n_boot=2000, confidence=0.95, seed=0):
 
 
 def _write(path, rows):
-    from ..sweep.table import atomic_text, row_line
     cols = list(ANALYSIS_COLUMNS)
     with atomic_text(path) as fh:
         fh.write(row_line({c: c for c in cols}, cols))
@@ -439,7 +439,6 @@ def analyse_files(paths, out=None, kind=None, units=None, pool=False, n_boot=200
     ValueError
         As :func:`~.readers.read_rheometer` and the analyses.
     """
-    from .readers import read_rheometer
     read = [(p, read_rheometer(p, kind=kind, units=units)) for p in paths]
     if out is not None:
         os.makedirs(out, exist_ok=True)
@@ -497,7 +496,6 @@ def main(argv):
     import argparse
     import json
 
-    from .tables import KINDS
     p = argparse.ArgumentParser(prog="particleShear analyse", description="Analyse measured rheometer files "
                                 "(RheoCompass, TRIOS, RepTate, CSV/TSV): a summary per test with units, written "
                                 "to FILE_analysis.csv next to each file or into --out.")

@@ -43,6 +43,12 @@ import sys
 import numpy as np
 
 from .tables import KINDS, MeasuredTest
+from ..analysis.grouping import measured_row, row_protocol
+from ..run.guard import SuggestingParser
+from ..run.result import SimulationResult
+from ..run.rheometer import RheometerResult
+from ..simulation.formats import RunData, read_run
+from ..sweep.table import atomic_text
 
 __all__ = ["FORMATS", "REPTATE_TYPES", "PYRHEO_COLUMNS", "reptate_text", "pyrheo_text", "write_reptate",
            "write_pyrheo", "tests_from_sweep", "tests_from_result", "export", "main"]
@@ -218,7 +224,6 @@ def pyrheo_text(test):
 
 
 def _write(path, text):
-    from ..sweep.table import atomic_text
     path = os.fspath(path)
     folder = os.path.dirname(path)
     if folder:
@@ -354,7 +359,6 @@ def tests_from_sweep(folder, estimator="surface"):
     """
     _check_estimator(estimator)
     from ..analysis.cli import grouping_columns
-    from ..analysis.grouping import measured_row, row_protocol
     from ..plot import ok_moduli, read_sweep_table
     rows = read_sweep_table(folder)
     notes = list(getattr(rows, "notes", []) or [])
@@ -413,7 +417,6 @@ def tests_from_sweep(folder, estimator="surface"):
             notes.append(f"run {row.get('run_id', '')}: its file {row['output_path']} is not there: left out")
             continue
         try:
-            from ..simulation.formats import read_run
             data = read_run(path)
             tests += tests_from_result(data, estimator=estimator,
                                        meta={"name": os.path.basename(path), "run_id": row.get("run_id", ""),
@@ -453,9 +456,6 @@ def tests_from_result(result, estimator="surface", meta=None):
         An unknown estimator or result type, or a result without what its kind needs.
     """
     _check_estimator(estimator)
-    from ..run.rheometer import RheometerResult
-    from ..run.result import SimulationResult
-    from ..simulation.formats import RunData
     meta = dict(meta or {}, estimator=estimator)
     if isinstance(result, RunData):
         params = dict(result.metadata.get("parameters") or {})
@@ -575,7 +575,6 @@ def export(folder, format="reptate", out=None, estimator="surface"):
 
 def build_parser():
     """Parser of ``particleShear export``."""
-    from ..run.guard import SuggestingParser
     p = SuggestingParser(prog="particleShear export",
                          description="Write a sweep folder's results as RepTate files (.osc per frequency sweep, .gt, "
                                      ".creep, .shear, .laos per run waveform) or pyRheo tables (tab-delimited, "

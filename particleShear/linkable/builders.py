@@ -10,6 +10,7 @@ import numpy as np
 from ..checks import finite, in_range, integer, non_negative, positive
 from ..objects.model import particle_shear_model_parameters
 from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
+from ..engine.relax import relax_ensembles
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
@@ -111,7 +112,6 @@ class Relaxation:
 
     def run(self):
         """Relax this ensemble alone in the engine (:func:`particleShear.engine.relax.relax_ensembles`)."""
-        from ..engine.relax import relax_ensembles
         relax_ensembles([self.ensemble], self.N)
 
     def __repr__(self):

@@ -16,6 +16,7 @@ from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
 from .canvas import CanvasPointsLinkable, EnsembleLinkable
 from .spheres import SphereLinkableAdjustableInterfaceStrength
+from ..engine.relax import relax_ensembles
 
 __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
            "component_labels"]
@@ -99,7 +100,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         ValueError
             If ``dt`` is not > 0 or ``N`` < 0 (before any step).
         """
-        from ..engine.relax import relax_ensembles
         relax_ensembles([self], N)
 
     def _labels(self, physical_neighbors_only=True):

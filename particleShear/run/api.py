@@ -22,6 +22,7 @@ from .batch import check_batch_size, measure_batch
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 from ..parameters import PARAMETERS
+from ..simulation.drawing import _backend_choice, display_available
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -434,7 +435,6 @@ def _save_headless_stress_plot(result, renderer):
     """Without a display the live stress window cannot open: save its content instead, as
     ``<output file>_stress.png`` (trace and Lissajous loop, needs matplotlib; skipped without it)."""
     import importlib.util
-    from ..simulation.drawing import _backend_choice, display_available
     if _backend_choice(renderer) in ("auto", "tk") and display_available()[0]:
         return  # the live window was shown
     if importlib.util.find_spec("matplotlib") is None:

@@ -29,6 +29,9 @@ from ..parameters import defaults as _defaults
 from ..parameters import names as _names
 from ..simulation.driver import ENGINE_SKIN_FACTOR, _guarded, measure_sessions, pre_equilibrated, replica_record
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
+from ..engine.xp import get_backend
+from ..simulation.provenance import run_identity
+from ..simulation.simulations import RunSession
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
@@ -68,7 +71,6 @@ def check_backend(backend):
         For an unknown name (naming ``backend``, its value and the allowed values), or for
         ``"cupy"`` without CuPy or without a CUDA device.
     """
-    from ..engine.xp import get_backend
     get_backend(backend)
 
 
@@ -288,8 +290,6 @@ def build_sessions(runs):
     sessions : list of RunSession
         One session per run, in order.
     """
-    from ..simulation.provenance import run_identity
-    from ..simulation.simulations import RunSession
     from .api import _build_simulation, _seed_sequence
     from .validation import contact_law_spec
 

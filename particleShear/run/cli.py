@@ -30,8 +30,18 @@ import time
 from .._version import __version__
 from .guard import SuggestingParser, shorten_values
 from ..signals import sigterm_raises
-from .validation import IMAGE_FILE_TYPES
+from .validation import IMAGE_FILE_TYPES, validate_run
 from ..parameters import BY_NAME, PARAMETERS
+from ..analysis.cli import main as analyse_main
+from ..analysis.verdicts import CHECKS, verdict_lines
+from ..base.stability import SimulationInstabilityError
+from ..experiment.calibration import main as calibrate_main
+from ..experiment.writers import main as export_main
+from ..plot import check_figure_path, cli_main
+from ..sweep.cli import main as sweep_main
+from ..sweep.progress import RemainingTime
+from ..sweep.schema import column_spec
+from .api import doParticleShearSimulation
 
 __all__ = ["main", "console_main", "build_parser", "ProgressLine", "PARAMETER_FLAGS", "cli_message", "parameter_docs",
            "flag_name", "api_kwargs", "NOT_FLAGS"]
@@ -111,7 +121,7 @@ def parameter_docs(func=None):
     dict
     """
     if func is None:
-        from .api import doParticleShearSimulation as func
+        func = doParticleShearSimulation
     lines = inspect.cleandoc(func.__doc__ or "").splitlines()
     try:
         i = next(k for k in range(len(lines) - 1) if lines[k].strip() == "Parameters"
@@ -307,7 +317,6 @@ class ProgressLine:
     """
 
     def __init__(self, stream=None, clock=time.perf_counter):
-        from ..sweep.progress import RemainingTime
         self.stream = stream if stream is not None else sys.stderr
         self.clock = clock
         self.t0 = clock()
@@ -515,19 +524,14 @@ def main(argv=None):
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["plot"]:
-        from ..plot import cli_main
         return cli_main(argv[1:])
     if argv[:1] == ["sweep"]:  # python -m particleShear sweep SPEC --out DIR (particleShear.sweep.cli)
-        from ..sweep.cli import main as sweep_main
         return sweep_main(argv[1:])
     if argv[:1] in (["analyse"], ["analyze"]):  # python -m particleShear analyse DIR (particleShear.analysis.cli)
-        from ..analysis.cli import main as analyse_main
         return analyse_main(argv[1:])
     if argv[:1] == ["export"]:  # particleShear export DIR --format reptate|pyrheo (particleShear.experiment.writers)
-        from ..experiment.writers import main as export_main
         return export_main(argv[1:])
     if argv[:1] == ["calibrate"]:  # particleShear calibrate MEASURED DIR (particleShear.experiment.calibration)
-        from ..experiment.calibration import main as calibrate_main
         return calibrate_main(argv[1:])
     if argv[:1] == ["run"]:
         argv = argv[1:]
@@ -543,9 +547,6 @@ def main(argv=None):
         typed.setdefault("saveData", "--save")
     if "images" in typed:
         typed.setdefault("saveOutputImages", "--images")
-    from .api import doParticleShearSimulation
-    from .validation import validate_run
-    from ..base.stability import SimulationInstabilityError
     try:
         kw = api_kwargs(args)
     except ValueError as exc:
@@ -572,7 +573,6 @@ def main(argv=None):
                   f"{exc.strerror or exc}", file=sys.stderr)
             return 2
     if args.plot:
-        from ..plot import check_figure_path
         try:
             check_figure_path(args.plot, name="--plot")
         except (ValueError, ImportError) as exc:
@@ -612,7 +612,6 @@ def main(argv=None):
     if args.json:
         print(_json_row(res))
     elif not hasattr(res, "G_internal"):     # another protocol than "oscillatory" (docs/protocols.md)
-        from ..sweep.schema import column_spec
 
         def unit(name):   # the unit of the results.csv column of the same name (docs/protocols.md)
             u = column_spec(name).get("unit") or ""
@@ -620,7 +619,6 @@ def main(argv=None):
 
         def shown(items):
             return "  ".join(f"{k} = {v:.6g}{unit(k)}" if isinstance(v, float) else f"{k} = {v}" for k, v in items)
-        from ..analysis.verdicts import CHECKS, verdict_lines
         for st in res.steps:
             print(shown((k, st[k]) for k in ("position", "amplitude", "relative_frequency", "Gp_surface",
                                              "Gp_surface_se", "Gpp_surface", "Gpp_surface_se", "Gp_internal",
@@ -635,7 +633,6 @@ def main(argv=None):
     else:
         print(f"G'  = {res.G_internal[0]} Pa   G'' = {res.G_internal[1]} Pa   (internal estimator)")
         print(f"G'  = {res.G_surface[0]} Pa   G'' = {res.G_surface[1]} Pa   (surface estimator)")
-        from ..analysis.verdicts import verdict_lines
         print("\n".join(verdict_lines(res.measures)))
         t = res.timings
         print("seed entropy = " + str(res.seed) + "; wall time " + ", ".join(

@@ -13,6 +13,12 @@ from .._version import __version__
 from ..hooks import entry
 from ..parameters import spec_defaults
 from ..simulation.microstructure_pictures import microstructure_pictures
+from ..analysis.demodulation import ESTIMATOR_COLUMNS
+from ..analysis.laos import laos
+from ..analysis.measures import empty_measures, measured_window, run_measures
+from ..analysis.microstructure import micro_measures
+from ..analysis.verdicts import verdict_lines
+from ..simulation.provenance import run_identity
 
 __all__ = ["SimulationResult"]
 
@@ -155,7 +161,6 @@ class SimulationResult:
 
     def _verdict_lines(self):
         """:func:`~particleShear.analysis.verdicts.verdict_lines` of the run; none when its measures fail."""
-        from ..analysis.verdicts import verdict_lines
         try:
             return verdict_lines(self.measures)
         except Exception:  # noqa: BLE001 - a repr never fails
@@ -188,14 +193,12 @@ class SimulationResult:
         (:func:`~particleShear.analysis.measures.run_measures`; docs/analysis.md)."""
         if self._measures is None:
             import warnings
-            from ..analysis.measures import empty_measures, run_measures
             p = self.parameters or {}
             try:
                 self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0),
                                               p.get("pre_periods", 0), p.get("periods", 0),
                                               moduli={"surface": self.G_surface, "internal": self.G_internal})
                 if self.microstructure is not None:
-                    from ..analysis.microstructure import micro_measures
                     self._measures.update(micro_measures(self.microstructure))
             except Exception as exc:  # noqa: BLE001 - a measure must never turn a finished run into a failure
                 warnings.warn(f"the measures of run {self.run_id or '?'} could not be evaluated "
@@ -247,9 +250,6 @@ class SimulationResult:
             For another estimator, a result without its series, or a measured span shorter than
             one period.
         """
-        from ..analysis.demodulation import ESTIMATOR_COLUMNS
-        from ..analysis.laos import laos
-        from ..analysis.measures import measured_window
         if estimator not in ESTIMATOR_COLUMNS:
             raise ValueError(f"estimator={estimator!r} is not allowed: use 'surface' or 'internal'")
         key = ESTIMATOR_COLUMNS[estimator][1]
@@ -322,7 +322,6 @@ class SimulationResult:
         -------
         dict
         """
-        from ..simulation.provenance import run_identity
         params = spec_defaults()
         params.update({k: v for k, v in self.parameters.items() if k in params})
         row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",

@@ -34,6 +34,8 @@ from ..parameters import BY_NAME, PARAMETERS
 from ..parameters import defaults as _defaults
 from ..simulation.formats import check_output_format
 from .batch import check_backend, check_run_backend
+from ..analysis.measures import warn_few_periods
+from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 
 __all__ = ["validate_run", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
            "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
@@ -570,7 +572,6 @@ def validate_run(params):
     defaults = _defaults()
     unknown = sorted(set(params) - set(defaults))
     if unknown:
-        from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
         near = {n: close_names(n, list(defaults), hints=PARAMETER_ALIASES) for n in unknown}
         guess = "; ".join(f"{n}: did you mean {' or '.join(s)}?" for n, s in near.items() if s)
         raise UnknownParameterError(f"unknown parameters {unknown}{': ' + guess if guess else ''} (allowed the "
@@ -609,7 +610,6 @@ def validate_run(params):
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
-    from ..analysis.measures import warn_few_periods
     if p["protocol"] in ("oscillatory", "amplitude_sweep", "frequency_sweep"):
         warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
     return cost

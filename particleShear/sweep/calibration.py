@@ -21,7 +21,11 @@ import time
 import warnings
 
 from .._version import __version__
-from .cost import _step_seconds, run_steps
+from .cost import _human_s, _step_seconds, run_seconds, run_steps
+from ..analysis.measures import MeasurementWarning
+from ..run.api import doParticleShearSimulation
+from ..run.batch import run_batch, schedule_key
+from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps
 
 __all__ = ["cache_path", "calibration_key", "measure_calibration", "load_or_measure", "project_cost",
            "format_projection", "representative_point", "MIN_SPREAD", "CALIBRATION_BUDGET_S"]
@@ -100,7 +104,6 @@ def representative_point(points, counts):
     dict
         One of ``points`` (the first one when every count is 0).
     """
-    from .cost import run_seconds
     best, best_cost = points[0], -1.0
     for p, n in zip(points, counts):
         c = int(n) * run_seconds(p)
@@ -122,7 +125,6 @@ def _shortened(p, steps, root):
     if proto == "oscillatory":
         per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
         return dict(p, pre_periods=0, post_periods=0, periods=min(float(p["periods"]), steps / per_period), **view)
-    from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps
     q = normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p})
     st = protocol_steps(q)
     dtr = st["dt_over_tau"]
@@ -147,7 +149,6 @@ def _calibration_runs(run):
     a period, no baseline): a warning about those values would name values the user never set.
     The user's own values were checked, and warned about, when the sweep was expanded.
     """
-    from ..analysis.measures import MeasurementWarning
 
     def quiet(arg):
         with warnings.catch_warnings():
@@ -208,12 +209,10 @@ def _assemble(p, replicas, budget_s, items, why=None):
 
 
 def _default_run(kw):
-    from ..run.api import doParticleShearSimulation
     return doParticleShearSimulation(**dict(kw, return_result=True))
 
 
 def _default_batch(kws):
-    from ..run.batch import run_batch
     return run_batch(kws)
 
 
@@ -456,7 +455,7 @@ def project_cost(points, counts, cal, workers=1, batch_size=None, cores=None, sc
     samples = [(c, f) for c, f in zip(cal["per_step_s"], cal["fixed_s"])]
     mid = sorted(range(len(samples)), key=lambda i: cal["single_s"][i])[len(samples) // 2]
     if schedule is None and batch_size:
-        from ..run.batch import schedule_key as schedule
+        schedule = schedule_key
     groups = {}
     for i, (p, n) in enumerate(zip(points, counts)):
         if int(n) > 0:
@@ -506,7 +505,6 @@ def format_projection(c, workers, batch_size=None):
     -------
     str
     """
-    from .cost import _human_s
     batched = f", batches of up to {batch_size}" if batch_size else ""
     return (f"calibrated here: ~{_human_s(c['cpu_s'])} CPU = ~{_human_s(c['wall_s'])} wall "
             f"(range {_human_s(c['wall_low_s'])} – {_human_s(c['wall_high_s'])}) on {c['parallel']} of {workers} "

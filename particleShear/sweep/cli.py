@@ -8,6 +8,12 @@ import sys
 from ..messages import console_messages
 from ..run.guard import SuggestingParser, shorten_values
 from ..signals import sigterm_raises
+from .calibration import (CALIBRATION_BUDGET_S, cache_path, format_projection, load_or_measure, project_cost,
+                          representative_point)
+from .cost import format_cost
+from .locks import FolderBusyError
+from .pool import SweepTerminated
+from .runner import Sweep
 
 _log = logging.getLogger(__name__)
 
@@ -90,7 +96,6 @@ EXIT_STATUS = {"ok": 0, "runs failed": 1, "invalid input": 2, "folder busy": 3, 
 
 def _sigterm_stops_the_sweep():
     """SIGTERM (a scheduler's walltime, ``kill``) stops the sweep at once: workers killed, rows kept, 143."""
-    from .pool import SweepTerminated
     return sigterm_raises(SweepTerminated)
 
 
@@ -115,9 +120,6 @@ def _dask_client(args, workers, stack):
 
 
 def _main(args):
-    from .locks import FolderBusyError
-    from .pool import SweepTerminated
-    from .runner import Sweep
     try:
         _positive("workers", "--workers", args.workers)
         _positive("batch_size", "--batch-size", args.batch_size)
@@ -178,15 +180,12 @@ def _kept(sweep, args):
 
 
 def _dry_run(args, sweep, workers):
-    from .cost import format_cost
     _log.info(f"sweep {args.spec}: {sweep.spec.n_points} points x {sweep.spec.repetitions} repetitions")
     all_c, todo_c = sweep.cost(workers), sweep.cost(workers, pending_only=True)
     _log.info("all runs:   " + format_cost(all_c) + " [static model]")
     _log.info("still to run: " + format_cost(todo_c) + " [static model]")
     if args.no_calibrate or not hasattr(sweep.runs, "points"):
         return 0
-    from .calibration import (CALIBRATION_BUDGET_S, cache_path, format_projection, load_or_measure, project_cost,
-                              representative_point)
     points = sweep.runs.points
     counts = sweep._point_counts()
     todo = sweep._point_counts(sweep._classify()[0].values())

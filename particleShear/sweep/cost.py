@@ -14,6 +14,8 @@ import math
 
 from ..linkable.builders import time_steps_from_model
 from ..simulation.experiment import protocol_steps
+from ..run.api import doParticleShearSimulation
+from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps as steps_of
 
 __all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "estimate_point_cost", "format_cost"]
 
@@ -46,8 +48,6 @@ def run_steps(p):
     """
     proto = p.get("protocol") or "oscillatory"
     if proto != "oscillatory":
-        from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol
-        from ..run.rheometer import protocol_steps as steps_of
         st = steps_of(normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p}))
         return int(sum(st["segments"])) if "segments" in st else int(st["steps"])
     dt, _ = time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"],
@@ -215,7 +215,6 @@ def calibrate(p, target_steps=2000):
         Measured wall time divided by the projected one (1 = the documented costs hold here).
     """
     import time
-    from ..run.api import doParticleShearSimulation
     per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
     short = dict(p, pre_periods=0, post_periods=0, periods=min(1.0, target_steps / per_period), saveData=False,
                  saveOutputImages=False, doDrawing=False, plotStress=False)

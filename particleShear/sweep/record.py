@@ -21,6 +21,8 @@ import json
 import os
 
 from .._version import __version__
+from ..simulation.provenance import identity_parameters, run_identity
+from .table import atomic_text
 
 __all__ = ["RECORD_NAME", "canonical_spec", "spec_hash", "spec_changes", "read_record", "write_record",
            "extended_runs", "check_record"]
@@ -165,7 +167,6 @@ def write_record(out_dir, segments, docs):
     """
     rec = {"format": _FORMAT, "package_version": __version__,
            "segments": [{"spec": c, "sha256": spec_hash(c), "doc": d} for c, d in zip(segments, docs)]}
-    from .table import atomic_text
     with atomic_text(os.path.join(out_dir, RECORD_NAME)) as fh:   # a temporary name per process: tasks race
         json.dump(rec, fh, indent=1)
 
@@ -224,7 +225,6 @@ def extended_runs(segment_specs, segment_runs):
         indexed (spawn key) on from the runs before them.
     """
     import dataclasses
-    from ..simulation.provenance import identity_parameters, run_identity
     seen = set()
     out = []
     for spec, runs in zip(segment_specs, segment_runs):

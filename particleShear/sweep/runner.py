@@ -36,11 +36,15 @@ from .pool import pool_context, run_jobs
 from .progress import SweepProgress
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
-from .schema import typed_row, write_schema
+from .schema import SCHEMA_NAME, typed_row, write_schema
 from .table import (REJECTED_SUFFIX, TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
                     remove_dead_temporaries, row_problem, sort_table, table_columns, task_table_name,
                     write_parquet, write_table)
 from .tasks import execute_batch, execute_run
+from ..run.batch import batches, check_backend
+from ..simulation.formats import run_file_identity, verify_run
+from ..simulation.output import sidecar_path
+from ..simulation.provenance import identity_parameters
 
 __all__ = ["Sweep", "SweepOutcome", "run_sweep", "execute_run", "execute_batch", "SweepProgress", "FolderBusyError"]
 
@@ -111,7 +115,6 @@ def _spec_doc(spec):
 
 def _run_key(run):
     """What makes two runs of a folder's segments one run (:func:`~.record.extended_runs`)."""
-    from ..simulation.provenance import identity_parameters
     return json.dumps(identity_parameters(run.parameters), sort_keys=True), run.repetition, run.seed_entropy
 
 
@@ -170,7 +173,6 @@ class Sweep:
         else:
             self.spec = load_spec(spec)
         if backend is not None:
-            from ..run.batch import check_backend
             try:
                 check_backend(backend)
             except ValueError as exc:
@@ -261,7 +263,6 @@ class Sweep:
 
     def _written_paths(self):
         """Every fixed path a sweep writes, replaces or cleans in ``DIR``: none may be a symbolic link."""
-        from .schema import SCHEMA_NAME
         out = self.out_dir
         tables = {self.table_path, os.path.join(out, TABLE_NAME)} | set(self._tables())
         paths = [os.path.join(out, "runs"), os.path.join(out, RECORD_NAME), os.path.join(out, RECORD_NAME + ".lock"),
@@ -300,17 +301,12 @@ class Sweep:
             return "its row names no file"
         name = os.path.basename(path)
         full = os.path.join(self.out_dir, name)   # always in DIR, never elsewhere
-        from ..simulation.output import sidecar_path
         side = sidecar_path(full)
         for p in (full, side, full + ".json"):
             if os.path.islink(p):
                 return f"{os.path.basename(p)} is a symbolic link (to {os.readlink(p)}), not a file of this sweep"
         if not os.path.isfile(full):
             return f"its file {name} is missing"
-        try:
-            from ..simulation.formats import run_file_identity, verify_run
-        except ImportError:  # pragma: no cover - formats without verification
-            return None if os.path.getsize(full) > 0 else f"its file {name} is empty"
         try:
             meta = verify_run(full)
             header = run_file_identity(full)
@@ -455,7 +451,6 @@ class Sweep:
             for r in todo:
                 yield [self._task(r, keep_series, scratch_dir)]
             return
-        from ..run.batch import batches
         while True:
             chunk = list(itertools.islice(todo, _BATCH_CHUNK))
             if not chunk:

@@ -10,6 +10,13 @@ import os
 from .pool import pool_context, run_jobs
 from .runner import Sweep
 from .table import TABLE_NAME, table_columns
+from ..analysis.measures import MEASURE_COLUMNS, NON_NUMERIC_MEASURES
+from ..analysis.microstructure import MICRO_COLUMNS
+from ..run.api import SimulationResult
+from ..run.batch import batches
+from ..run.rheometer import RheometerResult, normalize_protocol
+from ..simulation.provenance import run_identity
+from .spec import SweepRun, sweep_parameter_defaults, uses_protocols
 
 __all__ = ["run_series", "series_parameters"]
 
@@ -31,15 +38,12 @@ def _from_runs(runs, out_dir):
 def _result_from_rows(rows, run, out_dir):
     """A light result of a run finished in an earlier call, from its typed rows (moduli or the protocol's
     values, measures, time scales, parameters, seed, path; no series)."""
-    from ..run.api import SimulationResult
     row = rows[0]
     path = os.path.join(out_dir, os.path.basename(row["output_path"])) if row.get("output_path") else None
     if run.parameters.get("protocol", "oscillatory") != "oscillatory":
-        from ..run.rheometer import RheometerResult
         res = RheometerResult.from_rows(rows, run.parameters, run.seed_entropy, run.spawn_key, path)
         res.repetition = run.repetition
         return res
-    from ..analysis.measures import NON_NUMERIC_MEASURES, MEASURE_COLUMNS
     g = tuple(_number(row.get(c)) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
     result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
                               parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
@@ -47,7 +51,6 @@ def _result_from_rows(rows, run, out_dir):
                               output_path=path,
                               dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
                               N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
-    from ..analysis.microstructure import MICRO_COLUMNS
     # (an empty microstructure cell stays None: not evaluated, as the run without the observer reports it)
     result._measures = {c: (row.get(c) if c in NON_NUMERIC_MEASURES or (c in MICRO_COLUMNS and row.get(c) is None)
                             else _number(row.get(c))) for c in MEASURE_COLUMNS}
@@ -76,8 +79,6 @@ def series_parameters(kwargs):
     -------
     dict
     """
-    from ..run.rheometer import normalize_protocol
-    from .spec import sweep_parameter_defaults, uses_protocols
     given = {n: v for n, v in kwargs.items() if n not in ("root_folder", "seed", "verbose")}
     if not uses_protocols(given):          # the oscillatory series: its table keeps its columns
         return dict(sweep_parameter_defaults(), **given)
@@ -113,8 +114,6 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
     RuntimeError
         If any run failed (after all have finished), naming the first failed run.
     """
-    from ..simulation.provenance import run_identity
-    from .spec import SweepRun
     runs = []
     for k, kw in enumerate(all_kwargs):
         ss = kw["seed"]
@@ -146,7 +145,6 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         if batch_size is None:
             jobs = [[t] for t in tasks]
         else:
-            from ..run.batch import batches
             jobs = [[tasks[i] for i in g] for g in batches([r.parameters for r in runs], batch_size)]
         n_workers = min(max_workers or os.cpu_count() or 1, len(jobs))
         for job, outcomes in run_jobs(jobs, executor=executor, workers=n_workers,

@@ -37,6 +37,8 @@ import os
 
 from ..checks import cut_text, show_value
 from ..parameters import BY_NAME, PARAMETERS, SPEC_RESERVED, spec_defaults
+from ..run.guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
+from ..simulation.provenance import run_identity
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
@@ -362,7 +364,6 @@ def _scalar(where, v, name=None):
 
 def _known(where, name, known):
     if name not in known:
-        from ..run.guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
         if name in _RESERVED:
             raise UnknownParameterError(f"{where}.{name} is not a parameter a SPEC may set: the sweep sets it "
                                         "itself", name=name)
@@ -423,7 +424,6 @@ def _parse_spec(doc, source):
     for table in doc:
         if table not in SPEC_TABLES:
             raise ValueError(f"SPEC table [{cut_text(str(table))}] is unknown: allowed {', '.join(SPEC_TABLES)}")
-    from ..run.guard import PARAMETER_ALIASES
     known = dict(sweep_parameter_defaults(protocols=True), **_NOT_SWEPT)
     seen = {}
 
@@ -545,7 +545,6 @@ class SweepRuns:
             k += n
         if not 0 <= k < n:
             raise IndexError(f"run index {k} is out of range: the sweep has {n} runs")
-        from ..simulation.provenance import run_identity
         rep, p = divmod(int(k), len(self.points))
         params = self.points[p]
         return SweepRun(index=int(k), point=p, repetition=rep, parameters=params, seed_entropy=self.root,

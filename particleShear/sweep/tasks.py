@@ -20,6 +20,8 @@ import numpy as np
 from .._version import __version__
 from ..simulation.output import SIDECAR_SUFFIX, run_file_stem
 from .table import atomic_text
+from ..run import api
+from ..run.batch import run_batch
 
 __all__ = ["execute_run", "execute_batch", "failed_row", "publish", "error_text"]
 
@@ -140,7 +142,6 @@ def execute_run(task):
         ``(row, result)``: the results-table row (dict) and the SimulationResult, or None
         when the run failed before its moduli were known.
     """
-    from ..run import api
     t0 = time.perf_counter()
     run_dir = None
     try:
@@ -225,7 +226,6 @@ def execute_batch(tasks):
     list of tuple
         ``(row, result or None)`` per task, in the given order.
     """
-    from ..run.batch import run_batch
     t0 = time.perf_counter()
     prepared = []
     try:
