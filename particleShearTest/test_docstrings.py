@@ -122,6 +122,7 @@ PENDING_SECTION_SIGNS = set()
 ENGINE_MODULES = [
     "particleShear.base",
     "particleShear.base.canvas",
+    "particleShear.base.canvas_base",
     "particleShear.base.pair_canvas",
     "particleShear.base.elastic_canvas",
     "particleShear.base.engine_view",
@@ -131,6 +132,7 @@ ENGINE_MODULES = [
     "particleShear.base.memo",
     "particleShear.base.neighbours",
     "particleShear.base.points",
+    "particleShear.base.point_base",
     "particleShear.base.circles",
     "particleShear.base.elastic_circles",
     "particleShear.base.register",

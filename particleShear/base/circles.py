@@ -9,7 +9,7 @@ from ..engine.integrate import kick
 from .register import Force_register
 from .relations import neighbor_relation
 
-from .points import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
+from .point_base import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
 from .graphics import Graphical_output_configuration
 
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]

@@ -6,9 +6,9 @@ per-term methods (``elastic_force_from_neighbors()`` …) are 1.0.2's loops over
 __docformat__ = "numpy"
 from ..engine.integrate import kick, shift_flow
 from ..engine.step import BatchEngine
-from .points import _check_finite
+from ..checks import finite as _check_finite
 
-from .canvas import NonNegative, check_time_step
+from .canvas_base import NonNegative, check_time_step
 from .pair_canvas import CanvasPointsShear
 
 __all__ = ["CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards", "CanvasPointsFrictionElasticityLeesEdwards"]

@@ -17,7 +17,7 @@ from ..engine.integrate import damp, kick, xi_increments
 from ..engine.terms import (elastic_term, normal_speed, pair_forces, tangential_term, term_constants, viscous_term)
 from .laws import elastic_force_law
 from .circles import Circle, CircleMassNeighbors
-from .points import ArrayField, Point, PointLeesEdwards, _one, _with
+from .point_base import ArrayField, Point, PointLeesEdwards, _one, _with
 
 __all__ = ["CircleBasicElasticity", "CircleFrictionElasticity"]
 

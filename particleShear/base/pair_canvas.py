@@ -6,9 +6,9 @@ from ..engine.integrate import kick, mobile_mask, plates_follow
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
 
-from .canvas import CanvasPointsMass
+from .canvas_base import CanvasPointsMass
 from .engine_view import EngineStep
-from .points import PointLeesEdwards
+from .point_base import PointLeesEdwards
 
 __all__ = ["CanvasPointsNeighbors", "CanvasPointsShear"]
 

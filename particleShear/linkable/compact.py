@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..base.canvas import check_non_negative
+from ..base.canvas_base import check_non_negative
 from ..checks import in_range
 from ..engine.box import min_image
 from ..engine.graph import adjacency, component_labels, connected_without_edge

@@ -8,7 +8,7 @@ __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
 from ..engine import callbacks as _engine_callbacks
 from ..engine.box import inside_half_cell
-from ..base.points import ArrayField, _one
+from ..base.point_base import ArrayField, _one
 from ..checks import non_negative
 from ..base.relations import RelationView, neighbor_relation
 from ..objects.spheres import SphereFrictionLeesEdwards

@@ -1,0 +1,508 @@
+"""The first canvases: the ensemble's state arrays, ``sphereList``, mass and force register (docs/design.md,
+"The documented classes").
+
+The pair canvases of :mod:`.pair_canvas` and the force canvases of :mod:`.elastic_canvas` subclass
+:class:`CanvasPointsMass`; :mod:`.canvas` gathers all of them.
+"""
+__docformat__ = "numpy"
+
+import math
+from operator import attrgetter
+
+import numpy as np
+
+from .fields import FIELDS, ROW
+from .graphics import Graphical_output_configuration
+from ..engine.box import flow_velocity, inside_cell, wrap
+from ..engine.forces import pair_roles
+from ..engine.integrate import damp, drift, kick, remove_mean_velocity
+from .memo import Memo
+from ..engine.memory import tune_allocator
+from ..checks import finite as _check_finite, non_negative as check_non_negative, positive as _check_positive
+from .register import Force_register, SphereSelection, record_method
+from .stability import StabilityGuard
+from .neighbours import STATE_CODES
+
+
+__all__ = ["CanvasPoints", "CanvasPointsMass", "SphereList", "check_non_negative", "check_time_step"]
+
+#: a sphere farther than this many cell lengths outside the cell has diverged (or was misplaced)
+MAX_CELLS_OUTSIDE = 1000
+
+
+def check_time_step(dt, step=None):
+    """Raise ValueError unless the time step ``dt`` (s) is a finite number > 0 (not a bool).
+
+    Parameters
+    ----------
+    dt : float
+    step : int or None
+        Current step, named in the message.
+    """
+    if isinstance(dt, bool) or not 0.0 < dt < math.inf:
+        where = "" if step is None else f" at step {step}"
+        raise ValueError(f"dt={dt!r} is out of range{where}: allowed a finite time step > 0 (s)")
+
+
+class NonNegative:
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu); only assignment is checked."""
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __set__(self, obj, value):
+        check_non_negative(self.name, value)
+        obj.__dict__[self.name] = value
+
+
+class SphereList(list):
+    """The ensemble's spheres in index order; they can only be added (else ``TypeError``).
+
+    Parameters
+    ----------
+    canvas : CanvasPoints
+        The ensemble that owns the list.
+    """
+
+    def __init__(self, canvas):
+        list.__init__(self)
+        self._canvas = canvas
+
+    def append(self, sphere):
+        """Add a sphere, moving its state into the ensemble's arrays (ValueError if already in one or invalid).
+
+        Parameters
+        ----------
+        sphere : Sphere
+        """
+        self._canvas._attach(sphere)
+        list.append(self, sphere)
+
+    def extend(self, spheres):
+        """Append every sphere of ``spheres`` in order.
+
+        Parameters
+        ----------
+        spheres : iterable of Sphere
+        """
+        for s in spheres:
+            self.append(s)
+
+    def __iadd__(self, spheres):
+        self.extend(spheres)
+        return self
+
+    def _forbidden(self, *args, **kwargs):
+        """Raise TypeError: spheres cannot be removed, replaced or reordered once in an ensemble.
+
+        Parameters
+        ----------
+        *args, **kwargs
+            Ignored.
+        """
+        raise TypeError("spheres cannot be removed, replaced or reordered once in an ensemble")
+
+    insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
+
+
+# ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
+_max_reduce = np.maximum.reduce
+_min_reduce = np.minimum.reduce
+
+
+class CanvasPoints:
+    """Periodic cell of ``size_x × size_y`` µm holding spheres in structure-of-arrays form.
+
+    Parameters
+    ----------
+    size_x, size_y : float
+        Cell size Lx, Ly (µm), finite and > 0 (else ValueError).
+    theCanvas : object or bool
+        Tk canvas of the live window (False when none).
+    doDrawing : bool
+        Whether the spheres are drawn.
+    """
+
+    use_lees_edwards = False
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False):
+        _check_positive("size_x", size_x)
+        _check_positive("size_y", size_y)
+        tune_allocator()
+        self.theCanvas = theCanvas
+        self.size_x = size_x
+        self.size_y = size_y
+        self.doDrawing = doDrawing
+        self._n = 0
+        self._set_capacity(0)
+        self._sphereList = SphereList(self)
+        self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
+        self._rng = np.random.default_rng()
+        self._renderer = None
+        self._memo = Memo()   # every value kept between calls
+        self._pos_version = 0
+        self._params_version = 0
+        self.graphical_output_configuration = Graphical_output_configuration()
+
+    # -- sphere list and state arrays ----------------------------------------------------------
+    @property
+    def sphereList(self):
+        """The spheres in index order (a :class:`SphereList`); assignable only while the ensemble is empty."""
+        return self._sphereList
+
+    @sphereList.setter
+    def sphereList(self, spheres):
+        if len(self._sphereList):
+            raise TypeError("sphereList can only be assigned while the ensemble is empty")
+        self._sphereList.extend(spheres)
+
+    def set_random_generator(self, rng):
+        """Use ``rng`` for every random choice of this ensemble (the run seeds it).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+        """
+        self._rng = rng
+
+    def _set_capacity(self, cap):
+        """(Re)allocate the state block: one row per field of FIELDS, one column per sphere slot."""
+        block = np.zeros((len(FIELDS), cap))
+        old = getattr(self, "_block", None)
+        if old is not None:
+            block[:, :self._n] = old[:, :self._n]
+        self._block = block
+        self._cap = cap
+        self._views()
+
+    def _fit_block(self):
+        """Drop the state block's spare columns (kept for appends): contiguous ``_pos``, ``_vel``, ``_frc`` rows."""
+        if self._cap != self._n:
+            self._set_capacity(self._n)
+
+    def _views(self):
+        """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
+        st = self._block[:, :self._n]
+        self._st = st
+        self._block_version = getattr(self, "_block_version", 0) + 1     # a key of what depends on the block
+        self._a = {name: st[k] for k, name in enumerate(FIELDS)}
+        x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
+        self._pos = st[x:x + 2]
+        self._vel = st[vx:vx + 3]
+        self._frc = st[fx:fx + 3]
+
+    def _attach(self, sphere):
+        if sphere.__dict__.get("_ens") is not None:
+            raise ValueError("sphere is already in an ensemble; a sphere can be appended to one ensemble only")
+        for name in ("x", "y", "xspeed", "yspeed"):
+            _check_finite(name, getattr(sphere, name))
+        _check_positive("r", getattr(sphere, "r", 1.0))
+        _check_positive("m", getattr(sphere, "m", 1.0))
+        n = self._n
+        if n == self._cap:
+            self._set_capacity(max(16, 2 * self._cap))
+        cls = type(sphere)
+        self._m_given.append(getattr(sphere, "m", 1.0))
+        col = self._block[:, n]
+        for name, default in FIELDS.items():
+            col[ROW[name]] = float(getattr(sphere, name) if hasattr(cls, name) else default)
+        self._n = n + 1
+        self._views()
+        d = sphere.__dict__
+        d.update(_ens=self, _idx=n)
+        for name in FIELDS:
+            d.pop("_v_" + name, None)
+        self._params_changed()
+        self._invalidate_neighbours()
+        self._adopt_relations(sphere)
+
+    def _adopt_relations(self, sphere):
+        """Move relations made before appending (e.g. links) into the pair table once both spheres are in."""
+        own = sphere.__dict__.get("_own_neighbors")
+        if not own or not hasattr(self, "_pairs"):
+            return
+        p = sphere.__dict__["_idx"]
+        pending = []
+        for rel in own:
+            partner = rel.theSphere
+            if partner.__dict__.get("_ens") is not self:
+                pending.append(rel)  # adopted when the partner joins
+                continue
+            q = partner.__dict__["_idx"]
+            pt = self._pairs
+            slot = int(pt.ensure(p, q)[0])
+            pt.open_relations(slot)
+            pt.state[slot] = STATE_CODES[rel.interface_type]
+            pt.d_eq[slot] = getattr(rel, "equilibrium_distance", 0)
+            (pt.xi_ij if p < q else pt.xi_ji)[slot] = rel.friction_position
+            back = [b for b in partner.__dict__.get("_own_neighbors", []) if b.theSphere is sphere]
+            if back:
+                (pt.xi_ji if p < q else pt.xi_ij)[slot] = back[-1].friction_position
+        sphere.__dict__["_own_neighbors"] = pending
+        self._links_changed()
+
+    def _invalidate_neighbours(self):
+        self._pos_version += 1
+
+    def _params_changed(self):
+        self._params_version += 1
+
+    def _param(self, name):
+        """Scalar value of a per-sphere parameter if all spheres share it, else None."""
+        arr = self._a[name]
+        return float(arr[0]) if len(arr) and (arr == arr[0]).all() else None
+
+    # -- bookkeeping ----------------------------------------------------------------------------
+    def set_graphical_output_configuration(self, graphical_output_configuration):
+        """Share one drawing configuration with every sphere.
+
+        Parameters
+        ----------
+        graphical_output_configuration : Graphical_output_configuration
+        """
+        self.graphical_output_configuration = graphical_output_configuration
+        for s in self.sphereList:
+            s.set_graphical_output_configuration(graphical_output_configuration)
+
+    def initiateGraphics(self):
+        """Draw the ensemble in its live window, if a renderer is attached (else nothing)."""
+        if self._renderer is not None:
+            self._renderer.draw(self)
+
+    def correct_linear_drift(self):
+        """Subtract the unweighted mean velocity from all spheres."""
+        remove_mean_velocity(self._vel[:2], 1)
+
+    def particle_info(self):
+        """Return a short description of the ensemble for the output header."""
+        return "Points in a periodic cell"
+
+    def canMove(self, theSphere):
+        """Whether ``theSphere`` is mobile: always, except plate spheres while a :class:`CanvasPointsShear` shears.
+
+        Parameters
+        ----------
+        theSphere : Sphere
+        """
+        return True
+
+    def _mobile_mask(self):
+        """Mask of the mobile spheres, or None when every sphere is mobile."""
+        return None
+
+    def movableSphereList(self):
+        """The mobile spheres in index order (a new :class:`SphereSelection`, which the stress evaluation sums fast)."""
+        return SphereSelection(self, self._mobile_mask())
+
+    _mobile_selection = movableSphereList
+
+    def do_linear_acceleration(self, dt):
+        """Kick every sphere ``v += F·dt/m`` and reset its force (all move: :class:`CanvasPointsShear` has plates).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
+        kick(self._vel[:2], self._frc[:2], self._a["m"], dt)
+
+    #: the velocity rows a damping step scales: (vx, vy), and ω where spheres spin
+    _damped_rows = 2
+
+    def cool(self, f=0.8):
+        """Multiply the velocity relative to the affine flow ``γ̇ (y − Ly/2)`` (and any spin) by ``f``.
+
+        Parameters
+        ----------
+        f : float
+            Damping factor, 0 < f ≤ 1 (1 = no damping).
+        """
+        rate = getattr(self, "shear_rate", 0)
+        damp(self._vel[:self._damped_rows], flow_velocity(self._pos[1], self.size_y, rate) if rate else None, f)
+
+    def move(self, dt=1):
+        """Drift every position by velocity × ``dt`` (with pairs: their ξ rule first, and φ turns by ω·dt).
+
+        Parameters
+        ----------
+        dt : float
+            Time step (s).
+        """
+        drift(self._pos, None, self._vel, dt)
+        self._pos_version += 1
+
+    def _le_shift(self):
+        return 0.0
+
+    def _y_centred(self):
+        """``y − Ly/2`` of every sphere (µm)."""
+        return self._pos[1] - self.size_y / 2
+
+    def boundary_conditions(self):
+        """Wrap every sphere into the cell (Lees-Edwards shifted where active).
+
+        Raises :class:`SimulationInstabilityError` for a non-finite position or one more than
+        :data:`MAX_CELLS_OUTSIDE` cell lengths outside.
+        """
+        a = self._a
+        if not inside_cell(a["x"], a["y"], self.size_x, self.size_y):
+            self._check_positions()
+            wrap(a["x"], a["y"], a["xspeed"], float(self.size_x), float(self.size_y), float(self._le_shift()),
+                 float(getattr(self, "shear_rate", 0)) if self.use_lees_edwards else 0.0)
+        self._pos_version += 1
+
+    def _check_positions(self, pos=None):
+        """Raise SimulationInstabilityError for a non-finite or far-outside position among ``pos`` (2, n)."""
+        pos = self._pos if pos is None else pos
+        x, y = pos[0], pos[1]
+        Lx, Ly = self.size_x, self.size_y
+        far = MAX_CELLS_OUTSIDE * min(Lx, Ly)
+        if _min_reduce(pos, axis=None) >= -far and _max_reduce(pos, axis=None) < max(Lx, Ly) + far:
+            return  # two reductions (False for NaN) clear the ordinary case
+        with np.errstate(invalid="ignore"):
+            bad = ~((np.abs(x - Lx / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Lx)
+                    & (np.abs(y - Ly / 2) <= (MAX_CELLS_OUTSIDE + 0.5) * Ly))
+        if not bad.any():
+            return
+        k = int(np.flatnonzero(bad)[0])
+        what = ("is not finite" if not (math.isfinite(x[k]) and math.isfinite(y[k]))
+                else f"is more than {MAX_CELLS_OUTSIDE} cell lengths outside the {Lx:g} x {Ly:g} µm cell")
+        a = self._a
+        reason = (f"position (x, y) = ({float(x[k])!r}, {float(y[k])!r}) µm of sphere {k} {what} (velocity "
+                  f"({float(a['xspeed'][k])!r}, {float(a['yspeed'][k])!r}) µm/s): a diverging step or a sphere "
+                  "placed outside the cell")
+        guard = getattr(self, "stability_guard", None) or StabilityGuard()
+        guard._fail(self, getattr(self, "step_count", None), getattr(self, "phase", ""),
+                    getattr(self, "_last_dt", None), reason, pair=(k,))
+
+    def regular_sphere_distribution(self, rand_fraction=0.5):
+        """Place the spheres on a square grid with random jitter.
+
+        Parameters
+        ----------
+        rand_fraction : float
+            Jitter amplitude as a fraction of the grid spacing (0 = exact grid).
+        """
+        n = self._n
+        if n == 0:
+            return
+        cols = int(math.ceil(math.sqrt(n * self.size_x / self.size_y)))
+        rows = int(math.ceil(n / cols))
+        sx, sy = self.size_x / cols, self.size_y / rows
+        k = np.arange(n)
+        jitter = (self._rng.random((2, n)) - 0.5) * rand_fraction
+        a = self._a
+        a["x"][:] = ((k % cols) + 0.5 + jitter[0] * 1.0) * sx % self.size_x
+        a["y"][:] = ((k // cols) + 0.5 + jitter[1] * 1.0) * sy % self.size_y
+        self._invalidate_neighbours()
+
+
+def _register_filter(name, what):
+    """The ``record_*`` method ``name`` of :class:`CanvasPointsMass`, documented as recording ``what`` ({}: quantity).
+
+    It calls the register's method ``name`` for a mobile target; a pair entry (``record_individual_*``) is routed as
+    the step routes it (:meth:`CanvasPointsMass._entry_of`): internal, external (``record_external_*``) or dropped.
+    """
+    force = name.endswith("force")
+    pair = name.startswith("record_individual")
+    register = attrgetter(name)
+    external = attrgetter("record_external_" + ("force" if force else "torque"))
+
+    def route(self, target, source, value):
+        where = self._entry_of(target, source)
+        if where == 1:
+            register(self.force_register)(target, source, value)
+        elif where == 2:
+            external(self.force_register)(target, value)
+
+    def filtered(self, target, source, value):
+        if self.canMove(target):
+            register(self.force_register)(target, value)
+
+    quantity = "force ``(F_x, F_y)`` (mg·µm·s⁻² per m)" if force else "torque (mg·µm²·s⁻² per m)"
+    rule = (".\n\nDropped on an immobile target; external from an immobile source or through the boundary." if pair
+            else " unless it is immobile.")
+    return record_method(name, "CanvasPointsMass", route if pair else filtered,
+                         f"Record {what.format(quantity)} ``target``{rule}")
+
+
+class CanvasPointsMass(CanvasPoints):
+    """Adds the clock ``t`` (s), the force register and momentum bookkeeping.
+
+    Parameters
+    ----------
+    size_x, size_y, theCanvas, doDrawing
+        As for :class:`CanvasPoints`.
+    m : float
+        Default sphere mass (mg per m depth); each sphere carries its own.
+    """
+
+    def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
+        CanvasPoints.__init__(self, size_x, size_y, theCanvas, doDrawing)
+        self.t = 0
+        self.force_register = Force_register()
+        self.m = m
+
+    def reset_force_register(self):
+        """Clear the force register (start of a force phase)."""
+        self.force_register.reset_force_register()
+
+    # registration filters for scripts that apply forces sphere by sphere
+    def _through_boundary(self, target, source):
+        """Whether the pair acts through the periodic boundary (its minimum image removes a period)."""
+        return False
+
+    def _entry_of(self, target, source):
+        """Where an entry of ``source`` on ``target`` goes: 0 nowhere (immobile target), 1 internal,
+        2 external (:func:`~particleShear.engine.forces.pair_roles`, the rule of the step)."""
+        internal, external, _ = pair_roles(self.canMove(target), self.canMove(source),
+                                           np.bool_(self._through_boundary(target, source)))
+        return 1 if internal else 2 if external else 0
+
+    for _name, _what in (("record_individual_internal_force", "the pair {} of ``source`` on"),
+                         ("record_individual_internal_torque", "the pair {} of ``source`` on"),
+                         ("record_total_particle_force", "the total {} of"),
+                         ("record_external_force", "an external {} on"),
+                         ("record_external_torque", "an external {} on"),
+                         ("record_unbalanced_moment", "the net {} of")):
+        locals()[_name] = _register_filter(_name, _what)
+    del _name, _what
+
+    def _torque_total(self):
+        return None
+
+    def record_total_particle_forces(self):
+        """Store the accumulated force of every mobile sphere (and torques, where spin exists)."""
+        tot = self._frc.copy()
+        self.force_register._set_totals(self, self._mobile_mask(), tot[0], tot[1],
+                                        tot[2] if self._torque_total() is not None else None)
+
+    def particle_info(self):
+        return "Spheres with mass"
+
+    def evaluate_stress_tensors(self, StressTensorEvaluator):
+        """Evaluate every tensor (eqs. S1-16 to S1-24) of the register, mobile spheres and rate; return the evaluator.
+
+        Parameters
+        ----------
+        StressTensorEvaluator : StressTensorEvaluation
+        """
+        sel = self._mobile_selection()
+        StressTensorEvaluator.evaluate_stress_tensors(self.force_register, sel, getattr(self, "shear_rate", 0))
+        return StressTensorEvaluator
+
+    def reset_force(self):
+        """Set the force of every sphere to zero."""
+        self._frc[:2] = 0.0
+
+    # momenta in raw coordinates (origin at the cell corner)
+    def total_momentum(self):
+        """Linear momentum ``Σ m v`` (mg·µm/s per m depth)."""
+        a = self._a
+        return np.array([a["m"] @ a["xspeed"], a["m"] @ a["yspeed"]])
+
+    def total_angular_momentum(self):
+        """``Σ m (x v_y − y v_x) + Σ I ω`` about the origin (mg·µm²/s per m depth)."""
+        a = self._a
+        return float(a["m"] @ (a["x"] * a["yspeed"] - a["y"] * a["xspeed"]) + a["inertia"] @ a["omega"])
+
