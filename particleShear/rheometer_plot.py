@@ -31,7 +31,7 @@ plot_rheometer_result
 __docformat__ = "numpy"
 import numpy as np
 
-from .plot import _figure, check_figure_path, fit_title, made_by, save_figure
+from .plot_tools import _figure, check_figure_path, fit_title, made_by, save_figure
 from .analysis.flow_curve import fit_flow_curve, flow_curve_table
 from .analysis.sweep import _vector
 from .sweep.schema import load_results

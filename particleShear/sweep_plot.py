@@ -48,7 +48,7 @@ import warnings
 import numpy as np
 
 from .analysis.sweep import DEFAULT_SEED, N_BOOT_MAX, sweep_summary
-from .plot import (ESTIMATORS, FLAGGED_LABEL, _figure, _float, dodge_factors, fit_title, group_of, is_flagged,
+from .plot_tools import (ESTIMATORS, FLAGGED_LABEL, _figure, _float, dodge_factors, fit_title, group_of, is_flagged,
                    made_by, ok_moduli)
 from .analysis.grouping import short_value
 from .simulation.provenance import IDENTITY_EXCLUDED

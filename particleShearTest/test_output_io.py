@@ -399,7 +399,7 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
 
     def test_failed_write_in_a_binary_format(self):
         with tempfile.TemporaryDirectory() as d:
-            with mock.patch("particleShear.simulation.simulations.write_run",
+            with mock.patch("particleShear.simulation.oscillatory.write_run",
                             side_effect=OSError(errno.EIO, "I/O error")):
                 r = run(d, output_format="npz", **QUICK)
             self.assertIsInstance(r.write_error, OSError)
@@ -422,7 +422,7 @@ class TestFilesCompleteOrAbsent(unittest.TestCase):
 
     def test_unwritable_folder_refused_before_any_work(self):
         with tempfile.TemporaryDirectory() as d:
-            with mock.patch("particleShear.simulation.simulations.probe_writable",
+            with mock.patch("particleShear.simulation.oscillatory.probe_writable",
                             side_effect=PermissionError(errno.EACCES, "Permission denied")), \
                     mock.patch("particleShear.simulation.simulations.Simulation_interlocking_rheology.initEnsemble"
                                ) as build:

@@ -257,7 +257,7 @@ class TestPlotTargetOfTheCommandLine(unittest.TestCase):
         self.assertIn("no such directory", err)
 
     def test_matplotlib(self):
-        with tempfile.TemporaryDirectory() as d, mock.patch("particleShear.plot._has_matplotlib", lambda: False):
+        with tempfile.TemporaryDirectory() as d, mock.patch("particleShear.plot_tools._has_matplotlib", lambda: False):
             err = self.refused(["--plot", os.path.join(d, "figure.png")])
         self.assertIn("pip install 'particleShear[plot]'", err)
 

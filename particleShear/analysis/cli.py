@@ -55,7 +55,7 @@ import numpy as np
 from ..run.guard import SuggestingParser, command_line_names
 from .sweep import CHARACTERISTICS, DEFAULT_SEED, FLAGS, MIN_POINT_AMPLITUDES, N_BOOT_MAX, sweep_summary
 from ..experiment.measured import main as measured_main
-from ..plot import ESTIMATORS, _float, _has_matplotlib, is_flagged, ok_moduli, read_sweep_table
+from ..plot_tools import ESTIMATORS, _float, _has_matplotlib, is_flagged, ok_moduli, read_sweep_table
 from ..run.rheometer import PROTOCOL_DEFAULTS
 from ..signals import sigterm_raises
 from ..simulation.provenance import IDENTITY_EXCLUDED

@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from .tables import MeasuredTest
+from .tables import Calibration, MeasuredTest
 from ..analysis.sweep import sweep_summary
-from ..plot import _figure, _has_matplotlib, check_figure_path, fit_title, save_figure
+from ..plot_tools import _figure, _has_matplotlib, check_figure_path, fit_title, save_figure
 
 __all__ = ["plot_comparison", "plot_calibration"]
 
@@ -184,7 +184,6 @@ def plot_calibration(calibration, path=None, top=1):
     -------
     matplotlib.figure.Figure
     """
-    from .calibration import Calibration
     if not isinstance(calibration, Calibration):
         raise ValueError(f"calibration={type(calibration).__name__} is invalid: allowed a Calibration")
     if isinstance(top, bool) or not isinstance(top, int) or top < 1:

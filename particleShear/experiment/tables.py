@@ -3,14 +3,18 @@
 A test is one kind of measurement (:data:`KINDS`) with columns of :data:`QUANTITIES`, every
 column a float array in the quantity's SI unit (strain absolute, not %), all of one length.
 Readers (:mod:`particleShear.experiment.readers`) make them from files; writers
-(:mod:`particleShear.experiment.writers`) write them for RepTate and pyRheo.
+(:mod:`particleShear.experiment.writers`) write them for RepTate and pyRheo.  :class:`Calibration` is
+the ranking a calibration (:mod:`particleShear.experiment.calibration`) makes of a campaign against one.
 """
 __docformat__ = "numpy"
 import dataclasses
+import os
 
 import numpy as np
 
-__all__ = ["KINDS", "QUANTITIES", "MeasuredTest"]
+from ..sweep.table import write_table
+
+__all__ = ["ASSUMPTIONS", "KINDS", "QUANTITIES", "RANKING_COLUMNS", "Calibration", "MeasuredTest"]
 
 #: the kinds of test and the columns each must have (others may be present)
 KINDS = {
@@ -124,3 +128,113 @@ class MeasuredTest:
         return dataclasses.replace(self, columns={k: v[keep] for k, v in self.columns.items()}, meta=dict(self.meta))
 
 
+#: the assumptions of a calibration, stated with every ranking (:mod:`particleShear.experiment.calibration`)
+ASSUMPTIONS = (
+    "rates: the simulation's frequency is dimensionless (f·τ = relative_frequency); the measured sweep is compared "
+    "with a campaign run at the f·τ the material's τ gives for the rheometer's f (Hz); amplitudes are matched, the "
+    "frequency is not",
+    "moduli: G ∝ E at fixed dimensionless parameters, so the E to use is scale × Young_modulus_spheres",
+    "2D vs 3D: the simulated stress is force per length per metre of depth (Pa), compared with the 3D moduli as is; "
+    "a 2D→3D geometric factor would be absorbed into the scale (into E)",
+    "shape: curves are normalised by their own G′ at the smallest amplitude both cover, interpolated linearly in "
+    "log γ₀ on the overlap of the amplitude ranges",
+)
+
+#: columns of the ranking table: name → (unit, description)
+RANKING_COLUMNS = {
+    "rank": ("1", "1 = best match (smallest mismatch)"),
+    "label": ("", "the grid point: its parameters that vary across the campaign"),
+    "mismatch": ("1", "rms difference of G′/G′_p and G″/G′_p over the comparison points"),
+    "p_best": ("1", "fraction of bootstrap replicates in which this grid point ranks first"),
+    "scale": ("1", "modulus scale s = measured G′_p / simulated G′_p"),
+    "scale_ci_low": ("1", "lower end of the bootstrap interval of scale"),
+    "scale_ci_high": ("1", "upper end of the bootstrap interval of scale"),
+    "Young_modulus_spheres": ("Pa", "the E the grid point was simulated with"),
+    "E_to_use": ("Pa", "scale × Young_modulus_spheres: the E that matches the measured plateau"),
+    "E_ci_low": ("Pa", "lower end of the bootstrap interval of E_to_use"),
+    "E_ci_high": ("Pa", "upper end of the bootstrap interval of E_to_use"),
+    "overlap_min": ("1", "smallest strain amplitude compared"),
+    "overlap_max": ("1", "largest strain amplitude compared"),
+    "n_points": ("1", "comparison points"),
+    "n_runs": ("1", "simulated runs of the grid point"),
+}
+
+
+@dataclasses.dataclass
+class Calibration:
+    """The ranking of a campaign's grid points against a measured amplitude sweep (:func:`~particleShear.experiment.calibration.calibrate`).
+
+    Parameters
+    ----------
+    rows : list of dict
+        One per grid point, best first; columns :data:`RANKING_COLUMNS` plus the varying parameters.
+    varying : list of str
+        The parameters that vary across the grid (they label the grid points).
+    measured : dict
+        ``"A"`` (1), ``"Gp"``, ``"Gpp"`` (Pa): the mean measured curve; ``"replicates"``.
+    simulated : dict
+        label → ``{"A", "Gp", "Gpp", "parameters"}``: each grid point's mean curve (Pa, unscaled).
+    settings : dict
+        ``estimator``, ``n_boot``, ``confidence``, ``seed``, ``sweep_dir``.
+    assumptions : tuple of str
+        :data:`ASSUMPTIONS`.
+    notes : list of str
+        Grid points left out (fewer than 2 amplitudes, no overlap) and other remarks.
+    """
+
+    rows: list
+    varying: list
+    measured: dict
+    simulated: dict
+    settings: dict
+    assumptions: tuple = ASSUMPTIONS
+    notes: list = dataclasses.field(default_factory=list)
+
+    @property
+    def best(self):
+        """The first row (the best grid point), or None."""
+        return self.rows[0] if self.rows else None
+
+    def columns(self):
+        """The ranking table's columns, in order."""
+        return ["rank", "label"] + list(self.varying) + [c for c in RANKING_COLUMNS if c not in ("rank", "label")]
+
+    def write_csv(self, path):
+        """Write the ranking table (atomically).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+
+        Returns
+        -------
+        str
+        """
+        path = os.fspath(path)
+        write_table(path, self.rows, self.columns())
+        return path
+
+    def table_text(self, limit=20):
+        """The ranking as printed text: one line per grid point (best first), the notes, the assumptions.
+
+        Parameters
+        ----------
+        limit : int, optional
+            Most grid points shown (default 20).
+
+        Returns
+        -------
+        str
+        """
+        conf = int(round(100 * self.settings["confidence"]))
+        lines = [f"calibration against {self.measured['replicates']} measured replicate(s), "
+                 f"{self.settings['estimator']} estimator, {conf} % bootstrap intervals ({self.settings['n_boot']})"]
+        for r in self.rows[:limit]:
+            lines.append(f"{r['rank']:3d}. {r['label']}: mismatch {r['mismatch']:.4g}, p_best {r['p_best']:.2f}, "
+                         f"scale {r['scale']:.4g} [{r['scale_ci_low']:.4g}, {r['scale_ci_high']:.4g}] "
+                         f"-> E = {r['E_to_use']:.4g} Pa [{r['E_ci_low']:.4g}, {r['E_ci_high']:.4g}]")
+        if len(self.rows) > limit:
+            lines.append(f"     … {len(self.rows) - limit} more in the table")
+        lines += [f"note: {n}" for n in self.notes]
+        lines += [f"assumption: {a}" for a in self.assumptions]
+        return "\n".join(lines)

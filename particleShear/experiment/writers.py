@@ -49,6 +49,8 @@ from ..run.result import SimulationResult
 from ..run.rheometer import RheometerResult
 from ..simulation.formats import RunData, read_run
 from ..sweep.table import atomic_text
+from ..analysis.cli import grouping_columns
+from ..plot_tools import ok_moduli, read_sweep_table
 
 __all__ = ["FORMATS", "REPTATE_TYPES", "PYRHEO_COLUMNS", "reptate_text", "pyrheo_text", "write_reptate",
            "write_pyrheo", "tests_from_sweep", "tests_from_result", "export", "main"]
@@ -358,8 +360,6 @@ def tests_from_sweep(folder, estimator="surface"):
         An unknown estimator, no ``results.csv``.
     """
     _check_estimator(estimator)
-    from ..analysis.cli import grouping_columns
-    from ..plot import ok_moduli, read_sweep_table
     rows = read_sweep_table(folder)
     notes = list(getattr(rows, "notes", []) or [])
     header = list(rows[0]) if rows else []

@@ -31,7 +31,7 @@ from ..simulation.driver import ENGINE_SKIN_FACTOR, _guarded, measure_sessions, 
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 from ..engine.xp import get_backend
 from ..simulation.provenance import run_identity
-from ..simulation.simulations import RunSession
+from ..simulation.oscillatory import RunSession
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
@@ -233,7 +233,7 @@ def measure_batch(runs):
     """Constitute every replica with the documented builder, then measure all of them in one engine.
 
     ``runs``: complete, validated keyword dicts sharing one schedule.  Each replica runs through
-    the phases of ``runSimulation`` (:class:`~particleShear.simulation.simulations.RunSession`:
+    the phases of ``runSimulation`` (:class:`~particleShear.simulation.oscillatory.RunSession`:
     validation, constitution, reservation of its output file, experiment set-up, schedule) except
     the measurement, which the engine does for all replicas at once; each experiment then adopts
     its replica's record and the session writes the output file as ``runSimulation`` does.
@@ -274,7 +274,7 @@ def measure_batch(runs):
 
 
 def build_sessions(runs):
-    """The simulation object and :class:`~particleShear.simulation.simulations.RunSession` of every run.
+    """The simulation object and :class:`~particleShear.simulation.oscillatory.RunSession` of every run.
 
     Parameters
     ----------

@@ -41,9 +41,9 @@ def measure_sessions(sessions, constituted=False):
 
     Constitution (relaxations in the engine, :func:`_constitute`), then per session the
     reservation of its output file, the experiment and the schedule
-    (:meth:`~particleShear.simulation.simulations.RunSession.prepare`), then the measurement of
+    (:meth:`~particleShear.simulation.oscillatory.RunSession.prepare`), then the measurement of
     all sessions in the engine (:func:`_measure`), and per session the adoption of its record
-    and the writing (:meth:`~particleShear.simulation.simulations.RunSession.finish`, which
+    and the writing (:meth:`~particleShear.simulation.oscillatory.RunSession.finish`, which
     fills ``sim.result_info``).  ``runSimulation`` calls it with its one session,
     :func:`measure_batch` with a batch's.  An interrupt (``KeyboardInterrupt``) removes every
     reservation and is re-raised with ``position = (phase, step, total)``.
@@ -89,7 +89,7 @@ def measure_sessions(sessions, constituted=False):
 def _constitute(sessions):
     """Constitute every replica: bookkeeping per replica through the classes, relaxations in the engine.
 
-    Each session's constitution (:meth:`~particleShear.simulation.simulations.RunSession.constitution`)
+    Each session's constitution (:meth:`~particleShear.simulation.oscillatory.RunSession.constitution`)
     yields its relaxation requests; the pending requests of equal key (steps, ``dt``, ``dt_max``)
     run together in one engine (:func:`particleShear.engine.relax.relax_ensembles`), the key of
     the first waiting replica first, until every constitution is done.  A replica's ensemble does

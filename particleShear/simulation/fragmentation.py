@@ -4,7 +4,7 @@
 :class:`Simulation_dermal_filler_rheology` (full material parameters, legacy builder) and
 :class:`Simulation_interlocking_rheology` (the adjustable interface strength builder: the scene of
 ``doParticleShearSimulation``).  Each builds its ensemble in ``initEnsemble`` and writes its file
-header; the run itself is :class:`~particleShear.simulation.simulations.OscillatorySimulation`'s.
+header; the run itself is :class:`~particleShear.simulation.oscillatory.OscillatorySimulation`'s.
 """
 __docformat__ = "numpy"
 import math
@@ -13,7 +13,7 @@ import os
 from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, adjustable_interface_constitution,
                                  relax_constitution)
 from .provenance import header_number, positional_numbers_in_call, provenance_lines
-from .simulations import OscillatorySimulation, _log, _writes, call_string
+from .oscillatory import OscillatorySimulation, _log, _writes, call_string
 
 __all__ = ["OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology", "Simulation_interlocking_rheology"]
 
