@@ -44,7 +44,7 @@ LAYERS = (
     ("plots", ("particleShear.plot", "particleShear.plot_tools", "particleShear.sweep_plot", "particleShear.rheometer_plot",
                "particleShear.analysis.figure", "particleShear.experiment.figure")),
     ("command line", ("particleShear.run.cli", "particleShear.sweep.cli", "particleShear.analysis.cli",
-                      "particleShear.experiment.calibration", "particleShear.experiment.writers",
+                      "particleShear.analysis.outputs", "particleShear.experiment.calibration", "particleShear.experiment.writers",
                       "particleShear.__main__")),
     ("package", ("particleShear",)),
 )
@@ -62,8 +62,6 @@ PACKAGE = "particleShear"
 #: upward import or an import at the bottom of a module that closes a cycle.  The test accepts
 #: these and nothing else, and fails when one of them is gone (the list only shrinks).
 _PENDING = (
-    "analysis.outputs > run.validation",
-    "analysis.outputs > sweep.locks",
     "analysis.protocol_summary > analysis.flow_curve",
     "analysis.protocol_summary > analysis.sweep",
     "run.api > run.rheometer",
@@ -89,13 +87,8 @@ _PENDING = (
     "run.rheometer_files > simulation.provenance",
     "run.validation > run.batch",
     "run.validation > run.rheometer",
-    "sweep.reader > sweep.schema",
-    "sweep.schema > sweep.reader",
-    "sweep.schema > sweep.spec",
-    "sweep.schema > sweep.table",
     "sweep.spec > run.rheometer",
     "sweep.spec > run.validation",
-    "sweep.table > sweep.spec",
 )
 PENDING = frozenset(tuple("particleShear." + m for m in e.split(" > ")) for e in _PENDING)
 

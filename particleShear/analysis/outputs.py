@@ -26,6 +26,8 @@ import stat
 
 from ..signals import dead_leftovers, signals_held
 from ..simulation.output import fsync_folder
+from ..run.validation import check_folder_writable
+from ..sweep.locks import folder_lock
 
 __all__ = ["LOCK_NAME", "LOCK_WAIT_S", "PublishInterrupted", "check_targets", "make_staging", "publish",
            "remove_dead_staging"]
@@ -70,7 +72,6 @@ def check_targets(folder, names):
         One line: the folder is not writable, a name of the set is a directory (or another
         non-file), or a file of the set is read-only (or not writable by this user).
     """
-    from ..run.validation import check_folder_writable
     check_folder_writable("DIR", folder)
     for name in names:
         path = os.path.join(folder, name)
@@ -154,7 +155,6 @@ def publish(folder, staging, names, every_name):
     PublishInterrupted
         SIGINT or SIGTERM arrived during the publication, which completed first.
     """
-    from ..sweep.locks import folder_lock
     removed = []
     with folder_lock(os.path.join(folder, LOCK_NAME), wait_s=LOCK_WAIT_S):
         check_targets(folder, every_name)

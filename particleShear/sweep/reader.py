@@ -49,6 +49,7 @@ import sys
 import numpy as np
 
 from ..checks import cut_text
+from ..run.columns import SCHEMA_NAME, cell_problem, column_spec, read_schema, typed_value
 
 __all__ = ["read_table", "ResultsTable", "escape_cell", "unescape_cell", "TableRow", "TableRows"]
 
@@ -195,7 +196,6 @@ class _NumberColumn(_Column):
                 continue
             text = unescape_cell(texts[i])
             self.odd[base + i] = text
-            from .schema import typed_value
             try:
                 v = typed_value(text, self.kind)
                 if v is not None and self.kind == "int" and not -2 ** 63 <= v < 2 ** 63:
@@ -238,7 +238,6 @@ class _BoolColumn(_Column):
     _CODES = {"True": 1, "False": 0, "": -1}
 
     def add(self, texts, base, problems):
-        from .schema import typed_value
         codes = np.empty(len(texts), dtype=np.int8)
         for i, t in enumerate(texts):
             c = self._CODES.get(t)
@@ -281,7 +280,6 @@ class _TextColumn(_Column):
         self.uniques, self.index, self.why = [], {}, []
 
     def add(self, texts, base, problems):
-        from .schema import cell_problem
         codes = np.empty(len(texts), dtype=np.int32)
         index, uniques = self.index, self.uniques
         for i, t in enumerate(texts):
@@ -306,7 +304,6 @@ class _TextColumn(_Column):
         return self.uniques[self.values[i]]
 
     def typed(self, i):
-        from .schema import typed_value
         if self.why[self.values[i]] is not None:
             return None
         return typed_value(self.uniques[self.values[i]], self.kind)
@@ -612,7 +609,6 @@ def _lines(numbers, shown=10):
 
 
 def _schema_for(path, header, schema):
-    from .schema import SCHEMA_NAME, column_spec, read_schema
     if schema == "package":
         schema = {"columns": []}
     elif schema is None:

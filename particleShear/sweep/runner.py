@@ -36,10 +36,10 @@ from .pool import pool_context, run_jobs
 from .progress import SweepProgress
 from .record import RECORD_NAME, canonical_spec, check_record, extended_runs, read_record, spec_hash, write_record
 from .spec import SweepRuns, SweepSpec, load_spec, parse_spec, spec_runs
-from .schema import SCHEMA_NAME, typed_row, write_schema
+from .schema import SCHEMA_NAME, typed_row
 from .table import (REJECTED_SUFFIX, TABLE_NAME, append_row, check_table, check_table_header, read_rows, reject_lines, row_line,
                     remove_dead_temporaries, row_problem, sort_table, table_columns, task_table_name,
-                    write_parquet, write_table)
+                    write_parquet, write_schema, write_table)
 from .tasks import execute_batch, execute_run
 from ..run.batch import batches, check_backend
 from ..simulation.formats import run_file_identity, verify_run

@@ -39,21 +39,18 @@ from ..signals import dead_leftovers
 from ..analysis.measures import MEASURE_COLUMNS
 from ..parameters import BY_NAME, identity_excluded
 from ..simulation.provenance import identity_parameters, same_input
-from .schema import PROTOCOL_COLUMNS, RUN_COLUMNS, arrow_table, cell_problem, column_spec, results_schema
+from ..run.columns import (PROTOCOL_COLUMNS, RESULT_COLUMNS, RUN_COLUMNS, SCHEMA_NAME, TABLE_NAME,  # noqa: F401 - re-exported
+                           cell_problem, column_spec, table_columns)
+from .schema import arrow_table, results_schema
 
 __all__ = ["RESULT_COLUMNS", "table_columns", "row_line", "append_row", "read_rows", "repair_table",
            "write_table", "write_parquet", "TABLE_NAME", "task_table_name", "check_table", "row_problem", "atomic_text",
            "reject_lines", "remove_dead_temporaries",
-           "REJECTED_SUFFIX", "sort_table"]
+           "REJECTED_SUFFIX", "sort_table", "write_schema"]
 
 #: lines of a table that cannot be rows (wrong number of fields) are moved to ``<table>`` + this suffix
 REJECTED_SUFFIX = ".rejected"
 
-#: the first columns of every results table
-RESULT_COLUMNS = ("run_id", "status", "error", "Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") \
-    + MEASURE_COLUMNS + RUN_COLUMNS
-_TAIL_COLUMNS = ("seed_entropy", "spawn_key", "package_version", "wall_time_s", "output_path")
-TABLE_NAME = "results.csv"
 
 
 def task_table_name(task_index, task_count):
@@ -72,28 +69,6 @@ def task_table_name(task_index, task_count):
         The file name (no folder).
     """
     return f"results.task-{task_index:04d}-of-{task_count:04d}.csv"
-
-
-def table_columns(parameter_names=None):
-    """All columns, given the parameter names (order of the module docstring).
-
-    Parameters
-    ----------
-    parameter_names : iterable of str, optional
-        The parameter columns, in order (default: every SPEC-settable parameter of the
-        oscillatory protocol, signature order of ``doParticleShearSimulation``).  When they hold
-        ``protocol``, the protocol columns come before them.
-
-    Returns
-    -------
-    list of str
-    """
-    if parameter_names is None:
-        from .spec import sweep_parameter_defaults
-        parameter_names = list(sweep_parameter_defaults())
-    parameter_names = list(parameter_names)
-    extra = list(PROTOCOL_COLUMNS) if "protocol" in parameter_names else []
-    return list(RESULT_COLUMNS) + extra + parameter_names + list(_TAIL_COLUMNS)
 
 
 def _cell(v):
@@ -637,3 +612,30 @@ def _header_of(path):
         return next(csv.reader([first]), [])
     except csv.Error:
         return []
+
+
+def write_schema(folder, columns):
+    """Write ``folder/results.schema.json`` (atomically) for a table of ``columns``; its path.
+
+    Parameters
+    ----------
+    folder : str
+        The sweep folder.
+    columns : sequence of str
+        The table's columns.
+
+    Returns
+    -------
+    str
+    """
+    path = os.path.join(folder, SCHEMA_NAME)
+    text = json.dumps(results_schema(columns), indent=1, ensure_ascii=False) + "\n"
+    try:
+        with open(path, encoding="utf-8") as fh:
+            if fh.read() == text:
+                return path
+    except OSError:
+        pass
+    with atomic_text(path) as fh:
+        fh.write(text)
+    return path
