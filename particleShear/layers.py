@@ -87,8 +87,6 @@ _PENDING = (
     "run.rheometer_files > simulation.provenance",
     "run.validation > run.batch",
     "run.validation > run.rheometer",
-    "sweep.spec > run.rheometer",
-    "sweep.spec > run.validation",
 )
 PENDING = frozenset(tuple("particleShear." + m for m in e.split(" > ")) for e in _PENDING)
 

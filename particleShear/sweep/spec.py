@@ -39,6 +39,8 @@ from ..checks import cut_text, show_value
 from ..parameters import BY_NAME, PARAMETERS, SPEC_RESERVED, spec_defaults
 from ..run.guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 from ..simulation.provenance import run_identity
+from ..run.rheometer import LIST_PARAMETERS, normalize_protocol
+from ..run.validation import SEED_LIMIT, validate_run
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
@@ -348,7 +350,6 @@ def _name_source(exc, source):
 
 
 def _scalar(where, v, name=None):
-    from ..run.rheometer import LIST_PARAMETERS
     if name in LIST_PARAMETERS:   # a list is one value of these (the steps of a one-packing sweep)
         if not isinstance(v, list) or not v:
             raise ValueError(f"{where}={show_value(v)} is invalid: allowed a non-empty list of numbers (one value of {name})")
@@ -479,7 +480,6 @@ def _parse_spec(doc, source):
     for key in seeds:
         if key not in _SEED_KEYS:
             raise ValueError(f"seeds.{key} is unknown: allowed {', '.join(_SEED_KEYS)}")
-    from ..run.validation import SEED_LIMIT, show_value
     root = seeds.get("root")
     if isinstance(root, bool) or not isinstance(root, numbers.Integral) or not 0 <= root < SEED_LIMIT:
         raise ValueError(f"seeds.root={show_value(root)} is invalid: allowed an integer 0 <= value < 2**128")
@@ -595,8 +595,6 @@ def expand_runs(spec):
 
 def _validated_points(spec):
     """The complete parameter set of every point of ``spec``, each validated (point order)."""
-    from ..run.rheometer import normalize_protocol
-    from ..run.validation import show_value, validate_run
     defaults = sweep_parameter_defaults(protocols=uses_protocols(_spec_keys(spec)))
     points = []
     for p_index, point in enumerate(_points(spec)):
