@@ -75,7 +75,7 @@ def _work(*args, **kwargs):
 @contextlib.contextmanager
 def no_work():
     """Fail the test as soon as any path builds, measures or submits a run."""
-    with mock.patch("particleShear.run.api._build_simulation", _work), \
+    with mock.patch("particleShear.run.sessions._build_simulation", _work), \
             mock.patch("particleShear.run.api.measure_batch", _work), \
             mock.patch("particleShear.run.batch.measure_batch", _work), \
             mock.patch("particleShear.sweep.series.run_series", _work):

@@ -16,9 +16,8 @@ from ..hooks import entry
 from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA
 from ..simulation.provenance import run_identity
-from ..simulation.simulations import Simulation_interlocking_rheology
 from .validation import check_seed, validate_run, validate_series
-from .batch import check_batch_size, measure_batch
+from .sessions import _build_simulation, _seed_sequence, check_batch_size, measure_batch  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 from ..parameters import PARAMETERS
@@ -26,77 +25,6 @@ from ..simulation.drawing import _backend_choice, display_available
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
-
-
-def _seed_sequence(seed):
-    """(SeedSequence or None, Generator) for ``seed`` = None, int, SeedSequence, Generator or BitGenerator."""
-    if isinstance(seed, np.random.Generator):
-        return None, seed
-    if isinstance(seed, np.random.BitGenerator):
-        return None, np.random.Generator(seed)
-    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-    return ss, np.random.default_rng(ss)
-
-
-def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, reference_header, renderer,
-                      time_step_factor, integrator, stability_guard):
-    """The :class:`Simulation_interlocking_rheology` of one run, configured but not run (``params``: the
-    validated reference arguments of :func:`doParticleShearSimulation`; ``rng`` its Generator)."""
-    p = params
-    root_folder, do_permanent_links, cut_lines, N = p["root_folder"], p["do_permanent_links"], p["cut_lines"], p["N"]
-    (packing_fraction, density, bimodal_factor, theAmplitude) = (p["packing_fraction"], p["density"],
-                                                                 p["bimodal_factor"], p["theAmplitude"])
-    Young_modulus_spheres, theMu, relative_y_scale_force = p["Young_modulus_spheres"], p["theMu"], p[
-        "relative_y_scale_force"]
-    relative_frequency, relative_viscosity = p["relative_frequency"], p["relative_viscosity"]
-    relative_transversal_link_strength = p["relative_transversal_link_strength"]
-    central_repulsion_coefficient = p["central_repulsion_coefficient"]
-    avoid_horizontal_angle_degree = p["avoid_horizontal_angle_degree"]
-    interface_reenforcement_central = p["interface_reenforcement_central"]
-    interface_reenforcement_tangential = p["interface_reenforcement_tangential"]
-    keep_viscosity_coefficients_constant = p["keep_viscosity_coefficients_constant"]
-    avoid_height_spanning_particles, cut_top_bottom = p["avoid_height_spanning_particles"], p["cut_top_bottom"]
-    doCutByTriangulation, remove_link_fraction = p["doCutByTriangulation"], p["remove_link_fraction"]
-    edge_fuzziness, doDrawing, saveData = p["edge_fuzziness"], p["doDrawing"], p["saveData"]
-    pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
-    saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
-    saveStressTensorData = p["saveStressTensorData"]
-    theSimulation = Simulation_interlocking_rheology(
-        root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
-        packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor, amplitude=theAmplitude,
-        Young_modulus_spheres=Young_modulus_spheres, mu=theMu, relative_y_scale_force=relative_y_scale_force,
-        relative_frequency=relative_frequency, relative_viscosity=relative_viscosity,
-        relative_transversal_link_strength=relative_transversal_link_strength,
-        central_repulsion_coefficient=central_repulsion_coefficient,
-        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-        interface_reenforcement_central=interface_reenforcement_central,
-        interface_reenforcement_tangential=interface_reenforcement_tangential,
-        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
-        avoid_height_spanning_particles=avoid_height_spanning_particles, cut_top_bottom=cut_top_bottom,
-        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
-        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, saveData=saveData)
-    theSimulation.function_call += (
-        "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
-        + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
-        + "\n\ttheSimulation.saveOutputImages = " + str(saveOutputImages)
-        + "\n\ttheSimulation.imageFileType = " + str(imageFileType)
-        + "\n\ttheSimulation.runSimulation(periods=" + str(periods) + ", cool_factor=" + str(cool_factor) + ")")
-    theSimulation.baseline_pre_periods = pre_periods
-    theSimulation.baseline_post_periods = post_periods
-    theSimulation.saveOutputImages = saveOutputImages
-    theSimulation.imageFileType = imageFileType
-    theSimulation.saveStressTensorData = saveStressTensorData
-    theSimulation.rng = rng
-    theSimulation.verbose = verbose
-    theSimulation.progress = progress
-    theSimulation.correct_drift_sign = correct_drift_sign
-    theSimulation.reference_header = reference_header
-    theSimulation.renderer_backend = renderer
-    theSimulation.time_step_factor = float(time_step_factor)
-    theSimulation.integrator = integrator
-    theSimulation.stability_guard = bool(stability_guard)
-
-    return theSimulation
 
 
 #: the defaults of the contact laws' parameters outside the signature (``**law_parameters``)

@@ -24,14 +24,11 @@ Its parameters (``plateau_begin``, ``plateau_end``, ``plateau_slope``) may diffe
 """
 __docformat__ = "numpy"
 from ..linkable.builders import time_steps_from_model
-from ..parameters import PARAMETERS
-from ..parameters import defaults as _defaults
 from ..parameters import names as _names
 from ..simulation.driver import ENGINE_SKIN_FACTOR, _guarded, measure_sessions, pre_equilibrated, replica_record
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
-from ..engine.xp import get_backend
-from ..simulation.provenance import run_identity
-from ..simulation.oscillatory import RunSession
+from .sessions import (BACKENDS, _REFERENCE_ARGUMENTS, _signature_defaults, build_sessions,  # noqa: F401 - re-exported
+                       check_backend, check_batch_size, check_run_backend, measure_batch)
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
@@ -46,64 +43,6 @@ PER_REPLICA_PARAMETERS = frozenset(_names(batch="replica"))
 #: parameters that fix the step schedule: N, the model constants behind τ, the protocol's periods and
 #: the integrator (batch class "schedule" of :mod:`particleShear.parameters`)
 SCHEDULE_PARAMETERS = _names(batch="schedule")
-
-#: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
-BACKENDS = ("numpy", "cupy")
-
-
-def _signature_defaults():
-    """Defaults of every keyword of ``doParticleShearSimulation`` (the parameter table's)."""
-    return _defaults()
-
-
-def check_backend(backend):
-    """Raise ValueError unless ``backend`` names a backend that can run here.
-
-    Parameters
-    ----------
-    backend : str
-        Name of the array library of a measurement: one of :data:`BACKENDS` (or a backend
-        registered with :func:`particleShear.engine.xp.register_backend`).
-
-    Raises
-    ------
-    ValueError
-        For an unknown name (naming ``backend``, its value and the allowed values), or for
-        ``"cupy"`` without CuPy or without a CUDA device.
-    """
-    get_backend(backend)
-
-
-def check_run_backend(kw):
-    """Check the backend of one run: usable here (every run is measured by the engine).
-
-    Parameters
-    ----------
-    kw : dict
-        Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` (missing
-        ones take their defaults).
-
-    Raises
-    ------
-    ValueError
-        Naming ``backend``, for an unusable backend.
-    """
-    check_backend(dict(_signature_defaults(), **kw)["backend"])
-
-
-def check_batch_size(batch_size):
-    """Raise ValueError unless ``batch_size`` is None or an integer >= 1.
-
-    Parameters
-    ----------
-    batch_size : int or None
-        Largest number of replicas per batch.
-    """
-    if batch_size is None:
-        return
-    if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
-        raise ValueError(f"batch_size={batch_size!r} is out of range: allowed None or an integer >= 1")
-
 
 def schedule_key(kwargs):
     """Hashable key of the step schedule of one run (runs with equal keys may share a batch).
@@ -227,91 +166,3 @@ def run_batch(list_of_kwargs, backend=None):
     results = measure_batch(full)
     doParticleShearSimulation.last_result = results[-1]
     return results
-
-
-def measure_batch(runs):
-    """Constitute every replica with the documented builder, then measure all of them in one engine.
-
-    ``runs``: complete, validated keyword dicts sharing one schedule.  Each replica runs through
-    the phases of ``runSimulation`` (:class:`~particleShear.simulation.oscillatory.RunSession`:
-    validation, constitution, reservation of its output file, experiment set-up, schedule) except
-    the measurement, which the engine does for all replicas at once; each experiment then adopts
-    its replica's record and the session writes the output file as ``runSimulation`` does.
-    Returns the :class:`~particleShear.run.api.SimulationResult` of each run, in order.  An
-    interrupt (``KeyboardInterrupt``) removes every reservation and is re-raised with
-    ``position = (phase, step, total)``.
-
-    Parameters
-    ----------
-    runs : list of dict
-        Complete, validated keyword dicts of the replicas (one schedule).
-
-    Returns
-    -------
-    list of SimulationResult
-    """
-    from .api import SimulationResult
-
-    sims, seeds, sessions = build_sessions(runs)
-    measure_sessions(sessions)
-    results = []
-    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
-        info = sim.result_info
-        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
-        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
-                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
-        results.append(SimulationResult(
-            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
-            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
-            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
-            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
-            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
-            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
-            microstructure=getattr(run, "microstructure", None)))
-        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
-    return results
-
-
-def build_sessions(runs):
-    """The simulation object and :class:`~particleShear.simulation.oscillatory.RunSession` of every run.
-
-    Parameters
-    ----------
-    runs : list of dict
-        Complete, validated keyword dicts of the replicas.
-
-    Returns
-    -------
-    sims : list
-        The documented simulation of each run (not constituted).
-    seeds : list of tuple
-        ``(seed entropy, spawn key, reference parameters)`` of each run.
-    sessions : list of RunSession
-        One session per run, in order.
-    """
-    from .api import _build_simulation, _seed_sequence
-    from .validation import contact_law_spec
-
-    sims, seeds, sessions = [], [], []
-    for kw in runs:  # every replica's settings are checked before any work
-        ss, rng = _seed_sequence(kw["seed"])
-        seed_entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
-        params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
-        sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
-                                correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
-                                renderer=kw.get("renderer", "auto"), time_step_factor=kw["time_step_factor"],
-                                integrator=kw["integrator"], stability_guard=kw["stability_guard"])
-        sim.output_format = kw.get("output_format", "text")
-        sim.saveOutputMovie = bool(kw.get("saveOutputMovie", False))
-        sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
-        sim.parameters = kw
-        sim.contact_law = contact_law_spec(kw)
-        sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
-        sims.append(sim)
-        seeds.append((seed_entropy, spawn_key, params))
-    return sims, seeds, sessions
-
-
-#: the arguments a SimulationResult lists in ``parameters`` (the reference's, in its order)
-_REFERENCE_ARGUMENTS = tuple(p.name for p in PARAMETERS if not p.keyword_only)

@@ -26,14 +26,15 @@ import tempfile
 import numpy as np
 
 from ..checks import as_float as _as_float, in_range, integer as _int, range_text, real_type, show_value
-from ..engine import contact_laws
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters
 from ..parameters import BY_NAME, PARAMETERS
 from ..parameters import defaults as _defaults
 from ..simulation.formats import check_output_format
-from .batch import check_backend, check_run_backend
+from .limits import (CELL, MAX_N, MAX_SERIES_RUNS, MAX_TOTAL_STEPS, MIN_SPHERES_PER_PARTICLE,  # noqa: F401 - re-exported
+                     MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED, SEED_LIMIT, _protocol_room)
+from .sessions import check_backend, check_run_backend, contact_law_spec
 from ..analysis.measures import warn_few_periods
 from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 
@@ -48,27 +49,6 @@ IMAGE_FILE_TYPES = BY_NAME["imageFileType"].choices
 RENDERERS = BY_NAME["renderer"].choices
 #: accepted ``integrator`` values (the engine's)
 INTEGRATORS = BatchEngine.INTEGRATORS
-
-#: cell of every run (µm)
-CELL = 500.0
-#: fewest protocol steps per excitation period at the reference time step: the demodulation
-#: integrates one sine period with the rectangle rule, whose error on G′, G″ is O(1/n²)
-#: (~1e-4 relative at n = 100), and the explicit step stays far below the period
-MIN_STEPS_PER_PERIOD = 100
-#: fewest protocol steps per period that a coarsened time step (``time_step_factor`` > 1) may
-#: leave: below 2 samples a period the excitation cannot be represented at all (Nyquist)
-MIN_STEPS_PER_PERIOD_COARSENED = 2
-#: fewest spheres per particle of a cut gel (mean): fewer than three bonded discs have no area
-#: and no shear rigidity of their own
-MIN_SPHERES_PER_PARTICLE = 3
-#: most spheres of one run (constitution cost grows faster than N; ~10 kB each)
-MAX_N = 1_000_000
-#: most integration steps of one run (constitution + pre-equilibration + protocol)
-MAX_TOTAL_STEPS = 10 ** 9
-#: most runs of one series
-MAX_SERIES_RUNS = 100_000
-#: integer seeds are below this bound (the 128 bits of entropy numpy draws for a fresh SeedSequence)
-SEED_LIMIT = 2 ** 128
 
 #: upper and lower limits of the single parameters, from the parameter table
 #: (:mod:`particleShear.parameters`, where each limit's reason is stated): the physical ones far
@@ -258,52 +238,6 @@ def _check_keyword_options(p):
     contact_law_spec(p)
 
 
-def contact_law_spec(p):
-    """The central law of one run as the engine takes it: None for "linear", else ``(name, values)``.
-
-    "linear" is the documented callback ``CircleBasicElasticity.call_back_elastic_force_law``
-    (the built-in linear law unless replaced: the class-attribute way of 1.0.2); another law of
-    the laws folder (:mod:`particleShear.engine.contact_laws`), of :func:`register_law` or
-    ``"package.module:function"`` is that law with its parameters (given, else their declared
-    defaults).  The parameters of every law of the laws folder are checked whatever the law
-    (types, declared ranges, the law's own check), as the plateau parameters were in 2.0.0.
-
-    Parameters
-    ----------
-    p : dict
-        Arguments of the run (``contact_law`` and the laws' parameters; missing ones take
-        their defaults).
-
-    Returns
-    -------
-    tuple or None
-        ``(name, values)``: the law's name and its parameter values in order.
-
-    Raises
-    ------
-    TypeError
-        For a law parameter that is not a real number.
-    ValueError
-        For an unknown law (naming ``contact_law``, the allowed names and the closest one) or a
-        law parameter out of range (naming it, its value and the range).
-    """
-    def given(law):
-        out = {}
-        for name, default in law.parameters.items():
-            v = p.get(name, default)
-            if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
-                raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
-            out[name] = float(v)
-        return out
-
-    for name in contact_laws.MODULES:
-        contact_laws.law_values(contact_laws.LAWS[name], given(contact_laws.LAWS[name]))
-    law = contact_laws.get_law(p.get("contact_law", "linear"))
-    if law.name == "linear":
-        return None
-    return law.name, contact_laws.law_values(law, given(law))
-
-
 # -- cost ------------------------------------------------------------------------------------------
 def estimate_run_cost(p):
     """Steps and memory a run will need, computed from its parameters without building anything.
@@ -395,31 +329,6 @@ def _protocol_culprit(p, cost, steps_ok):
     name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
     room = max(0.0, steps_ok * factor / spp - (n_periods - float(p[name])))
     return name, f"{name} <= {room:.4g}"
-
-
-def _protocol_room(p, detail, steps_ok):
-    """(name, allowed) of the parameter of another protocol than "oscillatory" that makes it longer
-    than ``steps_ok`` steps: ``total_strain`` (steady), ``hold_time`` (relaxation, creep), the
-    largest of pre_periods / periods / post_periods (sweeps)."""
-    proto = p["protocol"]
-    dtr = detail["dt_over_tau"]
-    if proto == "steady":
-        name, room = "total_strain", steps_ok * float(p["relative_rate"]) * dtr
-    elif proto == "creep":
-        name, room = "hold_time", steps_ok * dtr
-    elif proto == "relaxation":
-        name, room = "hold_time", (steps_ok - 1 - detail["ramp"]) * dtr
-        if room <= 0:
-            name, room = "ramp_time", (steps_ok - 1) * dtr
-    else:
-        n_periods = float(p["pre_periods"]) + float(p["periods"]) + float(p["post_periods"])
-        per_period = sum(detail["segments"]) / n_periods      # steps of one period of every step
-        name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(p[n]))
-        room = steps_ok / max(per_period, 1e-300) - (n_periods - float(p[name]))
-        if room <= 0:
-            name = "sweep_amplitudes" if proto == "amplitude_sweep" else "sweep_frequencies"
-            return name, "fewer or shorter steps"
-    return name, f"{name} <= {max(room, 0.0):.4g}"
 
 
 def _check_constitution(p):

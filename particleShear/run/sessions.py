@@ -1,0 +1,282 @@
+"""The sessions of a batch's runs: each run's simulation object and seed, its contact law, and the
+measurement of all of them in one engine (:func:`measure_batch`).
+
+Below :mod:`particleShear.run.api`, :mod:`particleShear.run.batch` and the rheometer's protocols
+(:mod:`particleShear.run.rheometer`), which all measure through it; the names keep their old homes
+as re-exports (``run.batch.measure_batch``, ``run.api._build_simulation``, ``run.validation.contact_law_spec``).
+"""
+__docformat__ = "numpy"
+import numbers
+
+import numpy as np
+
+from ..checks import show_value
+from ..engine import contact_laws
+from ..engine.xp import get_backend
+from ..parameters import PARAMETERS
+from ..parameters import defaults as _defaults
+from ..simulation.driver import measure_sessions
+from ..simulation.fragmentation import Simulation_interlocking_rheology
+from ..simulation.oscillatory import RunSession
+from ..simulation.provenance import run_identity
+from .result import SimulationResult
+
+__all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "check_run_backend", "contact_law_spec",
+           "measure_batch"]
+
+#: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
+BACKENDS = ("numpy", "cupy")
+
+
+def _signature_defaults():
+    """Defaults of every keyword of ``doParticleShearSimulation`` (the parameter table's)."""
+    return _defaults()
+
+
+def check_backend(backend):
+    """Raise ValueError unless ``backend`` names a backend that can run here.
+
+    Parameters
+    ----------
+    backend : str
+        Name of the array library of a measurement: one of :data:`BACKENDS` (or a backend
+        registered with :func:`particleShear.engine.xp.register_backend`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (naming ``backend``, its value and the allowed values), or for
+        ``"cupy"`` without CuPy or without a CUDA device.
+    """
+    get_backend(backend)
+
+
+def check_run_backend(kw):
+    """Check the backend of one run: usable here (every run is measured by the engine).
+
+    Parameters
+    ----------
+    kw : dict
+        Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` (missing
+        ones take their defaults).
+
+    Raises
+    ------
+    ValueError
+        Naming ``backend``, for an unusable backend.
+    """
+    check_backend(dict(_signature_defaults(), **kw)["backend"])
+
+
+def check_batch_size(batch_size):
+    """Raise ValueError unless ``batch_size`` is None or an integer >= 1.
+
+    Parameters
+    ----------
+    batch_size : int or None
+        Largest number of replicas per batch.
+    """
+    if batch_size is None:
+        return
+    if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
+        raise ValueError(f"batch_size={batch_size!r} is out of range: allowed None or an integer >= 1")
+
+
+def _seed_sequence(seed):
+    """(SeedSequence or None, Generator) for ``seed`` = None, int, SeedSequence, Generator or BitGenerator."""
+    if isinstance(seed, np.random.Generator):
+        return None, seed
+    if isinstance(seed, np.random.BitGenerator):
+        return None, np.random.Generator(seed)
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    return ss, np.random.default_rng(ss)
+
+
+def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, reference_header, renderer,
+                      time_step_factor, integrator, stability_guard):
+    """The :class:`Simulation_interlocking_rheology` of one run, configured but not run (``params``: the
+    validated reference arguments of :func:`doParticleShearSimulation`; ``rng`` its Generator)."""
+    p = params
+    root_folder, do_permanent_links, cut_lines, N = p["root_folder"], p["do_permanent_links"], p["cut_lines"], p["N"]
+    (packing_fraction, density, bimodal_factor, theAmplitude) = (p["packing_fraction"], p["density"],
+                                                                 p["bimodal_factor"], p["theAmplitude"])
+    Young_modulus_spheres, theMu, relative_y_scale_force = p["Young_modulus_spheres"], p["theMu"], p[
+        "relative_y_scale_force"]
+    relative_frequency, relative_viscosity = p["relative_frequency"], p["relative_viscosity"]
+    relative_transversal_link_strength = p["relative_transversal_link_strength"]
+    central_repulsion_coefficient = p["central_repulsion_coefficient"]
+    avoid_horizontal_angle_degree = p["avoid_horizontal_angle_degree"]
+    interface_reenforcement_central = p["interface_reenforcement_central"]
+    interface_reenforcement_tangential = p["interface_reenforcement_tangential"]
+    keep_viscosity_coefficients_constant = p["keep_viscosity_coefficients_constant"]
+    avoid_height_spanning_particles, cut_top_bottom = p["avoid_height_spanning_particles"], p["cut_top_bottom"]
+    doCutByTriangulation, remove_link_fraction = p["doCutByTriangulation"], p["remove_link_fraction"]
+    edge_fuzziness, doDrawing, saveData = p["edge_fuzziness"], p["doDrawing"], p["saveData"]
+    pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
+    saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
+    saveStressTensorData = p["saveStressTensorData"]
+    theSimulation = Simulation_interlocking_rheology(
+        root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
+        packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor, amplitude=theAmplitude,
+        Young_modulus_spheres=Young_modulus_spheres, mu=theMu, relative_y_scale_force=relative_y_scale_force,
+        relative_frequency=relative_frequency, relative_viscosity=relative_viscosity,
+        relative_transversal_link_strength=relative_transversal_link_strength,
+        central_repulsion_coefficient=central_repulsion_coefficient,
+        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+        interface_reenforcement_central=interface_reenforcement_central,
+        interface_reenforcement_tangential=interface_reenforcement_tangential,
+        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
+        avoid_height_spanning_particles=avoid_height_spanning_particles, cut_top_bottom=cut_top_bottom,
+        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
+        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, saveData=saveData)
+    theSimulation.function_call += (
+        "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
+        + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
+        + "\n\ttheSimulation.saveOutputImages = " + str(saveOutputImages)
+        + "\n\ttheSimulation.imageFileType = " + str(imageFileType)
+        + "\n\ttheSimulation.runSimulation(periods=" + str(periods) + ", cool_factor=" + str(cool_factor) + ")")
+    theSimulation.baseline_pre_periods = pre_periods
+    theSimulation.baseline_post_periods = post_periods
+    theSimulation.saveOutputImages = saveOutputImages
+    theSimulation.imageFileType = imageFileType
+    theSimulation.saveStressTensorData = saveStressTensorData
+    theSimulation.rng = rng
+    theSimulation.verbose = verbose
+    theSimulation.progress = progress
+    theSimulation.correct_drift_sign = correct_drift_sign
+    theSimulation.reference_header = reference_header
+    theSimulation.renderer_backend = renderer
+    theSimulation.time_step_factor = float(time_step_factor)
+    theSimulation.integrator = integrator
+    theSimulation.stability_guard = bool(stability_guard)
+
+    return theSimulation
+
+
+def contact_law_spec(p):
+    """The central law of one run as the engine takes it: None for "linear", else ``(name, values)``.
+
+    "linear" is the documented callback ``CircleBasicElasticity.call_back_elastic_force_law``
+    (the built-in linear law unless replaced: the class-attribute way of 1.0.2); another law of
+    the laws folder (:mod:`particleShear.engine.contact_laws`), of :func:`register_law` or
+    ``"package.module:function"`` is that law with its parameters (given, else their declared
+    defaults).  The parameters of every law of the laws folder are checked whatever the law
+    (types, declared ranges, the law's own check), as the plateau parameters were in 2.0.0.
+
+    Parameters
+    ----------
+    p : dict
+        Arguments of the run (``contact_law`` and the laws' parameters; missing ones take
+        their defaults).
+
+    Returns
+    -------
+    tuple or None
+        ``(name, values)``: the law's name and its parameter values in order.
+
+    Raises
+    ------
+    TypeError
+        For a law parameter that is not a real number.
+    ValueError
+        For an unknown law (naming ``contact_law``, the allowed names and the closest one) or a
+        law parameter out of range (naming it, its value and the range).
+    """
+    def given(law):
+        out = {}
+        for name, default in law.parameters.items():
+            v = p.get(name, default)
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+                raise TypeError(f"{name}={show_value(v)} is invalid: allowed a real number")
+            out[name] = float(v)
+        return out
+
+    for name in contact_laws.MODULES:
+        contact_laws.law_values(contact_laws.LAWS[name], given(contact_laws.LAWS[name]))
+    law = contact_laws.get_law(p.get("contact_law", "linear"))
+    if law.name == "linear":
+        return None
+    return law.name, contact_laws.law_values(law, given(law))
+
+
+def measure_batch(runs):
+    """Constitute every replica with the documented builder, then measure all of them in one engine.
+
+    ``runs``: complete, validated keyword dicts sharing one schedule.  Each replica runs through
+    the phases of ``runSimulation`` (:class:`~particleShear.simulation.oscillatory.RunSession`:
+    validation, constitution, reservation of its output file, experiment set-up, schedule) except
+    the measurement, which the engine does for all replicas at once; each experiment then adopts
+    its replica's record and the session writes the output file as ``runSimulation`` does.
+    Returns the :class:`~particleShear.run.api.SimulationResult` of each run, in order.  An
+    interrupt (``KeyboardInterrupt``) removes every reservation and is re-raised with
+    ``position = (phase, step, total)``.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Complete, validated keyword dicts of the replicas (one schedule).
+
+    Returns
+    -------
+    list of SimulationResult
+    """
+    sims, seeds, sessions = build_sessions(runs)
+    measure_sessions(sessions)
+    results = []
+    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
+        info = sim.result_info
+        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
+        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
+                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
+        results.append(SimulationResult(
+            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
+            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
+            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
+            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
+            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
+            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
+            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
+            microstructure=getattr(run, "microstructure", None)))
+        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
+    return results
+
+
+def build_sessions(runs):
+    """The simulation object and :class:`~particleShear.simulation.oscillatory.RunSession` of every run.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Complete, validated keyword dicts of the replicas.
+
+    Returns
+    -------
+    sims : list
+        The documented simulation of each run (not constituted).
+    seeds : list of tuple
+        ``(seed entropy, spawn key, reference parameters)`` of each run.
+    sessions : list of RunSession
+        One session per run, in order.
+    """
+    sims, seeds, sessions = [], [], []
+    for kw in runs:  # every replica's settings are checked before any work
+        ss, rng = _seed_sequence(kw["seed"])
+        seed_entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
+        params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
+        sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
+                                correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
+                                renderer=kw.get("renderer", "auto"), time_step_factor=kw["time_step_factor"],
+                                integrator=kw["integrator"], stability_guard=kw["stability_guard"])
+        sim.output_format = kw.get("output_format", "text")
+        sim.saveOutputMovie = bool(kw.get("saveOutputMovie", False))
+        sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
+        sim.parameters = kw
+        sim.contact_law = contact_law_spec(kw)
+        sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
+        sims.append(sim)
+        seeds.append((seed_entropy, spawn_key, params))
+    return sims, seeds, sessions
+
+
+#: the arguments a SimulationResult lists in ``parameters`` (the reference's, in its order)
+_REFERENCE_ARGUMENTS = tuple(p.name for p in PARAMETERS if not p.keyword_only)
