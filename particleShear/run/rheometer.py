@@ -169,7 +169,7 @@ def check_protocol(p):
     if proto.endswith("sweep"):
         check_sweep_resolution(q, steps)
     total = sum(steps["segments"]) if proto.endswith("sweep") else steps["steps"]
-    from .validation import MAX_TOTAL_STEPS, _protocol_room
+    from .limits import MAX_TOTAL_STEPS, _protocol_room
     if total > MAX_TOTAL_STEPS:
         name, allowed = _protocol_room(q, steps, MAX_TOTAL_STEPS)
         raise ValueError(f"{name}={_shown(q[name])} is out of range: protocol={proto!r} needs {total:.3g} steps, more "
@@ -208,7 +208,7 @@ def check_sweep_resolution(q, steps=None):
         Naming the step's value (``sweep_frequencies[j]`` or ``sweep_amplitudes[j]``), its steps
         per period, the limit, the allowed range and the CLI flag.
     """
-    from .validation import MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED
+    from .limits import MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED
     proto = q["protocol"]
     steps = protocol_steps(q) if steps is None else steps
     factor = float(q["time_step_factor"])
@@ -397,7 +397,7 @@ class RheometerResult:
         list of dict
         """
         from ..simulation.provenance import run_identity
-        from ..sweep.schema import PROTOCOL_COLUMNS
+        from .columns import PROTOCOL_COLUMNS
         params = spec_defaults(protocols=True)
         params.update({k: v for k, v in self.parameters.items() if k in params})
         base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
@@ -440,7 +440,7 @@ class RheometerResult:
         RheometerResult
         """
         from ..analysis.measures import MEASURE_COLUMNS
-        from ..sweep.schema import PROTOCOL_COLUMNS
+        from .columns import PROTOCOL_COLUMNS
         first = rows[0]
         proto = parameters["protocol"]
         inverse = {c: k for k, c in STEP_COLUMNS.items()}
@@ -479,7 +479,7 @@ class RheometerResult:
         the units of the results-table columns of the same names; for sweeps one row per step
         (G′, G″ of both estimators in Pa).
         """
-        from ..sweep.schema import column_spec
+        from .columns import column_spec
         p = self.parameters or {}
         seed = "None" if self.seed is None else str(self.seed)
         if self.spawn_key:
@@ -582,7 +582,7 @@ def measure_rheometer(runs):
     from ..engine import rheometer as eng
     from ..engine.step import protocol as oscillatory
     from ..simulation.provenance import run_identity
-    from .batch import build_sessions
+    from .sessions import build_sessions
     from .rheometer_analysis import analyse_record, analyse_sweep
     from .rheometer_files import write_protocol_file
 
