@@ -14,14 +14,14 @@ import numpy as np
 
 from ..hooks import entry
 from ..messages import console_messages
-from ..parameters import BY_NAME, EXTRA
+from ..parameters import BY_NAME, EXTRA, PARAMETERS
 from ..simulation.provenance import run_identity
 from .validation import check_seed, validate_run, validate_series
 from .sessions import _build_simulation, _seed_sequence, check_batch_size, measure_batch  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
-from ..parameters import PARAMETERS
 from ..simulation.drawing import _backend_choice, display_available
+from .rheometer import measure_rheometer, normalize_protocol
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -336,7 +336,6 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     spawn_key = () if ss is None else tuple(ss.spawn_key)
     run_id = run_identity(params, seed_entropy, spawn_key)
     if protocol != "oscillatory":
-        from .rheometer import measure_rheometer, normalize_protocol
         with console_messages(verbose):
             result = measure_rheometer([normalize_protocol(params)])[0]
         doParticleShearSimulation.last_result = result

@@ -29,6 +29,9 @@ from ..simulation.driver import ENGINE_SKIN_FACTOR, _guarded, measure_sessions, 
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 from .sessions import (BACKENDS, _REFERENCE_ARGUMENTS, _signature_defaults, build_sessions,  # noqa: F401 - re-exported
                        check_backend, check_batch_size, check_run_backend, measure_batch)
+from .api import doParticleShearSimulation
+from .rheometer import measure_rheometer, normalize_protocol, protocol_steps
+from .validation import validate_run
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
@@ -64,7 +67,6 @@ def schedule_key(kwargs):
     -------
     tuple
     """
-    from .rheometer import normalize_protocol, protocol_steps
     full = normalize_protocol(dict(_signature_defaults(), **kwargs))
     shared = tuple((name, repr(full[name])) for name in SCHEDULE_PARAMETERS)
     steps = time_steps_from_model(1.0, full["bimodal_factor"], full["theMu"],
@@ -137,8 +139,6 @@ def run_batch(list_of_kwargs, backend=None):
         For a key of a replica's dict that is not a parameter (naming ``list_of_kwargs[n]`` and
         the closest parameters), or a keyword of this function that is not one of its parameters.
     """
-    from .api import doParticleShearSimulation
-    from .validation import validate_run
 
     names = list(_signature_defaults())
     runs = [resolve_names(kw, names, f"run_batch list_of_kwargs[{n}]", aliases=PARAMETER_ALIASES)
@@ -159,7 +159,6 @@ def run_batch(list_of_kwargs, backend=None):
     defaults = _signature_defaults()
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
     if full[0]["protocol"] != "oscillatory":      # the protocol is part of the schedule key
-        from .rheometer import measure_rheometer, normalize_protocol
         results = measure_rheometer([normalize_protocol(kw) for kw in full])
         doParticleShearSimulation.last_result = results[-1]
         return results

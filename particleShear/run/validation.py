@@ -29,14 +29,14 @@ from ..checks import as_float as _as_float, in_range, integer as _int, range_tex
 from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters
-from ..parameters import BY_NAME, PARAMETERS
-from ..parameters import defaults as _defaults
+from ..parameters import BY_NAME, PARAMETERS, defaults as _defaults
 from ..simulation.formats import check_output_format
 from .limits import (CELL, MAX_N, MAX_SERIES_RUNS, MAX_TOTAL_STEPS, MIN_SPHERES_PER_PARTICLE,  # noqa: F401 - re-exported
                      MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED, SEED_LIMIT, _protocol_room)
 from .sessions import check_backend, check_run_backend, contact_law_spec
 from ..analysis.measures import warn_few_periods
 from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
+from .rheometer import PROTOCOL_DEFAULTS, _shown, check_protocol, normalize_protocol, protocol_steps
 
 __all__ = ["validate_run", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
            "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
@@ -280,7 +280,6 @@ def estimate_run_cost(p):
     proto = p.get("protocol", "oscillatory")
     detail = None
     if proto != "oscillatory":   # the protocol's own steps (a sweep: every step's), not the oscillation's
-        from .rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps
         detail = protocol_steps(normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p}))
         protocol = float(sum(detail["segments"]) if "segments" in detail else detail["steps"])
     # fixed-plate pre-equilibration: N/2 steps per halving level from dt_max down to dt, then 3N steps,
@@ -384,7 +383,6 @@ def _check_cost(p):
         other = cost["total_steps"] - cost["protocol_steps"]
         name, allowed = _protocol_culprit(p, cost, MAX_TOTAL_STEPS - other)
         if cost.get("protocol_detail") is not None:
-            from .rheometer import _shown
             raise ValueError(
                 f"{name}={_shown(p[name])} is out of range: the run would take {cost['total_steps']:.3g} steps, "
                 f"more than the limit of {MAX_TOTAL_STEPS:.0e}; allowed {allowed} (flag --{name.replace('_', '-')})")
@@ -419,7 +417,6 @@ def _check_cost(p):
     hint = " (or saveStressTensorData=False)" if mem["output_text"] else ""
     what, flag = "protocol steps", ""
     if cost.get("protocol_detail") is not None:
-        from .rheometer import _shown
         what = f"protocol steps of protocol={p['protocol']!r} ({per_step:.3g} B per step)"
         flag, name_value = f" (flag --{name.replace('_', '-')})", _shown(p[name])
     else:
@@ -509,7 +506,6 @@ def validate_run(params):
         raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder "
                          "(no such directory)")
     check_seed("seed", p["seed"])
-    from .rheometer import check_protocol, normalize_protocol
     check_protocol(p)             # the protocol's own parameters and steps (docs/protocols.md)
     p = normalize_protocol(p)     # a sweep is constituted for its first value
     cost = _check_cost(p)
