@@ -9,11 +9,11 @@ of every module, function-body imports included).  A function-body import (an im
 (NumPy; Pillow only where it draws) is at the top of its module.
 
 A module's layer is that of the longest entry of :data:`LAYERS` that names it or a package
-above it, so a module may be placed above the rest of its package (``analysis.cli`` is a
-command-line module, ``analysis.figure`` a figure).  The figures (layer ``plots``) are an
-optional layer: a result's ``plot()`` method lies below them and reaches its figure through
-:mod:`particleShear.signals`' figure registry, which the plot modules fill when imported
-(:func:`particleShear.signals.figure` imports them by name on first use).
+above it, so a module may be placed above the rest of its package (``analysis.cli`` and
+``experiment.calibration`` are command-line modules, ``analysis.figure`` a figure).  The figures
+(layer ``plots``) are an optional layer: a result's ``plot()`` method lies below them and reaches
+its figure through a named entry point of :mod:`particleShear.hooks` (resolved on call, no import
+statement).
 
 This module imports the standard library only; it is read by the test and by docs/design.md
 ("Layers"), never at run time.
@@ -58,9 +58,9 @@ LAZY_ALLOWED = frozenset(("matplotlib", "mpl_toolkits", "dask", "distributed", "
 PACKAGE = "particleShear"
 
 #: imports not yet moved to their layer (issue 45, in part): ``"importer > imported"`` (names
-#: without the leading ``particleShear.``), each a function-body import of a package module, an
-#: upward import or an import at the bottom of a module that closes a cycle.  The test accepts
-#: these and nothing else, and fails when one of them is gone (the list only shrinks).
+#: without the leading ``particleShear.``), each a function-body import of a package module that
+#: points downwards (the rheometer's protocol modules).  The test accepts these and nothing else,
+#: and fails when one of them is gone (the list only shrinks).
 _PENDING = (
     "analysis.protocol_summary > analysis.flow_curve",
     "analysis.protocol_summary > analysis.sweep",
