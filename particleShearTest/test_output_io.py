@@ -239,7 +239,7 @@ class TestFormats(unittest.TestCase):
         self.assertIn("particleShear[parquet]", str(cm.exception))
 
     def test_bad_format(self):
-        with mock.patch("particleShear.run.api.Simulation_interlocking_rheology") as sim:
+        with mock.patch("particleShear.run.sessions.Simulation_interlocking_rheology") as sim:
             with self.assertRaises(ValueError) as cm:
                 doParticleShearSimulation(self.dir.name, saveData=True, output_format="csv", **QUICK)
             sim.assert_not_called()

@@ -32,7 +32,7 @@ def _never_built(*args, **kwargs):
 def _no_work(memory=None):
     """No session may be built; ``available_memory`` fixed when ``memory`` is given."""
     with contextlib.ExitStack() as st:
-        st.enter_context(mock.patch("particleShear.run.batch.build_sessions", _never_built))
+        st.enter_context(mock.patch("particleShear.run.sessions.build_sessions", _never_built))
         if memory is not None:
             st.enter_context(mock.patch.object(V, "available_memory", return_value=memory))
         st.enter_context(warnings.catch_warnings())
