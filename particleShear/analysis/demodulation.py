@@ -13,6 +13,7 @@ import math
 import numbers
 
 import numpy as np
+
 from ..simulation.formats import read_run
 
 __all__ = ["demodulate", "jump_corrected", "measurement_periods", "evaluate_run", "PHASES",

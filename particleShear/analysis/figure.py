@@ -13,6 +13,7 @@ __docformat__ = "numpy"
 import math
 
 import numpy as np
+
 from ..plot_tools import FLAGGED_LABEL, _figure, fit_title, made_by, place_labels, save_figure
 
 __all__ = ["MARKERS", "MAX_FIGURE_PANELS", "not_drawn_line", "plot_analysis"]

@@ -16,6 +16,7 @@ import collections
 import math
 
 import numpy as np
+
 from .sweep import _vector
 
 __all__ = ["BlockAverage", "SteadyState", "block_average", "transient_end", "steady_state", "log_grid", "plateau",

@@ -32,6 +32,7 @@ __docformat__ = "numpy"
 import math
 
 import numpy as np
+
 from .periods import t_critical
 from .rheometry import final_rate, plateau as plateau_mean
 

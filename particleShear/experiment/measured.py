@@ -30,6 +30,7 @@ import sys
 import warnings
 
 import numpy as np
+
 from ..analysis.flow_curve import herschel_bulkley_bootstrap
 from ..analysis.laos import laos
 from ..analysis.rheometry import final_rate, plateau
