@@ -6,7 +6,7 @@
 module imports the module of its base class, never this one).
 """
 __docformat__ = "numpy"
-from .point_base import ArrayField, EnsembleField, Point, PointLeesEdwards, dotProduct2
+from .point_base import ArrayField, EnsembleField, Point, PointLeesEdwards, dotProduct2  # noqa: F401
 from .circles import Circle, CircleMass, CircleMassNeighbors
 from .elastic_circles import CircleBasicElasticity, CircleFrictionElasticity
 
