@@ -1,0 +1,71 @@
+"""Amplitude sweep: on one packing, the oscillatory protocol at each amplitude of ``sweep_amplitudes`` in turn.
+
+The constitution and the first step are those of the independent oscillatory run with the first
+amplitude (``theAmplitude`` is set to it); one G′/G″ (with standard errors and LAOS measures) per
+step (docs/protocols.md).
+"""
+__docformat__ = "numpy"
+
+from ..parameter_entry import Parameter
+from . import MIN_STEPS_PER_PERIOD, monotonic_values, register_protocol
+from ._oscillations import check_resolution, room as _room, sweep_steps
+
+__all__ = ["PROTOCOL", "PARAMETERS"]
+
+POSITION = 4
+SIGNATURE = True
+PARAMETERS = (
+    Parameter('sweep_amplitudes', None, 'float_list', unit='1', role='protocol:amplitude_sweep', keyword_only=True, nullable=True, doc='``protocol="amplitude_sweep"`` (required there): the strain amplitudes, in the order run, strictly increasing or strictly decreasing, each 0 < A <= 100; ``theAmplitude`` is set to the first'),
+)
+_SW = "; empty unless protocol is 'amplitude_sweep' or 'frequency_sweep'"
+#: the columns of a sweep's step (shared with frequency_sweep)
+COLUMNS = {
+    "sweep_position": ("int", "", "position of the step in its one-packing sweep (0, 1, ...; one row per step)" + _SW),
+    "sweep_amplitude": ("float", "1", "strain amplitude of the step" + _SW),
+    "sweep_relative_frequency": ("float", "1", "relative frequency f·τ of the step" + _SW),
+}
+
+
+def normalize(q):
+    """``sweep_amplitudes`` as floats (checked), ``theAmplitude`` its first."""
+    q["sweep_amplitudes"] = monotonic_values("sweep_amplitudes", q.get("sweep_amplitudes"), 0, 100)
+    q["theAmplitude"] = q["sweep_amplitudes"][0]
+
+
+def steps(q, dt_over_tau):
+    """Each step's dt/τ (``dts``) and oscillatory steps (``segments``)."""
+    amps = q["sweep_amplitudes"]
+    return sweep_steps(q, dt_over_tau, amps, [q["relative_frequency"]] * len(amps))
+
+
+def check_steps(q, steps):
+    """Every step resolves its period (:func:`~particleShear.protocols._oscillations.check_resolution`)."""
+    factor = float(q["time_step_factor"])
+
+    def allowed(j, fr, spp, flag):
+        rf_max = min(1.0 / (MIN_STEPS_PER_PERIOD * d / factor) for d in steps["dts"])
+        return f"relative_frequency <= {rf_max:.4g} for every amplitude of this sweep (flag --relative-frequency)"
+    check_resolution(q, steps, [float(q["relative_frequency"])] * len(steps["dts"]),
+                     lambda j: (f"sweep_amplitudes[{j}]", q["sweep_amplitudes"][j], "--sweep-amplitudes"), allowed)
+
+
+def segments(kws, steps, tau, f):
+    """``(f, amplitudes of the replicas, dt)`` of each step: the run's frequency, the step's amplitude."""
+    return [(f, [k["sweep_amplitudes"][j] for k in kws], dtr * tau) for j, dtr in enumerate(steps[0]["dts"])]
+
+
+def room(q, steps, steps_ok):
+    """The longest of the periods, else fewer or shorter steps."""
+    return _room(q, steps, steps_ok, "sweep_amplitudes")
+
+
+def label(step):
+    """``A = …`` of a step."""
+    return f"A = {step.get('amplitude', float('nan')):.4g}"
+
+
+PROTOCOL = register_protocol("amplitude_sweep", parameters=PARAMETERS, normalize=normalize, steps=steps,
+                             check_steps=check_steps, segments=segments, columns=COLUMNS,
+                             checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
+                                     "excitation_resolved"), room=room, label=label,
+                             doc="the oscillation at each of sweep_amplitudes in turn on one packing")

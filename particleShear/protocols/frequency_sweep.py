@@ -1,0 +1,63 @@
+"""Frequency sweep: on one packing, the oscillatory protocol at each relative frequency of ``sweep_frequencies`` in turn.
+
+The constitution and the first step are those of the independent oscillatory run with the first
+frequency (``relative_frequency`` is set to it); one G′/G″ (with standard errors and LAOS
+measures) per step (docs/protocols.md).
+"""
+__docformat__ = "numpy"
+
+from ..parameter_entry import Parameter
+from . import MIN_STEPS_PER_PERIOD, monotonic_values, register_protocol
+from ._oscillations import check_resolution, room as _room, sweep_steps
+from .amplitude_sweep import COLUMNS
+
+__all__ = ["PROTOCOL", "PARAMETERS"]
+
+POSITION = 5
+SIGNATURE = True
+PARAMETERS = (
+    Parameter('sweep_frequencies', None, 'float_list', unit='1', role='protocol:frequency_sweep', batch='shared', keyword_only=True, nullable=True, doc='``protocol="frequency_sweep"`` (required there): the relative frequencies f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first'),
+)
+
+
+def normalize(q):
+    """``sweep_frequencies`` as floats (checked), ``relative_frequency`` its first."""
+    q["sweep_frequencies"] = monotonic_values("sweep_frequencies", q.get("sweep_frequencies"), 0, 1e6)
+    q["relative_frequency"] = q["sweep_frequencies"][0]
+
+
+def steps(q, dt_over_tau):
+    """Each step's dt/τ (``dts``) and oscillatory steps (``segments``)."""
+    freqs = q["sweep_frequencies"]
+    return sweep_steps(q, dt_over_tau, [q["theAmplitude"]] * len(freqs), freqs)
+
+
+def check_steps(q, steps):
+    """Every step resolves its period (:func:`~particleShear.protocols._oscillations.check_resolution`)."""
+    def allowed(j, fr, spp, flag):
+        return f"every value of sweep_frequencies <= {fr * spp / MIN_STEPS_PER_PERIOD:.4g} (flag {flag})"
+    freqs = q["sweep_frequencies"]
+    check_resolution(q, steps, freqs, lambda j: (f"sweep_frequencies[{j}]", freqs[j], "--sweep-frequencies"), allowed)
+
+
+def segments(kws, steps, tau, f):
+    """``(f, amplitudes of the replicas, dt)`` of each step: the step's frequency, the run's amplitude."""
+    return [(kws[0]["sweep_frequencies"][j] / tau, [k["theAmplitude"] for k in kws], dtr * tau)
+            for j, dtr in enumerate(steps[0]["dts"])]
+
+
+def room(q, steps, steps_ok):
+    """The longest of the periods, else fewer or shorter steps."""
+    return _room(q, steps, steps_ok, "sweep_frequencies")
+
+
+def label(step):
+    """``f·τ = …`` of a step."""
+    return f"f·τ = {step.get('relative_frequency', float('nan')):.4g}"
+
+
+PROTOCOL = register_protocol("frequency_sweep", parameters=PARAMETERS, normalize=normalize, steps=steps,
+                             check_steps=check_steps, segments=segments, columns=COLUMNS,
+                             checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
+                                     "excitation_resolved"), room=room, label=label,
+                             doc="the oscillation at each of sweep_frequencies in turn on one packing")

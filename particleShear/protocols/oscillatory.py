@@ -1,0 +1,27 @@
+"""The reference's protocol: oscillatory shear at ``theAmplitude`` and ``relative_frequency``.
+
+Its parameters are the model's (``theAmplitude``, ``relative_frequency``, ``pre_periods``,
+``periods``, ``post_periods``: roles of the table, not ``protocol:``), its loop is
+:func:`particleShear.engine.step.protocol`, and its run, summary (G′, G″, measures) and columns
+are those of :mod:`particleShear.run.batch` and :class:`particleShear.run.api.SimulationResult`.
+"""
+__docformat__ = "numpy"
+
+from . import register_protocol
+
+__all__ = ["PROTOCOL"]
+
+POSITION = 0
+SIGNATURE = True
+PARAMETERS = ()
+
+
+def steps(q, dt_over_tau):
+    """No protocol steps of its own here (the oscillatory run counts its periods itself)."""
+    return {"dt_over_tau": dt_over_tau()}
+
+
+PROTOCOL = register_protocol("oscillatory", parameters=PARAMETERS, steps=steps,
+                             checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
+                                     "excitation_resolved"),
+                             doc="the reference's oscillation")
