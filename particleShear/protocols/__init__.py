@@ -236,6 +236,10 @@ def _discover():
 
 #: the protocol modules of this folder, protocol name → module, in the order of ``protocol``'s choices
 MODULES = _discover()
+# the registry in the same order (a protocol registered later follows)
+_ORDERED = {name: PROTOCOLS[name] for name in MODULES}
+PROTOCOLS.clear()
+PROTOCOLS.update(_ORDERED)
 
 
 def declared_parameters():
