@@ -101,6 +101,13 @@ class Protocol:
         protocol needs more than ``steps_ok`` steps.
     label : callable or None
         ``label(step) -> str`` of a sweep's step (the summary's row label).
+    required : tuple of str or None
+        The columns an ``ok`` row of the protocol must hold a number in (a row without one is run
+        again on resume); None: its float ``columns``.
+    record_bytes : int
+        Memory a run plans per protocol step (bytes; default: the recording loop's 5 series of
+        8 bytes and as much again for the run's series, analysis and file columns,
+        :data:`particleShear.run.validation.PROTOCOL_RECORD_BYTES_PER_STEP`).
     quantities : dict
         The quantities ``python -m particleShear analyse`` summarises over a group of runs
         (name, ``{est}`` the estimator → unit).
@@ -122,8 +129,17 @@ class Protocol:
     checks: tuple = ()
     room: object = None
     label: object = None
+    required: tuple = None
+    record_bytes: int = 2 * 5 * 8
     quantities: dict = dataclasses.field(default_factory=dict)
     doc: str = ""
+
+    @property
+    def required_numbers(self):
+        """:attr:`required`, or the float columns when None."""
+        if self.required is not None:
+            return tuple(self.required)
+        return tuple(name for name, (kind, *_) in self.columns.items() if kind == "float")
 
     @property
     def recorded(self):

@@ -64,8 +64,9 @@ def label(step):
     return f"A = {step.get('amplitude', float('nan')):.4g}"
 
 
-PROTOCOL = register_protocol("amplitude_sweep", parameters=PARAMETERS, normalize=normalize, steps=steps,
+PROTOCOL = register_protocol("amplitude_sweep", parameters=PARAMETERS,
+                             required=("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "sweep_position"), normalize=normalize, steps=steps,
                              check_steps=check_steps, segments=segments, columns=COLUMNS,
                              checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
-                                     "excitation_resolved"), room=room, label=label,
+                                     "excitation_resolved"), room=room, record_bytes=200, label=label,
                              doc="the oscillation at each of sweep_amplitudes in turn on one packing")

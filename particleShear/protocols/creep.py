@@ -205,7 +205,8 @@ def values(s):
     return [s["creep_rate"], s["creep_viscosity"]]
 
 
-PROTOCOL = register_protocol("creep", parameters=PARAMETERS, steps=steps, check=check, check_steps=check_steps,
+PROTOCOL = register_protocol("creep", parameters=PARAMETERS,
+                             required=("creep_rate", "strain_plateau"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,
                              checks=("stress_held", "rate_unsaturated", "hold_sufficient"), room=room,
                              quantities={"creep_rate": "1/s", "creep_viscosity": "Pa·s", "strain_plateau": "1",

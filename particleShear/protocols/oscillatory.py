@@ -21,7 +21,8 @@ def steps(q, dt_over_tau):
     return {"dt_over_tau": dt_over_tau()}
 
 
-PROTOCOL = register_protocol("oscillatory", parameters=PARAMETERS, steps=steps,
+PROTOCOL = register_protocol("oscillatory", parameters=PARAMETERS,
+                             required=("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"), steps=steps,
                              checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
                                      "excitation_resolved"),
                              doc="the reference's oscillation")

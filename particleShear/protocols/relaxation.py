@@ -106,7 +106,8 @@ def values(s):
     return [s["G_plateau_surface"]]
 
 
-PROTOCOL = register_protocol("relaxation", parameters=PARAMETERS, steps=steps, check=check, check_steps=check_steps,
+PROTOCOL = register_protocol("relaxation", parameters=PARAMETERS,
+                             required=("G_plateau_surface", "G_plateau_internal"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,
                              checks=("plateau_reached", "strain_above_noise"), room=room,
                              quantities={"G_plateau_{est}": "Pa", "residual_stress": "Pa"},

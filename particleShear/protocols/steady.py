@@ -102,8 +102,9 @@ def values(s):
     return [s["stress_surface"], s["viscosity_surface"]]
 
 
-PROTOCOL = register_protocol("steady", parameters=PARAMETERS, steps=steps, check=check, check_steps=check_steps, schedule=schedule,
+PROTOCOL = register_protocol("steady", parameters=PARAMETERS,
+                             required=("stress_surface", "stress_internal", "strain_rate"), steps=steps, check=check, check_steps=check_steps, schedule=schedule,
                              summary=summary, values=values, columns=COLUMNS,
-                             checks=("plateau_reached", "strain_sufficient"), room=room,
+                             checks=("plateau_reached", "strain_sufficient"), room=room, record_bytes=2 * 6 * 8,
                              quantities={"sigma_y": "Pa", "K": "Pa·s^n", "n": "1"},
                              doc="a constant shear rate")

@@ -98,8 +98,8 @@ MEMORY_FRACTION = 0.8
 #: steps); a sweep's steps keep the oscillatory record and its demodulation and join the steps' records
 #: (185 B per step of a frequency sweep at 2,518 → 5,542 steps); rounded up.  The whole record is held
 #: until the run ends.
-PROTOCOL_RECORD_BYTES_PER_STEP = {"steady": 2 * 6 * 8, "relaxation": 2 * 5 * 8, "creep": 2 * 5 * 8,
-                                  "amplitude_sweep": 200, "frequency_sweep": 200}
+#: Each protocol states its own (``record_bytes``, :mod:`particleShear.protocols`).
+PROTOCOL_RECORD_BYTES_PER_STEP = {name: p.record_bytes for name, p in _PROTOCOLS.items() if name != "oscillatory"}
 
 
 # -- single values ---------------------------------------------------------------------------------
