@@ -101,6 +101,11 @@ class Protocol:
         protocol needs more than ``steps_ok`` steps.
     label : callable or None
         ``label(step) -> str`` of a sweep's step (the summary's row label).
+    header : tuple of str or None
+        The parameters the header of the run's file lists (:mod:`particleShear.run.rheometer_files`);
+        None: its own parameters.
+    file_name : tuple or None
+        ``(word, parameter)`` the file name carries (``<protocol>_<word>_<value>``); None: none.
     required : tuple of str or None
         The columns an ``ok`` row of the protocol must hold a number in (a row without one is run
         again on resume); None: its float ``columns``.
@@ -129,10 +134,17 @@ class Protocol:
     checks: tuple = ()
     room: object = None
     label: object = None
+    header: tuple = None
+    file_name: tuple = None
     required: tuple = None
     record_bytes: int = 2 * 5 * 8
     quantities: dict = dataclasses.field(default_factory=dict)
     doc: str = ""
+
+    @property
+    def header_parameters(self):
+        """:attr:`header`, or the names of its own parameters when None."""
+        return tuple(self.header) if self.header is not None else tuple(p.name for p in self.parameters)
 
     @property
     def required_numbers(self):

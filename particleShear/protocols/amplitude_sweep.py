@@ -65,6 +65,7 @@ def label(step):
 
 
 PROTOCOL = register_protocol("amplitude_sweep", parameters=PARAMETERS,
+                             header=("sweep_amplitudes", "relative_frequency", "pre_periods", "periods", "post_periods"),
                              required=("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "sweep_position"), normalize=normalize, steps=steps,
                              check_steps=check_steps, segments=segments, columns=COLUMNS,
                              checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",

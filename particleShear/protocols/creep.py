@@ -206,6 +206,7 @@ def values(s):
 
 
 PROTOCOL = register_protocol("creep", parameters=PARAMETERS,
+                             header=("creep_stress", "creep_modulus", "creep_response_time", "hold_time"), file_name=("stress", "creep_stress"),
                              required=("creep_rate", "strain_plateau"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,
                              checks=("stress_held", "rate_unsaturated", "hold_sufficient"), room=room,

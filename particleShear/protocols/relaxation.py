@@ -107,6 +107,7 @@ def values(s):
 
 
 PROTOCOL = register_protocol("relaxation", parameters=PARAMETERS,
+                             header=("theAmplitude", "ramp_time", "hold_time"), file_name=("strain", "theAmplitude"),
                              required=("G_plateau_surface", "G_plateau_internal"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,
                              checks=("plateau_reached", "strain_above_noise"), room=room,

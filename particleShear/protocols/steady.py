@@ -103,6 +103,7 @@ def values(s):
 
 
 PROTOCOL = register_protocol("steady", parameters=PARAMETERS,
+                             header=("relative_rate", "total_strain"), file_name=("rate", "relative_rate"),
                              required=("stress_surface", "stress_internal", "strain_rate"), steps=steps, check=check, check_steps=check_steps, schedule=schedule,
                              summary=summary, values=values, columns=COLUMNS,
                              checks=("plateau_reached", "strain_sufficient"), room=room, record_bytes=2 * 6 * 8,
