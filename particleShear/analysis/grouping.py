@@ -30,8 +30,7 @@ MODULI_PROTOCOLS = ("oscillatory",) + tuple(n for n, p in PROTOCOLS.items() if p
 #: protocols whose rows hold a summary of one run (docs/protocols.md): those of the recording loop
 SUMMARY_PROTOCOLS = tuple(n for n, p in PROTOCOLS.items() if p.recorded)
 #: the column of a step row that holds the step's value of a parameter column
-_STEP_VALUE = {"amplitude_sweep": ("theAmplitude", "sweep_amplitude"),
-               "frequency_sweep": ("relative_frequency", "sweep_relative_frequency")}
+_STEP_VALUE = {n: p.step_value for n, p in PROTOCOLS.items() if p.step_value is not None}
 
 
 def row_protocol(row):

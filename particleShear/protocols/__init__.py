@@ -101,6 +101,18 @@ class Protocol:
         protocol needs more than ``steps_ok`` steps.
     label : callable or None
         ``label(step) -> str`` of a sweep's step (the summary's row label).
+    shorten : callable or None
+        ``shorten(q, steps, n, steps_of) -> dict``: the parameters that cut the protocol to about
+        ``n`` steps, never longer (a sweep's cost calibration, :mod:`particleShear.sweep.calibration`;
+        ``steps_of(q)`` the step counts of other arguments); None: the protocol is not cut.
+    n_rows : callable or None
+        ``n_rows(q)``: rows of a run in a results table (a sweep's steps); None: one.
+    step_value : tuple or None
+        ``(parameter column, step column)``: the column a step row's value of a sweep's list
+        stands for (``analyse`` groups steps by it); None for a protocol without steps.
+    shown : tuple or None
+        ``(column, label, unit)`` a sweep's progress line shows for a run; None: the first of
+        :attr:`required_numbers`.
     header : tuple of str or None
         The parameters the header of the run's file lists (:mod:`particleShear.run.rheometer_files`);
         None: its own parameters.
@@ -134,6 +146,10 @@ class Protocol:
     checks: tuple = ()
     room: object = None
     label: object = None
+    shorten: object = None
+    n_rows: object = None
+    step_value: tuple = None
+    shown: tuple = None
     header: tuple = None
     file_name: tuple = None
     required: tuple = None

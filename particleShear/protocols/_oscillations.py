@@ -9,7 +9,7 @@ __docformat__ = "numpy"
 
 from . import MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED
 
-__all__ = ["sweep_steps", "check_resolution", "room"]
+__all__ = ["sweep_steps", "check_resolution", "room", "shorten"]
 
 
 def sweep_steps(q, dt_over_tau, amps, freqs):
@@ -74,3 +74,12 @@ def room(q, steps, steps_ok, list_name):
     if room <= 0:
         return list_name, "fewer or shorter steps"
     return name, f"{name} <= {max(room, 0.0):.4g}"
+
+
+def shorten(q, n, steps_of, list_name):
+    """The first two values of ``list_name``, no baseline periods, the excitation periods cut so that
+    both steps together take about ``n`` steps (a sweep's cost calibration)."""
+    q2 = dict(q, **{list_name: q[list_name][:2]}, pre_periods=0, post_periods=0, periods=1)
+    per_period = max(1, sum(steps_of(q2)["segments"]))
+    return {list_name: list(q[list_name][:2]), "pre_periods": 0, "post_periods": 0,
+            "periods": min(float(q["periods"]), n / per_period)}

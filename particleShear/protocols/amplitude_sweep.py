@@ -8,7 +8,7 @@ __docformat__ = "numpy"
 
 from ..parameter_entry import Parameter
 from . import MIN_STEPS_PER_PERIOD, monotonic_values, register_protocol
-from ._oscillations import check_resolution, room as _room, sweep_steps
+from ._oscillations import check_resolution, room as _room, shorten as _shorten, sweep_steps
 
 __all__ = ["PROTOCOL", "PARAMETERS"]
 
@@ -64,7 +64,19 @@ def label(step):
     return f"A = {step.get('amplitude', float('nan')):.4g}"
 
 
+def shorten(q, steps, n, steps_of):
+    """The first two values of the list, no baseline periods, the excitation periods cut so that both
+    steps together take about ``n`` steps."""
+    return _shorten(q, n, steps_of, "sweep_amplitudes")
+
+
+def n_rows(q):
+    """One row per value of ``sweep_amplitudes``."""
+    return len(q["sweep_amplitudes"])
+
+
 PROTOCOL = register_protocol("amplitude_sweep", parameters=PARAMETERS,
+                             shorten=shorten, n_rows=n_rows, step_value=("theAmplitude", "sweep_amplitude"),
                              header=("sweep_amplitudes", "relative_frequency", "pre_periods", "periods", "post_periods"),
                              required=("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "sweep_position"), normalize=normalize, steps=steps,
                              check_steps=check_steps, segments=segments, columns=COLUMNS,

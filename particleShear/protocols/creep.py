@@ -205,7 +205,13 @@ def values(s):
     return [s["creep_rate"], s["creep_viscosity"]]
 
 
+def shorten(q, steps, n, steps_of):
+    """The hold cut to ``n`` steps."""
+    return {"hold_time": min(float(q["hold_time"]), n * steps["dt_over_tau"])}
+
+
 PROTOCOL = register_protocol("creep", parameters=PARAMETERS,
+                             shorten=shorten, shown=("creep_rate", "creep rate", "1/s"),
                              header=("creep_stress", "creep_modulus", "creep_response_time", "hold_time"), file_name=("stress", "creep_stress"),
                              required=("creep_rate", "strain_plateau"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,

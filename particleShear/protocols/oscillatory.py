@@ -22,6 +22,7 @@ def steps(q, dt_over_tau):
 
 
 PROTOCOL = register_protocol("oscillatory", parameters=PARAMETERS,
+                             shown=("Gp_surface", "G'", "Pa"),
                              required=("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"), steps=steps,
                              checks=("steady_state", "linear_response", "estimators_agree", "moduli_positive",
                                      "excitation_resolved"),

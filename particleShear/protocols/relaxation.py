@@ -106,7 +106,13 @@ def values(s):
     return [s["G_plateau_surface"]]
 
 
+def shorten(q, steps, n, steps_of):
+    """The ramp kept (its rate is bounded), the hold cut."""
+    return {"hold_time": min(float(q["hold_time"]), max(n - 1 - steps["ramp"], 1) * steps["dt_over_tau"])}
+
+
 PROTOCOL = register_protocol("relaxation", parameters=PARAMETERS,
+                             shorten=shorten, shown=("G_plateau_surface", "G_plateau", "Pa"),
                              header=("theAmplitude", "ramp_time", "hold_time"), file_name=("strain", "theAmplitude"),
                              required=("G_plateau_surface", "G_plateau_internal"), steps=steps, check=check, check_steps=check_steps,
                              schedule=schedule, summary=summary, values=values, columns=COLUMNS,

@@ -102,7 +102,13 @@ def values(s):
     return [s["stress_surface"], s["viscosity_surface"]]
 
 
+def shorten(q, steps, n, steps_of):
+    """The strain of ``n`` steps at the run's rate."""
+    return {"total_strain": min(float(q["total_strain"]), n * float(q["relative_rate"]) * steps["dt_over_tau"])}
+
+
 PROTOCOL = register_protocol("steady", parameters=PARAMETERS,
+                             shorten=shorten, shown=("stress_surface", "σ", "Pa"),
                              header=("relative_rate", "total_strain"), file_name=("rate", "relative_rate"),
                              required=("stress_surface", "stress_internal", "strain_rate"), steps=steps, check=check, check_steps=check_steps, schedule=schedule,
                              summary=summary, values=values, columns=COLUMNS,

@@ -588,7 +588,7 @@ def validate_run(params):
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
     from ..analysis.measures import warn_few_periods
-    if p["protocol"] in ("oscillatory", "amplitude_sweep", "frequency_sweep"):
+    if p["protocol"] == "oscillatory" or _PROTOCOLS[p["protocol"]].segmented:
         warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
     return cost
 
