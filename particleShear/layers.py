@@ -163,7 +163,6 @@ _PENDING = (
     "run.result > analysis.microstructure",
     "run.result > analysis.verdicts",
     "run.result > simulation.provenance",
-    "run.rheometer > sweep.schema",
     "run.validation > analysis.measures",
     "run.validation > run.batch",
     "run.validation > run.guard",

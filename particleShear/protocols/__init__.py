@@ -49,7 +49,7 @@ from ..parameter_entry import Parameter
 
 __all__ = ["Protocol", "PROTOCOLS", "MODULES", "MAX_STRAIN_PER_STEP", "MIN_STEPS_PER_PERIOD",
            "MIN_STEPS_PER_PERIOD_COARSENED", "register_protocol", "get_protocol",
-           "declared_parameters", "positive", "monotonic_values"]
+           "declared_parameters", "result_columns", "positive", "monotonic_values"]
 
 #: largest strain increment |γ̇|·dt of one step (≈ 9× the default oscillation's peak, 5.6e-4):
 #: neighbours 2r apart then move by at most 1 % of r relative to each other per step
@@ -284,6 +284,38 @@ MODULES = _discover()
 _ORDERED = {name: PROTOCOLS[name] for name in MODULES}
 PROTOCOLS.clear()
 PROTOCOLS.update(_ORDERED)
+
+
+def result_columns(check_order=()):
+    """The result columns of the protocols, in table order.
+
+    The step columns of the sweeps first, then the summaries of the other protocols (each column
+    once, in the order of ``protocol``'s choices), then the checks of the recorded protocols (those
+    of ``check_order`` in its order, then a protocol's own in protocol order).
+
+    Parameters
+    ----------
+    check_order : sequence of str
+        The known checks in table order (:data:`particleShear.analysis.verdicts.CHECKS`).
+
+    Returns
+    -------
+    values : dict
+        Column → ``(type, unit, description)`` of the protocols' ``columns``.
+    checks : dict
+        Check → the names of the protocols that judge it.
+    """
+    checks = {}
+    for p in PROTOCOLS.values():
+        if p.recorded:
+            for c in p.checks:
+                checks.setdefault(c, []).append(p.name)
+    order = list(check_order)
+    checks = {c: tuple(checks[c]) for c in sorted(checks, key=lambda c: order.index(c) if c in order else len(order))}
+    values = {}
+    for p in [p for p in PROTOCOLS.values() if p.segmented] + [p for p in PROTOCOLS.values() if not p.segmented]:
+        values.update({k: v for k, v in p.columns.items() if k not in values and k not in checks})
+    return values, checks
 
 
 def declared_parameters():

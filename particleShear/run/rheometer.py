@@ -40,8 +40,8 @@ from ..engine.rheometer import shear_record
 from ..engine.step import protocol as oscillation
 from ..hooks import entry
 from ..linkable.builders import time_steps_from_model
-from ..parameters import PARAMETERS, spec_defaults
-from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY
+from ..parameters import BY_NAME, PARAMETERS, spec_defaults
+from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY, result_columns
 from ..protocols.creep import CREEP_MODULUS_FRACTION
 from ..protocols.steady import N1_EVERY
 from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
@@ -51,7 +51,7 @@ from .rheometer_analysis import analyse_record, analyse_sweep
 from .rheometer_files import write_protocol_file
 from .validation import MAX_TOTAL_STEPS, _protocol_room
 
-__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
+__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "PROTOCOL_COLUMNS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
 #: the protocols' names, in the order of ``protocol``'s choices (:mod:`particleShear.protocols`)
@@ -60,6 +60,12 @@ PROTOCOLS = tuple(REGISTRY)
 #: the protocol's selector and the protocols' own parameters with their defaults (roles "protocol" of
 #: :mod:`particleShear.parameters`)
 PROTOCOL_DEFAULTS = {p.name: p.default for p in PARAMETERS if p.base_role == "protocol"}
+
+#: the result columns of the protocols, in table order (the summaries, the checks; the results
+#: table's :data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`), name → unit
+_COLUMN_UNITS = {name: spec[1] for name, spec in result_columns(CHECKS)[0].items()}
+_COLUMN_UNITS.update((name, "") for name in result_columns(CHECKS)[1])
+PROTOCOL_COLUMNS = tuple(_COLUMN_UNITS)
 
 #: the protocol parameters whose value is a list (one value of a sweep is a whole list)
 LIST_PARAMETERS = tuple(p.name for p in PARAMETERS if p.kind == "float_list")
@@ -282,7 +288,7 @@ class RheometerResult:
         Keys as :func:`particleShear.sweep.table.table_columns` of a protocol sweep: ``run_id``,
         ``status`` ("ok"), ``error``, the moduli and measures (sweep steps), the run columns
         (``repetition``, ``frequency_Hz`` and ``omega`` of a sweep step, ``dt``, ``N_steps``), the
-        protocol columns (:data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`: the summary, or
+        protocol columns (:data:`PROTOCOL_COLUMNS`: the summary, or
         ``sweep_position``, ``sweep_amplitude``, ``sweep_relative_frequency`` of a step), every
         parameter, ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s),
         ``output_path``.  Columns a protocol does not produce are absent (empty cells).
@@ -291,7 +297,6 @@ class RheometerResult:
         -------
         list of dict
         """
-        from ..sweep.schema import PROTOCOL_COLUMNS
         params = spec_defaults(protocols=True)
         params.update({k: v for k, v in self.parameters.items() if k in params})
         base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
@@ -333,7 +338,6 @@ class RheometerResult:
         -------
         RheometerResult
         """
-        from ..sweep.schema import PROTOCOL_COLUMNS
         first = rows[0]
         proto = parameters["protocol"]
         inverse = {c: k for k, c in STEP_COLUMNS.items()}
@@ -372,7 +376,6 @@ class RheometerResult:
         the units of the results-table columns of the same names; for sweeps one row per step
         (G′, G″ of both estimators in Pa).
         """
-        from ..sweep.schema import column_spec
         p = self.parameters or {}
         seed = "None" if self.seed is None else str(self.seed)
         if self.spawn_key:
@@ -399,7 +402,7 @@ class RheometerResult:
             for name, v in self.summary.items():
                 if name.endswith("_se") or name in CHECKS or name == "verdict":
                     continue
-                unit = column_spec(name).get("unit") or ""
+                unit = _unit(name)
                 rows.append((name, num(v, self.summary.get(name + "_se")), "" if unit == "1" else unit))
         return fields, rows
 
@@ -440,6 +443,14 @@ class RheometerResult:
         out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
+
+
+def _unit(name):
+    """The unit of a summary number: its result column's, or its parameter's ("" when none)."""
+    if name in _COLUMN_UNITS:
+        return _COLUMN_UNITS[name]
+    par = BY_NAME.get(name)
+    return par.unit if par is not None and par.kind in ("float", "int", "float_list") else ""
 
 
 def _concatenated(records):

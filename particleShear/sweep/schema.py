@@ -30,7 +30,7 @@ import os
 import warnings
 from ..analysis.verdicts import CHECKS
 from ..parameters import BY_NAME
-from ..protocols import PROTOCOLS
+from ..protocols import PROTOCOLS, result_columns
 
 __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "results_schema", "column_spec", "write_schema",
            "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
@@ -104,23 +104,13 @@ _FIXED = {
 
 def _protocol_columns():
     """The outputs of the rheometer's protocols (docs/protocols.md), from their files
-    (:mod:`particleShear.protocols`): the step columns of the sweeps, the summaries of the
-    recorded protocols (each column once, in the order of ``protocol``'s choices), then their
-    checks (in the order of :data:`~particleShear.analysis.verdicts.CHECKS`, then a protocol's own)."""
-    ordered = [p for p in PROTOCOLS.values() if p.segmented] + [p for p in PROTOCOLS.values() if not p.segmented]
-    checks = {}
-    for p in PROTOCOLS.values():
-        if p.recorded:
-            for c in p.checks:
-                checks.setdefault(c, []).append(p.name)
-    out = {}
-    for p in ordered:
-        out.update({k: v for k, v in p.columns.items() if k not in out and k not in checks})
-    for c in sorted(checks, key=lambda c: list(CHECKS).index(c) if c in CHECKS else len(CHECKS)):
-        owner = PROTOCOLS[checks[c][0]]
-        text = (_CHECK.format(c) if c in CHECKS else owner.columns[c][2]) \
-            + "; empty unless protocol is " + " or ".join(f"'{n}'" for n in checks[c])
-        out[c] = ("bool", "", text)
+    (:func:`particleShear.protocols.result_columns`: the step columns of the sweeps, the summaries,
+    then the checks in the order of :data:`~particleShear.analysis.verdicts.CHECKS`)."""
+    values, checks = result_columns(CHECKS)
+    out = dict(values)
+    for c, names in checks.items():
+        text = _CHECK.format(c) if c in CHECKS else PROTOCOLS[names[0]].columns[c][2]
+        out[c] = ("bool", "", text + "; empty unless protocol is " + " or ".join(f"'{n}'" for n in names))
     return out
 
 
