@@ -65,9 +65,10 @@ MIN_STEPS_PER_PERIOD_COARSENED = 2
 
 @dataclasses.dataclass(frozen=True)
 class Protocol:
-    """A registered protocol (module docstring; made by :func:`register_protocol`).
+    """A registered protocol (module docstring; made by :func:`register_protocol`); each parameter
+    is the attribute of the same name.
 
-    Attributes
+    Parameters
     ----------
     name : str
         The value of ``protocol=``.
@@ -217,6 +218,15 @@ def register_protocol(name, **fields):
 def get_protocol(name):
     """The registered protocol ``name``.
 
+    Parameters
+    ----------
+    name : str
+        The value of ``protocol=``.
+
+    Returns
+    -------
+    Protocol
+
     Raises
     ------
     KeyError
@@ -227,6 +237,19 @@ def get_protocol(name):
 
 def positive(name, v, hi=math.inf):
     """``float(v)`` when ``0 < v <= hi``.
+
+    Parameters
+    ----------
+    name : str
+        The parameter (named in the message with its flag).
+    v : object
+        Its value.
+    hi : float, default inf
+        The upper limit (included).
+
+    Returns
+    -------
+    float
 
     Raises
     ------
@@ -245,6 +268,19 @@ def positive(name, v, hi=math.inf):
 
 def monotonic_values(name, v, lo, hi):
     """The list ``v`` as floats: 1 to 10000 values in ``(lo, hi]``, strictly increasing or decreasing.
+
+    Parameters
+    ----------
+    name : str
+        The parameter (a sweep's list).
+    v : object
+        Its value.
+    lo, hi : float
+        The range of every value (``lo`` excluded, ``hi`` included; ``lo`` is 0 here).
+
+    Returns
+    -------
+    list of float
 
     Raises
     ------

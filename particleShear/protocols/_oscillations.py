@@ -13,7 +13,22 @@ __all__ = ["sweep_steps", "check_resolution", "room", "shorten"]
 
 
 def sweep_steps(q, dt_over_tau, amps, freqs):
-    """``dts`` (each step's dt/τ) and ``segments`` (each step's oscillatory steps)."""
+    """``dts`` (each step's dt/τ) and ``segments`` (each step's oscillatory steps).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (normalized).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ.
+    amps, freqs : list of float
+        Each step's amplitude and relative frequency f·τ.
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau``, ``dts``, ``segments``.
+    """
     out = {"dt_over_tau": dt_over_tau()}
     out["dts"] = [dt_over_tau(A) for A in amps]
     n_per = float(q["pre_periods"]) + float(q["periods"]) + float(q["post_periods"])
@@ -66,7 +81,24 @@ def check_resolution(q, steps, freqs, name_of, allowed_of):
 
 
 def room(q, steps, steps_ok, list_name):
-    """The largest of pre_periods / periods / post_periods shortens a sweep, else its list."""
+    """The largest of pre_periods / periods / post_periods shortens a sweep, else its list.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (normalized).
+    steps : dict
+        :func:`sweep_steps` of ``q``.
+    steps_ok : float
+        The most steps the run may take.
+    list_name : str
+        The sweep's list parameter.
+
+    Returns
+    -------
+    tuple of str
+        ``(parameter, allowed text)``.
+    """
     n_periods = float(q["pre_periods"]) + float(q["periods"]) + float(q["post_periods"])
     per_period = sum(steps["segments"]) / n_periods      # steps of one period of every step
     name = max(("periods", "pre_periods", "post_periods"), key=lambda n: float(q[n]))
@@ -78,7 +110,24 @@ def room(q, steps, steps_ok, list_name):
 
 def shorten(q, n, steps_of, list_name):
     """The first two values of ``list_name``, no baseline periods, the excitation periods cut so that
-    both steps together take about ``n`` steps (a sweep's cost calibration)."""
+    both steps together take about ``n`` steps (a sweep's cost calibration).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (normalized).
+    n : int
+        About how many steps the cut sweep takes.
+    steps_of : callable
+        ``steps_of(q)``: the step counts of other arguments.
+    list_name : str
+        The sweep's list parameter.
+
+    Returns
+    -------
+    dict
+        The parameters to change.
+    """
     q2 = dict(q, **{list_name: q[list_name][:2]}, pre_periods=0, post_periods=0, periods=1)
     per_period = max(1, sum(steps_of(q2)["segments"]))
     return {list_name: list(q[list_name][:2]), "pre_periods": 0, "post_periods": 0,

@@ -27,19 +27,51 @@ COLUMNS = {
 
 
 def normalize(q):
-    """``sweep_amplitudes`` as floats (checked), ``theAmplitude`` its first."""
+    """``sweep_amplitudes`` as floats (checked), ``theAmplitude`` its first.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    """
     q["sweep_amplitudes"] = monotonic_values("sweep_amplitudes", q.get("sweep_amplitudes"), 0, 100)
     q["theAmplitude"] = q["sweep_amplitudes"][0]
 
 
 def steps(q, dt_over_tau):
-    """Each step's dt/τ (``dts``) and oscillatory steps (``segments``)."""
+    """Each step's dt/τ (``dts``) and oscillatory steps (``segments``).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ (at ``theAmplitude`` or the amplitude given).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau`` and the protocol's counts (module docstring of :mod:`particleShear.protocols`).
+    """
     amps = q["sweep_amplitudes"]
     return sweep_steps(q, dt_over_tau, amps, [q["relative_frequency"]] * len(amps))
 
 
 def check_steps(q, steps):
-    """Every step resolves its period (:func:`~particleShear.protocols._oscillations.check_resolution`)."""
+    """Every step resolves its period (:func:`~particleShear.protocols._oscillations.check_resolution`).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, its value and the allowed range.
+    """
     factor = float(q["time_step_factor"])
 
     def allowed(j, fr, spp, flag):
@@ -50,28 +82,97 @@ def check_steps(q, steps):
 
 
 def segments(kws, steps, tau, f):
-    """``(f, amplitudes of the replicas, dt)`` of each step: the run's frequency, the step's amplitude."""
+    """``(f, amplitudes of the replicas, dt)`` of each step: the run's frequency, the step's amplitude.
+
+    Parameters
+    ----------
+    kws : list of dict
+        The arguments of the batch's replicas, in batch order.
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    tau : float
+        Model time constant τ (s).
+    f : float
+        The run's excitation frequency (Hz).
+
+    Returns
+    -------
+    list of tuple
+        ``(f (Hz), amplitude of each replica, dt (s))`` of each step.
+    """
     return [(f, [k["sweep_amplitudes"][j] for k in kws], dtr * tau) for j, dtr in enumerate(steps[0]["dts"])]
 
 
 def room(q, steps, steps_ok):
-    """The longest of the periods, else fewer or shorter steps."""
+    """The longest of the periods, else fewer or shorter steps.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    steps_ok : float
+        The most steps the run may take.
+
+    Returns
+    -------
+    tuple of str
+        ``(parameter, allowed text)``.
+    """
     return _room(q, steps, steps_ok, "sweep_amplitudes")
 
 
 def label(step):
-    """``A = …`` of a step."""
+    """``A = …`` of a step.
+
+    Parameters
+    ----------
+    step : dict
+        One step of a sweep (``RheometerResult.steps``).
+
+    Returns
+    -------
+    str
+    """
     return f"A = {step.get('amplitude', float('nan')):.4g}"
 
 
 def shorten(q, steps, n, steps_of):
     """The first two values of the list, no baseline periods, the excitation periods cut so that both
-    steps together take about ``n`` steps."""
+    steps together take about ``n`` steps.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    n : int
+        About how many steps the cut protocol takes.
+    steps_of : callable
+        ``steps_of(q)``: the step counts of other arguments.
+
+    Returns
+    -------
+    dict
+        The parameters to change.
+    """
     return _shorten(q, n, steps_of, "sweep_amplitudes")
 
 
 def n_rows(q):
-    """One row per value of ``sweep_amplitudes``."""
+    """One row per value of ``sweep_amplitudes``.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+
+    Returns
+    -------
+    int
+    """
     return len(q["sweep_amplitudes"])
 
 

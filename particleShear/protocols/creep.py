@@ -43,7 +43,18 @@ COLUMNS = {
 
 
 def check(q):
-    """``hold_time``, ``creep_stress`` (required), ``creep_modulus`` (or None) and ``creep_response_time`` > 0."""
+    """``hold_time``, ``creep_stress`` (required), ``creep_modulus`` (or None) and ``creep_response_time`` > 0.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+
+    Raises
+    ------
+    ValueError, TypeError
+        Naming the parameter, its value and the allowed range.
+    """
     positive("hold_time", q["hold_time"], 1e9)
     if q["creep_stress"] is None:
         raise ValueError("creep_stress=None is invalid with protocol='creep': give the applied stress σ₀ in Pa "
@@ -55,7 +66,20 @@ def check(q):
 
 
 def check_steps(q, steps):
-    """A controller response time of at least 10 steps."""
+    """A controller response time of at least 10 steps.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, its value and the allowed range.
+    """
     dtr = steps["dt_over_tau"]
     T = float(q["creep_response_time"])
     if T < 10 * dtr:
@@ -64,13 +88,41 @@ def check_steps(q, steps):
 
 
 def steps(q, dt_over_tau):
-    """``steps``: the hold over the time step, rounded up (its first step at rest)."""
+    """``steps``: the hold over the time step, rounded up (its first step at rest).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ (at ``theAmplitude`` or the amplitude given).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau`` and the protocol's counts (module docstring of :mod:`particleShear.protocols`).
+    """
     dtr = dt_over_tau()
     return {"dt_over_tau": dtr, "steps": int(math.ceil(float(q["hold_time"]) / dtr))}
 
 
 def room(q, steps, steps_ok):
-    """``hold_time`` shortens a creep run."""
+    """``hold_time`` shortens a creep run.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    steps_ok : float
+        The most steps the run may take.
+
+    Returns
+    -------
+    tuple of str
+        ``(parameter, allowed text)``.
+    """
     room = steps_ok * steps["dt_over_tau"]
     return "hold_time", f"hold_time <= {max(room, 0.0):.4g}"
 
@@ -167,7 +219,26 @@ class CreepController:
 
 
 def schedule(kws, steps, tau, dt, backend):
-    """The controller of every replica (σ₀, G_c per replica; T_c shared), |γ̇| <= MAX_STRAIN_PER_STEP/dt."""
+    """The controller of every replica (σ₀, G_c per replica; T_c shared), |γ̇| <= MAX_STRAIN_PER_STEP/dt.
+
+    Parameters
+    ----------
+    kws : list of dict
+        The arguments of the batch's replicas, in batch order.
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    tau : float
+        Model time constant τ (s).
+    dt : float
+        Time step (s).
+    backend : Backend
+        The batch's array backend (``asarray``, ``xp``).
+
+    Returns
+    -------
+    dict
+        ``n_steps``, ``rate_of(i)`` (γ̇ of every replica at step i, 1/s) and optionally ``after_step``, ``tensors_every``.
+    """
     G_c = [k["creep_modulus"] if k["creep_modulus"] is not None else
            CREEP_MODULUS_FRACTION * k["Young_modulus_spheres"] for k in kws]
     ctl = CreepController(backend.xp, backend.asarray(np.asarray([k["creep_stress"] for k in kws], dtype=float)),
@@ -177,7 +248,26 @@ def schedule(kws, steps, tau, dt, backend):
 
 
 def summary(kw, series, tau, steps, stats):
-    """J(t), the final creep rate, σ₀/γ̇, the strain plateau and the stress tracking (module docstring)."""
+    """J(t), the final creep rate, σ₀/γ̇, the strain plateau and the stress tracking (module docstring).
+
+    Parameters
+    ----------
+    kw : dict
+        The run's arguments.
+    series : dict of ndarray
+        The replica's record (:func:`particleShear.engine.rheometer.shear_record`).
+    tau : float
+        Model time constant τ (s).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    stats : namespace
+        :data:`particleShear.run.rheometer_analysis.STATS` (estimators, statistics, verdict checks).
+
+    Returns
+    -------
+    tuple of dict
+        ``(scalars, curves, checks)``: column → value, ``name → (t, y, y_sem)``, check → bool or None.
+    """
     t = series["t"]
     out, curves = {}, {}
     s0 = kw["creep_stress"]
@@ -201,12 +291,39 @@ def summary(kw, series, tau, steps, stats):
 
 
 def values(s):
-    """``[final creep rate, σ₀/γ̇]``."""
+    """``[final creep rate, σ₀/γ̇]``.
+
+    Parameters
+    ----------
+    s : dict
+        The run's summary.
+
+    Returns
+    -------
+    list of float
+    """
     return [s["creep_rate"], s["creep_viscosity"]]
 
 
 def shorten(q, steps, n, steps_of):
-    """The hold cut to ``n`` steps."""
+    """The hold cut to ``n`` steps.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    n : int
+        About how many steps the cut protocol takes.
+    steps_of : callable
+        ``steps_of(q)``: the step counts of other arguments.
+
+    Returns
+    -------
+    dict
+        The parameters to change.
+    """
     return {"hold_time": min(float(q["hold_time"]), n * steps["dt_over_tau"])}
 
 

@@ -17,7 +17,20 @@ PARAMETERS = ()
 
 
 def steps(q, dt_over_tau):
-    """No protocol steps of its own here (the oscillatory run counts its periods itself)."""
+    """No protocol steps of its own here (the oscillatory run counts its periods itself).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ (at ``theAmplitude`` or the amplitude given).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau`` and the protocol's counts (module docstring of :mod:`particleShear.protocols`).
+    """
     return {"dt_over_tau": dt_over_tau()}
 
 

@@ -37,13 +37,37 @@ COLUMNS = {
 
 
 def check(q):
-    """``hold_time`` and ``ramp_time`` in (0, 1e9]."""
+    """``hold_time`` and ``ramp_time`` in (0, 1e9].
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+
+    Raises
+    ------
+    ValueError, TypeError
+        Naming the parameter, its value and the allowed range.
+    """
     positive("hold_time", q["hold_time"], 1e9)
     positive("ramp_time", q["ramp_time"], 1e9)
 
 
 def check_steps(q, steps):
-    """A ramp of at most :data:`~particleShear.protocols.MAX_STRAIN_PER_STEP` strain per step."""
+    """A ramp of at most :data:`~particleShear.protocols.MAX_STRAIN_PER_STEP` strain per step.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, its value and the allowed range.
+    """
     dtr = steps["dt_over_tau"]
     per_step = q["theAmplitude"] / steps["ramp"]
     if per_step > MAX_STRAIN_PER_STEP:
@@ -54,14 +78,42 @@ def check_steps(q, steps):
 
 
 def steps(q, dt_over_tau):
-    """``ramp`` (>= 1) and ``steps``: a first step at rest, the ramp, the hold."""
+    """``ramp`` (>= 1) and ``steps``: a first step at rest, the ramp, the hold.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ (at ``theAmplitude`` or the amplitude given).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau`` and the protocol's counts (module docstring of :mod:`particleShear.protocols`).
+    """
     dtr = dt_over_tau()
     ramp = max(1, int(round(float(q["ramp_time"]) / dtr)))
     return {"dt_over_tau": dtr, "ramp": ramp, "steps": 1 + ramp + int(math.ceil(float(q["hold_time"]) / dtr))}
 
 
 def room(q, steps, steps_ok):
-    """``hold_time`` shortens a relaxation run, or ``ramp_time`` when the ramp alone is too long."""
+    """``hold_time`` shortens a relaxation run, or ``ramp_time`` when the ramp alone is too long.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    steps_ok : float
+        The most steps the run may take.
+
+    Returns
+    -------
+    tuple of str
+        ``(parameter, allowed text)``.
+    """
     dtr = steps["dt_over_tau"]
     name, room = "hold_time", (steps_ok - 1 - steps["ramp"]) * dtr
     if room <= 0:
@@ -70,7 +122,26 @@ def room(q, steps, steps_ok):
 
 
 def schedule(kws, steps, tau, dt, backend):
-    """One step at rest, the ramp at ``γ₀/(n_ramp·dt)`` for ``n_ramp`` steps, then γ̇ = 0."""
+    """One step at rest, the ramp at ``γ₀/(n_ramp·dt)`` for ``n_ramp`` steps, then γ̇ = 0.
+
+    Parameters
+    ----------
+    kws : list of dict
+        The arguments of the batch's replicas, in batch order.
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    tau : float
+        Model time constant τ (s).
+    dt : float
+        Time step (s).
+    backend : Backend
+        The batch's array backend (``asarray``, ``xp``).
+
+    Returns
+    -------
+    dict
+        ``n_steps``, ``rate_of(i)`` (γ̇ of every replica at step i, 1/s) and optionally ``after_step``, ``tensors_every``.
+    """
     st = steps[0]
     n_ramp = st["ramp"]
     ramp = backend.asarray(np.asarray([k["theAmplitude"] for k in kws], dtype=float) / (n_ramp * dt))
@@ -79,7 +150,26 @@ def schedule(kws, steps, tau, dt, backend):
 
 
 def summary(kw, series, tau, steps, stats):
-    """G(t) from the end of the ramp, its plateau and the residual stress (module docstring)."""
+    """G(t) from the end of the ramp, its plateau and the residual stress (module docstring).
+
+    Parameters
+    ----------
+    kw : dict
+        The run's arguments.
+    series : dict of ndarray
+        The replica's record (:func:`particleShear.engine.rheometer.shear_record`).
+    tau : float
+        Model time constant τ (s).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    stats : namespace
+        :data:`particleShear.run.rheometer_analysis.STATS` (estimators, statistics, verdict checks).
+
+    Returns
+    -------
+    tuple of dict
+        ``(scalars, curves, checks)``: column → value, ``name → (t, y, y_sem)``, check → bool or None.
+    """
     t = series["t"]
     out, curves = {}, {}
     g0 = kw["theAmplitude"]
@@ -102,12 +192,39 @@ def summary(kw, series, tau, steps, stats):
 
 
 def values(s):
-    """``[G_plateau]`` of the plate forces."""
+    """``[G_plateau]`` of the plate forces.
+
+    Parameters
+    ----------
+    s : dict
+        The run's summary.
+
+    Returns
+    -------
+    list of float
+    """
     return [s["G_plateau_surface"]]
 
 
 def shorten(q, steps, n, steps_of):
-    """The ramp kept (its rate is bounded), the hold cut."""
+    """The ramp kept (its rate is bounded), the hold cut.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    n : int
+        About how many steps the cut protocol takes.
+    steps_of : callable
+        ``steps_of(q)``: the step counts of other arguments.
+
+    Returns
+    -------
+    dict
+        The parameters to change.
+    """
     return {"hold_time": min(float(q["hold_time"]), max(n - 1 - steps["ramp"], 1) * steps["dt_over_tau"])}
 
 

@@ -43,13 +43,37 @@ COLUMNS = {
 
 
 def check(q):
-    """``relative_rate`` and ``total_strain`` > 0 (``total_strain`` <= 1e6)."""
+    """``relative_rate`` and ``total_strain`` > 0 (``total_strain`` <= 1e6).
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+
+    Raises
+    ------
+    ValueError, TypeError
+        Naming the parameter, its value and the allowed range.
+    """
     positive("relative_rate", q["relative_rate"])
     positive("total_strain", q["total_strain"], 1e6)
 
 
 def check_steps(q, steps):
-    """At most :data:`~particleShear.protocols.MAX_STRAIN_PER_STEP` strain per step."""
+    """At most :data:`~particleShear.protocols.MAX_STRAIN_PER_STEP` strain per step.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, its value and the allowed range.
+    """
     dtr = steps["dt_over_tau"]
     rate = float(q["relative_rate"])
     if rate * dtr > MAX_STRAIN_PER_STEP:
@@ -59,26 +83,92 @@ def check_steps(q, steps):
 
 
 def steps(q, dt_over_tau):
-    """``steps``: the strain over the strain per step, rounded up."""
+    """``steps``: the strain over the strain per step, rounded up.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    dt_over_tau : callable
+        ``dt_over_tau(amplitude=None)``: the protocol time step in units of τ (at ``theAmplitude`` or the amplitude given).
+
+    Returns
+    -------
+    dict
+        ``dt_over_tau`` and the protocol's counts (module docstring of :mod:`particleShear.protocols`).
+    """
     dtr = dt_over_tau()
     return {"dt_over_tau": dtr, "steps": int(math.ceil(float(q["total_strain"]) / (float(q["relative_rate"]) * dtr)))}
 
 
 def room(q, steps, steps_ok):
-    """``total_strain`` shortens a steady run."""
+    """``total_strain`` shortens a steady run.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    steps_ok : float
+        The most steps the run may take.
+
+    Returns
+    -------
+    tuple of str
+        ``(parameter, allowed text)``.
+    """
     room = steps_ok * float(q["relative_rate"]) * steps["dt_over_tau"]
     return "total_strain", f"total_strain <= {max(room, 0.0):.4g}"
 
 
 def schedule(kws, steps, tau, dt, backend):
     """A constant γ̇ per replica from the first step (``set_rate`` moves every sphere onto the new
-    flow, so the start is no velocity shock); N1 every :data:`N1_EVERY` steps."""
+    flow, so the start is no velocity shock); N1 every :data:`N1_EVERY` steps.
+
+    Parameters
+    ----------
+    kws : list of dict
+        The arguments of the batch's replicas, in batch order.
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    tau : float
+        Model time constant τ (s).
+    dt : float
+        Time step (s).
+    backend : Backend
+        The batch's array backend (``asarray``, ``xp``).
+
+    Returns
+    -------
+    dict
+        ``n_steps``, ``rate_of(i)`` (γ̇ of every replica at step i, 1/s) and optionally ``after_step``, ``tensors_every``.
+    """
     R = backend.asarray(np.asarray([k["relative_rate"] / tau for k in kws], dtype=float))
     return {"n_steps": max(s["steps"] for s in steps), "rate_of": lambda i: R, "tensors_every": N1_EVERY}
 
 
 def summary(kw, series, tau, steps, stats):
-    """The steady stress, viscosity and N1 after the transient (module docstring)."""
+    """The steady stress, viscosity and N1 after the transient (module docstring).
+
+    Parameters
+    ----------
+    kw : dict
+        The run's arguments.
+    series : dict of ndarray
+        The replica's record (:func:`particleShear.engine.rheometer.shear_record`).
+    tau : float
+        Model time constant τ (s).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    stats : namespace
+        :data:`particleShear.run.rheometer_analysis.STATS` (estimators, statistics, verdict checks).
+
+    Returns
+    -------
+    tuple of dict
+        ``(scalars, curves, checks)``: column → value, ``name → (t, y, y_sem)``, check → bool or None.
+    """
     t = series["t"]
     out = {}
     rate = kw["relative_rate"] / tau
@@ -98,12 +188,39 @@ def summary(kw, series, tau, steps, stats):
 
 
 def values(s):
-    """``[σ, η]`` of the plate forces."""
+    """``[σ, η]`` of the plate forces.
+
+    Parameters
+    ----------
+    s : dict
+        The run's summary.
+
+    Returns
+    -------
+    list of float
+    """
     return [s["stress_surface"], s["viscosity_surface"]]
 
 
 def shorten(q, steps, n, steps_of):
-    """The strain of ``n`` steps at the run's rate."""
+    """The strain of ``n`` steps at the run's rate.
+
+    Parameters
+    ----------
+    q : dict
+        The run's arguments (defaults filled in; normalized by the protocol's ``normalize``).
+    steps : dict or list of dict
+        The protocol's step counts (its ``steps``; for ``schedule`` and ``segments`` one per replica, in batch order).
+    n : int
+        About how many steps the cut protocol takes.
+    steps_of : callable
+        ``steps_of(q)``: the step counts of other arguments.
+
+    Returns
+    -------
+    dict
+        The parameters to change.
+    """
     return {"total_strain": min(float(q["total_strain"]), n * float(q["relative_rate"]) * steps["dt_over_tau"])}
 
 
