@@ -451,7 +451,7 @@ class BatchState:
         self.pos = xp.zeros((2, n))
         self.vel = xp.zeros((3, n))
         self.frc = xp.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
-        self._views()
+        self._bind_views()
         for name in ("phi", "r", "m", "inertia"):
             setattr(self, name, xp.zeros(n))
         for name in self.REPLICA_ARRAYS:
@@ -476,9 +476,9 @@ class BatchState:
         self.__dict__.update(state)
         self.backend = get_backend(state["backend"])
         self.xp = self.backend.xp
-        self._views()
+        self._bind_views()
 
-    def _views(self):
+    def _bind_views(self):
         """Row views of the position, velocity and force blocks (indexing, not iteration: no host read)."""
         self.x, self.y = self.pos[0], self.pos[1]
         self.vx, self.vy, self.omega = self.vel[0], self.vel[1], self.vel[2]
@@ -512,7 +512,7 @@ class BatchState:
                 raise ValueError(f"{name} has shape {tuple(a.shape)}: it must be {want} (B·N = {n} rows)")
         self.pos, self.vel, self.frc = pos, vel, frc
         self.phi, self.r, self.m, self.inertia = phi, r, m, inertia
-        self._views()
+        self._bind_views()
 
     def to_backend(self, backend):
         """This state with its arrays copied to ``backend`` (the same object if it is there already).
@@ -540,7 +540,7 @@ class BatchState:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
             out.visit = target.asarray(to_host(self.visit, "state"))
-        out._views()
+        out._bind_views()
         return out
 
     @classmethod
