@@ -195,9 +195,7 @@ def state_of_ensembles(ensembles, laws=None):
         block = np.empty((ensembles[0]._st.shape[0], s.B * N))
         for b, e in enumerate(ensembles):
             block[:, b * N:(b + 1) * N] = e._st
-            e._block, e._cap = block[:, b * N:(b + 1) * N], N
-            e._views()
-            e._invalidate_neighbours()      # caches of the old block (the documented step's engine)
+            e.adopt_state_block(block[:, b * N:(b + 1) * N])   # (its caches of the old block dropped)
     x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
     s.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
                *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
@@ -258,10 +256,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
 
     engine.flush()
 
-    ensemble._invalidate_neighbours()
-    ensemble._links_changed()
-    ensemble._relations_edited()
-    ensemble._g = None
+    ensemble.invalidate_caches()
     ensemble._last_dt = float(ensemble.dt if dt is None else dt)
     if engine.half is not None and hasattr(ensemble, "_half_kick"):
         h = to_host(engine.half[:, rows], "state")
@@ -292,10 +287,7 @@ def untouched_on_failure(ensemble):
     except BaseException:
         ensemble._block[:, :n] = block
         ensemble._pairs.assign(pairs)
-        ensemble._invalidate_neighbours()
-        ensemble._links_changed()
-        ensemble._relations_edited()
-        ensemble._g = None
+        ensemble.invalidate_caches()
         raise
 
 
