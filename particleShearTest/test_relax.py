@@ -299,6 +299,24 @@ class TestBatchIndependence(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "twice"):
             state_of_ensembles([a, a])
 
+    def test_rows_and_blocks_of_the_wrong_shape_are_refused(self):
+        # a state on external rows needs B·N columns, an ensemble's block one row per field and one
+        # column per sphere: anything else is refused before it is used
+        import numpy as np
+
+        from particleShear.base.fields import FIELDS
+        from particleShear.engine.state import BatchState
+        s = BatchState(2, 3)
+        rows = dict(pos=np.zeros((2, 6)), vel=np.zeros((3, 6)), frc=np.zeros((3, 6)), phi=np.zeros(6),
+                    r=np.ones(6), m=np.ones(6), inertia=np.ones(6))
+        s.use_rows(**rows)
+        self.assertIs(s.x.base, rows["pos"])         # the state's x is a view of the caller's rows
+        with self.assertRaisesRegex(ValueError, r"pos has shape \(2, 5\).*\(2, 6\)"):
+            s.use_rows(**{**rows, "pos": np.zeros((2, 5))})
+        a = random_packing(5)
+        with self.assertRaisesRegex(ValueError, "block has shape"):
+            a.adopt_state_block(np.zeros((len(FIELDS), len(a.sphereList) + 1)))
+
     def test_a_refused_batch_leaves_the_ensembles_stepping_as_before(self):
         # a batch refused before any step (guards that differ, an unusable skin) leaves each ensemble
         # to step on exactly as its twin that was never batched, also one that kept the documented
