@@ -340,9 +340,9 @@ class TestStressRegistry(unittest.TestCase):
 
 
 class TestStateOfOneEnsemble(unittest.TestCase):
-    """``BatchState.of_ensemble``: the batch of one whose sphere arrays are the ensemble's own rows.
+    """``state_of_ensemble``: the batch of one whose sphere arrays are the ensemble's own rows.
     The engine's steps on it write into the ensemble, and they are the steps of a copy
-    (``from_ensembles``) bit for bit: the same arithmetic on the same numbers."""
+    (``state_from_ensembles``) bit for bit: the same arithmetic on the same numbers."""
 
     def test_steps_write_into_the_ensemble_as_on_a_copy(self):
         _, ens_v, sc = constituted(13, theMu=0.05, do_permanent_links=True, cut_lines=1)

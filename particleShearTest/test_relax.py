@@ -268,7 +268,7 @@ class TestBatchIndependence(unittest.TestCase):
         self.assertEqual((a._a["x"].tobytes(), a.t), (x.tobytes(), t))
 
     def test_write_back_needs_the_ensembles_own_state(self):
-        # a copy of the ensemble (from_ensembles) is not handed back: the engine's spheres are not
+        # a copy of the ensemble (state_from_ensembles) is not handed back: the engine's spheres are not
         # the ensemble's, and nothing copies them
         from particleShear.base.engine_adapter import write_back
         from particleShear.engine.step import BatchEngine
@@ -283,7 +283,7 @@ class TestBatchIndependence(unittest.TestCase):
             write_back(both, 0, b)
 
     def test_a_batch_steps_the_ensembles_own_rows(self):
-        # of_ensembles: the batch's sphere arrays are the ensembles' rows, so a relaxed batch leaves
+        # state_of_ensembles: the batch's sphere arrays are the ensembles' rows, so a relaxed batch leaves
         # each ensemble exactly where the engine put its replica
         from particleShear.engine.step import BatchEngine
         a, b = random_packing(5), random_packing(6)
