@@ -132,6 +132,7 @@ ENGINE_MODULES = [
     "particleShear.base.canvas",
     "particleShear.base.pair_canvas",
     "particleShear.base.elastic_canvas",
+    "particleShear.base.engine_adapter",
     "particleShear.base.engine_view",
     "particleShear.base.fields",
     "particleShear.base.graphics",

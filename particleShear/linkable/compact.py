@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..base.canvas import check_non_negative
+from ..base.engine_adapter import relax_ensembles
 from ..checks import in_range
 from ..engine.box import min_image
 from ..engine.graph import adjacency, component_labels, connected_without_edge
@@ -99,7 +100,6 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         ValueError
             If ``dt`` is not > 0 or ``N`` < 0 (before any step).
         """
-        from ..engine.relax import relax_ensembles
         relax_ensembles([self], N)
 
     def _labels(self, physical_neighbors_only=True):
