@@ -11,7 +11,7 @@ Two scenes (``--scene``):
   (``bench_scenes.build``: the builder's crosslinked particles, 5 cut lines, μ = 0.01,
   pre-equilibrated with plates; the constitution grows faster than N: ~10 s at N = 10,000).
 
-The ensemble is copied into a ``BatchState`` of one replica (``BatchState.from_ensembles``), whose
+The ensemble is copied into a ``BatchState`` of one replica (``state_from_ensembles``), whose
 engine has the Verlet skin of a run's engine (``run.batch.ENGINE_SKIN_FACTOR``, 0.2 r_max), and
 both advance the same start under sinusoidal shear, in alternating blocks (so a slow moment of a
 shared machine hits both):
@@ -55,7 +55,7 @@ from bench_step import AMPLITUDE, DT, F_EXC, PHI, R_MODEL, build  # noqa: E402
 
 from particleShear import StressTensorEvaluation  # noqa: E402
 from particleShear.engine.neighbours import near_pairs, near_pairs_all, near_pairs_cells  # noqa: E402
-from particleShear.engine.state import BatchState  # noqa: E402
+from particleShear.base.engine_adapter import state_from_ensembles  # noqa: E402
 from particleShear.engine.step import BatchEngine  # noqa: E402
 from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 from particleShear.simulation.evaluation import EvaluationHandler  # noqa: E402
@@ -104,7 +104,7 @@ def compare(n, steps, block, scene):
     handler.allocate(steps + 2 * block + 5, keep_tensor_history=False)
     run_classes = (lambda k: classes_block(ens, ev, handler, k, **shear))
     t_build = time.perf_counter() - t0
-    eng = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR)   # as a run's engine
+    eng = BatchEngine(state_from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR)   # as a run's engine
     run_engine(eng, 5)                 # warm-up (the first list build is not timed)
     run_classes(5)
     rebuilds0 = int(eng.rebuilds[0])

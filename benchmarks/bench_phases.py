@@ -10,7 +10,7 @@ tree runs in its own process (the tree first on ``sys.path``, one thread, pinned
 ``taskset`` exists); compare trees within one run of the script.
 
 For comparison it also times the engine's own step without the documented view around it:
-``BatchEngine.step(cool, dt, sample=…)`` on a copy of the same scene (``BatchState.from_ensembles``,
+``BatchEngine.step(cool, dt, sample=…)`` on a copy of the same scene (``state_from_ensembles``,
 plates on), with no stresses, the two shear stresses and every tensor (``sample=False``, ``True``,
 ``"tensors"``), the same statistics; "n/a" (and the error) where the tree's engine cannot.
 
@@ -60,8 +60,9 @@ out = {n: sorted(v)[len(v) // 4] for n, v in means.items()}
 try:
     import numpy as np
     from particleShear.engine.state import BatchState
+    from particleShear.base.engine_adapter import state_from_ensembles
     from particleShear.engine.step import BatchEngine
-    eng = BatchEngine(BatchState.from_ensembles([bench_step.build(150, seed=2)]), guard=False)
+    eng = BatchEngine(state_from_ensembles([bench_step.build(150, seed=2)]), guard=False)
     eng.s.applying_shear = True
     for label, sample in engine_rows:
         eng.step(cool, dt, sample=sample)           # (raises where the tree's engine lacks the mode)

@@ -4,8 +4,9 @@ Each :class:`Parameter` of :data:`PARAMETERS` holds a keyword of
 :func:`~particleShear.run.api.doParticleShearSimulation` (in its signature's order, then the contact
 laws' parameters outside the signature, :data:`EXTRA`): its default, type, unit, allowed range,
 role and a one-line description.  The contact laws declare their parameters in their own files
-(:mod:`particleShear.engine.contact_laws`); the table is the base entries written here composed
-with every discovered law's (the plateau law's after ``contact_law``, as in the signature).  The signature and the docstring of
+(:mod:`particleShear.engine.contact_laws`), the protocols likewise (:mod:`particleShear.protocols`);
+the table is the base entries written here composed with every discovered law's and protocol's (the
+plateau law's after ``contact_law``, the shipped protocols' after ``protocol``, as in the signature).  The signature and the docstring of
 ``doParticleShearSimulation`` keep particleShear 1.0.2's order, names and defaults; the suite checks
 them against this table, never the other way round (particleShearTest/test_parameter_table.py).
 What is derived from it: the range checks of the validation (:mod:`particleShear.run.validation`),
@@ -43,12 +44,15 @@ import math
 
 from .engine.contact_laws import declared_parameters
 from .parameter_entry import KINDS, ROLES, Parameter
+from .protocols import declared_parameters as declared_protocol_parameters
 
 __all__ = ["Parameter", "PARAMETERS", "SIGNATURE", "EXTRA", "BY_NAME", "ROLES", "KINDS", "defaults", "names",
            "law_parameters", "SPEC_RESERVED", "spec_defaults", "protocol_parameters", "identity_excluded"]
 
 #: the contact laws of the laws folder: name → (their declared parameters, in the signature or not)
 _LAWS = declared_parameters()
+#: the protocols of the protocols folder: name → (their declared parameters, in the signature or not)
+_PROTOCOLS = declared_protocol_parameters()
 
 #: the entries written here; the laws' parameters are composed into :data:`PARAMETERS` below
 _BASE = (
@@ -101,38 +105,50 @@ _BASE = (
     Parameter('strict_io', False, 'bool', role='call', batch='shared', keyword_only=True, doc='Raise the ``OSError`` of a failed write after the run; False: return the result with ``write_error`` set (``last_result`` holds it either way)'),
     Parameter('backend', 'numpy', 'str', choices=('numpy', 'cupy'), role='numerics', batch='shared', keyword_only=True, doc='Array library of the measurement: "numpy", or "cupy" to measure on a CUDA GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for bit)'),
     Parameter('contact_law', 'linear', 'str', choices=tuple(_LAWS), role='law', batch='shared', keyword_only=True, doc='Central contact law, a law of the folder particleShear/engine/contact_laws (its parameters follow it in this table), a law added with ``register_law``, or ``"package.module:function"``: "linear" the blend of eqs'),
-    Parameter('protocol', 'oscillatory', 'str', choices=('oscillatory', 'steady', 'relaxation', 'creep', 'amplitude_sweep', 'frequency_sweep'), role='protocol', batch='shared', keyword_only=True, doc="What the rheometer does after the pre-equilibration (docs/protocols.md): the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude`` and hold; a constant applied stress; or, on one packing, the oscillation at each of ``sweep_amplitudes`` or ``sweep_frequencies`` in turn"),
-    Parameter('relative_rate', 0.01, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: shear rate γ̇·τ, dimensionless like ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant); allowed > 0 with at most 0.005 strain per time step'),
-    Parameter('total_strain', 2.0, 'float', unit='1', role='protocol:steady', keyword_only=True, doc='``protocol="steady"``: strain sheared in all; allowed 0 < value <= 1e6'),
-    Parameter('ramp_time', 1.0, 'float', unit='τ', role='protocol:relaxation', batch='shared', keyword_only=True, doc='``protocol="relaxation"``: duration of the strain ramp to γ₀, in units of τ; allowed > 0 with at most 0.005 strain per time step'),
-    Parameter('hold_time', 200.0, 'float', unit='τ', role='protocol:relaxation,creep', batch='shared', keyword_only=True, doc='``protocol="relaxation"`` and ``"creep"``: duration of the hold, in units of τ; allowed 0 < value <= 1e9 within the step limit'),
-    Parameter('creep_stress', None, 'float', unit='Pa', role='protocol:creep', keyword_only=True, nullable=True, doc='``protocol="creep"`` (required there): applied shear stress σ₀ in Pa, > 0'),
-    Parameter('creep_modulus', None, 'float', unit='Pa', role='protocol:creep', keyword_only=True, nullable=True, doc='``protocol="creep"``: modulus scale G_c (Pa) of the stress controller; None: Young_modulus_spheres/8 (docs/protocols.md)'),
-    Parameter('creep_response_time', 5.0, 'float', unit='τ', role='protocol:creep', batch='shared', keyword_only=True, doc='``protocol="creep"``: response time T_c of the stress controller in units of τ; allowed >= 10 time steps'),
-    Parameter('sweep_amplitudes', None, 'float_list', unit='1', role='protocol:amplitude_sweep', keyword_only=True, nullable=True, doc='``protocol="amplitude_sweep"`` (required there): the strain amplitudes, in the order run, strictly increasing or strictly decreasing, each 0 < A <= 100; ``theAmplitude`` is set to the first'),
-    Parameter('sweep_frequencies', None, 'float_list', unit='1', role='protocol:frequency_sweep', batch='shared', keyword_only=True, nullable=True, doc='``protocol="frequency_sweep"`` (required there): the relative frequencies f·τ, in the order run, strictly monotonic; ``relative_frequency`` is set to the first'),
+    Parameter('protocol', 'oscillatory', 'str', choices=tuple(_PROTOCOLS), role='protocol', batch='shared', keyword_only=True, doc="What the rheometer does after the pre-equilibration (docs/protocols.md): the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude`` and hold; a constant applied stress; or, on one packing, the oscillation at each of ``sweep_amplitudes`` or ``sweep_frequencies`` in turn"),
     Parameter('stroboscopic', False, 'bool', role='observer', keyword_only=True, doc='Watch the oscillatory protocol with the stroboscopic observer (:class:`particleShear.engine.microstructure.Stroboscope`): a snapshot at the start of every shear period; per cycle the non-affine displacement, D²_min, contacts made and broken, Z without rattlers and P(f/⟨f⟩) in ``result.microstructure`` and the per-run columns ``irreversibility``, ``moved_fraction``, ``Z_rattler_free``, ``rattler_fraction``, ``contact_change_rate`` in ``result.measures`` (docs/microstructure.md)'),
 )
 
 
 
-def _compose(base, laws):
-    """The base entries with every law's parameters: those of a law in the signature (the plateau
-    law) right after ``contact_law``, the others (``extra``) after the base entries."""
-    signature = [p for params, in_signature in laws.values() if in_signature for p in params]
+def _joined(declared):
+    """The parameters of several laws or protocols in order, each once: a parameter two of them read
+    (declared by each, the same entry but its role) carries both names in its role."""
+    out = {}
+    for p in declared:
+        q = out.get(p.name)
+        if q is None:
+            out[p.name] = p
+            continue
+        if dataclasses.replace(q, role=p.role) != p:
+            raise ValueError(f"parameter {p.name!r} is declared twice with different entries: {q} and {p}")
+        out[p.name] = dataclasses.replace(q, role=f"{q.base_role}:{','.join(q.role_names + p.role_names)}")
+    return tuple(out.values())
+
+
+def _compose(base, laws, protocols):
+    """The base entries with every law's and protocol's parameters: those in the signature (the
+    plateau law's, the shipped protocols') right after their selector (``contact_law``,
+    ``protocol``), the others (``extra``) after the base entries."""
+    def signature(groups):
+        return [dataclasses.replace(p, keyword_only=True)
+                for p in _joined(p for params, in_signature in groups.values() if in_signature for p in params)]
     extra = [dataclasses.replace(p, keyword_only=True, extra=True)
-             for params, in_signature in laws.values() if not in_signature for p in params]
-    at = [p.name for p in base].index("contact_law") + 1
-    return tuple(base[:at]) + tuple(dataclasses.replace(p, keyword_only=True) for p in signature) \
-        + tuple(base[at:]) + tuple(extra)
+             for groups in (laws, protocols)
+             for p in _joined(p for params, in_signature in groups.values() if not in_signature for p in params)]
+    names = [p.name for p in base]
+    law_at, protocol_at = names.index("contact_law") + 1, names.index("protocol") + 1
+    return tuple(base[:law_at]) + tuple(signature(laws)) + tuple(base[law_at:protocol_at]) \
+        + tuple(signature(protocols)) + tuple(base[protocol_at:]) + tuple(extra)
 
 
 #: every parameter of a run: the keywords of ``doParticleShearSimulation`` in signature order, then the
-#: parameters of the contact laws that are not in its signature (``extra``: its ``**law_parameters``)
-PARAMETERS = _compose(_BASE, _LAWS)
+#: parameters of the contact laws and protocols that are not in its signature (``extra``: its
+#: ``**law_parameters``)
+PARAMETERS = _compose(_BASE, _LAWS, _PROTOCOLS)
 #: the keywords of ``doParticleShearSimulation``'s signature, in its order
 SIGNATURE = tuple(p for p in PARAMETERS if not p.extra)
-#: the parameters of contact laws outside the signature (taken by ``**law_parameters``)
+#: the parameters of contact laws and protocols outside the signature (taken by ``**law_parameters``)
 EXTRA = tuple(p.name for p in PARAMETERS if p.extra)
 
 #: name → :class:`Parameter`

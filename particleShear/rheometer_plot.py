@@ -436,7 +436,8 @@ def plot_rheometer_result(result, path=None):
     Raises
     ------
     ValueError
-        A result without the data its figure needs, or a bad ``path``.
+        A result without the data its figure needs, a protocol without a figure (one not shipped), or
+        a bad ``path``.
     """
     proto, summ = result.protocol, result.summary
     title = _result_title(result)
@@ -459,6 +460,9 @@ def plot_rheometer_result(result, path=None):
         return plot_steady_run(result.series["strain"], result.series["stress_surface"],
                                (summ["stress_surface"], summ["stress_surface_se"]), summ.get("strain_transient"),
                                path, title=title, is_steady=summ.get("plateau_reached") is not False)
+    if proto not in ("relaxation", "creep"):
+        raise ValueError(f"plot has no figure of protocol={proto!r}: the figures are those of the shipped protocols "
+                         "(plot result.series, the record of every step, yourself)")
     name = "G_surface" if proto == "relaxation" else "J"
     if name not in result.curves:
         raise ValueError(f"plot needs the curve {name!r} of the run (a result of this session, not one rebuilt "

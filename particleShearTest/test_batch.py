@@ -366,7 +366,7 @@ class TestDocumentedSimulationWithPerSphereParameters(unittest.TestCase):
     documented step loop to rounding."""
 
     def test_per_sphere_parameters_run_in_the_engine(self):
-        from particleShear.engine.state import uniform_parameters
+        from particleShear.base.engine_adapter import uniform_parameters
         from particleShear.simulation.simulations import Simulation_interlocking_rheology
 
         class Mine(Simulation_interlocking_rheology):

@@ -17,7 +17,7 @@ import numpy as np
 from particleShear import (CircleBasicElasticity, PlateauConfiguration, SphereLinkable, doParticleShearSimulation,
                            elastic_force_law, elastic_force_law_plateau, elastic_force_law_tensile)
 from particleShear.engine import laws
-from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShear.engine.step import BatchEngine
 from particleShear.run.batch import batches, run_batch
 from particleShear.simulation.output import sidecar_path
@@ -56,7 +56,7 @@ def engine_force(d, laws_=None, link=False, c=0.0, stretch=None):
     ens, s1, s2 = _pair_scene(d, link=link, c=c)
     if stretch is not None:
         s2.x = 200.0 + stretch
-    s = BatchState.from_ensembles([ens], laws=laws_)
+    s = state_from_ensembles([ens], laws=laws_)
     s.applying_shear = False
     dt = 2.0 ** -30
     BatchEngine(s, guard=False).step(1.0, dt)
@@ -121,7 +121,7 @@ class TestPlateauThroughTheEngine(ClassCallbacks):
         ens, _, _ = _pair_scene(60.0)
         ens2, _, _ = _pair_scene(60.0)
         with self.assertRaisesRegex(ValueError, "laws="):
-            BatchState.from_ensembles([ens, ens2], laws=[("plateau", (0.3, 0.8, 0.1)), None])
+            state_from_ensembles([ens, ens2], laws=[("plateau", (0.3, 0.8, 0.1)), None])
 
 
 class TestPlateauRuns(ClassCallbacks):

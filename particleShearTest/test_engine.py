@@ -22,6 +22,7 @@ from particleShear.engine.box import min_image, wrap
 from particleShear.engine.laws import central_law, tensile_law
 from particleShear.engine.neighbours import build_candidates, verlet_bound
 from particleShear.engine.state import PERMANENT, BatchState, ReplicaPairs
+from particleShear.base.engine_adapter import state_from_ensembles, state_of_ensemble
 from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.run.api import _build_simulation, _seed_sequence
 from particleShear.run.batch import _REFERENCE_ARGUMENTS, _signature_defaults
@@ -179,7 +180,7 @@ class TestEngineAgainstClasses(unittest.TestCase):
                 _, ens_e, _ = constituted(7 + n, **scene)
                 ens_c.set_integrator(integrator)
                 ref = classes_measurement(ens_c, sc)
-                eng = BatchEngine(BatchState.from_ensembles([ens_e]), integrator=integrator)
+                eng = BatchEngine(state_from_ensembles([ens_e]), integrator=integrator)
                 pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
                 got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5)
                 self.assertGreater(len(ref["t"]), 200)
@@ -201,7 +202,7 @@ class TestFrictionlessReplicas(unittest.TestCase):
 
         def measure(which):
             ensembles = [constituted(3 + n, **scenes[n])[1] for n in which]
-            eng = BatchEngine(BatchState.from_ensembles(ensembles))
+            eng = BatchEngine(state_from_ensembles(ensembles))
             pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
             return eng, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, 1, 0.5)
 
@@ -277,7 +278,7 @@ class TestStressRegistry(unittest.TestCase):
         _, ens_c, sc = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
         _, ens_e, _ = constituted(21, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.3)
         ref = classes_measurement(ens_c, sc, keep_tensors=True)["tensors"]
-        eng = BatchEngine(BatchState.from_ensembles([ens_e]))
+        eng = BatchEngine(state_from_ensembles([ens_e]))
         pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
         got = protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5, keep_tensors=True)
         # every registry name is a documented tensor attribute of the classes (2×2 nested lists)
@@ -313,8 +314,8 @@ class TestStressRegistry(unittest.TestCase):
             return ens, sc
         runs = {}
         for sample in (True, "tensors"):
-            engines = [BatchEngine(BatchState.from_ensembles([scene(seed)[0]]), guard=False) for seed in (3, 4)]
-            batch = BatchEngine(BatchState.from_ensembles([scene(seed)[0] for seed in (3, 4)]), guard=False)
+            engines = [BatchEngine(state_from_ensembles([scene(seed)[0]]), guard=False) for seed in (3, 4)]
+            batch = BatchEngine(state_from_ensembles([scene(seed)[0] for seed in (3, 4)]), guard=False)
             dt = scene(3)[1]["dt"]
             runs[sample] = [[e.step(0.999, dt, sample=sample) for _ in range(20)] for e in engines + [batch]]
             self.assertIsNotNone(batch.C.Kj)
@@ -339,14 +340,14 @@ class TestStressRegistry(unittest.TestCase):
 
 
 class TestStateOfOneEnsemble(unittest.TestCase):
-    """``BatchState.of_ensemble``: the batch of one whose sphere arrays are the ensemble's own rows.
+    """``state_of_ensemble``: the batch of one whose sphere arrays are the ensemble's own rows.
     The engine's steps on it write into the ensemble, and they are the steps of a copy
-    (``from_ensembles``) bit for bit: the same arithmetic on the same numbers."""
+    (``state_from_ensembles``) bit for bit: the same arithmetic on the same numbers."""
 
     def test_steps_write_into_the_ensemble_as_on_a_copy(self):
         _, ens_v, sc = constituted(13, theMu=0.05, do_permanent_links=True, cut_lines=1)
         _, ens_c, _ = constituted(13, theMu=0.05, do_permanent_links=True, cut_lines=1)
-        view, copy = BatchState.of_ensemble(ens_v), BatchState.from_ensembles([ens_c])
+        view, copy = state_of_ensemble(ens_v), state_from_ensembles([ens_c])
         self.assertIs(view.ensemble, ens_v)
         self.assertIsNone(copy.ensemble)
         for name, row in (("x", "x"), ("vy", "yspeed"), ("omega", "omega"), ("fx", "xforce"), ("r", "r")):
@@ -436,7 +437,7 @@ class TestPhasesOneByOne(unittest.TestCase):
 class TestVerletListKeepsEveryContact(unittest.TestCase):
     def test_contacts_equal_all_pairs_during_shear(self):
         _, ens, sc = constituted(11, theMu=0.05, do_permanent_links=False, cut_lines=0, theAmplitude=0.5)
-        s = BatchState.from_ensembles([ens])
+        s = state_from_ensembles([ens])
         eng = BatchEngine(s, skin_factor=0.2, guard=False)   # a thin skin: many rebuilds, the bound is exercised
         s.applying_shear = True
         rate = np.array([0.5 * 2 * math.pi * sc["f"] * 8])   # 8× the protocol's peak rate

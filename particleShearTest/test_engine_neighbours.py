@@ -17,6 +17,7 @@ import numpy as np
 from particleShear.engine.neighbours import (CELL_LIST_MIN_N, build_candidates, cell_grid, near_pairs,
                                              near_pairs_all, near_pairs_cells)
 from particleShear.engine.state import PERMANENT, ReplicaPairs
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShearTest.test_engine import constituted
 from particleShearTest.test_neighbours import oracle_pairs
 
@@ -175,7 +176,6 @@ class TestEngineWithTheCellList(unittest.TestCase):
         # forced instead, the candidate lists, hence every force and position, must be the same bits
         from unittest import mock
         from particleShear.engine import neighbours
-        from particleShear.engine.state import BatchState
         from particleShear.engine.step import BatchEngine
         N = 400
         self.assertGreaterEqual(N, CELL_LIST_MIN_N)
@@ -184,7 +184,7 @@ class TestEngineWithTheCellList(unittest.TestCase):
         runs = []
         for min_n in (CELL_LIST_MIN_N, 10 ** 9):
             with mock.patch.object(neighbours, "CELL_LIST_MIN_N", min_n):
-                s = BatchState.from_ensembles([ens])
+                s = state_from_ensembles([ens])
                 eng = BatchEngine(s, skin_factor=0.2, guard=False)       # a thin skin: many rebuilds
                 s.applying_shear = True
                 eng.set_rate(np.array([0.5 * 2 * math.pi * f * 8]))     # 8× the protocol's peak rate

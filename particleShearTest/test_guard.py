@@ -16,7 +16,7 @@ import numpy as np
 
 from particleShear import EnsembleLinkable, SphereLinkable
 from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
-from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_of_ensemble
 from particleShear.engine.step import BatchEngine, EngineInstability
 
 L = 400.0
@@ -60,7 +60,7 @@ def verdicts(ens):
         by_class = None
     except SimulationInstabilityError as exc:
         by_class = exc.reason
-    engine = BatchEngine(BatchState.of_ensemble(ens), guard=True, check_interval=1)
+    engine = BatchEngine(state_of_ensemble(ens), guard=True, check_interval=1)
     engine.rate_max[...] = RATE
     try:
         engine.force_phase()

@@ -18,7 +18,7 @@ import numpy as np
 from particleShear import EnsembleLinkable, SphereLinkable, doParticleShearSimulation
 from particleShear.engine.contact_laws import LAWS, MODULES
 from particleShear.engine.contact_laws.hertz import hertz
-from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShear.engine.step import BatchEngine
 from particleShear.parameters import BY_NAME, EXTRA, defaults
 from particleShear.simulation.provenance import identity_parameters
@@ -49,7 +49,7 @@ def engine_force(d, s=0.05):
     ens.sphereList.append(s1)
     ens.sphereList.append(s2)
     ens.set_central_repulsion_coefficient(0.0)
-    state = BatchState.from_ensembles([ens], laws=[("hertz", (s,))])
+    state = state_from_ensembles([ens], laws=[("hertz", (s,))])
     state.applying_shear = False
     dt = 2.0 ** -30
     BatchEngine(state, guard=False).step(1.0, dt)

@@ -265,13 +265,13 @@ class ForceRegisterOrderTest(unittest.TestCase):
     def test_scenes_through_the_engine(self):
         # the engine's force phase on the ensemble's own state, its terms given to the register
         # (Force_register.set_from_engine): the same entries, in the same order
-        from particleShear.engine.state import BatchState
+        from particleShear.base.engine_adapter import state_of_ensemble
         from particleShear.engine.step import BatchEngine
         for name, spec in SCENES.items():
             with self.subTest(scene=name):
                 ens = two_sphere_scene(**spec)
                 want = reference_force_phase(ens)
-                eng = BatchEngine(BatchState.of_ensemble(ens), guard=False)
+                eng = BatchEngine(state_of_ensemble(ens), guard=False)
                 eng.keep_terms = True
                 eng.force_phase()
                 eng.flush()                    # the states of the relations into the ensemble's table

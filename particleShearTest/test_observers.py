@@ -23,7 +23,7 @@ import numpy as np
 
 from particleShear import doParticleShearSimulation
 from particleShear.engine.observers import Observer, check_observers
-from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShear.engine.step import BatchEngine, pre_equilibrate, pre_equilibration_blocks, protocol
 from particleShear.run.batch import run_batch
 from particleShear.simulation.drawing import CAPTION_HEIGHT, PillowRenderer
@@ -70,7 +70,7 @@ class Reader(Observer):
 def measured(seed, observers=()):
     """Pre-equilibration and protocol of one constituted replica in the engine, with ``observers``."""
     _, ens, sc = constituted(seed, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)
-    eng = BatchEngine(BatchState.from_ensembles([ens]), skin_factor=0.2)
+    eng = BatchEngine(state_from_ensembles([ens]), skin_factor=0.2)
     pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"], observers=observers)
     return protocol(eng, sc["dt"], sc["f"], [sc["A"]], sc["cool"], 0.5, 1, 0.5, observers=observers), sc
 
@@ -123,7 +123,7 @@ class TestReplicaView(unittest.TestCase):
         # before any step the state is the ensemble's: the same SVG, the renderer being the definition
         _, ens, _ = constituted(8, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)
         ens.shear = 0.13          # a Lees-Edwards shift, so the periodic images are exercised
-        eng = BatchEngine(BatchState.from_ensembles([ens]))
+        eng = BatchEngine(state_from_ensembles([ens]))
         view = ReplicaView(eng, 0, ens.graphical_output_configuration)
         r = PillowRenderer()
         self.assertIn("circle", r.vector(ens, "svg", step=3))
@@ -131,7 +131,7 @@ class TestReplicaView(unittest.TestCase):
 
     def test_view_shows_its_replica_of_a_batch(self):
         ens = [constituted(s, theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)[1] for s in (9, 10)]
-        eng = BatchEngine(BatchState.from_ensembles(ens))
+        eng = BatchEngine(state_from_ensembles(ens))
         r = PillowRenderer()
         for b in (0, 1):
             self.assertEqual(r.vector(ReplicaView(eng, b), "svg"), r.vector(ens[b], "svg"))
@@ -139,7 +139,7 @@ class TestReplicaView(unittest.TestCase):
 
     def test_scene_refuses_an_engine_it_is_not_bound_to(self):
         _, ens, _ = constituted(8)
-        a, b = (BatchEngine(BatchState.from_ensembles([ens])) for _ in range(2))
+        a, b = (BatchEngine(state_from_ensembles([ens])) for _ in range(2))
         scene = ReplicaScene()
         scene.bind(a, 0)
         self.assertIs(scene(a).engine, a)

@@ -19,8 +19,10 @@ import unittest
 import numpy as np
 
 from particleShear.engine.box import min_image
-from particleShear.engine.relax import relax_ensembles, relaxation_levels, remove_linear_drift
+from particleShear.base.engine_adapter import relax_ensembles
+from particleShear.engine.relax import relaxation_levels, remove_linear_drift
 from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_from_ensembles, state_of_ensemble, state_of_ensembles
 from particleShear.linkable.builders import adjustable_interface_constitution, relax_constitution
 
 #: a small scene of the run API's builder (nominal area fraction 1: a jammed packing)
@@ -254,10 +256,10 @@ class TestBatchIndependence(unittest.TestCase):
     def test_write_back_needs_the_relations_numbered(self):
         # an engine that did not number its relations as they formed cannot give the ensemble the
         # order of its neighbors: refused, and the ensemble is left as it was
-        from particleShear.engine.relax import write_back
+        from particleShear.base.engine_adapter import write_back
         from particleShear.engine.step import BatchEngine
         a = random_packing(3)
-        eng = BatchEngine(BatchState.of_ensemble(a))
+        eng = BatchEngine(state_of_ensemble(a))
         eng.numbers_relations = False
         eng.step(1.0, a.dt)
         x, t = a._a["x"].copy(), a.t
@@ -266,26 +268,26 @@ class TestBatchIndependence(unittest.TestCase):
         self.assertEqual((a._a["x"].tobytes(), a.t), (x.tobytes(), t))
 
     def test_write_back_needs_the_ensembles_own_state(self):
-        # a copy of the ensemble (from_ensembles) is not handed back: the engine's spheres are not
+        # a copy of the ensemble (state_from_ensembles) is not handed back: the engine's spheres are not
         # the ensemble's, and nothing copies them
-        from particleShear.engine.relax import write_back
+        from particleShear.base.engine_adapter import write_back
         from particleShear.engine.step import BatchEngine
         a, b = random_packing(3), random_packing(4)
-        eng = BatchEngine(BatchState.from_ensembles([a]))
+        eng = BatchEngine(state_from_ensembles([a]))
         eng.numbers_relations = True
         eng.step(1.0, a.dt)
         with self.assertRaisesRegex(ValueError, "own state"):
             write_back(eng, 0, a)
-        both = BatchEngine(BatchState.of_ensembles([a, b]))
+        both = BatchEngine(state_of_ensembles([a, b]))
         with self.assertRaisesRegex(ValueError, "own state"):
             write_back(both, 0, b)
 
     def test_a_batch_steps_the_ensembles_own_rows(self):
-        # of_ensembles: the batch's sphere arrays are the ensembles' rows, so a relaxed batch leaves
+        # state_of_ensembles: the batch's sphere arrays are the ensembles' rows, so a relaxed batch leaves
         # each ensemble exactly where the engine put its replica
         from particleShear.engine.step import BatchEngine
         a, b = random_packing(5), random_packing(6)
-        s = BatchState.of_ensembles([a, b])
+        s = state_of_ensembles([a, b])
         eng = BatchEngine(s)
         for _ in range(5):
             eng.step(1.0, a.dt)
@@ -295,7 +297,25 @@ class TestBatchIndependence(unittest.TestCase):
                 self.assertEqual(e._a[name].tobytes(), getattr(s, src)[rows].tobytes())
             self.assertIs(s.pairs[k], e._pairs)
         with self.assertRaisesRegex(ValueError, "twice"):
-            BatchState.of_ensembles([a, a])
+            state_of_ensembles([a, a])
+
+    def test_rows_and_blocks_of_the_wrong_shape_are_refused(self):
+        # a state on external rows needs B·N columns, an ensemble's block one row per field and one
+        # column per sphere: anything else is refused before it is used
+        import numpy as np
+
+        from particleShear.base.fields import FIELDS
+        from particleShear.engine.state import BatchState
+        s = BatchState(2, 3)
+        rows = dict(pos=np.zeros((2, 6)), vel=np.zeros((3, 6)), frc=np.zeros((3, 6)), phi=np.zeros(6),
+                    r=np.ones(6), m=np.ones(6), inertia=np.ones(6))
+        s.use_rows(**rows)
+        self.assertIs(s.x.base, rows["pos"])         # the state's x is a view of the caller's rows
+        with self.assertRaisesRegex(ValueError, r"pos has shape \(2, 5\).*\(2, 6\)"):
+            s.use_rows(**{**rows, "pos": np.zeros((2, 5))})
+        a = random_packing(5)
+        with self.assertRaisesRegex(ValueError, "block has shape"):
+            a.adopt_state_block(np.zeros((len(FIELDS), len(a.sphereList) + 1)))
 
     def test_a_refused_batch_leaves_the_ensembles_stepping_as_before(self):
         # a batch refused before any step (guards that differ, an unusable skin) leaves each ensemble

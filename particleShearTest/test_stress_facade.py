@@ -17,7 +17,7 @@ import numpy as np
 from particleShear import StressTensorEvaluation
 from particleShear.base.register import Force_register
 from particleShear.engine import stress as es
-from particleShear.engine.state import BatchState
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShear.engine.step import BatchEngine
 from particleShearTest.test_engine import constituted
 
@@ -39,7 +39,7 @@ class TestClassesEqualEngine(unittest.TestCase):
 
     def check_scene(self, plates):
         ens, sc = sheared(3, plates)
-        s = BatchState.from_ensembles([ens])
+        s = state_from_ensembles([ens])
         s.applying_shear = plates
         engine = BatchEngine(s, guard=False)
         tau_int_e, tau_surf_e, tens_e = engine.step(1.0, sc["dt"], sample="tensors")
@@ -81,7 +81,7 @@ class TestLinearMaps(unittest.TestCase):
         for both replicas of a batch of two; the torque and spin tensors have their fixed pattern
         (antisymmetric, isotropic), their zero entries the sign of ``value · 0``."""
         ens = [sheared(seed, True)[0] for seed in (5, 6)]
-        engine = BatchEngine(BatchState.from_ensembles(ens), guard=False)
+        engine = BatchEngine(state_from_ensembles(ens), guard=False)
         captured = []
         real = es.evaluate_all
         from particleShear.engine import step as step_module

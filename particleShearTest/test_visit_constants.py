@@ -16,6 +16,7 @@ import unittest
 import numpy as np
 
 from particleShear.engine.state import PER_SPHERE_PARAMETERS, PERMANENT, STICK, BatchState, ReplicaPairs
+from particleShear.base.engine_adapter import state_from_ensembles
 from particleShear.engine.step import BatchEngine, pre_equilibrate, protocol
 from particleShear.simulation.experiment import OscillatoryShearExperiment
 from particleShearTest.test_engine import classes_measurement, constituted
@@ -107,7 +108,7 @@ class TestSceneAgainstClasses(unittest.TestCase):
         perturb(ens_c)
         perturb(ens_e)
         ref = classes_measurement(ens_c, sc, keep_tensors=True)
-        state = BatchState.from_ensembles([ens_e])
+        state = state_from_ensembles([ens_e])
         self.assertIsNotNone(state.visit)
         eng = BatchEngine(state)
         pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
@@ -221,7 +222,7 @@ class TestExperimentInTheEngine(unittest.TestCase):
         # the engine steps the ensemble's own spheres and pair table; a run stopped by its guard (here
         # after a few steps of a protocol and of a relaxation) puts them back, so a retry starts from them
         from particleShear.base.stability import SimulationInstabilityError, StabilityGuard
-        from particleShear.engine.relax import relax_ensembles
+        from particleShear.base.engine_adapter import relax_ensembles
         from particleShear.engine.step import EngineInstability
         _, ens, sc = constituted(7, **SCENE)
         exp = OscillatoryShearExperiment(ens, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
@@ -261,7 +262,7 @@ class TestBatchOfOwnAndShared(unittest.TestCase):
 
         def measure(which):
             ensembles = [ensemble(n) for n in which]
-            state = BatchState.from_ensembles(ensembles)
+            state = state_from_ensembles(ensembles)
             eng = BatchEngine(state)
             pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
             return state, protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(which), sc["cool"], 0.5, 1, 0.5), ensembles

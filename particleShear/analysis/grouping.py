@@ -21,16 +21,16 @@ protocol and the parameters it reads split groups — and pools only seeds.
 """
 __docformat__ = "numpy"
 from ..parameters import names, protocol_parameters
+from ..protocols import PROTOCOLS
 
 __all__ = ["MODULI_PROTOCOLS", "SUMMARY_PROTOCOLS", "row_protocol", "measured_row", "short_value"]
 
 #: protocols whose rows hold G′ and G″ (one amplitude and frequency each)
-MODULI_PROTOCOLS = ("oscillatory", "amplitude_sweep", "frequency_sweep")
-#: protocols whose rows hold a summary of one run (docs/protocols.md)
-SUMMARY_PROTOCOLS = ("steady", "relaxation", "creep")
+MODULI_PROTOCOLS = ("oscillatory",) + tuple(n for n, p in PROTOCOLS.items() if p.segmented)
+#: protocols whose rows hold a summary of one run (docs/protocols.md): those of the recording loop
+SUMMARY_PROTOCOLS = tuple(n for n, p in PROTOCOLS.items() if p.recorded)
 #: the column of a step row that holds the step's value of a parameter column
-_STEP_VALUE = {"amplitude_sweep": ("theAmplitude", "sweep_amplitude"),
-               "frequency_sweep": ("relative_frequency", "sweep_relative_frequency")}
+_STEP_VALUE = {n: p.step_value for n, p in PROTOCOLS.items() if p.step_value is not None}
 
 
 def row_protocol(row):

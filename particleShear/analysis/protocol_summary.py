@@ -28,6 +28,7 @@ import zlib
 
 import numpy as np
 
+from ..protocols import PROTOCOLS
 from .grouping import SUMMARY_PROTOCOLS, measured_row, row_protocol, short_value
 from .verdicts import counts_note, verdict_counts
 
@@ -40,11 +41,9 @@ FLAGS = {"ok": "a value with its interval",
          "non_positive": "a modulus whose mean is <= 0: the value, no interval (a modulus interval is >= 0)",
          "undefined": "no value (no finished run, or no fit)"}
 
-#: the quantities summarised per protocol: name (``{est}`` the estimator) → unit
-QUANTITIES = {"relaxation": {"G_plateau_{est}": "Pa", "residual_stress": "Pa"},
-              "creep": {"creep_rate": "1/s", "creep_viscosity": "Pa·s", "strain_plateau": "1",
-                        "residual_stress": "Pa"},
-              "steady": {"sigma_y": "Pa", "K": "Pa·s^n", "n": "1"}}
+#: the quantities summarised per protocol: name (``{est}`` the estimator) → unit (each protocol's
+#: ``quantities``, :mod:`particleShear.protocols`)
+QUANTITIES = {name: dict(p.quantities) for name, p in PROTOCOLS.items() if p.quantities}
 
 #: columns of ``analysis_protocols.csv``: name → (type, unit, description); the varying parameters
 #: follow ``protocol``

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from ..protocols import PROTOCOLS
 from .periods import t_critical
 from .rheometry import final_rate, plateau as plateau_mean
 
@@ -101,12 +102,8 @@ CHECKS = {
     "strain_above_noise": ("relaxation", f"γ0·|G_plateau| >= {RELAXATION_SIGNAL_MIN:g} × |residual_stress| "
                                          "(both estimators)"),
 }
-_OSC = ("steady_state", "linear_response", "estimators_agree", "moduli_positive", "excitation_resolved")
-#: protocol → its checks, in table order
-PROTOCOL_CHECKS = {"oscillatory": _OSC, "amplitude_sweep": _OSC, "frequency_sweep": _OSC,
-                   "steady": ("plateau_reached", "strain_sufficient"),
-                   "relaxation": ("plateau_reached", "strain_above_noise"),
-                   "creep": ("stress_held", "rate_unsaturated", "hold_sufficient")}
+#: protocol → its checks, in table order (each protocol's ``checks``, :mod:`particleShear.protocols`)
+PROTOCOL_CHECKS = {name: tuple(p.checks) for name, p in PROTOCOLS.items()}
 #: the results-table columns of the verdicts: every check (bool, nullable), then ``verdict`` (string)
 VERDICT_COLUMNS = tuple(CHECKS) + ("verdict",)
 

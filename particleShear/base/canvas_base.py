@@ -180,6 +180,31 @@ class CanvasPoints:
         if self._cap != self._n:
             self._set_capacity(self._n)
 
+    def adopt_state_block(self, block):
+        """Hold the spheres' state in ``block`` from now on (the columns of a batch's joint block).
+
+        The values are the caller's to have copied there (e.g.
+        :func:`~particleShear.base.engine_adapter.state_of_ensembles`, which steps several
+        ensembles as one batch); the ensemble's field views and its neighbour list follow the new
+        block.  Appending a sphere later copies the block out again.
+
+        Parameters
+        ----------
+        block : numpy.ndarray (len(FIELDS), N)
+            One row per field of :data:`~particleShear.base.fields.FIELDS`, one column per sphere.
+
+        Raises
+        ------
+        ValueError
+            If ``block`` does not have that shape.
+        """
+        want = (len(FIELDS), self._n)
+        if tuple(np.shape(block)) != want:
+            raise ValueError(f"block has shape {tuple(np.shape(block))}: it must be {want} (fields × spheres)")
+        self._block, self._cap = block, self._n
+        self._views()
+        self._invalidate_neighbours()
+
     def _views(self):
         """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
         st = self._block[:, :self._n]

@@ -1,7 +1,7 @@
 """The documented step as the engine's phases on the ensemble's own state (docs/design.md, "The documented classes").
 
 A canvas keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
-(:meth:`~particleShear.engine.state.BatchState.of_ensemble`) whose sphere arrays are the ensemble's
+(:func:`~particleShear.base.engine_adapter.state_of_ensemble`) whose sphere arrays are the ensemble's
 rows and whose pairs are its pair table.  What a step reads (clock, strain, rate, μ, plates) is
 handed to the engine before each force phase; clock, strain and relations come back after each
 movement.  The engine is kept under one key and dropped at :meth:`EngineStep._drop_engine`.
@@ -10,8 +10,8 @@ __docformat__ = "numpy"
 import numpy as np
 
 from ..engine.guard import transient_ratios
-from ..engine.state import BatchState
 from ..engine.step import BatchEngine
+from .engine_adapter import state_of_ensemble
 
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
 
@@ -43,7 +43,7 @@ class EngineStep:
 
     def _step_engine(self):
         """The ensemble's engine, kept in the memo under :meth:`_engine_view_key` (the block fitted
-        first, as ``BatchState.of_ensembles`` fits it: the key holds the block the engine is made on)."""
+        first, as ``state_of_ensembles`` fits it: the key holds the block the engine is made on)."""
         self._fit_block()
         return self._memo.get("engine", self._engine_view_key(), self._new_engine)
 
@@ -52,7 +52,7 @@ class EngineStep:
         half = self._half_kick
         self._drop_engine()
         integrator = getattr(self, "integrator", "euler")
-        eng = BatchEngine(BatchState.of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
+        eng = BatchEngine(state_of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
                           integrator=integrator)
         eng.keep_terms = True      # the force register of every force phase
         if integrator == "verlet" and half is not None and len(half[0]) == self._n:

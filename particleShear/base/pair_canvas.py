@@ -35,6 +35,18 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         self._pos_version += 1
         self._drop_engine()
 
+    def invalidate_caches(self):
+        """Forget everything derived from the spheres and the pair table (neighbour list, the step's
+        engine, the links' count, the last force phase's geometry), after they were changed in
+        place from outside the ensemble: by an engine on its own state
+        (:func:`~particleShear.base.engine_adapter.state_of_ensembles`) or when such a run is undone
+        (:func:`~particleShear.base.engine_adapter.untouched_on_failure`).  The next step starts
+        from the spheres and the table as they are."""
+        self._invalidate_neighbours()
+        self._links_changed()
+        self._relations_edited()
+        self._g = None
+
     def _links_changed(self):
         self._pairs.n_permanent = int((self._pairs.state == PERMANENT).sum())
         self._engine_pairs = None       # the step's engine rebuilds its candidates from the table

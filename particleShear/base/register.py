@@ -9,11 +9,64 @@ import itertools
 
 import numpy as np
 
-from ..engine.step import register_block
+from ..engine.forces import pair_roles
 from ..engine.terms import pair_forces
 from ..engine.xp import to_host
 
-__all__ = ["Force_register", "SphereSelection"]
+__all__ = ["Force_register", "SphereSelection", "register_block"]
+
+
+def register_block(t, N, b, tangential=True):
+    """The force register's block of replica ``b`` of a force phase whose terms an engine kept
+    (:attr:`~particleShear.engine.step.BatchEngine.terms` with
+    :attr:`~particleShear.engine.step.BatchEngine.keep_terms` on), in the layout the
+    documented classes' register (:class:`Force_register`) reads.
+
+    Per candidate of the replica (local sphere indices ``i < j``): the forces on i and j, the
+    torques, the internal and external flags (:func:`~particleShear.engine.forces.pair_roles`),
+    the relations, the pair vectors, and per visit the elastic and viscous scalars, the two
+    tangential visits' forces, normals, tangents, distances, lever fractions, contacts, bonds
+    and creation numbers, from which the six reference lists are built when read.
+
+    Parameters
+    ----------
+    t : _TermRecord or None
+        The engine's record of the force phase (:attr:`~particleShear.engine.step.BatchEngine.terms`).
+    N : int
+        Spheres per replica.
+    b : int
+        Replica index (0 … B−1).
+    tangential : bool, default True
+        The replica's ensemble has the tangential term (its register lists tangential visits
+        and torques, zero forces where μ = 0 and no bond).
+
+    Returns
+    -------
+    dict
+        The block's arrays (on the host); None before a force phase that kept its terms.  The
+        replica's totals and mobility the register takes from ``t.totals`` and ``t.mob`` itself.
+    """
+    if t is None:
+        return None
+    C = t.C
+    lo, hi = int(C.offsets[b]), int(C.offsets[b + 1])
+    h = lambda a: None if a is None else to_host(a, "register")[..., lo:hi]   # noqa: E731
+    ai, aj = h(C.ai) - b * N, h(C.aj) - b * N
+    mob = to_host(t.mob, "register")[b * N:(b + 1) * N]
+    internal, ext_i, ext_j = pair_roles(mob[ai], mob[aj], h(t.shifted))
+    Fi = np.array((h(t.fx_i), h(t.fy_i)))
+    Fj = -Fi if t.fx_j is None else -np.array((h(t.fx_j), h(t.fy_j)))
+    nx, ny = h(t.nx), h(t.ny)
+    el_i, v_i = (h(a) for a in t.parts[0])
+    el_j, v_j = (h(a) for a in t.parts[1]) if t.parts[1] else (None, None)
+    tq = h(t.tq) if tangential else None
+    return {"i": ai, "j": aj, "Fi": Fi, "Fj": Fj, "ti": None if tq is None else tq[0],
+            "tj": None if tq is None else tq[1], "internal": internal, "ext_i": ext_i, "ext_j": ext_j,
+            "active": h(t.active), "antisymmetric": t.fx_j is None, "engine": True,
+            "D": np.array((h(t.dx), h(t.dy))),
+            "visits": ([("elastic", el_i, el_j), ("viscous", v_i, v_j)], h(t.F) if tangential else None,
+                       np.array((nx, ny)), np.array((-ny, nx)), h(t.d), h(C.w), h(t.touching), h(C.perm),
+                       h(t.birth), slice(None))}
 
 
 class PairBlock(dict):
@@ -33,7 +86,7 @@ class PairBlock(dict):
 class EngineForcePhase:
     """Force phase of replica ``b`` of an engine, held by a register (which does not keep the engine alive).
 
-    ``block``: its register block (:func:`~particleShear.engine.step.register_block`), made when read.
+    ``block``: its register block (:func:`register_block`), made when read.
 
     Parameters
     ----------

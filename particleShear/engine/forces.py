@@ -106,7 +106,7 @@ class PairConstants:
         i_host[0] = rep
         i_host[1] = np.concatenate([p.i for p in pairs]) + rep * N
         i_host[2] = np.concatenate([p.j for p in pairs]) + rep * N
-        self._blocks(xp.empty((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
+        self._set_blocks(xp.empty((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
         self._index(s, offsets)
         f = self.f
         f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
@@ -119,7 +119,7 @@ class PairConstants:
         """The lever fractions ``(w_i, w_j)`` as one (2, P) view of the float block (eq. S1-3)."""
         return self.f[3:5]
 
-    def _blocks(self, f, i, b, i_host):
+    def _set_blocks(self, f, i, b, i_host):
         """Take the blocks and bind every named attribute to a view of its row."""
         d = self.__dict__
         d.update(f=f, i=i, b=b, i_host=i_host)
@@ -191,7 +191,7 @@ class PairConstants:
         C.backend = old.backend
         f, i, b = (splice_arrays(getattr(old, n), getattr(new, n), segments) for n in ("f", "i", "b"))
         i_host = i if old.i_host is old.i else splice_arrays(old.i_host, new.i_host, segments)
-        C._blocks(f, i, b, i_host)
+        C._set_blocks(f, i, b, i_host)
         C._index(s, offsets)
         return C
 

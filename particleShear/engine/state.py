@@ -13,26 +13,12 @@ Units: µm, s, mg per m depth (reference units, docs/parameters.md).
 """
 __docformat__ = "numpy"
 
-import math
-
 import numpy as np
 
 from .xp import get_backend, to_host
 
-#: the per-sphere fields of a documented ensemble's state block (fields × spheres) and their defaults;
-#: rows advanced or gathered together sit next to each other: (x, y, phi) are moved by
-#: (xspeed, yspeed, omega)·dt in one pass, (xforce, yforce, torque) kicked in one pass
-FIELDS = {
-    "x": 0.0, "y": 0.0, "phi": -math.pi / 2, "xspeed": 0.0, "yspeed": 0.0, "omega": 0.0,
-    "r": 1.0, "m": 1.0, "inertia": 0.5, "xforce": 0.0, "yforce": 0.0, "torque": 0.0,
-    "central_repulsion_coefficient": 0.0, "permanent_ratio_central": 1.0,
-    "permanent_ratio_tangential": 1.0, "keep_viscosity_coefficients_constant": 1.0,
-}
-#: row of each field in that block
-ROW = {name: k for k, name in enumerate(FIELDS)}
-
 __all__ = ["STICK", "SLIP", "PERMANENT", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
-           "uniform_parameters", "spread", "FIELDS", "ROW"]
+           "PER_REPLICA_PARAMETERS", "spread"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
 
@@ -41,24 +27,7 @@ STICK, SLIP, PERMANENT = 0, 1, 2
 PER_SPHERE_PARAMETERS = ("central_repulsion_coefficient", "permanent_ratio_central", "permanent_ratio_tangential",
                          "keep_viscosity_coefficients_constant")
 #: the per-replica arrays of :class:`BatchState` that hold these parameters when a replica's spheres share them
-_PER_REPLICA = ("c", "prc", "prt", "keep")
-
-
-def uniform_parameters(ensemble):
-    """Whether every parameter of :data:`PER_SPHERE_PARAMETERS` is one value in ``ensemble`` (then the
-    batch state holds it once per replica, else per sphere in :attr:`BatchState.visit`).
-
-    Parameters
-    ----------
-    ensemble : ensemble
-        A documented ensemble (its ``_a`` rows are read).
-
-    Returns
-    -------
-    bool
-    """
-    a, n = ensemble._a, len(ensemble.sphereList)
-    return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
+PER_REPLICA_PARAMETERS = ("c", "prc", "prt", "keep")
 
 
 def spread(values, rep, B):
@@ -141,8 +110,8 @@ class PairTable:
     ``active`` (a relation of the reference: touching at the last neighbour update, or a bond) and
     ``birth``, the creation number of each relation (the order of ``sphere.neighbors``), with the
     counter of the next number (``_births``).  The one pair table of the package: the documented
-    ensembles hold one (``ens._pairs``), and the engine keeps one per replica
-    (:attr:`BatchState.pairs`; a state of one ensemble, :meth:`BatchState.of_ensemble`, keeps the
+    ensembles hold one, and the engine keeps one per replica (:attr:`BatchState.pairs`; a state on
+    an ensemble's own memory, :func:`particleShear.base.engine_adapter.state_of_ensembles`, keeps the
     ensemble's own).  The arguments are converted (not validated) to the dtypes below.
 
     Parameters
@@ -442,7 +411,8 @@ class BatchState:
     B : int
         Number of replicas (≥ 0).
     N : int
-        Spheres per replica (≥ 0).  Every array starts at zero; :meth:`from_ensembles` fills them.
+        Spheres per replica (≥ 0).  Every array starts at zero (the caller fills them, e.g.
+        :func:`particleShear.base.engine_adapter.state_from_ensembles`).
     backend : str or Backend, default "numpy"
         Array backend of the state (``"numpy"``, ``"cupy"``, or a registered one).
 
@@ -458,12 +428,16 @@ class BatchState:
 
     #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
     visit = None
-    #: the ensembles whose sphere rows this state's per-sphere arrays are (:meth:`of_ensembles`), else None
+    #: the objects whose memory this state's per-sphere arrays and pair lists are, one per replica
+    #: (set by :func:`particleShear.base.engine_adapter.state_of_ensembles`: the documented
+    #: ensembles), else None; a copy (:meth:`to_backend`, pickling) owns its arrays and has None.  An
+    #: engine on such a state numbers the relations as they form
+    #: (:attr:`~particleShear.engine.step.BatchEngine.numbers_relations`).
     ensembles = None
 
     @property
     def ensemble(self):
-        """The ensemble of a batch of one on its own rows (:meth:`of_ensemble`), else None."""
+        """The one entry of :attr:`ensembles` of a batch of one, else None."""
         e = self.ensembles
         return e[0] if e is not None and len(e) == 1 else None
 
@@ -477,7 +451,7 @@ class BatchState:
         self.pos = xp.zeros((2, n))
         self.vel = xp.zeros((3, n))
         self.frc = xp.zeros((3, n))            # (F_x, F_y, torque) of the last force phase
-        self._views()
+        self._bind_views()
         for name in ("phi", "r", "m", "inertia"):
             setattr(self, name, xp.zeros(n))
         for name in self.REPLICA_ARRAYS:
@@ -502,13 +476,43 @@ class BatchState:
         self.__dict__.update(state)
         self.backend = get_backend(state["backend"])
         self.xp = self.backend.xp
-        self._views()
+        self._bind_views()
 
-    def _views(self):
+    def _bind_views(self):
         """Row views of the position, velocity and force blocks (indexing, not iteration: no host read)."""
         self.x, self.y = self.pos[0], self.pos[1]
         self.vx, self.vy, self.omega = self.vel[0], self.vel[1], self.vel[2]
         self.fx, self.fy, self.torque = self.frc[0], self.frc[1], self.frc[2]
+
+    def use_rows(self, pos, vel, frc, phi, r, m, inertia):
+        """Make the given arrays the state's per-sphere arrays (views of memory the caller keeps, e.g.
+        the rows of an ensemble's state block): what a step writes, the caller's arrays hold.
+
+        Parameters
+        ----------
+        pos : ndarray (2, B·N)
+            Positions (x, y), µm.
+        vel : ndarray (3, B·N)
+            Velocities (vx, vy in µm/s, ω in 1/s).
+        frc : ndarray (3, B·N)
+            Forces and torques of the last force phase (F_x, F_y, torque).
+        phi, r, m, inertia : ndarray (B·N,)
+            Orientation (rad), radius (µm), mass (mg/m) and moment of inertia (mg·µm²/m).
+
+        Raises
+        ------
+        ValueError
+            If a shape does not match the state's B·N rows.
+        """
+        n = self.B * self.N
+        for name, a, rows in (("pos", pos, 2), ("vel", vel, 3), ("frc", frc, 3), ("phi", phi, None), ("r", r, None),
+                              ("m", m, None), ("inertia", inertia, None)):
+            want = (n,) if rows is None else (rows, n)
+            if tuple(a.shape) != want:
+                raise ValueError(f"{name} has shape {tuple(a.shape)}: it must be {want} (B·N = {n} rows)")
+        self.pos, self.vel, self.frc = pos, vel, frc
+        self.phi, self.r, self.m, self.inertia = phi, r, m, inertia
+        self._bind_views()
 
     def to_backend(self, backend):
         """This state with its arrays copied to ``backend`` (the same object if it is there already).
@@ -535,164 +539,8 @@ class BatchState:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
             out.visit = target.asarray(to_host(self.visit, "state"))
-        out._views()
+        out._bind_views()
         return out
-
-    @classmethod
-    def from_ensembles(cls, ensembles, backend="numpy", laws=None):
-        """Copy B ensembles of equal N (after constitution) into one batch state.
-
-        The ensembles are not modified; each replica keeps a reference to its ensemble's
-        random generator, so the random normals of ``d = 0`` continue its stream.
-
-        Parameters
-        ----------
-        ensembles : sequence of ensemble
-            Constituted ensembles (``particleShear.objects`` or ``particleShear.linkable``
-            ensembles), all with the same number of spheres.
-        backend : str or Backend, default "numpy"
-            Where the arrays of the state live: the ensembles are read on the host and the
-            state is copied to the device once.
-        laws : sequence, optional
-            The central law of each ensemble: ``None`` (the documented callback) or
-            ``(name, values)``, a name of :data:`~particleShear.engine.laws.LAWS` and its
-            parameter values in order (:func:`~particleShear.engine.laws.law_values`).  One law
-            per batch; the values may differ between replicas.  Default: None for every one.
-
-        Returns
-        -------
-        BatchState
-            Replica b holds ``ensembles[b]``: spheres, box, strain, rate, clock, constants and
-            the relations and bonds of its pair table.
-
-        Raises
-        ------
-        ValueError
-            If the ensembles differ in N, or their laws differ, or for an unusable backend (before
-            any copy).
-        """
-        target = get_backend(backend)
-        laws = [None] * len(ensembles) if laws is None else list(laws)
-        names = {None if law is None else law[0] for law in laws}
-        if len(laws) != len(ensembles) or len(names) > 1:
-            raise ValueError(f"laws={laws!r} is invalid: one law per ensemble, the same law for every one "
-                             "(its parameters may differ)")
-        Ns = {len(e.sphereList) for e in ensembles}
-        if len(Ns) != 1:
-            raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
-        B, N = len(ensembles), Ns.pop()
-        s = cls(B, N)
-        own = [not uniform_parameters(e) for e in ensembles]     # spheres with parameters of their own
-        if any(own):
-            s.visit = np.zeros((len(_PER_REPLICA), B * N))
-        for b, e in enumerate(ensembles):
-            a = e._a
-            rows = slice(b * N, (b + 1) * N)
-            for name, src in (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"),
-                              ("phi", "phi"), ("r", "r"), ("m", "m"), ("inertia", "inertia"),
-                              ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
-                getattr(s, name)[rows] = a[src][:N]
-            s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
-            s.gamma[b], s.rate[b], s.t[b] = (float(getattr(e, name, 0.0)) for name in ("shear", "shear_rate", "t"))
-            # a frictionless ensemble of particleShear.objects has no tangential constants (a canvas
-            # without forces none at all): 0
-            s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(getattr(e, name, 0.0))
-                                                             for name in ("k", "nu", "k_t", "nu_t", "mu"))
-            for name, src, empty in zip(_PER_REPLICA, PER_SPHERE_PARAMETERS, (0.0, 1.0, 1.0, 1.0)):
-                getattr(s, name)[b] = float(a[src][0]) if N else empty
-            if own[b]:
-                s.visit[:, rows] = [np.asarray(a[src][:N], dtype=float) for src in PER_SPHERE_PARAMETERS]
-            pt = e._pairs
-            keep = pt.active | (pt.state == PERMANENT)
-            s.pairs[b] = pt.copy(keep)
-            s.rng[b] = e._rng
-        if any(own):
-            shared = np.repeat(np.logical_not(own), N)
-            s.visit[:, shared] = s.per_replica_parameters()[:, shared]
-        s.law = names.pop() if names else None
-        if s.law is not None:
-            s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
-        return s.to_backend(target)
-
-    @classmethod
-    def of_ensemble(cls, ensemble, laws=None):
-        """:meth:`of_ensembles` of one ensemble (the ensemble keeps its own block).
-
-        Parameters
-        ----------
-        ensemble : ensemble
-            A documented ensemble of ``particleShear.objects`` or ``particleShear.linkable``.
-        laws : sequence, optional
-            As :meth:`from_ensembles` (one entry).
-
-        Returns
-        -------
-        BatchState
-            B = 1 on NumPy, with :attr:`ensemble` set to ``ensemble``.
-        """
-        return cls.of_ensembles([ensemble], laws=laws)
-
-    @classmethod
-    def of_ensembles(cls, ensembles, laws=None):
-        """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:
-        what the engine's steps write, the ensembles hold (nothing to copy back).
-
-        The sphere rows of replica b are columns ``b·N … b·N + N − 1`` of one state block laid out as
-        the ensembles' (:data:`FIELDS` × spheres); a single ensemble keeps its own block, fitted to
-        its spheres (so the engine's rows of positions, velocities and forces are contiguous: ≈ 4 %
-        of a documented step at N = 150), several move theirs into the joint block, of which each
-        then holds its columns as a view (an ensemble that later gains a sphere copies its block
-        out again).
-        Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
-        block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the box, strain,
-        rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
-        by :meth:`from_ensembles`, the plates (``applying_shear``) from the first ensemble's
-        ``applyingShear``.  An engine on this state numbers the relations as they form, and
-        :func:`~particleShear.engine.relax.write_back` afterwards gives each ensemble its clock,
-        strain and relations and drops its caches (and
-        :func:`~particleShear.engine.relax.untouched_on_failure` puts one back after a failed run).
-
-        Parameters
-        ----------
-        ensembles : sequence of ensemble
-            Documented ensembles of ``particleShear.objects`` or ``particleShear.linkable`` with
-            equal N, each at most once.
-        laws : sequence, optional
-            As :meth:`from_ensembles`.
-
-        Returns
-        -------
-        BatchState
-            On NumPy, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
-
-        Raises
-        ------
-        ValueError
-            As :meth:`from_ensembles`, or if an ensemble is given twice.
-        """
-        ensembles = list(ensembles)
-        if len({id(e) for e in ensembles}) != len(ensembles):
-            raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
-        s = cls.from_ensembles(ensembles, laws=laws)
-        N = s.N
-        if len(ensembles) == 1:
-            ensembles[0]._fit_block()      # no spare columns: the (2|3, N) rows below are contiguous
-            block = ensembles[0]._st
-        else:
-            block = np.empty((ensembles[0]._st.shape[0], s.B * N))
-            for b, e in enumerate(ensembles):
-                block[:, b * N:(b + 1) * N] = e._st
-                e._block, e._cap = block[:, b * N:(b + 1) * N], N
-                e._views()
-                e._invalidate_neighbours()      # caches of the old block (the documented step's engine)
-        x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
-        s.pos, s.vel, s.frc = block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3]
-        s.phi, s.r, s.m, s.inertia = (block[ROW[name]] for name in ("phi", "r", "m", "inertia"))
-        s._views()
-        s.pairs = [e._pairs for e in ensembles]
-        s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
-        s.ensembles = ensembles
-        return s
 
     @classmethod
     def concat(cls, states):
@@ -750,7 +598,7 @@ class BatchState:
         ndarray (4, B·N) or (4, len(rep))
             For a given ``rep`` in a batch of one, (4, 1): the values, which broadcast to its rows.
         """
-        values = self.xp.stack([getattr(self, name) for name in _PER_REPLICA])
+        values = self.xp.stack([getattr(self, name) for name in PER_REPLICA_PARAMETERS])
         return values[:, self.rep] if rep is None else spread(values, rep, self.B)
 
     def visit_rows(self):

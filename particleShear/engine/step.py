@@ -39,7 +39,7 @@ from .state import PERMANENT, SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 
-__all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks", "register_block"]
+__all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
 
 class EngineInstability(RuntimeError):
@@ -68,7 +68,7 @@ class EngineInstability(RuntimeError):
 
 class _TermRecord:
     """The per-candidate terms of the last force phase that the force register reads
-    (:func:`register_block`; kept only with :attr:`BatchEngine.keep_terms`)."""
+    (:func:`particleShear.base.register.register_block`; kept only with :attr:`BatchEngine.keep_terms`)."""
     __slots__ = ("C", "parts", "F", "dx", "dy", "nx", "ny", "d", "touching", "active", "shifted", "mob",
                  "fx_i", "fy_i", "fx_j", "fy_j", "dF", "tq", "birth", "totals")
 
@@ -86,58 +86,6 @@ class _ForceRecord:
     def __init__(self, dx, dy, nx, ny, dvx, active, yc, mob):
         self.dx, self.dy, self.nx, self.ny, self.dvx = dx, dy, nx, ny, dvx
         self.active, self.yc, self.mob = active, yc, mob
-
-
-def register_block(t, N, b, tangential=True):
-    """The force register's block of replica ``b`` of a force phase whose terms an engine kept
-    (:attr:`BatchEngine.terms` with :attr:`BatchEngine.keep_terms` on), in the layout the
-    documented classes' register reads (``base.register``).
-
-    Per candidate of the replica (local sphere indices ``i < j``): the forces on i and j, the
-    torques, the internal and external flags (:func:`~particleShear.engine.forces.pair_roles`),
-    the relations, the pair vectors, and per visit the elastic and viscous scalars, the two
-    tangential visits' forces, normals, tangents, distances, lever fractions, contacts, bonds
-    and creation numbers, from which the six reference lists are built when read.
-
-    Parameters
-    ----------
-    t : _TermRecord or None
-        The engine's record of the force phase (:attr:`BatchEngine.terms`).
-    N : int
-        Spheres per replica.
-    b : int
-        Replica index (0 … B−1).
-    tangential : bool, default True
-        The replica's ensemble has the tangential term (its register lists tangential visits
-        and torques, zero forces where μ = 0 and no bond).
-
-    Returns
-    -------
-    dict
-        The block's arrays (on the host); None before a force phase that kept its terms.  The
-        replica's totals and mobility the register takes from ``t.totals`` and ``t.mob`` itself.
-    """
-    if t is None:
-        return None
-    C = t.C
-    lo, hi = int(C.offsets[b]), int(C.offsets[b + 1])
-    h = lambda a: None if a is None else to_host(a, "register")[..., lo:hi]   # noqa: E731
-    ai, aj = h(C.ai) - b * N, h(C.aj) - b * N
-    mob = to_host(t.mob, "register")[b * N:(b + 1) * N]
-    internal, ext_i, ext_j = pair_roles(mob[ai], mob[aj], h(t.shifted))
-    Fi = np.array((h(t.fx_i), h(t.fy_i)))
-    Fj = -Fi if t.fx_j is None else -np.array((h(t.fx_j), h(t.fy_j)))
-    nx, ny = h(t.nx), h(t.ny)
-    el_i, v_i = (h(a) for a in t.parts[0])
-    el_j, v_j = (h(a) for a in t.parts[1]) if t.parts[1] else (None, None)
-    tq = h(t.tq) if tangential else None
-    return {"i": ai, "j": aj, "Fi": Fi, "Fj": Fj, "ti": None if tq is None else tq[0],
-            "tj": None if tq is None else tq[1], "internal": internal, "ext_i": ext_i, "ext_j": ext_j,
-            "active": h(t.active), "antisymmetric": t.fx_j is None, "engine": True,
-            "D": np.array((h(t.dx), h(t.dy))),
-            "visits": ([("elastic", el_i, el_j), ("viscous", v_i, v_j)], h(t.F) if tangential else None,
-                       np.array((nx, ny)), np.array((-ny, nx)), h(t.d), h(C.w), h(t.touching), h(C.perm),
-                       h(t.birth), slice(None))}
 
 
 class BatchEngine:
@@ -179,7 +127,7 @@ class BatchEngine:
         self.integrator = integrator
         self.half = None          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
         self.g = None             # the record of the last force phase (_ForceRecord)
-        #: keep the per-term arrays of each force phase for the force register (:func:`register_block`;
+        #: keep the per-term arrays of each force phase for the force register (``base.register``;
         #: a script's experiment sets it, so its ensemble's register holds the engine's last step)
         self.keep_terms = False
         self.terms = None

@@ -7,10 +7,10 @@ import logging
 
 import numpy as np
 
+from ..base.engine_adapter import relax_ensembles
 from ..checks import finite, in_range, integer, non_negative, positive
 from ..objects.model import particle_shear_model_parameters
 from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
-from ..engine.relax import relax_ensembles
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
@@ -111,7 +111,7 @@ class Relaxation:
         return (self.N, float(e.dt), float(e.dt_max))
 
     def run(self):
-        """Relax this ensemble alone in the engine (:func:`particleShear.engine.relax.relax_ensembles`)."""
+        """Relax this ensemble alone in the engine (:func:`particleShear.base.engine_adapter.relax_ensembles`)."""
         relax_ensembles([self.ensemble], self.N)
 
     def __repr__(self):

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..base.canvas_base import check_non_negative
+from ..base.engine_adapter import relax_ensembles
 from ..checks import in_range
 from ..engine.box import min_image
 from ..engine.graph import adjacency, component_labels, connected_without_edge
@@ -16,7 +17,6 @@ from ..base.neighbours import PERMANENT
 from ..objects.ensembles import RandomBimodalSpheres
 from .canvas import CanvasPointsLinkable, EnsembleLinkable
 from .spheres import SphereLinkableAdjustableInterfaceStrength
-from ..engine.relax import relax_ensembles
 
 __all__ = ["EnsembleCompactParticles", "EnsembleCompactParticlesAdjustableInterfaceStrength",
            "component_labels"]

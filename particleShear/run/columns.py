@@ -11,7 +11,9 @@ __docformat__ = "numpy"
 import json
 
 from ..analysis.measures import MEASURE_COLUMNS
+from ..analysis.verdicts import CHECKS
 from ..parameters import BY_NAME, spec_defaults
+from ..protocols import PROTOCOLS, result_columns
 
 __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "RESULT_COLUMNS", "TABLE_NAME",
            "column_spec", "table_columns", "read_schema", "typed_value", "cell_problem"]
@@ -80,59 +82,23 @@ _FIXED = {
     "wall_time_s": ("float", "s", "wall time of the run", False),
     "output_path": ("string", "", "the run's output file, relative to the sweep folder; empty when none", False),
 }
-_P = "; empty unless protocol is {}"
-_SW = "'amplitude_sweep' or 'frequency_sweep'"
-#: the outputs of the rheometer's protocols (docs/protocols.md), after the run columns in a table
-#: whose SPEC sets a protocol parameter: name -> (type, unit, description)
-_PROTOCOL_FIXED = {
-    "sweep_position": ("int", "", "position of the step in its one-packing sweep (0, 1, ...; one row per step)"
-                       + _P.format(_SW)),
-    "sweep_amplitude": ("float", "1", "strain amplitude of the step" + _P.format(_SW)),
-    "sweep_relative_frequency": ("float", "1", "relative frequency f·τ of the step" + _P.format(_SW)),
-    "strain_rate": ("float", "1/s", "imposed shear rate γ̇ = relative_rate/τ" + _P.format("'steady'")),
-    "stress_surface": ("float", "Pa", "steady shear stress from the plate forces (mean after the transient)"
-                       + _P.format("'steady'")),
-    "stress_surface_se": ("float", "Pa", "standard error of stress_surface by block averaging" + _P.format("'steady'")),
-    "stress_internal": ("float", "Pa", "steady shear stress of the internal estimator (stress tensor, eq. S1-24)"
-                        + _P.format("'steady'")),
-    "stress_internal_se": ("float", "Pa", "standard error of stress_internal by block averaging"
-                           + _P.format("'steady'")),
-    "viscosity_surface": ("float", "Pa·s", "viscosity stress_surface/strain_rate" + _P.format("'steady'")),
-    "viscosity_surface_se": ("float", "Pa·s", "standard error of viscosity_surface" + _P.format("'steady'")),
-    "viscosity_internal": ("float", "Pa·s", "viscosity stress_internal/strain_rate" + _P.format("'steady'")),
-    "viscosity_internal_se": ("float", "Pa·s", "standard error of viscosity_internal" + _P.format("'steady'")),
-    "N1": ("float", "Pa", "first normal-stress difference σ_xx − σ_yy of the overall tensor after the transient"
-           + _P.format("'steady'")),
-    "N1_se": ("float", "Pa", "standard error of N1 by block averaging" + _P.format("'steady'")),
-    "t_transient": ("float", "s", "end of the start-up transient (MSER-5 on the plate stress)" + _P.format("'steady'")),
-    "strain_transient": ("float", "1", "strain at the end of the start-up transient" + _P.format("'steady'")),
-    "ramp_time_s": ("float", "s", "duration of the strain ramp to theAmplitude" + _P.format("'relaxation'")),
-    "residual_stress": ("float", "Pa", "plate stress σ_res of the packing at rest before the step strain or "
-                        "stress (the origin of G(t); a solid creeps by (σ₀ − σ_res)/G)" + _P.format("'relaxation' or 'creep'")),
-    "G_plateau_surface": ("float", "Pa", "long-time plateau of G(t) = (σ(t) − σ_res)/γ₀, plate forces (last 20 % "
-                          "of the hold)"
-                          + _P.format("'relaxation'")),
-    "G_plateau_surface_se": ("float", "Pa", "standard error of G_plateau_surface by block averaging"
-                             + _P.format("'relaxation'")),
-    "G_plateau_internal": ("float", "Pa", "long-time plateau of G(t), internal estimator" + _P.format("'relaxation'")),
-    "G_plateau_internal_se": ("float", "Pa", "standard error of G_plateau_internal by block averaging"
-                              + _P.format("'relaxation'")),
-    "creep_rate": ("float", "1/s", "final creep rate dγ/dt over the last 20 % of the hold" + _P.format("'creep'")),
-    "creep_rate_se": ("float", "1/s", "standard error of creep_rate (5 sub-windows)" + _P.format("'creep'")),
-    "creep_viscosity": ("float", "Pa·s", "creep_stress/creep_rate (inf when the strain does not grow)"
-                        + _P.format("'creep'")),
-    "strain_plateau": ("float", "1", "strain γ(t) − γ(0) over the last 20 % of the hold (its plateau for a solid)"
-                       + _P.format("'creep'")),
-    "strain_plateau_se": ("float", "1", "standard error of strain_plateau by block averaging" + _P.format("'creep'")),
-    "stress_tracking": ("float", "1", "(mean plate stress over the second half of the hold − σ₀)/σ₀"
-                        + _P.format("'creep'")),
-    "plateau_reached": ("bool", "", _CHECK.format("plateau_reached") + _P.format("'steady' or 'relaxation'")),
-    "strain_sufficient": ("bool", "", _CHECK.format("strain_sufficient") + _P.format("'steady'")),
-    "stress_held": ("bool", "", _CHECK.format("stress_held") + _P.format("'creep'")),
-    "rate_unsaturated": ("bool", "", _CHECK.format("rate_unsaturated") + _P.format("'creep'")),
-    "hold_sufficient": ("bool", "", _CHECK.format("hold_sufficient") + _P.format("'creep'")),
-    "strain_above_noise": ("bool", "", _CHECK.format("strain_above_noise") + _P.format("'relaxation'")),
-}
+
+
+def _protocol_columns():
+    """The outputs of the rheometer's protocols (docs/protocols.md), from their files
+    (:func:`particleShear.protocols.result_columns`: the step columns of the sweeps, the summaries,
+    then the checks in the order of :data:`~particleShear.analysis.verdicts.CHECKS`)."""
+    values, checks = result_columns(CHECKS)
+    out = dict(values)
+    for c, names in checks.items():
+        text = _CHECK.format(c) if c in CHECKS else PROTOCOLS[names[0]].columns[c][2]
+        out[c] = ("bool", "", text + "; empty unless protocol is " + " or ".join(f"'{n}'" for n in names))
+    return out
+
+
+#: the outputs of the rheometer's protocols, after the run columns in a table whose SPEC sets a
+#: protocol parameter: name -> (type, unit, description)
+_PROTOCOL_FIXED = _protocol_columns()
 #: the protocol columns, in table order
 PROTOCOL_COLUMNS = tuple(_PROTOCOL_FIXED)
 _FIXED.update({k: v + (True,) for k, v in _PROTOCOL_FIXED.items()})

@@ -32,19 +32,40 @@ import time
 
 import numpy as np
 
-from ..parameters import BY_NAME, PARAMETERS, spec_defaults
 from .._version import __version__
+from ..analysis.measures import MEASURE_COLUMNS
+from ..analysis.verdicts import CHECKS, PROTOCOL_CHECKS, verdict, verdict_lines
+from ..checks import show_value
+from ..engine.rheometer import shear_record
+from ..engine.step import protocol as oscillation
 from ..hooks import entry
+from ..linkable.builders import time_steps_from_model
+from ..parameters import BY_NAME, PARAMETERS, spec_defaults
+from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY, result_columns
+from ..protocols.creep import CREEP_MODULUS_FRACTION
+from ..protocols.steady import N1_EVERY
 from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
+from ..simulation.provenance import run_identity
+from .sessions import build_sessions
+from .rheometer_analysis import analyse_record, analyse_sweep
+from .rheometer_files import write_protocol_file
+from .limits import MAX_TOTAL_STEPS, _protocol_room
 
-__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
+__all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "PROTOCOL_COLUMNS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
            "check_sweep_resolution", "normalize_protocol", "protocol_steps", "measure_rheometer"]
 
-PROTOCOLS = BY_NAME["protocol"].choices
+#: the protocols' names, in the order of ``protocol``'s choices (:mod:`particleShear.protocols`)
+PROTOCOLS = tuple(REGISTRY)
 
 #: the protocol's selector and the protocols' own parameters with their defaults (roles "protocol" of
 #: :mod:`particleShear.parameters`)
 PROTOCOL_DEFAULTS = {p.name: p.default for p in PARAMETERS if p.base_role == "protocol"}
+
+#: the result columns of the protocols, in table order (the summaries, the checks; the results
+#: table's :data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`), name → unit
+_COLUMN_UNITS = {name: spec[1] for name, spec in result_columns(CHECKS)[0].items()}
+_COLUMN_UNITS.update((name, "") for name in result_columns(CHECKS)[1])
+PROTOCOL_COLUMNS = tuple(_COLUMN_UNITS)
 
 #: the protocol parameters whose value is a list (one value of a sweep is a whole list)
 LIST_PARAMETERS = tuple(p.name for p in PARAMETERS if p.kind == "float_list")
@@ -54,46 +75,12 @@ LIST_PARAMETERS = tuple(p.name for p in PARAMETERS if p.kind == "float_list")
 STEP_COLUMNS = {"position": "sweep_position", "amplitude": "sweep_amplitude",
                 "relative_frequency": "sweep_relative_frequency", "f": "frequency_Hz", "dt": "dt", "N_steps": "N_steps"}
 
-#: largest strain increment |γ̇|·dt of one step (≈ 9× the default oscillation's peak, 5.6e-4):
-#: neighbours 2r apart then move by at most 1 % of r relative to each other per step
-MAX_STRAIN_PER_STEP = 0.005
-
-#: the controller's modulus scale, as a fraction of Young_modulus_spheres when creep_modulus is None
-#: (the default packing has G′ ≈ 0.14 E, so the closed loop settles in about one response time)
-CREEP_MODULUS_FRACTION = 0.125
-
-#: N1 of the overall tensor is sampled every this many steps (the tensors cost about one step)
-N1_EVERY = 10
-
 
 def _dt_over_tau(p, amplitude=None):
     """Protocol time step in units of τ (the time-step rule is linear in τ)."""
-    from ..linkable.builders import time_steps_from_model
     A = p["theAmplitude"] if amplitude is None else amplitude
     return time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"], A,
                                  p["relative_viscosity"])[0] * p["time_step_factor"]
-
-
-def _positive(name, v, hi=math.inf):
-    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name}={v!r} is invalid: allowed a real number > 0 (flag --{name.replace('_', '-')})")
-    if not (math.isfinite(v) and 0 < v <= hi):
-        raise ValueError(f"{name}={v!r} is out of range: allowed 0 < {name} <= {hi:g} "
-                         f"(flag --{name.replace('_', '-')})")
-    return float(v)
-
-
-def _values(name, v, lo, hi):
-    if v is None or isinstance(v, (str, bytes)) or not hasattr(v, "__len__"):
-        raise ValueError(f"{name}={v!r} is invalid: the sweep needs a list of values in ({lo:g}, {hi:g}]")
-    vals = [_positive(name, x, hi) for x in list(v)[:10001]]
-    if not 1 <= len(vals) <= 10000:
-        raise ValueError(f"{name} has {len(vals)} values: allowed 1 ... 10000")
-    d = np.diff(vals)
-    if len(vals) > 1 and not ((d > 0).all() or (d < 0).all()):
-        raise ValueError(f"{name}={vals!r} is invalid: a sweep runs in one direction on one sample, so the values "
-                         "must be strictly increasing or strictly decreasing (no repeats)")
-    return vals
 
 
 def check_protocol(p):
@@ -121,7 +108,7 @@ def check_protocol(p):
         shorten), or options of the drawing with a protocol other than "oscillatory".
     """
     proto = p.get("protocol", "oscillatory")
-    if proto not in PROTOCOLS:
+    if proto not in REGISTRY:
         near = difflib.get_close_matches(str(proto), PROTOCOLS, n=1)
         raise ValueError(f"protocol={proto!r} is invalid: allowed one of {PROTOCOLS}"
                          + (f"; did you mean {near[0]!r}?" if near else "") + " (flag --protocol)")
@@ -131,45 +118,13 @@ def check_protocol(p):
         raise ValueError(f"saveOutputImages=True is invalid with protocol={proto!r}: snapshots are taken of the "
                          "oscillatory protocol only")
     q = normalize_protocol(p)
-    if proto == "steady":
-        _positive("relative_rate", q["relative_rate"])
-        _positive("total_strain", q["total_strain"], 1e6)
-    if proto in ("relaxation", "creep"):
-        _positive("hold_time", q["hold_time"], 1e9)
-    if proto == "relaxation":
-        _positive("ramp_time", q["ramp_time"], 1e9)
-    if proto == "creep":
-        if q["creep_stress"] is None:
-            raise ValueError("creep_stress=None is invalid with protocol='creep': give the applied stress σ₀ in Pa "
-                             "(> 0; flag --creep-stress)")
-        _positive("creep_stress", q["creep_stress"], 1e12)
-        if q["creep_modulus"] is not None:
-            _positive("creep_modulus", q["creep_modulus"], 1e15)
-        _positive("creep_response_time", q["creep_response_time"], 1e9)
+    spec = REGISTRY[proto]
+    if spec.check is not None:
+        spec.check(q)
     steps = protocol_steps(q)
-    dtr = steps["dt_over_tau"]
-    if proto == "steady":
-        rate = float(q["relative_rate"])
-        if rate * dtr > MAX_STRAIN_PER_STEP:
-            raise ValueError(f"relative_rate={rate!r} is out of range: the time step (dt = {dtr:.3g} τ) resolves "
-                             f"at most {MAX_STRAIN_PER_STEP} strain per step, i.e. relative_rate <= "
-                             f"{MAX_STRAIN_PER_STEP / dtr:.4g} (flag --relative-rate)")
-    if proto == "relaxation":
-        per_step = q["theAmplitude"] / steps["ramp"]
-        if per_step > MAX_STRAIN_PER_STEP:
-            raise ValueError(f"ramp_time={q['ramp_time']!r} is out of range: a ramp to theAmplitude="
-                             f"{q['theAmplitude']!r} in {steps['ramp']} steps is {per_step:.3g} strain per step, more "
-                             f"than {MAX_STRAIN_PER_STEP}; allowed ramp_time >= "
-                             f"{q['theAmplitude'] / MAX_STRAIN_PER_STEP * dtr:.4g} (flag --ramp-time)")
-    if proto == "creep":
-        T = float(q["creep_response_time"])
-        if T < 10 * dtr:
-            raise ValueError(f"creep_response_time={T!r} is out of range: the controller needs >= 10 steps per "
-                             f"response time, allowed >= {10 * dtr:.4g} (flag --creep-response-time)")
-    if proto.endswith("sweep"):
-        check_sweep_resolution(q, steps)
-    total = sum(steps["segments"]) if proto.endswith("sweep") else steps["steps"]
-    from .limits import MAX_TOTAL_STEPS, _protocol_room
+    if spec.check_steps is not None:
+        spec.check_steps(q, steps)
+    total = sum(steps["segments"]) if spec.segmented else steps["steps"]
     if total > MAX_TOTAL_STEPS:
         name, allowed = _protocol_room(q, steps, MAX_TOTAL_STEPS)
         raise ValueError(f"{name}={_shown(q[name])} is out of range: protocol={proto!r} needs {total:.3g} steps, more "
@@ -179,7 +134,6 @@ def check_protocol(p):
 
 def _shown(v):
     """A value for a message: a long list cut to its first and last values."""
-    from ..checks import show_value
     if isinstance(v, (list, tuple)) and len(v) > 6:
         return f"[{', '.join(f'{x:g}' for x in v[:3])}, ..., {v[-1]:g}] ({len(v)} values)"
     return show_value(v)
@@ -208,36 +162,8 @@ def check_sweep_resolution(q, steps=None):
         Naming the step's value (``sweep_frequencies[j]`` or ``sweep_amplitudes[j]``), its steps
         per period, the limit, the allowed range and the CLI flag.
     """
-    from .limits import MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED
-    proto = q["protocol"]
     steps = protocol_steps(q) if steps is None else steps
-    factor = float(q["time_step_factor"])
-    n = len(steps["dts"])
-    freqs = q["sweep_frequencies"] if proto == "frequency_sweep" else [float(q["relative_frequency"])] * n
-    for j, (fr, dtr) in enumerate(zip(freqs, steps["dts"])):
-        spp = 1.0 / (fr * dtr / factor)        # steps per period at the reference time step
-        if spp >= MIN_STEPS_PER_PERIOD and spp / factor >= MIN_STEPS_PER_PERIOD_COARSENED:
-            continue
-        if proto == "frequency_sweep":
-            name, value, flag = f"sweep_frequencies[{j}]", fr, "--sweep-frequencies"
-        else:
-            name, value, flag = f"sweep_amplitudes[{j}]", q["sweep_amplitudes"][j], "--sweep-amplitudes"
-        if spp < MIN_STEPS_PER_PERIOD:
-            if proto == "frequency_sweep":
-                allowed = (f"every value of sweep_frequencies <= {fr * spp / MIN_STEPS_PER_PERIOD:.4g} "
-                           f"(flag {flag})")
-            else:
-                rf_max = min(1.0 / (MIN_STEPS_PER_PERIOD * d / factor) for d in steps["dts"])
-                allowed = (f"relative_frequency <= {rf_max:.4g} for every amplitude of this sweep "
-                           "(flag --relative-frequency)")
-            raise ValueError(
-                f"{name}={value:g} is out of range: this step of protocol={proto!r} (relative frequency {fr:g}, "
-                f"dt = {dtr / factor:.3g} τ at the reference time step) would resolve an excitation period with "
-                f"{spp:.3g} steps, fewer than {MIN_STEPS_PER_PERIOD}; allowed {allowed}")
-        raise ValueError(
-            f"time_step_factor={q['time_step_factor']!r} is out of range: it leaves {spp / factor:.3g} steps per "
-            f"excitation period at {name}={value:g}, fewer than {MIN_STEPS_PER_PERIOD_COARSENED}; allowed "
-            f"time_step_factor <= {spp / MIN_STEPS_PER_PERIOD_COARSENED:.3g} (flag --time-step-factor)")
+    REGISTRY[q["protocol"]].check_steps(q, steps)
 
 
 def normalize_protocol(p):
@@ -260,13 +186,9 @@ def normalize_protocol(p):
         For a sweep without its list, or a list that is empty or not monotonic.
     """
     q = dict(p)
-    proto = q.get("protocol", "oscillatory")
-    if proto == "amplitude_sweep":
-        q["sweep_amplitudes"] = _values("sweep_amplitudes", q.get("sweep_amplitudes"), 0, 100)
-        q["theAmplitude"] = q["sweep_amplitudes"][0]
-    elif proto == "frequency_sweep":
-        q["sweep_frequencies"] = _values("sweep_frequencies", q.get("sweep_frequencies"), 0, 1e6)
-        q["relative_frequency"] = q["sweep_frequencies"][0]
+    spec = REGISTRY.get(q.get("protocol", "oscillatory"))
+    if spec is not None and spec.normalize is not None:
+        spec.normalize(q)
     return q
 
 
@@ -285,23 +207,7 @@ def protocol_steps(q):
         ``segments`` (sweeps: the oscillatory steps of each step of the sweep) and ``dts`` (sweeps:
         each step's dt/τ).
     """
-    proto = q.get("protocol", "oscillatory")
-    dtr = _dt_over_tau(q)
-    out = {"dt_over_tau": dtr}
-    if proto == "steady":
-        out["steps"] = int(math.ceil(float(q["total_strain"]) / (float(q["relative_rate"]) * dtr)))
-    elif proto == "relaxation":
-        out["ramp"] = max(1, int(round(float(q["ramp_time"]) / dtr)))
-        out["steps"] = 1 + out["ramp"] + int(math.ceil(float(q["hold_time"]) / dtr))   # a first step at rest
-    elif proto == "creep":
-        out["steps"] = int(math.ceil(float(q["hold_time"]) / dtr))
-    elif proto.endswith("sweep"):
-        amps = q["sweep_amplitudes"] if proto == "amplitude_sweep" else [q["theAmplitude"]] * len(q["sweep_frequencies"])
-        freqs = q["sweep_frequencies"] if proto == "frequency_sweep" else [q["relative_frequency"]] * len(amps)
-        out["dts"] = [_dt_over_tau(q, A) for A in amps]
-        n_per = float(q["pre_periods"]) + float(q["periods"]) + float(q["post_periods"])
-        out["segments"] = [int(n_per / fr / d) for fr, d in zip(freqs, out["dts"])]
-    return out
+    return REGISTRY[q.get("protocol", "oscillatory")].steps(q, lambda amplitude=None: _dt_over_tau(q, amplitude))
 
 
 class RheometerResult:
@@ -365,20 +271,15 @@ class RheometerResult:
         steps together (None when not judged)."""
         if not self.steps:
             return self.summary.get("verdict")
-        from ..analysis.verdicts import PROTOCOL_CHECKS, verdict
         names = PROTOCOL_CHECKS[self.protocol]
         return verdict({n: (False if any(st.get(n) is False for st in self.steps) else None) for n in names})
 
     @property
     def values(self):
         """The main numbers of the protocol (see the class docstring)."""
-        s = self.summary
-        if self.protocol == "steady":
-            return [s["stress_surface"], s["viscosity_surface"]]
-        if self.protocol == "relaxation":
-            return [s["G_plateau_surface"]]
-        if self.protocol == "creep":
-            return [s["creep_rate"], s["creep_viscosity"]]
+        values = REGISTRY[self.protocol].values
+        if values is not None:
+            return values(self.summary)
         return [[st["Gp_surface"], st["Gpp_surface"]] for st in self.steps]
 
     def rows(self):
@@ -387,7 +288,7 @@ class RheometerResult:
         Keys as :func:`particleShear.sweep.table.table_columns` of a protocol sweep: ``run_id``,
         ``status`` ("ok"), ``error``, the moduli and measures (sweep steps), the run columns
         (``repetition``, ``frequency_Hz`` and ``omega`` of a sweep step, ``dt``, ``N_steps``), the
-        protocol columns (:data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`: the summary, or
+        protocol columns (:data:`PROTOCOL_COLUMNS`: the summary, or
         ``sweep_position``, ``sweep_amplitude``, ``sweep_relative_frequency`` of a step), every
         parameter, ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s),
         ``output_path``.  Columns a protocol does not produce are absent (empty cells).
@@ -396,14 +297,12 @@ class RheometerResult:
         -------
         list of dict
         """
-        from ..simulation.provenance import run_identity
-        from .columns import PROTOCOL_COLUMNS
         params = spec_defaults(protocols=True)
         params.update({k: v for k, v in self.parameters.items() if k in params})
         base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
                 "repetition": int(getattr(self, "repetition", 0)), "dt": float(self.dt)}
         base.update({k: v for k, v in self.summary.items() if k in PROTOCOL_COLUMNS or k == "verdict"})
-        if self.protocol in ("steady", "relaxation", "creep"):
+        if REGISTRY[self.protocol].recorded:
             base["N_steps"] = int(len(self.series["t"])) if "t" in self.series else None
         base.update(params)
         base.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
@@ -439,14 +338,12 @@ class RheometerResult:
         -------
         RheometerResult
         """
-        from ..analysis.measures import MEASURE_COLUMNS
-        from .columns import PROTOCOL_COLUMNS
         first = rows[0]
         proto = parameters["protocol"]
         inverse = {c: k for k, c in STEP_COLUMNS.items()}
         moduli = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") + tuple(MEASURE_COLUMNS)
         steps = [{inverse.get(c, c): r.get(c) for c in tuple(STEP_COLUMNS.values()) + moduli}
-                 for r in rows] if proto in ("amplitude_sweep", "frequency_sweep") else []
+                 for r in rows] if REGISTRY[proto].segmented else []
         summary = {} if steps else {c: first[c] for c in PROTOCOL_COLUMNS + ("verdict",)
                                     if first.get(c) is not None}
         dt = float(first["dt"])
@@ -479,7 +376,6 @@ class RheometerResult:
         the units of the results-table columns of the same names; for sweeps one row per step
         (G′, G″ of both estimators in Pa).
         """
-        from .columns import column_spec
         p = self.parameters or {}
         seed = "None" if self.seed is None else str(self.seed)
         if self.spawn_key:
@@ -496,19 +392,17 @@ class RheometerResult:
         rows = []
         if self.steps:
             for st in self.steps:
-                label = (f"A = {st.get('amplitude', float('nan')):.4g}" if self.protocol == "amplitude_sweep"
-                         else f"f·τ = {st.get('relative_frequency', float('nan')):.4g}")
+                label = REGISTRY[self.protocol].label(st)
                 for est in ("surface", "internal"):
                     rows.append((f"{label} ({est})",
                                  f"G′ = {num(st.get('Gp_' + est, float('nan')), st.get('Gp_' + est + '_se'))}, "
                                  f"G″ = {num(st.get('Gpp_' + est, float('nan')), st.get('Gpp_' + est + '_se'))}",
                                  "Pa"))
         else:
-            from ..analysis.verdicts import CHECKS
             for name, v in self.summary.items():
                 if name.endswith("_se") or name in CHECKS or name == "verdict":
                     continue
-                unit = column_spec(name).get("unit") or ""
+                unit = _unit(name)
                 rows.append((name, num(v, self.summary.get(name + "_se")), "" if unit == "1" else unit))
         return fields, rows
 
@@ -528,7 +422,6 @@ class RheometerResult:
 
     def _verdict_lines(self):
         """The verdict of the run (:func:`~particleShear.analysis.verdicts.verdict_lines`); a sweep's per step."""
-        from ..analysis.verdicts import verdict_lines
         if not self.steps:
             return verdict_lines(self.summary, self.protocol) if "verdict" in self.summary else []
         return [f"step {st.get('position', j)}: {st.get('verdict') or 'not judged'}" for j, st in enumerate(self.steps)]
@@ -550,6 +443,14 @@ class RheometerResult:
         out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
+
+
+def _unit(name):
+    """The unit of a summary number: its result column's, or its parameter's ("" when none)."""
+    if name in _COLUMN_UNITS:
+        return _COLUMN_UNITS[name]
+    par = BY_NAME.get(name)
+    return par.unit if par is not None and par.kind in ("float", "int", "float_list") else ""
 
 
 def _concatenated(records):
@@ -579,14 +480,8 @@ def measure_rheometer(runs):
     -------
     list of RheometerResult
     """
-    from ..engine import rheometer as eng
-    from ..engine.step import protocol as oscillatory
-    from ..simulation.provenance import run_identity
-    from .sessions import build_sessions
-    from .rheometer_analysis import analyse_record, analyse_sweep
-    from .rheometer_files import write_protocol_file
-
     proto = runs[0]["protocol"]
+    spec = REGISTRY[proto]
     sims, seeds, sessions = build_sessions(runs)
     where = ["constitution", 0, 0]
     _constitute(sessions)
@@ -602,35 +497,19 @@ def measure_rheometer(runs):
     kws = [runs[b] for b in order]
     tau = sc.dt / steps[0]["dt_over_tau"]
     say, report = _console(sims, order, "protocol", where)
-    loop = dict(say=say, report=report)
     t0 = time.perf_counter()
     recs, sweep_recs = None, None
-    if proto == "steady":
-        n = max(steps[b]["steps"] for b in order)
-        recs = _guarded(lambda e: eng.steady_shear(e, sc.dt, sc.cool, [k["relative_rate"] / tau for k in kws], n,
-                                                   N1_EVERY, **loop), engine, dt=sc.dt)
-    elif proto == "relaxation":
-        st = steps[order[0]]
-        recs = _guarded(lambda e: eng.stress_relaxation(e, sc.dt, sc.cool, [k["theAmplitude"] for k in kws],
-                                                        st["ramp"], st["steps"] - st["ramp"] - 1, **loop), engine, dt=sc.dt)
-    elif proto == "creep":
-        G_c = [k["creep_modulus"] if k["creep_modulus"] is not None else
-               CREEP_MODULUS_FRACTION * k["Young_modulus_spheres"] for k in kws]
-        rate_max = MAX_STRAIN_PER_STEP / sc.dt
-        recs = _guarded(lambda e: eng.creep(e, sc.dt, sc.cool, [k["creep_stress"] for k in kws], G_c,
-                                            kws[0]["creep_response_time"] * tau, steps[order[0]]["steps"], rate_max,
-                                            **loop), engine, dt=sc.dt)
+    if spec.recorded:
+        # the one recording loop, driven by the protocol's rate schedule or controller
+        drive = spec.schedule(kws, [steps[b] for b in order], tau, sc.dt, engine.backend)
+        recs = _guarded(lambda e: shear_record(e, sc.dt, sc.cool, drive["n_steps"], drive["rate_of"],
+                                               drive.get("tensors_every", 0), say, report,
+                                               after_step=drive.get("after_step")), engine, dt=sc.dt)
     else:
         sweep_recs = []
-        st = steps[order[0]]
-        for j, dtr in enumerate(st["dts"]):
-            dt = dtr * tau
-            if proto == "amplitude_sweep":
-                f, A = sc.f, [k["sweep_amplitudes"][j] for k in kws]
-            else:
-                f, A = kws[0]["sweep_frequencies"][j] / tau, [k["theAmplitude"] for k in kws]
+        for f, A, dt in spec.segments(kws, [steps[b] for b in order], tau, sc.f):
             cool = kws[0]["cool_factor"] ** (f * dt)
-            out = _guarded(oscillatory, engine, dt, f, A, cool, kws[0]["pre_periods"], kws[0]["periods"],
+            out = _guarded(oscillation, engine, dt, f, A, cool, kws[0]["pre_periods"], kws[0]["periods"],
                            kws[0]["post_periods"], False, say, report, (), dt=dt)
             sweep_recs.append((f, A, dt, out))
     t_protocol = (time.perf_counter() - t0) / len(order)
@@ -641,7 +520,7 @@ def measure_rheometer(runs):
         if sweep_recs is None:
             n = steps[b]["steps"]
             series = {key: np.ascontiguousarray(v[:n, col]) for key, v in recs.items()}
-            summary, curves = analyse_record(proto, kw, series, tau, steps[b], MAX_STRAIN_PER_STEP)
+            summary, curves = analyse_record(proto, kw, series, tau, steps[b])
             sweep = []
         else:
             segments = [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()

@@ -6,25 +6,32 @@ Used by :func:`particleShear.run.rheometer.measure_rheometer`; the statistics ar
 (:func:`particleShear.analysis.measures.run_measures`).
 """
 __docformat__ = "numpy"
-import math
-
-import numpy as np
+import types
 
 from ..analysis import verdicts as vd
+from ..analysis.measures import run_measures
 from ..analysis.rheometry import final_rate, log_grid, plateau, steady_state
+from ..protocols import PROTOCOLS
+from ..simulation.evaluation import demodulation
 
-__all__ = ["analyse_record", "analyse_sweep"]
+__all__ = ["analyse_record", "analyse_sweep", "STATS"]
 
 _EST = (("surface", "stress_surface"), ("internal", "stress_internal"))
 
+#: what a protocol's ``summary`` computes with (:mod:`particleShear.protocols`): the estimators
+#: ``ESTIMATORS`` (``(name, series key)``), the statistics of :mod:`particleShear.analysis.rheometry`
+#: (``steady_state``, ``plateau``, ``log_grid``, ``final_rate``) and :mod:`particleShear.analysis.verdicts`
+STATS = types.SimpleNamespace(ESTIMATORS=_EST, steady_state=steady_state, plateau=plateau, log_grid=log_grid,
+                              final_rate=final_rate, verdicts=vd)
 
-def analyse_record(protocol, kw, series, tau, steps, rate_limit=math.inf):
-    """Scalars and log-grid curves of one replica's record (steady, relaxation, creep).
+
+def analyse_record(protocol, kw, series, tau, steps):
+    """Scalars and log-grid curves of one replica's record (a protocol run by the recording loop).
 
     Parameters
     ----------
-    protocol : {"steady", "relaxation", "creep"}
-        The protocol.
+    protocol : str
+        The protocol (its ``summary``, :mod:`particleShear.protocols`).
     kw : dict
         The run's arguments.
     series : dict of ndarray
@@ -33,8 +40,6 @@ def analyse_record(protocol, kw, series, tau, steps, rate_limit=math.inf):
         Model time constant (s).
     steps : dict
         :func:`particleShear.run.rheometer.protocol_steps` of the run.
-    rate_limit : float, default inf
-        The creep controller's largest strain per step (its rate limit times dt).
 
     Returns
     -------
@@ -44,58 +49,10 @@ def analyse_record(protocol, kw, series, tau, steps, rate_limit=math.inf):
     curves : dict
         ``name -> (t, y, y_sem)``.
     """
-    t = series["t"]
-    out, curves = {}, {}
-    if protocol == "steady":
-        rate = kw["relative_rate"] / tau
-        out["strain_rate"] = rate
-        for est, key in _EST:
-            ss = steady_state(t, series[key])
-            out[f"stress_{est}"], out[f"stress_{est}_se"] = ss.mean, ss.sem
-            out[f"viscosity_{est}"], out[f"viscosity_{est}_se"] = ss.mean / rate, ss.sem / rate
-            if est == "surface":
-                out["t_transient"], out["strain_transient"] = ss.t_transient, ss.t_transient * rate
-        n1 = series["N1"]
-        keep = np.isfinite(n1) & (t >= out["t_transient"])
-        ba = plateau(t[keep], n1[keep], 1.0) if keep.sum() >= 2 else None
-        out["N1"], out["N1_se"] = (ba.mean, ba.sem) if ba else (math.nan, math.nan)
-        checks = vd.steady_checks(t, {key: series[key] for _, key in _EST}, kw["total_strain"])
-    elif protocol == "relaxation":
-        g0 = kw["theAmplitude"]
-        n_ramp = steps["ramp"] + 1          # the first hold sample: step 0 at rest, then the ramp
-        t_end = t[n_ramp] if len(t) > n_ramp else math.nan
-        th = t[n_ramp:] - t_end
-        out["step_strain"], out["ramp_time_s"] = g0, t_end
-        out["residual_stress"] = float(series["stress_surface"][0])
-        for est, key in _EST:
-            # the stress the step strain adds to the packing's residual stress (step 0, γ = 0)
-            G = (series[key][n_ramp:] - series[key][0]) / g0
-            ba = plateau(th, G)
-            out[f"G_plateau_{est}"], out[f"G_plateau_{est}_se"] = ba.mean, ba.sem
-            tm, gm, gs, _ = log_grid(th, G)
-            curves[f"G_{est}"] = (tm, gm, gs)
-        checks = vd.relaxation_checks(th, {est: (series[key][n_ramp:] - series[key][0]) / g0 for est, key in _EST},
-                                      g0, {est: float(series[key][0]) for est, key in _EST})
-    elif protocol == "creep":
-        s0 = kw["creep_stress"]
-        gam = series["strain"] - series["strain"][0]
-        out["creep_stress"] = s0
-        rate, rate_se = final_rate(t, gam)
-        out["creep_rate"], out["creep_rate_se"] = rate, rate_se
-        out["creep_viscosity"] = s0 / rate if rate > 0 else math.inf
-        ba = plateau(t, gam)
-        out["strain_plateau"], out["strain_plateau_se"] = ba.mean, ba.sem
-        half = t >= t[-1] / 2
-        res0 = float(series["stress_surface"][0])      # step 0 at rest: the residual stress
-        out["residual_stress"] = res0
-        out["stress_tracking"] = float((series["stress_surface"][half].mean() - s0) / s0)
-        tm, jm, js, _ = log_grid(t, gam / s0)
-        curves["J"] = (tm, jm, js)
-        dt = float(t[1] - t[0]) if len(t) >= 2 else math.nan
-        checks = vd.creep_checks(t, series["strain_rate"], out["stress_tracking"], rate_limit / dt,
-                                 kw["hold_time"], kw["creep_response_time"])
-    else:
-        return out, curves
+    summarise = PROTOCOLS[protocol].summary
+    if summarise is None:
+        return {}, {}
+    out, curves, checks = summarise(kw, series, tau, steps, STATS)
     out.update(checks)
     out["verdict"] = vd.verdict(checks)
     return out, curves
@@ -117,8 +74,6 @@ def analyse_sweep(kw, segments, tau):
     -------
     list of dict
     """
-    from ..analysis.measures import run_measures
-    from ..simulation.evaluation import demodulation
     rows = []
     pre, periods, post = kw["pre_periods"], kw["periods"], kw["post_periods"]
     for j, (f, A, dt, rec) in enumerate(segments):

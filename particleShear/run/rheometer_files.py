@@ -16,29 +16,22 @@ oscillatory files; :func:`~particleShear.simulation.formats.read_run` reads and 
   oscillatory file's, plus ``protocol``, ``tau``, ``summary``, ``steps`` and the log-grid
   ``curves``.
 
-The name is ``<ensemble><mu>_<protocol>_<value>_nr_<k><suffix>`` (value: the rate, γ₀ or σ₀;
-none for sweeps) in ``root_folder``.
+The name is ``<ensemble><mu>_<protocol>_<value>_nr_<k><suffix>`` (value: the protocol's ``file_name``
+parameter, :mod:`particleShear.protocols`: the rate, γ₀ or σ₀; none for sweeps) in ``root_folder``.
 """
 __docformat__ = "numpy"
+import io
 import json
 import os
 
 import numpy as np
 
+from ..protocols import PROTOCOLS
+from ..simulation.formats import FORMAT_SUFFIXES, RHEOMETER_DETAILED, RHEOMETER_TITLE, write_columns
+from ..simulation.output import TABLE_COLUMNS, reserve_numbered_path, sidecar_path
+from ..simulation.provenance import json_safe
+
 __all__ = ["record_columns", "protocol_header", "write_protocol_file"]
-
-#: the main parameter a file name carries, per protocol
-_NAME_VALUE = {"steady": ("rate", "relative_rate"), "relaxation": ("strain", "theAmplitude"),
-               "creep": ("stress", "creep_stress")}
-
-#: the protocol parameters the header lists, per protocol
-_HEADER_PARAMETERS = {
-    "steady": ("relative_rate", "total_strain"),
-    "relaxation": ("theAmplitude", "ramp_time", "hold_time"),
-    "creep": ("creep_stress", "creep_modulus", "creep_response_time", "hold_time"),
-    "amplitude_sweep": ("sweep_amplitudes", "relative_frequency", "pre_periods", "periods", "post_periods"),
-    "frequency_sweep": ("sweep_frequencies", "theAmplitude", "pre_periods", "periods", "post_periods"),
-}
 
 
 def record_columns(result):
@@ -52,7 +45,6 @@ def record_columns(result):
     -------
     dict
     """
-    from ..simulation.output import TABLE_COLUMNS
     s = result.series
     n = len(s["t"])
     cols = {"index": np.arange(n, dtype=np.int64)}
@@ -83,11 +75,10 @@ def protocol_header(block1, result):
     str
         Ending with the line "Detailed rheometer protocol data".
     """
-    from ..simulation.formats import RHEOMETER_DETAILED, RHEOMETER_TITLE
     p = result.parameters
     lines = [RHEOMETER_TITLE, "", "Protocol = " + result.protocol,
              f"Characteristic time constant = {result.tau!r}s", f"Time step = {result.dt!r}s"]
-    lines += [_line(name, p.get(name)) for name in _HEADER_PARAMETERS[result.protocol]]
+    lines += [_line(name, p.get(name)) for name in PROTOCOLS[result.protocol].header_parameters]
     lines += ["", "", "Output data", "Summary data"]
     if result.steps:
         lines += ["step " + str(st["position"]) + ": " + ", ".join(f"{k}={v!r}" for k, v in st.items()
@@ -107,8 +98,8 @@ def _stem(sim, result):
     base = os.path.basename(sim._file_stem())
     ensemble = base.split("_f_", 1)[0]
     name = ensemble + "_" + result.protocol
-    if result.protocol in _NAME_VALUE:
-        what, key = _NAME_VALUE[result.protocol]
+    if PROTOCOLS[result.protocol].file_name is not None:
+        what, key = PROTOCOLS[result.protocol].file_name
         name += f"_{what}_{result.parameters[key]:g}"
     return os.path.join(str(sim.root_folder), name + "_nr_")
 
@@ -126,11 +117,6 @@ def write_protocol_file(sim, result):
         The run's simulation (block 1, ``root_folder``, provenance).
     result : RheometerResult
     """
-    import io
-
-    from ..simulation.formats import FORMAT_SUFFIXES, write_columns
-    from ..simulation.output import reserve_numbered_path, sidecar_path
-    from ..simulation.provenance import json_safe
     fmt = getattr(sim, "output_format", "text")
     out = None
     try:

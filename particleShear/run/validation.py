@@ -30,6 +30,7 @@ from ..engine.step import BatchEngine
 from ..linkable.builders import time_steps_from_model
 from ..objects.model import particle_shear_model_parameters
 from ..parameters import BY_NAME, PARAMETERS, defaults as _defaults
+from ..protocols import PROTOCOLS as _PROTOCOLS
 from ..simulation.formats import check_output_format
 from .limits import (CELL, MAX_N, MAX_SERIES_RUNS, MAX_TOTAL_STEPS, MIN_SPHERES_PER_PARTICLE,  # noqa: F401 - re-exported
                      MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED, SEED_LIMIT, _protocol_room)
@@ -86,8 +87,8 @@ MEMORY_FRACTION = 0.8
 #: steps); a sweep's steps keep the oscillatory record and its demodulation and join the steps' records
 #: (185 B per step of a frequency sweep at 2,518 → 5,542 steps); rounded up.  The whole record is held
 #: until the run ends.
-PROTOCOL_RECORD_BYTES_PER_STEP = {"steady": 2 * 6 * 8, "relaxation": 2 * 5 * 8, "creep": 2 * 5 * 8,
-                                  "amplitude_sweep": 200, "frequency_sweep": 200}
+#: Each protocol states its own (``record_bytes``, :mod:`particleShear.protocols`).
+PROTOCOL_RECORD_BYTES_PER_STEP = {name: p.record_bytes for name, p in _PROTOCOLS.items() if name != "oscillatory"}
 
 
 # -- single values ---------------------------------------------------------------------------------
@@ -515,7 +516,7 @@ def validate_run(params):
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
-    if p["protocol"] in ("oscillatory", "amplitude_sweep", "frequency_sweep"):
+    if p["protocol"] == "oscillatory" or _PROTOCOLS[p["protocol"]].segmented:
         warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
     return cost
 

@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
+from ..base.engine_adapter import relax_ensembles, state_from_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
-from ..engine.relax import relax_ensembles
 from ..engine.state import BatchState
 from ..engine.step import BatchEngine, EngineInstability, pre_equilibrate, protocol
 from ..linkable.builders import MAX_RELAXATIONS
@@ -91,7 +91,7 @@ def _constitute(sessions):
 
     Each session's constitution (:meth:`~particleShear.simulation.oscillatory.RunSession.constitution`)
     yields its relaxation requests; the pending requests of equal key (steps, ``dt``, ``dt_max``)
-    run together in one engine (:func:`particleShear.engine.relax.relax_ensembles`), the key of
+    run together in one engine (:func:`particleShear.base.engine_adapter.relax_ensembles`), the key of
     the first waiting replica first, until every constitution is done.  A replica's ensemble does
     not depend on its companions (each has its own generator, and the engine's relaxation is per
     replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
@@ -238,7 +238,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     for key in dict.fromkeys(pre):
         group = [b for b, k in zip(members, pre) if k == key]
         t0 = time.perf_counter()
-        st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
+        st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
                                        laws=[sims[b].contact_law for b in group])
         say, report = _console(sims, group, "pre-equilibration", where)
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],

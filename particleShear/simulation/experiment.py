@@ -19,15 +19,13 @@ import numpy as np
 
 from ..base.stress import StressTensorEvaluation
 from ..engine.loops import relaxation_levels
-from ..engine.relax import untouched_on_failure
+from ..base.engine_adapter import state_of_ensemble, untouched_on_failure, write_back
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 from .drawing import IMAGE_EXTENSIONS
 from .driver import ENGINE_SKIN_FACTOR, _guarded, replica_record
 from .evaluation import _FORCE, _RATE, _SHEAR, _STRAIN, _T
 from .observers import LiveDrawing, SnapshotWriter, StressWindow, ReplicaScene
-from ..engine.relax import write_back
-from ..engine.state import BatchState
 from ..engine.step import pre_equilibrate, protocol, BatchEngine
 
 _log = logging.getLogger(__name__)
@@ -514,7 +512,7 @@ class OscillatoryShearExperiment:
         return record, {k: self.timings[k] for k in ("pre_equilibration", "protocol")}
 
     def engine_of_ensemble(self, carry_predictor=True):
-        """A batch of one on the ensemble's own state (:meth:`~particleShear.engine.state.BatchState.of_ensemble`):
+        """A batch of one on the ensemble's own state (:func:`~particleShear.base.engine_adapter.state_of_ensemble`):
         the ensemble's integrator, stability guard (its interval and the thresholds of a
         :class:`~particleShear.base.stability.StabilityGuard`; a guard's own ``check`` is not
         called) and contact-law callbacks; it numbers the relations as they form (as every engine on
@@ -534,7 +532,7 @@ class OscillatoryShearExperiment:
         ens = self.theEnsemble
         guard = getattr(ens, "stability_guard", None)
         integrator = getattr(ens, "integrator", "euler")
-        engine = BatchEngine(BatchState.of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
+        engine = BatchEngine(state_of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                              check_interval=getattr(guard, "interval", 4), integrator=integrator)
         engine.keep_terms = True          # the last step's terms, for the ensemble's force register
         if guard is not None:     # the thresholds of the ensemble's guard

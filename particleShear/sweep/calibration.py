@@ -21,6 +21,7 @@ import time
 import warnings
 
 from .._version import __version__
+from ..protocols import PROTOCOLS
 from .cost import _human_s, _step_seconds, run_seconds, run_steps
 from ..analysis.measures import MeasurementWarning
 from ..run.api import doParticleShearSimulation
@@ -115,31 +116,22 @@ def representative_point(points, counts):
 def _shortened(p, steps, root):
     """``p`` with its protocol cut to about ``steps`` steps (never longer than its own), output to ``root``.
 
-    "oscillatory": no baseline periods and at most ``steps`` steps of excitation; "steady": the
-    strain of ``steps`` steps at its rate; "relaxation": the ramp kept (its rate is bounded),
-    the hold cut; "creep": the hold cut; sweeps: the first two values of the list, no baseline
-    periods, the excitation periods cut so that both steps together take about ``steps`` steps.
+    "oscillatory": no baseline periods and at most ``steps`` steps of excitation; another protocol
+    by its ``shorten`` (:mod:`particleShear.protocols`: a steady run's strain of ``steps`` steps at
+    its rate; a relaxation's ramp kept and its hold cut; a creep's hold cut; a sweep's first two
+    values, no baseline periods, its excitation periods cut so that both steps together take about
+    ``steps`` steps), kept as it is when it has none.
     """
     proto = p.get("protocol") or "oscillatory"
     view = dict(doDrawing=False, plotStress=False, saveOutputImages=False, root_folder=root, verbose=False)
     if proto == "oscillatory":
         per_period = max(1, run_steps(dict(p, pre_periods=0, periods=1, post_periods=0)))
         return dict(p, pre_periods=0, post_periods=0, periods=min(float(p["periods"]), steps / per_period), **view)
+    shorten = PROTOCOLS[proto].shorten
+    if shorten is None:
+        return dict(p, **view)
     q = normalize_protocol({**PROTOCOL_DEFAULTS, "time_step_factor": 1.0, **p})
-    st = protocol_steps(q)
-    dtr = st["dt_over_tau"]
-    if proto == "steady":
-        rate = float(q["relative_rate"])
-        return dict(p, total_strain=min(float(q["total_strain"]), steps * rate * dtr), **view)
-    if proto == "creep":
-        return dict(p, hold_time=min(float(q["hold_time"]), steps * dtr), **view)
-    if proto == "relaxation":
-        return dict(p, hold_time=min(float(q["hold_time"]), max(steps - 1 - st["ramp"], 1) * dtr), **view)
-    key = "sweep_amplitudes" if proto == "amplitude_sweep" else "sweep_frequencies"
-    q2 = normalize_protocol(dict(q, **{key: q[key][:2]}, pre_periods=0, post_periods=0, periods=1))
-    per_period = max(1, sum(protocol_steps(q2)["segments"]))
-    return dict(p, **{key: list(q[key][:2])}, pre_periods=0, post_periods=0,
-                periods=min(float(p["periods"]), steps / per_period), **view)
+    return dict(p, **shorten(q, protocol_steps(q), steps, lambda q2: protocol_steps(normalize_protocol(q2))), **view)
 
 
 def _calibration_runs(run):

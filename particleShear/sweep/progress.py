@@ -3,16 +3,17 @@ __docformat__ = "numpy"
 import sys
 import time
 
+from ..protocols import PROTOCOLS
+
 __all__ = ["SweepProgress", "RemainingTime", "sweep_remaining_s"]
 
-#: the column whose value a progress line shows, per protocol (the oscillatory run's G′)
-_SHOWN = {"steady": ("stress_surface", "σ", "Pa"), "relaxation": ("G_plateau_surface", "G_plateau", "Pa"),
-          "creep": ("creep_rate", "creep rate", "1/s")}
-
-
 def _shown(row):
-    name, label, unit = _SHOWN.get(row.get("protocol") or "", ("Gp_surface", "G'", "Pa"))
-    return f"{label}={float(row[name]):.6g} {unit}"
+    """``label=value unit`` of a finished row: the column its protocol's ``shown`` names
+    (:mod:`particleShear.protocols`; the oscillatory run's G′)."""
+    proto = PROTOCOLS.get(row.get("protocol") or "oscillatory", PROTOCOLS["oscillatory"])
+    name, label, unit = proto.shown or (proto.required_numbers[0], proto.required_numbers[0],
+                                        proto.columns.get(proto.required_numbers[0], ("", ""))[1])
+    return f"{label}={float(row[name]):.6g} {unit}".rstrip()
 
 
 class RemainingTime:

@@ -30,6 +30,7 @@ import sys
 
 import numpy as np
 
+from ..protocols import PROTOCOLS
 from .cost import estimate_cost, estimate_point_cost, format_cost
 from .locks import FolderBusyError, ScratchOwner, folder_lock, foreign_entries, refuse_links
 from .pool import pool_context, run_jobs
@@ -93,12 +94,8 @@ class SweepOutcome:
 
 def _n_rows(run):
     """Rows of an ``ok`` run in the table: one per step of a one-packing sweep, else one."""
-    proto = run.parameters.get("protocol", "oscillatory")
-    if proto == "amplitude_sweep":
-        return len(run.parameters["sweep_amplitudes"])
-    if proto == "frequency_sweep":
-        return len(run.parameters["sweep_frequencies"])
-    return 1
+    n_rows = PROTOCOLS[run.parameters.get("protocol", "oscillatory")].n_rows
+    return 1 if n_rows is None else n_rows(run.parameters)
 
 
 def _flat(items):

@@ -37,6 +37,7 @@ __all__ = ["SCHEMA_NAME", "COLUMN_TYPES", "RUN_COLUMNS", "PROTOCOL_COLUMNS", "re
            "read_schema", "typed_value", "typed_row", "cell_problem", "arrow_schema", "arrow_table",
            "load_results"]
 
+
 def results_schema(columns=None):
     """The schema of a results table: one entry per column, in table order.
 

@@ -38,6 +38,7 @@ from .reader import escape_cell, read_table
 from ..signals import dead_leftovers
 from ..analysis.measures import MEASURE_COLUMNS
 from ..parameters import BY_NAME, identity_excluded
+from ..protocols import PROTOCOLS
 from ..simulation.provenance import identity_parameters, same_input
 from ..run.columns import (PROTOCOL_COLUMNS, RESULT_COLUMNS, RUN_COLUMNS, SCHEMA_NAME, TABLE_NAME,  # noqa: F401 - re-exported
                            cell_problem, column_spec, table_columns)
@@ -340,14 +341,9 @@ def check_table_header(path, columns):
                          "another --out DIR")
 
 
-#: the columns an ``ok`` row of each protocol must hold a number in
-_OK_NUMBERS = {"oscillatory": ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "wall_time_s"),
-               "steady": ("stress_surface", "stress_internal", "strain_rate", "wall_time_s"),
-               "relaxation": ("G_plateau_surface", "G_plateau_internal", "wall_time_s"),
-               "creep": ("creep_rate", "strain_plateau", "wall_time_s"),
-               "amplitude_sweep": ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal", "sweep_position",
-                                   "wall_time_s")}
-_OK_NUMBERS["frequency_sweep"] = _OK_NUMBERS["amplitude_sweep"]
+#: the columns an ``ok`` row of each protocol must hold a number in (each protocol's ``required``,
+#: :mod:`particleShear.protocols`, and the wall time)
+_OK_NUMBERS = {name: p.required_numbers + ("wall_time_s",) for name, p in PROTOCOLS.items()}
 
 
 def row_problem(row, run):

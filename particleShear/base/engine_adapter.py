@@ -1,0 +1,360 @@
+"""The documented ensembles as views of the engine's state: conversion, write-back, relaxation.
+
+The engine (:mod:`particleShear.engine`) advances a :class:`~particleShear.engine.state.BatchState`
+of plain arrays and knows nothing of the documented classes.  This module is their adapter
+(docs/design.md, "The documented classes"):
+
+* :func:`state_from_ensembles` copies B ensembles into a new batch state (a measurement's batch);
+* :func:`state_of_ensembles` (:func:`state_of_ensemble` for one) makes a batch state whose
+  per-sphere arrays are the ensembles' own state rows and whose pair lists are their pair tables,
+  so that what the engine's steps write the ensembles hold;
+* :func:`write_back` hands an ensemble its clock, strain, plates, μ, relations and half kick after
+  such an engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as
+  it was when a run on its own state fails;
+* :func:`relax_ensembles` is ``free_pre_equilibration`` of a list of ensembles in one engine
+  (:func:`~particleShear.engine.relax.free_relaxation`), written back.
+
+This module and the classes themselves are the only code that reads the classes' state blocks,
+pair tables and generators and drops their caches (through the classes' package-private members).
+
+Units: µm, s, mg per m depth (docs/parameters.md).
+"""
+__docformat__ = "numpy"
+
+import contextlib
+
+import numpy as np
+
+from ..checks import integer
+from ..engine.loops import relaxation_levels
+from ..engine.relax import RELAX_SKIN, free_relaxation
+from ..engine.state import PER_REPLICA_PARAMETERS, PER_SPHERE_PARAMETERS, PERMANENT, BatchState
+from ..engine.step import BatchEngine
+from ..engine.xp import get_backend, to_host
+from .fields import ROW
+
+__all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
+           "untouched_on_failure", "relax_ensembles"]
+
+
+def uniform_parameters(ensemble):
+    """Whether every parameter of :data:`PER_SPHERE_PARAMETERS` is one value in ``ensemble`` (then the
+    batch state holds it once per replica, else per sphere in :attr:`BatchState.visit`).
+
+    Parameters
+    ----------
+    ensemble : ensemble
+        A documented ensemble (its ``_a`` rows are read).
+
+    Returns
+    -------
+    bool
+    """
+    a, n = ensemble._a, len(ensemble.sphereList)
+    return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
+
+
+def state_from_ensembles(ensembles, backend="numpy", laws=None):
+    """Copy B ensembles of equal N (after constitution) into one batch state.
+
+    The ensembles are not modified; each replica keeps a reference to its ensemble's
+    random generator, so the random normals of ``d = 0`` continue its stream.
+
+    Parameters
+    ----------
+    ensembles : sequence of ensemble
+        Constituted ensembles (``particleShear.objects`` or ``particleShear.linkable``
+        ensembles), all with the same number of spheres.
+    backend : str or Backend, default "numpy"
+        Where the arrays of the state live: the ensembles are read on the host and the
+        state is copied to the device once.
+    laws : sequence, optional
+        The central law of each ensemble: ``None`` (the documented callback) or
+        ``(name, values)``, a name of :data:`~particleShear.engine.laws.LAWS` and its
+        parameter values in order (:func:`~particleShear.engine.laws.law_values`).  One law
+        per batch; the values may differ between replicas.  Default: None for every one.
+
+    Returns
+    -------
+    BatchState
+        Replica b holds ``ensembles[b]``: spheres, box, strain, rate, clock, constants and
+        the relations and bonds of its pair table.
+
+    Raises
+    ------
+    ValueError
+        If the ensembles differ in N, or their laws differ, or for an unusable backend (before
+        any copy).
+    """
+    target = get_backend(backend)
+    laws = [None] * len(ensembles) if laws is None else list(laws)
+    names = {None if law is None else law[0] for law in laws}
+    if len(laws) != len(ensembles) or len(names) > 1:
+        raise ValueError(f"laws={laws!r} is invalid: one law per ensemble, the same law for every one "
+                         "(its parameters may differ)")
+    Ns = {len(e.sphereList) for e in ensembles}
+    if len(Ns) != 1:
+        raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
+    B, N = len(ensembles), Ns.pop()
+    s = BatchState(B, N)
+    own = [not uniform_parameters(e) for e in ensembles]     # spheres with parameters of their own
+    if any(own):
+        s.visit = np.zeros((len(PER_REPLICA_PARAMETERS), B * N))
+    for b, e in enumerate(ensembles):
+        a = e._a
+        rows = slice(b * N, (b + 1) * N)
+        for name, src in (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"),
+                          ("phi", "phi"), ("r", "r"), ("m", "m"), ("inertia", "inertia"),
+                          ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
+            getattr(s, name)[rows] = a[src][:N]
+        s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
+        s.gamma[b], s.rate[b], s.t[b] = (float(getattr(e, name, 0.0)) for name in ("shear", "shear_rate", "t"))
+        # a frictionless ensemble of particleShear.objects has no tangential constants (a canvas
+        # without forces none at all): 0
+        s.k[b], s.nu[b], s.k_t[b], s.nu_t[b], s.mu[b] = (float(getattr(e, name, 0.0))
+                                                         for name in ("k", "nu", "k_t", "nu_t", "mu"))
+        for name, src, empty in zip(PER_REPLICA_PARAMETERS, PER_SPHERE_PARAMETERS, (0.0, 1.0, 1.0, 1.0)):
+            getattr(s, name)[b] = float(a[src][0]) if N else empty
+        if own[b]:
+            s.visit[:, rows] = [np.asarray(a[src][:N], dtype=float) for src in PER_SPHERE_PARAMETERS]
+        pt = e._pairs
+        keep = pt.active | (pt.state == PERMANENT)
+        s.pairs[b] = pt.copy(keep)
+        s.rng[b] = e._rng
+    if any(own):
+        shared = np.repeat(np.logical_not(own), N)
+        s.visit[:, shared] = s.per_replica_parameters()[:, shared]
+    s.law = names.pop() if names else None
+    if s.law is not None:
+        s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
+    return s.to_backend(target)
+
+def state_of_ensemble(ensemble, laws=None):
+    """:func:`state_of_ensembles` of one ensemble (the ensemble keeps its own block).
+
+    Parameters
+    ----------
+    ensemble : ensemble
+        A documented ensemble of ``particleShear.objects`` or ``particleShear.linkable``.
+    laws : sequence, optional
+        As :func:`state_from_ensembles` (one entry).
+
+    Returns
+    -------
+    BatchState
+        B = 1 on NumPy, with :attr:`ensemble` set to ``ensemble``.
+    """
+    return state_of_ensembles([ensemble], laws=laws)
+
+def state_of_ensembles(ensembles, laws=None):
+    """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:
+    what the engine's steps write, the ensembles hold (nothing to copy back).
+
+    The sphere rows of replica b are columns ``b·N … b·N + N − 1`` of one state block laid out as
+    the ensembles' (:data:`FIELDS` × spheres); a single ensemble keeps its own block, fitted to
+    its spheres (so the engine's rows of positions, velocities and forces are contiguous: ≈ 4 %
+    of a documented step at N = 150), several move theirs into the joint block, of which each
+    then holds its columns as a view (an ensemble that later gains a sphere copies its block
+    out again).
+    Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
+    block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the box, strain,
+    rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
+    by :func:`state_from_ensembles`, the plates (``applying_shear``) from the first ensemble's
+    ``applyingShear``.  An engine on this state numbers the relations as they form, and
+    :func:`write_back` afterwards gives each ensemble its clock,
+    strain and relations and drops its caches (and
+    :func:`untouched_on_failure` puts one back after a failed run).
+
+    Parameters
+    ----------
+    ensembles : sequence of ensemble
+        Documented ensembles of ``particleShear.objects`` or ``particleShear.linkable`` with
+        equal N, each at most once.
+    laws : sequence, optional
+        As :func:`state_from_ensembles`.
+
+    Returns
+    -------
+    BatchState
+        On NumPy, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
+
+    Raises
+    ------
+    ValueError
+        As :func:`state_from_ensembles`, or if an ensemble is given twice.
+    """
+    ensembles = list(ensembles)
+    if len({id(e) for e in ensembles}) != len(ensembles):
+        raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
+    s = state_from_ensembles(ensembles, laws=laws)
+    N = s.N
+    if len(ensembles) == 1:
+        ensembles[0]._fit_block()      # no spare columns: the (2|3, N) rows below are contiguous
+        block = ensembles[0]._st
+    else:
+        block = np.empty((ensembles[0]._st.shape[0], s.B * N))
+        for b, e in enumerate(ensembles):
+            block[:, b * N:(b + 1) * N] = e._st
+            e.adopt_state_block(block[:, b * N:(b + 1) * N])   # (its caches of the old block dropped)
+    x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
+    s.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
+               *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
+    s.pairs = [e._pairs for e in ensembles]
+    s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
+    s.ensembles = ensembles
+    return s
+
+
+def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
+    """Hand replica ``b`` of a relaxed (or measured) engine on the ensembles' state back to its ensemble.
+
+    The spheres and the pair table are the ensemble's own already
+    (:func:`state_of_ensembles`): what is handed back is the
+    clock, the strain, the plates, μ, the relations of the last step (written into the table,
+    with the creation numbers the engine gave them as they formed: the order of ``neighbors``), a
+    Verlet engine's half kick, and the bookkeeping: the ensemble's neighbour list and caches are
+    invalidated, its ``step_count`` and ``n_constitution_steps`` advance by ``steps``.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine after :func:`~particleShear.engine.relax.free_relaxation`, with ``numbers_relations`` set before its first step.
+    b : int
+        Replica index (0 … B−1).
+    ensemble : ensemble of ``particleShear.linkable``
+        The ensemble that is replica ``b`` of the engine's state (``state.ensembles[b]``).
+    steps : int, optional
+        Steps the replica was advanced (bookkeeping of the classes).
+    constitution : bool, default True
+        The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
+        ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
+        the shear rate of its last step; a Verlet engine's half kick becomes the ensemble's).
+    dt : float, optional
+        The time step of the last step (default: the ensemble's ``dt``).
+
+    Raises
+    ------
+    ValueError
+        If the engine's state is not the ensembles' own with ``ensemble`` as replica b, or the
+        engine does not number its relations (``numbers_relations`` False).
+    """
+    s = engine.s
+    if s.ensembles is None or s.ensembles[b] is not ensemble:
+        raise ValueError("write_back needs an engine on the ensemble's own state "
+                         "(state_of_ensembles, of which replica b is the ensemble)")
+    if not engine.numbers_relations:
+        raise ValueError("write_back needs an engine with numbers_relations = True from its first step "
+                         "(the creation numbers of the relations order the ensemble's neighbors)")
+    rows = s.replica(b)
+    ensemble.t = float(s.t[b])
+    ensemble.shear = float(s.gamma[b])
+    ensemble.applyingShear = bool(s.applying_shear) and not constitution
+    if not constitution:
+        ensemble.shear_rate = float(s.rate[b])
+    if hasattr(ensemble, "mu"):        # a frictionless ensemble of particleShear.objects has none
+        ensemble.mu = float(s.mu[b])
+
+    engine.flush()
+
+    ensemble.invalidate_caches()
+    ensemble._last_dt = float(ensemble.dt if dt is None else dt)
+    if engine.half is not None and hasattr(ensemble, "_half_kick"):
+        h = to_host(engine.half[:, rows], "state")
+        ensemble._half_kick = (h[0].copy(), h[1].copy(), h[2].copy())
+    ensemble.step_count += int(steps)
+    if constitution and hasattr(ensemble, "n_constitution_steps"):
+        ensemble.n_constitution_steps += int(steps)
+
+
+@contextlib.contextmanager
+def untouched_on_failure(ensemble):
+    """Leave ``ensemble`` as it was when the block raises (an instability, an interrupt).
+
+    An engine on the ensemble's own state (:func:`state_of_ensemble`)
+    steps its spheres and pair table in place; a run that fails before its write-back would leave
+    them half-advanced, out of step with the ensemble's clock and caches.  This keeps a copy of
+    both and puts it back (and drops the ensemble's caches) on any exception, which is re-raised.
+
+    Parameters
+    ----------
+    ensemble : ensemble
+        A documented ensemble.
+    """
+    n = len(ensemble.sphereList)
+    block, pairs = ensemble._block[:, :n].copy(), ensemble._pairs.copy()
+    try:
+        yield
+    except BaseException:
+        ensemble._block[:, :n] = block
+        ensemble._pairs.assign(pairs)
+        ensemble.invalidate_caches()
+        raise
+
+
+def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
+    """``free_pre_equilibration(N)`` of every ensemble, all in one engine, written back.
+
+    Parameters
+    ----------
+    ensembles : sequence of ensemble
+        Ensembles of ``particleShear.linkable`` with equal N, ``dt`` and ``dt_max`` (their μ may
+        differ); shear rate 0, as in a constitution.
+    N : int
+        Steps per level and per final block (>= 0).
+    skin_factor : float, optional
+        Verlet skin of the engine in units of each replica's largest radius (> 0).  The result
+        does not depend on it: the contacts are exact for any skin, and the zero terms of the
+        candidates out of contact change no sum.
+    laws : sequence, optional
+        The central law of each ensemble, as :func:`state_from_ensembles`
+        takes them (default: the documented callback for every one).
+
+    Returns
+    -------
+    int
+        Steps run per ensemble.
+
+    Raises
+    ------
+    ValueError
+        If the ensembles differ in N, ``dt``, ``dt_max``, integrator or the settings of their
+        stability guards, or a step is not usable (before any step).
+    EngineInstability
+        If the stability guard of an ensemble (its interval and thresholds) finds it unstable; the
+        ensembles are then left as they were (:func:`untouched_on_failure`).
+    """
+    ensembles = list(ensembles)
+    N = integer("N", N, 0)
+    if not ensembles:
+        return 0
+    dts = {(float(e.dt), float(e.dt_max)) for e in ensembles}
+    if len(dts) != 1:
+        raise ValueError(f"ensembles have (dt, dt_max) = {sorted(dts)}: one engine relaxes one schedule")
+    (dt, dt_max), = dts
+    relaxation_levels(dt, dt_max)   # checks the steps before any work
+    integrators = {getattr(e, "integrator", "euler") for e in ensembles}
+    if len(integrators) != 1:
+        raise ValueError(f"ensembles use the integrators {sorted(integrators)}: one engine relaxes with one")
+    # the guard where an ensemble has one (a script's; the builders guard the measurement only), with
+    # its interval and thresholds (one set per engine)
+    guards = [getattr(e, "stability_guard", None) for e in ensembles]
+    settings = {(getattr(g, "interval", 4), getattr(g, "min_distance_ratio", 0.05), getattr(g, "max_kinetic_energy", None))
+                for g in guards if g is not None}
+    if len(settings) > 1:
+        raise ValueError(f"the ensembles' stability guards differ ({sorted(settings, key=str)}): one engine "
+                         "relaxes with one guard")
+    interval, ratio, ke = settings.pop() if settings else (4, 0.05, None)
+    with contextlib.ExitStack() as stack:      # their own state is stepped: put back on any failure
+        for e in ensembles:
+            stack.enter_context(untouched_on_failure(e))
+        # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
+        state = state_of_ensembles(ensembles, laws=laws)
+        engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
+                             guard=[g is not None for g in guards])
+        engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
+        engine.phase = "constitution"
+        engine.numbers_relations = True
+        steps = free_relaxation(engine, N, dt, dt_max, state.mu.copy())
+    for b, e in enumerate(ensembles):
+        write_back(engine, b, e, steps)
+    return steps
