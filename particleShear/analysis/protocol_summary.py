@@ -29,7 +29,9 @@ import zlib
 import numpy as np
 
 from ..protocols import PROTOCOLS
+from .flow_curve import fit_flow_curve
 from .grouping import SUMMARY_PROTOCOLS, measured_row, row_protocol, short_value
+from .sweep import modulus_interval
 from .verdicts import counts_note, verdict_counts
 
 __all__ = ["COLUMNS", "FLAGS", "QUANTITIES", "protocol_summaries", "summary_columns"]
@@ -91,7 +93,6 @@ def _mean_interval(values, n_boot, confidence, rng, modulus=False):
         stop = min(n_boot, start + _CHUNK)
         means[start:stop] = v[rng.integers(0, n, size=(stop - start, n))].mean(axis=1)
     if modulus:
-        from .sweep import modulus_interval
         return (float(v.mean()),) + modulus_interval(means, float(v.mean()), confidence)
     q = (1 - confidence) / 2
     return float(v.mean()), float(np.quantile(means, q)), float(np.quantile(means, 1 - q))
@@ -144,7 +145,6 @@ def protocol_summaries(rows, names, estimator="surface", n_boot=2000, confidence
     varying : list of str
         The parameter columns that differ between the groups.
     """
-    from .flow_curve import fit_flow_curve
     cells = {}
     for row in rows:
         proto = row_protocol(row)
