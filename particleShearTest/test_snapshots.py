@@ -142,9 +142,9 @@ class TestParticleColours(unittest.TestCase):
 
         def recording(renderer, ens, fmt, step=None):
             text = original(renderer, ens, fmt, step)
-            pt = ens._pairs
+            pt = ens.pair_table
             perm = pt.state == 2                             # PERMANENT
-            frames.append(dict(svg=text, x=ens._a["x"].copy(), y=ens._a["y"].copy(), r=ens._a["r"].copy(),
+            frames.append(dict(svg=text, x=ens.sphere_arrays["x"].copy(), y=ens.sphere_arrays["y"].copy(), r=ens.sphere_arrays["r"].copy(),
                                i=pt.i[perm].copy(), j=pt.j[perm].copy(), shift=ens._le_shift(),
                                L=(ens.size_x, ens.size_y)))
             return text

@@ -172,11 +172,11 @@ class TestClassesUseTheTerms(unittest.TestCase):
         s.permanent_ratio_central = 0.5
         s.permanent_ratio_tangential = 2.0
         s.keep_viscosity_coefficients_constant = False    # its bonds' viscosities take the ratios too
-        before = ens._pairs.copy()                 # the histories the force phase starts from
+        before = ens.pair_table                        # (a copy) the histories the force phase starts from
         ens.mechanical_simulation_step_calculate_forces()
         g = ens._g
-        pt = ens._pairs
-        a = ens._a
+        pt = ens.pair_table
+        a = ens.sphere_arrays
         perm = pt.state[g.slots] == PERMANENT
         self.assertTrue(perm.any() and ((g.ai == 5) | (g.aj == 5))[perm].any())
         mine = np.arange(len(ens.sphereList)) == 5
