@@ -62,6 +62,8 @@ class TestSphereViews(unittest.TestCase):
         a.neighbors[0].friction_position = 1.5
         pt = ens.pair_table
         self.assertEqual(pt.xi_ij[pt.find(0, 1)], 1.5)
+        pt.xi_ij[:] = 0.0                                           # a copy: the ensemble keeps its history
+        self.assertEqual(a.neighbors[0].friction_position, 1.5)
         self.assertEqual(b.neighbors[0].friction_position, 0.0)  # the other direction is its own history
         a.cut_permanent_link(b)
         self.assertEqual(a.neighbors[0].interface_type, "slip")

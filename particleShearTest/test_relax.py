@@ -325,7 +325,7 @@ class TestBatchIndependence(unittest.TestCase):
                 for _ in range(3):
                     for e in (a, twin):
                         e.mechanical_simulation_step(1, e.dt)
-                self.assertEqual(a._st.tobytes(), twin._st.tobytes())
+                self.assertEqual(state_block(a).tobytes(), state_block(twin).tobytes())
 
     def test_a_failed_batch_leaves_every_ensemble_as_it_was(self):
         # the batch steps the ensembles' own rows: when one replica's guard stops it (a bound on the

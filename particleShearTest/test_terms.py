@@ -181,7 +181,9 @@ class TestClassesUseTheTerms(unittest.TestCase):
         self.assertTrue(perm.any() and ((g.ai == 5) | (g.aj == 5))[perm].any())
         mine = np.arange(len(ens.sphereList)) == 5
         # each visit's constants by hand: the ratios of its own sphere
-        c = ens._param("central_repulsion_coefficient")
+        crc = a["central_repulsion_coefficient"]
+        self.assertTrue((crc == crc[0]).all())        # one value for every sphere
+        c = float(crc[0])
         K_i, K_j = (term_constants(g.d0, perm, pt.d_eq[g.slots], ens.k, c, ens.nu, ens.k_t, ens.nu_t, ens.mu,
                                    np.where(mine, 0.5, 1.0)[rows], np.where(mine, 2.0, 1.0)[rows],
                                    a["keep_viscosity_coefficients_constant"][rows])
