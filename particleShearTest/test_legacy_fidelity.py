@@ -1,4 +1,4 @@
-"""Scripts written against particleShear 1.0.2 run unchanged (issue 9).
+"""Scripts written against particleShear 1.0.2 run unchanged.
 
 * the six force-register lists hold the reference's entries, in its order and granularity
   (one entry per central elastic visit, one per central viscous visit, two per tangential visit),

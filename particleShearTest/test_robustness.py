@@ -1,4 +1,4 @@
-"""Nothing hangs: pathological inputs end quickly with an error that names what to change (issue 10).
+"""Nothing hangs: pathological inputs end quickly with an error that names what to change.
 
 * the Lees-Edwards wrap and the minimum image cost O(1) in the size of a coordinate and stay
   bit-identical to the one-period-at-a-time reference loop for ordinary coordinates;
