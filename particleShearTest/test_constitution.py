@@ -104,7 +104,8 @@ class TestDerivedConstants(unittest.TestCase):
         self.assertAlmostEqual(ens.k / (math.pi / 8 * 8000 * 1e6), 1.0, delta=4e-16)
         self.assertAlmostEqual(ens.nu / (0.1 * ens.k * tau), 1.0, delta=8e-16)
         r_b = math.sqrt(500 * 500 * 1.5 / (150 * math.pi) * 2 / (1.4 + 1 / 1.4))
-        np.testing.assert_allclose(np.unique(ens.sphere_arrays["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)], rtol=4e-16)
+        np.testing.assert_allclose(np.unique(ens.sphere_arrays["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)],
+                                   rtol=4e-16)
         # and the reference's printed values, bit for bit
         self.assertEqual(ens.k, 3141592653.5897927)
         self.assertEqual(ens.k_t, 3141592653.5897927)

@@ -359,8 +359,8 @@ class TestStateOfOneEnsemble(unittest.TestCase):
             e.set_rate(np.array([0.2]))
             for _ in range(60):
                 e.step(0.99, sc["dt"])
-        self.assertEqual(ens_c.sphere_arrays["x"].tobytes(), x0.tobytes())          # a copy leaves the ensemble alone
-        self.assertFalse(np.array_equal(ens_v.sphere_arrays["x"], x0))               # the view moved the ensemble's spheres
+        self.assertEqual(ens_c.sphere_arrays["x"].tobytes(), x0.tobytes())   # a copy leaves the ensemble alone
+        self.assertFalse(np.array_equal(ens_v.sphere_arrays["x"], x0))        # the view moved the ensemble's spheres
         for name in BatchState.SPHERE_ARRAYS:
             self.assertEqual(getattr(view, name).tobytes(), getattr(copy, name).tobytes(), name)
         # a pickled (or device) copy of the view is no longer the ensemble's rows
@@ -379,9 +379,10 @@ class TestStateOfOneEnsemble(unittest.TestCase):
             ens.mechanical_simulation_step(0.99, sc["dt"])
         for name in ("_pos", "_vel", "_frc"):
             self.assertTrue(getattr(ens, name).flags["C_CONTIGUOUS"], name)
-        before = {name: ens.sphere_arrays[name].copy() for name in ("x", "y", "xspeed", "yspeed", "omega", "r", "m")}
-        r = float(np.median(ens.sphere_arrays["r"]))
-        new = SphereLinkable("grey", 0.5 * ens.size_x, 0.5 * ens.size_y, 2 * r, float(np.median(ens.sphere_arrays["m"])),
+        a = ens.sphere_arrays
+        before = {name: a[name].copy() for name in ("x", "y", "xspeed", "yspeed", "omega", "r", "m")}
+        r = float(np.median(a["r"]))
+        new = SphereLinkable("grey", 0.5 * ens.size_x, 0.5 * ens.size_y, 2 * r, float(np.median(a["m"])),
                              len(ens.sphereList), force_register=ens, size_x=ens.size_x, size_y=ens.size_y)
         ens.sphereList.append(new)
         for name, old in before.items():

@@ -74,7 +74,8 @@ class TestAgainstTheClasses(unittest.TestCase):
     def assert_same_relaxation(self, ref, eng, N, min_bonds=0):
         """The classes' step loop of ``free_pre_equilibration(N)`` against the engine's, on a copy
         (:func:`relax_ensembles`, and ``free_pre_equilibration`` itself every other call)."""
-        self.assertTrue(all(np.array_equal(ref.sphere_arrays[k], eng.sphere_arrays[k]) for k in SPHERE_ROWS))   # the same start
+        a, b = ref.sphere_arrays, eng.sphere_arrays
+        self.assertTrue(all(np.array_equal(a[k], b[k]) for k in SPHERE_ROWS))   # the same start
         n_levels = len(relaxation_levels(ref.dt, ref.dt_max))
         before = ref.n_constitution_steps
         classes_free_pre_equilibration(ref, N)
@@ -242,10 +243,11 @@ class TestBatchIndependence(unittest.TestCase):
         relax_ensembles([b], 40, skin_factor=0.1)
         for k in SPHERE_ROWS:
             self.assertEqual(a.sphere_arrays[k].tobytes(), b.sphere_arrays[k].tobytes(), k)
-        self.assertEqual(a.pair_table.key[a.pair_table.active].tolist(), b.pair_table.key[b.pair_table.active].tolist())
+        pa, pb = a.pair_table, b.pair_table
+        self.assertEqual(pa.key[pa.active].tolist(), pb.key[pb.active].tolist())
         # the creation numbers follow the relations through the list rebuilds
-        self.assertEqual(a.pair_table.birth[a.pair_table.active].tolist(), b.pair_table.birth[b.pair_table.active].tolist())
-        self.assertEqual(a.pair_table.birth_count, b.pair_table.birth_count)
+        self.assertEqual(pa.birth[pa.active].tolist(), pb.birth[pb.active].tolist())
+        self.assertEqual(pa.birth_count, pb.birth_count)
 
     def test_mismatched_schedules_are_refused(self):
         a, b = random_packing(1), random_packing(2)
