@@ -1,4 +1,4 @@
-"""``analyse`` and ``plot`` on every folder a sweep writes, bounded, and published as one set (issue 43).
+"""``analyse`` and ``plot`` on every folder a sweep writes, bounded, and published as one set.
 
 Synthetic ``results.csv`` tables with the real header (``table_columns``, ``row_line``) stand for
 one-packing sweeps (step rows: ``theAmplitude`` is the first amplitude, ``sweep_amplitude`` the

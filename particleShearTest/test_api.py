@@ -23,8 +23,12 @@ class TestSphereViews(unittest.TestCase):
         ens = linkable()
         s = add(ens, 150, 200)
         s.xspeed = 3.5
-        self.assertEqual(ens._a["xspeed"][0], 3.5)
-        ens._a["omega"][0] = 0.25
+        arrays = ens.sphere_arrays
+        self.assertEqual(arrays["xspeed"][0], 3.5)
+        s.omega = 0.25
+        self.assertEqual(arrays["omega"][0], 0.25)       # the arrays are views of the ensemble's state
+        with self.assertRaises(ValueError):              # read-only: writes go through the spheres
+            arrays["omega"][0] = 0.5
         self.assertEqual(s.omega, 0.25)
         self.assertEqual(s.inertia, 1 * 60 * 60 / 2)
 
@@ -56,7 +60,10 @@ class TestSphereViews(unittest.TestCase):
         b = add(ens, 220, 260, idx=2)
         a.establish_permanent_link(b)
         a.neighbors[0].friction_position = 1.5
-        self.assertEqual(ens._pairs.xi_ij[ens._pairs.find(0, 1)], 1.5)
+        pt = ens.pair_table
+        self.assertEqual(pt.xi_ij[pt.find(0, 1)], 1.5)
+        pt.xi_ij[:] = 0.0                                           # a copy: the ensemble keeps its history
+        self.assertEqual(a.neighbors[0].friction_position, 1.5)
         self.assertEqual(b.neighbors[0].friction_position, 0.0)  # the other direction is its own history
         a.cut_permanent_link(b)
         self.assertEqual(a.neighbors[0].interface_type, "slip")
@@ -172,14 +179,16 @@ class TestLegacyEnsembles(unittest.TestCase):
         from particleShear import EnsembleFriction
         ens = EnsembleFriction(500, 500, 60, packing_fraction=1.2, k=1, nu=0.5, k_t=1, nu_t=0.5, mu=0.3)
         ens.set_random_generator(np.random.default_rng(3))
-        ens._a["xspeed"][:] = np.random.default_rng(1).normal(0, 1, 60)
+        for sphere, v in zip(ens.sphereList, np.random.default_rng(1).normal(0, 1, 60)):
+            sphere.xspeed = v
         p0 = ens.total_momentum()
         for _ in range(100):
             ens.mechanical_simulation_step(1, 0.05)
-        scale = float(ens._a["m"] @ np.abs(ens._a["xspeed"]))
+        a = ens.sphere_arrays
+        scale = float(a["m"] @ np.abs(a["xspeed"]))
         self.assertLess(np.abs(ens.total_momentum() - p0).max(), 1e-12 * scale)
         self.assertIn("tangential", ens.active_terms)
-        self.assertTrue(np.any(ens._a["omega"] != 0))  # friction spins the spheres
+        self.assertTrue(np.any(ens.sphere_arrays["omega"] != 0))  # friction spins the spheres
 
 
 class TestAllocatorTuning(unittest.TestCase):

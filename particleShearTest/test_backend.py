@@ -153,7 +153,7 @@ def _forbid(what):
 
 def _unwrap(v):
     if isinstance(v, DeviceArray):
-        return v._a
+        return v._host
     if isinstance(v, np.ndarray):
         _forbid("a host ndarray mixed with device arrays")
     if isinstance(v, tuple):
@@ -184,20 +184,20 @@ def _key_arrays(key):
 class DeviceArray(np.lib.mixins.NDArrayOperatorsMixin):
     """An array of the stand-in device: NumPy arithmetic underneath, CuPy's API, no implicit host reads."""
 
-    __slots__ = ("_a",)
+    __slots__ = ("_host",)
 
     def __init__(self, a):
-        object.__setattr__(self, "_a", a)
+        object.__setattr__(self, "_host", a)
 
     # metadata is free on a device too
-    shape = property(lambda self: self._a.shape)
-    dtype = property(lambda self: self._a.dtype)
-    ndim = property(lambda self: self._a.ndim)
-    size = property(lambda self: self._a.size)
-    T = property(lambda self: DeviceArray(self._a.T))
+    shape = property(lambda self: self._host.shape)
+    dtype = property(lambda self: self._host.dtype)
+    ndim = property(lambda self: self._host.ndim)
+    size = property(lambda self: self._host.size)
+    T = property(lambda self: DeviceArray(self._host.T))
 
     def __len__(self):
-        return len(self._a)
+        return len(self._host)
 
     def __repr__(self):
         return f"DeviceArray(shape={self.shape}, dtype={self.dtype})"
@@ -241,7 +241,7 @@ class DeviceArray(np.lib.mixins.NDArrayOperatorsMixin):
         key = _unwrap(key)
         if any(k.dtype == bool for k in _key_arrays(key)):
             _forbid("a boolean mask as index (CuPy reads the number of its True entries on the host)")
-        return _wrap(self._a[key])
+        return _wrap(self._host[key])
 
     def __setitem__(self, key, value):
         key, value = _unwrap(key), _unwrap(value)
@@ -250,19 +250,19 @@ class DeviceArray(np.lib.mixins.NDArrayOperatorsMixin):
             _forbid("assignment through a boolean mask (CuPy reads the number of its True entries on the host)")
         if any(k.dtype != bool for k in arrays):
             # CuPy stores an undefined one of the values aimed at one element (NumPy: the last)
-            target = np.arange(self._a.size).reshape(self._a.shape)[key].ravel()
+            target = np.arange(self._host.size).reshape(self._host.shape)[key].ravel()
             if np.unique(target).size != target.size:
                 _not_cupy("assignment through integer indices with repeats (undefined order in CuPy)")
-        self._a[key] = value
+        self._host[key] = value
 
     def __getattr__(self, name):
         if name.startswith("__"):   # no __array_interface__, __array_struct__, __dlpack__, ...: no host view
             raise AttributeError(name)
         if name in CUPY_METADATA:
-            return getattr(self._a, name)
+            return getattr(self._host, name)
         if name not in CUPY_METHODS:
             _not_cupy(f"ndarray.{name}")
-        attr = getattr(self._a, name)
+        attr = getattr(self._host, name)
 
         def method(*args, **kwargs):
             _check_keywords(name, kwargs, CUPY_METHODS[name])
@@ -335,7 +335,7 @@ class DeviceNamespace:
 
 
 def _host(a):
-    return a._a if isinstance(a, DeviceArray) else a
+    return a._host if isinstance(a, DeviceArray) else a
 
 
 def standin_backend(name=STANDIN, ordered=True):
@@ -347,7 +347,7 @@ def standin_backend(name=STANDIN, ordered=True):
     :data:`ORDERED_UFUNC_METHODS`) to it.  The allowances follow :func:`standin_registered`.
     """
     return xpmod.Backend(name, DeviceNamespace(), host=False, asarray=lambda a: DeviceArray(np.array(a)),
-                         to_host=lambda a: np.array(a._a), owns=lambda a: isinstance(a, DeviceArray),
+                         to_host=lambda a: np.array(a._host), owns=lambda a: isinstance(a, DeviceArray),
                          ordered_reductions=ordered)
 
 

@@ -1,4 +1,4 @@
-"""The command line (issue 13 item 5) and messages through logging (item 6).
+"""The command line and messages through logging.
 
 The flags are checked against ``inspect.signature(doParticleShearSimulation)`` (every parameter
 reachable, its value arriving unchanged at the API), the help against the signature's defaults,

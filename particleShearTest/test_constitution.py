@@ -104,7 +104,8 @@ class TestDerivedConstants(unittest.TestCase):
         self.assertAlmostEqual(ens.k / (math.pi / 8 * 8000 * 1e6), 1.0, delta=4e-16)
         self.assertAlmostEqual(ens.nu / (0.1 * ens.k * tau), 1.0, delta=8e-16)
         r_b = math.sqrt(500 * 500 * 1.5 / (150 * math.pi) * 2 / (1.4 + 1 / 1.4))
-        np.testing.assert_allclose(np.unique(ens._a["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)], rtol=4e-16)
+        np.testing.assert_allclose(np.unique(ens.sphere_arrays["r"]), [r_b / math.sqrt(1.4), r_b * math.sqrt(1.4)],
+                                   rtol=4e-16)
         # and the reference's printed values, bit for bit
         self.assertEqual(ens.k, 3141592653.5897927)
         self.assertEqual(ens.k_t, 3141592653.5897927)
@@ -114,8 +115,8 @@ class TestDerivedConstants(unittest.TestCase):
         self.assertEqual(ens.dt_max, 5.631992236652144e-07)
         self.assertEqual(ens.model.m, 0.125)
         self.assertEqual(ens.central_repulsion_coefficient, 1)
-        self.assertTrue((ens._a["central_repulsion_coefficient"] == 1).all())
-        r = np.unique(ens._a["r"])
+        self.assertTrue((ens.sphere_arrays["central_repulsion_coefficient"] == 1).all())
+        r = np.unique(ens.sphere_arrays["r"])
         self.assertTrue(np.allclose(r, [23.1880490458706, 32.46326866421884], rtol=1e-15))
         ex = Build(**dict(RUN, Young_modulus_spheres=10000, density=1000, anticipated_amplitude=0.3,
                           do_pre_equilibration=False, do_permanent_links=False, rng=0))
@@ -132,8 +133,8 @@ class TestDerivedConstants(unittest.TestCase):
         self.assertAlmostEqual(ens.nu / (nu * 2), 1, places=14)
         self.assertAlmostEqual(ens.nu_t / (nu * 0.5 * 4), 1, places=14)
         self.assertEqual((ens.permanent_ratio_central, ens.permanent_ratio_tangential), (0.5, 0.25))
-        self.assertTrue((ens._a["permanent_ratio_tangential"] == 0.25).all())
-        self.assertTrue((ens._a["keep_viscosity_coefficients_constant"] == 0).all())
+        self.assertTrue((ens.sphere_arrays["permanent_ratio_tangential"] == 0.25).all())
+        self.assertTrue((ens.sphere_arrays["keep_viscosity_coefficients_constant"] == 0).all())
         kept = Build(**dict(RUN, interface_reenforcement_central=2, keep_viscosity_coefficients_constant=True,
                             do_pre_equilibration=False, do_permanent_links=False, rng=0))
         self.assertEqual(kept.nu, nu)
@@ -191,13 +192,13 @@ class TestReproducibility(unittest.TestCase):
     def test_same_seed_same_ensemble(self):
         kw = dict(RUN, N=60, do_debug=True)
         a, b, c = Build(**kw, rng=11), Build(**kw, rng=11), Build(**kw, rng=12)
-        self.assertTrue(np.array_equal(a._a["x"], b._a["x"]))
-        self.assertTrue(np.array_equal(a._a["y"], b._a["y"]))
+        self.assertTrue(np.array_equal(a.sphere_arrays["x"], b.sphere_arrays["x"]))
+        self.assertTrue(np.array_equal(a.sphere_arrays["y"], b.sphere_arrays["y"]))
         for u, v in zip(a.permanent_pairs(), b.permanent_pairs()):
             self.assertTrue(np.array_equal(u, v))
-        self.assertFalse(np.array_equal(a._a["x"], c._a["x"]))
+        self.assertFalse(np.array_equal(a.sphere_arrays["x"], c.sphere_arrays["x"]))
         g = Build(**kw, rng=np.random.default_rng(11))
-        self.assertTrue(np.array_equal(a._a["x"], g._a["x"]))
+        self.assertTrue(np.array_equal(a.sphere_arrays["x"], g.sphere_arrays["x"]))
 
     def test_legacy_builder(self):
         ens = BuildLegacy(N=60, packing_fraction=1.5, mu=0.01, cut_lines=4, relative_viscosity=0.1,
@@ -239,7 +240,7 @@ class TestCutting(unittest.TestCase):
         self.assertTrue((ens.sphere_seed == 0).all())
         self.assertEqual(ens.n_permanent_connections(False), n0)
         ens.cutByTriangulationPoints([(125, 250), (375, 250)])  # cells x<250 and x>250, split at 0 and 250
-        x = ens._a["x"]
+        x = ens.sphere_arrays["x"]
         self.assertTrue((ens.sphere_seed == (x > 250)).all())
         i, j = ens.permanent_pairs()
         self.assertTrue(((x[i] > 250) == (x[j] > 250)).all())
@@ -316,7 +317,7 @@ class TestLinkRemovalAndJoining(unittest.TestCase):
         ens = relaxed(4)
         ens.makeAllLinksPermanent()
         ens.cutByTriangulation(60)  # many small cells → many spheres without a link
-        pt = ens._pairs
+        pt = ens.pair_table
         had_relation = np.zeros(ens.N, bool)
         had_relation[pt.i[pt.active]] = True
         had_relation[pt.j[pt.active]] = True

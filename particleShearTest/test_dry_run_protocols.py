@@ -1,4 +1,4 @@
-"""Bounded, honest dry runs of protocol SPECs (issue 43, item 6; docs/sweeps.md, "Projected cost"):
+"""Bounded, honest dry runs of protocol SPECs (docs/sweeps.md, "Projected cost"):
 the calibration shortens every protocol and stops at its wall-clock budget, the projection counts each
 protocol's own steps, an interrupted sweep names its table only when it exists, and the final line
 counts runs and rows apart.

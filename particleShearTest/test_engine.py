@@ -351,17 +351,17 @@ class TestStateOfOneEnsemble(unittest.TestCase):
         self.assertIs(view.ensemble, ens_v)
         self.assertIsNone(copy.ensemble)
         for name, row in (("x", "x"), ("vy", "yspeed"), ("omega", "omega"), ("fx", "xforce"), ("r", "r")):
-            self.assertTrue(np.shares_memory(getattr(view, name), ens_v._a[row]), name)
-            self.assertFalse(np.shares_memory(getattr(copy, name), ens_c._a[row]), name)
-        x0 = ens_c._a["x"].copy()
+            self.assertTrue(np.shares_memory(getattr(view, name), ens_v.sphere_arrays[row]), name)
+            self.assertFalse(np.shares_memory(getattr(copy, name), ens_c.sphere_arrays[row]), name)
+        x0 = ens_c.sphere_arrays["x"].copy()
         ev, ec = BatchEngine(view), BatchEngine(copy)
         for e in (ev, ec):
             e.s.applying_shear = True
             e.set_rate(np.array([0.2]))
             for _ in range(60):
                 e.step(0.99, sc["dt"])
-        self.assertEqual(ens_c._a["x"].tobytes(), x0.tobytes())          # a copy leaves the ensemble alone
-        self.assertFalse(np.array_equal(ens_v._a["x"], x0))               # the view moved the ensemble's spheres
+        self.assertEqual(ens_c.sphere_arrays["x"].tobytes(), x0.tobytes())   # a copy leaves the ensemble alone
+        self.assertFalse(np.array_equal(ens_v.sphere_arrays["x"], x0))        # the view moved the ensemble's spheres
         for name in BatchState.SPHERE_ARRAYS:
             self.assertEqual(getattr(view, name).tobytes(), getattr(copy, name).tobytes(), name)
         # a pickled (or device) copy of the view is no longer the ensemble's rows
@@ -380,18 +380,19 @@ class TestStateOfOneEnsemble(unittest.TestCase):
             ens.mechanical_simulation_step(0.99, sc["dt"])
         for name in ("_pos", "_vel", "_frc"):
             self.assertTrue(getattr(ens, name).flags["C_CONTIGUOUS"], name)
-        before = {name: ens._a[name].copy() for name in ("x", "y", "xspeed", "yspeed", "omega", "r", "m")}
-        r = float(np.median(ens._a["r"]))
-        new = SphereLinkable("grey", 0.5 * ens.size_x, 0.5 * ens.size_y, 2 * r, float(np.median(ens._a["m"])),
+        a = ens.sphere_arrays
+        before = {name: a[name].copy() for name in ("x", "y", "xspeed", "yspeed", "omega", "r", "m")}
+        r = float(np.median(a["r"]))
+        new = SphereLinkable("grey", 0.5 * ens.size_x, 0.5 * ens.size_y, 2 * r, float(np.median(a["m"])),
                              len(ens.sphereList), force_register=ens, size_x=ens.size_x, size_y=ens.size_y)
         ens.sphereList.append(new)
         for name, old in before.items():
-            self.assertEqual(ens._a[name][:-1].tobytes(), old.tobytes(), name)
-        self.assertEqual((ens._a["x"][-1], ens._a["y"][-1]), (new.x, new.y))
+            self.assertEqual(ens.sphere_arrays[name][:-1].tobytes(), old.tobytes(), name)
+        self.assertEqual((ens.sphere_arrays["x"][-1], ens.sphere_arrays["y"][-1]), (new.x, new.y))
         ens.mechanical_simulation_step(0.99, sc["dt"])
         for name in ("_pos", "_vel", "_frc"):
             self.assertTrue(getattr(ens, name).flags["C_CONTIGUOUS"], name)
-        self.assertTrue(np.all(np.isfinite(ens._pos)))
+        self.assertTrue(all(np.isfinite(ens.sphere_arrays[k]).all() for k in ("x", "y")))
         self.assertEqual(ens._engine.s.N, len(ens.sphereList))
 
 
@@ -426,9 +427,9 @@ class TestPhasesOneByOne(unittest.TestCase):
                     self.assertEqual(np.asarray(whole[key]).tobytes(), parts[key].tobytes(), key)
                     self.assertEqual(np.asarray(whole[key])[:40].tobytes(), first[key].tobytes(), key)
                 for row in ("x", "y", "phi", "xspeed", "yspeed", "omega"):
-                    self.assertEqual(e1._a[row].tobytes(), e2._a[row].tobytes(), row)
+                    self.assertEqual(e1.sphere_arrays[row].tobytes(), e2.sphere_arrays[row].tobytes(), row)
                 self.assertEqual((e1.t, e1.shear, e1.step_count, e1.phase), (e2.t, e2.shear, e2.step_count, "protocol"))
-                self.assertEqual(e1._pairs.birth.tobytes(), e2._pairs.birth.tobytes())
+                self.assertEqual(e1.pair_table.birth.tobytes(), e2.pair_table.birth.tobytes())
                 np.testing.assert_array_equal(x2.theEvaluator.tensors, np.asarray(whole["tensors"])[-1])
                 np.testing.assert_array_equal(x3.theEvaluator.tensors, np.asarray(whole["tensors"])[39])
                 self.assertEqual(x3.N_steps, 40)

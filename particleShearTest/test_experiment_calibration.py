@@ -1,4 +1,4 @@
-"""Calibration recovers a held-out grid point and its modulus scale (issue 48, item 5).
+"""Calibration recovers a held-out grid point and its modulus scale.
 
 The campaign is a synthetic results.csv (written with the package's table writer) from a model family
 in which each grid point (theMu × cut_lines) has its own normalised amplitude sweep; the "measured"

@@ -1,4 +1,4 @@
-"""Readers of measured rheometer files (particleShear.experiment.readers) and the analysis on them (issue 48).
+"""Readers of measured rheometer files (particleShear.experiment.readers) and the analysis on them.
 
 Real RheoCompass and RepTate files are read from ``../shared/data/rheometer`` (or
 ``$PARTICLESHEAR_RHEOMETER_DATA``, or /work/shared/data/rheometer) when present, checked against an

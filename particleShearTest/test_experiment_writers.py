@@ -1,4 +1,4 @@
-"""RepTate and pyRheo files written from MeasuredTest and from simulation results (issue 48, item 3).
+"""RepTate and pyRheo files written from MeasuredTest and from simulation results.
 
 RepTate itself is not installable here (Qt, NumPy >= 2.4), so its files are checked against the rules of
 ``RepTate.core.FileType.TXTColumnFile`` by a small parser written here: first line ``param=value;…``, then the

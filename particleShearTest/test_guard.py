@@ -30,9 +30,9 @@ def ensemble(positions, diameter=40.0, rate=RATE):
     for n, (x, y) in enumerate(positions):
         ens.sphereList.append(SphereLinkable("grey", x, y, diameter, 2.0, n, force_register=ens))
     ens.setShearRate(rate)
-    a = ens._a
-    a["xspeed"][:] = rate * (a["y"] - L / 2)      # at rest relative to the flow, without spin
-    a["omega"][:] = 0.0
+    for s in ens.sphereList:                      # at rest relative to the flow, without spin
+        s.xspeed = rate * (s.y - L / 2)
+        s.omega = 0.0
     return ens
 
 
@@ -107,7 +107,9 @@ class TestOneRule(unittest.TestCase):
 
     def test_non_finite_state(self):
         ens = ensemble([(50.0, 50.0), (250.0, 90.0)])
-        ens._a["omega"][1] = np.nan      # past the setter's check, as a diverging torque would leave it
+        # the engine's state of the ensemble is its own rows: a value past the setter's check, as a
+        # diverging torque would leave it
+        state_of_ensemble(ens).omega[1] = np.nan
         self.assertVerdicts(ens, "non-finite")
 
 

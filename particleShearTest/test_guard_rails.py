@@ -1,4 +1,4 @@
-"""Guard-rails for common mistakes (issue 22 item 5): misspelled names get the closest names.
+"""Guard-rails for common mistakes: misspelled names get the closest names.
 
 * an unknown keyword of ``doParticleShearSimulation``, the series and ``run_batch`` (and an unknown
   key of a batch's dicts or of a sweep SPEC) raises :class:`UnknownParameterError` — a TypeError

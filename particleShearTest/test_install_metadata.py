@@ -52,6 +52,29 @@ class TestDeclaredDependencies(unittest.TestCase):
         self.assertEqual(users, ["particleShear/sweep/spec.py"])
 
 
+@unittest.skipUnless((ROOT / ".ci" / "run").exists() and (ROOT / "README.md").exists(),
+                     "CI script and README not shipped with this installation")
+class TestReadmeTestCommand(unittest.TestCase):
+    """CI runs the README's test command, and the [test] extra installs what that command uses."""
+
+    def test_ci_runs_the_readme_test_command(self):
+        readme = (ROOT / "README.md").read_text(encoding="utf-8")
+        commands = re.findall(r'pip install "\.\[test\]" && (python -m pytest [^\n]*)', readme)
+        self.assertEqual(len(commands), 1, "README.md: one test command after pip install \".[test]\"")
+        ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+              if line.strip() and not line.lstrip().startswith("#")]
+        self.assertIn('pip install ".[test]"', ci)
+        self.assertEqual(ci[-1], commands[0].strip())
+
+    def test_test_extra_has_the_plugins_of_the_command(self):
+        readme = (ROOT / "README.md").read_text(encoding="utf-8")
+        (command,) = re.findall(r'pip install "\.\[test\]" && (python -m pytest [^\n]*)', readme)
+        test_extra = " ".join(_pyproject()["project"]["optional-dependencies"]["test"])
+        self.assertIn("pytest", test_extra)
+        if re.search(r"(^| )(-n|--dist)( |=)", command):      # pytest-xdist's options
+            self.assertIn("pytest-xdist", test_extra)
+
+
 class TestTomlWithoutReader(unittest.TestCase):
     def test_clear_error_without_tomllib_and_tomli(self):
         from particleShear.sweep.spec import _read_toml

@@ -1,4 +1,4 @@
-"""Scripts written against particleShear 1.0.2 run unchanged (issue 9).
+"""Scripts written against particleShear 1.0.2 run unchanged.
 
 * the six force-register lists hold the reference's entries, in its order and granularity
   (one entry per central elastic visit, one per central viscous visit, two per tangential visit),
@@ -448,7 +448,7 @@ class MechanicalRelaxationTest(unittest.TestCase):
             b.mechanical_simulation_step(0.98, 2e-7)
         b.evaluate_stress_tensors(ev_b)
         for name in ("x", "y", "phi", "xspeed", "yspeed", "omega"):
-            self.assertEqual(a._a[name].tobytes(), b._a[name].tobytes(), name)
+            self.assertEqual(a.sphere_arrays[name].tobytes(), b.sphere_arrays[name].tobytes(), name)
         self.assertEqual((a.t, a.shear, a.step_count), (b.t, b.shear, b.step_count))
         self.assertGreater(abs(a.shear), 0.0)
         self.assertEqual(Tk.updates, 17)

@@ -86,7 +86,7 @@ class TestCanvasMemo(unittest.TestCase):
 
     def test_mobile_mask_is_its_definition(self):
         ens = self.ens
-        a = ens._a
+        a = ens.sphere_arrays
         expected = (a["r"] < a["y"]) & (a["y"] < ens.size_y - a["r"])
         mob = ens._mobile_mask()
         np.testing.assert_array_equal(mob, expected)
@@ -102,7 +102,7 @@ class TestCanvasMemo(unittest.TestCase):
 
     def test_mobile_selection_holds_the_mobile_spheres(self):
         ens = self.ens
-        a = ens._a
+        a = ens.sphere_arrays
         mobile = (a["r"] < a["y"]) & (a["y"] < ens.size_y - a["r"])
         expected = [s for s, m in zip(ens.sphereList, mobile) if m]
         for sel in (ens._mobile_selection(), ens.movableSphereList()):
@@ -119,14 +119,14 @@ class TestCanvasMemo(unittest.TestCase):
         """The per-candidate constants of the last force phase and the table rows they describe."""
         ens = self.ens
         C = ens._engine.C
-        pt = ens._pairs
+        pt = ens.pair_table
         return C, pt.find(C.ai, C.aj)
 
     def test_pair_constants_are_their_definition(self):
         ens = self.ens
         C, slots = self._constants()
-        pt = ens._pairs
-        r = ens._a["r"]
+        pt = ens.pair_table
+        r = ens.sphere_arrays["r"]
         self.assertTrue((slots >= 0).all())          # every candidate of the engine is a row of the table
         i, j = pt.i[slots], pt.j[slots]
         np.testing.assert_array_equal(C.ai, i)
@@ -182,10 +182,10 @@ class TestCanvasMemo(unittest.TestCase):
         later.record_total_particle_forces()
         at_once.record_total_particle_forces()
         expected = lists(at_once)
-        xi_before = later._pairs.xi.copy()
+        xi_before = later.pair_table.xi.copy()
         later.mechanical_simulation_step_calculate_acceleration(0.95, 1e-3)
         later.mechanical_simulation_step_calculate_movement(1e-3)
-        self.assertFalse(np.array_equal(later._pairs.xi, xi_before))     # the movement changed the history
+        self.assertFalse(np.array_equal(later.pair_table.xi, xi_before))     # the movement changed the history
         got = lists(later)
         self.assertGreater(len(expected["pair_register"]), 0)
         self.assertGreater(len(expected["external_force_register"]), 0)
@@ -198,7 +198,7 @@ class TestCanvasMemo(unittest.TestCase):
         s.permanent_ratio_tangential = 2.0            # one sphere: its visits see twice k_t on its bonds
         ens.mechanical_simulation_step_calculate_forces()
         C, slots = self._constants()
-        perm = ens._pairs.state[slots] == PERMANENT
+        perm = ens.pair_table.state[slots] == PERMANENT
         ratio = np.where(np.arange(len(ens.sphereList)) == 3, 2.0, 1.0)
         self.assertIsNotNone(C.Kj)
         np.testing.assert_array_equal(C.k_t, ens.k_t * np.where(perm, ratio[C.ai], 1.0))
@@ -212,7 +212,7 @@ class TestCanvasMemo(unittest.TestCase):
                 setattr(ens, name, value)
                 ens.mechanical_simulation_step_calculate_forces()
                 C, slots = self._constants()
-                perm = ens._pairs.state[slots] == PERMANENT
+                perm = ens.pair_table.state[slots] == PERMANENT
                 got = {"mu": np.max(C.mu), "k": np.max(C.k), "nu": np.max(C.nu), "k_t": np.max(C.k_t),
                        "nu_t": np.max(C.nu_t)}[name]
                 self.assertEqual(got, value)

@@ -1,4 +1,4 @@
-"""The stroboscopic observer and its measures (issue 49; docs/microstructure.md).
+"""The stroboscopic observer and its measures (docs/microstructure.md).
 
 Geometry tests are exact statements (affine maps, rigid motions, a hand-built contact graph) checked
 to rounding; the run tests use N = 40 spheres and 3 shear periods.

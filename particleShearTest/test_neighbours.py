@@ -213,7 +213,7 @@ class TestVerletCriterionUnderAffineFlow(unittest.TestCase):
 
         def check(tag):
             ens.test_neighbor_relation()
-            xs, ys, rs = ens._a["x"], ens._a["y"], ens._a["r"]
+            xs, ys, rs = ens.sphere_arrays["x"], ens.sphere_arrays["y"], ens.sphere_arrays["r"]
             want = oracle_pairs(xs, ys, rs, Lx, Ly, ens.shear)
             got = set(zip(*map(np.ndarray.tolist, ens.contact_pairs())))
             if got != want:

@@ -28,6 +28,7 @@ from particleShear.engine.step import BatchEngine, pre_equilibrate, pre_equilibr
 from particleShear.run.batch import run_batch
 from particleShear.simulation.drawing import CAPTION_HEIGHT, PillowRenderer
 from particleShear.simulation.observers import ReplicaScene, ReplicaView
+from particleShear.simulation.scene import scene_geometry
 from particleShearTest.test_engine import constituted
 
 #: ~560 protocol steps of 20 spheres, crosslinked and cut (the quick scene of test_batch.py)
@@ -61,8 +62,9 @@ class Reader(Observer):
             self.scene.bind(engine, 0)
             self.bound = engine
         v = self.scene(engine)
-        a, p = v._a, v._pairs
-        self.sums.append(float(a["x"].sum() + a["y"].sum()) + int(p.state.sum()) + v.t + v.shear + v._le_shift())
+        g = scene_geometry(v)           # what a picture reads: spheres, contacts, bonds (Lees-Edwards images)
+        self.sums.append(sum(float(g[k].sum()) for k in ("x", "y", "r", "phi", "chords", "links"))
+                         + int(g["chord_state"].sum()) + v.t + v.shear)
         if phase == "protocol":
             self.sums.append(float(self.scene.samples(engine, 0, step).sum()))
 

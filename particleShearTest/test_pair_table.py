@@ -94,12 +94,13 @@ class TestRelationEdits(unittest.TestCase):
         rng = np.random.default_rng(7)
         t = table(rng)
         before = t.copy()
-        t._births = 1000
+        t.next_births(1000)                        # the counter starts at 0: the next number is 1000
         slots = rng.permutation(len(t.i))[:30]
         new = t.open_relations(slots)
         was_off = ~before.active[slots]
         np.testing.assert_array_equal(new, slots[was_off])                    # in the order given
         np.testing.assert_array_equal(t.birth[new], 1000 + np.arange(len(new)))
+        self.assertEqual(t.birth_count, 1000 + len(new))                       # the next number to give
         kept = slots[~was_off]
         np.testing.assert_array_equal(t.birth[kept], before.birth[kept])      # relations keep their number
         self.assertTrue(t.active[slots].all())

@@ -1,4 +1,4 @@
-"""The documented per-sphere API evaluates the engine's terms (issue 20, deliverable 5).
+"""The documented per-sphere API evaluates the engine's terms.
 
 Every documented per-sphere method of ``base/points.py`` and ``linkable/spheres.py`` is checked
 against the engine's pure functions (``engine.box``, ``engine.terms``, ``engine.integrate``)

@@ -1,4 +1,4 @@
-"""Protocols refuse what they cannot resolve, before any work (issue 43, item 5; docs/protocols.md,
+"""Protocols refuse what they cannot resolve, before any work (docs/protocols.md,
 "Limits and errors"): every step of an amplitude or frequency sweep is checked for resolution like
 the first, and the memory of every protocol's record is estimated from its own steps and bounded
 like the oscillatory run's, with one ValueError naming the parameter, its flag, the estimate and the

@@ -1,4 +1,4 @@
-"""The rheometer's protocols in sweeps, tables, series and files (issue 23, docs/protocols.md).
+"""The rheometer's protocols in sweeps, tables, series and files (docs/protocols.md).
 
 A sweep's row of a protocol run must be the direct call's result with the same seed (the
 run's ``SeedSequence(root, spawn_key=(index,))``), bit for bit; a one-packing sweep writes one

@@ -25,6 +25,12 @@ from particleShear.engine.state import BatchState
 from particleShear.base.engine_adapter import state_from_ensembles, state_of_ensemble, state_of_ensembles
 from particleShear.linkable.builders import adjustable_interface_constitution, relax_constitution
 
+
+def state_block(ens):
+    """The ensemble's per-sphere state, one row per field of ``FIELDS`` (a copy)."""
+    return np.array(list(ens.sphere_arrays.values()))
+
+
 #: a small scene of the run API's builder (nominal area fraction 1: a jammed packing)
 SCENE = dict(N=40, packing_fraction=1.0, mu=0.1, Young_modulus_spheres=1000, cut_lines=3, anticipated_amplitude=0.1,
              central_repulsion_coefficient=1, doDrawing=False)
@@ -70,7 +76,8 @@ class TestAgainstTheClasses(unittest.TestCase):
     def assert_same_relaxation(self, ref, eng, N, min_bonds=0):
         """The classes' step loop of ``free_pre_equilibration(N)`` against the engine's, on a copy
         (:func:`relax_ensembles`, and ``free_pre_equilibration`` itself every other call)."""
-        self.assertTrue(all(np.array_equal(ref._a[k], eng._a[k]) for k in SPHERE_ROWS))   # the same start
+        a, b = ref.sphere_arrays, eng.sphere_arrays
+        self.assertTrue(all(np.array_equal(a[k], b[k]) for k in SPHERE_ROWS))   # the same start
         n_levels = len(relaxation_levels(ref.dt, ref.dt_max))
         before = ref.n_constitution_steps
         classes_free_pre_equilibration(ref, N)
@@ -88,17 +95,17 @@ class TestAgainstTheClasses(unittest.TestCase):
         self.assertAlmostEqual(eng.t, ref.t, delta=1e-12 * ref.t)
         self.assertEqual(eng.mu, ref.mu)
         for k in SPHERE_ROWS:
-            a, b = ref._a[k], eng._a[k]
+            a, b = ref.sphere_arrays[k], eng.sphere_arrays[k]
             scale = np.abs(a).max()   # 0 only for ω and φ without tangential forces: then both exactly 0
             self.assertTrue(scale > 0.0 or k in ("omega", "phi"), k)
             self.assertLessEqual(np.abs(a - b).max(), 1e-12 * scale, k)
         # the relations (and so what the crosslinking links) and their states are the same
-        pr, pe = ref._pairs, eng._pairs
+        pr, pe = ref.pair_table, eng.pair_table
         self.assertEqual(pr.key[pr.active].tolist(), pe.key[pe.active].tolist())
         self.assertEqual(pr.state[pr.active].tolist(), pe.state[pe.active].tolist())
         # ... created in the same order (creation numbers order ``neighbors``)
         self.assertEqual(pr.birth[pr.active].tolist(), pe.birth[pe.active].tolist())
-        self.assertEqual(pr._births, pe._births)
+        self.assertEqual(pr.birth_count, pe.birth_count)
         self.assertGreaterEqual(int((pe.state == 2).sum()), min_bonds)
         xr, xe = pr.xi[:, pr.active], pe.xi[:, pe.active]
         self.assertLessEqual(np.abs(xr - xe).max(), 1e-12 * max(np.abs(xr).max(), 1e-300))
@@ -112,7 +119,7 @@ class TestAgainstTheClasses(unittest.TestCase):
         self.assertEqual(len(relaxation_levels(ref.dt, ref.dt_max)), 2)
         self.assert_same_relaxation(ref, eng, 20)
         # friction acted in the last block: some contact sticks with a history
-        self.assertGreater(np.abs(eng._pairs.xi).max(), 0.0)
+        self.assertGreater(np.abs(eng.pair_table.xi).max(), 0.0)
 
     def test_velocity_verlet(self):
         # an ensemble set to velocity Verlet relaxes with it (the engine's predictor, the classes' step)
@@ -135,7 +142,7 @@ class TestAgainstTheClasses(unittest.TestCase):
         for e in (ref, eng):
             e.dt_max = 2 * e.dt
         ref, eng = self.assert_same_relaxation(ref, eng, 20)
-        pe = eng._pairs
+        pe = eng.pair_table
         self.assertTrue(np.all(pe.xi == 0.0))
         self.assertTrue(np.all(pe.state[pe.active] == 1))   # SLIP
 
@@ -158,14 +165,14 @@ class TestAgainstTheClasses(unittest.TestCase):
             self.assertEqual(e.mu, 0.1)
         self.assertEqual(seen[0], seen[1])
         for k in SPHERE_ROWS:
-            scale = np.abs(ref._a[k]).max()
-            self.assertLessEqual(np.abs(ref._a[k] - eng._a[k]).max(), 1e-12 * scale, k)
+            scale = np.abs(ref.sphere_arrays[k]).max()
+            self.assertLessEqual(np.abs(ref.sphere_arrays[k] - eng.sphere_arrays[k]).max(), 1e-12 * scale, k)
 
 
 def energies(e):
     """Kinetic energy, elastic energy ½k·overlap² of the linear law (c = 0) and the largest
     relative overlap of an ensemble (all pairs; reference units)."""
-    a = e._a
+    a = e.sphere_arrays
     n = len(e.sphereList)
     i, j = np.triu_indices(n, 1)
     dx, dy, _, _ = min_image(a["x"][j] - a["x"][i], a["y"][j] - a["y"][i], e.size_x, e.size_y, 0.0)
@@ -224,9 +231,9 @@ class TestBatchIndependence(unittest.TestCase):
         relax_ensembles([a1], 15)
         relax_ensembles([other, a2], 15)
         for k in SPHERE_ROWS:
-            self.assertEqual(a1._a[k].tobytes(), a2._a[k].tobytes(), k)
+            self.assertEqual(a1.sphere_arrays[k].tobytes(), a2.sphere_arrays[k].tobytes(), k)
         for name in ("key", "state", "xi", "d_eq", "active", "birth"):
-            self.assertEqual(getattr(a1._pairs, name).tobytes(), getattr(a2._pairs, name).tobytes(), name)
+            self.assertEqual(getattr(a1.pair_table, name).tobytes(), getattr(a2.pair_table, name).tobytes(), name)
         self.assertEqual(a1.t, a2.t)
 
     def test_result_does_not_depend_on_the_verlet_skin(self):
@@ -237,11 +244,12 @@ class TestBatchIndependence(unittest.TestCase):
         relax_ensembles([a], 40, skin_factor=0.5)
         relax_ensembles([b], 40, skin_factor=0.1)
         for k in SPHERE_ROWS:
-            self.assertEqual(a._a[k].tobytes(), b._a[k].tobytes(), k)
-        self.assertEqual(a._pairs.key[a._pairs.active].tolist(), b._pairs.key[b._pairs.active].tolist())
+            self.assertEqual(a.sphere_arrays[k].tobytes(), b.sphere_arrays[k].tobytes(), k)
+        pa, pb = a.pair_table, b.pair_table
+        self.assertEqual(pa.key[pa.active].tolist(), pb.key[pb.active].tolist())
         # the creation numbers follow the relations through the list rebuilds
-        self.assertEqual(a._pairs.birth[a._pairs.active].tolist(), b._pairs.birth[b._pairs.active].tolist())
-        self.assertEqual(a._pairs._births, b._pairs._births)
+        self.assertEqual(pa.birth[pa.active].tolist(), pb.birth[pb.active].tolist())
+        self.assertEqual(pa.birth_count, pb.birth_count)
 
     def test_mismatched_schedules_are_refused(self):
         a, b = random_packing(1), random_packing(2)
@@ -262,10 +270,10 @@ class TestBatchIndependence(unittest.TestCase):
         eng = BatchEngine(state_of_ensemble(a))
         eng.numbers_relations = False
         eng.step(1.0, a.dt)
-        x, t = a._a["x"].copy(), a.t
+        x, t = a.sphere_arrays["x"].copy(), a.t
         with self.assertRaisesRegex(ValueError, "numbers_relations"):
             write_back(eng, 0, a)
-        self.assertEqual((a._a["x"].tobytes(), a.t), (x.tobytes(), t))
+        self.assertEqual((a.sphere_arrays["x"].tobytes(), a.t), (x.tobytes(), t))
 
     def test_write_back_needs_the_ensembles_own_state(self):
         # a copy of the ensemble (state_from_ensembles) is not handed back: the engine's spheres are not
@@ -294,8 +302,12 @@ class TestBatchIndependence(unittest.TestCase):
         for k, e in enumerate((a, b)):
             rows = s.replica(k)
             for name, src in (("x", "x"), ("yspeed", "vy"), ("omega", "omega"), ("xforce", "fx")):
-                self.assertEqual(e._a[name].tobytes(), getattr(s, src)[rows].tobytes())
-            self.assertIs(s.pairs[k], e._pairs)
+                self.assertEqual(e.sphere_arrays[name].tobytes(), getattr(s, src)[rows].tobytes())
+            # replica k's pair list is the ensemble's own table: an edit there is the ensemble's
+            d_eq = e.pair_table.d_eq
+            self.assertGreater(len(d_eq), 0)
+            s.pairs[k].d_eq[0] += 1.0
+            self.assertEqual(e.pair_table.d_eq[0], d_eq[0] + 1.0)
         with self.assertRaisesRegex(ValueError, "twice"):
             state_of_ensembles([a, a])
 
@@ -335,7 +347,7 @@ class TestBatchIndependence(unittest.TestCase):
                 for _ in range(3):
                     for e in (a, twin):
                         e.mechanical_simulation_step(1, e.dt)
-                self.assertEqual(a._st.tobytes(), twin._st.tobytes())
+                self.assertEqual(state_block(a).tobytes(), state_block(twin).tobytes())
 
     def test_a_failed_batch_leaves_every_ensemble_as_it_was(self):
         # the batch steps the ensembles' own rows: when one replica's guard stops it (a bound on the
@@ -346,21 +358,21 @@ class TestBatchIndependence(unittest.TestCase):
         a, b = random_packing(7), random_packing(8)
         ra, rb = random_packing(7), random_packing(8)
         n = len(a.sphereList)
-        before = [(e._block[:, :n].copy(), e._pairs.copy(), e.t, e.step_count) for e in (a, b)]
+        before = [(state_block(e), e.pair_table, e.t, e.step_count) for e in (a, b)]
         b.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=4)
         with self.assertRaises(EngineInstability):
             relax_ensembles([a, b], 6)
         for e, (block, pt, t, steps) in zip((a, b), before):
-            self.assertEqual(e._block[:, :n].tobytes(), block.tobytes())
+            self.assertEqual(state_block(e).tobytes(), block.tobytes())
             for name in ("key", "state", "xi", "active", "birth"):
-                self.assertEqual(getattr(e._pairs, name).tobytes(), getattr(pt, name).tobytes(), name)
+                self.assertEqual(getattr(e.pair_table, name).tobytes(), getattr(pt, name).tobytes(), name)
             self.assertEqual((e.t, e.step_count), (t, steps))
         b.stability_guard = None
         relax_ensembles([a, b], 6)
         relax_ensembles([ra, rb], 6)
         for e, r in ((a, ra), (b, rb)):
-            self.assertEqual(e._block[:, :n].tobytes(), r._block[:, :n].tobytes())
-            self.assertEqual(e._pairs.key.tobytes(), r._pairs.key.tobytes())
+            self.assertEqual(state_block(e).tobytes(), state_block(r).tobytes())
+            self.assertEqual(e.pair_table.key.tobytes(), r.pair_table.key.tobytes())
 
 
 if __name__ == "__main__":

@@ -142,10 +142,10 @@ class TestParticleColours(unittest.TestCase):
 
         def recording(renderer, ens, fmt, step=None):
             text = original(renderer, ens, fmt, step)
-            pt = ens._pairs
+            pt, a = ens.pair_table, ens.sphere_arrays     # the run's replica, as the renderer sees it
             perm = pt.state == 2                             # PERMANENT
-            frames.append(dict(svg=text, x=ens._a["x"].copy(), y=ens._a["y"].copy(), r=ens._a["r"].copy(),
-                               i=pt.i[perm].copy(), j=pt.j[perm].copy(), shift=ens._le_shift(),
+            frames.append(dict(svg=text, x=a["x"].copy(), y=a["y"].copy(), r=a["r"].copy(),
+                               i=pt.i[perm].copy(), j=pt.j[perm].copy(), shift=ens.size_y * ens.shear,
                                L=(ens.size_x, ens.size_y)))
             return text
 

@@ -1,5 +1,7 @@
 """Every ```python block of README.md and docs/*.md runs as pasted, headless, in order.
 
+One test class per document (``TestSnippets_README_md``, ``TestSnippets_docs_sweeps_md`` …).
+
 Each document's blocks are pasted in the order they appear into ONE fresh empty folder, each by a
 fresh interpreter (so every block carries its own imports, and a block may use the files an
 earlier block of the same document made, as a reader following the page would), without a
@@ -75,22 +77,38 @@ class TestDocumentSnippets(unittest.TestCase):
     def test_blocks_found(self):
         self.assertGreater(len(document_blocks(ROOT / "README.md")), 0, "README.md has no python block")
 
-    def test_every_document_runs_in_order_in_one_folder(self):
+
+class DocumentRun:
+    """The blocks of one document run in order in one folder (a mixin: one TestCase class per
+    document, so a parallel run (pytest-xdist, ``--dist loadscope``) spreads the documents)."""
+
+    document = None     # path relative to the checkout, e.g. "docs/sweeps.md"
+
+    def test_blocks_run_in_order_in_one_folder(self):
         env = _headless_env()
-        for doc in documents():
-            name = doc.relative_to(ROOT).as_posix()
-            blocks = document_blocks(doc)
-            if not blocks:
-                continue
-            with tempfile.TemporaryDirectory() as folder:
-                for k, code in enumerate(blocks):
-                    with self.subTest(document=name, block=k):
-                        proc = run_block(code, folder, env)
-                        self.assertEqual(proc.returncode, 0,
-                                         f"{name} block {k} (pasted after blocks 0..{k - 1} in the same folder) "
-                                         f"failed:\n{code}\n--- stderr ---\n{proc.stderr[-3000:]}")
-                        self.assertNotIn("Warning", proc.stderr,
-                                         f"{name} block {k} warned:\n{proc.stderr[-3000:]}")
+        name = self.document
+        blocks = document_blocks(ROOT / name)
+        with tempfile.TemporaryDirectory() as folder:
+            for k, code in enumerate(blocks):
+                with self.subTest(document=name, block=k):
+                    proc = run_block(code, folder, env)
+                    self.assertEqual(proc.returncode, 0,
+                                     f"{name} block {k} (pasted after blocks 0..{k - 1} in the same folder) "
+                                     f"failed:\n{code}\n--- stderr ---\n{proc.stderr[-3000:]}")
+                    self.assertNotIn("Warning", proc.stderr, f"{name} block {k} warned:\n{proc.stderr[-3000:]}")
+
+
+def _test_class_name(name):
+    """``docs/sweeps.md`` → ``TestSnippets_docs_sweeps_md``."""
+    return "TestSnippets_" + re.sub(r"\W", "_", name)
+
+
+for _doc in documents():
+    if document_blocks(_doc):
+        _name = _doc.relative_to(ROOT).as_posix()
+        globals()[_test_class_name(_name)] = type(_test_class_name(_name), (DocumentRun, unittest.TestCase),
+                                                  {"document": _name, "__module__": __name__,
+                                                   "__doc__": f"The python blocks of {_name} run as pasted, in order."})
 
 
 if __name__ == "__main__":

@@ -70,7 +70,7 @@ class ContactMonitor:
         self._prev = None
 
     def check(self, ens, step=None, phase=None, dt=None):
-        a = ens._a
+        a = ens.sphere_arrays
         st = np.concatenate([a["x"], a["y"], a["xspeed"], a["yspeed"], a["omega"]])
         self.finite &= bool(np.isfinite(st).all())
         rate = ens.shear_rate or 0.0
@@ -100,7 +100,7 @@ class ContactMonitor:
 
 def reference_energy(ens):
     """E_ref = Σ ½ k r_i² (mg·µm²·s⁻² per m): compressing every sphere by its radius (linear law)."""
-    return 0.5 * float(ens.k) * float((ens._a["r"] ** 2).sum())
+    return 0.5 * float(ens.k) * float((ens.sphere_arrays["r"] ** 2).sum())
 
 
 def pair_energy(d, d0, k, c=1.0):
@@ -162,7 +162,7 @@ class StabilityAssertions:
         ens = exp.theEnsemble
         self.assertGreater(mon.steps, 0, label)
         self.assertTrue(mon.finite, f"{label}: non-finite state")
-        a = ens._a
+        a = ens.sphere_arrays
         for name in ("x", "y", "xspeed", "yspeed", "omega"):
             self.assertTrue(np.isfinite(a[name]).all(), f"{label}: {name} not finite")
         # positions wrapped into the cell (docs/design.md)
@@ -286,7 +286,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
 
     def overlap_run(self, ratio):
         sim, exp, ens = self.pair((250.0, 250.0), (250.0, 250.0))
-        d0 = float(ens._a["r"].sum())
+        d0 = float(ens.sphere_arrays["r"].sum())
         ens.sphereList[1].x = 250.0 + ratio * d0
         mon = ContactMonitor()
         self.until_apart(exp, mon)
@@ -303,7 +303,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
         self.assertLessEqual(ke.max(), U0)                                 # no energy created
         self.assertGreater(ke[-1], 0.5 * U0)                               # viscous loss is moderate (rv 0.1)
         ens.mechanical_simulation_step(1.0, exp.dt)                        # apart: no force, KE constant
-        a = ens._a
+        a = ens.sphere_arrays
         ke_next = 0.5 * float(a["m"] @ (a["xspeed"] ** 2 + a["yspeed"] ** 2) + a["inertia"] @ a["omega"] ** 2)
         self.assertAlmostEqual(ke_next, ke[-1], delta=1e-12 * ke[-1])
 
@@ -319,7 +319,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
     def test_coincident_centres(self):
         """d = 0: a random normal (docs/design.md) and the capped force 999·k·c·d0 (eq. S1-6) separate the pair."""
         sim, exp, ens = self.pair((250.0, 250.0), (250.0, 250.0))
-        d0 = float(ens._a["r"].sum())
+        d0 = float(ens.sphere_arrays["r"].sum())
         mon = ContactMonitor(skip_first=True)
         self.until_apart(exp, mon)
         self.assertTrue(mon.finite)
@@ -327,7 +327,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
         # after the first kick the centres are apart and the gap only opens
         self.assertGreater(mon.ratios[1], 0.0)
         self.assertTrue(all(b >= a * (1 - 1e-12) for a, b in zip(mon.ratios[1:], mon.ratios[2:])))
-        a = ens._a
+        a = ens.sphere_arrays
         # momentum conserved by the equal and opposite pair force: Σ m v = 0 (up to round-off)
         p = ens.total_momentum()
         scale = float(a["m"] @ np.hypot(a["xspeed"], a["yspeed"]))
@@ -349,7 +349,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
         for label, (p0, p1, plates) in cases.items():
             with self.subTest(label):
                 sim, exp, ens = self.pair((100.0, 100.0), (300.0, 300.0))
-                d0 = float(ens._a["r"].sum())
+                d0 = float(ens.sphere_arrays["r"].sum())
                 s0, s1 = ens.sphereList
                 s0.x, s0.y = p0
                 # partner overlaps by 20 % across the boundary
@@ -371,8 +371,8 @@ class TestStabilityGuard(unittest.TestCase):
     def test_two_sphere_blow_up(self):
         sim, exp, ens = build(N=2, links=False, cut_lines=0, packing_fraction=0.05, avoid=False)
         s0, s1 = ens.sphereList
-        s0.x, s0.y, s1.x, s1.y = 250.0, 250.0, 250.0 + 0.9 * float(ens._a["r"].sum()), 250.0
-        s1.xspeed = -1e3 * float(ens._a["r"].sum()) / exp.dt     # head-on at 1000 d0 per step
+        s0.x, s0.y, s1.x, s1.y = 250.0, 250.0, 250.0 + 0.9 * float(ens.sphere_arrays["r"].sum()), 250.0
+        s1.xspeed = -1e3 * float(ens.sphere_arrays["r"].sum()) / exp.dt     # head-on at 1000 d0 per step
         ens.applyingShear = False
         ens.stability_guard = StabilityGuard()
         ens.phase = "test"

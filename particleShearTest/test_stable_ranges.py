@@ -1,4 +1,4 @@
-"""The documented ranges of the stiffness and viscosity factors are the ranges that run (issue 43, item 10).
+"""The documented ranges of the stiffness and viscosity factors are the ranges that run.
 
 Beyond them the explicit step diverges during the constitution (whose step ``time_step_factor``
 does not change), so they are refused before any work; at their limits a run ends with finite

@@ -1,4 +1,4 @@
-"""Sweeps (issue 12): SPEC parsing and validation, run identity, results table, resume after a
+"""Sweeps: SPEC parsing and validation, run identity, results table, resume after a
 SIGKILL, failed runs as rows, Dask and job-array execution equal to the local one, the series on
 the sweep machinery.
 

@@ -1,4 +1,4 @@
-"""A sweep touches only what it made, and resume verifies every kept run (issue 43, Why 1 and 3).
+"""A sweep touches only what it made, and resume verifies every kept run.
 
 * scratch: ``DIR/runs`` may hold the user's folders and files, old ones included (mtimes set in
   the past with ``os.utime``), folders of dead sweeps, and symbolic links; a sweep removes only the

@@ -1,4 +1,4 @@
-"""One table reader for ``load_results``, ``analyse``, ``plot`` and the sweep (issue 43, Why 4 and 7).
+"""One table reader for ``load_results``, ``analyse``, ``plot`` and the sweep.
 
 Real files throughout: a sweep folder is made once by a real ``run_sweep`` over a stand-in
 simulation (instant, deterministic rows: 3 amplitudes × 2 friction coefficients, one seed), then

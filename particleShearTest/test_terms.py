@@ -172,16 +172,18 @@ class TestClassesUseTheTerms(unittest.TestCase):
         s.permanent_ratio_central = 0.5
         s.permanent_ratio_tangential = 2.0
         s.keep_viscosity_coefficients_constant = False    # its bonds' viscosities take the ratios too
-        before = ens._pairs.copy()                 # the histories the force phase starts from
+        before = ens.pair_table                        # (a copy) the histories the force phase starts from
         ens.mechanical_simulation_step_calculate_forces()
         g = ens._g
-        pt = ens._pairs
-        a = ens._a
+        pt = ens.pair_table
+        a = ens.sphere_arrays
         perm = pt.state[g.slots] == PERMANENT
         self.assertTrue(perm.any() and ((g.ai == 5) | (g.aj == 5))[perm].any())
         mine = np.arange(len(ens.sphereList)) == 5
         # each visit's constants by hand: the ratios of its own sphere
-        c = ens._param("central_repulsion_coefficient")
+        crc = a["central_repulsion_coefficient"]
+        self.assertTrue((crc == crc[0]).all())        # one value for every sphere
+        c = float(crc[0])
         K_i, K_j = (term_constants(g.d0, perm, pt.d_eq[g.slots], ens.k, c, ens.nu, ens.k_t, ens.nu_t, ens.mu,
                                    np.where(mine, 0.5, 1.0)[rows], np.where(mine, 2.0, 1.0)[rows],
                                    a["keep_viscosity_coefficients_constant"][rows])

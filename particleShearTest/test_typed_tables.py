@@ -1,4 +1,4 @@
-"""Typed, self-describing results tables (issue 22): ``load_results``, ``results.schema.json``, the
+"""Typed, self-describing results tables: ``load_results``, ``results.schema.json``, the
 typed Parquet copy, typed ``run_sweep`` rows, the run columns (repetition, frequency, ω, dt, steps),
 rows in SPEC order after a sweep whose runs finished in reverse order, and no lock or scratch file
 left behind.

@@ -23,6 +23,11 @@ from particleShearTest.test_engine import classes_measurement, constituted
 from particleShearTest.test_force_laws import central_law_definition as _definition
 from particleShearTest.classes_loops import assert_same_register, classes_pre_equilibrate, classes_run_protocol
 
+
+def state_block(ens):
+    """The ensemble's per-sphere state, one row per field of ``FIELDS`` (a copy)."""
+    return np.array(list(ens.sphere_arrays.values()))
+
 K, NU = 1000.0, 7.0
 
 
@@ -165,17 +170,17 @@ class TestExperimentInTheEngine(unittest.TestCase):
             self.assertLessEqual(np.max(np.abs(a[key] - b[key])), 1e-12 * np.max(np.abs(b[key])), key)
         self.assertTrue(all(np.isfinite(G)))
         for name in ("x", "y"):
-            self.assertLessEqual(np.max(np.abs(ens._a[name] - ref._a[name])), 1e-12 * 200, name)
+            self.assertLessEqual(np.max(np.abs(ens.sphere_arrays[name] - ref.sphere_arrays[name])), 1e-12 * 200, name)
         self.assertEqual((ens.t, ens.shear, ens.step_count), (ref.t, ref.shear, ref.step_count))
         # the force register holds the last step's forces, as the step loop leaves it
         assert_same_register(self, ens, ref)
         self.assertGreater(len(ens.force_register.pair_register), 0)
         self.assertEqual(len(ens.force_register.internal_moment_register) > 0, "k_t" in kw)   # tangential visits
         # the same relations, numbered in the order they formed (the order of ``neighbors``)
-        pe, pr = ens._pairs, ref._pairs
+        pe, pr = ens.pair_table, ref.pair_table
         self.assertEqual(pe.key[pe.active].tolist(), pr.key[pr.active].tolist())
         self.assertEqual(pe.birth[pe.active].tolist(), pr.birth[pr.active].tolist())
-        self.assertEqual(pe._births, pr._births)
+        self.assertEqual(pe.birth_count, pr.birth_count)
 
 
     def test_register_and_tensors_after_the_protocol(self):
@@ -230,23 +235,23 @@ class TestExperimentInTheEngine(unittest.TestCase):
         n = len(ens.sphereList)
         for run in ("protocol", "relaxation"):
             with self.subTest(run=run):
-                block, pt = ens._block[:, :n].copy(), ens._pairs.copy()
-                state = (ens.t, ens.shear, ens.step_count, ens.phase, ens._pairs._births)
+                block, pt = state_block(ens), ens.pair_table
+                state = (ens.t, ens.shear, ens.step_count, ens.phase, ens.pair_table.birth_count)
                 ens.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=8)
                 with self.assertRaises(SimulationInstabilityError if run == "protocol" else EngineInstability):
                     exp.run_protocol(sc["cool"]) if run == "protocol" else relax_ensembles([ens], 20)
                 ens.stability_guard = None
-                self.assertEqual(ens._block[:, :n].tobytes(), block.tobytes())
+                self.assertEqual(state_block(ens).tobytes(), block.tobytes())
                 for name in ("key", "state", "xi", "d_eq", "active", "birth"):
-                    self.assertEqual(getattr(ens._pairs, name).tobytes(), getattr(pt, name).tobytes(), name)
-                self.assertEqual((ens.t, ens.shear, ens.step_count, ens.phase, ens._pairs._births), state)
+                    self.assertEqual(getattr(ens.pair_table, name).tobytes(), getattr(pt, name).tobytes(), name)
+                self.assertEqual((ens.t, ens.shear, ens.step_count, ens.phase, ens.pair_table.birth_count), state)
         # ... and a run after it is the run of an ensemble that never failed
         _, ref, _ = constituted(7, **SCENE)
         x_ref = OscillatoryShearExperiment(ref, sc["dt"], sc["f"], sc["A"], False, dt_max=sc["dt_max"])
         x_ref.pre_equilibrate(4, sc["cool"])
         for e, x in ((ens, exp), (ref, x_ref)):
             x.run_protocol(sc["cool"], 30)
-        self.assertEqual(ens._block[:, :n].tobytes(), ref._block[:, :n].tobytes())
+        self.assertEqual(state_block(ens).tobytes(), state_block(ref).tobytes())
         self.assertEqual(exp.plotter.arrays()["stress_surface"].tobytes(), x_ref.plotter.arrays()["stress_surface"].tobytes())
 
 
@@ -273,7 +278,7 @@ class TestBatchOfOwnAndShared(unittest.TestCase):
         state, both, ensembles = measure([0, 1])
         # every sphere of the batch carries its own ensemble's values, the shared replica's included
         for k, name in enumerate(PER_SPHERE_PARAMETERS):
-            want = np.concatenate([np.asarray(e._a[name][:state.N], dtype=float) for e in ensembles])
+            want = np.concatenate([np.asarray(e.sphere_arrays[name][:state.N], dtype=float) for e in ensembles])
             np.testing.assert_array_equal(state.visit[k], want, name)
         for b in range(2):
             for key in ("stress_internal", "stress_surface", "strain"):

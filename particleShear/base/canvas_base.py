@@ -156,6 +156,31 @@ class CanvasPoints:
             raise TypeError("sphereList can only be assigned while the ensemble is empty")
         self._sphereList.extend(spheres)
 
+    @property
+    def sphere_arrays(self):
+        """The per-sphere state and parameters, one read-only array per field (``sphereList`` order).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            A new dict on each read, keyed by the fields of
+            :data:`~particleShear.base.fields.FIELDS`: ``x, y`` (µm), ``phi`` (rad), ``xspeed,
+            yspeed`` (µm/s), ``omega`` (1/s), ``r`` (µm), ``m`` (mg/m), ``inertia`` (mg·µm²/m),
+            ``xforce, yforce, torque`` of the last force phase (per metre of depth, reference
+            units of docs/parameters.md) and the per-sphere model parameters
+            ``central_repulsion_coefficient``, ``permanent_ratio_central``,
+            ``permanent_ratio_tangential``, ``keep_viscosity_coefficients_constant``.  Each value
+            is a read-only view (shape (N,)) of the ensemble's own state: it follows later steps
+            until a sphere is appended (then read the property again).  Change a value through
+            the sphere's attribute (``ens.sphereList[k].x = ...``), which checks it.
+        """
+        out = {}
+        for name, row in self._a.items():
+            view = row.view()
+            view.flags.writeable = False
+            out[name] = view
+        return out
+
     def set_random_generator(self, rng):
         """Use ``rng`` for every random choice of this ensemble (the run seeds it).
 

@@ -95,6 +95,21 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
         elif s >= 0:
             pt.close_relations(s)
 
+    @property
+    def pair_table(self):
+        """A copy of the ensemble's pair table: its candidate pairs and their relation history.
+
+        Returns
+        -------
+        PairTable
+            An independent :class:`~particleShear.engine.state.PairTable` (sphere indices
+            ``i < j``, ``state``, ``xi`` (µm), ``d_eq`` (µm), ``active``, ``birth`` and the counter
+            :attr:`~particleShear.engine.state.PairTable.birth_count`) as of this read; editing
+            it leaves the ensemble alone (relations are edited through the spheres and their
+            ``neighbors``).
+        """
+        return self._pairs.copy()
+
     def contact_pairs(self):
         """Sphere indices (i, j), i < j, of the current relations (contacts and links)."""
         pt = self._pairs

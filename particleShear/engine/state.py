@@ -109,9 +109,10 @@ class PairTable:
     ``state`` (stick / slip / permanent), ``xi`` (2, C: ξ_ij, ξ_ji in µm), ``d_eq`` (µm, bonds),
     ``active`` (a relation of the reference: touching at the last neighbour update, or a bond) and
     ``birth``, the creation number of each relation (the order of ``sphere.neighbors``), with the
-    counter of the next number (``_births``).  The one pair table of the package: the documented
-    ensembles hold one, and the engine keeps one per replica (:attr:`BatchState.pairs`; a state on
-    an ensemble's own memory, :func:`particleShear.base.engine_adapter.state_of_ensembles`, keeps the
+    counter of the next number (:attr:`birth_count`).  The one pair table of the package: the documented
+    ensembles hold one (a copy: ``ens.pair_table``), and the engine keeps one per replica
+    (:attr:`BatchState.pairs`; a state on an ensemble's own memory,
+    :func:`particleShear.base.engine_adapter.state_of_ensembles`, keeps the
     ensemble's own).  The arguments are converted (not validated) to the dtypes below.
 
     Parameters
@@ -188,6 +189,14 @@ class PairTable:
         self.n_permanent = int((self.state == PERMANENT).sum())
         self._births = other._births
         self.version += 1
+
+    @property
+    def birth_count(self):
+        """How many creation numbers were handed out (int): the number the next relation gets.
+
+        Read-only; :meth:`next_births` and :meth:`open_relations` advance it.
+        """
+        return self._births
 
     @property
     def xi_ij(self):

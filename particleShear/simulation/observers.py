@@ -36,7 +36,8 @@ class ReplicaView:
     """Replica ``b`` of an engine's state, seen as the ensemble the renderers of :mod:`.drawing` draw.
 
     It offers what they read — ``_a`` (host copies of ``x, y, r, phi``, µm and rad), ``_pairs``
-    (``i, j, state, active`` of the replica's candidates), ``_le_shift()`` (L_y·γ, µm),
+    (``i, j, state, active`` of the replica's candidates; both also as the public, read-only
+    :attr:`sphere_arrays` and :attr:`pair_table`), ``_le_shift()`` (L_y·γ, µm),
     ``size_x``, ``size_y`` (µm), ``t`` (s), ``shear`` (γ) and ``graphical_output_configuration`` —
     as copies read from ``engine.s`` and the engine's pair history when first asked after a step
     (one read per step at most, however often a picture reads them).  Nothing of the engine is
@@ -93,6 +94,35 @@ class ReplicaView:
                 state, active = (to_host(a[lo:hi], "state") for a in (e.state_p, e.active))
             cur["_pairs"] = _Pairs(np.array(p.i), np.array(p.j), np.array(state), np.array(active))
         return cur["_pairs"]
+
+    @property
+    def sphere_arrays(self):
+        """``x, y, r, phi`` of the replica's spheres (µm, rad), named as an ensemble's
+        :attr:`~particleShear.base.canvas.CanvasPoints.sphere_arrays`.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Read-only views of the host copies this view read after the engine's last step.
+        """
+        out = {}
+        for name, row in self._a.items():
+            out[name] = row.view()
+            out[name].flags.writeable = False
+        return out
+
+    @property
+    def pair_table(self):
+        """The replica's candidate pairs: ``i, j`` (local sphere indices), ``state`` (stick / slip /
+        permanent) and ``active`` (a relation), host copies (the fields a picture reads of an
+        ensemble's :attr:`~particleShear.base.pair_canvas.CanvasPointsNeighbors.pair_table`).
+
+        Returns
+        -------
+        object
+            With array attributes ``i, j, state, active``.
+        """
+        return self._pairs
 
     @property
     def size_x(self):
