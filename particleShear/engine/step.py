@@ -511,7 +511,7 @@ class BatchEngine:
         out = None
         shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
         if self.keep_terms:
-            self.terms = _TermRecord(C, parts, F, dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
+            self.terms = _TermRecord(C, parts, self.xp.stack(F), dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
                                      fx_j, fy_j, dF, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(

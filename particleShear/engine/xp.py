@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
+__all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
            "backend_of", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
@@ -46,6 +46,44 @@ REASONS = {
     "register": "the last force phase's terms, for the force register of a documented ensemble",
     "microstructure": "positions, strain and contact forces at a snapshot of the stroboscopic observer (once per period)",
 }
+
+def select(cond, a, b):
+    """``a`` where ``cond`` holds, else ``b``: the one branch a law may take (docs/design.md, "One law, two drivers").
+
+    On arrays (NumPy, or CuPy through NumPy's dispatch) it is ``numpy.where(cond, a, b)``; inside
+    compiled code it is ``a if cond else b`` on numbers (registered with Numba by
+    :func:`particleShear.engine.numba_driver.register_helpers`, only where Numba is installed).
+
+    Parameters
+    ----------
+    cond : ndarray of bool or bool
+        The condition, per element.
+    a, b : ndarray or float
+        The values where it holds and where it does not (broadcast).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    return np.where(cond, a, b)
+
+
+def maximum(a, b):
+    """Element-wise maximum of a law (``max`` on two numbers, ``numpy.maximum`` otherwise; Numba: ``max``).
+
+    Parameters
+    ----------
+    a, b : ndarray or float
+        The operands (broadcast).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    if isinstance(a, float) and isinstance(b, float):   # (the documented per-pair callbacks: no ufunc call)
+        return max(a, b)
+    return np.maximum(a, b)
+
 
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
 
