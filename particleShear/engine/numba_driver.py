@@ -1,0 +1,246 @@
+"""The compiled pair loop (Numba, optional): the force terms of the candidates, from the same law functions.
+
+The laws, the viscous term and the two-visit tangential rule are pure expressions of plain
+arguments (:func:`~particleShear.engine.laws.linear_term`, :func:`~particleShear.engine.laws.divergent_term`,
+:func:`~particleShear.engine.laws.blend_inside`, :func:`~particleShear.engine.laws.tensile_inside`,
+:func:`~particleShear.engine.laws.contact_or_bond`, :func:`~particleShear.engine.terms.viscous_force`,
+:func:`~particleShear.engine.tangential.two_visit_rule`, with :func:`~particleShear.engine.xp.select`
+and :func:`~particleShear.engine.xp.maximum` for their branches).  The NumPy engine calls them on
+arrays; this module registers the very same function objects with Numba
+(:func:`jit_laws`; ``select`` becomes ``a if cond else b`` and ``maximum`` ``max`` on numbers) and calls them on numbers inside one compiled loop over the candidate pairs
+(:func:`pair_terms`).  Changing a law's body therefore changes both backends (tested).
+
+What this module compiles is the force terms of a candidate set (central scalar, elastic law,
+the two tangential visits, the slip flags and the ξ reset), bit-identical to the NumPy terms
+(:func:`~particleShear.engine.terms.central_term` and :func:`~particleShear.engine.terms.tangential_term`);
+the step loop itself (neighbours, scatter, integration, the protocol) runs on NumPy
+(docs/backends.md, "The compiled backend").
+
+Numba is imported only inside the functions here, never by importing the package.  The compiled
+code is cached (``cache=True``) in :func:`cache_dir`, a folder keyed by the source of the law
+modules (Numba's own cache checks only the file of the compiled function, not the laws it calls).
+"""
+__docformat__ = "numpy"
+
+import hashlib
+import os
+import sys
+
+import numpy as np
+
+from . import laws, tangential, terms, xp
+
+__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "compile_pair_kernel", "pair_terms", "FORMS", "LAW_FUNCTIONS"]
+
+#: the code of each form of the compressive law in the compiled loop
+FORMS = {laws.BLEND: 0, laws.LINEAR: 1, laws.DIVERGENT: 2}
+
+#: the pure functions the compiled loop calls: ``(module, name)``, looked up when it is compiled
+LAW_FUNCTIONS = ((laws, "linear_term"), (laws, "divergent_term"), (laws, "blend_inside"), (laws, "tensile_inside"),
+                 (laws, "contact_or_bond"), (terms, "viscous_force"), (tangential, "coulomb_clip"),
+                 (tangential, "two_visit_rule"))
+
+_SOURCES = (laws, terms, tangential, xp, sys.modules[__name__])
+_registered = set()     # the helpers registered with Numba (their ids)
+_kernels = {}           # cache flag -> compiled kernel
+
+
+def available():
+    """Whether Numba can be imported here (bool)."""
+    try:
+        import numba  # noqa: F401
+    except Exception:   # ImportError, or a Numba build that does not fit the installed NumPy
+        return False
+    return True
+
+
+def cache_dir():
+    """The folder of the compiled code: ``$NUMBA_CACHE_DIR`` or the user's cache folder, keyed by the law sources.
+
+    ``$PARTICLESHEAR_CACHE`` or ``$XDG_CACHE_HOME/particleShear`` (default ``~/.cache/particleShear``),
+    then ``numba-<hash>``, the hash of the source files of the laws, terms, tangential rule,
+    :mod:`.xp` and this module: an edited law gets a fresh folder (Numba's cache would not notice it).
+
+    Returns
+    -------
+    str
+        A writable folder (created).
+    """
+    h = hashlib.sha1()
+    for m in _SOURCES:
+        with open(m.__file__, "rb") as f:
+            h.update(f.read())
+    base = os.environ.get("PARTICLESHEAR_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "particleShear")
+    folder = os.path.join(os.environ.get("NUMBA_CACHE_DIR") or base, f"numba-{h.hexdigest()[:12]}")
+    os.makedirs(folder, exist_ok=True)
+    return folder
+
+
+def register_helpers():
+    """Register :func:`~particleShear.engine.xp.select` and :func:`~particleShear.engine.xp.maximum`
+    with Numba for numbers (``a if cond else b``, ``max``); once per process.
+
+    Raises
+    ------
+    ImportError
+        Without Numba.
+    """
+    from numba.extending import overload
+
+    if id(xp.select) not in _registered:
+        @overload(xp.select)
+        def _select(cond, a, b):
+            return lambda cond, a, b: a if cond else b
+
+        @overload(xp.maximum)
+        def _maximum(a, b):
+            return lambda a, b: max(a, b)
+
+        _registered.add(id(xp.select))
+
+
+def jit_laws(cache=True):
+    """The law functions of :data:`LAW_FUNCTIONS` as they are now, each compiled by Numba.
+
+    Each function is compiled from its own code object with its module's globals, in which the
+    names of the other law functions are their compiled versions (so ``blend_inside`` calls the
+    compiled ``linear_term`` of this call: a law replaced in its module is read afresh).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        ``cache=True`` for Numba (the folder :func:`cache_dir`).
+
+    Returns
+    -------
+    dict
+        Name → Numba dispatcher.
+    """
+    import types
+
+    import numba
+
+    register_helpers()
+    compiled, namespaces = {}, []
+    for module, name in LAW_FUNCTIONS:
+        f = getattr(module, name)
+        g = dict(f.__globals__)
+        namespaces.append(g)
+        copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
+        copy.__qualname__, copy.__module__ = f.__qualname__, f.__module__
+        compiled[name] = numba.njit(copy, cache=cache)
+    for g in namespaces:      # (globals are read when a function is compiled, at its first call)
+        g.update(compiled)
+    return compiled
+
+
+def compile_pair_kernel(cache=True):
+    """The compiled loop over candidate pairs that evaluates their force terms (see :func:`pair_terms`).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        Keep the compiled code in :func:`cache_dir` (and reuse the kernel of this process); False
+        compiles afresh from the law functions as they are now (a test that edits a law).
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+        ``kernel(form, d, vn, vt, touching, active, xi, d_law, d_cap, a_lin, a_div, d_eq, a_tens,
+        ratio_c, nu, k_t, k_t_j, nu_t, nu_t_j, mu, fc_inf, fn, law, F, slip)``; writes ``fn, law,
+        F, slip`` and resets ``xi`` (all arrays of the P candidates, ``xi`` and ``F`` (2, P)).
+    """
+    if cache and True in _kernels:
+        return _kernels[True]
+    import numba
+
+    if cache:
+        numba.config.CACHE_DIR = cache_dir()
+    # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
+    L = jit_laws(cache)
+    linear_term, divergent_term, blend_inside = L["linear_term"], L["divergent_term"], L["blend_inside"]
+    tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
+    viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
+
+    def kernel(form, d, vn, vt, touching, active, xi, d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t,
+               k_t_j, nu_t, nu_t_j, mu, fc_inf, fn, law_out, F, slip):
+        for p in range(d.shape[0]):
+            r = d[p]
+            if form == 1:
+                inside = linear_term(r, d_law[p], a_lin[p])
+            elif form == 2:
+                inside = divergent_term(r, d_law[p], d_cap[p], a_div[p])
+            else:
+                inside = blend_inside(r, d_law[p], d_cap[p], a_lin[p], a_div[p])
+            law = contact_or_bond(r, d_law[p], inside, tensile_inside(r, d_eq[p], a_tens[p]))
+            f = law * ratio_c[p]
+            f += viscous_force(nu[p], vn[p], active[p])
+            fn[p] = f
+            law_out[p] = law
+            fc = np.abs(mu[p] * law)
+            fc += fc_inf[p]
+            F_i, F_j, s, reset = two_visit_rule(vt[p], touching[p], xi[0, p], xi[1, p], k_t[p], k_t_j[p], nu_t[p],
+                                                nu_t_j[p], fc)
+            F[0, p] = F_i
+            F[1, p] = F_j
+            slip[p] = s
+            if reset:
+                xi[0, p] = 0.0
+                xi[1, p] = 0.0
+
+    compiled = numba.njit(kernel, cache=cache)
+    if cache:
+        _kernels[True] = compiled
+    return compiled
+
+
+def _rows(value, P):
+    """``value`` as a contiguous float array over the P candidates (a number is repeated)."""
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=float), (P,)))
+
+
+def pair_terms(K, d, vn, vt, touching, active, xi, K_j=None, kernel=None):
+    """Force terms of P candidates in one compiled loop: what ``central_term`` and ``tangential_term`` give.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs seen by the visit from i (:func:`~particleShear.engine.terms.term_constants`).
+    d, vn, vt : ndarray (P,)
+        Centre distances (µm), normal and tangential relative velocities (µm/s).
+    touching, active : ndarray of bool (P,)
+        Overlapping pairs; relations (touching, or a bond).
+    xi : ndarray (2, P)
+        Histories ξ_ij, ξ_ji (µm), reset to 0 in place on slip.
+    K_j : TermConstants, optional
+        Constants seen by the visit from j (its ``k_t``, ``nu_t``; default ``K``).
+    kernel : callable, optional
+        A kernel of :func:`compile_pair_kernel` (default: the cached one).
+
+    Returns
+    -------
+    fn : ndarray (P,)
+        Central scalar on i along ``n_ij`` (elastic + viscous; mg·µm·s⁻² per m depth).
+    law : ndarray (P,)
+        The elastic law before the permanent ratio.
+    F : ndarray (2, P)
+        Tangential forces of the two visits.
+    slip : ndarray of bool (P,)
+        The final slip flag.
+    """
+    kernel = compile_pair_kernel() if kernel is None else kernel
+    K_j = K if K_j is None else K_j
+    P = len(d)
+    # no bond: the tensile law of contacts, −0·(0 − d) = +0 (what the NumPy term puts beyond contact)
+    d_eq, a_tens = (0.0, -0.0) if K.a_tens is None else (K.d_eq, K.a_tens)
+    rows = [_rows(v, P) for v in (K.d_law, K.d_cap, K.a_lin, K.a_div, d_eq, a_tens, K.ratio_c, K.nu, K.k_t, K_j.k_t,
+                                  K.nu_t, K_j.nu_t, K.mu, K.fc_inf)]
+    if not (isinstance(xi, np.ndarray) and xi.dtype == np.float64 and xi.flags.c_contiguous):
+        raise ValueError(f"xi of dtype {getattr(xi, 'dtype', type(xi))} is invalid: allowed a C-contiguous float64 "
+                         "(2, P) NumPy array (reset in place)")
+    fn, law, F, slip = np.empty(P), np.empty(P), np.empty((2, P)), np.empty(P, dtype=np.bool_)
+    kernel(FORMS[K.form], np.ascontiguousarray(d, dtype=float), np.ascontiguousarray(vn, dtype=float),
+           np.ascontiguousarray(vt, dtype=float), np.ascontiguousarray(touching, dtype=float),
+           np.ascontiguousarray(active, dtype=np.bool_), xi, *rows, fn, law, F, slip)
+    return fn, law, F, slip
