@@ -29,6 +29,7 @@ import sys
 import numpy as np
 
 from . import laws, tangential, terms, xp
+from .forces import PairConstants
 
 __all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "compile_pair_kernel", "pair_terms", "FORMS", "LAW_FUNCTIONS"]
 
@@ -39,6 +40,11 @@ FORMS = {laws.BLEND: 0, laws.LINEAR: 1, laws.DIVERGENT: 2}
 LAW_FUNCTIONS = ((laws, "linear_term"), (laws, "divergent_term"), (laws, "blend_inside"), (laws, "tensile_inside"),
                  (laws, "contact_or_bond"), (terms, "viscous_force"), (tangential, "coulomb_clip"),
                  (tangential, "two_visit_rule"))
+
+#: the constants the compiled loop reads, in the order of the rows of its block (the kernel reads them by position)
+TERM_BLOCK = PairConstants.TERM_ROWS
+_TERM_START = PairConstants.FLOAT_ROWS.index(TERM_BLOCK[0])     # where they start in the engine's float block
+assert PairConstants.FLOAT_ROWS[_TERM_START:_TERM_START + len(TERM_BLOCK)] == TERM_BLOCK
 
 _SOURCES = (laws, terms, tangential, xp, sys.modules[__name__])
 _registered = set()     # the helpers registered with Numba (their ids)
@@ -147,9 +153,9 @@ def compile_pair_kernel(cache=True):
     Returns
     -------
     numba.core.registry.CPUDispatcher
-        ``kernel(form, d, vn, vt, touching, active, xi, d_law, d_cap, a_lin, a_div, d_eq, a_tens,
-        ratio_c, nu, k_t, k_t_j, nu_t, nu_t_j, mu, fc_inf, fn, law, F, slip)``; writes ``fn, law,
-        F, slip`` and resets ``xi`` (all arrays of the P candidates, ``xi`` and ``F`` (2, P)).
+        ``kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law, F, slip)`` with
+        ``T`` the (12, P) constants of :data:`TERM_BLOCK`; writes ``fn, law, F, slip`` and resets
+        ``xi`` (all arrays of the P candidates, ``xi`` and ``F`` (2, P)).
     """
     if cache and True in _kernels:
         return _kernels[True]
@@ -163,25 +169,25 @@ def compile_pair_kernel(cache=True):
     tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
     viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
 
-    def kernel(form, d, vn, vt, touching, active, xi, d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t,
-               k_t_j, nu_t, nu_t_j, mu, fc_inf, fn, law_out, F, slip):
+    def kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
+        # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
         for p in range(d.shape[0]):
             r = d[p]
             if form == 1:
-                inside = linear_term(r, d_law[p], a_lin[p])
+                inside = linear_term(r, T[0, p], T[2, p])
             elif form == 2:
-                inside = divergent_term(r, d_law[p], d_cap[p], a_div[p])
+                inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
             else:
-                inside = blend_inside(r, d_law[p], d_cap[p], a_lin[p], a_div[p])
-            law = contact_or_bond(r, d_law[p], inside, tensile_inside(r, d_eq[p], a_tens[p]))
-            f = law * ratio_c[p]
-            f += viscous_force(nu[p], vn[p], active[p])
+                inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
+            law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
+            f = law * T[6, p]
+            f += viscous_force(T[7, p], vn[p], active[p])
             fn[p] = f
             law_out[p] = law
-            fc = np.abs(mu[p] * law)
-            fc += fc_inf[p]
-            F_i, F_j, s, reset = two_visit_rule(vt[p], touching[p], xi[0, p], xi[1, p], k_t[p], k_t_j[p], nu_t[p],
-                                                nu_t_j[p], fc)
+            fc = np.abs(T[10, p] * law)
+            fc += T[11, p]
+            F_i, F_j, s, reset = two_visit_rule(vt[p], 1.0 if touching[p] else 0.0, xi[0, p], xi[1, p], T[8, p],
+                                                k_t_j[p], T[9, p], nu_t_j[p], fc)
             F[0, p] = F_i
             F[1, p] = F_j
             slip[p] = s
@@ -197,6 +203,8 @@ def compile_pair_kernel(cache=True):
 
 def _rows(value, P):
     """``value`` as a contiguous float array over the P candidates (a number is repeated)."""
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (P,) and value.flags.c_contiguous:
+        return value        # (the engine's constants per candidate: as they are)
     return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=float), (P,)))
 
 
@@ -230,17 +238,23 @@ def pair_terms(K, d, vn, vt, touching, active, xi, K_j=None, kernel=None):
         The final slip flag.
     """
     kernel = compile_pair_kernel() if kernel is None else kernel
-    K_j = K if K_j is None else K_j
     P = len(d)
-    # no bond: the tensile law of contacts, −0·(0 − d) = +0 (what the NumPy term puts beyond contact)
-    d_eq, a_tens = (0.0, -0.0) if K.a_tens is None else (K.d_eq, K.a_tens)
-    rows = [_rows(v, P) for v in (K.d_law, K.d_cap, K.a_lin, K.a_div, d_eq, a_tens, K.ratio_c, K.nu, K.k_t, K_j.k_t,
-                                  K.nu_t, K_j.nu_t, K.mu, K.fc_inf)]
+    if isinstance(K, PairConstants) and isinstance(K.f, np.ndarray):
+        T = K.f[_TERM_START:_TERM_START + len(TERM_BLOCK)]    # the engine's constants: rows of its block, as they are
+    else:
+        # no bond: the tensile law of contacts, −0·(0 − d) = +0 (what the NumPy term puts beyond contact)
+        values = dict(d_eq=0.0, a_tens=-0.0) if K.a_tens is None else {}
+        T = np.empty((len(TERM_BLOCK), P))
+        for k, name in enumerate(TERM_BLOCK):
+            T[k] = values.get(name, getattr(K, name))
+    if K_j is None:
+        k_t_j, nu_t_j = T[8], T[9]
+    else:
+        k_t_j, nu_t_j = _rows(K_j.k_t, P), _rows(K_j.nu_t, P)
     if not (isinstance(xi, np.ndarray) and xi.dtype == np.float64 and xi.flags.c_contiguous):
         raise ValueError(f"xi of dtype {getattr(xi, 'dtype', type(xi))} is invalid: allowed a C-contiguous float64 "
                          "(2, P) NumPy array (reset in place)")
     fn, law, F, slip = np.empty(P), np.empty(P), np.empty((2, P)), np.empty(P, dtype=np.bool_)
-    kernel(FORMS[K.form], np.ascontiguousarray(d, dtype=float), np.ascontiguousarray(vn, dtype=float),
-           np.ascontiguousarray(vt, dtype=float), np.ascontiguousarray(touching, dtype=float),
-           np.ascontiguousarray(active, dtype=np.bool_), xi, *rows, fn, law, F, slip)
+    kernel(FORMS[K.form], _rows(d, P), _rows(vn, P), _rows(vt, P), np.asarray(touching, dtype=np.bool_),
+           np.asarray(active, dtype=np.bool_), xi, T, k_t_j, nu_t_j, fn, law, F, slip)
     return fn, law, F, slip

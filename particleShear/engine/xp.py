@@ -22,15 +22,18 @@ and :func:`array_namespace` recognises CuPy arrays only once CuPy has been impor
 __docformat__ = "numpy"
 
 import contextlib
+import os
 import sys
 
 import numpy as np
 
 __all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
-           "backend_of", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+           "backend_of", "resolve_backend", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
 CUPY_INSTALL = "pip install cupy-cuda12x"
+#: how to install Numba (named in the error of ``backend="numba"`` without it)
+NUMBA_INSTALL = "pip install particleShear[fast]"
 
 #: the reasons for which the engine reads device values on the host (the argument ``why`` of :func:`to_host`)
 REASONS = {
@@ -135,6 +138,9 @@ class Backend:
         reduction along rows.
     """
 
+    #: the force terms of a step run in one compiled loop (:mod:`.numba_driver`), on NumPy arrays
+    compiled = False
+
     def __init__(self, name, xp, host, asarray, to_host, owns, ordered_reductions=True):
         self.name, self.xp, self.host = name, xp, bool(host)
         self.asarray, self._to_host, self.owns = asarray, to_host, owns
@@ -146,6 +152,47 @@ class Backend:
 
 def _numpy_backend():
     return Backend("numpy", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
+
+
+def _numba_backend():
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:  # ImportError, or a Numba build that does not fit the installed NumPy
+        raise ValueError(f"backend='numba' needs Numba: it cannot be imported ({exc}); install it with "
+                         f"`{NUMBA_INSTALL}` or choose backend='numpy'") from None
+    b = Backend("numba", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
+    b.compiled = True
+    return b
+
+
+def _numba_importable():
+    try:
+        import numba  # noqa: F401
+    except Exception:
+        return False
+    return True
+
+
+def resolve_backend(name=None):
+    """The backend a run uses: ``name``, ``$PARTICLESHEAR_BACKEND`` when ``name`` is None, and
+    ``"auto"`` resolved (``"numba"`` where Numba can be imported, else ``"numpy"``).
+
+    Parameters
+    ----------
+    name : str or None
+        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"`` or a registered name; None: the
+        environment variable ``PARTICLESHEAR_BACKEND`` (default ``"numpy"``).
+
+    Returns
+    -------
+    str
+        The name of a backend (not ``"auto"``).
+    """
+    if name is None:
+        name = os.environ.get("PARTICLESHEAR_BACKEND") or "numpy"
+    if name == "auto":
+        return "numba" if _numba_importable() else "numpy"
+    return name
 
 
 def _cupy_backend():
@@ -166,7 +213,7 @@ def _cupy_backend():
                    ordered_reductions=False)
 
 
-_FACTORIES = {"numpy": _numpy_backend, "cupy": _cupy_backend}
+_FACTORIES = {"numpy": _numpy_backend, "numba": _numba_backend, "cupy": _cupy_backend}
 _MADE = {}
 
 
@@ -194,7 +241,7 @@ def unregister_backend(name):
     ----------
     name : str
     """
-    if name not in ("numpy", "cupy"):
+    if name not in ("numpy", "numba", "cupy"):
         _FACTORIES.pop(name, None)
         _MADE.pop(name, None)
 
@@ -220,6 +267,8 @@ def get_backend(name="numpy"):
     """
     if isinstance(name, Backend):
         return name
+    if name == "auto":
+        name = resolve_backend(name)
     if not isinstance(name, str) or name not in _FACTORIES:
         raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, _FACTORIES))}")
     b = _MADE.get(name)

@@ -45,7 +45,7 @@ PER_REPLICA_PARAMETERS = frozenset(_names(batch="replica"))
 SCHEDULE_PARAMETERS = _names(batch="schedule")
 
 #: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
-BACKENDS = ("numpy", "cupy")
+BACKENDS = ("numpy", "numba", "auto", "cupy")
 
 
 def _signature_defaults():
