@@ -9,6 +9,7 @@ imports Numba on import (tested here with and without it).
 import subprocess
 import sys
 import unittest
+import warnings
 
 import numpy as np
 
@@ -109,6 +110,67 @@ class TestCompiledPairTerms(unittest.TestCase):
         self.assertEqual(f(True, 1.5, 2.0), 3.5)
         self.assertEqual(f(False, 1.5, 2.0), 4.0)
         self.assertIsInstance(f(True, 1.5, 2.0), float)
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestNumbaBackendRuns(unittest.TestCase):
+    """backend="numba" steps the engine with the compiled terms: the whole measurement (pre-equilibration
+    and protocol, 0.5 + 3 + 0.5 periods, > 1,000 steps) equals the NumPy engine's bit for bit, a
+    batch of two equals its single runs, and a scene the loop does not cover runs the NumPy terms
+    with a note."""
+
+    SCENES = (dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2),
+              dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))
+
+    def measure(self, scenes, backend, integrator="euler", periods=1):
+        from particleShear.engine.loops import pre_equilibrate, protocol
+        from particleShear.engine.state import BatchState
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        sc = constituted(11, **self.SCENES[0])[2]      # one schedule for every batch
+        ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
+        eng = BatchEngine(BatchState.from_ensembles(ensembles, backend=backend), integrator=integrator)
+        pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+        out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
+        return eng, out
+
+    def assert_same(self, a, b, columns=None):
+        for key in ("t", "strain", "stress_internal", "stress_surface"):
+            x, y = a[key], b[key]
+            if x.ndim == 2 and columns is not None:
+                x, y = x[:, columns[0]], y[:, columns[1]]
+            np.testing.assert_array_equal(_bits(x), _bits(y), err_msg=key)
+
+    def test_measurement_bit_identical_to_numpy(self):
+        for integrator in ("euler", "verlet"):
+            with self.subTest(integrator=integrator):
+                scenes = [(0, self.SCENES[0])]
+                e_np, ref = self.measure(scenes, "numpy", integrator, periods=3)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", RuntimeWarning)   # no fallback on this scene
+                    e_nb, got = self.measure(scenes, "numba", integrator, periods=3)
+                self.assertGreaterEqual(e_nb.step_count, 1000, "pre-equilibration + protocol steps")
+                self.assertGreater(np.max(np.abs(ref["stress_surface"])), 0.0)
+                self.assert_same(ref, got)
+                p, q = e_np.pairs_of(0), e_nb.pairs_of(0)
+                np.testing.assert_array_equal(_bits(p.xi), _bits(q.xi))
+                self.assertTrue(np.any(p.xi != 0.0))
+                np.testing.assert_array_equal(_bits(e_np.s.pos), _bits(e_nb.s.pos))
+
+    def test_batch_equals_single_runs(self):
+        scenes = list(enumerate(self.SCENES))
+        _, both = self.measure(scenes, "numba")
+        for n, scene in scenes:
+            _, single = self.measure([(n, scene)], "numba")
+            self.assert_same(single, both, (0, n))
+
+    def test_fallback_is_announced(self):
+        """A frictionless replica without bonds (the NumPy shortcut) runs the NumPy terms, with a note."""
+        scenes = [(0, dict(theMu=0.0, do_permanent_links=False, cut_lines=0, theAmplitude=0.2))]
+        with self.assertWarnsRegex(RuntimeWarning, "frictionless"):
+            _, got = self.measure(scenes, "numba")
+        self.assert_same(self.measure(scenes, "numpy")[1], got)
 
 
 class TestNumbaStaysOptional(unittest.TestCase):
