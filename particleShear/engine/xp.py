@@ -22,7 +22,6 @@ and :func:`array_namespace` recognises CuPy arrays only once CuPy has been impor
 __docformat__ = "numpy"
 
 import contextlib
-import os
 import sys
 
 import numpy as np
@@ -173,23 +172,20 @@ def _numba_importable():
     return True
 
 
-def resolve_backend(name=None):
-    """The backend a run uses: ``name``, ``$PARTICLESHEAR_BACKEND`` when ``name`` is None, and
-    ``"auto"`` resolved (``"numba"`` where Numba can be imported, else ``"numpy"``).
+def resolve_backend(name):
+    """The backend a run uses: ``name``, with ``"auto"`` resolved (``"numba"`` where Numba can be
+    imported, else ``"numpy"``).
 
     Parameters
     ----------
-    name : str or None
-        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"`` or a registered name; None: the
-        environment variable ``PARTICLESHEAR_BACKEND`` (default ``"numpy"``).
+    name : str
+        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"`` or a registered name.
 
     Returns
     -------
     str
         The name of a backend (not ``"auto"``).
     """
-    if name is None:
-        name = os.environ.get("PARTICLESHEAR_BACKEND") or "numpy"
     if name == "auto":
         return "numba" if _numba_importable() else "numpy"
     return name
@@ -270,7 +266,7 @@ def get_backend(name="numpy"):
     if name == "auto":
         name = resolve_backend(name)
     if not isinstance(name, str) or name not in _FACTORIES:
-        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, _FACTORIES))}")
+        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, (*_FACTORIES, 'auto')))}")
     b = _MADE.get(name)
     if b is None:
         b = _MADE[name] = _FACTORIES[name]()

@@ -240,6 +240,9 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         t0 = time.perf_counter()
         st = BatchState.from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
                                        laws=[sims[b].contact_law for b in group])
+        for b in group:           # the backend used ("auto" resolved), as the result records it
+            if sims[b].parameters is not None:
+                sims[b].parameters["backend"] = st.backend.name
         say, report = _console(sims, group, "pre-equilibration", where)
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
