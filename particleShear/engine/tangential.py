@@ -13,13 +13,15 @@ from .xp import array_namespace, select
 __all__ = ["two_visit_rule", "coulomb_clip", "tangential_two_pass"]
 
 
-def coulomb_clip(ft, fc):
+def coulomb_clip(ft, a, fc):
     """A trial tangential force clipped to the Coulomb bound: ``copysign(min(|ft|, fc), ft)``.
 
     Parameters
     ----------
     ft : ndarray or float
         Trial force ``k_t·ξ + ν_t·v_t`` (mg·µm·s⁻² per m depth).
+    a : ndarray or float
+        Its magnitude ``|ft|`` (computed once by the caller, who also compares it with the bound).
     fc : ndarray or float
         Coulomb bound (≥ 0; ``inf`` for a bond).
 
@@ -27,7 +29,7 @@ def coulomb_clip(ft, fc):
     -------
     ndarray or float
     """
-    return np.copysign(np.minimum(np.abs(ft), fc), ft)
+    return np.copysign(np.minimum(a, fc), ft)
 
 
 def two_visit_rule(vt, touching, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, f_coulomb):
@@ -65,15 +67,18 @@ def two_visit_rule(vt, touching, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, f_coulo
     reset : ndarray of bool or bool
         Whether the histories are reset to 0 (a slip in either visit).
     """
-    # ×touching: ×1 is exact; ×0 gives a zero whose sign may differ from +0, which changes nothing
-    # downstream (added to k_t·ξ, and ξ is never −0)
-    ftv_i = nut_i * vt * touching
-    ftv_j = nut_j * vt * touching
+    # the viscous part on touching pairs only: ×1 is exact; ×0 gives a zero whose sign may differ
+    # from +0, which changes nothing downstream (added to k_t·ξ, and ξ is never −0)
+    v = vt * touching
+    ftv_i = nut_i * v
+    ftv_j = nut_j * v
     ft_i = kt_i * xi_ij + ftv_i
-    slip_i = np.abs(ft_i) > f_coulomb
+    a_i = np.abs(ft_i)
+    slip_i = a_i > f_coulomb
     ft_j = select(slip_i, ftv_j, kt_j * xi_ji + ftv_j)     # visit 2 sees ξ_ji = 0 after a slip in visit 1
-    slip_j = np.abs(ft_j) > f_coulomb
-    return coulomb_clip(ft_i, f_coulomb), coulomb_clip(ft_j, f_coulomb), slip_j, slip_i | slip_j
+    a_j = np.abs(ft_j)
+    slip_j = a_j > f_coulomb
+    return coulomb_clip(ft_i, a_i, f_coulomb), coulomb_clip(ft_j, a_j, f_coulomb), slip_j, slip_i | slip_j
 
 
 def tangential_two_pass(vt, touching, xi, kt_i, kt_j, nut_i, nut_j, f_coulomb):
