@@ -141,7 +141,7 @@ def jit_laws(cache=True):
     return compiled
 
 
-def compile_pair_kernel(cache=True):
+def compile_pair_kernel(cache=True, say=None):
     """The compiled loop over candidate pairs that evaluates their force terms (see :func:`pair_terms`).
 
     Parameters
@@ -149,6 +149,8 @@ def compile_pair_kernel(cache=True):
     cache : bool, default True
         Keep the compiled code in :func:`cache_dir` (and reuse the kernel of this process); False
         compiles afresh from the law functions as they are now (a test that edits a law).
+    say : callable, optional
+        ``say(message)``: told once per process, before the compile (or the load from the cache).
 
     Returns
     -------
@@ -196,6 +198,12 @@ def compile_pair_kernel(cache=True):
                 xi[1, p] = 0.0
 
     compiled = numba.njit(kernel, cache=cache)
+    if say is not None:
+        say(f"backend 'numba': compiling the force loop (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
+    # compile (or load) now, for the argument types of the engine's call
+    e, b = np.empty(0), np.empty(0, dtype=np.bool_)
+    compiled(0, e, e, e, b, b, np.empty((2, 0)), np.empty((len(TERM_BLOCK), 0)), e, e, np.empty(0), np.empty(0),
+             np.empty((2, 0)), np.empty(0, dtype=np.bool_))
     if cache:
         _kernels[True] = compiled
     return compiled
