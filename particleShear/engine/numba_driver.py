@@ -25,6 +25,7 @@ __docformat__ = "numpy"
 import hashlib
 import os
 import sys
+import tempfile
 
 import numpy as np
 
@@ -70,7 +71,7 @@ def cache_dir():
     Returns
     -------
     str
-        A writable folder (created).
+        A writable folder (created; the system's temporary folder when that one cannot be written).
     """
     h = hashlib.sha1()
     for m in _SOURCES:
@@ -78,8 +79,15 @@ def cache_dir():
             h.update(f.read())
     base = os.environ.get("PARTICLESHEAR_CACHE") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "particleShear")
-    folder = os.path.join(os.environ.get("NUMBA_CACHE_DIR") or base, f"numba-{h.hexdigest()[:12]}")
-    os.makedirs(folder, exist_ok=True)
+    name = f"numba-{h.hexdigest()[:12]}"
+    folder = os.path.join(os.environ.get("NUMBA_CACHE_DIR") or base, name)
+    try:
+        os.makedirs(folder, exist_ok=True)
+        if not os.access(folder, os.W_OK):
+            raise PermissionError(folder)
+    except OSError:        # a read-only home: the system's temporary folder
+        folder = os.path.join(tempfile.gettempdir(), "particleShear", name)
+        os.makedirs(folder, exist_ok=True)
     return folder
 
 
