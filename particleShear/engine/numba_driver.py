@@ -54,11 +54,7 @@ _kernels = {}           # cache flag -> compiled kernel
 
 def available():
     """Whether Numba can be imported here (bool)."""
-    try:
-        import numba  # noqa: F401
-    except Exception:   # ImportError, or a Numba build that does not fit the installed NumPy
-        return False
-    return True
+    return xp._numba_importable()
 
 
 def cache_dir():
