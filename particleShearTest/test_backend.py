@@ -607,7 +607,7 @@ class TestBadBackend(unittest.TestCase):
                      lambda: doParticleShearSimulation(backend="nonsense", **QUICK),
                      lambda: doParticleShearSimulationSeries(backend="nonsense", **QUICK),
                      lambda: xpmod.get_backend("nonsense")):
-            with self.assertRaisesRegex(ValueError, r"backend='nonsense' is out of range: allowed 'numpy', 'cupy'"):
+            with self.assertRaisesRegex(ValueError, r"backend='nonsense' is out of range: allowed 'numpy', 'numba', 'cupy', 'auto'"):
                 call()
 
     def test_cupy_without_cupy_or_device(self):
@@ -646,7 +646,7 @@ class TestBadBackend(unittest.TestCase):
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             code = main(["--backend", "nonsense", "--N", "20", "--quiet"])
         self.assertEqual(code, 2)   # refused by the API's validation, with its message
-        self.assertIn("--backend='nonsense' is out of range: allowed 'numpy', 'cupy'", err.getvalue())
+        self.assertIn("--backend='nonsense' is out of range: allowed 'numpy', 'numba', 'cupy', 'auto'", err.getvalue())
         try:
             xpmod.get_backend("cupy")
         except ValueError:

@@ -43,7 +43,7 @@ def elastic_force_law(d, d0, k, central_repulsion_coefficient):
     if np.ndim(d) == 0 and np.ndim(d0) == 0:
         if d > d0:
             return 0
-        f = _engine_laws.central_inside(d, d0, *_engine_laws.central_constants(d0, k, c), maximum=max)
+        f = _engine_laws.central_inside(d, d0, *_engine_laws.central_constants(d0, k, c))
         return _scalar_result(f, k, c)
     return _engine_laws.central_law(d, d0, k, c)
 

@@ -40,10 +40,10 @@ import math
 import numbers
 
 from ..checks import in_range
-from .xp import array_namespace
+from .xp import array_namespace, maximum, select
 
 __all__ = ["BLEND", "LINEAR", "DIVERGENT", "central_form", "central_constants", "central_inside",
-           "central_law", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_constants",
+           "central_law", "linear_term", "divergent_term", "blend_inside", "contact_or_bond", "tensile_inside", "tensile_law", "linear_law", "plateau_distance", "plateau_constants",
            "plateau_inside", "plateau_law",
            "check_plateau", "ContactLaw", "LAWS", "register_law", "unregister_law", "get_law", "law_names",
            "law_values"]
@@ -99,12 +99,70 @@ def central_constants(d0, k, c):
     return d0 / 1000, -k * (1 - c), -k * c * d0
 
 
-def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND, maximum=None):
+def linear_term(d, d0, a_lin):
+    """Linear term of the compressive law, ``a_lin (d0 − d)`` (eq. S1-5a with ``a_lin = −k(1−c)``).
+
+    A pure expression (docs/design.md, "One law, two drivers"): the NumPy engine calls it on
+    arrays, the compiled driver on numbers.
+
+    Parameters
+    ----------
+    d, d0 : ndarray or float
+        Centre and contact distance (µm).
+    a_lin : ndarray or float
+        Coefficient of :func:`central_constants` (mg·s⁻² per m depth).
+
+    Returns
+    -------
+    ndarray or float
+        Force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return a_lin * (d0 - d)
+
+
+def divergent_term(d, d0, d0_cap, a_div):
+    """Divergent term of the compressive law, ``a_div (d0 / max(d, d0_cap) − 1)`` (eqs. S1-5b, S1-6).
+
+    A pure expression (docs/design.md, "One law, two drivers"): arrays or numbers.
+
+    Parameters
+    ----------
+    d, d0 : ndarray or float
+        Centre and contact distance (µm).
+    d0_cap, a_div : ndarray or float
+        Constants of :func:`central_constants` (µm; mg·µm·s⁻² per m depth).
+
+    Returns
+    -------
+    ndarray or float
+        Force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return a_div * (d0 / maximum(d, d0_cap) - 1)
+
+
+def blend_inside(d, d0, d0_cap, a_lin, a_div):
+    """The blended compressive law from its constants: :func:`linear_term` + :func:`divergent_term`.
+
+    Parameters
+    ----------
+    d, d0, d0_cap, a_lin, a_div : ndarray or float
+        As :func:`central_inside`.
+
+    Returns
+    -------
+    ndarray or float
+        Force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return linear_term(d, d0, a_lin) + divergent_term(d, d0, d0_cap, a_div)
+
+
+def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND):
     """Compressive law from its constants, as if every pair were in contact (no cut-off at ``d0``).
 
     ``a_lin (d0 − d) + a_div (d0 / max(d, d0_cap) − 1)``, i.e. with the constants of
     :func:`central_constants` ``−k(1−c)(d0−d) − k·c·d0·(d0/d − 1)``: the blend of the linear
-    law (eq. S1-5a) and the divergent law (eq. S1-5b) with the cap of eq. S1-6.
+    law (eq. S1-5a) and the divergent law (eq. S1-5b) with the cap of eq. S1-6
+    (:func:`blend_inside`; the pure terms :func:`linear_term`, :func:`divergent_term`).
 
     Parameters
     ----------
@@ -115,22 +173,17 @@ def central_inside(d, d0, d0_cap, a_lin, a_div, form=BLEND, maximum=None):
     form : {BLEND, LINEAR, DIVERGENT}, default BLEND
         :data:`LINEAR` keeps only the linear term, :data:`DIVERGENT` only the divergent term
         (the other one is ±0 for c = 0, resp. c = 1; see :func:`central_form`).
-    maximum : callable, optional
-        Element-wise maximum (default: ``maximum`` of the namespace of ``d``); the scalar path
-        passes the builtin :func:`max`.
 
     Returns
     -------
     ndarray or float
         Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth; ≤ 0 for ``d ≤ d0``).
     """
-    if maximum is None:
-        maximum = array_namespace(d, d0_cap).maximum
     if form is DIVERGENT:
-        return a_div * (d0 / maximum(d, d0_cap) - 1)
+        return divergent_term(d, d0, d0_cap, a_div)
     if form is LINEAR:
-        return a_lin * (d0 - d)
-    return a_lin * (d0 - d) + a_div * (d0 / maximum(d, d0_cap) - 1)
+        return linear_term(d, d0, a_lin)
+    return blend_inside(d, d0, d0_cap, a_lin, a_div)
 
 
 def central_law(d, d0, k, c):
@@ -181,6 +234,28 @@ def tensile_inside(d, d_eq, a_t):
         ``d > d_eq``).
     """
     return a_t * (d_eq - d)
+
+
+def contact_or_bond(d, d_law, inside, beyond):
+    """The elastic law of a pair: the compressive law ``inside`` up to ``d_law``, ``beyond`` above it.
+
+    ``beyond`` is the tensile law of a stretched bond (:func:`tensile_inside`) and +0 for a contact
+    that has separated.  A pure expression (docs/design.md, "One law, two drivers").
+
+    Parameters
+    ----------
+    d, d_law : ndarray or float
+        Centre distance and the distance where the compressive law ends (µm: ``r_i + r_j`` for a
+        contact, ``d_eq`` for a bond).
+    inside, beyond : ndarray or float
+        The compressive and the tensile law at ``d`` (mg·µm·s⁻² per m depth).
+
+    Returns
+    -------
+    ndarray or float
+        Force on i along ``n_ij`` (mg·µm·s⁻² per m depth; negative repels).
+    """
+    return select(d > d_law, beyond, inside)
 
 
 def tensile_law(d, d_eq, k):
@@ -258,8 +333,7 @@ def plateau_distance(d, plateau_begin, plateau_end, slope):
 
 def _plateau_map(d, pb, pe, s, low):
     """:func:`plateau_distance` with its constant ``low = pe + (pb − pe)·s`` (the map at ``d = pb``)."""
-    xp = array_namespace(d, pb, pe, s)
-    return xp.where(d >= pe, d, xp.where(d >= pb, pe + (d - pe) * s, d * low / pb))
+    return select(d >= pe, d, select(d >= pb, pe + (d - pe) * s, d * low / pb))
 
 
 def plateau_constants(d0, k, c, plateau_begin, plateau_end, plateau_slope):

@@ -23,6 +23,7 @@ in Pa (docs/parameters.md, docs/output.md).
 __docformat__ = "numpy"
 
 import math
+import warnings
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
+from . import numba_driver
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
@@ -136,6 +138,7 @@ class BatchEngine:
         s = self.s = state
         xp = self.xp = s.xp
         self.backend = s.backend
+        self.notes = set()        # why the compiled backend fell back to NumPy (each reason once)
         if xp is np:
             tune_allocator()   # step temporaries stay mapped (engine/memory.py; measured, see there)
         B, N = s.B, s.N
@@ -445,8 +448,11 @@ class BatchEngine:
         vt = None if self.free_p is True else slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
         parts = ([], [])          # the central terms of each visit, kept for the register (keep_terms)
-        fn, law = self._central(C, d, vn, active, parts[0])
-        F, slip = self._tangential(C, vt, touching, xi, law, active)
+        if self.backend.compiled and self._compiled_terms(C):   # the same laws in one compiled loop (bit-identical)
+            fn, law, F, slip = numba_driver.pair_terms(C, d, vn, vt, touching, active, xi, C.Kj)
+        else:
+            fn, law = self._central(C, d, vn, active, parts[0])
+            F, slip = self._tangential(C, vt, touching, xi, law, active)
         self.state_p = slip.view(np.int8) + C.perm_code
         ft = (F[0] + F[1]) * 0.5
         fx_i, fy_i, dF, tq = pair_forces(fn, ft, nx, ny, d, C.w)
@@ -459,7 +465,7 @@ class BatchEngine:
         out = None
         shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
         if self.keep_terms:
-            self.terms = _TermRecord(C, parts, F, dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
+            self.terms = _TermRecord(C, parts, self.xp.stack(F), dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
                                      fx_j, fy_j, dF, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(
@@ -513,6 +519,28 @@ class BatchEngine:
         self.xi = xp.where(active, self.xi, 0.0)        # an opened contact loses its history
         self.active = active
         return yc, dx, dy, ky, kx, d, touching, active, image_rate
+
+    def _compiled_terms(self, C):
+        """Whether the force terms of this phase run in the compiled loop of :mod:`.numba_driver`.
+
+        They do for the default laws (the linear law and the tensile law of bonds, from prepared
+        constants) of frictional replicas or bonds when the terms are not kept for a register;
+        otherwise the NumPy terms run, and a one-line note (a ``RuntimeWarning``, once per engine)
+        says why.
+        """
+        why = None
+        if self.keep_terms:
+            why = "the force register keeps the terms of each visit"
+        elif self.free_p is not None:
+            why = "a replica without friction and bonds (the frictionless shortcut)"
+        elif force_phase_laws(self.s, C) != (None, None):
+            why = "a contact law other than the linear one, or a law callback"
+        if why is None:
+            return True
+        if why not in self.notes:
+            self.notes.add(why)
+            warnings.warn(f"backend='numba': the force terms run on NumPy here ({why})", RuntimeWarning, stacklevel=3)
+        return False
 
     def _central(self, K, d, vn, active, parts):
         """The central term of one visit (:func:`~particleShear.engine.terms.central_term`); with

@@ -34,9 +34,9 @@ import numbers
 
 from . import laws
 from .tangential import tangential_two_pass
-from .xp import array_namespace
+from .xp import array_namespace, select
 
-__all__ = ["relative_velocity", "normal_speed", "slip_speed", "TermConstants", "term_constants", "elastic_term", "viscous_term", "central_term", "tangential_term",
+__all__ = ["relative_velocity", "normal_speed", "slip_speed", "TermConstants", "term_constants", "elastic_term", "viscous_term", "viscous_force", "central_term", "tangential_term",
            "pair_forces"]
 
 
@@ -240,7 +240,7 @@ def elastic_term(K, d, central=None, tensile=None):
         beyond = 0.0
     else:
         beyond = laws.tensile_inside(d, K.d_eq, K.a_tens) if tensile is None else tensile(d)
-    law = array_namespace(d).where(d > K.d_law, beyond, inside)
+    law = laws.contact_or_bond(d, K.d_law, inside, beyond)
     return law * K.ratio_c, law
 
 
@@ -263,7 +263,29 @@ def viscous_term(K, vn, active):
     """
     if active is None:
         return K.nu * vn
-    return array_namespace(vn).where(active, K.nu, 0.0) * vn
+    return viscous_force(K.nu, vn, active)
+
+
+def viscous_force(nu, vn, active):
+    """Central viscous force ``ν·v_n`` of a relation (eq. S1-9), 0 on a candidate that is none.
+
+    A pure expression (docs/design.md, "One law, two drivers"): arrays or numbers.
+
+    Parameters
+    ----------
+    nu : ndarray or float
+        Central viscosity (mg·s⁻¹ per m depth).
+    vn : ndarray or float
+        Normal relative velocity (µm/s; positive when separating).
+    active : ndarray of bool or bool
+        Relation (touching, or a bond).
+
+    Returns
+    -------
+    ndarray or float
+        Viscous force on i along ``n_ij`` (mg·µm·s⁻² per m depth).
+    """
+    return select(active, nu, 0.0) * vn
 
 
 def central_term(K, d, vn, active, central=None, tensile=None):

@@ -26,11 +26,13 @@ import sys
 
 import numpy as np
 
-__all__ = ["Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
-           "backend_of", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+__all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
+           "backend_of", "resolve_backend", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
 CUPY_INSTALL = "pip install cupy-cuda12x"
+#: how to install Numba (named in the error of ``backend="numba"`` without it)
+NUMBA_INSTALL = "pip install particleShear[fast]"
 
 #: the reasons for which the engine reads device values on the host (the argument ``why`` of :func:`to_host`)
 REASONS = {
@@ -46,6 +48,44 @@ REASONS = {
     "register": "the last force phase's terms, for the force register of a documented ensemble",
     "microstructure": "positions, strain and contact forces at a snapshot of the stroboscopic observer (once per period)",
 }
+
+def select(cond, a, b):
+    """``a`` where ``cond`` holds, else ``b``: the one branch a law may take (docs/design.md, "One law, two drivers").
+
+    On arrays (NumPy, or CuPy through NumPy's dispatch) it is ``numpy.where(cond, a, b)``; inside
+    compiled code it is ``a if cond else b`` on numbers (registered with Numba by
+    :func:`particleShear.engine.numba_driver.register_helpers`, only where Numba is installed).
+
+    Parameters
+    ----------
+    cond : ndarray of bool or bool
+        The condition, per element.
+    a, b : ndarray or float
+        The values where it holds and where it does not (broadcast).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    return np.where(cond, a, b)
+
+
+def maximum(a, b):
+    """Element-wise maximum of a law (``max`` on two numbers, ``numpy.maximum`` otherwise; Numba: ``max``).
+
+    Parameters
+    ----------
+    a, b : ndarray or float
+        The operands (broadcast).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    if isinstance(a, float) and isinstance(b, float):   # (the documented per-pair callbacks: no ufunc call)
+        return max(a, b)
+    return np.maximum(a, b)
+
 
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
 
@@ -97,6 +137,9 @@ class Backend:
         reduction along rows.
     """
 
+    #: the force terms of a step run in one compiled loop (:mod:`.numba_driver`), on NumPy arrays
+    compiled = False
+
     def __init__(self, name, xp, host, asarray, to_host, owns, ordered_reductions=True):
         self.name, self.xp, self.host = name, xp, bool(host)
         self.asarray, self._to_host, self.owns = asarray, to_host, owns
@@ -108,6 +151,44 @@ class Backend:
 
 def _numpy_backend():
     return Backend("numpy", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
+
+
+def _numba_backend():
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:  # ImportError, or a Numba build that does not fit the installed NumPy
+        raise ValueError(f"backend='numba' needs Numba: it cannot be imported ({exc}); install it with "
+                         f"`{NUMBA_INSTALL}` or choose backend='numpy'") from None
+    b = Backend("numba", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
+    b.compiled = True
+    return b
+
+
+def _numba_importable():
+    try:
+        import numba  # noqa: F401
+    except Exception:
+        return False
+    return True
+
+
+def resolve_backend(name):
+    """The backend a run uses: ``name``, with ``"auto"`` resolved (``"numba"`` where Numba can be
+    imported, else ``"numpy"``).
+
+    Parameters
+    ----------
+    name : str
+        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"`` or a registered name.
+
+    Returns
+    -------
+    str
+        The name of a backend (not ``"auto"``).
+    """
+    if name == "auto":
+        return "numba" if _numba_importable() else "numpy"
+    return name
 
 
 def _cupy_backend():
@@ -128,7 +209,7 @@ def _cupy_backend():
                    ordered_reductions=False)
 
 
-_FACTORIES = {"numpy": _numpy_backend, "cupy": _cupy_backend}
+_FACTORIES = {"numpy": _numpy_backend, "numba": _numba_backend, "cupy": _cupy_backend}
 _MADE = {}
 
 
@@ -156,7 +237,7 @@ def unregister_backend(name):
     ----------
     name : str
     """
-    if name not in ("numpy", "cupy"):
+    if name not in ("numpy", "numba", "cupy"):
         _FACTORIES.pop(name, None)
         _MADE.pop(name, None)
 
@@ -182,8 +263,10 @@ def get_backend(name="numpy"):
     """
     if isinstance(name, Backend):
         return name
+    if name == "auto":
+        name = resolve_backend(name)
     if not isinstance(name, str) or name not in _FACTORIES:
-        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, _FACTORIES))}")
+        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, (*_FACTORIES, 'auto')))}")
     b = _MADE.get(name)
     if b is None:
         b = _MADE[name] = _FACTORIES[name]()

@@ -194,10 +194,13 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     strict_io : bool, default False
         Keyword-only.  Raise the ``OSError`` of a failed write after the run; False: return the
         result with ``write_error`` set (``last_result`` holds it either way).
-    backend : {"numpy", "cupy"}, default "numpy"
-        Keyword-only.  Array library of the measurement: "numpy", or "cupy" to measure on a CUDA
-        GPU (needs ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding,
-        not bit for bit).  Every run measures through the engine (:mod:`particleShear.engine`) as a
+    backend : {"numpy", "numba", "auto", "cupy"}, default "numpy"
+        Keyword-only.  Array library of the measurement: "numpy"; "numba" (NumPy arrays, the
+        force terms of each step in one compiled loop of the same laws, bit-identical; needs
+        ``pip install particleShear[fast]``); "auto" ("numba" where Numba is installed, else
+        "numpy"; the result records the one used); or "cupy" to measure on a CUDA GPU (needs
+        ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for
+        bit).  Every run measures through the engine (:mod:`particleShear.engine`) as a
         batch of one — drawn or not, with files and snapshots or not, either integrator, any law —
         so that a run in a batched series (``doParticleShearSimulationSeries(..., batch_size=B)``)
         is bit-identical to it and a drawn run to the same run headless (the drawing observes the
@@ -497,8 +500,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
         unbatched series, in the same order (and resumes like it with a ``root_folder``).
         Default None: one task per run.
-    backend : {"numpy", "cupy"}, default "numpy"
-        Keyword-only.  Array backend of every run ("cupy": on a CUDA GPU, for runs without
+    backend : {"numpy", "numba", "auto", "cupy"}, default "numpy"
+        Keyword-only.  Array backend of every run ("numba": compiled force terms; "cupy": on a CUDA GPU, for runs without
         drawing and plotting; see :func:`doParticleShearSimulation`).  With ``batch_size`` a
         batch of replicas is measured in one set of device arrays.
     **options

@@ -47,6 +47,7 @@ PER_REPLICA_PARAMETERS = frozenset(_names(batch="replica"))
 #: the integrator (batch class "schedule" of :mod:`particleShear.parameters`)
 SCHEDULE_PARAMETERS = _names(batch="schedule")
 
+
 def schedule_key(kwargs):
     """Hashable key of the step schedule of one run (runs with equal keys may share a batch).
 

@@ -25,7 +25,7 @@ __all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "c
            "measure_batch"]
 
 #: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
-BACKENDS = ("numpy", "cupy")
+BACKENDS = ("numpy", "numba", "auto", "cupy")
 
 
 def _signature_defaults():

@@ -17,6 +17,7 @@ import numpy as np
 from ..base.engine_adapter import relax_ensembles, state_from_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
+from ..engine.numba_driver import compile_pair_kernel
 from ..engine.state import BatchState
 from ..engine.step import BatchEngine, EngineInstability, pre_equilibrate, protocol
 from ..linkable.builders import MAX_RELAXATIONS
@@ -240,7 +241,14 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         t0 = time.perf_counter()
         st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
                                        laws=[sims[b].contact_law for b in group])
+        for b in group:           # the backend used ("auto" resolved), as the result records it
+            if sims[b].parameters is not None:
+                sims[b].parameters["backend"] = st.backend.name
         say, report = _console(sims, group, "pre-equilibration", where)
+        if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
+            tc = time.perf_counter()
+            compile_pair_kernel(say=say)
+            t0 += time.perf_counter() - tc
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
         _guarded(pre_equilibrate, engine, key[1], dt, key[0], cool, say, report, observers(engine, group), dt=dt)

@@ -41,7 +41,8 @@ def build_parser():
       help="measure runs of one step schedule (same N, time-step rule, protocol) in batches of up to B "
            "replicas, one task each; rows identical to unbatched runs (default: one task per run)")
     a("--backend", default=None, metavar="NAME",
-      help="array backend of every run: numpy, or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`); "
+      help="array backend of every run: numpy, numba (compiled force terms; `pip install particleShear[fast]`), "
+           "auto (numba where installed), or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`); "
            "sets the SPEC's backend (default: the SPEC's, numpy)")
     a("--dask", action="store_true", help="run on a dask.distributed LocalCluster of --workers processes")
     a("--scheduler", metavar="ADDRESS", default=None, help="run on an existing Dask cluster (e.g. tcp://host:8786)")

@@ -149,7 +149,7 @@ class Sweep:
         and writes its rows to its own table, merged later by :meth:`merge`.
     backend : str, optional
         Array backend of every run (``--backend``), set as the SPEC's ``[parameters] backend``:
-        "numpy" or "cupy" (a CUDA GPU).  It is part of each run's
+        "numpy", "numba", "auto" or "cupy" (a CUDA GPU).  It is part of each run's
         identity, so a sweep measured on the GPU does not resume the rows of a NumPy sweep.
         Default: the SPEC's (``"numpy"`` unless it sets one).
     extend : bool, optional

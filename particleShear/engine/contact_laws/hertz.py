@@ -23,9 +23,11 @@ step (chosen from ``k``) stays stable.
 """
 __docformat__ = "numpy"
 
+import numpy as np
+
 from ...parameter_entry import Parameter
 from ..laws import register_law
-from ..xp import array_namespace
+from ..xp import maximum
 
 __all__ = ["hertz", "PARAMETERS", "LAW"]
 
@@ -60,10 +62,9 @@ def hertz(d, d0, r_i, r_j, k, c, hertz_scale):
         Central force on i along ``n_ij`` (mg·µm·s⁻² per m depth): < 0 (repulsive) for ``d < d0``,
         0 for ``d ≥ d0``.
     """
-    xp = array_namespace(d, d0, r_i, r_j)
-    overlap = xp.maximum(d0 - d, 0.0)
+    overlap = maximum(d0 - d, 0.0)
     reduced = r_i * r_j / (r_i + r_j)
-    return -hertz_scale * k * xp.sqrt(reduced) * overlap * xp.sqrt(overlap)
+    return -hertz_scale * k * np.sqrt(reduced) * overlap * np.sqrt(overlap)
 
 
 LAW = register_law("hertz", hertz, PARAMETERS, radii=True, built_in=True)

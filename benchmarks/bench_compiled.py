@@ -1,0 +1,99 @@
+"""backend="numba" against backend="numpy": µs per (replica-)step of the engine, and the default run (not a test).
+
+Scenes: ``bench_step.build(N, seed)`` (frictional, crosslinked, plates on, sinusoidal shear; the
+scene of docs/performance.md), stepped through ``BatchEngine.set_rate`` + ``step(cool, dt,
+sample=True)`` on one ``BatchState`` of B replicas (seeds 1 … B), per backend.  Both engines are
+built and warmed first (the compile, or the load from the cache, is not timed); then timed blocks
+alternate NumPy / Numba / NumPy / … and the median of each backend's blocks is printed, with
+their ratio.  One thread (``OMP_NUM_THREADS=1`` …).  The compiled backend runs the force terms of
+a step (laws, viscous term, two-visit tangential rule) in one compiled loop; everything else is the
+NumPy engine's (docs/backends.md).
+
+Last row: the default run ``doParticleShearSimulation(seed=1)`` (no drawing, no files), whole call
+with a warm compile cache, per backend.
+
+Usage: python benchmarks/bench_compiled.py [--quick]
+"""
+import os
+
+for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import argparse  # noqa: E402
+import contextlib  # noqa: E402
+import io  # noqa: E402
+import math  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_step  # noqa: E402
+
+from particleShear.engine.state import BatchState  # noqa: E402
+from particleShear.engine.step import BatchEngine  # noqa: E402
+from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
+
+BACKENDS = ("numpy", "numba")
+
+
+def engine(ensembles, backend):
+    """A BatchEngine of copies of ``ensembles`` on ``backend`` and its timed block function."""
+    eng = BatchEngine(BatchState.from_ensembles(ensembles, backend=backend), skin_factor=ENGINE_SKIN_FACTOR)
+    s, B = eng.s, len(ensembles)
+    w = 2 * math.pi * bench_step.F_EXC
+    cool, dt, amp = 0.99969060716623, bench_step.DT, bench_step.AMPLITUDE
+
+    def block(n):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            eng.set_rate(np.full(B, amp * w * math.cos(w * float(s.t[0]))))
+            eng.step(cool, dt, sample=True)
+        return time.perf_counter() - t0
+    return block
+
+
+def row(N, B, steps, blocks):
+    ensembles = [bench_step.build(N, seed=1 + b) for b in range(B)]
+    run = {be: engine(ensembles, be) for be in BACKENDS}
+    for be in BACKENDS:
+        run[be](5)                       # warm-up: the compile (or the cache load) is not timed
+    samples = {be: [] for be in BACKENDS}
+    for _ in range(blocks):
+        for be in BACKENDS:
+            samples[be].append(run[be](steps) / (steps * B))
+    return {be: statistics.median(v) for be, v in samples.items()}
+
+
+def default_run(backend):
+    from particleShear import doParticleShearSimulation
+    t0 = time.perf_counter()
+    with contextlib.redirect_stdout(io.StringIO()):
+        doParticleShearSimulation(doDrawing=False, plotStress=False, saveData=False, seed=1, backend=backend)
+    return time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer steps and blocks")
+    args = ap.parse_args()
+    q = args.quick
+    rows = [(150, 1, 100 if q else 400, 3 if q else 7, "µs/step"),
+            (150, 32, 10 if q else 40, 3 if q else 5, "µs/replica-step"),
+            (10_000, 1, 3 if q else 10, 3 if q else 5, "ns/particle-step")]
+    print("| N | B | NumPy | Numba | NumPy / Numba | unit |\n|---|---|---|---|---|---|", flush=True)
+    for N, B, steps, blocks, unit in rows:
+        m = row(N, B, steps, blocks)
+        scale = 1e9 / N if unit.startswith("ns") else 1e6
+        print(f"| {N:,} | {B} | {m['numpy'] * scale:.1f} | {m['numba'] * scale:.1f} | "
+              f"{m['numpy'] / m['numba']:.2f}× | {unit} |", flush=True)
+    default_run("numba")                 # the cache warm (a first compile is not timed)
+    t = {be: statistics.median(default_run(be) for _ in range(1 if q else 3)) for be in BACKENDS}
+    print(f"| default run (seed 1), whole call | | {t['numpy']:.2f} | {t['numba']:.2f} | "
+          f"{t['numpy'] / t['numba']:.2f}× | s |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,272 @@
+"""The compiled pair loop (Numba, optional): the force terms of the candidates, from the same law functions.
+
+The laws, the viscous term and the two-visit tangential rule are pure expressions of plain
+arguments (:func:`~particleShear.engine.laws.linear_term`, :func:`~particleShear.engine.laws.divergent_term`,
+:func:`~particleShear.engine.laws.blend_inside`, :func:`~particleShear.engine.laws.tensile_inside`,
+:func:`~particleShear.engine.laws.contact_or_bond`, :func:`~particleShear.engine.terms.viscous_force`,
+:func:`~particleShear.engine.tangential.two_visit_rule`, with :func:`~particleShear.engine.xp.select`
+and :func:`~particleShear.engine.xp.maximum` for their branches).  The NumPy engine calls them on
+arrays; this module registers the very same function objects with Numba
+(:func:`jit_laws`; ``select`` becomes ``a if cond else b`` and ``maximum`` ``max`` on numbers) and calls them on numbers inside one compiled loop over the candidate pairs
+(:func:`pair_terms`).  Changing a law's body therefore changes both backends (tested).
+
+What this module compiles is the force terms of a candidate set (central scalar, elastic law,
+the two tangential visits, the slip flags and the ξ reset), bit-identical to the NumPy terms
+(:func:`~particleShear.engine.terms.central_term` and :func:`~particleShear.engine.terms.tangential_term`);
+the step loop itself (neighbours, scatter, integration, the protocol) runs on NumPy
+(docs/backends.md, "The compiled backend").
+
+Numba is imported only inside the functions here, never by importing the package.  The compiled
+code is cached (``cache=True``) in :func:`cache_dir`, a folder keyed by the source of the law
+modules (Numba's own cache checks only the file of the compiled function, not the laws it calls).
+"""
+__docformat__ = "numpy"
+
+import hashlib
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+from . import laws, tangential, terms, xp
+from .forces import PairConstants
+
+__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "compile_pair_kernel", "pair_terms", "FORMS", "LAW_FUNCTIONS"]
+
+#: the code of each form of the compressive law in the compiled loop
+FORMS = {laws.BLEND: 0, laws.LINEAR: 1, laws.DIVERGENT: 2}
+
+#: the pure functions the compiled loop calls: ``(module, name)``, looked up when it is compiled
+LAW_FUNCTIONS = ((laws, "linear_term"), (laws, "divergent_term"), (laws, "blend_inside"), (laws, "tensile_inside"),
+                 (laws, "contact_or_bond"), (terms, "viscous_force"), (tangential, "coulomb_clip"),
+                 (tangential, "two_visit_rule"))
+
+#: the constants the compiled loop reads, in the order of the rows of its block (the kernel reads them by position)
+TERM_BLOCK = PairConstants.TERM_ROWS
+_TERM_START = PairConstants.FLOAT_ROWS.index(TERM_BLOCK[0])     # where they start in the engine's float block
+assert PairConstants.FLOAT_ROWS[_TERM_START:_TERM_START + len(TERM_BLOCK)] == TERM_BLOCK
+
+_SOURCES = (laws, terms, tangential, xp, sys.modules[__name__])
+_registered = set()     # the helpers registered with Numba (their ids)
+_kernels = {}           # cache flag -> compiled kernel
+
+
+def available():
+    """Whether Numba can be imported here (bool)."""
+    return xp._numba_importable()
+
+
+def cache_dir():
+    """The folder of the compiled code: ``$NUMBA_CACHE_DIR`` or the user's cache folder, keyed by the law sources.
+
+    ``$PARTICLESHEAR_CACHE`` or ``$XDG_CACHE_HOME/particleShear`` (default ``~/.cache/particleShear``),
+    then ``numba-<hash>``, the hash of the source files of the laws, terms, tangential rule,
+    :mod:`.xp` and this module: an edited law gets a fresh folder (Numba's cache would not notice it).
+
+    Returns
+    -------
+    str
+        A writable folder (created; the system's temporary folder when that one cannot be written).
+    """
+    h = hashlib.sha1()
+    for m in _SOURCES:
+        with open(m.__file__, "rb") as f:
+            h.update(f.read())
+    base = os.environ.get("PARTICLESHEAR_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "particleShear")
+    name = f"numba-{h.hexdigest()[:12]}"
+    folder = os.path.join(os.environ.get("NUMBA_CACHE_DIR") or base, name)
+    try:
+        os.makedirs(folder, exist_ok=True)
+        if not os.access(folder, os.W_OK):
+            raise PermissionError(folder)
+    except OSError:        # a read-only home: the system's temporary folder
+        folder = os.path.join(tempfile.gettempdir(), "particleShear", name)
+        os.makedirs(folder, exist_ok=True)
+    return folder
+
+
+def register_helpers():
+    """Register :func:`~particleShear.engine.xp.select` and :func:`~particleShear.engine.xp.maximum`
+    with Numba for numbers (``a if cond else b``, ``max``); once per process.
+
+    Raises
+    ------
+    ImportError
+        Without Numba.
+    """
+    from numba.extending import overload
+
+    if id(xp.select) not in _registered:
+        @overload(xp.select)
+        def _select(cond, a, b):
+            return lambda cond, a, b: a if cond else b
+
+        @overload(xp.maximum)
+        def _maximum(a, b):
+            return lambda a, b: max(a, b)
+
+        _registered.add(id(xp.select))
+
+
+def jit_laws(cache=True):
+    """The law functions of :data:`LAW_FUNCTIONS` as they are now, each compiled by Numba.
+
+    Each function is compiled from its own code object with its module's globals, in which the
+    names of the other law functions are their compiled versions (so ``blend_inside`` calls the
+    compiled ``linear_term`` of this call: a law replaced in its module is read afresh).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        ``cache=True`` for Numba (the folder :func:`cache_dir`).
+
+    Returns
+    -------
+    dict
+        Name → Numba dispatcher.
+    """
+    import types
+
+    import numba
+
+    register_helpers()
+    compiled, namespaces = {}, []
+    for module, name in LAW_FUNCTIONS:
+        f = getattr(module, name)
+        g = dict(f.__globals__)
+        namespaces.append(g)
+        copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
+        copy.__qualname__, copy.__module__ = f.__qualname__, f.__module__
+        compiled[name] = numba.njit(copy, cache=cache)
+    for g in namespaces:      # (globals are read when a function is compiled, at its first call)
+        g.update(compiled)
+    return compiled
+
+
+def compile_pair_kernel(cache=True, say=None):
+    """The compiled loop over candidate pairs that evaluates their force terms (see :func:`pair_terms`).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        Keep the compiled code in :func:`cache_dir` (and reuse the kernel of this process); False
+        compiles afresh from the law functions as they are now (a test that edits a law).
+    say : callable, optional
+        ``say(message)``: told once per process, before the compile (or the load from the cache).
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+        ``kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law, F, slip)`` with
+        ``T`` the (12, P) constants of :data:`TERM_BLOCK`; writes ``fn, law, F, slip`` and resets
+        ``xi`` (all arrays of the P candidates, ``xi`` and ``F`` (2, P)).
+    """
+    if cache and True in _kernels:
+        return _kernels[True]
+    import numba
+
+    if cache:
+        numba.config.CACHE_DIR = cache_dir()
+    # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
+    L = jit_laws(cache)
+    linear_term, divergent_term, blend_inside = L["linear_term"], L["divergent_term"], L["blend_inside"]
+    tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
+    viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
+
+    def kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
+        # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
+        for p in range(d.shape[0]):
+            r = d[p]
+            if form == 1:
+                inside = linear_term(r, T[0, p], T[2, p])
+            elif form == 2:
+                inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
+            else:
+                inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
+            law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
+            f = law * T[6, p]
+            f += viscous_force(T[7, p], vn[p], active[p])
+            fn[p] = f
+            law_out[p] = law
+            fc = np.abs(T[10, p] * law)
+            fc += T[11, p]
+            F_i, F_j, s, reset = two_visit_rule(vt[p], 1.0 if touching[p] else 0.0, xi[0, p], xi[1, p], T[8, p],
+                                                k_t_j[p], T[9, p], nu_t_j[p], fc)
+            F[0, p] = F_i
+            F[1, p] = F_j
+            slip[p] = s
+            if reset:
+                xi[0, p] = 0.0
+                xi[1, p] = 0.0
+
+    compiled = numba.njit(kernel, cache=cache)
+    if say is not None:
+        say(f"backend 'numba': compiling the force loop (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
+    # compile (or load) now, for the argument types of the engine's call
+    e, b = np.empty(0), np.empty(0, dtype=np.bool_)
+    compiled(0, e, e, e, b, b, np.empty((2, 0)), np.empty((len(TERM_BLOCK), 0)), e, e, np.empty(0), np.empty(0),
+             np.empty((2, 0)), np.empty(0, dtype=np.bool_))
+    if cache:
+        _kernels[True] = compiled
+    return compiled
+
+
+def _rows(value, P):
+    """``value`` as a contiguous float array over the P candidates (a number is repeated)."""
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (P,) and value.flags.c_contiguous:
+        return value        # (the engine's constants per candidate: as they are)
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=float), (P,)))
+
+
+def pair_terms(K, d, vn, vt, touching, active, xi, K_j=None, kernel=None):
+    """Force terms of P candidates in one compiled loop: what ``central_term`` and ``tangential_term`` give.
+
+    Parameters
+    ----------
+    K : TermConstants or PairConstants
+        Constants of the pairs seen by the visit from i (:func:`~particleShear.engine.terms.term_constants`).
+    d, vn, vt : ndarray (P,)
+        Centre distances (µm), normal and tangential relative velocities (µm/s).
+    touching, active : ndarray of bool (P,)
+        Overlapping pairs; relations (touching, or a bond).
+    xi : ndarray (2, P)
+        Histories ξ_ij, ξ_ji (µm), reset to 0 in place on slip.
+    K_j : TermConstants, optional
+        Constants seen by the visit from j (its ``k_t``, ``nu_t``; default ``K``).
+    kernel : callable, optional
+        A kernel of :func:`compile_pair_kernel` (default: the cached one).
+
+    Returns
+    -------
+    fn : ndarray (P,)
+        Central scalar on i along ``n_ij`` (elastic + viscous; mg·µm·s⁻² per m depth).
+    law : ndarray (P,)
+        The elastic law before the permanent ratio.
+    F : ndarray (2, P)
+        Tangential forces of the two visits.
+    slip : ndarray of bool (P,)
+        The final slip flag.
+    """
+    kernel = compile_pair_kernel() if kernel is None else kernel
+    P = len(d)
+    if isinstance(K, PairConstants) and isinstance(K.f, np.ndarray):
+        T = K.f[_TERM_START:_TERM_START + len(TERM_BLOCK)]    # the engine's constants: rows of its block, as they are
+    else:
+        # no bond: the tensile law of contacts, −0·(0 − d) = +0 (what the NumPy term puts beyond contact)
+        values = dict(d_eq=0.0, a_tens=-0.0) if K.a_tens is None else {}
+        T = np.empty((len(TERM_BLOCK), P))
+        for k, name in enumerate(TERM_BLOCK):
+            T[k] = values.get(name, getattr(K, name))
+    if K_j is None:
+        k_t_j, nu_t_j = T[8], T[9]
+    else:
+        k_t_j, nu_t_j = _rows(K_j.k_t, P), _rows(K_j.nu_t, P)
+    if not (isinstance(xi, np.ndarray) and xi.dtype == np.float64 and xi.flags.c_contiguous):
+        raise ValueError(f"xi of dtype {getattr(xi, 'dtype', type(xi))} is invalid: allowed a C-contiguous float64 "
+                         "(2, P) NumPy array (reset in place)")
+    fn, law, F, slip = np.empty(P), np.empty(P), np.empty((2, P)), np.empty(P, dtype=np.bool_)
+    kernel(FORMS[K.form], _rows(d, P), _rows(vn, P), _rows(vt, P), np.asarray(touching, dtype=np.bool_),
+           np.asarray(active, dtype=np.bool_), xi, T, k_t_j, nu_t_j, fn, law, F, slip)
+    return fn, law, F, slip

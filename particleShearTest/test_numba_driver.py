@@ -1,0 +1,195 @@
+"""The compiled pair loop (engine/numba_driver.py) against the NumPy terms: one law, two drivers.
+
+The compiled loop calls the same pure law functions on numbers that the NumPy engine calls on
+arrays (laws.linear_term …, terms.viscous_force, tangential.two_visit_rule), in the same order of
+operations, so the results are equal bit for bit (signs of zeros included) — not merely close.
+Skipped where Numba is not installed (the ``test`` extra installs it); the package itself never
+imports Numba on import (tested here with and without it).
+"""
+import subprocess
+import sys
+import unittest
+import warnings
+
+import numpy as np
+
+from particleShear.engine import laws, numba_driver, terms
+
+HAVE_NUMBA = numba_driver.available()
+
+
+def _bits(a):
+    """The bit patterns of a float array (equal bits: equal values and equal signs of zero)."""
+    return np.ascontiguousarray(a, dtype=float).view(np.int64)
+
+
+def _candidates(seed, P=600):
+    """Random candidate pairs around contact: distances 0.6–1.2 × d0, a third of them bonds
+    (d_eq 0.9–1.05 × d0), velocities and histories large enough that some contacts slip."""
+    rng = np.random.default_rng(seed)
+    r = rng.uniform(20.0, 35.0, (2, P))
+    d0 = r.sum(0)
+    d = d0 * rng.uniform(0.6, 1.2, P)
+    perm = rng.random(P) < 0.3
+    d_eq = d0 * rng.uniform(0.9, 1.05, P)
+    vn, vt = rng.normal(0.0, 1e3, P), rng.normal(0.0, 1e3, P)
+    xi = rng.normal(0.0, 3.0, (2, P))
+    return d0, d, perm, d_eq, vn, vt, xi
+
+
+def _numpy_terms(K, d, vn, vt, touching, active, xi, K_j=None):
+    fn, law = terms.central_term(K, d, vn, active)
+    F, slip = terms.tangential_term(K, vt, touching.astype(float), xi, law, K_j)
+    return fn, law, np.stack(F), slip
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestCompiledPairTerms(unittest.TestCase):
+    def test_bit_identical_to_numpy_terms(self):
+        """Every form of the compressive law (c = 0, 0.3, 1), with and without bonds, and with the
+        visit from j seeing its own k_t, ν_t: central scalar, law, both tangential visits, slip flags
+        and the reset histories equal the NumPy terms bit for bit."""
+        kernel = numba_driver.compile_pair_kernel()
+        for seed, c in ((1, 0.0), (2, 0.3), (3, 1.0)):
+            d0, d, perm, d_eq, vn, vt, xi0 = _candidates(seed)
+            touching = d < d0
+            for bonds in (False, True):
+                for own_j in (False, True):
+                    with self.subTest(c=c, bonds=bonds, own_j=own_j):
+                        K = terms.term_constants(d0, perm if bonds else None, d_eq if bonds else None, 3.1e9, c, 2.2e3,
+                                                 2.9e9, 1.9e3, 0.3, prc=0.5, prt=0.7, keep=0.0)
+                        K_j = terms.term_constants(d0, perm if bonds else None, d_eq if bonds else None, 3.1e9, c,
+                                                   2.2e3, 1.3e9, 0.8e3, 0.3) if own_j else None
+                        active = (perm | touching) if bonds else touching
+                        xi_np, xi_nb = xi0.copy(), xi0.copy()
+                        want = _numpy_terms(K, d, vn, vt, touching, active, xi_np, K_j)
+                        got = numba_driver.pair_terms(K, d, vn, vt, touching, active, xi_nb, K_j, kernel=kernel)
+                        for name, a, b in zip(("fn", "law", "F"), want[:3], got[:3]):
+                            np.testing.assert_array_equal(_bits(a), _bits(b), err_msg=name)
+                        np.testing.assert_array_equal(want[3], got[3])
+                        np.testing.assert_array_equal(_bits(xi_np), _bits(xi_nb))
+                        # the scene is one that tests something: some contacts slip and reset, some stick
+                        self.assertTrue(0 < want[3].sum() < touching.sum())
+                        self.assertTrue((xi_np == 0).any() and (xi_np != 0).any())
+
+    def test_one_law_changes_both_backends(self):
+        """Replacing the body of one law (the linear term, doubled) changes the forces of both
+        drivers, and they still agree bit for bit: the compiled loop reads the law, not a copy."""
+        d0, d, perm, d_eq, vn, vt, xi0 = _candidates(4)
+        touching = d < d0
+        K = terms.term_constants(d0, None, None, 3.1e9, 0.3, 2.2e3, 2.9e9, 1.9e3, 0.3)
+        before = _numpy_terms(K, d, vn, vt, touching, touching, xi0.copy())
+        original = laws.linear_term
+
+        def doubled(d, d0, a_lin):
+            return 2.0 * (a_lin * (d0 - d))
+
+        laws.linear_term = doubled
+        try:
+            kernel = numba_driver.compile_pair_kernel(cache=False)
+            after_np = _numpy_terms(K, d, vn, vt, touching, touching, xi0.copy())
+            after_nb = numba_driver.pair_terms(K, d, vn, vt, touching, touching, xi0.copy(), kernel=kernel)
+        finally:
+            laws.linear_term = original
+        inside = touching & (d < d0)
+        # the linear part doubles: law_after − law_before = a_lin·(d0 − d) on every overlapping pair
+        np.testing.assert_allclose(after_np[1][inside] - before[1][inside], (K.a_lin * (d0 - d))[inside], rtol=1e-9)
+        np.testing.assert_array_equal(_bits(after_np[0]), _bits(after_nb[0]))
+        np.testing.assert_array_equal(_bits(after_np[1]), _bits(after_nb[1]))
+        # and the kernel of the unchanged law gives the forces before
+        np.testing.assert_array_equal(_bits(numba_driver.pair_terms(K, d, vn, vt, touching, touching, xi0.copy())[0]),
+                                      _bits(before[0]))
+
+    def test_select_is_a_number_in_compiled_code(self):
+        """``select`` on numbers compiles to a branch that returns a float (not a 0-d array)."""
+        import numba
+
+        from particleShear.engine.xp import maximum, select
+        numba_driver.register_helpers()
+        f = numba.njit(lambda c, a, b: select(c, a, b) + maximum(a, b))
+        self.assertEqual(f(True, 1.5, 2.0), 3.5)
+        self.assertEqual(f(False, 1.5, 2.0), 4.0)
+        self.assertIsInstance(f(True, 1.5, 2.0), float)
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestNumbaBackendRuns(unittest.TestCase):
+    """backend="numba" steps the engine with the compiled terms: the whole measurement (pre-equilibration
+    and protocol, 0.5 + 3 + 0.5 periods, > 1,000 steps) equals the NumPy engine's bit for bit, a
+    batch of two equals its single runs, and a scene the loop does not cover runs the NumPy terms
+    with a note."""
+
+    SCENES = (dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2),
+              dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))
+
+    def measure(self, scenes, backend, integrator="euler", periods=1):
+        from particleShear.engine.loops import pre_equilibrate, protocol
+        from particleShear.engine.state import BatchState
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        sc = constituted(11, **self.SCENES[0])[2]      # one schedule for every batch
+        ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
+        eng = BatchEngine(BatchState.from_ensembles(ensembles, backend=backend), integrator=integrator)
+        pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+        out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
+        return eng, out
+
+    def assert_same(self, a, b, columns=None):
+        for key in ("t", "strain", "stress_internal", "stress_surface"):
+            x, y = a[key], b[key]
+            if x.ndim == 2 and columns is not None:
+                x, y = x[:, columns[0]], y[:, columns[1]]
+            np.testing.assert_array_equal(_bits(x), _bits(y), err_msg=key)
+
+    def test_measurement_bit_identical_to_numpy(self):
+        for integrator in ("euler", "verlet"):
+            with self.subTest(integrator=integrator):
+                scenes = [(0, self.SCENES[0])]
+                e_np, ref = self.measure(scenes, "numpy", integrator, periods=3)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", RuntimeWarning)   # no fallback on this scene
+                    e_nb, got = self.measure(scenes, "numba", integrator, periods=3)
+                self.assertGreaterEqual(e_nb.step_count, 1000, "pre-equilibration + protocol steps")
+                self.assertGreater(np.max(np.abs(ref["stress_surface"])), 0.0)
+                self.assert_same(ref, got)
+                p, q = e_np.pairs_of(0), e_nb.pairs_of(0)
+                np.testing.assert_array_equal(_bits(p.xi), _bits(q.xi))
+                self.assertTrue(np.any(p.xi != 0.0))
+                np.testing.assert_array_equal(_bits(e_np.s.pos), _bits(e_nb.s.pos))
+
+    def test_batch_equals_single_runs(self):
+        scenes = list(enumerate(self.SCENES))
+        _, both = self.measure(scenes, "numba")
+        for n, scene in scenes:
+            _, single = self.measure([(n, scene)], "numba")
+            self.assert_same(single, both, (0, n))
+
+    def test_fallback_is_announced(self):
+        """A frictionless replica without bonds (the NumPy shortcut) runs the NumPy terms, with a note."""
+        scenes = [(0, dict(theMu=0.0, do_permanent_links=False, cut_lines=0, theAmplitude=0.2))]
+        with self.assertWarnsRegex(RuntimeWarning, "frictionless"):
+            _, got = self.measure(scenes, "numba")
+        self.assert_same(self.measure(scenes, "numpy")[1], got)
+
+
+class TestNumbaStaysOptional(unittest.TestCase):
+    def test_import_without_numba(self):
+        """Importing the package (and the compiled driver's module) imports no Numba, and with Numba
+        unimportable the driver says it is not available."""
+        code = ("import sys; sys.modules['numba'] = None\n"
+                "import particleShear\n"
+                "from particleShear.engine import numba_driver, laws\n"
+                "assert not numba_driver.available()\n"
+                "import numpy as np\n"
+                "print(laws.blend_inside(np.array([1.0]), 2.0, 0.002, -1.0, -1.0)[0])\n")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertEqual(float(out.stdout), -1.0 * (2.0 - 1.0) + -1.0 * (2.0 / 1.0 - 1.0))
+        code = "import sys, particleShear\nprint('numba' in sys.modules)"
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(out.stdout.strip(), "False", out.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
