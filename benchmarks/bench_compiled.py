@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_step  # noqa: E402
 
-from particleShear.engine.state import BatchState  # noqa: E402
+from particleShear.base.engine_adapter import state_from_ensembles  # noqa: E402
 from particleShear.engine.step import BatchEngine  # noqa: E402
 from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 
@@ -41,7 +41,7 @@ BACKENDS = ("numpy", "numba")
 
 def engine(ensembles, backend):
     """A BatchEngine of copies of ``ensembles`` on ``backend`` and its timed block function."""
-    eng = BatchEngine(BatchState.from_ensembles(ensembles, backend=backend), skin_factor=ENGINE_SKIN_FACTOR)
+    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), skin_factor=ENGINE_SKIN_FACTOR)
     s, B = eng.s, len(ensembles)
     w = 2 * math.pi * bench_step.F_EXC
     cool, dt, amp = 0.99969060716623, bench_step.DT, bench_step.AMPLITUDE

@@ -124,13 +124,13 @@ class TestNumbaBackendRuns(unittest.TestCase):
 
     def measure(self, scenes, backend, integrator="euler", periods=1):
         from particleShear.engine.loops import pre_equilibrate, protocol
-        from particleShear.engine.state import BatchState
+        from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
 
         sc = constituted(11, **self.SCENES[0])[2]      # one schedule for every batch
         ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
-        eng = BatchEngine(BatchState.from_ensembles(ensembles, backend=backend), integrator=integrator)
+        eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), integrator=integrator)
         pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
         out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
         return eng, out
