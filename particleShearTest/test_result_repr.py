@@ -140,3 +140,33 @@ class TestRheometerRepr(unittest.TestCase):
         self.assertIn("&lt;b&gt;x&lt;/b&gt;", html)
         self.assertNotIn("<b>", html)
         self.assertIn("<td>1/s</td>", html)
+
+
+class TestOneResultInterface(unittest.TestCase):
+    """An oscillatory result answers what a protocol result answers (protocol, curves, steps, rows), so
+    the sweep's tasks, the CLI and the writers never ask which type they hold."""
+
+    def test_oscillatory_result_is_one_row_of_its_moduli(self):
+        res = noisy_result()
+        self.assertEqual(res.protocol, "oscillatory")
+        self.assertEqual((res.curves, res.steps), ({}, []))
+        rows = res.rows()
+        self.assertEqual(len(rows), 1)
+        # the row holds the measured moduli (the demodulated stresses of the series) and the run's f
+        row = rows[0]
+        self.assertEqual((row["Gp_surface"], row["Gpp_surface"]), tuple(float(g) for g in res.G_surface))
+        self.assertAlmostEqual(row["omega"], 2 * np.pi * res.f, places=12)
+
+    def test_no_module_branches_on_the_result_type(self):
+        import ast
+        import pathlib
+        import particleShear
+        names = {"G_internal", "to_dict", "steps", "rows", "curves"}
+        found = []
+        for path in pathlib.Path(particleShear.__file__).parent.rglob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if (isinstance(node, ast.Call) and getattr(node.func, "id", None) == "hasattr"
+                        and len(node.args) == 2 and isinstance(node.args[1], ast.Constant)
+                        and node.args[1].value in names and getattr(node.args[0], "id", "") in ("res", "result")):
+                    found.append(f"{path.name}:{node.lineno}")
+        self.assertEqual(found, [])

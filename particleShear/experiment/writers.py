@@ -462,12 +462,11 @@ def tests_from_result(result, estimator="surface", meta=None):
         protocol, series, curves, steps = result.protocol, result.series, result.curves, result.steps
         if protocol == "oscillatory":
             f, gamma = result.frequency, result.strain_amplitude
-    elif isinstance(result, SimulationResult):
-        params, protocol, series, curves, steps = dict(result.parameters), "oscillatory", result.series, {}, []
-        f, gamma = result.f, _f(params.get("theAmplitude"))
-    elif isinstance(result, RheometerResult):
+    elif isinstance(result, (SimulationResult, RheometerResult)):   # one interface: protocol, series, curves, steps
         params, protocol, series, curves, steps = (dict(result.parameters), result.protocol, result.series,
                                                    result.curves, result.steps)
+        if protocol == "oscillatory":
+            f, gamma = result.f, _f(params.get("theAmplitude"))
     else:
         raise ValueError(f"result={type(result).__name__} is invalid: a SimulationResult, RheometerResult or RunData")
     E = params.get("Young_modulus_spheres")

@@ -493,12 +493,10 @@ def _json_row(res):
         if isinstance(v, (list, tuple)):
             return [clean(x) for x in v]
         return v
-    if not hasattr(res, "to_dict"):      # a RheometerResult: its table row, or a sweep's rows in one object
-        rows = [{k: clean(v) for k, v in row.items()} for row in res.rows()]
-        if len(rows) == 1:
-            return json.dumps(rows[0], default=str)
-        return json.dumps({"protocol": res.protocol, "run_id": rows[0].get("run_id"), "rows": rows}, default=str)
-    return json.dumps({k: clean(v) for k, v in res.to_dict().items()}, default=str)
+    rows = [{k: clean(v) for k, v in row.items()} for row in res.rows()]   # one, or a sweep's steps
+    if len(rows) == 1:
+        return json.dumps(rows[0], default=str)
+    return json.dumps({"protocol": res.protocol, "run_id": rows[0].get("run_id"), "rows": rows}, default=str)
 
 
 class RunTerminated(KeyboardInterrupt):
@@ -611,7 +609,7 @@ def main(argv=None):
     info = sys.stderr if args.json else sys.stdout
     if args.json:
         print(_json_row(res))
-    elif not hasattr(res, "G_internal"):     # another protocol than "oscillatory" (docs/protocols.md)
+    elif res.protocol != "oscillatory":     # a summary or a sweep's steps (docs/protocols.md)
 
         def unit(name):   # the unit of the results.csv column of the same name (docs/protocols.md)
             u = column_spec(name).get("unit") or ""

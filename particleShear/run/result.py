@@ -335,6 +335,33 @@ class SimulationResult:
                    wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")
         return row
 
+    #: the protocol of the run: a SimulationResult is an oscillatory run (a
+    #: :class:`~particleShear.run.rheometer.RheometerResult` names its own)
+    protocol = "oscillatory"
+
+    @property
+    def curves(self):
+        """Empty: an oscillatory run has no G(t) or J(t) curve (the interface of
+        :class:`~particleShear.run.rheometer.RheometerResult`, so that callers need not ask which
+        result they hold)."""
+        return {}
+
+    @property
+    def steps(self):
+        """Empty: an oscillatory run is one step (sweeps have one entry per step; the interface of
+        :class:`~particleShear.run.rheometer.RheometerResult`)."""
+        return []
+
+    def rows(self):
+        """The rows of this run in a sweep's results table: ``[self.to_dict()]`` (one run, one row;
+        the interface of :meth:`particleShear.run.rheometer.RheometerResult.rows`).
+
+        Returns
+        -------
+        list of dict
+        """
+        return [self.to_dict()]
+
     def to_dataframe(self):
         """:meth:`to_dict` as a pandas Series (index: the column names, table order; needs pandas).
 

@@ -186,7 +186,7 @@ def _finish_run(task, result, wall_time_s):
         if image_folder:  # published beside the file: its name after the run's name, renamed as the file
             tail = os.path.basename(image_folder)[len(os.path.basename(run_file_stem(produced))):]
             result.image_folder = run_file_stem(result.output_path) + tail
-    rows = result.rows() if hasattr(result, "steps") else [result.to_dict()]   # a protocol run: its rows
+    rows = result.rows()          # one row, or one per step of a sweep protocol
     if "protocol" in task["parameters"]:   # a table with protocol columns: an oscillatory row says so too
         for row in rows:
             if row.get("protocol") in (None, ""):
