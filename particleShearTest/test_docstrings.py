@@ -172,6 +172,7 @@ ENGINE_MODULES = [
     "particleShear.engine.callbacks",
     "particleShear.engine.memory",
     "particleShear.engine.neighbours",
+    "particleShear.engine.numba_driver",
     "particleShear.engine.observers",
     "particleShear.engine.microstructure",
     "particleShear.simulation.microstructure_pictures",

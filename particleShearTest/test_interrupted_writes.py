@@ -17,10 +17,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 _SCRIPT = r"""
 import json, os, signal, sys
-import particleShear.simulation.formats as formats
+import particleShear.run.rheometer_files as rheometer_files
 from particleShear.run.cli import main
 
-real = formats.write_columns
+real = rheometer_files.write_columns      # patched where the protocol writer looks it up
 state = {}
 
 def interrupted(fh, fmt, *args, **kw):
@@ -29,7 +29,7 @@ def interrupted(fh, fmt, *args, **kw):
     os.kill(os.getpid(), state["signal"])      # delivered now: the write is under way
     return real(fh, fmt, *args, **kw)
 
-formats.write_columns = interrupted
+rheometer_files.write_columns = interrupted
 out = {}
 for fmt in sys.argv[2].split(","):
     for name in ("SIGINT", "SIGTERM"):
