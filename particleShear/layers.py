@@ -15,7 +15,7 @@ above it, so a module may be placed above the rest of its package (``analysis.cl
 its figure through a named entry point of :mod:`particleShear.hooks` (resolved on call, no import
 statement).
 
-This module imports the standard library only; it is read by the test and by docs/design.md
+This module imports the standard library only; it is read by the tests and drawn in docs/design.md
 ("Layers"), never at run time.
 """
 __docformat__ = "numpy"
@@ -33,7 +33,7 @@ LAYERS = (
               "particleShear.signals", "particleShear.layers", "particleShear.parameter_entry")),
     ("engine", ("particleShear.engine",)),
     ("protocols", ("particleShear.protocols",)),
-    ("parameters", ("particleShear.parameters", "particleShear.parameter_table", "particleShear.parameters_table")),
+    ("parameters", ("particleShear.parameters",)),
     ("base", ("particleShear.base",)),
     ("objects", ("particleShear.objects",)),
     ("linkable", ("particleShear.linkable",)),

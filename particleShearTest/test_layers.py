@@ -47,14 +47,40 @@ class TestLayers(unittest.TestCase):
         lazy = sorted(e for e, kinds in self.graph["edges"].items() if "function" in kinds and e not in layers.PENDING)
         self.assertEqual(lazy, [], self._say("function-body imports of the package's modules", lazy))
 
-    def test_design_states_the_table(self):
-        """docs/design.md's layer table lists the layers of particleShear.layers, in order."""
-        with open(os.path.join(ROOT, "docs", "design.md"), encoding="utf-8") as fh:
-            text = fh.read()
-        section = text.split("## Layers", 1)[1].split("\n## ", 1)[0]
-        rows = re.findall(r"^\| (\d+) \| ([^|]+?) \|", section, re.M)
-        self.assertEqual([(int(i), n.strip()) for i, n in rows], [(i, n) for i, (n, _) in enumerate(layers.LAYERS)])
+    def test_every_entry_is_a_module(self):
+        """Every module named in LAYERS exists (a layer lists no module that is gone)."""
+        modules = set(self.graph["modules"])
+        gone = [m for _, names in layers.LAYERS for m in names if m not in modules]
+        self.assertEqual(gone, [], self._say("entries of LAYERS that are no module", gone))
 
+    def test_design_draws_the_layers(self):
+        """docs/design.md's layer diagram lists the layers of particleShear.layers, in order, with their modules."""
+        expected = [(i, name, sorted(names)) for i, (name, names) in enumerate(layers.LAYERS)]
+        self.assertEqual(design_layers(), expected[::-1], "the diagram draws every layer, highest first")
+
+
+#: a row of the layer diagram: its number, its name (words separated by one space), its modules
+#: (separated by single spaces) and, after two spaces or more, what they hold
+_ROW = re.compile(r"^\s*(\d+) (\S+(?: \S+)*?)\s{2,}(\S+(?: \S+)*?)(?:\s{2,}.*)?$")
+
+
+def design_layers():
+    """``(number, name, sorted module names)`` of every row of docs/design.md's layer diagram, in its order.
+
+    The diagram is the ```text block of the section "Layers"; its modules are named relative to the
+    package (``particleShear`` itself as ``particleShear``).
+    """
+    with open(os.path.join(ROOT, "docs", "design.md"), encoding="utf-8") as fh:
+        text = fh.read()
+    section = text.split("\n## Layers\n", 1)[1].split("\n## ", 1)[0]
+    block = section.split("```text\n", 1)[1].split("```", 1)[0]
+    rows = []
+    for line in block.splitlines():
+        m = _ROW.match(line)
+        if m:
+            names = [n if n == "particleShear" else "particleShear." + n for n in m.group(3).split(" ")]
+            rows.append((int(m.group(1)), m.group(2), sorted(names)))
+    return rows
 
 if __name__ == "__main__":
     unittest.main()
