@@ -2,7 +2,7 @@
 
 One protocol step = setShearRate + forces (neighbour update, central, tangential,
 links) + register totals + every stress tensor + acceleration (kick, damping)
-+ movement (ξ, drift, strain, wrap) + reset — the per-step sequence of the protocol (docs/design.md).
++ movement (ξ, drift, strain, wrap) + reset — the per-step sequence of the protocol (docs/engine.md).
 
 Scenes: EnsembleLinkable with random bimodal spheres (radius ratio 1.4) at packing
 fraction 1.5 in a cell that grows with N (the sphere size of the default 150-sphere

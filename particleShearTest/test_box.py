@@ -2,7 +2,7 @@
 
 * every finite coordinate, however large, ends inside the half-open cell (wrap) or the half-open
   intervals ``[−L/2, L/2)`` (minimum image): the closed-form fold is clipped against rounding;
-* one crossing of ``y = Ly`` moves x by exactly ``−Ly·γ`` and vx by exactly ``−Ly·γ̇`` (docs/design.md);
+* one crossing of ``y = Ly`` moves x by exactly ``−Ly·γ`` and vx by exactly ``−Ly·γ̇`` (docs/engine.md);
   a NaN height stays NaN and is moved by no period;
 * the device form of the box (every pass, then the fold) gives NumPy's numbers, for ordinary,
   huge, infinite and NaN coordinates;

@@ -1,5 +1,5 @@
 """Ensemble constitution: derived constants (the reference's values and their definitions), builders, cutting,
-link removal and particles (docs/design.md)."""
+link removal and particles (docs/engine.md)."""
 import math
 import unittest
 from unittest import mock
@@ -169,7 +169,7 @@ class TestDerivedConstants(unittest.TestCase):
     def test_debug_schedule_lengths(self):
         ens = relaxed(0)
         self.assertEqual(ens.n_constitution_steps, 150 + 100)  # (3·30 + 60) + (3·20 + 40)
-        # A = 0.001, irc = irt = 2 (prc = 0.5): dt = 0.00625, dt_max = 0.125 (units τ/bf), docs/design.md with R = 10
+        # A = 0.001, irc = irt = 2 (prc = 0.5): dt = 0.00625, dt_max = 0.125 (units τ/bf), docs/engine.md with R = 10
         low = Build(**dict(RUN, N=40, anticipated_amplitude=0.001, interface_reenforcement_central=2,
                            interface_reenforcement_tangential=2, do_debug=True, rng=0))
         pre = 3 * (5 * 10 + 2 * 10)            # free(10) at dt_max 0.2, its repeat, free(10) at dt_max 0.125

@@ -5,7 +5,7 @@ The analytic forces are the laws' formulas written out here, independently of th
 engine's force on sphere 1 of a two-sphere scene at rest along +x is the law's value (n_12 = +x,
 no viscous or tangential force at rest).  Their tolerance, 1e-13 relative, covers the different
 association of a few O(1) floating-point operations.  Batches are compared to single runs bit for
-bit (docs/design.md, "Runs").
+bit (docs/engine.md, "Runs").
 """
 import math
 import os

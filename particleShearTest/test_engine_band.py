@@ -1,4 +1,4 @@
-"""The y band of the all-pairs search drops no pair within reach (docs/design.md, "Neighbour lists and box").
+"""The y band of the all-pairs search drops no pair within reach (docs/engine.md, "Neighbour lists and box").
 
 ``near_pairs_all`` tests on the host only the pairs whose ``|y_j − y_i|`` lies within
 ``2 r_max + skin`` (plus a relative margin of 1e-9) of 0 or of ``Ly``.  Its definition is still

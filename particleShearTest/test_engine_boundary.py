@@ -1,4 +1,4 @@
-"""The engine reads no private member of the documented classes (docs/design.md, "The documented classes").
+"""The engine reads no private member of the documented classes (docs/classes.md, "The documented classes").
 
 The engine (``particleShear/engine``) works on a :class:`~particleShear.engine.state.BatchState`
 of plain arrays; the documented classes (``base``, ``objects``, ``linkable``) reach it through

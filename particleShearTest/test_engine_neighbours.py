@@ -1,4 +1,4 @@
-"""The engine's cell-list neighbour search against the all-pairs search (docs/design.md, "Neighbour lists and box").
+"""The engine's cell-list neighbour search against the all-pairs search (docs/engine.md, "Neighbour lists and box").
 
 ``near_pairs_cells`` bins spheres into cells of at least ``2 r_max + skin`` and searches the
 3 × 3 cells around each sphere, the rows through ``y = 0`` / ``Ly`` at the x moved by the

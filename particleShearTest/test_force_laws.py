@@ -1,4 +1,4 @@
-"""Central force laws (eq. S1-5a/b, S1-6; docs/design.md) and the reference numbers of Appendix A.1.
+"""Central force laws (eq. S1-5a/b, S1-6; docs/engine.md) and the reference numbers of Appendix A.1.
 
 Sign convention: negative = repulsion.  The reference numbers are compared to
 1e-12 relative (an exact 0 where the reference prints 0).
@@ -84,7 +84,7 @@ def central_law_definition(d, d0, k, c):
 
 
 class TestLawProperties(unittest.TestCase):
-    """Properties of docs/design.md that hold for every d0, k and c in [0, 1]."""
+    """Properties of docs/engine.md that hold for every d0, k and c in [0, 1]."""
 
     CS = (0.0, 0.1, 0.25, 0.5, 0.75, 1.0)
 
@@ -204,7 +204,7 @@ def _central_force_on_1(ens, s1):
 
 
 class TestCallbackMechanism(unittest.TestCase):
-    """docs/design.md: the class attribute is looked up at every call and used in all three places."""
+    """docs/engine.md: the class attribute is looked up at every call and used in all three places."""
 
     def setUp(self):
         self._saved = CircleBasicElasticity.__dict__["call_back_elastic_force_law"]
@@ -252,7 +252,7 @@ class TestCallbackMechanism(unittest.TestCase):
         self.assertLessEqual(abs(f - ref), 1e-13 * abs(ref))
 
     def test_callback_sets_coulomb_bound(self):
-        """A fast tangential slip saturates at |μ·law(d, d0, k, c)| of the active callback (docs/design.md)."""
+        """A fast tangential slip saturates at |μ·law(d, d0, k, c)| of the active callback (docs/engine.md)."""
         d, mu = 60.0, 0.3
         for law in (elastic_force_law, elastic_force_law_plateau):
             with self.subTest(law=law.__name__):
@@ -330,7 +330,7 @@ def _engine_central(d, d0, k, c, bond):
 
 
 class TestOneLawEverywhere(unittest.TestCase):
-    """The documented callbacks, the classes' array step and the engine evaluate one law (docs/design.md).
+    """The documented callbacks, the classes' array step and the engine evaluate one law (docs/engine.md).
 
     The same pair geometry (d0 = 120 µm, k = 2, at rest, no viscosity, no friction) must give the
     same central force, bit for bit, in all three: they share the arithmetic of

@@ -1,4 +1,4 @@
-"""The Hertz contact law (particleShear/engine/contact_laws/hertz.py, eq. H-1 of docs/design.md).
+"""The Hertz contact law (particleShear/engine/contact_laws/hertz.py, eq. H-1 of docs/engine.md).
 
 The analytic two-sphere force is written out here, independently of the package:
 ``F = −s·k·√R*·δ^{3/2}`` (lengths in µm, so the ``1/(1 µm)`` of eq. H-1 is 1) with

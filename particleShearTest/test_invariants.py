@@ -1,4 +1,4 @@
-"""Physical invariants of the stress evaluation and of the integrator (docs/design.md).
+"""Physical invariants of the stress evaluation and of the integrator (docs/engine.md).
 
 * The overall tensor σ = σ_LW + σ_Tint + σ_cen is symmetric (the internal-torque
   term cancels the antisymmetric Love–Weber part of the tangential forces) in a
@@ -7,7 +7,7 @@
 * Every tensor of the array path equals its definition (eq. S1-16 … S1-24) summed entry by entry
   over the reference register lists and the mobile spheres.
 * Pair forces obey Newton's third law and the torque split conserves angular
-  momentum (docs/design.md), so Σ m v and Σ m (x v_y − y v_x) + Σ I ω of an isolated,
+  momentum (docs/engine.md), so Σ m v and Σ m (x v_y − y v_x) + Σ I ω of an isolated,
   undamped scene are constant up to rounding — with the symplectic Euler step
   this holds exactly in exact arithmetic (forces are evaluated at x_n and
   x_{n+1} × v_{n+1} = x_n × v_{n+1}).
@@ -49,7 +49,7 @@ def random_ensemble(n, L, seed, packing_fraction=1.2, k=3.14e9, nu=2e3, mu=0.3, 
 
 
 def definition_tensors(ens, Lx, Ly):
-    """Every tensor from its definition (reference manual eq. S1-16 … S1-24; docs/design.md), summed
+    """Every tensor from its definition (reference manual eq. S1-16 … S1-24; docs/engine.md), summed
     entry by entry over the reference register lists and the mobile spheres, independently of the
     array path: V = Lx·Ly·1e-12 m², forces ×1e-12, lengths ×1e-6, torques and inertias ×1e-18,
     lever arms from the cell centre."""
@@ -265,7 +265,7 @@ class TestGalileanInvariance(unittest.TestCase):
     (≈ 1e-13 µm) is the only difference; 60 steps keep its chaotic growth far below 1e-12.
 
     Note: a velocity boost is compared with ``k_t = 0``.  With a tangential spring, the
-    reference's sequential ξ rule (docs/design.md, B.2) integrates ξ_ji with sphere i already moved
+    reference's sequential ξ rule (docs/engine.md, B.2) integrates ξ_ji with sphere i already moved
     by ``v_i·dt``, i.e. with an *absolute* displacement, so ξ_ji (and the tensors) change by
     O(|u|·dt/d) under a boost — a reference quirk, not a rounding effect.
     """

@@ -3,7 +3,7 @@
 * the six force-register lists hold the reference's entries, in its order and granularity
   (one entry per central elastic visit, one per central viscous visit, two per tangential visit),
   checked against an independent sphere-by-sphere evaluation of the interaction laws
-  (docs/design.md; manual eqs. S1-3, S1-5) written here from the model's equations;
+  (docs/engine.md; manual eqs. S1-3, S1-5) written here from the model's equations;
 * the evaluation handler's momenta are plain Python values summed sphere by sphere (int masses
   give an int total mass, as the reference computes them);
 * ``False`` (and None) mean "no file" wherever the reference accepts it;

@@ -1,10 +1,10 @@
-"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/design.md, "Neighbour lists and box").
+"""Neighbour search: the cell list with Lees-Edwards-shifted rows against an all-pairs oracle (docs/engine.md, "Neighbour lists and box").
 
 The classes' ``candidate_pairs`` is the engine's ``near_pairs`` (all pairs below
 ``CELL_LIST_MIN_N`` spheres, the cell list from there: n = 70 and n ≥ 500 below test both).
 
 The oracle here is written independently of the package: the minimum image of
-docs/design.md (y image first, shifting x by Ly·γ; half-open intervals; one period
+docs/engine.md (y image first, shifting x by Ly·γ; half-open intervals; one period
 subtracted at a time) over every pair, and the strict contact test
 ``d < r_i + r_j``.
 """

@@ -10,7 +10,7 @@ The manual also asserts that the Otsuki peculiar-acceleration tensor vanishes in
 manual Part 4 scenario 1 (single sphere in linear motion) and manual Part 4 scenario 3 (frictionless central collision); it does not (it is −Σ m v⊗v/V for moving spheres), which is why
 the reference fails those two tests by design.  They are kept here as
 ``expectedFailure`` so that the suite reports them, and the actual value of the
-term is checked against its formula (docs/design.md) by ordinary tests.
+term is checked against its formula (docs/engine.md) by ordinary tests.
 """
 import unittest
 
@@ -127,7 +127,7 @@ class TestSingleSphereLinearMotion(_Checks):
         self.assertExactlyZero(self.ev.stress_tensor_linear_acceleration_otsuki)
 
     def test_otsuki_value(self):
-        """What the term actually is (docs/design.md): −m v_a v_b·1e-18/V, e.g. −1.96e-12 Pa for xx."""
+        """What the term actually is (docs/engine.md): −m v_a v_b·1e-18/V, e.g. −1.96e-12 Pa for xx."""
         v = np.array([0.7, 0.3])
         ref = -np.outer(v, v) * 1e-18 / V
         got = T(self.ev, "stress_tensor_linear_acceleration_otsuki")
@@ -272,7 +272,7 @@ class TestFrictionlessCentralCollision(_Checks):
         self.assertExactlyZero(self.t["stress_tensor_linear_acceleration_otsuki"])
 
     def test_otsuki_value(self):
-        """−Σ m v⊗v·1e-18/V with the velocities at the start of the tested step (m = 1), docs/design.md."""
+        """−Σ m v⊗v·1e-18/V with the velocities at the start of the tested step (m = 1), docs/engine.md."""
         got = self.t["stress_tensor_linear_acceleration_otsuki"]
         ref = -sum(np.outer(v, v) for v in self.v) * 1e-18 / V
         self.assertFalse(np.all(ref == 0))

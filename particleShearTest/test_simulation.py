@@ -29,7 +29,7 @@ QUICK = dict(N=20, do_permanent_links=False, cut_lines=0, relative_frequency=0.2
 
 
 def reference_demodulation(t, s, f, A, pre, P, post):
-    """Direct transcription of the reference formula of docs/design.md (drift-sign quirk included)."""
+    """Direct transcription of the reference formula (docs/analysis.md, "The R evaluation"; drift-sign quirk included)."""
     t = list(t)
     s = list(s)
     e = 1 if P >= 2 else 0
@@ -175,7 +175,7 @@ class TestEvaluationHandler(unittest.TestCase):
 
 
 def parse_header(text):
-    """The downstream regular expressions of docs/design.md on the first 100 lines (first match wins)."""
+    """The downstream regular expressions (docs/output.md, "Downstream compatibility") on the first 100 lines (first match wins)."""
     head = "\n".join(text.split("\n")[:100])
     num = r"([0-9]*\.?[0-9]*)"
     gnum = r"(-?[0-9]*\.?[0-9]*)"
@@ -261,7 +261,7 @@ class TestOutputFile(unittest.TestCase):
         # fixed bookkeeping defects (the reference defects listed in docs/output.md #21, #22)
         self.assertIn("\nPost-measurement periods = 1 [-]\n", self.text)
         self.assertIn("\nSimulated time = " + str(6 / self.res.f) + "s\n", self.text)
-        # literal layout details of docs/design.md
+        # literal layout details of the reference header (docs/output.md, "Blocks")
         self.assertTrue(self.text.startswith("Dermal filler Ensemble: \n\tCutting lines used to generate the "
                                              "particles3\n\tN=30 spheres, nominal packing density = 1.5\n"))
         self.assertIn("\tYoung modulus of the individual spheres = 8000 Pa \n", self.text)
@@ -286,10 +286,10 @@ class TestOutputFile(unittest.TestCase):
         np.testing.assert_array_equal(col["t"], s["t"])
         np.testing.assert_array_equal(col["stress_measured_at_surface"], s["stress_surface"])
         np.testing.assert_array_equal(col["shear_stress_internal_stress-tensor"], s["stress_internal"])
-        # strain is the running sum of rate·dt (docs/design.md)
+        # strain is the running sum of rate·dt (docs/engine.md, "One step")
         dt = self.res.dt
         np.testing.assert_array_equal(col["strain"][1:], col["strain"][:-1] + col["strain_rate"][:-1] * dt)
-        # the header G values are reproduced by the reference formula (docs/design.md) from the stored
+        # the header G values are reproduced by the reference formula (docs/analysis.md) from the stored
         # columns (written with str(), read back exactly): the same sums in another order, 1.3e-15 measured
         p = self.res.parameters
         for c, G in (("shear_stress_internal_stress-tensor", self.res.G_internal),

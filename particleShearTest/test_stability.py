@@ -1,8 +1,8 @@
 """Stability matrix and stability guard (issue "Accuracy and stability").
 
-Every case builds a real ensemble with the docs/design.md builder (``do_debug=True``: ten times shorter
+Every case builds a real ensemble with the docs/engine.md builder (``do_debug=True``: ten times shorter
 constitution, same physics), runs the experiment's fixed-plate pre-equilibration and a limited
-number of protocol steps (docs/design.md, the reference per-step order), and asserts physical
+number of protocol steps (docs/engine.md, the reference per-step order), and asserts physical
 truths at every step through a read-only monitor installed where the stability guard sits
 (``ensemble.stability_guard``; it is called after every force phase with the pair geometry
 of the step):
@@ -10,7 +10,7 @@ of the step):
 * the state stays finite;
 * the peculiar kinetic energy (relative to the affine flow) stays bounded (see ``KE_FRACTION``);
 * the overall stress tensor is symmetric to ``SYM_TOL`` relative (eq. S1-24: it is the sum of a
-  symmetric part and of torque terms that cancel exactly in its construction — docs/design.md — so only
+  symmetric part and of torque terms that cancel exactly in its construction — docs/engine.md — so only
   round-off remains, ~1e-16);
 * no sphere pair passes through another: ``min d/(r_i + r_j)`` over transient contacts stays > 0
   and no pair's contact normal flips sign between consecutive steps while it is in contact
@@ -21,7 +21,7 @@ periodic boundary) use a dilute two-sphere builder ensemble with positions set b
 same monitor checks them, plus energy statements specific to an isolated pair.
 
 Slow full runs (convergence, long protocols) live in ``benchmarks/accuracy_study.py``.
-Units: µm, s, mg per m depth (internal units of docs/design.md); energies in mg·µm²·s⁻² per m.
+Units: µm, s, mg per m depth (internal units of docs/engine.md); energies in mg·µm²·s⁻² per m.
 """
 import math
 import os
@@ -104,7 +104,7 @@ def reference_energy(ens):
 
 
 def pair_energy(d, d0, k, c=1.0):
-    """Elastic energy stored by the default law (docs/design.md, cap included) at distance d: ∫_d^d0 −F(s) ds."""
+    """Elastic energy stored by the default law (docs/engine.md, cap included) at distance d: ∫_d^d0 −F(s) ds."""
     cap = d0 / 1000
     lin = 0.5 * k * (1 - c) * (d0 - d) ** 2
     e = max(d, cap)
@@ -137,7 +137,7 @@ def build(N=30, seed=1, links=True, cut_lines=3, packing_fraction=1.5, E=8000.0,
 
 
 def shear(exp, n_steps, pre=True, monitor=None):
-    """Pre-equilibrate (fixed plates, docs/design.md) and run ``n_steps`` protocol steps with every tensor kept."""
+    """Pre-equilibrate (fixed plates, docs/engine.md) and run ``n_steps`` protocol steps with every tensor kept."""
     ens = exp.theEnsemble
     mon = monitor or ContactMonitor()
     ens.stability_guard = mon
@@ -165,7 +165,7 @@ class StabilityAssertions:
         a = ens.sphere_arrays
         for name in ("x", "y", "xspeed", "yspeed", "omega"):
             self.assertTrue(np.isfinite(a[name]).all(), f"{label}: {name} not finite")
-        # positions wrapped into the cell (docs/design.md)
+        # positions wrapped into the cell (docs/engine.md)
         self.assertTrue(((a["x"] >= 0) & (a["x"] < ens.size_x)).all(), f"{label}: x outside [0, Lx)")
         self.assertTrue(((a["y"] >= 0) & (a["y"] < ens.size_y)).all(), f"{label}: y outside [0, Ly)")
         E_ref = reference_energy(ens)
@@ -317,7 +317,7 @@ class TestExtremeGeometry(StabilityAssertions, unittest.TestCase):
         self.assertLessEqual(max(mon.ke), U0)
 
     def test_coincident_centres(self):
-        """d = 0: a random normal (docs/design.md) and the capped force 999·k·c·d0 (eq. S1-6) separate the pair."""
+        """d = 0: a random normal (docs/engine.md) and the capped force 999·k·c·d0 (eq. S1-6) separate the pair."""
         sim, exp, ens = self.pair((250.0, 250.0), (250.0, 250.0))
         d0 = float(ens.sphere_arrays["r"].sum())
         mon = ContactMonitor(skip_first=True)

@@ -1,4 +1,4 @@
-"""The documented classes' stress tensors are the engine's (docs/design.md, "Written once").
+"""The documented classes' stress tensors are the engine's (docs/engine.md, "Written once").
 
 * On the same state, the classes' tensors (their own force phase, read through the register)
   equal the tensors of the engine's step (``BatchEngine.step(sample="tensors")``, its own force

@@ -1,4 +1,4 @@
-"""Canvases: the ensemble's state arrays and the documented step (docs/design.md, "The documented classes").
+"""Canvases: the ensemble's state arrays and the documented step (docs/classes.md, "The documented classes").
 
 Each class adds one capability: points and ``sphereList``, mass and force register (:mod:`.canvas_base`),
 pair table, Lees-Edwards shear and plates (:mod:`.pair_canvas`), central forces and the step, shear-rate

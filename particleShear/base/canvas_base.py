@@ -1,4 +1,4 @@
-"""The first canvases: the ensemble's state arrays, ``sphereList``, mass and force register (docs/design.md,
+"""The first canvases: the ensemble's state arrays, ``sphereList``, mass and force register (docs/classes.md,
 "The documented classes").
 
 The pair canvases of :mod:`.pair_canvas` and the force canvases of :mod:`.elastic_canvas` subclass

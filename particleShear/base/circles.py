@@ -1,4 +1,4 @@
-"""Circles: discs with a mass and relations to their neighbours (docs/design.md, "State").
+"""Circles: discs with a mass and relations to their neighbours (docs/engine.md, "State").
 
 :class:`Circle` (radius, drawing), :class:`CircleMass` (mass, forces, 1.0.2's register) and
 :class:`CircleMassNeighbors` (relations); handles into the ensemble's arrays once appended.

@@ -1,4 +1,4 @@
-"""Canvases with pair forces and the documented step (docs/design.md, "The documented classes").
+"""Canvases with pair forces and the documented step (docs/classes.md, "The documented classes").
 
 The phases of a step are the engine's (:mod:`particleShear.base.engine_view`); the canvas-wide
 per-term methods (``elastic_force_from_neighbors()`` …) are 1.0.2's loops over the per-sphere API.

@@ -1,4 +1,4 @@
-"""Elastic and frictional circles: the per-sphere force API of 1.0.2 (docs/design.md, "The documented classes").
+"""Elastic and frictional circles: the per-sphere force API of 1.0.2 (docs/classes.md, "The documented classes").
 
 Each method evaluates :mod:`particleShear.engine.terms` on the pairs it is asked about, one visit per
 call.  ``theSphere`` is the partner; ``k``, ``k_t`` the central and tangential spring constants

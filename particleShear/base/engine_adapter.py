@@ -2,7 +2,7 @@
 
 The engine (:mod:`particleShear.engine`) advances a :class:`~particleShear.engine.state.BatchState`
 of plain arrays and knows nothing of the documented classes.  This module is their adapter
-(docs/design.md, "The documented classes"):
+(docs/classes.md, "The documented classes"):
 
 * :func:`state_from_ensembles` copies B ensembles into a new batch state (a measurement's batch);
 * :func:`state_of_ensembles` (:func:`state_of_ensemble` for one) makes a batch state whose

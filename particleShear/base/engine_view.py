@@ -1,4 +1,4 @@
-"""The documented step as the engine's phases on the ensemble's own state (docs/design.md, "The documented classes").
+"""The documented step as the engine's phases on the ensemble's own state (docs/classes.md, "The documented classes").
 
 A canvas keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
 (:func:`~particleShear.base.engine_adapter.state_of_ensemble`) whose sphere arrays are the ensemble's

@@ -1,7 +1,7 @@
 """The one cache mechanism of the canvas classes: named values kept under an explicit key.
 
 The key lists everything a value is computed from (version counters, parameters), so a kept value
-is what recomputing it gives.  Only values worth ≥ ~10 % of a step are kept (docs/design.md, "The one cache").
+is what recomputing it gives.  Only values worth ≥ ~10 % of a step are kept (docs/engine.md, "Caches").
 """
 __docformat__ = "numpy"
 

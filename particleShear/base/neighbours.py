@@ -1,4 +1,4 @@
-"""Pair table and O(N) neighbour search, the engine's (re-exported for the classes; docs/design.md):
+"""Pair table and O(N) neighbour search, the engine's (re-exported for the classes; docs/classes.md):
 ``candidate_pairs`` is :func:`~particleShear.engine.neighbours.near_pairs`.
 
 A pair of the table is *active* (a relation) while it touches or is a permanent link.

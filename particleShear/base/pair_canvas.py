@@ -1,4 +1,4 @@
-"""Canvases with pairs: the pair table, the neighbour update and the Lees-Edwards cell (docs/design.md)."""
+"""Canvases with pairs: the pair table, the neighbour update and the Lees-Edwards cell (docs/classes.md)."""
 __docformat__ = "numpy"
 import numpy as np
 from ..engine import box as _box

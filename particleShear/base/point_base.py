@@ -1,4 +1,4 @@
-"""Points, the root of the per-sphere API (docs/design.md, "The documented classes"); the circles of
+"""Points, the root of the per-sphere API (docs/classes.md, "The documented classes"); the circles of
 :mod:`.circles` and :mod:`.elastic_circles` subclass them, and :mod:`.points` gathers all of them.
 
 A sphere keeps its own values until appended to an ensemble, then reads and writes the ensemble's

@@ -1,4 +1,4 @@
-"""Points and circles, the per-sphere API (docs/design.md, "The documented classes").
+"""Points and circles, the per-sphere API (docs/classes.md, "The documented classes").
 
 :class:`Point` and :class:`PointLeesEdwards` (:mod:`.point_base`), :class:`Circle`, :class:`CircleMass`,
 :class:`CircleMassNeighbors` (:mod:`.circles`), :class:`CircleBasicElasticity` and

@@ -1,4 +1,4 @@
-"""Force register: the forces and torques the stress tensors sum (eqs. S1-16 to S1-24; docs/design.md).
+"""Force register: the forces and torques the stress tensors sum (eqs. S1-16 to S1-24; docs/classes.md).
 
 The engine stores a force phase as arrays; the six reference lists (``pair_register`` …) are built
 from them on demand, and manual ``record_*`` calls (scripts without an ensemble) append to them.
@@ -327,7 +327,7 @@ class Force_register:
 
     @property
     def pair_register(self):
-        """``[target, source, [F_x, F_y]]`` per internal pair force, in the reference's order (docs/design.md)."""
+        """``[target, source, [F_x, F_y]]`` per internal pair force, in the reference's order (docs/classes.md)."""
         return self._engine_lists()["pair"] + self._m_pair
 
     @property
@@ -368,7 +368,7 @@ class Force_register:
 
 
 def _visit_entries(p, sl, out):
-    """Append the reference entries of one engine register block to the lists in ``out`` (docs/design.md).
+    """Append the reference entries of one engine register block to the lists in ``out`` (docs/classes.md).
 
     Each pair is visited from i (side 0) and from j (side 1), ordered by visitor, relation birth,
     partner.  Central terms give one entry per visit on the visitor, a tangential visit ``±F/2·t``

@@ -1,4 +1,4 @@
-"""Neighbour relations: plain objects, and views of an ensemble's pair table (see docs/design.md)."""
+"""Neighbour relations: plain objects, and views of an ensemble's pair table (see docs/classes.md)."""
 __docformat__ = "numpy"
 
 from .neighbours import STATE_CODES, STATE_NAMES

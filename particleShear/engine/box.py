@@ -1,4 +1,4 @@
-"""Lees-Edwards box: minimum image, wrap and affine flow over arrays (docs/design.md).
+"""Lees-Edwards box: minimum image, wrap and affine flow over arrays (docs/engine.md).
 
 Every function takes per-element box lengths and offsets (arrays or scalars), so one call
 serves pairs or spheres of many replicas with different boxes and strains.  Lengths in µm,
@@ -75,7 +75,7 @@ def _fold(v, L, lo, hi, xp):
 
 
 def min_image(dx, dy, Lx, Ly, shift):
-    """Lees-Edwards minimum image of raw differences ``x_j − x_i`` (docs/design.md, "State").
+    """Lees-Edwards minimum image of raw differences ``x_j − x_i`` (docs/engine.md, "State").
 
     The pair vector of a step is the separation to the nearest periodic image of j.  The y
     image is chosen first and moves x by ``shift = Ly·γ`` (the offset of the image rows
@@ -167,7 +167,7 @@ def inside_cell(x, y, Lx, Ly):
 
 
 def wrap(x, y, vx, Lx, Ly, shift, rate):
-    """Bring positions into ``[0, Lx) × [0, Ly)`` in place (Lees-Edwards wrap, docs/design.md).
+    """Bring positions into ``[0, Lx) × [0, Ly)`` in place (Lees-Edwards wrap, docs/engine.md).
 
     A sphere leaving through the top re-enters at the bottom in the image frame that moves
     with the flow: crossing ``y = Ly`` moves x by ``−shift`` (``shift = Ly·γ`` after the strain
@@ -243,7 +243,7 @@ def flow_velocity(y, Ly, rate):
     """x velocity ``γ̇ (y − Ly/2)`` of the affine shear flow at height y.
 
     The imposed flow field: the centre line of the cell is at rest, the top moves with
-    ``+γ̇·Ly/2``.  Damping acts on the velocity relative to it (docs/design.md).
+    ``+γ̇·Ly/2``.  Damping acts on the velocity relative to it (docs/engine.md).
 
     Parameters
     ----------

@@ -5,7 +5,7 @@ whose term constants come from :func:`.terms.term_constants`), the normals of th
 scatter of pair forces to spheres and the two shear stresses G′/G″ need.  The force terms
 themselves are in :mod:`.terms`.  Equations: reference manual eq.
 S1-3 (torque split), S1-5/S1-6 (laws), S1-16 (external-force tensor), S1-19 (Love-Weber),
-S1-22/S1-24 (torque terms, overall tensor); details in ``docs/design.md``.
+S1-22/S1-24 (torque terms, overall tensor); details in ``docs/engine.md``.
 
 Shapes: P candidate pairs of the whole batch (the replicas' lists concatenated in replica
 order), B replicas, B·N spheres.  Units: µm, µm/s, forces in mg·µm·s⁻² per m depth, torques
@@ -46,7 +46,7 @@ class PairConstants:
     attribute (``C.ri``, ``C.mu``, …) is a view of its row, and assigning one writes into the
     row, so the blocks always hold every constant and a rebuild of some replicas' lists
     (:meth:`splice`) is a few concatenations of blocks instead of one per constant
-    (docs/design.md, "The one cache").
+    (docs/engine.md, "Caches").
 
     Parameters
     ----------

@@ -6,7 +6,7 @@ and the documented canvas classes (``mechanical_simulation_step_calculate_accele
 on the rows they are given (a sphere block of B·N columns, or of the N spheres of one ensemble), in
 the array namespace of their inputs (NumPy or CuPy).
 
-The order of a step (docs/design.md, "One step"): forces → :func:`kick` → :func:`plates_follow`
+The order of a step (docs/engine.md, "One step"): forces → :func:`kick` → :func:`plates_follow`
 → :func:`damp` → :func:`xi_increments` (velocities after the kick and damping, positions of the force
 phase) → :func:`drift` → strain → wrap (:func:`~particleShear.engine.box.wrap`) → clock.
 
@@ -70,7 +70,7 @@ def half_kick(frc, weights, dt, mobile=None):
 
 
 def mobile_mask(r, y, Ly):
-    """Which spheres move freely while the plates are on: ``r < y < Ly − r`` (docs/design.md).
+    """Which spheres move freely while the plates are on: ``r < y < Ly − r`` (docs/engine.md).
 
     A sphere overlapping ``y = 0`` or ``y = Ly`` is glued to its plate (:func:`plates_follow`); the
     same rule decides which pair forces count as external (eq. S1-16).
@@ -92,7 +92,7 @@ def mobile_mask(r, y, Ly):
 
 
 def plates_follow(vx, vy, immobile, yc, plate_speed):
-    """Immobile (plate) spheres take the velocity of their plate and no y velocity (docs/design.md).
+    """Immobile (plate) spheres take the velocity of their plate and no y velocity (docs/engine.md).
 
     A sphere overlapping ``y = 0`` or ``y = Ly`` while the shear is applied is glued to its plate:
     ``vx = ±γ̇·Ly/2`` (+ above the centre line), ``vy = 0``.  Applied after :func:`kick`, which
@@ -118,7 +118,7 @@ def plates_follow(vx, vy, immobile, yc, plate_speed):
 def damp(vel, flow, cool):
     """Damp the velocity relative to the affine flow and the spin: ``v_x ← u + (v_x − u)·f``, ``v_y, ω ← f·…``.
 
-    SLLOD-like damping (docs/design.md): only the peculiar velocity loses ``1 − f`` per step, so
+    SLLOD-like damping (docs/engine.md): only the peculiar velocity loses ``1 − f`` per step, so
     a steady shear flow ``u = γ̇ (y − Ly/2)`` is not slowed down.
 
     Parameters
@@ -143,7 +143,7 @@ def shift_flow(vx, omega, yc, delta):
     """A change ``Δγ̇`` of the shear rate without a velocity shock: ``v_x += (y − Ly/2)·Δγ̇``, ``ω −= Δγ̇/2``.
 
     Every sphere keeps its velocity relative to the affine flow and its spin relative to the
-    flow's rotation rate ``−γ̇/2`` (docs/design.md).  In place.
+    flow's rotation rate ``−γ̇/2`` (docs/engine.md).  In place.
 
     Parameters
     ----------

@@ -102,7 +102,7 @@ def central_constants(d0, k, c):
 def linear_term(d, d0, a_lin):
     """Linear term of the compressive law, ``a_lin (d0 − d)`` (eq. S1-5a with ``a_lin = −k(1−c)``).
 
-    A pure expression (docs/design.md, "One law, two drivers"): the NumPy engine calls it on
+    A pure expression (docs/backends.md, "One law, two drivers"): the NumPy engine calls it on
     arrays, the compiled driver on numbers.
 
     Parameters
@@ -123,7 +123,7 @@ def linear_term(d, d0, a_lin):
 def divergent_term(d, d0, d0_cap, a_div):
     """Divergent term of the compressive law, ``a_div (d0 / max(d, d0_cap) − 1)`` (eqs. S1-5b, S1-6).
 
-    A pure expression (docs/design.md, "One law, two drivers"): arrays or numbers.
+    A pure expression (docs/backends.md, "One law, two drivers"): arrays or numbers.
 
     Parameters
     ----------
@@ -240,7 +240,7 @@ def contact_or_bond(d, d_law, inside, beyond):
     """The elastic law of a pair: the compressive law ``inside`` up to ``d_law``, ``beyond`` above it.
 
     ``beyond`` is the tensile law of a stretched bond (:func:`tensile_inside`) and +0 for a contact
-    that has separated.  A pure expression (docs/design.md, "One law, two drivers").
+    that has separated.  A pure expression (docs/backends.md, "One law, two drivers").
 
     Parameters
     ----------

@@ -1,5 +1,5 @@
 """The measurement's loops over the engine's one step: the fixed-boundary pre-equilibration and the
-oscillatory protocol of a batch (docs/design.md, "One step").
+oscillatory protocol of a batch (docs/engine.md, "One step").
 
 :func:`pre_equilibrate` (plates fixed: coarse levels from ``dt_max``, then 2N and N steps at
 ``dt``) and :func:`protocol` (recording t, γ, γ̇, τ_internal and τ_surface of every replica and
@@ -90,7 +90,7 @@ def _quiet(*args):
 
 def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, observers=()):
     """Relax with the plates fixed: coarse levels from ``dt_max``, 2N steps at ``dt`` (damping
-    0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment (docs/design.md).
+    0.98), N steps at ``dt`` with ``cool`` and γ̇ reset to 0 by assignment (docs/engine.md).
 
     Parameters
     ----------
@@ -161,7 +161,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
 
 def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=False, say=_quiet, report=_quiet,
              observers=(), stop=None):
-    """The oscillatory protocol of every replica, clock reset to 0 (docs/design.md).
+    """The oscillatory protocol of every replica, clock reset to 0 (docs/engine.md).
 
     Every step first sets γ̇ = ``A·2πf·cos(2π(f t − pre))`` during the shear periods (0 in the
     baselines), so the strain follows ``A·sin(2π(f t − pre))``, then records and steps.

@@ -215,7 +215,7 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     sphere); each pair is visited once, from the same cell (``i < j``) or from the sphere whose
     partner lies in the cell to the right or in one of the three cells of the row above.  The
     row above the top row is the bottom row seen through the Lees-Edwards image, so it is
-    searched around ``x − shift``, as the minimum image of docs/design.md moves x by the offset
+    searched around ``x − shift``, as the minimum image of docs/engine.md moves x by the offset
     when it takes the y image.  Every candidate is then tested exactly as
     :func:`near_pairs_all` tests it (same orientation ``i < j``, same operations), so both
     return the same pairs.

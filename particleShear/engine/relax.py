@@ -8,7 +8,7 @@ ending with the removal of the mean velocity), one frictionless block at ``dt``,
 of a :class:`~particleShear.engine.step.BatchEngine`; :func:`remove_linear_drift` is the classes'
 ``correct_linear_drift`` per replica.  The documented ensembles are relaxed on their own state
 and handed their clock and relations back by their adapter,
-:func:`particleShear.base.engine_adapter.relax_ensembles` (docs/design.md, "Runs").
+:func:`particleShear.base.engine_adapter.relax_ensembles` (docs/engine.md, "Runs").
 
 A replica's relaxation does not depend on its batch (every operation of the step is per
 replica, see :mod:`.step`; the drift is removed per replica), so a run constituted in a batch

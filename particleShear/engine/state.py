@@ -1,4 +1,4 @@
-"""The state of a batch of replicas as explicit arrays (docs/design.md, "Runs").
+"""The state of a batch of replicas as explicit arrays (docs/engine.md, "Runs").
 
 Spheres of replica b occupy rows ``b·N … b·N + N − 1`` of every per-sphere array; per-replica
 values (box, strain, rate, model constants) are arrays of length B and are gathered to spheres

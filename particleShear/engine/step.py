@@ -1,6 +1,6 @@
 """One step of a batch of replicas, top to bottom in the reference order.
 
-:meth:`BatchEngine.step` reads like the reference's step (docs/design.md, "One step"): shear rate →
+:meth:`BatchEngine.step` reads like the reference's step (docs/engine.md, "One step"): shear rate →
 neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
 The measurement's loops, :func:`~.loops.pre_equilibrate` and :func:`~.loops.protocol`, are in
 :mod:`.loops` (and importable from here).
@@ -346,7 +346,7 @@ class BatchEngine:
         """Change γ̇ per replica; each sphere keeps its velocity relative to the local flow.
 
         ``vx += (y − Ly/2)·Δγ̇`` and ``ω −= Δγ̇/2`` (the flow's rotation rate), so a change of
-        rate gives no velocity shock (docs/design.md).
+        rate gives no velocity shock (docs/engine.md).
 
         Parameters
         ----------

@@ -8,7 +8,7 @@ reductions, one over the pairs and one over the spheres.  Each row is summed per
 its own segment, so a tensor's numbers do not depend on which other rows, tensors or replicas
 are summed with it.  Units as in the reference: forces ×1e-12 (N per m depth), lengths ×1e-6
 (m), torques and inertias ×1e-18, volume ``V = Lx·Ly·1e-12`` m², lever arms from the cell
-centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/design.md).
+centre.  Definitions: reference manual eq. S1-16 … S1-24 (docs/engine.md).
 """
 __docformat__ = "numpy"
 

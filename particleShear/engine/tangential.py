@@ -1,4 +1,4 @@
-"""Tangential two-visit rule over arrays (docs/design.md, "One step"), written once.
+"""Tangential two-visit rule over arrays (docs/engine.md, "One step"), written once.
 
 Used by the engine's step and by the documented canvas classes alike, on the array namespace of
 its inputs (NumPy or CuPy, :mod:`.xp`).  Forces in mg·µm·s⁻² per m depth, ξ in µm, velocities
@@ -40,7 +40,7 @@ def two_visit_rule(vt, touching, xi_ij, xi_ji, kt_i, kt_j, nut_i, nut_j, f_coulo
     on touching pairs only), clipped to ``f_coulomb`` (:func:`coulomb_clip`).  Visit 1 (from i)
     sees ξ_ij; visit 2 (from j) sees ξ_ji, or 0 if visit 1 slipped; a slip in either visit resets
     both histories.  Written with arithmetic, ``abs/minimum/copysign`` and
-    :func:`~particleShear.engine.xp.select` only (docs/design.md, "One law, two drivers"): the
+    :func:`~particleShear.engine.xp.select` only (docs/backends.md, "One law, two drivers"): the
     NumPy engine calls it on arrays (:func:`tangential_two_pass`), the compiled driver on numbers.
 
     Parameters

@@ -1,7 +1,7 @@
 """The pair force terms, each written once: their constants, the elastic, viscous and tangential terms.
 
 Contacts and bonds, the engine's step and the documented canvas classes all evaluate a pair's
-forces through these functions (docs/design.md, "One step"):
+forces through these functions (docs/engine.md, "One step"):
 
 * :func:`relative_velocity`, :func:`normal_speed` and :func:`slip_speed` are the kinematics of a
   contact: the velocity of j's image relative to i, its normal part ``v_n`` and the tangential slip
@@ -269,7 +269,7 @@ def viscous_term(K, vn, active):
 def viscous_force(nu, vn, active):
     """Central viscous force ``ν·v_n`` of a relation (eq. S1-9), 0 on a candidate that is none.
 
-    A pure expression (docs/design.md, "One law, two drivers"): arrays or numbers.
+    A pure expression (docs/backends.md, "One law, two drivers"): arrays or numbers.
 
     Parameters
     ----------

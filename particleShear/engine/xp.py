@@ -50,7 +50,7 @@ REASONS = {
 }
 
 def select(cond, a, b):
-    """``a`` where ``cond`` holds, else ``b``: the one branch a law may take (docs/design.md, "One law, two drivers").
+    """``a`` where ``cond`` holds, else ``b``: the one branch a law may take (docs/backends.md, "One law, two drivers").
 
     On arrays (NumPy, or CuPy through NumPy's dispatch) it is ``numpy.where(cond, a, b)``; inside
     compiled code it is ``a if cond else b`` on numbers (registered with Numba by

@@ -90,7 +90,7 @@ def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut
 class Relaxation:
     """Request to run ``ensemble.free_pre_equilibration(N)`` in the engine, yielded by a constitution.
 
-    Run by :meth:`run` or by a batch's driver; ``dt``, ``dt_max``, ``mu`` are read then (docs/design.md, "Runs").
+    Run by :meth:`run` or by a batch's driver; ``dt``, ``dt_max``, ``mu`` are read then (docs/engine.md, "Runs").
 
     Parameters
     ----------
@@ -222,7 +222,7 @@ def adjustable_interface_constitution(
     """Constitution of :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters` as a generator.
 
     Each ``free_pre_equilibration`` block is yielded as a :class:`Relaxation` for the caller to run
-    (:func:`relax_constitution`, or ``particleShear.run.batch`` for all replicas; docs/design.md,
+    (:func:`relax_constitution`, or ``particleShear.run.batch`` for all replicas; docs/engine.md,
     "Runs"); the ensemble is returned (``StopIteration.value``).  Invalid inputs raise as in the
     builder, on the first ``next()``.
 

@@ -88,7 +88,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         """Damped frictionless multi-level relaxation, then N frictionless and N frictional steps at ``dt``.
 
         From ``dt_max`` with damping 0.5, N steps per level while the step exceeds ``dt``, each level halving
-        the step, moving the damping half-way to 1 and removing the mean velocity (docs/design.md, "Runs").
+        the step, moving the damping half-way to 1 and removing the mean velocity (docs/engine.md, "Runs").
 
         Parameters
         ----------

@@ -213,7 +213,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         ``CircleBasicElasticity.call_back_elastic_force_law``, the class-attribute way of 1.0.2),
         "plateau" the same law of a plateau-transformed distance (spongy particles, the manual's
         ``elastic_force_law_plateau``), "hertz" the Hertz force of two spheres of unequal radii
-        (eq. H-1, parameter ``hertz_scale``; docs/parameters.md, docs/design.md).
+        (eq. H-1, parameter ``hertz_scale``; docs/parameters.md, docs/engine.md).
     plateau_begin : float, default 0.3
         Keyword-only.  Begin of the plateau of ``contact_law="plateau"``, a fraction of the
         contact distance; allowed 0 < plateau_begin < plateau_end.

@@ -15,8 +15,8 @@ A replica's result does not depend on the other replicas of its batch: its recor
 G′/G″ are bit-identical to its single run (tested).  Every run — single runs included, drawn or
 not, any integrator, any contact law, any N, saving data and snapshots or not — measures through :mod:`particleShear.engine`, all replicas of a batch
 in one set of arrays, each replica's drawing an observer of its replica
-(:mod:`particleShear.simulation.observers`).  See ``docs/design.md`` (sections "Batches of
-replicas" and "Observers").
+(:mod:`particleShear.simulation.observers`).  See ``docs/engine.md`` (sections "Runs" and
+"Observers").
 
 The contact law (``contact_law``) must agree within a batch (:func:`batches` groups runs by it, as
 it groups them by schedule): the engine evaluates one law function on all candidates of a step.

@@ -296,7 +296,7 @@ class EvaluationHandler:
 
     def _momentum_values(self):
         """``total_mass``, ``xg``, ``v_mean``, ``angular_momentum_around_origin`` of the last fully evaluated
-        step as the reference computes them (docs/design.md): plain Python numbers, summed sphere by sphere
+        step as the reference computes them (docs/classes.md): plain Python numbers, summed sphere by sphere
         in list order, with the masses as given (``int`` masses give an ``int`` total mass)."""
         v = self._momenta_values
         if v is None:

@@ -4,7 +4,7 @@
 pre-equilibration and the measurement protocol (strain ``A·sin(2π(f t − pre))`` during the
 excitation periods, at rest during the baselines) with the engine's one step and its one
 protocol loop on the ensemble's own state (:meth:`OscillatoryShearExperiment.engine_of_ensemble`;
-docs/design.md, "One step"), records every step, demodulates τ_internal and τ_surface
+docs/engine.md, "One step"), records every step, demodulates τ_internal and τ_surface
 (:func:`~.evaluation.demodulation`) and returns ``[G′_surface, G″_surface]`` (Pa) as the reference
 does.  ``pre_equilibrate`` and ``run_protocol`` run the two phases one by one.
 """

@@ -89,7 +89,7 @@ class RunSession:
     :func:`particleShear.run.batch.measure_sessions` drives the phases of one session
     (``runSimulation``) or of a batch's (``run_batch``, ``doParticleShearSimulation``): the engine
     measures and each experiment adopts its record, so every run builds, reserves, writes and
-    cleans up in one way (docs/output.md, docs/design.md "Runs").
+    cleans up in one way (docs/output.md, docs/engine.md "Runs").
 
     Parameters
     ----------
@@ -128,7 +128,7 @@ class RunSession:
         self.t_start = time.perf_counter()
 
     def constitution(self):
-        """The constitution as a generator of its relaxations (docs/design.md, "Runs").
+        """The constitution as a generator of its relaxations (docs/engine.md, "Runs").
 
         Yields each :class:`~particleShear.linkable.builders.Relaxation` of the builder (the
         caller runs it in the engine, alone or with a batch's, and resumes) when the
@@ -542,7 +542,7 @@ class OscillatorySimulation:
 
     def time_steps(self):
         """``(dt, f, dt_max)`` of the measurement: the ensemble's steps times ``time_step_factor`` and
-        ``f = relative_frequency / τ`` (docs/parameters.md, "Time step").  Needs the ensemble."""
+        ``f = relative_frequency / τ`` (docs/parameters.md, "Derived quantities (default run)").  Needs the ensemble."""
         ens = self.theEnsemble
         model = self.model or getattr(ens, "model", False)
         factor = getattr(self, "time_step_factor", 1.0)

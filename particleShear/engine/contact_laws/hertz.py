@@ -34,7 +34,7 @@ __all__ = ["hertz", "PARAMETERS", "LAW"]
 PARAMETERS = (
     Parameter('hertz_scale', 0.05, 'float', unit='1', low=0, high=1000.0, low_open=True, role='law:hertz',
               doc='Scale s of the Hertz law F = −s·k·√R*·δ^{3/2}/(1 µm) of ``contact_law="hertz"`` '
-                  '(eq. H-1, docs/design.md), dimensionless'),
+                  '(eq. H-1, docs/engine.md), dimensionless'),
 )
 
 
