@@ -23,7 +23,7 @@ DESIGN = ROOT / "docs" / "design.md"
 MAX_LINES = 200
 
 #: a dotted Python name: identifiers joined by dots (a file name such as results.csv is not one)
-DOTTED = re.compile(r"(?<![\w.])[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)+(?![\w(])")
+DOTTED = re.compile(r"(?<![\w.])[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)+(?!\w)")
 FILE_SUFFIXES = (".py", ".md", ".csv", ".json", ".toml", ".txt", ".gz", ".npz", ".parquet", ".png")
 #: a citation: a page ``….md`` (optionally in backticks), then a comma or a space (and optionally
 #: "section"/"sections"), then one or more quoted titles joined by "and" or commas
