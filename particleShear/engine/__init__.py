@@ -1,4 +1,5 @@
-"""The engine layer (layer 1 of :data:`particleShear.layers.LAYERS`): array kernels with a leading replica axis (``docs/engine.md``).
+"""The engine layer (layer 1 of :data:`particleShear.layers.LAYERS`): array kernels with a leading
+replica axis (``docs/engine.md``).
 
 The engine advances B independent replicas of the measurement (pre-equilibration with plates,
 then the oscillatory protocol) in one set of flat arrays: spheres of replica b occupy rows
