@@ -49,8 +49,8 @@ STANDIN = "cpu-standin"
 # cupy/_statistics/histogram.py; add.reduceat in cupy/_core/_routines_indexing.pyx), its reference
 # (docs.cupy.dev: cupy.ufunc, cupy.copyto, cupy.argsort, cupy.bincount) and its page "Differences
 # between CuPy and NumPy" (docs.cupy.dev/en/stable/user_guide/difference.html).  The table of
-# docs/backends.md ("What the engine uses on a device, checked against CuPy") gives each entry's CuPy status and its use by the engine: to add a
-# name, check it there first and add its row.
+# docs/backends.md, "What the engine uses on a device, checked against CuPy", gives each entry's CuPy
+# status and its use by the engine: to add a name, check it there first and add its row.
 
 #: namespace functions -> the keywords CuPy accepts (all the same in NumPy for these uses)
 CUPY_FUNCTIONS = {
@@ -317,7 +317,8 @@ class DeviceNamespace:
             _not_cupy("bincount on a device without ordered reductions")
         if name not in _ALLOW["functions"]:
             raise AttributeError(f"the CuPy namespace has no audited {name!r} (particleShearTest/test_backend.py, "
-                                 "CUPY_FUNCTIONS; docs/backends.md, 'What the engine uses on a device, checked against CuPy')")
+                                 "CUPY_FUNCTIONS; "
+                                 "docs/backends.md, 'What the engine uses on a device, checked against CuPy')")
         f = getattr(np, name)
 
         def function(*args, **kwargs):
