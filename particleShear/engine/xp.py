@@ -165,7 +165,7 @@ def _numba_backend():
     try:
         import numba  # noqa: F401
     except Exception as exc:  # ImportError, or a Numba build that does not fit the installed NumPy
-        raise ValueError(f"backend='numba' (--backend numba) needs Numba, which cannot be imported here ({exc}): "
+        raise ValueError(f"backend='numba' needs Numba, which cannot be imported here ({exc}): "
                          f"install it with `{NUMBA_INSTALL}`, or choose backend='numpy' or 'auto'") from None
     b = Backend("numba", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
     b.compiled = True

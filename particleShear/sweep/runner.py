@@ -173,9 +173,8 @@ class Sweep:
             try:
                 check_backend(backend)
             except ValueError as exc:
-                text = str(exc)
-                raise ValueError(text if "--backend" in text else
-                                 text.replace(f"backend={backend!r}", f"backend={backend!r} (--backend)", 1)) from None
+                raise ValueError(str(exc).replace(f"backend={backend!r}", f"backend={backend!r} (--backend)", 1)) \
+                    from None
             if "backend" in self.spec.grid or any("backend" in z for z in self.spec.zips):
                 raise ValueError(f"backend={backend!r} (--backend) conflicts with the SPEC, which varies backend")
             self.spec = dataclasses.replace(self.spec, parameters=dict(self.spec.parameters, backend=backend))
