@@ -15,9 +15,13 @@ Run it with ``OMP_NUM_THREADS=1``.  Usage: python benchmarks/bench_batch.py [--b
 [--relative-frequency F] (a larger F shortens every run by the same factor, for a quick look).
 """
 import argparse
+import os
 import time
 
 from particleShear import doParticleShearSimulation, doParticleShearSimulationSeries
+
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 
 def main():

@@ -7,9 +7,13 @@ output) and the moduli.  Target: total <= 10 s on one core.
 Usage: python benchmarks/bench_default_run.py [--seed S] [--repeat R]
 """
 import argparse
+import os
 import time
 
 from particleShear import doParticleShearSimulation
+
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 
 def main():

@@ -36,6 +36,9 @@ from particleShear.engine.state import BatchState
 from particleShear.engine.step import BatchEngine
 from particleShear.run.batch import run_batch
 
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
+
 
 class _Captured(Exception):
     pass

@@ -60,6 +60,9 @@ from particleShear.engine.step import BatchEngine  # noqa: E402
 from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 from particleShear.simulation.evaluation import EvaluationHandler  # noqa: E402
 
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
+
 COOL = 0.99969060716623
 W = 2 * math.pi * F_EXC
 

@@ -59,7 +59,7 @@ def main():
     print(f"device: {name}, CuPy {cupy.__version__}, NumPy {np.__version__}")
 
     t0 = time.perf_counter()
-    single = doParticleShearSimulation(seed=args.seed, return_result=True, **kw)
+    single = doParticleShearSimulation(seed=args.seed, return_result=True, backend="numpy", **kw)
     w_single = time.perf_counter() - t0
     N = single.parameters["N"]
     ns_numpy = 1e9 * single.timings["protocol"] / (single.N_steps * N)

@@ -46,6 +46,9 @@ import sys
 import tempfile
 import time
 
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_BASELINE = os.path.normpath(os.path.join(HERE, "..", "..", "baseline-e45c1fa"))   # beside the repo
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")

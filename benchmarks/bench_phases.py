@@ -23,6 +23,9 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+#: the NumPy engine's figures (docs/performance.md; the workers inherit it); PARTICLESHEAR_BACKEND=numba times
+#: the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 PHASES = ("rate", "forces", "totals", "tensors", "acceleration", "movement")
 #: the engine's own step on a copy of the scene: (row label, ``sample``)
 ENGINE = (("engine step alone, no stresses", False), ("engine step alone, shear stresses", True),

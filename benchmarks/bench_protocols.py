@@ -7,11 +7,15 @@ Whole calls of ``doParticleShearSimulation(seed=s, doDrawing=False, protocol=...
     python benchmarks/bench_protocols.py [--N 150] [--batch 8]
 """
 import argparse
+import os
 import time
 import warnings
 
 from particleShear import doParticleShearSimulation
 from particleShear.run.batch import run_batch
+
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 PROTOCOLS = {
     "oscillatory": {},

@@ -11,6 +11,7 @@ Process time, the smallest of ``--blocks`` blocks of 40 steps (the host's scatte
 Run it with ``OMP_NUM_THREADS=1``.  Usage: python benchmarks/bench_rebuild.py [--blocks K] [--baseline REV]
 """
 import argparse
+import os
 import tempfile
 import time
 
@@ -18,6 +19,9 @@ import numpy as np
 
 from bench_engine import baseline_engine, protocol_start, subset
 from particleShear.engine.step import BatchEngine
+
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 
 def main():

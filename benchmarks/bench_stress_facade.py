@@ -40,6 +40,9 @@ sys.path.insert(0, HERE)
 import particleShear.base.stress as new_stress  # noqa: E402
 from bench_step import DT, build, protocol_steps  # noqa: E402
 
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
+
 
 def load_baseline(rev):
     """``particleShear.base.stress`` of git revision ``rev``, as module ``particleShear.base._stress_baseline``."""

@@ -8,10 +8,14 @@ paired ratios on/off.  The moduli of each pair are checked to be identical (the 
     python benchmarks/stroboscopic_cost.py --N 150 --periods 3 --repeats 3
 """
 import argparse
+import os
 import statistics
 import time
 
 from particleShear import doParticleShearSimulation
+
+#: the NumPy engine's figures (docs/performance.md); PARTICLESHEAR_BACKEND=numba times the compiled loop
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 
 def main(argv=None):

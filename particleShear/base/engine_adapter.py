@@ -54,7 +54,7 @@ def uniform_parameters(ensemble):
     return all(np.all(np.asarray(a[name][:n]) == a[name][0]) for name in PER_SPHERE_PARAMETERS) if n else True
 
 
-def state_from_ensembles(ensembles, backend="numpy", laws=None):
+def state_from_ensembles(ensembles, backend="auto", laws=None):
     """Copy B ensembles of equal N (after constitution) into one batch state.
 
     The ensembles are not modified; each replica keeps a reference to its ensemble's
@@ -65,9 +65,11 @@ def state_from_ensembles(ensembles, backend="numpy", laws=None):
     ensembles : sequence of ensemble
         Constituted ensembles (``particleShear.objects`` or ``particleShear.linkable``
         ensembles), all with the same number of spheres.
-    backend : str or Backend, default "numpy"
-        Where the arrays of the state live: the ensembles are read on the host and the
-        state is copied to the device once.
+    backend : str or Backend, default "auto"
+        Where the arrays of the state live and how its steps run
+        (:func:`~particleShear.engine.xp.resolve_backend`: ``"auto"`` is ``"numba"`` where Numba
+        can be imported, else ``"numpy"``, unless ``PARTICLESHEAR_BACKEND`` says otherwise): the
+        ensembles are read on the host and the state is copied to the device once.
     laws : sequence, optional
         The central law of each ensemble: ``None`` (the documented callback) or
         ``(name, values)``, a name of :data:`~particleShear.engine.laws.LAWS` and its
@@ -96,7 +98,7 @@ def state_from_ensembles(ensembles, backend="numpy", laws=None):
     if len(Ns) != 1:
         raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
     B, N = len(ensembles), Ns.pop()
-    s = BatchState(B, N)
+    s = BatchState(B, N, backend="numpy")     # filled on the host, then moved to the target
     own = [not uniform_parameters(e) for e in ensembles]     # spheres with parameters of their own
     if any(own):
         s.visit = np.zeros((len(PER_REPLICA_PARAMETERS), B * N))
@@ -186,7 +188,7 @@ def state_of_ensembles(ensembles, laws=None):
     ensembles = list(ensembles)
     if len({id(e) for e in ensembles}) != len(ensembles):
         raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
-    s = state_from_ensembles(ensembles, laws=laws)
+    s = state_from_ensembles(ensembles, backend="numpy", laws=laws)   # views of the ensembles' NumPy rows
     N = s.N
     if len(ensembles) == 1:
         ensembles[0]._fit_block()      # no spare columns: the (2|3, N) rows below are contiguous

@@ -54,7 +54,7 @@ _kernels = {}           # cache flag -> compiled kernel
 
 def available():
     """Whether Numba can be imported here (bool)."""
-    return xp._numba_importable()
+    return xp.numba_importable()
 
 
 def cache_dir():

@@ -422,13 +422,14 @@ class BatchState:
     N : int
         Spheres per replica (≥ 0).  Every array starts at zero (the caller fills them, e.g.
         :func:`particleShear.base.engine_adapter.state_from_ensembles`).
-    backend : str or Backend, default "numpy"
-        Array backend of the state (``"numpy"``, ``"cupy"``, or a registered one).
+    backend : str or Backend, default "auto"
+        Array backend of the state (``"numpy"``, ``"numba"``, ``"cupy"``, a registered one, or
+        ``"auto"``: :func:`~particleShear.engine.xp.resolve_backend`).
 
     Raises
     ------
     ValueError
-        For an unknown backend, or ``"cupy"`` without CuPy or a CUDA device.
+        For an unknown backend, ``"numba"`` without Numba, or ``"cupy"`` without CuPy or a CUDA device.
     """
 
     #: names of the per-sphere (B·N,) and per-replica (B,) arrays, in the order :meth:`concat` copies them
@@ -450,7 +451,7 @@ class BatchState:
         e = self.ensembles
         return e[0] if e is not None and len(e) == 1 else None
 
-    def __init__(self, B, N, backend="numpy"):
+    def __init__(self, B, N, backend="auto"):
         self.backend = get_backend(backend)
         xp = self.xp = self.backend.xp
         self.B = int(B)

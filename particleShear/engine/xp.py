@@ -4,8 +4,12 @@ The engine's kernels take the namespace of their inputs (:func:`array_namespace`
 functions that NumPy and CuPy share.  This module holds the few things that cannot be written
 once for both:
 
-* :func:`get_backend` — a backend by name (``"numpy"``, ``"cupy"``, or one registered with
+* :func:`get_backend` — a backend by name (``"numpy"``, ``"numba"``, ``"cupy"``, or one registered with
   :func:`register_backend`, e.g. the CPU stand-in device of the tests), checked before any work;
+  :func:`resolve_backend` — the one rule of selection: ``"auto"`` (every default) is the
+  environment variable ``PARTICLESHEAR_BACKEND`` when set, else ``"numba"`` where Numba can be
+  imported, else ``"numpy"``; :func:`identity_backend` — the backends that give NumPy's bits are
+  one run identity;
 * :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres; on CuPy
   also the sums and minima over a replica's rows): ``bincount`` on NumPy; on CuPy a gather of each
   bin's rows into a padded (bins, width) matrix, built once per candidate set, and a sum along its
@@ -22,17 +26,21 @@ and :func:`array_namespace` recognises CuPy arrays only once CuPy has been impor
 __docformat__ = "numpy"
 
 import contextlib
+import os
 import sys
 
 import numpy as np
 
 __all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
-           "backend_of", "resolve_backend", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+           "backend_of", "resolve_backend", "default_backend", "identity_backend", "numba_importable", "backend_names",
+           "BACKEND_ENV", "NUMBA_INSTALL", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
 CUPY_INSTALL = "pip install cupy-cuda12x"
 #: how to install Numba (named in the error of ``backend="numba"`` without it)
 NUMBA_INSTALL = "pip install particleShear[fast]"
+#: the environment variable that sets what ``backend="auto"`` (the default) stands for (:func:`resolve_backend`)
+BACKEND_ENV = "PARTICLESHEAR_BACKEND"
 
 #: the reasons for which the engine reads device values on the host (the argument ``why`` of :func:`to_host`)
 REASONS = {
@@ -157,14 +165,22 @@ def _numba_backend():
     try:
         import numba  # noqa: F401
     except Exception as exc:  # ImportError, or a Numba build that does not fit the installed NumPy
-        raise ValueError(f"backend='numba' needs Numba: it cannot be imported ({exc}); install it with "
-                         f"`{NUMBA_INSTALL}` or choose backend='numpy'") from None
+        raise ValueError(f"backend='numba' needs Numba, which cannot be imported here ({exc}): "
+                         f"install it with `{NUMBA_INSTALL}`, or choose backend='numpy' or 'auto'") from None
     b = Backend("numba", np, True, np.asarray, np.asarray, lambda a: isinstance(a, (np.ndarray, np.generic)))
     b.compiled = True
     return b
 
 
-def _numba_importable():
+def numba_importable():
+    """Whether Numba can be imported here (what ``backend="auto"`` chooses by).
+
+    Returns
+    -------
+    bool
+        False also for a Numba build that fails to import (e.g. one that does not fit the
+        installed NumPy).
+    """
     try:
         import numba  # noqa: F401
     except Exception:
@@ -172,23 +188,87 @@ def _numba_importable():
     return True
 
 
-def resolve_backend(name):
-    """The backend a run uses: ``name``, with ``"auto"`` resolved (``"numba"`` where Numba can be
-    imported, else ``"numpy"``).
+def backend_names():
+    """The names ``backend=`` accepts: every backend (registered ones included) and ``"auto"``.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return (*_FACTORIES, "auto")
+
+
+def default_backend():
+    """The backend ``"auto"`` stands for before the automatic choice: the environment variable
+    :data:`BACKEND_ENV` when it is set (and not empty), else ``"auto"``.
+
+    Returns
+    -------
+    str
+        A name of :func:`backend_names`.
+
+    Raises
+    ------
+    ValueError
+        When the variable names no backend (naming the variable, its value and the allowed values).
+    """
+    value = os.environ.get(BACKEND_ENV, "").strip()
+    if not value:
+        return "auto"
+    if value not in backend_names():
+        raise ValueError(f"the environment variable {BACKEND_ENV}={value!r} is out of range: "
+                         f"allowed {', '.join(map(repr, backend_names()))} (or unset)")
+    return value
+
+
+def resolve_backend(name="auto"):
+    """The backend a run uses: the one rule of backend selection (docs/backends.md).
+
+    ``"auto"`` (the default of every ``backend=``; also None) is the environment variable
+    :data:`BACKEND_ENV` when it is set, and otherwise — or when that is ``"auto"`` too —
+    ``"numba"`` where Numba can be imported (:func:`numba_importable`), else ``"numpy"``.
+    Any other name is returned as it is (:func:`get_backend` checks that it can run here).
 
     Parameters
     ----------
-    name : str
-        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"`` or a registered name.
+    name : str or None
+        ``"auto"``, ``"numpy"``, ``"numba"``, ``"cupy"``, a registered name, or None (``"auto"``).
 
     Returns
     -------
     str
         The name of a backend (not ``"auto"``).
+
+    Raises
+    ------
+    ValueError
+        For a value of :data:`BACKEND_ENV` that names no backend.
     """
+    if name is None or name == "auto":
+        name = default_backend()
     if name == "auto":
-        return "numba" if _numba_importable() else "numpy"
+        return "numba" if numba_importable() else "numpy"
     return name
+
+
+def identity_backend(name):
+    """The backend as the run identity sees it: ``"numpy"`` for every backend that gives NumPy's bits.
+
+    ``"numpy"``, ``"numba"`` (the same laws in a compiled loop, bit-identical) and ``"auto"`` (one
+    of them, or the environment's choice) are one run: the same id, the same results row.  Any
+    other name (``"cupy"``: equal to rounding, not bit for bit; a registered backend) is itself.
+
+    Parameters
+    ----------
+    name : object
+        A run's ``backend`` input, or its results-table cell.
+
+    Returns
+    -------
+    object
+        ``"numpy"``, or ``name`` unchanged.
+    """
+    return "numpy" if name is None or name in _BIT_IDENTICAL else name
 
 
 def _cupy_backend():
@@ -210,6 +290,8 @@ def _cupy_backend():
 
 
 _FACTORIES = {"numpy": _numpy_backend, "numba": _numba_backend, "cupy": _cupy_backend}
+#: the backends whose runs are NumPy's bit for bit (one run identity, :func:`identity_backend`)
+_BIT_IDENTICAL = ("numpy", "numba", "auto")
 _MADE = {}
 
 
@@ -242,13 +324,14 @@ def unregister_backend(name):
         _MADE.pop(name, None)
 
 
-def get_backend(name="numpy"):
+def get_backend(name="auto"):
     """The backend called ``name``, checked to be usable here.
 
     Parameters
     ----------
-    name : str or Backend
-        ``"numpy"`` (default), ``"cupy"`` (needs CuPy and a CUDA device) or a registered name; a
+    name : str or Backend or None
+        ``"auto"`` (default; also None: :func:`resolve_backend`), ``"numpy"``, ``"numba"`` (needs
+        Numba), ``"cupy"`` (needs CuPy and a CUDA device) or a registered name; a
         :class:`Backend` is returned as it is.
 
     Returns
@@ -258,15 +341,15 @@ def get_backend(name="numpy"):
     Raises
     ------
     ValueError
-        For an unknown name (naming ``backend``, its value and the allowed values), or for
+        For an unknown name (naming ``backend``, its value and the allowed values), for a value
+        of :data:`BACKEND_ENV` that names no backend, for ``"numba"`` without Numba, or for
         ``"cupy"`` without CuPy or without a CUDA device.
     """
     if isinstance(name, Backend):
         return name
-    if name == "auto":
-        name = resolve_backend(name)
-    if not isinstance(name, str) or name not in _FACTORIES:
-        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, (*_FACTORIES, 'auto')))}")
+    if not (name is None or isinstance(name, str) and name in backend_names()):
+        raise ValueError(f"backend={name!r} is out of range: allowed {', '.join(map(repr, backend_names()))}")
+    name = resolve_backend(name)
     b = _MADE.get(name)
     if b is None:
         b = _MADE[name] = _FACTORIES[name]()

@@ -45,7 +45,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                               post_periods=1, cool_factor=0.5, seed=None, *, return_result=False, verbose=True,
                               progress=None, correct_drift_sign=False, reference_header=False, renderer="auto",
                               time_step_factor=1.0, integrator="euler", stability_guard=True,
-                              saveOutputMovie=False, output_format="text", strict_io=False, backend="numpy",
+                              saveOutputMovie=False, output_format="text", strict_io=False, backend="auto",
                               contact_law="linear", plateau_begin=0.3, plateau_end=0.8, plateau_slope=0.1,
                               protocol="oscillatory", relative_rate=0.01, total_strain=2.0, ramp_time=1.0,
                               hold_time=200.0, creep_stress=None, creep_modulus=None, creep_response_time=5.0,
@@ -194,13 +194,15 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     strict_io : bool, default False
         Keyword-only.  Raise the ``OSError`` of a failed write after the run; False: return the
         result with ``write_error`` set (``last_result`` holds it either way).
-    backend : {"numpy", "numba", "auto", "cupy"}, default "numpy"
-        Keyword-only.  Array library of the measurement: "numpy"; "numba" (NumPy arrays, the
-        force terms of each step in one compiled loop of the same laws, bit-identical; needs
-        ``pip install particleShear[fast]``); "auto" ("numba" where Numba is installed, else
-        "numpy"; the result records the one used); or "cupy" to measure on a CUDA GPU (needs
+    backend : {"auto", "numpy", "numba", "cupy"}, default "auto"
+        Keyword-only.  Array library of the measurement: "auto" (the environment variable
+        ``PARTICLESHEAR_BACKEND`` when set, else "numba" where Numba can be imported, else
+        "numpy"; :func:`particleShear.engine.xp.resolve_backend`); "numpy"; "numba" (NumPy
+        arrays, the force terms of each step in one compiled loop of the same laws, bit-identical;
+        needs ``pip install particleShear[fast]``); or "cupy" to measure on a CUDA GPU (needs
         ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for
-        bit).  Every run measures through the engine (:mod:`particleShear.engine`) as a
+        bit).  The result (``result.parameters["backend"]``), results.csv and the sidecar record
+        the backend used; "numpy", "numba" and "auto" give one run identity.  Every run measures through the engine (:mod:`particleShear.engine`) as a
         batch of one — drawn or not, with files and snapshots or not, either integrator, any law —
         so that a run in a batched series (``doParticleShearSimulationSeries(..., batch_size=B)``)
         is bit-identical to it and a drawn run to the same run headless (the drawing observes the
@@ -432,7 +434,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
                                     central_repulsion_coefficient=1, doDrawing=True, saveData=False,
                                     saveStressTensorData=True, plotStress=True, pre_periods=2, periods=3,
                                     post_periods=1, cool_factor=0.5, executor=None, seed=None, *,
-                                    max_workers=None, verbose=False, batch_size=None, backend="numpy",
+                                    max_workers=None, verbose=False, batch_size=None, backend="auto",
                                     **options):
     """Run the reference series (repetitions × amplitudes × μ × controls) on an executor.
 
@@ -500,8 +502,9 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         (:func:`particleShear.run.batch.run_batch`).  The results are exactly those of the
         unbatched series, in the same order (and resumes like it with a ``root_folder``).
         Default None: one task per run.
-    backend : {"numpy", "numba", "auto", "cupy"}, default "numpy"
-        Keyword-only.  Array backend of every run ("numba": compiled force terms; "cupy": on a CUDA GPU, for runs without
+    backend : {"auto", "numpy", "numba", "cupy"}, default "auto"
+        Keyword-only.  Array backend of every run ("auto": ``PARTICLESHEAR_BACKEND`` when set, else "numba" where
+        Numba can be imported, else "numpy"; "numba": compiled force terms; "cupy": on a CUDA GPU, for runs without
         drawing and plotting; see :func:`doParticleShearSimulation`).  With ``batch_size`` a
         batch of replicas is measured in one set of device arrays.
     **options

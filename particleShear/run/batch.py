@@ -122,9 +122,9 @@ def run_batch(list_of_kwargs, backend=None):
         Keyword arguments of :func:`~particleShear.run.api.doParticleShearSimulation` per replica
         (``return_result`` is implied; the aliases ``amplitude`` and ``mu`` are accepted as there).
         All must have the same :func:`schedule_key`.
-    backend : {None, "numpy", "cupy"}, default None
-        Array backend of the batch; None: the runs' own ``backend`` keyword (default "numpy").
-        A backend other than "numpy" needs runs the engine measures (see :func:`check_run_backend`).
+    backend : {None, "auto", "numpy", "numba", "cupy"}, default None
+        Array backend of the batch; None: the runs' own ``backend`` keyword (default "auto":
+        :func:`particleShear.engine.xp.resolve_backend`).  Every result records the backend used.
 
     Returns
     -------

@@ -24,8 +24,8 @@ from .result import SimulationResult
 __all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "check_run_backend", "contact_law_spec",
            "measure_batch"]
 
-#: array backends a batch can run on ("cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
-BACKENDS = ("numpy", "numba", "auto", "cupy")
+#: array backends a batch can run on ("auto" first, the default; "cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
+BACKENDS = ("auto", "numpy", "numba", "cupy")
 
 
 def _signature_defaults():
@@ -45,7 +45,9 @@ def check_backend(backend):
     Raises
     ------
     ValueError
-        For an unknown name (naming ``backend``, its value and the allowed values), or for
+        For an unknown name (naming ``backend``, its value and the allowed values), for
+        ``"auto"`` with a value of ``PARTICLESHEAR_BACKEND`` that names no backend (naming the
+        variable), for ``"numba"`` without Numba (naming ``particleShear[fast]``), or for
         ``"cupy"`` without CuPy or without a CUDA device.
     """
     get_backend(backend)

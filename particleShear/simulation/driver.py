@@ -232,7 +232,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     """
 
     sims = [run.sim for run in sessions]
-    backend = (sims[members[0]].parameters or {}).get("backend", "numpy")   # one backend per batch
+    backend = (sims[members[0]].parameters or {}).get("backend", "auto")   # one backend per batch
     guard_of = [bool(run.sim.stability_guard) for run in sessions]
     integrator = sims[members[0]].integrator        # part of the schedule key
     states, halves, order = [], [], []

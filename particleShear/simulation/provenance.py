@@ -20,6 +20,7 @@ import re
 import numpy as np
 
 from ..engine.contact_laws import get_law
+from ..engine.xp import identity_backend
 from ..parameters import identity_excluded
 from ..parameters import names as _names
 from .._version import __version__
@@ -85,6 +86,13 @@ def _identity_value(value):
     return json_safe(value)
 
 
+def _identity_form(name, value):
+    """The input ``name`` as the identity sees it: ``backend`` through
+    :func:`~particleShear.engine.xp.identity_backend` (the backends that give NumPy's bits are one
+    run), every other input as it is."""
+    return identity_backend(value) if name == "backend" else value
+
+
 def identity_parameters(parameters):
     """The inputs that make a run what it is, in the form the run identity hashes them.
 
@@ -92,7 +100,9 @@ def identity_parameters(parameters):
     :data:`IDENTITY_EXCLUDED`, the parameters of the laws and protocols the run does not use, and
     ``contact_law`` and ``protocol`` at their defaults: they change nothing of such a run, and a run
     keeps the id it had before the law or the protocol was a parameter); every real number is a float (``N = 30`` and
-    ``N = 30.0``, ``0.2`` and ``numpy.float64(0.2)`` are the same input), bools stay bools.  This
+    ``N = 30.0``, ``0.2`` and ``numpy.float64(0.2)`` are the same input), bools stay bools, and
+    ``backend`` is ``"numpy"`` for ``"numpy"``, ``"numba"`` and ``"auto"`` (bit-identical runs:
+    :func:`~particleShear.engine.xp.identity_backend`).  This
     is the one rule of "the same run": :func:`run_identity` hashes it, a sweep compares a results
     row and matches the runs of an extended folder with it.
 
@@ -106,10 +116,10 @@ def identity_parameters(parameters):
     dict
     """
     unused = identity_excluded(parameters)
-    return {k: _identity_value(v) for k, v in parameters.items() if k not in unused}
+    return {k: _identity_value(_identity_form(k, v)) for k, v in parameters.items() if k not in unused}
 
 
-def same_input(text, value):
+def same_input(text, value, name=None):
     """True when the text ``text`` (a results-table cell) is the input ``value`` under :func:`identity_parameters`.
 
     Parameters
@@ -118,6 +128,9 @@ def same_input(text, value):
         The cell as read back.
     value : object
         The run's input.
+    name : str, optional
+        The input's name: a cell of ``backend`` (the backend used, e.g. ``"numba"``) is the input
+        ``"auto"`` or ``"numpy"`` as the identity sees them.
 
     Returns
     -------
@@ -125,7 +138,8 @@ def same_input(text, value):
     """
     if text is None:
         return False
-    want = _identity_value(value)
+    text = _identity_form(name, text)
+    want = _identity_value(_identity_form(name, value))
     if want is None:                 # an unset option (creep_modulus=None) is an empty cell
         return text == ""
     if isinstance(want, list):       # a list (sweep_amplitudes) is a JSON cell

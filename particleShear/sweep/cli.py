@@ -41,9 +41,10 @@ def build_parser():
       help="measure runs of one step schedule (same N, time-step rule, protocol) in batches of up to B "
            "replicas, one task each; rows identical to unbatched runs (default: one task per run)")
     a("--backend", default=None, metavar="NAME",
-      help="array backend of every run: numpy, numba (compiled force terms; `pip install particleShear[fast]`), "
-           "auto (numba where installed), or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`); "
-           "sets the SPEC's backend (default: the SPEC's, numpy)")
+      help="array backend of every run: auto (the environment variable PARTICLESHEAR_BACKEND when set, else "
+           "numba where installed, else numpy), numpy, numba (the force terms in one compiled loop, bit-identical; "
+           "`pip install particleShear[fast]`), or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`); "
+           "sets the SPEC's backend (default: the SPEC's, auto)")
     a("--dask", action="store_true", help="run on a dask.distributed LocalCluster of --workers processes")
     a("--scheduler", metavar="ADDRESS", default=None, help="run on an existing Dask cluster (e.g. tcp://host:8786)")
     a("--task-index", type=int, default=None, metavar="I", help="job-array task I (0-based) of --task-count K")

@@ -234,7 +234,8 @@ def pool_context(parameters):
     """Start method of the default worker pool: "spawn" when a run uses a device backend.
 
     The parent has initialised CUDA when it checked ``backend="cupy"``, and a forked child
-    cannot use CUDA after that; fresh ("spawn") workers can.  NumPy runs keep the platform's default.
+    cannot use CUDA after that; fresh ("spawn") workers can.  Runs on the host (``"numpy"``,
+    ``"numba"``, and ``"auto"`` resolved to one of them) keep the platform's default.
 
     Parameters
     ----------
@@ -246,7 +247,9 @@ def pool_context(parameters):
     multiprocessing context or None
     """
     import multiprocessing
-    if any(p.get("backend", "numpy") != "numpy" for p in parameters):
+    from ..engine.xp import get_backend
+    names = {p.get("backend", "auto") for p in parameters}
+    if any(not get_backend(name).host for name in names):
         return multiprocessing.get_context("spawn")
     return None
 

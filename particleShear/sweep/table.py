@@ -374,7 +374,7 @@ def row_problem(row, run):
         return "its seed is not the run's"
     compared = identity_parameters(run.parameters)   # the one rule of "the same run"
     for name, v in run.parameters.items():
-        if name in compared and not same_input(row.get(name), v):
+        if name in compared and not same_input(row.get(name), v, name):
             return f"{name}={row.get(name)!r} is not the run's {_cell(v)!r}"
     numbers = _OK_NUMBERS.get(run.parameters.get("protocol", "oscillatory"), _OK_NUMBERS["oscillatory"]) \
         if status == "ok" else ("wall_time_s",)
