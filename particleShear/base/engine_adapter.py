@@ -67,8 +67,8 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
         ensembles), all with the same number of spheres.
     backend : str or Backend, default "auto"
         Where the arrays of the state live and how its steps run
-        (:func:`~particleShear.engine.xp.resolve_backend`: ``"auto"`` is ``"numba"`` where Numba
-        can be imported, else ``"numpy"``, unless ``PARTICLESHEAR_BACKEND`` says otherwise): the
+        (:func:`~particleShear.engine.xp.resolve_backend`: ``"auto"`` is ``"numpy"`` unless
+        ``PARTICLESHEAR_BACKEND`` says otherwise): the
         ensembles are read on the host and the state is copied to the device once.
     laws : sequence, optional
         The central law of each ensemble: ``None`` (the documented callback) or

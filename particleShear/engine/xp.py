@@ -7,8 +7,8 @@ once for both:
 * :func:`get_backend` — a backend by name (``"numpy"``, ``"numba"``, ``"cupy"``, or one registered with
   :func:`register_backend`, e.g. the CPU stand-in device of the tests), checked before any work;
   :func:`resolve_backend` — the one rule of selection: ``"auto"`` (every default) is the
-  environment variable ``PARTICLESHEAR_BACKEND`` when set, else ``"numba"`` where Numba can be
-  imported, else ``"numpy"``; :func:`identity_backend` — the backends that give NumPy's bits are
+  environment variable ``PARTICLESHEAR_BACKEND`` when set, else ``"numpy"`` (its value ``auto``:
+  ``"numba"`` where Numba can be imported); :func:`identity_backend` — the backends that give NumPy's bits are
   one run identity;
 * :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres; on CuPy
   also the sums and minima over a replica's rows): ``bincount`` on NumPy; on CuPy a gather of each
@@ -33,7 +33,7 @@ import numpy as np
 
 __all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
            "backend_of", "resolve_backend", "default_backend", "identity_backend", "numba_importable", "backend_names",
-           "BACKEND_ENV", "NUMBA_INSTALL", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+           "BACKEND_ENV", "AUTO_DEFAULT", "NUMBA_INSTALL", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
 CUPY_INSTALL = "pip install cupy-cuda12x"
@@ -173,7 +173,7 @@ def _numba_backend():
 
 
 def numba_importable():
-    """Whether Numba can be imported here (what ``backend="auto"`` chooses by).
+    """Whether Numba can be imported here (what ``PARTICLESHEAR_BACKEND=auto`` chooses by).
 
     Returns
     -------
@@ -198,14 +198,21 @@ def backend_names():
     return (*_FACTORIES, "auto")
 
 
+#: What ``backend="auto"`` stands for when :data:`BACKEND_ENV` is unset.  NumPy: the compiled
+#: backend compiles the force terms only, which gains nothing measurable on a default run while
+#: importing Numba and loading its cache adds ~0.7 s to every process (docs/backends.md,
+#: "Selecting a backend"); ``PARTICLESHEAR_BACKEND=auto`` asks for Numba where it is installed.
+AUTO_DEFAULT = "numpy"
+
+
 def default_backend():
-    """The backend ``"auto"`` stands for before the automatic choice: the environment variable
-    :data:`BACKEND_ENV` when it is set (and not empty), else ``"auto"``.
+    """The backend ``"auto"`` stands for: the environment variable :data:`BACKEND_ENV` when it is
+    set (and not empty), else :data:`AUTO_DEFAULT`.
 
     Returns
     -------
     str
-        A name of :func:`backend_names`.
+        A name of :func:`backend_names` (``"auto"`` when the variable says so).
 
     Raises
     ------
@@ -214,7 +221,7 @@ def default_backend():
     """
     value = os.environ.get(BACKEND_ENV, "").strip()
     if not value:
-        return "auto"
+        return AUTO_DEFAULT
     if value not in backend_names():
         raise ValueError(f"the environment variable {BACKEND_ENV}={value!r} is out of range: "
                          f"allowed {', '.join(map(repr, backend_names()))} (or unset)")
@@ -225,8 +232,9 @@ def resolve_backend(name="auto"):
     """The backend a run uses: the one rule of backend selection (docs/backends.md).
 
     ``"auto"`` (the default of every ``backend=``; also None) is the environment variable
-    :data:`BACKEND_ENV` when it is set, and otherwise — or when that is ``"auto"`` too —
-    ``"numba"`` where Numba can be imported (:func:`numba_importable`), else ``"numpy"``.
+    :data:`BACKEND_ENV` when it is set, otherwise :data:`AUTO_DEFAULT` (``"numpy"``); the
+    variable's value ``"auto"`` means ``"numba"`` where Numba can be imported
+    (:func:`numba_importable`), else ``"numpy"``.
     Any other name is returned as it is (:func:`get_backend` checks that it can run here).
 
     Parameters
