@@ -30,6 +30,7 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 
 from . import tasks as _tasks
+from ..engine.xp import get_backend
 
 __all__ = ["run_jobs", "isolated", "pool_context", "WorkerDied", "SweepTerminated", "WATCH_INTERVAL_S", "worker_init", "new_pool",
            "terminate"]
@@ -247,7 +248,6 @@ def pool_context(parameters):
     multiprocessing context or None
     """
     import multiprocessing
-    from ..engine.xp import get_backend
     names = {p.get("backend", "auto") for p in parameters}
     if any(not get_backend(name).host for name in names):
         return multiprocessing.get_context("spawn")
