@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..engine import callbacks as _engine_callbacks
+from . import callbacks as _engine_callbacks
 from ..engine.box import flow_velocity
 from ..engine.integrate import damp, kick, xi_increments
 from ..engine.terms import (elastic_term, normal_speed, pair_forces, tangential_term, term_constants, viscous_term)

@@ -31,6 +31,7 @@ from ..engine.relax import RELAX_SKIN, free_relaxation
 from ..engine.state import PER_REPLICA_PARAMETERS, PER_SPHERE_PARAMETERS, PERMANENT, BatchState
 from ..engine.step import BatchEngine
 from ..engine.xp import get_backend, to_host
+from .callbacks import callback_phase_laws
 from .fields import ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
@@ -127,6 +128,7 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
         shared = np.repeat(np.logical_not(own), N)
         s.visit[:, shared] = s.per_replica_parameters()[:, shared]
     s.law = names.pop() if names else None
+    s.callback_laws = callback_phase_laws      # the classes' law callbacks, read at every force phase
     if s.law is not None:
         s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
     return s.to_backend(target)

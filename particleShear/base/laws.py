@@ -7,7 +7,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from ..engine import callbacks as _callbacks
+from . import callbacks as _callbacks
 from ..engine import laws as _engine_laws
 
 __all__ = [

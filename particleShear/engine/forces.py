@@ -273,7 +273,7 @@ class PairConstants:
 
 class VisitConstants(TermConstants):
     """The :class:`~particleShear.engine.terms.TermConstants` of one visit of a batch's candidates,
-    with what the laws of a force phase read besides them (:func:`~particleShear.engine.callbacks.force_phase_laws`):
+    with what the laws of a force phase read besides them (:func:`~particleShear.engine.phase_laws.force_phase_laws`):
     the candidates' bonds, replicas and radii, and a place for their prepared law arguments.
 
     Parameters

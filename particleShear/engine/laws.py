@@ -19,9 +19,10 @@ documented callbacks of :mod:`particleShear.base.laws`:
 * ``"tensile"`` (:func:`tensile_law`, kind ``"tensile"``, registered here): the linear tensile law of bonds.
 
 The documented callbacks of particleShear 1.0.2 (``CircleBasicElasticity.call_back_elastic_force_law``,
-``SphereLinkable.call_back_elastic_force_law_tensile``) keep working: the engine looks them up
-once per force phase (:mod:`.callbacks`: ``force_phase_laws``); a callback registered there (the
-package's own law functions) is its registered law, any other one is evaluated on arrays when it
+``SphereLinkable.call_back_elastic_force_law_tensile``) keep working: the adapter that builds a
+state from ensembles gives it :func:`particleShear.base.callbacks.callback_phase_laws`, which the
+engine calls once per force phase (:func:`.phase_laws.force_phase_laws`); a callback registered
+there (the package's own law functions) is its registered law, any other one is evaluated on arrays when it
 accepts them and pair by pair otherwise.
 
 The linear and tensile laws are also split into their constants (:func:`central_constants`,

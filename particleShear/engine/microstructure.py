@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 from .box import min_image
-from .callbacks import force_phase_laws
+from .phase_laws import force_phase_laws
 from .terms import elastic_term
 from .xp import to_host
 

@@ -406,10 +406,15 @@ class BatchState:
         Each visit of a pair sees its own sphere's values (:meth:`~particleShear.engine.forces.PairConstants.set_visits`).
     law : str or None
         Central law of every replica, a name of :data:`~particleShear.engine.laws.LAWS` (one per
-        batch), or None: the documented callback ``call_back_elastic_force_law`` (looked up once
-        per force phase, :func:`~particleShear.engine.callbacks.force_phase_laws`).
+        batch), or None: the central law of ``callback_laws`` (looked up once per force phase,
+        :func:`~particleShear.engine.phase_laws.force_phase_laws`).
     law_params : ndarray (n, B)
         The law's parameters per replica, in the order of its ``parameters`` (n = 0 for None).
+    callback_laws : callable or None
+        ``callback_laws(C, central)`` → ``(central or None, tensile or None)``: the law callbacks
+        of the documented classes, given by the adapter that built the state from ensembles
+        (:func:`particleShear.base.callbacks.callback_phase_laws`); None: the built-in laws
+        (:func:`~particleShear.engine.phase_laws.force_phase_laws`).
     backend : Backend
         Where the arrays live (:func:`~particleShear.engine.xp.get_backend`).
     xp : module
@@ -472,6 +477,7 @@ class BatchState:
         self.applying_shear = True
         self.law = None
         self.law_params = xp.zeros((0, self.B))
+        self.callback_laws = None
         self.visit = None
 
     def __getstate__(self):
@@ -589,6 +595,10 @@ class BatchState:
         out.rng = [g for st in states for g in st.rng]
         out.applying_shear = all(st.applying_shear for st in states)
         out.law = laws.pop()
+        given = {st.callback_laws for st in states}
+        if len(given) != 1:
+            raise ValueError("states have different law callbacks: a batch needs one source of laws")
+        out.callback_laws = given.pop()
         out.law_params = xp.concatenate([st.law_params for st in states], axis=1)
         if any(st.visit is not None for st in states):
             out.visit = xp.concatenate([st.visit_rows() for st in states], axis=1)

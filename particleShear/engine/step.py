@@ -31,7 +31,7 @@ from .box import min_image, wrap
 from .integrate import damp, drift, half_kick, kick, mobile_mask, plates_follow, shift_flow, xi_increments
 from .guard import KINETIC_ENERGY, NON_FINITE, closest_transient, verdict as guard_verdict
 from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses, splice_arrays
-from .callbacks import force_phase_laws
+from .phase_laws import force_phase_laws
 from .terms import (central_term, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
                     tangential_term, viscous_term)
 from .memory import tune_allocator

@@ -218,7 +218,7 @@ def elastic_term(K, d, central=None, tensile=None):
         Centre distances (µm).
     central : callable, optional
         ``central(d)``: the compressive law of every pair as if in contact (a law of the
-        registry, :func:`~particleShear.engine.callbacks.force_phase_laws`); None: the linear law
+        registry, :func:`~particleShear.engine.phase_laws.force_phase_laws`); None: the linear law
         from the constants of ``K``.
     tensile : callable, optional
         ``tensile(d)``: the tensile law on the stretched bonds, 0 on the other pairs; None: the

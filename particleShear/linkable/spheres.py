@@ -6,7 +6,7 @@ it never breaks and its tangential spring has no Coulomb bound.
 """
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
-from ..engine import callbacks as _engine_callbacks
+from ..base import callbacks as _engine_callbacks
 from ..engine.box import inside_half_cell
 from ..base.point_base import ArrayField, _one
 from ..checks import non_negative

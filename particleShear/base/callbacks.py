@@ -1,13 +1,15 @@
-"""The documented law callbacks of particleShear 1.0.2 and the laws of one force phase.
+"""The documented law callbacks of particleShear 1.0.2, as the engine's laws of a force phase.
 
 ``CircleBasicElasticity.call_back_elastic_force_law`` and
 ``SphereLinkable.call_back_elastic_force_law_tensile`` are class attributes of the documented
-classes; those classes name themselves as the holders (:func:`hold_callbacks`), so the engine
-reads the callbacks without importing their layers.  :func:`force_phase_laws` looks the laws of a
-force phase up once: the run's ``contact_law`` of the registry (:data:`.laws.LAWS`), else the
-callbacks — a callback registered with :func:`register_callback` (the package's own law functions)
-is its registered law, any other one is evaluated by :func:`call_law`, on arrays when it accepts
-them and pair by pair otherwise (docs/design.md, "Adding a contact law").
+classes; those classes name themselves as the holders (:func:`hold_callbacks`; the linkable
+class lives in a higher layer).  The adapter that builds the engine's state from ensembles
+(:mod:`.engine_adapter`) gives the state :func:`callback_phase_laws`, which the engine's
+:func:`~particleShear.engine.phase_laws.force_phase_laws` calls once per force phase: a callback
+registered with :func:`register_callback` (the package's own law functions) is its registered
+law, any other one is evaluated by :func:`call_law`, on arrays when it accepts them and pair by
+pair otherwise (docs/design.md, "Adding a contact law").  The engine keeps nothing of the
+callbacks: all of it lives here, next to the classes.
 
 Forces in mg·µm·s⁻² per m depth; negative = repulsion.
 """
@@ -18,10 +20,11 @@ import weakref
 
 import numpy as np
 
-from .contact_laws import LAWS, get_law, law_values
-from .xp import array_namespace, to_host
+from ..engine.contact_laws import LAWS, law_values
+from ..engine.phase_laws import cached, law_arguments, prepared_law
+from ..engine.xp import array_namespace, to_host
 
-__all__ = ["register_callback", "callback_law", "call_law", "force_phase_laws", "class_callbacks", "hold_callbacks"]
+__all__ = ["register_callback", "callback_law", "call_law", "callback_phase_laws", "class_callbacks", "hold_callbacks"]
 
 
 # -- the documented callbacks ----------------------------------------------------------------------
@@ -184,89 +187,45 @@ def _on_host(law, *args, select=None):
     return xp.asarray(call_law(law, *host, select=None if select is None else to_host(select, "scalar law")))
 
 
-def _cached(C, key, make):
-    """The per-candidate arguments of a law, kept with the candidates' constants ``C`` under ``key``
-    (dropped with ``C`` at the one invalidation point, a rebuild of the candidate lists)."""
-    got = C.__dict__.get("law_args")
-    if got is None or got[0] != key:
-        got = (key, make())
-        C.__dict__["law_args"] = got
-    return got[1]
+def callback_phase_laws(C, central=True):
+    """The laws of one force phase from the documented callbacks (the state's ``callback_laws``
+    that :mod:`.engine_adapter` gives the engine; :func:`particleShear.engine.phase_laws.force_phase_laws`).
 
-
-def force_phase_laws(s, C):
-    """The central and tensile laws of one force phase of the engine, looked up once per phase.
-
-    The central law is the state's ``s.law`` (a run's ``contact_law``, its parameters per
-    replica in ``s.law_params``) when set, else the documented callback
-    ``CircleBasicElasticity.call_back_elastic_force_law``: a registered law when it was declared
-    one (:func:`register_callback`), a user function otherwise (:func:`call_law`, pair by pair on
-    the pairs inside their contact distance when it accepts numbers only).  The tensile law of
-    bonds is the callback ``SphereLinkable.call_back_elastic_force_law_tensile`` in the same way.
+    The central law is ``CircleBasicElasticity.call_back_elastic_force_law``: a registered law
+    when it was declared one (:func:`register_callback`), a user function otherwise
+    (:func:`call_law`, pair by pair on the pairs inside their contact distance when it accepts
+    numbers only).  The tensile law of bonds is ``SphereLinkable.call_back_elastic_force_law_tensile``
+    in the same way.  The class attributes are read at every call, as 1.0.2 reads them.
 
     Parameters
     ----------
-    s : BatchState
-        The batch (``law``, ``law_params``).
     C : PairConstants or VisitConstants
-        The constants of one visit of its candidates (``rep``, ``k``, ``c``, ``d_law``, ``d_eq``,
-        ``perm``; :class:`~particleShear.engine.forces.VisitConstants` for the visit from j of
-        spheres with parameters of their own).
+        The constants of one visit of the candidates.
+    central : bool
+        Whether the central law is asked for (False: the run has a ``contact_law`` of its own).
 
     Returns
     -------
-    central : callable or None
-        ``central(d)``: the compressive law of every candidate as if in contact; None for the
-        linear law, which :func:`~particleShear.engine.terms.elastic_term` evaluates from the
-        prepared constants of ``C``.
-    tensile : callable or None
-        ``tensile(d)``: the tensile law on the stretched bonds (0 elsewhere); None for the
-        built-in one (prepared constants).
+    central, tensile : callable or None
+        ``law(d)`` on the candidates, or None for the built-in law (prepared constants).
     """
     compressive, stretched = class_callbacks()
-    builtin_c = compressive is None or _registered(compressive) == "linear"
-    builtin_t = stretched is None or _registered(stretched) == "tensile"
-    if s.law is None and builtin_c and builtin_t:
-        return None, None           # the default: both laws from the prepared constants
-    central = None
-    if s.law is not None:
-        law = get_law(s.law)
-        if law.name != "linear" or law.parameters:
-            central = _prepared(law, C, (law.name, id(s.law_params)),
-                                lambda: _law_arguments(law, C) + tuple(s.law_params[:, C.rep]))
-    elif not builtin_c:
+    law_c = None
+    if central and not (compressive is None or _registered(compressive) == "linear"):
         found = callback_law(compressive)
         if found is None:
-            args = _cached(C, ("callback",), lambda: (C.d_law, C.k, C.c))
-            central = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
+            args = cached(C, ("callback",), lambda: (C.d_law, C.k, C.c))
+            law_c = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
         elif found[0].name != "linear":
             law, values = found
-            central = _prepared(law, C, (law.name, values), lambda: _law_arguments(law, C) + values)
+            law_c = prepared_law(law, C, (law.name, values), lambda: law_arguments(law, C) + values)
     tensile = None
-    if not builtin_t:
+    if not (stretched is None or _registered(stretched) == "tensile"):
         found = callback_law(stretched)
         if found is None or found[0].name != "tensile":
             law = stretched if found is None else found[0].function
             tensile = (lambda d: _stretched(law, C, d))
-    return central, tensile
-
-
-def _law_arguments(law, C):
-    """The arguments of a central law after ``d`` and before its own parameters, per candidate:
-    ``(d0, r_i, r_j, k, c)`` for a law of the laws folder (``law.radii``), else ``(d0, k, c)``."""
-    return (C.d_law, C.ri, C.rj, C.k, C.c) if law.radii else (C.d_law, C.k, C.c)
-
-
-def _prepared(law, C, key, arguments):
-    """``law`` as a function of ``d`` on the candidates ``C``: ``inside(d, *constants)`` with the
-    constants kept with ``C`` under ``key`` when the law is prepared, else ``function(d, *arguments())``
-    (``arguments()``: :func:`_law_arguments` and the law's parameters, per candidate)."""
-    if law.prepared is None:
-        args = _cached(C, key, arguments)
-        return lambda d: law.function(d, *args)
-    constants, inside = law.prepared
-    args = _cached(C, key, lambda: constants(*arguments()))
-    return lambda d: inside(d, *args)
+    return law_c, tensile
 
 
 def _stretched(law, C, d):
