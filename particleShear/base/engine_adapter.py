@@ -354,10 +354,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
         state = state_of_ensembles(ensembles, laws=laws)
         engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
-                             guard=[g is not None for g in guards])
-        engine.min_distance_ratio, engine.max_kinetic_energy = ratio, ke
-        engine.phase = "constitution"
-        engine.numbers_relations = True
+                             guard=[g is not None for g in guards], min_distance_ratio=ratio,
+                             max_kinetic_energy=ke, phase="constitution", numbers_relations=True)
         steps = free_relaxation(engine, N, dt, dt_max, state.mu.copy())
     for b, e in enumerate(ensembles):
         write_back(engine, b, e, steps)

@@ -52,11 +52,10 @@ class EngineStep:
         half = self._half_kick
         self._drop_engine()
         integrator = getattr(self, "integrator", "euler")
+        carried = (np.array([h if h is not None else np.zeros(self._n) for h in half])
+                   if integrator == "verlet" and half is not None and len(half[0]) == self._n else None)
         eng = BatchEngine(state_of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
-                          integrator=integrator)
-        eng.keep_terms = True      # the force register of every force phase
-        if integrator == "verlet" and half is not None and len(half[0]) == self._n:
-            eng.half = np.array([h if h is not None else np.zeros(self._n) for h in half])
+                          integrator=integrator, keep_terms=True, half=carried)   # keep_terms: the force register
         self._engine_pairs = (self._pairs, self._pairs.version)
         return eng
 

@@ -112,6 +112,23 @@ class BatchEngine:
         half-kick predictor — the velocity-dependent terms of a force phase see the velocities
         moved ``F·dt/(2m)`` ahead by the forces of the previous step (the classes'
         ``set_integrator("verlet")``).
+    keep_terms : bool, keyword-only
+        Keep the per-term arrays of each force phase for the force register of a script's
+        ensemble (:func:`particleShear.base.register.register_block`).
+    min_distance_ratio : float, keyword-only
+        The guard's smallest d/(r_i + r_j) of a transient contact (the attribute of a
+        :class:`~particleShear.base.stability.StabilityGuard`).
+    max_kinetic_energy : float or None, keyword-only
+        The guard's bound of the kinetic energy relative to the flow (mg·µm²/s² per m depth);
+        None: the bound above.
+    half : ndarray (3, B·N) or None, keyword-only
+        Verlet: the half kick F·dt/(2m) of (vx, vy, ω) of the step before (a predictor carried on
+        from an earlier engine); None: no step yet.
+    phase : str, keyword-only
+        The phase its steps belong to, for messages (the loops set it as they run).
+    numbers_relations : bool or None, keyword-only
+        Number the relations as they form, for a write-back into ensembles; None: for a state
+        that is an ensemble's own (``state.ensembles``).
 
     Raises
     ------
@@ -121,17 +138,19 @@ class BatchEngine:
 
     INTEGRATORS = ("euler", "verlet")
 
-    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler"):
+    def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler", *,
+                 keep_terms=False, min_distance_ratio=0.05, max_kinetic_energy=None, half=None,
+                 phase="pre-equilibration", numbers_relations=None):
         if not skin_factor > 0:
             raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
         if integrator not in self.INTEGRATORS:
             raise ValueError(f"integrator={integrator!r} is not allowed: one of {self.INTEGRATORS}")
         self.integrator = integrator
-        self.half = None          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
+        self.half = half          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
         self.g = None             # the record of the last force phase (_ForceRecord)
         #: keep the per-term arrays of each force phase for the force register (``base.register``;
         #: a script's experiment sets it, so its ensemble's register holds the engine's last step)
-        self.keep_terms = False
+        self.keep_terms = bool(keep_terms)
         self.terms = None
         self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
         self.verdict = None       # a device's guard verdict of the force phase, read at the end of the step
@@ -164,15 +183,15 @@ class BatchEngine:
         #: the guard's smallest d/(r_i + r_j) of a transient contact and its bound of the kinetic energy
         #: relative to the flow (mg·µm²/s² per m depth; None: the bound of the class docstring), as
         #: the attributes of a :class:`~particleShear.base.stability.StabilityGuard`
-        self.min_distance_ratio = 0.05
-        self.max_kinetic_energy = None
+        self.min_distance_ratio = min_distance_ratio
+        self.max_kinetic_energy = max_kinetic_energy
         self.step_count = 0
         #: number the relations as they form (:meth:`_number`), for a write-back into ensembles (on
         #: from the start for a state that is an ensemble's own); ``next_birth``: the number the
         #: next relation of each replica gets
-        self.numbers_relations = s.ensembles is not None
+        self.numbers_relations = s.ensembles is not None if numbers_relations is None else bool(numbers_relations)
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
-        self.phase = "pre-equilibration"
+        self.phase = phase
         self.rebuilds = np.zeros(B, dtype=np.int64)
         #: per replica, 1.0 for a Lees-Edwards cell and 0.0 for a plain periodic one (the documented
         #: ``use_lees_edwards = False`` ensembles): the factor of the image offset ``Ly·γ`` and of the

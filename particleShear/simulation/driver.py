@@ -257,12 +257,14 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
             timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
         states.append(st)
         order += group
-    engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR,
-                         guard=[guard_of[b] for b in order], integrator=integrator)
+    state = BatchState.concat(states)
+    half = None
     if integrator == "verlet":
         # the predictor carries on from the pre-equilibration, as in one ensemble (no step yet: none)
-        engine.half = engine.xp.concatenate([engine.xp.zeros((3, st.B * st.N)) if h is None else h
-                                             for h, st in zip(halves, states)], axis=1)
+        half = state.xp.concatenate([state.xp.zeros((3, st.B * st.N)) if h is None else h
+                                     for h, st in zip(halves, states)], axis=1)
+    engine = BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in order],
+                         integrator=integrator, half=half)
     return engine, order
 
 

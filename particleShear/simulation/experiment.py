@@ -532,17 +532,17 @@ class OscillatoryShearExperiment:
         ens = self.theEnsemble
         guard = getattr(ens, "stability_guard", None)
         integrator = getattr(ens, "integrator", "euler")
-        engine = BatchEngine(state_of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
-                             check_interval=getattr(guard, "interval", 4), integrator=integrator)
-        engine.keep_terms = True          # the last step's terms, for the ensemble's force register
-        if guard is not None:     # the thresholds of the ensemble's guard
-            engine.min_distance_ratio = guard.min_distance_ratio
-            engine.max_kinetic_energy = guard.max_kinetic_energy
         half = getattr(ens, "_half_kick", None) if carry_predictor else None
+        carried = None
         if integrator == "verlet" and half is not None and len(half[0]) == len(ens.sphereList):
             # the predictor carries on from the ensemble's last step (no spin half kick: none)
-            engine.half = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
-        return engine
+            carried = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
+        thresholds = ({} if guard is None else     # the thresholds of the ensemble's guard
+                      dict(min_distance_ratio=guard.min_distance_ratio, max_kinetic_energy=guard.max_kinetic_energy))
+        # keep_terms: the last step's terms, for the ensemble's force register
+        return BatchEngine(state_of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
+                           check_interval=getattr(guard, "interval", 4), integrator=integrator, keep_terms=True,
+                           half=carried, **thresholds)
 
     def _scene(self, engine):
         scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
