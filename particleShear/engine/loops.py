@@ -14,7 +14,7 @@ import numpy as np
 
 from ..checks import finite, positive
 from .observers import check_observers, notify
-from .xp import to_host
+from .rheometer import shear_record
 
 __all__ = ["pre_equilibrate", "protocol", "pre_equilibration_blocks", "relaxation_levels", "MAX_LEVELS"]
 
@@ -210,10 +210,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
         If a guarded replica becomes unstable.
     """
     check_observers(observers)
-    s, xp = engine.s, engine.xp
-    s.applying_shear = True
-    s.t = xp.zeros(s.B)
-    t = 0.0                    # the clock of every replica, kept on the host too (same additions of dt)
+    xp = engine.xp
     T_total = (periods + pre + post) / f
     n_steps = total = int(T_total / dt)
     if stop is not None:
@@ -221,37 +218,15 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
     lo = pre / (f * dt)
     hi = (periods + pre) / (f * dt)
     A = engine.backend.asarray(np.asarray(amplitudes, dtype=float))
-    rec = {name: xp.empty((n_steps, s.B)) for name in ("t", "strain", "strain_rate", "stress_internal",
-                                                         "stress_surface")}
-    if keep_tensors:
-        rec["tensors"] = xp.empty((n_steps, s.B, 9, 2, 2))
-    engine.record = rec        # what observers read of the record (the rows written so far)
-    say("Start application shear protocol, total N= " + str(total) + " steps")
-    engine.phase = "protocol"
-    engine.step_count = 0
-    zero = xp.zeros(s.B)
-    for i in range(n_steps):
+    zero = xp.zeros(engine.s.B)
+    clock = [0.0]              # the clock of every replica, kept on the host too (same additions of dt)
+
+    def rate_of(i):
+        t = clock[0]
+        clock[0] = t + dt      # = s.t[b] after the step, for every b (same dt, same schedule)
         if lo <= i <= hi:
-            rate = A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
-        else:
-            rate = zero
-        engine.set_rate(rate)
-        rec["t"][i] = s.t
-        rec["strain"][i] = s.gamma
-        rec["strain_rate"][i] = s.rate
-        ends = i == 0 or i == n_steps - 1
-        out = engine.step(cool, dt, sample="tensors" if keep_tensors or ends else True)
-        rec["stress_internal"][i] = out[0]
-        rec["stress_surface"][i] = out[1]
-        if keep_tensors:
-            rec["tensors"][i] = out[2]
-        if i == 0:
-            rec["first_tensors"] = out[2]
-        if i == n_steps - 1:
-            rec["last_tensors"] = out[2]
-        t = t + dt             # = s.t[b] for every b (same dt, same schedule)
-        report(i + 1, n_steps)
-        notify(observers, engine, "protocol", i + 1, n_steps)
-    engine.flush()
-    engine.record = None
-    return {name: to_host(v, "series") for name, v in rec.items()}
+            return A * math.cos(2 * math.pi * (t * f - pre)) * 2 * math.pi * f
+        return zero
+
+    return shear_record(engine, dt, cool, n_steps, rate_of, say=say, report=report, observers=observers,
+                        keep_tensors=keep_tensors, end_tensors=True, total=total)

@@ -41,13 +41,16 @@ def _quiet(*args):
 
 
 def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet, report=_quiet, observers=(),
-                 after_step=None):
-    """Step every replica ``n_steps`` times at the rates ``rate_of`` gives, recording the series.
+                 after_step=None, keep_tensors=False, end_tensors=False, total=None):
+    """Step every replica ``n_steps`` times at the rates ``rate_of`` gives, recording the series:
+    the one recording loop of every protocol, the oscillation included
+    (:func:`~particleShear.engine.loops.protocol` is its cosine schedule).
 
     At step i: ``γ̇ = rate_of(i)`` (set with ``set_rate``, keeping each sphere's velocity
     relative to the flow), record t, γ, γ̇, step with the stresses sampled, record them, then
     ``after_step(i, tau_internal, tau_surface)`` when given (a controller's update).  The clock
-    is reset to 0 at the start; the strain continues from its current value.
+    is reset to 0 at the start; the strain continues from its current value.  ``rate_of`` is
+    called once per step, in order.
 
     Parameters
     ----------
@@ -70,12 +73,20 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
         ``engine.record`` holds the record as it fills.
     after_step : callable or None
         ``after_step(i, tau_internal, tau_surface)`` after each step (arrays (B,) on the backend).
+    keep_tensors : bool, default False
+        Also record every tensor of the registry at every step ("tensors", (n_steps, B, 9, 2, 2), Pa).
+    end_tensors : bool, default False
+        Also record every tensor at the first and the last step ("first_tensors",
+        "last_tensors", (B, 9, 2, 2), Pa).
+    total : int, optional
+        The number of steps the console message announces (default ``n_steps``; a protocol
+        stopped early announces its whole length).
 
     Returns
     -------
     dict of numpy.ndarray (n_steps, B)
         "t", "strain", "strain_rate", "stress_internal", "stress_surface" and, with
-        ``tensors_every``, "N1" (Pa; NaN where not sampled).
+        ``tensors_every``, "N1" (Pa; NaN where not sampled), with the tensors asked for.
     """
     check_observers(observers)
     s, xp = engine.s, engine.xp
@@ -85,8 +96,10 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
     rec = {name: xp.empty((n_steps, s.B)) for name in names}
     if tensors_every:
         rec["N1"][...] = math.nan
-    engine.record = rec
-    say("Start application shear protocol, total N= " + str(n_steps) + " steps")
+    if keep_tensors:
+        rec["tensors"] = xp.empty((n_steps, s.B, len(TENSORS), 2, 2))
+    engine.record = rec        # what observers read of the record (the rows written so far)
+    say("Start application shear protocol, total N= " + str(n_steps if total is None else total) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
     for i in range(n_steps):
@@ -94,13 +107,20 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
         rec["t"][i] = s.t
         rec["strain"][i] = s.gamma
         rec["strain_rate"][i] = s.rate
-        tensors = bool(tensors_every) and i % tensors_every == 0
-        out = engine.step(cool, dt, sample="tensors" if tensors else True)
+        n1 = bool(tensors_every) and i % tensors_every == 0
+        ends = end_tensors and (i == 0 or i == n_steps - 1)
+        out = engine.step(cool, dt, sample="tensors" if n1 or keep_tensors or ends else True)
         rec["stress_internal"][i] = out[0]
         rec["stress_surface"][i] = out[1]
-        if tensors:
+        if n1:
             T = out[2][:, OVERALL]
             rec["N1"][i] = -(T[:, 0, 0] - T[:, 1, 1])
+        if keep_tensors:
+            rec["tensors"][i] = out[2]
+        if ends and i == 0:
+            rec["first_tensors"] = out[2]
+        if ends and i == n_steps - 1:
+            rec["last_tensors"] = out[2]
         if after_step is not None:
             after_step(i, out[0], out[1])
         report(i + 1, n_steps)
