@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from . import callbacks as _engine_callbacks
+from . import callbacks as _callbacks
 from ..engine.box import flow_velocity
 from ..engine.integrate import damp, kick, xi_increments
 from ..engine.terms import (elastic_term, normal_speed, pair_forces, tangential_term, term_constants, viscous_term)
@@ -323,4 +323,4 @@ class CircleFrictionElasticity(CircleBasicElasticity):
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
-_engine_callbacks.hold_callbacks("central", CircleBasicElasticity)
+_callbacks.hold_callbacks("central", CircleBasicElasticity)

@@ -6,7 +6,7 @@ it never breaks and its tangential spring has no Coulomb bound.
 """
 __docformat__ = "numpy"
 from ..base.laws import elastic_force_law_tensile
-from ..base import callbacks as _engine_callbacks
+from ..base import callbacks as _callbacks
 from ..engine.box import inside_half_cell
 from ..base.point_base import ArrayField, _one
 from ..checks import non_negative
@@ -235,4 +235,4 @@ class SphereLinkableAdjustableInterfaceStrength(SphereLinkable):
 
 
 # the engine reads the documented callback from this class at every force phase (it never imports this layer)
-_engine_callbacks.hold_callbacks("tensile", SphereLinkable)
+_callbacks.hold_callbacks("tensile", SphereLinkable)
