@@ -209,8 +209,7 @@ def protocol(engine, dt, f, amplitudes, cool, pre, periods, post, keep_tensors=F
     EngineInstability
         If a guarded replica becomes unstable.
     """
-    check_observers(observers)
-    xp = engine.xp
+    xp = engine.xp             # (the observers are checked by shear_record, before any step)
     T_total = (periods + pre + post) / f
     n_steps = total = int(T_total / dt)
     if stop is not None:
