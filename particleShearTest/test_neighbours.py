@@ -241,7 +241,8 @@ def _of_the_package(obj):
     if isinstance(obj, types.FrameType):
         return "particleShear" in obj.f_code.co_filename
     if isinstance(obj, (types.FunctionType, types.MethodType)):
-        return "particleShear" in getattr(obj, "__code__", obj.__func__.__code__).co_filename
+        code = getattr(obj, "__code__", None) or getattr(obj.__func__, "__code__", None)
+        return code is not None and "particleShear" in code.co_filename
     return type(obj).__module__.startswith("particleShear")
 
 
