@@ -11,9 +11,11 @@ __docformat__ = "numpy"
 
 import contextlib
 
-from .xp import array_namespace, backend_of
+import numpy as np
 
-__all__ = ["min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cell", "in_intervals", "MAX_PASSES"]
+from .xp import array_namespace, backend_of, maximum, minimum, select
+
+__all__ = ["period_count", "folded", "min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cell", "in_intervals", "MAX_PASSES"]
 
 #: one-period passes of :func:`min_image` and :func:`wrap` before the rest is folded in closed form
 #: (floor): a protocol needs at most one or two, so ordinary states keep the exact subtractions of the
@@ -21,15 +23,31 @@ __all__ = ["min_image", "wrap", "flow_velocity", "inside_cell", "inside_half_cel
 MAX_PASSES = 4
 
 
-def _count(v, half, minus_half):
-    """−1, 0 or +1 per element as float: a period to subtract (``v ≥ half``) or to add (``v < −half``)."""
-    return (v >= half).astype(float) - (v < minus_half)
+def period_count(v, half, minus_half):
+    """−1, 0 or +1 as float: a period to subtract (``v ≥ half``) or to add (``v < minus_half``).
+
+    The one pass of :func:`min_image` (``half = L/2``, ``minus_half = −L/2``) and of :func:`wrap`
+    (``half = L``, ``minus_half = 0``); a pure expression, so the compiled step
+    (:mod:`particleShear.engine.numba_step`) calls it on numbers.
+
+    Parameters
+    ----------
+    v : ndarray or float
+        Separations or coordinates (µm).
+    half, minus_half : ndarray or float
+        The interval ``[minus_half, half)`` (µm).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    return select(v >= half, 1.0, 0.0) - select(v < minus_half, 1.0, 0.0)
 
 
 def in_intervals(dx, dy, Lx, Ly):
     """Where a separation lies in ``[−Lx/2, Lx/2) × [−Ly/2, Ly/2)``, the intervals of :func:`min_image`.
 
-    The complement of :func:`_count`'s rule on both axes: there :func:`min_image` removes no
+    The complement of :func:`period_count`'s rule on both axes: there :func:`min_image` removes no
     period and returns the separation unchanged.
 
     Parameters
@@ -58,6 +76,15 @@ def _quiet_invalid(xp):
     return errstate(invalid="ignore") if errstate is not None else contextlib.nullcontext()
 
 
+def folded(v, L, lo, hi):
+    """``v`` brought into ``[lo, hi)`` (``hi = lo + L``) in closed form: ``(folded v, periods removed)``.
+
+    The pure expression of :func:`_fold` (numbers or arrays; the compiled step calls it on numbers).
+    """
+    k = select((v >= hi) | (v < lo), np.floor((v - lo) / L), 0.0)
+    return minimum(maximum(v - L * k, lo), np.nextafter(hi, lo)), k
+
+
 def _fold(v, L, lo, hi, xp):
     """``v`` brought into ``[lo, hi)`` (``hi = lo + L``) in closed form; returns ``(folded v, periods removed)``.
 
@@ -69,9 +96,7 @@ def _fold(v, L, lo, hi, xp):
     of :func:`min_image` and :func:`wrap` for any finite input.
     """
     with _quiet_invalid(xp):
-        k = xp.where((v >= hi) | (v < lo), xp.floor((v - lo) / L), 0.0)
-        w = xp.clip(v - L * k, lo, xp.nextafter(hi, lo))
-    return w, k
+        return folded(v, L, lo, hi)
 
 
 def min_image(dx, dy, Lx, Ly, shift):
@@ -116,7 +141,7 @@ def min_image(dx, dy, Lx, Ly, shift):
     mhy, mhx = -hy, -hx
     ky_total = kx_total = None
     for _ in range(MAX_PASSES):
-        ky = _count(dy, hy, mhy)
+        ky = period_count(dy, hy, mhy)
         if be.host and not ky.any():
             break
         dy = dy - Ly * ky
@@ -128,7 +153,7 @@ def min_image(dx, dy, Lx, Ly, shift):
             dx = dx - shift * ky
         ky_total = _accumulate(ky_total, ky)
     for _ in range(MAX_PASSES):
-        kx = _count(dx, hx, mhx)
+        kx = period_count(dx, hx, mhx)
         if be.host and not kx.any():
             break
         dx = dx - Lx * kx
@@ -211,7 +236,7 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     moved = False if be.host else None
     y0 = None if be.host else y.copy()   # heights before the wrap, for the velocity correction
     for _ in range(MAX_PASSES):
-        up = (y >= Ly).astype(float) - (y < 0)
+        up = period_count(y, Ly, 0.0)
         if be.host:
             if not up.any():
                 break
@@ -228,7 +253,7 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
         with _quiet_invalid(xp):
             vx += (y - y0) * rate
     for _ in range(MAX_PASSES):
-        right = (x >= Lx).astype(float) - (x < 0)
+        right = period_count(x, Lx, 0.0)
         if be.host:
             if not right.any():
                 break

@@ -24,7 +24,7 @@ from .xp import SegmentSum, array_namespace, to_host
 from . import laws
 from .terms import TermConstants, term_constants
 
-__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "scatter", "replica_sums", "pair_roles",
+__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "scatter", "replica_sums", "pair_roles", "shear_rows",
            "shear_from_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
@@ -478,24 +478,53 @@ def shear_stresses(C, B, yc, roles, active, dy, fx_i, dF, V, fx_j=None):
     """
     xp = array_namespace(fx_i)
     internal, ext_i, ext_j = roles
+    rows = xp.empty((3, fx_i.shape[0]))
+    rows[0], rows[1], rows[2] = shear_rows(internal, ext_i, ext_j, active, yc[C.ai], yc[C.aj], dy, fx_i, dF, fx_j)
+    sums = replica_sums(C, rows)
+    return shear_from_sums(sums[0], sums[1], sums[2], V)
+
+
+def shear_rows(internal, ext_i, ext_j, active, yc_i, yc_j, dy, fx_i, dF, fx_j=None):
+    """The three pair rows of the shear stresses (pure; summed per replica by :func:`shear_stresses`).
+
+    ``F_x,i·D_y`` of an internal relation (``= −F_x,i (y_i − y_j)``), ``d·F_T`` of an internal
+    relation, and ``F_x·(y_target − Ly/2)`` of the external entries — the products of the
+    tensors' xy entries (:mod:`particleShear.engine.stress`).  Numbers or arrays; the compiled
+    step (:mod:`particleShear.engine.numba_step`) calls it pair by pair.
+
+    Parameters
+    ----------
+    internal, ext_i, ext_j : ndarray of bool or bool
+        The roles of :func:`pair_roles`.
+    active : ndarray of bool or bool
+        Relations.
+    yc_i, yc_j : ndarray or float
+        Heights of i and j above the centre line (µm).
+    dy : ndarray or float
+        ``D_y`` (µm).
+    fx_i : ndarray or float
+        x force on i (mg·µm·s⁻² per m depth).
+    dF : ndarray or float
+        ``d·F_T``.
+    fx_j : ndarray or float, optional
+        x force of j's own visit (default ``fx_i``).
+
+    Returns
+    -------
+    tuple of three ndarray or float
+    """
     internal = internal & active
     ext_j = ext_j & active
-    lever_j = yc[C.aj] * ext_j
-    lever = yc[C.ai] * (ext_i & active)
+    lever_j = yc_j * ext_j
+    lever = yc_i * (ext_i & active)
     lever -= lever_j
-    # the rows of the tensors' xy entries (engine.stress), the same products: Σ F_x,i·D_y (= −Σ F_x,i
-    # (y_i − y_j)), Σ d·F_T, Σ F_x·lever, in one reduction
-    rows = xp.empty((3, fx_i.shape[0]))
     fx_lw = fx_i if fx_j is None else (fx_i + fx_j) * 0.5
-    xp.multiply(fx_lw * internal, dy, out=rows[0])
-    xp.multiply(dF, internal, out=rows[1])
-    xp.multiply(fx_i, lever, out=rows[2])
+    surface = fx_i * lever
     if fx_j is not None:
         # F_i at i and −F_j at j: F_i·lever + (F_i − F_j)·(y_j − Ly/2), so a pair with F_j = F_i gives
         # the same number as without fx_j (a batch's replica equals its single run)
-        rows[2] += (fx_i - fx_j) * lever_j
-    sums = replica_sums(C, rows)
-    return shear_from_sums(sums[0], sums[1], sums[2], V)
+        surface += (fx_i - fx_j) * lever_j
+    return (fx_lw * internal) * dy, dF * internal, surface
 
 
 def shear_from_sums(lw, tint, surf, V):

@@ -14,13 +14,63 @@ __docformat__ = "numpy"
 
 import math
 
-from .xp import array_namespace
+from .xp import array_namespace, select
 
-__all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "verdict", "transient_ratios",
+__all__ = ["SOUND", "NON_FINITE", "KINETIC_ENERGY", "INTERPENETRATION", "kinetic_term", "energy_bound", "verdict_code",
+           "transient_ratio", "verdict", "transient_ratios",
            "closest_transient"]
 
 #: verdict codes, in the order they are tested (the first that holds is reported)
 SOUND, NON_FINITE, KINETIC_ENERGY, INTERPENETRATION = 0, 1, 2, 3
+
+
+def kinetic_term(m, u, vy, inertia, omega):
+    """Twice the kinetic energy of a sphere relative to the flow, ``m |u|² + I ω²`` (pure).
+
+    Parameters
+    ----------
+    m, inertia : ndarray or float
+        Mass (mg per m depth) and moment of inertia (mg·µm² per m depth).
+    u, vy : ndarray or float
+        Peculiar x velocity ``v_x − γ̇ (y − Ly/2)`` and y velocity (µm/s).
+    omega : ndarray or float
+        Spin (rad/s).
+
+    Returns
+    -------
+    ndarray or float
+        mg·µm²·s⁻² per m depth.
+    """
+    return m * (u * u + vy * vy) + inertia * omega * omega
+
+
+def energy_bound(N, k, r_mean, m_sum, rate_max, Ly):
+    """The default bound of a replica's kinetic energy, ``N·k'·r_mean² + Σ m (γ̇_max·Ly/2)²`` (pure; see :func:`verdict`).
+
+    Parameters
+    ----------
+    N : int
+        Spheres per replica.
+    k, r_mean, m_sum, rate_max, Ly : ndarray (B,) or float
+        Spring constant, mean radius (µm), total mass, largest |γ̇| seen (1/s) and cell height (µm).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    plate = rate_max * Ly / 2
+    return N * select(k > 0, k, 1.0) * (r_mean * r_mean) + m_sum * plate * plate
+
+
+def verdict_code(finite, ke, bound, closest, min_distance_ratio):
+    """The verdict code of a replica from its checks, in the order of the rule (pure; see :func:`verdict`)."""
+    return select(~finite, NON_FINITE, select(ke > bound, KINETIC_ENERGY,
+                                               select(closest < min_distance_ratio, INTERPENETRATION, SOUND)))
+
+
+def transient_ratio(d, d0, active, trans):
+    """``d/d0`` of a transient relation, inf otherwise (pure; see :func:`transient_ratios`)."""
+    return select(active & trans, d / d0, math.inf)
 
 
 def verdict(B, x, yc, vx, vy, omega, rate_s, m, inertia, r, k, Ly, rate_max, closest, min_distance_ratio=0.05,
@@ -67,17 +117,12 @@ def verdict(B, x, yc, vx, vy, omega, rate_s, m, inertia, r, k, Ly, rate_max, clo
     N = len(x) // B
     state = xp.stack((x, yc, vx, vy, omega)).reshape(5, B, N)
     finite = xp.isfinite(state).all(axis=(0, 2))
-    u = vx - yc * rate_s
-    ke = 0.5 * (m * (u * u + vy * vy) + inertia * omega * omega).reshape(B, N).sum(axis=1)
+    ke = 0.5 * kinetic_term(m, vx - yc * rate_s, vy, inertia, omega).reshape(B, N).sum(axis=1)
     if max_kinetic_energy is None:
-        plate = rate_max * Ly / 2
-        bound = N * xp.where(k > 0, k, 1.0) * xp.square(r.reshape(B, N).mean(axis=1)) \
-            + m.reshape(B, N).sum(axis=1) * plate * plate
+        bound = energy_bound(N, k, r.reshape(B, N).mean(axis=1), m.reshape(B, N).sum(axis=1), rate_max, Ly)
     else:
         bound = xp.full(B, float(max_kinetic_energy))
-    code = xp.where(~finite, NON_FINITE, xp.where(ke > bound, KINETIC_ENERGY,
-                                                  xp.where(closest < min_distance_ratio, INTERPENETRATION, SOUND)))
-    return code, ke, bound
+    return verdict_code(finite, ke, bound, closest, min_distance_ratio), ke, bound
 
 
 def transient_ratios(C, d, active):
@@ -92,8 +137,7 @@ def transient_ratios(C, d, active):
     active : array of bool (P,)
         Relations (touching or bonded).
     """
-    xp = array_namespace(d)
-    return xp.where(active & C.trans, d / C.d0, math.inf)
+    return transient_ratio(d, C.d0, active, C.trans)
 
 
 def closest_transient(C, d, active):

@@ -14,10 +14,99 @@ Units: µm, s, mg per m depth; forces mg·µm·s⁻², torques mg·µm²·s⁻²
 """
 __docformat__ = "numpy"
 
-from .xp import array_namespace
+from .xp import array_namespace, select
 
-__all__ = ["kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
+__all__ = ["velocity_change", "plate_velocity", "damped", "xi_rates", "kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
            "xi_increments", "drift"]
+
+
+def velocity_change(f, w, dt):
+    """The kick of one velocity component by its force: ``F·dt/m`` (or ``T·dt/I``), a pure expression.
+
+    :func:`kick` adds it on arrays; the compiled step (:mod:`particleShear.engine.numba_step`) on numbers.
+
+    Parameters
+    ----------
+    f : ndarray or float
+        Force (mg·µm·s⁻² per m depth) or torque (mg·µm²·s⁻² per m depth).
+    w : ndarray or float
+        Mass (mg per m depth) or moment of inertia (mg·µm² per m depth).
+    dt : float
+        Time step (s).
+
+    Returns
+    -------
+    ndarray or float
+        µm/s (or rad/s).
+    """
+    step = f * dt
+    step /= w
+    return step
+
+
+def plate_velocity(yc, plate_speed):
+    """The x velocity of a plate sphere: ``+γ̇·Ly/2`` above the centre line, ``−γ̇·Ly/2`` below (pure).
+
+    Parameters
+    ----------
+    yc : ndarray or float
+        Height above the centre line (µm).
+    plate_speed : ndarray or float
+        ``γ̇·Ly/2`` (µm/s).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    return select(yc > 0, 1.0, -1.0) * plate_speed
+
+
+def damped(v, flow, cool):
+    """SLLOD-like damping of an x velocity: ``u + (v_x − u)·f`` (pure; see :func:`damp`).
+
+    Parameters
+    ----------
+    v : ndarray or float
+        x velocity (µm/s).
+    flow : ndarray or float
+        The affine flow's velocity u there (µm/s).
+    cool : float
+        Damping factor f.
+
+    Returns
+    -------
+    ndarray or float
+    """
+    v = v - flow
+    v *= cool
+    v += flow
+    return v
+
+
+def xi_rates(rvx, rvy, nx, ny, mx, my, spin, rvx_ji):
+    """``dξ_ij/dt`` and ``dξ_ji/dt`` of one pair or of arrays of pairs (the sequential rule, a pure expression).
+
+    See :func:`xi_increments`, which composes the arguments; the compiled step calls it on numbers.
+
+    Parameters
+    ----------
+    rvx, rvy : ndarray or float
+        ``v_j − v_i + Δv_image`` (µm/s).
+    nx, ny : ndarray or float
+        Unit normal of the force phase.
+    mx, my : ndarray or float
+        Unit vector of ``R`` (the pair seen from j after i moved).
+    spin : ndarray or float
+        ``r_i ω_i + r_j ω_j`` (µm/s).
+    rvx_ji : ndarray or float
+        x relative velocity of the second visit (``rvx`` unless R was taken to another image).
+
+    Returns
+    -------
+    inc_ij, inc_ji : ndarray or float
+        µm/s.
+    """
+    return rvx * -ny + rvy * nx - spin, rvx_ji * my - rvy * mx - spin
 
 
 def kick(vel, frc, weights, dt):
@@ -34,9 +123,7 @@ def kick(vel, frc, weights, dt):
     dt : float
         Time step (s).
     """
-    step = frc * dt
-    step /= weights
-    vel += step
+    vel += velocity_change(frc, weights, dt)
     frc[...] = 0.0
 
 
@@ -110,7 +197,7 @@ def plates_follow(vx, vy, immobile, yc, plate_speed):
         ``γ̇·Ly/2`` of each sphere's replica (µm/s).
     """
     xp = array_namespace(vx)
-    plate = xp.where(yc > 0, 1.0, -1.0) * plate_speed
+    plate = plate_velocity(yc, plate_speed)
     xp.copyto(vy, 0.0, where=immobile)
     xp.copyto(vx, plate, where=immobile)
 
@@ -134,9 +221,8 @@ def damp(vel, flow, cool):
     if flow is None:
         vel *= cool
         return
-    vel[0] -= flow
-    vel *= cool
-    vel[0] += flow
+    vel[0] = damped(vel[0], flow, cool)
+    vel[1:] *= cool
 
 
 def shift_flow(vx, omega, yc, delta):
@@ -224,11 +310,9 @@ def xi_increments(Vi, Vj, dvx, nx, ny, ri, rj, Rx, Ry, unit, dvx_ji=None):
         rvx = rvx + dvx
     rvy = Vj[1] - Vi[1]
     spin = ri * Vi[2] + rj * Vj[2]
-    inc_ij = rvx * -ny + rvy * nx - spin
     mx, my = unit(Rx, Ry)
     rvx_ji = rvx if dvx_ji is None else (Vj[0] - Vi[0]) - dvx_ji
-    inc_ji = rvx_ji * my - rvy * mx - spin
-    return inc_ij, inc_ji
+    return xi_rates(rvx, rvy, nx, ny, mx, my, spin, rvx_ji)
 
 
 def drift(pos, phi, vel, dt):

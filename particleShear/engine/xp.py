@@ -95,6 +95,23 @@ def maximum(a, b):
     return np.maximum(a, b)
 
 
+def minimum(a, b):
+    """Element-wise minimum (``min`` on two numbers, ``numpy.minimum`` otherwise; Numba: ``min``).
+
+    Parameters
+    ----------
+    a, b : ndarray or float
+        The operands (broadcast).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    if isinstance(a, float) and isinstance(b, float):
+        return min(a, b)
+    return np.minimum(a, b)
+
+
 _HOST_TYPES = (np.ndarray, np.generic, bool, int, float, complex, type(None))
 
 _log = None   # list receiving each reason while record_host_reads() is active
