@@ -88,8 +88,9 @@ def cache_dir():
 
 
 def register_helpers():
-    """Register :func:`~particleShear.engine.xp.select` and :func:`~particleShear.engine.xp.maximum`
-    with Numba for numbers (``a if cond else b``, ``max``); once per process.
+    """Register :func:`~particleShear.engine.xp.select`, :func:`~particleShear.engine.xp.maximum` and
+    :func:`~particleShear.engine.xp.minimum` with Numba for numbers (``a if cond else b``, ``max``,
+    ``min``); once per process.
 
     Raises
     ------
@@ -107,20 +108,26 @@ def register_helpers():
         def _maximum(a, b):
             return lambda a, b: max(a, b)
 
+        @overload(xp.minimum)
+        def _minimum(a, b):
+            return lambda a, b: min(a, b)
+
         _registered.add(id(xp.select))
 
 
-def jit_laws(cache=True):
-    """The law functions of :data:`LAW_FUNCTIONS` as they are now, each compiled by Numba.
+def jit_laws(cache=True, functions=LAW_FUNCTIONS):
+    """The pure functions ``functions`` as they are now, each compiled by Numba.
 
     Each function is compiled from its own code object with its module's globals, in which the
-    names of the other law functions are their compiled versions (so ``blend_inside`` calls the
+    names of the other compiled functions are their compiled versions (so ``blend_inside`` calls the
     compiled ``linear_term`` of this call: a law replaced in its module is read afresh).
 
     Parameters
     ----------
     cache : bool, default True
         ``cache=True`` for Numba (the folder :func:`cache_dir`).
+    functions : sequence of (module, name), default :data:`LAW_FUNCTIONS`
+        The functions to compile.
 
     Returns
     -------
@@ -133,7 +140,7 @@ def jit_laws(cache=True):
 
     register_helpers()
     compiled, namespaces = {}, []
-    for module, name in LAW_FUNCTIONS:
+    for module, name in functions:
         f = getattr(module, name)
         g = dict(f.__globals__)
         namespaces.append(g)
@@ -143,6 +150,48 @@ def jit_laws(cache=True):
     for g in namespaces:      # (globals are read when a function is compiled, at its first call)
         g.update(compiled)
     return compiled
+
+
+def pair_term_function(L, cache=True):
+    """The force terms of one candidate pair, compiled from the law functions ``L`` (of :func:`jit_laws`).
+
+    The body both compiled loops run per pair (:func:`compile_pair_kernel` and the whole step of
+    :mod:`.numba_step`): the compressive law of the form, the tensile law of bonds, the viscous
+    term, the Coulomb bound and the two-visit tangential rule.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+        ``pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j) -> (fn, law, F_i, F_j, slip)``;
+        resets ``xi[:, p]`` on slip.  ``T`` holds the rows of :data:`TERM_BLOCK`.
+    """
+    import numba
+
+    linear_term, divergent_term, blend_inside = L["linear_term"], L["divergent_term"], L["blend_inside"]
+    tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
+    viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
+
+    def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j):
+        # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
+        if form == 1:
+            inside = linear_term(r, T[0, p], T[2, p])
+        elif form == 2:
+            inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
+        else:
+            inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
+        law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
+        f = law * T[6, p]
+        f += viscous_force(T[7, p], vn, active)
+        fc = np.abs(T[10, p] * law)
+        fc += T[11, p]
+        F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi[0, p], xi[1, p], T[8, p],
+                                            k_t_j[p], T[9, p], nu_t_j[p], fc)
+        if reset:
+            xi[0, p] = 0.0
+            xi[1, p] = 0.0
+        return f, law, F_i, F_j, s
+
+    return numba.njit(pair_term, cache=cache)
 
 
 def compile_pair_kernel(cache=True, say=None):
@@ -170,36 +219,12 @@ def compile_pair_kernel(cache=True, say=None):
     if cache:
         numba.config.CACHE_DIR = cache_dir()
     # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
-    L = jit_laws(cache)
-    linear_term, divergent_term, blend_inside = L["linear_term"], L["divergent_term"], L["blend_inside"]
-    tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
-    viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
+    pair_term = pair_term_function(jit_laws(cache), cache)
 
     def kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
-        # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
         for p in range(d.shape[0]):
-            r = d[p]
-            if form == 1:
-                inside = linear_term(r, T[0, p], T[2, p])
-            elif form == 2:
-                inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
-            else:
-                inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
-            law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
-            f = law * T[6, p]
-            f += viscous_force(T[7, p], vn[p], active[p])
-            fn[p] = f
-            law_out[p] = law
-            fc = np.abs(T[10, p] * law)
-            fc += T[11, p]
-            F_i, F_j, s, reset = two_visit_rule(vt[p], 1.0 if touching[p] else 0.0, xi[0, p], xi[1, p], T[8, p],
-                                                k_t_j[p], T[9, p], nu_t_j[p], fc)
-            F[0, p] = F_i
-            F[1, p] = F_j
-            slip[p] = s
-            if reset:
-                xi[0, p] = 0.0
-                xi[1, p] = 0.0
+            fn[p], law_out[p], F[0, p], F[1, p], slip[p] = pair_term(form, p, d[p], vn[p], vt[p], touching[p],
+                                                                     active[p], xi, T, k_t_j, nu_t_j)
 
     compiled = numba.njit(kernel, cache=cache)
     if say is not None:

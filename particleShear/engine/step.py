@@ -39,7 +39,7 @@ from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
-from . import numba_driver
+from . import numba_driver, numba_step
 
 __all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
@@ -424,6 +424,10 @@ class BatchEngine:
             If the stability guard finds a guarded replica unstable (checked every
             ``check_interval`` steps).
         """
+        if self.backend.compiled and sample != "tensors":      # the whole step in one compiled call
+            out = numba_step.run_step(self, cool, dt, sample)
+            if out is not numba_step.NOT_RUN:
+                return out
         out = self.force_phase(sample)
         self.accelerate(cool, dt)
         self.move(dt)

@@ -1,0 +1,455 @@
+"""The whole step of a batch in one compiled call (Numba, optional), from the same pure functions.
+
+:meth:`~particleShear.engine.step.BatchEngine.step` on the ``"numba"`` backend runs the step here:
+one call per step does the force phase (Lees-Edwards minimum image, relations and their numbers,
+normals, relative velocities, the force terms of :func:`~.numba_driver.pair_term_function`, pair
+forces, the scatter in the order of ``bincount``, the per-replica shear sums when sampled, the
+stability guard when due), the kick with the plates and the damping, the sequential ξ rule, the
+displacement since the lists were built, the drift, the strain, the wrap and the clock.  Every
+formula is a pure function of the NumPy engine called here on numbers
+(:data:`STEP_FUNCTIONS`: :func:`~.box.period_count`, :func:`~.box.folded`,
+:func:`~.integrate.velocity_change`, :func:`~.integrate.plate_velocity`, :func:`~.integrate.damped`,
+:func:`~.integrate.xi_rates`, :func:`~.terms.normal_speed`, :func:`~.terms.slip_speed`,
+:func:`~.terms.pair_forces`, :func:`~.forces.pair_roles`, :func:`~.forces.shear_rows`,
+:func:`~.forces.shear_from_sums`, :func:`~.guard.kinetic_term`, :func:`~.guard.energy_bound`,
+:func:`~.guard.verdict_code`, :func:`~.guard.transient_ratio`, :func:`~.neighbours.verlet_bound`
+and the laws), in the NumPy engine's order of operations, so the trajectories are the same bits.
+
+What stays in Python: the candidate search when a list is due (the one search,
+:meth:`~particleShear.engine.step.BatchEngine.neighbours`), the random directions at ``d = 0``
+and ``|R| = 0`` (drawn from each replica's generator, as :func:`~.forces.normals` does), and the
+protocol's schedule and observers.  Sums that NumPy takes pairwise (the per-replica shear sums,
+the guard's kinetic energy) are taken in pair or sphere order here: they agree to rounding
+(relative 1e-15 for the shear stresses of the suite's scenes; they never feed back into the
+trajectory).  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
+one-line note per engine and reason.
+"""
+__docformat__ = "numpy"
+
+import math
+import warnings
+
+import numpy as np
+
+from . import box, forces, guard, integrate, laws, neighbours, numba_driver, terms
+from .phase_laws import force_phase_laws
+
+__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "run_step", "NOT_RUN"]
+
+#: the pure functions the compiled step calls besides the laws: ``(module, name)``
+STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
+    (box, "period_count"), (box, "folded"), (integrate, "velocity_change"), (integrate, "plate_velocity"),
+    (integrate, "damped"), (integrate, "xi_rates"), (terms, "normal_speed"), (terms, "slip_speed"),
+    (terms, "pair_forces"), (forces, "pair_roles"), (forces, "shear_rows"), (forces, "shear_from_sums"),
+    (guard, "kinetic_term"), (guard, "energy_bound"), (guard, "verdict_code"), (guard, "transient_ratio"),
+    (neighbours, "verlet_bound"))
+
+#: what :func:`run_step` returns when the step was not run (the NumPy step runs it)
+NOT_RUN = object()
+
+# the kernel's return codes
+_DONE, _D_ZERO, _GUARD, _UNITS = 0, 1, 2, 3
+
+_kernels = {}
+
+
+def reason(engine):
+    """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
+
+    Covered: the semi-implicit Euler integrator, every replica Lees-Edwards with its strain
+    advancing, frictional replicas or bonds, the spheres sharing their replica's parameters, the
+    linear law (and the tensile law of bonds) from the prepared constants, no force register, a
+    sample of the two shear stresses (not the whole tensors).
+    """
+    if engine.integrator != "euler":
+        return "the velocity Verlet integrator"
+    if engine.keep_terms:
+        return "the force register keeps the terms of each visit"
+    if engine.lees_edwards is not None or engine.strain_advances is not None:
+        return "a plain periodic replica, or a strain held while not shearing"
+    if engine.free_p is not None:
+        return "a replica without friction and bonds (the frictionless shortcut)"
+    C = engine.C
+    if C.Kj is not None:
+        return "spheres with parameters of their own"
+    if force_phase_laws(engine.s, C) != (None, None):
+        return "a contact law other than the linear one, or a law callback"
+    return None
+
+
+def compile_step_kernel(cache=True, say=None):
+    """The compiled step (see :func:`run_step`), compiled once per process (or loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        Keep the compiled code in :func:`~.numba_driver.cache_dir`; False compiles afresh from the
+        functions as they are now (a test that edits one).
+    say : callable, optional
+        ``say(message)``, told before the compile (or the load from the cache).
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    if cache and True in _kernels:
+        return _kernels[True]
+    import numba
+
+    if cache:
+        numba.config.CACHE_DIR = numba_driver.cache_dir()
+    if say is not None:
+        say(f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
+    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS)
+    pair_term = numba_driver.pair_term_function(L, cache)
+    period_count, folded = L["period_count"], L["folded"]
+    velocity_change, plate_velocity, damped, xi_rates = (L["velocity_change"], L["plate_velocity"], L["damped"],
+                                                         L["xi_rates"])
+    normal_speed, slip_speed, pair_forces = L["normal_speed"], L["slip_speed"], L["pair_forces"]
+    pair_roles, shear_rows, shear_from_sums = L["pair_roles"], L["shear_rows"], L["shear_from_sums"]
+    kinetic_term, energy_bound, verdict_code, transient_ratio = (L["kinetic_term"], L["energy_bound"],
+                                                                 L["verdict_code"], L["transient_ratio"])
+    verlet_bound = L["verlet_bound"]
+    passes = box.MAX_PASSES
+    T0 = numba_driver._TERM_START
+    iLx, iLy, iri, irj, id0, iwi, iwj = (forces.PairConstants.FLOAT_ROWS.index(n)
+                                         for n in ("Lx", "Ly", "ri", "rj", "d0", "w_i", "w_j"))
+
+    def image(dx, dy, Lx, Ly, shift):
+        # the minimum image of one pair (box.min_image element by element)
+        hy, hx = Ly / 2, Lx / 2
+        ky = 0.0
+        for q in range(passes + 1):
+            if q == passes:
+                dy, k = folded(dy, Ly, -hy, hy)
+                dx = dx - shift * k
+                ky += k
+                break
+            k = period_count(dy, hy, -hy)
+            if k == 0.0:
+                break
+            dy = dy - Ly * k
+            dx = dx - shift * k
+            ky += k
+        kx = 0.0
+        for q in range(passes + 1):
+            if q == passes:
+                dx, k = folded(dx, Lx, -hx, hx)
+                kx += k
+                break
+            k = period_count(dx, hx, -hx)
+            if k == 0.0:
+                break
+            dx = dx - Lx * k
+            kx += k
+        return dx, dy, ky, kx
+
+    image = numba.njit(image, cache=cache)
+
+    def kernel(start, N, cool, dt, sample, check, applying, numbers, form,
+               pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
+               rate, gamma, t, Lx, Ly, V,
+               Cf, Ci, Cb, state_p, xi, active, birth, next_birth,
+               u, u_max, strain, bound, r_max, skin,
+               guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
+               work, mob, yc, y0, zero, tau, verdict, need):
+        B = rate.shape[0]
+        P = Ci.shape[1]
+        n = pos.shape[1]
+        T = Cf[T0:T0 + 12]
+        k_t_j, nu_t_j = T[8], T[9]
+        dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
+                                                                 work[6], work[7], work[8], work[9], work[10])
+        if start == 0:
+            # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
+            for p in range(P):
+                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+                dx, dy, ky, kx = image(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[iLx, p], Cf[iLy, p],
+                                       Ly[b] * gamma[b])
+                d = np.sqrt(dx * dx + dy * dy)
+                if d == 0.0:
+                    return _D_ZERO
+                dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
+            for k in range(n):
+                yc[k] = pos[1, k] - Ly_s[k] / 2
+                mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
+                frc[0, k] = 0.0
+                frc[1, k] = 0.0
+                frc[2, k] = 0.0
+            for b in range(B):
+                tau[0, b] = 0.0
+                tau[1, b] = 0.0
+                verdict[3, b] = math.inf
+            sums = np.zeros((3, B))
+            # relations, terms and the pair forces on i (the scatter's first half, in pair order)
+            for p in range(P):
+                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+                d = ds[p]
+                touching = d < Cf[id0, p]
+                rel = Cb[0, p] or touching
+                if rel and not active[p]:
+                    state_p[p] = 0                      # a new relation starts sticking
+                    if numbers:
+                        birth[p] = next_birth[b]
+                        next_birth[b] += 1
+                if not rel:
+                    xi[0, p] = 0.0                      # an opened contact loses its history
+                    xi[1, p] = 0.0
+                active[p] = rel
+                nx, ny = dxs[p] / d, dys[p] / d
+                dvx = -(Cf[iLy, p] * rate[b]) * kys[p]
+                rv = (vel[0, j] - vel[0, i] + dvx, vel[1, j] - vel[1, i])
+                vn = normal_speed(rv, nx, ny)
+                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vel[2, i], vel[2, j])
+                fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j)
+                state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
+                ft = (F_i + F_j) * 0.5
+                fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
+                nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx, fy
+                frc[0, i] += fx
+                frc[1, i] += fy
+                frc[2, i] += dF * Cf[iwi, p]
+                dFs[p] = dF
+                if sample:
+                    internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
+                    r0, r1, r2 = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j], dys[p], fx, dF, None)
+                    sums[0, b] += r0
+                    sums[1, b] += r1
+                    sums[2, b] += r2
+                if check:
+                    ratio = transient_ratio(d, Cf[id0, p], rel, Cb[1, p])
+                    if ratio < verdict[3, b]:
+                        verdict[3, b] = ratio
+            # the scatter's second half: −F on j and the torque on j, in pair order
+            for p in range(P):
+                j = Ci[2, p]
+                frc[0, j] += -mxs[p]
+                frc[1, j] += -mys[p]
+                frc[2, j] += dFs[p] * Cf[iwj, p]
+            if sample:
+                for b in range(B):
+                    tau[0, b], tau[1, b] = shear_from_sums(sums[0, b], sums[1, b], sums[2, b], V[b])
+            if check:
+                bad = False
+                for b in range(B):
+                    rate_max[b] = max(rate_max[b], abs(rate[b]))
+                    finite = True
+                    ke = 0.0
+                    for k in range(b * N, (b + 1) * N):
+                        finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
+                            and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
+                        ke += kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
+                    ke = 0.5 * ke
+                    bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
+                        else max_ke
+                    code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
+                    verdict[0, b], verdict[1, b], verdict[2, b] = code, ke, bnd
+                    bad = bad or code != 0
+                if bad:
+                    return _GUARD
+            # -- kick (plates follow), damping
+            for k in range(n):
+                b = rep_s[k]
+                vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
+                vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
+                vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
+                frc[0, k] = 0.0
+                frc[1, k] = 0.0
+                frc[2, k] = 0.0
+                if applying and not mob[k]:
+                    vel[1, k] = 0.0
+                    vel[0, k] = plate_velocity(yc[k], rate[b] * Ly_s[k] / 2)
+                vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
+                vel[1, k] *= cool
+                vel[2, k] *= cool
+            # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
+            units = False
+            for p in range(P):
+                i = Ci[1, p]
+                Rx = vel[0, i] * dt - dxs[p]
+                Ry = vel[1, i] * dt - dys[p]
+                dR = np.sqrt(Rx * Rx + Ry * Ry)
+                zero[p] = dR == 0.0
+                if zero[p]:
+                    units = True
+                else:
+                    mxs[p], mys[p] = Rx / dR, Ry / dR
+            if units:
+                return _UNITS
+        # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
+        for p in range(P):
+            i, j = Ci[1, p], Ci[2, p]
+            kd = dt if active[p] and state_p[p] != 1 else 0.0
+            rvx = vel[0, j] - vel[0, i] + dvxs[p]
+            spin = Cf[iri, p] * vel[2, i] + Cf[irj, p] * vel[2, j]
+            inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
+            xi[0, p] += inc_ij * kd
+            xi[1, p] += inc_ji * kd
+        # displacement since the lists were built, Verlet bound, drift
+        for b in range(B):
+            largest = -math.inf
+            for k in range(b * N, (b + 1) * N):
+                u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
+                u[1, k] += vel[1, k] * dt
+                sq = u[0, k] * u[0, k] + u[1, k] * u[1, k]
+                if not sq <= largest:
+                    largest = sq
+            u_max[b] = max(u_max[b], np.sqrt(largest))
+            strain[b] += abs(rate[b]) * dt
+            bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
+        for k in range(n):
+            pos[0, k] += vel[0, k] * dt
+            pos[1, k] += vel[1, k] * dt
+            phi[k] += vel[2, k] * dt
+        # strain, wrap (box.wrap element by element), clock
+        for b in range(B):
+            gamma[b] = gamma[b] + rate[b] * dt
+        crossed = False
+        for k in range(n):
+            b = rep_s[k]
+            y0[k] = pos[1, k]
+            for q in range(passes + 1):
+                if q == passes:
+                    pos[1, k], up = folded(pos[1, k], Ly_s[k], 0.0, Ly_s[k])
+                    pos[0, k] -= (Ly[b] * gamma[b]) * up
+                    break
+                up = period_count(pos[1, k], Ly_s[k], 0.0)
+                if up == 0.0:
+                    break
+                crossed = True
+                pos[1, k] -= Ly_s[k] * up
+                pos[0, k] -= (Ly[b] * gamma[b]) * up
+        if crossed:
+            for k in range(n):
+                vel[0, k] += (pos[1, k] - y0[k]) * rate[rep_s[k]]
+        for k in range(n):
+            Lxk = Lx[rep_s[k]]
+            for q in range(passes + 1):
+                if q == passes:
+                    pos[0, k], _ = folded(pos[0, k], Lxk, 0.0, Lxk)
+                    break
+                right = period_count(pos[0, k], Lxk, 0.0)
+                if right == 0.0:
+                    break
+                pos[0, k] -= Lxk * right
+        for b in range(B):
+            t[b] = t[b] + dt
+            need[b] = bound[b] >= skin[b]
+        return _DONE
+
+    compiled = numba.njit(kernel, cache=cache)
+    if cache:
+        _kernels[True] = compiled
+    return compiled
+
+
+class _Workspace:
+    """The compiled step's buffers and constants of one engine, for one set of candidates ``C``."""
+
+    def __init__(self, engine):
+        s, C = engine.s, engine.C
+        B, N = s.B, s.N
+        self.C = C
+        self.work = np.empty((11, C.P))
+        self.zero = np.zeros(C.P, dtype=np.bool_)
+        self.mob = np.ones(B * N, dtype=np.bool_)
+        self.yc = np.empty(B * N)
+        self.y0 = np.empty(B * N)
+        self.tau = np.zeros((2, B))
+        self.verdict = np.zeros((4, B))
+        self.need = np.zeros(B, dtype=np.bool_)
+        self.Ly_s = np.ascontiguousarray(np.broadcast_to(engine.Ly_s, (B * N,)), dtype=float)
+        self.rep_s = np.ascontiguousarray(s.rep, dtype=np.intp)
+        self.V = np.ascontiguousarray(np.broadcast_to(engine.V, (B,)), dtype=float)
+        self.r_mean = s.r.reshape(B, N).mean(axis=1)
+        self.m_sum = s.m.reshape(B, N).sum(axis=1)
+        self.kk = np.ascontiguousarray(np.broadcast_to(s.k, (B,)), dtype=float)
+
+
+def _workspace(engine):
+    ws = engine.__dict__.get("_compiled_workspace")
+    if ws is None or ws.C is not engine.C:
+        ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine)
+    return ws
+
+
+def _array(a, dtype=float):
+    """``a`` as a contiguous array of ``dtype`` (itself when it is one: written in place)."""
+    if type(a) is np.ndarray and a.dtype == dtype and a.flags.c_contiguous:
+        return a
+    return np.ascontiguousarray(a, dtype=dtype)
+
+
+def run_step(engine, cool, dt, sample):
+    """One step of ``engine`` in the compiled code, or :data:`NOT_RUN` when it does not cover it.
+
+    The candidate lists are rebuilt first when due (:meth:`~particleShear.engine.step.BatchEngine.neighbours`,
+    on NumPy).  A pair at ``d = 0`` leaves the step to NumPy (nothing changed yet; its random normal
+    is drawn there); a ``|R| = 0`` of the ξ rule gets its random direction here, from the
+    replica's generator in pair order, as :func:`~.forces.normals` draws it.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``).
+    cool, dt : float
+        Damping factor and time step (s).
+    sample : bool
+        Return the two shear stresses.
+
+    Returns
+    -------
+    None, tuple or NOT_RUN
+        As :meth:`~particleShear.engine.step.BatchEngine.step` for ``sample`` False or True.
+
+    Raises
+    ------
+    EngineInstability
+        When the guard finds a guarded replica unstable (after the force phase, as NumPy).
+    """
+    engine.neighbours()
+    why = reason(engine)
+    if why is not None:
+        if why not in engine.notes:
+            engine.notes.add(why)
+            warnings.warn(f"backend='numba': this step runs on NumPy ({why})", RuntimeWarning, stacklevel=3)
+        return NOT_RUN
+    kernel = compile_step_kernel()
+    s, C, ws = engine.s, engine.C, _workspace(engine)
+    check = not engine.step_count % engine.check_interval and bool(engine.guard.any())
+    rate, gamma, t = _array(s.rate), s.gamma.astype(float), s.t.astype(float)
+    Lx, Ly = _array(np.broadcast_to(s.Lx, (s.B,))), _array(np.broadcast_to(s.Ly, (s.B,)))
+    state = (engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth, engine.u, engine.u_max,
+             engine.strain, engine.bound)
+    state_p, xi, active, birth, next_birth, u, u_max, strain, bound = (
+        _array(a, a.dtype) for a in state)
+    rate_max = _array(engine.rate_max).copy()
+    guard_on = engine.guard.astype(np.float64)
+    max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
+    args = [s.N, float(cool), float(dt), bool(sample), check, bool(s.applying_shear), engine.numbers_relations,
+            numba_driver.FORMS[C.form], s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
+            rate, gamma, t, Lx, Ly, ws.V, C.f, C.i, C.b, state_p, xi, active, birth, next_birth,
+            u, u_max, strain, bound, _array(engine.r_max), _array(engine.skin),
+            guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), max_ke,
+            ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need]
+    status = kernel(0, *args)
+    if status == _D_ZERO:
+        return NOT_RUN
+    engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth = state_p, xi, active, birth, next_birth
+    if check:
+        engine.rate_max = rate_max
+    if status == _GUARD:
+        v = ws.verdict
+        engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
+    if status == _UNITS:
+        where = np.flatnonzero(ws.zero)
+        for p in where:      # pair order, each pair's own replica's generator (forces.normals)
+            theta = 2 * np.pi * s.rng[int(C.rep_host[p])].random()
+            ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
+        kernel(1, *args)
+    engine.u, engine.u_max, engine.strain, engine.bound = u, u_max, strain, bound
+    s.gamma, s.t = gamma, t
+    engine.need = ws.need.copy()
+    engine.step_count += 1
+    engine.g = engine.verdict = None
+    return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
