@@ -150,7 +150,7 @@ def state_of_ensemble(ensemble, laws=None):
     """
     return state_of_ensembles([ensemble], laws=laws)
 
-def state_of_ensembles(ensembles, laws=None):
+def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:
     what the engine's steps write, the ensembles hold (nothing to copy back).
 
@@ -176,11 +176,14 @@ def state_of_ensembles(ensembles, laws=None):
         equal N, each at most once.
     laws : sequence, optional
         As :func:`state_from_ensembles`.
+    backend : {"numpy", "numba", "auto"} or Backend, default "numpy"
+        A backend whose arrays are the host's (the rows stay the ensembles' own); ``"numba"``
+        runs the engine's steps in the compiled step (:mod:`particleShear.engine.numba_step`).
 
     Returns
     -------
     BatchState
-        On NumPy, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
+        On the host, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
 
     Raises
     ------
@@ -190,6 +193,10 @@ def state_of_ensembles(ensembles, laws=None):
     ensembles = list(ensembles)
     if len({id(e) for e in ensembles}) != len(ensembles):
         raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
+    target = get_backend(backend)
+    if not target.host:
+        raise ValueError(f"backend={target.name!r} is not allowed here: the ensembles' own rows are host "
+                         "arrays (numpy, numba or auto)")
     s = state_from_ensembles(ensembles, backend="numpy", laws=laws)   # views of the ensembles' NumPy rows
     N = s.N
     if len(ensembles) == 1:
@@ -206,6 +213,7 @@ def state_of_ensembles(ensembles, laws=None):
     s.pairs = [e._pairs for e in ensembles]
     s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
     s.ensembles = ensembles
+    s.backend = target         # (the same host arrays)
     return s
 
 
@@ -295,7 +303,7 @@ def untouched_on_failure(ensemble):
         raise
 
 
-def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
+def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None, backend="numpy"):
     """``free_pre_equilibration(N)`` of every ensemble, all in one engine, written back.
 
     Parameters
@@ -312,6 +320,8 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
     laws : sequence, optional
         The central law of each ensemble, as :func:`state_from_ensembles`
         takes them (default: the documented callback for every one).
+    backend : {"numpy", "numba", "auto"}, default "numpy"
+        The host backend of the engine (:func:`state_of_ensembles`).
 
     Returns
     -------
@@ -352,7 +362,7 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None):
         for e in ensembles:
             stack.enter_context(untouched_on_failure(e))
         # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
-        state = state_of_ensembles(ensembles, laws=laws)
+        state = state_of_ensembles(ensembles, laws=laws, backend=backend)
         engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
                              guard=[g is not None for g in guards], min_distance_ratio=ratio,
                              max_kinetic_energy=ke, phase="constitution", numbers_relations=True)

@@ -162,8 +162,10 @@ def pair_term_function(L, cache=True):
     Returns
     -------
     numba.core.registry.CPUDispatcher
-        ``pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j) -> (fn, law, F_i, F_j, slip)``;
-        resets ``xi[:, p]`` on slip.  ``T`` holds the rows of :data:`TERM_BLOCK`.
+        ``pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True) -> (fn, law,
+        F_i, F_j, slip)``; resets ``xi[:, p]`` on slip.  ``T`` holds the rows of :data:`TERM_BLOCK`;
+        ``friction`` False: no tangential term (0, 0, slip where active, ξ reset), as the engine's
+        frictionless shortcut.
     """
     import numba
 
@@ -171,7 +173,7 @@ def pair_term_function(L, cache=True):
     tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
     viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
 
-    def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j):
+    def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True):
         # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
         if form == 1:
             inside = linear_term(r, T[0, p], T[2, p])
@@ -182,6 +184,10 @@ def pair_term_function(L, cache=True):
         law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
         f = law * T[6, p]
         f += viscous_force(T[7, p], vn, active)
+        if not friction:          # no tangential force (the frictionless shortcut): every relation slips
+            xi[0, p] = 0.0
+            xi[1, p] = 0.0
+            return f, law, 0.0, 0.0, active
         fc = np.abs(T[10, p] * law)
         fc += T[11, p]
         F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi[0, p], xi[1, p], T[8, p],
@@ -191,7 +197,7 @@ def pair_term_function(L, cache=True):
             xi[1, p] = 0.0
         return f, law, F_i, F_j, s
 
-    return numba.njit(pair_term, cache=cache)
+    return numba.njit(pair_term, cache=cache, inline="always")
 
 
 def compile_pair_kernel(cache=True, say=None):

@@ -18,10 +18,9 @@ and the laws), in the NumPy engine's order of operations, so the trajectories ar
 What stays in Python: the candidate search when a list is due (the one search,
 :meth:`~particleShear.engine.step.BatchEngine.neighbours`), the random directions at ``d = 0``
 and ``|R| = 0`` (drawn from each replica's generator, as :func:`~.forces.normals` does), and the
-protocol's schedule and observers.  Sums that NumPy takes pairwise (the per-replica shear sums,
-the guard's kinetic energy) are taken in pair or sphere order here: they agree to rounding
-(relative 1e-15 for the shear stresses of the suite's scenes; they never feed back into the
-trajectory).  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
+protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
+``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
+pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
 """
 __docformat__ = "numpy"
@@ -34,7 +33,7 @@ import numpy as np
 from . import box, forces, guard, integrate, laws, neighbours, numba_driver, terms
 from .phase_laws import force_phase_laws
 
-__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "run_step", "NOT_RUN"]
+__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_kernels", "run_step", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -57,7 +56,7 @@ def reason(engine):
     """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
 
     Covered: the semi-implicit Euler integrator, every replica Lees-Edwards with its strain
-    advancing, frictional replicas or bonds, the spheres sharing their replica's parameters, the
+    advancing, replicas with and without friction and bonds, the spheres sharing their replica's parameters, the
     linear law (and the tensile law of bonds) from the prepared constants, no force register, a
     sample of the two shear stresses (not the whole tensors).
     """
@@ -67,8 +66,6 @@ def reason(engine):
         return "the force register keeps the terms of each visit"
     if engine.lees_edwards is not None or engine.strain_advances is not None:
         return "a plain periodic replica, or a strain held while not shearing"
-    if engine.free_p is not None:
-        return "a replica without friction and bonds (the frictionless shortcut)"
     C = engine.C
     if C.Kj is not None:
         return "spheres with parameters of their own"
@@ -144,12 +141,51 @@ def compile_step_kernel(cache=True, say=None):
             kx += k
         return dx, dy, ky, kx
 
-    image = numba.njit(image, cache=cache)
+    image = numba.njit(image, cache=cache, inline="always")
 
-    def kernel(start, N, cool, dt, sample, check, applying, numbers, form,
+    def pairwise(a, lo, n):
+        # NumPy's pairwise summation of a[lo:lo + n] (numpy/_core/src/umath/loops_utils.h.src): the
+        # order of numpy.sum along a contiguous axis, so the compiled sums are NumPy's to the bit
+        if n < 8:
+            res = 0.0
+            for i in range(lo, lo + n):
+                res += a[i]
+            return res
+        if n <= 128:
+            r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+            r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+            i = 8
+            while i < n - n % 8:
+                r0 += a[lo + i]
+                r1 += a[lo + i + 1]
+                r2 += a[lo + i + 2]
+                r3 += a[lo + i + 3]
+                r4 += a[lo + i + 4]
+                r5 += a[lo + i + 5]
+                r6 += a[lo + i + 6]
+                r7 += a[lo + i + 7]
+                i += 8
+            res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+            while i < n:
+                res += a[lo + i]
+                i += 1
+            return res
+        n2 = n // 2
+        n2 -= n2 % 8
+        return pairwise(a, lo, n2) + pairwise(a, lo + n2, n - n2)
+
+    pairwise = numba.njit(pairwise, cache=cache)
+
+    def segment_sum(a, lo, hi):
+        # numpy.add.reduceat over one segment: its first element, then the pairwise sum of the rest
+        return a[lo] + pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
+
+    segment_sum = numba.njit(segment_sum, cache=cache, inline="always")
+
+    def kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free,
                pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
                rate, gamma, t, Lx, Ly, V,
-               Cf, Ci, Cb, state_p, xi, active, birth, next_birth,
+               Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
                u, u_max, strain, bound, r_max, skin,
                guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
                work, mob, yc, y0, zero, tau, verdict, need):
@@ -180,7 +216,6 @@ def compile_step_kernel(cache=True, say=None):
                 tau[0, b] = 0.0
                 tau[1, b] = 0.0
                 verdict[3, b] = math.inf
-            sums = np.zeros((3, B))
             # relations, terms and the pair forces on i (the scatter's first half, in pair order)
             for p in range(P):
                 b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
@@ -200,8 +235,13 @@ def compile_step_kernel(cache=True, say=None):
                 dvx = -(Cf[iLy, p] * rate[b]) * kys[p]
                 rv = (vel[0, j] - vel[0, i] + dvx, vel[1, j] - vel[1, i])
                 vn = normal_speed(rv, nx, ny)
-                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vel[2, i], vel[2, j])
-                fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j)
+                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vel[2, i], vel[2, j]) if free_mode != 1 else 0.0
+                fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j,
+                                                    free_mode != 1)
+                if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
+                    xi[0, p] = 0.0
+                    xi[1, p] = 0.0
+                    slip = slip or rel
                 state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
                 ft = (F_i + F_j) * 0.5
                 fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
@@ -212,10 +252,8 @@ def compile_step_kernel(cache=True, say=None):
                 dFs[p] = dF
                 if sample:
                     internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
-                    r0, r1, r2 = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j], dys[p], fx, dF, None)
-                    sums[0, b] += r0
-                    sums[1, b] += r1
-                    sums[2, b] += r2
+                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                       dys[p], fx, dF, None)
                 if check:
                     ratio = transient_ratio(d, Cf[id0, p], rel, Cb[1, p])
                     if ratio < verdict[3, b]:
@@ -226,20 +264,21 @@ def compile_step_kernel(cache=True, say=None):
                 frc[0, j] += -mxs[p]
                 frc[1, j] += -mys[p]
                 frc[2, j] += dFs[p] * Cf[iwj, p]
-            if sample:
+            if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
                 for b in range(B):
-                    tau[0, b], tau[1, b] = shear_from_sums(sums[0, b], sums[1, b], sums[2, b], V[b])
+                    lo, hi = offsets[b], offsets[b + 1]
+                    tau[0, b], tau[1, b] = shear_from_sums(segment_sum(work[11], lo, hi), segment_sum(work[12], lo, hi),
+                                                           segment_sum(work[13], lo, hi), V[b])
             if check:
                 bad = False
                 for b in range(B):
                     rate_max[b] = max(rate_max[b], abs(rate[b]))
                     finite = True
-                    ke = 0.0
                     for k in range(b * N, (b + 1) * N):
                         finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
                             and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
-                        ke += kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
-                    ke = 0.5 * ke
+                        y0[k] = kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
+                    ke = 0.5 * pairwise(y0, b * N, N)        # (guard.verdict: the sum of each replica's row)
                     bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
                         else max_ke
                     code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
@@ -262,13 +301,17 @@ def compile_step_kernel(cache=True, say=None):
                 vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
                 vel[1, k] *= cool
                 vel[2, k] *= cool
+            if free_mode == 1:            # no ξ without friction and bonds
+                start = 2
             # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
             units = False
-            for p in range(P):
+            for p in range(P if start == 0 else 0):
                 i = Ci[1, p]
                 Rx = vel[0, i] * dt - dxs[p]
                 Ry = vel[1, i] * dt - dys[p]
                 dR = np.sqrt(Rx * Rx + Ry * Ry)
+                if free_mode == 2 and free[p]:
+                    dR = 1.0                  # (no direction drawn for a replica without ξ)
                 zero[p] = dR == 0.0
                 if zero[p]:
                     units = True
@@ -277,7 +320,7 @@ def compile_step_kernel(cache=True, say=None):
             if units:
                 return _UNITS
         # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
-        for p in range(P):
+        for p in range(P if start != 2 else 0):
             i, j = Ci[1, p], Ci[2, p]
             kd = dt if active[p] and state_p[p] != 1 else 0.0
             rvx = vel[0, j] - vel[0, i] + dvxs[p]
@@ -343,14 +386,29 @@ def compile_step_kernel(cache=True, say=None):
     return compiled
 
 
-class _Workspace:
-    """The compiled step's buffers and constants of one engine, for one set of candidates ``C``."""
+def compile_kernels(say=None):
+    """Compile (or load from the cache) both compiled loops of the ``"numba"`` backend now: the force
+    terms (:func:`~.numba_driver.compile_pair_kernel`) and the step (:func:`compile_step_kernel`),
+    so that no timing of a run counts them.
 
-    def __init__(self, engine):
+    Parameters
+    ----------
+    say : callable, optional
+        ``say(message)``, told once per kernel before it is compiled or loaded.
+    """
+    numba_driver.compile_pair_kernel(say=say)
+    compile_step_kernel(say=say)
+
+
+class _Workspace:
+    """The compiled step's buffers and constants of one engine for one set of candidates ``C``, and
+    the reason the step is not compiled (None: it is), under the key of what that depends on."""
+
+    def __init__(self, engine, key):
         s, C = engine.s, engine.C
         B, N = s.B, s.N
-        self.C = C
-        self.work = np.empty((11, C.P))
+        self.C, self.key, self.why = C, key, reason(engine)
+        self.work = np.empty((14, C.P))
         self.zero = np.zeros(C.P, dtype=np.bool_)
         self.mob = np.ones(B * N, dtype=np.bool_)
         self.yc = np.empty(B * N)
@@ -358,26 +416,42 @@ class _Workspace:
         self.tau = np.zeros((2, B))
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
-        self.Ly_s = np.ascontiguousarray(np.broadcast_to(engine.Ly_s, (B * N,)), dtype=float)
+        per_sphere = lambda a: np.ascontiguousarray(np.broadcast_to(a, (B * N,)), dtype=float)
+        per_replica = lambda a: np.ascontiguousarray(np.broadcast_to(a, (B,)), dtype=float)
+        self.Ly_s = per_sphere(engine.Ly_s)
         self.rep_s = np.ascontiguousarray(s.rep, dtype=np.intp)
-        self.V = np.ascontiguousarray(np.broadcast_to(engine.V, (B,)), dtype=float)
+        self.V, self.Lx, self.Ly, self.kk = (per_replica(a) for a in (engine.V, s.Lx, s.Ly, s.k))
+        self.r_max, self.skin = per_replica(engine.r_max), per_replica(engine.skin)
         self.r_mean = s.r.reshape(B, N).mean(axis=1)
         self.m_sum = s.m.reshape(B, N).sum(axis=1)
-        self.kk = np.ascontiguousarray(np.broadcast_to(s.k, (B,)), dtype=float)
+        self.guard_on = engine.guard.astype(np.float64)
+        self.guarded = bool(engine.guard.any())
+        self.max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
+        self.form = numba_driver.FORMS[C.form]
+        self.offsets = np.ascontiguousarray(C.offsets, dtype=np.int64)
+
+
+def _key(engine):
+    """What :func:`reason` and the workspace depend on besides the candidates (compared by identity)."""
+    s = engine.s
+    return (engine.integrator, engine.keep_terms, engine.lees_edwards, engine.strain_advances, engine.free_p,
+            s.law, s.law_params, engine.guard, engine.max_kinetic_energy)
 
 
 def _workspace(engine):
+    """The engine's :class:`_Workspace`, rebuilt at a rebuild of the lists (new ``C``) or when its key changed."""
     ws = engine.__dict__.get("_compiled_workspace")
-    if ws is None or ws.C is not engine.C:
-        ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine)
+    key = _key(engine)
+    if ws is None or ws.C is not engine.C or any(a is not b for a, b in zip(ws.key, key)):
+        ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine, key)
     return ws
 
 
-def _array(a, dtype=float):
-    """``a`` as a contiguous array of ``dtype`` (itself when it is one: written in place)."""
-    if type(a) is np.ndarray and a.dtype == dtype and a.flags.c_contiguous:
+def _array(a):
+    """``a`` itself when it is a C-contiguous NumPy array (written in place), else a contiguous copy."""
+    if type(a) is np.ndarray and a.flags.c_contiguous:
         return a
-    return np.ascontiguousarray(a, dtype=dtype)
+    return np.ascontiguousarray(a)
 
 
 def run_step(engine, cool, dt, sample):
@@ -408,42 +482,37 @@ def run_step(engine, cool, dt, sample):
         When the guard finds a guarded replica unstable (after the force phase, as NumPy).
     """
     engine.neighbours()
-    why = reason(engine)
-    if why is not None:
-        if why not in engine.notes:
-            engine.notes.add(why)
-            warnings.warn(f"backend='numba': this step runs on NumPy ({why})", RuntimeWarning, stacklevel=3)
+    ws = _workspace(engine)
+    if ws.why is not None:
+        if ws.why not in engine.notes:
+            engine.notes.add(ws.why)
+            warnings.warn(f"backend='numba': this step runs on NumPy ({ws.why})", RuntimeWarning, stacklevel=3)
         return NOT_RUN
-    kernel = compile_step_kernel()
-    s, C, ws = engine.s, engine.C, _workspace(engine)
-    check = not engine.step_count % engine.check_interval and bool(engine.guard.any())
-    rate, gamma, t = _array(s.rate), s.gamma.astype(float), s.t.astype(float)
-    Lx, Ly = _array(np.broadcast_to(s.Lx, (s.B,))), _array(np.broadcast_to(s.Ly, (s.B,)))
-    state = (engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth, engine.u, engine.u_max,
-             engine.strain, engine.bound)
-    state_p, xi, active, birth, next_birth, u, u_max, strain, bound = (
-        _array(a, a.dtype) for a in state)
-    rate_max = _array(engine.rate_max).copy()
-    guard_on = engine.guard.astype(np.float64)
-    max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
-    args = [s.N, float(cool), float(dt), bool(sample), check, bool(s.applying_shear), engine.numbers_relations,
-            numba_driver.FORMS[C.form], s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
-            rate, gamma, t, Lx, Ly, ws.V, C.f, C.i, C.b, state_p, xi, active, birth, next_birth,
-            u, u_max, strain, bound, _array(engine.r_max), _array(engine.skin),
-            guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), max_ke,
-            ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need]
+    kernel = _kernels.get(True) or compile_step_kernel()
+    s, C = engine.s, engine.C
+    check = ws.guarded and not engine.step_count % engine.check_interval
+    gamma, t = s.gamma.astype(float), s.t.astype(float)       # (copies: the state's arrays are replaced)
+    state_p, xi, active, birth, next_birth, u, u_max, strain, bound, rate_max = (
+        _array(a) for a in (engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth, engine.u,
+                            engine.u_max, engine.strain, engine.bound, engine.rate_max))
+    free = engine.free_p
+    free_mode, free = (0, ws.zero) if free is None else (1, ws.zero) if free is True else (2, _array(free))
+    args = (s.N, float(cool), float(dt), bool(sample), check, bool(s.applying_shear), engine.numbers_relations,
+            ws.form, free_mode, free, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
+            _array(s.rate), gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active, birth, next_birth,
+            u, u_max, strain, bound, ws.r_max, ws.skin,
+            ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
+            ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
     status = kernel(0, *args)
     if status == _D_ZERO:
         return NOT_RUN
     engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth = state_p, xi, active, birth, next_birth
-    if check:
-        engine.rate_max = rate_max
+    engine.rate_max = rate_max
     if status == _GUARD:
         v = ws.verdict
         engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
     if status == _UNITS:
-        where = np.flatnonzero(ws.zero)
-        for p in where:      # pair order, each pair's own replica's generator (forces.normals)
+        for p in np.flatnonzero(ws.zero):      # pair order, each pair's own replica's generator (forces.normals)
             theta = 2 * np.pi * s.rng[int(C.rep_host[p])].random()
             ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
         kernel(1, *args)

@@ -17,9 +17,10 @@ import numpy as np
 from ..base.engine_adapter import relax_ensembles, state_from_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
-from ..engine.numba_driver import compile_pair_kernel
+from ..engine.numba_step import compile_kernels
 from ..engine.state import BatchState
 from ..engine.step import BatchEngine, EngineInstability, pre_equilibrate, protocol
+from ..engine.xp import get_backend
 from ..linkable.builders import MAX_RELAXATIONS
 from .observers import ReplicaScene
 
@@ -98,6 +99,11 @@ def _constitute(sessions):
     replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
     the relaxations it took part in."""
 
+    # the backend of each replica's relaxations: its run's, where that keeps the host's arrays (the
+    # compiled step is compiled, or loaded from the cache, here: not counted in the timings)
+    backends = [_host_backend(run) for run in sessions]
+    if any(be.compiled for be in backends):
+        compile_kernels(say=_console([run.sim for run in sessions], [0], "constitution", ["constitution", 0, 0])[0])
     steps = [run.constitution() for run in sessions]
     pending = {}            # replica -> its waiting Relaxation
     since = {}              # replica -> when it was suspended
@@ -120,7 +126,7 @@ def _constitute(sessions):
         group = [b for b in sorted(pending) if pending[b].key == key]
         t0 = time.perf_counter()
         relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR,
-                        laws=[sessions[b].sim.contact_law for b in group])
+                        laws=[sessions[b].sim.contact_law for b in group], backend=backends[group[0]])
         share = (time.perf_counter() - t0) / len(group)
         for b in group:
             advance(b, share)
@@ -247,7 +253,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         say, report = _console(sims, group, "pre-equilibration", where)
         if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
             tc = time.perf_counter()
-            compile_pair_kernel(say=say)
+            compile_kernels(say=say)
             t0 += time.perf_counter() - tc
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
@@ -266,6 +272,13 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     engine = BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in order],
                          integrator=integrator, half=half)
     return engine, order
+
+
+def _host_backend(run):
+    """The backend of a session's constitution: its run's backend where that works on the host's
+    arrays (NumPy, Numba), else NumPy (the ensembles' own rows are relaxed in place)."""
+    be = get_backend((run.sim.parameters or {}).get("backend", "auto"))
+    return be if be.host else get_backend("numpy")
 
 
 def _console(sims, members, phase, where):
