@@ -16,7 +16,7 @@ __docformat__ = "numpy"
 
 from .xp import array_namespace, select
 
-__all__ = ["velocity_change", "plate_velocity", "damped", "xi_rates", "kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
+__all__ = ["velocity_change", "half_velocity_change", "plate_velocity", "damped", "xi_rates", "kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
            "xi_increments", "drift"]
 
 
@@ -42,6 +42,25 @@ def velocity_change(f, w, dt):
     step = f * dt
     step /= w
     return step
+
+
+def half_velocity_change(f, w, dt):
+    """The velocity Verlet predictor's half kick of one component: ``F·dt/(2m)`` (pure; see :func:`half_kick`).
+
+    Parameters
+    ----------
+    f, w : ndarray or float
+        Force and mass (or torque and moment of inertia).
+    dt : float
+        Time step (s).
+
+    Returns
+    -------
+    ndarray or float
+    """
+    h = f * dt
+    h /= 2 * w
+    return h
 
 
 def plate_velocity(yc, plate_speed):
@@ -149,8 +168,7 @@ def half_kick(frc, weights, dt, mobile=None):
     ndarray (k, n)
         Half kicks of the velocity rows (µm/s, and rad/s for ω).
     """
-    h = frc * dt
-    h /= 2 * weights
+    h = half_velocity_change(frc, weights, dt)
     if mobile is not None:
         h[:2] = array_namespace(h).where(mobile, h[:2], 0.0)
     return h

@@ -37,7 +37,8 @@ __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_kernels",
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
-    (box, "period_count"), (box, "folded"), (integrate, "velocity_change"), (integrate, "plate_velocity"),
+    (box, "period_count"), (box, "folded"), (integrate, "velocity_change"), (integrate, "half_velocity_change"),
+    (integrate, "plate_velocity"),
     (integrate, "damped"), (integrate, "xi_rates"), (terms, "normal_speed"), (terms, "slip_speed"),
     (terms, "pair_forces"), (forces, "pair_roles"), (forces, "shear_rows"), (forces, "shear_from_sums"),
     (guard, "kinetic_term"), (guard, "energy_bound"), (guard, "verdict_code"), (guard, "transient_ratio"),
@@ -55,13 +56,11 @@ _kernels = {}
 def reason(engine):
     """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
 
-    Covered: the semi-implicit Euler integrator, every replica Lees-Edwards with its strain
+    Covered: both integrators, every replica Lees-Edwards with its strain
     advancing, replicas with and without friction and bonds, the spheres sharing their replica's parameters, the
     linear law (and the tensile law of bonds) from the prepared constants, no force register, a
     sample of the two shear stresses (not the whole tensors).
     """
-    if engine.integrator != "euler":
-        return "the velocity Verlet integrator"
     if engine.keep_terms:
         return "the force register keeps the terms of each visit"
     if engine.lees_edwards is not None or engine.strain_advances is not None:
@@ -102,6 +101,7 @@ def compile_step_kernel(cache=True, say=None):
     period_count, folded = L["period_count"], L["folded"]
     velocity_change, plate_velocity, damped, xi_rates = (L["velocity_change"], L["plate_velocity"], L["damped"],
                                                          L["xi_rates"])
+    half_velocity_change = L["half_velocity_change"]
     normal_speed, slip_speed, pair_forces = L["normal_speed"], L["slip_speed"], L["pair_forces"]
     pair_roles, shear_rows, shear_from_sums = L["pair_roles"], L["shear_rows"], L["shear_from_sums"]
     kinetic_term, energy_bound, verdict_code, transient_ratio = (L["kinetic_term"], L["energy_bound"],
@@ -182,7 +182,7 @@ def compile_step_kernel(cache=True, say=None):
 
     segment_sum = numba.njit(segment_sum, cache=cache, inline="always")
 
-    def kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free,
+    def kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted, half, half_out,
                pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
                rate, gamma, t, Lx, Ly, V,
                Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
@@ -233,9 +233,14 @@ def compile_step_kernel(cache=True, say=None):
                 active[p] = rel
                 nx, ny = dxs[p] / d, dys[p] / d
                 dvx = -(Cf[iLy, p] * rate[b]) * kys[p]
-                rv = (vel[0, j] - vel[0, i] + dvx, vel[1, j] - vel[1, i])
+                if predicted:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
+                    vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
+                    vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
+                else:
+                    vi0, vi1, vi2, vj0, vj1, vj2 = vel[0, i], vel[1, i], vel[2, i], vel[0, j], vel[1, j], vel[2, j]
+                rv = (vj0 - vi0 + dvx, vj1 - vi1)
                 vn = normal_speed(rv, nx, ny)
-                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vel[2, i], vel[2, j]) if free_mode != 1 else 0.0
+                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vi2, vj2) if free_mode != 1 else 0.0
                 fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j,
                                                     free_mode != 1)
                 if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
@@ -289,6 +294,10 @@ def compile_step_kernel(cache=True, say=None):
             # -- kick (plates follow), damping
             for k in range(n):
                 b = rep_s[k]
+                if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
+                    half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
+                    half_out[1, k] = half_velocity_change(frc[1, k], mmi[1, k], dt) if mob[k] else 0.0
+                    half_out[2, k] = half_velocity_change(frc[2, k], mmi[2, k], dt)
                 vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
                 vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
                 vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
@@ -429,6 +438,7 @@ class _Workspace:
         self.max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
         self.form = numba_driver.FORMS[C.form]
         self.offsets = np.ascontiguousarray(C.offsets, dtype=np.int64)
+        self.no_half = np.zeros((3, 0))
 
 
 def _key(engine):
@@ -497,8 +507,12 @@ def run_step(engine, cool, dt, sample):
                             engine.u_max, engine.strain, engine.bound, engine.rate_max))
     free = engine.free_p
     free_mode, free = (0, ws.zero) if free is None else (1, ws.zero) if free is True else (2, _array(free))
+    verlet = engine.integrator == "verlet"
+    predicted = verlet and engine.half is not None
+    half = _array(engine.half) if predicted else ws.no_half
+    new_half = np.empty((3, s.B * s.N)) if verlet else ws.no_half    # (a new array per step, as half_kick gives)
     args = (s.N, float(cool), float(dt), bool(sample), check, bool(s.applying_shear), engine.numbers_relations,
-            ws.form, free_mode, free, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
+            ws.form, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
             _array(s.rate), gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active, birth, next_birth,
             u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
@@ -517,6 +531,8 @@ def run_step(engine, cool, dt, sample):
             ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
         kernel(1, *args)
     engine.u, engine.u_max, engine.strain, engine.bound = u, u_max, strain, bound
+    if verlet:
+        engine.half = new_half
     s.gamma, s.t = gamma, t
     engine.need = ws.need.copy()
     engine.step_count += 1

@@ -1,0 +1,191 @@
+"""The whole step in one compiled call (engine/numba_step.py) against the NumPy engine: the same bits.
+
+The compiled step calls the NumPy engine's own pure functions on numbers in the NumPy engine's
+order of operations (the per-replica sums in NumPy's pairwise order), so trajectories, relations,
+histories, creation numbers and the sampled stresses are equal bit for bit (signs of zeros
+included), not merely close.  Scenes: crosslinked particles with cut bonds, frictional spheres,
+frictionless spheres (the shortcut), a batch mixing frictionless and frictional replicas, the
+velocity Verlet integrator, plates off (the constitution's relaxation), a run's whole
+constitution and measurement, a diverging replica (the same guard verdict), and a pair at
+distance 0 (that step runs on NumPy, which draws the random normal).  Skipped without Numba.
+"""
+import unittest
+import warnings
+
+import numpy as np
+
+from particleShear.engine import numba_driver, numba_step
+from particleShearTest.test_numba_driver import _bits
+
+HAVE_NUMBA = numba_driver.available()
+
+FRICTIONAL_BONDS = dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2)
+FRICTIONAL = dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1)
+FRICTIONLESS = dict(theMu=0.0, do_permanent_links=False, cut_lines=0, theAmplitude=0.2)
+
+
+def _measure(scenes, backend, integrator="euler", periods=1, keep_engine=False):
+    """Pre-equilibration and protocol (0.5 + periods + 0.5 periods) of constituted ensembles in one engine."""
+    from particleShear.base.engine_adapter import state_from_ensembles
+    from particleShear.engine.loops import pre_equilibrate, protocol
+    from particleShear.engine.step import BatchEngine
+    from particleShearTest.test_engine import constituted
+
+    sc = constituted(11, **FRICTIONAL_BONDS)[2]      # one schedule for every batch
+    ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
+    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), integrator=integrator)
+    pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
+    out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
+    return eng, out
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestCompiledStepBits(unittest.TestCase):
+
+    def assert_same_engines(self, a, b):
+        for key in ("pos", "vel", "phi"):
+            np.testing.assert_array_equal(_bits(getattr(a.s, key)), _bits(getattr(b.s, key)), err_msg=key)
+        for key in ("gamma", "t"):
+            np.testing.assert_array_equal(_bits(getattr(a.s, key)), _bits(getattr(b.s, key)), err_msg=key)
+        for r in range(a.s.B):
+            p, q = a.pairs_of(r), b.pairs_of(r)
+            for key in ("i", "j", "state", "active", "birth"):
+                np.testing.assert_array_equal(getattr(p, key), getattr(q, key), err_msg=key)
+            np.testing.assert_array_equal(_bits(p.xi), _bits(q.xi), err_msg="xi")
+        self.assertEqual(a.step_count, b.step_count)
+        np.testing.assert_array_equal(a.rebuilds, b.rebuilds)
+
+    def assert_same_records(self, a, b):
+        for key in ("t", "strain", "strain_rate", "stress_internal", "stress_surface"):
+            np.testing.assert_array_equal(_bits(a[key]), _bits(b[key]), err_msg=key)
+
+    def test_scenes_bit_identical(self):
+        """Every scene: the engine's state after pre-equilibration and protocol and the recorded
+        series equal NumPy's bit for bit; no step of these scenes falls back (no note)."""
+        cases = {"bonds and friction": ([(0, FRICTIONAL_BONDS)], "euler"),
+                 "friction": ([(1, FRICTIONAL)], "euler"),
+                 "frictionless shortcut": ([(2, FRICTIONLESS)], "euler"),
+                 "frictionless and frictional replicas": ([(2, FRICTIONLESS), (1, FRICTIONAL)], "euler"),
+                 "velocity Verlet": ([(0, FRICTIONAL_BONDS)], "verlet")}
+        for name, (scenes, integrator) in cases.items():
+            with self.subTest(name):
+                e_np, ref = _measure(scenes, "numpy", integrator)
+                with warnings.catch_warnings():       # no step on NumPy but the tensor samples
+                    warnings.filterwarnings("error", "backend='numba': this step runs on NumPy", RuntimeWarning)
+                    e_nb, got = _measure(scenes, "numba", integrator)
+                self.assertGreater(e_nb.step_count, 250)
+                self.assertGreater(np.abs(ref["stress_surface"]).max(), 0.0)
+                self.assert_same_records(ref, got)
+                self.assert_same_engines(e_np, e_nb)
+                if name == "bonds and friction":
+                    self.assertTrue(np.any(e_nb.pairs_of(0).xi != 0.0))      # the ξ rule really ran
+
+    def test_the_step_ran_compiled(self):
+        """The compiled step ran the steps (not the NumPy phases), but for the protocol's first and
+        last steps, which sample every tensor."""
+        from unittest import mock
+
+        from particleShear.engine.step import BatchEngine
+        phases = []
+        original = BatchEngine.force_phase
+
+        def numpy_phase(engine, sample=False):
+            if engine.backend.compiled:          # (the ensembles' constitution runs on NumPy engines)
+                phases.append(sample)
+            return original(engine, sample)
+
+        with mock.patch.object(BatchEngine, "force_phase", numpy_phase):
+            eng, _ = _measure([(0, FRICTIONAL_BONDS)], "numba")
+        self.assertEqual(phases, ["tensors", "tensors"])
+        self.assertGreater(eng.step_count, 250)
+
+    def test_plates_off_relaxation_and_numbers(self):
+        """The constitution's relaxation (plates off, μ = 0 blocks, drift removal) on the ensembles' own
+        state, whose engine numbers the relations as they form: the same bits and creation numbers."""
+        from particleShear.base.engine_adapter import state_of_ensembles
+        from particleShear.engine.relax import free_relaxation
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        engines = []
+        for backend in ("numpy", "numba"):
+            e = constituted(21, **FRICTIONAL_BONDS)[1]
+            eng = BatchEngine(state_of_ensembles([e], backend=backend), skin_factor=0.2, numbers_relations=True)
+            free_relaxation(eng, 60, e.dt, e.dt_max, eng.s.mu.copy())
+            engines.append(eng)
+        self.assertFalse(engines[1].s.applying_shear)
+        self.assert_same_engines(*engines)
+        self.assertGreater(engines[1].pairs_of(0).birth.max(), 0)
+
+    def test_batch_replica_equals_single_run(self):
+        _, both = _measure([(0, FRICTIONAL_BONDS), (1, FRICTIONAL)], "numba")
+        for col, scene in enumerate((FRICTIONAL_BONDS, FRICTIONAL)):
+            _, single = _measure([(col, scene)], "numba")
+            for key in ("t", "strain", "stress_internal", "stress_surface"):
+                np.testing.assert_array_equal(_bits(single[key][:, 0]), _bits(both[key][:, col]), err_msg=key)
+
+    def test_run_bit_identical(self):
+        """A whole run (constitution, pre-equilibration, protocol, demodulation): the same series,
+        moduli and run id on both backends; the result records the backend used."""
+        from particleShear import doParticleShearSimulation
+        kw = dict(seed=5, N=40, relative_frequency=0.2, periods=2, pre_periods=0.5, post_periods=0.5,
+                  return_result=True, verbose=False, doDrawing=False, plotStress=False)
+        a = doParticleShearSimulation(backend="numpy", **kw)
+        b = doParticleShearSimulation(backend="numba", **kw)
+        self.assertEqual(b.parameters["backend"], "numba")
+        self.assertEqual(a.run_id, b.run_id)
+        self.assertEqual(a.G_surface, b.G_surface)
+        self.assertEqual(a.G_internal, b.G_internal)
+        for key in ("t", "strain", "stress_surface", "stress_internal"):
+            np.testing.assert_array_equal(_bits(a.series[key]), _bits(b.series[key]), err_msg=key)
+
+    def test_guard_verdict_identical(self):
+        """A replica driven unstable (a step far above the stable one): the same EngineInstability
+        (replica, step, phase, reason) on both backends."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine, EngineInstability
+        from particleShearTest.test_engine import constituted
+
+        errors = []
+        for backend in ("numpy", "numba"):
+            e = constituted(31, **FRICTIONAL)[1]
+            eng = BatchEngine(state_from_ensembles([e], backend=backend))
+            eng.s.vel[...] *= 1e6
+            with self.assertRaises(EngineInstability) as ctx:
+                for _ in range(400):
+                    eng.step(1.0, e.dt * 20)
+            errors.append((str(ctx.exception), ctx.exception.step, ctx.exception.replica))
+        self.assertEqual(errors[0], errors[1])
+
+    def test_pair_at_distance_zero_runs_on_numpy(self):
+        """Two spheres at the same place: that step leaves the compiled code before changing anything,
+        and NumPy draws the random normal from the replica's generator; the same bits follow."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        engines = []
+        for backend in ("numpy", "numba"):
+            e = constituted(41, **FRICTIONAL)[1]
+            s = state_from_ensembles([e], backend=backend)
+            s.pos[:, 1] = s.pos[:, 0]
+            eng = BatchEngine(s, guard=False)        # (the guard would stop the interpenetration)
+            for _ in range(5):
+                eng.step(0.999, e.dt)
+            engines.append(eng)
+        self.assert_same_engines(*engines)
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestOneFunctionTwoDrivers(unittest.TestCase):
+    def test_compiled_functions_are_the_modules_functions(self):
+        """Every function the compiled step calls is compiled from the code object of the NumPy
+        engine's function of that name (no second copy of a rule)."""
+        L = numba_driver.jit_laws(True, numba_step.STEP_FUNCTIONS)
+        for module, name in numba_step.STEP_FUNCTIONS:
+            with self.subTest(name=name):
+                self.assertIs(L[name].py_func.__code__, getattr(module, name).__code__)
+
+
+if __name__ == "__main__":
+    unittest.main()
