@@ -174,6 +174,7 @@ ENGINE_MODULES = [
     "particleShear.engine.memory",
     "particleShear.engine.neighbours",
     "particleShear.engine.numba_driver",
+    "particleShear.engine.numba_step",
     "particleShear.engine.observers",
     "particleShear.engine.microstructure",
     "particleShear.simulation.microstructure_pictures",

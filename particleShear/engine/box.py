@@ -80,6 +80,20 @@ def folded(v, L, lo, hi):
     """``v`` brought into ``[lo, hi)`` (``hi = lo + L``) in closed form: ``(folded v, periods removed)``.
 
     The pure expression of :func:`_fold` (numbers or arrays; the compiled step calls it on numbers).
+
+    Parameters
+    ----------
+    v : ndarray or float
+        Separations or coordinates (µm).
+    L : ndarray or float
+        The period (µm).
+    lo, hi : ndarray or float
+        The interval (µm).
+
+    Returns
+    -------
+    tuple
+        The folded value and the number of periods removed (float).
     """
     k = select((v >= hi) | (v < lo), np.floor((v - lo) / L), 0.0)
     return minimum(maximum(v - L * k, lo), np.nextafter(hi, lo)), k

@@ -63,13 +63,42 @@ def energy_bound(N, k, r_mean, m_sum, rate_max, Ly):
 
 
 def verdict_code(finite, ke, bound, closest, min_distance_ratio):
-    """The verdict code of a replica from its checks, in the order of the rule (pure; see :func:`verdict`)."""
+    """The verdict code of a replica from its checks, in the order of the rule (pure; see :func:`verdict`).
+
+    Parameters
+    ----------
+    finite : ndarray of bool or bool
+        The state is finite.
+    ke, bound : ndarray or float
+        Kinetic energy relative to the flow and its bound.
+    closest : ndarray or float
+        Smallest ``d/(r_i + r_j)`` of a transient contact.
+    min_distance_ratio : float
+        Its smallest allowed value.
+
+    Returns
+    -------
+    ndarray of int or int
+        :data:`NON_FINITE`, :data:`KINETIC_ENERGY`, :data:`INTERPENETRATION` or :data:`SOUND`.
+    """
     return select(~finite, NON_FINITE, select(ke > bound, KINETIC_ENERGY,
                                                select(closest < min_distance_ratio, INTERPENETRATION, SOUND)))
 
 
 def transient_ratio(d, d0, active, trans):
-    """``d/d0`` of a transient relation, inf otherwise (pure; see :func:`transient_ratios`)."""
+    """``d/d0`` of a transient relation, inf otherwise (pure; see :func:`transient_ratios`).
+
+    Parameters
+    ----------
+    d, d0 : ndarray or float
+        Distance and contact distance (µm).
+    active, trans : ndarray of bool or bool
+        A relation; a candidate that is no bond.
+
+    Returns
+    -------
+    ndarray or float
+    """
     return select(active & trans, d / d0, math.inf)
 
 

@@ -159,6 +159,13 @@ def pair_term_function(L, cache=True):
     :mod:`.numba_step`): the compressive law of the form, the tensile law of bonds, the viscous
     term, the Coulomb bound and the two-visit tangential rule.
 
+    Parameters
+    ----------
+    L : dict
+        The compiled law functions (:func:`jit_laws`).
+    cache : bool, default True
+        Numba's ``cache``.
+
     Returns
     -------
     numba.core.registry.CPUDispatcher

@@ -60,6 +60,15 @@ def reason(engine):
     advancing, replicas with and without friction and bonds, the spheres sharing their replica's parameters, the
     linear law (and the tensile law of bonds) from the prepared constants, no force register, a
     sample of the two shear stresses (not the whole tensors).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine, with its candidates' constants built.
+
+    Returns
+    -------
+    str or None
     """
     if engine.keep_terms:
         return "the force register keeps the terms of each visit"
