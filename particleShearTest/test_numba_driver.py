@@ -114,7 +114,7 @@ class TestCompiledPairTerms(unittest.TestCase):
 
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestNumbaBackendRuns(unittest.TestCase):
-    """backend="numba" steps the engine with the compiled terms: the whole measurement (pre-equilibration
+    """backend="numba" steps the engine in the compiled step: the whole measurement (pre-equilibration
     and protocol, 0.5 + 3 + 0.5 periods, > 1,000 steps) equals the NumPy engine's bit for bit, a
     batch of two equals its single runs, and a scene the loop does not cover runs the NumPy terms
     with a note."""
@@ -122,7 +122,7 @@ class TestNumbaBackendRuns(unittest.TestCase):
     SCENES = (dict(theMu=0.05, do_permanent_links=True, cut_lines=2, theAmplitude=0.2),
               dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))
 
-    def measure(self, scenes, backend, integrator="euler", periods=1):
+    def measure(self, scenes, backend, integrator="euler", periods=1, law=None):
         from particleShear.engine.loops import pre_equilibrate, protocol
         from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
@@ -130,7 +130,8 @@ class TestNumbaBackendRuns(unittest.TestCase):
 
         sc = constituted(11, **self.SCENES[0])[2]      # one schedule for every batch
         ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
-        eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), integrator=integrator)
+        eng = BatchEngine(state_from_ensembles(ensembles, backend=backend, laws=[law] * len(ensembles)),
+                          integrator=integrator)
         pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
         out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
         return eng, out
@@ -166,11 +167,12 @@ class TestNumbaBackendRuns(unittest.TestCase):
             self.assert_same(single, both, (0, n))
 
     def test_fallback_is_announced(self):
-        """A frictionless replica without bonds (the NumPy shortcut) runs the NumPy terms, with a note."""
-        scenes = [(0, dict(theMu=0.0, do_permanent_links=False, cut_lines=0, theAmplitude=0.2))]
-        with self.assertWarnsRegex(RuntimeWarning, "frictionless"):
-            _, got = self.measure(scenes, "numba")
-        self.assert_same(self.measure(scenes, "numpy")[1], got)
+        """A contact law the compiled code does not cover (Hertz) runs on NumPy, with a note, and
+        gives NumPy's numbers."""
+        scenes = [(0, dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))]
+        with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*contact law"):
+            _, got = self.measure(scenes, "numba", law=("hertz", (0.05,)))
+        self.assert_same(self.measure(scenes, "numpy", law=("hertz", (0.05,)))[1], got)
 
 
 class TestNumbaStaysOptional(unittest.TestCase):
