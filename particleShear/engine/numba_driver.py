@@ -23,6 +23,7 @@ modules (Numba's own cache checks only the file of the compiled function, not th
 __docformat__ = "numpy"
 
 import hashlib
+import importlib
 import os
 import sys
 import tempfile
@@ -31,8 +32,12 @@ import numpy as np
 
 from . import laws, tangential, terms, xp
 from .forces import PairConstants
+from .laws import blend_inside, contact_or_bond, divergent_term, linear_term, tensile_inside
+from .tangential import two_visit_rule
+from .terms import viscous_force
 
-__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "compile_pair_kernel", "pair_terms", "FORMS", "LAW_FUNCTIONS"]
+__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "pair_term", "compile_pair_kernel",
+           "pair_terms", "FORMS", "LAW_FUNCTIONS", "PAIR_FUNCTIONS"]
 
 #: the code of each form of the compressive law in the compiled loop
 FORMS = {laws.BLEND: 0, laws.LINEAR: 1, laws.DIVERGENT: 2}
@@ -47,7 +52,9 @@ TERM_BLOCK = PairConstants.TERM_ROWS
 _TERM_START = PairConstants.FLOAT_ROWS.index(TERM_BLOCK[0])     # where they start in the engine's float block
 assert PairConstants.FLOAT_ROWS[_TERM_START:_TERM_START + len(TERM_BLOCK)] == TERM_BLOCK
 
-_SOURCES = (laws, terms, tangential, xp, sys.modules[__name__])
+#: the engine modules whose functions the compiled loops run (the cache folder is keyed by their sources)
+SOURCE_MODULES = ("laws", "terms", "tangential", "xp", "box", "integrate", "guard", "forces", "neighbours", "numba_driver",
+                  "numba_step")
 _registered = set()     # the helpers registered with Numba (their ids)
 _kernels = {}           # cache flag -> compiled kernel
 
@@ -61,8 +68,9 @@ def cache_dir():
     """The folder of the compiled code: ``$NUMBA_CACHE_DIR`` or the user's cache folder, keyed by the law sources.
 
     ``$PARTICLESHEAR_CACHE`` or ``$XDG_CACHE_HOME/particleShear`` (default ``~/.cache/particleShear``),
-    then ``numba-<hash>``, the hash of the source files of the laws, terms, tangential rule,
-    :mod:`.xp` and this module: an edited law gets a fresh folder (Numba's cache would not notice it).
+    then ``numba-<hash>``, the hash of the source files of :data:`SOURCE_MODULES` (the modules whose
+    functions the compiled loops run): an edited law or rule gets a fresh folder (Numba's cache
+    checks only the file of each compiled function, not the functions it calls).
 
     Returns
     -------
@@ -70,8 +78,8 @@ def cache_dir():
         A writable folder (created; the system's temporary folder when that one cannot be written).
     """
     h = hashlib.sha1()
-    for m in _SOURCES:
-        with open(m.__file__, "rb") as f:
+    for name in SOURCE_MODULES:
+        with open(importlib.import_module(f"{__package__}.{name}").__file__, "rb") as f:
             h.update(f.read())
     base = os.environ.get("PARTICLESHEAR_CACHE") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "particleShear")
@@ -115,12 +123,14 @@ def register_helpers():
         _registered.add(id(xp.select))
 
 
-def jit_laws(cache=True, functions=LAW_FUNCTIONS):
+def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=()):
     """The pure functions ``functions`` as they are now, each compiled by Numba.
 
     Each function is compiled from its own code object with its module's globals, in which the
     names of the other compiled functions are their compiled versions (so ``blend_inside`` calls the
-    compiled ``linear_term`` of this call: a law replaced in its module is read afresh).
+    compiled ``linear_term`` of this call: a law replaced in its module is read afresh).  No
+    function is a closure, so Numba's cache (keyed by the function's file, name and types) finds
+    the compiled code again in the next process.
 
     Parameters
     ----------
@@ -128,6 +138,8 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS):
         ``cache=True`` for Numba (the folder :func:`cache_dir`).
     functions : sequence of (module, name), default :data:`LAW_FUNCTIONS`
         The functions to compile.
+    inline : collection of str, default ()
+        Names compiled with ``inline="always"`` (inlined into their callers).
 
     Returns
     -------
@@ -146,65 +158,78 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS):
         namespaces.append(g)
         copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
         copy.__qualname__, copy.__module__ = f.__qualname__, f.__module__
-        compiled[name] = numba.njit(copy, cache=cache)
+        compiled[name] = numba.njit(copy, cache=cache, **({"inline": "always"} if name in inline else {}))
     for g in namespaces:      # (globals are read when a function is compiled, at its first call)
         g.update(compiled)
     return compiled
 
 
-def pair_term_function(L, cache=True):
-    """The force terms of one candidate pair, compiled from the law functions ``L`` (of :func:`jit_laws`).
+def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True):
+    """The force terms of candidate ``p`` on numbers (compiled; see :func:`compile_pair_kernel`).
 
-    The body both compiled loops run per pair (:func:`compile_pair_kernel` and the whole step of
-    :mod:`.numba_step`): the compressive law of the form, the tensile law of bonds, the viscous
-    term, the Coulomb bound and the two-visit tangential rule.
+    The body both compiled loops run per pair (the force terms of :func:`pair_terms` and the whole
+    step of :mod:`.numba_step`): the compressive law of the form, the tensile law of bonds, the
+    viscous term, the Coulomb bound and the two-visit tangential rule, from the same functions as
+    the NumPy terms.
 
     Parameters
     ----------
-    L : dict
-        The compiled law functions (:func:`jit_laws`).
-    cache : bool, default True
-        Numba's ``cache``.
+    form : int
+        :data:`FORMS` code of the compressive law.
+    p : int
+        The candidate (column of ``T``, ``xi``, ``k_t_j``, ``nu_t_j``).
+    r, vn, vt : float
+        Distance (µm), normal and tangential relative velocity (µm/s).
+    touching, active : bool
+        Overlap; relation.
+    xi : ndarray (2, P)
+        Histories, reset in place on slip.
+    T : ndarray (12, P)
+        The rows of :data:`TERM_BLOCK`.
+    k_t_j, nu_t_j : ndarray (P,)
+        The constants of the visit from j.
+    friction : bool, default True
+        False: no tangential term (0, 0, slip where active, ξ reset), the engine's frictionless shortcut.
 
     Returns
     -------
-    numba.core.registry.CPUDispatcher
-        ``pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True) -> (fn, law,
-        F_i, F_j, slip)``; resets ``xi[:, p]`` on slip.  ``T`` holds the rows of :data:`TERM_BLOCK`;
-        ``friction`` False: no tangential term (0, 0, slip where active, ξ reset), as the engine's
-        frictionless shortcut.
+    tuple
+        ``(fn, law, F_i, F_j, slip)``.
     """
-    import numba
+    # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
+    if form == 1:
+        inside = linear_term(r, T[0, p], T[2, p])
+    elif form == 2:
+        inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
+    else:
+        inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
+    law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
+    f = law * T[6, p]
+    f += viscous_force(T[7, p], vn, active)
+    if not friction:          # no tangential force (the frictionless shortcut): every relation slips
+        xi[0, p] = 0.0
+        xi[1, p] = 0.0
+        return f, law, 0.0, 0.0, active
+    fc = np.abs(T[10, p] * law)
+    fc += T[11, p]
+    F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi[0, p], xi[1, p], T[8, p],
+                                        k_t_j[p], T[9, p], nu_t_j[p], fc)
+    if reset:
+        xi[0, p] = 0.0
+        xi[1, p] = 0.0
+    return f, law, F_i, F_j, s
 
-    linear_term, divergent_term, blend_inside = L["linear_term"], L["divergent_term"], L["blend_inside"]
-    tensile_inside, contact_or_bond = L["tensile_inside"], L["contact_or_bond"]
-    viscous_force, two_visit_rule = L["viscous_force"], L["two_visit_rule"]
 
-    def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True):
-        # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
-        if form == 1:
-            inside = linear_term(r, T[0, p], T[2, p])
-        elif form == 2:
-            inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
-        else:
-            inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
-        law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
-        f = law * T[6, p]
-        f += viscous_force(T[7, p], vn, active)
-        if not friction:          # no tangential force (the frictionless shortcut): every relation slips
-            xi[0, p] = 0.0
-            xi[1, p] = 0.0
-            return f, law, 0.0, 0.0, active
-        fc = np.abs(T[10, p] * law)
-        fc += T[11, p]
-        F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi[0, p], xi[1, p], T[8, p],
-                                            k_t_j[p], T[9, p], nu_t_j[p], fc)
-        if reset:
-            xi[0, p] = 0.0
-            xi[1, p] = 0.0
-        return f, law, F_i, F_j, s
+def _pair_kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
+    """The force terms of every candidate (compiled; see :func:`pair_terms`): writes ``fn, law_out, F, slip``."""
+    for p in range(d.shape[0]):
+        fn[p], law_out[p], F[0, p], F[1, p], slip[p] = pair_term(form, p, d[p], vn[p], vt[p], touching[p],
+                                                                 active[p], xi, T, k_t_j, nu_t_j)
 
-    return numba.njit(pair_term, cache=cache, inline="always")
+
+#: the functions of the compiled pair loop besides the laws, and those inlined into their callers
+PAIR_FUNCTIONS = (LAW_FUNCTIONS + ((sys.modules[__name__], "pair_term"), (sys.modules[__name__], "_pair_kernel")))
+INLINE = ("pair_term",)
 
 
 def compile_pair_kernel(cache=True, say=None):
@@ -231,17 +256,10 @@ def compile_pair_kernel(cache=True, say=None):
 
     if cache:
         numba.config.CACHE_DIR = cache_dir()
-    # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
-    pair_term = pair_term_function(jit_laws(cache), cache)
-
-    def kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
-        for p in range(d.shape[0]):
-            fn[p], law_out[p], F[0, p], F[1, p], slip[p] = pair_term(form, p, d[p], vn[p], vt[p], touching[p],
-                                                                     active[p], xi, T, k_t_j, nu_t_j)
-
-    compiled = numba.njit(kernel, cache=cache)
     if say is not None:
         say(f"backend 'numba': compiling the force loop (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
+    # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
+    compiled = jit_laws(cache, PAIR_FUNCTIONS, inline=INLINE)["_pair_kernel"]
     # compile (or load) now, for the argument types of the engine's call
     e, b = np.empty(0), np.empty(0, dtype=np.bool_)
     compiled(0, e, e, e, b, b, np.empty((2, 0)), np.empty((len(TERM_BLOCK), 0)), e, e, np.empty(0), np.empty(0),

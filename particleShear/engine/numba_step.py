@@ -2,7 +2,7 @@
 
 :meth:`~particleShear.engine.step.BatchEngine.step` on the ``"numba"`` backend runs the step here:
 one call per step does the force phase (Lees-Edwards minimum image, relations and their numbers,
-normals, relative velocities, the force terms of :func:`~.numba_driver.pair_term_function`, pair
+normals, relative velocities, the force terms of :func:`~.numba_driver.pair_term`, pair
 forces, the scatter in the order of ``bincount``, the per-replica shear sums when sampled, the
 stability guard when due), the kick with the plates and the damping, the sequential ξ rule, the
 displacement since the lists were built, the drift, the strain, the wrap and the clock.  Every
@@ -20,18 +20,26 @@ What stays in Python: the candidate search when a list is due (the one search,
 and ``|R| = 0`` (drawn from each replica's generator, as :func:`~.forces.normals` does), and the
 protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
-pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
+_pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
 """
 __docformat__ = "numpy"
 
 import math
+import sys
 import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, laws, neighbours, numba_driver, terms
+from . import box, forces, guard, integrate, neighbours, numba_driver, terms
+from .box import MAX_PASSES, folded, period_count
+from .forces import pair_roles, shear_from_sums, shear_rows
+from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
+from .integrate import damped, half_velocity_change, plate_velocity, velocity_change, xi_rates
+from .neighbours import verlet_bound
+from .numba_driver import pair_term
 from .phase_laws import force_phase_laws
+from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_kernels", "run_step", "NOT_RUN"]
 
@@ -43,6 +51,22 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
     (terms, "pair_forces"), (forces, "pair_roles"), (forces, "shear_rows"), (forces, "shear_from_sums"),
     (guard, "kinetic_term"), (guard, "energy_bound"), (guard, "verdict_code"), (guard, "transient_ratio"),
     (neighbours, "verlet_bound"))
+
+#: the step's own compiled functions (this module's), and those inlined into their callers
+KERNEL_FUNCTIONS = ((numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
+                    (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
+                    (sys.modules[__name__], "_step_kernel"))
+INLINE = ("pair_term", "_min_image_pair", "_segment_sum")
+
+#: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
+#: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
+_ARGUMENTS = ("i i f f b b b b i i b[:] b b f[:,:] f[:,:] "          # start … half_out
+              "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
+              "f[:] f[:] f[:] f[:] f[:] f[:] "                       # rate … V
+              "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
+              "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
+              "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
+              "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:]").split()   # work … need
 
 #: what :func:`run_step` returns when the step was not run (the NumPy step runs it)
 NOT_RUN = object()
@@ -74,7 +98,10 @@ def reason(engine):
         return "the force register keeps the terms of each visit"
     if engine.lees_edwards is not None or engine.strain_advances is not None:
         return "a plain periodic replica, or a strain held while not shearing"
-    C = engine.C
+    C, s = engine.C, engine.s
+    for a in (s.pos, s.vel, s.frc, s.phi, s.r, engine.mmi, C.f, C.i, C.b):
+        if not (type(a) is np.ndarray and a.flags.c_contiguous and a.flags.writeable):
+            return "state arrays that are not writable C-contiguous NumPy arrays"
     if C.Kj is not None:
         return "spheres with parameters of their own"
     if force_phase_laws(engine.s, C) != (None, None):
@@ -82,8 +109,305 @@ def reason(engine):
     return None
 
 
+
+# the rows of the candidates' float block the step reads (PairConstants.FLOAT_ROWS) and where the
+# constants of the force terms start (numba_driver.TERM_BLOCK)
+_ILX, _ILY, _IRI, _IRJ, _ID0, _IWI, _IWJ = (forces.PairConstants.FLOAT_ROWS.index(n)
+                                           for n in ("Lx", "Ly", "ri", "rj", "d0", "w_i", "w_j"))
+_T0 = numba_driver._TERM_START
+
+
+def _min_image_pair(dx, dy, Lx, Ly, shift):
+    # the minimum image of one pair (box.min_image element by element)
+    hy, hx = Ly / 2, Lx / 2
+    ky = 0.0
+    for q in range(MAX_PASSES + 1):
+        if q == MAX_PASSES:
+            dy, k = folded(dy, Ly, -hy, hy)
+            dx = dx - shift * k
+            ky += k
+            break
+        k = period_count(dy, hy, -hy)
+        if k == 0.0:
+            break
+        dy = dy - Ly * k
+        dx = dx - shift * k
+        ky += k
+    kx = 0.0
+    for q in range(MAX_PASSES + 1):
+        if q == MAX_PASSES:
+            dx, k = folded(dx, Lx, -hx, hx)
+            kx += k
+            break
+        k = period_count(dx, hx, -hx)
+        if k == 0.0:
+            break
+        dx = dx - Lx * k
+        kx += k
+    return dx, dy, ky, kx
+
+
+def _pairwise(a, lo, n):
+    """NumPy's _pairwise sum of ``a[lo:lo + n]`` (compiled)."""
+    # NumPy's _pairwise summation of a[lo:lo + n] (numpy/_core/src/umath/loops_utils.h.src): the
+    # order of numpy.sum along a contiguous axis, so the compiled sums are NumPy's to the bit
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    if n <= 128:
+        r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+        r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+        i = 8
+        while i < n - n % 8:
+            r0 += a[lo + i]
+            r1 += a[lo + i + 1]
+            r2 += a[lo + i + 2]
+            r3 += a[lo + i + 3]
+            r4 += a[lo + i + 4]
+            r5 += a[lo + i + 5]
+            r6 += a[lo + i + 6]
+            r7 += a[lo + i + 7]
+            i += 8
+        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        while i < n:
+            res += a[lo + i]
+            i += 1
+        return res
+    n2 = n // 2
+    n2 -= n2 % 8
+    return _pairwise(a, lo, n2) + _pairwise(a, lo + n2, n - n2)
+
+
+def _segment_sum(a, lo, hi):
+    # numpy.add.reduceat over one segment: its first element, then the _pairwise sum of the rest
+    return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
+
+
+def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted, half, half_out,
+           pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
+           rate, gamma, t, Lx, Ly, V,
+           Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
+           u, u_max, strain, bound, r_max, skin,
+           guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
+           work, mob, yc, y0, zero, tau, verdict, need):
+    """One step of every replica on numbers (compiled; run by :func:`run_step`, which passes the arguments).
+
+    ``start`` 0 runs the whole step; 1 resumes at the ξ rule once the caller gave the random
+    directions at ``|R| = 0`` (``work`` rows 8, 9).  The arguments are the engine's (the flags of
+    the step, the state's sphere rows, the per-replica box, strain, rate and clock, the candidates'
+    blocks and history, the Verlet bookkeeping, the guard's constants) and the buffers of its
+    :class:`_Workspace`; everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO`
+    (nothing changed: a pair at ``d = 0``), :data:`_GUARD` (after the force phase) or :data:`_UNITS`.
+    """
+    B = rate.shape[0]
+    P = Ci.shape[1]
+    n = pos.shape[1]
+    T = Cf[_T0:_T0 + 12]
+    k_t_j, nu_t_j = T[8], T[9]
+    dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
+                                                             work[6], work[7], work[8], work[9], work[10])
+    if start == 0:
+        # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
+        for p in range(P):
+            b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+            dx, dy, ky, kx = _min_image_pair(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[_ILX, p], Cf[_ILY, p],
+                                   Ly[b] * gamma[b])
+            d = np.sqrt(dx * dx + dy * dy)
+            if d == 0.0:
+                return _D_ZERO
+            dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
+        for k in range(n):
+            yc[k] = pos[1, k] - Ly_s[k] / 2
+            mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
+            frc[0, k] = 0.0
+            frc[1, k] = 0.0
+            frc[2, k] = 0.0
+        for b in range(B):
+            tau[0, b] = 0.0
+            tau[1, b] = 0.0
+            verdict[3, b] = math.inf
+        # relations, terms and the pair forces on i (the scatter's first half, in pair order)
+        for p in range(P):
+            b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+            d = ds[p]
+            touching = d < Cf[_ID0, p]
+            rel = Cb[0, p] or touching
+            if rel and not active[p]:
+                state_p[p] = 0                      # a new relation starts sticking
+                if numbers:
+                    birth[p] = next_birth[b]
+                    next_birth[b] += 1
+            if not rel:
+                xi[0, p] = 0.0                      # an opened contact loses its history
+                xi[1, p] = 0.0
+            active[p] = rel
+            nx, ny = dxs[p] / d, dys[p] / d
+            dvx = -(Cf[_ILY, p] * rate[b]) * kys[p]
+            if predicted:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
+                vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
+                vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
+            else:
+                vi0, vi1, vi2, vj0, vj1, vj2 = vel[0, i], vel[1, i], vel[2, i], vel[0, j], vel[1, j], vel[2, j]
+            rv = (vj0 - vi0 + dvx, vj1 - vi1)
+            vn = normal_speed(rv, nx, ny)
+            vt = slip_speed(rv, nx, ny, Cf[_IRI, p], Cf[_IRJ, p], vi2, vj2) if free_mode != 1 else 0.0
+            fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j,
+                                                free_mode != 1)
+            if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
+                xi[0, p] = 0.0
+                xi[1, p] = 0.0
+                slip = slip or rel
+            state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
+            ft = (F_i + F_j) * 0.5
+            fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
+            nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx, fy
+            frc[0, i] += fx
+            frc[1, i] += fy
+            frc[2, i] += dF * Cf[_IWI, p]
+            dFs[p] = dF
+            if sample:
+                internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
+                work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                   dys[p], fx, dF, None)
+            if check:
+                ratio = transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p])
+                if ratio < verdict[3, b]:
+                    verdict[3, b] = ratio
+        # the scatter's second half: −F on j and the torque on j, in pair order
+        for p in range(P):
+            j = Ci[2, p]
+            frc[0, j] += -mxs[p]
+            frc[1, j] += -mys[p]
+            frc[2, j] += dFs[p] * Cf[_IWJ, p]
+        if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
+            for b in range(B):
+                lo, hi = offsets[b], offsets[b + 1]
+                tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
+                                                       _segment_sum(work[13], lo, hi), V[b])
+        if check:
+            bad = False
+            for b in range(B):
+                rate_max[b] = max(rate_max[b], abs(rate[b]))
+                finite = True
+                for k in range(b * N, (b + 1) * N):
+                    finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
+                        and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
+                    y0[k] = kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
+                ke = 0.5 * _pairwise(y0, b * N, N)        # (guard.verdict: the sum of each replica's row)
+                bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
+                    else max_ke
+                code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
+                verdict[0, b], verdict[1, b], verdict[2, b] = code, ke, bnd
+                bad = bad or code != 0
+            if bad:
+                return _GUARD
+        # -- kick (plates follow), damping
+        for k in range(n):
+            b = rep_s[k]
+            if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
+                half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
+                half_out[1, k] = half_velocity_change(frc[1, k], mmi[1, k], dt) if mob[k] else 0.0
+                half_out[2, k] = half_velocity_change(frc[2, k], mmi[2, k], dt)
+            vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
+            vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
+            vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
+            frc[0, k] = 0.0
+            frc[1, k] = 0.0
+            frc[2, k] = 0.0
+            if applying and not mob[k]:
+                vel[1, k] = 0.0
+                vel[0, k] = plate_velocity(yc[k], rate[b] * Ly_s[k] / 2)
+            vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
+            vel[1, k] *= cool
+            vel[2, k] *= cool
+        if free_mode == 1:            # no ξ without friction and bonds
+            start = 2
+        # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
+        units = False
+        for p in range(P if start == 0 else 0):
+            i = Ci[1, p]
+            Rx = vel[0, i] * dt - dxs[p]
+            Ry = vel[1, i] * dt - dys[p]
+            dR = np.sqrt(Rx * Rx + Ry * Ry)
+            if free_mode == 2 and free[p]:
+                dR = 1.0                  # (no direction drawn for a replica without ξ)
+            zero[p] = dR == 0.0
+            if zero[p]:
+                units = True
+            else:
+                mxs[p], mys[p] = Rx / dR, Ry / dR
+        if units:
+            return _UNITS
+    # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
+    for p in range(P if start != 2 else 0):
+        i, j = Ci[1, p], Ci[2, p]
+        kd = dt if active[p] and state_p[p] != 1 else 0.0
+        rvx = vel[0, j] - vel[0, i] + dvxs[p]
+        spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
+        inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
+        xi[0, p] += inc_ij * kd
+        xi[1, p] += inc_ji * kd
+    # displacement since the lists were built, Verlet bound, drift
+    for b in range(B):
+        largest = -math.inf
+        for k in range(b * N, (b + 1) * N):
+            u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
+            u[1, k] += vel[1, k] * dt
+            sq = u[0, k] * u[0, k] + u[1, k] * u[1, k]
+            if not sq <= largest:
+                largest = sq
+        u_max[b] = max(u_max[b], np.sqrt(largest))
+        strain[b] += abs(rate[b]) * dt
+        bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
+    for k in range(n):
+        pos[0, k] += vel[0, k] * dt
+        pos[1, k] += vel[1, k] * dt
+        phi[k] += vel[2, k] * dt
+    # strain, wrap (box.wrap element by element), clock
+    for b in range(B):
+        gamma[b] = gamma[b] + rate[b] * dt
+    crossed = False
+    for k in range(n):
+        b = rep_s[k]
+        y0[k] = pos[1, k]
+        for q in range(MAX_PASSES + 1):
+            if q == MAX_PASSES:
+                pos[1, k], up = folded(pos[1, k], Ly_s[k], 0.0, Ly_s[k])
+                pos[0, k] -= (Ly[b] * gamma[b]) * up
+                break
+            up = period_count(pos[1, k], Ly_s[k], 0.0)
+            if up == 0.0:
+                break
+            crossed = True
+            pos[1, k] -= Ly_s[k] * up
+            pos[0, k] -= (Ly[b] * gamma[b]) * up
+    if crossed:
+        for k in range(n):
+            vel[0, k] += (pos[1, k] - y0[k]) * rate[rep_s[k]]
+    for k in range(n):
+        Lxk = Lx[rep_s[k]]
+        for q in range(MAX_PASSES + 1):
+            if q == MAX_PASSES:
+                pos[0, k], _ = folded(pos[0, k], Lxk, 0.0, Lxk)
+                break
+            right = period_count(pos[0, k], Lxk, 0.0)
+            if right == 0.0:
+                break
+            pos[0, k] -= Lxk * right
+    for b in range(B):
+        t[b] = t[b] + dt
+        need[b] = bound[b] >= skin[b]
+    return _DONE
+
+
+
 def compile_step_kernel(cache=True, say=None):
     """The compiled step (see :func:`run_step`), compiled once per process (or loaded from the cache).
+
+    Every function of the step is a module-level function compiled from its own code object
+    (:func:`~.numba_driver.jit_laws`), so Numba's cache finds it again in the next process.
 
     Parameters
     ----------
@@ -105,303 +429,23 @@ def compile_step_kernel(cache=True, say=None):
         numba.config.CACHE_DIR = numba_driver.cache_dir()
     if say is not None:
         say(f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
-    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS)
-    pair_term = numba_driver.pair_term_function(L, cache)
-    period_count, folded = L["period_count"], L["folded"]
-    velocity_change, plate_velocity, damped, xi_rates = (L["velocity_change"], L["plate_velocity"], L["damped"],
-                                                         L["xi_rates"])
-    half_velocity_change = L["half_velocity_change"]
-    normal_speed, slip_speed, pair_forces = L["normal_speed"], L["slip_speed"], L["pair_forces"]
-    pair_roles, shear_rows, shear_from_sums = L["pair_roles"], L["shear_rows"], L["shear_from_sums"]
-    kinetic_term, energy_bound, verdict_code, transient_ratio = (L["kinetic_term"], L["energy_bound"],
-                                                                 L["verdict_code"], L["transient_ratio"])
-    verlet_bound = L["verlet_bound"]
-    passes = box.MAX_PASSES
-    T0 = numba_driver._TERM_START
-    iLx, iLy, iri, irj, id0, iwi, iwj = (forces.PairConstants.FLOAT_ROWS.index(n)
-                                         for n in ("Lx", "Ly", "ri", "rj", "d0", "w_i", "w_j"))
-
-    def image(dx, dy, Lx, Ly, shift):
-        # the minimum image of one pair (box.min_image element by element)
-        hy, hx = Ly / 2, Lx / 2
-        ky = 0.0
-        for q in range(passes + 1):
-            if q == passes:
-                dy, k = folded(dy, Ly, -hy, hy)
-                dx = dx - shift * k
-                ky += k
-                break
-            k = period_count(dy, hy, -hy)
-            if k == 0.0:
-                break
-            dy = dy - Ly * k
-            dx = dx - shift * k
-            ky += k
-        kx = 0.0
-        for q in range(passes + 1):
-            if q == passes:
-                dx, k = folded(dx, Lx, -hx, hx)
-                kx += k
-                break
-            k = period_count(dx, hx, -hx)
-            if k == 0.0:
-                break
-            dx = dx - Lx * k
-            kx += k
-        return dx, dy, ky, kx
-
-    image = numba.njit(image, cache=cache, inline="always")
-
-    def pairwise(a, lo, n):
-        # NumPy's pairwise summation of a[lo:lo + n] (numpy/_core/src/umath/loops_utils.h.src): the
-        # order of numpy.sum along a contiguous axis, so the compiled sums are NumPy's to the bit
-        if n < 8:
-            res = 0.0
-            for i in range(lo, lo + n):
-                res += a[i]
-            return res
-        if n <= 128:
-            r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-            r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-            i = 8
-            while i < n - n % 8:
-                r0 += a[lo + i]
-                r1 += a[lo + i + 1]
-                r2 += a[lo + i + 2]
-                r3 += a[lo + i + 3]
-                r4 += a[lo + i + 4]
-                r5 += a[lo + i + 5]
-                r6 += a[lo + i + 6]
-                r7 += a[lo + i + 7]
-                i += 8
-            res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-            while i < n:
-                res += a[lo + i]
-                i += 1
-            return res
-        n2 = n // 2
-        n2 -= n2 % 8
-        return pairwise(a, lo, n2) + pairwise(a, lo + n2, n - n2)
-
-    pairwise = numba.njit(pairwise, cache=cache)
-
-    def segment_sum(a, lo, hi):
-        # numpy.add.reduceat over one segment: its first element, then the pairwise sum of the rest
-        return a[lo] + pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
-
-    segment_sum = numba.njit(segment_sum, cache=cache, inline="always")
-
-    def kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted, half, half_out,
-               pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
-               rate, gamma, t, Lx, Ly, V,
-               Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
-               u, u_max, strain, bound, r_max, skin,
-               guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
-               work, mob, yc, y0, zero, tau, verdict, need):
-        B = rate.shape[0]
-        P = Ci.shape[1]
-        n = pos.shape[1]
-        T = Cf[T0:T0 + 12]
-        k_t_j, nu_t_j = T[8], T[9]
-        dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
-                                                                 work[6], work[7], work[8], work[9], work[10])
-        if start == 0:
-            # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
-            for p in range(P):
-                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
-                dx, dy, ky, kx = image(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[iLx, p], Cf[iLy, p],
-                                       Ly[b] * gamma[b])
-                d = np.sqrt(dx * dx + dy * dy)
-                if d == 0.0:
-                    return _D_ZERO
-                dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
-            for k in range(n):
-                yc[k] = pos[1, k] - Ly_s[k] / 2
-                mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
-                frc[0, k] = 0.0
-                frc[1, k] = 0.0
-                frc[2, k] = 0.0
-            for b in range(B):
-                tau[0, b] = 0.0
-                tau[1, b] = 0.0
-                verdict[3, b] = math.inf
-            # relations, terms and the pair forces on i (the scatter's first half, in pair order)
-            for p in range(P):
-                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
-                d = ds[p]
-                touching = d < Cf[id0, p]
-                rel = Cb[0, p] or touching
-                if rel and not active[p]:
-                    state_p[p] = 0                      # a new relation starts sticking
-                    if numbers:
-                        birth[p] = next_birth[b]
-                        next_birth[b] += 1
-                if not rel:
-                    xi[0, p] = 0.0                      # an opened contact loses its history
-                    xi[1, p] = 0.0
-                active[p] = rel
-                nx, ny = dxs[p] / d, dys[p] / d
-                dvx = -(Cf[iLy, p] * rate[b]) * kys[p]
-                if predicted:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
-                    vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
-                    vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
-                else:
-                    vi0, vi1, vi2, vj0, vj1, vj2 = vel[0, i], vel[1, i], vel[2, i], vel[0, j], vel[1, j], vel[2, j]
-                rv = (vj0 - vi0 + dvx, vj1 - vi1)
-                vn = normal_speed(rv, nx, ny)
-                vt = slip_speed(rv, nx, ny, Cf[iri, p], Cf[irj, p], vi2, vj2) if free_mode != 1 else 0.0
-                fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j,
-                                                    free_mode != 1)
-                if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
-                    xi[0, p] = 0.0
-                    xi[1, p] = 0.0
-                    slip = slip or rel
-                state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
-                ft = (F_i + F_j) * 0.5
-                fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
-                nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx, fy
-                frc[0, i] += fx
-                frc[1, i] += fy
-                frc[2, i] += dF * Cf[iwi, p]
-                dFs[p] = dF
-                if sample:
-                    internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
-                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
-                                                                       dys[p], fx, dF, None)
-                if check:
-                    ratio = transient_ratio(d, Cf[id0, p], rel, Cb[1, p])
-                    if ratio < verdict[3, b]:
-                        verdict[3, b] = ratio
-            # the scatter's second half: −F on j and the torque on j, in pair order
-            for p in range(P):
-                j = Ci[2, p]
-                frc[0, j] += -mxs[p]
-                frc[1, j] += -mys[p]
-                frc[2, j] += dFs[p] * Cf[iwj, p]
-            if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
-                for b in range(B):
-                    lo, hi = offsets[b], offsets[b + 1]
-                    tau[0, b], tau[1, b] = shear_from_sums(segment_sum(work[11], lo, hi), segment_sum(work[12], lo, hi),
-                                                           segment_sum(work[13], lo, hi), V[b])
-            if check:
-                bad = False
-                for b in range(B):
-                    rate_max[b] = max(rate_max[b], abs(rate[b]))
-                    finite = True
-                    for k in range(b * N, (b + 1) * N):
-                        finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
-                            and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
-                        y0[k] = kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
-                    ke = 0.5 * pairwise(y0, b * N, N)        # (guard.verdict: the sum of each replica's row)
-                    bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
-                        else max_ke
-                    code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
-                    verdict[0, b], verdict[1, b], verdict[2, b] = code, ke, bnd
-                    bad = bad or code != 0
-                if bad:
-                    return _GUARD
-            # -- kick (plates follow), damping
-            for k in range(n):
-                b = rep_s[k]
-                if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
-                    half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
-                    half_out[1, k] = half_velocity_change(frc[1, k], mmi[1, k], dt) if mob[k] else 0.0
-                    half_out[2, k] = half_velocity_change(frc[2, k], mmi[2, k], dt)
-                vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
-                vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
-                vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
-                frc[0, k] = 0.0
-                frc[1, k] = 0.0
-                frc[2, k] = 0.0
-                if applying and not mob[k]:
-                    vel[1, k] = 0.0
-                    vel[0, k] = plate_velocity(yc[k], rate[b] * Ly_s[k] / 2)
-                vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
-                vel[1, k] *= cool
-                vel[2, k] *= cool
-            if free_mode == 1:            # no ξ without friction and bonds
-                start = 2
-            # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
-            units = False
-            for p in range(P if start == 0 else 0):
-                i = Ci[1, p]
-                Rx = vel[0, i] * dt - dxs[p]
-                Ry = vel[1, i] * dt - dys[p]
-                dR = np.sqrt(Rx * Rx + Ry * Ry)
-                if free_mode == 2 and free[p]:
-                    dR = 1.0                  # (no direction drawn for a replica without ξ)
-                zero[p] = dR == 0.0
-                if zero[p]:
-                    units = True
-                else:
-                    mxs[p], mys[p] = Rx / dR, Ry / dR
-            if units:
-                return _UNITS
-        # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
-        for p in range(P if start != 2 else 0):
-            i, j = Ci[1, p], Ci[2, p]
-            kd = dt if active[p] and state_p[p] != 1 else 0.0
-            rvx = vel[0, j] - vel[0, i] + dvxs[p]
-            spin = Cf[iri, p] * vel[2, i] + Cf[irj, p] * vel[2, j]
-            inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
-            xi[0, p] += inc_ij * kd
-            xi[1, p] += inc_ji * kd
-        # displacement since the lists were built, Verlet bound, drift
-        for b in range(B):
-            largest = -math.inf
-            for k in range(b * N, (b + 1) * N):
-                u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
-                u[1, k] += vel[1, k] * dt
-                sq = u[0, k] * u[0, k] + u[1, k] * u[1, k]
-                if not sq <= largest:
-                    largest = sq
-            u_max[b] = max(u_max[b], np.sqrt(largest))
-            strain[b] += abs(rate[b]) * dt
-            bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
-        for k in range(n):
-            pos[0, k] += vel[0, k] * dt
-            pos[1, k] += vel[1, k] * dt
-            phi[k] += vel[2, k] * dt
-        # strain, wrap (box.wrap element by element), clock
-        for b in range(B):
-            gamma[b] = gamma[b] + rate[b] * dt
-        crossed = False
-        for k in range(n):
-            b = rep_s[k]
-            y0[k] = pos[1, k]
-            for q in range(passes + 1):
-                if q == passes:
-                    pos[1, k], up = folded(pos[1, k], Ly_s[k], 0.0, Ly_s[k])
-                    pos[0, k] -= (Ly[b] * gamma[b]) * up
-                    break
-                up = period_count(pos[1, k], Ly_s[k], 0.0)
-                if up == 0.0:
-                    break
-                crossed = True
-                pos[1, k] -= Ly_s[k] * up
-                pos[0, k] -= (Ly[b] * gamma[b]) * up
-        if crossed:
-            for k in range(n):
-                vel[0, k] += (pos[1, k] - y0[k]) * rate[rep_s[k]]
-        for k in range(n):
-            Lxk = Lx[rep_s[k]]
-            for q in range(passes + 1):
-                if q == passes:
-                    pos[0, k], _ = folded(pos[0, k], Lxk, 0.0, Lxk)
-                    break
-                right = period_count(pos[0, k], Lxk, 0.0)
-                if right == 0.0:
-                    break
-                pos[0, k] -= Lxk * right
-        for b in range(B):
-            t[b] = t[b] + dt
-            need[b] = bound[b] >= skin[b]
-        return _DONE
-
-    compiled = numba.njit(kernel, cache=cache)
+    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS, inline=INLINE)
+    compiled = L["_step_kernel"]
+    compiled.compile(_signature())          # (or loaded from the cache): before any timing
     if cache:
         _kernels[True] = compiled
     return compiled
+
+
+def _signature():
+    """The Numba signature of :func:`_step_kernel` (:data:`_ARGUMENTS`)."""
+    from numba import types
+    scalars = {"f": types.float64, "i": types.int64, "b": types.boolean, "i1": types.int8}
+    out = []
+    for a in _ARGUMENTS:
+        name, _, dims = a.partition("[")
+        out.append(types.Array(scalars[name], dims.count(":"), "C") if dims else scalars[name])
+    return types.int64(*out)
 
 
 def compile_kernels(say=None):
@@ -434,10 +478,10 @@ class _Workspace:
         self.tau = np.zeros((2, B))
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
-        per_sphere = lambda a: np.ascontiguousarray(np.broadcast_to(a, (B * N,)), dtype=float)
-        per_replica = lambda a: np.ascontiguousarray(np.broadcast_to(a, (B,)), dtype=float)
+        per_sphere = lambda a: np.array(np.broadcast_to(a, (B * N,)), dtype=float)       # (writable copies)
+        per_replica = lambda a: np.array(np.broadcast_to(a, (B,)), dtype=float)
         self.Ly_s = per_sphere(engine.Ly_s)
-        self.rep_s = np.ascontiguousarray(s.rep, dtype=np.intp)
+        self.rep_s = np.array(s.rep, dtype=np.int64)
         self.V, self.Lx, self.Ly, self.kk = (per_replica(a) for a in (engine.V, s.Lx, s.Ly, s.k))
         self.r_max, self.skin = per_replica(engine.r_max), per_replica(engine.skin)
         self.r_mean = s.r.reshape(B, N).mean(axis=1)
@@ -446,7 +490,7 @@ class _Workspace:
         self.guarded = bool(engine.guard.any())
         self.max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
         self.form = numba_driver.FORMS[C.form]
-        self.offsets = np.ascontiguousarray(C.offsets, dtype=np.int64)
+        self.offsets = np.array(C.offsets, dtype=np.int64)
         self.no_half = np.zeros((3, 0))
 
 
