@@ -1,5 +1,5 @@
-"""Backend selection (docs/backends.md): ``backend="auto"`` by default (NumPy unless the environment
-variable ``PARTICLESHEAR_BACKEND`` says otherwise; its value ``auto``: Numba where importable), the backend recorded by a run, and one run identity for the backends
+"""Backend selection (docs/backends.md): ``backend="auto"`` by default (Numba where importable, else
+NumPy, unless the environment variable ``PARTICLESHEAR_BACKEND`` says otherwise), the backend recorded by a run, and one run identity for the backends
 that give NumPy's bits.
 
 Numba is optional: the checks that need it are skipped without it, and a subprocess in which
@@ -42,10 +42,10 @@ def _environment(value):
 
 
 class TestResolver(unittest.TestCase):
-    def test_auto_is_numpy_unless_the_environment_says_otherwise(self):
+    def test_auto_is_numba_where_importable_unless_the_environment_says_otherwise(self):
         with _environment(None):
-            want = xpmod.AUTO_DEFAULT
-            self.assertEqual(want, "numpy")
+            self.assertEqual(xpmod.AUTO_DEFAULT, "auto")
+            want = "numba" if HAVE_NUMBA else "numpy"
             self.assertEqual(xpmod.resolve_backend("auto"), want)
             self.assertEqual(xpmod.resolve_backend(None), want)
             self.assertEqual(xpmod.get_backend().name, want)

@@ -215,11 +215,10 @@ def backend_names():
     return (*_FACTORIES, "auto")
 
 
-#: What ``backend="auto"`` stands for when :data:`BACKEND_ENV` is unset.  NumPy: the compiled
-#: backend compiles the force terms only, which gains 5–8 % of a step once loaded, while
-#: importing Numba and loading its cache adds ~0.7 s to every process (docs/backends.md,
-#: "Selecting a backend"); ``PARTICLESHEAR_BACKEND=auto`` asks for Numba where it is installed.
-AUTO_DEFAULT = "numpy"
+#: What ``backend="auto"`` stands for when :data:`BACKEND_ENV` is unset: ``"auto"``, i.e. Numba
+#: where it can be imported (the whole step compiled, the same bits as NumPy, the default run
+#: ~3× faster once its cache is warm; docs/backends.md, "Selecting a backend"), else NumPy.
+AUTO_DEFAULT = "auto"
 
 
 def default_backend():
@@ -249,9 +248,8 @@ def resolve_backend(name="auto"):
     """The backend a run uses: the one rule of backend selection (docs/backends.md).
 
     ``"auto"`` (the default of every ``backend=``; also None) is the environment variable
-    :data:`BACKEND_ENV` when it is set, otherwise :data:`AUTO_DEFAULT` (``"numpy"``); the
-    variable's value ``"auto"`` means ``"numba"`` where Numba can be imported
-    (:func:`numba_importable`), else ``"numpy"``.
+    :data:`BACKEND_ENV` when it is set, otherwise :data:`AUTO_DEFAULT` (``"auto"``); ``"auto"``
+    then means ``"numba"`` where Numba can be imported (:func:`numba_importable`), else ``"numpy"``.
     Any other name is returned as it is (:func:`get_backend` checks that it can run here).
 
     Parameters
