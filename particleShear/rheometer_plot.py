@@ -25,7 +25,7 @@ plot_flow_curve_sweep
     The flow curve of a steady-shear sweep's table: seed means with standard errors and the
     Herschel–Bulkley fit with bootstrap intervals (``particleShear plot DIR`` of such a sweep).
 plot_rheometer_result
-    The figure of one :class:`~particleShear.run.rheometer.RheometerResult` (``result.plot()``
+    The figure of one protocol run's :class:`~particleShear.run.result.SimulationResult` (``result.plot()``
     and the command line's ``--plot``): one of the above, chosen by its protocol.
 """
 __docformat__ = "numpy"
@@ -421,7 +421,7 @@ def plot_rheometer_result(result, path=None):
 
     Parameters
     ----------
-    result : RheometerResult
+    result : SimulationResult
         A run of this session (the series and curves are needed; a result rebuilt from a
         results table has the steps only, enough for the sweeps).
     path : str or os.PathLike, optional

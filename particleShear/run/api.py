@@ -230,7 +230,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude``
         and hold; a constant applied stress; or, on one packing, the oscillation at each of
         ``sweep_amplitudes`` or ``sweep_frequencies`` in turn.  The other protocols are headless
-        (no drawing, no snapshots) and return a :class:`~particleShear.run.rheometer.RheometerResult`.
+        (no drawing, no snapshots); their result is a :class:`SimulationResult` naming the protocol
+        (``summary``, ``curves``, ``steps``; docs/protocols.md).
     relative_rate : float, default 0.01
         Keyword-only.  ``protocol="steady"``: shear rate γ̇·τ, dimensionless like
         ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant);
@@ -280,9 +281,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         ``[G′_surface, G″_surface]`` in Pa (the moduli from the surface forces, as the reference
         returns), or the :class:`SimulationResult` with ``return_result=True``; the full result
         of the last call is ``doParticleShearSimulation.last_result`` either way.  Other
-        protocols: ``RheometerResult.values`` (steady ``[σ, η]``, relaxation ``[G_plateau]``,
+        protocols: ``SimulationResult.values`` (steady ``[σ, η]``, relaxation ``[G_plateau]``,
         creep ``[creep rate, σ₀/γ̇]``, sweeps ``[[G′, G″], …]``), or the
-        :class:`~particleShear.run.rheometer.RheometerResult` with ``return_result=True``.
+        :class:`SimulationResult` with ``return_result=True``.
 
     Raises
     ------
@@ -357,7 +358,7 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     doParticleShearSimulation.last_result = result
     if strict_io and result.write_error is not None:
         raise result.write_error
-    return result if return_result else result.G
+    return result if return_result else result.values
 
 
 doParticleShearSimulation.last_result = None
@@ -519,9 +520,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
 
     Returns
     -------
-    list of SimulationResult or list of RheometerResult
-        One result per run (a :class:`~particleShear.run.rheometer.RheometerResult` for a
-        protocol other than "oscillatory"; resumed runs rebuilt from the table's rows), in the
+    list of SimulationResult
+        One result per run (whatever its protocol; resumed runs rebuilt from the table's rows), in the
         reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
 
