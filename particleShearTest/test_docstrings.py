@@ -105,6 +105,8 @@ DOCUMENTED_MODULES = [
     "particleShear.run",
     "particleShear.run.api",
     "particleShear.run.result",
+    "particleShear.run.moduli_summary",
+    "particleShear.run.protocol_summary",
     "particleShear.run.batch",
     "particleShear.run.cli",
     "particleShear.run.guard",

@@ -236,8 +236,12 @@ class SimulationResult:
         form = self._form
         head = ", ".join(f"{k}={v}" for k, v in form.text_fields(self))
         lines = [f"SimulationResult({head}"] + form.text_lines(self)
-        lines += ["  " + line for line in form.verdict_text(self)]
+        lines += ["  " + line for line in self._verdict_lines()]
         return "\n".join(lines) + ")"
+
+    def _verdict_lines(self):
+        """The verdict of the summary, as lines (the protocol's ``verdict_text``; none when not evaluable)."""
+        return self._form.verdict_text(self)
 
     def _repr_html_(self):
         """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
@@ -254,7 +258,7 @@ class SimulationResult:
         out = ["<table>", f"<caption>SimulationResult: {cap}</caption>",
                "<tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>"]
         out += ["<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in cells]
-        out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in form.verdict_text(self)]
+        out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
 
