@@ -406,7 +406,7 @@ def _result_title(result):
         kw["stress"] = num("creep_stress")
     if proto == "amplitude_sweep" and num("relative_frequency") is not None:
         kw["rate"] = f"f·τ = {num('relative_frequency'):g}"
-    seed = getattr(result, "seed", None)
+    seed = result.seed
     tail = f" (seed {seed})" if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) else ""
     return f"{_PROTOCOL_TITLES.get(proto, proto)}: {made_by(**kw)}{tail}"
 
@@ -441,7 +441,7 @@ def plot_rheometer_result(result, path=None):
     """
     proto, summ = result.protocol, result.summary
     title = _result_title(result)
-    verdict = getattr(result, "verdict", None)
+    verdict = result.verdict
     if verdict and verdict != "ok":
         title += f"; {verdict}"           # flags are drawn, never hidden (docs/analysis.md, "Verdicts")
     if proto in ("amplitude_sweep", "frequency_sweep"):
