@@ -107,6 +107,7 @@ DOCUMENTED_MODULES = [
     "particleShear.run.result",
     "particleShear.run.moduli_summary",
     "particleShear.run.protocol_summary",
+    "particleShear.run.measurement",
     "particleShear.run.batch",
     "particleShear.run.cli",
     "particleShear.run.guard",

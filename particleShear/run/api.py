@@ -21,7 +21,7 @@ from .sessions import _build_simulation, _seed_sequence, check_batch_size, measu
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 from ..simulation.drawing import _backend_choice, display_available
-from .rheometer import measure_rheometer, normalize_protocol
+from .measurement import measure
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -336,24 +336,11 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
-    ss, rng = _seed_sequence(seed)
     params.update(options)   # every input, the keyword-only options included
-    seed_entropy = None if ss is None else ss.entropy
-    spawn_key = () if ss is None else tuple(ss.spawn_key)
-    run_id = run_identity(params, seed_entropy, spawn_key)
-    if protocol != "oscillatory":
-        with console_messages(verbose):
-            result = measure_rheometer([normalize_protocol(params)])[0]
-        doParticleShearSimulation.last_result = result
-        if strict_io and result.write_error is not None:
-            raise result.write_error
-        return result if return_result else result.values
-
-    # measured by the engine, a batch of one (particleShear.run.batch)
+    # measured by the engine, a batch of one (particleShear.run.measurement)
     with console_messages(verbose):
-        result = measure_batch([params])[0]
-    result.parameters, result.run_id = params, run_id
-    if plotStress and doDrawing and result.output_path:
+        result = measure([params])[0]
+    if plotStress and doDrawing and result.output_path and protocol == "oscillatory":
         _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
     if strict_io and result.write_error is not None:
