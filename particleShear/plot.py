@@ -125,7 +125,7 @@ def plot_result(result, path=None):
                         fig.add_subplot(grid[1, 2]))
     p = result.parameters
     N = p.get("N")
-    seed = getattr(result, "seed", None)
+    seed = result.seed
     rate = f"f·τ = {float(p['relative_frequency']):g}" if "relative_frequency" in p else None
     line = made_by(N=int(N) if N is not None else None, seeds=1, rate=rate,
                    amplitude=float(A) if isinstance(A, (int, float)) else None)

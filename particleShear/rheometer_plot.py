@@ -25,7 +25,7 @@ plot_flow_curve_sweep
     The flow curve of a steady-shear sweep's table: seed means with standard errors and the
     Herschel–Bulkley fit with bootstrap intervals (``particleShear plot DIR`` of such a sweep).
 plot_rheometer_result
-    The figure of one :class:`~particleShear.run.rheometer.RheometerResult` (``result.plot()``
+    The figure of one protocol run's :class:`~particleShear.run.result.SimulationResult` (``result.plot()``
     and the command line's ``--plot``): one of the above, chosen by its protocol.
 """
 __docformat__ = "numpy"
@@ -406,7 +406,7 @@ def _result_title(result):
         kw["stress"] = num("creep_stress")
     if proto == "amplitude_sweep" and num("relative_frequency") is not None:
         kw["rate"] = f"f·τ = {num('relative_frequency'):g}"
-    seed = getattr(result, "seed", None)
+    seed = result.seed
     tail = f" (seed {seed})" if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) else ""
     return f"{_PROTOCOL_TITLES.get(proto, proto)}: {made_by(**kw)}{tail}"
 
@@ -421,7 +421,7 @@ def plot_rheometer_result(result, path=None):
 
     Parameters
     ----------
-    result : RheometerResult
+    result : SimulationResult
         A run of this session (the series and curves are needed; a result rebuilt from a
         results table has the steps only, enough for the sweeps).
     path : str or os.PathLike, optional
@@ -441,7 +441,7 @@ def plot_rheometer_result(result, path=None):
     """
     proto, summ = result.protocol, result.summary
     title = _result_title(result)
-    verdict = getattr(result, "verdict", None)
+    verdict = result.verdict
     if verdict and verdict != "ok":
         title += f"; {verdict}"           # flags are drawn, never hidden (docs/analysis.md, "Verdicts")
     if proto in ("amplitude_sweep", "frequency_sweep"):

@@ -222,12 +222,12 @@ class TestLaosBox(unittest.TestCase):
 class TestProtocolFigures(unittest.TestCase):
     @staticmethod
     def sweep_result(protocol, **parameters):
-        import types
+        from particleShear.run.result import SimulationResult
         x = "amplitude" if protocol == "amplitude_sweep" else "relative_frequency"
         steps = [{x: v, "Gp_surface": 300.0 - 50 * k, "Gpp_surface": 60.0 + 10 * k, "Gp_surface_se": 5.0,
                   "Gpp_surface_se": 3.0} for k, v in enumerate((0.01, 0.03, 0.1))]
-        return types.SimpleNamespace(protocol=protocol, summary={}, steps=steps, seed=7,
-                                     parameters=dict(N=40, theAmplitude=0.1, relative_frequency=0.025, **parameters))
+        return SimulationResult.of_protocol(protocol, dict(N=40, theAmplitude=0.1, relative_frequency=0.025,
+                                                           **parameters), 7, (), "", None, 0.0, {}, {}, {}, steps, {})
 
     def test_titles_and_legends_say_what_made_them(self):
         from particleShear.rheometer_plot import plot_rheometer_result

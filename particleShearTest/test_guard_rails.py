@@ -135,7 +135,7 @@ class TestAliases(unittest.TestCase):
         # what the batch measures is the canonical dict (measurement replaced: only the names matter here)
         seen = []
         self.addCleanup(setattr, doParticleShearSimulation, "last_result", doParticleShearSimulation.last_result)
-        with mock.patch("particleShear.run.batch.measure_batch", side_effect=lambda runs: seen.extend(runs) or
+        with mock.patch("particleShear.run.batch.measure", side_effect=lambda runs: seen.extend(runs) or
                         [None] * len(runs)):
             quiet(run_batch, [dict(TINY, amplitude=0.1, mu=0.05), dict(TINY, theAmplitude=0.1, theMu=0.05)])
         self.assertEqual(len(seen), 2)

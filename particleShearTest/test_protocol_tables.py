@@ -193,7 +193,7 @@ class TestFilesAndSeries(unittest.TestCase):
             self.assertEqual([r.summary["G_plateau_surface"] for r in again],
                              [r.summary["G_plateau_surface"] for r in first])
             self.assertTrue(all(r.protocol == "relaxation" for r in again))
-            # resumed from the table's rows (RheometerResult.from_rows: no record), not run again
+            # resumed from the table's rows (SimulationResult.from_rows: no record), not run again
             self.assertEqual([r.series for r in again], [{}, {}])
             self.assertEqual([len(r.series["t"]) > 0 for r in first], [True, True])
 

@@ -99,7 +99,7 @@ if __name__ == "__main__":
 
 
 class TestRheometerRepr(unittest.TestCase):
-    """``repr(RheometerResult)`` and its HTML: every summary number with its standard error and the
+    """``repr`` of a protocol run's SimulationResult and its HTML: every summary number with its standard error and the
     unit of its results-table column, the run's identity; no records dumped; the HTML escaped."""
 
     @classmethod
@@ -112,7 +112,7 @@ class TestRheometerRepr(unittest.TestCase):
 
     def test_summary_numbers_units_and_identity(self):
         text = repr(self.creep)
-        self.assertTrue(text.startswith("RheometerResult(protocol=creep, N=30"))
+        self.assertTrue(text.startswith("SimulationResult(protocol=creep, N=30"))
         self.assertIn(f"run_id={self.creep.run_id}", text)
         s = self.creep.summary
         m = re.search(r"creep_rate: ([-+0-9.e]+) ± ([-+0-9.e]+) 1/s", text)

@@ -38,7 +38,7 @@ class TestRangesThatRun(unittest.TestCase):
         def no_work(*a, **k):
             raise AssertionError("a run was started")
         for kw in cases:
-            with self.subTest(kw=kw), mock.patch("particleShear.run.api.measure_batch", no_work), \
+            with self.subTest(kw=kw), mock.patch("particleShear.run.api.measure", no_work), \
                     self.assertRaisesRegex(ValueError, "out of range"):
                 doParticleShearSimulation(**TINY, **kw)
 
@@ -46,7 +46,7 @@ class TestRangesThatRun(unittest.TestCase):
         # with the viscosities kept constant rv·irc is not a viscosity: only the single ranges apply
         bound = STIFF_VISCOUS["relative_viscosity*interface_reenforcement_central"]
         kw = dict(relative_viscosity=1.0, interface_reenforcement_central=bound * 2)
-        with mock.patch("particleShear.run.api.measure_batch", side_effect=AssertionError("a run was started")), \
+        with mock.patch("particleShear.run.api.measure", side_effect=AssertionError("a run was started")), \
                 self.assertRaisesRegex(ValueError, "out of range"):
             doParticleShearSimulation(**TINY, **kw)
         from particleShear.run.validation import _check_stiff_viscous

@@ -76,8 +76,8 @@ def _work(*args, **kwargs):
 def no_work():
     """Fail the test as soon as any path builds, measures or submits a run."""
     with mock.patch("particleShear.run.sessions._build_simulation", _work), \
-            mock.patch("particleShear.run.api.measure_batch", _work), \
-            mock.patch("particleShear.run.batch.measure_batch", _work), \
+            mock.patch("particleShear.run.api.measure", _work), \
+            mock.patch("particleShear.run.batch.measure", _work), \
             mock.patch("particleShear.sweep.series.run_series", _work):
         yield
 

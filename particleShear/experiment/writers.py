@@ -45,9 +45,7 @@ import numpy as np
 from .tables import KINDS, MeasuredTest
 from ..analysis.grouping import measured_row, row_protocol
 from ..run.guard import SuggestingParser
-from ..run.result import SimulationResult
-from ..run.rheometer import RheometerResult
-from ..simulation.formats import RunData, read_run
+from ..simulation.formats import read_run
 from ..sweep.table import atomic_text
 from ..analysis.cli import grouping_columns
 from ..plot_tools import ok_moduli, read_sweep_table
@@ -436,7 +434,7 @@ def tests_from_result(result, estimator="surface", meta=None):
 
     Parameters
     ----------
-    result : SimulationResult, RheometerResult or RunData
+    result : SimulationResult or RunData
         An oscillatory run (its LAOS waveform from ``series``: ``time`` s, ``strain``, ``stress``
         Pa with ``omega`` = 2πf rad/s and ``gamma`` = the amplitude), a protocol run (steady:
         the start-up as a flow curve with ``time``; relaxation: G(t) of the estimator's log-grid
@@ -457,18 +455,14 @@ def tests_from_result(result, estimator="surface", meta=None):
     """
     _check_estimator(estimator)
     meta = dict(meta or {}, estimator=estimator)
-    if isinstance(result, RunData):
-        params = dict(result.metadata.get("parameters") or {})
-        protocol, series, curves, steps = result.protocol, result.series, result.curves, result.steps
-        if protocol == "oscillatory":
-            f, gamma = result.frequency, result.strain_amplitude
-    elif isinstance(result, (SimulationResult, RheometerResult)):   # one interface: protocol, series, curves, steps
+    try:   # one interface: a result of any protocol, or a run file (RunData)
         params, protocol, series, curves, steps = (dict(result.parameters), result.protocol, result.series,
                                                    result.curves, result.steps)
-        if protocol == "oscillatory":
-            f, gamma = result.f, _f(params.get("theAmplitude"))
-    else:
-        raise ValueError(f"result={type(result).__name__} is invalid: a SimulationResult, RheometerResult or RunData")
+    except AttributeError:
+        raise ValueError(f"result={type(result).__name__} is invalid: a SimulationResult or RunData") from None
+    if protocol == "oscillatory":
+        f = result.f
+        gamma = params["theAmplitude"] if "theAmplitude" in params else result.strain_amplitude
     E = params.get("Young_modulus_spheres")
     meta.setdefault("parameters", {k: v for k, v in params.items() if isinstance(v, (int, float, str, bool))})
     if E is not None:

@@ -121,7 +121,7 @@ def label(step):
     Parameters
     ----------
     step : dict
-        One step of a sweep (``RheometerResult.steps``).
+        One step of a sweep (``SimulationResult.steps``).
 
     Returns
     -------

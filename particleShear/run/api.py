@@ -21,7 +21,7 @@ from .sessions import _build_simulation, _seed_sequence, check_batch_size, measu
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 from ..simulation.drawing import _backend_choice, display_available
-from .rheometer import measure_rheometer, normalize_protocol
+from .measurement import measure
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]
@@ -230,7 +230,8 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         the reference's oscillation; a constant shear rate; a step strain to ``theAmplitude``
         and hold; a constant applied stress; or, on one packing, the oscillation at each of
         ``sweep_amplitudes`` or ``sweep_frequencies`` in turn.  The other protocols are headless
-        (no drawing, no snapshots) and return a :class:`~particleShear.run.rheometer.RheometerResult`.
+        (no drawing, no snapshots); their result is a :class:`SimulationResult` naming the protocol
+        (``summary``, ``curves``, ``steps``; docs/protocols.md).
     relative_rate : float, default 0.01
         Keyword-only.  ``protocol="steady"``: shear rate γ̇·τ, dimensionless like
         ``relative_frequency`` (γ̇ = relative_rate/τ in 1/s, τ the model time constant);
@@ -280,9 +281,9 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         ``[G′_surface, G″_surface]`` in Pa (the moduli from the surface forces, as the reference
         returns), or the :class:`SimulationResult` with ``return_result=True``; the full result
         of the last call is ``doParticleShearSimulation.last_result`` either way.  Other
-        protocols: ``RheometerResult.values`` (steady ``[σ, η]``, relaxation ``[G_plateau]``,
+        protocols: ``SimulationResult.values`` (steady ``[σ, η]``, relaxation ``[G_plateau]``,
         creep ``[creep rate, σ₀/γ̇]``, sweeps ``[[G′, G″], …]``), or the
-        :class:`~particleShear.run.rheometer.RheometerResult` with ``return_result=True``.
+        :class:`SimulationResult` with ``return_result=True``.
 
     Raises
     ------
@@ -335,29 +336,16 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md)
     validate_run(dict(params, **options))
-    ss, rng = _seed_sequence(seed)
     params.update(options)   # every input, the keyword-only options included
-    seed_entropy = None if ss is None else ss.entropy
-    spawn_key = () if ss is None else tuple(ss.spawn_key)
-    run_id = run_identity(params, seed_entropy, spawn_key)
-    if protocol != "oscillatory":
-        with console_messages(verbose):
-            result = measure_rheometer([normalize_protocol(params)])[0]
-        doParticleShearSimulation.last_result = result
-        if strict_io and result.write_error is not None:
-            raise result.write_error
-        return result if return_result else result.values
-
-    # measured by the engine, a batch of one (particleShear.run.batch)
+    # measured by the engine, a batch of one (particleShear.run.measurement)
     with console_messages(verbose):
-        result = measure_batch([params])[0]
-    result.parameters, result.run_id = params, run_id
-    if plotStress and doDrawing and result.output_path:
+        result = measure([params])[0]
+    if plotStress and doDrawing and result.output_path and protocol == "oscillatory":
         _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result
     if strict_io and result.write_error is not None:
         raise result.write_error
-    return result if return_result else result.G
+    return result if return_result else result.values
 
 
 doParticleShearSimulation.last_result = None
@@ -519,9 +507,8 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
 
     Returns
     -------
-    list of SimulationResult or list of RheometerResult
-        One result per run (a :class:`~particleShear.run.rheometer.RheometerResult` for a
-        protocol other than "oscillatory"; resumed runs rebuilt from the table's rows), in the
+    list of SimulationResult
+        One result per run (whatever its protocol; resumed runs rebuilt from the table's rows), in the
         reference iteration order (repetition, amplitude, μ, then bulk control, material,
         uncrosslinked control, non-frictional control).
 

@@ -30,7 +30,8 @@ from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 from .sessions import (BACKENDS, _REFERENCE_ARGUMENTS, _signature_defaults, build_sessions,  # noqa: F401 - re-exported
                        check_backend, check_batch_size, check_run_backend, measure_batch)
 from .api import doParticleShearSimulation
-from .rheometer import measure_rheometer, normalize_protocol, protocol_steps
+from .measurement import measure
+from .rheometer import normalize_protocol, protocol_steps
 from .validation import validate_run
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
@@ -159,10 +160,6 @@ def run_batch(list_of_kwargs, backend=None):
                              "time-step rule and protocol")
     defaults = _signature_defaults()
     full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
-    if full[0]["protocol"] != "oscillatory":      # the protocol is part of the schedule key
-        results = measure_rheometer([normalize_protocol(kw) for kw in full])
-        doParticleShearSimulation.last_result = results[-1]
-        return results
-    results = measure_batch(full)
+    results = measure(full)       # the protocol is part of the schedule key
     doParticleShearSimulation.last_result = results[-1]
     return results

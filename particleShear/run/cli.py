@@ -640,7 +640,7 @@ def main(argv=None):
             print("output file: " + res.output_path)
         if res.image_folder:
             print(f"images: {res.n_images} in {res.image_folder}")
-    if getattr(res, "write_error", None) is not None:
+    if res.write_error is not None:
         print(f"particleShear: writing the output failed, nothing was saved: {res.write_error}", file=sys.stderr)
         return 1
     if args.plot:

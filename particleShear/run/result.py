@@ -1,44 +1,59 @@
-"""What one run produced: :class:`SimulationResult` (moduli, their errors and LAOS measures, series, files).
+"""What one run produced: :class:`SimulationResult`, the one result type of every protocol.
 
-Made by :func:`~particleShear.run.api.doParticleShearSimulation` and the batch; rebuilt from a
-results-table row by a resumed series.
+Every run — the oscillatory one (moduli, their errors and LAOS measures) and the rheometer's other
+protocols (a summary, curves, a sweep's steps) — returns a :class:`SimulationResult` naming its
+``protocol``; what differs between protocols (the results-table rows, the text summary, the
+verdict, the values returned, the figure) is the protocol's summary module,
+:mod:`~particleShear.run.moduli_summary` for "oscillatory" and
+:mod:`~particleShear.run.protocol_summary` for the others (:func:`_summary_of`).  Made by
+:func:`~particleShear.run.api.doParticleShearSimulation` and the batch; rebuilt from results-table
+rows by a resumed series (:meth:`SimulationResult.from_rows`).
 """
 __docformat__ = "numpy"
 import dataclasses
-import math
 
 import numpy as np
 
-from .._version import __version__
 from ..hooks import entry
-from ..parameters import spec_defaults
 from ..simulation.microstructure_pictures import microstructure_pictures
 from ..analysis.demodulation import ESTIMATOR_COLUMNS
 from ..analysis.laos import laos
-from ..analysis.measures import empty_measures, measured_window, run_measures
-from ..analysis.microstructure import micro_measures
-from ..analysis.verdicts import verdict_lines
-from ..simulation.provenance import run_identity
+from ..analysis.measures import measured_window
+from . import moduli_summary, protocol_summary
 
 __all__ = ["SimulationResult"]
+
+#: the summary module of a protocol that has its own (every other protocol: :mod:`.protocol_summary`)
+_SUMMARIES = {"oscillatory": moduli_summary}
+
+
+def _summary_of(protocol):
+    """The module that summarises a run of ``protocol`` (module docstring)."""
+    return _SUMMARIES.get(protocol, protocol_summary)
 
 
 @dataclasses.dataclass
 class SimulationResult:
-    """Everything a run of :func:`doParticleShearSimulation` produced.
+    """Everything a run of :func:`doParticleShearSimulation` produced, whatever its protocol.
+
+    The fields G_surface … microstructure are those of the oscillatory protocol (empty or at their
+    defaults for another); protocol … steps those of the others (docs/protocols.md; empty for the
+    oscillatory run, which is one step).  A run of another protocol is made by
+    :meth:`of_protocol`.
 
     Parameters
     ----------
     G_surface : tuple of float
         (G′, G″) in Pa from the external (surface) forces on the plate bands — the
-        reference's return value.
+        reference's return value; () for another protocol.
     G_internal : tuple of float
         (G′, G″) in Pa from the overall stress tensor (eq. S1-24) — the values the output
-        header lists first.
+        header lists first; () for another protocol.
     stress_surface, stress_internal : tuple of float
         (in-phase, out-of-phase) shear stress amplitudes in Pa of the two estimators.
     parameters : dict
-        Every argument of the call (reference names), keyword-only options included.
+        Every argument of the call (reference names), keyword-only options included (another
+        protocol: normalized, a sweep's first value in ``theAmplitude`` or ``relative_frequency``).
     seed : int or None, default None
         Entropy of the ``numpy.random.SeedSequence`` that drove the run (None if a Generator
         was given).
@@ -46,7 +61,8 @@ class SimulationResult:
         Spawn key of that SeedSequence (non-empty for the runs of a series).
     timings : dict of float
         Wall time in s of "constitution", "pre_equilibration", "protocol", "demodulation",
-        "output" and "total".
+        "output" and "total" (another protocol: "constitution", "pre_equilibration",
+        "protocol", "analysis" and "output").
     output_path : str or None, default None
         The output file (when ``saveData``).
     image_folder : str or None, default None
@@ -54,7 +70,7 @@ class SimulationResult:
     n_images : int, default 0
         Number of snapshots written.
     dt : float, default 0.0
-        Protocol time step in s.
+        Protocol time step in s (of the first step for sweeps).
     f : float, default 0.0
         Excitation frequency in Hz.
     N_steps : int, default 0
@@ -69,7 +85,9 @@ class SimulationResult:
     series : dict of numpy.ndarray
         Per protocol step: "t" (s), "strain", "strain_rate" (1/s), "stress_surface" and
         "stress_internal" (Pa), and "tensors" (n, 9, 2, 2) in Pa when the tensor history was kept
-        (``saveData`` with ``saveStressTensorData``).
+        (``saveData`` with ``saveStressTensorData``); for "steady" also "N1" (Pa, NaN where not
+        sampled); for sweeps the steps' records one after the other with "sweep_position" (each
+        step's clock from 0).
     run_id : str, default ""
         12 hex digits identifying parameters + seed
         (:func:`~particleShear.simulation.provenance.run_identity`).
@@ -79,11 +97,24 @@ class SimulationResult:
         The per-cycle arrays of the stroboscopic observer (a run with ``stroboscopic=True``;
         :meth:`particleShear.engine.microstructure.Stroboscope.replica`, docs/microstructure.md);
         None for a run without it.
+    protocol : str, default "oscillatory"
+        The protocol of the run (:data:`particleShear.protocols.PROTOCOLS`).
+    tau : float or None, default None
+        Model time constant τ (s) of another protocol's run (its rates and times are in units of τ).
+    summary : dict, default {}
+        Another protocol's scalar results by name (units in docs/protocols.md), its checks and verdict.
+    curves : dict, default {}
+        ``name -> (t, y, y_sem)`` on log-spaced grids: "G" (relaxation, Pa), "J" (creep, 1/Pa).
+    steps : list of dict, default []
+        Sweeps: one dict per step (position, amplitude, relative_frequency, f, G′/G″ of both
+        estimators with standard errors, LAOS measures).
 
     Attributes
     ----------
     G : list of float
         ``[G′_surface, G″_surface]`` in Pa — what :func:`doParticleShearSimulation` returns.
+    values : list
+        What :func:`doParticleShearSimulation` returns without ``return_result``, for every protocol.
     """
 
     G_surface: tuple
@@ -107,64 +138,110 @@ class SimulationResult:
     run_id: str = ""
     write_error: object = None
     microstructure: object = dataclasses.field(default=None, repr=False, compare=False)
+    protocol: str = "oscillatory"
+    tau: object = None
+    summary: dict = dataclasses.field(default_factory=dict)
+    curves: dict = dataclasses.field(default_factory=dict, repr=False)
+    steps: list = dataclasses.field(default_factory=list)
     _measures: dict = dataclasses.field(default=None, init=False, repr=False, compare=False)
+
+    def __setstate__(self, state):
+        """Unpickle a result of an earlier version: the fields it lacks take their defaults (a 2.x
+        ``RheometerResult`` has no moduli, a 2.x ``SimulationResult`` no protocol summary)."""
+        for field in dataclasses.fields(self):
+            if field.name not in state:
+                if field.default_factory is not dataclasses.MISSING:
+                    state[field.name] = field.default_factory()
+                else:
+                    state[field.name] = () if field.default is dataclasses.MISSING else field.default
+        self.__dict__.update(state)
 
     @property
     def G(self):
-        """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns."""
-        return [self.G_surface[0], self.G_surface[1]]
+        """``[G′_surface, G″_surface]`` — what :func:`doParticleShearSimulation` returns for the
+        oscillatory protocol (another protocol's numbers: :attr:`values`).
 
-    def _summary(self):
-        """(estimator rows, run fields) of :meth:`__repr__` and :meth:`_repr_html_`.
-
-        Rows: ``(name, G′, se G′, G″, se G″)`` with the standard errors None where not finite
-        (fewer than 2 measured periods, or no recorded series); fields: ``(label, text)`` of N,
-        A, μ, seed and run id as recorded.
+        Raises
+        ------
+        AttributeError
+            For a run of another protocol, which has no G′, G″ of its own.
         """
-        rows = []
-        for name, G, se_name in (("surface", self.G_surface, "G_surface_se"),
-                                 ("internal", self.G_internal, "G_internal_se")):
-            try:
-                se = getattr(self, se_name)
-            except Exception:  # noqa: BLE001 - a repr never fails: no error bars then
-                se = (float("nan"), float("nan"))
-            se = [float(v) if v is not None and np.isfinite(v) else None for v in se]
-            rows.append((name, float(G[0]), se[0], float(G[1]), se[1]))
-        p = self.parameters or {}
-        seed = "None" if self.seed is None else str(self.seed)
-        if self.spawn_key:
-            seed += " spawn " + ",".join(str(k) for k in self.spawn_key)
-        fields = [("N", str(p.get("N", "?"))), ("A", str(p.get("theAmplitude", "?"))),
-                  ("μ", str(p.get("theMu", "?"))), ("seed", seed), ("run_id", self.run_id or "–")]
-        return rows, fields
+        if len(self.G_surface) < 2:
+            raise AttributeError(f"a run of protocol={self.protocol!r} has no G: its numbers are result.values "
+                                 "(a sweep's moduli per step: result.steps)")
+        return moduli_summary.values(self)
 
-    @staticmethod
-    def _modulus_text(value, se):
-        return f"{value:.4g}" + ("" if se is None else f" ± {se:.2g}")
+    @classmethod
+    def of_protocol(cls, protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps,
+                    timings, output_path=None):
+        """The result of a run of a protocol other than "oscillatory" (the arguments of 2.x's
+        ``RheometerResult``, which now names this constructor).
+
+        Parameters
+        ----------
+        protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps, timings
+            The fields of the same names (class docstring).
+        output_path : str, optional
+            The run's file.
+
+        Returns
+        -------
+        SimulationResult
+        """
+        return cls(G_surface=(), G_internal=(), stress_surface=(), stress_internal=(), parameters=parameters,
+                   seed=seed, spawn_key=tuple(spawn_key), timings=timings, output_path=output_path, dt=dt,
+                   series=series, run_id=run_id, protocol=protocol, tau=tau, summary=summary, curves=curves,
+                   steps=steps)
+
+    @classmethod
+    def from_rows(cls, rows, parameters, seed, spawn_key, output_path=None):
+        """The result of a finished run rebuilt from its results-table rows (no series, no curves).
+
+        Used when a series or a sweep resumes: the moduli and measures, the protocol's summary, or
+        the steps of a sweep, are the rows' values (the inverse of :meth:`rows`).
+
+        Parameters
+        ----------
+        rows : list of dict
+            The run's typed rows (:func:`particleShear.sweep.schema.typed_row`), in step order.
+        parameters : dict
+            The run's parameters (``protocol`` among them, or "oscillatory").
+        seed, spawn_key
+            The run's seed entropy and spawn key.
+        output_path : str, optional
+            The run's file.
+
+        Returns
+        -------
+        SimulationResult
+        """
+        return _summary_of(parameters.get("protocol", "oscillatory")).from_rows(cls, rows, parameters, seed,
+                                                                                spawn_key, output_path)
+
+    @property
+    def _form(self):
+        """The module that summarises this run's protocol (:func:`_summary_of`)."""
+        return _summary_of(self.protocol)
 
     def __repr__(self):
-        """A short summary: G′, G″ of both estimators (± standard error over the measured periods where
-        finite), N, A, μ, seed and run id — not the parameter dict (``result.parameters``).
+        """A short summary — the oscillatory protocol's G′, G″ of both estimators (± standard error
+        over the measured periods where finite) with N, A, μ, seed and run id; another protocol's
+        name, N, μ, seed, run id and each summary number with its standard error and unit (sweeps:
+        G′, G″ per step and estimator); then the verdict — not the parameters nor the records.
 
         Returns
         -------
         str
         """
-        rows, fields = self._summary()
-        head = ", ".join(f"{k}={v}" for k, v in fields)
-        lines = [f"SimulationResult({head}"]
-        for name, g1, s1, g2, s2 in rows:
-            lines.append(f"  {name + ':':<9} G′ = {self._modulus_text(g1, s1)} Pa, "
-                         f"G″ = {self._modulus_text(g2, s2)} Pa")
+        form = self._form
+        head = ", ".join(f"{k}={v}" for k, v in form.text_fields(self))
+        lines = [f"SimulationResult({head}"] + form.text_lines(self)
         lines += ["  " + line for line in self._verdict_lines()]
         return "\n".join(lines) + ")"
 
     def _verdict_lines(self):
-        """:func:`~particleShear.analysis.verdicts.verdict_lines` of the run; none when its measures fail."""
-        try:
-            return verdict_lines(self.measures)
-        except Exception:  # noqa: BLE001 - a repr never fails
-            return []
+        """The verdict of the summary, as lines (the protocol's ``verdict_text``; none when not evaluable)."""
+        return self._form.verdict_text(self)
 
     def _repr_html_(self):
         """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
@@ -174,14 +251,13 @@ class SimulationResult:
         str
         """
         import html
-        rows, fields = self._summary()
         esc = html.escape
-        cap = ", ".join(f"{esc(k)} = {esc(v)}" for k, v in fields)
+        form = self._form
+        cap = ", ".join(f"{esc(k)} = {esc(v)}" for k, v in form.text_fields(self))
+        header, cells = form.html_rows(self)
         out = ["<table>", f"<caption>SimulationResult: {cap}</caption>",
-               "<tr><th>estimator</th><th>G′ (Pa)</th><th>G″ (Pa)</th></tr>"]
-        for name, g1, s1, g2, s2 in rows:
-            out.append(f"<tr><td>{esc(name)}</td><td>{esc(self._modulus_text(g1, s1))}</td>"
-                       f"<td>{esc(self._modulus_text(g2, s2))}</td></tr>")
+               "<tr>" + "".join(f"<th>{esc(h)}</th>" for h in header) + "</tr>"]
+        out += ["<tr>" + "".join(f"<td>{esc(c)}</td>" for c in row) + "</tr>" for row in cells]
         out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
         out.append("</table>")
         return "\n".join(out)
@@ -192,18 +268,7 @@ class SimulationResult:
         :data:`~particleShear.analysis.measures.MEASURE_COLUMNS`), evaluated once from ``series``
         (:func:`~particleShear.analysis.measures.run_measures`; docs/analysis.md)."""
         if self._measures is None:
-            import warnings
-            p = self.parameters or {}
-            try:
-                self._measures = run_measures(self.series, self.f, p.get("theAmplitude", 0.0),
-                                              p.get("pre_periods", 0), p.get("periods", 0),
-                                              moduli={"surface": self.G_surface, "internal": self.G_internal})
-                if self.microstructure is not None:
-                    self._measures.update(micro_measures(self.microstructure))
-            except Exception as exc:  # noqa: BLE001 - a measure must never turn a finished run into a failure
-                warnings.warn(f"the measures of run {self.run_id or '?'} could not be evaluated "
-                              f"({type(exc).__name__}: {exc}); they are left empty", RuntimeWarning, stacklevel=2)
-                self._measures = empty_measures()
+            self._measures = self._form.measures(self)
         return self._measures
 
     @property
@@ -220,7 +285,15 @@ class SimulationResult:
     def verdict(self):
         """``"ok"`` when no check of the run failed, else ``"flagged: …"`` naming the failed checks
         (:mod:`particleShear.analysis.verdicts`; docs/analysis.md, "Verdicts")."""
-        return self.measures["verdict"]
+        return self._form.verdict(self)
+
+    @property
+    def values(self):
+        """The protocol's main numbers — what :func:`doParticleShearSimulation` returns without
+        ``return_result``: oscillatory ``[G′, G″]`` (surface, :attr:`G`), steady ``[σ, η]``
+        (surface), relaxation ``[G_plateau]``, creep ``[final creep rate, σ₀/γ̇]``, sweeps
+        ``[[G′, G″], …]`` per step (surface)."""
+        return self._form.values(self)
 
     @property
     def steady_state(self):
@@ -262,9 +335,10 @@ class SimulationResult:
         return laos(np.asarray(s["t"])[w], np.asarray(s["strain"])[w], np.asarray(s[key])[w], self.f, n_max=n_max)
 
     def plot(self, path=None):
-        """Strain and stress traces against time plus the Lissajous loop (needs ``particleShear[plot]``).
-
-        See :func:`particleShear.plot.plot_result`.
+        """The protocol's figure (needs ``particleShear[plot]``): strain and stress traces against time
+        plus the Lissajous loop of an oscillatory run (:func:`particleShear.plot.plot_result`); the
+        stress against strain of a steady run, G(t), J(t), or G′/G″ of a sweep's steps
+        (:func:`particleShear.rheometer_plot.plot_rheometer_result`).
 
         Parameters
         ----------
@@ -275,7 +349,7 @@ class SimulationResult:
         -------
         matplotlib.figure.Figure
         """
-        return entry("plot_result")(self, path)
+        return entry(self._form.PLOT_ENTRY)(self, path)
 
     def microstructure_pictures(self, folder, colour_by="d2min", gif=True, **options):
         """One picture per excitation cycle (force chains, spheres coloured by D²_min) and a GIF.
@@ -316,51 +390,29 @@ class SimulationResult:
         every parameter (defaults filled in for those not recorded), ``seed_entropy``,
         ``spawn_key``, ``package_version``, ``wall_time_s`` (s), ``output_path``.  Values are
         typed: float, int, bool (``steady_state`` None when it cannot be judged), str, the spawn
-        key a list (types, units: :mod:`particleShear.sweep.schema`).
+        key a list (types, units: :mod:`particleShear.sweep.schema`).  Another protocol: its one
+        row of :meth:`rows`.
 
         Returns
         -------
         dict
+
+        Raises
+        ------
+        ValueError
+            For a sweep protocol, which has a row per step (:meth:`rows`).
         """
-        params = spec_defaults()
-        params.update({k: v for k, v in self.parameters.items() if k in params})
-        row = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
-               "Gp_surface": float(self.G_surface[0]), "Gpp_surface": float(self.G_surface[1]),
-               "Gp_internal": float(self.G_internal[0]), "Gpp_internal": float(self.G_internal[1])}
-        row.update(self.measures)
-        row.update(repetition=int(self.repetition), frequency_Hz=float(self.f), omega=2 * math.pi * float(self.f),
-                   dt=float(self.dt), N_steps=int(self.N_steps))
-        row.update(params)
-        row.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
-                   wall_time_s=float(self.timings.get("total", 0.0)), output_path=self.output_path or "")
-        return row
-
-    #: the protocol of the run: a SimulationResult is an oscillatory run (a
-    #: :class:`~particleShear.run.rheometer.RheometerResult` names its own)
-    protocol = "oscillatory"
-
-    @property
-    def curves(self):
-        """Empty: an oscillatory run has no G(t) or J(t) curve (the interface of
-        :class:`~particleShear.run.rheometer.RheometerResult`, so that callers need not ask which
-        result they hold)."""
-        return {}
-
-    @property
-    def steps(self):
-        """Empty: an oscillatory run is one step (sweeps have one entry per step; the interface of
-        :class:`~particleShear.run.rheometer.RheometerResult`)."""
-        return []
+        return self._form.to_dict(self)
 
     def rows(self):
-        """The rows of this run in a sweep's results table: ``[self.to_dict()]`` (one run, one row;
-        the interface of :meth:`particleShear.run.rheometer.RheometerResult.rows`).
+        """The rows of this run in a sweep's results table: ``[self.to_dict()]`` (one run, one row),
+        or one per step of a sweep protocol (:func:`particleShear.run.protocol_summary.rows`).
 
         Returns
         -------
         list of dict
         """
-        return [self.to_dict()]
+        return self._form.rows(self)
 
     def to_dataframe(self):
         """:meth:`to_dict` as a pandas Series (index: the column names, table order; needs pandas).

@@ -27,25 +27,21 @@ gives the same packing), then drive the engine with another rate schedule
 """
 __docformat__ = "numpy"
 import difflib
-import math
 import time
 
 import numpy as np
 
-from .._version import __version__
-from ..analysis.measures import MEASURE_COLUMNS
-from ..analysis.verdicts import CHECKS, PROTOCOL_CHECKS, verdict, verdict_lines
 from ..checks import show_value
 from ..engine.rheometer import shear_record
 from ..engine.step import protocol as oscillation
-from ..hooks import entry
-from ..linkable.builders import time_steps_from_model
-from ..parameters import BY_NAME, PARAMETERS, spec_defaults
-from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY, result_columns
+from ..parameters import PARAMETERS
+from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY
 from ..protocols.creep import CREEP_MODULUS_FRACTION
 from ..protocols.steady import N1_EVERY
 from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
 from ..simulation.provenance import run_identity
+from .protocol_summary import PROTOCOL_COLUMNS, STEP_COLUMNS, dt_over_tau  # noqa: F401 - PROTOCOL_COLUMNS, STEP_COLUMNS re-exported
+from .result import SimulationResult
 from .sessions import build_sessions
 from .rheometer_analysis import analyse_record, analyse_sweep
 from .rheometer_files import write_protocol_file
@@ -61,26 +57,8 @@ PROTOCOLS = tuple(REGISTRY)
 #: :mod:`particleShear.parameters`)
 PROTOCOL_DEFAULTS = {p.name: p.default for p in PARAMETERS if p.base_role == "protocol"}
 
-#: the result columns of the protocols, in table order (the summaries, the checks; the results
-#: table's :data:`particleShear.sweep.schema.PROTOCOL_COLUMNS`), name → unit
-_COLUMN_UNITS = {name: spec[1] for name, spec in result_columns(CHECKS)[0].items()}
-_COLUMN_UNITS.update((name, "") for name in result_columns(CHECKS)[1])
-PROTOCOL_COLUMNS = tuple(_COLUMN_UNITS)
-
 #: the protocol parameters whose value is a list (one value of a sweep is a whole list)
 LIST_PARAMETERS = tuple(p.name for p in PARAMETERS if p.kind == "float_list")
-
-#: key of a sweep step (``RheometerResult.steps``) -> its column in a results table (the other keys,
-#: the moduli and measures, are columns of the same name)
-STEP_COLUMNS = {"position": "sweep_position", "amplitude": "sweep_amplitude",
-                "relative_frequency": "sweep_relative_frequency", "f": "frequency_Hz", "dt": "dt", "N_steps": "N_steps"}
-
-
-def _dt_over_tau(p, amplitude=None):
-    """Protocol time step in units of τ (the time-step rule is linear in τ)."""
-    A = p["theAmplitude"] if amplitude is None else amplitude
-    return time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"], A,
-                                 p["relative_viscosity"])[0] * p["time_step_factor"]
 
 
 def check_protocol(p):
@@ -207,250 +185,25 @@ def protocol_steps(q):
         ``segments`` (sweeps: the oscillatory steps of each step of the sweep) and ``dts`` (sweeps:
         each step's dt/τ).
     """
-    return REGISTRY[q.get("protocol", "oscillatory")].steps(q, lambda amplitude=None: _dt_over_tau(q, amplitude))
+    return REGISTRY[q.get("protocol", "oscillatory")].steps(q, lambda amplitude=None: dt_over_tau(q, amplitude))
 
 
-class RheometerResult:
-    """What a run of a protocol other than "oscillatory" produced (docs/protocols.md).
+class RheometerResult(SimulationResult):
+    """Deprecated: every protocol's run returns a :class:`~particleShear.run.result.SimulationResult`.
 
-    The constructor's parameters are the attributes below of the same names (``values`` is derived).
-
-    Parameters
-    ----------
-    protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps, timings
-        See Attributes.
-
-    Attributes
-    ----------
-    protocol : str
-        The protocol.
-    parameters : dict
-        Every argument of the run (normalized: a sweep's first value in ``theAmplitude`` or
-        ``relative_frequency``).
-    seed, spawn_key, run_id
-        As :class:`~particleShear.run.api.SimulationResult`.
-    tau : float
-        Model time constant τ (s).
-    dt : float
-        Time step (s; of the first step for sweeps).
-    series : dict of numpy.ndarray
-        The record of every step: "t" (s), "strain", "strain_rate" (1/s), "stress_internal",
-        "stress_surface" (Pa), for "steady" "N1" (Pa, NaN where not sampled); for sweeps the
-        steps' records one after the other with "sweep_position" (each step's clock from 0).
-    output_path : str or None
-        The run's file (``saveData=True``; :mod:`particleShear.run.rheometer_files`), else None.
-    write_error : Exception or None
-        Why writing the file failed (the result is kept), else None.
-    summary : dict
-        Scalar results by name (units in docs/protocols.md).
-    curves : dict
-        ``name -> (t, y, y_sem)`` on log-spaced grids: "G" (relaxation, Pa), "J" (creep, 1/Pa).
-    steps : list of dict
-        Sweeps: one dict per step (position, amplitude, relative_frequency, f, G′/G″ of both
-        estimators with standard errors, LAOS measures).
-    timings : dict
-        Wall times (s) of "constitution", "pre_equilibration", "protocol", "analysis".
-    values : list of float
-        What ``doParticleShearSimulation`` returns without ``return_result``: steady ``[σ, η]``
-        (surface), relaxation ``[G_plateau]``, creep ``[final creep rate, σ₀/γ̇]``, sweeps
-        ``[[G′, G″], …]`` per step (surface).
+    ``RheometerResult(protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves,
+    steps, timings)`` (2.x) makes that result (:meth:`SimulationResult.of_protocol
+    <particleShear.run.result.SimulationResult.of_protocol>`) with a ``DeprecationWarning``; the
+    name stays so that scripts and pickles of 2.x keep working.
     """
 
-    def __init__(self, protocol, parameters, seed, spawn_key, run_id, tau, dt, series, summary, curves, steps,
-                 timings):
-        self.protocol, self.parameters, self.seed, self.spawn_key, self.run_id = (protocol, parameters, seed,
-                                                                                  spawn_key, run_id)
-        self.tau, self.dt, self.series, self.summary, self.curves, self.steps = tau, dt, series, summary, curves, steps
-        self.timings = timings
-        self.output_path = None
-        self.write_error = None
-
-    @property
-    def verdict(self):
-        """``"ok"`` or ``"flagged: …"`` (:mod:`particleShear.analysis.verdicts`); a sweep's is that of its
-        steps together (None when not judged)."""
-        if not self.steps:
-            return self.summary.get("verdict")
-        names = PROTOCOL_CHECKS[self.protocol]
-        return verdict({n: (False if any(st.get(n) is False for st in self.steps) else None) for n in names})
-
-    @property
-    def values(self):
-        """The main numbers of the protocol (see the class docstring)."""
-        values = REGISTRY[self.protocol].values
-        if values is not None:
-            return values(self.summary)
-        return [[st["Gp_surface"], st["Gpp_surface"]] for st in self.steps]
-
-    def rows(self):
-        """The rows of this run in a sweep's results table: one, or one per step of a sweep.
-
-        Keys as :func:`particleShear.sweep.table.table_columns` of a protocol sweep: ``run_id``,
-        ``status`` ("ok"), ``error``, the moduli and measures (sweep steps), the run columns
-        (``repetition``, ``frequency_Hz`` and ``omega`` of a sweep step, ``dt``, ``N_steps``), the
-        protocol columns (:data:`PROTOCOL_COLUMNS`: the summary, or
-        ``sweep_position``, ``sweep_amplitude``, ``sweep_relative_frequency`` of a step), every
-        parameter, ``seed_entropy``, ``spawn_key``, ``package_version``, ``wall_time_s`` (s),
-        ``output_path``.  Columns a protocol does not produce are absent (empty cells).
-
-        Returns
-        -------
-        list of dict
-        """
-        params = spec_defaults(protocols=True)
-        params.update({k: v for k, v in self.parameters.items() if k in params})
-        base = {"run_id": run_identity(params, self.seed, self.spawn_key), "status": "ok", "error": "",
-                "repetition": int(getattr(self, "repetition", 0)), "dt": float(self.dt)}
-        base.update({k: v for k, v in self.summary.items() if k in PROTOCOL_COLUMNS or k == "verdict"})
-        if REGISTRY[self.protocol].recorded:
-            base["N_steps"] = int(len(self.series["t"])) if "t" in self.series else None
-        base.update(params)
-        base.update(seed_entropy=self.seed, spawn_key=list(self.spawn_key), package_version=__version__,
-                    wall_time_s=float(sum(self.timings.values())), output_path=self.output_path or "")
-        if not self.steps:
-            return [base]
-        out = []
-        for st in self.steps:
-            row = dict(base, **{STEP_COLUMNS.get(k, k): v for k, v in st.items()})
-            row["omega"] = 2 * math.pi * float(st["f"])
-            out.append(row)
-        return out
-
-    @classmethod
-    def from_rows(cls, rows, parameters, seed, spawn_key, output_path=None):
-        """The result of a finished run rebuilt from its table rows (no series, no curves).
-
-        Used when a series or a sweep resumes: the summary, or the steps of a sweep, are the
-        rows' values (the inverse of :meth:`rows`).
-
-        Parameters
-        ----------
-        rows : list of dict
-            The run's typed rows (:func:`particleShear.sweep.schema.typed_row`), in step order.
-        parameters : dict
-            The run's parameters.
-        seed, spawn_key
-            The run's seed entropy and spawn key.
-        output_path : str, optional
-            The run's file.
-
-        Returns
-        -------
-        RheometerResult
-        """
-        first = rows[0]
-        proto = parameters["protocol"]
-        inverse = {c: k for k, c in STEP_COLUMNS.items()}
-        moduli = ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal") + tuple(MEASURE_COLUMNS)
-        steps = [{inverse.get(c, c): r.get(c) for c in tuple(STEP_COLUMNS.values()) + moduli}
-                 for r in rows] if REGISTRY[proto].segmented else []
-        summary = {} if steps else {c: first[c] for c in PROTOCOL_COLUMNS + ("verdict",)
-                                    if first.get(c) is not None}
-        dt = float(first["dt"])
-        res = cls(proto, dict(parameters), seed, tuple(spawn_key), first["run_id"], dt / _dt_over_tau(parameters), dt,
-                  {}, summary, {}, steps, {"total": float(first.get("wall_time_s") or 0.0)})
-        res.output_path = output_path
-        return res
-
-    def plot(self, path=None):
-        """The protocol's figure (needs ``particleShear[plot]``): the stress against strain of a
-        steady run, G(t), J(t), or G′/G″ of a sweep's steps
-        (:func:`particleShear.rheometer_plot.plot_rheometer_result`).
-
-        Parameters
-        ----------
-        path : str or os.PathLike, optional
-            File to write (PNG, PDF, SVG or EPS, chosen by the extension); None writes nothing.
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-        """
-        return entry("plot_rheometer_result")(self, path)
-
-    def _summary(self):
-        """(run fields, rows) of :meth:`__repr__` and :meth:`_repr_html_`.
-
-        Fields: ``(label, text)`` of protocol, N, μ, seed and run id.  Rows ``(name, value text,
-        unit)``: the summary's numbers with their standard errors (``name_se``) where finite, and
-        the units of the results-table columns of the same names; for sweeps one row per step
-        (G′, G″ of both estimators in Pa).
-        """
-        p = self.parameters or {}
-        seed = "None" if self.seed is None else str(self.seed)
-        if self.spawn_key:
-            seed += " spawn " + ",".join(str(k) for k in self.spawn_key)
-        fields = [("protocol", self.protocol), ("N", str(p.get("N", "?"))), ("μ", str(p.get("theMu", "?"))),
-                  ("seed", seed), ("run_id", self.run_id or "–")]
-
-        def num(v, se=None):
-            text = f"{v:.4g}" if isinstance(v, (float, int)) and not isinstance(v, bool) else str(v)
-            if isinstance(se, float) and math.isfinite(se):
-                text += f" ± {se:.2g}"
-            return text
-
-        rows = []
-        if self.steps:
-            for st in self.steps:
-                label = REGISTRY[self.protocol].label(st)
-                for est in ("surface", "internal"):
-                    rows.append((f"{label} ({est})",
-                                 f"G′ = {num(st.get('Gp_' + est, float('nan')), st.get('Gp_' + est + '_se'))}, "
-                                 f"G″ = {num(st.get('Gpp_' + est, float('nan')), st.get('Gpp_' + est + '_se'))}",
-                                 "Pa"))
-        else:
-            for name, v in self.summary.items():
-                if name.endswith("_se") or name in CHECKS or name == "verdict":
-                    continue
-                unit = _unit(name)
-                rows.append((name, num(v, self.summary.get(name + "_se")), "" if unit == "1" else unit))
-        return fields, rows
-
-    def __repr__(self):
-        """A short summary: protocol, N, μ, seed, run id, then each summary number with its standard
-        error and unit (sweeps: G′, G″ of both estimators per step) — not the records.
-
-        Returns
-        -------
-        str
-        """
-        fields, rows = self._summary()
-        lines = ["RheometerResult(" + ", ".join(f"{k}={v}" for k, v in fields)]
-        lines += [f"  {name}: {text}" + (f" {unit}" if unit else "") for name, text, unit in rows]
-        lines += ["  " + line for line in self._verdict_lines()]
-        return "\n".join(lines) + ")"
-
-    def _verdict_lines(self):
-        """The verdict of the run (:func:`~particleShear.analysis.verdicts.verdict_lines`); a sweep's per step."""
-        if not self.steps:
-            return verdict_lines(self.summary, self.protocol) if "verdict" in self.summary else []
-        return [f"step {st.get('position', j)}: {st.get('verdict') or 'not judged'}" for j, st in enumerate(self.steps)]
-
-    def _repr_html_(self):
-        """The summary of :meth:`__repr__` as a small HTML table (Jupyter); all text HTML-escaped.
-
-        Returns
-        -------
-        str
-        """
-        import html
-        esc = html.escape
-        fields, rows = self._summary()
-        cap = ", ".join(f"{esc(k)} = {esc(v)}" for k, v in fields)
-        out = ["<table>", f"<caption>RheometerResult: {cap}</caption>",
-               "<tr><th>quantity</th><th>value</th><th>unit</th></tr>"]
-        out += [f"<tr><td>{esc(name)}</td><td>{esc(text)}</td><td>{esc(unit)}</td></tr>" for name, text, unit in rows]
-        out += [f'<tr><td colspan="3">{esc(line.strip())}</td></tr>' for line in self._verdict_lines()]
-        out.append("</table>")
-        return "\n".join(out)
-
-
-def _unit(name):
-    """The unit of a summary number: its result column's, or its parameter's ("" when none)."""
-    if name in _COLUMN_UNITS:
-        return _COLUMN_UNITS[name]
-    par = BY_NAME.get(name)
-    return par.unit if par is not None and par.kind in ("float", "int", "float_list") else ""
+    def __new__(cls, *args, **kwargs):
+        if not args and not kwargs:      # unpickling a 2.x RheometerResult: its fields come with its state
+            return super().__new__(cls)
+        import warnings
+        warnings.warn("RheometerResult is deprecated: every protocol's run returns a SimulationResult "
+                      "(SimulationResult.of_protocol takes these arguments)", DeprecationWarning, stacklevel=2)
+        return SimulationResult.of_protocol(*args, **kwargs)
 
 
 def _concatenated(records):
@@ -478,7 +231,7 @@ def measure_rheometer(runs):
 
     Returns
     -------
-    list of RheometerResult
+    list of SimulationResult
     """
     proto = runs[0]["protocol"]
     spec = REGISTRY[proto]
@@ -529,9 +282,9 @@ def measure_rheometer(runs):
             series, curves, summary = _concatenated([rec for *_, rec in segments]), {}, {}
         seed_entropy, spawn_key, _ = seeds[b]
         tm = dict(timings[b], protocol=t_protocol, analysis=time.perf_counter() - t1)
-        results[b] = RheometerResult(proto, dict(kw), seed_entropy, spawn_key,
-                                     run_identity(kw, seed_entropy, spawn_key), tau, sc.dt, series, summary, curves,
-                                     sweep, tm)
+        results[b] = SimulationResult.of_protocol(proto, dict(kw), seed_entropy, spawn_key,
+                                                  run_identity(kw, seed_entropy, spawn_key), tau, sc.dt, series,
+                                                  summary, curves, sweep, tm)
         if kw["saveData"]:
             t2 = time.perf_counter()
             write_protocol_file(sessions[b].sim, results[b])

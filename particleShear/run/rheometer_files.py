@@ -39,7 +39,7 @@ def record_columns(result):
 
     Parameters
     ----------
-    result : RheometerResult
+    result : SimulationResult
 
     Returns
     -------
@@ -68,7 +68,7 @@ def protocol_header(block1, result):
     ----------
     block1 : str
         Block 1 of the oscillatory file (``write_information_on_simulation_to_file``).
-    result : RheometerResult
+    result : SimulationResult
 
     Returns
     -------
@@ -115,7 +115,7 @@ def write_protocol_file(sim, result):
     ----------
     sim : Simulation_interlocking_rheology
         The run's simulation (block 1, ``root_folder``, provenance).
-    result : RheometerResult
+    result : SimulationResult
     """
     fmt = getattr(sim, "output_format", "text")
     out = None

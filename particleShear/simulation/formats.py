@@ -293,8 +293,9 @@ class RunData(dict):
     ``stress_tensor_*`` columns when saved); empty for a text file written with
     ``saveStressTensorData=False`` (the reference writes no table then).  A rheometer
     protocol's file (docs/protocols.md) has the first six columns and ``N1`` (steady) or
-    ``sweep_position`` (sweeps); its ``protocol``, ``summary``, ``steps`` and ``curves`` are
-    properties.
+    ``sweep_position`` (sweeps); its ``protocol``, ``parameters``, ``f``, ``summary``, ``steps``,
+    ``curves`` and ``series`` are properties, named as those of a
+    :class:`~particleShear.run.result.SimulationResult`.
 
     Made by :func:`read_run`; the parameters are also its attributes.
 
@@ -334,6 +335,17 @@ class RunData(dict):
         return self._header_value("frequency")
 
     @property
+    def f(self):
+        """The excitation frequency f (Hz), as ``SimulationResult.f``: :attr:`frequency`."""
+        return self.frequency
+
+    @property
+    def parameters(self):
+        """The run's parameters as the file's metadata records them (``SimulationResult.parameters``;
+        {} when absent)."""
+        return dict(self.metadata.get("parameters") or {})
+
+    @property
     def strain_amplitude(self):
         """The strain amplitude γ₀ (dimensionless), from the call's ``amplitude=…`` in the header
         (exactly the value given), else ``Strain amplitude = …%`` / 100."""
@@ -359,12 +371,12 @@ class RunData(dict):
 
     @property
     def summary(self):
-        """A protocol file's scalar results (``RheometerResult.summary``, from the metadata; {} when absent)."""
+        """A protocol file's scalar results (``SimulationResult.summary``, from the metadata; {} when absent)."""
         return dict(self.metadata.get("summary") or {})
 
     @property
     def steps(self):
-        """A sweep file's steps (``RheometerResult.steps``, from the metadata; [] when absent)."""
+        """A sweep file's steps (``SimulationResult.steps``, from the metadata; [] when absent)."""
         return [dict(st) for st in self.metadata.get("steps") or []]
 
     @property
@@ -378,7 +390,7 @@ class RunData(dict):
     @property
     def series(self):
         """The columns under the keys of ``SimulationResult.series`` (tensors as (n, 9, 2, 2)), and
-        of ``RheometerResult.series`` for a protocol file (``N1``, ``sweep_position``)."""
+        of another protocol's ``SimulationResult.series`` for a protocol file (``N1``, ``sweep_position``)."""
         out = {key: self[col] for key, col in _SERIES_COLUMNS if col in self}
         out.update({col: self[col] for col in RHEOMETER_EXTRA_COLUMNS if col in self})
         names = TABLE_COLUMNS[6:]

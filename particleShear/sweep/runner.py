@@ -68,9 +68,8 @@ class SweepOutcome:
         Its row of ``results.csv`` (status ``ok`` or ``failed``, moduli in Pa, parameters, ...),
         values typed as the worker produced them (floats, ints, bools, the spawn key a list);
         the first step's row for a one-packing sweep.
-    result : SimulationResult, RheometerResult or None, optional
-        The :class:`~particleShear.run.api.SimulationResult` (a
-        :class:`~particleShear.run.rheometer.RheometerResult` for the other protocols; None for a
+    result : SimulationResult or None, optional
+        The :class:`~particleShear.run.api.SimulationResult` (of any protocol; None for a
         failed run); its per-step ``series`` are kept only with ``keep_series=True``.
     rows : list of dict, optional
         Every row of the run: one per step of a one-packing sweep (``sweep_position`` 0, 1, ...),

@@ -10,11 +10,9 @@ import os
 from .pool import pool_context, run_jobs
 from .runner import Sweep
 from .table import TABLE_NAME, table_columns
-from ..analysis.measures import MEASURE_COLUMNS, NON_NUMERIC_MEASURES
-from ..analysis.microstructure import MICRO_COLUMNS
 from ..run.api import SimulationResult
 from ..run.batch import batches
-from ..run.rheometer import RheometerResult, normalize_protocol
+from ..run.rheometer import normalize_protocol
 from ..simulation.provenance import run_identity
 from .spec import SweepRun, sweep_parameter_defaults, uses_protocols
 
@@ -37,29 +35,12 @@ def _from_runs(runs, out_dir):
 
 def _result_from_rows(rows, run, out_dir):
     """A light result of a run finished in an earlier call, from its typed rows (moduli or the protocol's
-    values, measures, time scales, parameters, seed, path; no series)."""
+    values, measures, time scales, parameters, seed, path; no series: :meth:`SimulationResult.from_rows`)."""
     row = rows[0]
     path = os.path.join(out_dir, os.path.basename(row["output_path"])) if row.get("output_path") else None
-    if run.parameters.get("protocol", "oscillatory") != "oscillatory":
-        res = RheometerResult.from_rows(rows, run.parameters, run.seed_entropy, run.spawn_key, path)
-        res.repetition = run.repetition
-        return res
-    g = tuple(_number(row.get(c)) for c in ("Gp_surface", "Gpp_surface", "Gp_internal", "Gpp_internal"))
-    result = SimulationResult(G_surface=g[:2], G_internal=g[2:], stress_surface=(), stress_internal=(),
-                              parameters=dict(run.parameters), seed=run.seed_entropy, spawn_key=tuple(run.spawn_key),
-                              timings={"total": _number(row.get("wall_time_s"))},
-                              output_path=path,
-                              dt=_number(row.get("dt")), f=_number(row.get("frequency_Hz")),
-                              N_steps=int(row.get("N_steps") or 0), repetition=run.repetition, run_id=run.run_id)
-    # (an empty microstructure cell stays None: not evaluated, as the run without the observer reports it)
-    result._measures = {c: (row.get(c) if c in NON_NUMERIC_MEASURES or (c in MICRO_COLUMNS and row.get(c) is None)
-                            else _number(row.get(c))) for c in MEASURE_COLUMNS}
+    result = SimulationResult.from_rows(rows, run.parameters, run.seed_entropy, run.spawn_key, path)
+    result.repetition, result.run_id = run.repetition, run.run_id
     return result
-
-
-def _number(value):
-    """A typed cell as float: None (empty) is NaN."""
-    return float("nan") if value is None else float(value)
 
 
 def series_parameters(kwargs):
@@ -106,8 +87,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
 
     Returns
     -------
-    list of SimulationResult or list of RheometerResult
-        In the order of ``all_kwargs`` (RheometerResult for a protocol other than "oscillatory").
+    list of SimulationResult
+        In the order of ``all_kwargs``.
 
     Raises
     ------

@@ -139,7 +139,8 @@ def execute_run(task):
     Returns
     -------
     tuple
-        ``(row, result)``: the results-table row (dict) and the SimulationResult, or None
+        ``(row, result)``: the results-table row (dict; a list of the rows of a sweep protocol's
+        steps) and the SimulationResult, or None
         when the run failed before its moduli were known.
     """
     t0 = time.perf_counter()
@@ -181,7 +182,7 @@ def _finish_run(task, result, wall_time_s):
     result.repetition = int(task.get("repetition", 0))
     if result.output_path:
         run_dir = os.path.dirname(result.output_path)
-        image_folder, produced = getattr(result, "image_folder", None), result.output_path
+        image_folder, produced = result.image_folder, result.output_path
         result.output_path = publish(run_dir, task["out_dir"], result.output_path, task["run_id"])
         if image_folder:  # published beside the file: its name after the run's name, renamed as the file
             tail = os.path.basename(image_folder)[len(os.path.basename(run_file_stem(produced))):]
@@ -191,7 +192,7 @@ def _finish_run(task, result, wall_time_s):
         for row in rows:
             if row.get("protocol") in (None, ""):
                 row["protocol"] = task["parameters"]["protocol"] or "oscillatory"
-    err = getattr(result, "write_error", None)
+    err = result.write_error
     for row in rows:
         if row["run_id"] != task["run_id"]:  # pragma: no cover - identity must not depend on the process
             raise RuntimeError(f"run id {row['run_id']} differs from the sweep's {task['run_id']}")
