@@ -5,9 +5,9 @@ scene of docs/performance.md), stepped through ``BatchEngine.set_rate`` + ``step
 sample=True)`` on one ``BatchState`` of B replicas (seeds 1 … B), per backend.  Both engines are
 built and warmed first (the compile, or the load from the cache, is not timed); then timed blocks
 alternate NumPy / Numba / NumPy / … and the median of each backend's blocks is printed, with
-their ratio.  One thread (``OMP_NUM_THREADS=1`` …).  The compiled backend runs the force terms of
-a step (laws, viscous term, two-visit tangential rule) in one compiled loop; everything else is the
-NumPy engine's (docs/backends.md).
+their ratio.  One thread (``OMP_NUM_THREADS=1`` …).  The compiled backend runs each step in one
+compiled call from the NumPy engine's own functions (engine/numba_step.py, docs/backends.md); the
+candidate search and the Python of the loop around the step are the same on both.
 
 Last row: the default run ``doParticleShearSimulation(seed=1)`` (no drawing, no files), whole call
 with a warm compile cache, per backend.
