@@ -16,7 +16,7 @@ __docformat__ = "numpy"
 
 from .xp import array_namespace, select
 
-__all__ = ["velocity_change", "half_velocity_change", "plate_velocity", "damped", "xi_rates", "kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
+__all__ = ["velocity_change", "half_velocity_change", "plate_velocity", "flow_shifted", "damped", "xi_rates", "kick", "half_kick", "mobile_mask", "plates_follow", "damp", "shift_flow", "remove_mean_velocity",
            "xi_increments", "drift"]
 
 
@@ -258,8 +258,26 @@ def shift_flow(vx, omega, yc, delta):
     delta : ndarray (n,) or float
         Change of the shear rate of each sphere's replica (1/s).
     """
-    vx += yc * delta
-    omega -= delta / 2
+    vx[...], omega[...] = flow_shifted(vx, omega, yc, delta)
+
+
+def flow_shifted(vx, omega, yc, delta):
+    """``(v_x + (y − Ly/2)·Δγ̇, ω − Δγ̇/2)``: the velocities after a change of the shear rate (pure; see :func:`shift_flow`).
+
+    Parameters
+    ----------
+    vx, omega : ndarray or float
+        x velocity (µm/s) and spin (rad/s).
+    yc : ndarray or float
+        Height above the cell's centre line (µm).
+    delta : ndarray or float
+        Change of the shear rate (1/s).
+
+    Returns
+    -------
+    tuple
+    """
+    return vx + yc * delta, omega - delta / 2
 
 
 def remove_mean_velocity(vel, B):

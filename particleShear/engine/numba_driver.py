@@ -164,29 +164,28 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=()):
     return compiled
 
 
-def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, friction=True):
-    """The force terms of candidate ``p`` on numbers (compiled; see :func:`compile_pair_kernel`).
+def pair_term(form, r, vn, vt, touching, active, xi_ij, xi_ji, d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c,
+              nu, k_t, nu_t, mu, fc_inf, k_t_j, nu_t_j, friction=True):
+    """The force terms of one candidate pair on numbers (compiled; see :func:`compile_pair_kernel`).
 
     The body both compiled loops run per pair (the force terms of :func:`pair_terms` and the whole
     step of :mod:`.numba_step`): the compressive law of the form, the tensile law of bonds, the
     viscous term, the Coulomb bound and the two-visit tangential rule, from the same functions as
-    the NumPy terms.
+    the NumPy terms.  Numbers only (an array argument costs a reference count per call).
 
     Parameters
     ----------
     form : int
         :data:`FORMS` code of the compressive law.
-    p : int
-        The candidate (column of ``T``, ``xi``, ``k_t_j``, ``nu_t_j``).
     r, vn, vt : float
         Distance (µm), normal and tangential relative velocity (µm/s).
     touching, active : bool
         Overlap; relation.
-    xi : ndarray (2, P)
-        Histories, reset in place on slip.
-    T : ndarray (12, P)
-        The rows of :data:`TERM_BLOCK`.
-    k_t_j, nu_t_j : ndarray (P,)
+    xi_ij, xi_ji : float
+        Histories (µm).
+    d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf : float
+        The pair's constants of :data:`TERM_BLOCK` (:func:`~particleShear.engine.terms.term_constants`).
+    k_t_j, nu_t_j : float
         The constants of the visit from j.
     friction : bool, default True
         False: no tangential term (0, 0, slip where active, ξ reset), the engine's frictionless shortcut.
@@ -194,37 +193,34 @@ def pair_term(form, p, r, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fricti
     Returns
     -------
     tuple
-        ``(fn, law, F_i, F_j, slip)``.
+        ``(fn, law, F_i, F_j, slip, reset)``: ``reset`` where both histories become 0.
     """
-    # T: the rows of TERM_ROWS (d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c, nu, k_t, nu_t, mu, fc_inf)
     if form == 1:
-        inside = linear_term(r, T[0, p], T[2, p])
+        inside = linear_term(r, d_law, a_lin)
     elif form == 2:
-        inside = divergent_term(r, T[0, p], T[1, p], T[3, p])
+        inside = divergent_term(r, d_law, d_cap, a_div)
     else:
-        inside = blend_inside(r, T[0, p], T[1, p], T[2, p], T[3, p])
-    law = contact_or_bond(r, T[0, p], inside, tensile_inside(r, T[4, p], T[5, p]))
-    f = law * T[6, p]
-    f += viscous_force(T[7, p], vn, active)
+        inside = blend_inside(r, d_law, d_cap, a_lin, a_div)
+    law = contact_or_bond(r, d_law, inside, tensile_inside(r, d_eq, a_tens))
+    f = law * ratio_c
+    f += viscous_force(nu, vn, active)
     if not friction:          # no tangential force (the frictionless shortcut): every relation slips
-        xi[0, p] = 0.0
-        xi[1, p] = 0.0
-        return f, law, 0.0, 0.0, active
-    fc = np.abs(T[10, p] * law)
-    fc += T[11, p]
-    F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi[0, p], xi[1, p], T[8, p],
-                                        k_t_j[p], T[9, p], nu_t_j[p], fc)
-    if reset:
-        xi[0, p] = 0.0
-        xi[1, p] = 0.0
-    return f, law, F_i, F_j, s
+        return f, law, 0.0, 0.0, active, True
+    fc = np.abs(mu * law)
+    fc += fc_inf
+    F_i, F_j, s, reset = two_visit_rule(vt, 1.0 if touching else 0.0, xi_ij, xi_ji, k_t, k_t_j, nu_t, nu_t_j, fc)
+    return f, law, F_i, F_j, s, reset
 
 
 def _pair_kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, law_out, F, slip):
     """The force terms of every candidate (compiled; see :func:`pair_terms`): writes ``fn, law_out, F, slip``."""
     for p in range(d.shape[0]):
-        fn[p], law_out[p], F[0, p], F[1, p], slip[p] = pair_term(form, p, d[p], vn[p], vt[p], touching[p],
-                                                                 active[p], xi, T, k_t_j, nu_t_j)
+        fn[p], law_out[p], F[0, p], F[1, p], slip[p], reset = pair_term(
+            form, d[p], vn[p], vt[p], touching[p], active[p], xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p],
+            T[3, p], T[4, p], T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p])
+        if reset:
+            xi[0, p] = 0.0
+            xi[1, p] = 0.0
 
 
 #: the functions of the compiled pair loop besides the laws, and those inlined into their callers

@@ -35,13 +35,14 @@ from . import box, forces, guard, integrate, neighbours, numba_driver, terms
 from .box import MAX_PASSES, folded, period_count
 from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
-from .integrate import damped, half_velocity_change, plate_velocity, velocity_change, xi_rates
+from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
 from .neighbours import verlet_bound
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws
 from .terms import normal_speed, pair_forces, slip_speed
 
-__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_kernels", "run_step", "NOT_RUN"]
+__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_kernels", "run_step",
+           "run_block", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -57,6 +58,8 @@ KERNEL_FUNCTIONS = ((numba_driver, "pair_term"), (sys.modules[__name__], "_min_i
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum")
+#: the functions of the compiled block (:func:`run_block`) besides the step's
+BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
@@ -72,7 +75,7 @@ _ARGUMENTS = ("i i f f b b b b i i b[:] b b f[:,:] f[:,:] "          # start …
 NOT_RUN = object()
 
 # the kernel's return codes
-_DONE, _D_ZERO, _GUARD, _UNITS = 0, 1, 2, 3
+_DONE, _D_ZERO, _GUARD, _UNITS, _NEED = 0, 1, 2, 3, 4
 
 _kernels = {}
 
@@ -253,8 +256,12 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, fre
             rv = (vj0 - vi0 + dvx, vj1 - vi1)
             vn = normal_speed(rv, nx, ny)
             vt = slip_speed(rv, nx, ny, Cf[_IRI, p], Cf[_IRJ, p], vi2, vj2) if free_mode != 1 else 0.0
-            fn, law, F_i, F_j, slip = pair_term(form, p, d, vn, vt, touching, rel, xi, T, k_t_j, nu_t_j,
-                                                free_mode != 1)
+            fn, law, F_i, F_j, slip, reset = pair_term(
+                form, d, vn, vt, touching, rel, xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p], T[3, p], T[4, p],
+                T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p], free_mode != 1)
+            if reset:
+                xi[0, p] = 0.0
+                xi[1, p] = 0.0
             if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
                 xi[0, p] = 0.0
                 xi[1, p] = 0.0
@@ -460,6 +467,7 @@ def compile_kernels(say=None):
     """
     numba_driver.compile_pair_kernel(say=say)
     compile_step_kernel(say=say)
+    compile_block_kernel()
 
 
 class _Workspace:
@@ -545,16 +553,41 @@ def run_step(engine, cool, dt, sample):
         When the guard finds a guarded replica unstable (after the force phase, as NumPy).
     """
     engine.neighbours()
-    ws = _workspace(engine)
-    if ws.why is not None:
-        if ws.why not in engine.notes:
-            engine.notes.add(ws.why)
-            warnings.warn(f"backend='numba': this step runs on NumPy ({ws.why})", RuntimeWarning, stacklevel=3)
+    ws = _prepared(engine)
+    if ws is None:
         return NOT_RUN
     kernel = _kernels.get(True) or compile_step_kernel()
-    s, C = engine.s, engine.C
     check = ws.guarded and not engine.step_count % engine.check_interval
-    gamma, t = s.gamma.astype(float), s.t.astype(float)       # (copies: the state's arrays are replaced)
+    args, held = _arguments(engine, ws, cool, dt, sample, check)
+    status = kernel(0, *args)
+    if status == _D_ZERO:
+        return NOT_RUN
+    _adopt(engine, ws, held)
+    if status == _GUARD:
+        _report(engine, ws)
+    if status == _UNITS:
+        _draw_units(engine, ws)
+        kernel(1, *args)
+    _adopt(engine, ws, held, stepped=True)
+    engine.step_count += 1
+    return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
+
+
+def _prepared(engine):
+    """The engine's workspace when its step runs compiled, else None (with the note, once per reason)."""
+    ws = _workspace(engine)
+    if ws.why is None:
+        return ws
+    if ws.why not in engine.notes:
+        engine.notes.add(ws.why)
+        warnings.warn(f"backend='numba': this step runs on NumPy ({ws.why})", RuntimeWarning, stacklevel=4)
+    return None
+
+
+def _arguments(engine, ws, cool, dt, sample, check):
+    """The arguments of :func:`_step_kernel` after ``start``, and the arrays to hand back (:func:`_adopt`)."""
+    s, C = engine.s, engine.C
+    gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
     state_p, xi, active, birth, next_birth, u, u_max, strain, bound, rate_max = (
         _array(a) for a in (engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth, engine.u,
                             engine.u_max, engine.strain, engine.bound, engine.rate_max))
@@ -562,32 +595,201 @@ def run_step(engine, cool, dt, sample):
     free_mode, free = (0, ws.zero) if free is None else (1, ws.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
     predicted = verlet and engine.half is not None
-    half = _array(engine.half) if predicted else ws.no_half
+    half = np.array(engine.half, dtype=float) if predicted else np.empty((3, s.B * s.N)) if verlet else ws.no_half
     new_half = np.empty((3, s.B * s.N)) if verlet else ws.no_half    # (a new array per step, as half_kick gives)
-    args = (s.N, float(cool), float(dt), bool(sample), check, bool(s.applying_shear), engine.numbers_relations,
-            ws.form, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r, ws.Ly_s, ws.rep_s,
-            _array(s.rate), gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active, birth, next_birth,
-            u, u_max, strain, bound, ws.r_max, ws.skin,
+    args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
+            ws.form, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r,
+            ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active,
+            birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
-    status = kernel(0, *args)
-    if status == _D_ZERO:
-        return NOT_RUN
-    engine.state_p, engine.xi, engine.active, engine.birth, engine.next_birth = state_p, xi, active, birth, next_birth
-    engine.rate_max = rate_max
-    if status == _GUARD:
-        v = ws.verdict
-        engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
-    if status == _UNITS:
-        for p in np.flatnonzero(ws.zero):      # pair order, each pair's own replica's generator (forces.normals)
-            theta = 2 * np.pi * s.rng[int(C.rep_host[p])].random()
-            ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
-        kernel(1, *args)
-    engine.u, engine.u_max, engine.strain, engine.bound = u, u_max, strain, bound
-    if verlet:
-        engine.half = new_half
-    s.gamma, s.t = gamma, t
-    engine.need = ws.need.copy()
-    engine.step_count += 1
-    engine.g = engine.verdict = None
-    return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
+    held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
+                u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate, half=new_half if verlet else None)
+    return args, held
+
+
+def _adopt(engine, ws, held, stepped=False):
+    """Hand the arrays the kernel wrote back to the engine: after the force phase the relations and
+    the guard's record; after a whole step (``stepped``) also the displacement bookkeeping, the
+    strain, the clock, the Verlet half kick and the lists due."""
+    for name in ("state_p", "xi", "active", "birth", "next_birth", "rate_max"):
+        setattr(engine, name, held[name])
+    engine.s.rate = held["rate"]
+    if stepped:
+        for name in ("u", "u_max", "strain", "bound"):
+            setattr(engine, name, held[name])
+        if held["half"] is not None:
+            engine.half = held["half"]
+        engine.s.gamma, engine.s.t = held["gamma"], held["t"]
+        engine.need = ws.need.copy()
+        engine.g = engine.verdict = None
+
+
+def _report(engine, ws):
+    """Raise the guard's EngineInstability of the verdict the kernel wrote."""
+    v = ws.verdict
+    engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
+
+
+def _draw_units(engine, ws):
+    """The random unit vectors at ``|R| = 0`` (``work`` rows 8, 9): pair order, each pair's own
+    replica's generator, as :func:`~particleShear.engine.forces.normals` draws them."""
+    s, C = engine.s, engine.C
+    for p in np.flatnonzero(ws.zero):
+        theta = 2 * np.pi * s.rng[int(C.rep_host[p])].random()
+        ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
+
+
+def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
+    """Steps of the engine in compiled blocks: a protocol's steps at the rates ``rates``, recorded
+    from row ``row`` on, or ``n`` steps at the state's rate without samples (``rates`` None).
+
+    Each step of a schedule is what :func:`~particleShear.engine.rheometer.shear_record` does for
+    it with a sample of the two shear stresses: ``set_rate`` (each sphere keeps its velocity
+    relative to the flow, :func:`~particleShear.engine.integrate.flow_shifted`), record the clock,
+    strain and rate, the step, record the stresses.  One compiled call runs steps until the block
+    ends or a candidate list is due (rebuilt here, on NumPy); a pair at ``d = 0`` runs its step on
+    NumPy, a ``|R| = 0`` gets its random direction here, and the guard's verdict is reported as
+    the step's.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``).
+    rates : ndarray (n, B) or None
+        γ̇ of every replica at each of the n steps (1/s); None: ``n`` steps at the state's rate.
+    cool, dt : float
+        Damping factor and time step (s).
+    record : dict of ndarray (n_steps, B), optional
+        The protocol's record ("t", "strain", "strain_rate", "stress_internal", "stress_surface"),
+        with ``rates``.
+    row : int, default 0
+        The record's row of the first step.
+    n : int, optional
+        The number of steps without ``rates``.
+
+    Returns
+    -------
+    int
+        The steps run, or fewer when the engine's steps do not run compiled (the caller runs the
+        rest step by step).
+    """
+    scheduled = rates is not None
+    if scheduled:
+        rates = np.ascontiguousarray(rates, dtype=float)
+        n = len(rates)
+        rec = tuple(record[name] for name in ("t", "strain", "strain_rate", "stress_internal", "stress_surface"))
+    else:
+        rates = _NO_RECORD
+        rec = (_NO_RECORD,) * 5
+    k = 0
+    while k < n:
+        engine.neighbours()
+        ws = _prepared(engine)
+        if ws is None:
+            return k
+        kernel = _kernels.get("block") or compile_block_kernel()
+        args, held = _arguments(engine, ws, cool, dt, scheduled, False)
+        k, status, engine.step_count = kernel(k, n, rates, *rec, row, engine.step_count, engine.check_interval,
+                                              ws.guarded, scheduled, *args)
+        _adopt(engine, ws, held, stepped=True)
+        if status == _D_ZERO:      # (its rate is set and its clock, strain and rate recorded)
+            out = engine.step(cool, dt, sample=scheduled)
+            if scheduled:
+                rec[3][row + k], rec[4][row + k] = out[0], out[1]
+            k += 1
+        elif status == _GUARD:
+            _adopt(engine, ws, held)
+            _report(engine, ws)
+        elif status == _UNITS:     # the rest of step k, on the block's own arrays
+            _draw_units(engine, ws)
+            (_kernels.get(True) or compile_step_kernel())(1, *args)
+            _adopt(engine, ws, held, stepped=True)
+            if scheduled:
+                rec[3][row + k], rec[4][row + k] = ws.tau[0], ws.tau[1]
+            engine.step_count += 1
+            k += 1
+    return n
+
+
+_NO_RECORD = np.zeros((0, 0))
+
+
+def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step_count, interval,
+                  guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted,
+                  half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V,
+                  Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin,
+                  guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero, tau, verdict, need):
+    """Steps ``k … n − 1`` of a block on numbers (compiled; run by :func:`run_block`).
+
+    Per step of a schedule (``scheduled``): the new rate (:func:`~particleShear.engine.integrate.flow_shifted`
+    on every sphere), the record of clock, strain and rate, :func:`_step_kernel` with the two
+    stresses sampled, their record; otherwise :func:`_step_kernel` alone, at the rate of the state.
+    Returns ``(k, status, step_count)``: the next step and :data:`_DONE`, :data:`_NEED` (a list is
+    due), or the step a status of :func:`_step_kernel` stopped.
+    """
+    B = rate.shape[0]
+    nsph = pos.shape[1]
+    while k < n:
+        if scheduled:
+            for q in range(nsph):
+                b = rep_s[q]
+                vel[0, q], vel[2, q] = flow_shifted(vel[0, q], vel[2, q], pos[1, q] - Ly_s[q] / 2,
+                                                    rates[k, b] - rate[b])
+            for b in range(B):
+                rate[b] = rates[k, b]
+                rec_t[row + k, b] = t[b]
+                rec_strain[row + k, b] = gamma[b]
+                rec_rate[row + k, b] = rate[b]
+        check = guarded and step_count % interval == 0
+        status = _step_kernel(0, N, cool, dt, scheduled, check, applying, numbers, form, free_mode, free, verlet,
+                              predicted, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t,
+                              Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max,
+                              strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
+                              work, mob, yc, y0, zero, tau, verdict, need)
+        if status != _DONE:
+            return k, status, step_count
+        due = False
+        for b in range(B):
+            if scheduled:
+                rec_internal[row + k, b] = tau[0, b]
+                rec_surface[row + k, b] = tau[1, b]
+            due = due or need[b]
+        step_count += 1
+        k += 1
+        if verlet:
+            half[:, :] = half_out
+            predicted = True
+        if due:
+            return k, _NEED, step_count
+    return k, _DONE, step_count
+
+
+def compile_block_kernel(cache=True):
+    """The compiled block of :func:`run_block`, compiled once per process (or loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    if cache and "block" in _kernels:
+        return _kernels["block"]
+    import numba
+    from numba import types
+
+    if cache:
+        numba.config.CACHE_DIR = numba_driver.cache_dir()
+    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE)
+    compiled = L["_block_kernel"]
+    f2, i = types.Array(types.float64, 2, "C"), types.int64
+    step = _signature()
+    compiled.compile(types.UniTuple(i, 3)(i, i, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean,
+                                          *step.args[1:]))
+    if cache:
+        _kernels["block"] = compiled
+    return compiled

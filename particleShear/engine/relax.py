@@ -49,9 +49,6 @@ def remove_linear_drift(state):
     remove_mean_velocity(state.vel[:2], state.B)
 
 
-def _steps(engine, n, cool, dt):
-    for _ in range(n):
-        engine.step(cool, dt)
 
 
 def free_relaxation(engine, N, dt, dt_max, mu):
@@ -92,11 +89,11 @@ def free_relaxation(engine, N, dt, dt_max, mu):
     s.applying_shear = False
     engine.set_mu(np.zeros(s.B))
     for level_dt, cf in levels:
-        _steps(engine, N, cf, level_dt)
+        engine.steps(N, cf, level_dt)
         remove_linear_drift(s)
-    _steps(engine, N, 1, dt)
+    engine.steps(N, 1, dt)
     engine.set_mu(mu)
-    _steps(engine, N, 1, dt)
+    engine.steps(N, 1, dt)
     engine.flush()
     return N * (len(levels) + 2)
 

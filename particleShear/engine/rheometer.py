@@ -26,6 +26,7 @@ __docformat__ = "numpy"
 
 import math
 
+from .numba_step import run_block
 from .observers import check_observers, notify
 from .stress import TENSORS
 from .xp import to_host
@@ -38,6 +39,33 @@ OVERALL = [t.name for t in TENSORS].index("overall_stress_tensor")
 
 def _quiet(*args):
     pass
+
+
+#: the longest block of steps in one compiled call (:func:`_block_end`): the progress is reported
+#: between blocks, and the block's rates are one (BLOCK, B) array
+BLOCK = 256
+
+
+def _block_end(engine, i, n_steps, tensors_every, keep_tensors, end_tensors, after_step, observers):
+    """Where a compiled block of steps from step ``i`` ends (``i``: none), for the compiled backend.
+
+    A block holds steps that sample the two shear stresses only, whose rate does not depend on the
+    steps before (no controller ``after_step``), and ends at the latest after the first step an
+    observer is due after, and after :data:`BLOCK` steps."""
+    if not engine.backend.compiled or after_step is not None or keep_tensors:
+        return i
+    j = min(n_steps, i + BLOCK)
+    if end_tensors:
+        if i == 0 or i == n_steps - 1:
+            return i
+        j = min(j, n_steps - 1)
+    if tensors_every:
+        if i % tensors_every == 0:
+            return i
+        j = min(j, (i // tensors_every + 1) * tensors_every)
+    for ob in observers:          # (observers are notified after the steps that are multiples of their every)
+        j = min(j, (i // ob.every + 1) * ob.every)
+    return j
 
 
 def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet, report=_quiet, observers=(),
@@ -102,8 +130,21 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
     say("Start application shear protocol, total N= " + str(n_steps if total is None else total) + " steps")
     engine.phase = "protocol"
     engine.step_count = 0
-    for i in range(n_steps):
-        engine.set_rate(rate_of(i))
+    i = 0
+    pending = []        # rates of a block's steps that the compiled block left to the loop below
+    while i < n_steps:
+        j = i if pending else _block_end(engine, i, n_steps, tensors_every, keep_tensors, end_tensors, after_step,
+                                         observers)
+        if j > i:       # steps without tensors, controller or observer in one compiled block (numba_step.run_block)
+            rates = [rate_of(k) for k in range(i, j)]           # (rate_of once per step, in order)
+            done = run_block(engine, xp.stack(rates), cool, dt, rec, i)
+            i += done
+            report(i, n_steps)
+            notify(observers, engine, "protocol", i, n_steps)
+            if i == j:
+                continue
+            pending = rates[done:]
+        engine.set_rate(pending.pop(0) if pending else rate_of(i))
         rec["t"][i] = s.t
         rec["strain"][i] = s.gamma
         rec["strain_rate"][i] = s.rate
@@ -125,6 +166,7 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
             after_step(i, out[0], out[1])
         report(i + 1, n_steps)
         notify(observers, engine, "protocol", i + 1, n_steps)
+        i += 1
     engine.flush()
     engine.record = None
     return {name: to_host(v, "series") for name, v in rec.items()}

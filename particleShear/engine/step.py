@@ -433,6 +433,21 @@ class BatchEngine:
         self.move(dt)
         return out
 
+    def steps(self, n, cool, dt):
+        """``n`` steps without samples at the state's rate (:meth:`step` n times; on the compiled
+        backend in compiled blocks, :func:`~particleShear.engine.numba_step.run_block`).
+
+        Parameters
+        ----------
+        n : int
+            Steps (≥ 0).
+        cool, dt : float
+            Damping factor and time step (s).
+        """
+        done = numba_step.run_block(self, None, cool, dt, n=n) if self.backend.compiled and n > 0 else 0
+        for _ in range(done, n):
+            self.step(cool, dt)
+
     def force_phase(self, sample=False):
         """Neighbours (when due) → geometry and relations → kinematics → force terms → scatter.
 
