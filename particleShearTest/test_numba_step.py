@@ -175,6 +175,32 @@ class TestCompiledStepBits(unittest.TestCase):
             engines.append(eng)
         self.assert_same_engines(*engines)
 
+    def test_zero_R_draws_from_the_replica_generator(self):
+        """``R = v_i dt − D = 0`` exactly (sphere i moves onto j's place in one step): the ξ rule's
+        random direction is drawn from the replica's generator in the compiled step as on NumPy —
+        the same state and the same next number of the generator."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_invariants import random_ensemble
+
+        dt = 2.0 ** -20
+        after = []
+        for backend in ("numpy", "numba"):
+            e = random_ensemble(2, 1000.0, seed=3, packing_fraction=0.05)
+            s = state_from_ensembles([e], backend=backend)
+            s.rng = [np.random.default_rng(7)]
+            s.pos[:, 0], s.pos[:, 1] = (100.0, 500.0), (300.0, 500.0)    # 200 µm apart: a candidate, no contact
+            s.vel[...] = 0.0
+            s.vel[0, 0] = 200.0 / dt                                      # exactly onto j's place in one step
+            eng = BatchEngine(s, guard=False, skin_factor=2.0)
+            eng.set_rate(np.zeros(1))
+            eng.step(1.0, dt)
+            self.assertEqual(len(eng.pairs_of(0).i), 1)
+            after.append((eng, s.rng[0].random()))
+        self.assert_same_engines(after[0][0], after[1][0])
+        self.assertEqual(after[0][1], after[1][1])
+        self.assertNotEqual(after[1][1], np.random.default_rng(7).random())    # one number was drawn
+
 
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestOneFunctionTwoDrivers(unittest.TestCase):
