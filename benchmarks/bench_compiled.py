@@ -9,8 +9,10 @@ their ratio.  One thread (``OMP_NUM_THREADS=1`` …).  The compiled backend runs
 compiled call from the NumPy engine's own functions (engine/numba_step.py, docs/backends.md); the
 candidate search and the Python of the loop around the step are the same on both.
 
-Last row: the default run ``doParticleShearSimulation(seed=1)`` (no drawing, no files), whole call
-with a warm compile cache, per backend.
+"Numba, compiled blocks": the same steps through ``numba_step.run_block`` (many steps per compiled
+call, the rate update and the records inside, as the protocols' recording loop runs them).  Last
+row: the default run ``doParticleShearSimulation(seed=1)`` (no drawing, no files), whole call with a
+warm compile cache, per backend.
 
 Usage: python benchmarks/bench_compiled.py [--quick]
 """
@@ -33,15 +35,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_step  # noqa: E402
 
 from particleShear.base.engine_adapter import state_from_ensembles  # noqa: E402
+from particleShear.engine import numba_step  # noqa: E402
 from particleShear.engine.step import BatchEngine  # noqa: E402
 from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 
-BACKENDS = ("numpy", "numba")
+BACKENDS = ("numpy", "numba", "numba blocks")
 
 
 def engine(ensembles, backend):
     """A BatchEngine of copies of ``ensembles`` on ``backend`` and its timed block function."""
-    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), skin_factor=ENGINE_SKIN_FACTOR)
+    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend.split()[0]), skin_factor=ENGINE_SKIN_FACTOR)
     s, B = eng.s, len(ensembles)
     w = 2 * math.pi * bench_step.F_EXC
     cool, dt, amp = 0.99969060716623, bench_step.DT, bench_step.AMPLITUDE
@@ -52,7 +55,17 @@ def engine(ensembles, backend):
             eng.set_rate(np.full(B, amp * w * math.cos(w * float(s.t[0]))))
             eng.step(cool, dt, sample=True)
         return time.perf_counter() - t0
-    return block
+
+    def compiled_block(n):
+        # the same steps in compiled blocks (numba_step.run_block, as the protocols' recording loop runs them)
+        t0 = time.perf_counter()
+        start = float(s.t[0])
+        rates = np.repeat((amp * w * np.cos(w * (start + dt * np.arange(n))))[:, None], B, axis=1)
+        record = {name: np.empty((n, B)) for name in ("t", "strain", "strain_rate", "stress_internal",
+                                                      "stress_surface")}
+        numba_step.run_block(eng, rates, cool, dt, record, 0)
+        return time.perf_counter() - t0
+    return compiled_block if backend == "numba blocks" else block
 
 
 def row(N, B, steps, blocks):
@@ -83,15 +96,16 @@ def main():
     rows = [(150, 1, 100 if q else 400, 3 if q else 7, "µs/step"),
             (150, 32, 10 if q else 40, 3 if q else 5, "µs/replica-step"),
             (10_000, 1, 3 if q else 10, 3 if q else 5, "ns/particle-step")]
-    print("| N | B | NumPy | Numba | NumPy / Numba | unit |\n|---|---|---|---|---|---|", flush=True)
+    print("| N | B | NumPy | Numba, a call per step | Numba, compiled blocks | NumPy / Numba per step | "
+          "NumPy / Numba blocks | unit |\n|---|---|---|---|---|---|---|---|", flush=True)
     for N, B, steps, blocks, unit in rows:
         m = row(N, B, steps, blocks)
         scale = 1e9 / N if unit.startswith("ns") else 1e6
-        print(f"| {N:,} | {B} | {m['numpy'] * scale:.1f} | {m['numba'] * scale:.1f} | "
-              f"{m['numpy'] / m['numba']:.2f}× | {unit} |", flush=True)
+        print(f"| {N:,} | {B} | {m['numpy'] * scale:.1f} | {m['numba'] * scale:.1f} | {m['numba blocks'] * scale:.1f} | "
+              f"{m['numpy'] / m['numba']:.2f}× | {m['numpy'] / m['numba blocks']:.2f}× | {unit} |", flush=True)
     default_run("numba")                 # the cache warm (a first compile is not timed)
-    t = {be: statistics.median(default_run(be) for _ in range(1 if q else 3)) for be in BACKENDS}
-    print(f"| default run (seed 1), whole call | | {t['numpy']:.2f} | {t['numba']:.2f} | "
+    t = {be: statistics.median(default_run(be) for _ in range(1 if q else 3)) for be in ("numpy", "numba")}
+    print(f"| default run (seed 1), whole call | | {t['numpy']:.2f} | | {t['numba']:.2f} | | "
           f"{t['numpy'] / t['numba']:.2f}× | s |")
 
 

@@ -23,7 +23,6 @@ in Pa (docs/parameters.md, docs/output.md).
 __docformat__ = "numpy"
 
 import math
-import warnings
 
 import numpy as np
 
@@ -559,26 +558,15 @@ class BatchEngine:
         return yc, dx, dy, ky, kx, d, touching, active, image_rate
 
     def _compiled_terms(self, C):
-        """Whether the force terms of this phase run in the compiled loop of :mod:`.numba_driver`.
+        """Whether the force terms of a NumPy force phase run in the compiled pair loop of :mod:`.numba_driver`.
 
-        They do for the default laws (the linear law and the tensile law of bonds, from prepared
-        constants) of frictional replicas or bonds when the terms are not kept for a register;
-        otherwise the NumPy terms run, and a one-line note (a ``RuntimeWarning``, once per engine)
-        says why.
+        A NumPy force phase on the compiled backend is a step the compiled step leaves to NumPy (one
+        that samples every tensor, a pair at ``d = 0``, or a scene :func:`.numba_step.reason` names,
+        with its note there).  Its terms run compiled for the default laws (the linear law and the
+        tensile law of bonds, from prepared constants) of frictional replicas or bonds when the
+        terms are not kept for a register; otherwise the NumPy terms run (the same bits).
         """
-        why = None
-        if self.keep_terms:
-            why = "the force register keeps the terms of each visit"
-        elif self.free_p is not None:
-            why = "a replica without friction and bonds (the frictionless shortcut)"
-        elif force_phase_laws(self.s, C) != (None, None):
-            why = "a contact law other than the linear one, or a law callback"
-        if why is None:
-            return True
-        if why not in self.notes:
-            self.notes.add(why)
-            warnings.warn(f"backend='numba': the force terms run on NumPy here ({why})", RuntimeWarning, stacklevel=3)
-        return False
+        return not self.keep_terms and self.free_p is None and force_phase_laws(self.s, C) == (None, None)
 
     def _central(self, K, d, vn, active, parts):
         """The central term of one visit (:func:`~particleShear.engine.terms.central_term`); with
