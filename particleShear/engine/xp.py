@@ -7,8 +7,8 @@ once for both:
 * :func:`get_backend` — a backend by name (``"numpy"``, ``"numba"``, ``"cupy"``, or one registered with
   :func:`register_backend`, e.g. the CPU stand-in device of the tests), checked before any work;
   :func:`resolve_backend` — the one rule of selection: ``"auto"`` (every default) is the
-  environment variable ``PARTICLESHEAR_BACKEND`` when set, else ``"numpy"`` (its value ``auto``:
-  ``"numba"`` where Numba can be imported); :func:`identity_backend` — the backends that give NumPy's bits are
+  environment variable ``PARTICLESHEAR_BACKEND`` when set, else ``"numba"`` where Numba can be
+  imported, else ``"numpy"``; :func:`identity_backend` — the backends that give NumPy's bits are
   one run identity;
 * :class:`SegmentSum` — sums of weights into bins (the scatter of pair forces to spheres; on CuPy
   also the sums and minima over a replica's rows): ``bincount`` on NumPy; on CuPy a gather of each

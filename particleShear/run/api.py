@@ -196,10 +196,10 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
         result with ``write_error`` set (``last_result`` holds it either way).
     backend : {"auto", "numpy", "numba", "cupy"}, default "auto"
         Keyword-only.  Array library of the measurement: "auto" (the environment variable
-        ``PARTICLESHEAR_BACKEND`` when set, else "numpy"; the variable's value "auto": "numba"
-        where Numba can be imported; :func:`particleShear.engine.xp.resolve_backend`); "numpy"; "numba" (NumPy
-        arrays, the force terms of each step in one compiled loop of the same laws, bit-identical;
-        needs ``pip install particleShear[fast]``); or "cupy" to measure on a CUDA GPU (needs
+        ``PARTICLESHEAR_BACKEND`` when set, else "numba" where Numba can be imported, else "numpy";
+        :func:`particleShear.engine.xp.resolve_backend`); "numpy"; "numba" (NumPy arrays, each step
+        compiled from the NumPy engine's own functions, bit-identical; needs
+        ``pip install particleShear[fast]``); or "cupy" to measure on a CUDA GPU (needs
         ``pip install cupy-cuda12x`` and a device; equal to the NumPy run to rounding, not bit for
         bit).  The result (``result.parameters["backend"]``), results.csv and the sidecar record
         the backend used; "numpy", "numba" and "auto" give one run identity.  Every run measures through the engine (:mod:`particleShear.engine`) as a
@@ -492,7 +492,7 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
         Default None: one task per run.
     backend : {"auto", "numpy", "numba", "cupy"}, default "auto"
         Keyword-only.  Array backend of every run ("auto": ``PARTICLESHEAR_BACKEND`` when set, else
-        "numpy"; "numba": compiled force terms; "cupy": on a CUDA GPU, for runs without
+        "numba" where Numba can be imported, else "numpy"; "numba": each step compiled; "cupy": on a CUDA GPU, for runs without
         drawing and plotting; see :func:`doParticleShearSimulation`).  With ``batch_size`` a
         batch of replicas is measured in one set of device arrays.
     **options

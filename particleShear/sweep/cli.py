@@ -42,7 +42,7 @@ def build_parser():
            "replicas, one task each; rows identical to unbatched runs (default: one task per run)")
     a("--backend", default=None, metavar="NAME",
       help="array backend of every run: auto (the environment variable PARTICLESHEAR_BACKEND when set, else "
-           "numpy), numpy, numba (the force terms in one compiled loop, bit-identical; "
+           "numba where Numba can be imported, else numpy), numpy, numba (each step compiled, bit-identical; "
            "`pip install particleShear[fast]`), or cupy (a CUDA GPU; needs `pip install cupy-cuda12x`); "
            "sets the SPEC's backend (default: the SPEC's, auto)")
     a("--dask", action="store_true", help="run on a dask.distributed LocalCluster of --workers processes")
