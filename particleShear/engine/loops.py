@@ -107,7 +107,8 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
     say : callable
         ``say(message)`` receives the reference's console messages.
     report : callable
-        ``report(step, total)`` is called after every step (progress).
+        ``report(step, total)`` is called after each run of steps between the observers' steps
+        (progress; after every step with an observer of ``every`` 1).
     observers : sequence, default ()
         Observers (:mod:`particleShear.engine.observers`): each is called as
         ``observe(engine, "pre-equilibration", step, total)`` after every step that is a multiple
@@ -136,25 +137,25 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
         + " final dt " + str(dt))
     step = 0
     phase = engine.phase
-    for n, level_dt, cf in blocks:
-        say("dt= " + str(level_dt))
-        for _ in range(n):
-            engine.step(cf, level_dt)
-            step += 1
+
+    def run(n, cf, level_dt):
+        # n steps, in runs that end where an observer is due (engine.steps: compiled blocks on Numba)
+        nonlocal step
+        end = step + n
+        while step < end:
+            stop = min([end] + [(step // ob.every + 1) * ob.every for ob in observers])
+            engine.steps(stop - step, cf, level_dt)
+            step = stop
             report(step, total)
             notify(observers, engine, phase, step, total)
+
+    for n, level_dt, cf in blocks:
+        say("dt= " + str(level_dt))
+        run(n, cf, level_dt)
     say("  Setting final dt= " + str(dt))
-    for _ in range(2 * int(N)):
-        engine.step(0.98, dt)
-        step += 1
-        report(step, total)
-        notify(observers, engine, phase, step, total)
-    for _ in range(int(N)):
-        s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here)
-        engine.step(cool, dt)
-        step += 1
-        report(step, total)
-        notify(observers, engine, phase, step, total)
+    run(2 * int(N), 0.98, dt)
+    s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here; no step changes it)
+    run(int(N), cool, dt)
     engine.flush()
     return step
 
