@@ -112,6 +112,14 @@ class TestCompiledPairTerms(unittest.TestCase):
         self.assertIsInstance(f(True, 1.5, 2.0), float)
 
 
+_SCALE = {"linear": 1.0}
+
+
+def _python_only_law(d, d0, k, c):
+    """A user's law: the linear law, scaled by a number looked up in a dict."""
+    return -k * (d0 - d) * _SCALE["linear"]
+
+
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestNumbaBackendRuns(unittest.TestCase):
     """backend="numba" steps the engine in the compiled step: the whole measurement (pre-equilibration
@@ -167,12 +175,17 @@ class TestNumbaBackendRuns(unittest.TestCase):
             self.assert_same(single, both, (0, n))
 
     def test_fallback_is_announced(self):
-        """A contact law the compiled code does not cover (Hertz) runs on NumPy, with a note, and
-        gives NumPy's numbers."""
-        scenes = [(0, dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))]
-        with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*contact law"):
-            _, got = self.measure(scenes, "numba", law=("hertz", (0.05,)))
-        self.assert_same(self.measure(scenes, "numpy", law=("hertz", (0.05,)))[1], got)
+        """A user's contact law (not among the laws compiled bit for bit) runs on NumPy, with a note,
+        and gives NumPy's numbers."""
+        from particleShear.engine.laws import register_law, unregister_law
+        register_law("python_only", _python_only_law)
+        try:
+            scenes = [(0, dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))]
+            with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*python_only.*not among the laws compiled"):
+                _, got = self.measure(scenes, "numba", law=("python_only", ()))
+            self.assert_same(self.measure(scenes, "numpy", law=("python_only", ()))[1], got)
+        finally:
+            unregister_law("python_only")
 
 
 class TestNumbaStaysOptional(unittest.TestCase):

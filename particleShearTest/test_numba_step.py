@@ -5,7 +5,7 @@ order of operations (the per-replica sums in NumPy's pairwise order), so traject
 histories, creation numbers and the sampled stresses are equal bit for bit (signs of zeros
 included), not merely close.  Scenes: crosslinked particles with cut bonds, frictional spheres,
 frictionless spheres (the shortcut), a batch mixing frictionless and frictional replicas, the
-velocity Verlet integrator, plates off (the constitution's relaxation), a run's whole
+velocity Verlet integrator, the Hertz and the plateau law of the laws folder, plates off (the constitution's relaxation), a run's whole
 constitution and measurement, a diverging replica (the same guard verdict), and a pair at
 distance 0 (that step runs on NumPy, which draws the random normal).  Skipped without Numba.
 """
@@ -24,7 +24,7 @@ FRICTIONAL = dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude
 FRICTIONLESS = dict(theMu=0.0, do_permanent_links=False, cut_lines=0, theAmplitude=0.2)
 
 
-def _measure(scenes, backend, integrator="euler", periods=1, keep_engine=False):
+def _measure(scenes, backend, integrator="euler", periods=1, law=None):
     """Pre-equilibration and protocol (0.5 + periods + 0.5 periods) of constituted ensembles in one engine."""
     from particleShear.base.engine_adapter import state_from_ensembles
     from particleShear.engine.loops import pre_equilibrate, protocol
@@ -33,7 +33,8 @@ def _measure(scenes, backend, integrator="euler", periods=1, keep_engine=False):
 
     sc = constituted(11, **FRICTIONAL_BONDS)[2]      # one schedule for every batch
     ensembles = [constituted(11 + n, **scene)[1] for n, scene in scenes]
-    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend), integrator=integrator)
+    eng = BatchEngine(state_from_ensembles(ensembles, backend=backend, laws=[law] * len(ensembles)),
+                      integrator=integrator)
     pre_equilibrate(eng, sc["N_pre"], sc["dt"], sc["dt_max"], sc["cool"])
     out = protocol(eng, sc["dt"], sc["f"], [sc["A"]] * len(ensembles), sc["cool"], 0.5, periods, 0.5)
     return eng, out
@@ -62,17 +63,20 @@ class TestCompiledStepBits(unittest.TestCase):
     def test_scenes_bit_identical(self):
         """Every scene: the engine's state after pre-equilibration and protocol and the recorded
         series equal NumPy's bit for bit; no step of these scenes falls back (no note)."""
-        cases = {"bonds and friction": ([(0, FRICTIONAL_BONDS)], "euler"),
-                 "friction": ([(1, FRICTIONAL)], "euler"),
-                 "frictionless shortcut": ([(2, FRICTIONLESS)], "euler"),
-                 "frictionless and frictional replicas": ([(2, FRICTIONLESS), (1, FRICTIONAL)], "euler"),
-                 "velocity Verlet": ([(0, FRICTIONAL_BONDS)], "verlet")}
-        for name, (scenes, integrator) in cases.items():
+        cases = {"bonds and friction": ([(0, FRICTIONAL_BONDS)], "euler", None),
+                 "friction": ([(1, FRICTIONAL)], "euler", None),
+                 "frictionless shortcut": ([(2, FRICTIONLESS)], "euler", None),
+                 "frictionless and frictional replicas": ([(2, FRICTIONLESS), (1, FRICTIONAL)], "euler", None),
+                 "velocity Verlet": ([(0, FRICTIONAL_BONDS)], "verlet", None),
+                 "Hertz law, two replicas": ([(0, FRICTIONAL_BONDS), (1, FRICTIONAL)], "euler", ("hertz", (0.05,))),
+                 "plateau law (prepared constants)": ([(0, FRICTIONAL_BONDS)], "euler",
+                                                      ("plateau", (0.3, 0.8, 0.1)))}
+        for name, (scenes, integrator, law) in cases.items():
             with self.subTest(name):
-                e_np, ref = _measure(scenes, "numpy", integrator)
+                e_np, ref = _measure(scenes, "numpy", integrator, law=law)
                 with warnings.catch_warnings():       # no step on NumPy but the tensor samples
                     warnings.filterwarnings("error", "backend='numba': this step runs on NumPy", RuntimeWarning)
-                    e_nb, got = _measure(scenes, "numba", integrator)
+                    e_nb, got = _measure(scenes, "numba", integrator, law=law)
                 self.assertGreater(e_nb.step_count, 250)
                 self.assertGreater(np.abs(ref["stress_surface"]).max(), 0.0)
                 self.assert_same_records(ref, got)

@@ -123,7 +123,7 @@ def register_helpers():
         _registered.add(id(xp.select))
 
 
-def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=()):
+def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=None):
     """The pure functions ``functions`` as they are now, each compiled by Numba.
 
     Each function is compiled from its own code object with its module's globals, in which the
@@ -140,6 +140,11 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=()):
         The functions to compile.
     inline : collection of str, default ()
         Names compiled with ``inline="always"`` (inlined into their callers).
+    extra : dict, optional
+        Further names of the functions' globals → compiled functions (a variant's adapter).
+    rename : dict, optional
+        Name → the qualified name its compiled copy gets (a variant's own entry in Numba's cache,
+        which is keyed by file, qualified name and types).
 
     Returns
     -------
@@ -157,15 +162,28 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=()):
         g = dict(f.__globals__)
         namespaces.append(g)
         copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
-        copy.__qualname__, copy.__module__ = f.__qualname__, f.__module__
+        copy.__qualname__, copy.__module__ = (rename or {}).get(name, f.__qualname__), f.__module__
         compiled[name] = numba.njit(copy, cache=cache, **({"inline": "always"} if name in inline else {}))
     for g in namespaces:      # (globals are read when a function is compiled, at its first call)
         g.update(compiled)
+        g.update(extra or {})
     return compiled
 
 
+#: the most arguments after ``d`` of a run's law in the compiled step (:func:`pair_term`'s ``a``)
+LAW_SLOTS = 8
+_NO_ARGUMENTS = (0.0,) * LAW_SLOTS
+
+
+def _central_law(d, a):
+    """The run's compressive law in compiled code, ``law(d, a)`` (``a``: its arguments): here the one of a run
+    without a law of its own (never called: the built-in forms run); a compiled variant of the step
+    binds the name to an adapter of the run's law (:func:`~.numba_step._law_kernels`)."""
+    return 0.0
+
+
 def pair_term(form, r, vn, vt, touching, active, xi_ij, xi_ji, d_law, d_cap, a_lin, a_div, d_eq, a_tens, ratio_c,
-              nu, k_t, nu_t, mu, fc_inf, k_t_j, nu_t_j, friction=True):
+              nu, k_t, nu_t, mu, fc_inf, k_t_j, nu_t_j, friction, custom, a):
     """The force terms of one candidate pair on numbers (compiled; see :func:`compile_pair_kernel`).
 
     The body both compiled loops run per pair (the force terms of :func:`pair_terms` and the whole
@@ -187,15 +205,23 @@ def pair_term(form, r, vn, vt, touching, active, xi_ij, xi_ji, d_law, d_cap, a_l
         The pair's constants of :data:`TERM_BLOCK` (:func:`~particleShear.engine.terms.term_constants`).
     k_t_j, nu_t_j : float
         The constants of the visit from j.
-    friction : bool, default True
+    friction : bool
         False: no tangential term (0, 0, slip where active, ξ reset), the engine's frictionless shortcut.
+    custom : bool
+        The compressive law is the run's law, ``_central_law(r, a)`` (``a`` the arguments of
+        :func:`~particleShear.engine.phase_laws.run_law` for this pair), instead of the form.
+    a : tuple of float
+        Those arguments, :data:`LAW_SLOTS` numbers (unused ones 0; a tuple keeps the call within
+        the 30 arguments Python passes without packing them, which Numba's inlining needs).
 
     Returns
     -------
     tuple
         ``(fn, law, F_i, F_j, slip, reset)``: ``reset`` where both histories become 0.
     """
-    if form == 1:
+    if custom:
+        inside = _central_law(r, a)
+    elif form == 1:
         inside = linear_term(r, d_law, a_lin)
     elif form == 2:
         inside = divergent_term(r, d_law, d_cap, a_div)
@@ -217,14 +243,16 @@ def _pair_kernel(form, d, vn, vt, touching, active, xi, T, k_t_j, nu_t_j, fn, la
     for p in range(d.shape[0]):
         fn[p], law_out[p], F[0, p], F[1, p], slip[p], reset = pair_term(
             form, d[p], vn[p], vt[p], touching[p], active[p], xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p],
-            T[3, p], T[4, p], T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p])
+            T[3, p], T[4, p], T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p],
+            True, False, _NO_ARGUMENTS)
         if reset:
             xi[0, p] = 0.0
             xi[1, p] = 0.0
 
 
 #: the functions of the compiled pair loop besides the laws, and those inlined into their callers
-PAIR_FUNCTIONS = (LAW_FUNCTIONS + ((sys.modules[__name__], "pair_term"), (sys.modules[__name__], "_pair_kernel")))
+PAIR_FUNCTIONS = (LAW_FUNCTIONS + ((sys.modules[__name__], "_central_law"), (sys.modules[__name__], "pair_term"),
+                                   (sys.modules[__name__], "_pair_kernel")))
 INLINE = ("pair_term",)
 
 

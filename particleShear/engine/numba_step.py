@@ -31,14 +31,15 @@ import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, neighbours, numba_driver, terms
+from . import box, forces, guard, integrate, neighbours, numba_driver, terms, xp
 from .box import MAX_PASSES, folded, period_count
 from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
+from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
 from .neighbours import verlet_bound
 from .numba_driver import pair_term
-from .phase_laws import force_phase_laws
+from .phase_laws import force_phase_laws, run_law
 from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_kernels", "run_step",
@@ -54,7 +55,7 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
     (neighbours, "verlet_bound"))
 
 #: the step's own compiled functions (this module's), and those inlined into their callers
-KERNEL_FUNCTIONS = ((numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
+KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum")
@@ -63,13 +64,19 @@ BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
-_ARGUMENTS = ("i i f f b b b b i i b[:] b b f[:,:] f[:,:] "          # start … half_out
+_ARGUMENTS = ("i i f f b b b b i b f[:,:] i b[:] b b f[:,:] f[:,:] "   # start … half_out
               "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
               "f[:] f[:] f[:] f[:] f[:] f[:] "                       # rate … V
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
               "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
               "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
               "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:]").split()   # work … need
+
+#: the contact laws of the laws folder whose compiled form is checked bit for bit against NumPy's
+#: (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and min.  The
+#: compiled step runs another law on NumPy (a law's ``**`` or ``exp`` may round otherwise in the
+#: last bit in compiled code, which would break "the same bits on every backend")
+COMPILED_LAWS = ("hertz", "plateau")
 
 #: what :func:`run_step` returns when the step was not run (the NumPy step runs it)
 NOT_RUN = object()
@@ -83,10 +90,11 @@ _kernels = {}
 def reason(engine):
     """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
 
-    Covered: both integrators, every replica Lees-Edwards with its strain
-    advancing, replicas with and without friction and bonds, the spheres sharing their replica's parameters, the
-    linear law (and the tensile law of bonds) from the prepared constants, no force register, a
-    sample of the two shear stresses (not the whole tensors).
+    Covered: both integrators, every replica Lees-Edwards with its strain advancing, replicas with
+    and without friction and bonds, the spheres sharing their replica's parameters, the linear law
+    from the prepared constants or a run's contact law of :data:`COMPILED_LAWS`, the tensile law
+    of bonds, no force register, a sample of the two shear stresses (not
+    the whole tensors).
 
     Parameters
     ----------
@@ -107,8 +115,13 @@ def reason(engine):
             return "state arrays that are not writable C-contiguous NumPy arrays"
     if C.Kj is not None:
         return "spheres with parameters of their own"
-    if force_phase_laws(engine.s, C) != (None, None):
-        return "a contact law other than the linear one, or a law callback"
+    central, tensile = force_phase_laws(s, C)
+    if tensile is not None or (central is not None and s.law is None):
+        return "a law callback of the documented classes"
+    if central is not None and s.law not in COMPILED_LAWS:
+        return (f"contact_law={s.law!r} is not among the laws compiled bit for bit ({', '.join(COMPILED_LAWS)}): "
+                "compiled code may round its functions (e.g. ** with a fractional exponent) in the last bit "
+                "otherwise than NumPy")
     return None
 
 
@@ -188,7 +201,8 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
-def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted, half, half_out,
+def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free, verlet,
+                 predicted, half, half_out,
            pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
            rate, gamma, t, Lx, Ly, V,
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
@@ -256,9 +270,11 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, fre
             rv = (vj0 - vi0 + dvx, vj1 - vi1)
             vn = normal_speed(rv, nx, ny)
             vt = slip_speed(rv, nx, ny, Cf[_IRI, p], Cf[_IRJ, p], vi2, vj2) if free_mode != 1 else 0.0
+            q = p if custom else 0                # (the run law's arguments: A is (8, 1) without one)
             fn, law, F_i, F_j, slip, reset = pair_term(
                 form, d, vn, vt, touching, rel, xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p], T[3, p], T[4, p],
-                T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p], free_mode != 1)
+                T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p], free_mode != 1,
+                custom, (A[0, q], A[1, q], A[2, q], A[3, q], A[4, q], A[5, q], A[6, q], A[7, q]))
             if reset:
                 xi[0, p] = 0.0
                 xi[1, p] = 0.0
@@ -444,6 +460,14 @@ def compile_step_kernel(cache=True, say=None):
     return compiled
 
 
+def _block_signature():
+    """The Numba signature of :func:`_block_kernel`."""
+    from numba import types
+    f2, i = types.Array(types.float64, 2, "C"), types.int64
+    return types.UniTuple(i, 3)(i, i, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean,
+                                *_signature().args[1:])
+
+
 def _signature():
     """The Numba signature of :func:`_step_kernel` (:data:`_ARGUMENTS`)."""
     from numba import types
@@ -455,19 +479,111 @@ def _signature():
     return types.int64(*out)
 
 
-def compile_kernels(say=None):
-    """Compile (or load from the cache) both compiled loops of the ``"numba"`` backend now: the force
-    terms (:func:`~.numba_driver.compile_pair_kernel`) and the step (:func:`compile_step_kernel`),
-    so that no timing of a run counts them.
+def _kernels_of(ws):
+    """The compiled step and block of a workspace: the built-in laws', or its run law's variant."""
+    if ws.law is None:
+        return _kernels.get(True) or compile_step_kernel(), _kernels.get("block") or compile_block_kernel()
+    return _law_kernels(*ws.law)
+
+
+def _jit_deep(f, done):
+    """``f`` compiled, with every Python function its globals name compiled as well (recursively;
+    :func:`~particleShear.engine.xp.select`, ``maximum`` and ``minimum`` are Numba's overloads)."""
+    import types
+
+    import numba
+
+    if f in done:
+        return done[f]
+    g = dict(f.__globals__)
+    copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
+    done[f] = compiled = numba.njit(copy)
+    for name in f.__code__.co_names:
+        v = f.__globals__.get(name)
+        if isinstance(v, types.FunctionType) and v not in (xp.select, xp.maximum, xp.minimum):
+            g[name] = _jit_deep(v, done)
+    return compiled
+
+
+def _law_kernels(function, m):
+    """The compiled step and block for a run's law ``function(d, a0 … a{m−1})`` (:func:`~.phase_laws.run_law`).
+
+    The law (and every function it calls) is compiled, an adapter ``_central_law(d, a)`` passes it
+    the first m numbers of ``a``, and the step's functions are compiled with that adapter under their
+    own names (``…__<hash>``: the law's module source, name and m), so that Numba's cache keeps one
+    entry per law and an edited law gets a new one.
+
+    Returns
+    -------
+    tuple
+        ``(step, block)``: the dispatchers of :func:`_step_kernel` and :func:`_block_kernel`.
+    """
+    import hashlib
+    import inspect
+
+    import numba
+
+    key = ("law", function, m)
+    if key in _kernels:
+        return _kernels[key]
+    numba_driver.register_helpers()
+    numba.config.CACHE_DIR = numba_driver.cache_dir()
+    h = hashlib.sha1(f"{function.__module__}.{function.__qualname__}/{m}".encode())
+    try:
+        with open(inspect.getsourcefile(function), "rb") as fh:
+            h.update(fh.read())
+    except (OSError, TypeError):
+        h.update(function.__code__.co_code)
+    suffix = "__" + h.hexdigest()[:12]
+    law = _jit_deep(function, {})
+    source = "def _central_law(d, a):\n    return LAW(d" + "".join(f", a[{i}]" for i in range(m)) + ")\n"
+    namespace = {"LAW": law}
+    exec(source, namespace)           # (an adapter of m arguments; numbers only, so no reference counts)
+    adapter = numba.njit(namespace["_central_law"], inline="always")
+    names = ("pair_term", "_step_kernel", "_block_kernel")
+    L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
+                              extra={"_central_law": adapter}, rename={n: n + suffix for n in names})
+    step, block = L["_step_kernel"], L["_block_kernel"]
+    step.compile(_signature())
+    block.compile(_block_signature())
+    _kernels[key] = step, block
+    return step, block
+
+
+def compile_kernels(say=None, law=None):
+    """Compile (or load from the cache) the compiled loops of the ``"numba"`` backend now: the force
+    terms (:func:`~.numba_driver.compile_pair_kernel`), the step (:func:`compile_step_kernel`) and its
+    blocks, and the variant of a run's contact law, so that no timing of a run counts them.
 
     Parameters
     ----------
     say : callable, optional
         ``say(message)``, told once per kernel before it is compiled or loaded.
+    law : str or None, optional
+        The run's ``contact_law`` (a name of the registry; None or ``"linear"``: the built-in law).
+        A law Numba cannot compile is left to the step, which then runs on NumPy with a note.
     """
     numba_driver.compile_pair_kernel(say=say)
     compile_step_kernel(say=say)
     compile_block_kernel()
+    if law is None:
+        return
+    found = get_law(law)
+    if found.name not in COMPILED_LAWS:
+        return
+    if found.prepared is None:
+        function, m = found.function, (5 if found.radii else 3) + len(found.parameters)
+    else:      # (as many constants as the law prepares: its constants of one pair, at its defaults)
+        constants, function = found.prepared
+        values = tuple(float(v) for v in found.parameters.values())
+        m = len(constants(*((2.0, 1.0, 1.0) if found.radii else (2.0,)), 1.0, 0.5, *values))
+    if m <= numba_driver.LAW_SLOTS:
+        if say is not None:
+            say(f"backend 'numba': compiling the step for contact_law={found.name!r} (first use)")
+        try:
+            _law_kernels(function, m)
+        except Exception:      # (the step notes it and runs on NumPy)
+            pass
 
 
 class _Workspace:
@@ -499,6 +615,21 @@ class _Workspace:
         self.max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
         self.form = numba_driver.FORMS[C.form]
         self.offsets = np.array(C.offsets, dtype=np.int64)
+        # the run's law (run_law): its function and its arguments per candidate, rows of law_rows
+        got = run_law(s, C) if self.why is None else None
+        if got is not None and len(got[1]) > numba_driver.LAW_SLOTS:
+            self.why, got = f"a contact law of more than {numba_driver.LAW_SLOTS} arguments after d", None
+        self.custom = got is not None
+        self.law_rows = np.zeros((numba_driver.LAW_SLOTS, C.P if self.custom else 1))
+        self.law = None if got is None else got[0]
+        if self.custom:
+            for k, a in enumerate(got[1]):
+                self.law_rows[k] = np.broadcast_to(np.asarray(a, dtype=float), (C.P,))
+            self.law = (got[0], len(got[1]))
+            try:
+                _law_kernels(*self.law)
+            except Exception as exc:          # (a law Numba cannot compile: NumPy runs it)
+                self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
 
 
@@ -556,7 +687,7 @@ def run_step(engine, cool, dt, sample):
     ws = _prepared(engine)
     if ws is None:
         return NOT_RUN
-    kernel = _kernels.get(True) or compile_step_kernel()
+    kernel = _kernels_of(ws)[0]
     check = ws.guarded and not engine.step_count % engine.check_interval
     args, held = _arguments(engine, ws, cool, dt, sample, check)
     status = kernel(0, *args)
@@ -598,7 +729,7 @@ def _arguments(engine, ws, cool, dt, sample, check):
     half = np.array(engine.half, dtype=float) if predicted else np.empty((3, s.B * s.N)) if verlet else ws.no_half
     new_half = np.empty((3, s.B * s.N)) if verlet else ws.no_half    # (a new array per step, as half_kick gives)
     args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
-            ws.form, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r,
+            ws.form, ws.custom, ws.law_rows, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r,
             ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active,
             birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
@@ -688,7 +819,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
         ws = _prepared(engine)
         if ws is None:
             return k
-        kernel = _kernels.get("block") or compile_block_kernel()
+        kernel = _kernels_of(ws)[1]
         args, held = _arguments(engine, ws, cool, dt, scheduled, False)
         k, status, engine.step_count = kernel(k, n, rates, *rec, row, engine.step_count, engine.check_interval,
                                               ws.guarded, scheduled, *args)
@@ -703,7 +834,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
             _report(engine, ws)
         elif status == _UNITS:     # the rest of step k, on the block's own arrays
             _draw_units(engine, ws)
-            (_kernels.get(True) or compile_step_kernel())(1, *args)
+            _kernels_of(ws)[0](1, *args)
             _adopt(engine, ws, held, stepped=True)
             if scheduled:
                 rec[3][row + k], rec[4][row + k] = ws.tau[0], ws.tau[1]
@@ -716,7 +847,8 @@ _NO_RECORD = np.zeros((0, 0))
 
 
 def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step_count, interval,
-                  guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, free_mode, free, verlet, predicted,
+                  guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free,
+                  verlet, predicted,
                   half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V,
                   Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin,
                   guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero, tau, verdict, need):
@@ -742,7 +874,7 @@ def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_su
                 rec_strain[row + k, b] = gamma[b]
                 rec_rate[row + k, b] = rate[b]
         check = guarded and step_count % interval == 0
-        status = _step_kernel(0, N, cool, dt, scheduled, check, applying, numbers, form, free_mode, free, verlet,
+        status = _step_kernel(0, N, cool, dt, scheduled, check, applying, numbers, form, custom, A, free_mode, free, verlet,
                               predicted, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t,
                               Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max,
                               strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
@@ -780,16 +912,12 @@ def compile_block_kernel(cache=True):
     if cache and "block" in _kernels:
         return _kernels["block"]
     import numba
-    from numba import types
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
     L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE)
     compiled = L["_block_kernel"]
-    f2, i = types.Array(types.float64, 2, "C"), types.int64
-    step = _signature()
-    compiled.compile(types.UniTuple(i, 3)(i, i, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean,
-                                          *step.args[1:]))
+    compiled.compile(_block_signature())
     if cache:
         _kernels["block"] = compiled
     return compiled

@@ -13,7 +13,7 @@ __docformat__ = "numpy"
 
 from .contact_laws import get_law
 
-__all__ = ["force_phase_laws", "prepared_law", "law_arguments", "cached"]
+__all__ = ["force_phase_laws", "run_law", "law_function", "prepared_law", "law_arguments", "cached"]
 
 
 def cached(C, key, make):
@@ -72,12 +72,44 @@ def force_phase_laws(s, C):
     given = getattr(s, "callback_laws", None)
     central, tensile = (None, None) if given is None else given(C, s.law is None)
     if s.law is not None:
-        law = get_law(s.law)
-        central = None
-        if law.name != "linear" or law.parameters:
-            central = prepared_law(law, C, (law.name, id(s.law_params)),
-                                   lambda: law_arguments(law, C) + tuple(s.law_params[:, C.rep]))
+        got = run_law(s, C)
+        central = None if got is None else _bound(*got)
     return central, tensile
+
+
+def _bound(function, arguments):
+    """``function(d, *arguments)`` as a function of ``d``."""
+    return lambda d: function(d, *arguments)
+
+
+def run_law(s, C):
+    """The run's contact law on the candidates ``C`` as ``(function, arguments)``: the compressive law
+    of every candidate at ``d`` is ``function(d, *arguments)``; None for the linear law (evaluated
+    from the prepared constants of ``C``) or a state without a run's law.
+
+    For a law with ``prepared`` constants, ``function`` is its ``inside`` and ``arguments`` the
+    constants (kept with ``C``, :func:`cached`); otherwise the law's function and
+    :func:`law_arguments` with its parameters per candidate.  The NumPy force phase and the
+    compiled step (:mod:`.numba_step`) both evaluate the law from these.
+
+    Parameters
+    ----------
+    s : BatchState
+        The batch (``law``, ``law_params``).
+    C : PairConstants or VisitConstants
+        The constants of one visit of its candidates.
+
+    Returns
+    -------
+    tuple or None
+    """
+    if s.law is None:
+        return None
+    law = get_law(s.law)
+    if law.name == "linear" and not law.parameters:
+        return None
+    return law_function(law, C, (law.name, id(s.law_params)),
+                        lambda: law_arguments(law, C) + tuple(s.law_params[:, C.rep]))
 
 
 def law_arguments(law, C):
@@ -99,9 +131,9 @@ def law_arguments(law, C):
     return (C.d_law, C.ri, C.rj, C.k, C.c) if law.radii else (C.d_law, C.k, C.c)
 
 
-def prepared_law(law, C, key, arguments):
-    """``law`` as a function of ``d`` on the candidates ``C``: ``inside(d, *constants)`` with the
-    constants kept with ``C`` under ``key`` when the law is prepared, else ``function(d, *arguments())``.
+def law_function(law, C, key, arguments):
+    """``law`` on the candidates ``C`` as ``(function, arguments)``: ``inside`` and its constants kept
+    with ``C`` under ``key`` when the law is prepared, else ``law.function`` and ``arguments()``.
 
     Parameters
     ----------
@@ -116,13 +148,28 @@ def prepared_law(law, C, key, arguments):
 
     Returns
     -------
+    tuple
+        ``(function, arguments)``: the central force of every candidate at ``d`` is
+        ``function(d, *arguments)`` (mg·µm·s⁻² per m depth, negative repels).
+    """
+    if law.prepared is None:
+        return law.function, cached(C, key, arguments)
+    constants, inside = law.prepared
+    return inside, cached(C, key, lambda: constants(*arguments()))
+
+
+def prepared_law(law, C, key, arguments):
+    """``law`` as a function of ``d`` on the candidates ``C`` (:func:`law_function` bound to its arguments).
+
+    Parameters
+    ----------
+    law, C, key, arguments
+        As :func:`law_function`.
+
+    Returns
+    -------
     callable
         ``law(d)``: the central force of every candidate at distance ``d`` (µm), mg·µm·s⁻² per m
         depth, negative repels.
     """
-    if law.prepared is None:
-        args = cached(C, key, arguments)
-        return lambda d: law.function(d, *args)
-    constants, inside = law.prepared
-    args = cached(C, key, lambda: constants(*arguments()))
-    return lambda d: inside(d, *args)
+    return _bound(*law_function(law, C, key, arguments))

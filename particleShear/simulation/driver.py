@@ -103,7 +103,9 @@ def _constitute(sessions):
     # compiled step is compiled, or loaded from the cache, here: not counted in the timings)
     backends = [_host_backend(run) for run in sessions]
     if any(be.compiled for be in backends):
-        compile_kernels(say=_console([run.sim for run in sessions], [0], "constitution", ["constitution", 0, 0])[0])
+        say = _console([run.sim for run in sessions], [0], "constitution", ["constitution", 0, 0])[0]
+        for law in {(run.sim.contact_law or (None,))[0] for run in sessions}:
+            compile_kernels(say=say, law=law)
     steps = [run.constitution() for run in sessions]
     pending = {}            # replica -> its waiting Relaxation
     since = {}              # replica -> when it was suspended
@@ -253,7 +255,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         say, report = _console(sims, group, "pre-equilibration", where)
         if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
             tc = time.perf_counter()
-            compile_kernels(say=say)
+            compile_kernels(say=say, law=st.law)
             t0 += time.perf_counter() - tc
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
