@@ -29,6 +29,13 @@ def pytest_configure(config):
         config.option.loadscopereorder = False
 
 
+def pytest_sessionstart(session):
+    """The compiled backend's loops, compiled (or loaded) before any test of this process
+    (:func:`particleShearTest.warm_compiled_backend`)."""
+    from particleShearTest import warm_compiled_backend
+    warm_compiled_backend()
+
+
 def _rank(item):
     for k, prefix in enumerate(LONG_FIRST):
         if item.nodeid.startswith(prefix):

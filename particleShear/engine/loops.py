@@ -107,8 +107,8 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
     say : callable
         ``say(message)`` receives the reference's console messages.
     report : callable
-        ``report(step, total)`` is called after each run of steps between the observers' steps
-        (progress; after every step with an observer of ``every`` 1).
+        ``report(step, total)`` is called after the first step and after each run of steps between
+        the observers' steps (progress; after every step with an observer of ``every`` 1).
     observers : sequence, default ()
         Observers (:mod:`particleShear.engine.observers`): each is called as
         ``observe(engine, "pre-equilibration", step, total)`` after every step that is a multiple
@@ -143,7 +143,8 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
         nonlocal step
         end = step + n
         while step < end:
-            stop = min([end] + [(step // ob.every + 1) * ob.every for ob in observers])
+            first = 1 if step == 0 else end       # (step 1 alone: the phase's first progress call)
+            stop = min([end, first] + [(step // ob.every + 1) * ob.every for ob in observers])
             engine.steps(stop - step, cf, level_dt)
             step = stop
             report(step, total)

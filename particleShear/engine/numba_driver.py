@@ -256,6 +256,24 @@ PAIR_FUNCTIONS = (LAW_FUNCTIONS + ((sys.modules[__name__], "_central_law"), (sys
 INLINE = ("pair_term",)
 
 
+def on_disk(dispatcher):
+    """Whether Numba's cache holds compiled code of ``dispatcher`` (its index file exists): a compile
+    is then a load, which needs no announcement.
+
+    Parameters
+    ----------
+    dispatcher : numba.core.registry.CPUDispatcher
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        return os.path.exists(dispatcher._cache._cache_file._index_path)
+    except AttributeError:          # (no cache, or another Numba's layout: announce)
+        return False
+
+
 def compile_pair_kernel(cache=True, say=None):
     """The compiled loop over candidate pairs that evaluates their force terms (see :func:`pair_terms`).
 
@@ -265,7 +283,7 @@ def compile_pair_kernel(cache=True, say=None):
         Keep the compiled code in :func:`cache_dir` (and reuse the kernel of this process); False
         compiles afresh from the law functions as they are now (a test that edits a law).
     say : callable, optional
-        ``say(message)``: told once per process, before the compile (or the load from the cache).
+        ``say(message)``: told before a compile (not before a load from the cache).
 
     Returns
     -------
@@ -280,10 +298,10 @@ def compile_pair_kernel(cache=True, say=None):
 
     if cache:
         numba.config.CACHE_DIR = cache_dir()
-    if say is not None:
-        say(f"backend 'numba': compiling the force loop (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
     # the functions the loop calls, compiled from the module attributes now (a test may have replaced one)
     compiled = jit_laws(cache, PAIR_FUNCTIONS, inline=INLINE)["_pair_kernel"]
+    if say is not None and not on_disk(compiled):
+        say(f"backend 'numba': compiling the force loop (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
     # compile (or load) now, for the argument types of the engine's call
     e, b = np.empty(0), np.empty(0, dtype=np.bool_)
     compiled(0, e, e, e, b, b, np.empty((2, 0)), np.empty((len(TERM_BLOCK), 0)), e, e, np.empty(0), np.empty(0),

@@ -438,7 +438,7 @@ def compile_step_kernel(cache=True, say=None):
         Keep the compiled code in :func:`~.numba_driver.cache_dir`; False compiles afresh from the
         functions as they are now (a test that edits one).
     say : callable, optional
-        ``say(message)``, told before the compile (or the load from the cache).
+        ``say(message)``, told before a compile (not before a load from the cache).
 
     Returns
     -------
@@ -450,10 +450,10 @@ def compile_step_kernel(cache=True, say=None):
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
-    if say is not None:
-        say(f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
     L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS, inline=INLINE)
     compiled = L["_step_kernel"]
+    if say is not None and not numba_driver.on_disk(compiled):
+        say(f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
     compiled.compile(_signature())          # (or loaded from the cache): before any timing
     if cache:
         _kernels[True] = compiled
@@ -505,7 +505,7 @@ def _jit_deep(f, done):
     return compiled
 
 
-def _law_kernels(function, m):
+def _law_kernels(function, m, say=None):
     """The compiled step and block for a run's law ``function(d, a0 … a{m−1})`` (:func:`~.phase_laws.run_law`).
 
     The law (and every function it calls) is compiled, an adapter ``_central_law(d, a)`` passes it
@@ -544,6 +544,8 @@ def _law_kernels(function, m):
     L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
                               extra={"_central_law": adapter}, rename={n: n + suffix for n in names})
     step, block = L["_step_kernel"], L["_block_kernel"]
+    if say is not None and not numba_driver.on_disk(step):
+        say(f"backend 'numba': compiling the step for the law {function.__qualname__} (first use)")
     step.compile(_signature())
     block.compile(_block_signature())
     _kernels[key] = step, block
@@ -578,10 +580,8 @@ def compile_kernels(say=None, law=None):
         values = tuple(float(v) for v in found.parameters.values())
         m = len(constants(*((2.0, 1.0, 1.0) if found.radii else (2.0,)), 1.0, 0.5, *values))
     if m <= numba_driver.LAW_SLOTS:
-        if say is not None:
-            say(f"backend 'numba': compiling the step for contact_law={found.name!r} (first use)")
         try:
-            _law_kernels(function, m)
+            _law_kernels(function, m, say)
         except Exception:      # (the step notes it and runs on NumPy)
             pass
 
