@@ -179,6 +179,24 @@ class TestCompiledStepBits(unittest.TestCase):
             engines.append(eng)
         self.assert_same_engines(*engines)
 
+    def test_pair_at_distance_zero_in_a_verlet_block(self):
+        """A block of Verlet steps whose first step meets a pair at d = 0: that step runs on NumPy with
+        the engine's own half kick (none yet), then the block goes on; the same bits as NumPy."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        engines = []
+        for backend in ("numpy", "numba"):
+            e = constituted(43, **FRICTIONAL)[1]
+            s = state_from_ensembles([e], backend=backend)
+            s.pos[:, 1] = s.pos[:, 0]
+            eng = BatchEngine(s, guard=False, integrator="verlet")
+            eng.steps(6, 0.999, e.dt)
+            engines.append(eng)
+        self.assert_same_engines(*engines)
+        np.testing.assert_array_equal(_bits(engines[0].half), _bits(engines[1].half))
+
     def test_zero_R_draws_from_the_replica_generator(self):
         """``R = v_i dt − D = 0`` exactly (sphere i moves onto j's place in one step): the ξ rule's
         random direction is drawn from the replica's generator in the compiled step as on NumPy —
@@ -228,7 +246,7 @@ class TestCompiledBlocks(unittest.TestCase):
     called at the same steps seeing the same rows; a controller (rate from the stresses before)
     steps one at a time and agrees as well."""
 
-    def record(self, backend, controller=False):
+    def record(self, backend, controller=False, law=None):
         import math
 
         from particleShear.base.engine_adapter import state_from_ensembles
@@ -237,7 +255,7 @@ class TestCompiledBlocks(unittest.TestCase):
         from particleShearTest.test_engine import constituted
 
         _, e, sc = constituted(51, **FRICTIONAL_BONDS)
-        eng = BatchEngine(state_from_ensembles([e], backend=backend))
+        eng = BatchEngine(state_from_ensembles([e], backend=backend, laws=[law]))
         seen = []
 
         class Watch:
@@ -270,3 +288,20 @@ class TestCompiledBlocks(unittest.TestCase):
                 for a, b in zip(seen_ref, seen_got):
                     np.testing.assert_array_equal(_bits(a[2]), _bits(b[2]))
                 self.assertEqual(int(np.isfinite(got["N1"][:, 0]).sum()), len(range(0, 600, 7)))
+
+    def test_steps_left_to_numpy_notify_once(self):
+        """A law the compiled step leaves to NumPy: the loop runs every step itself, and the observer is
+        called at the same steps as on NumPy, each once."""
+        from particleShear.engine.laws import register_law, unregister_law
+        from particleShearTest.test_numba_driver import _python_only_law
+        register_law("python_only_blocks", _python_only_law)
+        try:
+            ref, seen_ref, _ = self.record("numpy", law=("python_only_blocks", ()))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                got, seen_got, _ = self.record("numba", law=("python_only_blocks", ()))
+        finally:
+            unregister_law("python_only_blocks")
+        self.assertEqual([s[:2] for s in seen_got], [s[:2] for s in seen_ref])
+        self.assertEqual([s[1] for s in seen_got], list(range(50, 601, 50)))
+        np.testing.assert_array_equal(_bits(ref["stress_surface"]), _bits(got["stress_surface"]))

@@ -57,8 +57,9 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 #: the step's own compiled functions (this module's), and those inlined into their callers
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
+                    (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
                     (sys.modules[__name__], "_step_kernel"))
-INLINE = ("pair_term", "_min_image_pair", "_segment_sum")
+INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the compiled block (:func:`run_block`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
 
@@ -196,6 +197,16 @@ def _pairwise(a, lo, n):
     return _pairwise(a, lo, n2) + _pairwise(a, lo + n2, n - n2)
 
 
+def _nan_max(a, b):
+    """``numpy.maximum`` of two numbers (NaN when either is): the reductions of the NumPy engine."""
+    return a + b if a != a or b != b else max(a, b)
+
+
+def _nan_min(a, b):
+    """``numpy.minimum`` of two numbers (NaN when either is)."""
+    return a + b if a != a or b != b else min(a, b)
+
+
 def _segment_sum(a, lo, hi):
     # numpy.add.reduceat over one segment: its first element, then the _pairwise sum of the rest
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
@@ -295,9 +306,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
                 work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
                                                                    dys[p], fx, dF, None)
             if check:
-                ratio = transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p])
-                if ratio < verdict[3, b]:
-                    verdict[3, b] = ratio
+                verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
         # the scatter's second half: −F on j and the torque on j, in pair order
         for p in range(P):
             j = Ci[2, p]
@@ -312,7 +321,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
         if check:
             bad = False
             for b in range(B):
-                rate_max[b] = max(rate_max[b], abs(rate[b]))
+                rate_max[b] = _nan_max(rate_max[b], abs(rate[b]))
                 finite = True
                 for k in range(b * N, (b + 1) * N):
                     finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
@@ -378,10 +387,8 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
         for k in range(b * N, (b + 1) * N):
             u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
             u[1, k] += vel[1, k] * dt
-            sq = u[0, k] * u[0, k] + u[1, k] * u[1, k]
-            if not sq <= largest:
-                largest = sq
-        u_max[b] = max(u_max[b], np.sqrt(largest))
+            largest = _nan_max(largest, u[0, k] * u[0, k] + u[1, k] * u[1, k])
+        u_max[b] = _nan_max(u_max[b], np.sqrt(largest))
         strain[b] += abs(rate[b]) * dt
         bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
     for k in range(n):
@@ -725,7 +732,7 @@ def _arguments(engine, ws, cool, dt, sample, check):
     free = engine.free_p
     free_mode, free = (0, ws.zero) if free is None else (1, ws.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
-    predicted = verlet and engine.half is not None
+    predicted = engine.half is not None        # (the force phase sees the velocities half a kick ahead, as NumPy's)
     half = np.array(engine.half, dtype=float) if predicted else np.empty((3, s.B * s.N)) if verlet else ws.no_half
     new_half = np.empty((3, s.B * s.N)) if verlet else ws.no_half    # (a new array per step, as half_kick gives)
     args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
@@ -739,17 +746,18 @@ def _arguments(engine, ws, cool, dt, sample, check):
     return args, held
 
 
-def _adopt(engine, ws, held, stepped=False):
+def _adopt(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the engine: after the force phase the relations and
     the guard's record; after a whole step (``stepped``) also the displacement bookkeeping, the
-    strain, the clock, the Verlet half kick and the lists due."""
+    strain, the clock, the lists due and, when a step of this call reached its kick (``kicked``),
+    the Verlet half kick."""
     for name in ("state_p", "xi", "active", "birth", "next_birth", "rate_max"):
         setattr(engine, name, held[name])
     engine.s.rate = held["rate"]
     if stepped:
         for name in ("u", "u_max", "strain", "bound"):
             setattr(engine, name, held[name])
-        if held["half"] is not None:
+        if held["half"] is not None and kicked:
             engine.half = held["half"]
         engine.s.gamma, engine.s.t = held["gamma"], held["t"]
         engine.need = ws.need.copy()
@@ -821,9 +829,12 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
             return k
         kernel = _kernels_of(ws)[1]
         args, held = _arguments(engine, ws, cool, dt, scheduled, False)
+        k0 = k
         k, status, engine.step_count = kernel(k, n, rates, *rec, row, engine.step_count, engine.check_interval,
                                               ws.guarded, scheduled, *args)
-        _adopt(engine, ws, held, stepped=True)
+        # (a half kick is handed back once a step of this call reached its kick: one finished, or the
+        # step that stopped for its random directions; else the engine keeps its own)
+        _adopt(engine, ws, held, stepped=True, kicked=k > k0 or status == _UNITS)
         if status == _D_ZERO:      # (its rate is set and its clock, strain and rate recorded)
             out = engine.step(cool, dt, sample=scheduled)
             if scheduled:

@@ -139,8 +139,9 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
             rates = [rate_of(k) for k in range(i, j)]           # (rate_of once per step, in order)
             done = run_block(engine, xp.stack(rates), cool, dt, rec, i)
             i += done
-            report(i, n_steps)
-            notify(observers, engine, "protocol", i, n_steps)
+            if done:
+                report(i, n_steps)
+                notify(observers, engine, "protocol", i, n_steps)
             if i == j:
                 continue
             pending = rates[done:]
