@@ -225,6 +225,31 @@ class TestCompiledStepBits(unittest.TestCase):
 
 
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestCompiledSearch(unittest.TestCase):
+    def test_same_pairs_as_the_numpy_search(self):
+        """The compiled all-pairs search gives the NumPy search's pairs in its order: random replicas of
+        2 … 198 spheres, Lees-Edwards offsets of zero, a fraction of a cell and many cells, a NaN
+        position, skins from 0 to 20 µm."""
+        from particleShear.engine import neighbours
+        rng = np.random.default_rng(0)
+        for t in range(200):
+            N = int(rng.integers(2, neighbours.CELL_LIST_MIN_N - 1))
+            L = 500.0
+            x, y, r = rng.uniform(0, L, N), rng.uniform(0, 0.8 * L, N), rng.uniform(10, 40, N)
+            if t % 10 == 0:
+                x[0] = np.nan
+            shift = float(rng.choice([0.0, 37.5, -620.0, 5e4]))
+            skin = float(rng.uniform(0, 20))
+            with self.subTest(t=t):
+                want = neighbours.near_pairs_all(x, y, r, L, 0.8 * L, shift, skin)
+                got = numba_step.search(x, y, r, L, 0.8 * L, shift, skin)
+                np.testing.assert_array_equal(got[0], want[0])
+                np.testing.assert_array_equal(got[1], want[1])
+                if t == 1:
+                    self.assertGreater(len(got[0]), 0)
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestOneFunctionTwoDrivers(unittest.TestCase):
     def test_compiled_functions_are_the_modules_functions(self):
         """Every function the compiled step calls is compiled from the code object of the NumPy

@@ -29,7 +29,7 @@ from .box import in_intervals, min_image
 from .xp import array_namespace
 
 __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
-           "verlet_bound", "CELL_LIST_MIN_N"]
+           "verlet_bound", "within_reach", "CELL_LIST_MIN_N"]
 
 #: smallest N for which :func:`near_pairs` uses the cell list (below it the all-pairs search is
 #: faster; measured with ``benchmarks/bench_engine_large.py --crossover``, docs/performance.md)
@@ -103,7 +103,26 @@ def _near(i, j, x, y, r, Lx, Ly, shift, skin):
     else:
         moved = slice(None)
     dx[moved], dy[moved], _, _ = min_image(dx[moved], dy[moved], Lx, Ly, shift)
-    reach = r[i] + r[j] + skin
+    return within_reach(dx, dy, r[i] + r[j] + skin)
+
+
+def within_reach(dx, dy, reach):
+    """Whether a minimum-image separation is shorter than ``reach``: ``dx² + dy² < reach²`` (pure).
+
+    The one criterion of the candidate searches (:func:`_near`, and the compiled search of
+    :mod:`particleShear.engine.numba_step`).
+
+    Parameters
+    ----------
+    dx, dy : ndarray or float
+        Separation (µm).
+    reach : ndarray or float
+        ``r_i + r_j + skin`` (µm).
+
+    Returns
+    -------
+    ndarray of bool or bool
+    """
     return dx * dx + dy * dy < reach * reach
 
 
@@ -328,7 +347,7 @@ def near_pairs(x, y, r, Lx, Ly, shift, skin):
     return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
 
 
-def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
+def build_candidates(x, y, r, Lx, Ly, shift, skin, old, search=None):
     """Make the near pairs of one replica its candidates, keeping the history of those that stay.
 
     Parameters
@@ -341,6 +360,9 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
         Verlet skin (µm).
     old : PairTable
         The replica's pair list, changed in place (:meth:`~particleShear.engine.state.PairTable.replace`).
+    search : callable, optional
+        The search, with the arguments and result of :func:`near_pairs` (default :func:`near_pairs`;
+        the compiled backend's gives the same pairs).
 
     Returns
     -------
@@ -349,7 +371,7 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old):
         ``(i, j)`` order; a pair that stays a candidate keeps its state, ξ, ``d_eq``, relation and
         creation number, a new one starts at rest.
     """
-    old.replace(*near_pairs(x, y, r, Lx, Ly, shift, skin), keep_relations=False)
+    old.replace(*(search or near_pairs)(x, y, r, Lx, Ly, shift, skin), keep_relations=False)
     return old
 
 

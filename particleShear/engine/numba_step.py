@@ -37,13 +37,13 @@ from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
 from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
-from .neighbours import verlet_bound
+from .neighbours import CELL_LIST_MIN_N, near_pairs, verlet_bound, within_reach
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
 from .terms import normal_speed, pair_forces, slip_speed
 
-__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_kernels", "run_step",
-           "run_block", "NOT_RUN"]
+__all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
+           "compile_kernels", "run_step", "run_block", "search", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -52,7 +52,7 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
     (integrate, "damped"), (integrate, "xi_rates"), (terms, "normal_speed"), (terms, "slip_speed"),
     (terms, "pair_forces"), (forces, "pair_roles"), (forces, "shear_rows"), (forces, "shear_from_sums"),
     (guard, "kinetic_term"), (guard, "energy_bound"), (guard, "verdict_code"), (guard, "transient_ratio"),
-    (neighbours, "verlet_bound"))
+    (neighbours, "verlet_bound"), (neighbours, "within_reach"))
 
 #: the step's own compiled functions (this module's), and those inlined into their callers
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
@@ -575,6 +575,7 @@ def compile_kernels(say=None, law=None):
     numba_driver.compile_pair_kernel(say=say)
     compile_step_kernel(say=say)
     compile_block_kernel()
+    compile_search_kernel()
     if law is None:
         return
     found = get_law(law)
@@ -855,6 +856,85 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
 
 
 _NO_RECORD = np.zeros((0, 0))
+
+
+def _search_kernel(x, y, r, Lx, Ly, shift, skin, out_i, out_j):
+    """The pairs ``i < j`` within ``r_i + r_j + skin`` of one replica, every pair tested (compiled;
+    :func:`~particleShear.engine.neighbours.near_pairs_all`'s pairs, in its ``(i, j)`` order): the
+    minimum image of :func:`_min_image_pair` and the criterion
+    :func:`~particleShear.engine.neighbours.within_reach`.  Writes ``out_i``, ``out_j``; returns their count."""
+    n = 0
+    N = x.shape[0]
+    for i in range(N):
+        for j in range(i + 1, N):
+            reach = r[i] + r[j] + skin
+            ady = abs(y[j] - y[i])
+            if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
+                continue
+            dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+            if within_reach(dx, dy, reach):
+                out_i[n] = i
+                out_j[n] = j
+                n += 1
+    return n
+
+
+def search(x, y, r, Lx, Ly, shift, skin):
+    """:func:`~particleShear.engine.neighbours.near_pairs` of the compiled backend: the same pairs, in the
+    same order; below :data:`~particleShear.engine.neighbours.CELL_LIST_MIN_N` spheres every pair is
+    tested in compiled code (:func:`_search_kernel`), from there on the NumPy cell list runs.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+
+    Returns
+    -------
+    i, j : ndarray of int
+        The pairs, sorted by ``(i, j)``.
+    """
+    N = len(x)
+    if N >= CELL_LIST_MIN_N or not math.isfinite(float(shift)):   # (an infinite offset: no pair is near, as NumPy's)
+        return near_pairs(x, y, r, Lx, Ly, shift, skin)
+    kernel = _kernels.get("search") or compile_search_kernel()
+    out = np.empty((2, N * (N - 1) // 2), dtype=np.int64)
+    n = kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+               np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), out[0], out[1])
+    return out[0, :n].copy(), out[1, :n].copy()
+
+
+def compile_search_kernel(cache=True):
+    """The compiled all-pairs search of :func:`search`, compiled once per process (or loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    if cache and "search" in _kernels:
+        return _kernels["search"]
+    import numba
+    from numba import types
+
+    if cache:
+        numba.config.CACHE_DIR = numba_driver.cache_dir()
+    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS + ((sys.modules[__name__], "_search_kernel"),),
+                              inline=INLINE)
+    compiled = L["_search_kernel"]
+    f1, i1, f = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64
+    compiled.compile(types.int64(f1, f1, f1, f, f, f, f, i1, i1))
+    if cache:
+        _kernels["search"] = compiled
+    return compiled
 
 
 def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step_count, interval,
