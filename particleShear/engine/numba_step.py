@@ -60,8 +60,9 @@ KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
                     (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
-#: the functions of the compiled block (:func:`run_block`) besides the step's
+#: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
+SEARCH_FUNCTIONS = ((sys.modules[__name__], "_search_kernel"),)
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
@@ -451,20 +452,35 @@ def compile_step_kernel(cache=True, say=None):
     -------
     numba.core.registry.CPUDispatcher
     """
-    if cache and True in _kernels:
-        return _kernels[True]
+    import numba
+    return _compile(True, "_step_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS, _signature, cache, say,
+                    lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
+
+
+def _compile(key, name, functions, signature, cache=True, say=None, message=None):
+    """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
+    ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
+    before a compile (not before a load)."""
+    if cache and key in _kernels:
+        return _kernels[key]
     import numba
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
-    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS, inline=INLINE)
-    compiled = L["_step_kernel"]
+    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE)[name]
     if say is not None and not numba_driver.on_disk(compiled):
-        say(f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR or 'memory'})")
-    compiled.compile(_signature())          # (or loaded from the cache): before any timing
+        say(message())
+    compiled.compile(signature())          # (or loaded from the cache): before any timing
     if cache:
-        _kernels[True] = compiled
+        _kernels[key] = compiled
     return compiled
+
+
+def _search_signature():
+    """The Numba signature of :func:`_search_kernel`."""
+    from numba import types
+    f1, i1, f = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64
+    return types.int64(f1, f1, f1, f, f, f, f, i1, i1)
 
 
 def _block_signature():
@@ -920,21 +936,8 @@ def compile_search_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    if cache and "search" in _kernels:
-        return _kernels["search"]
-    import numba
-    from numba import types
-
-    if cache:
-        numba.config.CACHE_DIR = numba_driver.cache_dir()
-    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS + ((sys.modules[__name__], "_search_kernel"),),
-                              inline=INLINE)
-    compiled = L["_search_kernel"]
-    f1, i1, f = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64
-    compiled.compile(types.int64(f1, f1, f1, f, f, f, f, i1, i1))
-    if cache:
-        _kernels["search"] = compiled
-    return compiled
+    return _compile("search", "_search_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS, _search_signature,
+                    cache)
 
 
 def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step_count, interval,
@@ -1000,15 +1003,5 @@ def compile_block_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    if cache and "block" in _kernels:
-        return _kernels["block"]
-    import numba
-
-    if cache:
-        numba.config.CACHE_DIR = numba_driver.cache_dir()
-    L = numba_driver.jit_laws(cache, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE)
-    compiled = L["_block_kernel"]
-    compiled.compile(_block_signature())
-    if cache:
-        _kernels["block"] = compiled
-    return compiled
+    return _compile("block", "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, _block_signature,
+                    cache)
