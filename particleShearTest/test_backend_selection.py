@@ -158,3 +158,37 @@ print(code, err.getvalue().strip().splitlines()[-1])
 
 if __name__ == "__main__":
     unittest.main()
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed")
+class TestNumbaThatDoesNotCompile(unittest.TestCase):
+    """Numba imports but compiling its loops fails (an unsupported build): a run that asked for
+    "auto" warns once and runs NumPy with the same numbers and records "numpy"; one that asked for
+    "numba" gets the error."""
+
+    def test_auto_falls_back_and_numba_raises(self):
+        code = ("import warnings, particleShear.simulation.driver as d\n"
+                "def broken(**kw):\n"
+                "    raise RuntimeError('no compiler here')\n"
+                "d.compile_kernels = broken\n"
+                "from particleShear import doParticleShearSimulation\n"
+                "kw = dict(seed=1, N=30, relative_frequency=0.25, periods=1, verbose=False, doDrawing=False,\n"
+                "          plotStress=False, return_result=True)\n"
+                "try:\n"
+                "    doParticleShearSimulation(backend='numba', **kw)\n"
+                "    print('numba ran')\n"
+                "except RuntimeError as e:\n"
+                "    print('numba raised', e)\n"
+                "with warnings.catch_warnings(record=True) as w:\n"
+                "    warnings.simplefilter('always')\n"
+                "    a = doParticleShearSimulation(**kw)\n"
+                "print(a.parameters['backend'], sum('compiling its loops failed' in str(x.message) for x in w))\n"
+                "b = doParticleShearSimulation(backend='numpy', **kw)\n"
+                "print(a.G_surface == b.G_surface, a.run_id == b.run_id)\n")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                             env={k: v for k, v in os.environ.items() if k != xpmod.BACKEND_ENV})
+        self.assertEqual(out.returncode, 0, out.stderr)
+        lines = out.stdout.strip().splitlines()
+        self.assertEqual(lines[0], "numba raised no compiler here")
+        self.assertEqual(lines[1], "numpy 1")
+        self.assertEqual(lines[2], "True True")

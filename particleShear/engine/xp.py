@@ -28,12 +28,13 @@ __docformat__ = "numpy"
 import contextlib
 import os
 import sys
+import warnings
 
 import numpy as np
 
 __all__ = ["select", "maximum", "Backend", "get_backend", "register_backend", "unregister_backend", "array_namespace",
            "backend_of", "resolve_backend", "default_backend", "identity_backend", "numba_importable", "backend_names",
-           "BACKEND_ENV", "AUTO_DEFAULT", "NUMBA_INSTALL", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
+           "BACKEND_ENV", "AUTO_DEFAULT", "auto_without_numba", "NUMBA_INSTALL", "to_host", "SegmentSum", "REASONS", "record_host_reads", "CUPY_INSTALL"]
 
 #: how to install CuPy for CUDA 12 (named in the error of ``backend="cupy"`` without it)
 CUPY_INSTALL = "pip install cupy-cuda12x"
@@ -205,6 +206,27 @@ def numba_importable():
     return True
 
 
+#: why Numba is not what ``"auto"`` stands for in this process although it can be imported (its
+#: compile failed: :func:`auto_without_numba`); empty while it is
+_AUTO_WITHOUT_NUMBA = []
+
+
+def auto_without_numba(reason):
+    """Make ``"auto"`` stand for NumPy for the rest of this process: Numba imports but its compile
+    failed (an unsupported Numba build, for instance).  Warns once, naming the reason; an explicit
+    ``backend="numba"`` is not affected (its runs raise the compile's error).
+
+    Parameters
+    ----------
+    reason : str or Exception
+        What failed.
+    """
+    if not _AUTO_WITHOUT_NUMBA:
+        warnings.warn(f"backend 'auto': Numba is installed but compiling its loops failed ({reason}); this process "
+                      "runs NumPy (the same numbers)", RuntimeWarning, stacklevel=2)
+    _AUTO_WITHOUT_NUMBA.append(str(reason))
+
+
 def backend_names():
     """The names ``backend=`` accepts: every backend (registered ones included) and ``"auto"``.
 
@@ -270,7 +292,7 @@ def resolve_backend(name="auto"):
     if name is None or name == "auto":
         name = default_backend()
     if name == "auto":
-        return "numba" if numba_importable() else "numpy"
+        return "numba" if numba_importable() and not _AUTO_WITHOUT_NUMBA else "numpy"
     return name
 
 

@@ -20,7 +20,7 @@ from ..engine.microstructure import Stroboscope
 from ..engine.numba_step import compile_kernels
 from ..engine.state import BatchState
 from ..engine.step import BatchEngine, EngineInstability, pre_equilibrate, protocol
-from ..engine.xp import get_backend
+from ..engine.xp import auto_without_numba, get_backend
 from ..linkable.builders import MAX_RELAXATIONS
 from .observers import ReplicaScene
 
@@ -102,10 +102,12 @@ def _constitute(sessions):
     # the backend of each replica's relaxations: its run's, where that keeps the host's arrays (the
     # compiled step is compiled, or loaded from the cache, here: not counted in the timings)
     backends = [_host_backend(run) for run in sessions]
-    if any(be.compiled for be in backends):
+    compiled = [b for b, be in enumerate(backends) if be.compiled]
+    if compiled:
         say = _console([run.sim for run in sessions], [0], "constitution", ["constitution", 0, 0])[0]
-        for law in {(run.sim.contact_law or (None,))[0] for run in sessions}:
-            compile_kernels(say=say, law=law)
+        requested = {(sessions[b].sim.parameters or {}).get("backend", "auto") for b in compiled}
+        if not all(_compiled(requested, say, law) for law in {(run.sim.contact_law or (None,))[0] for run in sessions}):
+            backends = [_host_backend(run) for run in sessions]        # ("auto": NumPy now)
     steps = [run.constitution() for run in sessions]
     pending = {}            # replica -> its waiting Relaxation
     since = {}              # replica -> when it was suspended
@@ -255,7 +257,12 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         say, report = _console(sims, group, "pre-equilibration", where)
         if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
             tc = time.perf_counter()
-            compile_kernels(say=say, law=st.law)
+            if not _compiled({backend}, say, st.law):       # ("auto" without a usable Numba: NumPy)
+                st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
+                                          laws=[sims[b].contact_law for b in group])
+                for b in group:
+                    if sims[b].parameters is not None:
+                        sims[b].parameters["backend"] = st.backend.name
             t0 += time.perf_counter() - tc
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
@@ -274,6 +281,22 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     engine = BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in order],
                          integrator=integrator, half=half)
     return engine, order
+
+
+def _compiled(requested, say, law):
+    """Compile (or load) the compiled backend's loops before the timings (:func:`~particleShear.engine.numba_step.compile_kernels`).
+
+    Returns False when the compile failed for runs that asked for ``"auto"`` (which then stands for
+    NumPy in this process: :func:`~particleShear.engine.xp.auto_without_numba`); a run that asked
+    for ``"numba"`` gets the error."""
+    try:
+        compile_kernels(say=say, law=law)
+        return True
+    except Exception as exc:
+        if not requested <= {"auto", None}:
+            raise
+        auto_without_numba(f"{type(exc).__name__}: {exc}")
+        return False
 
 
 def _host_backend(run):
