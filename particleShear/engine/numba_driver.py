@@ -36,7 +36,7 @@ from .laws import blend_inside, contact_or_bond, divergent_term, linear_term, te
 from .tangential import two_visit_rule
 from .terms import viscous_force
 
-__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "pair_term", "compile_pair_kernel",
+__all__ = ["available", "cache_dir", "register_helpers", "jit_laws", "jit_deep", "pair_term", "compile_pair_kernel",
            "pair_terms", "FORMS", "LAW_FUNCTIONS", "PAIR_FUNCTIONS"]
 
 #: the code of each form of the compressive law in the compiled loop
@@ -151,22 +151,60 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=
     dict
         Name → Numba dispatcher.
     """
-    import types
-
     import numba
 
     register_helpers()
     compiled, namespaces = {}, []
     for module, name in functions:
         f = getattr(module, name)
-        g = dict(f.__globals__)
-        namespaces.append(g)
-        copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
-        copy.__qualname__, copy.__module__ = (rename or {}).get(name, f.__qualname__), f.__module__
+        copy = _copy(f, (rename or {}).get(name))
+        namespaces.append(copy.__globals__)
         compiled[name] = numba.njit(copy, cache=cache, **({"inline": "always"} if name in inline else {}))
     for g in namespaces:      # (globals are read when a function is compiled, at its first call)
         g.update(compiled)
         g.update(extra or {})
+    return compiled
+
+
+def _copy(f, qualname=None):
+    """``f`` as a new function of the same code with a copy of its globals (to bind other names to
+    compiled functions there), under ``qualname`` (default its own)."""
+    import types
+
+    copy = types.FunctionType(f.__code__, dict(f.__globals__), f.__name__, f.__defaults__, f.__closure__)
+    copy.__qualname__, copy.__module__ = qualname or f.__qualname__, f.__module__
+    return copy
+
+
+def jit_deep(f, done=None):
+    """``f`` compiled (not cached), with every Python function its globals name compiled as well,
+    recursively (:func:`~particleShear.engine.xp.select`, ``maximum`` and ``minimum`` are Numba's
+    overloads): a contact law and the helpers of its module.
+
+    Parameters
+    ----------
+    f : function
+        A pure function of numbers.
+    done : dict, optional
+        Function → its compiled version, shared by the recursion.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    import types
+
+    import numba
+
+    done = {} if done is None else done
+    if f in done:
+        return done[f]
+    copy = _copy(f)
+    done[f] = compiled = numba.njit(copy)
+    for name in f.__code__.co_names:
+        v = f.__globals__.get(name)
+        if isinstance(v, types.FunctionType) and v not in (xp.select, xp.maximum, xp.minimum):
+            copy.__globals__[name] = jit_deep(v, done)
     return compiled
 
 

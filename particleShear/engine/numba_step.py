@@ -31,7 +31,7 @@ import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, neighbours, numba_driver, terms, xp
+from . import box, forces, guard, integrate, neighbours, numba_driver, terms
 from .box import MAX_PASSES, folded, period_count
 from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
@@ -509,25 +509,6 @@ def _kernels_of(ws):
     return _law_kernels(*ws.law)
 
 
-def _jit_deep(f, done):
-    """``f`` compiled, with every Python function its globals name compiled as well (recursively;
-    :func:`~particleShear.engine.xp.select`, ``maximum`` and ``minimum`` are Numba's overloads)."""
-    import types
-
-    import numba
-
-    if f in done:
-        return done[f]
-    g = dict(f.__globals__)
-    copy = types.FunctionType(f.__code__, g, f.__name__, f.__defaults__, f.__closure__)
-    done[f] = compiled = numba.njit(copy)
-    for name in f.__code__.co_names:
-        v = f.__globals__.get(name)
-        if isinstance(v, types.FunctionType) and v not in (xp.select, xp.maximum, xp.minimum):
-            g[name] = _jit_deep(v, done)
-    return compiled
-
-
 def _law_kernels(function, m, say=None):
     """The compiled step and block for a run's law ``function(d, a0 … a{m−1})`` (:func:`~.phase_laws.run_law`).
 
@@ -558,7 +539,7 @@ def _law_kernels(function, m, say=None):
     except (OSError, TypeError):
         h.update(function.__code__.co_code)
     suffix = "__" + h.hexdigest()[:12]
-    law = _jit_deep(function, {})
+    law = numba_driver.jit_deep(function)
     source = "def _central_law(d, a):\n    return LAW(d" + "".join(f", a[{i}]" for i in range(m)) + ")\n"
     namespace = {"LAW": law}
     exec(source, namespace)           # (an adapter of m arguments; numbers only, so no reference counts)
