@@ -213,7 +213,9 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     update) and vx by ``−Ly·γ̇``; crossing ``y = 0`` the reverse.  Then x is wrapped into
     ``[0, Lx)``.  The velocity correction is the reference's ``vx += (y' − y)·γ̇`` with ``y`` and
     ``y'`` the heights before and after the wrap (exactly ``∓Ly·γ̇`` for one crossing; the
-    same number as the reference's also for several).
+    same number as the reference's also for several), on the spheres that moved: the others keep
+    their velocity to the bit (a ``−0.0`` included), so a replica's trajectory does not depend on
+    whether a sphere of another replica of its batch crossed.
 
     Parameters
     ----------
@@ -263,9 +265,9 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
         y[...], up = _fold(y, Ly, 0.0, Ly, xp)
         with _quiet_invalid(xp):
             x -= shift * up
-    if y0 is not None:
+    if y0 is not None:      # a sphere moved by a period takes the flow's velocity difference; the others keep theirs
         with _quiet_invalid(xp):
-            vx += (y - y0) * rate
+            vx[...] = xp.where(y != y0, vx + (y - y0) * rate, vx)
     for _ in range(MAX_PASSES):
         right = period_count(x, Lx, 0.0)
         if be.host:

@@ -66,7 +66,7 @@ SEARCH_FUNCTIONS = ((sys.modules[__name__], "_search_kernel"),)
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
-_ARGUMENTS = ("i i f f b b b b i b f[:,:] i b[:] b b f[:,:] f[:,:] "   # start … half_out
+_ARGUMENTS = ("i i i i f f b b b b i b f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
               "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
               "f[:] f[:] f[:] f[:] f[:] f[:] "                       # rate … V
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
@@ -83,8 +83,9 @@ COMPILED_LAWS = ("hertz", "plateau")
 #: what :func:`run_step` returns when the step was not run (the NumPy step runs it)
 NOT_RUN = object()
 
-# the kernel's return codes
+# the kernel's return codes, and the start of a replica a block skips
 _DONE, _D_ZERO, _GUARD, _UNITS, _NEED = 0, 1, 2, 3, 4
+_SKIP = -1
 
 _kernels = {}
 
@@ -213,52 +214,60 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
-def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free, verlet,
-                 predicted, half, half_out,
+def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free, verlet,
+                 pred, half, half_out,
            pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
            rate, gamma, t, Lx, Ly, V,
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
            u, u_max, strain, bound, r_max, skin,
            guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
            work, mob, yc, y0, zero, tau, verdict, need):
-    """One step of every replica on numbers (compiled; run by :func:`run_step`, which passes the arguments).
+    """One step of the replicas ``b0 … b1 − 1`` on numbers (compiled; run by :func:`run_step` for the
+    whole batch and by :func:`_block_kernel` for one replica at a time).
 
-    ``start`` 0 runs the whole step; 1 resumes at the ξ rule once the caller gave the random
-    directions at ``|R| = 0`` (``work`` rows 8, 9).  The arguments are the engine's (the flags of
-    the step, the state's sphere rows, the per-replica box, strain, rate and clock, the candidates'
-    blocks and history, the Verlet bookkeeping, the guard's constants) and the buffers of its
-    :class:`_Workspace`; everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO`
-    (nothing changed: a pair at ``d = 0``), :data:`_GUARD` (after the force phase) or :data:`_UNITS`.
+    The replicas' spheres are the rows ``b0·N … b1·N − 1`` and their candidates the columns
+    ``offsets[b0] … offsets[b1] − 1``; nothing of another replica is read or written, so a replica's
+    step is the same numbers whatever else the batch holds or in which order its replicas step.
+    ``start`` 0 runs the whole step; 3 runs it with the random normals of the pairs at ``d = 0``
+    given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes at the ξ rule
+    once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9).  ``pred[b]``:
+    replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
+    its first step).  The other arguments are the engine's (the flags of the step, the state's
+    sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
+    the Verlet bookkeeping, the guard's constants) and the buffers of its :class:`_Workspace`;
+    everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO` (nothing changed: a
+    pair at ``d = 0`` whose normal is not given), :data:`_GUARD` (after the force phase) or :data:`_UNITS`.
     """
-    B = rate.shape[0]
-    P = Ci.shape[1]
-    n = pos.shape[1]
+    P0, P1 = offsets[b0], offsets[b1]
+    n0, n1 = b0 * N, b1 * N
     T = Cf[_T0:_T0 + 12]
     k_t_j, nu_t_j = T[8], T[9]
     dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
                                                              work[6], work[7], work[8], work[9], work[10])
-    if start == 0:
+    if start != 1:
         # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
-        for p in range(P):
+        coincident = False
+        for p in range(P0, P1):
             b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
             dx, dy, ky, kx = _min_image_pair(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[_ILX, p], Cf[_ILY, p],
                                    Ly[b] * gamma[b])
             d = np.sqrt(dx * dx + dy * dy)
-            if d == 0.0:
-                return _D_ZERO
+            coincident = coincident or d == 0.0
             dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
-        for k in range(n):
+        if coincident and start != 3:
+            return _D_ZERO
+        for k in range(n0, n1):
             yc[k] = pos[1, k] - Ly_s[k] / 2
             mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
             frc[0, k] = 0.0
             frc[1, k] = 0.0
             frc[2, k] = 0.0
-        for b in range(B):
+        for b in range(b0, b1):
             tau[0, b] = 0.0
             tau[1, b] = 0.0
             verdict[3, b] = math.inf
         # relations, terms and the pair forces on i (the scatter's first half, in pair order)
-        for p in range(P):
+        for p in range(P0, P1):
             b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
             d = ds[p]
             touching = d < Cf[_ID0, p]
@@ -272,9 +281,12 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
                 xi[0, p] = 0.0                      # an opened contact loses its history
                 xi[1, p] = 0.0
             active[p] = rel
-            nx, ny = dxs[p] / d, dys[p] / d
+            if d == 0.0:      # (the random normal the caller drew, as forces.normals draws it)
+                nx, ny = nxs[p], nys[p]
+            else:
+                nx, ny = dxs[p] / d, dys[p] / d
             dvx = -(Cf[_ILY, p] * rate[b]) * kys[p]
-            if predicted:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
+            if pred[b]:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
                 vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
                 vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
             else:
@@ -309,19 +321,19 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
             if check:
                 verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
         # the scatter's second half: −F on j and the torque on j, in pair order
-        for p in range(P):
+        for p in range(P0, P1):
             j = Ci[2, p]
             frc[0, j] += -mxs[p]
             frc[1, j] += -mys[p]
             frc[2, j] += dFs[p] * Cf[_IWJ, p]
         if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
-            for b in range(B):
+            for b in range(b0, b1):
                 lo, hi = offsets[b], offsets[b + 1]
                 tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
                                                        _segment_sum(work[13], lo, hi), V[b])
         if check:
             bad = False
-            for b in range(B):
+            for b in range(b0, b1):
                 rate_max[b] = _nan_max(rate_max[b], abs(rate[b]))
                 finite = True
                 for k in range(b * N, (b + 1) * N):
@@ -337,7 +349,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
             if bad:
                 return _GUARD
         # -- kick (plates follow), damping
-        for k in range(n):
+        for k in range(n0, n1):
             b = rep_s[k]
             if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
                 half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
@@ -359,7 +371,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
             start = 2
         # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
         units = False
-        for p in range(P if start == 0 else 0):
+        for p in range(P0, P1 if start != 2 else P0):
             i = Ci[1, p]
             Rx = vel[0, i] * dt - dxs[p]
             Ry = vel[1, i] * dt - dys[p]
@@ -374,7 +386,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
         if units:
             return _UNITS
     # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
-    for p in range(P if start != 2 else 0):
+    for p in range(P0, P1 if start != 2 else P0):
         i, j = Ci[1, p], Ci[2, p]
         kd = dt if active[p] and state_p[p] != 1 else 0.0
         rvx = vel[0, j] - vel[0, i] + dvxs[p]
@@ -383,7 +395,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
         xi[0, p] += inc_ij * kd
         xi[1, p] += inc_ji * kd
     # displacement since the lists were built, Verlet bound, drift
-    for b in range(B):
+    for b in range(b0, b1):
         largest = -math.inf
         for k in range(b * N, (b + 1) * N):
             u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
@@ -392,15 +404,15 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
         u_max[b] = _nan_max(u_max[b], np.sqrt(largest))
         strain[b] += abs(rate[b]) * dt
         bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
-    for k in range(n):
+    for k in range(n0, n1):
         pos[0, k] += vel[0, k] * dt
         pos[1, k] += vel[1, k] * dt
         phi[k] += vel[2, k] * dt
-    # strain, wrap (box.wrap element by element), clock
-    for b in range(B):
+    # strain, wrap (box.wrap element by element: a sphere moved by a period in y takes the flow's
+    # velocity difference), clock
+    for b in range(b0, b1):
         gamma[b] = gamma[b] + rate[b] * dt
-    crossed = False
-    for k in range(n):
+    for k in range(n0, n1):
         b = rep_s[k]
         y0[k] = pos[1, k]
         for q in range(MAX_PASSES + 1):
@@ -411,13 +423,11 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
             up = period_count(pos[1, k], Ly_s[k], 0.0)
             if up == 0.0:
                 break
-            crossed = True
             pos[1, k] -= Ly_s[k] * up
             pos[0, k] -= (Ly[b] * gamma[b]) * up
-    if crossed:
-        for k in range(n):
-            vel[0, k] += (pos[1, k] - y0[k]) * rate[rep_s[k]]
-    for k in range(n):
+        if pos[1, k] != y0[k]:
+            vel[0, k] += (pos[1, k] - y0[k]) * rate[b]
+    for k in range(n0, n1):
         Lxk = Lx[rep_s[k]]
         for q in range(MAX_PASSES + 1):
             if q == MAX_PASSES:
@@ -427,7 +437,7 @@ def _step_kernel(start, N, cool, dt, sample, check, applying, numbers, form, cus
             if right == 0.0:
                 break
             pos[0, k] -= Lxk * right
-    for b in range(B):
+    for b in range(b0, b1):
         t[b] = t[b] + dt
         need[b] = bound[b] >= skin[b]
     return _DONE
@@ -486,9 +496,8 @@ def _search_signature():
 def _block_signature():
     """The Numba signature of :func:`_block_kernel`."""
     from numba import types
-    f2, i = types.Array(types.float64, 2, "C"), types.int64
-    return types.UniTuple(i, 3)(i, i, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean,
-                                *_signature().args[1:])
+    f2, i1, i = types.Array(types.float64, 2, "C"), types.Array(types.int64, 1, "C"), types.int64
+    return i(i1, i, i1, i1, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean, *_signature().args[3:])
 
 
 def _signature():
@@ -665,9 +674,9 @@ def run_step(engine, cool, dt, sample):
     """One step of ``engine`` in the compiled code, or :data:`NOT_RUN` when it does not cover it.
 
     The candidate lists are rebuilt first when due (:meth:`~particleShear.engine.step.BatchEngine.neighbours`,
-    on NumPy).  A pair at ``d = 0`` leaves the step to NumPy (nothing changed yet; its random normal
-    is drawn there); a ``|R| = 0`` of the ξ rule gets its random direction here, from the
-    replica's generator in pair order, as :func:`~.forces.normals` draws it.
+    on NumPy).  A pair at ``d = 0`` (its random normal) and a ``|R| = 0`` of the ξ rule (its random
+    direction) get their directions here, from the replica's generator in pair order, as
+    :func:`~.forces.normals` draws them, and the step goes on compiled.
 
     Parameters
     ----------
@@ -692,18 +701,21 @@ def run_step(engine, cool, dt, sample):
     ws = _prepared(engine)
     if ws is None:
         return NOT_RUN
-    kernel = _kernels_of(ws)[0]
+    kernel, B = _kernels_of(ws)[0], engine.s.B
     check = ws.guarded and not engine.step_count % engine.check_interval
-    args, held = _arguments(engine, ws, cool, dt, sample, check)
-    status = kernel(0, *args)
+    args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None))
+    status = kernel(0, 0, B, *args)
     if status == _D_ZERO:
-        return NOT_RUN
+        for b in range(B):
+            _draw(engine, ws, b, ws.work[4] == 0.0, 5)
+        status = kernel(3, 0, B, *args)
     _adopt(engine, ws, held)
     if status == _GUARD:
         _report(engine, ws)
     if status == _UNITS:
-        _draw_units(engine, ws)
-        kernel(1, *args)
+        for b in range(B):
+            _draw(engine, ws, b, ws.zero, 8)
+        kernel(1, 0, B, *args)
     _adopt(engine, ws, held, stepped=True)
     engine.step_count += 1
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
@@ -720,8 +732,10 @@ def _prepared(engine):
     return None
 
 
-def _arguments(engine, ws, cool, dt, sample, check):
-    """The arguments of :func:`_step_kernel` after ``start``, and the arrays to hand back (:func:`_adopt`)."""
+def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
+    """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
+    (:func:`_adopt`); ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
+    ``half_out``: the buffer of the new half kicks (default a new array, as ``half_kick`` gives)."""
     s, C = engine.s, engine.C
     gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
     state_p, xi, active, birth, next_birth, u, u_max, strain, bound, rate_max = (
@@ -730,17 +744,19 @@ def _arguments(engine, ws, cool, dt, sample, check):
     free = engine.free_p
     free_mode, free = (0, ws.zero) if free is None else (1, ws.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
-    predicted = engine.half is not None        # (the force phase sees the velocities half a kick ahead, as NumPy's)
-    half = np.array(engine.half, dtype=float) if predicted else np.empty((3, s.B * s.N)) if verlet else ws.no_half
-    new_half = np.empty((3, s.B * s.N)) if verlet else ws.no_half    # (a new array per step, as half_kick gives)
+    half = np.array(engine.half, dtype=float) if engine.half is not None else np.empty((3, s.B * s.N)) if verlet \
+        else ws.no_half
+    new_half = ws.no_half if not verlet else np.empty((3, s.B * s.N)) if half_out is None else half_out
+    ws.need[:] = engine.need        # (a replica a block skips keeps its flag)
     args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
-            ws.form, ws.custom, ws.law_rows, free_mode, free, verlet, predicted, half, new_half, s.pos, s.vel, s.frc, s.phi, engine.mmi, s.r,
-            ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p, xi, active,
-            birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
+            ws.form, ws.custom, ws.law_rows, free_mode, free, verlet, pred, half, new_half, s.pos, s.vel, s.frc, s.phi,
+            engine.mmi, s.r, ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p,
+            xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
     held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
-                u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate, half=new_half if verlet else None)
+                u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate, half_in=half,
+                half=new_half if verlet else None)
     return args, held
 
 
@@ -768,13 +784,16 @@ def _report(engine, ws):
     engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
 
 
-def _draw_units(engine, ws):
-    """The random unit vectors at ``|R| = 0`` (``work`` rows 8, 9): pair order, each pair's own
-    replica's generator, as :func:`~particleShear.engine.forces.normals` draws them."""
-    s, C = engine.s, engine.C
-    for p in np.flatnonzero(ws.zero):
-        theta = 2 * np.pi * s.rng[int(C.rep_host[p])].random()
-        ws.work[8, p], ws.work[9, p] = np.cos(theta), np.sin(theta)
+def _draw(engine, ws, b, mask, row):
+    """Random unit vectors ``(cos 2πu, sin 2πu)`` into ``work`` rows ``row``, ``row + 1`` for replica
+    b's candidates where ``mask`` holds: in pair order, from the replica's own generator, as
+    :func:`~particleShear.engine.forces.normals` draws them (rows 5, 6: the normals at ``d = 0``;
+    rows 8, 9: the directions at ``|R| = 0``)."""
+    lo, hi = ws.offsets[b], ws.offsets[b + 1]
+    rng = engine.s.rng[b]
+    for p in np.flatnonzero(mask[lo:hi]) + lo:
+        theta = 2 * np.pi * rng.random()
+        ws.work[row, p], ws.work[row + 1, p] = np.cos(theta), np.sin(theta)
 
 
 def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
@@ -784,10 +803,12 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
     Each step of a schedule is what :func:`~particleShear.engine.rheometer.shear_record` does for
     it with a sample of the two shear stresses: ``set_rate`` (each sphere keeps its velocity
     relative to the flow, :func:`~particleShear.engine.integrate.flow_shifted`), record the clock,
-    strain and rate, the step, record the stresses.  One compiled call runs steps until the block
-    ends or a candidate list is due (rebuilt here, on NumPy); a pair at ``d = 0`` runs its step on
-    NumPy, a ``|R| = 0`` gets its random direction here, and the guard's verdict is reported as
-    the step's.
+    strain and rate, the step, record the stresses.  One compiled call runs each replica until the
+    block ends or its candidate list is due (:func:`_block_kernel`); the lists due are then
+    rebuilt (on NumPy, the one rebuild) and the next call goes on.  A pair at ``d = 0`` and a
+    ``|R| = 0`` get their random directions here, from the replica's own generator, and the step
+    goes on compiled.  The guard's verdict is reported as the step's: the earliest step at which
+    a guarded replica failed, the first such replica (each replica runs at least to that step).
 
     Parameters
     ----------
@@ -808,8 +829,12 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
     Returns
     -------
     int
-        The steps run, or fewer when the engine's steps do not run compiled (the caller runs the
-        rest step by step).
+        ``n``, or 0 when the engine's steps do not run compiled (the caller runs them step by step).
+
+    Raises
+    ------
+    EngineInstability
+        When the guard finds a guarded replica unstable.
     """
     scheduled = rates is not None
     if scheduled:
@@ -819,36 +844,53 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
     else:
         rates = _NO_RECORD
         rec = (_NO_RECORD,) * 5
-    k = 0
-    while k < n:
-        engine.neighbours()
+    B, step0 = engine.s.B, engine.step_count
+    ks, starts, status = np.zeros(B, np.int64), np.zeros(B, np.int64), np.zeros(B, np.int64)
+    pred = np.full(B, engine.half is not None)
+    # (one buffer of new half kicks for the block: a step resumed in the next call kicked into it)
+    half_out = np.empty((3, B * engine.s.N)) if engine.integrator == "verlet" else None
+    failed, verdicts = np.full(B, -1, np.int64), np.zeros((4, B))
+    end, drawn = n, False
+    for _ in range(3 * n * B + 2):       # (each call advances a replica or draws for one: bounded)
+        going = (ks < end) & (failed < 0)
+        if not going.any():
+            break
+        if not drawn:     # rebuild the lists due of the replicas still going, and start them anew
+            due = engine.need.copy()
+            engine.need = due & going
+            engine.neighbours()
+            engine.need = due & ~going
+            starts[going & (starts == _SKIP)] = 0
         ws = _prepared(engine)
         if ws is None:
-            return k
-        kernel = _kernels_of(ws)[1]
-        args, held = _arguments(engine, ws, cool, dt, scheduled, False)
-        k0 = k
-        k, status, engine.step_count = kernel(k, n, rates, *rec, row, engine.step_count, engine.check_interval,
-                                              ws.guarded, scheduled, *args)
-        # (a half kick is handed back once a step of this call reached its kick: one finished, or the
-        # step that stopped for its random directions; else the engine keeps its own)
-        _adopt(engine, ws, held, stepped=True, kicked=k > k0 or status == _UNITS)
-        if status == _D_ZERO:      # (its rate is set and its clock, strain and rate recorded)
-            out = engine.step(cool, dt, sample=scheduled)
-            if scheduled:
-                rec[3][row + k], rec[4][row + k] = out[0], out[1]
-            k += 1
-        elif status == _GUARD:
-            _adopt(engine, ws, held)
-            _report(engine, ws)
-        elif status == _UNITS:     # the rest of step k, on the block's own arrays
-            _draw_units(engine, ws)
-            _kernels_of(ws)[0](1, *args)
-            _adopt(engine, ws, held, stepped=True)
-            if scheduled:
-                rec[3][row + k], rec[4][row + k] = ws.tau[0], ws.tau[1]
-            engine.step_count += 1
-            k += 1
+            if ks.any():
+                raise RuntimeError("run_block: the step stopped running compiled within a block")
+            return 0
+        starts[~going] = _SKIP
+        args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out)
+        _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
+                           scheduled, *args)
+        held["half"] = held["half_in"]
+        _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
+        drawn = False
+        for b in np.flatnonzero(going):
+            st = status[b]
+            starts[b] = _SKIP
+            if st == _D_ZERO:        # (nothing of the step changed: its normals at d = 0, then the step)
+                _draw(engine, ws, b, ws.work[4] == 0.0, 5)
+                starts[b], drawn = 3, True
+            elif st == _UNITS:       # (the rest of the step, from the ξ rule)
+                _draw(engine, ws, b, ws.zero, 8)
+                starts[b], drawn = 1, True
+            elif st == _GUARD:       # (the other replicas run to this step at least: the first failure is reported)
+                failed[b], verdicts[:, b] = ks[b], ws.verdict[:, b]
+                end = min(end, int(ks[b]) + 1)
+    if (failed >= 0).any():
+        first = int(failed[failed >= 0].min())
+        code = np.where(failed == first, verdicts[0], 0).astype(np.int64)
+        engine.step_count = step0 + first
+        engine._report((code, verdicts[1], verdicts[2], verdicts[3]), engine.step_count)
+    engine.step_count = step0 + n
     return n
 
 
@@ -921,55 +963,62 @@ def compile_search_kernel(cache=True):
                     cache)
 
 
-def _block_kernel(k, n, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step_count, interval,
-                  guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free,
-                  verlet, predicted,
-                  half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V,
-                  Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin,
-                  guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero, tau, verdict, need):
-    """Steps ``k … n − 1`` of a block on numbers (compiled; run by :func:`run_block`).
+def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
+                  interval, guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A,
+                  free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma,
+                  t, Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound,
+                  r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
+                  tau, verdict, need):
+    """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
 
-    Per step of a schedule (``scheduled``): the new rate (:func:`~particleShear.engine.integrate.flow_shifted`
-    on every sphere), the record of clock, strain and rate, :func:`_step_kernel` with the two
-    stresses sampled, their record; otherwise :func:`_step_kernel` alone, at the rate of the state.
-    Returns ``(k, status, step_count)``: the next step and :data:`_DONE`, :data:`_NEED` (a list is
-    due), or the step a status of :func:`_step_kernel` stopped.
+    Replica b runs its steps ``ks[b] … n − 1`` until the block ends, a candidate list of it is due
+    or a step of it stops (:func:`_step_kernel`'s statuses); its first step here starts as
+    ``starts[b]`` says (:data:`_SKIP`: not at all; 0: a new step; 1 or 3: the resumption of a
+    step whose random directions the caller drew).  Per step of a schedule (``scheduled``): the
+    new rate (:func:`~particleShear.engine.integrate.flow_shifted` on the replica's spheres), the
+    record of clock, strain and rate, :func:`_step_kernel` with the two stresses sampled, their
+    record; otherwise :func:`_step_kernel` alone, at the rate of the state.  The guard checks the
+    step ``step0 + k``.  Writes the next step of each replica into ``ks`` and its status into
+    ``status`` (:data:`_DONE`, :data:`_NEED` or a status of :func:`_step_kernel`).
+
+    The replicas share nothing (each reads and writes its own spheres, candidates and records),
+    so each runs to its own next rebuild: a batch's block is as long as its replicas' own,
+    instead of ending at the first list due in any replica.
     """
     B = rate.shape[0]
-    nsph = pos.shape[1]
-    while k < n:
-        if scheduled:
-            for q in range(nsph):
-                b = rep_s[q]
-                vel[0, q], vel[2, q] = flow_shifted(vel[0, q], vel[2, q], pos[1, q] - Ly_s[q] / 2,
-                                                    rates[k, b] - rate[b])
-            for b in range(B):
+    for b in range(B):
+        k, start, st = ks[b], starts[b], _DONE
+        while start != _SKIP and k < n:
+            if scheduled and start == 0:      # (a resumed step has its rate and records)
+                for q in range(b * N, (b + 1) * N):
+                    vel[0, q], vel[2, q] = flow_shifted(vel[0, q], vel[2, q], pos[1, q] - Ly_s[q] / 2,
+                                                        rates[k, b] - rate[b])
                 rate[b] = rates[k, b]
                 rec_t[row + k, b] = t[b]
                 rec_strain[row + k, b] = gamma[b]
                 rec_rate[row + k, b] = rate[b]
-        check = guarded and step_count % interval == 0
-        status = _step_kernel(0, N, cool, dt, scheduled, check, applying, numbers, form, custom, A, free_mode, free, verlet,
-                              predicted, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t,
-                              Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max,
-                              strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
-                              work, mob, yc, y0, zero, tau, verdict, need)
-        if status != _DONE:
-            return k, status, step_count
-        due = False
-        for b in range(B):
+            due_check = guarded and (step0 + k) % interval == 0
+            st = _step_kernel(start, b, b + 1, N, cool, dt, scheduled, due_check, applying, numbers, form, custom, A,
+                              free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
+                              rate, gamma, t, Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
+                              u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
+                              max_ke, work, mob, yc, y0, zero, tau, verdict, need)
+            start = 0
+            if st != _DONE:
+                break
             if scheduled:
                 rec_internal[row + k, b] = tau[0, b]
                 rec_surface[row + k, b] = tau[1, b]
-            due = due or need[b]
-        step_count += 1
-        k += 1
-        if verlet:
-            half[:, :] = half_out
-            predicted = True
-        if due:
-            return k, _NEED, step_count
-    return k, _DONE, step_count
+            if verlet:        # (the half kick the replica's next force phase sees)
+                for q in range(b * N, (b + 1) * N):
+                    half[0, q], half[1, q], half[2, q] = half_out[0, q], half_out[1, q], half_out[2, q]
+                pred[b] = True
+            k += 1
+            if need[b]:
+                st = _NEED
+                break
+        ks[b], status[b] = k, st
+    return 0
 
 
 def compile_block_kernel(cache=True):
