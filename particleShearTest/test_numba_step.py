@@ -6,8 +6,9 @@ histories, creation numbers and the sampled stresses are equal bit for bit (sign
 included), not merely close.  Scenes: crosslinked particles with cut bonds, frictional spheres,
 frictionless spheres (the shortcut), a batch mixing frictionless and frictional replicas, the
 velocity Verlet integrator, the Hertz and the plateau law of the laws folder, plates off (the constitution's relaxation), a run's whole
-constitution and measurement, a diverging replica (the same guard verdict), and a pair at
-distance 0 (that step runs on NumPy, which draws the random normal).  Skipped without Numba.
+constitution and measurement, a diverging replica (the same guard verdict, also in blocks), a pair at
+distance 0 (the compiled step draws its random normal from the replica's generator), and a block's
+replicas on two threads.  Skipped without Numba.
 """
 import unittest
 import warnings
@@ -121,6 +122,27 @@ class TestCompiledStepBits(unittest.TestCase):
         self.assert_same_engines(*engines)
         self.assertGreater(engines[1].pairs_of(0).birth.max(), 0)
 
+    def test_guard_in_blocks_reports_the_first_failure(self):
+        """Three replicas stepped far above the stable step in compiled blocks (each replica to its own
+        next rebuild), the last one also kicked: replica 0 diverges at the guard's second check, the
+        kicked replica 2 at its first; the compiled blocks, which step replica 0 first, report what
+        NumPy's step-by-step loop reports: the earliest failing step (replica 2, step 0)."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine, EngineInstability
+        from particleShearTest.test_engine import constituted
+
+        errors = []
+        for backend in ("numpy", "numba"):
+            ens = [constituted(31 + k, **FRICTIONAL)[1] for k in range(3)]
+            eng = BatchEngine(state_from_ensembles(ens, backend=backend))
+            N = eng.s.N
+            eng.s.vel[:, 2 * N:] *= 1e6
+            with self.assertRaises(EngineInstability) as ctx:
+                eng.steps(400, 1.0, ens[0].dt * 20)
+            errors.append((str(ctx.exception), ctx.exception.step, ctx.exception.replica))
+        self.assertEqual(errors[0], errors[1])
+        self.assertEqual(errors[0][1:], (0, 2))
+
     def test_batch_replica_equals_single_run(self):
         _, both = _measure([(0, FRICTIONAL_BONDS), (1, FRICTIONAL)], "numba")
         for col, scene in enumerate((FRICTIONAL_BONDS, FRICTIONAL)):
@@ -161,9 +183,13 @@ class TestCompiledStepBits(unittest.TestCase):
             errors.append((str(ctx.exception), ctx.exception.step, ctx.exception.replica))
         self.assertEqual(errors[0], errors[1])
 
-    def test_pair_at_distance_zero_runs_on_numpy(self):
-        """Two spheres at the same place: that step leaves the compiled code before changing anything,
-        and NumPy draws the random normal from the replica's generator; the same bits follow."""
+    def test_pair_at_distance_zero(self):
+        """Two spheres at the same place: the compiled step draws the random normal from the replica's
+        generator (as forces.normals does) and goes on compiled (the NumPy force phase never runs);
+        the same bits and the same next number of the generator."""
+        import contextlib
+        from unittest import mock
+
         from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
@@ -174,14 +200,44 @@ class TestCompiledStepBits(unittest.TestCase):
             s = state_from_ensembles([e], backend=backend)
             s.pos[:, 1] = s.pos[:, 0]
             eng = BatchEngine(s, guard=False)        # (the guard would stop the interpenetration)
-            for _ in range(5):
-                eng.step(0.999, e.dt)
+            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            with numpy_phase if backend == "numba" else contextlib.nullcontext():
+                for _ in range(5):
+                    eng.step(0.999, e.dt)
             engines.append(eng)
         self.assert_same_engines(*engines)
+        self.assertEqual(engines[0].s.rng[0].random(), engines[1].s.rng[0].random())
+
+    def test_distance_zero_in_one_replica_of_a_block(self):
+        """A batch of three whose middle replica has a pair at d = 0 and runs Verlet blocks: that
+        replica's step takes its normal from its own generator and the others are not held back;
+        every replica is its single run's bits, on NumPy as compiled."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        dt = constituted(42, **FRICTIONAL)[1].dt
+
+        def engine(backend, seeds):
+            s = state_from_ensembles([constituted(s, **FRICTIONAL)[1] for s in seeds], backend=backend)
+            if 43 in seeds:
+                b = seeds.index(43) * s.N
+                s.pos[:, b + 1] = s.pos[:, b]
+            eng = BatchEngine(s, guard=False, integrator="verlet")
+            eng.steps(40, 0.999, dt)
+            return eng
+
+        batch = engine("numba", [42, 43, 44])
+        self.assert_same_engines(engine("numpy", [42, 43, 44]), batch)
+        for k, seed in enumerate((42, 43, 44)):
+            single = engine("numba", [seed])
+            for key in ("pos", "vel", "phi"):
+                got = getattr(batch.s, key).reshape(getattr(batch.s, key).shape[:-1] + (3, -1))[..., k, :]
+                np.testing.assert_array_equal(_bits(got), _bits(getattr(single.s, key)), err_msg=key)
 
     def test_pair_at_distance_zero_in_a_verlet_block(self):
-        """A block of Verlet steps whose first step meets a pair at d = 0: that step runs on NumPy with
-        the engine's own half kick (none yet), then the block goes on; the same bits as NumPy."""
+        """A block of Verlet steps whose first step meets a pair at d = 0 (before any half kick): its
+        normal is drawn and the block goes on; the same bits as NumPy."""
         from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
@@ -330,3 +386,28 @@ class TestCompiledBlocks(unittest.TestCase):
         self.assertEqual([s[:2] for s in seen_got], [s[:2] for s in seen_ref])
         self.assertEqual([s[1] for s in seen_got], list(range(50, 601, 50)))
         np.testing.assert_array_equal(_bits(ref["stress_surface"]), _bits(got["stress_surface"]))
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestThreads(unittest.TestCase):
+    """``PARTICLESHEAR_THREADS``: a block's replicas on several threads (numba.prange over replicas)."""
+
+    def test_two_threads_same_bits(self):
+        """Three replicas (bonds, friction, none) through pre-equilibration and protocol in blocks on two
+        threads: every record and the whole state are the one-thread bits (each replica reads and
+        writes only its own rows)."""
+        from unittest import mock
+        scenes = [(0, FRICTIONAL_BONDS), (1, FRICTIONAL), (2, FRICTIONLESS)]
+        one = _measure(scenes, "numba")
+        with mock.patch.dict("os.environ", {numba_step.THREADS_VARIABLE: "2"}):
+            self.assertEqual(numba_step.threads(), 2)
+            two = _measure(scenes, "numba")
+        TestCompiledStepBits.assert_same_engines(self, one[0], two[0])
+        TestCompiledStepBits.assert_same_records(self, one[1], two[1])
+
+    def test_invalid_thread_count(self):
+        from unittest import mock
+        for text in ("0", "two", "-1", "1.5"):
+            with mock.patch.dict("os.environ", {numba_step.THREADS_VARIABLE: text}):
+                with self.assertRaisesRegex(ValueError, "PARTICLESHEAR_THREADS=.*whole number of threads >= 1"):
+                    numba_step.threads()

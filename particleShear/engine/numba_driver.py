@@ -123,7 +123,7 @@ def register_helpers():
         _registered.add(id(xp.select))
 
 
-def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=None):
+def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=None, parallel=()):
     """The pure functions ``functions`` as they are now, each compiled by Numba.
 
     Each function is compiled from its own code object with its module's globals, in which the
@@ -145,6 +145,9 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=
     rename : dict, optional
         Name → the qualified name its compiled copy gets (a variant's own entry in Numba's cache,
         which is keyed by file, qualified name and types).
+    parallel : collection of str, default ()
+        Names compiled with ``parallel=True``, their ``prange`` (``range`` in the module) bound to
+        ``numba.prange`` (loops over independent replicas on several threads).
 
     Returns
     -------
@@ -159,7 +162,11 @@ def jit_laws(cache=True, functions=LAW_FUNCTIONS, inline=(), extra=None, rename=
         f = getattr(module, name)
         copy = _copy(f, (rename or {}).get(name))
         namespaces.append(copy.__globals__)
-        compiled[name] = numba.njit(copy, cache=cache, **({"inline": "always"} if name in inline else {}))
+        options = {"inline": "always"} if name in inline else {}
+        if name in parallel:
+            copy.__globals__["prange"] = numba.prange
+            options["parallel"] = True
+        compiled[name] = numba.njit(copy, cache=cache, **options)
     for g in namespaces:      # (globals are read when a function is compiled, at its first call)
         g.update(compiled)
         g.update(extra or {})

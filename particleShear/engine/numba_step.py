@@ -89,6 +89,45 @@ _SKIP = -1
 
 _kernels = {}
 
+#: the loop over a block's replicas (:func:`_block_kernel`): ``range`` here and in the serial
+#: compile, ``numba.prange`` in the compile for several threads (:func:`threads`)
+prange = range
+
+#: the environment variable of the threads a compiled block steps its replicas on
+THREADS_VARIABLE = "PARTICLESHEAR_THREADS"
+
+
+def threads():
+    """The threads a compiled block steps a batch's replicas on: ``PARTICLESHEAR_THREADS`` (default 1).
+
+    More than one runs the replicas of a block in parallel (``numba.prange``; each replica reads and
+    writes only its own rows, so the numbers are the same bits on any number of threads).  It is a
+    choice of the process, off by default: runs in several processes (sweeps, pools) or threads
+    already use the cores, and Numba's default threading layer takes one parallel call at a time.
+
+    Returns
+    -------
+    int
+        The number of threads (≥ 1).
+
+    Raises
+    ------
+    ValueError
+        When the variable is set to anything but a whole number ≥ 1.
+    """
+    import os
+    text = os.environ.get(THREADS_VARIABLE, "").strip()
+    if not text:
+        return 1
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise ValueError(f"{THREADS_VARIABLE}={text!r} is invalid: allowed a whole number of threads >= 1 "
+                         "(1: one thread, the default)")
+    return n
+
 
 def reason(engine):
     """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
@@ -467,17 +506,18 @@ def compile_step_kernel(cache=True, say=None):
                     lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
 
 
-def _compile(key, name, functions, signature, cache=True, say=None, message=None):
+def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
     ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
-    before a compile (not before a load)."""
+    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``)."""
     if cache and key in _kernels:
         return _kernels[key]
     import numba
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
-    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE)[name]
+    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE,
+                                     **({"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {}))[name]
     if say is not None and not numba_driver.on_disk(compiled):
         say(message())
     compiled.compile(signature())          # (or loaded from the cache): before any timing
@@ -513,18 +553,25 @@ def _signature():
 
 def _kernels_of(ws):
     """The compiled step and block of a workspace: the built-in laws', or its run law's variant."""
+    n = threads()
+    if n > 1:
+        import numba
+        numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
     if ws.law is None:
-        return _kernels.get(True) or compile_step_kernel(), _kernels.get("block") or compile_block_kernel()
-    return _law_kernels(*ws.law)
+        step = _kernels.get(True) or compile_step_kernel()
+        return step, _kernels.get(("block", n > 1)) or compile_block_kernel(parallel=n > 1)
+    return _law_kernels(*ws.law, parallel=n > 1)
 
 
-def _law_kernels(function, m, say=None):
+def _law_kernels(function, m, say=None, parallel=False):
     """The compiled step and block for a run's law ``function(d, a0 … a{m−1})`` (:func:`~.phase_laws.run_law`).
 
     The law (and every function it calls) is compiled, an adapter ``_central_law(d, a)`` passes it
     the first m numbers of ``a``, and the step's functions are compiled with that adapter under their
     own names (``…__<hash>``: the law's module source, name and m), so that Numba's cache keeps one
     entry per law and an edited law gets a new one.
+
+    With ``parallel`` the block is the variant over several threads (:func:`threads`).
 
     Returns
     -------
@@ -536,12 +583,12 @@ def _law_kernels(function, m, say=None):
 
     import numba
 
-    key = ("law", function, m)
+    key = ("law", function, m, parallel)
     if key in _kernels:
         return _kernels[key]
     numba_driver.register_helpers()
     numba.config.CACHE_DIR = numba_driver.cache_dir()
-    h = hashlib.sha1(f"{function.__module__}.{function.__qualname__}/{m}".encode())
+    h = hashlib.sha1(f"{function.__module__}.{function.__qualname__}/{m}{'/parallel' if parallel else ''}".encode())
     try:
         with open(inspect.getsourcefile(function), "rb") as fh:
             h.update(fh.read())
@@ -555,7 +602,8 @@ def _law_kernels(function, m, say=None):
     adapter = numba.njit(namespace["_central_law"], inline="always")
     names = ("pair_term", "_step_kernel", "_block_kernel")
     L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
-                              extra={"_central_law": adapter}, rename={n: n + suffix for n in names})
+                              extra={"_central_law": adapter}, rename={n: n + suffix for n in names},
+                              parallel=("_block_kernel",) if parallel else ())
     step, block = L["_step_kernel"], L["_block_kernel"]
     if say is not None and not numba_driver.on_disk(step):
         say(f"backend 'numba': compiling the step for the law {function.__qualname__} (first use)")
@@ -580,7 +628,8 @@ def compile_kernels(say=None, law=None):
     """
     numba_driver.compile_pair_kernel(say=say)
     compile_step_kernel(say=say)
-    compile_block_kernel()
+    parallel = threads() > 1
+    compile_block_kernel(parallel=parallel)
     compile_search_kernel()
     if law is None:
         return
@@ -595,7 +644,7 @@ def compile_kernels(say=None, law=None):
         m = len(constants(*((2.0, 1.0, 1.0) if found.radii else (2.0,)), 1.0, 0.5, *values))
     if m <= numba_driver.LAW_SLOTS:
         try:
-            _law_kernels(function, m, say)
+            _law_kernels(function, m, say, parallel)
         except Exception:      # (the step notes it and runs on NumPy)
             pass
 
@@ -986,7 +1035,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     instead of ending at the first list due in any replica.
     """
     B = rate.shape[0]
-    for b in range(B):
+    for b in prange(B):
         k, start, st = ks[b], starts[b], _DONE
         while start != _SKIP and k < n:
             if scheduled and start == 0:      # (a resumed step has its rate and records)
@@ -1021,17 +1070,20 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     return 0
 
 
-def compile_block_kernel(cache=True):
+def compile_block_kernel(cache=True, parallel=False):
     """The compiled block of :func:`run_block`, compiled once per process (or loaded from the cache).
 
     Parameters
     ----------
     cache : bool, default True
         As :func:`compile_step_kernel`.
+    parallel : bool, default False
+        The variant that steps the replicas on several threads (:func:`threads`; its own entry in
+        Numba's cache, under the name ``_block_kernel__parallel``).
 
     Returns
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("block", "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, _block_signature,
-                    cache)
+    return _compile(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
+                    _block_signature, cache, parallel=bool(parallel))
