@@ -2,6 +2,9 @@
 
 :meth:`BatchEngine.step` reads like the reference's step (docs/engine.md, "One step"): shear rate →
 neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
+The phases pass what one leaves the next as values: :meth:`BatchEngine.force_phase` returns a
+:class:`ForceRecord`, which :meth:`BatchEngine.accelerate` and :meth:`BatchEngine.move` take as an
+argument, so the engine holds no record of a phase between calls.
 The measurement's loops, :func:`~.loops.pre_equilibrate` and :func:`~.loops.protocol`, are in
 :mod:`.loops` (and importable from here).
 
