@@ -275,7 +275,7 @@ class ForceRegisterOrderTest(unittest.TestCase):
                 eng.keep_terms = True
                 eng.force_phase()
                 eng.flush()                    # the states of the relations into the ensemble's table
-                self.assertTrue(ens.force_register.set_from_engine(ens, eng))
+                self.assertTrue(ens.force_register.set_from_engine(ens, eng, current=True))
                 self._compare(name, ens, want)
 
     def test_scenes_exercise_every_list(self):

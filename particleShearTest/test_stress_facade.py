@@ -87,7 +87,7 @@ class TestLinearMaps(unittest.TestCase):
         from particleShear.engine import step as step_module
         step_module.evaluate_all = lambda q: captured.append(q) or real(q)
         try:
-            T = engine.force_phase(sample="tensors")[2]      # (the state stays that of the inputs)
+            T = engine.force_phase(sample="tensors")[1][2]   # (the state stays that of the inputs)
         finally:
             step_module.evaluate_all = real
         q = captured[0]

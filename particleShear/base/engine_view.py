@@ -5,6 +5,10 @@ A canvas keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of
 rows and whose pairs are its pair table.  What a step reads (clock, strain, rate, μ, plates) is
 handed to the engine before each force phase; clock, strain and relations come back after each
 movement.  The engine is kept under one key and dropped at :meth:`EngineStep._drop_engine`.
+
+The documented step's three phases are three calls of the canvas, so the record a force phase
+returns (:class:`~particleShear.engine.step.ForceRecord`) is kept here, on the canvas, until its
+step's movement: the engine passes it as a value and keeps none.
 """
 __docformat__ = "numpy"
 import numpy as np
@@ -24,6 +28,9 @@ class EngineStep:
 
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
     _engine_half = None     # the Verlet half kick while no engine is kept
+    #: the record of the last force phase of the kept engine (ForceRecord), for the acceleration and
+    #: movement phases of its step; None before one, after the step's movement and with the engine dropped
+    _force_record = None
 
     def _lees_edwards(self):
         return bool(self.use_lees_edwards)
@@ -62,6 +69,7 @@ class EngineStep:
     def _drop_engine(self):
         """Forget the engine (the one invalidation point; its Verlet half kick is kept)."""
         eng = self._memo.drop("engine")
+        self._force_record = None       # (the record is the dropped engine's)
         if eng is not None:
             self._engine_half = None if eng.half is None else tuple(np.array(h) for h in eng.half)
             self._engine_pairs = None
@@ -117,11 +125,11 @@ class EngineStep:
         eng = self._step_engine()
         self._hand_to_engine(eng)
         extra = self._frc.copy() if self._frc.any() else None     # forces put on before the phase add up
-        eng.force_phase()
+        g = self._force_record = eng.force_phase()[0]
         if extra is not None:
             self._frc += extra
-        self.force_register.set_from_engine(self, eng)
-        self._g = ForcePhaseGeometry(eng)
+        self.force_register.set_from_engine(self, eng, current=True)
+        self._g = ForcePhaseGeometry(eng, g)
         self._take_relations(eng)
         return eng
 
@@ -136,7 +144,7 @@ class EngineStep:
         if eng is None:          # a kick without a force phase before it
             eng = self._step_engine()
             self._hand_to_engine(eng)
-        eng.accelerate(cool, dt)
+        eng.accelerate(cool, dt, self._force_record)
 
     def _engine_move(self, dt):
         """Movement on the engine, then the clock and strain and the relations back into the ensemble."""
@@ -146,7 +154,8 @@ class EngineStep:
             self._hand_to_engine(eng)
         # where the drift takes the spheres: non-finite or far outside the cell stops the run (before the wrap)
         self._check_positions(self._pos + self._vel[:2] * dt)
-        eng.move(dt)
+        eng.move(dt, self._force_record)
+        self._force_record = None       # (the step's record ends with its movement, as in BatchEngine.step)
         s = eng.s
         self.t = float(s.t[0])
         self.shear = float(s.gamma[0])
@@ -158,16 +167,15 @@ class EngineStep:
         if eng is None:
             eng = self._step_engine()
             self._hand_to_engine(eng)
-        eng.move_spheres(dt)
+        eng.move_spheres(dt, self._force_record)
         eng.need[:] = True
         self._pos_version += 1
 
     def _closest_contact(self):
         """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force phase
         (:func:`~particleShear.engine.guard.transient_ratios`, inf without one), or None without candidates."""
-        eng = self._engine
-        g = None if eng is None else eng.g
-        if g is None or not eng.C.P:
+        eng, g = self._engine, self._force_record
+        if eng is None or g is None or not eng.C.P:
             return None
         ratio = transient_ratios(eng.C, np.sqrt(g.dx * g.dx + g.dy * g.dy), g.active)
         k = int(np.argmin(ratio))
@@ -185,19 +193,22 @@ class ForcePhaseGeometry:
     ----------
     engine : BatchEngine
         The ensemble's engine after its force phase (a batch of one).
+    record : ForceRecord
+        What that force phase returned (:meth:`~particleShear.engine.step.BatchEngine.force_phase`).
     """
 
     NAMES = ("P", "slots", "ai", "aj", "ri", "rj", "d", "d0", "nx", "ny", "dx", "dy", "dvx", "perm", "trans",
              "active")
 
-    def __init__(self, engine):
+    def __init__(self, engine, record):
         self._engine = engine
+        self._record = record
 
     def __getattr__(self, name):
         if name not in self.NAMES:
             raise AttributeError(name)
         eng = self._engine
-        g, C = eng.g, eng.C
+        g, C = self._record, eng.C
         m = np.asarray(g.active, dtype=bool)
         dx, dy = g.dx[m], g.dy[m]
         ai, aj = C.ai[m], C.aj[m]

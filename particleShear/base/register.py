@@ -5,6 +5,7 @@ from them on demand, and manual ``record_*`` calls (scripts without an ensemble)
 """
 __docformat__ = "numpy"
 
+import collections
 import itertools
 
 import numpy as np
@@ -13,7 +14,46 @@ from ..engine.forces import pair_roles
 from ..engine.terms import pair_forces
 from ..engine.xp import to_host
 
-__all__ = ["Force_register", "SphereSelection", "register_block"]
+__all__ = ["Force_register", "SphereSelection", "TermRecord", "register_block"]
+
+
+class TermRecord(collections.namedtuple("TermRecord", "C parts F dx dy nx ny d touching active shifted mob fx_i fy_i "
+                                                      "fx_j fy_j dF tq birth totals")):
+    """The per-candidate terms of an engine's last force phase, as the force register reads them.
+
+    Made from :attr:`~particleShear.engine.step.BatchEngine.terms` (a dict of the same names, kept
+    with :attr:`~particleShear.engine.step.BatchEngine.keep_terms`) by :meth:`Force_register.set_from_engine`.
+    The record type lives here, beside its only reader, rather than in the engine: the engine
+    keeps the arrays as plain values and knows nothing of the register's layout (the layers go
+    engine → base, never back).
+
+    Attributes
+    ----------
+    C : PairConstants
+        The candidates' constants of the phase (:class:`~particleShear.engine.forces.PairConstants`).
+    parts : tuple of two lists
+        Per visit (i's, j's; j's empty without per-sphere parameters), the elastic and viscous
+        central scalars.
+    F : array (2, P)
+        The tangential forces of the two visits.
+    dx, dy, nx, ny, d : array (P,)
+        Pair vectors (µm), unit normals and distances (µm).
+    touching, active : array of bool (P,)
+        Contacts and relations.
+    shifted : array of bool (P,)
+        Pairs whose j is an image across a periodic boundary.
+    mob : array of bool (B·N,)
+        The mobility mask of the phase.
+    fx_i, fy_i, fx_j, fy_j : array (P,) or None
+        The forces on i and (per-sphere parameters only; else None) on j.
+    dF, tq : array
+        The tangential scalar and the torques (2, P) of the pair.
+    birth : array of int (P,)
+        The creation numbers of the relations.
+    totals : array (3, B·N)
+        The forces and torques of every sphere after the phase.
+    """
+    __slots__ = ()
 
 
 def register_block(t, N, b, tangential=True):
@@ -30,8 +70,9 @@ def register_block(t, N, b, tangential=True):
 
     Parameters
     ----------
-    t : _TermRecord or None
-        The engine's record of the force phase (:attr:`~particleShear.engine.step.BatchEngine.terms`).
+    t : TermRecord or None
+        The record of the force phase (:class:`TermRecord` of the engine's
+        :attr:`~particleShear.engine.step.BatchEngine.terms`).
     N : int
         Spheres per replica.
     b : int
@@ -90,7 +131,7 @@ class EngineForcePhase:
 
     Parameters
     ----------
-    terms : object
+    terms : TermRecord
         The engine's :attr:`~particleShear.engine.step.BatchEngine.terms` of the phase.
     N, b, pos_version : int
         Spheres per replica; the replica; the ensemble's position version of the phase (−1: moved since).
@@ -270,7 +311,7 @@ class Force_register:
         self._tot = (mobile, fx, fy)
         self._mom = torque
 
-    def set_from_engine(self, ensemble, engine, b=0):
+    def set_from_engine(self, ensemble, engine, b=0, current=False):
         """Hold the last force phase (pairs, totals) of replica ``b``; return False, changing nothing, if none.
 
         Parameters
@@ -281,17 +322,23 @@ class Force_register:
             An engine after a force phase with ``keep_terms`` on.
         b : int, default 0
             The replica.
+        current : bool, default False
+            The phase is of the ensemble's present positions (a force phase just run on them, its
+            spheres not moved since): the stresses may then read the phase's pair vectors.  False
+            (after whole steps of the engine, whose last movement followed the phase): they are
+            evaluated anew.  The caller says it, since the engine keeps no record of its phases.
         """
         t = engine.terms
         if t is None:
             return False
+        t = TermRecord(**t)
         spin = ensemble._torque_total() is not None
         N = engine.s.N
         mobile = to_host(t.mob, "register")[b * N:(b + 1) * N]
         tot = to_host(t.totals, "register")[:, b * N:(b + 1) * N]
         self.reset_force_register()
         # the register's pair vectors are those of the force phase, while the spheres have not moved
-        self._phase = EngineForcePhase(t, N, b, spin, ensemble._pos_version if engine.g is not None else -1,
+        self._phase = EngineForcePhase(t, N, b, spin, ensemble._pos_version if current else -1,
                                        engine.s.B == 1 and engine.backend.host)
         self._set_totals(ensemble, mobile, tot[0], tot[1], tot[2] if spin else None)
         return True

@@ -824,7 +824,6 @@ def _adopt(engine, ws, held, stepped=False, kicked=True):
             engine.half = held["half"]
         engine.s.gamma, engine.s.t = held["gamma"], held["t"]
         engine.need = ws.need.copy()
-        engine.g = engine.verdict = None
 
 
 def _report(engine, ws):

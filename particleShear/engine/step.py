@@ -2,6 +2,9 @@
 
 :meth:`BatchEngine.step` reads like the reference's step (docs/engine.md, "One step"): shear rate →
 neighbours → forces → shear stresses when sampled → kick/damping → ξ → drift → wrap → clock.
+The phases pass what one leaves the next as values: :meth:`BatchEngine.force_phase` returns a
+:class:`ForceRecord`, which :meth:`BatchEngine.accelerate` and :meth:`BatchEngine.move` take as an
+argument, so the engine holds no record of a phase between calls.
 The measurement's loops, :func:`~.loops.pre_equilibrate` and :func:`~.loops.protocol`, are in
 :mod:`.loops` (and importable from here).
 
@@ -22,6 +25,7 @@ in Pa (docs/parameters.md, docs/output.md).
 """
 __docformat__ = "numpy"
 
+import collections
 import math
 
 import numpy as np
@@ -40,7 +44,7 @@ from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 from . import numba_driver, numba_step
 
-__all__ = ["BatchEngine", "EngineInstability", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
+__all__ = ["BatchEngine", "EngineInstability", "ForceRecord", "pre_equilibrate", "protocol", "pre_equilibration_blocks"]
 
 
 class EngineInstability(RuntimeError):
@@ -67,26 +71,37 @@ class EngineInstability(RuntimeError):
         self.phase = phase
 
 
-class _TermRecord:
-    """The per-candidate terms of the last force phase that the force register reads
-    (:func:`particleShear.base.register.register_block`; kept only with :attr:`BatchEngine.keep_terms`)."""
-    __slots__ = ("C", "parts", "F", "dx", "dy", "nx", "ny", "d", "touching", "active", "shifted", "mob",
-                 "fx_i", "fy_i", "fx_j", "fy_j", "dF", "tq", "birth", "totals")
+class ForceRecord(collections.namedtuple("ForceRecord", "dx dy nx ny dvx active yc mob verdict")):
+    """What a force phase hands to the acceleration and movement phases of its step.
 
-    def __init__(self, *values):
-        for name, value in zip(self.__slots__, values):
-            setattr(self, name, value)
+    :meth:`BatchEngine.force_phase` returns it; :meth:`BatchEngine.accelerate`,
+    :meth:`BatchEngine.move`, :meth:`BatchEngine.move_spheres` and :meth:`BatchEngine.advance_cells`
+    take it as an argument (None: a phase without a force phase before it).  The phases pass it as
+    a value rather than through an attribute of the engine, so what a phase reads is in its
+    signature, and the arrays are freed when the caller drops the record (in :meth:`BatchEngine.step`
+    at the end of the step, before the next force phase allocates their successors: kept alive they
+    double the step's peak memory, measured ≈ 30 % of a step at B = 16 in page faults).
 
-
-class _ForceRecord:
-    """What a force phase leaves for the acceleration and movement phases of its step (see
-    :meth:`BatchEngine.force_phase`): the candidates' minimum-image vectors, normals and image
-    velocity, the relations, the heights above the centre line and the mobility mask."""
-    __slots__ = ("dx", "dy", "nx", "ny", "dvx", "active", "yc", "mob")
-
-    def __init__(self, dx, dy, nx, ny, dvx, active, yc, mob):
-        self.dx, self.dy, self.nx, self.ny, self.dvx = dx, dy, nx, ny, dvx
-        self.active, self.yc, self.mob = active, yc, mob
+    Attributes
+    ----------
+    dx, dy : array (P,)
+        Per candidate, the minimum-image pair vector (µm, j's nearest image minus i).
+    nx, ny : array (P,)
+        Per candidate, the unit normal.
+    dvx : array (P,)
+        Per candidate, the x velocity of j's image relative to j (µm/s, ``−Ly·γ̇`` per period above).
+    active : array of bool (P,)
+        The relations (touching or bonded).
+    yc : array (B·N,)
+        The heights ``y − Ly/2`` of the spheres above their cell's centre line (µm).
+    mob : array of bool (B·N,)
+        The mobility mask (:meth:`BatchEngine.mobile`).
+    verdict : tuple or None
+        On a device, the stability guard's verdict of the phase (:meth:`BatchEngine._check`), read
+        with the step's flags at its end (:meth:`BatchEngine.advance_cells`); None when the phase
+        did not check or on NumPy (which reports at once).
+    """
+    __slots__ = ()
 
 
 class BatchEngine:
@@ -146,13 +161,13 @@ class BatchEngine:
             raise ValueError(f"integrator={integrator!r} is not allowed: one of {self.INTEGRATORS}")
         self.integrator = integrator
         self.half = half          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
-        self.g = None             # the record of the last force phase (_ForceRecord)
         #: keep the per-term arrays of each force phase for the force register (``base.register``;
         #: a script's experiment sets it, so its ensemble's register holds the engine's last step)
         self.keep_terms = bool(keep_terms)
+        #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
+        #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
         self.terms = None
         self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
-        self.verdict = None       # a device's guard verdict of the force phase, read at the end of the step
         s = self.s = state
         xp = self.xp = s.xp
         self.backend = s.backend
@@ -428,9 +443,9 @@ class BatchEngine:
             out = numba_step.run_step(self, cool, dt, sample)
             if out is not numba_step.NOT_RUN:
                 return out
-        out = self.force_phase(sample)
-        self.accelerate(cool, dt)
-        self.move(dt)
+        g, out = self.force_phase(sample)       # (g, the phase's record, is freed with this call)
+        self.accelerate(cool, dt, g)
+        self.move(dt, g)
         return out
 
     def steps(self, n, cool, dt):
@@ -451,12 +466,15 @@ class BatchEngine:
     def force_phase(self, sample=False):
         """Neighbours (when due) → geometry and relations → kinematics → force terms → scatter.
 
-        Writes the forces and torques of every sphere into ``state.frc`` and keeps what the other
-        two phases of the step read in :attr:`g` (the candidates' ``dx, dy``, normals ``nx, ny``,
-        image velocity ``dvx``, relations ``active``, the heights ``y − Ly/2``, the mobility
-        mask; dropped at the end of :meth:`move`).  With the
-        velocity Verlet integrator (:attr:`integrator`) the velocity-dependent terms see the
-        velocities moved half a kick ahead (the half kick of the previous step).
+        Writes the forces and torques of every sphere into ``state.frc`` and returns what the other
+        two phases of the step read, a :class:`ForceRecord` (the candidates' ``dx, dy``, normals
+        ``nx, ny``, image velocity ``dvx``, relations ``active``, the heights ``y − Ly/2``, the
+        mobility mask, a device's guard verdict), which the caller hands to :meth:`accelerate` and
+        :meth:`move` and then drops (the engine keeps no record of the phase: what a phase reads
+        is its arguments).  With :attr:`keep_terms` the per-term arrays are kept in :attr:`terms`
+        for the force register.  With the velocity Verlet integrator (:attr:`integrator`) the
+        velocity-dependent terms see the velocities moved half a kick ahead (the half kick of the
+        previous step).
 
         Parameters
         ----------
@@ -465,8 +483,10 @@ class BatchEngine:
 
         Returns
         -------
-        None or tuple
-            As :meth:`step`.
+        record : ForceRecord
+            What :meth:`accelerate` and :meth:`move` of the step read.
+        stresses : None or tuple
+            As :meth:`step` returns.
         """
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
@@ -503,8 +523,9 @@ class BatchEngine:
         out = None
         shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
         if self.keep_terms:
-            self.terms = _TermRecord(C, parts, self.xp.stack(F), dx, dy, nx, ny, d, touching, active, shifted, mob, fx_i, fy_i,
-                                     fx_j, fy_j, dF, tq, self.birth, s.frc.copy())   # (the kick resets s.frc)
+            self.terms = dict(C=C, parts=parts, F=self.xp.stack(F), dx=dx, dy=dy, nx=nx, ny=ny, d=d, touching=touching,
+                              active=active, shifted=shifted, mob=mob, fx_i=fx_i, fy_i=fy_i, fx_j=fx_j, fy_j=fy_j, dF=dF,
+                              tq=tq, birth=self.birth, totals=s.frc.copy())   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(
                 C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,
@@ -516,15 +537,13 @@ class BatchEngine:
             else:       # the tensors' xy entries are the shear stresses, bit for bit (engine.stress)
                 T = evaluate_all(q)
                 out = (-T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T)
-        self.verdict = None
+        verdict = None
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)
             if self.backend.host:     # NumPy: report at once (a device reports with the flags at the end)
                 self._report(verdict, self.step_count)
-            else:
-                self.verdict = verdict
-        self.g = _ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob)
-        return out
+                verdict = None
+        return ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob, verdict), out
 
     def relations(self):
         """The neighbour update of a force phase: neighbour lists (when due) → Lees-Edwards minimum
@@ -635,7 +654,7 @@ class BatchEngine:
         else:
             self.free_p = self.backend.asarray(free)[self.C.rep]
 
-    def accelerate(self, cool, dt):
+    def accelerate(self, cool, dt, g=None):
         """Kick (plates follow), rotational kick and damping of every replica (eqs. S1-10, S1-11).
 
         With velocity Verlet the half kick ``F·dt/(2m)`` of the mobile spheres is kept for the
@@ -647,8 +666,12 @@ class BatchEngine:
             Damping factor of the velocity relative to the flow and of ω (1 = no damping).
         dt : float
             Time step (s).
+        g : ForceRecord or None
+            The record of the step's force phase (:meth:`force_phase`): its mobility mask and
+            heights; None: a kick without a force phase, with those of now (the same numbers
+            while the spheres have not moved since the force phase).
         """
-        s, g = self.s, self.g
+        s = self.s
         # the force phase's mobility and heights (a kick without a force phase: those of now)
         mob, yc = (self.mobile(), s.y - self.hy_s) if g is None else (g.mob, g.yc)
         if self.integrator == "verlet":
@@ -659,7 +682,7 @@ class BatchEngine:
             plates_follow(s.vx, s.vy, ~mob, yc, rate_s * self.Ly_s / 2)
         damp(s.vel, yc * rate_s, cool)
 
-    def move(self, dt):
+    def move(self, dt, g=None):
         """ξ of sticking contacts and bonds (sequential rule, Appendix B.2), drift, strain, wrap, clock.
 
         Ends with the step's one read of per-replica flags on the host: the lists due for a
@@ -669,16 +692,19 @@ class BatchEngine:
         ----------
         dt : float
             Time step (s).
+        g : ForceRecord or None
+            The record of the step's force phase (:meth:`force_phase`); None: a movement without
+            a force phase (no ξ rule, no verdict).
 
         Raises
         ------
         EngineInstability
             On a device, if the force phase's guard verdict is not sound.
         """
-        self.move_spheres(dt)
-        self.advance_cells(dt)
+        self.move_spheres(dt, g)
+        self.advance_cells(dt, g)
 
-    def move_spheres(self, dt):
+    def move_spheres(self, dt, g=None):
         """The first part of :meth:`move`: ξ of sticking contacts and bonds (sequential rule,
         Appendix B.2; none without a force phase), the displacement since the lists were built, and
         the drift ``x, y, φ += (v_x, v_y, ω)·dt``.
@@ -687,8 +713,11 @@ class BatchEngine:
         ----------
         dt : float
             Time step (s).
+        g : ForceRecord or None
+            The record of the step's force phase (:meth:`force_phase`): the relations, pair
+            vectors, normals and image velocity the ξ rule reads, the heights; None: no ξ rule.
         """
-        s, xp, C, g = self.s, self.xp, self.C, self.g
+        s, xp, C = self.s, self.xp, self.C
         vx, vy = s.vx, s.vy
         free = self.free_p
         if free is not True and g is not None:   # without friction and bonds no ξ (nor without a force phase)
@@ -717,7 +746,7 @@ class BatchEngine:
         self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
         drift(s.pos, s.phi, s.vel, dt)
 
-    def advance_cells(self, dt):
+    def advance_cells(self, dt, g=None):
         """The second part of :meth:`move`: strain, Lees-Edwards wrap, clock, and the step's one read
         of per-replica flags (see there).
 
@@ -725,6 +754,9 @@ class BatchEngine:
         ----------
         dt : float
             Time step (s) by which the strain and the clock advance.
+        g : ForceRecord or None
+            The record of the step's force phase: on a device its guard verdict, read with the
+            flags; None: no verdict.
 
         Raises
         ------
@@ -737,17 +769,13 @@ class BatchEngine:
         wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, spread(self._image_shift(), s.rep, s.B), rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
-        verdict = self.verdict
+        verdict = None if g is None else g.verdict
         due = self.bound >= self.skin
         flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
         self.need = flags[:s.B]
         if verdict is not None and flags[s.B:].any():
             self._report(verdict, self.step_count)
         self.step_count += 1
-        # the force phase's record ends with its step: its arrays are freed before the next force phase
-        # allocates their successors (kept alive, they double the step's peak memory; measured ≈ 30 %
-        # of a step at B = 16 in page faults)
-        self.g = self.verdict = None
 
     def _check(self, d, active):
         """The stability guard's verdict (:func:`~particleShear.engine.guard.verdict`), on the state's backend.
