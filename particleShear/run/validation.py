@@ -539,8 +539,10 @@ class RunParameters(dict):
     A ``dict`` (read like the keyword dict it replaces, ``json``-able, ``dict(run)`` a plain copy)
     whose items cannot change: a value changed after the check would be a value nobody checked.
 
-    Attributes
+    Parameters
     ----------
+    values : dict
+        The complete, normalized arguments (taken as they are).
     run_id : str
         :func:`~particleShear.simulation.provenance.run_identity` of the arguments and the seed.
     seed_sequence : numpy.random.SeedSequence or None
@@ -558,6 +560,18 @@ class RunParameters(dict):
         self.run_id, self.seed_sequence, self.generator, self.cost = run_id, seed_sequence, generator, cost
 
     def _immutable(self, *args, **kwargs):
+        """Refused: the checked arguments of a run do not change.
+
+        Parameters
+        ----------
+        *args, **kwargs
+            Those of the ``dict`` method; ignored.
+
+        Raises
+        ------
+        TypeError
+            Always.
+        """
         raise TypeError("RunParameters is immutable: the validated arguments of a run do not change "
                         "(change a copy, dict(run), and validate it again)")
 
