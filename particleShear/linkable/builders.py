@@ -270,10 +270,14 @@ def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus
     if not keep_viscosity_coefficients_constant:
         nu_ens = nu_ens * irc
         nu_t_ens = nu_t_ens * irt
-    cls, extra = ((EnsembleCompactParticles, ()) if legacy else (EnsembleCompactParticlesAdjustableInterfaceStrength,
-                                                                 (prc, prt, keep_viscosity_coefficients_constant)))
-    ens = cls(size_x, size_y, N, packing_fraction, False, doDrawing, k_ens, nu_ens, model.m, bf, k_t_ens, nu_t_ens,
-              mu, dt, dt_max, False, avoid_horizontal_angle_degree, *extra, rng=np.random.default_rng(rng))
+    cls, extra = ((EnsembleCompactParticles, {}) if legacy else (
+        EnsembleCompactParticlesAdjustableInterfaceStrength,
+        dict(permanent_ratio_central=prc, permanent_ratio_tangential=prt,
+             keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant)))
+    ens = cls(size_x, size_y, N, packing_fraction=packing_fraction, theCanvas=False, doDrawing=doDrawing, k=k_ens,
+              nu=nu_ens, m=model.m, bimodal_factor=bf, k_t=k_t_ens, nu_t=nu_t_ens, mu=mu, dt=dt, dt_max=dt_max,
+              theTkSimulation=False, avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+              rng=np.random.default_rng(rng), **extra)
     ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
     ens.avoid_height_spanning_particles = avoid
     ens.model = model

@@ -41,7 +41,8 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1, nu=0.01,
                  m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1, dt=1, dt_max=10, theTkSimulation=False,
                  avoid_horizontal_angle_degree=0, rng=None):
-        CanvasPointsLinkable.__init__(self, size_x, size_y, theCanvas, doDrawing, k, nu, m, k_t, nu_t, mu)
+        CanvasPointsLinkable.__init__(self, size_x, size_y, theCanvas=theCanvas, doDrawing=doDrawing, k=k, nu=nu, m=m,
+                                      k_t=k_t, nu_t=nu_t, mu=mu)
         in_range("avoid_horizontal_angle_degree", avoid_horizontal_angle_degree, 0, 90, hi_open=True)
         self._init_bimodal(N, packing_fraction, bimodal_factor)
         if rng is not None:
@@ -370,9 +371,10 @@ class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticl
         self.permanent_ratio_tangential = permanent_ratio_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant
         self.cut_top_bottom = False
-        EnsembleCompactParticles.__init__(self, size_x, size_y, N, packing_fraction, theCanvas, doDrawing, k, nu, m,
-                                          bimodal_factor, k_t, nu_t, mu, dt, dt_max, theTkSimulation,
-                                          avoid_horizontal_angle_degree, rng)
+        EnsembleCompactParticles.__init__(
+            self, size_x, size_y, N, packing_fraction=packing_fraction, theCanvas=theCanvas, doDrawing=doDrawing,
+            k=k, nu=nu, m=m, bimodal_factor=bimodal_factor, k_t=k_t, nu_t=nu_t, mu=mu, dt=dt, dt_max=dt_max,
+            theTkSimulation=theTkSimulation, avoid_horizontal_angle_degree=avoid_horizontal_angle_degree, rng=rng)
 
     def _new_sphere(self, x, y, r, m, index):
         return SphereLinkableAdjustableInterfaceStrength(

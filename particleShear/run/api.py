@@ -16,7 +16,7 @@ from ..hooks import entry
 from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA, PARAMETERS
 from ..simulation.provenance import run_identity
-from .validation import check_seed, validate_run, validate_series
+from .validation import check_seed, validate_run, validate_series, validated_run
 from .sessions import _build_simulation, _seed_sequence, check_batch_size, measure_batch  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
@@ -333,13 +333,14 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
                    creep_modulus=creep_modulus, creep_response_time=creep_response_time,
                    sweep_amplitudes=sweep_amplitudes, sweep_frequencies=sweep_frequencies,
                    stroboscopic=stroboscopic, **dict(_EXTRA_DEFAULTS, **law_parameters))
-    # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
-    # run are checked before any work (limits in docs/parameters.md)
-    validate_run(dict(params, **options))
     params.update(options)   # every input, the keyword-only options included
+    # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
+    # run are checked before any work (limits in docs/parameters.md); the checked arguments, seed and
+    # run id travel down as they are (RunParameters)
+    run = validated_run(params)
     # measured by the engine, a batch of one (particleShear.run.measurement)
     with console_messages(verbose):
-        result = measure([params])[0]
+        result = measure([run])[0]
     if plotStress and doDrawing and result.output_path and protocol == "oscillatory":
         _save_headless_stress_plot(result, renderer)
     doParticleShearSimulation.last_result = result

@@ -32,7 +32,7 @@ from .sessions import (BACKENDS, _REFERENCE_ARGUMENTS, _signature_defaults, buil
 from .api import doParticleShearSimulation
 from .measurement import measure
 from .rheometer import normalize_protocol, protocol_steps
-from .validation import validate_run
+from .validation import validated_run
 
 __all__ = ["run_batch", "batches", "schedule_key", "measure_sessions", "PER_REPLICA_PARAMETERS", "BACKENDS",
            "check_backend", "check_run_backend"]
@@ -150,7 +150,9 @@ def run_batch(list_of_kwargs, backend=None):
         raise ValueError("list_of_kwargs=[] is invalid: a batch needs at least one run")
     for kw in runs:
         kw.pop("return_result", None)
-        validate_run(kw)   # every replica, before any work (and before its schedule is computed)
+    # every replica checked, completed and identified once, before any work (and before its schedule
+    # is computed); a batch returns its results
+    runs = [validated_run(dict(kw, return_result=True)) for kw in runs]
     keys = [schedule_key(kw) for kw in runs]
     for n, key in enumerate(keys):
         if key != keys[0]:
@@ -158,8 +160,6 @@ def run_batch(list_of_kwargs, backend=None):
             raise ValueError(f"list_of_kwargs[{n}] does not share the step schedule of list_of_kwargs[0] "
                              f"(differs in {', '.join(diff) or 'its parameters'}); a batch needs equal N, "
                              "time-step rule and protocol")
-    defaults = _signature_defaults()
-    full = [dict(defaults, **kw, return_result=True) for kw in runs]  # a batch returns its results
-    results = measure(full)       # the protocol is part of the schedule key
+    results = measure(runs)       # the protocol is part of the schedule key
     doParticleShearSimulation.last_result = results[-1]
     return results

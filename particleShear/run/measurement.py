@@ -2,8 +2,9 @@
 
 Every caller — :func:`~particleShear.run.api.doParticleShearSimulation` (a batch of one),
 :func:`~particleShear.run.batch.run_batch`, and through them the series and sweeps — measures
-through :func:`measure`, which normalizes the runs (:func:`~particleShear.run.rheometer.normalize_protocol`)
-and hands them to their protocol's driver: the oscillatory protocol's
+through :func:`measure`, which hands the checked runs
+(:class:`~particleShear.run.validation.RunParameters`, made once per run by
+:func:`~particleShear.run.validation.validated_run`) unchanged to their protocol's driver: the oscillatory protocol's
 (:func:`~particleShear.run.sessions.measure_batch`: the documented run's phases, its output file and
 snapshots) or every other protocol's (:func:`~particleShear.run.rheometer.measure_rheometer`: the
 same sessions, constitution and pre-equilibration, then the protocol's rate schedule).  Either
@@ -11,7 +12,7 @@ returns one :class:`~particleShear.run.result.SimulationResult` per run.
 """
 __docformat__ = "numpy"
 
-from .rheometer import measure_rheometer, normalize_protocol
+from .rheometer import measure_rheometer
 from .sessions import measure_batch
 
 __all__ = ["measure"]
@@ -25,14 +26,13 @@ def measure(runs):
 
     Parameters
     ----------
-    runs : list of dict
-        Complete, validated keyword dicts of the runs (every argument of
-        :func:`~particleShear.run.api.doParticleShearSimulation`, defaults filled in).
+    runs : list of RunParameters
+        The checked arguments of the runs (:func:`~particleShear.run.validation.validated_run`:
+        complete, normalized, with their seed and run id), handed to the driver as they are.
 
     Returns
     -------
     list of SimulationResult
         One per run, in order; each records its normalized arguments in ``parameters``.
     """
-    runs = [normalize_protocol(kw) for kw in runs]
     return _DRIVERS.get(runs[0]["protocol"], measure_rheometer)(runs)

@@ -39,7 +39,6 @@ from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY
 from ..protocols.creep import CREEP_MODULUS_FRACTION
 from ..protocols.steady import N1_EVERY
 from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
-from ..simulation.provenance import run_identity
 from .protocol_summary import PROTOCOL_COLUMNS, STEP_COLUMNS, dt_over_tau  # noqa: F401 - PROTOCOL_COLUMNS, STEP_COLUMNS re-exported
 from .result import SimulationResult
 from .sessions import build_sessions
@@ -226,8 +225,9 @@ def measure_rheometer(runs):
 
     Parameters
     ----------
-    runs : list of dict
-        Complete, validated, normalized keyword dicts sharing a protocol and a schedule.
+    runs : list of RunParameters
+        The checked arguments of the runs (:func:`~particleShear.run.validation.validated_run`:
+        complete, normalized), sharing a protocol and a schedule.
 
     Returns
     -------
@@ -282,8 +282,8 @@ def measure_rheometer(runs):
             series, curves, summary = _concatenated([rec for *_, rec in segments]), {}, {}
         seed_entropy, spawn_key, _ = seeds[b]
         tm = dict(timings[b], protocol=t_protocol, analysis=time.perf_counter() - t1)
-        results[b] = SimulationResult.of_protocol(proto, dict(kw), seed_entropy, spawn_key,
-                                                  run_identity(kw, seed_entropy, spawn_key), tau, sc.dt, series,
+        results[b] = SimulationResult.of_protocol(proto, sessions[b].sim.parameters_record(), seed_entropy,
+                                                  spawn_key, kw.run_id, tau, sc.dt, series,
                                                   summary, curves, sweep, tm)
         if kw["saveData"]:
             t2 = time.perf_counter()

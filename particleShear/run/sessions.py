@@ -18,7 +18,6 @@ from ..parameters import defaults as _defaults
 from ..simulation.driver import measure_sessions
 from ..simulation.fragmentation import Simulation_interlocking_rheology
 from ..simulation.oscillatory import RunSession
-from ..simulation.provenance import run_identity
 from .result import SimulationResult
 
 __all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "check_run_backend", "contact_law_spec",
@@ -94,43 +93,45 @@ def _seed_sequence(seed):
     return ss, np.random.default_rng(ss)
 
 
+#: the arguments of :class:`Simulation_interlocking_rheology` that are run parameters of the same name
+#: (its ``amplitude`` and ``mu`` are ``theAmplitude`` and ``theMu``; ``cut_lines`` and ``N`` are made int)
+_SIMULATION_ARGUMENTS = ("do_permanent_links", "packing_fraction", "density", "bimodal_factor",
+                         "Young_modulus_spheres", "relative_y_scale_force", "relative_frequency",
+                         "relative_viscosity", "relative_transversal_link_strength", "central_repulsion_coefficient",
+                         "avoid_horizontal_angle_degree", "interface_reenforcement_central",
+                         "interface_reenforcement_tangential", "keep_viscosity_coefficients_constant",
+                         "avoid_height_spanning_particles", "cut_top_bottom", "doCutByTriangulation",
+                         "remove_link_fraction", "edge_fuzziness", "doDrawing", "saveData")
+
+
 def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, reference_header, renderer,
                       time_step_factor, integrator, stability_guard):
-    """The :class:`Simulation_interlocking_rheology` of one run, configured but not run (``params``: the
-    validated reference arguments of :func:`doParticleShearSimulation`; ``rng`` its Generator)."""
+    """The :class:`Simulation_interlocking_rheology` of one run, configured but not run.
+
+    The documented class is made with keyword arguments read straight from ``params`` (no
+    intermediate names), so a parameter's value reaches the simulation object in one step.
+
+    Parameters
+    ----------
+    params : Mapping
+        The validated arguments of :func:`doParticleShearSimulation` (a
+        :class:`~particleShear.run.validation.RunParameters`, or any mapping with the reference
+        arguments).
+    rng : numpy.random.Generator
+        The run's generator.
+    verbose, progress, correct_drift_sign, reference_header, renderer, time_step_factor, integrator, stability_guard
+        The keyword-only options of the run, set as attributes.
+
+    Returns
+    -------
+    Simulation_interlocking_rheology
+    """
     p = params
-    root_folder, do_permanent_links, cut_lines, N = p["root_folder"], p["do_permanent_links"], p["cut_lines"], p["N"]
-    (packing_fraction, density, bimodal_factor, theAmplitude) = (p["packing_fraction"], p["density"],
-                                                                 p["bimodal_factor"], p["theAmplitude"])
-    Young_modulus_spheres, theMu, relative_y_scale_force = p["Young_modulus_spheres"], p["theMu"], p[
-        "relative_y_scale_force"]
-    relative_frequency, relative_viscosity = p["relative_frequency"], p["relative_viscosity"]
-    relative_transversal_link_strength = p["relative_transversal_link_strength"]
-    central_repulsion_coefficient = p["central_repulsion_coefficient"]
-    avoid_horizontal_angle_degree = p["avoid_horizontal_angle_degree"]
-    interface_reenforcement_central = p["interface_reenforcement_central"]
-    interface_reenforcement_tangential = p["interface_reenforcement_tangential"]
-    keep_viscosity_coefficients_constant = p["keep_viscosity_coefficients_constant"]
-    avoid_height_spanning_particles, cut_top_bottom = p["avoid_height_spanning_particles"], p["cut_top_bottom"]
-    doCutByTriangulation, remove_link_fraction = p["doCutByTriangulation"], p["remove_link_fraction"]
-    edge_fuzziness, doDrawing, saveData = p["edge_fuzziness"], p["doDrawing"], p["saveData"]
     pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
     saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
-    saveStressTensorData = p["saveStressTensorData"]
     theSimulation = Simulation_interlocking_rheology(
-        root_folder, do_permanent_links=do_permanent_links, cut_lines=int(cut_lines), N=int(N),
-        packing_fraction=packing_fraction, density=density, bimodal_factor=bimodal_factor, amplitude=theAmplitude,
-        Young_modulus_spheres=Young_modulus_spheres, mu=theMu, relative_y_scale_force=relative_y_scale_force,
-        relative_frequency=relative_frequency, relative_viscosity=relative_viscosity,
-        relative_transversal_link_strength=relative_transversal_link_strength,
-        central_repulsion_coefficient=central_repulsion_coefficient,
-        avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
-        interface_reenforcement_central=interface_reenforcement_central,
-        interface_reenforcement_tangential=interface_reenforcement_tangential,
-        keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant,
-        avoid_height_spanning_particles=avoid_height_spanning_particles, cut_top_bottom=cut_top_bottom,
-        doCutByTriangulation=doCutByTriangulation, remove_link_fraction=remove_link_fraction,
-        edge_fuzziness=edge_fuzziness, doDrawing=doDrawing, saveData=saveData)
+        p["root_folder"], cut_lines=int(p["cut_lines"]), N=int(p["N"]), amplitude=p["theAmplitude"], mu=p["theMu"],
+        **{name: p[name] for name in _SIMULATION_ARGUMENTS})
     theSimulation.function_call += (
         "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
         + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
@@ -141,7 +142,7 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     theSimulation.baseline_post_periods = post_periods
     theSimulation.saveOutputImages = saveOutputImages
     theSimulation.imageFileType = imageFileType
-    theSimulation.saveStressTensorData = saveStressTensorData
+    theSimulation.saveStressTensorData = p["saveStressTensorData"]
     theSimulation.rng = rng
     theSimulation.verbose = verbose
     theSimulation.progress = progress
@@ -204,7 +205,8 @@ def contact_law_spec(p):
 def measure_batch(runs):
     """Constitute every replica with the documented builder, then measure all of them in one engine.
 
-    ``runs``: complete, validated keyword dicts sharing one schedule.  Each replica runs through
+    ``runs``: the checked arguments of the runs (:class:`~particleShear.run.validation.RunParameters`),
+    sharing one schedule.  Each replica runs through
     the phases of ``runSimulation`` (:class:`~particleShear.simulation.oscillatory.RunSession`:
     validation, constitution, reservation of its output file, experiment set-up, schedule) except
     the measurement, which the engine does for all replicas at once; each experiment then adopts
@@ -215,8 +217,8 @@ def measure_batch(runs):
 
     Parameters
     ----------
-    runs : list of dict
-        Complete, validated keyword dicts of the replicas (one schedule).
+    runs : list of RunParameters
+        The checked arguments of the replicas (one schedule).
 
     Returns
     -------
@@ -225,21 +227,20 @@ def measure_batch(runs):
     sims, seeds, sessions = build_sessions(runs)
     measure_sessions(sessions)
     results = []
-    for kw, sim, run, (seed_entropy, spawn_key, params) in zip(runs, sims, sessions, seeds):
+    for sim, run, (seed_entropy, spawn_key, _) in zip(sims, sessions, seeds):
         info = sim.result_info
         # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
         info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
                                        ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
         results.append(SimulationResult(
             G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-            stress_internal=info["stress_internal"], parameters=params, seed=seed_entropy,
+            stress_internal=info["stress_internal"], parameters=sim.parameters_record(), seed=seed_entropy,
             spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
             image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
             N_steps=info["N_steps"], damping_factor=info["damping_factor"],
             removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
             series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
             microstructure=getattr(run, "microstructure", None)))
-        results[-1].parameters = dict(kw)  # every input, as doParticleShearSimulation records it
     return results
 
 
@@ -248,35 +249,34 @@ def build_sessions(runs):
 
     Parameters
     ----------
-    runs : list of dict
-        Complete, validated keyword dicts of the replicas.
+    runs : list of RunParameters
+        The checked arguments of the replicas (:func:`~particleShear.run.validation.validated_run`);
+        each is read as it is (no copy) and keeps its seed and run id.
 
     Returns
     -------
     sims : list
         The documented simulation of each run (not constituted).
     seeds : list of tuple
-        ``(seed entropy, spawn key, reference parameters)`` of each run.
+        ``(seed entropy, spawn key, run parameters)`` of each run.
     sessions : list of RunSession
         One session per run, in order.
     """
     sims, seeds, sessions = [], [], []
-    for kw in runs:  # every replica's settings are checked before any work
-        ss, rng = _seed_sequence(kw["seed"])
-        seed_entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
-        params = {k: kw[k] for k in _REFERENCE_ARGUMENTS}
-        sim = _build_simulation(params, rng, verbose=kw["verbose"], progress=kw["progress"],
+    for kw in runs:  # every replica's settings were checked (validated_run) before any work
+        seed_entropy, spawn_key = kw.seed_entropy, kw.spawn_key
+        sim = _build_simulation(kw, kw.generator, verbose=kw["verbose"], progress=kw["progress"],
                                 correct_drift_sign=kw["correct_drift_sign"], reference_header=kw["reference_header"],
-                                renderer=kw.get("renderer", "auto"), time_step_factor=kw["time_step_factor"],
+                                renderer=kw["renderer"], time_step_factor=kw["time_step_factor"],
                                 integrator=kw["integrator"], stability_guard=kw["stability_guard"])
-        sim.output_format = kw.get("output_format", "text")
-        sim.saveOutputMovie = bool(kw.get("saveOutputMovie", False))
-        sim.run_id, sim.seed_entropy, sim.spawn_key = run_identity(kw, seed_entropy, spawn_key), seed_entropy, spawn_key
+        sim.output_format = kw["output_format"]
+        sim.saveOutputMovie = bool(kw["saveOutputMovie"])
+        sim.run_id, sim.seed_entropy, sim.spawn_key = kw.run_id, seed_entropy, spawn_key
         sim.parameters = kw
         sim.contact_law = contact_law_spec(kw)
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
-        seeds.append((seed_entropy, spawn_key, params))
+        seeds.append((seed_entropy, spawn_key, kw))
     return sims, seeds, sessions
 
 

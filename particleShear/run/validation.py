@@ -34,12 +34,13 @@ from ..protocols import PROTOCOLS as _PROTOCOLS
 from ..simulation.formats import check_output_format
 from .limits import (CELL, MAX_N, MAX_SERIES_RUNS, MAX_TOTAL_STEPS, MIN_SPHERES_PER_PARTICLE,  # noqa: F401 - re-exported
                      MIN_STEPS_PER_PERIOD, MIN_STEPS_PER_PERIOD_COARSENED, SEED_LIMIT, _protocol_room)
-from .sessions import check_backend, check_run_backend, contact_law_spec
+from .sessions import _seed_sequence, check_backend, check_run_backend, contact_law_spec
+from ..simulation.provenance import run_identity
 from ..analysis.measures import warn_few_periods
 from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 from .rheometer import PROTOCOL_DEFAULTS, _shown, check_protocol, normalize_protocol, protocol_steps
 
-__all__ = ["validate_run", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
+__all__ = ["validate_run", "validated_run", "RunParameters", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
            "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
            "INTEGRATORS", "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS",
            "MAX_SERIES_RUNS", "SEED_LIMIT", "contact_law_spec"]
@@ -476,6 +477,13 @@ def validate_run(params):
     particleShear.analysis.measures.MeasurementWarning
         When ``periods`` measures fewer than 2 whole excitation periods (no standard error).
     """
+    return _checked(params)[1]
+
+
+def _checked(params):
+    """:func:`validate_run`'s checks; returns ``(p, cost)``: the complete, normalized arguments the
+    checks read (defaults filled in, :func:`~particleShear.run.rheometer.normalize_protocol` applied)
+    and the cost estimate."""
     defaults = _defaults()
     unknown = sorted(set(params) - set(defaults))
     if unknown:
@@ -518,7 +526,101 @@ def validate_run(params):
     check_run_backend(p)   # another backend than NumPy only for runs the engine measures
     if p["protocol"] == "oscillatory" or _PROTOCOLS[p["protocol"]].segmented:
         warn_few_periods(p["periods"])   # valid, but fewer than 2 whole periods give no error bar
-    return cost
+    return p, cost
+
+
+class RunParameters(dict):
+    """The complete, validated arguments of one run, immutable: what travels from the check to the engine.
+
+    Made only by :func:`validated_run`, once per run, so that nothing below the check validates,
+    completes, normalizes or hashes the arguments again: the sessions, the simulation object and
+    the ensemble builders read their values from it by the names of the parameter table
+    (:mod:`particleShear.parameters`), and the run's identity and seed are the ones computed here.
+    A ``dict`` (read like the keyword dict it replaces, ``json``-able, ``dict(run)`` a plain copy)
+    whose items cannot change: a value changed after the check would be a value nobody checked.
+
+    Parameters
+    ----------
+    values : dict
+        The complete, normalized arguments (taken as they are).
+    run_id : str
+        :func:`~particleShear.simulation.provenance.run_identity` of the arguments and the seed.
+    seed_sequence : numpy.random.SeedSequence or None
+        The run's seed sequence (None when ``seed`` is a Generator or a BitGenerator).
+    generator : numpy.random.Generator
+        The generator of every random choice of the run, made from ``seed_sequence`` (or ``seed``).
+    cost : dict
+        The cost estimate of :func:`estimate_run_cost` (steps and memory).
+    """
+
+    __slots__ = ("run_id", "seed_sequence", "generator", "cost")
+
+    def __init__(self, values, run_id, seed_sequence, generator, cost):
+        dict.__init__(self, values)
+        self.run_id, self.seed_sequence, self.generator, self.cost = run_id, seed_sequence, generator, cost
+
+    def _immutable(self, *args, **kwargs):
+        """Refused: the checked arguments of a run do not change.
+
+        Parameters
+        ----------
+        *args, **kwargs
+            Those of the ``dict`` method; ignored.
+
+        Raises
+        ------
+        TypeError
+            Always.
+        """
+        raise TypeError("RunParameters is immutable: the validated arguments of a run do not change "
+                        "(change a copy, dict(run), and validate it again)")
+
+    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _immutable
+
+    def __reduce__(self):
+        # a plain dict's pickling sets the items one by one (refused here): rebuild from the values
+        return type(self), (dict(self), self.run_id, self.seed_sequence, self.generator, self.cost)
+
+    @property
+    def seed_entropy(self):
+        """``SeedSequence.entropy`` of the run (None without a seed sequence): part of its identity."""
+        return None if self.seed_sequence is None else self.seed_sequence.entropy
+
+    @property
+    def spawn_key(self):
+        """``SeedSequence.spawn_key`` of the run as a tuple (empty without a seed sequence)."""
+        return () if self.seed_sequence is None else tuple(self.seed_sequence.spawn_key)
+
+
+def validated_run(params):
+    """Check one run's arguments (:func:`validate_run`) and return them as :class:`RunParameters`.
+
+    The one place where a run's arguments are checked, completed, normalized, seeded and
+    identified: every way to measure (:func:`~particleShear.run.api.doParticleShearSimulation`,
+    :func:`~particleShear.run.batch.run_batch`, the sweep's tasks) calls it once per run and hands
+    the result down unchanged, so the validation, the run identity and the parameter dict are
+    each made once per run.
+
+    Parameters
+    ----------
+    params : dict
+        As for :func:`validate_run`.
+
+    Returns
+    -------
+    RunParameters
+        The complete arguments (defaults filled in, a sweep protocol's first value put in), the
+        run id, the seed sequence and generator, and the cost estimate.
+
+    Raises
+    ------
+    TypeError, ValueError, ImportError
+        As :func:`validate_run`.
+    """
+    p, cost = _checked(params)
+    ss, rng = _seed_sequence(p["seed"])
+    entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
+    return RunParameters(p, run_identity(p, entropy, spawn_key), ss, rng, cost)
 
 
 #: the former name of :func:`validate_run` (the same function)

@@ -252,8 +252,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
                                        laws=[sims[b].contact_law for b in group])
         for b in group:           # the backend used ("auto" resolved), as the result records it
-            if sims[b].parameters is not None:
-                sims[b].parameters["backend"] = st.backend.name
+            sims[b].backend_used = st.backend.name
         say, report = _console(sims, group, "pre-equilibration", where)
         if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
             tc = time.perf_counter()
@@ -261,8 +260,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
                 st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
                                           laws=[sims[b].contact_law for b in group])
                 for b in group:
-                    if sims[b].parameters is not None:
-                        sims[b].parameters["backend"] = st.backend.name
+                    sims[b].backend_used = st.backend.name
             t0 += time.perf_counter() - tc
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)

@@ -208,9 +208,11 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
                  relative_transversal_link_strength=1, central_repulsion_coefficient=1,
                  avoid_horizontal_angle_degree=0, avoid_height_spanning_particles=False, doCutByTriangulation=True,
                  doDrawing=True, saveData=False):
-        OscillatorySimulationFragmentation.__init__(self, root_folder, do_permanent_links, cut_lines, N,
-                                                    packing_fraction, amplitude, Young_modulus_spheres, mu,
-                                                    relative_y_scale_force, relative_frequency, doDrawing, saveData)
+        OscillatorySimulationFragmentation.__init__(
+            self, root_folder, do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N,
+            packing_fraction=packing_fraction, amplitude=amplitude, Young_modulus_spheres=Young_modulus_spheres,
+            mu=mu, relative_y_scale_force=relative_y_scale_force, relative_frequency=relative_frequency,
+            doDrawing=doDrawing, saveData=saveData)
         self.avoid_horizontal_angle_degree = avoid_horizontal_angle_degree
         self.avoid_height_spanning_particles = avoid_height_spanning_particles
         self.doCutByTriangulation = doCutByTriangulation
@@ -370,10 +372,16 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
                  keep_viscosity_coefficients_constant=True, cut_top_bottom=True, doCutByTriangulation=True,
                  remove_link_fraction=0, edge_fuzziness=0, doDrawing=True, saveData=False):
         Simulation_dermal_filler_rheology.__init__(
-            self, root_folder, do_permanent_links, cut_lines, N, packing_fraction, bimodal_factor, amplitude,
-            Young_modulus_spheres, density, mu, relative_viscosity, relative_y_scale_force, relative_frequency,
-            relative_transversal_link_strength, central_repulsion_coefficient, avoid_horizontal_angle_degree,
-            avoid_height_spanning_particles, doCutByTriangulation, doDrawing, saveData)
+            self, root_folder, do_permanent_links=do_permanent_links, cut_lines=cut_lines, N=N,
+            packing_fraction=packing_fraction, bimodal_factor=bimodal_factor, amplitude=amplitude,
+            Young_modulus_spheres=Young_modulus_spheres, density=density, mu=mu,
+            relative_viscosity=relative_viscosity, relative_y_scale_force=relative_y_scale_force,
+            relative_frequency=relative_frequency,
+            relative_transversal_link_strength=relative_transversal_link_strength,
+            central_repulsion_coefficient=central_repulsion_coefficient,
+            avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+            avoid_height_spanning_particles=avoid_height_spanning_particles,
+            doCutByTriangulation=doCutByTriangulation, doDrawing=doDrawing, saveData=saveData)
         self.interface_reenforcement_central = interface_reenforcement_central
         self.interface_reenforcement_tangential = interface_reenforcement_tangential
         self.keep_viscosity_coefficients_constant = keep_viscosity_coefficients_constant

@@ -311,7 +311,10 @@ class OscillatorySimulation:
     run_id = None
     seed_entropy = None
     spawn_key = ()
+    #: the run's checked arguments (a :class:`~particleShear.run.validation.RunParameters`; None outside a run)
     parameters = None
+    #: the backend that measured the run (``backend="auto"`` resolved by the driver; None before)
+    backend_used = None
     #: the contact law of the run, ``(name, values)`` of ``run.validation.contact_law_spec`` (None: the callbacks')
     contact_law = None
     #: the exception of a failed write after the run (None when the output was written)
@@ -569,6 +572,25 @@ class OscillatorySimulation:
         N_per_period = 1 / f / dt
         return MeasurementSchedule(dt, f, cool_factor ** (1 / N_per_period), N_pre, dt_max)
 
+    def parameters_record(self):
+        """The run's arguments as its result and its files record them: a plain dict of
+        :attr:`parameters`, with ``backend`` the backend that measured the run (:attr:`backend_used`).
+
+        The checked arguments themselves stay as they were checked (immutable); the resolved
+        backend is only known once the driver has made the run's state, so it is put into this copy.
+
+        Returns
+        -------
+        dict or None
+            None when the simulation has no run parameters (made by its class, not by a run).
+        """
+        if self.parameters is None:
+            return None
+        record = dict(self.parameters)
+        if self.backend_used is not None:
+            record["backend"] = self.backend_used
+        return record
+
     def run_metadata(self, output_format, path):
         """JSON-safe description of the run: parameters and provenance (the sidecar's content).
 
@@ -588,7 +610,7 @@ class OscillatorySimulation:
             "package_version": package_version(), "run_id": getattr(self, "run_id", None),
             "seed_entropy": json_safe(getattr(self, "seed_entropy", None)),
             "spawn_key": json_safe(list(getattr(self, "spawn_key", ()))),
-            "parameters": json_safe(getattr(self, "parameters", None)),
+            "parameters": json_safe(self.parameters_record()),
             "time_step_factor": float(getattr(self, "time_step_factor", 1.0)),
             "integrator": getattr(self, "integrator", "euler"), "correct_drift_sign": bool(self.correct_drift_sign),
             "reference_header": bool(self.reference_header), "function_call": self.function_call,

@@ -1,0 +1,143 @@
+"""The path of a parameter from the public call to the force kernel (issue 45, "Parameters as data").
+
+A run's arguments are checked, completed, normalized, seeded and identified once
+(:func:`particleShear.run.validation.validated_run`); the immutable
+:class:`~particleShear.run.validation.RunParameters` it returns travels unchanged to the sessions,
+and a parameter's value (here μ, ``theMu``) reaches the engine's per-replica constants
+(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given.
+"""
+import contextlib
+import pickle
+import sys
+import unittest
+from unittest import mock
+
+import numpy as np
+
+import particleShear.engine.forces as forces
+import particleShear.run.validation as validation
+import particleShear.simulation.driver as driver
+from particleShear.run.api import doParticleShearSimulation
+from particleShear.run.batch import run_batch
+from particleShear.run.validation import RunParameters, validated_run
+from particleShear.simulation import provenance
+
+#: a short run (amplitude 0.2: no μ = 0 relaxation block in the constitution)
+SMALL = dict(N=20, cut_lines=0, relative_frequency=0.2, pre_periods=0.2, periods=1, post_periods=0, seed=1,
+             doDrawing=False, verbose=False, backend="numpy", theAmplitude=0.2)
+MU = 0.37
+
+
+@contextlib.contextmanager
+def counted(function, *modules):
+    """Count the calls of ``function`` made through the names it has in ``modules``."""
+    calls = []
+
+    def wrapper(*args, **kwargs):
+        calls.append(args)
+        return function(*args, **kwargs)
+
+    with contextlib.ExitStack() as stack:
+        for module in modules:
+            for name, value in vars(module).items():
+                if value is function:
+                    stack.enter_context(mock.patch.object(module, name, wrapper))
+        yield calls
+
+
+def identity_modules():
+    """Every loaded particleShear module that holds ``run_identity`` under some name."""
+    return [m for name, m in sys.modules.items() if name.startswith("particleShear") and m is not None
+            and any(v is provenance.run_identity for v in vars(m).values())]
+
+
+class TestOncePerRun(unittest.TestCase):
+    """Validation and identity are computed exactly once per run."""
+
+    def test_one_call_checks_and_identifies_once(self):
+        with counted(validation._checked, validation) as checks, \
+                counted(provenance.run_identity, *identity_modules()) as ids, \
+                self.assertWarns(Warning):       # periods=1: no standard error (MeasurementWarning)
+            result = doParticleShearSimulation(theMu=MU, return_result=True, **SMALL)
+        self.assertEqual(len(checks), 1)
+        self.assertEqual(len(ids), 1)
+        # the id computed by the check is the run's, and equal to a fresh computation
+        run = validated_run(dict(result.parameters, seed=1, backend="numpy"))
+        self.assertEqual(result.run_id, run.run_id)
+
+    def test_batch_checks_and_identifies_each_replica_once(self):
+        runs = [dict(SMALL, theMu=m, seed=s) for m, s in ((MU, 1), (0.5, 2))]
+        with counted(validation._checked, validation) as checks, \
+                counted(provenance.run_identity, *identity_modules()) as ids, \
+                self.assertWarns(Warning):
+            results = run_batch(runs)
+        self.assertEqual(len(checks), 2)
+        self.assertEqual(len(ids), 2)
+        self.assertEqual([r.parameters["theMu"] for r in results], [MU, 0.5])
+
+
+class TestRunParameters(unittest.TestCase):
+    """The checked arguments cannot change on their way down, and survive a process boundary."""
+
+    def setUp(self):
+        with self.assertWarns(Warning):
+            self.run = validated_run(dict(SMALL, theMu=MU))
+
+    def test_complete_and_immutable(self):
+        self.assertIsInstance(self.run, dict)
+        self.assertEqual(self.run["theMu"], MU)
+        self.assertIn("contact_law", self.run)         # defaults filled in
+        for change in (lambda r: r.__setitem__("theMu", 0.5), lambda r: r.update(theMu=0.5),
+                       lambda r: r.pop("theMu"), lambda r: r.setdefault("x", 1), lambda r: r.clear(),
+                       lambda r: r.__delitem__("theMu"), lambda r: r.popitem()):
+            with self.assertRaises(TypeError):
+                change(self.run)
+        self.assertEqual(self.run["theMu"], MU)
+        copy = dict(self.run)
+        copy["theMu"] = 0.5                              # a plain copy is the caller's to change
+        self.assertEqual(self.run["theMu"], MU)
+
+    def test_pickles_with_its_identity_and_seed(self):
+        back = pickle.loads(pickle.dumps(self.run))
+        self.assertIsInstance(back, RunParameters)
+        self.assertEqual(dict(back), dict(self.run))
+        self.assertEqual((back.run_id, back.seed_entropy, back.spawn_key),
+                         (self.run.run_id, self.run.seed_entropy, self.run.spawn_key))
+        self.assertEqual(back.generator.random(), self.run.generator.random())
+
+    def test_identity_is_the_provenance_identity(self):
+        self.assertEqual(self.run.run_id, provenance.run_identity(self.run, self.run.seed_entropy, self.run.spawn_key))
+
+
+class TestMuReachesTheKernel(unittest.TestCase):
+    """A changed ``theMu`` reaches ``BatchState.mu`` and the pair constants unchanged."""
+
+    def test_mu_in_batch_state_and_pair_constants(self):
+        """The measurement's BatchState.mu and every pair constant μ it gives term_constants equal theMu."""
+        states, pair_mu = [], []
+        state_from_ensembles, term_constants = driver.state_from_ensembles, forces.term_constants
+
+        def capture_state(*args, **kwargs):
+            st = state_from_ensembles(*args, **kwargs)
+            states.append(np.asarray(st.mu).copy())
+            return st
+
+        def capture_terms(*args, **kwargs):
+            if states:      # the measurement's pair constants (the constitution's relaxations may run at μ = 0)
+                pair_mu.append(np.asarray(args[8] if len(args) > 8 else kwargs["mu"]).copy())
+            return term_constants(*args, **kwargs)
+
+        with mock.patch.object(driver, "state_from_ensembles", capture_state), \
+                mock.patch.object(forces, "term_constants", capture_terms), self.assertWarns(Warning):
+            result = doParticleShearSimulation(theMu=MU, return_result=True, **SMALL)
+        self.assertEqual(result.parameters["theMu"], MU)
+        self.assertTrue(states)
+        for mu in states:                          # the measurement's state: μ of the replica as given
+            np.testing.assert_array_equal(mu, [MU])
+        self.assertTrue(pair_mu)
+        for mu in pair_mu:                         # every pair constant of the Coulomb bound: μ as given
+            self.assertTrue(np.all(mu == MU), mu)
+
+
+if __name__ == "__main__":
+    unittest.main()
