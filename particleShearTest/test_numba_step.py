@@ -283,26 +283,37 @@ class TestCompiledStepBits(unittest.TestCase):
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestCompiledSearch(unittest.TestCase):
     def test_same_pairs_as_the_numpy_search(self):
-        """The compiled all-pairs search gives the NumPy search's pairs in its order: random replicas of
-        2 … 198 spheres, Lees-Edwards offsets of zero, a fraction of a cell and many cells, a NaN
-        position, skins from 0 to 20 µm."""
+        """The compiled search (cell list, or every pair on a grid of fewer than 3 cells per side) gives
+        the NumPy searches' pairs in their order: random replicas of 2 … 1,500 spheres, radii small
+        and large against the box (both kinds of grid), Lees-Edwards offsets of zero, a fraction of a
+        cell and many cells, a NaN position, positions a period outside the box, skins from 0 to 20 µm,
+        and a dense replica with more pairs than the first buffer holds."""
         from particleShear.engine import neighbours
         rng = np.random.default_rng(0)
-        for t in range(200):
-            N = int(rng.integers(2, neighbours.CELL_LIST_MIN_N - 1))
-            L = 500.0
-            x, y, r = rng.uniform(0, L, N), rng.uniform(0, 0.8 * L, N), rng.uniform(10, 40, N)
+        grids = set()
+        for t in range(240):
+            N = int(rng.integers(2, 200)) if t % 2 else int(rng.integers(200, 1500))
+            L = 500.0 if t % 3 else 2000.0
+            x, y, r = rng.uniform(0, L, N), rng.uniform(0, 0.8 * L, N), rng.uniform(10, 40 if t % 5 else 150, N)
             if t % 10 == 0:
                 x[0] = np.nan
+            if t % 7 == 0:
+                y[-1] += 0.8 * L        # (a sphere above the box: binned at its image, as NumPy's)
+            if t == 11:
+                x, y = rng.uniform(0, 60, N), rng.uniform(0, 60, N)      # dense: ≈ N²/2 pairs
             shift = float(rng.choice([0.0, 37.5, -620.0, 5e4]))
             skin = float(rng.uniform(0, 20))
-            with self.subTest(t=t):
-                want = neighbours.near_pairs_all(x, y, r, L, 0.8 * L, shift, skin)
+            with self.subTest(t=t, N=N):
+                want_all = neighbours.near_pairs_all(x, y, r, L, 0.8 * L, shift, skin)
+                want_cells = neighbours.near_pairs_cells(x, y, r, L, 0.8 * L, shift, skin)
                 got = numba_step.search(x, y, r, L, 0.8 * L, shift, skin)
-                np.testing.assert_array_equal(got[0], want[0])
-                np.testing.assert_array_equal(got[1], want[1])
-                if t == 1:
-                    self.assertGreater(len(got[0]), 0)
+                for want in (want_all, want_cells):
+                    np.testing.assert_array_equal(got[0], want[0])
+                    np.testing.assert_array_equal(got[1], want[1])
+                grids.add(min(neighbours.cell_grid(L, 0.8 * L, 2 * float(r.max()) + skin, N)) >= 3)
+                if t == 11:
+                    self.assertGreater(len(got[0]), 16 * N)
+        self.assertEqual(grids, {True, False})
 
 
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")

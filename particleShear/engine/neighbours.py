@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from .box import in_intervals, min_image
-from .xp import array_namespace
+from .xp import array_namespace, minimum, select
 
 __all__ = ["all_pairs", "near_pairs_all", "near_pairs_cells", "near_pairs", "cell_grid", "build_candidates",
            "verlet_bound", "within_reach", "CELL_LIST_MIN_N"]
@@ -225,6 +225,29 @@ def cell_grid(Lx, Ly, reach, N):
     return nx, ny
 
 
+def cell_index(v, size, n):
+    """The cell of coordinates ``v`` in ``[0, n·size]``, as a float: ``floor(v/size)``, a non-finite or
+    negative one in cell 0 (its pairs fail the distance test anyway), one on the far border in the
+    last cell ``n − 1`` (pure: the binning of both cell lists, :func:`near_pairs_cells` and the
+    compiled one of :mod:`particleShear.engine.numba_step`).
+
+    Parameters
+    ----------
+    v : ndarray or float
+        Coordinates folded into the box (µm).
+    size : float
+        Cell width (µm).
+    n : int
+        Cells along the axis.
+
+    Returns
+    -------
+    ndarray or float
+    """
+    c = np.floor(v / size)
+    return minimum(select(c >= 0, c, 0.0), n - 1)
+
+
 def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     """Pairs ``i < j`` within ``r_i + r_j + skin`` (minimum image), by a cell list in O(N).
 
@@ -271,10 +294,7 @@ def near_pairs_cells(x, y, r, Lx, Ly, shift, skin):
     cw, ch = Lx / nx, Ly / ny
 
     def index(v, size, n):
-        # cell index of coordinates in [0, n·size]; a non-finite coordinate goes to cell 0 (its pairs
-        # fail the distance test anyway), one on the far border to the last cell
-        c = xp.floor(v / size)
-        return xp.minimum(xp.where(c >= 0, c, 0), n - 1).astype(xp.intp)
+        return cell_index(v, size, n).astype(xp.intp)
 
     def column(xs):
         return index(xp.mod(xs, Lx), cw, nx)

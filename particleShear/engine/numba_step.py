@@ -15,10 +15,11 @@ formula is a pure function of the NumPy engine called here on numbers
 :func:`~.guard.verdict_code`, :func:`~.guard.transient_ratio`, :func:`~.neighbours.verlet_bound`
 and the laws), in the NumPy engine's order of operations, so the trajectories are the same bits.
 
-What stays in Python: the candidate search when a list is due (the one search,
-:meth:`~particleShear.engine.step.BatchEngine.neighbours`), the random directions at ``d = 0``
-and ``|R| = 0`` (drawn from each replica's generator, as :func:`~.forces.normals` does), and the
-protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
+What stays in Python: the rebuild of a candidate list when one is due
+(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; its search runs compiled,
+:func:`search`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
+replica's generator, as :func:`~.forces.normals` draws them; the step then goes on compiled), and
+the protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
 _pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
@@ -37,7 +38,7 @@ from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
 from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
-from .neighbours import CELL_LIST_MIN_N, near_pairs, verlet_bound, within_reach
+from .neighbours import _INT32_MAX, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
 from .terms import normal_speed, pair_forces, slip_speed
@@ -62,7 +63,7 @@ KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"),
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
-SEARCH_FUNCTIONS = ((sys.modules[__name__], "_search_kernel"),)
+SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
@@ -529,8 +530,8 @@ def _compile(key, name, functions, signature, cache=True, say=None, message=None
 def _search_signature():
     """The Numba signature of :func:`_search_kernel`."""
     from numba import types
-    f1, i1, f = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64
-    return types.int64(f1, f1, f1, f, f, f, f, i1, i1)
+    f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
+    return i(f1, f1, f1, f, f, f, f, i, i, i1)
 
 
 def _block_signature():
@@ -945,31 +946,74 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
 _NO_RECORD = np.zeros((0, 0))
 
 
-def _search_kernel(x, y, r, Lx, Ly, shift, skin, out_i, out_j):
-    """The pairs ``i < j`` within ``r_i + r_j + skin`` of one replica, every pair tested (compiled;
-    :func:`~particleShear.engine.neighbours.near_pairs_all`'s pairs, in its ``(i, j)`` order): the
-    minimum image of :func:`_min_image_pair` and the criterion
-    :func:`~particleShear.engine.neighbours.within_reach`.  Writes ``out_i``, ``out_j``; returns their count."""
-    n = 0
+def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, out):
+    """The pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled): the minimum image of
+    :func:`_min_image_pair` and the criterion :func:`~particleShear.engine.neighbours.within_reach`
+    on the candidates of an ``nx × ny`` cell list (the grid, binning and half neighbourhood of
+    :func:`~particleShear.engine.neighbours.near_pairs_cells`: the same cell, the cell to the right,
+    the three cells of the row above, the row above the top row being the bottom row at
+    ``x − shift``), or on every pair when ``nx`` or ``ny`` is below 3.  Writes the keys
+    ``i·N + j`` into ``out`` while they fit (unsorted: NumPy's sort is the faster); returns their
+    count (more than ``len(out)``: the caller gives room for that many and calls again)."""
     N = x.shape[0]
-    for i in range(N):
-        for j in range(i + 1, N):
-            reach = r[i] + r[j] + skin
-            ady = abs(y[j] - y[i])
-            if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
-                continue
-            dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-            if within_reach(dx, dy, reach):
-                out_i[n] = i
-                out_j[n] = j
-                n += 1
+    cap = out.shape[0]
+    n = 0
+    if nx < 3 or ny < 3:
+        for i in range(N):
+            for j in range(i + 1, N):
+                reach = r[i] + r[j] + skin
+                ady = abs(y[j] - y[i])
+                if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
+                    continue
+                dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+                if within_reach(dx, dy, reach):
+                    if n < cap:
+                        out[n] = i * N + j
+                    n += 1
+    else:
+        cw, ch = Lx / nx, Ly / ny
+        cx, cy, cu = np.empty(N, np.int64), np.empty(N, np.int64), np.empty(N, np.int64)
+        start = np.zeros(nx * ny + 1, np.int64)
+        for a in range(N):       # bin: fold into the cell (a y period moves x by the offset)
+            ky = np.floor(y[a] / Ly)
+            xf = x[a] - shift * ky
+            cy[a] = int(cell_index(y[a] - Ly * ky, ch, ny))
+            cx[a] = int(cell_index(np.mod(xf, Lx), cw, nx))
+            # the column of the row above (the bottom row at x − shift above the top row)
+            cu[a] = int(cell_index(np.mod(xf - shift, Lx), cw, nx)) if cy[a] + 1 >= ny else cx[a]
+            start[cy[a] * nx + cx[a] + 1] += 1
+        for c in range(nx * ny):
+            start[c + 1] += start[c]
+        fill = start[:-1].copy()
+        order = np.empty(N, np.int64)
+        for a in range(N):       # (spheres of a cell in increasing order)
+            c = cy[a] * nx + cx[a]
+            order[fill[c]] = a
+            fill[c] += 1
+        for a in range(N):
+            up = (cy[a] + 1) % ny
+            for q in range(5):
+                if q < 2:
+                    cell = cy[a] * nx + (cx[a] + q) % nx
+                else:
+                    cell = up * nx + (cu[a] + q - 3) % nx
+                for m in range(start[cell], start[cell + 1]):
+                    b = order[m]
+                    if q == 0 and b <= a:
+                        continue
+                    i, j = min(a, b), max(a, b)     # (the pair vector as the all-pairs search takes it)
+                    dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+                    if within_reach(dx, dy, r[i] + r[j] + skin):
+                        if n < cap:
+                            out[n] = i * N + j
+                        n += 1
     return n
 
 
 def search(x, y, r, Lx, Ly, shift, skin):
     """:func:`~particleShear.engine.neighbours.near_pairs` of the compiled backend: the same pairs, in the
-    same order; below :data:`~particleShear.engine.neighbours.CELL_LIST_MIN_N` spheres every pair is
-    tested in compiled code (:func:`_search_kernel`), from there on the NumPy cell list runs.
+    same order, from the same grid (:func:`~particleShear.engine.neighbours.cell_grid`; every pair
+    where it has fewer than 3 cells per side), in compiled code (:func:`_search_kernel`).
 
     Parameters
     ----------
@@ -986,13 +1030,19 @@ def search(x, y, r, Lx, Ly, shift, skin):
         The pairs, sorted by ``(i, j)``.
     """
     N = len(x)
-    if N >= CELL_LIST_MIN_N or not math.isfinite(float(shift)):   # (an infinite offset: no pair is near, as NumPy's)
+    if not math.isfinite(float(shift)) or N < 2:   # (an infinite offset: no pair is near, as NumPy's)
         return near_pairs(x, y, r, Lx, Ly, shift, skin)
     kernel = _kernels.get("search") or compile_search_kernel()
-    out = np.empty((2, N * (N - 1) // 2), dtype=np.int64)
-    n = kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-               np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), out[0], out[1])
-    return out[0, :n].copy(), out[1, :n].copy()
+    nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
+    args = (np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+            np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
+    out = np.empty(min(16 * N, N * (N - 1) // 2), dtype=np.int64)
+    n = kernel(*args, out)
+    if n > len(out):       # (a dense replica: room for every pair found, once)
+        out = np.empty(n, dtype=np.int64)
+        kernel(*args, out)
+    key = np.sort(out[:n].astype(np.int32) if N * N <= _INT32_MAX else out[:n])   # (as near_pairs_cells sorts)
+    return (key // N).astype(np.intp), (key % N).astype(np.intp)
 
 
 def compile_search_kernel(cache=True):

@@ -261,7 +261,7 @@ class BatchEngine:
         pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
         gamma = to_host(s.gamma, "rebuild")
         r, Lx, Ly, skin = self.host_consts
-        search = numba_step.search if be.compiled else None      # (the same pairs: compiled below the cell list's N)
+        search = numba_step.search if be.compiled else None      # (the same pairs, the same grid, compiled)
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
             s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], Ly[b] * gamma[b], skin[b],
