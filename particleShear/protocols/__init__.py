@@ -32,6 +32,9 @@ by name) and ``SIGNATURE`` (True: the parameters are keywords of ``doParticleShe
 signature — the shipped protocols', as in 2.0.0; another protocol's parameters are taken by its
 ``**law_parameters``).
 
+Every protocol is measured by the one driver, :func:`particleShear.simulation.driver.measure_sessions`,
+whose part for it is that of its :attr:`Protocol.loop`.
+
 Shipped: ``oscillatory`` (the default, the reference's experiment), ``steady``, ``relaxation``, ``creep``, ``amplitude_sweep``,
 ``frequency_sweep``.
 """

@@ -258,23 +258,69 @@ class Oscillation:
 
     @staticmethod
     def dt(key):
-        """The protocol time step (s) of a schedule key."""
+        """The protocol time step of a group.
+
+        Parameters
+        ----------
+        key : tuple
+            The group's schedule key (:meth:`plan`).
+
+        Returns
+        -------
+        float
+            dt (s).
+        """
         return key[0]
 
     @staticmethod
     def cool(key):
-        """The damping factor per step of a schedule key."""
+        """The damping factor per step of a group.
+
+        Parameters
+        ----------
+        key : tuple
+            The group's schedule key (:meth:`plan`).
+
+        Returns
+        -------
+        float
+        """
         return key[2]
 
     def observers(self, engine, members):
-        """Each member's observers, shown its replica in ``engine``."""
+        """Each member's observers (its drawing), shown its replica in ``engine``.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The engine the members are replicas of, in the order of ``members``.
+        members : list of int
+            The sessions of the engine's replicas.
+
+        Returns
+        -------
+        list
+            The observers of every member.
+        """
         for col, b in enumerate(members):
             self.scenes[b].bind(engine, col)
         return [ob for b in members for ob in self.watch[b]]
 
     def measure(self, engine, order, key, where):
-        """The oscillatory protocol of the replicas of ``engine`` (sessions ``order``); each
-        replica's record (:func:`replica_record`) and its share of the wall time."""
+        """The oscillatory protocol of the replicas of ``engine``; each replica's record
+        (:func:`replica_record`) and its share of the wall time are kept for :meth:`conclude`.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The pre-equilibrated engine of the group.
+        order : list of int
+            The session of each replica of ``engine``.
+        key : tuple
+            The group's schedule key ``(dt, f, cool, pre_periods, periods, post_periods)``.
+        where : list
+            ``[phase, step, total]``, followed for an interrupt's position.
+        """
         sessions = self.sessions
         dt, f, cool, pre_p, periods, post = key
         t0 = time.perf_counter()
@@ -365,20 +411,67 @@ class Recording:
         return [(None, (s.dt_max, s.N_pre)) for s in self.schedules]
 
     def dt(self, key):
-        """The protocol time step (s): the batch's."""
+        """The protocol time step: the batch's (its first replica's).
+
+        Parameters
+        ----------
+        key : None
+            The one group's key (:meth:`plan`).
+
+        Returns
+        -------
+        float
+            dt (s).
+        """
         return self.sc.dt
 
     def cool(self, key):
-        """The damping factor per step: the batch's."""
+        """The damping factor per step: the batch's (its first replica's).
+
+        Parameters
+        ----------
+        key : None
+            The one group's key (:meth:`plan`).
+
+        Returns
+        -------
+        float
+        """
         return self.sc.cool
 
     @staticmethod
     def observers(engine, members):
-        """None: the drawing observes the oscillatory protocol only."""
+        """No observer: the drawing observes the oscillatory protocol only.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The engine of the members.
+        members : list of int
+            The sessions of its replicas.
+
+        Returns
+        -------
+        list
+            Empty.
+        """
         return []
 
     def measure(self, engine, order, key, where):
-        """The protocol's loop on ``engine`` (sessions ``order``); the protocol time per replica."""
+        """The protocol's loop (:meth:`run`) on ``engine``; its record and each replica's share of
+        its wall time are kept for :meth:`conclude`.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The pre-equilibrated engine of the batch.
+        order : list of int
+            The session of each replica of ``engine``.
+        key : None
+            The one group's key (:meth:`plan`).
+        where : list
+            ``[phase, step, total]``, followed for an interrupt's position.
+        """
         self.order = order
         say, report = _console([run.sim for run in self.sessions], order, "protocol", where)
         t0 = time.perf_counter()
@@ -386,7 +479,24 @@ class Recording:
         self.t_protocol = (time.perf_counter() - t0) / len(order)
 
     def run(self, engine, kws, steps, say, report):
-        """The recording loop driven by the protocol's ``schedule``; the batch's record."""
+        """The recording loop driven by the protocol's ``schedule`` (a rate schedule or a controller).
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The pre-equilibrated engine.
+        kws : list of RunParameters
+            The arguments of its replicas, in replica order.
+        steps : list of dict
+            Their step counts (:func:`protocol_steps`), in replica order.
+        say, report : callable
+            The phase's messages and progress (:func:`_console`).
+
+        Returns
+        -------
+        dict of ndarray
+            The batch's record (:func:`~particleShear.engine.rheometer.shear_record`).
+        """
         sc = self.sc
         drive = self.spec.schedule(kws, steps, self.tau, sc.dt, engine.backend)
         return _guarded(lambda e: shear_record(e, sc.dt, sc.cool, drive["n_steps"], drive["rate_of"],
@@ -394,7 +504,22 @@ class Recording:
                                                after_step=drive.get("after_step")), engine, dt=sc.dt)
 
     def replica(self, col, b, conclusion):
-        """``(series, summary, curves, steps)`` of the replica in column ``col`` (session ``b``)."""
+        """One replica's record cut at its own length, and its analysis.
+
+        Parameters
+        ----------
+        col : int
+            The replica's column in the batch's record.
+        b : int
+            Its session.
+        conclusion : Conclusion
+            The analysis (:attr:`Conclusion.analyse_record`).
+
+        Returns
+        -------
+        tuple
+            ``(series, summary, curves, steps)``: the fields of its result.
+        """
         n = self.steps[b]["steps"]
         series = {key: np.ascontiguousarray(v[:n, col]) for key, v in self.out.items()}
         summary, curves = conclusion.analyse_record(self.spec.name, self.kws[b], series, self.tau, self.steps[b])
@@ -441,7 +566,24 @@ class Segments(Recording):
     """
 
     def run(self, engine, kws, steps, say, report):
-        """Every step of the sweep on ``engine``; ``[(f, amplitudes, dt, record), ...]``."""
+        """Every step of the sweep on ``engine``, one after the other.
+
+        Parameters
+        ----------
+        engine : BatchEngine
+            The pre-equilibrated engine.
+        kws : list of RunParameters
+            The arguments of its replicas, in replica order.
+        steps : list of dict
+            Their step counts (:func:`protocol_steps`), in replica order.
+        say, report : callable
+            The phase's messages and progress (:func:`_console`).
+
+        Returns
+        -------
+        list of tuple
+            ``(f, amplitudes, dt, record)`` of each step (:func:`~particleShear.engine.step.protocol`).
+        """
         out = []
         for f, A, dt in self.spec.segments(kws, steps, self.tau, self.sc.f):
             cool = kws[0]["cool_factor"] ** (f * dt)
@@ -451,7 +593,22 @@ class Segments(Recording):
         return out
 
     def replica(self, col, b, conclusion):
-        """``(series, summary, curves, steps)`` of the replica in column ``col`` (session ``b``)."""
+        """One replica's steps, analysed, and its record of them one after the other.
+
+        Parameters
+        ----------
+        col : int
+            The replica's column in each step's record.
+        b : int
+            Its session.
+        conclusion : Conclusion
+            The analysis (:attr:`Conclusion.analyse_sweep`).
+
+        Returns
+        -------
+        tuple
+            ``(series, summary, curves, steps)``: the fields of its result (no summary, no curves).
+        """
         segments = [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in rec.items()
                                      if not key.endswith("tensors")}) for f, A, dt, rec in self.out]
         sweep = conclusion.analyse_sweep(self.kws[b], segments, self.tau)
