@@ -55,7 +55,7 @@ def _deprecated(name):
                       DeprecationWarning, stacklevel=2)
         return measure(runs)
     alias.__name__ = alias.__qualname__ = name
-    alias.__doc__ = f"""Deprecated: :func:`measure` (every protocol's runs, "oscillatory" included).
+    alias.__doc__ = """Deprecated: :func:`measure` (every protocol's runs, "oscillatory" included).
 
     Parameters
     ----------
