@@ -122,6 +122,7 @@ DOCUMENTED_MODULES = [
     "particleShear.run.rheometer",
     "particleShear.run.rheometer_analysis",
     "particleShear.run.rheometer_files",
+    "particleShear.simulation.driver",
 ]
 
 #: Modules of DOCUMENTED_MODULES still being completed on another branch: their docstring

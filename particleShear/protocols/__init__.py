@@ -32,8 +32,10 @@ by name) and ``SIGNATURE`` (True: the parameters are keywords of ``doParticleShe
 signature — the shipped protocols', as in 2.0.0; another protocol's parameters are taken by its
 ``**law_parameters``).
 
-Shipped: ``oscillatory`` (the default, the reference's experiment, measured by
-:mod:`particleShear.run.batch`), ``steady``, ``relaxation``, ``creep``, ``amplitude_sweep``,
+Every protocol is measured by the one driver, :func:`particleShear.simulation.driver.measure_sessions`,
+whose part for it is that of its :attr:`Protocol.loop`.
+
+Shipped: ``oscillatory`` (the default, the reference's experiment), ``steady``, ``relaxation``, ``creep``, ``amplitude_sweep``,
 ``frequency_sweep``.
 """
 __docformat__ = "numpy"
@@ -47,7 +49,7 @@ import numpy as np
 
 from ..parameter_entry import Parameter
 
-__all__ = ["Protocol", "PROTOCOLS", "MODULES", "MAX_STRAIN_PER_STEP", "MIN_STEPS_PER_PERIOD",
+__all__ = ["Protocol", "PROTOCOLS", "LOOPS", "MODULES", "MAX_STRAIN_PER_STEP", "MIN_STEPS_PER_PERIOD",
            "MIN_STEPS_PER_PERIOD_COARSENED", "register_protocol", "get_protocol",
            "declared_parameters", "result_columns", "positive", "monotonic_values"]
 
@@ -180,6 +182,18 @@ class Protocol:
         """True for a sequence of oscillations on one packing (a sweep)."""
         return self.segments is not None
 
+    @property
+    def loop(self):
+        """The part of the measurement driver that runs it (:data:`LOOPS`): ``"record"`` (the one
+        recording loop, driven by :attr:`schedule`), ``"segments"`` (oscillations on one packing,
+        :attr:`segments`) or ``"oscillation"`` (neither: the reference's experiment, its observers,
+        snapshots and file)."""
+        return "record" if self.recorded else "segments" if self.segmented else "oscillation"
+
+
+#: the parts of the measurement driver a protocol is run by (:attr:`Protocol.loop`;
+#: :func:`particleShear.simulation.driver.measure_sessions` keeps one for each)
+LOOPS = ("oscillation", "record", "segments")
 
 #: the registered protocols, name → :class:`Protocol`
 PROTOCOLS = {}

@@ -3,7 +3,8 @@
 Its parameters are the model's (``theAmplitude``, ``relative_frequency``, ``pre_periods``,
 ``periods``, ``post_periods``: roles of the table, not ``protocol:``), its loop is
 :func:`particleShear.engine.step.protocol`, and its run, summary (G′, G″, measures) and columns
-are those of :mod:`particleShear.run.batch` and :class:`particleShear.run.api.SimulationResult`.
+are those of the driver's oscillation (:class:`particleShear.simulation.driver.Oscillation`) and of
+:class:`particleShear.run.result.SimulationResult`.
 """
 __docformat__ = "numpy"
 

@@ -17,11 +17,11 @@ from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA, PARAMETERS
 from ..simulation.provenance import run_identity
 from .validation import check_seed, validate_run, validate_series, validated_run
-from .sessions import _build_simulation, _seed_sequence, check_batch_size, measure_batch  # noqa: F401 - re-exported
+from .sessions import _build_simulation, _seed_sequence, check_batch_size  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
 from ..simulation.drawing import _backend_choice, display_available
-from .measurement import measure
+from .measurement import measure, measure_batch  # noqa: F401 - measure_batch re-exported (deprecated)
 
 __docformat__ = "numpy"
 __all__ = ["doParticleShearSimulation", "doParticleShearSimulationSeries", "SimulationResult", "series_jobs"]

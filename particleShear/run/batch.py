@@ -28,9 +28,9 @@ from ..parameters import names as _names
 from ..simulation.driver import ENGINE_SKIN_FACTOR, _guarded, measure_sessions, pre_equilibrated, replica_record
 from .guard import PARAMETER_ALIASES, checked_keywords, resolve_names
 from .sessions import (BACKENDS, _REFERENCE_ARGUMENTS, _signature_defaults, build_sessions,  # noqa: F401 - re-exported
-                       check_backend, check_batch_size, check_run_backend, measure_batch)
+                       check_backend, check_batch_size, check_run_backend)
 from .api import doParticleShearSimulation
-from .measurement import measure
+from .measurement import measure, measure_batch  # noqa: F401 - measure_batch re-exported (deprecated)
 from .rheometer import normalize_protocol, protocol_steps
 from .validation import validated_run
 

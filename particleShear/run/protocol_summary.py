@@ -13,9 +13,9 @@ import math
 from .._version import __version__
 from ..analysis.measures import MEASURE_COLUMNS, empty_measures
 from ..analysis.verdicts import CHECKS, PROTOCOL_CHECKS, verdict as combined_verdict, verdict_lines
-from ..linkable.builders import time_steps_from_model
 from ..parameters import BY_NAME, spec_defaults
 from ..protocols import PROTOCOLS as REGISTRY, result_columns
+from ..simulation.driver import dt_over_tau  # noqa: F401 - re-exported (moved to the driver)
 from ..simulation.provenance import run_identity
 from .moduli_summary import seed_text
 
@@ -35,25 +35,6 @@ PROTOCOL_COLUMNS = tuple(_COLUMN_UNITS)
 #: the moduli and measures, are columns of the same name)
 STEP_COLUMNS = {"position": "sweep_position", "amplitude": "sweep_amplitude",
                 "relative_frequency": "sweep_relative_frequency", "f": "frequency_Hz", "dt": "dt", "N_steps": "N_steps"}
-
-
-def dt_over_tau(p, amplitude=None):
-    """The protocol time step in units of τ (the time-step rule is linear in τ).
-
-    Parameters
-    ----------
-    p : dict
-        The run's arguments (defaults filled in).
-    amplitude : float, optional
-        The strain amplitude the rule is evaluated at (default ``p["theAmplitude"]``).
-
-    Returns
-    -------
-    float
-    """
-    A = p["theAmplitude"] if amplitude is None else amplitude
-    return time_steps_from_model(1.0, p["bimodal_factor"], p["theMu"], p["relative_transversal_link_strength"], A,
-                                 p["relative_viscosity"])[0] * p["time_step_factor"]
 
 
 def unit(name):

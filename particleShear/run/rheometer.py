@@ -1,9 +1,12 @@
 """The rheometer's protocols of a run: ``protocol=`` of :func:`~particleShear.run.api.doParticleShearSimulation`.
 
-``"oscillatory"`` (the default) is the reference's experiment (:mod:`particleShear.run.batch`).
-The others constitute and pre-equilibrate exactly as it does (the same functions, so one seed
-gives the same packing), then drive the engine with another rate schedule
-(:mod:`particleShear.engine.rheometer`, docs/protocols.md):
+``"oscillatory"`` (the default) is the reference's experiment.  Every protocol is measured by the
+one driver (:func:`particleShear.simulation.driver.measure_sessions`, through
+:func:`particleShear.run.measurement.measure`): the others constitute and pre-equilibrate exactly
+as it does (the same functions, so one seed gives the same packing), then drive the engine with
+another rate schedule (:mod:`particleShear.engine.rheometer`, docs/protocols.md).  This module
+checks and normalizes their parameters and counts their steps (:func:`protocol_steps`, the
+driver's):
 
 ``"steady"``
     γ̇ = ``relative_rate``/τ until the strain ``total_strain``; the steady shear stress (mean and
@@ -27,23 +30,16 @@ gives the same packing), then drive the engine with another rate schedule
 """
 __docformat__ = "numpy"
 import difflib
-import time
-
-import numpy as np
 
 from ..checks import show_value
-from ..engine.rheometer import shear_record
-from ..engine.step import protocol as oscillation
 from ..parameters import PARAMETERS
 from ..protocols import MAX_STRAIN_PER_STEP, PROTOCOLS as REGISTRY
-from ..protocols.creep import CREEP_MODULUS_FRACTION
-from ..protocols.steady import N1_EVERY
-from ..simulation.driver import _console, _constitute, _guarded, pre_equilibrated
-from .protocol_summary import PROTOCOL_COLUMNS, STEP_COLUMNS, dt_over_tau  # noqa: F401 - PROTOCOL_COLUMNS, STEP_COLUMNS re-exported
+from ..protocols.creep import CREEP_MODULUS_FRACTION  # noqa: F401 - re-exported
+from ..protocols.steady import N1_EVERY  # noqa: F401 - re-exported
+from ..simulation.driver import protocol_steps
+from .protocol_summary import PROTOCOL_COLUMNS, STEP_COLUMNS  # noqa: F401 - PROTOCOL_COLUMNS, STEP_COLUMNS re-exported
 from .result import SimulationResult
-from .sessions import build_sessions
-from .rheometer_analysis import analyse_record, analyse_sweep
-from .rheometer_files import write_protocol_file
+from .measurement import measure_rheometer  # noqa: F401 - re-exported (deprecated)
 from .limits import MAX_TOTAL_STEPS, _protocol_room
 
 __all__ = ["PROTOCOLS", "PROTOCOL_DEFAULTS", "PROTOCOL_COLUMNS", "LIST_PARAMETERS", "STEP_COLUMNS", "MAX_STRAIN_PER_STEP", "RheometerResult", "check_protocol",
@@ -169,24 +165,6 @@ def normalize_protocol(p):
     return q
 
 
-def protocol_steps(q):
-    """Step counts of a (normalized, checked) protocol.
-
-    Parameters
-    ----------
-    q : dict
-        The arguments of the run (:func:`normalize_protocol`).
-
-    Returns
-    -------
-    dict
-        ``dt_over_tau``; ``steps`` (steady, relaxation, creep: all steps), ``ramp`` (relaxation);
-        ``segments`` (sweeps: the oscillatory steps of each step of the sweep) and ``dts`` (sweeps:
-        each step's dt/τ).
-    """
-    return REGISTRY[q.get("protocol", "oscillatory")].steps(q, lambda amplitude=None: dt_over_tau(q, amplitude))
-
-
 class RheometerResult(SimulationResult):
     """Deprecated: every protocol's run returns a :class:`~particleShear.run.result.SimulationResult`.
 
@@ -203,92 +181,3 @@ class RheometerResult(SimulationResult):
         warnings.warn("RheometerResult is deprecated: every protocol's run returns a SimulationResult "
                       "(SimulationResult.of_protocol takes these arguments)", DeprecationWarning, stacklevel=2)
         return SimulationResult.of_protocol(*args, **kwargs)
-
-
-def _concatenated(records):
-    """The records of a sweep's steps one after the other, with ``sweep_position`` (each step keeps
-    its own clock ``t``)."""
-    keys = ("t", "strain", "strain_rate", "stress_surface", "stress_internal")
-    out = {key: np.concatenate([rec[key] for rec in records]) for key in keys}
-    out["sweep_position"] = np.concatenate([np.full(len(rec["t"]), j, dtype=np.int64) for j, rec in enumerate(records)])
-    return out
-
-
-def measure_rheometer(runs):
-    """Constitute, pre-equilibrate and measure runs of one protocol other than "oscillatory".
-
-    The constitution and pre-equilibration are those of the oscillatory runs
-    (:func:`~particleShear.run.batch.build_sessions`, ``_constitute``,
-    :func:`~particleShear.simulation.driver.pre_equilibrated`); every replica then runs its rate
-    schedule in one engine.  Replicas may differ in rate, strain, stress, γ₀ and amplitude list;
-    the batch runs the longest and cuts each record at the replica's own length.
-
-    Parameters
-    ----------
-    runs : list of RunParameters
-        The checked arguments of the runs (:func:`~particleShear.run.validation.validated_run`:
-        complete, normalized), sharing a protocol and a schedule.
-
-    Returns
-    -------
-    list of SimulationResult
-    """
-    proto = runs[0]["protocol"]
-    spec = REGISTRY[proto]
-    sims, seeds, sessions = build_sessions(runs)
-    where = ["constitution", 0, 0]
-    _constitute(sessions)
-    scheds, steps = [], []
-    for run, kw in zip(sessions, runs):
-        scheds.append(run.sim.measurement_schedule(kw["cool_factor"]))
-        steps.append(protocol_steps(kw))
-    sc = scheds[0]
-    timings = [dict(constitution=run.sim.timings.get("constitution", 0.0)) for run in sessions]
-    members = list(range(len(sessions)))
-    engine, order = pre_equilibrated(sessions, members, [(s.dt_max, s.N_pre) for s in scheds], sc.dt, sc.cool,
-                                     where, lambda e, m: [], timings)
-    kws = [runs[b] for b in order]
-    tau = sc.dt / steps[0]["dt_over_tau"]
-    say, report = _console(sims, order, "protocol", where)
-    t0 = time.perf_counter()
-    recs, sweep_recs = None, None
-    if spec.recorded:
-        # the one recording loop, driven by the protocol's rate schedule or controller
-        drive = spec.schedule(kws, [steps[b] for b in order], tau, sc.dt, engine.backend)
-        recs = _guarded(lambda e: shear_record(e, sc.dt, sc.cool, drive["n_steps"], drive["rate_of"],
-                                               drive.get("tensors_every", 0), say, report,
-                                               after_step=drive.get("after_step")), engine, dt=sc.dt)
-    else:
-        sweep_recs = []
-        for f, A, dt in spec.segments(kws, [steps[b] for b in order], tau, sc.f):
-            cool = kws[0]["cool_factor"] ** (f * dt)
-            out = _guarded(oscillation, engine, dt, f, A, cool, kws[0]["pre_periods"], kws[0]["periods"],
-                           kws[0]["post_periods"], False, say, report, (), dt=dt)
-            sweep_recs.append((f, A, dt, out))
-    t_protocol = (time.perf_counter() - t0) / len(order)
-    results = [None] * len(sessions)
-    for col, b in enumerate(order):
-        kw = runs[b]
-        t1 = time.perf_counter()
-        if sweep_recs is None:
-            n = steps[b]["steps"]
-            series = {key: np.ascontiguousarray(v[:n, col]) for key, v in recs.items()}
-            summary, curves = analyse_record(proto, kw, series, tau, steps[b])
-            sweep = []
-        else:
-            segments = [(f, A[col], dt, {key: np.ascontiguousarray(v[:, col]) for key, v in out.items()
-                                         if not key.endswith("tensors")}) for f, A, dt, out in sweep_recs]
-            sweep = analyse_sweep(kw, segments, tau)
-            series, curves, summary = _concatenated([rec for *_, rec in segments]), {}, {}
-        seed_entropy, spawn_key, _ = seeds[b]
-        tm = dict(timings[b], protocol=t_protocol, analysis=time.perf_counter() - t1)
-        results[b] = SimulationResult.of_protocol(proto, sessions[b].sim.parameters_record(), seed_entropy,
-                                                  spawn_key, kw.run_id, tau, sc.dt, series,
-                                                  summary, curves, sweep, tm)
-        if kw["saveData"]:
-            t2 = time.perf_counter()
-            write_protocol_file(sessions[b].sim, results[b])
-            tm["output"] = time.perf_counter() - t2
-    for run in sessions:
-        run.close()
-    return results

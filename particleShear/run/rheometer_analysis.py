@@ -1,6 +1,7 @@
 """The summary of one replica's record of a rheometer protocol (docs/protocols.md, "Outputs").
 
-Used by :func:`particleShear.run.rheometer.measure_rheometer`; the statistics are those of
+Given to the one driver (:data:`particleShear.run.measurement.CONCLUSION`, for
+:func:`particleShear.simulation.driver.measure_sessions`); the statistics are those of
 :mod:`particleShear.analysis.rheometry`, the sweeps' moduli the oscillatory run's demodulation
 (:func:`particleShear.simulation.evaluation.demodulation`) and measures
 (:func:`particleShear.analysis.measures.run_measures`).

@@ -1,9 +1,10 @@
-"""The sessions of a batch's runs: each run's simulation object and seed, its contact law, and the
-measurement of all of them in one engine (:func:`measure_batch`).
+"""The sessions of a batch's runs: each run's simulation object and seed, its contact law
+(:func:`build_sessions`), which :func:`particleShear.run.measurement.measure` hands to the one
+measurement driver.
 
-Below :mod:`particleShear.run.api`, :mod:`particleShear.run.batch` and the rheometer's protocols
-(:mod:`particleShear.run.rheometer`), which all measure through it; the names keep their old homes
-as re-exports (``run.batch.measure_batch``, ``run.api._build_simulation``, ``run.validation.contact_law_spec``).
+Below :mod:`particleShear.run.api`, :mod:`particleShear.run.batch` and
+:mod:`particleShear.run.measurement`; the names keep their old homes as re-exports
+(``run.api._build_simulation``, ``run.validation.contact_law_spec``).
 """
 __docformat__ = "numpy"
 import numbers
@@ -15,13 +16,10 @@ from ..engine import contact_laws
 from ..engine.xp import get_backend
 from ..parameters import PARAMETERS
 from ..parameters import defaults as _defaults
-from ..simulation.driver import measure_sessions
 from ..simulation.fragmentation import Simulation_interlocking_rheology
 from ..simulation.oscillatory import RunSession
-from .result import SimulationResult
 
-__all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "check_run_backend", "contact_law_spec",
-           "measure_batch"]
+__all__ = ["BACKENDS", "build_sessions", "check_backend", "check_batch_size", "check_run_backend", "contact_law_spec"]
 
 #: array backends a batch can run on ("auto" first, the default; "cupy" needs CuPy and a CUDA device; see particleShear.engine.xp)
 BACKENDS = ("auto", "numpy", "numba", "cupy")
@@ -200,48 +198,6 @@ def contact_law_spec(p):
     if law.name == "linear":
         return None
     return law.name, contact_laws.law_values(law, given(law))
-
-
-def measure_batch(runs):
-    """Constitute every replica with the documented builder, then measure all of them in one engine.
-
-    ``runs``: the checked arguments of the runs (:class:`~particleShear.run.validation.RunParameters`),
-    sharing one schedule.  Each replica runs through
-    the phases of ``runSimulation`` (:class:`~particleShear.simulation.oscillatory.RunSession`:
-    validation, constitution, reservation of its output file, experiment set-up, schedule) except
-    the measurement, which the engine does for all replicas at once; each experiment then adopts
-    its replica's record and the session writes the output file as ``runSimulation`` does.
-    Returns the :class:`~particleShear.run.api.SimulationResult` of each run, in order.  An
-    interrupt (``KeyboardInterrupt``) removes every reservation and is re-raised with
-    ``position = (phase, step, total)``.
-
-    Parameters
-    ----------
-    runs : list of RunParameters
-        The checked arguments of the replicas (one schedule).
-
-    Returns
-    -------
-    list of SimulationResult
-    """
-    sims, seeds, sessions = build_sessions(runs)
-    measure_sessions(sessions)
-    results = []
-    for sim, run, (seed_entropy, spawn_key, _) in zip(sims, sessions, seeds):
-        info = sim.result_info
-        # a replica's wall time is its share of the batch: its own phases and its part of the shared ones
-        info["timings"]["total"] = sum(info["timings"].get(k, 0.0) for k in
-                                       ("constitution", "pre_equilibration", "protocol", "demodulation", "output"))
-        results.append(SimulationResult(
-            G_surface=info["G_surface"], G_internal=info["G_internal"], stress_surface=info["stress_surface"],
-            stress_internal=info["stress_internal"], parameters=sim.parameters_record(), seed=seed_entropy,
-            spawn_key=spawn_key, timings=info["timings"], output_path=info["output_path"],
-            image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
-            N_steps=info["N_steps"], damping_factor=info["damping_factor"],
-            removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
-            series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
-            microstructure=getattr(run, "microstructure", None)))
-    return results
 
 
 def build_sessions(runs):

@@ -592,7 +592,7 @@ class OscillatoryShearExperiment:
     def adopt_measurement(self, cool_factor, record, timings=None):
         """Take the measurement of this experiment from the engine's record instead of running it.
 
-        The engine (:mod:`particleShear.engine`, used by :func:`particleShear.run.batch.measure_batch`)
+        The engine (:mod:`particleShear.engine`, used by :func:`particleShear.simulation.driver.measure_sessions`)
         pre-equilibrates and shears the same ensemble with the same schedule; this fills the
         recording (:attr:`plotter`: series, tensor history when kept, first and last tensors),
         demodulates the recorded series exactly as :meth:`oscillatory_shear_experiment` does and
@@ -619,7 +619,7 @@ class OscillatoryShearExperiment:
         self._record(record)
         self.timings.update(timings or {})
         t0 = time.perf_counter()
-        # the contiguous series of the record, demodulated as measure_batch always did
+        # the contiguous series of the record, demodulated as the batch driver always did
         G_int = self.demodulation(record["t"], record["stress_internal"])
         G_surf = self.demodulation(record["t"], record["stress_surface"])
         return self._conclude(G_int, G_surf, t0)

@@ -86,7 +86,7 @@ damping factor per step, pre-equilibration step unit and coarsest pre-equilibrat
 class RunSession:
     """One run of :meth:`OscillatorySimulation.runSimulation`, in its phases.
 
-    :func:`particleShear.run.batch.measure_sessions` drives the phases of one session
+    :func:`particleShear.simulation.driver.measure_sessions` drives the phases of one session
     (``runSimulation``) or of a batch's (``run_batch``, ``doParticleShearSimulation``): the engine
     measures and each experiment adopts its record, so every run builds, reserves, writes and
     cleans up in one way (docs/output.md, docs/engine.md "Runs").
@@ -497,7 +497,7 @@ class OscillatorySimulation:
 
         Measured as ``doParticleShearSimulation`` measures: the constitution's relaxations, the
         pre-equilibration and the protocol run in the engine, a batch of one
-        (:func:`particleShear.run.batch.measure_sessions`); the drawing, snapshots and the live
+        (:func:`particleShear.simulation.driver.measure_sessions`); the drawing, snapshots and the live
         stress window observe its loops.  Spheres with parameters of their own (c, permanent
         ratios, kept viscosities set through the sphere handles) are measured by the engine too:
         each visit of a relation sees its own sphere's values, as in 1.0.2.
