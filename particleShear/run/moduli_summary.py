@@ -81,24 +81,6 @@ def values(result):
     return [result.G_surface[0], result.G_surface[1]]
 
 
-def row_run_id(result, params):
-    """The ``run_id`` of a result's rows: the id its run was measured under (``result.run_id``, computed once
-    by the run's check), or, for a result made without one, :func:`~particleShear.simulation.provenance.run_identity`
-    of ``params`` (its table parameters) and its seed.
-
-    Parameters
-    ----------
-    result : SimulationResult
-    params : dict
-        The result's parameters as its rows record them.
-
-    Returns
-    -------
-    str
-    """
-    return result.run_id or run_identity(params, result.seed, result.spawn_key)
-
-
 def to_dict(result):
     """The run's row of a results table (:meth:`SimulationResult.to_dict
     <particleShear.run.result.SimulationResult.to_dict>`).
@@ -113,7 +95,7 @@ def to_dict(result):
     """
     params = spec_defaults()
     params.update({k: v for k, v in result.parameters.items() if k in params})
-    row = {"run_id": row_run_id(result, params), "status": "ok", "error": "",
+    row = {"run_id": run_identity(params, result.seed, result.spawn_key), "status": "ok", "error": "",
            "Gp_surface": float(result.G_surface[0]), "Gpp_surface": float(result.G_surface[1]),
            "Gp_internal": float(result.G_internal[0]), "Gpp_internal": float(result.G_internal[1])}
     row.update(result.measures)

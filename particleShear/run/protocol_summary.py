@@ -16,7 +16,8 @@ from ..analysis.verdicts import CHECKS, PROTOCOL_CHECKS, verdict as combined_ver
 from ..parameters import BY_NAME, spec_defaults
 from ..protocols import PROTOCOLS as REGISTRY, result_columns
 from ..simulation.driver import dt_over_tau  # noqa: F401 - re-exported (moved to the driver)
-from .moduli_summary import row_run_id, seed_text
+from ..simulation.provenance import run_identity
+from .moduli_summary import seed_text
 
 __all__ = ["PLOT_ENTRY", "PROTOCOL_COLUMNS", "STEP_COLUMNS", "dt_over_tau", "unit", "measures", "verdict", "values", "to_dict",
            "rows", "from_rows", "text_fields", "text_lines", "html_rows", "verdict_text"]
@@ -125,7 +126,7 @@ def rows(result):
     """
     params = spec_defaults(protocols=True)
     params.update({k: v for k, v in result.parameters.items() if k in params})
-    base = {"run_id": row_run_id(result, params), "status": "ok", "error": "",
+    base = {"run_id": run_identity(params, result.seed, result.spawn_key), "status": "ok", "error": "",
             "repetition": int(result.repetition), "dt": float(result.dt)}
     base.update({k: v for k, v in result.summary.items() if k in PROTOCOL_COLUMNS or k == "verdict"})
     if REGISTRY[result.protocol].recorded:
