@@ -6,10 +6,14 @@ A run's arguments are checked, completed, normalized, seeded and identified once
 and a parameter's value (here μ, ``theMu``) reaches the engine's per-replica constants
 (``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given.
 """
+import concurrent.futures
 import contextlib
+import os
 import pickle
 import sys
+import tempfile
 import unittest
+import warnings
 from unittest import mock
 
 import numpy as np
@@ -19,8 +23,10 @@ import particleShear.run.validation as validation
 import particleShear.simulation.driver as driver
 from particleShear.run.api import doParticleShearSimulation
 from particleShear.run.batch import run_batch
-from particleShear.run.validation import RunParameters, validated_run
+import particleShear.run.batch as batch
+from particleShear.run.validation import CheckedPoint, RunParameters, checked_point, validated_run
 from particleShear.simulation import provenance
+from particleShear.sweep import Sweep
 
 #: a short run (amplitude 0.2: no μ = 0 relaxation block in the constitution)
 SMALL = dict(N=20, cut_lines=0, relative_frequency=0.2, pre_periods=0.2, periods=1, post_periods=0, seed=1,
@@ -74,6 +80,78 @@ class TestOncePerRun(unittest.TestCase):
         self.assertEqual(len(checks), 2)
         self.assertEqual(len(ids), 2)
         self.assertEqual([r.parameters["theMu"] for r in results], [MU, 0.5])
+
+
+#: a sweep of two points, one run each (a tiny run: N = 30, 112 steps a period), writing its files
+SWEEP = {"parameters": dict(N=30, relative_frequency=0.5, pre_periods=0.5, periods=1, post_periods=0.5,
+                            doDrawing=False, plotStress=False, saveData=True, backend="numpy"),
+         "grid": {"theAmplitude": [0.2, 0.1]}, "seeds": {"root": 7, "repetitions": 1}}
+
+
+class TestOncePerSweepRun(unittest.TestCase):
+    """A sweep checks each point once and its worker does not check a run again (issue 45)."""
+
+    def _sweep(self, batch_size):
+        """Run :data:`SWEEP` in this process; the checks, run ids and schedule keys it computed, its rows."""
+        with tempfile.TemporaryDirectory() as d, warnings.catch_warnings(), \
+                counted(validation._checked, validation) as checks, \
+                counted(provenance.run_identity, *identity_modules()) as ids, \
+                counted(batch.schedule_key, batch) as keys, \
+                concurrent.futures.ThreadPoolExecutor(1) as ex:
+            warnings.simplefilter("ignore")      # periods=1: no standard error (MeasurementWarning)
+            sweep = Sweep(SWEEP, d)
+            n_checks, n_ids = len(checks), len(ids)
+            rows = sweep.run(executor=ex, progress=False, batch_size=batch_size)
+            return (n_checks, n_ids), (len(checks) - n_checks, len(ids) - n_ids, len(keys)), rows
+
+    def test_a_sweep_run_is_validated_once_and_identified_for_its_task(self):
+        (made_checks, _), (run_checks, run_ids, keys), rows = self._sweep(None)
+        self.assertEqual([r["status"] for r in rows], ["ok", "ok"])
+        self.assertEqual(made_checks, 2)       # the SPEC's check: one per point
+        self.assertEqual(run_checks, 0)        # the worker does not validate again (was 1 per run)
+        # per run: its task's SweepRun, its results row, the table sorted at the end, the rows read back
+        # (was 6: the worker's validation and the recording of its outcome identified it again)
+        self.assertEqual(run_ids, 4 * 2)
+        self.assertEqual(keys, 0)
+
+    def test_a_batched_sweep_groups_once(self):
+        (made_checks, _), (run_checks, _, keys), rows = self._sweep(4)
+        self.assertEqual([r["status"] for r in rows], ["ok", "ok"])
+        self.assertEqual((made_checks, run_checks), (2, 0))
+        self.assertEqual(keys, 2)              # batches(): one schedule key per run (was 2: run_batch again)
+
+    def test_a_run_of_a_checked_point_is_its_validated_run(self):
+        """CheckedPoint.run gives what validated_run gives for the same arguments, and pickles."""
+        ss = np.random.SeedSequence(7, spawn_key=(3,))
+        for extra in ({}, dict(protocol="amplitude_sweep", sweep_amplitudes=[0.05, 0.1])):
+            with tempfile.TemporaryDirectory() as d, warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                params = dict(SWEEP["parameters"], theAmplitude=0.2, **extra)
+                point = checked_point(dict(params, root_folder=os.curdir))
+                self.assertIsInstance(point, CheckedPoint)
+                point = pickle.loads(pickle.dumps(point))
+                run = point.run(d, ss, return_result=True, verbose=False)
+                want = validated_run(dict(params, root_folder=d, seed=ss, return_result=True, verbose=False))
+                self.assertIsInstance(run, RunParameters)
+                self.assertEqual(dict(run), dict(want))
+                self.assertEqual((run.run_id, run.seed_entropy, run.spawn_key),
+                                 (want.run_id, want.seed_entropy, want.spawn_key))
+                self.assertEqual(run.cost, want.cost)
+                with self.assertRaises(ValueError):     # the values a run sets are checked all the same
+                    point.run(os.path.join(d, "missing"), ss, return_result=True, verbose=False)
+                with self.assertRaises(TypeError):
+                    point.run(d, ss, return_result=1, verbose=False)
+                with self.assertRaises(TypeError):
+                    point["theMu"] = 0.5
+
+    def test_the_sweep_id_is_the_id_of_the_checked_run(self):
+        """The id a sweep computes for a run (and gives its worker) is the one validated_run computes."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sweep = Sweep(SWEEP, os.path.join(tempfile.gettempdir(), "never-made"))
+            for run in sweep.runs:
+                ss = np.random.SeedSequence(run.seed_entropy, spawn_key=run.spawn_key)
+                self.assertEqual(validated_run(dict(run.parameters, seed=ss, root_folder=os.curdir)).run_id, run.run_id)
 
 
 class TestRunParameters(unittest.TestCase):

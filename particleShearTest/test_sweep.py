@@ -257,16 +257,16 @@ class TestSweep(unittest.TestCase):
 
     def test_failed_run_is_a_row(self):
         from particleShear.run import api
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
         @functools.wraps(real)
-        def flaky(**kw):
-            if kw["theAmplitude"] == 0.1 and not kw["do_permanent_links"]:
+        def flaky(run):
+            if run["theAmplitude"] == 0.1 and not run["do_permanent_links"]:
                 raise FloatingPointError("simulated node failure")
-            return real(**kw)
+            return real(run)
 
         out = os.path.join(self.tmp, "failing")
-        with mock.patch.object(api, "doParticleShearSimulation", flaky), \
+        with mock.patch.object(api, "measure_run", flaky), \
                 concurrent.futures.ThreadPoolExecutor(2) as ex:
             rows = run_sweep(SPEC, out, executor=ex, progress=False)
         self.assertEqual([r["status"] for r in rows], ["ok", "ok", "ok", "failed"])

@@ -24,6 +24,7 @@ import numpy as np
 
 from particleShearTest.sweep_copies import CopiesOfOneSweep
 from particleShear import doParticleShearSimulationSeries
+from particleShear.run.validation import RunParameters
 from particleShear.sweep import Sweep, expand_runs, parse_spec, run_sweep
 from particleShear.sweep.cli import main as sweep_main
 from particleShear.sweep.locks import FolderBusyError
@@ -220,15 +221,15 @@ class TestKilledWorker(unittest.TestCase):
         if multiprocessing.get_start_method() != "fork":
             self.skipTest("the default start method is not fork")
         from particleShear.run import api
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
         @functools.wraps(real)
-        def oom(**kw):     # what the out-of-memory killer does to the worker of this run
-            if kw["theAmplitude"] == 0.1 and not kw["do_permanent_links"]:
+        def oom(run):     # what the out-of-memory killer does to the worker of this run
+            if run["theAmplitude"] == 0.1 and not run["do_permanent_links"]:
                 os.kill(os.getpid(), signal.SIGKILL)
-            return real(**kw)
+            return real(run)
 
-        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", oom):
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "measure_run", oom):
             rows = run_sweep(SPEC, d, workers=2, progress=False)
         self.assertEqual([r["status"] for r in rows], ["ok", "ok", "ok", "failed"])
         self.assertIn("killed by SIGKILL", rows[3]["error"])
@@ -297,15 +298,15 @@ class TestSameRun(unittest.TestCase):
 
     def test_control_characters_in_an_error_keep_the_row_one_line(self):
         from particleShear.run import api
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
         @functools.wraps(real)
-        def odd(**kw):
-            if kw["theAmplitude"] == 0.1:
+        def odd(run):
+            if run["theAmplitude"] == 0.1:
                 raise RuntimeError("line\rbreak\x0bvt\u2028ls\x85nel\nnl")
-            return real(**kw)
+            return real(run)
 
-        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", odd), \
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "measure_run", odd), \
                 concurrent.futures.ThreadPoolExecutor(2) as ex:
             run_sweep(SPEC, d, executor=ex, progress=False)
             rows = Sweep(SPEC, d).rows()
@@ -336,15 +337,15 @@ class TestExternalProcessPool(unittest.TestCase):
     def test_a_broken_pool_of_the_caller_fails_its_runs_and_stops_clearly(self):
         import multiprocessing
         from particleShear.run import api
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
         @functools.wraps(real)
-        def oom(**kw):
-            if kw["theAmplitude"] == 0.1:
+        def oom(run):
+            if run["theAmplitude"] == 0.1:
                 os.kill(os.getpid(), signal.SIGKILL)
-            return real(**kw)
+            return real(run)
 
-        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", oom), \
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "measure_run", oom), \
                 concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as ex:
             with self.assertRaisesRegex(RuntimeError, "process pool is broken"):
                 run_sweep(dict(SPEC, zip=[]), d, executor=ex, progress=False)
@@ -553,15 +554,16 @@ class TestBoundedAndChecked(unittest.TestCase):
 
     def test_a_write_failure_is_a_failed_row_with_its_error(self):
         from particleShear.run import api
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
         @functools.wraps(real)
-        def full_disk(**kw):
-            res = real(**dict(kw, saveData=False))
+        def full_disk(run):
+            res = real(RunParameters(dict(run, saveData=False), run.run_id, run.seed_sequence, run.generator,
+                                     run.cost))
             res.write_error = OSError(28, "No space left on device")
             return res
 
-        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "doParticleShearSimulation", full_disk), \
+        with tempfile.TemporaryDirectory() as d, mock.patch.object(api, "measure_run", full_disk), \
                 concurrent.futures.ThreadPoolExecutor(1) as ex:
             rows = run_sweep(dict(SPEC, grid={"theAmplitude": [0.2]}, zip=[]), d, executor=ex, progress=False)
             self.assertEqual(rows[0]["status"], "failed")

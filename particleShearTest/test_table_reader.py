@@ -47,10 +47,15 @@ def _fake_simulation(**kw):
                             seed=ss.entropy, spawn_key=tuple(ss.spawn_key), f=100.0, dt=1e-4, N_steps=500)
 
 
+def _fake_run(run):
+    """Instant stand-in of the worker's measurement (``api.measure_run``) of a sweep's checked run."""
+    return _fake_simulation(**run)
+
+
 def _resume(out):
     """Resume the sweep over ``out`` (nothing should run); the run ids run and what was said."""
     err = io.StringIO()
-    with mock.patch.object(api, "doParticleShearSimulation", _fake_simulation), \
+    with mock.patch.object(api, "measure_run", _fake_run), \
             concurrent.futures.ThreadPoolExecutor(1) as ex:
         ran = [o.row["run_id"] for o in Sweep(SPEC, out).as_completed(executor=ex, stream=err)]
     return ran, err.getvalue()
@@ -62,7 +67,7 @@ class TestOneReader(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="ps_reader_")
         cls.out = os.path.join(cls.tmp, "sweep")
-        with mock.patch.object(api, "doParticleShearSimulation", _fake_simulation), \
+        with mock.patch.object(api, "measure_run", _fake_run), \
                 concurrent.futures.ThreadPoolExecutor(1) as ex:
             cls.rows = run_sweep(SPEC, cls.out, executor=ex, progress=False)
         with open(os.path.join(cls.out, "results.csv"), "rb") as fh:

@@ -90,6 +90,11 @@ def _fake_simulation(**kw):
                             spawn_key=tuple(ss.spawn_key), f=100.0, dt=1e-4, N_steps=500)
 
 
+def _fake_run(run):
+    """Instant stand-in of the worker's measurement (``api.measure_run``) of a sweep's checked run."""
+    return _fake_simulation(**run)
+
+
 def _leftovers(folder):
     """Lock files, temporary files and scratch folders under ``folder``."""
     out = []
@@ -158,7 +163,7 @@ class TestTypedTables(unittest.TestCase):
         base = dict(SPEC, grid={"theAmplitude": [0.1, 0.3]}, seeds={"root": 11, "repetitions": 1})
         grown = dict(SPEC, grid={"theAmplitude": [0.2, 0.1]}, seeds={"root": 11, "repetitions": 1})
         d = os.path.join(self.tmp, "extended")
-        fake = mock.patch.object(api, "doParticleShearSimulation", _fake_simulation)   # the runs, not the checks
+        fake = mock.patch.object(api, "measure_run", _fake_run)   # the runs, not the checks
         sweep = Sweep(base, d)
         with fake, concurrent.futures.ThreadPoolExecutor(1) as ex:
             first = sweep.run(executor=ex, progress=False)                 # A = 0.1, then 0.3
@@ -304,17 +309,17 @@ class TestTypedTables(unittest.TestCase):
         self.assertEqual(data["Gp_surface"], [r["Gp_surface"] for r in self.rows])
 
     def test_failed_row_has_empty_run_columns(self):
-        real = api.doParticleShearSimulation
+        real = api.measure_run          # what the worker measures a sweep's run with
 
-        @functools.wraps(real)           # the signature the SPEC is checked against
-        def fail_small(**kw):
-            if kw["theAmplitude"] == 0.1:
+        @functools.wraps(real)
+        def fail_small(run):
+            if run["theAmplitude"] == 0.1:
                 raise FloatingPointError("simulated failure")
-            return real(**kw)
+            return real(run)
 
         d = os.path.join(self.tmp, "failed")
         spec = dict(SPEC, seeds={"root": 11, "repetitions": 1})
-        with mock.patch.object(api, "doParticleShearSimulation", fail_small), \
+        with mock.patch.object(api, "measure_run", fail_small), \
                 concurrent.futures.ThreadPoolExecutor(1) as ex:
             rows = run_sweep(spec, d, executor=ex, progress=False)
         self.assertEqual([r["status"] for r in rows], ["failed", "ok"])

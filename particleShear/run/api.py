@@ -15,7 +15,6 @@ import numpy as np
 from ..hooks import entry
 from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA, PARAMETERS
-from ..simulation.provenance import run_identity
 from .validation import check_seed, validate_run, validate_series, validated_run
 from .sessions import _build_simulation, _seed_sequence, check_batch_size  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
@@ -336,20 +335,47 @@ def doParticleShearSimulation(root_folder="", theAmplitude=0.2, theMu=0.01, do_p
     params.update(options)   # every input, the keyword-only options included
     # every parameter and option, the resolution, the ensemble size and the cost (steps, memory) of the
     # run are checked before any work (limits in docs/parameters.md); the checked arguments, seed and
-    # run id travel down as they are (RunParameters)
-    run = validated_run(params)
-    # measured by the engine, a batch of one (particleShear.run.measurement)
-    with console_messages(verbose):
-        result = measure([run])[0]
-    if plotStress and doDrawing and result.output_path and protocol == "oscillatory":
-        _save_headless_stress_plot(result, renderer)
-    doParticleShearSimulation.last_result = result
-    if strict_io and result.write_error is not None:
-        raise result.write_error
+    # run id travel down as they are (RunParameters), measured by the engine as a batch of one
+    result = measure_run(validated_run(params))
     return result if return_result else result.values
 
 
 doParticleShearSimulation.last_result = None
+
+
+def measure_run(run):
+    """Measure one checked run as :func:`doParticleShearSimulation` does after its validation.
+
+    The run is measured by the engine as a batch of one (:func:`~particleShear.run.measurement.measure`,
+    console messages as ``run["verbose"]`` says); without a display the stress window of a saved
+    oscillatory run is saved as a picture; the result becomes ``doParticleShearSimulation.last_result``.
+    A sweep's worker measures the runs it made from a checked point (:meth:`CheckedPoint.run
+    <particleShear.run.validation.CheckedPoint.run>`) here, so that they are not validated again.
+
+    Parameters
+    ----------
+    run : RunParameters
+        The checked arguments (:func:`~particleShear.run.validation.validated_run`).
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    OSError
+        The write error of the run's file with ``strict_io`` (``last_result`` holds the result).
+    SimulationInstabilityError
+        When the measurement diverges (``stability_guard``).
+    """
+    with console_messages(run["verbose"]):
+        result = measure([run])[0]
+    if run["plotStress"] and run["doDrawing"] and result.output_path and run["protocol"] == "oscillatory":
+        _save_headless_stress_plot(result, run["renderer"])
+    doParticleShearSimulation.last_result = result
+    if run["strict_io"] and result.write_error is not None:
+        raise result.write_error
+    return result
 
 
 def _save_headless_stress_plot(result, renderer):

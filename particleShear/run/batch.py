@@ -160,6 +160,27 @@ def run_batch(list_of_kwargs, backend=None):
             raise ValueError(f"list_of_kwargs[{n}] does not share the step schedule of list_of_kwargs[0] "
                              f"(differs in {', '.join(diff) or 'its parameters'}); a batch needs equal N, "
                              "time-step rule and protocol")
-    results = measure(runs)       # the protocol is part of the schedule key
+    return measure_replicas(runs)       # the protocol is part of the schedule key
+
+
+def measure_replicas(runs):
+    """Measure checked runs of one step schedule as one batch, as :func:`run_batch` does after its checks.
+
+    The schedule is not checked here: the runs are a batch of :func:`batches` (a sweep's worker
+    measures the batches its driving process grouped), or :func:`run_batch` has compared their
+    :func:`schedule_key`.  The last result becomes ``doParticleShearSimulation.last_result``.
+
+    Parameters
+    ----------
+    runs : list of RunParameters
+        The checked arguments of the replicas (:func:`~particleShear.run.validation.validated_run`),
+        all of one :func:`schedule_key`.
+
+    Returns
+    -------
+    list of SimulationResult
+        One per replica, in order.
+    """
+    results = measure(runs)
     doParticleShearSimulation.last_result = results[-1]
     return results

@@ -40,7 +40,7 @@ from ..analysis.measures import warn_few_periods
 from .guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 from .rheometer import PROTOCOL_DEFAULTS, _shown, check_protocol, normalize_protocol, protocol_steps
 
-__all__ = ["validate_run", "validated_run", "RunParameters", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
+__all__ = ["validate_run", "validated_run", "RunParameters", "checked_point", "CheckedPoint", "RUN_OWN", "validate_simulation_parameters", "validate_series", "show_value", "check_seed",
            "estimate_run_cost", "available_memory", "check_folder_writable", "IMAGE_FILE_TYPES", "RENDERERS",
            "INTEGRATORS", "MIN_STEPS_PER_PERIOD", "MIN_SPHERES_PER_PARTICLE", "MAX_N", "MAX_TOTAL_STEPS",
            "MAX_SERIES_RUNS", "SEED_LIMIT", "contact_law_spec"]
@@ -480,6 +480,23 @@ def validate_run(params):
     return _checked(params)[1]
 
 
+def _check_root_folder(p):
+    """Check ``p["root_folder"]`` (type; an existing folder where the run writes) and return what writes there.
+
+    The writability probe (:func:`check_folder_writable`) is the caller's, when the list is not empty.
+    """
+    root = p["root_folder"]
+    if not isinstance(root, (str, os.PathLike)):
+        raise TypeError(f"root_folder={show_value(root)} is invalid: allowed a path string")
+    wants = [n + "=True" for n in ("saveData", "saveOutputImages") if p[n]]
+    if wants and not root:
+        raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder")
+    if wants and not os.path.isdir(root):
+        raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder "
+                         "(no such directory)")
+    return wants
+
+
 def _checked(params):
     """:func:`validate_run`'s checks; returns ``(p, cost)``: the complete, normalized arguments the
     checks read (defaults filled in, :func:`~particleShear.run.rheometer.normalize_protocol` applied)
@@ -505,21 +522,13 @@ def _checked(params):
             raise ValueError(f"{par.name}={show_value(p[par.name])} is invalid: allowed one of {par.choices}")
     _check_constitution(p)    # N and cut_lines: ranges that depend on the cell and on N
     _check_stiff_viscous(p)
-    root = p["root_folder"]
-    if not isinstance(root, (str, os.PathLike)):
-        raise TypeError(f"root_folder={show_value(root)} is invalid: allowed a path string")
-    wants = [n + "=True" for n in ("saveData", "saveOutputImages") if p[n]]
-    if wants and not root:
-        raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder")
-    if wants and not os.path.isdir(root):
-        raise ValueError(f"root_folder={root!r} is invalid: {' and '.join(wants)} needs an existing output folder "
-                         "(no such directory)")
+    wants = _check_root_folder(p)
     check_seed("seed", p["seed"])
     check_protocol(p)             # the protocol's own parameters and steps (docs/protocols.md)
     p = normalize_protocol(p)     # a sweep is constituted for its first value
     cost = _check_cost(p)
     if wants:
-        check_folder_writable("root_folder", root)
+        check_folder_writable("root_folder", p["root_folder"])
     if p["saveOutputMovie"] and not p["saveOutputImages"]:
         raise ValueError("saveOutputMovie=True is invalid with saveOutputImages=False: the movie is made of "
                          "the snapshots (set saveOutputImages=True and a root_folder)")
@@ -529,10 +538,36 @@ def _checked(params):
     return p, cost
 
 
-class RunParameters(dict):
+class _FrozenArguments(dict):
+    """A ``dict`` of checked arguments whose items cannot change (base of :class:`RunParameters` and
+    :class:`CheckedPoint`): a value changed after the check would be a value nobody checked."""
+
+    __slots__ = ()
+
+    def _immutable(self, *args, **kwargs):
+        """Refused: the checked arguments of a run do not change.
+
+        Parameters
+        ----------
+        *args, **kwargs
+            Those of the ``dict`` method; ignored.
+
+        Raises
+        ------
+        TypeError
+            Always.
+        """
+        raise TypeError(f"{type(self).__name__} is immutable: the validated arguments of a run do not change "
+                        "(change a copy, dict(run), and validate it again)")
+
+    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _immutable
+
+
+class RunParameters(_FrozenArguments):
     """The complete, validated arguments of one run, immutable: what travels from the check to the engine.
 
-    Made only by :func:`validated_run`, once per run, so that nothing below the check validates,
+    Made only by :func:`validated_run`, once per run (or, for the runs of a checked sweep point, by
+    :meth:`CheckedPoint.run`), so that nothing below the check validates,
     completes, normalizes or hashes the arguments again: the sessions, the simulation object and
     the ensemble builders read their values from it by the names of the parameter table
     (:mod:`particleShear.parameters`), and the run's identity and seed are the ones computed here.
@@ -559,24 +594,6 @@ class RunParameters(dict):
         dict.__init__(self, values)
         self.run_id, self.seed_sequence, self.generator, self.cost = run_id, seed_sequence, generator, cost
 
-    def _immutable(self, *args, **kwargs):
-        """Refused: the checked arguments of a run do not change.
-
-        Parameters
-        ----------
-        *args, **kwargs
-            Those of the ``dict`` method; ignored.
-
-        Raises
-        ------
-        TypeError
-            Always.
-        """
-        raise TypeError("RunParameters is immutable: the validated arguments of a run do not change "
-                        "(change a copy, dict(run), and validate it again)")
-
-    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _immutable
-
     def __reduce__(self):
         # a plain dict's pickling sets the items one by one (refused here): rebuild from the values
         return type(self), (dict(self), self.run_id, self.seed_sequence, self.generator, self.cost)
@@ -592,14 +609,25 @@ class RunParameters(dict):
         return () if self.seed_sequence is None else tuple(self.seed_sequence.spawn_key)
 
 
+def _identified(p, cost, run_id=None):
+    """:class:`RunParameters` of the checked arguments ``p``: seeded from ``p["seed"]`` and identified
+    (:func:`~particleShear.simulation.provenance.run_identity`, unless ``run_id`` is given)."""
+    ss, rng = _seed_sequence(p["seed"])
+    if run_id is None:
+        entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
+        run_id = run_identity(p, entropy, spawn_key)
+    return RunParameters(p, run_id, ss, rng, cost)
+
+
 def validated_run(params):
     """Check one run's arguments (:func:`validate_run`) and return them as :class:`RunParameters`.
 
     The one place where a run's arguments are checked, completed, normalized, seeded and
     identified: every way to measure (:func:`~particleShear.run.api.doParticleShearSimulation`,
-    :func:`~particleShear.run.batch.run_batch`, the sweep's tasks) calls it once per run and hands
+    :func:`~particleShear.run.batch.run_batch`, a series) calls it once per run and hands
     the result down unchanged, so the validation, the run identity and the parameter dict are
-    each made once per run.
+    each made once per run.  A sweep checks each point once (:func:`checked_point`) and makes its
+    runs from it (:meth:`CheckedPoint.run`).
 
     Parameters
     ----------
@@ -617,10 +645,97 @@ def validated_run(params):
     TypeError, ValueError, ImportError
         As :func:`validate_run`.
     """
+    return _identified(*_checked(params))
+
+
+#: the arguments in which the runs of one sweep point differ (where their files go, their seed, the
+#: console and the return value): a :class:`CheckedPoint` sets them per run
+RUN_OWN = ("root_folder", "seed", "return_result", "verbose")
+
+
+class CheckedPoint(_FrozenArguments):
+    """The complete, validated arguments of a sweep point: every run of it but :data:`RUN_OWN`, immutable.
+
+    Made by :func:`checked_point`, once per point; :meth:`run` makes each run's
+    :class:`RunParameters` from it, checking only the values the run sets, so a sweep run is
+    validated once (with its point) and its run id is the one the sweep computed.
+
+    Parameters
+    ----------
+    values : dict
+        The complete, normalized arguments (taken as they are).
+    cost : dict
+        The cost estimate of :func:`estimate_run_cost` (steps and memory): a run's, whatever its
+        :data:`RUN_OWN` values.
+    """
+
+    __slots__ = ("cost",)
+
+    def __init__(self, values, cost):
+        dict.__init__(self, values)
+        self.cost = cost
+
+    def __reduce__(self):
+        return type(self), (dict(self), self.cost)
+
+    def run(self, root_folder, seed, return_result, verbose, run_id=None):
+        """One run of this point: its :class:`RunParameters`, the point's values not checked again.
+
+        ``root_folder``, ``seed``, ``return_result`` and ``verbose`` are checked as
+        :func:`validate_run` checks them (the folder exists and is writable where the run writes);
+        the result equals ``validated_run(dict(point, root_folder=..., seed=..., ...))``.
+
+        Parameters
+        ----------
+        root_folder : str or os.PathLike
+            Where the run writes ("" when it writes nothing).
+        seed : None, int, numpy.random.SeedSequence or numpy.random.Generator
+            The run's seed.
+        return_result, verbose : bool
+            As for :func:`~particleShear.run.api.doParticleShearSimulation`.
+        run_id : str, optional
+            The run id when the caller has computed it
+            (:func:`~particleShear.simulation.provenance.run_identity` of the point and the seed,
+            e.g. a sweep's :class:`~particleShear.sweep.spec.SweepRun`); default: computed here.
+
+        Returns
+        -------
+        RunParameters
+
+        Raises
+        ------
+        TypeError, ValueError
+            As :func:`validate_run`, for one of the values set here.
+        """
+        p = dict(self, root_folder=root_folder, seed=seed, return_result=return_result, verbose=verbose)
+        for name in ("return_result", "verbose"):
+            _bool(name, p[name])
+        if _check_root_folder(p):
+            check_folder_writable("root_folder", root_folder)
+        check_seed("seed", seed)
+        return _identified(p, self.cost, run_id)
+
+
+def checked_point(params):
+    """Check the arguments of a sweep point (:func:`validate_run`) and return them as :class:`CheckedPoint`.
+
+    Parameters
+    ----------
+    params : dict
+        As for :func:`validate_run` (its :data:`RUN_OWN` values those of the check only: each run
+        sets its own, :meth:`CheckedPoint.run`).
+
+    Returns
+    -------
+    CheckedPoint
+
+    Raises
+    ------
+    TypeError, ValueError, ImportError
+        As :func:`validate_run`.
+    """
     p, cost = _checked(params)
-    ss, rng = _seed_sequence(p["seed"])
-    entropy, spawn_key = (None, ()) if ss is None else (ss.entropy, tuple(ss.spawn_key))
-    return RunParameters(p, run_identity(p, entropy, spawn_key), ss, rng, cost)
+    return CheckedPoint(p, cost)
 
 
 #: the former name of :func:`validate_run` (the same function)

@@ -437,14 +437,21 @@ class Sweep:
 
     # -- running -------------------------------------------------------------------------------
     def _task(self, run, keep_series, scratch_dir, batched=False):
-        return {"run_id": run.run_id, "index": run.index, "repetition": run.repetition, "parameters": run.parameters,
+        task = {"run_id": run.run_id, "index": run.index, "repetition": run.repetition, "parameters": run.parameters,
                 "seed_entropy": run.seed_entropy, "spawn_key": run.spawn_key, "out_dir": self.out_dir,
                 "scratch_dir": scratch_dir, "keep_series": bool(keep_series), "batched": batched}
+        if run.checked is not None:     # its point was checked: the worker does not validate it again
+            task["checked"] = run.checked
+        return task
 
-    def _jobs(self, todo, keep_series, scratch_dir, batch_size):
-        """Jobs (lists of tasks) of the pending runs ``todo`` (an iterator), one run or one batch each."""
+    def _jobs(self, todo, keep_series, scratch_dir, batch_size, in_flight):
+        """Jobs (lists of tasks) of the pending runs ``todo`` (an iterator), one run or one batch each.
+
+        Each job's runs are put in ``in_flight`` (run index -> run) until their outcome is recorded.
+        """
         if batch_size is None:
             for r in todo:
+                in_flight[r.index] = r
                 yield [self._task(r, keep_series, scratch_dir)]
             return
         while True:
@@ -452,6 +459,7 @@ class Sweep:
             if not chunk:
                 return
             for g in batches([r.parameters for r in chunk], batch_size):
+                in_flight.update((chunk[i].index, chunk[i]) for i in g)
                 yield [self._task(chunk[i], keep_series, scratch_dir, batched=True) for i in g]
 
     def _say(self, stream, progress, text):
@@ -585,7 +593,8 @@ class Sweep:
         """
         owner = ScratchOwner(self.out_dir)
         points = self.runs.points if isinstance(self.runs, SweepRuns) else [r.parameters for r in self.runs]
-        jobs = run_jobs(self._jobs(todo, keep_series, owner.path, batch_size), executor=executor,
+        in_flight = {}      # the runs of the jobs submitted and not yet recorded (bounded by the pool's window)
+        jobs = run_jobs(self._jobs(todo, keep_series, owner.path, batch_size, in_flight), executor=executor,
                         workers=min(workers or os.cpu_count() or 1, n_todo),
                         mp_context=pool_context(points) if executor is None else None)
 
@@ -595,8 +604,7 @@ class Sweep:
             for task, (row, result) in zip(job, outcomes):
                 rows = row if isinstance(row, list) else [row]
                 append_row(self.table_path, rows, self.columns, checked=True)   # checked when opened
-                run = self.runs[task["index"]] if isinstance(self.runs, SweepRuns) else \
-                    self._run_of({"run_id": task["run_id"]})
+                run = in_flight.pop(task["index"])
                 outcome = SweepOutcome(run, rows[0], result, rows)
                 if show is not None:
                     show(outcome)

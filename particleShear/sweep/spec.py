@@ -40,7 +40,7 @@ from ..parameters import BY_NAME, PARAMETERS, SPEC_RESERVED, spec_defaults
 from ..run.guard import PARAMETER_ALIASES, RUN_PARAMETERS_DOC, UnknownParameterError, close_names
 from ..simulation.provenance import run_identity
 from ..run.rheometer import LIST_PARAMETERS, normalize_protocol
-from ..run.validation import SEED_LIMIT, validate_run
+from ..run.validation import SEED_LIMIT, checked_point
 
 __all__ = ["SweepSpec", "SweepRun", "SweepRuns", "load_spec", "parse_spec", "expand_runs", "spec_runs",
            "sweep_parameter_defaults", "uses_protocols", "SPEC_TABLES", "MAX_POINTS", "MAX_RUNS"]
@@ -127,6 +127,11 @@ class SweepRun:
         reproducible random stream.
     run_id : str
         :func:`particleShear.simulation.provenance.run_identity` of the above.
+    checked : CheckedPoint or None, optional
+        The checked arguments of its point (:func:`particleShear.run.validation.checked_point`,
+        shared by the point's runs), from which a worker makes the run's
+        :class:`~particleShear.run.validation.RunParameters` without validating it again; None
+        (default) for a run without one (a series' run: validated where it runs).
     """
 
     index: int
@@ -136,6 +141,7 @@ class SweepRun:
     seed_entropy: int
     spawn_key: tuple
     run_id: str
+    checked: object = dataclasses.field(default=None, compare=False, repr=False)
 
 
 @dataclasses.dataclass
@@ -527,10 +533,14 @@ class SweepRuns:
         ``[seeds] root``.
     repetitions : int
         ``[seeds] repetitions``.
+    checked : list of CheckedPoint, optional
+        Each point's checked arguments (:func:`particleShear.run.validation.checked_point`), given
+        to its runs (``SweepRun.checked``); default None: runs without them.
     """
 
-    def __init__(self, points, root, repetitions):
+    def __init__(self, points, root, repetitions, checked=None):
         self.points, self.root, self.repetitions = list(points), root, int(repetitions)
+        self.checked = None if checked is None else list(checked)
 
     def __len__(self):
         return len(self.points) * self.repetitions
@@ -548,7 +558,8 @@ class SweepRuns:
         rep, p = divmod(int(k), len(self.points))
         params = self.points[p]
         return SweepRun(index=int(k), point=p, repetition=rep, parameters=params, seed_entropy=self.root,
-                        spawn_key=(int(k),), run_id=run_identity(params, self.root, (int(k),)))
+                        spawn_key=(int(k),), run_id=run_identity(params, self.root, (int(k),)),
+                        checked=None if self.checked is None else self.checked[p])
 
     def __iter__(self):
         return (self[k] for k in range(len(self)))
@@ -570,7 +581,8 @@ def spec_runs(spec):
     ValueError, TypeError
         The first invalid point, naming the parameter (and the point) — before any work.
     """
-    return SweepRuns(_validated_points(spec), spec.root, spec.repetitions)
+    points, checked = _validated_points(spec)
+    return SweepRuns(points, spec.root, spec.repetitions, checked)
 
 
 def expand_runs(spec):
@@ -594,18 +606,20 @@ def expand_runs(spec):
 
 
 def _validated_points(spec):
-    """The complete parameter set of every point of ``spec``, each validated (point order)."""
+    """``(points, checked)``: the complete parameter set of every point of ``spec`` (point order) and its
+    checked arguments (:func:`~particleShear.run.validation.checked_point`, each point validated once)."""
     defaults = sweep_parameter_defaults(protocols=uses_protocols(_spec_keys(spec)))
-    points = []
+    points, checked = [], []
     for p_index, point in enumerate(_points(spec)):
         params = dict(defaults, **spec.parameters, **point)
         where = f"point {p_index} ({', '.join(f'{k}={show_value(v)}' for k, v in point.items()) or 'fixed parameters'})"
         try:
-            validate_run(dict(params, root_folder=os.curdir))   # the sweep makes DIR: not required yet
+            # the sweep makes DIR (not required yet); each run sets its folder and seed (CheckedPoint.run)
+            checked.append(checked_point(dict(params, root_folder=os.curdir)))
         except (ValueError, TypeError) as exc:
             msg = f"{where}: {exc}" if not str(exc).startswith("point ") else str(exc)
             raise _name_source(type(exc)(msg), spec.source) from None
         # a one-packing sweep is constituted for its first value: its row says so (and its id is the
         # id of the same call to doParticleShearSimulation)
         points.append(normalize_protocol(params) if "protocol" in params else params)
-    return points
+    return points, checked

@@ -1,7 +1,10 @@
 """What a sweep's worker runs: one task (a picklable dict) or a batch of them, and the publication of the files.
 
 A task is ``{"run_id", "index", "repetition", "parameters", "seed_entropy", "spawn_key", "out_dir",
-"scratch_dir", "keep_series"}``.  A run writes into its scratch folder
+"scratch_dir", "keep_series"}`` and, for a sweep's run, ``"checked"``: its point's
+:class:`~particleShear.run.validation.CheckedPoint`, from which the worker makes the run's
+:class:`~particleShear.run.validation.RunParameters` without validating it again (a task without
+it, a series' run, is validated here).  A run writes into its scratch folder
 ``scratch_dir/<run id>/`` (cleared first: leftovers of a killed attempt); when it has finished,
 the worker renames its files into ``out_dir`` under the run id (companions first, the file
 itself last, :func:`publish`).  A failing run never raises: it becomes a ``failed`` row, and so
@@ -21,7 +24,8 @@ from .._version import __version__
 from ..simulation.output import SIDECAR_SUFFIX, run_file_stem
 from .table import atomic_text
 from ..run import api
-from ..run.batch import run_batch
+from ..run.batch import measure_replicas
+from ..run.validation import validated_run
 
 __all__ = ["execute_run", "execute_batch", "failed_row", "publish", "error_text"]
 
@@ -134,7 +138,9 @@ def execute_run(task):
         ``run_id``, ``index``, ``repetition`` (of its point; default 0), ``parameters`` (complete,
         of ``doParticleShearSimulation``),
         ``seed_entropy``, ``spawn_key``, ``out_dir`` (sweep folder; "" writes nothing),
-        ``scratch_dir`` (this driving process's scratch folder) and ``keep_series`` (bool).
+        ``scratch_dir`` (this driving process's scratch folder), ``keep_series`` (bool) and, for a
+        sweep's run, ``checked`` (its point's :class:`~particleShear.run.validation.CheckedPoint`:
+        the run is measured without validating it again, :func:`particleShear.run.api.measure_run`).
 
     Returns
     -------
@@ -146,8 +152,8 @@ def execute_run(task):
     t0 = time.perf_counter()
     run_dir = None
     try:
-        run_dir, kwargs = _prepare(task)
-        result = api.doParticleShearSimulation(**kwargs)
+        run_dir, run = _prepare(task)
+        result = api.measure_run(run)
         return _finish_run(task, result, time.perf_counter() - t0)
     except Exception as exc:  # a failed run is a row, never the end of the sweep
         return failed_row(task, exc, time.perf_counter() - t0), None
@@ -157,7 +163,8 @@ def execute_run(task):
 
 
 def _prepare(task):
-    """``(run_dir, kwargs)`` of a task: its empty scratch folder ("" when it writes nothing) and its call."""
+    """``(run_dir, run)`` of a task: its empty scratch folder ("" when it writes nothing) and its
+    :class:`~particleShear.run.validation.RunParameters` (made from the task's checked point, else validated)."""
     p = task["parameters"]
     writes = bool(task["out_dir"]) and bool(p.get("saveData") or p.get("saveOutputImages"))
     run_dir = ""
@@ -166,7 +173,11 @@ def _prepare(task):
         shutil.rmtree(run_dir, ignore_errors=True)      # leftovers of a killed attempt of this owner
         os.makedirs(run_dir)
     ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
-    return run_dir, dict(p, root_folder=run_dir, seed=ss, return_result=True, verbose=False)
+    checked = task.get("checked")
+    if checked is None:      # a series' run (no checked point): validated here
+        return run_dir, validated_run(dict(p, root_folder=run_dir, seed=ss, return_result=True, verbose=False))
+    # a sweep's run: its point was checked once (the SPEC's check), its id computed by the sweep
+    return run_dir, checked.run(run_dir, ss, return_result=True, verbose=False, run_id=task["run_id"])
 
 
 def _finish_run(task, result, wall_time_s):
@@ -212,7 +223,9 @@ def _finish_run(task, result, wall_time_s):
 def execute_batch(tasks):
     """Run sweep tasks that share a step schedule as one batch of replicas; ``[(row, result), ...]`` in order.
 
-    The replicas are measured together (:func:`particleShear.run.batch.run_batch`), each
+    The replicas are measured together (:func:`particleShear.run.batch.measure_replicas`, the
+    measurement of :func:`~particleShear.run.batch.run_batch`; the tasks are one batch of
+    :func:`~particleShear.run.batch.batches`, so their schedule is not compared again), each
     bit-identical to its single run, so the rows equal those of :func:`execute_run`.  If the
     batch fails (one replica diverging stops the batch), every task runs again on its own, so
     that only the failing run becomes a ``failed`` row.
@@ -231,7 +244,7 @@ def execute_batch(tasks):
     prepared = []
     try:
         prepared = [_prepare(task) for task in tasks]
-        results = run_batch([kw for _, kw in prepared])
+        results = measure_replicas([run for _, run in prepared])   # grouped by the driving process
         wall = (time.perf_counter() - t0) / len(tasks)
         return [_finish_run(task, result, wall) for task, result in zip(tasks, results)]
     except Exception:  # noqa: BLE001 - one bad replica: run them one by one (failed rows where they fail)
