@@ -267,8 +267,7 @@ class TestBatchIndependence(unittest.TestCase):
         from particleShear.base.engine_adapter import write_back
         from particleShear.engine.step import BatchEngine
         a = random_packing(3)
-        eng = BatchEngine(state_of_ensemble(a))
-        eng.numbers_relations = False
+        eng = BatchEngine(state_of_ensemble(a), numbers_relations=False)
         eng.step(1.0, a.dt)
         x, t = a.sphere_arrays["x"].copy(), a.t
         with self.assertRaisesRegex(ValueError, "numbers_relations"):
@@ -281,8 +280,7 @@ class TestBatchIndependence(unittest.TestCase):
         from particleShear.base.engine_adapter import write_back
         from particleShear.engine.step import BatchEngine
         a, b = random_packing(3), random_packing(4)
-        eng = BatchEngine(state_from_ensembles([a]))
-        eng.numbers_relations = True
+        eng = BatchEngine(state_from_ensembles([a]), numbers_relations=True)
         eng.step(1.0, a.dt)
         with self.assertRaisesRegex(ValueError, "own state"):
             write_back(eng, 0, a)

@@ -269,8 +269,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     _damped_rows = 3
 
-    def _strain_advances(self):
-        return True
+    _strain_only_while_shearing = False       # (the engine's strain advances in every step)
 
     @property
     def active_terms(self):

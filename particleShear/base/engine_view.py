@@ -23,7 +23,10 @@ __all__ = ["EngineStep", "ForcePhaseGeometry"]
 class EngineStep:
     """Mixin of the documented canvases: the step's phases on the ensemble's engine (a batch of one).
 
-    Hooks: :meth:`_lees_edwards` (images offset by ``Ly·γ``), :meth:`_strain_advances` (γ += γ̇·dt).
+    Hooks, read when an engine is made (its configuration, :class:`~particleShear.engine.config.EngineConfig`):
+    :meth:`_lees_edwards` (images offset by ``Ly·γ``; part of the engine's key, so a change of
+    ``use_lees_edwards`` makes a new engine) and :attr:`_strain_only_while_shearing` (γ += γ̇·dt only
+    while ``applyingShear``; a class attribute).
     """
 
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
@@ -32,11 +35,11 @@ class EngineStep:
     #: movement phases of its step; None before one, after the step's movement and with the engine dropped
     _force_record = None
 
+    #: the strain advances only while the plates shear (``applyingShear``; the frictionless canvases)
+    _strain_only_while_shearing = True
+
     def _lees_edwards(self):
         return bool(self.use_lees_edwards)
-
-    def _strain_advances(self):
-        return bool(getattr(self, "applyingShear", False))
 
     @property
     def _engine(self):
@@ -46,7 +49,7 @@ class EngineStep:
     def _engine_view_key(self):
         return (self._block_version, self._params_version, self._rng, float(getattr(self, "k", 0.0)),
                 float(getattr(self, "nu", 0.0)), float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)),
-                float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"))
+                float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"), self._lees_edwards())
 
     def _step_engine(self):
         """The ensemble's engine, kept in the memo under :meth:`_engine_view_key` (the block fitted
@@ -62,7 +65,9 @@ class EngineStep:
         carried = (np.array([h if h is not None else np.zeros(self._n) for h in half])
                    if integrator == "verlet" and half is not None and len(half[0]) == self._n else None)
         eng = BatchEngine(state_of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
-                          integrator=integrator, keep_terms=True, half=carried)   # keep_terms: the force register
+                          integrator=integrator, keep_terms=True, half=carried,   # keep_terms: the force register
+                          lees_edwards=self._lees_edwards(),
+                          strain_only_while_shearing=self._strain_only_while_shearing)
         self._engine_pairs = (self._pairs, self._pairs.version)
         return eng
 
@@ -103,8 +108,6 @@ class EngineStep:
         mu = float(getattr(self, "mu", 0.0))
         if s.mu[0] != mu:
             eng.set_mu(mu)
-        eng.lees_edwards = None if self._lees_edwards() else np.zeros(1)
-        eng.strain_advances = None if self._strain_advances() else np.zeros(1)
         pairs = self._pairs
         if self._engine_pairs != (pairs, pairs.version) or s.pairs[0] is not pairs:
             # edited since the engine's last write-back: candidates and constants anew from the table

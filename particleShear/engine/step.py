@@ -37,6 +37,7 @@ from .forces import PairConstants, normals, pair_roles, scatter, shear_stresses,
 from .phase_laws import force_phase_laws
 from .terms import (central_term, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
                     tangential_term, viscous_term)
+from .config import INTEGRATORS, EngineConfig
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
 from .state import PERMANENT, SLIP, STICK, spread
@@ -104,6 +105,10 @@ class ForceRecord(collections.namedtuple("ForceRecord", "dx dy nx ny dvx active 
     __slots__ = ()
 
 
+#: what an engine's configuration fixes per replica at its construction (read-only properties of the engine)
+_Fixed = collections.namedtuple("_Fixed", "skin guard guard_dev lees_edwards held")
+
+
 class BatchEngine:
     """Advances a :class:`~particleShear.engine.state.BatchState` step by step.
 
@@ -143,32 +148,53 @@ class BatchEngine:
     numbers_relations : bool or None, keyword-only
         Number the relations as they form, for a write-back into ensembles; None: for a state
         that is an ensemble's own (``state.ensembles``).
+    lees_edwards : bool, keyword-only
+        False: plain periodic cells (no Lees-Edwards images; the documented ``use_lees_edwards =
+        False`` ensembles).
+    strain_only_while_shearing : bool, keyword-only
+        The strain advances only in the steps where the state applies shear (the documented
+        frictionless canvases).
+    config : EngineConfig or None, keyword-only
+        The whole configuration at once (:class:`~particleShear.engine.config.EngineConfig`),
+        instead of the keyword arguments above (``state``, ``half`` and ``phase`` aside).
+
+    The configuration (every parameter but ``state``, ``half`` and ``phase``) is fixed at
+    construction: it is :attr:`config`, a frozen
+    :class:`~particleShear.engine.config.EngineConfig`, whose fields the engine also shows as
+    read-only properties (``engine.integrator``, ``engine.keep_terms`` …); an engine configured
+    otherwise is a new engine.
 
     Raises
     ------
     ValueError
-        If ``skin_factor`` is not > 0 or ``integrator`` is unknown.
+        If ``skin_factor`` is not > 0, ``integrator`` is unknown, ``check_interval`` < 1, or
+        ``config`` is given with configuration keywords.
     """
 
-    INTEGRATORS = ("euler", "verlet")
+    INTEGRATORS = INTEGRATORS
 
     def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler", *,
                  keep_terms=False, min_distance_ratio=0.05, max_kinetic_energy=None, half=None,
-                 phase="pre-equilibration", numbers_relations=None):
-        if not skin_factor > 0:
-            raise ValueError(f"skin_factor={skin_factor!r} is out of range: allowed > 0")
-        if integrator not in self.INTEGRATORS:
-            raise ValueError(f"integrator={integrator!r} is not allowed: one of {self.INTEGRATORS}")
-        self.integrator = integrator
+                 phase="pre-equilibration", numbers_relations=None, lees_edwards=True,
+                 strain_only_while_shearing=False, config=None):
+        given = EngineConfig(integrator=integrator, skin_factor=skin_factor, check_interval=check_interval,
+                             guard=guard, min_distance_ratio=min_distance_ratio,
+                             max_kinetic_energy=max_kinetic_energy, keep_terms=keep_terms,
+                             numbers_relations=numbers_relations, lees_edwards=lees_edwards,
+                             strain_only_while_shearing=strain_only_while_shearing)
+        if config is None:
+            config = given
+        elif given != EngineConfig():
+            raise ValueError("give the engine's configuration either as config or as keyword arguments, not both")
+        s = self.s = state
+        if config.numbers_relations is None:     # (on from the start for a state that is an ensemble's own)
+            config = config.replace(numbers_relations=s.ensembles is not None)
+        self._config = config     # (read-only: the property config)
         self.half = half          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
-        #: keep the per-term arrays of each force phase for the force register (``base.register``;
-        #: a script's experiment sets it, so its ensemble's register holds the engine's last step)
-        self.keep_terms = bool(keep_terms)
         #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
         #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
         self.terms = None
         self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
-        s = self.s = state
         xp = self.xp = s.xp
         self.backend = s.backend
         self.notes = set()        # why the compiled backend fell back to NumPy (each reason once)
@@ -176,7 +202,13 @@ class BatchEngine:
             tune_allocator()   # step temporaries stay mapped (engine/memory.py; measured, see there)
         B, N = s.B, s.N
         self.r_max = s.r.reshape(B, N).max(axis=1)
-        self.skin = skin_factor * self.r_max
+        guard_mask = config.guard_mask(B)           # per replica, on the host
+        guard_mask.setflags(write=False)
+        # what the configuration fixes per replica (read through the properties below)
+        self._fixed = _Fixed(skin=config.skin_factor * self.r_max, guard=guard_mask,
+                             guard_dev=self.backend.asarray(guard_mask),
+                             lees_edwards=None if config.lees_edwards else xp.zeros(B),
+                             held=xp.zeros(B) if config.strain_only_while_shearing else None)
         self.bound = xp.full(B, math.inf)      # Verlet bound of each replica (see verlet_bound)
         self.need = np.ones(B, bool)           # host: list rebuild due (the first step builds every list)
         self.u = xp.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
@@ -190,30 +222,54 @@ class BatchEngine:
         self.mmi = xp.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
         # what the candidate search (on the host) needs besides the positions: radii, boxes, skins
         self.host_consts = [to_host(a, "state") for a in (s.r, s.Lx, s.Ly, self.skin)]
-        self.check_interval = int(check_interval)
-        self.guard = np.broadcast_to(np.asarray(guard, dtype=bool), (B,)).copy()   # per replica, on the host
-        self.guard_dev = self.backend.asarray(self.guard)
         self.rate_max = xp.zeros(B)
-        #: the guard's smallest d/(r_i + r_j) of a transient contact and its bound of the kinetic energy
-        #: relative to the flow (mg·µm²/s² per m depth; None: the bound of the class docstring), as
-        #: the attributes of a :class:`~particleShear.base.stability.StabilityGuard`
-        self.min_distance_ratio = min_distance_ratio
-        self.max_kinetic_energy = max_kinetic_energy
         self.step_count = 0
-        #: number the relations as they form (:meth:`_number`), for a write-back into ensembles (on
-        #: from the start for a state that is an ensemble's own); ``next_birth``: the number the
-        #: next relation of each replica gets
-        self.numbers_relations = s.ensembles is not None if numbers_relations is None else bool(numbers_relations)
+        #: ``next_birth``: the number the next relation of each replica gets (:attr:`numbers_relations`)
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
-        self.phase = phase
+        self.phase = phase        # (the loops set it as they run: run state, not configuration)
         self.rebuilds = np.zeros(B, dtype=np.int64)
-        #: per replica, 1.0 for a Lees-Edwards cell and 0.0 for a plain periodic one (the documented
-        #: ``use_lees_edwards = False`` ensembles): the factor of the image offset ``Ly·γ`` and of the
-        #: image velocity ``Ly·γ̇``; None: every replica is Lees-Edwards
-        self.lees_edwards = None
-        #: per replica, 1.0 where the strain advances by ``γ̇·dt`` in a step and 0.0 where it is held
-        #: (the documented frictionless canvases advance it only while shearing); None: everywhere
-        self.strain_advances = None
+
+    # -- the configuration, read-only -------------------------------------------------------------
+    @property
+    def config(self):
+        """The engine's configuration (:class:`~particleShear.engine.config.EngineConfig`), fixed at
+        construction (its ``numbers_relations`` decided, a bool); its fields are also read-only
+        properties of the engine of the same names."""
+        return self._config
+
+    integrator = property(lambda self: self.config.integrator,
+                          doc="The integrator, ``\"euler\"`` or ``\"verlet\"`` (:attr:`config`).")
+    keep_terms = property(lambda self: self.config.keep_terms,
+                          doc="Keep the per-term arrays of each force phase for the force register "
+                              "(``base.register``; :attr:`config`).")
+    check_interval = property(lambda self: self.config.check_interval,
+                              doc="Steps between the checks of the stability guard (:attr:`config`).")
+    min_distance_ratio = property(lambda self: self.config.min_distance_ratio,
+                                  doc="The guard's smallest d/(r_i + r_j) of a transient contact (:attr:`config`).")
+    max_kinetic_energy = property(lambda self: self.config.max_kinetic_energy,
+                                  doc="The guard's bound of the kinetic energy relative to the flow "
+                                      "(mg·µm²/s² per m depth; None: the bound of the class docstring; :attr:`config`).")
+    numbers_relations = property(lambda self: self.config.numbers_relations,
+                                 doc="Number the relations as they form (:meth:`_number`), for a write-back "
+                                     "into ensembles (:attr:`config`).")
+    skin = property(lambda self: self._fixed.skin,
+                    doc="The Verlet skin of each replica, ``skin_factor`` times its largest radius (µm, (B,)).")
+    guard = property(lambda self: self._fixed.guard,
+                     doc="Per replica, whether the stability guard checks it (a read-only host array (B,)).")
+    guard_dev = property(lambda self: self._fixed.guard_dev,
+                         doc=":attr:`guard` on the state's backend.")
+    lees_edwards = property(lambda self: self._fixed.lees_edwards,
+                            doc="Per replica, 1.0 for a Lees-Edwards cell and 0.0 for a plain periodic one: the "
+                                "factor of the image offset ``Ly·γ`` and of the image velocity ``Ly·γ̇``; None: "
+                                "every replica is Lees-Edwards (the configuration's ``lees_edwards``; the same "
+                                "object at every read).")
+
+    @property
+    def strain_advances(self):
+        """Per replica, 1.0 where the strain advances by ``γ̇·dt`` in this step and 0.0 where it is
+        held; None: everywhere (the configuration's ``strain_only_while_shearing`` holds it while the
+        state does not apply shear; the same object at every read)."""
+        return None if self._fixed.held is None or self.s.applying_shear else self._fixed.held
 
     # -- the one cache ---------------------------------------------------------------------------
     def _sync_down(self, replicas=None):

@@ -106,7 +106,7 @@ class EnsembleFriction(Ensemble):
 
 # EnsembleFriction takes the friction canvas's tangential machinery; its strain advances as in its base class
 for _name, _value in vars(CanvasPointsFrictionElasticityLeesEdwards).items():
-    if not _name.startswith("__") and _name not in ("_strain_advances", "k_t", "nu_t", "mu"):
+    if not _name.startswith("__") and _name not in ("_strain_only_while_shearing", "k_t", "nu_t", "mu"):
         setattr(EnsembleFriction, _name, _value)
 del _name, _value
 
