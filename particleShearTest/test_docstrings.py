@@ -168,6 +168,7 @@ ENGINE_MODULES = [
     "particleShear.linkable.spheres",
     "particleShear.engine",
     "particleShear.engine.box",
+    "particleShear.engine.config",
     "particleShear.engine.forces",
     "particleShear.engine.graph",
     "particleShear.engine.guard",
