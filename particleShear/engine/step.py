@@ -112,6 +112,11 @@ _Fixed = collections.namedtuple("_Fixed", "skin guard guard_dev lees_edwards hel
 class BatchEngine:
     """Advances a :class:`~particleShear.engine.state.BatchState` step by step.
 
+    Its configuration (every parameter but ``state``, ``half`` and ``phase``) is fixed at its
+    construction: it is :attr:`config`, a frozen :class:`~particleShear.engine.config.EngineConfig`,
+    whose fields the engine also shows as read-only properties (``engine.integrator``,
+    ``engine.keep_terms`` …); an engine configured otherwise is a new engine.
+
     Parameters
     ----------
     state : BatchState
@@ -157,12 +162,6 @@ class BatchEngine:
     config : EngineConfig or None, keyword-only
         The whole configuration at once (:class:`~particleShear.engine.config.EngineConfig`),
         instead of the keyword arguments above (``state``, ``half`` and ``phase`` aside).
-
-    The configuration (every parameter but ``state``, ``half`` and ``phase``) is fixed at
-    construction: it is :attr:`config`, a frozen
-    :class:`~particleShear.engine.config.EngineConfig`, whose fields the engine also shows as
-    read-only properties (``engine.integrator``, ``engine.keep_terms`` …); an engine configured
-    otherwise is a new engine.
 
     Raises
     ------
