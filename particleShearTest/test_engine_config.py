@@ -108,5 +108,23 @@ class TestEngineConfig(unittest.TestCase):
                 self.assertEqual(float(eng.s.gamma[0]), 0.5e-3 if shearing else 0.0)
 
 
+class TestCanvasEngineConfig(unittest.TestCase):
+    """A documented canvas configures its engine when it makes it (and makes a new one for another)."""
+
+    def test_canvas_engine_configured_at_construction(self):
+        from particleShear.objects.ensembles import Ensemble, EnsembleFriction, EnsembleFrictionLeesEdwards
+        for cls, le, held in ((Ensemble, False, True), (EnsembleFriction, False, True),
+                              (EnsembleFrictionLeesEdwards, True, False)):
+            with self.subTest(cls=cls.__name__):
+                ens = cls(400.0, 400.0, 6)
+                ens.mechanical_simulation_step_calculate_forces()
+                eng = ens._engine
+                self.assertEqual((eng.config.lees_edwards, eng.config.strain_only_while_shearing), (le, held))
+                ens.use_lees_edwards = not le          # another configuration: another engine
+                ens.mechanical_simulation_step_calculate_forces()
+                self.assertIsNot(ens._engine, eng)
+                self.assertEqual(ens._engine.config.lees_edwards, not le)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -26,7 +26,7 @@ class EngineStep:
     Hooks, read when an engine is made (its configuration, :class:`~particleShear.engine.config.EngineConfig`):
     :meth:`_lees_edwards` (images offset by ``Ly·γ``; part of the engine's key, so a change of
     ``use_lees_edwards`` makes a new engine) and :attr:`_strain_only_while_shearing` (γ += γ̇·dt only
-    while ``applyingShear``; a class attribute).
+    while ``applyingShear``; a class attribute, also in the key).
     """
 
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
@@ -49,7 +49,8 @@ class EngineStep:
     def _engine_view_key(self):
         return (self._block_version, self._params_version, self._rng, float(getattr(self, "k", 0.0)),
                 float(getattr(self, "nu", 0.0)), float(getattr(self, "k_t", 0.0)), float(getattr(self, "nu_t", 0.0)),
-                float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"), self._lees_edwards())
+                float(self.size_x), float(self.size_y), getattr(self, "integrator", "euler"), self._lees_edwards(),
+                bool(self._strain_only_while_shearing))
 
     def _step_engine(self):
         """The ensemble's engine, kept in the memo under :meth:`_engine_view_key` (the block fitted
