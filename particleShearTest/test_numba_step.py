@@ -122,6 +122,34 @@ class TestCompiledStepBits(unittest.TestCase):
         self.assert_same_engines(*engines)
         self.assertGreater(engines[1].pairs_of(0).birth.max(), 0)
 
+    def test_plain_periodic_and_held_strain(self):
+        """Plain periodic cells (no Lees-Edwards images) with the strain held while not shearing, then
+        advancing while shearing, at a nonzero rate, in blocks and step by step: compiled (the NumPy
+        force phase never runs) with NumPy's bits."""
+        import contextlib
+        from unittest import mock
+
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        engines = []
+        for backend in ("numpy", "numba"):
+            ens = [constituted(51 + k, **FRICTIONAL)[1] for k in range(2)]
+            eng = BatchEngine(state_from_ensembles(ens, backend=backend), lees_edwards=False,
+                              strain_only_while_shearing=True)
+            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            with numpy_phase if backend == "numba" else contextlib.nullcontext():
+                for applying in (False, True):
+                    eng.s.applying_shear = applying
+                    eng.set_rate(np.array([300.0, -500.0]))
+                    eng.steps(30, 0.999, ens[0].dt)
+                    for _ in range(3):
+                        eng.step(0.999, ens[0].dt)
+            engines.append(eng)
+        self.assert_same_engines(*engines)
+        self.assertTrue(np.all(engines[1].s.gamma != 0.0))       # (it advanced while shearing)
+
     def test_guard_in_blocks_reports_the_first_failure(self):
         """Three replicas stepped far above the stable step in compiled blocks (each replica to its own
         next rebuild), the last one also kicked: replica 0 diverges at the guard's second check, the

@@ -69,7 +69,7 @@ SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
 _ARGUMENTS = ("i i i i f f b b b b i b f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
               "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
-              "f[:] f[:] f[:] f[:] f[:] f[:] "                       # rate … V
+              "f[:] f[:] f[:] f[:] f[:] f[:] f[:] f[:] "             # rate … V, le, adv
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
               "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
               "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
@@ -133,7 +133,8 @@ def threads():
 def reason(engine):
     """Why this engine's step cannot run in the compiled code (a short text), or None when it can.
 
-    Covered: both integrators, every replica Lees-Edwards with its strain advancing, replicas with
+    Covered: both integrators, Lees-Edwards and plain periodic replicas (:attr:`~particleShear.engine.step.BatchEngine.lees_edwards`),
+    strains advancing or held (:attr:`~particleShear.engine.step.BatchEngine.strain_advances`), replicas with
     and without friction and bonds, the spheres sharing their replica's parameters, the linear law
     from the prepared constants or a run's contact law of :data:`COMPILED_LAWS`, the tensile law
     of bonds, no force register, a sample of the two shear stresses (not
@@ -150,8 +151,6 @@ def reason(engine):
     """
     if engine.keep_terms:
         return "the force register keeps the terms of each visit"
-    if engine.lees_edwards is not None or engine.strain_advances is not None:
-        return "a plain periodic replica, or a strain held while not shearing"
     C, s = engine.C, engine.s
     for a in (s.pos, s.vel, s.frc, s.phi, s.r, engine.mmi, C.f, C.i, C.b):
         if not (type(a) is np.ndarray and a.flags.c_contiguous and a.flags.writeable):
@@ -257,7 +256,7 @@ def _segment_sum(a, lo, hi):
 def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free, verlet,
                  pred, half, half_out,
            pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
-           rate, gamma, t, Lx, Ly, V,
+           rate, gamma, t, Lx, Ly, V, le, adv,
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
            u, u_max, strain, bound, r_max, skin,
            guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
@@ -290,7 +289,7 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
         for p in range(P0, P1):
             b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
             dx, dy, ky, kx = _min_image_pair(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[_ILX, p], Cf[_ILY, p],
-                                   Ly[b] * gamma[b])
+                                   Ly[b] * gamma[b] * le[b])
             d = np.sqrt(dx * dx + dy * dy)
             coincident = coincident or d == 0.0
             dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
@@ -325,7 +324,7 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 nx, ny = nxs[p], nys[p]
             else:
                 nx, ny = dxs[p] / d, dys[p] / d
-            dvx = -(Cf[_ILY, p] * rate[b]) * kys[p]
+            dvx = -(Cf[_ILY, p] * (rate[b] * le[b])) * kys[p]
             if pred[b]:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
                 vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
                 vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
@@ -438,11 +437,11 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     for b in range(b0, b1):
         largest = -math.inf
         for k in range(b * N, (b + 1) * N):
-            u[0, k] += (vel[0, k] - yc[k] * rate[b]) * dt
+            u[0, k] += (vel[0, k] - yc[k] * (rate[b] * le[b])) * dt
             u[1, k] += vel[1, k] * dt
             largest = _nan_max(largest, u[0, k] * u[0, k] + u[1, k] * u[1, k])
         u_max[b] = _nan_max(u_max[b], np.sqrt(largest))
-        strain[b] += abs(rate[b]) * dt
+        strain[b] += abs(rate[b] * le[b]) * dt
         bound[b] = verlet_bound(u_max[b], strain[b], r_max[b])
     for k in range(n0, n1):
         pos[0, k] += vel[0, k] * dt
@@ -451,22 +450,22 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     # strain, wrap (box.wrap element by element: a sphere moved by a period in y takes the flow's
     # velocity difference), clock
     for b in range(b0, b1):
-        gamma[b] = gamma[b] + rate[b] * dt
+        gamma[b] = gamma[b] + rate[b] * dt * adv[b]
     for k in range(n0, n1):
         b = rep_s[k]
         y0[k] = pos[1, k]
         for q in range(MAX_PASSES + 1):
             if q == MAX_PASSES:
                 pos[1, k], up = folded(pos[1, k], Ly_s[k], 0.0, Ly_s[k])
-                pos[0, k] -= (Ly[b] * gamma[b]) * up
+                pos[0, k] -= (Ly[b] * gamma[b] * le[b]) * up
                 break
             up = period_count(pos[1, k], Ly_s[k], 0.0)
             if up == 0.0:
                 break
             pos[1, k] -= Ly_s[k] * up
-            pos[0, k] -= (Ly[b] * gamma[b]) * up
+            pos[0, k] -= (Ly[b] * gamma[b] * le[b]) * up
         if pos[1, k] != y0[k]:
-            vel[0, k] += (pos[1, k] - y0[k]) * rate[b]
+            vel[0, k] += (pos[1, k] - y0[k]) * (rate[b] * le[b])
     for k in range(n0, n1):
         Lxk = Lx[rep_s[k]]
         for q in range(MAX_PASSES + 1):
@@ -671,6 +670,9 @@ class _Workspace:
         self.Ly_s = per_sphere(engine.Ly_s)
         self.rep_s = np.array(s.rep, dtype=np.int64)
         self.V, self.Lx, self.Ly, self.kk = (per_replica(a) for a in (engine.V, s.Lx, s.Ly, s.k))
+        # the factors of the image offset and rate (1 for Lees-Edwards, 0 for a plain periodic replica)
+        # and of the strain's advance (0 where it is held): x·1.0 is x, so the products are NumPy's numbers
+        self.le, self.adv = (per_replica(1.0 if a is None else a) for a in (engine.lees_edwards, engine.strain_advances))
         self.r_max, self.skin = per_replica(engine.r_max), per_replica(engine.skin)
         self.r_mean = s.r.reshape(B, N).mean(axis=1)
         self.m_sum = s.m.reshape(B, N).sum(axis=1)
@@ -800,7 +802,8 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
     ws.need[:] = engine.need        # (a replica a block skips keeps its flag)
     args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
             ws.form, ws.custom, ws.law_rows, free_mode, free, verlet, pred, half, new_half, s.pos, s.vel, s.frc, s.phi,
-            engine.mmi, s.r, ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, C.f, C.i, C.b, ws.offsets, state_p,
+            engine.mmi, s.r, ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, ws.le, ws.adv, C.f, C.i, C.b,
+            ws.offsets, state_p,
             xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
@@ -1064,7 +1067,7 @@ def compile_search_kernel(cache=True):
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
                   interval, guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A,
                   free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma,
-                  t, Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound,
+                  t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound,
                   r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
                   tau, verdict, need):
     """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
@@ -1098,7 +1101,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
             due_check = guarded and (step0 + k) % interval == 0
             st = _step_kernel(start, b, b + 1, N, cool, dt, scheduled, due_check, applying, numbers, form, custom, A,
                               free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
-                              rate, gamma, t, Lx, Ly, V, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
+                              rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
                               u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
                               max_ke, work, mob, yc, y0, zero, tau, verdict, need)
             start = 0
