@@ -122,6 +122,41 @@ class TestCompiledStepBits(unittest.TestCase):
         self.assert_same_engines(*engines)
         self.assertGreater(engines[1].pairs_of(0).birth.max(), 0)
 
+    def test_spheres_with_their_own_parameters(self):
+        """Spheres with parameters of their own (a repulsion coefficient, permanent ratios, kept
+        viscosities differing between the spheres of a replica, beside a replica whose spheres share
+        theirs): each visit of a relation sees its own sphere's constants, the central force on j is
+        that of j's visit; compiled (the NumPy force phase never runs) with NumPy's bits, the sampled
+        stresses included."""
+        import contextlib
+        from unittest import mock
+
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        engines, samples = [], []
+        for backend in ("numpy", "numba"):
+            ens = [constituted(61, **FRICTIONAL_BONDS)[1], constituted(62, **FRICTIONAL_BONDS)[1]]
+            for k, sphere in enumerate(ens[0].sphereList[:9]):
+                sphere.central_repulsion_coefficient = 0.5 + 0.05 * k
+                sphere.permanent_ratio_central = 1.0 + 0.2 * k
+                sphere.permanent_ratio_tangential = 2.0 - 0.1 * k
+                sphere.keep_viscosity_coefficients_constant = bool(k % 2)
+            s = state_from_ensembles(ens, backend=backend)
+            self.assertIsNotNone(s.visit)
+            eng = BatchEngine(s)
+            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            with numpy_phase if backend == "numba" else contextlib.nullcontext():
+                eng.set_rate(np.array([400.0, -300.0]))
+                eng.steps(40, 0.999, ens[0].dt)
+                samples.append([eng.step(0.999, ens[0].dt, sample=True) for _ in range(5)])
+            engines.append(eng)
+        self.assertIsNotNone(engines[1].C.Kj)
+        self.assert_same_engines(*engines)
+        for a, b in zip(*samples):
+            np.testing.assert_array_equal(_bits(np.array(a)), _bits(np.array(b)))
+
     def test_plain_periodic_and_held_strain(self):
         """Plain periodic cells (no Lees-Edwards images) with the strain held while not shearing, then
         advancing while shearing, at a nonzero rate, in blocks and step by step: compiled (the NumPy

@@ -67,7 +67,7 @@ SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
-_ARGUMENTS = ("i i i i f f b b b b i b f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
+_ARGUMENTS = ("i i i i f f b b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
               "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
               "f[:] f[:] f[:] f[:] f[:] f[:] f[:] f[:] "             # rate … V, le, adv
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
@@ -135,7 +135,8 @@ def reason(engine):
 
     Covered: both integrators, Lees-Edwards and plain periodic replicas (:attr:`~particleShear.engine.step.BatchEngine.lees_edwards`),
     strains advancing or held (:attr:`~particleShear.engine.step.BatchEngine.strain_advances`), replicas with
-    and without friction and bonds, the spheres sharing their replica's parameters, the linear law
+    and without friction and bonds, spheres with parameters of their own under the linear law (the
+    visit from j with its own constants, ``C.Kj``), the linear law
     from the prepared constants or a run's contact law of :data:`COMPILED_LAWS`, the tensile law
     of bonds, no force register, a sample of the two shear stresses (not
     the whole tensors).
@@ -155,9 +156,9 @@ def reason(engine):
     for a in (s.pos, s.vel, s.frc, s.phi, s.r, engine.mmi, C.f, C.i, C.b):
         if not (type(a) is np.ndarray and a.flags.c_contiguous and a.flags.writeable):
             return "state arrays that are not writable C-contiguous NumPy arrays"
-    if C.Kj is not None:
-        return "spheres with parameters of their own"
     central, tensile = force_phase_laws(s, C)
+    if C.Kj is not None and central is not None:
+        return "spheres with parameters of their own under a contact law of the laws folder"
     if tensile is not None or (central is not None and s.law is None):
         return "a law callback of the documented classes"
     if central is not None and s.law not in COMPILED_LAWS:
@@ -253,7 +254,8 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
-def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, free_mode, free, verlet,
+def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, visit_j, form_j, Tj,
+                 free_mode, free, verlet,
                  pred, half, half_out,
            pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
            rate, gamma, t, Lx, Ly, V, le, adv,
@@ -280,7 +282,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     P0, P1 = offsets[b0], offsets[b1]
     n0, n1 = b0 * N, b1 * N
     T = Cf[_T0:_T0 + 12]
-    k_t_j, nu_t_j = T[8], T[9]
+    # the visit from j: its own constants where spheres have parameters of their own (visit_j), else i's
+    k_t_j, nu_t_j = (Tj[8], Tj[9]) if visit_j else (T[8], T[9])
     dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
                                                              work[6], work[7], work[8], work[9], work[10])
     if start != 1:
@@ -348,15 +351,26 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
             state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
             ft = (F_i + F_j) * 0.5
             fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
-            nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx, fy
+            fx_j, fy_j = fx, fy
+            if visit_j:       # j receives the central force of its own visit (PairConstants.set_visits)
+                fn_j = pair_term(form_j, d, vn, vt, touching, rel, xi[0, p], xi[1, p], Tj[0, p], Tj[1, p], Tj[2, p],
+                                 Tj[3, p], Tj[4, p], Tj[5, p], Tj[6, p], Tj[7, p], Tj[8, p], Tj[9, p], Tj[10, p],
+                                 Tj[11, p], k_t_j[p], nu_t_j[p], False, False,
+                                 (A[0, 0], A[1, 0], A[2, 0], A[3, 0], A[4, 0], A[5, 0], A[6, 0], A[7, 0]))[0]
+                fx_j, fy_j, _, _ = pair_forces(fn_j, ft, nx, ny, d, None)
+            nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx_j, fy_j
             frc[0, i] += fx
             frc[1, i] += fy
             frc[2, i] += dF * Cf[_IWI, p]
             dFs[p] = dF
             if sample:
                 internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
-                work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
-                                                                   dys[p], fx, dF, None)
+                if visit_j:
+                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                       dys[p], fx, dF, fx_j)
+                else:
+                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                       dys[p], fx, dF, None)
             if check:
                 verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
         # the scatter's second half: −F on j and the torque on j, in pair order
@@ -680,6 +694,12 @@ class _Workspace:
         self.guarded = bool(engine.guard.any())
         self.max_ke = math.nan if engine.max_kinetic_energy is None else float(engine.max_kinetic_energy)
         self.form = numba_driver.FORMS[C.form]
+        # the constants of the visit from j where spheres have parameters of their own (C.Kj)
+        Kj = C.Kj
+        self.visit_j = Kj is not None
+        self.form_j = numba_driver.FORMS[Kj.form] if Kj is not None else self.form
+        self.Tj = np.zeros((len(forces.PairConstants.TERM_ROWS), 1)) if Kj is None else np.ascontiguousarray(
+            [np.broadcast_to(np.asarray(getattr(Kj, n), dtype=float), (C.P,)) for n in forces.PairConstants.TERM_ROWS])
         self.offsets = np.array(C.offsets, dtype=np.int64)
         # the run's law (run_law): its function and its arguments per candidate, rows of law_rows
         got = run_law(s, C) if self.why is None else None
@@ -801,7 +821,8 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
     new_half = ws.no_half if not verlet else np.empty((3, s.B * s.N)) if half_out is None else half_out
     ws.need[:] = engine.need        # (a replica a block skips keeps its flag)
     args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
-            ws.form, ws.custom, ws.law_rows, free_mode, free, verlet, pred, half, new_half, s.pos, s.vel, s.frc, s.phi,
+            ws.form, ws.custom, ws.law_rows, ws.visit_j, ws.form_j, ws.Tj, free_mode, free, verlet, pred, half,
+            new_half, s.pos, s.vel, s.frc, s.phi,
             engine.mmi, s.r, ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, ws.le, ws.adv, C.f, C.i, C.b,
             ws.offsets, state_p,
             xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
@@ -1066,9 +1087,9 @@ def compile_search_kernel(cache=True):
 
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
                   interval, guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A,
-                  free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma,
-                  t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth, u, u_max, strain, bound,
-                  r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
+                  visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s,
+                  rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth,
+                  next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
                   tau, verdict, need):
     """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
 
@@ -1100,9 +1121,9 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                 rec_rate[row + k, b] = rate[b]
             due_check = guarded and (step0 + k) % interval == 0
             st = _step_kernel(start, b, b + 1, N, cool, dt, scheduled, due_check, applying, numbers, form, custom, A,
-                              free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s, rep_s,
-                              rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
-                              u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
+                              visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
+                              mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p,
+                              xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
                               max_ke, work, mob, yc, y0, zero, tau, verdict, need)
             start = 0
             if st != _DONE:
