@@ -379,6 +379,33 @@ class TestCompiledSearch(unittest.TestCase):
         self.assertEqual(grids, {True, False})
 
 
+    def test_history_merge_same_rows(self):
+        """The history merge compiled (``state.carried_rows``, the same function) gives NumPy's keys
+        and rows: random tables of 0 … 5,000 keys, kept subsets (bonds, relations) that the new
+        candidates miss or hold, new keys unsorted with repeats or sorted and unique, the compiled
+        function also above the size where :func:`numba_step.carried` hands over to NumPy."""
+        from particleShear.engine import state
+        rng = np.random.default_rng(2)
+        compiled = numba_step.compile_carried_kernel()
+        for t in range(300):
+            old = np.unique(rng.integers(0, 9000, int(rng.integers(0, 5000)))).astype(np.int64)
+            kept = old[rng.random(len(old)) < rng.random()] if len(old) else old
+            k = rng.integers(0, 9000, int(rng.integers(0, 5000))).astype(np.int64)
+            if t % 2:
+                k = np.unique(k)
+            want = state.carried_rows(old, kept, k)
+            with self.subTest(t=t):
+                for got in (numba_step.carried(old, kept, k), compiled(old, kept, k, state._MERGE_MIN),
+                            compiled(old, kept, k, 2 ** 62)):
+                    np.testing.assert_array_equal(got[0], want[0])
+                    np.testing.assert_array_equal(got[1], want[1])
+                self.assertTrue(np.all(np.diff(want[0]) > 0))
+                self.assertTrue(np.isin(kept, want[0]).all())           # every kept key stays
+                carried = want[1] < len(old)
+                np.testing.assert_array_equal(old[want[1][carried]], want[0][carried])   # each reads its own row
+                self.assertFalse(np.isin(want[0][~carried], old).any())  # and only new keys read none
+
+
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestOneFunctionTwoDrivers(unittest.TestCase):
     def test_compiled_functions_are_the_modules_functions(self):

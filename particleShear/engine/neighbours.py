@@ -367,7 +367,7 @@ def near_pairs(x, y, r, Lx, Ly, shift, skin):
     return near_pairs_all(x, y, r, Lx, Ly, shift, skin)
 
 
-def build_candidates(x, y, r, Lx, Ly, shift, skin, old, search=None):
+def build_candidates(x, y, r, Lx, Ly, shift, skin, old, search=None, rows=None):
     """Make the near pairs of one replica its candidates, keeping the history of those that stay.
 
     Parameters
@@ -383,6 +383,9 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old, search=None):
     search : callable, optional
         The search, with the arguments and result of :func:`near_pairs` (default :func:`near_pairs`;
         the compiled backend's gives the same pairs).
+    rows : callable, optional
+        The history merge (:func:`~particleShear.engine.state.carried_rows`, default; the compiled
+        backend passes it compiled).
 
     Returns
     -------
@@ -391,7 +394,7 @@ def build_candidates(x, y, r, Lx, Ly, shift, skin, old, search=None):
         ``(i, j)`` order; a pair that stays a candidate keeps its state, ξ, ``d_eq``, relation and
         creation number, a new one starts at rest.
     """
-    old.replace(*(search or near_pairs)(x, y, r, Lx, Ly, shift, skin), keep_relations=False)
+    old.replace(*(search or near_pairs)(x, y, r, Lx, Ly, shift, skin), keep_relations=False, rows=rows)
     return old
 
 

@@ -53,8 +53,8 @@ _TERM_START = PairConstants.FLOAT_ROWS.index(TERM_BLOCK[0])     # where they sta
 assert PairConstants.FLOAT_ROWS[_TERM_START:_TERM_START + len(TERM_BLOCK)] == TERM_BLOCK
 
 #: the engine modules whose functions the compiled loops run (the cache folder is keyed by their sources)
-SOURCE_MODULES = ("laws", "terms", "tangential", "xp", "box", "integrate", "guard", "forces", "neighbours", "numba_driver",
-                  "numba_step")
+SOURCE_MODULES = ("laws", "terms", "tangential", "xp", "box", "integrate", "guard", "forces", "neighbours", "state",
+                  "numba_driver", "numba_step")
 _registered = set()     # the helpers registered with Numba (their ids)
 _kernels = {}           # cache flag -> compiled kernel
 

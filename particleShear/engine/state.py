@@ -61,7 +61,7 @@ def _merge(k, extra):
     (``np.insert`` at the sorted positions, without its overhead on small arrays)."""
     at = np.searchsorted(k, extra) + np.arange(len(extra))
     out = np.empty(len(k) + len(extra), dtype=k.dtype)
-    rest = np.ones(len(out), dtype=bool)
+    rest = np.ones(len(out), dtype=np.bool_)
     rest[at] = False
     out[at] = extra
     out[rest] = k
@@ -73,7 +73,7 @@ def _merge(k, extra):
 _MERGE_MIN = 2000
 
 
-def _positions(a, v):
+def _positions(a, v, merge_min=_MERGE_MIN):
     """``np.searchsorted(a, v)`` (left side) of the sorted array ``v`` in the sorted array ``a``, by one merge.
 
     A stable sort of ``v`` followed by ``a`` merges two sorted runs (O(n) in NumPy's timsort, about
@@ -85,21 +85,78 @@ def _positions(a, v):
     ----------
     a, v : ndarray of int (n,), (m,)
         Sorted keys (repeats allowed).
+    merge_min : int, default :data:`_MERGE_MIN`
+        Keys in all from which it merges (compiled code passes more than any table holds: its
+        binary searches have no call overhead, and its sorts are slower than NumPy's).
 
     Returns
     -------
     ndarray of intp (m,)
         Index of the first element of ``a`` not below each ``v[m]``.
     """
-    if len(a) + len(v) < _MERGE_MIN:
+    if len(a) + len(v) < merge_min:
         return np.searchsorted(a, v)
-    order = np.argsort(np.concatenate((v, a)), kind="stable")
+    order = np.argsort(np.concatenate((v, a)), kind="mergesort")     # (stable: NumPy's "stable")
     return np.flatnonzero(order < len(v)) - np.arange(len(v))
 
 
 def _increasing(k, strict=True):
     """True if the 1-D array ``k`` is sorted (strictly: also without repeats); O(n), no sort."""
-    return len(k) < 2 or bool((k[1:] > k[:-1]).all() if strict else (k[1:] >= k[:-1]).all())
+    if len(k) < 2:
+        return True
+    return bool((k[1:] > k[:-1]).all()) if strict else bool((k[1:] >= k[:-1]).all())
+
+
+def carried_rows(old_key, kept, k, merge_min=_MERGE_MIN):
+    """The keys of a new candidate set and the old row each of them carries: the history merge of
+    :meth:`PairTable.replace`.
+
+    The new keys ``k`` (any order, repeats allowed) are sorted and made unique; the kept old keys
+    that ``k`` misses (bonds stretched beyond the search reach, relations) are merged in, in O(n)
+    (a union would sort the whole set anew, ≈ 60 ms of a rebuild at N = 100,000); each resulting
+    key reads its old row, a key new to the table the row ``len(old_key)`` (the zero appended after
+    the old rows: one gather per field instead of a gather and a scatter, ≈ 0.3 ms of a rebuild at
+    N = 10,000).  Written in the array operations Numba compiles as they stand: the compiled
+    backend runs this very function compiled (:func:`~particleShear.engine.numba_step.carried`).
+
+    Parameters
+    ----------
+    old_key : ndarray of int64 (n,)
+        The table's keys ``i << 32 | j``, sorted and unique.
+    kept : ndarray of int64 (m,)
+        Old keys to keep although ``k`` may miss them, sorted (a subset of ``old_key``).
+    k : ndarray of int64 (p,)
+        The new candidates' keys.
+    merge_min : int, default :data:`_MERGE_MIN`
+        As :func:`_positions`.
+
+    Returns
+    -------
+    key : ndarray of int64
+        The sorted unique keys of the new table.
+    src : ndarray of int64
+        The old row of each key, ``len(old_key)`` for a pair new to the table.
+    """
+    if not _increasing(k):          # (a search's pairs come sorted and unique: no sort)
+        k = np.sort(k)
+        if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
+            k = np.unique(k)
+    if len(kept):
+        at = _positions(k, kept, merge_min)
+        found = at < len(k)
+        found[found] = k[at[found]] == kept[found]
+        if not found.all():
+            extra = kept[~found]
+            if _increasing(extra, False):     # (the table's keys are sorted: no sort)
+                extra = extra[np.concatenate((np.ones(1, np.bool_), extra[1:] != extra[:-1]))]
+            else:
+                extra = np.unique(extra)
+            k = _merge(k, extra)
+    n = len(old_key)
+    pos = _positions(old_key, k, merge_min)
+    pos_c = np.minimum(pos, max(n - 1, 0))
+    had = (pos < n) & (old_key[pos_c] == k) if n else np.zeros(len(k), np.bool_)
+    return k, np.where(had, pos_c, n).astype(np.int64)
 
 
 class PairTable:
@@ -297,7 +354,7 @@ class PairTable:
         slots = np.flatnonzero(m)
         return slots[np.argsort(self.birth[slots], kind="stable")]
 
-    def replace(self, i, j, keep_existing=False, keep_relations=True):
+    def replace(self, i, j, keep_existing=False, keep_relations=True, rows=None):
         """Make (i, j) the candidate set, keeping the history of the pairs present before.
 
         Bonds are always kept, also where (i, j) misses them (a bond stretched beyond the search
@@ -314,35 +371,16 @@ class PairTable:
         keep_relations : bool, default True
             Keep the relations that (i, j) misses (the engine's lists keep only bonds: a relation
             out of its reach ended).
+        rows : callable, optional
+            ``rows(old_key, kept, k)`` → ``(key, src)``: :func:`carried_rows` (default), or the same
+            function compiled (:func:`~particleShear.engine.numba_step.carried`, the compiled backend's).
         """
         old_key = self.key
         k = _key(np.minimum(i, j), np.maximum(i, j))
-        if not _increasing(k):          # (a search's pairs come sorted and unique: no sort)
-            k = np.sort(k)
-            if len(k) > 1 and np.count_nonzero(k[1:] == k[:-1]):
-                k = np.unique(k)
         # rows to keep that the new candidates miss (e.g. bonds stretched beyond the search reach)
         bond = self.state == PERMANENT
         kept = old_key if keep_existing else old_key[np.flatnonzero((self.active | bond) if keep_relations else bond)]
-        if len(kept):
-            at = _positions(k, kept)
-            found = at < len(k)
-            found[found] = k[at[found]] == kept[found]
-            if not found.all():
-                # the few kept keys merged into the sorted unique candidates: an O(n) insert (a
-                # union1d sorts the whole set anew, ≈ 60 ms of a rebuild at N = 100,000)
-                extra = kept[~found]
-                if _increasing(extra, strict=False):     # (the table's keys are sorted: no sort)
-                    extra = extra[np.concatenate(((True,), extra[1:] != extra[:-1]))]
-                else:
-                    extra = np.unique(extra)
-                k = _merge(k, extra)
-        pos = _positions(old_key, k)
-        pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
-        had = (pos < len(old_key)) & (old_key[pos_c] == k) if len(old_key) else np.zeros(len(k), bool)
-        # each row reads its old row; a new pair reads the zero appended after the old rows (one gather
-        # per field instead of a gather and a scatter: ≈ 0.3 ms of a rebuild at N = 10,000)
-        src = np.where(had, pos_c, len(old_key))
+        k, src = (rows or carried_rows)(old_key, kept, k)
         self.i = (k >> 32).astype(np.intp)
         self.j = (k & 0xFFFFFFFF).astype(np.intp)
         for name, dtype in (("state", np.int8), ("d_eq", float), ("active", bool), ("birth", np.int64)):

@@ -316,11 +316,12 @@ class BatchEngine:
         pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
         gamma = to_host(s.gamma, "rebuild")
         r, Lx, Ly, skin = self.host_consts
-        search = numba_step.search if be.compiled else None      # (the same pairs, the same grid, compiled)
+        # (compiled: the same pairs from the same grid, the same history merge)
+        search, rows = (numba_step.search, numba_step.carried) if be.compiled else (None, None)
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
             s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], Ly[b] * gamma[b], skin[b],
-                                          s.pairs[b], search)
+                                          s.pairs[b], search, rows)
             self.rebuilds[b] += 1
         due = be.asarray(need)
         self.bound = xp.where(due, 0.0, self.bound)
