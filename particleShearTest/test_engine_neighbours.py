@@ -204,3 +204,31 @@ class TestEngineWithTheCellList(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestPlainPeriodicImages(unittest.TestCase):
+    """A plain periodic cell (``lees_edwards=False``, the documented ``use_lees_edwards = False``) has
+    its y images at the same x whatever the strain: two spheres overlapping across ``y = 0 / Ly``
+    are a candidate and a relation at γ = 0.3 as at γ = 0, on every host backend (the search takes
+    the force phase's image offset, 0 here, not ``Ly·γ``)."""
+
+    def test_contact_across_the_y_edge_at_any_strain(self):
+        from particleShear.engine import numba_driver
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_invariants import random_ensemble
+
+        for backend in ("numpy", "numba") if numba_driver.available() else ("numpy",):
+            for gamma in (0.0, 0.3):
+                with self.subTest(backend=backend, gamma=gamma):
+                    e = random_ensemble(2, 1000.0, seed=3, packing_fraction=0.05)
+                    s = state_from_ensembles([e], backend=backend)
+                    s.pos[:, 0], s.pos[:, 1] = (500.0, 1.0), (500.0, 999.0)    # 2 µm apart through the edge
+                    self.assertLess(2.0, s.r[0] + s.r[1])
+                    s.vel[...] = 0.0
+                    s.gamma = np.array([gamma])
+                    eng = BatchEngine(s, guard=False, lees_edwards=False)
+                    eng.set_rate(np.zeros(1))
+                    eng.step(1.0, 1e-9)
+                    p = eng.pairs_of(0)
+                    self.assertEqual((list(p.i), list(p.j)), ([0], [1]))
+                    self.assertTrue(p.active[0])

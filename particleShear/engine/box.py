@@ -214,8 +214,8 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
     ``[0, Lx)``.  The velocity correction is the reference's ``vx += (y' − y)·γ̇`` with ``y`` and
     ``y'`` the heights before and after the wrap (exactly ``∓Ly·γ̇`` for one crossing; the
     same number as the reference's also for several), on the spheres that moved: the others keep
-    their velocity to the bit (a ``−0.0`` included), so a replica's trajectory does not depend on
-    whether a sphere of another replica of its batch crossed.
+    their x and velocity to the bit (a ``−0.0`` included, whatever the offset), so a replica's
+    trajectory does not depend on whether a sphere of another replica of its batch crossed.
 
     Parameters
     ----------
@@ -260,11 +260,11 @@ def wrap(x, y, vx, Lx, Ly, shift, rate):
                 y0 = y.copy()
             moved = True
         y -= Ly * up
-        x -= shift * up
+        x[...] = xp.where(up != 0, x - shift * up, x)     # (a sphere not moved keeps its x to the bit)
     else:  # absurd coordinate (or a device, which ran every pass): fold what is still outside at once
         y[...], up = _fold(y, Ly, 0.0, Ly, xp)
         with _quiet_invalid(xp):
-            x -= shift * up
+            x[...] = xp.where(up != 0, x - shift * up, x)
     if y0 is not None:      # a sphere moved by a period takes the flow's velocity difference; the others keep theirs
         with _quiet_invalid(xp):
             vx[...] = xp.where(y != y0, vx + (y - y0) * rate, vx)

@@ -910,7 +910,9 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
     Raises
     ------
     EngineInstability
-        When the guard finds a guarded replica unstable.
+        When the guard finds a guarded replica unstable: the step and replica of the step-by-step
+        loop, but the engine is then left as a failed run leaves it (replicas stepped past that
+        step within the block, the records written beyond it): a run stops there.
     """
     scheduled = rates is not None
     if scheduled:

@@ -86,8 +86,8 @@ def _positions(a, v, merge_min=_MERGE_MIN):
     a, v : ndarray of int (n,), (m,)
         Sorted keys (repeats allowed).
     merge_min : int, default :data:`_MERGE_MIN`
-        Keys in all from which it merges (compiled code passes more than any table holds: its
-        binary searches have no call overhead, and its sorts are slower than NumPy's).
+        Keys in all from which it merges (a parameter so that compiled code may choose otherwise;
+        the result is the same either way).
 
     Returns
     -------

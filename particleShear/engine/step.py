@@ -314,14 +314,15 @@ class BatchEngine:
             self._sync_down(changed)     # the history the rebuilt lists carry over
         rows = np.concatenate([np.arange(b * s.N, (b + 1) * s.N) for b in changed])
         pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
-        gamma = to_host(s.gamma, "rebuild")
+        # the images' offset the force phase sees: Ly·γ, 0 for a plain periodic replica (lees_edwards)
+        shift = to_host(self._image_shift(), "rebuild")
         r, Lx, Ly, skin = self.host_consts
         # (compiled: the same pairs from the same grid, the same history merge)
-        search, rows = (numba_step.search, numba_step.carried) if be.compiled else (None, None)
+        search, merge = (numba_step.search, numba_step.carried) if be.compiled else (None, None)
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
-            s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], Ly[b] * gamma[b], skin[b],
-                                          s.pairs[b], search, rows)
+            s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b],
+                                          s.pairs[b], search, merge)
             self.rebuilds[b] += 1
         due = be.asarray(need)
         self.bound = xp.where(due, 0.0, self.bound)
