@@ -129,8 +129,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
     check_observers(observers)
     s = engine.s
     s.applying_shear = True
-    engine.phase = "pre-equilibration"
-    engine.step_count = 0
+    engine.begin_phase("pre-equilibration")
     blocks = pre_equilibration_blocks(N, dt, dt_max)
     total = sum(b[0] for b in blocks) + 3 * int(N)
     say("Pre-equilibration under experimental conditions, Steps per dt: " + str(N) + " max dt " + str(dt_max)

@@ -126,10 +126,8 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
         rec["N1"][...] = math.nan
     if keep_tensors:
         rec["tensors"] = xp.empty((n_steps, s.B, len(TENSORS), 2, 2))
-    engine.record = rec        # what observers read of the record (the rows written so far)
     say("Start application shear protocol, total N= " + str(n_steps if total is None else total) + " steps")
-    engine.phase = "protocol"
-    engine.step_count = 0
+    engine.begin_phase("protocol", rec)        # (observers read the record's rows written so far)
     i = 0
     pending = []        # rates of a block's steps that the compiled block left to the loop below
     while i < n_steps:
@@ -169,5 +167,5 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
         notify(observers, engine, "protocol", i + 1, n_steps)
         i += 1
     engine.flush()
-    engine.record = None
+    engine.end_phase()
     return {name: to_host(v, "series") for name, v in rec.items()}

@@ -225,7 +225,9 @@ class BatchEngine:
         self.step_count = 0
         #: ``next_birth``: the number the next relation of each replica gets (:attr:`numbers_relations`)
         self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
-        self.phase = phase        # (the loops set it as they run: run state, not configuration)
+        self.phase = phase        # (run state, not configuration: begin_phase sets it as the loops run)
+        #: the record of the running protocol (rows written so far; None outside one): what observers read
+        self.record = None
         self.rebuilds = np.zeros(B, dtype=np.int64)
 
     # -- the configuration, read-only -------------------------------------------------------------
@@ -431,6 +433,24 @@ class BatchEngine:
         if not s.applying_shear:
             return self.xp.ones(len(s.y), bool)
         return mobile_mask(s.r, s.y, self.Ly_s)
+
+    # -- the run state ---------------------------------------------------------------------------
+    def begin_phase(self, phase, record=None):
+        """Start a phase of a run: its name (the guard's reports name it), the step count from 0,
+        and the record observers read while it runs (None: none).
+
+        Parameters
+        ----------
+        phase : str
+            ``"pre-equilibration"`` or ``"protocol"``.
+        record : dict of ndarray, optional
+            The protocol's record (:func:`~particleShear.engine.rheometer.shear_record`).
+        """
+        self.phase, self.step_count, self.record = phase, 0, record
+
+    def end_phase(self):
+        """End a phase: the record is no longer the engine's to show (observers read None)."""
+        self.record = None
 
     # -- the step --------------------------------------------------------------------------------
     def set_rate(self, rate):
