@@ -810,7 +810,9 @@ def _prepared(engine):
 def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
     (:func:`_adopt`); ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
-    ``half_out``: the buffer of the new half kicks (default a new array, as ``half_kick`` gives)."""
+    ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
+    (``half`` is then the one handed back); default a new array per step, handed back itself (as
+    ``half_kick`` gives)."""
     s, C = engine.s, engine.C
     gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
     state_p, xi, active, birth, next_birth, u, u_max, strain, bound, rate_max = (
@@ -832,8 +834,8 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
     held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
-                u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate, half_in=half,
-                half=new_half if verlet else None)
+                u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate,
+                half=None if not verlet else new_half if half_out is None else half)
     return args, held
 
 
@@ -948,7 +950,6 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
         args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out)
         _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
                            scheduled, *args)
-        held["half"] = held["half_in"]
         _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
         drawn = False
         for b in np.flatnonzero(going):
