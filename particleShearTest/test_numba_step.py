@@ -86,8 +86,8 @@ class TestCompiledStepBits(unittest.TestCase):
                     self.assertTrue(np.any(e_nb.pairs_of(0).xi != 0.0))      # the ξ rule really ran
 
     def test_the_step_ran_compiled(self):
-        """The compiled step ran the steps (not the NumPy phases), but for the protocol's first and
-        last steps, which sample every tensor."""
+        """The compiled step ran every step of pre-equilibration and protocol (not the NumPy phases),
+        the protocol's first and last steps, which sample every tensor, included."""
         from unittest import mock
 
         from particleShear.engine.step import BatchEngine
@@ -101,8 +101,48 @@ class TestCompiledStepBits(unittest.TestCase):
 
         with mock.patch.object(BatchEngine, "force_phase", numpy_phase):
             eng, _ = _measure([(0, FRICTIONAL_BONDS)], "numba")
-        self.assertEqual(phases, ["tensors", "tensors"])
+        self.assertEqual(phases, [])
         self.assertGreater(eng.step_count, 250)
+
+    def test_every_tensor_sampled_compiled(self):
+        """Every tensor sampled at every step (a kept tensor history), in compiled blocks and in the
+        step-by-step path of a controller, and N1 every 7th step: the tensors, their N1 and the
+        series are NumPy's bits (the rows of :mod:`~particleShear.engine.stress` are summed per
+        replica in NumPy's order inside the compiled step), with the NumPy force phase never run;
+        the overall tensor's xy entry is −τ_internal and the external one's −τ_surface."""
+        import contextlib
+        from unittest import mock
+
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.rheometer import OVERALL, shear_record
+        from particleShear.engine.stress import EXTERNAL
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        for integrator in ("euler", "verlet"):
+            records = []
+            for backend in ("numpy", "numba"):
+                ens = [constituted(71, **FRICTIONAL_BONDS)[1], constituted(72, **FRICTIONAL)[1]]
+                eng = BatchEngine(state_from_ensembles(ens, backend=backend), integrator=integrator)
+                eng.s.applying_shear = True
+                rate_of = lambda i: np.array([300.0, -200.0]) * np.cos(0.01 * i)        # noqa: E731
+                numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+                with numpy_phase if backend == "numba" else contextlib.nullcontext():
+                    rec = shear_record(eng, ens[0].dt, 0.999, 90, rate_of, keep_tensors=True, end_tensors=True)
+                    rec_n1 = shear_record(eng, ens[0].dt, 0.999, 30, rate_of, tensors_every=7)
+                    ctl = shear_record(eng, ens[0].dt, 0.999, 12, rate_of, keep_tensors=True,
+                                       after_step=lambda i, a, b: None)         # (a controller: step by step)
+                records.append((rec, rec_n1, ctl))
+            for a, b in zip(*records):
+                self.assertEqual(sorted(a), sorted(b))
+                for key in a:
+                    with self.subTest(integrator=integrator, key=key):
+                        np.testing.assert_array_equal(_bits(a[key]), _bits(b[key]))
+            rec, rec_n1, _ = records[1]
+            self.assertGreater(np.abs(rec["tensors"]).max(), 0.0)
+            np.testing.assert_array_equal(_bits(rec["stress_internal"]), _bits(-rec["tensors"][:, :, OVERALL, 0, 1]))
+            np.testing.assert_array_equal(_bits(rec["stress_surface"]), _bits(-rec["tensors"][:, :, EXTERNAL, 0, 1]))
+            self.assertEqual(int(np.isfinite(rec_n1["N1"][:, 0]).sum()), 5)         # (steps 0, 7, … 28)
 
     def test_plates_off_relaxation_and_numbers(self):
         """The constitution's relaxation (plates off, μ = 0 blocks, drift removal) on the ensembles' own
@@ -150,12 +190,15 @@ class TestCompiledStepBits(unittest.TestCase):
             with numpy_phase if backend == "numba" else contextlib.nullcontext():
                 eng.set_rate(np.array([400.0, -300.0]))
                 eng.steps(40, 0.999, ens[0].dt)
-                samples.append([eng.step(0.999, ens[0].dt, sample=True) for _ in range(5)])
+                samples.append([eng.step(0.999, ens[0].dt, sample=True) for _ in range(5)]
+                               + [eng.step(0.999, ens[0].dt, sample="tensors") for _ in range(3)])
             engines.append(eng)
         self.assertIsNotNone(engines[1].C.Kj)
         self.assert_same_engines(*engines)
         for a, b in zip(*samples):
-            np.testing.assert_array_equal(_bits(np.array(a)), _bits(np.array(b)))
+            self.assertEqual(len(a), len(b))
+            for x, y in zip(a, b):
+                np.testing.assert_array_equal(_bits(np.asarray(x)), _bits(np.asarray(y)))
 
     def test_plain_periodic_and_held_strain(self):
         """Plain periodic cells (no Lees-Edwards images) with the strain held while not shearing, then

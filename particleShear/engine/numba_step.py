@@ -5,7 +5,9 @@ one call per step does the force phase (Lees-Edwards minimum image, relations an
 normals, relative velocities, the force terms of :func:`~.numba_driver.pair_term`, pair
 forces, the scatter in the order of ``bincount``, the per-replica shear sums when sampled, the
 stability guard when due), the kick with the plates and the damping, the sequential ξ rule, the
-displacement since the lists were built, the drift, the strain, the wrap and the clock.  Every
+displacement since the lists were built, the drift, the strain, the wrap and the clock; a step that
+samples every tensor also sums the rows of :mod:`~.stress` per replica (the maps of the sums to the
+tensors then run on NumPy, :func:`~.stress.tensors_from_sums`).  Every
 formula is a pure function of the NumPy engine called here on numbers
 (:data:`STEP_FUNCTIONS`: :func:`~.box.period_count`, :func:`~.box.folded`,
 :func:`~.integrate.velocity_change`, :func:`~.integrate.plate_velocity`, :func:`~.integrate.damped`,
@@ -32,7 +34,7 @@ import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, neighbours, numba_driver, state, terms
+from . import box, forces, guard, integrate, neighbours, numba_driver, state, stress, terms
 from .box import MAX_PASSES, folded, period_count
 from .forces import pair_roles, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
@@ -41,6 +43,8 @@ from .integrate import damped, flow_shifted, half_velocity_change, plate_velocit
 from .neighbours import _INT32_MAX, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
+from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, otsuki_entries, outer_entries,
+                     spin_entry, tensors_from_sums, unbalanced_entries)
 from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
@@ -53,7 +57,9 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
     (integrate, "damped"), (integrate, "xi_rates"), (terms, "normal_speed"), (terms, "slip_speed"),
     (terms, "pair_forces"), (forces, "pair_roles"), (forces, "shear_rows"), (forces, "shear_from_sums"),
     (guard, "kinetic_term"), (guard, "energy_bound"), (guard, "verdict_code"), (guard, "transient_ratio"),
-    (neighbours, "verlet_bound"), (neighbours, "within_reach"))
+    (neighbours, "verlet_bound"), (neighbours, "within_reach"), (stress, "outer_entries"),
+    (stress, "love_weber_entries"), (stress, "external_entries"), (stress, "unbalanced_entries"), (stress, "spin_entry"),
+    (stress, "otsuki_entries"))
 
 #: the step's own compiled functions (this module's), and those inlined into their callers
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
@@ -69,13 +75,13 @@ MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merg
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
-_ARGUMENTS = ("i i i i f f b b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
+_ARGUMENTS = ("i i i i f f i b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[:,:] "   # start, b0, b1, N … half_out
               "f[:,:] f[:,:] f[:,:] f[:] f[:,:] f[:] f[:] i[:] "      # pos … rep_s
               "f[:] f[:] f[:] f[:] f[:] f[:] f[:] f[:] "             # rate … V, le, adv
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
               "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
               "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
-              "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:]").split()   # work … need
+              "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:] f[:,:] f[:,:] f[:,:]").split()   # work … tsum
 
 #: the contact laws of the laws folder whose compiled form is checked bit for bit against NumPy's
 #: (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and min.  The
@@ -89,6 +95,8 @@ NOT_RUN = object()
 # the kernel's return codes, and the start of a replica a block skips
 _DONE, _D_ZERO, _GUARD, _UNITS, _NEED = 0, 1, 2, 3, 4
 _SKIP = -1
+#: the sums of every tensor's rows a sampling step makes (:data:`~.stress.SUMMED_ROWS`)
+_SUMS = sum(n for _, n in stress.SUMMED_ROWS)
 
 _kernels = {}
 
@@ -140,8 +148,8 @@ def reason(engine):
     and without friction and bonds, spheres with parameters of their own under the linear law (the
     visit from j with its own constants, ``C.Kj``), the linear law
     from the prepared constants or a run's contact law of :data:`COMPILED_LAWS`, the tensile law
-    of bonds, no force register, a sample of the two shear stresses (not
-    the whole tensors).
+    of bonds, no force register, samples of the two shear stresses and of every tensor of
+    :data:`~.stress.TENSORS` (their rows summed per replica in NumPy's order, :func:`~.stress.tensors_from_sums`).
 
     Parameters
     ----------
@@ -264,7 +272,7 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
            u, u_max, strain, bound, r_max, skin,
            guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
-           work, mob, yc, y0, zero, tau, verdict, need):
+           work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum):
     """One step of the replicas ``b0 … b1 − 1`` on numbers (compiled; run by :func:`run_step` for the
     whole batch and by :func:`_block_kernel` for one replica at a time).
 
@@ -275,7 +283,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes at the ξ rule
     once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9).  ``pred[b]``:
     replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
-    its first step).  The other arguments are the engine's (the flags of the step, the state's
+    its first step).  ``sample``: 0 no stresses, 1 the two shear stresses (``tau``), 2 also the sums of
+    every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
+    rows in ``ts``, summed per replica as NumPy sums them).  The other arguments are the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
     the Verlet bookkeeping, the guard's constants) and the buffers of its :class:`_Workspace`;
     everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO` (nothing changed: a
@@ -373,6 +383,15 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 else:
                     work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
                                                                        dys[p], fx, dF, None)
+                if sample == 2:      # every tensor: the pair rows of engine.stress (StressInputs.roles)
+                    internal, ext_i, ext_j = internal and rel, ext_i and rel, ext_j and rel
+                    xc_i, yc_i = pos[0, i] - Lx[b] / 2, pos[1, i] - Ly[b] / 2
+                    xc_j, yc_j = pos[0, j] - Lx[b] / 2, pos[1, j] - Ly[b] / 2
+                    tp[0, p], tp[1, p], tp[2, p], tp[3, p] = love_weber_entries(fx, fy, fx_j, fy_j, visit_j, dxs[p],
+                                                                                dys[p], internal)
+                    tp[4, p], tp[5, p], tp[6, p], tp[7, p] = external_entries(fx, fy, fx_j, fy_j, visit_j, xc_i, yc_i,
+                                                                              xc_j, yc_j, ext_i, ext_j)
+                    tp[8, p] = dF * internal
             if check:
                 verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
         # the scatter's second half: −F on j and the torque on j, in pair order
@@ -386,6 +405,20 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 lo, hi = offsets[b], offsets[b + 1]
                 tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
                                                        _segment_sum(work[13], lo, hi), V[b])
+        if sample == 2:     # the sphere rows (the totals of the scatter), then every row's sum per replica
+            for k in range(n0, n1):
+                b = rep_s[k]
+                xc, yck = pos[0, k] - Lx[b] / 2, pos[1, k] - Ly[b] / 2
+                ts[0, k], ts[1, k], ts[2, k], ts[3, k] = unbalanced_entries(frc[0, k], frc[1, k], mob[k], xc, yck)
+                ts[4, k] = frc[2, k]
+                ts[5, k] = spin_entry(mmi[2, k], vel[2, k], mob[k])
+                ts[6, k], ts[7, k], ts[8, k], ts[9, k] = otsuki_entries(mmi[0, k], vel[0, k], vel[1, k], rate[b], yck,
+                                                                        mob[k])
+            for b in range(b0, b1):
+                for q in range(9):       # (forces.replica_sums and StressInputs.per_replica: numpy.add.reduceat)
+                    tsum[q, b] = _segment_sum(tp[q], offsets[b], offsets[b + 1])
+                for q in range(10):
+                    tsum[9 + q, b] = _segment_sum(ts[q], b * N, (b + 1) * N)
         if check:
             bad = False
             for b in range(b0, b1):
@@ -553,7 +586,8 @@ def _block_signature():
     """The Numba signature of :func:`_block_kernel`."""
     from numba import types
     f2, i1, i = types.Array(types.float64, 2, "C"), types.Array(types.int64, 1, "C"), types.int64
-    return i(i1, i, i1, i1, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean, *_signature().args[3:])
+    b1, f3 = types.Array(types.boolean, 1, "C"), types.Array(types.float64, 3, "C")
+    return i(i1, i, i1, i1, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean, b1, f3, *_signature().args[3:])
 
 
 def _signature():
@@ -680,6 +714,8 @@ class _Workspace:
         self.yc = np.empty(B * N)
         self.y0 = np.empty(B * N)
         self.tau = np.zeros((2, B))
+        self.tsum = np.zeros((_SUMS, B))
+        self.tp = self.ts = None          # (the rows of every tensor: made at the first step that samples them)
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
         per_sphere = lambda a: np.array(np.broadcast_to(a, (B * N,)), dtype=float)       # (writable copies)
@@ -721,6 +757,16 @@ class _Workspace:
                 self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
 
+    def tensor_rows(self, tensors):
+        """The buffers of the rows of every tensor (:data:`~.stress.SUMMED_ROWS`): ``(tp, ts)``, the
+        pair rows (9, P) and the sphere rows (10, B·N) when ``tensors``, else empty ones."""
+        if not tensors:
+            return _NO_ROWS
+        if self.tp is None:
+            self.tp = np.empty((9, self.C.P))
+            self.ts = np.empty((10, len(self.mob)))
+        return self.tp, self.ts
+
 
 def _key(engine):
     """What :func:`reason` and the workspace depend on besides the candidates (compared by identity)."""
@@ -759,13 +805,14 @@ def run_step(engine, cool, dt, sample):
         The engine (backend ``"numba"``).
     cool, dt : float
         Damping factor and time step (s).
-    sample : bool
-        Return the two shear stresses.
+    sample : bool or str
+        False: no stresses; True: the two shear stresses; ``"tensors"``: also every tensor (their
+        rows summed in the compiled step, :func:`~.stress.tensors_from_sums`).
 
     Returns
     -------
     None, tuple or NOT_RUN
-        As :meth:`~particleShear.engine.step.BatchEngine.step` for ``sample`` False or True.
+        As :meth:`~particleShear.engine.step.BatchEngine.step`.
 
     Raises
     ------
@@ -793,6 +840,9 @@ def run_step(engine, cool, dt, sample):
         kernel(1, 0, B, *args)
     _adopt(engine, ws, held, stepped=True)
     engine.step_count += 1
+    if sample == "tensors":       # (the xy entries are the shear stresses, as the NumPy step returns them)
+        T = tensors_from_sums(ws.tsum.copy(), ws.V)
+        return -T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
 
 
@@ -807,9 +857,11 @@ def _prepared(engine):
     return None
 
 
-def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
+def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
-    (:func:`_adopt`); ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
+    (:func:`_adopt`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
+    (``tensors``: a block samples every tensor at some of its steps); ``pred`` (B,): which replicas'
+    force phase sees the Verlet half kick;
     ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
     (``half`` is then the one handed back); default a new array per step, handed back itself (as
     ``half_kick`` gives)."""
@@ -825,14 +877,16 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None):
         else ws.no_half
     new_half = ws.no_half if not verlet else np.empty((3, s.B * s.N)) if half_out is None else half_out
     ws.need[:] = engine.need        # (a replica a block skips keeps its flag)
-    args = (s.N, float(cool), float(dt), bool(sample), bool(check), bool(s.applying_shear), engine.numbers_relations,
+    code = 2 if sample == "tensors" else int(bool(sample))
+    args = (s.N, float(cool), float(dt), code, bool(check), bool(s.applying_shear), engine.numbers_relations,
             ws.form, ws.custom, ws.law_rows, ws.visit_j, ws.form_j, ws.Tj, free_mode, free, verlet, pred, half,
             new_half, s.pos, s.vel, s.frc, s.phi,
             engine.mmi, s.r, ws.Ly_s, ws.rep_s, rate, gamma, t, ws.Lx, ws.Ly, ws.V, ws.le, ws.adv, C.f, C.i, C.b,
             ws.offsets, state_p,
             xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
-            ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need)
+            ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need,
+            *ws.tensor_rows(tensors or code == 2), ws.tsum)
     held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
                 u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate,
                 half=None if not verlet else new_half if half_out is None else half)
@@ -874,14 +928,15 @@ def _draw(engine, ws, b, mask, row):
         ws.work[row, p], ws.work[row + 1, p] = np.cos(theta), np.sin(theta)
 
 
-def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
+def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None, tensor_out=None):
     """Steps of the engine in compiled blocks: a protocol's steps at the rates ``rates``, recorded
     from row ``row`` on, or ``n`` steps at the state's rate without samples (``rates`` None).
 
     Each step of a schedule is what :func:`~particleShear.engine.rheometer.shear_record` does for
     it with a sample of the two shear stresses: ``set_rate`` (each sphere keeps its velocity
     relative to the flow, :func:`~particleShear.engine.integrate.flow_shifted`), record the clock,
-    strain and rate, the step, record the stresses.  One compiled call runs each replica until the
+    strain and rate, the step, record the stresses (and, at the steps ``tensors`` marks, every
+    tensor, from its rows summed in the compiled step).  One compiled call runs each replica until the
     block ends or its candidate list is due (:func:`_block_kernel`); the lists due are then
     rebuilt (on NumPy, the one rebuild) and the next call goes on.  A pair at ``d = 0`` and a
     ``|R| = 0`` get their random directions here, from the replica's own generator, and the step
@@ -903,6 +958,10 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
         The record's row of the first step.
     n : int, optional
         The number of steps without ``rates``.
+    tensors : ndarray (n,) of bool, optional
+        With ``rates``: the steps that also sample every tensor of :data:`~.stress.TENSORS`.
+    tensor_out : ndarray (n, B, 9, 2, 2), optional
+        Where those steps' tensors go (Pa; the other rows are left as they are).
 
     Returns
     -------
@@ -925,6 +984,10 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
         rates = _NO_RECORD
         rec = (_NO_RECORD,) * 5
     B, step0 = engine.s.B, engine.step_count
+    want = np.zeros(n, dtype=np.bool_)          # (read at every scheduled step)
+    if tensors is not None and scheduled:
+        want[:] = tensors
+    sums = np.zeros((n, _SUMS, B)) if want.any() else _NO_SUMS
     ks, starts, status = np.zeros(B, np.int64), np.zeros(B, np.int64), np.zeros(B, np.int64)
     pred = np.full(B, engine.half is not None)
     # (one buffer of new half kicks for the block: a step resumed in the next call kicked into it)
@@ -947,9 +1010,9 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
                 raise RuntimeError("run_block: the step stopped running compiled within a block")
             return 0
         starts[~going] = _SKIP
-        args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out)
+        args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any())
         _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
-                           scheduled, *args)
+                           scheduled, want, sums, *args)
         _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
         drawn = False
         for b in np.flatnonzero(going):
@@ -964,6 +1027,11 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
             elif st == _GUARD:       # (the other replicas run to this step at least: the first failure is reported)
                 failed[b], verdicts[:, b] = ks[b], ws.verdict[:, b]
                 end = min(end, int(ks[b]) + 1)
+    if want.any():     # (the tensors of the sampled steps at once: each column is one replica's step)
+        k = np.flatnonzero(want)
+        S = sums[k].transpose(1, 0, 2).reshape(_SUMS, -1)
+        V = np.broadcast_to(np.asarray(engine.V, dtype=float), (B,))
+        tensor_out[k] = tensors_from_sums(S, np.tile(V, len(k))).reshape(len(k), B, *tensor_out.shape[2:])
     if (failed >= 0).any():
         first = int(failed[failed >= 0].min())
         code = np.where(failed == first, verdicts[0], 0).astype(np.int64)
@@ -974,6 +1042,8 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
 
 
 _NO_RECORD = np.zeros((0, 0))
+_NO_ROWS = np.zeros((9, 0)), np.zeros((10, 0))
+_NO_SUMS = np.zeros((0, 0, 0))
 
 
 def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, out):
@@ -1136,11 +1206,12 @@ def compile_search_kernel(cache=True):
 
 
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
-                  interval, guarded, scheduled, N, cool, dt, sample, check, applying, numbers, form, custom, A,
+                  interval, guarded, scheduled, want, rec_sums, N, cool, dt, sample, check, applying, numbers, form,
+                  custom, A,
                   visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s,
                   rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth,
                   next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
-                  tau, verdict, need):
+                  tau, verdict, need, tp, ts, tsum):
     """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
 
     Replica b runs its steps ``ks[b] … n − 1`` until the block ends, a candidate list of it is due
@@ -1149,7 +1220,8 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     step whose random directions the caller drew).  Per step of a schedule (``scheduled``): the
     new rate (:func:`~particleShear.engine.integrate.flow_shifted` on the replica's spheres), the
     record of clock, strain and rate, :func:`_step_kernel` with the two stresses sampled, their
-    record; otherwise :func:`_step_kernel` alone, at the rate of the state.  The guard checks the
+    record, and at the steps ``k`` where ``want[k]`` the sums of every tensor's rows into
+    ``rec_sums[k]`` (19, B); otherwise :func:`_step_kernel` alone, at the rate of the state.  The guard checks the
     step ``step0 + k``.  Writes the next step of each replica into ``ks`` and its status into
     ``status`` (:data:`_DONE`, :data:`_NEED` or a status of :func:`_step_kernel`).
 
@@ -1170,17 +1242,22 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                 rec_strain[row + k, b] = gamma[b]
                 rec_rate[row + k, b] = rate[b]
             due_check = guarded and (step0 + k) % interval == 0
-            st = _step_kernel(start, b, b + 1, N, cool, dt, scheduled, due_check, applying, numbers, form, custom, A,
-                              visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
+            tensors = scheduled and want[k]
+            code = 2 if tensors else 1 if scheduled else 0
+            st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
+                              applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
                               mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p,
                               xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
-                              max_ke, work, mob, yc, y0, zero, tau, verdict, need)
+                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum)
             start = 0
             if st != _DONE:
                 break
             if scheduled:
                 rec_internal[row + k, b] = tau[0, b]
                 rec_surface[row + k, b] = tau[1, b]
+                if tensors:
+                    for q in range(tsum.shape[0]):
+                        rec_sums[k, q, b] = tsum[q, b]
             if verlet:        # (the half kick the replica's next force phase sees)
                 for q in range(b * N, (b + 1) * N):
                     half[0, q], half[1, q], half[2, q] = half_out[0, q], half_out[1, q], half_out[2, q]

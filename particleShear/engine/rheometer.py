@@ -46,26 +46,39 @@ def _quiet(*args):
 BLOCK = 256
 
 
-def _block_end(engine, i, n_steps, tensors_every, keep_tensors, end_tensors, after_step, observers):
+def _block_end(engine, i, n_steps, after_step, observers):
     """Where a compiled block of steps from step ``i`` ends (``i``: none), for the compiled backend.
 
-    A block holds steps that sample the two shear stresses only, whose rate does not depend on the
-    steps before (no controller ``after_step``), and ends at the latest after the first step an
-    observer is due after, and after :data:`BLOCK` steps."""
-    if not engine.backend.compiled or after_step is not None or keep_tensors:
+    A block holds steps whose rate does not depend on the steps before (no controller
+    ``after_step``), and ends at the latest after the first step an observer is due after, and
+    after :data:`BLOCK` steps (its steps that sample every tensor sum their rows in the compiled
+    step, :func:`~particleShear.engine.numba_step.run_block`)."""
+    if not engine.backend.compiled or after_step is not None:
         return i
     j = min(n_steps, i + BLOCK)
-    if end_tensors:
-        if i == 0 or i == n_steps - 1:
-            return i
-        j = min(j, n_steps - 1)
-    if tensors_every:
-        if i % tensors_every == 0:
-            return i
-        j = min(j, (i // tensors_every + 1) * tensors_every)
     for ob in observers:          # (observers are notified after the steps that are multiples of their every)
         j = min(j, (i // ob.every + 1) * ob.every)
     return j
+
+
+def _samples_tensors(i, n_steps, tensors_every, keep_tensors, end_tensors):
+    """Whether step ``i`` samples every tensor: an N1 step, a kept history, or a first or last step."""
+    return bool(tensors_every) and i % tensors_every == 0 or keep_tensors or \
+        end_tensors and (i == 0 or i == n_steps - 1)
+
+
+def _record_tensors(rec, i, n_steps, T, tensors_every, keep_tensors, end_tensors):
+    """Record what step ``i`` keeps of its tensors ``T`` (B, 9, 2, 2): N1 of the overall tensor, the
+    history, the first and last tensors."""
+    if tensors_every and i % tensors_every == 0:
+        O = T[:, OVERALL]
+        rec["N1"][i] = -(O[:, 0, 0] - O[:, 1, 1])
+    if keep_tensors:
+        rec["tensors"][i] = T
+    if end_tensors and i == 0:
+        rec["first_tensors"] = T.copy()
+    if end_tensors and i == n_steps - 1:
+        rec["last_tensors"] = T.copy()
 
 
 def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet, report=_quiet, observers=(),
@@ -130,12 +143,17 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
     engine.begin_phase("protocol", rec)        # (observers read the record's rows written so far)
     i = 0
     pending = []        # rates of a block's steps that the compiled block left to the loop below
+    sampled = lambda k: _samples_tensors(k, n_steps, tensors_every, keep_tensors, end_tensors)    # noqa: E731
     while i < n_steps:
-        j = i if pending else _block_end(engine, i, n_steps, tensors_every, keep_tensors, end_tensors, after_step,
-                                         observers)
-        if j > i:       # steps without tensors, controller or observer in one compiled block (numba_step.run_block)
+        j = i if pending else _block_end(engine, i, n_steps, after_step, observers)
+        if j > i:       # steps without controller or observer in one compiled block (numba_step.run_block)
             rates = [rate_of(k) for k in range(i, j)]           # (rate_of once per step, in order)
-            done = run_block(engine, xp.stack(rates), cool, dt, rec, i)
+            want = [sampled(k) for k in range(i, j)]
+            T = xp.empty((j - i, s.B, len(TENSORS), 2, 2)) if any(want) else None
+            done = run_block(engine, xp.stack(rates), cool, dt, rec, i, tensors=want, tensor_out=T)
+            for k in range(done):
+                if want[k]:
+                    _record_tensors(rec, i + k, n_steps, T[k], tensors_every, keep_tensors, end_tensors)
             i += done
             if done:
                 report(i, n_steps)
@@ -147,20 +165,11 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
         rec["t"][i] = s.t
         rec["strain"][i] = s.gamma
         rec["strain_rate"][i] = s.rate
-        n1 = bool(tensors_every) and i % tensors_every == 0
-        ends = end_tensors and (i == 0 or i == n_steps - 1)
-        out = engine.step(cool, dt, sample="tensors" if n1 or keep_tensors or ends else True)
+        out = engine.step(cool, dt, sample="tensors" if sampled(i) else True)
         rec["stress_internal"][i] = out[0]
         rec["stress_surface"][i] = out[1]
-        if n1:
-            T = out[2][:, OVERALL]
-            rec["N1"][i] = -(T[:, 0, 0] - T[:, 1, 1])
-        if keep_tensors:
-            rec["tensors"][i] = out[2]
-        if ends and i == 0:
-            rec["first_tensors"] = out[2]
-        if ends and i == n_steps - 1:
-            rec["last_tensors"] = out[2]
+        if len(out) > 2:
+            _record_tensors(rec, i, n_steps, out[2], tensors_every, keep_tensors, end_tensors)
         if after_step is not None:
             after_step(i, out[0], out[1])
         report(i + 1, n_steps)

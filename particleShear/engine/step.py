@@ -516,7 +516,7 @@ class BatchEngine:
             If the stability guard finds a guarded replica unstable (checked every
             ``check_interval`` steps).
         """
-        if self.backend.compiled and sample != "tensors":      # the whole step in one compiled call
+        if self.backend.compiled:      # the whole step in one compiled call
             out = numba_step.run_step(self, cool, dt, sample)
             if out is not numba_step.NOT_RUN:
                 return out
@@ -657,9 +657,9 @@ class BatchEngine:
     def _compiled_terms(self, C):
         """Whether the force terms of a NumPy force phase run in the compiled pair loop of :mod:`.numba_driver`.
 
-        A NumPy force phase on the compiled backend is a step the compiled step leaves to NumPy (one
-        that samples every tensor, a pair at ``d = 0``, or a scene :func:`.numba_step.reason` names,
-        with its note there).  Its terms run compiled for the default laws (the linear law and the
+        A NumPy force phase on the compiled backend is a step the compiled step leaves to NumPy (a
+        scene :func:`.numba_step.reason` names, with its note there, or the documented classes'
+        own force phase).  Its terms run compiled for the default laws (the linear law and the
         tensile law of bonds, from prepared constants) of frictional replicas or bonds when the
         terms are not kept for a register; otherwise the NumPy terms run (the same bits).
         """

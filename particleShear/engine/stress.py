@@ -22,7 +22,8 @@ from .state import spread
 from .xp import array_namespace
 
 __all__ = ["StressInputs", "Tensor", "TENSORS", "OVERALL", "EXTERNAL", "ROWS", "KINETIC_ROWS", "evaluate_all",
-           "pair_rows", "sphere_rows"]
+           "pair_rows", "sphere_rows", "SUMMED_ROWS", "tensors_from_sums", "outer_entries",
+           "love_weber_entries", "external_entries", "unbalanced_entries", "spin_entry", "otsuki_entries"]
 
 
 
@@ -218,38 +219,74 @@ def sphere_rows(function):
     return function
 
 
-def _outer_rows(ux, uy, wx, wy):
-    """(4, n) rows ``u_a·w_c`` in the order (x, x), (x, y), (y, x), (y, y): a 2×2 tensor per row sum."""
-    xp = array_namespace(ux)
-    W = xp.empty((4, ux.shape[0]))
-    for r, (u, w) in enumerate(((ux, wx), (ux, wy), (uy, wx), (uy, wy))):
-        xp.multiply(u, w, out=W[r])
-    return W
+def outer_entries(ux, uy, wx, wy):
+    """The entries ``u_a·w_c`` of ``u ⊗ w`` in the order (x, x), (x, y), (y, x), (y, y) (numbers or arrays)."""
+    return ux * wx, ux * wy, uy * wx, uy * wy
+
+
+def love_weber_entries(fx_i, fy_i, fx_j, fy_j, own_j, dx, dy, internal):
+    """F ⊗ (x_i − x_j) = −F ⊗ D of a pair counted as internal (eq. S1-19; D = x_j − x_i, the minimum-image
+    pair vector, µm), 0 otherwise; F (mg·µm·s⁻² per m depth) is the force on i, or the mean of the two
+    visits' forces where j's visit has a force of its own (``own_j``: 1.0.2 registers each visit with
+    half).  Numbers inside the compiled step, arrays in :func:`_love_weber_rows`."""
+    if own_j:
+        fx, fy = (fx_i + fx_j) * 0.5, (fy_i + fy_j) * 0.5
+    else:
+        fx, fy = fx_i, fy_i
+    return outer_entries(fx * internal, fy * internal, -dx, -dy)
+
+
+def external_entries(fx_i, fy_i, fx_j, fy_j, own_j, xc_i, yc_i, xc_j, yc_j, ext_i, ext_j):
+    """F ⊗ (x_target − c) of a pair's external entries (eq. S1-16): F_i at i where ``ext_i``, −F_j at j
+    where ``ext_j``; ``xc, yc`` the spheres' positions from the cell centre (µm).  Where j's visit has
+    a force of its own (``own_j``) the rows add (F_i − F_j) ⊗ (x_j − c), exactly 0 where F_j = F_i (a
+    batch's replica equals its single run)."""
+    xj, yj = xc_j * ext_j, yc_j * ext_j
+    a, b, c, d = outer_entries(fx_i, fy_i, xc_i * ext_i - xj, yc_i * ext_i - yj)
+    if own_j:
+        e, f, g, h = outer_entries(fx_i - fx_j, fy_i - fy_j, xj, yj)
+        a, b, c, d = a + e, b + f, c + g, d + h
+    return a, b, c, d
+
+
+def unbalanced_entries(fx, fy, mob, xc, yc):
+    """F_total ⊗ (x − c) of a mobile sphere (eq. S1-17), 0 for an immobile one."""
+    return outer_entries(fx * mob, fy * mob, xc, yc)
+
+
+def spin_entry(inertia, omega, mob):
+    """I ω² of a mobile sphere (eq. S1-21, model units), 0 for an immobile one."""
+    return inertia * omega * omega * mob
+
+
+def otsuki_entries(m, vx, vy, rate, yc, mob):
+    """P ⊗ P / m of a mobile sphere with P = m (v_x − γ̇ (y − Ly/2), v_y), already in SI (J per m depth:
+    P in kg·m/s, m in kg), unlike the other rows, which are in the model's units."""
+    px = m * 1e-12 * (vx - rate * yc)
+    py = m * 1e-12 * vy
+    w = mob / (m * 1e-6)
+    return outer_entries(px * w, py * w, px, py)
+
+
+def _stack(entries):
+    """The (k, n) rows of a tuple of k arrays of entries."""
+    return array_namespace(entries[0]).stack(entries)
 
 
 @pair_rows
 def _love_weber_rows(q):
-    """F ⊗ (x_i − x_j) = −F ⊗ D of the internal pairs (D = x_j − x_i, the minimum-image pair vector); F the
-    mean of the two visits' forces where spheres have parameters of their own (1.0.2 registers each
-    visit with half)."""
-    w = q.internal
-    fx, fy = (q.fx_i, q.fy_i) if q.fx_j is None else ((q.fx_i + q.fx_j) * 0.5, (q.fy_i + q.fy_j) * 0.5)
-    return _outer_rows(fx * w, fy * w, -q.dx, -q.dy)
+    """:func:`love_weber_entries` of every candidate."""
+    return _stack(love_weber_entries(q.fx_i, q.fy_i, q.fx_j, q.fy_j, q.fx_j is not None, q.dx, q.dy, q.internal))
 
 
 @pair_rows
 def _external_rows(q):
-    """F ⊗ (x_target − c) of the external entries: F_i at i, −F_j at j (eq. S1-16)."""
+    """:func:`external_entries` of every candidate."""
     C = q.C
     _, ei, ej = q.roles
     xc, yc = q.tensor(_x_centred), q.tensor(_y_centred)
-    xj, yj = xc[C.aj] * ej, yc[C.aj] * ej
-    W = _outer_rows(q.fx_i, q.fy_i, xc[C.ai] * ei - xj, yc[C.ai] * ei - yj)
-    if q.fx_j is not None:
-        # j's visit has a force of its own: F_i ⊗ lever + (F_i − F_j) ⊗ (x_j − c), exactly the rows
-        # above where F_j = F_i (a batch's replica equals its single run)
-        W += _outer_rows(q.fx_i - q.fx_j, q.fy_i - q.fy_j, xj, yj)
-    return W
+    return _stack(external_entries(q.fx_i, q.fy_i, q.fx_j, q.fy_j, q.fx_j is not None, xc[C.ai], yc[C.ai], xc[C.aj],
+                                   yc[C.aj], ei, ej))
 
 
 @pair_rows
@@ -260,9 +297,8 @@ def _internal_torque_rows(q):
 
 @sphere_rows
 def _unbalanced_rows(q):
-    """F_total ⊗ (x − c) of the mobile spheres."""
-    w = q.mob
-    return _outer_rows(q.fx * w, q.fy * w, q.tensor(_x_centred), q.tensor(_y_centred))
+    """:func:`unbalanced_entries` of every sphere."""
+    return _stack(unbalanced_entries(q.fx, q.fy, q.mob, q.tensor(_x_centred), q.tensor(_y_centred)))
 
 
 @sphere_rows
@@ -273,18 +309,14 @@ def _torque_rows(q):
 
 @sphere_rows
 def _spin_rows(q):
-    """I ω² of the mobile spheres."""
-    return (q.inertia * q.omega * q.omega * q.mob)[None]
+    """:func:`spin_entry` of every sphere."""
+    return spin_entry(q.inertia, q.omega, q.mob)[None]
 
 
 @sphere_rows
 def _otsuki_rows(q):
-    """P ⊗ P / m of the mobile spheres, P = m (v_x − γ̇ (y − Ly/2), v_y), already in SI (J per m depth:
-    P in kg·m/s, m in kg), unlike the other rows, which are in the model's units."""
-    px = q.m * 1e-12 * (q.vx - spread(q.rate, q.rep, q.B) * q.tensor(_y_centred))
-    py = q.m * 1e-12 * q.vy
-    w = q.mob / (q.m * 1e-6)
-    return _outer_rows(px * w, py * w, px, py)
+    """:func:`otsuki_entries` of every sphere."""
+    return _stack(otsuki_entries(q.m, q.vx, q.vy, spread(q.rate, q.rep, q.B), q.tensor(_y_centred), q.mob))
 
 
 class Linear(collections.namedtuple("Linear", "rows index coef scale per_volume")):
@@ -581,6 +613,12 @@ ROWS = tuple(dict.fromkeys(r for t in TENSORS for r in t.rows))
 KINETIC_ROWS = (_spin_rows, _otsuki_rows)
 
 
+#: the rows the compiled step sums (:mod:`.numba_step`, :func:`tensors_from_sums`), in the order of its
+#: sums: the pair rows, then the sphere rows, with the number of rows of each
+SUMMED_ROWS = ((_love_weber_rows, 4), (_external_rows, 4), (_internal_torque_rows, 1), (_unbalanced_rows, 4),
+               (_torque_rows, 1), (_spin_rows, 1), (_otsuki_rows, 4))
+
+
 #: the tensors of :data:`TENSORS` that are :class:`Linear` maps, evaluated together by :func:`evaluate_all`
 _LINEAR = tuple(k for k, t in enumerate(TENSORS) if hasattr(t.function, "linear"))
 _LINEAR_MAPS = _LinearMaps([TENSORS[k].function.linear for k in _LINEAR])
@@ -613,3 +651,31 @@ def evaluate_all(q):
         if k not in _LINEAR:
             out[:, k] = q.tensor(t.function)
     return out
+
+
+def tensors_from_sums(sums, V):
+    """Every tensor of :data:`TENSORS` from the per-replica sums of its rows (the compiled step's).
+
+    The sums take the place of :meth:`StressInputs.reduce`; the tensors are then what
+    :func:`evaluate_all` makes of them, the same functions (so the same numbers as the NumPy force
+    phase when the sums are the same bits).
+
+    Parameters
+    ----------
+    sums : ndarray (19, B)
+        The sums of the rows of :data:`SUMMED_ROWS`, in its order (each row's unit), per replica.
+    V : ndarray (B,)
+        The cell volume of each replica (m² per m depth).
+
+    Returns
+    -------
+    ndarray (B, 9, 2, 2)
+        As :func:`evaluate_all` (Pa).
+    """
+    q = StressInputs(B=sums.shape[1], V=V)
+    memo = q.__dict__.setdefault("_row_sums", {})
+    k = 0
+    for rows, n in SUMMED_ROWS:
+        memo[rows] = sums[k:k + n]
+        k += n
+    return evaluate_all(q)
