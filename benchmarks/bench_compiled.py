@@ -11,8 +11,9 @@ candidate search and the Python of the loop around the step are the same on both
 
 "Numba, compiled blocks": the same steps through ``numba_step.run_block`` (many steps per compiled
 call, the rate update and the records inside, as the protocols' recording loop runs them).  Last
-row: the default run ``doParticleShearSimulation(seed=1)`` (no drawing, no files), whole call with a
-warm compile cache, per backend.
+rows: the default run ``doParticleShearSimulation(seed=1)`` (no drawing), whole call with a warm
+compile cache, per backend, without files and saving its files (``saveData=True`` into a temporary
+folder: the per-step table of every stress tensor, so every step samples every tensor).
 
 Usage: python benchmarks/bench_compiled.py [--quick]
 """
@@ -80,12 +81,17 @@ def row(N, B, steps, blocks):
     return {be: statistics.median(v) for be, v in samples.items()}
 
 
-def default_run(backend):
+def default_run(backend, save=False):
+    """Seconds of the whole default call; ``save``: with its files (every tensor sampled at every step)."""
+    import tempfile
+
     from particleShear import doParticleShearSimulation
-    t0 = time.perf_counter()
-    with contextlib.redirect_stdout(io.StringIO()):
-        doParticleShearSimulation(doDrawing=False, plotStress=False, saveData=False, seed=1, backend=backend)
-    return time.perf_counter() - t0
+    with tempfile.TemporaryDirectory() as folder:
+        t0 = time.perf_counter()
+        with contextlib.redirect_stdout(io.StringIO()):
+            doParticleShearSimulation(doDrawing=False, plotStress=False, saveData=save, seed=1, backend=backend,
+                                      root_folder=folder + os.sep if save else "")
+        return time.perf_counter() - t0
 
 
 def main():
@@ -106,7 +112,10 @@ def main():
     default_run("numba")                 # the cache warm (a first compile is not timed)
     t = {be: statistics.median(default_run(be) for _ in range(1 if q else 3)) for be in ("numpy", "numba")}
     print(f"| default run (seed 1), whole call | | {t['numpy']:.2f} | | {t['numba']:.2f} | | "
-          f"{t['numpy'] / t['numba']:.2f}× | s |")
+          f"{t['numpy'] / t['numba']:.2f}× | s |", flush=True)
+    t = {be: statistics.median(default_run(be, save=True) for _ in range(1 if q else 3)) for be in ("numpy", "numba")}
+    print(f"| default run saving its files (every tensor at every step), whole call | | {t['numpy']:.2f} | | "
+          f"{t['numba']:.2f} | | {t['numpy'] / t['numba']:.2f}× | s |")
 
 
 if __name__ == "__main__":
