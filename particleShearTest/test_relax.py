@@ -355,7 +355,6 @@ class TestBatchIndependence(unittest.TestCase):
         from particleShear.engine.step import EngineInstability
         a, b = random_packing(7), random_packing(8)
         ra, rb = random_packing(7), random_packing(8)
-        n = len(a.sphereList)
         before = [(state_block(e), e.pair_table, e.t, e.step_count) for e in (a, b)]
         b.stability_guard = StabilityGuard(max_kinetic_energy=1e-30, interval=4)
         with self.assertRaises(EngineInstability):
