@@ -220,10 +220,10 @@ class TestFrictionlessReplicas(unittest.TestCase):
         self.assertTrue(np.any(p1.xi != 0.0))
 
 
-def two_sphere_replicas(specs):
+def two_sphere_replicas(specs, backend="auto"):
     """A batch state of two spheres per replica: each spec ``(positions, vy, mu, seed)`` (radius 1 µm,
     unit masses, a 10 µm cell, plates on), the pair (0, 1) a candidate."""
-    s = BatchState(len(specs), 2)
+    s = BatchState(len(specs), 2, backend=backend)
     s.r[:], s.m[:], s.inertia[:] = 1.0, 1.0, 0.5
     s.Lx[:] = s.Ly[:] = 10.0
     s.k[:], s.nu[:], s.k_t[:], s.nu_t[:] = 1.0, 0.1, 1.0, 0.1

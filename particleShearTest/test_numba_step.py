@@ -314,6 +314,33 @@ class TestCompiledStepBits(unittest.TestCase):
         self.assert_same_engines(*engines)
         self.assertEqual(engines[0].s.rng[0].random(), engines[1].s.rng[0].random())
 
+    def test_random_directions_at_zero_R(self):
+        """Coincident frictional spheres in the plate band (immobile, so ``R = v_i·dt − D = 0`` at every
+        step) in a batch beside a sliding frictional pair: the compiled step updates the ξ of the
+        other pairs, stops before the ξ of the pair at ``|R| = 0``, whose direction the caller draws
+        from the replica's generator, and resumes with that pair's ξ alone; the same bits as NumPy
+        (ξ included: no pair's ξ is updated twice) and the same next number of each generator, step
+        by step and in blocks."""
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import two_sphere_replicas
+
+        specs = [(([5.0, 5.0], [0.5, 0.5]), [0.0, 0.0], 0.5, 1), (([5.0, 6.5], [5.0, 5.0]), [0.0, 1.0], 0.5, 2)]
+        engines = []
+        for backend in ("numpy", "numba"):
+            eng = BatchEngine(two_sphere_replicas(specs, backend), guard=False)
+            for _ in range(4):
+                eng.step(1.0, 1e-3)
+            eng.steps(4, 1.0, 1e-3)
+            engines.append(eng)
+        self.assert_same_engines(*engines)
+        self.assertTrue(np.all(engines[1].pairs_of(1).xi != 0.0))       # (the sliding pair integrates ξ)
+        # the coincident pair drew two directions per step: its normal at d = 0, its R at |R| = 0
+        expected = np.random.default_rng(1)
+        for _ in range(2 * 8):
+            expected.random()
+        self.assertEqual(engines[1].s.rng[0].random(), expected.random())
+        self.assertEqual(engines[0].s.rng[1].random(), engines[1].s.rng[1].random())
+
     def test_distance_zero_in_one_replica_of_a_block(self):
         """A batch of three whose middle replica has a pair at d = 0 and runs Verlet blocks: that
         replica's step takes its normal from its own generator and the others are not held back;

@@ -65,8 +65,8 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
-                    (sys.modules[__name__], "_step_kernel"))
-INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
+                    (sys.modules[__name__], "_xi_rule"), (sys.modules[__name__], "_step_kernel"))
+INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min", "_xi_rule")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
 SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
@@ -264,6 +264,18 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
+def _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi):
+    # the sequential ξ rule of pair p (integrate.xi_increments element by element): ξ_ij and ξ_ji
+    # grow by their rates times dt while the relation is active and not slipping
+    i, j = Ci[1, p], Ci[2, p]
+    kd = dt if active[p] and state_p[p] != 1 else 0.0
+    rvx = vel[0, j] - vel[0, i] + dvxs[p]
+    spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
+    inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
+    xi[0, p] += inc_ij * kd
+    xi[1, p] += inc_ji * kd
+
+
 def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, visit_j, form_j, Tj,
                  free_mode, free, verlet,
                  pred, half, half_out,
@@ -280,8 +292,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     ``offsets[b0] … offsets[b1] − 1``; nothing of another replica is read or written, so a replica's
     step is the same numbers whatever else the batch holds or in which order its replicas step.
     ``start`` 0 runs the whole step; 3 runs it with the random normals of the pairs at ``d = 0``
-    given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes at the ξ rule
-    once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9).  ``pred[b]``:
+    given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes with the ξ rule
+    of the pairs at ``|R| = 0`` once the caller gave their random directions (``work`` rows 8, 9).  ``pred[b]``:
     replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
     its first step).  ``sample``: 0 no stresses, 1 the two shear stresses (``tau``), 2 also the sums of
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
@@ -457,7 +469,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
             vel[2, k] *= cool
         if free_mode == 1:            # no ξ without friction and bonds
             start = 2
-        # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
+        # the unit vectors of R = v_i dt − D and the sequential ξ rule pair by pair (velocities after
+        # the kick and damping, geometry of the force phase); a pair at |R| = 0 waits for the random
+        # direction the caller draws (start 1)
         units = False
         for p in range(P0, P1 if start != 2 else P0):
             i = Ci[1, p]
@@ -471,17 +485,13 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 units = True
             else:
                 mxs[p], mys[p] = Rx / dR, Ry / dR
+                _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi)
         if units:
             return _UNITS
-    # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
-    for p in range(P0, P1 if start != 2 else P0):
-        i, j = Ci[1, p], Ci[2, p]
-        kd = dt if active[p] and state_p[p] != 1 else 0.0
-        rvx = vel[0, j] - vel[0, i] + dvxs[p]
-        spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
-        inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
-        xi[0, p] += inc_ij * kd
-        xi[1, p] += inc_ji * kd
+    else:       # (start 1) the ξ rule of the pairs at |R| = 0, their directions drawn
+        for p in range(P0, P1):
+            if zero[p]:
+                _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi)
     # displacement since the lists were built, Verlet bound, drift
     for b in range(b0, b1):
         largest = -math.inf
