@@ -144,6 +144,94 @@ class TestCompiledStepBits(unittest.TestCase):
             np.testing.assert_array_equal(_bits(rec["stress_surface"]), _bits(-rec["tensors"][:, :, EXTERNAL, 0, 1]))
             self.assertEqual(int(np.isfinite(rec_n1["N1"][:, 0]).sum()), 5)         # (steps 0, 7, … 28)
 
+    def test_terms_kept_for_a_force_register(self):
+        """An engine that keeps its terms for a force register (the documented experiment's) runs
+        compiled, in blocks and step by step, and keeps the terms of its last force phase with
+        NumPy's bits: every array of :attr:`BatchEngine.terms` (the elastic and viscous parts of
+        each visit, the tangential visits, the forces on i and j, geometry, roles, totals), with
+        spheres sharing their parameters and with spheres of their own, at B = 1 and 2."""
+        import contextlib
+        from unittest import mock
+
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        def same(a, b, path):
+            if isinstance(a, dict):
+                self.assertEqual(a.keys(), b.keys())
+                for k in a:
+                    if k != "C":
+                        same(a[k], b[k], f"{path}.{k}")
+            elif isinstance(a, (list, tuple)):
+                self.assertEqual(len(a), len(b), path)
+                for k, (x, y) in enumerate(zip(a, b)):
+                    same(x, y, f"{path}[{k}]")
+            elif a is None:
+                self.assertIsNone(b, path)
+            else:
+                self.assertEqual((a.dtype, a.shape), (b.dtype, b.shape), path)
+                np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a,
+                                              _bits(b) if b.dtype.kind == "f" else b, err_msg=path)
+
+        for own in (False, True):
+            for B in (1, 2):
+                for last in ("block", "step"):
+                    terms = []
+                    for backend in ("numpy", "numba"):
+                        ens = [constituted(61 + b, **FRICTIONAL_BONDS)[1] for b in range(B)]
+                        for k, sphere in enumerate(ens[0].sphereList[:9] if own else ()):
+                            sphere.central_repulsion_coefficient = 0.5 + 0.05 * k
+                            sphere.permanent_ratio_central = 1.0 + 0.2 * k
+                        eng = BatchEngine(state_from_ensembles(ens, backend=backend), keep_terms=True)
+                        eng.s.applying_shear = True
+                        eng.set_rate(np.array([400.0, -300.0][:B]))
+                        patch = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("NumPy"))
+                        with patch if backend == "numba" else contextlib.nullcontext():
+                            eng.steps(30, 0.999, ens[0].dt)
+                            if last == "step":
+                                eng.step(0.999, ens[0].dt, sample=True)
+                        terms.append(eng.terms)
+                    self.assertEqual(terms[1]["fx_j"] is not None, own)
+                    self.assertTrue(np.any(terms[1]["F"] != 0.0))
+                    same(terms[0], terms[1], f"own={own} B={B} {last}")
+
+    def test_documented_experiment_runs_compiled(self):
+        """The documented experiment's own pre-equilibration and protocol
+        (``OscillatoryShearExperiment.oscillatory_shear_experiment``, an engine on the ensemble's
+        state keeping its terms for the force register) run compiled where Numba is installed (no
+        NumPy force phase) and give NumPy's moduli, bit for bit."""
+        import os
+        from unittest import mock
+
+        from particleShear.engine.step import BatchEngine
+        from particleShear.simulation.simulations import Simulation_interlocking_rheology
+
+        results = {}
+        for backend in ("numpy", "numba"):
+            s = Simulation_interlocking_rheology("", N=20, cut_lines=2, do_permanent_links=True, relative_frequency=0.2,
+                                                 doDrawing=False, saveData=False)
+            s.baseline_pre_periods = s.baseline_post_periods = 0.5
+            s.rng = np.random.default_rng(3)
+            s.initEnsemble()
+            exp = s.createExperiment(False, 1, False)
+            sched = s.measurement_schedule(0.5)
+            phases = []
+            original = BatchEngine.force_phase
+
+            def counted(engine, sample=False):
+                phases.append(sample)
+                return original(engine, sample)
+
+            with mock.patch.dict(os.environ, {"PARTICLESHEAR_BACKEND": backend}), \
+                    mock.patch.object(BatchEngine, "force_phase", counted):
+                G = exp.oscillatory_shear_experiment(cool_factor=sched.cool,
+                                                     N_pre_equilibration_fixed_boundaries=sched.N_pre)
+            results[backend] = (G, len(phases))
+        self.assertEqual(results["numba"][0], results["numpy"][0])
+        self.assertGreater(results["numpy"][1], 100)
+        self.assertEqual(results["numba"][1], 0)
+
     def test_plates_off_relaxation_and_numbers(self):
         """The constitution's relaxation (plates off, μ = 0 blocks, drift removal) on the ensembles' own
         state, whose engine numbers the relations as they form: the same bits and creation numbers."""

@@ -133,7 +133,7 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
         s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
     return s.to_backend(target)
 
-def state_of_ensemble(ensemble, laws=None):
+def state_of_ensemble(ensemble, laws=None, backend="numpy"):
     """:func:`state_of_ensembles` of one ensemble (the ensemble keeps its own block).
 
     Parameters
@@ -142,13 +142,15 @@ def state_of_ensemble(ensemble, laws=None):
         A documented ensemble of ``particleShear.objects`` or ``particleShear.linkable``.
     laws : sequence, optional
         As :func:`state_from_ensembles` (one entry).
+    backend : {"numpy", "numba", "auto"} or Backend, default "numpy"
+        As :func:`state_of_ensembles`.
 
     Returns
     -------
     BatchState
-        B = 1 on NumPy, with :attr:`ensemble` set to ``ensemble``.
+        B = 1 on the host, with :attr:`ensemble` set to ``ensemble``.
     """
-    return state_of_ensembles([ensemble], laws=laws)
+    return state_of_ensembles([ensemble], laws=laws, backend=backend)
 
 def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:

@@ -45,7 +45,7 @@ from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
 from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, otsuki_entries, outer_entries,
                      spin_entry, tensors_from_sums, unbalanced_entries)
-from .terms import normal_speed, pair_forces, slip_speed
+from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
            "compile_carried_kernel", "compile_kernels", "run_step", "run_block", "search", "carried", "NOT_RUN"]
@@ -81,7 +81,8 @@ _ARGUMENTS = ("i i i i f f i b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[
               "f[:,:] i[:,:] b[:,:] i[:] i1[:] f[:,:] b[:] i[:] i[:] "  # Cf … next_birth
               "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
               "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
-              "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:] f[:,:] f[:,:] f[:,:]").split()   # work … tsum
+              "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:] f[:,:] f[:,:] f[:,:] "   # work … tsum
+              "b f[:,:] f[:,:]").split()                                    # keep, kt, ktot
 
 #: the contact laws of the laws folder whose compiled form is checked bit for bit against NumPy's
 #: (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and min.  The
@@ -160,8 +161,6 @@ def reason(engine):
     -------
     str or None
     """
-    if engine.keep_terms:
-        return "the force register keeps the terms of each visit"
     C, s = engine.C, engine.s
     for a in (s.pos, s.vel, s.frc, s.phi, s.r, engine.mmi, C.f, C.i, C.b):
         if not (type(a) is np.ndarray and a.flags.c_contiguous and a.flags.writeable):
@@ -184,6 +183,10 @@ def reason(engine):
 _ILX, _ILY, _IRI, _IRJ, _ID0, _IWI, _IWJ = (forces.PairConstants.FLOAT_ROWS.index(n)
                                            for n in ("Lx", "Ly", "ri", "rj", "d0", "w_i", "w_j"))
 _T0 = numba_driver._TERM_START
+# the rows of the permanent ratio and the viscosity in the term block (the register's elastic and viscous parts)
+_TRC, _TNU = (forces.PairConstants.TERM_ROWS.index(n) for n in ("ratio_c", "nu"))
+#: the rows of the terms a step keeps for a force register (``keep``; :func:`_terms`)
+_KEPT = ("el_i", "v_i", "F_i", "F_j", "fx_i", "fy_i", "el_j", "v_j", "fx_j", "fy_j")
 
 
 def _min_image_pair(dx, dy, Lx, Ly, shift):
@@ -284,7 +287,7 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
            u, u_max, strain, bound, r_max, skin,
            guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
-           work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum):
+           work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot):
     """One step of the replicas ``b0 … b1 − 1`` on numbers (compiled; run by :func:`run_step` for the
     whole batch and by :func:`_block_kernel` for one replica at a time).
 
@@ -297,7 +300,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
     its first step).  ``sample``: 0 no stresses, 1 the two shear stresses (``tau``), 2 also the sums of
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
-    rows in ``ts``, summed per replica as NumPy sums them).  The other arguments are the engine's (the flags of the step, the state's
+    rows in ``ts``, summed per replica as NumPy sums them).  ``keep``: the step keeps the terms of
+    its force phase for a force register (the rows :data:`_KEPT` of ``kt``, the sphere totals in
+    ``ktot``; :func:`_terms`).  The other arguments are the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
     the Verlet bookkeeping, the guard's constants) and the buffers of its :class:`_Workspace`;
     everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO` (nothing changed: a
@@ -377,11 +382,17 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
             fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
             fx_j, fy_j = fx, fy
             if visit_j:       # j receives the central force of its own visit (PairConstants.set_visits)
-                fn_j = pair_term(form_j, d, vn, vt, touching, rel, xi[0, p], xi[1, p], Tj[0, p], Tj[1, p], Tj[2, p],
-                                 Tj[3, p], Tj[4, p], Tj[5, p], Tj[6, p], Tj[7, p], Tj[8, p], Tj[9, p], Tj[10, p],
-                                 Tj[11, p], k_t_j[p], nu_t_j[p], False, False,
-                                 (A[0, 0], A[1, 0], A[2, 0], A[3, 0], A[4, 0], A[5, 0], A[6, 0], A[7, 0]))[0]
-                fx_j, fy_j, _, _ = pair_forces(fn_j, ft, nx, ny, d, None)
+                term_j = pair_term(form_j, d, vn, vt, touching, rel, xi[0, p], xi[1, p], Tj[0, p], Tj[1, p], Tj[2, p],
+                                   Tj[3, p], Tj[4, p], Tj[5, p], Tj[6, p], Tj[7, p], Tj[8, p], Tj[9, p], Tj[10, p],
+                                   Tj[11, p], k_t_j[p], nu_t_j[p], False, False,
+                                   (A[0, 0], A[1, 0], A[2, 0], A[3, 0], A[4, 0], A[5, 0], A[6, 0], A[7, 0]))
+                fx_j, fy_j, _, _ = pair_forces(term_j[0], ft, nx, ny, d, None)
+                if keep:
+                    kt[6, p], kt[7, p] = term_j[1] * Tj[_TRC, p], viscous_force(Tj[_TNU, p], vn, rel)
+                    kt[8, p], kt[9, p] = fx_j, fy_j
+            if keep:          # the terms of i's visit (terms.elastic_term, viscous_term: the same products)
+                kt[0, p], kt[1, p] = law * T[_TRC, p], viscous_force(T[_TNU, p], vn, rel)
+                kt[2, p], kt[3, p], kt[4, p], kt[5, p] = F_i, F_j, fx, fy
             nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx_j, fy_j
             frc[0, i] += fx
             frc[1, i] += fy
@@ -412,6 +423,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
             frc[0, j] += -mxs[p]
             frc[1, j] += -mys[p]
             frc[2, j] += dFs[p] * Cf[_IWJ, p]
+        if keep:          # the totals of the phase (the kick resets them)
+            for k in range(n0, n1):
+                ktot[0, k], ktot[1, k], ktot[2, k] = frc[0, k], frc[1, k], frc[2, k]
         if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
             for b in range(b0, b1):
                 lo, hi = offsets[b], offsets[b + 1]
@@ -726,6 +740,10 @@ class _Workspace:
         self.tau = np.zeros((2, B))
         self.tsum = np.zeros((_SUMS, B))
         self.tp = self.ts = None          # (the rows of every tensor: made at the first step that samples them)
+        # the terms a step keeps for a force register (engine.keep_terms)
+        self.keep = bool(engine.keep_terms)
+        self.kt = np.empty((len(_KEPT), C.P if self.keep else 0))
+        self.ktot = np.empty((3, B * N if self.keep else 0))
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
         per_sphere = lambda a: np.array(np.broadcast_to(a, (B * N,)), dtype=float)       # (writable copies)
@@ -842,6 +860,8 @@ def run_step(engine, cool, dt, sample):
             _draw(engine, ws, b, ws.work[4] == 0.0, 5)
         status = kernel(3, 0, B, *args)
     _adopt(engine, ws, held)
+    if ws.keep:
+        engine.terms = _terms(engine, ws)
     if status == _GUARD:
         _report(engine, ws)
     if status == _UNITS:
@@ -896,7 +916,7 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
             xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need,
-            *ws.tensor_rows(tensors or code == 2), ws.tsum)
+            *ws.tensor_rows(tensors or code == 2), ws.tsum, ws.keep, ws.kt, ws.ktot)
     held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
                 u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate,
                 half=None if not verlet else new_half if half_out is None else half)
@@ -918,6 +938,21 @@ def _adopt(engine, ws, held, stepped=False, kicked=True):
             engine.half = held["half"]
         engine.s.gamma, engine.s.t = held["gamma"], held["t"]
         engine.need = ws.need.copy()
+
+
+def _terms(engine, ws):
+    """The terms of the last force phase as the NumPy force phase keeps them for a force register
+    (:attr:`~particleShear.engine.step.BatchEngine.terms`): copies of the rows the step kept
+    (``keep``) and of its geometry; the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy
+    phase's expressions on them."""
+    C, w, kt, own = engine.C, ws.work, ws.kt, ws.visit_j
+    d, dF = w[4].copy(), w[10].copy()
+    return dict(C=C, parts=([kt[0].copy(), kt[1].copy()], [kt[6].copy(), kt[7].copy()] if own else []),
+                F=kt[2:4].copy(), dx=w[0].copy(), dy=w[1].copy(), nx=w[5].copy(), ny=w[6].copy(), d=d,
+                touching=d < C.d0, active=engine.active.copy(), shifted=(w[2] != 0) | (w[3] != 0),
+                mob=ws.mob.copy(), fx_i=kt[4].copy(), fy_i=kt[5].copy(), fx_j=kt[8].copy() if own else None,
+                fy_j=kt[9].copy() if own else None, dF=dF, tq=dF * C.w, birth=engine.birth.copy(),
+                totals=ws.ktot.copy())
 
 
 def _report(engine, ws):
@@ -1015,6 +1050,8 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
             engine.need = due & ~going
             starts[going & (starts == _SKIP)] = 0
         ws = _prepared(engine)
+        if ws is not None and ws.keep and B > 1 and not ks.any():
+            return 0          # (a batch keeping its terms steps together: one set of candidates, one record)
         if ws is None:
             if ks.any():
                 raise RuntimeError("run_block: the step stopped running compiled within a block")
@@ -1037,6 +1074,8 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
             elif st == _GUARD:       # (the other replicas run to this step at least: the first failure is reported)
                 failed[b], verdicts[:, b] = ks[b], ws.verdict[:, b]
                 end = min(end, int(ks[b]) + 1)
+    if ws.keep:        # (the terms of the last step: a batch of one, whose last call stepped it)
+        engine.terms = _terms(engine, ws)
     if want.any():     # (the tensors of the sampled steps at once: each column is one replica's step)
         k = np.flatnonzero(want)
         S = sums[k].transpose(1, 0, 2).reshape(_SUMS, -1)
@@ -1221,7 +1260,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                   visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s,
                   rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth,
                   next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
-                  tau, verdict, need, tp, ts, tsum):
+                  tau, verdict, need, tp, ts, tsum, keep, kt, ktot):
     """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
 
     Replica b runs its steps ``ks[b] … n − 1`` until the block ends, a candidate list of it is due
@@ -1258,7 +1297,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                               applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
                               mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p,
                               xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
-                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum)
+                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot)
             start = 0
             if st != _DONE:
                 break

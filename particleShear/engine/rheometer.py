@@ -51,11 +51,12 @@ def _block_end(engine, i, n_steps, after_step, observers):
 
     A block holds steps whose rate does not depend on the steps before (no controller
     ``after_step``), and ends at the latest after the first step an observer is due after, and
-    after :data:`BLOCK` steps (its steps that sample every tensor sum their rows in the compiled
+    after :data:`BLOCK` steps (the first block is the first step alone, so that the progress is
+    reported after it, as the pre-equilibration reports its first step) (its steps that sample every tensor sum their rows in the compiled
     step, :func:`~particleShear.engine.numba_step.run_block`)."""
     if not engine.backend.compiled or after_step is not None:
         return i
-    j = min(n_steps, i + BLOCK)
+    j = min(n_steps, i + BLOCK if i else 1)      # (step 1 alone: the phase's first progress call)
     for ob in observers:          # (observers are notified after the steps that are multiples of their every)
         j = min(j, (i // ob.every + 1) * ob.every)
     return j

@@ -512,8 +512,8 @@ class OscillatoryShearExperiment:
         return record, {k: self.timings[k] for k in ("pre_equilibration", "protocol")}
 
     def engine_of_ensemble(self, carry_predictor=True):
-        """A batch of one on the ensemble's own state (:func:`~particleShear.base.engine_adapter.state_of_ensemble`):
-        the ensemble's integrator, stability guard (its interval and the thresholds of a
+        """A batch of one on the ensemble's own state (:func:`~particleShear.base.engine_adapter.state_of_ensemble`,
+        on the default backend: compiled where Numba is installed): the ensemble's integrator, stability guard (its interval and the thresholds of a
         :class:`~particleShear.base.stability.StabilityGuard`; a guard's own ``check`` is not
         called) and contact-law callbacks; it numbers the relations as they form (as every engine on
         an ensemble's own state does), for the write-back.
@@ -539,9 +539,10 @@ class OscillatoryShearExperiment:
             carried = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
         thresholds = ({} if guard is None else     # the thresholds of the ensemble's guard
                       dict(min_distance_ratio=guard.min_distance_ratio, max_kinetic_energy=guard.max_kinetic_energy))
-        # keep_terms: the last step's terms, for the ensemble's force register
-        return BatchEngine(state_of_ensemble(ens), skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
-                           check_interval=getattr(guard, "interval", 4), integrator=integrator, keep_terms=True,
+        # keep_terms: the last step's terms, for the ensemble's force register; "auto": compiled where
+        # Numba is installed (the same numbers, terms included)
+        return BatchEngine(state_of_ensemble(ens, backend="auto"), skin_factor=ENGINE_SKIN_FACTOR,
+                           guard=guard is not None, check_interval=getattr(guard, "interval", 4), integrator=integrator, keep_terms=True,
                            half=carried, **thresholds)
 
     def _scene(self, engine):
