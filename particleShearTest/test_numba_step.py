@@ -232,6 +232,52 @@ class TestCompiledStepBits(unittest.TestCase):
         self.assertGreater(results["numpy"][1], 100)
         self.assertEqual(results["numba"][1], 0)
 
+    def test_documented_step_loop_runs_compiled(self):
+        """The documented step loop of the README (``setShearRate``, forces, totals, every tensor of
+        ``StressTensorEvaluation`` over ``movableSphereList()``, acceleration, movement) on an
+        ensemble's own state: its force phase and its tensors' row sums run compiled where Numba is
+        installed (NumPy's relations and row sums never run) and the spheres and all nine tensors
+        are NumPy's bits at every step."""
+        import math
+        import os
+        from unittest import mock
+
+        from particleShear import StressTensorEvaluation
+        from particleShear.engine.stress import TENSORS, StressInputs
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        runs = {}
+        for backend in ("numpy", "numba"):
+            ens = constituted(81, **FRICTIONAL_BONDS)[1]
+            ens.applyingShear = True
+            ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+            no_numpy = (mock.patch.object(BatchEngine, "relations", side_effect=AssertionError("NumPy relations")),
+                        mock.patch.object(StressInputs, "per_replica", side_effect=AssertionError("NumPy sums")))
+            seen = []
+            with mock.patch.dict(os.environ, {"PARTICLESHEAR_BACKEND": backend}):
+                if backend == "numba":
+                    for p in no_numpy:
+                        p.start()
+                try:
+                    for k in range(40):
+                        ens.setShearRate(300.0 * math.cos(0.05 * k))
+                        ens.mechanical_simulation_step_calculate_forces()
+                        ens.record_total_particle_forces()
+                        ev.evaluate_stress_tensors(ens.force_register, ens.movableSphereList(), ens.shear_rate)
+                        seen.append(np.array([getattr(ev, t.name) for t in TENSORS]))
+                        ens.mechanical_simulation_step_calculate_acceleration(0.999, ens.dt)
+                        ens.mechanical_simulation_step_calculate_movement(ens.dt)
+                finally:
+                    if backend == "numba":
+                        for p in no_numpy:
+                            p.stop()
+            spheres = np.array([(q.x, q.y, q.xspeed, q.yspeed, q.omega) for q in ens.sphereList])
+            runs[backend] = (np.array(seen), spheres)
+        self.assertGreater(np.abs(runs["numba"][0]).max(), 0.0)
+        for a, b in zip(runs["numpy"], runs["numba"]):
+            np.testing.assert_array_equal(_bits(a), _bits(b))
+
     def test_plates_off_relaxation_and_numbers(self):
         """The constitution's relaxation (plates off, μ = 0 blocks, drift removal) on the ensembles' own
         state, whose engine numbers the relations as they form: the same bits and creation numbers."""

@@ -65,7 +65,7 @@ class EngineStep:
         integrator = getattr(self, "integrator", "euler")
         carried = (np.array([h if h is not None else np.zeros(self._n) for h in half])
                    if integrator == "verlet" and half is not None and len(half[0]) == self._n else None)
-        eng = BatchEngine(state_of_ensemble(self), skin_factor=self.neighbour_skin, guard=False,
+        eng = BatchEngine(state_of_ensemble(self, backend="auto"), skin_factor=self.neighbour_skin, guard=False,
                           integrator=integrator, keep_terms=True, half=carried,   # keep_terms: the force register
                           lees_edwards=self._lees_edwards(),
                           strain_only_while_shearing=self._strain_only_while_shearing)

@@ -48,7 +48,8 @@ from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, ot
 from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_kernels", "run_step", "run_block", "search", "carried", "NOT_RUN"]
+           "compile_carried_kernel", "compile_kernels", "run_step", "run_force_phase", "run_block", "search", "carried",
+           "tensor_sums", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -65,11 +66,15 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
-                    (sys.modules[__name__], "_xi_rule"), (sys.modules[__name__], "_step_kernel"))
+                    (sys.modules[__name__], "_xi_rule"), (sys.modules[__name__], "_pair_rows"),
+                    (sys.modules[__name__], "_sphere_rows"), (sys.modules[__name__], "_row_sums"),
+                    (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min", "_xi_rule")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
 SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
+#: the compiled rows and sums of every tensor of a force phase's inputs (:func:`tensor_sums`)
+TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
 
@@ -82,7 +87,7 @@ _ARGUMENTS = ("i i i i f f i b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[
               "f[:,:] f[:] f[:] f[:] f[:] f[:] "                     # u … skin
               "f[:] f[:] f[:] f[:] f[:] f f "                        # guard_on … max_ke
               "f[:,:] b[:] f[:] f[:] b[:] f[:,:] f[:,:] b[:] f[:,:] f[:,:] f[:,:] "   # work … tsum
-              "b f[:,:] f[:,:]").split()                                    # keep, kt, ktot
+              "b f[:,:] f[:,:] b").split()                                  # keep, kt, ktot, forces_only
 
 #: the contact laws of the laws folder whose compiled form is checked bit for bit against NumPy's
 #: (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and min.  The
@@ -267,6 +272,57 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
+def _pair_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, tp):
+    """The pair rows of every tensor (:mod:`~.stress`: Love-Weber, external, internal torque) of the
+    candidates ``P0 … P1 − 1`` into ``tp`` (9, P); ``ky, kx`` nonzero where the pair acts through a
+    periodic boundary; ``fx_j, fy_j`` read only with ``own_j`` (compiled)."""
+    for p in range(P0, P1):
+        i, j, b = ai[p], aj[p], rep[p]
+        internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (ky[p] != 0.0) or (kx[p] != 0.0))
+        rel = active[p]
+        internal, ext_i, ext_j = internal and rel, ext_i and rel, ext_j and rel     # (StressInputs.roles)
+        xc_i, yc_i = x[i] - Lx[b] / 2, y[i] - Ly[b] / 2
+        xc_j, yc_j = x[j] - Lx[b] / 2, y[j] - Ly[b] / 2
+        tp[0, p], tp[1, p], tp[2, p], tp[3, p] = love_weber_entries(fx_i[p], fy_i[p], fx_j[p], fy_j[p], own_j, dx[p],
+                                                                    dy[p], internal)
+        tp[4, p], tp[5, p], tp[6, p], tp[7, p] = external_entries(fx_i[p], fy_i[p], fx_j[p], fy_j[p], own_j, xc_i, yc_i,
+                                                                  xc_j, yc_j, ext_i, ext_j)
+        tp[8, p] = dF[p] * internal
+
+
+def _sphere_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
+    """The sphere rows of every tensor (:mod:`~.stress`: unbalanced forces, torques, spin, Otsuki) of
+    the spheres ``n0 … n1 − 1`` into ``ts`` (10, B·N) (compiled)."""
+    for k in range(n0, n1):
+        b = rep[k]
+        xc, yc = x[k] - Lx[b] / 2, y[k] - Ly[b] / 2
+        ts[0, k], ts[1, k], ts[2, k], ts[3, k] = unbalanced_entries(fx[k], fy[k], mob[k], xc, yc)
+        ts[4, k] = torque[k]
+        ts[5, k] = spin_entry(inertia[k], omega[k], mob[k])
+        ts[6, k], ts[7, k], ts[8, k], ts[9, k] = otsuki_entries(m[k], vx[k], vy[k], rate[b], yc, mob[k])
+
+
+def _row_sums(b0, b1, N, offsets, tp, ts, tsum):
+    """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` into ``tsum`` (19, B), in
+    the order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
+    ``StressInputs.per_replica``: ``numpy.add.reduceat`` over each replica's segment) (compiled)."""
+    for b in range(b0, b1):
+        for q in range(9):
+            tsum[q, b] = _segment_sum(tp[q], offsets[b], offsets[b + 1])
+        for q in range(10):
+            tsum[9 + q, b] = _segment_sum(ts[q], b * N, (b + 1) * N)
+
+
+def _tensor_kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly, rate, mob,
+                   active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum):
+    """Every tensor's row sums of one force phase's inputs (compiled; :func:`tensor_sums`)."""
+    _pair_rows(offsets[0], offsets[B], ai, aj, rep_p, own_j, x, y, Lx, Ly, mob, active, shifted, shifted, dx, dy,
+               fx_i, fy_i, fx_j, fy_j, dF, tp)
+    _sphere_rows(0, B * N, rep_s, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts)
+    _row_sums(0, B, N, offsets, tp, ts, tsum)
+    return 0
+
+
 def _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi):
     # the sequential ξ rule of pair p (integrate.xi_increments element by element): ξ_ij and ξ_ji
     # grow by their rates times dt while the relation is active and not slipping
@@ -287,7 +343,7 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
            Cf, Ci, Cb, offsets, state_p, xi, active, birth, next_birth,
            u, u_max, strain, bound, r_max, skin,
            guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke,
-           work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot):
+           work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot, forces_only):
     """One step of the replicas ``b0 … b1 − 1`` on numbers (compiled; run by :func:`run_step` for the
     whole batch and by :func:`_block_kernel` for one replica at a time).
 
@@ -302,7 +358,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
     rows in ``ts``, summed per replica as NumPy sums them).  ``keep``: the step keeps the terms of
     its force phase for a force register (the rows :data:`_KEPT` of ``kt``, the sphere totals in
-    ``ktot``; :func:`_terms`).  The other arguments are the engine's (the flags of the step, the state's
+    ``ktot``; :func:`_terms`).  ``forces_only``: the force phase alone (:func:`run_force_phase`),
+    the forces and torques left in ``frc`` and its geometry in ``work``.  The other arguments are the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
     the Verlet bookkeeping, the guard's constants) and the buffers of its :class:`_Workspace`;
     everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO` (nothing changed: a
@@ -406,15 +463,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 else:
                     work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
                                                                        dys[p], fx, dF, None)
-                if sample == 2:      # every tensor: the pair rows of engine.stress (StressInputs.roles)
-                    internal, ext_i, ext_j = internal and rel, ext_i and rel, ext_j and rel
-                    xc_i, yc_i = pos[0, i] - Lx[b] / 2, pos[1, i] - Ly[b] / 2
-                    xc_j, yc_j = pos[0, j] - Lx[b] / 2, pos[1, j] - Ly[b] / 2
-                    tp[0, p], tp[1, p], tp[2, p], tp[3, p] = love_weber_entries(fx, fy, fx_j, fy_j, visit_j, dxs[p],
-                                                                                dys[p], internal)
-                    tp[4, p], tp[5, p], tp[6, p], tp[7, p] = external_entries(fx, fy, fx_j, fy_j, visit_j, xc_i, yc_i,
-                                                                              xc_j, yc_j, ext_i, ext_j)
-                    tp[8, p] = dF * internal
+                if sample == 2:      # (the force on i, for the tensors' pair rows below)
+                    work[14, p], work[15, p] = fx, fy
             if check:
                 verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
         # the scatter's second half: −F on j and the torque on j, in pair order
@@ -431,20 +481,12 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 lo, hi = offsets[b], offsets[b + 1]
                 tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
                                                        _segment_sum(work[13], lo, hi), V[b])
-        if sample == 2:     # the sphere rows (the totals of the scatter), then every row's sum per replica
-            for k in range(n0, n1):
-                b = rep_s[k]
-                xc, yck = pos[0, k] - Lx[b] / 2, pos[1, k] - Ly[b] / 2
-                ts[0, k], ts[1, k], ts[2, k], ts[3, k] = unbalanced_entries(frc[0, k], frc[1, k], mob[k], xc, yck)
-                ts[4, k] = frc[2, k]
-                ts[5, k] = spin_entry(mmi[2, k], vel[2, k], mob[k])
-                ts[6, k], ts[7, k], ts[8, k], ts[9, k] = otsuki_entries(mmi[0, k], vel[0, k], vel[1, k], rate[b], yck,
-                                                                        mob[k])
-            for b in range(b0, b1):
-                for q in range(9):       # (forces.replica_sums and StressInputs.per_replica: numpy.add.reduceat)
-                    tsum[q, b] = _segment_sum(tp[q], offsets[b], offsets[b + 1])
-                for q in range(10):
-                    tsum[9 + q, b] = _segment_sum(ts[q], b * N, (b + 1) * N)
+        if sample == 2:     # every tensor's rows (the totals of the scatter), summed per replica
+            _pair_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs, dys,
+                       work[14], work[15], mxs, mys, dFs, tp)
+            _sphere_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0], frc[1],
+                         frc[2], mob, rate, Lx, Ly, ts)
+            _row_sums(b0, b1, N, offsets, tp, ts, tsum)
         if check:
             bad = False
             for b in range(b0, b1):
@@ -462,6 +504,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 bad = bad or code != 0
             if bad:
                 return _GUARD
+        if forces_only:
+            return _DONE
         # -- kick (plates follow), damping
         for k in range(n0, n1):
             b = rep_s[k]
@@ -706,6 +750,7 @@ def compile_kernels(say=None, law=None):
     compile_block_kernel(parallel=parallel)
     compile_search_kernel()
     compile_carried_kernel()
+    _compile_tensor_kernel()
     if law is None:
         return
     found = get_law(law)
@@ -732,7 +777,7 @@ class _Workspace:
         s, C = engine.s, engine.C
         B, N = s.B, s.N
         self.C, self.key, self.why = C, key, reason(engine)
-        self.work = np.empty((14, C.P))
+        self.work = np.empty((16, C.P))
         self.zero = np.zeros(C.P, dtype=np.bool_)
         self.mob = np.ones(B * N, dtype=np.bool_)
         self.yc = np.empty(B * N)
@@ -870,10 +915,112 @@ def run_step(engine, cool, dt, sample):
         kernel(1, 0, B, *args)
     _adopt(engine, ws, held, stepped=True)
     engine.step_count += 1
+    return _samples(ws, sample)
+
+
+def run_force_phase(engine, sample=False):
+    """The force phase of ``engine`` in the compiled code (the first part of :func:`run_step`), or
+    :data:`NOT_RUN` when it does not cover it.
+
+    What :meth:`~particleShear.engine.step.BatchEngine.force_phase` does, with the same numbers: the
+    forces and torques in the state, the relations and their history, the guard when due, the
+    terms when kept; the acceleration and movement phases (on NumPy) then read the record.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``).
+    sample : bool or str
+        As :meth:`~particleShear.engine.step.BatchEngine.force_phase`.
+
+    Returns
+    -------
+    tuple or NOT_RUN
+        ``(fields, stresses)``: the fields of the phase's
+        :class:`~particleShear.engine.step.ForceRecord` but the verdict (``dx, dy, nx, ny, dvx,
+        active, yc, mob``: copies) and the stresses as
+        :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them.
+    """
+    engine.neighbours()
+    ws = _prepared(engine)
+    if ws is None:
+        return NOT_RUN
+    kernel, B = _kernels_of(ws)[0], engine.s.B
+    check = ws.guarded and not engine.step_count % engine.check_interval
+    args, held = _arguments(engine, ws, 1.0, 0.0, sample, check, np.full(B, engine.half is not None),
+                            forces_only=True)
+    status = kernel(0, 0, B, *args)
+    if status == _D_ZERO:
+        for b in range(B):
+            _draw(engine, ws, b, ws.work[4] == 0.0, 5)
+        status = kernel(3, 0, B, *args)
+    _adopt(engine, ws, held)
+    if ws.keep:
+        engine.terms = _terms(engine, ws)
+    if status == _GUARD:
+        _report(engine, ws)
+    w = ws.work
+    fields = (w[0].copy(), w[1].copy(), w[5].copy(), w[6].copy(), w[7].copy(), engine.active.copy(), ws.yc.copy(),
+              ws.mob.copy())
+    return fields, _samples(ws, sample)
+
+
+def _samples(ws, sample):
+    """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`)."""
     if sample == "tensors":       # (the xy entries are the shear stresses, as the NumPy step returns them)
         T = tensors_from_sums(ws.tsum.copy(), ws.V)
         return -T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
+
+
+def tensor_sums(q):
+    """The per-replica sums of every tensor's rows (:data:`~.stress.SUMMED_ROWS`) of one force phase's
+    inputs, in the compiled code: what :meth:`~.stress.StressInputs.reduce` sums on NumPy, the same
+    bits (the rows from the same entry functions, the sums in NumPy's order); the tensors are then
+    :func:`~.stress.tensors_from_sums` of them.
+
+    Parameters
+    ----------
+    q : StressInputs
+        Every input of the rows (one force phase of a batch whose spheres are ``B·N`` rows; host arrays).
+
+    Returns
+    -------
+    ndarray (19, B)
+    """
+    C, B = q.C, q.B
+    n = len(q.x)
+    N = n // B if B else 0
+    def f(a, k=n):        # (a contiguous float64 array of k: the array itself when it is one)
+        if type(a) is np.ndarray and a.dtype == np.float64 and a.shape == (k,) and a.flags.c_contiguous:
+            return a
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (k,)))
+
+    i = lambda a: np.ascontiguousarray(a, dtype=np.int64)                                          # noqa: E731
+    own = q.fx_j is not None
+    P = len(q.dx)
+    tsum = np.zeros((_SUMS, B))
+    _compile_tensor_kernel()(B, N, i(C.ai), i(C.aj), i(C.rep), i(C.offsets), i(q.rep), own, f(q.x), f(q.y), f(q.vx),
+                             f(q.vy), f(q.omega), f(q.m), f(q.inertia), f(q.Lx, B), f(q.Ly, B), f(q.rate, B),
+                             np.ascontiguousarray(q.mob, dtype=np.bool_), np.ascontiguousarray(q.active, dtype=np.bool_),
+                             f(q.shifted, P), f(q.dx, P), f(q.dy, P), f(q.fx_i, P), f(q.fy_i, P),
+                             f(q.fx_j if own else q.fx_i, P), f(q.fy_j if own else q.fy_i, P), f(q.dF, P), f(q.fx),
+                             f(q.fy), f(q.torque), np.empty((9, P)), np.empty((10, n)), tsum)
+    return tsum
+
+
+def _compile_tensor_kernel(cache=True):
+    """The compiled :func:`_tensor_kernel`, compiled once per process (or loaded from the cache)."""
+    if cache and "tensors" in _kernels:
+        return _kernels["tensors"]
+    from numba import types
+    f1, i1, f2 = (types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"),
+                  types.Array(types.float64, 2, "C"))
+    b1 = types.Array(types.boolean, 1, "C")
+    signature = types.int64(types.int64, types.int64, i1, i1, i1, i1, i1, types.boolean, *(f1,) * 10, b1, b1,
+                            *(f1,) * 11, f2, f2, f2)
+    return _compile("tensors", "_tensor_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + TENSOR_FUNCTIONS,
+                    lambda: signature, cache)
 
 
 def _prepared(engine):
@@ -887,11 +1034,11 @@ def _prepared(engine):
     return None
 
 
-def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False):
+def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
     (:func:`_adopt`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
-    (``tensors``: a block samples every tensor at some of its steps); ``pred`` (B,): which replicas'
-    force phase sees the Verlet half kick;
+    (``tensors``: a block samples every tensor at some of its steps); ``forces_only``: the force
+    phase alone; ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
     ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
     (``half`` is then the one handed back); default a new array per step, handed back itself (as
     ``half_kick`` gives)."""
@@ -916,7 +1063,7 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
             xi, active, birth, next_birth, u, u_max, strain, bound, ws.r_max, ws.skin,
             ws.guard_on, rate_max, ws.kk, ws.r_mean, ws.m_sum, float(engine.min_distance_ratio), ws.max_ke,
             ws.work, ws.mob, ws.yc, ws.y0, ws.zero, ws.tau, ws.verdict, ws.need,
-            *ws.tensor_rows(tensors or code == 2), ws.tsum, ws.keep, ws.kt, ws.ktot)
+            *ws.tensor_rows(tensors or code == 2), ws.tsum, ws.keep, ws.kt, ws.ktot, forces_only)
     held = dict(state_p=state_p, xi=xi, active=active, birth=birth, next_birth=next_birth, rate_max=rate_max,
                 u=u, u_max=u_max, strain=strain, bound=bound, gamma=gamma, t=t, rate=rate,
                 half=None if not verlet else new_half if half_out is None else half)
@@ -1260,7 +1407,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                   visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s,
                   rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p, xi, active, birth,
                   next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio, max_ke, work, mob, yc, y0, zero,
-                  tau, verdict, need, tp, ts, tsum, keep, kt, ktot):
+                  tau, verdict, need, tp, ts, tsum, keep, kt, ktot, forces_only):
     """Steps of a block, replica by replica, on numbers (compiled; run by :func:`run_block`).
 
     Replica b runs its steps ``ks[b] … n − 1`` until the block ends, a candidate list of it is due
@@ -1297,7 +1444,8 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                               applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
                               mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, state_p,
                               xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
-                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot)
+                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot,
+                              False)
             start = 0
             if st != _DONE:
                 break

@@ -565,6 +565,10 @@ class BatchEngine:
         stresses : None or tuple
             As :meth:`step` returns.
         """
+        if self.backend.compiled:       # the same phase in one compiled call
+            got = numba_step.run_force_phase(self, sample)
+            if got is not numba_step.NOT_RUN:
+                return ForceRecord(*got[0], None), got[1]
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         yc, dx, dy, ky, kx, d, touching, active, image_rate = self.relations()
