@@ -14,6 +14,7 @@ import numpy as np
 from ..checks import show_value
 from ..engine import contact_laws
 from ..engine.xp import get_backend
+from ..linkable.builders import EnsembleRecipe
 from ..parameters import PARAMETERS
 from ..parameters import defaults as _defaults
 from ..simulation.fragmentation import Simulation_interlocking_rheology
@@ -229,6 +230,10 @@ def build_sessions(runs):
         sim.saveOutputMovie = bool(kw["saveOutputMovie"])
         sim.run_id, sim.seed_entropy, sim.spawn_key = kw.run_id, seed_entropy, spawn_key
         sim.parameters = kw
+        # the ensemble's parameters as one record of the checked run's values (μ its field ``mu``), read
+        # by the constitution as they are
+        sim.recipe = EnsembleRecipe.of(kw, mu=kw["theMu"], anticipated_amplitude=kw["theAmplitude"],
+                                       N=int(kw["N"]), cut_lines=int(kw["cut_lines"]))
         sim.contact_law = contact_law_spec(kw)
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
