@@ -21,7 +21,9 @@ import numpy as np
 import particleShear.engine.forces as forces
 import particleShear.run.validation as validation
 import particleShear.simulation.driver as driver
-from particleShear.run.api import doParticleShearSimulation
+import particleShear.simulation.fragmentation as fragmentation
+from particleShear.linkable.builders import EnsembleRecipe
+from particleShear.run.api import doParticleShearSimulation, doParticleShearSimulationSeries
 from particleShear.run.batch import run_batch
 import particleShear.run.batch as batch
 from particleShear.run.validation import CheckedPoint, RunParameters, checked_point, validated_run
@@ -154,6 +156,38 @@ class TestOncePerSweepRun(unittest.TestCase):
                 self.assertEqual(validated_run(dict(run.parameters, seed=ss, root_folder=os.curdir)).run_id, run.run_id)
 
 
+#: a series of two runs (one amplitude, two μ) of the short run
+SERIES = dict(N=20, cut_lines=0, relative_frequency=0.2, pre_periods=0.2, periods=1, post_periods=0, seed=1,
+              doDrawing=False, plotStress=False, verbose=False, backend="numpy", amplitudes=[0.2], mu=[MU, 0.5],
+              N_repetitions=1)
+
+
+class TestOncePerSeriesRun(unittest.TestCase):
+    """A series checks each run once: its worker measures the run from its checked arguments (was twice)."""
+
+    def _series(self, **kw):
+        with warnings.catch_warnings(), counted(validation._checked, validation) as checks, \
+                concurrent.futures.ThreadPoolExecutor(1) as ex:
+            warnings.simplefilter("ignore")      # periods=1: no standard error (MeasurementWarning)
+            results = doParticleShearSimulationSeries(executor=ex, **dict(SERIES, **kw))
+        return len(checks), results
+
+    def test_each_run_is_validated_once(self):
+        with tempfile.TemporaryDirectory() as d:
+            for kw in ({}, dict(batch_size=2), dict(root_folder=d)):
+                with self.subTest(**{k: v != d and v for k, v in kw.items()}):
+                    checks, results = self._series(**kw)
+                    self.assertEqual(checks, 2)
+                    self.assertEqual([r.parameters["theMu"] for r in results], [MU, 0.5])
+                    # the run id the series gave its worker is the checked run's
+                    for r in results:
+                        ss = np.random.SeedSequence(r.seed, spawn_key=r.spawn_key)
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("ignore")
+                            want = validated_run(dict(r.parameters, seed=ss, backend="numpy"))
+                        self.assertEqual(r.run_id, want.run_id)
+
+
 class TestRunParameters(unittest.TestCase):
     """The checked arguments cannot change on their way down, and survive a process boundary."""
 
@@ -215,6 +249,25 @@ class TestMuReachesTheKernel(unittest.TestCase):
         self.assertTrue(pair_mu)
         for mu in pair_mu:                         # every pair constant of the Coulomb bound: μ as given
             self.assertTrue(np.all(mu == MU), mu)
+
+
+    def test_mu_travels_as_one_object_in_two_records(self):
+        """The hops of μ: the call's value is, as the very object, ``RunParameters["theMu"]``, then the field
+        ``mu`` of the run's :class:`EnsembleRecipe`, which the constitution sets as the ensemble's μ (read into
+        ``BatchState.mu``, above): no builder or constructor argument, no dict repacked on the way."""
+        mu = float("0.37")                  # an object of its own, followed by identity
+        recipes, constitution = [], fragmentation.constitution
+
+        def capture(recipe, **kw):
+            recipes.append(recipe)
+            return constitution(recipe, **kw)
+
+        with mock.patch.object(fragmentation, "constitution", capture), self.assertWarns(Warning):
+            result = doParticleShearSimulation(theMu=mu, return_result=True, **SMALL)
+        self.assertEqual(len(recipes), 1)
+        self.assertIsInstance(recipes[0], EnsembleRecipe)
+        self.assertIs(recipes[0].mu, mu)
+        self.assertIs(result.parameters["theMu"], mu)
 
 
 if __name__ == "__main__":
