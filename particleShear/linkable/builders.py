@@ -47,6 +47,21 @@ class EnsembleRecipe:
     meanings and units) but the call's options (``theTk``, ``doDrawing``, ``do_debug``, ``rng``,
     ``verbose``); those without a default here are required.
 
+    Parameters
+    ----------
+    N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor, cut_lines, do_permanent_links
+        As for the builder (required).
+    relative_viscosity, central_repulsion_coefficient, anticipated_amplitude, relative_transversal_link_strength
+        As for the builder (required).
+    avoid_horizontal_angle_degree, avoid_height_spanning_particles, doCutByTriangulation
+        As for the builder (required).
+    size_x, size_y, do_pre_equilibration : optional
+        The cell (µm; default 500 × 500, the documented simulations'); relax the packing (default True).
+    interface_reenforcement_central, interface_reenforcement_tangential, keep_viscosity_coefficients_constant
+        As for the builder (defaults 1, 1, True: the legacy builder's interface).
+    cut_top_bottom, remove_link_fraction, edge_fuzziness : optional
+        As for the builder (defaults True, 0, 0).
+
     Raises
     ------
     TypeError, ValueError
@@ -68,11 +83,9 @@ class EnsembleRecipe:
     avoid_horizontal_angle_degree: float
     avoid_height_spanning_particles: bool
     doCutByTriangulation: bool
-    #: the cell (µm) of the documented simulations
     size_x: float = 500
     size_y: float = 500
     do_pre_equilibration: bool = True
-    #: the adjustable interface (the legacy builder: these defaults)
     interface_reenforcement_central: float = 1
     interface_reenforcement_tangential: float = 1
     keep_viscosity_coefficients_constant: bool = True
