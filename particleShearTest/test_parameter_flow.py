@@ -4,7 +4,9 @@ A run's arguments are checked, completed, normalized, seeded and identified once
 (:func:`particleShear.run.validation.validated_run`); the immutable
 :class:`~particleShear.run.validation.RunParameters` it returns travels unchanged to the sessions,
 and a parameter's value (here μ, ``theMu``) reaches the engine's per-replica constants
-(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given.
+(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given, through
+the ensemble's :class:`~particleShear.linkable.builders.EnsembleRecipe` (its hops counted here).  A run,
+a batch, a series and a sweep validate each run once.
 """
 import concurrent.futures
 import contextlib
@@ -268,6 +270,46 @@ class TestMuReachesTheKernel(unittest.TestCase):
         self.assertIsInstance(recipes[0], EnsembleRecipe)
         self.assertIs(recipes[0].mu, mu)
         self.assertIs(result.parameters["theMu"], mu)
+
+
+    @unittest.skipUnless(sys.version_info >= (3, 11), "names functions by code.co_qualname (Python 3.11)")
+    def test_hops_of_mu(self):
+        """The functions that take μ itself as an argument, from the call to the measurement's state: only
+        the recipe and the ensemble's μ on the way to the kernel (was: the builder's generator and its
+        constitution, four ensemble constructors), beside the documented simulation's own three
+        constructors (its header, file name and pre-equilibration length read ``sim.mu``).  Readers of the
+        value are no hops: the checks (particleShear.checks), the run identity's hashing, the time-step rule."""
+        mu = float("0.37")                  # followed by identity
+        passed, done = [], []
+        readers = ("particleShear.checks", "particleShear.simulation.provenance", "abc")
+
+        def profile(frame, event, arg):
+            if event != "call" or done:
+                return
+            code = frame.f_code
+            if code.co_name == "state_from_ensembles":      # the measurement's state: the trip ends here
+                done.append(code)
+                return
+            if frame.f_globals.get("__name__") in readers or code.co_name == "time_steps_from_model":
+                return
+            arguments = code.co_varnames[:code.co_argcount + code.co_kwonlyargcount]
+            if any(frame.f_locals.get(name) is mu for name in arguments):
+                passed.append(code.co_qualname.rpartition("<locals>.")[2])
+
+        sys.setprofile(profile)
+        try:
+            with self.assertWarns(Warning):
+                result = doParticleShearSimulation(theMu=mu, return_result=True, **SMALL)
+        finally:
+            sys.setprofile(None)
+        self.assertTrue(done)
+        self.assertIs(result.parameters["theMu"], mu)
+        simulation = ["Simulation_interlocking_rheology.__init__", "Simulation_dermal_filler_rheology.__init__",
+                      "OscillatorySimulationFragmentation.__init__"]
+        # the call, then (in RunParameters, not an argument) the recipe (dataclass __init__) and the ensemble's
+        # μ (the NonNegative descriptor of the canvas), read into BatchState.mu by state_from_ensembles
+        self.assertEqual(sorted(passed), sorted(["doParticleShearSimulation", *simulation, "__init__",
+                                                 "NonNegative.__set__"]))
 
 
 if __name__ == "__main__":

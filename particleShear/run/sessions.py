@@ -108,7 +108,9 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     """The :class:`Simulation_interlocking_rheology` of one run, configured but not run.
 
     The documented class is made with keyword arguments read straight from ``params`` (no
-    intermediate names), so a parameter's value reaches the simulation object in one step.
+    intermediate names), so a parameter's value reaches the simulation object in one step; its
+    ensemble's :class:`~particleShear.linkable.builders.EnsembleRecipe` (``recipe``) is made from
+    ``params`` likewise, so the constitution reads the run's values, not the object's attributes.
 
     Parameters
     ----------
@@ -128,9 +130,14 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     p = params
     pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
     saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
+    N, cut_lines = int(p["N"]), int(p["cut_lines"])
     theSimulation = Simulation_interlocking_rheology(
-        p["root_folder"], cut_lines=int(p["cut_lines"]), N=int(p["N"]), amplitude=p["theAmplitude"], mu=p["theMu"],
+        p["root_folder"], cut_lines=cut_lines, N=N, amplitude=p["theAmplitude"], mu=p["theMu"],
         **{name: p[name] for name in _SIMULATION_ARGUMENTS})
+    # the ensemble's parameters: one record of the run's values (μ its field ``mu``), which the constitution
+    # reads as they are (not from the simulation's attributes)
+    theSimulation.recipe = EnsembleRecipe.of(p, mu=p["theMu"], anticipated_amplitude=p["theAmplitude"], N=N,
+                                             cut_lines=cut_lines)
     theSimulation.function_call += (
         "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
         + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)
@@ -230,10 +237,6 @@ def build_sessions(runs):
         sim.saveOutputMovie = bool(kw["saveOutputMovie"])
         sim.run_id, sim.seed_entropy, sim.spawn_key = kw.run_id, seed_entropy, spawn_key
         sim.parameters = kw
-        # the ensemble's parameters as one record of the checked run's values (μ its field ``mu``), read
-        # by the constitution as they are
-        sim.recipe = EnsembleRecipe.of(kw, mu=kw["theMu"], anticipated_amplitude=kw["theAmplitude"],
-                                       N=int(kw["N"]), cut_lines=int(kw["cut_lines"]))
         sim.contact_law = contact_law_spec(kw)
         sessions.append(RunSession(sim, kw["cool_factor"], kw["periods"], kw["plotStress"]))
         sims.append(sim)
