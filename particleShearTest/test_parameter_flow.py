@@ -4,7 +4,9 @@ A run's arguments are checked, completed, normalized, seeded and identified once
 (:func:`particleShear.run.validation.validated_run`); the immutable
 :class:`~particleShear.run.validation.RunParameters` it returns travels unchanged to the sessions,
 and a parameter's value (here μ, ``theMu``) reaches the engine's per-replica constants
-(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given.
+(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given, through
+the ensemble's :class:`~particleShear.linkable.builders.EnsembleRecipe` (its hops counted here).  A run,
+a batch, a series and a sweep validate each run once.
 """
 import concurrent.futures
 import contextlib
@@ -21,7 +23,9 @@ import numpy as np
 import particleShear.engine.forces as forces
 import particleShear.run.validation as validation
 import particleShear.simulation.driver as driver
-from particleShear.run.api import doParticleShearSimulation
+import particleShear.simulation.fragmentation as fragmentation
+from particleShear.linkable.builders import EnsembleRecipe
+from particleShear.run.api import doParticleShearSimulation, doParticleShearSimulationSeries
 from particleShear.run.batch import run_batch
 import particleShear.run.batch as batch
 from particleShear.run.validation import CheckedPoint, RunParameters, checked_point, validated_run
@@ -154,6 +158,38 @@ class TestOncePerSweepRun(unittest.TestCase):
                 self.assertEqual(validated_run(dict(run.parameters, seed=ss, root_folder=os.curdir)).run_id, run.run_id)
 
 
+#: a series of two runs (one amplitude, two μ) of the short run
+SERIES = dict(N=20, cut_lines=0, relative_frequency=0.2, pre_periods=0.2, periods=1, post_periods=0, seed=1,
+              doDrawing=False, plotStress=False, verbose=False, backend="numpy", amplitudes=[0.2], mu=[MU, 0.5],
+              N_repetitions=1)
+
+
+class TestOncePerSeriesRun(unittest.TestCase):
+    """A series checks each run once: its worker measures the run from its checked arguments (was twice)."""
+
+    def _series(self, **kw):
+        with warnings.catch_warnings(), counted(validation._checked, validation) as checks, \
+                concurrent.futures.ThreadPoolExecutor(1) as ex:
+            warnings.simplefilter("ignore")      # periods=1: no standard error (MeasurementWarning)
+            results = doParticleShearSimulationSeries(executor=ex, **dict(SERIES, **kw))
+        return len(checks), results
+
+    def test_each_run_is_validated_once(self):
+        with tempfile.TemporaryDirectory() as d:
+            for kw in ({}, dict(batch_size=2), dict(root_folder=d)):
+                with self.subTest(**{k: v != d and v for k, v in kw.items()}):
+                    checks, results = self._series(**kw)
+                    self.assertEqual(checks, 2)
+                    self.assertEqual([r.parameters["theMu"] for r in results], [MU, 0.5])
+                    # the run id the series gave its worker is the checked run's
+                    for r in results:
+                        ss = np.random.SeedSequence(r.seed, spawn_key=r.spawn_key)
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("ignore")
+                            want = validated_run(dict(r.parameters, seed=ss, backend="numpy"))
+                        self.assertEqual(r.run_id, want.run_id)
+
+
 class TestRunParameters(unittest.TestCase):
     """The checked arguments cannot change on their way down, and survive a process boundary."""
 
@@ -215,6 +251,65 @@ class TestMuReachesTheKernel(unittest.TestCase):
         self.assertTrue(pair_mu)
         for mu in pair_mu:                         # every pair constant of the Coulomb bound: μ as given
             self.assertTrue(np.all(mu == MU), mu)
+
+
+    def test_mu_travels_as_one_object_in_two_records(self):
+        """The hops of μ: the call's value is, as the very object, ``RunParameters["theMu"]``, then the field
+        ``mu`` of the run's :class:`EnsembleRecipe`, which the constitution sets as the ensemble's μ (read into
+        ``BatchState.mu``, above): no builder or constructor argument, no dict repacked on the way."""
+        mu = float("0.37")                  # an object of its own, followed by identity
+        recipes, constitution = [], fragmentation.constitution
+
+        def capture(recipe, **kw):
+            recipes.append(recipe)
+            return constitution(recipe, **kw)
+
+        with mock.patch.object(fragmentation, "constitution", capture), self.assertWarns(Warning):
+            result = doParticleShearSimulation(theMu=mu, return_result=True, **SMALL)
+        self.assertEqual(len(recipes), 1)
+        self.assertIsInstance(recipes[0], EnsembleRecipe)
+        self.assertIs(recipes[0].mu, mu)
+        self.assertIs(result.parameters["theMu"], mu)
+
+
+    @unittest.skipUnless(sys.version_info >= (3, 11), "names functions by code.co_qualname (Python 3.11)")
+    def test_hops_of_mu(self):
+        """The functions that take μ itself as an argument, from the call to the measurement's state: only
+        the recipe and the ensemble's μ on the way to the kernel (was: the builder's generator and its
+        constitution, four ensemble constructors), beside the documented simulation's own three
+        constructors (its header, file name and pre-equilibration length read ``sim.mu``).  Readers of the
+        value are no hops: the checks (particleShear.checks), the run identity's hashing, the time-step rule."""
+        mu = float("0.37")                  # followed by identity
+        passed, done = [], []
+        readers = ("particleShear.checks", "particleShear.simulation.provenance", "abc")
+
+        def profile(frame, event, arg):
+            if event != "call" or done:
+                return
+            code = frame.f_code
+            if code.co_name == "state_from_ensembles":      # the measurement's state: the trip ends here
+                done.append(code)
+                return
+            if frame.f_globals.get("__name__") in readers or code.co_name == "time_steps_from_model":
+                return
+            arguments = code.co_varnames[:code.co_argcount + code.co_kwonlyargcount]
+            if any(frame.f_locals.get(name) is mu for name in arguments):
+                passed.append(code.co_qualname.rpartition("<locals>.")[2])
+
+        sys.setprofile(profile)
+        try:
+            with self.assertWarns(Warning):
+                result = doParticleShearSimulation(theMu=mu, return_result=True, **SMALL)
+        finally:
+            sys.setprofile(None)
+        self.assertTrue(done)
+        self.assertIs(result.parameters["theMu"], mu)
+        simulation = ["Simulation_interlocking_rheology.__init__", "Simulation_dermal_filler_rheology.__init__",
+                      "OscillatorySimulationFragmentation.__init__"]
+        # the call, then (in RunParameters, not an argument) the recipe (dataclass __init__) and the ensemble's
+        # μ (the NonNegative descriptor of the canvas), read into BatchState.mu by state_from_ensembles
+        self.assertEqual(sorted(passed), sorted(["doParticleShearSimulation", *simulation, "__init__",
+                                                 "NonNegative.__set__"]))
 
 
 if __name__ == "__main__":

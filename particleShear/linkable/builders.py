@@ -3,6 +3,7 @@
 Constants: eq. S1-8 (spring), S1-9 (viscosity), S1-14 (radii); the time step: docs/accuracy.md.
 """
 __docformat__ = "numpy"
+import dataclasses
 import logging
 
 import numpy as np
@@ -14,7 +15,7 @@ from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustabl
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
-           "adjustable_interface_constitution", "Relaxation", "relax_constitution",
+           "adjustable_interface_constitution", "constitution", "EnsembleRecipe", "Relaxation", "relax_constitution",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
 
 #: attempts at cutting without a height-spanning particle before giving up (the reference loops forever)
@@ -30,6 +31,89 @@ _CHECKS = ((positive, "size_x"), (positive, "size_y"), (integer, "N", 2), (posit
            (in_range, "avoid_horizontal_angle_degree", 0, 90, False, True),
            (positive, "interface_reenforcement_central"), (positive, "interface_reenforcement_tangential"),
            (in_range, "remove_link_fraction", 0, 1), (non_negative, "edge_fuzziness"))
+
+
+@dataclasses.dataclass(frozen=True)
+class EnsembleRecipe:
+    """What one ensemble is constituted of: the builders' physical and cutting parameters, checked when made.
+
+    The one record a constitution (:func:`constitution`) reads its parameters from, field by field:
+    the documented builders make it from their arguments (:meth:`of`), a simulation from its
+    attributes, and a checked run (``doParticleShearSimulation``) from its
+    :class:`~particleShear.run.validation.RunParameters` (``particleShear.run.sessions``), so a
+    run's value — μ, say — reaches the ensemble as a field of this record, not through the
+    arguments of builders and constructors.  The fields are the parameters of
+    :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters` (same names,
+    meanings and units) but the call's options (``theTk``, ``doDrawing``, ``do_debug``, ``rng``,
+    ``verbose``); those without a default here are required.
+
+    Parameters
+    ----------
+    N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor, cut_lines, do_permanent_links
+        As for the builder (required).
+    relative_viscosity, central_repulsion_coefficient, anticipated_amplitude, relative_transversal_link_strength
+        As for the builder (required).
+    avoid_horizontal_angle_degree, avoid_height_spanning_particles, doCutByTriangulation
+        As for the builder (required).
+    size_x, size_y, do_pre_equilibration : optional
+        The cell (µm; default 500 × 500, the documented simulations'); relax the packing (default True).
+    interface_reenforcement_central, interface_reenforcement_tangential, keep_viscosity_coefficients_constant
+        As for the builder (defaults 1, 1, True: the legacy builder's interface).
+    cut_top_bottom, remove_link_fraction, edge_fuzziness : optional
+        As for the builder (defaults True, 0, 0).
+
+    Raises
+    ------
+    TypeError, ValueError
+        If a value is not a real number or out of range (named in the message), in the builders'
+        order (:data:`_CHECKS`).
+    """
+    N: int
+    packing_fraction: float
+    mu: float
+    Young_modulus_spheres: float
+    density: float
+    bimodal_factor: float
+    cut_lines: int
+    do_permanent_links: bool
+    relative_viscosity: float
+    central_repulsion_coefficient: float
+    anticipated_amplitude: float
+    relative_transversal_link_strength: float
+    avoid_horizontal_angle_degree: float
+    avoid_height_spanning_particles: bool
+    doCutByTriangulation: bool
+    size_x: float = 500
+    size_y: float = 500
+    do_pre_equilibration: bool = True
+    interface_reenforcement_central: float = 1
+    interface_reenforcement_tangential: float = 1
+    keep_viscosity_coefficients_constant: bool = True
+    cut_top_bottom: bool = True
+    remove_link_fraction: float = 0
+    edge_fuzziness: float = 0
+
+    def __post_init__(self):
+        for check, name, *limits in _CHECKS:
+            check(name, getattr(self, name), *limits)
+
+    @classmethod
+    def of(cls, values, **given):
+        """The recipe of the fields named in ``values`` (other names ignored), ``given`` taking precedence.
+
+        Parameters
+        ----------
+        values : Mapping
+            Values by field name (a builder's ``locals()``, a run's parameters).
+        **given
+            Fields by name, over ``values`` (a run's ``theMu`` as ``mu``, say).
+
+        Returns
+        -------
+        EnsembleRecipe
+        """
+        return cls(**{f.name: given[f.name] if f.name in given else values[f.name]
+                      for f in dataclasses.fields(cls) if f.name in given or f.name in values})
 
 
 def time_steps_from_model(time_constant, bimodal_factor, mu, relative_transversal_link_strength,
@@ -231,62 +315,80 @@ def adjustable_interface_constitution(
     Relaxation
         The next block (the ensemble's ``dt``, ``dt_max`` and ``mu`` set for it).
     """
-    return (yield from _constitution(False, **locals()))
+    return (yield from constitution(EnsembleRecipe.of(locals()), doDrawing=doDrawing, do_debug=do_debug, rng=rng,
+                                    verbose=verbose))
 
 
-def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus_spheres, density, bimodal_factor,
-                  cut_lines, do_permanent_links, theTk, do_pre_equilibration, relative_viscosity,
-                  central_repulsion_coefficient, anticipated_amplitude, relative_transversal_link_strength,
-                  avoid_horizontal_angle_degree, avoid_height_spanning_particles, doCutByTriangulation, doDrawing,
-                  do_debug, rng, verbose, interface_reenforcement_central=1, interface_reenforcement_tangential=1,
-                  keep_viscosity_coefficients_constant=True, cut_top_bottom=True, remove_link_fraction=0,
-                  edge_fuzziness=0):
-    """Both builders' constitution; ``legacy``: that of :func:`EnsembleCompactParticlesFromModelParameters`
-    (the parameters it lacks at their defaults, no halved step when dense, 25 steps per level after the cut)."""
-    arguments = locals()
-    for check, name, *limits in _CHECKS:
-        check(name, arguments[name], *limits)
-    N, cut_lines = int(N), int(cut_lines)
+def constitution(recipe, *, legacy=False, doDrawing=False, do_debug=False, rng=None, verbose=False):
+    """The constitution of the ensemble of ``recipe`` as a generator of its relaxations (both builders').
+
+    Every parameter is read from ``recipe`` where it is used; ``legacy``: the constitution of
+    :func:`EnsembleCompactParticlesFromModelParameters` (no halved step when dense, 25 steps per
+    level after the cut, the adjustable interface at the recipe's defaults).  μ is set on the
+    ensemble by the constitution itself, as for its μ = 0 blocks.
+
+    Parameters
+    ----------
+    recipe : EnsembleRecipe
+        The checked parameters of the ensemble.
+    legacy : bool, optional
+        The legacy builder's constitution.
+    doDrawing, do_debug, rng, verbose : optional
+        As for :func:`EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters`.
+
+    Yields
+    ------
+    Relaxation
+        The next block (the ensemble's ``dt``, ``dt_max`` and ``mu`` set for it).
+
+    Returns
+    -------
+    EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
+        The constituted ensemble (``StopIteration.value``).
+    """
+    r = recipe
+    N, cut_lines = int(r.N), int(r.cut_lines)
     R = 10 if do_debug else 1
-    irc, irt = interface_reenforcement_central, interface_reenforcement_tangential
-    rv, rts, A, bf = relative_viscosity, relative_transversal_link_strength, anticipated_amplitude, bimodal_factor
+    irc, irt = r.interface_reenforcement_central, r.interface_reenforcement_tangential
+    rv, rts, A, bf = r.relative_viscosity, r.relative_transversal_link_strength, r.anticipated_amplitude, r.bimodal_factor
     prc = 1 / irc
     prt = 1 / irt
-    avoid = avoid_height_spanning_particles
-    if avoid and cut_lines <= (1 if doCutByTriangulation else 0):   # no separate particles: no height to check
+    avoid = r.avoid_height_spanning_particles
+    if avoid and cut_lines <= (1 if r.doCutByTriangulation else 0):   # no separate particles: no height to check
         if verbose:
             logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines="
                                              + str(cut_lines) + " the gel is not cut into separate particles")
         avoid = False
 
-    model = particle_shear_model_parameters(size_x, size_y, N, packing_fraction, Young_modulus_spheres, density,
-                                            bimodal_factor=1)
+    model = particle_shear_model_parameters(r.size_x, r.size_y, N, r.packing_fraction, r.Young_modulus_spheres,
+                                            r.density, bimodal_factor=1)
     tau, k = model.time_constant, model.k
-    dt, dt_max = time_steps_from_model(tau, bf, mu, rts, A, rv)
+    dt, dt_max = time_steps_from_model(tau, bf, r.mu, rts, A, rv)
     k_ens = k * irc
     k_t_ens = k * rts * irt
     nu_ens = rv * k * tau
     nu_t_ens = rv * k * tau * rts
-    if not keep_viscosity_coefficients_constant:
+    if not r.keep_viscosity_coefficients_constant:
         nu_ens = nu_ens * irc
         nu_t_ens = nu_t_ens * irt
     cls, extra = ((EnsembleCompactParticles, {}) if legacy else (
         EnsembleCompactParticlesAdjustableInterfaceStrength,
         dict(permanent_ratio_central=prc, permanent_ratio_tangential=prt,
-             keep_viscosity_coefficients_constant=keep_viscosity_coefficients_constant)))
-    ens = cls(size_x, size_y, N, packing_fraction=packing_fraction, theCanvas=False, doDrawing=doDrawing, k=k_ens,
-              nu=nu_ens, m=model.m, bimodal_factor=bf, k_t=k_t_ens, nu_t=nu_t_ens, mu=mu, dt=dt, dt_max=dt_max,
-              theTkSimulation=False, avoid_horizontal_angle_degree=avoid_horizontal_angle_degree,
+             keep_viscosity_coefficients_constant=r.keep_viscosity_coefficients_constant)))
+    ens = cls(r.size_x, r.size_y, N, packing_fraction=r.packing_fraction, theCanvas=False, doDrawing=doDrawing,
+              k=k_ens, nu=nu_ens, m=model.m, bimodal_factor=bf, k_t=k_t_ens, nu_t=nu_t_ens, dt=dt, dt_max=dt_max,
+              theTkSimulation=False, avoid_horizontal_angle_degree=r.avoid_horizontal_angle_degree,
               rng=np.random.default_rng(rng), **extra)
-    ens.set_central_repulsion_coefficient(central_repulsion_coefficient)
+    ens.mu = r.mu        # the constitution's to set, as in its μ = 0 blocks (_free_mu0)
+    ens.set_central_repulsion_coefficient(r.central_repulsion_coefficient)
     ens.avoid_height_spanning_particles = avoid
     ens.model = model
-    ens.edge_fuzziness = edge_fuzziness
+    ens.edge_fuzziness = r.edge_fuzziness
 
-    if do_pre_equilibration:
+    if r.do_pre_equilibration:
         ens.dt = dt
         ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
-        if packing_fraction > 2 and not legacy:
+        if r.packing_fraction > 2 and not legacy:
             ens.dt_max = ens.dt_max / 2
         n1 = int(300 / R) if prc == 1 else int(100 / R)
         yield Relaxation(ens, n1)
@@ -299,12 +401,12 @@ def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus
             if A <= threshold and prc == 1:
                 yield Relaxation(ens, int(200 / R))
 
-    if do_permanent_links:
-        _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut_top_bottom, avoid, verbose)
-        if cut_top_bottom and not legacy:
+    if r.do_permanent_links:
+        _crosslink_and_cut(ens, cut_lines, r.doCutByTriangulation, r.edge_fuzziness, r.cut_top_bottom, avoid, verbose)
+        if r.cut_top_bottom and not legacy:
             ens.cut_top_bottom = True
-        if remove_link_fraction > 0:
-            ens.remove_non_essential_links(remove_link_fraction, True)
+        if r.remove_link_fraction > 0:
+            ens.remove_non_essential_links(r.remove_link_fraction, True)
             if verbose:
                 logging.getLogger(__name__).info("Actual fraction of removed non-essential links: "
                                                  + str(ens.removed_fraction))
@@ -318,19 +420,19 @@ def _constitution(legacy, size_x, size_y, N, packing_fraction, mu, Young_modulus
         yield Relaxation(ens, int(300 / R))
         n = int(150 / R)
         if A < 0.1:
-            yield from _free_mu0(ens, n, mu)
+            yield from _free_mu0(ens, n, r.mu)
             yield Relaxation(ens, n)
         n = int(100 / R)
         for threshold in (0.01, 0.001, 0.0001):
             if A <= threshold:
                 yield Relaxation(ens, n)
-                yield from _free_mu0(ens, n, mu)
+                yield from _free_mu0(ens, n, r.mu)
                 yield Relaxation(ens, n)
         if A <= 0.001 and (irt != 1 or irc != 1):
             ens.dt_max = ens.dt_max / 3
             n = int(200 / R)
             yield Relaxation(ens, n)
-            yield from _free_mu0(ens, n, mu)
+            yield from _free_mu0(ens, n, r.mu)
             yield Relaxation(ens, n)
     return ens
 
@@ -367,4 +469,5 @@ def EnsembleCompactParticlesFromModelParameters(
     anticipated_amplitude, do_pre_equilibration, do_debug, do_permanent_links, doCutByTriangulation
     avoid_horizontal_angle_degree, avoid_height_spanning_particles, theTk, rng, verbose
     """
-    return relax_constitution(_constitution(True, **locals()))
+    return relax_constitution(constitution(EnsembleRecipe.of(locals()), legacy=True, doDrawing=doDrawing,
+                                           do_debug=do_debug, rng=rng, verbose=verbose))

@@ -15,7 +15,7 @@ import numpy as np
 from ..hooks import entry
 from ..messages import console_messages
 from ..parameters import BY_NAME, EXTRA, PARAMETERS
-from .validation import check_seed, validate_run, validate_series, validated_run
+from .validation import check_seed, checked_point, validate_series, validated_run
 from .sessions import _build_simulation, _seed_sequence, check_batch_size  # noqa: F401 - re-exported
 from .guard import PARAMETER_ALIASES, PARAMETER_HINTS, checked_keywords
 from .result import SimulationResult
@@ -594,14 +594,15 @@ def doParticleShearSimulationSeries(root_folder="", amplitudes=[0.2], mu=[0.01],
     all_kwargs = [dict(common, theAmplitude=A, theMu=m, do_permanent_links=links, cut_lines=cl, seed=child,
                        verbose=verbose, backend=backend, **options)
                   for (A, m, links, cl), child in zip(jobs, children)]
-    # every run is checked before any work starts (without runs: the material run of the first point, so
-    # that the options and shared parameters are checked all the same)
-    for kw in all_kwargs or [dict(common, theAmplitude=amplitudes[0], theMu=mu[0], do_permanent_links=True,
-                                  cut_lines=cut_lines, seed=root, verbose=verbose, backend=backend, **options)]:
-        validate_run(kw)
+    # every run is checked before any work starts, once: its worker measures it from its checked arguments
+    # (without runs: the material run of the first point, so that the options and shared parameters are
+    # checked all the same)
+    checked = [checked_point(kw) for kw in all_kwargs or [
+        dict(common, theAmplitude=amplitudes[0], theMu=mu[0], do_permanent_links=True, cut_lines=cut_lines,
+             seed=root, verbose=verbose, backend=backend, **options)]]
     if not all_kwargs:
         return []
     run_series = entry("run_series")
     per_repetition = len(jobs) // int(N_repetitions)
     return run_series(all_kwargs, root_folder, executor=executor, max_workers=max_workers, batch_size=batch_size,
-                      repetitions=[k // per_repetition for k in range(len(jobs))])
+                      repetitions=[k // per_repetition for k in range(len(jobs))], checked=checked)

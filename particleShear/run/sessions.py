@@ -14,6 +14,7 @@ import numpy as np
 from ..checks import show_value
 from ..engine import contact_laws
 from ..engine.xp import get_backend
+from ..linkable.builders import EnsembleRecipe
 from ..parameters import PARAMETERS
 from ..parameters import defaults as _defaults
 from ..simulation.fragmentation import Simulation_interlocking_rheology
@@ -107,7 +108,9 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     """The :class:`Simulation_interlocking_rheology` of one run, configured but not run.
 
     The documented class is made with keyword arguments read straight from ``params`` (no
-    intermediate names), so a parameter's value reaches the simulation object in one step.
+    intermediate names), so a parameter's value reaches the simulation object in one step; its
+    ensemble's :class:`~particleShear.linkable.builders.EnsembleRecipe` (``recipe``) is made from
+    ``params`` likewise, so the constitution reads the run's values, not the object's attributes.
 
     Parameters
     ----------
@@ -127,9 +130,14 @@ def _build_simulation(params, rng, *, verbose, progress, correct_drift_sign, ref
     p = params
     pre_periods, post_periods, periods = p["pre_periods"], p["post_periods"], p["periods"]
     saveOutputImages, imageFileType, cool_factor = p["saveOutputImages"], p["imageFileType"], p["cool_factor"]
+    N, cut_lines = int(p["N"]), int(p["cut_lines"])
     theSimulation = Simulation_interlocking_rheology(
-        p["root_folder"], cut_lines=int(p["cut_lines"]), N=int(p["N"]), amplitude=p["theAmplitude"], mu=p["theMu"],
+        p["root_folder"], cut_lines=cut_lines, N=N, amplitude=p["theAmplitude"], mu=p["theMu"],
         **{name: p[name] for name in _SIMULATION_ARGUMENTS})
+    # the ensemble's parameters: one record of the run's values (μ its field ``mu``), which the constitution
+    # reads as they are (not from the simulation's attributes)
+    theSimulation.recipe = EnsembleRecipe.of(p, mu=p["theMu"], anticipated_amplitude=p["theAmplitude"], N=N,
+                                             cut_lines=cut_lines)
     theSimulation.function_call += (
         "\n\ttheSimulation.baseline_pre_periods = " + str(pre_periods)
         + "\n\ttheSimulation.baseline_post_periods = " + str(post_periods)

@@ -568,9 +568,10 @@ class RunParameters(_FrozenArguments):
 
     Made only by :func:`validated_run`, once per run (or, for the runs of a checked sweep point, by
     :meth:`CheckedPoint.run`), so that nothing below the check validates,
-    completes, normalizes or hashes the arguments again: the sessions, the simulation object and
-    the ensemble builders read their values from it by the names of the parameter table
-    (:mod:`particleShear.parameters`), and the run's identity and seed are the ones computed here.
+    completes, normalizes or hashes the arguments again: the sessions and the simulation object
+    read their values from it by the names of the parameter table (:mod:`particleShear.parameters`), the
+    constitution from the ensemble's recipe made from it
+    (:class:`~particleShear.linkable.builders.EnsembleRecipe`), and the run's identity and seed are the ones computed here.
     A ``dict`` (read like the keyword dict it replaces, ``json``-able, ``dict(run)`` a plain copy)
     whose items cannot change: a value changed after the check would be a value nobody checked.
 

@@ -10,7 +10,7 @@ __docformat__ = "numpy"
 import math
 import os
 
-from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, adjustable_interface_constitution,
+from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, EnsembleRecipe, constitution,
                                  relax_constitution)
 from .provenance import header_number, positional_numbers_in_call, provenance_lines
 from .oscillatory import OscillatorySimulation, _log, _writes, call_string
@@ -264,19 +264,34 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             _log.info("Adjustment factor of pre-equilibration time for low amplitude and friction: " + str(F))
         return F
 
-    def _builder_arguments(self, do_debug):
-        """Keyword arguments the builders of this class and its subclass share."""
+    #: the recipe of the ensemble when the run gives it (``doParticleShearSimulation``: made from the checked
+    #: run, :func:`particleShear.run.sessions.build_sessions`); None: made from this object's attributes
+    recipe = None
+
+    def ensemble_recipe(self):
+        """The :class:`~particleShear.linkable.builders.EnsembleRecipe` of this simulation's ensemble.
+
+        :attr:`recipe` when given, else the recipe of this object's attributes (the cell of
+        500 × 500 µm, the anticipated amplitude ``amplitude``).
+
+        Returns
+        -------
+        EnsembleRecipe
+        """
+        return self.recipe if self.recipe is not None else EnsembleRecipe(**self._recipe_fields())
+
+    def _recipe_fields(self):
+        """The fields of :meth:`ensemble_recipe` this class sets (the subclass adds its interface)."""
         return dict(
-            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
+            N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
             Young_modulus_spheres=self.Young_modulus_spheres, density=self.density,
             bimodal_factor=self.bimodal_factor, cut_lines=self.cut_lines, do_permanent_links=self.do_permanent_links,
-            theTk=False, do_pre_equilibration=True, relative_viscosity=self.relative_viscosity,
+            relative_viscosity=self.relative_viscosity,
             central_repulsion_coefficient=self.central_repulsion_coefficient, anticipated_amplitude=self.amplitude,
             relative_transversal_link_strength=self.relative_transversal_link_strength,
             avoid_horizontal_angle_degree=self.avoid_horizontal_angle_degree,
             avoid_height_spanning_particles=self.avoid_height_spanning_particles,
-            doCutByTriangulation=self.doCutByTriangulation, doDrawing=False, do_debug=do_debug, rng=self.rng,
-            verbose=self.verbose)
+            doCutByTriangulation=self.doCutByTriangulation)
 
     def initEnsemble(self, do_debug=False):
         """Build ``theEnsemble`` with the legacy builder and every material parameter.
@@ -291,7 +306,8 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
         EnsembleCompactParticlesFromModelParameters
             The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
         """
-        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(**self._builder_arguments(do_debug))
+        self.theEnsemble = relax_constitution(constitution(self.ensemble_recipe(), legacy=True, do_debug=do_debug,
+                                                           rng=self.rng, verbose=self.verbose))
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max
@@ -395,6 +411,14 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
             cut_top_bottom=cut_top_bottom, doCutByTriangulation=doCutByTriangulation,
             remove_link_fraction=remove_link_fraction, edge_fuzziness=edge_fuzziness, doDrawing=doDrawing)
 
+    def _recipe_fields(self):
+        return dict(Simulation_dermal_filler_rheology._recipe_fields(self),
+                    interface_reenforcement_central=self.interface_reenforcement_central,
+                    interface_reenforcement_tangential=self.interface_reenforcement_tangential,
+                    keep_viscosity_coefficients_constant=self.keep_viscosity_coefficients_constant,
+                    cut_top_bottom=self.cut_top_bottom, remove_link_fraction=self.remove_link_fraction,
+                    edge_fuzziness=self.edge_fuzziness)
+
     def initEnsemble(self, do_debug=False):
         """Build ``theEnsemble`` with the adjustable-interface builder (``anticipated_amplitude = amplitude``).
 
@@ -413,8 +437,8 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     def constitution_steps(self, do_debug=False):
         """:meth:`initEnsemble` as a generator of the builder's relaxations.
 
-        Runs :func:`~particleShear.linkable.builders.adjustable_interface_constitution` with this
-        simulation's parameters, yielding each of its
+        Runs :func:`~particleShear.linkable.builders.constitution` of this simulation's
+        :meth:`ensemble_recipe`, yielding each of its
         :class:`~particleShear.linkable.builders.Relaxation` requests, and sets ``theEnsemble``,
         ``model``, ``dt`` and ``dt_max`` at the end, as :meth:`initEnsemble` does (which runs
         the requests with the classes).
@@ -434,13 +458,8 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         EnsembleCompactParticlesAdjustableInterfaceStrength
             The constituted ensemble (also ``self.theEnsemble``).
         """
-        self.theEnsemble = yield from adjustable_interface_constitution(
-            **self._builder_arguments(do_debug),
-            interface_reenforcement_central=self.interface_reenforcement_central,
-            interface_reenforcement_tangential=self.interface_reenforcement_tangential,
-            keep_viscosity_coefficients_constant=self.keep_viscosity_coefficients_constant,
-            cut_top_bottom=self.cut_top_bottom, remove_link_fraction=self.remove_link_fraction,
-            edge_fuzziness=self.edge_fuzziness)
+        self.theEnsemble = yield from constitution(self.ensemble_recipe(), do_debug=do_debug, rng=self.rng,
+                                                   verbose=self.verbose)
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max

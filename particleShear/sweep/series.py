@@ -66,7 +66,8 @@ def series_parameters(kwargs):
     return normalize_protocol(dict(sweep_parameter_defaults(protocols=True), **given))
 
 
-def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None, repetitions=None):
+def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batch_size=None, repetitions=None,
+               checked=None):
     """Run the keyword sets of ``doParticleShearSimulationSeries`` on the sweep machinery; results in order.
 
     Parameters
@@ -84,6 +85,10 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         Runs sharing a step schedule measured in batches of up to ``batch_size`` (one task each).
     repetitions : sequence of int, optional
         ``repetitions[k]``: the repetition of run k (the ``repetition`` column; default 0 each).
+    checked : sequence of CheckedPoint, optional
+        ``checked[k]``: the checked arguments of run k (:func:`particleShear.run.validation.checked_point`
+        of ``all_kwargs[k]``): its worker measures the run from them without validating it again
+        (default None: each worker validates its run).
 
     Returns
     -------
@@ -101,7 +106,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
         params = series_parameters(kw)
         rep = 0 if repetitions is None else int(repetitions[k])
         runs.append(SweepRun(index=k, point=k, repetition=rep, parameters=params, seed_entropy=ss.entropy,
-                             spawn_key=tuple(ss.spawn_key), run_id=run_identity(params, ss.entropy, ss.spawn_key)))
+                             spawn_key=tuple(ss.spawn_key), run_id=run_identity(params, ss.entropy, ss.spawn_key),
+                             checked=None if checked is None else checked[k]))
     results = [None] * len(runs)
     failures = []
     if root_folder:
@@ -121,7 +127,8 @@ def run_series(all_kwargs, root_folder="", executor=None, max_workers=None, batc
                 failures.append(outcome.row)
     else:
         tasks = [{"run_id": r.run_id, "index": r.index, "repetition": r.repetition, "parameters": r.parameters,
-                  "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "", "keep_series": True, "batched": batch_size is not None}
+                  "seed_entropy": r.seed_entropy, "spawn_key": r.spawn_key, "out_dir": "", "keep_series": True,
+                  "batched": batch_size is not None, **({} if r.checked is None else {"checked": r.checked})}
                  for r in runs]
         if batch_size is None:
             jobs = [[t] for t in tasks]

@@ -1,10 +1,10 @@
 """What a sweep's worker runs: one task (a picklable dict) or a batch of them, and the publication of the files.
 
 A task is ``{"run_id", "index", "repetition", "parameters", "seed_entropy", "spawn_key", "out_dir",
-"scratch_dir", "keep_series"}`` and, for a sweep's run, ``"checked"``: its point's
+"scratch_dir", "keep_series"}`` and, for a sweep's or a series' run, ``"checked"``: its point's
 :class:`~particleShear.run.validation.CheckedPoint`, from which the worker makes the run's
 :class:`~particleShear.run.validation.RunParameters` without validating it again (a task without
-it, a series' run, is validated here).  A run writes into its scratch folder
+it is validated here).  A run writes into its scratch folder
 ``scratch_dir/<run id>/`` (cleared first: leftovers of a killed attempt); when it has finished,
 the worker renames its files into ``out_dir`` under the run id (companions first, the file
 itself last, :func:`publish`).  A failing run never raises: it becomes a ``failed`` row, and so
@@ -139,7 +139,7 @@ def execute_run(task):
         of ``doParticleShearSimulation``),
         ``seed_entropy``, ``spawn_key``, ``out_dir`` (sweep folder; "" writes nothing),
         ``scratch_dir`` (this driving process's scratch folder), ``keep_series`` (bool) and, for a
-        sweep's run, ``checked`` (its point's :class:`~particleShear.run.validation.CheckedPoint`:
+        sweep's or a series' run, ``checked`` (its point's :class:`~particleShear.run.validation.CheckedPoint`:
         the run is measured without validating it again, :func:`particleShear.run.api.measure_run`).
 
     Returns
@@ -174,9 +174,10 @@ def _prepare(task):
         os.makedirs(run_dir)
     ss = np.random.SeedSequence(task["seed_entropy"], spawn_key=tuple(task["spawn_key"]))
     checked = task.get("checked")
-    if checked is None:      # a series' run (no checked point): validated here
+    if checked is None:      # a task without its checked arguments: validated here
         return run_dir, validated_run(dict(p, root_folder=run_dir, seed=ss, return_result=True, verbose=False))
-    # a sweep's run: its point was checked once (the SPEC's check), its id computed by the sweep
+    # a sweep's run: its point was checked once (the SPEC's check), its id computed by the sweep; a series'
+    # run: checked once by the series
     return run_dir, checked.run(run_dir, ss, return_result=True, verbose=False, run_id=task["run_id"])
 
 
