@@ -48,8 +48,8 @@ from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, ot
 from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_kernels", "run_step", "run_force_phase", "run_block", "search", "carried",
-           "tensor_sums", "NOT_RUN"]
+           "compile_carried_kernel", "compile_kernels", "run_step", "run_force_phase", "run_move", "run_block",
+           "search", "carried", "tensor_sums", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -66,10 +66,10 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
-                    (sys.modules[__name__], "_xi_rule"), (sys.modules[__name__], "_pair_rows"),
+                    (sys.modules[__name__], "_pair_rows"),
                     (sys.modules[__name__], "_sphere_rows"), (sys.modules[__name__], "_row_sums"),
                     (sys.modules[__name__], "_step_kernel"))
-INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min", "_xi_rule")
+INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
 SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
@@ -323,18 +323,6 @@ def _tensor_kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, ome
     return 0
 
 
-def _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi):
-    # the sequential ξ rule of pair p (integrate.xi_increments element by element): ξ_ij and ξ_ji
-    # grow by their rates times dt while the relation is active and not slipping
-    i, j = Ci[1, p], Ci[2, p]
-    kd = dt if active[p] and state_p[p] != 1 else 0.0
-    rvx = vel[0, j] - vel[0, i] + dvxs[p]
-    spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
-    inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
-    xi[0, p] += inc_ij * kd
-    xi[1, p] += inc_ji * kd
-
-
 def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, visit_j, form_j, Tj,
                  free_mode, free, verlet,
                  pred, half, half_out,
@@ -351,15 +339,18 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     ``offsets[b0] … offsets[b1] − 1``; nothing of another replica is read or written, so a replica's
     step is the same numbers whatever else the batch holds or in which order its replicas step.
     ``start`` 0 runs the whole step; 3 runs it with the random normals of the pairs at ``d = 0``
-    given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes with the ξ rule
-    of the pairs at ``|R| = 0`` once the caller gave their random directions (``work`` rows 8, 9).  ``pred[b]``:
+    given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes at the ξ rule
+    once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9).  ``pred[b]``:
     replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
     its first step).  ``sample``: 0 no stresses, 1 the two shear stresses (``tau``), 2 also the sums of
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
     rows in ``ts``, summed per replica as NumPy sums them).  ``keep``: the step keeps the terms of
     its force phase for a force register (the rows :data:`_KEPT` of ``kt``, the sphere totals in
     ``ktot``; :func:`_terms`).  ``forces_only``: the force phase alone (:func:`run_force_phase`),
-    the forces and torques left in ``frc`` and its geometry in ``work``.  The other arguments are the engine's (the flags of the step, the state's
+    the forces and torques left in ``frc`` and its geometry in ``work``; ``start`` 5: the movement
+    alone (:func:`run_move`: the ξ rule, displacement, drift, strain, wrap and clock after a force
+    phase and a kick of their own, its geometry in ``work`` and ``yc``).  The other arguments are
+    the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
     the Verlet bookkeeping, the guard's constants) and the buffers of its :class:`_Workspace`;
     everything is written in place.  Returns :data:`_DONE`, or :data:`_D_ZERO` (nothing changed: a
@@ -373,163 +364,162 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     dxs, dys, kys, kxs, ds, nxs, nys, dvxs, mxs, mys, dFs = (work[0], work[1], work[2], work[3], work[4], work[5],
                                                              work[6], work[7], work[8], work[9], work[10])
     if start != 1:
-        # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
-        coincident = False
-        for p in range(P0, P1):
-            b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
-            dx, dy, ky, kx = _min_image_pair(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[_ILX, p], Cf[_ILY, p],
-                                   Ly[b] * gamma[b] * le[b])
-            d = np.sqrt(dx * dx + dy * dy)
-            coincident = coincident or d == 0.0
-            dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
-        if coincident and start != 3:
-            return _D_ZERO
-        for k in range(n0, n1):
-            yc[k] = pos[1, k] - Ly_s[k] / 2
-            mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
-            frc[0, k] = 0.0
-            frc[1, k] = 0.0
-            frc[2, k] = 0.0
-        for b in range(b0, b1):
-            tau[0, b] = 0.0
-            tau[1, b] = 0.0
-            verdict[3, b] = math.inf
-        # relations, terms and the pair forces on i (the scatter's first half, in pair order)
-        for p in range(P0, P1):
-            b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
-            d = ds[p]
-            touching = d < Cf[_ID0, p]
-            rel = Cb[0, p] or touching
-            if rel and not active[p]:
-                state_p[p] = 0                      # a new relation starts sticking
-                if numbers:
-                    birth[p] = next_birth[b]
-                    next_birth[b] += 1
-            if not rel:
-                xi[0, p] = 0.0                      # an opened contact loses its history
-                xi[1, p] = 0.0
-            active[p] = rel
-            if d == 0.0:      # (the random normal the caller drew, as forces.normals draws it)
-                nx, ny = nxs[p], nys[p]
-            else:
-                nx, ny = dxs[p] / d, dys[p] / d
-            dvx = -(Cf[_ILY, p] * (rate[b] * le[b])) * kys[p]
-            if pred[b]:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
-                vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
-                vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
-            else:
-                vi0, vi1, vi2, vj0, vj1, vj2 = vel[0, i], vel[1, i], vel[2, i], vel[0, j], vel[1, j], vel[2, j]
-            rv = (vj0 - vi0 + dvx, vj1 - vi1)
-            vn = normal_speed(rv, nx, ny)
-            vt = slip_speed(rv, nx, ny, Cf[_IRI, p], Cf[_IRJ, p], vi2, vj2) if free_mode != 1 else 0.0
-            q = p if custom else 0                # (the run law's arguments: A is (8, 1) without one)
-            fn, law, F_i, F_j, slip, reset = pair_term(
-                form, d, vn, vt, touching, rel, xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p], T[3, p], T[4, p],
-                T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p], free_mode != 1,
-                custom, (A[0, q], A[1, q], A[2, q], A[3, q], A[4, q], A[5, q], A[6, q], A[7, q]))
-            if reset:
-                xi[0, p] = 0.0
-                xi[1, p] = 0.0
-            if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
-                xi[0, p] = 0.0
-                xi[1, p] = 0.0
-                slip = slip or rel
-            state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
-            ft = (F_i + F_j) * 0.5
-            fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
-            fx_j, fy_j = fx, fy
-            if visit_j:       # j receives the central force of its own visit (PairConstants.set_visits)
-                term_j = pair_term(form_j, d, vn, vt, touching, rel, xi[0, p], xi[1, p], Tj[0, p], Tj[1, p], Tj[2, p],
-                                   Tj[3, p], Tj[4, p], Tj[5, p], Tj[6, p], Tj[7, p], Tj[8, p], Tj[9, p], Tj[10, p],
-                                   Tj[11, p], k_t_j[p], nu_t_j[p], False, False,
-                                   (A[0, 0], A[1, 0], A[2, 0], A[3, 0], A[4, 0], A[5, 0], A[6, 0], A[7, 0]))
-                fx_j, fy_j, _, _ = pair_forces(term_j[0], ft, nx, ny, d, None)
-                if keep:
-                    kt[6, p], kt[7, p] = term_j[1] * Tj[_TRC, p], viscous_force(Tj[_TNU, p], vn, rel)
-                    kt[8, p], kt[9, p] = fx_j, fy_j
-            if keep:          # the terms of i's visit (terms.elastic_term, viscous_term: the same products)
-                kt[0, p], kt[1, p] = law * T[_TRC, p], viscous_force(T[_TNU, p], vn, rel)
-                kt[2, p], kt[3, p], kt[4, p], kt[5, p] = F_i, F_j, fx, fy
-            nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx_j, fy_j
-            frc[0, i] += fx
-            frc[1, i] += fy
-            frc[2, i] += dF * Cf[_IWI, p]
-            dFs[p] = dF
-            if sample:
-                internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
-                if visit_j:
-                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
-                                                                       dys[p], fx, dF, fx_j)
-                else:
-                    work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
-                                                                       dys[p], fx, dF, None)
-                if sample == 2:      # (the force on i, for the tensors' pair rows below)
-                    work[14, p], work[15, p] = fx, fy
-            if check:
-                verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
-        # the scatter's second half: −F on j and the torque on j, in pair order
-        for p in range(P0, P1):
-            j = Ci[2, p]
-            frc[0, j] += -mxs[p]
-            frc[1, j] += -mys[p]
-            frc[2, j] += dFs[p] * Cf[_IWJ, p]
-        if keep:          # the totals of the phase (the kick resets them)
+        if start != 5:       # (5: the movement alone, after a force phase and a kick of their own)
+            # -- the force phase: geometry of every candidate first (nothing changes before d = 0 is ruled out)
+            coincident = False
+            for p in range(P0, P1):
+                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+                dx, dy, ky, kx = _min_image_pair(pos[0, j] - pos[0, i], pos[1, j] - pos[1, i], Cf[_ILX, p], Cf[_ILY, p],
+                                       Ly[b] * gamma[b] * le[b])
+                d = np.sqrt(dx * dx + dy * dy)
+                coincident = coincident or d == 0.0
+                dxs[p], dys[p], kys[p], kxs[p], ds[p] = dx, dy, ky, kx, d
+            if coincident and start != 3:
+                return _D_ZERO
             for k in range(n0, n1):
-                ktot[0, k], ktot[1, k], ktot[2, k] = frc[0, k], frc[1, k], frc[2, k]
-        if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
+                yc[k] = pos[1, k] - Ly_s[k] / 2
+                mob[k] = (r[k] < pos[1, k]) and (pos[1, k] < Ly_s[k] - r[k]) if applying else True
+                frc[0, k] = 0.0
+                frc[1, k] = 0.0
+                frc[2, k] = 0.0
             for b in range(b0, b1):
-                lo, hi = offsets[b], offsets[b + 1]
-                tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
-                                                       _segment_sum(work[13], lo, hi), V[b])
-        if sample == 2:     # every tensor's rows (the totals of the scatter), summed per replica
-            _pair_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs, dys,
-                       work[14], work[15], mxs, mys, dFs, tp)
-            _sphere_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0], frc[1],
-                         frc[2], mob, rate, Lx, Ly, ts)
-            _row_sums(b0, b1, N, offsets, tp, ts, tsum)
-        if check:
-            bad = False
-            for b in range(b0, b1):
-                rate_max[b] = _nan_max(rate_max[b], abs(rate[b]))
-                finite = True
-                for k in range(b * N, (b + 1) * N):
-                    finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
-                        and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
-                    y0[k] = kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
-                ke = 0.5 * _pairwise(y0, b * N, N)        # (guard.verdict: the sum of each replica's row)
-                bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
-                    else max_ke
-                code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
-                verdict[0, b], verdict[1, b], verdict[2, b] = code, ke, bnd
-                bad = bad or code != 0
-            if bad:
-                return _GUARD
-        if forces_only:
-            return _DONE
-        # -- kick (plates follow), damping
-        for k in range(n0, n1):
-            b = rep_s[k]
-            if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
-                half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
-                half_out[1, k] = half_velocity_change(frc[1, k], mmi[1, k], dt) if mob[k] else 0.0
-                half_out[2, k] = half_velocity_change(frc[2, k], mmi[2, k], dt)
-            vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
-            vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
-            vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
-            frc[0, k] = 0.0
-            frc[1, k] = 0.0
-            frc[2, k] = 0.0
-            if applying and not mob[k]:
-                vel[1, k] = 0.0
-                vel[0, k] = plate_velocity(yc[k], rate[b] * Ly_s[k] / 2)
-            vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
-            vel[1, k] *= cool
-            vel[2, k] *= cool
+                tau[0, b] = 0.0
+                tau[1, b] = 0.0
+                verdict[3, b] = math.inf
+            # relations, terms and the pair forces on i (the scatter's first half, in pair order)
+            for p in range(P0, P1):
+                b, i, j = Ci[0, p], Ci[1, p], Ci[2, p]
+                d = ds[p]
+                touching = d < Cf[_ID0, p]
+                rel = Cb[0, p] or touching
+                if rel and not active[p]:
+                    state_p[p] = 0                      # a new relation starts sticking
+                    if numbers:
+                        birth[p] = next_birth[b]
+                        next_birth[b] += 1
+                if not rel:
+                    xi[0, p] = 0.0                      # an opened contact loses its history
+                    xi[1, p] = 0.0
+                active[p] = rel
+                if d == 0.0:      # (the random normal the caller drew, as forces.normals draws it)
+                    nx, ny = nxs[p], nys[p]
+                else:
+                    nx, ny = dxs[p] / d, dys[p] / d
+                dvx = -(Cf[_ILY, p] * (rate[b] * le[b])) * kys[p]
+                if pred[b]:     # velocity Verlet: the velocity terms see the velocities half a kick ahead
+                    vi0, vi1, vi2 = vel[0, i] + half[0, i], vel[1, i] + half[1, i], vel[2, i] + half[2, i]
+                    vj0, vj1, vj2 = vel[0, j] + half[0, j], vel[1, j] + half[1, j], vel[2, j] + half[2, j]
+                else:
+                    vi0, vi1, vi2, vj0, vj1, vj2 = vel[0, i], vel[1, i], vel[2, i], vel[0, j], vel[1, j], vel[2, j]
+                rv = (vj0 - vi0 + dvx, vj1 - vi1)
+                vn = normal_speed(rv, nx, ny)
+                vt = slip_speed(rv, nx, ny, Cf[_IRI, p], Cf[_IRJ, p], vi2, vj2) if free_mode != 1 else 0.0
+                q = p if custom else 0                # (the run law's arguments: A is (8, 1) without one)
+                fn, law, F_i, F_j, slip, reset = pair_term(
+                    form, d, vn, vt, touching, rel, xi[0, p], xi[1, p], T[0, p], T[1, p], T[2, p], T[3, p], T[4, p],
+                    T[5, p], T[6, p], T[7, p], T[8, p], T[9, p], T[10, p], T[11, p], k_t_j[p], nu_t_j[p], free_mode != 1,
+                    custom, (A[0, q], A[1, q], A[2, q], A[3, q], A[4, q], A[5, q], A[6, q], A[7, q]))
+                if reset:
+                    xi[0, p] = 0.0
+                    xi[1, p] = 0.0
+                if free_mode == 2 and free[p]:   # a replica without friction and bonds in a batch with others
+                    xi[0, p] = 0.0
+                    xi[1, p] = 0.0
+                    slip = slip or rel
+                state_p[p] = np.int8(slip) + np.int8(2) * np.int8(Cb[0, p])
+                ft = (F_i + F_j) * 0.5
+                fx, fy, dF, _ = pair_forces(fn, ft, nx, ny, d, None)
+                fx_j, fy_j = fx, fy
+                if visit_j:       # j receives the central force of its own visit (PairConstants.set_visits)
+                    term_j = pair_term(form_j, d, vn, vt, touching, rel, xi[0, p], xi[1, p], Tj[0, p], Tj[1, p], Tj[2, p],
+                                       Tj[3, p], Tj[4, p], Tj[5, p], Tj[6, p], Tj[7, p], Tj[8, p], Tj[9, p], Tj[10, p],
+                                       Tj[11, p], k_t_j[p], nu_t_j[p], False, False,
+                                       (A[0, 0], A[1, 0], A[2, 0], A[3, 0], A[4, 0], A[5, 0], A[6, 0], A[7, 0]))
+                    fx_j, fy_j, _, _ = pair_forces(term_j[0], ft, nx, ny, d, None)
+                    if keep:
+                        kt[6, p], kt[7, p] = term_j[1] * Tj[_TRC, p], viscous_force(Tj[_TNU, p], vn, rel)
+                        kt[8, p], kt[9, p] = fx_j, fy_j
+                if keep:          # the terms of i's visit (terms.elastic_term, viscous_term: the same products)
+                    kt[0, p], kt[1, p] = law * T[_TRC, p], viscous_force(T[_TNU, p], vn, rel)
+                    kt[2, p], kt[3, p], kt[4, p], kt[5, p] = F_i, F_j, fx, fy
+                nxs[p], nys[p], dvxs[p], mxs[p], mys[p] = nx, ny, dvx, fx_j, fy_j
+                frc[0, i] += fx
+                frc[1, i] += fy
+                frc[2, i] += dF * Cf[_IWI, p]
+                dFs[p] = dF
+                if sample:
+                    internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (kys[p] != 0.0) or (kxs[p] != 0.0))
+                    if visit_j:
+                        work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                           dys[p], fx, dF, fx_j)
+                    else:
+                        work[11, p], work[12, p], work[13, p] = shear_rows(internal, ext_i, ext_j, rel, yc[i], yc[j],
+                                                                           dys[p], fx, dF, None)
+                    if sample == 2:      # (the force on i, for the tensors' pair rows below)
+                        work[14, p], work[15, p] = fx, fy
+                if check:
+                    verdict[3, b] = _nan_min(verdict[3, b], transient_ratio(d, Cf[_ID0, p], rel, Cb[1, p]))
+            # the scatter's second half: −F on j and the torque on j, in pair order
+            for p in range(P0, P1):
+                j = Ci[2, p]
+                frc[0, j] += -mxs[p]
+                frc[1, j] += -mys[p]
+                frc[2, j] += dFs[p] * Cf[_IWJ, p]
+            if keep:          # the totals of the phase (the kick resets them)
+                for k in range(n0, n1):
+                    ktot[0, k], ktot[1, k], ktot[2, k] = frc[0, k], frc[1, k], frc[2, k]
+            if sample:     # (forces.replica_sums: numpy.add.reduceat over each replica's segment)
+                for b in range(b0, b1):
+                    lo, hi = offsets[b], offsets[b + 1]
+                    tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
+                                                           _segment_sum(work[13], lo, hi), V[b])
+            if sample == 2:     # every tensor's rows (the totals of the scatter), summed per replica
+                _pair_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs, dys,
+                           work[14], work[15], mxs, mys, dFs, tp)
+                _sphere_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0], frc[1],
+                             frc[2], mob, rate, Lx, Ly, ts)
+                _row_sums(b0, b1, N, offsets, tp, ts, tsum)
+            if check:
+                bad = False
+                for b in range(b0, b1):
+                    rate_max[b] = _nan_max(rate_max[b], abs(rate[b]))
+                    finite = True
+                    for k in range(b * N, (b + 1) * N):
+                        finite = finite and np.isfinite(pos[0, k]) and np.isfinite(yc[k]) and np.isfinite(vel[0, k]) \
+                            and np.isfinite(vel[1, k]) and np.isfinite(vel[2, k])
+                        y0[k] = kinetic_term(mmi[0, k], vel[0, k] - yc[k] * rate[b], vel[1, k], mmi[2, k], vel[2, k])
+                    ke = 0.5 * _pairwise(y0, b * N, N)        # (guard.verdict: the sum of each replica's row)
+                    bnd = energy_bound(N, kk[b], r_mean[b], m_sum[b], rate_max[b], Ly[b]) if max_ke != max_ke \
+                        else max_ke
+                    code = verdict_code(finite, ke, bnd, verdict[3, b], min_ratio) * guard_on[b]
+                    verdict[0, b], verdict[1, b], verdict[2, b] = code, ke, bnd
+                    bad = bad or code != 0
+                if bad:
+                    return _GUARD
+            if forces_only:
+                return _DONE
+            # -- kick (plates follow), damping
+            for k in range(n0, n1):
+                b = rep_s[k]
+                if verlet:        # the half kick the next force phase sees (none in x, y on a plate sphere)
+                    half_out[0, k] = half_velocity_change(frc[0, k], mmi[0, k], dt) if mob[k] else 0.0
+                    half_out[1, k] = half_velocity_change(frc[1, k], mmi[1, k], dt) if mob[k] else 0.0
+                    half_out[2, k] = half_velocity_change(frc[2, k], mmi[2, k], dt)
+                vel[0, k] += velocity_change(frc[0, k], mmi[0, k], dt)
+                vel[1, k] += velocity_change(frc[1, k], mmi[1, k], dt)
+                vel[2, k] += velocity_change(frc[2, k], mmi[2, k], dt)
+                frc[0, k] = 0.0
+                frc[1, k] = 0.0
+                frc[2, k] = 0.0
+                if applying and not mob[k]:
+                    vel[1, k] = 0.0
+                    vel[0, k] = plate_velocity(yc[k], rate[b] * Ly_s[k] / 2)
+                vel[0, k] = damped(vel[0, k], yc[k] * rate[b], cool)
+                vel[1, k] *= cool
+                vel[2, k] *= cool
         if free_mode == 1:            # no ξ without friction and bonds
             start = 2
-        # the unit vectors of R = v_i dt − D and the sequential ξ rule pair by pair (velocities after
-        # the kick and damping, geometry of the force phase); a pair at |R| = 0 waits for the random
-        # direction the caller draws (start 1)
+        # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
         units = False
         for p in range(P0, P1 if start != 2 else P0):
             i = Ci[1, p]
@@ -543,13 +533,17 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 units = True
             else:
                 mxs[p], mys[p] = Rx / dR, Ry / dR
-                _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi)
         if units:
             return _UNITS
-    else:       # (start 1) the ξ rule of the pairs at |R| = 0, their directions drawn
-        for p in range(P0, P1):
-            if zero[p]:
-                _xi_rule(p, dt, Ci, vel, dvxs, nxs, nys, mxs, mys, Cf, active, state_p, xi)
+    # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
+    for p in range(P0, P1 if start != 2 else P0):
+        i, j = Ci[1, p], Ci[2, p]
+        kd = dt if active[p] and state_p[p] != 1 else 0.0
+        rvx = vel[0, j] - vel[0, i] + dvxs[p]
+        spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
+        inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mxs[p], mys[p], spin, rvx)
+        xi[0, p] += inc_ij * kd
+        xi[1, p] += inc_ji * kd
     # displacement since the lists were built, Verlet bound, drift
     for b in range(b0, b1):
         largest = -math.inf
@@ -963,6 +957,46 @@ def run_force_phase(engine, sample=False):
     fields = (w[0].copy(), w[1].copy(), w[5].copy(), w[6].copy(), w[7].copy(), engine.active.copy(), ws.yc.copy(),
               ws.mob.copy())
     return fields, _samples(ws, sample)
+
+
+def run_move(engine, dt, g):
+    """The movement of ``engine`` after its force phase ``g`` and its kick, in the compiled code (the
+    tail of :func:`run_step`), or :data:`NOT_RUN` when it does not cover it.
+
+    What :meth:`~particleShear.engine.step.BatchEngine.move` does, with the same numbers: the
+    sequential ξ rule (a random direction at ``|R| = 0`` drawn here, as in :func:`run_step`), the
+    displacement since the lists were built, the drift, the strain, the wrap, the clock and the
+    lists due.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``), its candidates those of the force phase.
+    dt : float
+        Time step (s).
+    g : ForceRecord
+        The record of the step's force phase (its pair vectors, normals, image velocity, heights).
+
+    Returns
+    -------
+    None or NOT_RUN
+    """
+    ws = _prepared(engine)
+    if ws is None or ws.C is not engine.C or g.verdict is not None:
+        return NOT_RUN
+    w = ws.work
+    w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
+    ws.yc[:] = g.yc
+    B = engine.s.B
+    kernel = _kernels_of(ws)[0]
+    args, held = _arguments(engine, ws, 1.0, dt, False, False, np.zeros(B, dtype=np.bool_))
+    if kernel(5, 0, B, *args) == _UNITS:
+        for b in range(B):
+            _draw(engine, ws, b, ws.zero, 8)
+        kernel(1, 0, B, *args)
+    _adopt(engine, ws, held, stepped=True, kicked=False)
+    engine.step_count += 1
+    return None
 
 
 def _samples(ws, sample):

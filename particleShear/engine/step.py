@@ -782,6 +782,8 @@ class BatchEngine:
         EngineInstability
             On a device, if the force phase's guard verdict is not sound.
         """
+        if self.backend.compiled and g is not None and numba_step.run_move(self, dt, g) is not numba_step.NOT_RUN:
+            return          # (the same movement in one compiled call)
         self.move_spheres(dt, g)
         self.advance_cells(dt, g)
 
