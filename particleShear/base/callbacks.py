@@ -228,6 +228,11 @@ def callback_phase_laws(C, central=True):
     return law_c, tensile
 
 
+#: what the laws of a phase depend on besides the candidates: the classes' law attributes now (an
+#: engine that keeps anything made from the laws, as the compiled step's workspace, compares them)
+callback_phase_laws.key = class_callbacks
+
+
 def _stretched(law, C, d):
     """A tensile callback on the stretched bonds of ``C`` (``d > d_eq``), 0 on every other candidate."""
     xp = array_namespace(d)

@@ -836,17 +836,21 @@ class _Workspace:
 
 
 def _key(engine):
-    """What :func:`reason` and the workspace depend on besides the candidates (compared by identity)."""
+    """What :func:`reason` and the workspace depend on besides the candidates (compared by identity):
+    the engine's configuration, the run's law, and the law callbacks of a state that has them (the
+    ``key()`` of its ``callback_laws``: the documented classes' law attributes, read at every phase)."""
     s = engine.s
+    given = getattr(s, "callback_laws", None)
+    laws = tuple(given.key()) if given is not None and hasattr(given, "key") else ()
     return (engine.integrator, engine.keep_terms, engine.lees_edwards, engine.strain_advances, engine.free_p,
-            s.law, s.law_params, engine.guard, engine.max_kinetic_energy)
+            s.law, s.law_params, engine.guard, engine.max_kinetic_energy) + laws
 
 
 def _workspace(engine):
     """The engine's :class:`_Workspace`, rebuilt at a rebuild of the lists (new ``C``) or when its key changed."""
     ws = engine.__dict__.get("_compiled_workspace")
     key = _key(engine)
-    if ws is None or ws.C is not engine.C or any(a is not b for a, b in zip(ws.key, key)):
+    if ws is None or ws.C is not engine.C or len(ws.key) != len(key) or any(a is not b for a, b in zip(ws.key, key)):
         ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine, key)
     return ws
 
@@ -886,13 +890,34 @@ def run_step(engine, cool, dt, sample):
     EngineInstability
         When the guard finds a guarded replica unstable (after the force phase, as NumPy).
     """
+    got = _launch(engine, cool, dt, sample)
+    if got is None:
+        return NOT_RUN
+    ws, kernel, args, held, status = got
+    if status == _UNITS:
+        for b in range(engine.s.B):
+            _draw(engine, ws, b, ws.zero, 8)
+        kernel(1, 0, engine.s.B, *args)
+    _adopt(engine, ws, held, stepped=True)
+    engine.step_count += 1
+    return _samples(ws, sample)
+
+
+def _launch(engine, cool, dt, sample, forces_only=False):
+    """The start of a compiled step (or of its force phase alone): the lists rebuilt when due, the
+    kernel run from the start (the normals at ``d = 0`` drawn and the step run with them), the
+    relations, the terms when kept and the guard's record handed back, an unsound verdict reported.
+
+    Returns ``(workspace, kernel, arguments, held arrays, status)``, or None when the compiled code
+    does not cover the engine's step."""
     engine.neighbours()
     ws = _prepared(engine)
     if ws is None:
-        return NOT_RUN
+        return None
     kernel, B = _kernels_of(ws)[0], engine.s.B
     check = ws.guarded and not engine.step_count % engine.check_interval
-    args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None))
+    args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
+                            forces_only=forces_only)
     status = kernel(0, 0, B, *args)
     if status == _D_ZERO:
         for b in range(B):
@@ -903,13 +928,7 @@ def run_step(engine, cool, dt, sample):
         engine.terms = _terms(engine, ws)
     if status == _GUARD:
         _report(engine, ws)
-    if status == _UNITS:
-        for b in range(B):
-            _draw(engine, ws, b, ws.zero, 8)
-        kernel(1, 0, B, *args)
-    _adopt(engine, ws, held, stepped=True)
-    engine.step_count += 1
-    return _samples(ws, sample)
+    return ws, kernel, args, held, status
 
 
 def run_force_phase(engine, sample=False):
@@ -935,24 +954,10 @@ def run_force_phase(engine, sample=False):
         active, yc, mob``: copies) and the stresses as
         :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them.
     """
-    engine.neighbours()
-    ws = _prepared(engine)
-    if ws is None:
+    got = _launch(engine, 1.0, 0.0, sample, forces_only=True)
+    if got is None:
         return NOT_RUN
-    kernel, B = _kernels_of(ws)[0], engine.s.B
-    check = ws.guarded and not engine.step_count % engine.check_interval
-    args, held = _arguments(engine, ws, 1.0, 0.0, sample, check, np.full(B, engine.half is not None),
-                            forces_only=True)
-    status = kernel(0, 0, B, *args)
-    if status == _D_ZERO:
-        for b in range(B):
-            _draw(engine, ws, b, ws.work[4] == 0.0, 5)
-        status = kernel(3, 0, B, *args)
-    _adopt(engine, ws, held)
-    if ws.keep:
-        engine.terms = _terms(engine, ws)
-    if status == _GUARD:
-        _report(engine, ws)
+    ws = got[0]
     w = ws.work
     fields = (w[0].copy(), w[1].copy(), w[5].copy(), w[6].copy(), w[7].copy(), engine.active.copy(), ws.yc.copy(),
               ws.mob.copy())

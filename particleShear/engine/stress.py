@@ -220,15 +220,46 @@ def sphere_rows(function):
 
 
 def outer_entries(ux, uy, wx, wy):
-    """The entries ``u_a·w_c`` of ``u ⊗ w`` in the order (x, x), (x, y), (y, x), (y, y) (numbers or arrays)."""
+    """The entries ``u_a·w_c`` of ``u ⊗ w`` in the order (x, x), (x, y), (y, x), (y, y).
+
+    Parameters
+    ----------
+    ux, uy, wx, wy : float or ndarray
+        The components of ``u`` and ``w`` (any units).
+
+    Returns
+    -------
+    tuple
+        The four products (the product of the units).
+    """
     return ux * wx, ux * wy, uy * wx, uy * wy
 
 
 def love_weber_entries(fx_i, fy_i, fx_j, fy_j, own_j, dx, dy, internal):
-    """F ⊗ (x_i − x_j) = −F ⊗ D of a pair counted as internal (eq. S1-19; D = x_j − x_i, the minimum-image
-    pair vector, µm), 0 otherwise; F (mg·µm·s⁻² per m depth) is the force on i, or the mean of the two
-    visits' forces where j's visit has a force of its own (``own_j``: 1.0.2 registers each visit with
-    half).  Numbers inside the compiled step, arrays in :func:`_love_weber_rows`."""
+    """F ⊗ (x_i − x_j) = −F ⊗ D of a pair counted as internal (eq. S1-19), 0 otherwise.
+
+    A pure expression of its arguments (numbers inside the compiled step, arrays in the NumPy row
+    function), written once for both (docs/backends.md, "One law, two drivers").
+
+    Parameters
+    ----------
+    fx_i, fy_i : float or ndarray
+        The force on i (mg·µm·s⁻² per m depth).
+    fx_j, fy_j : float or ndarray
+        The force of j's own visit (read only with ``own_j``).
+    own_j : bool
+        j's visit has a force of its own (spheres with parameters of their own): F is then the mean
+        of the two visits' forces (1.0.2 registers each visit with half); else F is the force on i.
+    dx, dy : float or ndarray
+        D = x_j − x_i, the minimum-image pair vector (µm).
+    internal : bool or ndarray of bool
+        The pair is internal: both spheres mobile, no image shift, a relation.
+
+    Returns
+    -------
+    tuple
+        The four entries (xx, xy, yx, yy) (mg·µm²·s⁻² per m depth).
+    """
     if own_j:
         fx, fy = (fx_i + fx_j) * 0.5, (fy_i + fy_j) * 0.5
     else:
@@ -237,10 +268,30 @@ def love_weber_entries(fx_i, fy_i, fx_j, fy_j, own_j, dx, dy, internal):
 
 
 def external_entries(fx_i, fy_i, fx_j, fy_j, own_j, xc_i, yc_i, xc_j, yc_j, ext_i, ext_j):
-    """F ⊗ (x_target − c) of a pair's external entries (eq. S1-16): F_i at i where ``ext_i``, −F_j at j
-    where ``ext_j``; ``xc, yc`` the spheres' positions from the cell centre (µm).  Where j's visit has
-    a force of its own (``own_j``) the rows add (F_i − F_j) ⊗ (x_j − c), exactly 0 where F_j = F_i (a
-    batch's replica equals its single run)."""
+    """F ⊗ (x_target − c) of a pair's external entries (eq. S1-16): F_i at i, −F_j at j.
+
+    Where j's visit has a force of its own the entries add (F_i − F_j) ⊗ (x_j − c), exactly 0
+    where F_j = F_i (a batch's replica equals its single run).
+
+    Parameters
+    ----------
+    fx_i, fy_i : float or ndarray
+        The force on i (mg·µm·s⁻² per m depth).
+    fx_j, fy_j : float or ndarray
+        The force of j's own visit (read only with ``own_j``).
+    own_j : bool
+        j's visit has a force of its own.
+    xc_i, yc_i, xc_j, yc_j : float or ndarray
+        The positions of i and j from the cell centre (µm).
+    ext_i, ext_j : bool or ndarray of bool
+        i (j) is mobile and receives the pair force as an external force (a pair through the
+        boundary or with an immobile partner; a relation).
+
+    Returns
+    -------
+    tuple
+        The four entries (xx, xy, yx, yy) (mg·µm²·s⁻² per m depth).
+    """
     xj, yj = xc_j * ext_j, yc_j * ext_j
     a, b, c, d = outer_entries(fx_i, fy_i, xc_i * ext_i - xj, yc_i * ext_i - yj)
     if own_j:
@@ -250,18 +301,67 @@ def external_entries(fx_i, fy_i, fx_j, fy_j, own_j, xc_i, yc_i, xc_j, yc_j, ext_
 
 
 def unbalanced_entries(fx, fy, mob, xc, yc):
-    """F_total ⊗ (x − c) of a mobile sphere (eq. S1-17), 0 for an immobile one."""
+    """F_total ⊗ (x − c) of a mobile sphere (eq. S1-17), 0 for an immobile one.
+
+    Parameters
+    ----------
+    fx, fy : float or ndarray
+        The sphere's total force (mg·µm·s⁻² per m depth).
+    mob : bool or ndarray of bool
+        The sphere is mobile.
+    xc, yc : float or ndarray
+        Its position from the cell centre (µm).
+
+    Returns
+    -------
+    tuple
+        The four entries (xx, xy, yx, yy) (mg·µm²·s⁻² per m depth).
+    """
     return outer_entries(fx * mob, fy * mob, xc, yc)
 
 
 def spin_entry(inertia, omega, mob):
-    """I ω² of a mobile sphere (eq. S1-21, model units), 0 for an immobile one."""
+    """I ω² of a mobile sphere (eq. S1-21), 0 for an immobile one.
+
+    Parameters
+    ----------
+    inertia : float or ndarray
+        Moment of inertia (mg·µm² per m depth).
+    omega : float or ndarray
+        Spin (rad/s).
+    mob : bool or ndarray of bool
+        The sphere is mobile.
+
+    Returns
+    -------
+    float or ndarray
+        I ω² (mg·µm²·s⁻² per m depth).
+    """
     return inertia * omega * omega * mob
 
 
 def otsuki_entries(m, vx, vy, rate, yc, mob):
-    """P ⊗ P / m of a mobile sphere with P = m (v_x − γ̇ (y − Ly/2), v_y), already in SI (J per m depth:
-    P in kg·m/s, m in kg), unlike the other rows, which are in the model's units."""
+    """P ⊗ P / m of a mobile sphere, P = m (v_x − γ̇ (y − Ly/2), v_y) (Otsuki & Hayakawa), 0 for an
+    immobile one; already in SI, unlike the other rows.
+
+    Parameters
+    ----------
+    m : float or ndarray
+        Mass (mg per m depth).
+    vx, vy : float or ndarray
+        Velocity (µm/s).
+    rate : float or ndarray
+        Shear rate γ̇ of the sphere's replica (1/s).
+    yc : float or ndarray
+        Height from the cell centre ``y − Ly/2`` (µm).
+    mob : bool or ndarray of bool
+        The sphere is mobile.
+
+    Returns
+    -------
+    tuple
+        The four entries (xx, xy, yx, yy) (J per m depth: P in kg·m/s, m in kg).
+    """
     px = m * 1e-12 * (vx - rate * yc)
     py = m * 1e-12 * vy
     w = mob / (m * 1e-6)
