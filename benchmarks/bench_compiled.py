@@ -10,8 +10,10 @@ compiled call from the NumPy engine's own functions (engine/numba_step.py, docs/
 candidate search and the Python of the loop around the step are the same on both.
 
 "Numba, compiled blocks": the same steps through ``numba_step.run_block`` (many steps per compiled
-call, the rate update and the records inside, as the protocols' recording loop runs them).  Last
-rows: the default run ``doParticleShearSimulation(seed=1)`` (no drawing), whole call with a warm
+call, the rate update and the records inside, as the protocols' recording loop runs them).  Then
+the documented step loop of the README (what 1.0.2's scripts run, every tensor at every step) on
+the N = 150 scene, its engine made on each backend, in alternating blocks.  Last rows: the default
+run ``doParticleShearSimulation(seed=1)`` (no drawing), whole call with a warm
 compile cache, per backend, without files and saving its files (``saveData=True`` into a temporary
 folder: the per-step table of every stress tensor, so every step samples every tensor).
 
@@ -81,6 +83,25 @@ def row(N, B, steps, blocks):
     return {be: statistics.median(v) for be, v in samples.items()}
 
 
+def documented(backend):
+    """The documented step loop of the README (``bench_step.documented_steps``: forces, totals, every
+    tensor of ``StressTensorEvaluation`` over ``movableSphereList()``, acceleration, movement) on the
+    N = 150 scene, its engine made on ``backend``; returns its timed block function."""
+    from particleShear import StressTensorEvaluation
+    before = os.environ.get("PARTICLESHEAR_BACKEND")
+    os.environ["PARTICLESHEAR_BACKEND"] = backend      # (read when the ensemble's engine is made)
+    try:
+        ens = bench_step.build(150, seed=2)
+        ev = StressTensorEvaluation(ens.size_x, ens.size_y)
+        bench_step.documented_steps(ens, ev, 5)
+    finally:
+        if before is None:
+            del os.environ["PARTICLESHEAR_BACKEND"]
+        else:
+            os.environ["PARTICLESHEAR_BACKEND"] = before
+    return lambda n: sum(bench_step.documented_steps(ens, ev, n))
+
+
 def default_run(backend, save=False):
     """Seconds of the whole default call; ``save``: with its files (every tensor sampled at every step)."""
     import tempfile
@@ -109,6 +130,14 @@ def main():
         scale = 1e9 / N if unit.startswith("ns") else 1e6
         print(f"| {N:,} | {B} | {m['numpy'] * scale:.1f} | {m['numba'] * scale:.1f} | {m['numba blocks'] * scale:.1f} | "
               f"{m['numpy'] / m['numba']:.2f}× | {m['numpy'] / m['numba blocks']:.2f}× | {unit} |", flush=True)
+    loops = {be: documented(be) for be in ("numpy", "numba")}
+    samples = {be: [] for be in loops}
+    for _ in range(3 if q else 7):
+        for be, run in loops.items():
+            samples[be].append(run(50 if q else 200) / (50 if q else 200))
+    t = {be: statistics.median(v) for be, v in samples.items()}
+    print(f"| documented step loop with every tensor (README), N = 150 | 1 | {t['numpy'] * 1e6:.1f} | | "
+          f"{t['numba'] * 1e6:.1f} | | {t['numpy'] / t['numba']:.2f}× | µs/step |", flush=True)
     default_run("numba")                 # the cache warm (a first compile is not timed)
     t = {be: statistics.median(default_run(be) for _ in range(1 if q else 3)) for be in ("numpy", "numba")}
     print(f"| default run (seed 1), whole call | | {t['numpy']:.2f} | | {t['numba']:.2f} | | "
