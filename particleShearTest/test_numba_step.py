@@ -278,6 +278,46 @@ class TestCompiledStepBits(unittest.TestCase):
         for a, b in zip(runs["numpy"], runs["numba"]):
             np.testing.assert_array_equal(_bits(a), _bits(b))
 
+    def test_plateau_law_set_the_1_0_2_way_runs_compiled(self):
+        """The plateau law set as 1.0.2 scripts set it (``CircleBasicElasticity.call_back_elastic_force_law``,
+        its ``PlateauConfiguration``) runs compiled in the documented step loop (NumPy's relations
+        never run), with NumPy's bits; a slope changed halfway, and the callback set back to the
+        linear law, take effect at the next force phase on both backends, as 1.0.2 reads them."""
+        import math
+        import os
+        from unittest import mock
+
+        from particleShear import (CircleBasicElasticity, PlateauConfiguration, elastic_force_law,
+                                   elastic_force_law_plateau)
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        runs = {}
+        slope = PlateauConfiguration.relative_plateau_slope
+        for backend in ("numpy", "numba"):
+            ens = constituted(91, **FRICTIONAL_BONDS)[1]
+            ens.applyingShear = True
+            patch = mock.patch.object(BatchEngine, "relations", side_effect=AssertionError("NumPy relations"))
+            try:
+                with mock.patch.dict(os.environ, {"PARTICLESHEAR_BACKEND": backend}), \
+                        (patch if backend == "numba" else mock.patch.dict({})), warnings.catch_warnings():
+                    warnings.filterwarnings("error", "backend='numba': this step runs on NumPy", RuntimeWarning)
+                    CircleBasicElasticity.call_back_elastic_force_law = elastic_force_law_plateau
+                    for k in range(90):
+                        if k == 30:
+                            PlateauConfiguration.relative_plateau_slope = 0.4
+                        if k == 60:
+                            CircleBasicElasticity.call_back_elastic_force_law = elastic_force_law
+                        ens.setShearRate(300.0 * math.cos(0.05 * k))
+                        ens.mechanical_simulation_step_calculate_forces()
+                        ens.mechanical_simulation_step_calculate_acceleration(0.999, ens.dt)
+                        ens.mechanical_simulation_step_calculate_movement(ens.dt)
+            finally:
+                CircleBasicElasticity.call_back_elastic_force_law = elastic_force_law
+                PlateauConfiguration.relative_plateau_slope = slope
+            runs[backend] = np.array([(q.x, q.y, q.xspeed, q.yspeed, q.omega) for q in ens.sphereList])
+        np.testing.assert_array_equal(_bits(runs["numpy"]), _bits(runs["numba"]))
+
     def test_plates_off_relaxation_and_numbers(self):
         """The constitution's relaxation (plates off, μ = 0 blocks, drift removal) on the ensembles' own
         state, whose engine numbers the relations as they form: the same bits and creation numbers."""

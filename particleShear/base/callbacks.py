@@ -21,10 +21,11 @@ import weakref
 import numpy as np
 
 from ..engine.contact_laws import LAWS, law_values
-from ..engine.phase_laws import cached, law_arguments, prepared_law
+from ..engine.phase_laws import cached, law_arguments, law_function
 from ..engine.xp import array_namespace, to_host
 
-__all__ = ["register_callback", "callback_law", "call_law", "callback_phase_laws", "class_callbacks", "hold_callbacks"]
+__all__ = ["register_callback", "callback_law", "call_law", "callback_phase_laws", "callback_central_law",
+           "callback_key", "class_callbacks", "hold_callbacks"]
 
 
 # -- the documented callbacks ----------------------------------------------------------------------
@@ -212,13 +213,12 @@ def callback_phase_laws(C, central=True):
     compressive, stretched = class_callbacks()
     law_c = None
     if central and not (compressive is None or _registered(compressive) == "linear"):
-        found = callback_law(compressive)
-        if found is None:
+        if callback_law(compressive) is None:
             args = cached(C, ("callback",), lambda: (C.d_law, C.k, C.c))
             law_c = (lambda d: _on_host(compressive, d, *args, select=d <= args[0]))
-        elif found[0].name != "linear":
-            law, values = found
-            law_c = prepared_law(law, C, (law.name, values), lambda: law_arguments(law, C) + values)
+        else:
+            got = callback_central_law(C)
+            law_c = None if got is None else (lambda d: got[1](d, *got[2]))
     tensile = None
     if not (stretched is None or _registered(stretched) == "tensile"):
         found = callback_law(stretched)
@@ -228,9 +228,46 @@ def callback_phase_laws(C, central=True):
     return law_c, tensile
 
 
-#: what the laws of a phase depend on besides the candidates: the classes' law attributes now (an
-#: engine that keeps anything made from the laws, as the compiled step's workspace, compares them)
-callback_phase_laws.key = class_callbacks
+def callback_central_law(C):
+    """The central law callback as a registered law on the candidates ``C``: ``(name, function,
+    arguments)``, the law of every candidate at ``d`` being ``function(d, *arguments)`` (what
+    :func:`callback_phase_laws` evaluates, :func:`~particleShear.engine.phase_laws.law_function`);
+    None for the built-in linear law, a user function, or no callback.
+
+    Parameters
+    ----------
+    C : PairConstants or VisitConstants
+        The constants of one visit of the candidates.
+
+    Returns
+    -------
+    tuple or None
+    """
+    compressive = class_callbacks()[0]
+    found = None if compressive is None or _registered(compressive) == "linear" else callback_law(compressive)
+    if found is None or found[0].name == "linear":
+        return None
+    law, values = found
+    return (law.name,) + law_function(law, C, (law.name, values), lambda: law_arguments(law, C) + values)
+
+
+def callback_key():
+    """What the laws of a phase depend on besides the candidates, compared by equality: the classes'
+    two law attributes now and the parameter values of a registered central law (the plateau law's
+    ``PlateauConfiguration``), read at every phase.
+
+    Returns
+    -------
+    tuple
+    """
+    compressive, stretched = class_callbacks()
+    found = None if compressive is None else callback_law(compressive)
+    return compressive, stretched, None if found is None else found[1]
+
+
+# what an engine that keeps anything made from the laws (the compiled step's workspace) reads
+callback_phase_laws.key = callback_key
+callback_phase_laws.central = callback_central_law
 
 
 def _stretched(law, C, d):

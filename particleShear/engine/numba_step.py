@@ -173,13 +173,30 @@ def reason(engine):
     central, tensile = force_phase_laws(s, C)
     if C.Kj is not None and central is not None:
         return "spheres with parameters of their own under a contact law of the laws folder"
-    if tensile is not None or (central is not None and s.law is None):
-        return "a law callback of the documented classes"
-    if central is not None and s.law not in COMPILED_LAWS:
-        return (f"contact_law={s.law!r} is not among the laws compiled bit for bit ({', '.join(COMPILED_LAWS)}): "
+    if tensile is not None:
+        return "a tensile law callback of the documented classes"
+    if central is None:
+        return None
+    got = _phase_law(s, C)
+    if got is None:
+        return "a law callback of the documented classes that is a function of its own"
+    if got[0] not in COMPILED_LAWS:
+        return (f"contact_law={got[0]!r} is not among the laws compiled bit for bit ({', '.join(COMPILED_LAWS)}): "
                 "compiled code may round its functions (e.g. ** with a fractional exponent) in the last bit "
                 "otherwise than NumPy")
     return None
+
+
+def _phase_law(s, C):
+    """The central law of a force phase other than the built-in one as ``(name, function, arguments)``
+    (the law of every candidate at ``d`` is ``function(d, *arguments)``, what the NumPy phase
+    evaluates): the run's contact law (:func:`~.phase_laws.run_law`), or a documented law callback
+    that is a registered law (the ``central`` of the state's ``callback_laws``); None otherwise."""
+    if s.law is not None:
+        got = run_law(s, C)
+        return None if got is None else (get_law(s.law).name,) + tuple(got)
+    central = getattr(getattr(s, "callback_laws", None), "central", None)
+    return None if central is None else central(C)
 
 
 
@@ -808,7 +825,8 @@ class _Workspace:
             [np.broadcast_to(np.asarray(getattr(Kj, n), dtype=float), (C.P,)) for n in forces.PairConstants.TERM_ROWS])
         self.offsets = np.array(C.offsets, dtype=np.int64)
         # the run's law (run_law): its function and its arguments per candidate, rows of law_rows
-        got = run_law(s, C) if self.why is None else None
+        got = _phase_law(s, C) if self.why is None else None
+        got = None if got is None else got[1:]
         if got is not None and len(got[1]) > numba_driver.LAW_SLOTS:
             self.why, got = f"a contact law of more than {numba_driver.LAW_SLOTS} arguments after d", None
         self.custom = got is not None
@@ -836,22 +854,28 @@ class _Workspace:
 
 
 def _key(engine):
-    """What :func:`reason` and the workspace depend on besides the candidates (compared by identity):
-    the engine's configuration, the run's law, and the law callbacks of a state that has them (the
-    ``key()`` of its ``callback_laws``: the documented classes' law attributes, read at every phase)."""
+    """What :func:`reason` and the workspace depend on besides the candidates and the law callbacks
+    (:func:`_laws_key`), compared by identity: the engine's configuration and the run's law."""
     s = engine.s
-    given = getattr(s, "callback_laws", None)
-    laws = tuple(given.key()) if given is not None and hasattr(given, "key") else ()
     return (engine.integrator, engine.keep_terms, engine.lees_edwards, engine.strain_advances, engine.free_p,
-            s.law, s.law_params, engine.guard, engine.max_kinetic_energy) + laws
+            s.law, s.law_params, engine.guard, engine.max_kinetic_energy)
+
+
+def _laws_key(engine):
+    """What the laws of a phase depend on in a state with law callbacks (the ``key()`` of its
+    ``callback_laws``: the documented classes' law attributes and a registered law's values, read
+    at every phase), compared by equality; None without."""
+    key = getattr(getattr(engine.s, "callback_laws", None), "key", None)
+    return None if key is None else key()
 
 
 def _workspace(engine):
     """The engine's :class:`_Workspace`, rebuilt at a rebuild of the lists (new ``C``) or when its key changed."""
     ws = engine.__dict__.get("_compiled_workspace")
-    key = _key(engine)
-    if ws is None or ws.C is not engine.C or len(ws.key) != len(key) or any(a is not b for a, b in zip(ws.key, key)):
+    key, laws = _key(engine), _laws_key(engine)
+    if ws is None or ws.C is not engine.C or any(a is not b for a, b in zip(ws.key, key)) or ws.laws != laws:
         ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine, key)
+        ws.laws = laws
     return ws
 
 

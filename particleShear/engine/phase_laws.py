@@ -13,7 +13,7 @@ __docformat__ = "numpy"
 
 from .contact_laws import get_law
 
-__all__ = ["force_phase_laws", "run_law", "law_function", "prepared_law", "law_arguments", "cached"]
+__all__ = ["force_phase_laws", "run_law", "law_function", "law_arguments", "cached"]
 
 
 def cached(C, key, make):
@@ -156,20 +156,3 @@ def law_function(law, C, key, arguments):
         return law.function, cached(C, key, arguments)
     constants, inside = law.prepared
     return inside, cached(C, key, lambda: constants(*arguments()))
-
-
-def prepared_law(law, C, key, arguments):
-    """``law`` as a function of ``d`` on the candidates ``C`` (:func:`law_function` bound to its arguments).
-
-    Parameters
-    ----------
-    law, C, key, arguments
-        As :func:`law_function`.
-
-    Returns
-    -------
-    callable
-        ``law(d)``: the central force of every candidate at distance ``d`` (µm), mg·µm·s⁻² per m
-        depth, negative repels.
-    """
-    return _bound(*law_function(law, C, key, arguments))
