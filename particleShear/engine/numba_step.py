@@ -63,7 +63,9 @@ KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"),
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
-SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
+SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pairs"),
+                    (sys.modules[__name__], "_cell_pairs"),
+                    (sys.modules[__name__], "_search_kernel"))
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
 
@@ -546,7 +548,7 @@ def _search_signature():
     """The Numba signature of :func:`_search_kernel`."""
     from numba import types
     f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
-    return i(f1, f1, f1, f, f, f, f, i, i, i1)
+    return i1(f1, f1, f1, f, f, f, f, i, i)
 
 
 def _block_signature():
@@ -976,67 +978,106 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
 _NO_RECORD = np.zeros((0, 0))
 
 
-def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, out):
-    """The pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled): the minimum image of
-    :func:`_min_image_pair` and the criterion :func:`~particleShear.engine.neighbours.within_reach`
-    on the candidates of an ``nx × ny`` cell list (the grid, binning and half neighbourhood of
+def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny):
+    """The keys ``i·N + j`` of the pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled).
+
+    The minimum image of :func:`_min_image_pair` and the criterion
+    :func:`~particleShear.engine.neighbours.within_reach` on the candidates of an ``nx × ny`` cell
+    list (:func:`_cell_pairs`), or on every pair when ``nx`` or ``ny`` is below 3
+    (:func:`_all_pairs`).  The keys are found into a buffer of ``8·N`` (once more, into one of the
+    size found, where a dense replica has more); unsorted (NumPy's sort of them is the faster:
+    :func:`search` sorts them).
+
+    Returns
+    -------
+    ndarray of int64
+        The keys, in the order found (a view of the buffer).
+    """
+    N = x.shape[0]
+    key = np.empty(8 * N + 16, np.int64)
+    for _ in range(2):
+        n = (_cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, key) if nx >= 3 and ny >= 3
+             else _all_pairs(x, y, r, Lx, Ly, shift, skin, key))
+        if n <= key.shape[0]:
+            break
+        key = np.empty(n, np.int64)      # (a dense replica: room for every pair found)
+    return key[:n]
+
+
+def _all_pairs(x, y, r, Lx, Ly, shift, skin, key):
+    """The keys ``i·N + j`` of every pair ``i < j`` within reach into ``key`` while they fit; returns
+    how many there are (compiled; the grid of fewer than 3 cells per side)."""
+    N, cap, n = x.shape[0], key.shape[0], 0
+    for i in range(N):
+        for j in range(i + 1, N):
+            reach = r[i] + r[j] + skin
+            ady = abs(y[j] - y[i])
+            if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
+                continue
+            dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+            if within_reach(dx, dy, reach):
+                if n < cap:
+                    key[n] = i * N + j
+                n += 1
+    return n
+
+
+def _cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, key):
+    """The keys ``i·N + j`` of the pairs ``i < j`` within reach by an ``nx × ny`` cell list, into
+    ``key`` (unordered) while they fit; returns how many there are (compiled).
+
+    The grid, binning and half neighbourhood of
     :func:`~particleShear.engine.neighbours.near_pairs_cells`: the same cell, the cell to the right,
     the three cells of the row above, the row above the top row being the bottom row at
-    ``x − shift``), or on every pair when ``nx`` or ``ny`` is below 3.  Writes the keys
-    ``i·N + j`` into ``out`` while they fit (unsorted: NumPy's sort is the faster); returns their
-    count (more than ``len(out)``: the caller gives room for that many and calls again)."""
-    N = x.shape[0]
-    cap = out.shape[0]
-    n = 0
-    if nx < 3 or ny < 3:
-        for i in range(N):
-            for j in range(i + 1, N):
-                reach = r[i] + r[j] + skin
-                ady = abs(y[j] - y[i])
-                if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
-                    continue
-                dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-                if within_reach(dx, dy, reach):
-                    if n < cap:
-                        out[n] = i * N + j
-                    n += 1
-    else:
-        cw, ch = Lx / nx, Ly / ny
-        cx, cy, cu = np.empty(N, np.int64), np.empty(N, np.int64), np.empty(N, np.int64)
-        start = np.zeros(nx * ny + 1, np.int64)
-        for a in range(N):       # bin: fold into the cell (a y period moves x by the offset)
-            ky = np.floor(y[a] / Ly)
-            xf = x[a] - shift * ky
-            cy[a] = int(cell_index(y[a] - Ly * ky, ch, ny))
-            cx[a] = int(cell_index(np.mod(xf, Lx), cw, nx))
-            # the column of the row above (the bottom row at x − shift above the top row)
-            cu[a] = int(cell_index(np.mod(xf - shift, Lx), cw, nx)) if cy[a] + 1 >= ny else cx[a]
-            start[cy[a] * nx + cx[a] + 1] += 1
-        for c in range(nx * ny):
-            start[c + 1] += start[c]
-        fill = start[:-1].copy()
-        order = np.empty(N, np.int64)
-        for a in range(N):       # (spheres of a cell in increasing order)
-            c = cy[a] * nx + cx[a]
-            order[fill[c]] = a
-            fill[c] += 1
-        for a in range(N):
-            up = (cy[a] + 1) % ny
-            for q in range(5):
-                if q < 2:
-                    cell = cy[a] * nx + (cx[a] + q) % nx
-                else:
-                    cell = up * nx + (cu[a] + q - 3) % nx
-                for m in range(start[cell], start[cell + 1]):
-                    b = order[m]
-                    if q == 0 and b <= a:
-                        continue
-                    i, j = min(a, b), max(a, b)     # (the pair vector as the all-pairs search takes it)
-                    dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-                    if within_reach(dx, dy, r[i] + r[j] + skin):
-                        if n < cap:
-                            out[n] = i * N + j
-                        n += 1
+    ``x − shift``.  The spheres' coordinates are copied in cell order first, so that each cell's
+    spheres are read from consecutive memory, and the cells are visited in order, each computing
+    its neighbours once.  Every pair within reach lies in neighbouring cells, so the pairs found do
+    not depend on the order of the visit; each is tested on ``j − i`` (``±1`` times ``b − a``,
+    exactly), as the all-pairs search tests it.
+    """
+    N, cap, n = x.shape[0], key.shape[0], 0
+    cw, ch = Lx / nx, Ly / ny
+    cell, cu = np.empty(N, np.int64), np.empty(N, np.int64)
+    start = np.zeros(nx * ny + 1, np.int64)
+    for a in range(N):       # bin: fold into the cell (a y period moves x by the offset)
+        ky = np.floor(y[a] / Ly)
+        xf = x[a] - shift * ky
+        cy = int(cell_index(y[a] - Ly * ky, ch, ny))
+        cx = int(cell_index(np.mod(xf, Lx), cw, nx))
+        # the column of the row above (the bottom row at x − shift above the top row)
+        cu[a] = int(cell_index(np.mod(xf - shift, Lx), cw, nx)) if cy + 1 >= ny else cx
+        cell[a] = cy * nx + cx
+        start[cell[a] + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    order = np.empty(N, np.int64)
+    for a in range(N):       # (spheres of a cell in increasing order)
+        order[fill[cell[a]]] = a
+        fill[cell[a]] += 1
+    xs, ys, rs, us = np.empty(N), np.empty(N), np.empty(N), np.empty(N, np.int64)
+    for m in range(N):       # (the coordinates in cell order: each cell's spheres side by side)
+        a = order[m]
+        xs[m], ys[m], rs[m], us[m] = x[a], y[a], r[a], cu[a]
+    for cy in range(ny):
+        up = (cy + 1 if cy + 1 < ny else 0) * nx
+        for cx in range(nx):
+            c = cy * nx + cx
+            right = c + 1 if cx + 1 < nx else c + 1 - nx
+            for m in range(start[c], start[c + 1]):
+                a, xa, ya, ra = order[m], xs[m], ys[m], rs[m]
+                u = us[m]
+                left_up, right_up = (u - 1 if u > 0 else nx - 1), (u + 1 if u + 1 < nx else 0)
+                for q in range(5):
+                    other = c if q == 0 else right if q == 1 else up + (left_up if q == 2 else u if q == 3 else right_up)
+                    for m2 in range(m + 1 if q == 0 else start[other], start[other + 1]):
+                        b = order[m2]
+                        sign = 1.0 if a < b else -1.0
+                        dx, dy, _, _ = _min_image_pair(sign * (xs[m2] - xa), sign * (ys[m2] - ya), Lx, Ly, shift)
+                        if within_reach(dx, dy, ra + rs[m2] + skin):
+                            if n < cap:
+                                key[n] = min(a, b) * N + max(a, b)
+                            n += 1
     return n
 
 
@@ -1064,14 +1105,9 @@ def search(x, y, r, Lx, Ly, shift, skin):
         return near_pairs(x, y, r, Lx, Ly, shift, skin)
     kernel = _kernels.get("search") or compile_search_kernel()
     nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
-    args = (np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-            np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
-    out = np.empty(min(16 * N, N * (N - 1) // 2), dtype=np.int64)
-    n = kernel(*args, out)
-    if n > len(out):       # (a dense replica: room for every pair found, once)
-        out = np.empty(n, dtype=np.int64)
-        kernel(*args, out)
-    key = np.sort(out[:n].astype(np.int32) if N * N <= _INT32_MAX else out[:n])   # (as near_pairs_cells sorts)
+    key = kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+                 np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
+    key = np.sort(key.astype(np.int32) if N * N <= _INT32_MAX else key)   # (as near_pairs_cells sorts)
     return (key // N).astype(np.intp), (key % N).astype(np.intp)
 
 
