@@ -32,9 +32,9 @@ import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, neighbours, numba_driver, state, terms
+from . import box, forces, guard, integrate, laws, neighbours, numba_driver, state, terms
 from .box import MAX_PASSES, folded, period_count
-from .forces import pair_roles, shear_from_sums, shear_rows
+from .forces import pair_roles, pair_rows, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
 from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
@@ -44,7 +44,7 @@ from .phase_laws import force_phase_laws, run_law
 from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_kernels", "run_step", "run_block", "search", "carried", "NOT_RUN"]
+           "compile_carried_kernel", "compile_constants_kernel", "compile_kernels", "run_step", "run_block", "search", "carried", "constant_rows", "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -66,6 +66,10 @@ BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_
 SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pairs"),
                     (sys.modules[__name__], "_cell_pairs"),
                     (sys.modules[__name__], "_search_kernel"))
+#: the constants of a rebuild's candidates (:func:`constant_rows`)
+CONSTANT_FUNCTIONS = ((laws, "central_constants"), (terms, "term_rows"), (forces, "geometry_rows"),
+                      (forces, "pair_rows"), (sys.modules[__name__], "_constants_kernel"))
+assert len(forces.PairConstants.FLOAT_ROWS) == 23      # (the rows _constants_kernel writes)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
 
@@ -650,6 +654,7 @@ def compile_kernels(say=None, law=None):
     compile_block_kernel(parallel=parallel)
     compile_search_kernel()
     compile_carried_kernel()
+    compile_constants_kernel()
     if law is None:
         return
     found = get_law(law)
@@ -1109,6 +1114,80 @@ def search(x, y, r, Lx, Ly, shift, skin):
                  np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
     key = np.sort(key.astype(np.int32) if N * N <= _INT32_MAX else key)   # (as near_pairs_cells sorts)
     return (key // N).astype(np.intp), (key % N).astype(np.intp)
+
+
+def _constants_kernel(f, flags, idx, r, per_replica, own, by_sphere, state, d_eq):
+    """Every constant of the candidates in one pass (compiled): column p of the float block ``f`` is
+    :func:`~particleShear.engine.forces.pair_rows` of candidate p (replica ``idx[0, p]``, sphere rows
+    ``idx[1, p]``, ``idx[2, p]``; ``per_replica`` rows ``Lx, Ly, k, ν, k_t, ν_t, μ`` per replica;
+    ``own`` rows ``c, prc, prt, keep`` per sphere row where ``by_sphere``, else per replica), and
+    ``flags`` rows 0, 1 are ``perm``, ``trans`` (``state`` 2: a bond)."""
+    for p in range(f.shape[1]):
+        b, ai, aj = idx[0, p], idx[1, p], idx[2, p]
+        o = ai if by_sphere else b
+        perm = state[p] == 2
+        rows = pair_rows(r[ai], r[aj], per_replica[0, b], per_replica[1, b], perm, d_eq[p], per_replica[2, b], own[0, o],
+                         per_replica[3, b], per_replica[4, b], per_replica[5, b], per_replica[6, b], own[1, o], own[2, o],
+                         own[3, o])
+        # (each row by its literal index: a tuple read at a variable index costs twice the whole pass)
+        (f[0, p], f[1, p], f[2, p], f[3, p], f[4, p], f[5, p], f[6, p], f[7, p], f[8, p], f[9, p], f[10, p], f[11, p],
+         f[12, p], f[13, p], f[14, p], f[15, p], f[16, p], f[17, p], f[18, p], f[19, p], f[20, p], f[21, p],
+         f[22, p]) = rows
+        flags[0, p], flags[1, p] = perm, not perm
+    return 0
+
+
+def constant_rows(f, flags, idx, s, state, d_eq):
+    """:meth:`~particleShear.engine.forces.PairConstants.set_bonds` of the compiled backend: its
+    blocks ``f`` (float, rows :data:`~particleShear.engine.forces.PairConstants.FLOAT_ROWS`) and
+    ``flags`` (``perm``, ``trans``) written in one compiled pass (:func:`_constants_kernel`) from the
+    same function, :func:`~particleShear.engine.forces.pair_rows`, that the NumPy engine calls on
+    arrays (≈ 20 array calls and a gather per parameter there).
+
+    Parameters
+    ----------
+    f, flags : ndarray (23, P), (2, P)
+        The blocks, written in place.
+    idx : ndarray of int (3, P)
+        Replica and sphere rows i, j of each candidate.
+    s : BatchState
+        The batch (radii, boxes, per-replica constants, ``visit``).
+    state : ndarray of int8 (P,)
+        State of each candidate (2: a bond).
+    d_eq : ndarray (P,)
+        Equilibrium distance of each candidate (µm).
+    """
+    kernel = _kernels.get("constants") or compile_constants_kernel()
+    per_replica = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(a, dtype=float), (s.B,)) for a in
+                                                 (s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)]))
+    by_sphere = s.visit is not None
+    own = np.ascontiguousarray(s.visit if by_sphere else s.per_replica_parameters(np.arange(s.B)), dtype=float)
+    kernel(f, flags, np.ascontiguousarray(idx, dtype=np.int64), np.ascontiguousarray(s.r, dtype=float), per_replica,
+           own, by_sphere, np.ascontiguousarray(state, dtype=np.int8), np.ascontiguousarray(d_eq, dtype=float))
+
+
+def compile_constants_kernel(cache=True):
+    """The compiled constants of a rebuild (:func:`constant_rows`), compiled once per process (or
+    loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    return _compile("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
+
+
+def _constants_signature():
+    """The Numba signature of :func:`_constants_kernel`."""
+    from numba import types
+    f2, b2, i2 = (types.Array(t, 2, "C") for t in (types.float64, types.boolean, types.int64))
+    f1, i1 = types.Array(types.float64, 1, "C"), types.Array(types.int8, 1, "C")
+    return types.int64(f2, b2, i2, f1, f2, f2, types.boolean, i1, f1)
 
 
 def carried(old_key, kept, k):
