@@ -334,12 +334,13 @@ class BatchEngine:
         self.need = np.zeros(s.B, bool)
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
         fresh = [s.pairs[b] for b in changed]
-        new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed)
         state_p = be.asarray(np.concatenate([p.state for p in fresh]))
         xi = be.asarray(np.concatenate([p.xi for p in fresh], axis=1))
         active = be.asarray(np.concatenate([p.active for p in fresh]))
         birth = be.asarray(np.concatenate([p.birth for p in fresh]))
-        new.set_bonds(s, state_p, be.asarray(np.concatenate([p.d_eq for p in fresh])))
+        # (every constant of the rebuilt replicas' candidates at once, from their states and d_eq)
+        new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed,
+                            state=state_p, d_eq=be.asarray(np.concatenate([p.d_eq for p in fresh])))
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active, self.birth = new, state_p, xi, active, birth
             self.C.set_visits(s)
