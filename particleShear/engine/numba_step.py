@@ -38,13 +38,16 @@ from .forces import pair_roles, pair_rows, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
 from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
-from .neighbours import _INT32_MAX, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
+from .neighbours import _INT32_MAX, build_candidates, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
+from .state import PERMANENT, carried_fields, carried_rows
 from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_constants_kernel", "compile_kernels", "run_step", "run_block", "search", "carried", "constant_rows", "NOT_RUN"]
+           "compile_carried_kernel", "compile_constants_kernel", "compile_rebuild_kernel",
+           "compile_kernels", "run_step", "run_block", "search", "carried", "rebuild", "constant_rows",
+           "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -528,18 +531,24 @@ def compile_step_kernel(cache=True, say=None):
                     lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
 
 
-def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False):
+def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
     ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
-    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``)."""
+    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``);
+    with ``linear`` the history merge's positions by one pass (:func:`_positions_linear`, in place of
+    :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache)."""
     if cache and key in _kernels:
         return _kernels[key]
     import numba
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
-    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE,
-                                     **({"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {}))[name]
+    options = {"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {}
+    if linear:
+        merged = numba_driver.jit_laws(cache, ((sys.modules[__name__], "_positions_linear"),))["_positions_linear"]
+        options = {"extra": {"_positions": merged},
+                   "rename": {n: n + "__linear" for _, n in MERGE_FUNCTIONS if n != "_positions"}}
+    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE, **options)[name]
     if say is not None and not numba_driver.on_disk(compiled):
         say(message())
     compiled.compile(signature())          # (or loaded from the cache): before any timing
@@ -552,7 +561,7 @@ def _search_signature():
     """The Numba signature of :func:`_search_kernel`."""
     from numba import types
     f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
-    return i1(f1, f1, f1, f, f, f, f, i, i)
+    return i1(f1, f1, f1, f, f, f, f, i, i, i)
 
 
 def _block_signature():
@@ -655,6 +664,7 @@ def compile_kernels(say=None, law=None):
     compile_search_kernel()
     compile_carried_kernel()
     compile_constants_kernel()
+    compile_rebuild_kernel()
     if law is None:
         return
     found = get_law(law)
@@ -983,8 +993,8 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None):
 _NO_RECORD = np.zeros((0, 0))
 
 
-def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny):
-    """The keys ``i·N + j`` of the pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled).
+def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, scale):
+    """The keys ``i·scale + j`` of the pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled).
 
     The minimum image of :func:`_min_image_pair` and the criterion
     :func:`~particleShear.engine.neighbours.within_reach` on the candidates of an ``nx × ny`` cell
@@ -1001,16 +1011,16 @@ def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny):
     N = x.shape[0]
     key = np.empty(8 * N + 16, np.int64)
     for _ in range(2):
-        n = (_cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, key) if nx >= 3 and ny >= 3
-             else _all_pairs(x, y, r, Lx, Ly, shift, skin, key))
+        n = (_cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, scale, key) if nx >= 3 and ny >= 3
+             else _all_pairs(x, y, r, Lx, Ly, shift, skin, scale, key))
         if n <= key.shape[0]:
             break
         key = np.empty(n, np.int64)      # (a dense replica: room for every pair found)
     return key[:n]
 
 
-def _all_pairs(x, y, r, Lx, Ly, shift, skin, key):
-    """The keys ``i·N + j`` of every pair ``i < j`` within reach into ``key`` while they fit; returns
+def _all_pairs(x, y, r, Lx, Ly, shift, skin, scale, key):
+    """The keys ``i·scale + j`` of every pair ``i < j`` within reach into ``key`` while they fit; returns
     how many there are (compiled; the grid of fewer than 3 cells per side)."""
     N, cap, n = x.shape[0], key.shape[0], 0
     for i in range(N):
@@ -1022,13 +1032,13 @@ def _all_pairs(x, y, r, Lx, Ly, shift, skin, key):
             dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
             if within_reach(dx, dy, reach):
                 if n < cap:
-                    key[n] = i * N + j
+                    key[n] = i * scale + j
                 n += 1
     return n
 
 
-def _cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, key):
-    """The keys ``i·N + j`` of the pairs ``i < j`` within reach by an ``nx × ny`` cell list, into
+def _cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, scale, key):
+    """The keys ``i·scale + j`` of the pairs ``i < j`` within reach by an ``nx × ny`` cell list, into
     ``key`` (unordered) while they fit; returns how many there are (compiled).
 
     The grid, binning and half neighbourhood of
@@ -1081,7 +1091,7 @@ def _cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, key):
                         dx, dy, _, _ = _min_image_pair(sign * (xs[m2] - xa), sign * (ys[m2] - ya), Lx, Ly, shift)
                         if within_reach(dx, dy, ra + rs[m2] + skin):
                             if n < cap:
-                                key[n] = min(a, b) * N + max(a, b)
+                                key[n] = min(a, b) * scale + max(a, b)
                             n += 1
     return n
 
@@ -1111,7 +1121,7 @@ def search(x, y, r, Lx, Ly, shift, skin):
     kernel = _kernels.get("search") or compile_search_kernel()
     nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
     key = kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-                 np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
+                 np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny, N)
     key = np.sort(key.astype(np.int32) if N * N <= _INT32_MAX else key)   # (as near_pairs_cells sorts)
     return (key // N).astype(np.intp), (key % N).astype(np.intp)
 
@@ -1125,7 +1135,7 @@ def _constants_kernel(f, flags, idx, r, per_replica, own, by_sphere, state, d_eq
     for p in range(f.shape[1]):
         b, ai, aj = idx[0, p], idx[1, p], idx[2, p]
         o = ai if by_sphere else b
-        perm = state[p] == 2
+        perm = state[p] == PERMANENT
         rows = pair_rows(r[ai], r[aj], per_replica[0, b], per_replica[1, b], perm, d_eq[p], per_replica[2, b], own[0, o],
                          per_replica[3, b], per_replica[4, b], per_replica[5, b], per_replica[6, b], own[1, o], own[2, o],
                          own[3, o])
@@ -1190,12 +1200,101 @@ def _constants_signature():
     return types.int64(f2, b2, i2, f1, f2, f2, types.boolean, i1, f1)
 
 
+#: key scale of the pair table (``i << 32 | j``, :class:`~particleShear.engine.state.PairTable`)
+_TABLE_SCALE = 1 << 32
+
+
+def _rebuild_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, old_key, state, d_eq, active, birth, xi, merge_min):
+    """The rebuild of one replica's pair table in one compiled call: the pairs of :func:`_search_kernel`
+    as table keys, the bonds kept, :func:`~particleShear.engine.state.carried_rows` and
+    :func:`~particleShear.engine.state.carried_fields` (the functions
+    :meth:`~particleShear.engine.state.PairTable.replace` calls, compiled).  Returns the new keys and
+    fields (:meth:`~particleShear.engine.state.PairTable.adopt`)."""
+    k = _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, _TABLE_SCALE)
+    key, src = carried_rows(old_key, old_key[state == PERMANENT], k, merge_min)
+    s, d, a, b, z = carried_fields(src, state, d_eq, active, birth, xi)
+    return key, s, d, a, b, z
+
+
+def rebuild(x, y, r, Lx, Ly, shift, skin, table):
+    """:func:`~particleShear.engine.neighbours.build_candidates` of the compiled backend (the same
+    table): below :data:`~particleShear.engine.state._MERGE_MIN` keys in one compiled call
+    (:func:`_rebuild_kernel`: the search, the history merge and the gathers, ≈ 40 NumPy calls of a
+    small replica in one); from there on the compiled search and NumPy's merge (:func:`search`,
+    :func:`carried`), whose sort and merge are the faster on many keys.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+    table : PairTable
+        The replica's pair list, changed in place.
+
+    Returns
+    -------
+    PairTable
+        ``table``.
+    """
+    N = len(x)
+    if not math.isfinite(float(shift)) or N < 2 or 2 * len(table.key) >= state._MERGE_MIN:
+        return build_candidates(x, y, r, Lx, Ly, shift, skin, table, search, carried)
+    kernel = _kernels.get("rebuild") or compile_rebuild_kernel()
+    nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
+    table.adopt(*kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+                        np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny,
+                        np.ascontiguousarray(table.key, dtype=np.int64), *table.fields(), state._MERGE_MIN))
+    return table
+
+
+def compile_rebuild_kernel(cache=True):
+    """The compiled rebuild of a small replica (:func:`rebuild`), compiled once per process (or loaded
+    from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    return _compile("rebuild", "_rebuild_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS + MERGE_FUNCTIONS
+                    + ((state, "carried_fields"), (sys.modules[__name__], "_rebuild_kernel")), _rebuild_signature, cache,
+                    linear=True)
+
+
+def _rebuild_signature():
+    """The Numba signature of :func:`_rebuild_kernel`."""
+    from numba import types
+    f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
+    s1, b1, f2 = types.Array(types.int8, 1, "C"), types.Array(types.boolean, 1, "C"), types.Array(types.float64, 2, "C")
+    return types.Tuple((i1, s1, f1, b1, i1, f2))(f1, f1, f1, f, f, f, f, i, i, i1, s1, f1, b1, i1, f2, i)
+
+
+def _positions_linear(a, v, merge_min):
+    """``numpy.searchsorted(a, v)`` (left side) of the sorted array ``v`` in the sorted array ``a`` by
+    one linear pass (compiled): what :func:`~particleShear.engine.state._positions` returns, in
+    O(n + m) where compiled code has no run-adaptive sort to merge with and binary searches cost
+    O(m log n) (the compiled history merge, :func:`carried`, takes it in place of that function;
+    ``merge_min`` is not read)."""
+    out = np.empty(len(v), np.int64)
+    i, n = 0, len(a)
+    for m in range(len(v)):
+        while i < n and a[i] < v[m]:
+            i += 1
+        out[m] = i
+    return out
+
+
 def carried(old_key, kept, k):
-    """:func:`~particleShear.engine.state.carried_rows` compiled (the same function object) below
-    :data:`~particleShear.engine.state._MERGE_MIN` keys, where its binary searches run: the keys of a
-    rebuilt candidate list and the old row each carries, without NumPy's call overhead (≈ 20 array
-    calls per rebuilt replica: 54 → 38 µs at N = 150).  From there on NumPy's (its merge by a radix
-    sort is faster than a compiled one: 1.3 against 1.6 ms at N = 10,000).
+    """:func:`~particleShear.engine.state.carried_rows` compiled (the same function, its positions found
+    by :func:`_positions_linear`): the keys of a rebuilt candidate list and the old row each carries,
+    in O(n) and without NumPy's call overhead (≈ 20 array calls per rebuilt replica).
 
     Parameters
     ----------
@@ -1206,8 +1305,6 @@ def carried(old_key, kept, k):
     -------
     key, src : ndarray of int64
     """
-    if len(old_key) + len(k) >= state._MERGE_MIN:     # (NumPy's merge by its radix sort is the faster there)
-        return state.carried_rows(old_key, kept, k)
     kernel = _kernels.get("carried") or compile_carried_kernel()
     return kernel(*(np.ascontiguousarray(a, dtype=np.int64) for a in (old_key, kept, k)), state._MERGE_MIN)
 
@@ -1224,7 +1321,7 @@ def compile_carried_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache)
+    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
 
 
 def _carried_signature():

@@ -319,12 +319,11 @@ class BatchEngine:
         # the images' offset the force phase sees: Ly·γ, 0 for a plain periodic replica (lees_edwards)
         shift = to_host(self._image_shift(), "rebuild")
         r, Lx, Ly, skin = self.host_consts
-        # (compiled: the same pairs from the same grid, the same history merge)
-        search, merge = (numba_step.search, numba_step.carried) if be.compiled else (None, None)
+        # (compiled: the same pairs from the same grid, the same history merge, numba_step.rebuild)
+        build = numba_step.rebuild if be.compiled else build_candidates
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
-            s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b],
-                                          s.pairs[b], search, merge)
+            s.pairs[b] = build(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b], s.pairs[b])
             self.rebuilds[b] += 1
         due = be.asarray(need)
         self.bound = xp.where(due, 0.0, self.bound)
