@@ -58,7 +58,9 @@ class PairConstants:
         ``offsets[0] = 0`` and ``offsets[B] = P``.
     replicas : sequence of int, optional
         Build the constants of these replicas only, in this order (their candidates
-        concatenated; ``offsets`` then describes that concatenation), for :meth:`splice`.
+        concatenated; ``offsets`` then describes that concatenation), for :meth:`splice` (which
+        reads the blocks; the index arrays of the scatter and the sums are then the spliced
+        batch's, not built here).
     state, d_eq : ndarray (P,), optional
         The candidates' states and equilibrium distances: every constant is set at once
         (:meth:`set_bonds`); default: the rows of :func:`geometry_rows` only, the others by a later
@@ -111,7 +113,10 @@ class PairConstants:
         i_host[1] = np.concatenate([p.i for p in pairs]) + rep * N
         i_host[2] = np.concatenate([p.j for p in pairs]) + rep * N
         self._set_blocks(xp.empty((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
-        self._index(s, offsets)
+        if len(replicas) == s.B:
+            self._index(s, offsets)
+        else:       # (the rebuilt replicas' constants, read by splice only: the batch's index arrays are the spliced ones')
+            self.offsets, self.P = offsets, P
         if state is not None:
             self.set_bonds(s, state, d_eq)
             return

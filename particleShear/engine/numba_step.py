@@ -699,8 +699,8 @@ class _Workspace:
         self.tau = np.zeros((2, B))
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
-        per_sphere = lambda a: np.array(np.broadcast_to(a, (B * N,)), dtype=float)       # (writable copies)
-        per_replica = lambda a: np.array(np.broadcast_to(a, (B,)), dtype=float)
+        per_sphere = lambda a: _copy_of(a, B * N)       # (writable copies)
+        per_replica = lambda a: _copy_of(a, B)
         self.Ly_s = per_sphere(engine.Ly_s)
         self.rep_s = np.array(s.rep, dtype=np.int64)
         self.V, self.Lx, self.Ly, self.kk = (per_replica(a) for a in (engine.V, s.Lx, s.Ly, s.k))
@@ -737,6 +737,15 @@ class _Workspace:
             except Exception as exc:          # (a law Numba cannot compile: NumPy runs it)
                 self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
+
+
+def _copy_of(a, n):
+    """A new float64 array (n,) of ``a``: a number repeated, or a copy of the array (a writable
+    buffer of the workspace; ``numpy.broadcast_to`` costs several times a copy on short arrays)."""
+    if np.ndim(a) == 0:
+        return np.full(n, float(a))
+    out = np.array(a, dtype=np.float64)
+    return out if out.shape == (n,) else np.array(np.broadcast_to(out, (n,)))
 
 
 def _key(engine):
@@ -1126,19 +1135,17 @@ def search(x, y, r, Lx, Ly, shift, skin):
     return (key // N).astype(np.intp), (key % N).astype(np.intp)
 
 
-def _constants_kernel(f, flags, idx, r, per_replica, own, by_sphere, state, d_eq):
+def _constants_kernel(f, flags, idx, r, Lx, Ly, k, nu, k_t, nu_t, mu, c, prc, prt, keep, by_sphere, state, d_eq):
     """Every constant of the candidates in one pass (compiled): column p of the float block ``f`` is
     :func:`~particleShear.engine.forces.pair_rows` of candidate p (replica ``idx[0, p]``, sphere rows
-    ``idx[1, p]``, ``idx[2, p]``; ``per_replica`` rows ``Lx, Ly, k, ν, k_t, ν_t, μ`` per replica;
-    ``own`` rows ``c, prc, prt, keep`` per sphere row where ``by_sphere``, else per replica), and
-    ``flags`` rows 0, 1 are ``perm``, ``trans`` (``state`` 2: a bond)."""
+    ``idx[1, p]``, ``idx[2, p]``; ``Lx … mu`` per replica; ``c, prc, prt, keep`` per sphere row where
+    ``by_sphere``, else per replica), and ``flags`` rows 0, 1 are ``perm``, ``trans``."""
     for p in range(f.shape[1]):
         b, ai, aj = idx[0, p], idx[1, p], idx[2, p]
         o = ai if by_sphere else b
         perm = state[p] == PERMANENT
-        rows = pair_rows(r[ai], r[aj], per_replica[0, b], per_replica[1, b], perm, d_eq[p], per_replica[2, b], own[0, o],
-                         per_replica[3, b], per_replica[4, b], per_replica[5, b], per_replica[6, b], own[1, o], own[2, o],
-                         own[3, o])
+        rows = pair_rows(r[ai], r[aj], Lx[b], Ly[b], perm, d_eq[p], k[b], c[o], nu[b], k_t[b], nu_t[b], mu[b], prc[o],
+                         prt[o], keep[o])
         # (each row by its literal index: a tuple read at a variable index costs twice the whole pass)
         (f[0, p], f[1, p], f[2, p], f[3, p], f[4, p], f[5, p], f[6, p], f[7, p], f[8, p], f[9, p], f[10, p], f[11, p],
          f[12, p], f[13, p], f[14, p], f[15, p], f[16, p], f[17, p], f[18, p], f[19, p], f[20, p], f[21, p],
@@ -1168,12 +1175,19 @@ def constant_rows(f, flags, idx, s, state, d_eq):
         Equilibrium distance of each candidate (µm).
     """
     kernel = _kernels.get("constants") or compile_constants_kernel()
-    per_replica = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(a, dtype=float), (s.B,)) for a in
-                                                 (s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)]))
-    by_sphere = s.visit is not None
-    own = np.ascontiguousarray(s.visit if by_sphere else s.per_replica_parameters(np.arange(s.B)), dtype=float)
-    kernel(f, flags, np.ascontiguousarray(idx, dtype=np.int64), np.ascontiguousarray(s.r, dtype=float), per_replica,
-           own, by_sphere, np.ascontiguousarray(state, dtype=np.int8), np.ascontiguousarray(d_eq, dtype=float))
+    own = s.visit if s.visit is not None else (s.c, s.prc, s.prt, s.keep)
+    kernel(f, flags, _int64(idx), _float(s.r), *(_float(a) for a in (s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)),
+           *(_float(a) for a in own), s.visit is not None, np.ascontiguousarray(state, dtype=np.int8), _float(d_eq))
+
+
+def _float(a):
+    """``a`` as a C-contiguous float64 array (itself when it is one)."""
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _int64(a):
+    """``a`` as a C-contiguous int64 array (itself when it is one)."""
+    return np.ascontiguousarray(a, dtype=np.int64)
 
 
 def compile_constants_kernel(cache=True):
@@ -1197,7 +1211,7 @@ def _constants_signature():
     from numba import types
     f2, b2, i2 = (types.Array(t, 2, "C") for t in (types.float64, types.boolean, types.int64))
     f1, i1 = types.Array(types.float64, 1, "C"), types.Array(types.int8, 1, "C")
-    return types.int64(f2, b2, i2, f1, f2, f2, types.boolean, i1, f1)
+    return types.int64(f2, b2, i2, *(f1,) * 12, types.boolean, i1, f1)
 
 
 #: key scale of the pair table (``i << 32 | j``, :class:`~particleShear.engine.state.PairTable`)
