@@ -419,8 +419,8 @@ class TestCompiledSearch(unittest.TestCase):
                 np.testing.assert_array_equal(linear(a, v, 0), np.searchsorted(a, v))
 
     def test_rebuild_same_table_as_numpy(self):
-        """The compiled rebuild of a replica's pair table (``numba_step.rebuild``: one compiled call
-        below the merge size, the compiled search and merge above) gives the table NumPy's
+        """The compiled rebuild of a replica's pair table (``numba_step.rebuild``: the compiled search
+        of the table's keys, their sort, the compiled history merge and gathers) gives the table NumPy's
         ``build_candidates`` gives, every field to the bit with its dtype and C order: random
         replicas of 1 … 1,200 spheres whose old table holds bonds (kept beyond reach), relations
         with ξ and creation numbers, Lees-Edwards offsets, a dense replica, an infinite offset."""

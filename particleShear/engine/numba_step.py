@@ -45,7 +45,7 @@ from .state import PERMANENT, carried_fields, carried_rows
 from .terms import normal_speed, pair_forces, slip_speed
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_constants_kernel", "compile_rebuild_kernel",
+           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel",
            "compile_kernels", "run_step", "run_block", "search", "carried", "rebuild", "constant_rows",
            "NOT_RUN"]
 
@@ -664,7 +664,7 @@ def compile_kernels(say=None, law=None):
     compile_search_kernel()
     compile_carried_kernel()
     compile_constants_kernel()
-    compile_rebuild_kernel()
+    compile_carry_kernel()
     if law is None:
         return
     found = get_law(law)
@@ -1218,13 +1218,12 @@ def _constants_signature():
 _TABLE_SCALE = 1 << 32
 
 
-def _rebuild_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, old_key, state, d_eq, active, birth, xi, merge_min):
-    """The rebuild of one replica's pair table in one compiled call: the pairs of :func:`_search_kernel`
-    as table keys, the bonds kept, :func:`~particleShear.engine.state.carried_rows` and
-    :func:`~particleShear.engine.state.carried_fields` (the functions
-    :meth:`~particleShear.engine.state.PairTable.replace` calls, compiled).  Returns the new keys and
-    fields (:meth:`~particleShear.engine.state.PairTable.adopt`)."""
-    k = _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, _TABLE_SCALE)
+def _carry_kernel(old_key, k, state, d_eq, active, birth, xi, merge_min):
+    """The history merge of a rebuild in one compiled call: the bonds of the old table kept,
+    :func:`~particleShear.engine.state.carried_rows` and :func:`~particleShear.engine.state.carried_fields`
+    (the functions :meth:`~particleShear.engine.state.PairTable.replace` calls with
+    ``keep_relations=False``, compiled).  Returns the new keys and fields
+    (:meth:`~particleShear.engine.state.PairTable.adopt`)."""
     key, src = carried_rows(old_key, old_key[state == PERMANENT], k, merge_min)
     s, d, a, b, z = carried_fields(src, state, d_eq, active, birth, xi)
     return key, s, d, a, b, z
@@ -1232,10 +1231,10 @@ def _rebuild_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, old_key, state, d_eq, 
 
 def rebuild(x, y, r, Lx, Ly, shift, skin, table):
     """:func:`~particleShear.engine.neighbours.build_candidates` of the compiled backend (the same
-    table): below :data:`~particleShear.engine.state._MERGE_MIN` keys in one compiled call
-    (:func:`_rebuild_kernel`: the search, the history merge and the gathers, ≈ 40 NumPy calls of a
-    small replica in one); from there on the compiled search and NumPy's merge (:func:`search`,
-    :func:`carried`), whose sort and merge are the faster on many keys.
+    table) in three calls: the search (:func:`_search_kernel`, the pairs as the table's keys
+    ``i << 32 | j``), NumPy's sort of the keys, and the history merge with its gathers
+    (:func:`_carry_kernel`): ≈ 40 NumPy calls of :meth:`~particleShear.engine.state.PairTable.replace`
+    and :func:`search` fewer, and no key taken apart and put together again.
 
     Parameters
     ----------
@@ -1254,19 +1253,20 @@ def rebuild(x, y, r, Lx, Ly, shift, skin, table):
         ``table``.
     """
     N = len(x)
-    if not math.isfinite(float(shift)) or N < 2 or 2 * len(table.key) >= state._MERGE_MIN:
-        return build_candidates(x, y, r, Lx, Ly, shift, skin, table, search, carried)
-    kernel = _kernels.get("rebuild") or compile_rebuild_kernel()
+    if not math.isfinite(float(shift)) or N < 2:     # (an infinite offset: no pair is near, as NumPy's)
+        return build_candidates(x, y, r, Lx, Ly, shift, skin, table)
+    find = _kernels.get("search") or compile_search_kernel()
+    carry = _kernels.get("carry") or compile_carry_kernel()
     nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
-    table.adopt(*kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-                        np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny,
-                        np.ascontiguousarray(table.key, dtype=np.int64), *table.fields(), state._MERGE_MIN))
+    key = np.sort(find(_float(x), _float(y), _float(r), float(Lx), float(Ly), float(shift), float(skin), nx, ny,
+                       _TABLE_SCALE))
+    table.adopt(*carry(_int64(table.key), key, *table.fields(), state._MERGE_MIN))
     return table
 
 
-def compile_rebuild_kernel(cache=True):
-    """The compiled rebuild of a small replica (:func:`rebuild`), compiled once per process (or loaded
-    from the cache).
+def compile_carry_kernel(cache=True):
+    """The compiled history merge of a rebuild (:func:`rebuild`), compiled once per process (or
+    loaded from the cache).
 
     Parameters
     ----------
@@ -1277,17 +1277,17 @@ def compile_rebuild_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("rebuild", "_rebuild_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS + MERGE_FUNCTIONS
-                    + ((state, "carried_fields"), (sys.modules[__name__], "_rebuild_kernel")), _rebuild_signature, cache,
-                    linear=True)
+    return _compile("carry", "_carry_kernel", MERGE_FUNCTIONS + ((state, "carried_fields"),
+                                                                (sys.modules[__name__], "_carry_kernel")),
+                    _carry_signature, cache, linear=True)
 
 
-def _rebuild_signature():
-    """The Numba signature of :func:`_rebuild_kernel`."""
+def _carry_signature():
+    """The Numba signature of :func:`_carry_kernel`."""
     from numba import types
-    f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
+    f1, i1, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.int64
     s1, b1, f2 = types.Array(types.int8, 1, "C"), types.Array(types.boolean, 1, "C"), types.Array(types.float64, 2, "C")
-    return types.Tuple((i1, s1, f1, b1, i1, f2))(f1, f1, f1, f, f, f, f, i, i, i1, s1, f1, b1, i1, f2, i)
+    return types.Tuple((i1, s1, f1, b1, i1, f2))(i1, i1, s1, f1, b1, i1, f2, i)
 
 
 def _positions_linear(a, v, merge_min):
