@@ -235,12 +235,11 @@ class PairConstants:
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
-        per_replica = spread(s.xp.stack((s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)), self.rep, s.B)
+        rep = spread(s.xp.stack((s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)), self.rep, s.B)
         # the visiting sphere's own values; where a replica's spheres share them, its values directly
         own = s.per_replica_parameters(self.rep) if s.visit is None else s.visit[:, self.ai]
-        Lx, Ly, k, nu, k_t, nu_t, mu = per_replica
-        rows = pair_rows(s.r[self.ai], s.r[self.aj], Lx, Ly, perm, d_eq, k, own[0], nu, k_t, nu_t, mu, own[1], own[2],
-                         own[3])
+        rows = pair_rows(s.r[self.ai], s.r[self.aj], rep[0], rep[1], perm, d_eq, rep[2], own[0], rep[3], rep[4], rep[5],
+                         rep[6], own[1], own[2], own[3])
         for n, row in enumerate(rows):
             self.f[n] = row
 
