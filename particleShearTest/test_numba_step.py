@@ -478,7 +478,8 @@ class TestCompiledSearch(unittest.TestCase):
                                                   np.zeros((2, n)), g.uniform(15, 30, n), np.zeros(n, bool))
                     state_p = np.concatenate([p.state for p in s.pairs])
                     d_eq = np.concatenate([p.d_eq for p in s.pairs])
-                    C = PairConstants(s, np.concatenate(([0], np.cumsum(sizes))), state=state_p, d_eq=d_eq)
+                    C = PairConstants(s, np.concatenate(([0], np.cumsum(sizes))), state=state_p, d_eq=d_eq,
+                                      fill=numba_step.constant_rows if backend == "numba" else None)
                     blocks.append((C.f.tobytes(), C.b.tobytes(), C.perm_code.tobytes()))
                 with self.subTest(B=B, own=own):
                     self.assertEqual(blocks[0], blocks[1])

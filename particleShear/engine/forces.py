@@ -65,6 +65,8 @@ class PairConstants:
         The candidates' states and equilibrium distances: every constant is set at once
         (:meth:`set_bonds`); default: the rows of :func:`geometry_rows` only, the others by a later
         :meth:`set_bonds`.
+    fill : callable, optional
+        As :meth:`set_bonds`.
     """
 
     #: rows of the float block :attr:`f`: radii and weights ``r/(r_i + r_j)``, box and half box (µm),
@@ -99,7 +101,7 @@ class PairConstants:
              **{n: ("b", k) for k, n in enumerate(BOOL_ROWS)},
              **{n: ("i_host", k) for k, n in enumerate(HOST_PER_PAIR)}}
 
-    def __init__(self, s, offsets, replicas=None, state=None, d_eq=None):
+    def __init__(self, s, offsets, replicas=None, state=None, d_eq=None, fill=None):
         be = self.backend = s.backend
         xp = s.xp
         replicas = np.arange(s.B) if replicas is None else np.asarray(replicas)
@@ -118,7 +120,7 @@ class PairConstants:
         else:       # (the rebuilt replicas' constants, read by splice only: the batch's index arrays are the spliced ones')
             self.offsets, self.P = offsets, P
         if state is not None:
-            self.set_bonds(s, state, d_eq)
+            self.set_bonds(s, state, d_eq, fill)
             return
         box = spread(s.xp.stack((s.Lx, s.Ly)), self.rep, s.B)
         for k, row in enumerate(geometry_rows(s.r[self.i[1]], s.r[self.i[2]], box[0], box[1])):
@@ -205,16 +207,14 @@ class PairConstants:
         C._index(s, offsets)
         return C
 
-    def set_bonds(self, s, state, d_eq):
+    def set_bonds(self, s, state, d_eq, fill=None):
         """Set every constant of the candidates from their states (bonds never change during the measurement).
 
         The rows of :data:`FLOAT_ROWS` are :func:`pair_rows` of each candidate (the geometry, and the
         constants of the central law, eq. S1-5a/b, S1-6, of the tensile law of bonds, the permanent
         ratios and the viscosities, the tangential constants and the Coulomb bound offset, ``inf``
-        for bonds, seen by the visit from i), the flags ``perm``, ``trans`` follow from ``state``.
-        One pass over the candidates: compiled on the compiled backend
-        (:func:`~particleShear.engine.numba_step.constant_rows`, the same function on numbers), else
-        :func:`pair_rows` on the arrays, one row at a time.
+        for bonds, seen by the visit from i), the flags ``perm``, ``trans`` follow from ``state``:
+        :func:`pair_rows` on the arrays, one row at a time, or ``fill``.
 
         Parameters
         ----------
@@ -226,10 +226,13 @@ class PairConstants:
             State of each candidate; 2 (:data:`~particleShear.engine.state.PERMANENT`) marks a bond.
         d_eq : ndarray (P,)
             Equilibrium distance of each candidate (µm; used for bonds only).
+        fill : callable, optional
+            ``fill(f, b, i, s, state, d_eq)`` writes the blocks :attr:`f` and :attr:`b` in one pass
+            from the same :func:`pair_rows` (the compiled backend's
+            :func:`~particleShear.engine.numba_step.constant_rows`); default NumPy's rows.
         """
-        if self.backend.compiled:
-            from . import numba_step
-            numba_step.constant_rows(self.f, self.b, self.i, s, state, d_eq)
+        if fill is not None:
+            fill(self.f, self.b, self.i, s, state, d_eq)
             self.__dict__["perm_code"] = self.perm.view(np.int8) * np.int8(2)
             return
         perm = state == 2

@@ -339,7 +339,8 @@ class BatchEngine:
         birth = be.asarray(np.concatenate([p.birth for p in fresh]))
         # (every constant of the rebuilt replicas' candidates at once, from their states and d_eq)
         new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed,
-                            state=state_p, d_eq=be.asarray(np.concatenate([p.d_eq for p in fresh])))
+                            state=state_p, d_eq=be.asarray(np.concatenate([p.d_eq for p in fresh])),
+                            fill=numba_step.constant_rows if be.compiled else None)
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active, self.birth = new, state_p, xi, active, birth
             self.C.set_visits(s)
