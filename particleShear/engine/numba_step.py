@@ -15,9 +15,10 @@ formula is a pure function of the NumPy engine called here on numbers
 :func:`~.guard.verdict_code`, :func:`~.guard.transient_ratio`, :func:`~.neighbours.verlet_bound`
 and the laws), in the NumPy engine's order of operations, so the trajectories are the same bits.
 
-What stays in Python: the rebuild of a candidate list when one is due
-(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; its search runs compiled,
-:func:`search`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
+What stays in Python: the bookkeeping of a rebuild of the candidate lists when one is due
+(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; per replica the search and the history
+merge run compiled, :func:`rebuild`, and the new candidates' constants in one compiled pass,
+:func:`constant_rows`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
 replica's generator, as :func:`~.forces.normals` draws them; the step then goes on compiled), and
 the protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
@@ -1308,7 +1309,9 @@ def _positions_linear(a, v, merge_min):
 def carried(old_key, kept, k):
     """:func:`~particleShear.engine.state.carried_rows` compiled (the same function, its positions found
     by :func:`_positions_linear`): the keys of a rebuilt candidate list and the old row each carries,
-    in O(n) and without NumPy's call overhead (≈ 20 array calls per rebuilt replica).
+    in O(n) and without NumPy's call overhead (``rows=`` of
+    :meth:`~particleShear.engine.state.PairTable.replace`; :func:`rebuild` merges with its gathers
+    in :func:`_carry_kernel`).
 
     Parameters
     ----------
