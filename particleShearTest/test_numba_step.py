@@ -624,10 +624,10 @@ class TestCompiledSearch(unittest.TestCase):
 
 
     def test_history_merge_same_rows(self):
-        """The history merge compiled (``state.carried_rows``, the same function) gives NumPy's keys
-        and rows: random tables of 0 … 5,000 keys, kept subsets (bonds, relations) that the new
-        candidates miss or hold, new keys unsorted with repeats or sorted and unique, the compiled
-        function also above the size where :func:`numba_step.carried` hands over to NumPy."""
+        """The history merge compiled (``state.carried_rows``, the same function, its positions by one
+        linear pass) gives NumPy's keys and rows: random tables of 0 … 5,000 keys, kept subsets
+        (bonds, relations) that the new candidates miss or hold, new keys unsorted with repeats or
+        sorted and unique, with either merge size."""
         from particleShear.engine import state
         rng = np.random.default_rng(2)
         compiled = numba_step.compile_carried_kernel()
@@ -648,6 +648,85 @@ class TestCompiledSearch(unittest.TestCase):
                 carried = want[1] < len(old)
                 np.testing.assert_array_equal(old[want[1][carried]], want[0][carried])   # each reads its own row
                 self.assertFalse(np.isin(want[0][~carried], old).any())  # and only new keys read none
+
+
+    def test_linear_positions_are_searchsorted(self):
+        """``_positions_linear`` (the compiled merge's positions) is ``numpy.searchsorted`` (left) of a
+        sorted array in a sorted array: repeats in either, empty arrays, values below and above all."""
+        from particleShear.engine import numba_driver as nd
+        linear = nd.jit_laws(True, ((numba_step, "_positions_linear"),))["_positions_linear"]
+        rng = np.random.default_rng(4)
+        for t in range(200):
+            a = np.sort(rng.integers(0, 300, int(rng.integers(0, 400)))).astype(np.int64)
+            v = np.sort(rng.integers(-20, 320, int(rng.integers(0, 400)))).astype(np.int64)
+            with self.subTest(t=t):
+                np.testing.assert_array_equal(linear(a, v, 0), np.searchsorted(a, v))
+
+    def test_rebuild_same_table_as_numpy(self):
+        """The compiled rebuild of a replica's pair table (``numba_step.rebuild``: the compiled search
+        of the table's keys, their sort, the compiled history merge and gathers) gives the table NumPy's
+        ``build_candidates`` gives, every field to the bit with its dtype and C order: random
+        replicas of 1 … 1,200 spheres whose old table holds bonds (kept beyond reach), relations
+        with ξ and creation numbers, Lees-Edwards offsets, a dense replica, an infinite offset."""
+        from particleShear.engine import neighbours, state
+        rng = np.random.default_rng(3)
+        for t in range(120):
+            N = int(rng.integers(1, 150)) if t % 3 else int(rng.integers(150, 1200))
+            L = float(np.sqrt(N) * 40.0)
+            x, y, r = rng.uniform(0, L, N), rng.uniform(0, L, N), rng.uniform(10, 16, N)
+            if t == 7:
+                x, y = rng.uniform(0, 50, N), rng.uniform(0, 50, N)      # dense: more pairs than the buffer
+            shift = float(rng.choice([0.0, 0.3 * L, -2.5 * L])) if t != 5 else np.inf
+            skin = float(rng.uniform(0, 8))
+            table = neighbours.build_candidates(x, y, r, L, L, 0.0, skin, state.PairTable())
+            C = len(table)
+            table.state[:] = rng.choice([state.STICK, state.SLIP, state.PERMANENT], C, p=[0.5, 0.2, 0.3])
+            table.active[:] = rng.random(C) < 0.6
+            table.xi[:] = rng.normal(size=(2, C))
+            table.d_eq[:] = rng.uniform(20, 30, C)
+            table.birth[:] = rng.permutation(C)
+            x = (x + rng.normal(0, 15, N)) % L      # moved: bonds out of reach, new pairs
+            with np.errstate(invalid="ignore"):        # (NumPy's search at an infinite offset)
+                want = neighbours.build_candidates(x, y, r, L, L, shift, skin, table.copy())
+                got = numba_step.rebuild(x, y, r, L, L, shift, skin, table.copy())
+            with self.subTest(t=t, N=N):
+                for name in state.PairTable.ARRAYS:
+                    a, b = getattr(got, name), getattr(want, name)
+                    self.assertEqual((a.dtype, a.shape, a.flags.c_contiguous, a.tobytes()),
+                                     (b.dtype, b.shape, True, b.tobytes()), name)
+
+    def test_constants_same_as_numpy(self):
+        """The compiled constants of candidates (``numba_step.constant_rows``, ``forces.pair_rows`` on
+        numbers) are NumPy's (``pair_rows`` on arrays) to the bit: per-replica constants, bonds with
+        and without kept viscosities, spheres with parameters of their own (``visit``), B = 1 and 4."""
+        from particleShear.engine.forces import PairConstants
+        from particleShear.engine.state import PERMANENT, BatchState, ReplicaPairs
+        for B in (1, 4):
+            for own in (False, True):
+                blocks = []
+                for backend in ("numpy", "numba"):
+                    g = np.random.default_rng(B + 2 * own)
+                    s = BatchState(B, 20, backend=backend)
+                    s.Lx[:], s.Ly[:] = g.uniform(150, 200, B), g.uniform(150, 200, B)
+                    s.r[:] = g.uniform(8, 12, B * 20)
+                    for name in ("k", "nu", "k_t", "nu_t", "mu", "c", "prc", "prt"):
+                        getattr(s, name)[:] = g.uniform(0.1, 1.0, B)
+                    s.keep[:] = g.integers(0, 2, B)
+                    if own:
+                        s.visit = np.ascontiguousarray(g.uniform(0.1, 1.0, (4, B * 20)))
+                        s.visit[3] = g.integers(0, 2, B * 20)
+                    sizes = g.integers(0, 40, B)
+                    for b, n in enumerate(sizes):
+                        i = g.integers(0, 19, n)
+                        s.pairs[b] = ReplicaPairs(i, i + 1 + g.integers(0, 19 - i), g.choice([0, 1, PERMANENT], n),
+                                                  np.zeros((2, n)), g.uniform(15, 30, n), np.zeros(n, bool))
+                    state_p = np.concatenate([p.state for p in s.pairs])
+                    d_eq = np.concatenate([p.d_eq for p in s.pairs])
+                    C = PairConstants(s, np.concatenate(([0], np.cumsum(sizes))), state=state_p, d_eq=d_eq,
+                                      fill=numba_step.constant_rows if backend == "numba" else None)
+                    blocks.append((C.f.tobytes(), C.b.tobytes(), C.perm_code.tobytes()))
+                with self.subTest(B=B, own=own):
+                    self.assertEqual(blocks[0], blocks[1])
 
 
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")

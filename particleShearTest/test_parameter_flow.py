@@ -4,7 +4,7 @@ A run's arguments are checked, completed, normalized, seeded and identified once
 (:func:`particleShear.run.validation.validated_run`); the immutable
 :class:`~particleShear.run.validation.RunParameters` it returns travels unchanged to the sessions,
 and a parameter's value (here μ, ``theMu``) reaches the engine's per-replica constants
-(``BatchState.mu``) and the pair constants of the Coulomb bound (``term_constants``) as given, through
+(``BatchState.mu``) and the pair constants of the Coulomb bound (``PairConstants.mu``) as given, through
 the ensemble's :class:`~particleShear.linkable.builders.EnsembleRecipe` (its hops counted here).  A run,
 a batch, a series and a sweep validate each run once.
 """
@@ -227,22 +227,23 @@ class TestMuReachesTheKernel(unittest.TestCase):
     """A changed ``theMu`` reaches ``BatchState.mu`` and the pair constants unchanged."""
 
     def test_mu_in_batch_state_and_pair_constants(self):
-        """The measurement's BatchState.mu and every pair constant μ it gives term_constants equal theMu."""
+        """The measurement's BatchState.mu and every candidate's constant μ (the row ``mu`` of the
+        pair constants, written by ``PairConstants.set_bonds`` on every backend) equal theMu."""
         states, pair_mu = [], []
-        state_from_ensembles, term_constants = driver.state_from_ensembles, forces.term_constants
+        state_from_ensembles, set_bonds = driver.state_from_ensembles, forces.PairConstants.set_bonds
 
         def capture_state(*args, **kwargs):
             st = state_from_ensembles(*args, **kwargs)
             states.append(np.asarray(st.mu).copy())
             return st
 
-        def capture_terms(*args, **kwargs):
+        def capture_constants(C, *args, **kwargs):
+            set_bonds(C, *args, **kwargs)
             if states:      # the measurement's pair constants (the constitution's relaxations may run at μ = 0)
-                pair_mu.append(np.asarray(args[8] if len(args) > 8 else kwargs["mu"]).copy())
-            return term_constants(*args, **kwargs)
+                pair_mu.append(np.asarray(C.mu).copy())
 
         with mock.patch.object(driver, "state_from_ensembles", capture_state), \
-                mock.patch.object(forces, "term_constants", capture_terms), self.assertWarns(Warning):
+                mock.patch.object(forces.PairConstants, "set_bonds", capture_constants), self.assertWarns(Warning):
             result = doParticleShearSimulation(theMu=MU, return_result=True, **SMALL)
         self.assertEqual(result.parameters["theMu"], MU)
         self.assertTrue(states)

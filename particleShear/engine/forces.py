@@ -22,9 +22,9 @@ import numpy as np
 from .state import spread
 from .xp import SegmentSum, array_namespace, to_host
 from . import laws
-from .terms import TermConstants, term_constants
+from .terms import TERM_ROWS, TermConstants, term_constants, term_rows
 
-__all__ = ["PairConstants", "VisitConstants", "splice_arrays", "scatter", "replica_sums", "pair_roles", "shear_rows",
+__all__ = ["PairConstants", "VisitConstants", "geometry_rows", "pair_rows", "splice_arrays", "scatter", "replica_sums", "pair_roles", "shear_rows",
            "shear_from_sums", "shear_stresses"]
 
 #: force·length scale of the stress tensors (mg·µm·s⁻²·µm → N·m per m depth) and torque scale
@@ -58,7 +58,15 @@ class PairConstants:
         ``offsets[0] = 0`` and ``offsets[B] = P``.
     replicas : sequence of int, optional
         Build the constants of these replicas only, in this order (their candidates
-        concatenated; ``offsets`` then describes that concatenation), for :meth:`splice`.
+        concatenated; ``offsets`` then describes that concatenation), for :meth:`splice` (which
+        reads the blocks; the index arrays of the scatter and the sums are then the spliced
+        batch's, not built here).
+    state, d_eq : ndarray (P,), optional
+        The candidates' states and equilibrium distances: every constant is set at once
+        (:meth:`set_bonds`); default: the rows of :func:`geometry_rows` only, the others by a later
+        :meth:`set_bonds`.
+    fill : callable, optional
+        As :meth:`set_bonds`.
     """
 
     #: rows of the float block :attr:`f`: radii and weights ``r/(r_i + r_j)``, box and half box (µm),
@@ -67,7 +75,7 @@ class PairConstants:
                   "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
     #: the rows set from :func:`~particleShear.engine.terms.term_constants` (the attributes of a
     #: :class:`~particleShear.engine.terms.TermConstants` but ``form``)
-    TERM_ROWS = ("d_law", "d_cap", "a_lin", "a_div", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
+    TERM_ROWS = TERM_ROWS
     #: form of the compressive law: c is a constant per candidate, so the general blend
     form = laws.BLEND
     #: rows of the index block :attr:`i` (and of its host copy :attr:`i_host`): replica, sphere rows i and j
@@ -93,7 +101,7 @@ class PairConstants:
              **{n: ("b", k) for k, n in enumerate(BOOL_ROWS)},
              **{n: ("i_host", k) for k, n in enumerate(HOST_PER_PAIR)}}
 
-    def __init__(self, s, offsets, replicas=None):
+    def __init__(self, s, offsets, replicas=None, state=None, d_eq=None, fill=None):
         be = self.backend = s.backend
         xp = s.xp
         replicas = np.arange(s.B) if replicas is None else np.asarray(replicas)
@@ -107,12 +115,16 @@ class PairConstants:
         i_host[1] = np.concatenate([p.i for p in pairs]) + rep * N
         i_host[2] = np.concatenate([p.j for p in pairs]) + rep * N
         self._set_blocks(xp.empty((len(self.FLOAT_ROWS), P)), be.asarray(i_host), xp.zeros((2, P), dtype=bool), i_host)
-        self._index(s, offsets)
-        f = self.f
-        f[0:2] = s.r[self.i[1:3]]                 # r_i, r_j
-        f[2] = f[0] + f[1]                        # d0 = r_i + r_j
-        f[3:5] = f[0:2] / f[2]                    # w_i, w_j = r/d0
-        f[5:9] = spread(s.xp.stack((s.Lx, s.Ly, s.Ly / 2, s.Lx / 2)), self.rep, s.B)     # Lx, Ly, hy, hx
+        if len(replicas) == s.B:
+            self._index(s, offsets)
+        else:       # (the rebuilt replicas' constants, read by splice only: the batch's index arrays are the spliced ones')
+            self.offsets, self.P = offsets, P
+        if state is not None:
+            self.set_bonds(s, state, d_eq, fill)
+            return
+        box = spread(s.xp.stack((s.Lx, s.Ly)), self.rep, s.B)
+        for k, row in enumerate(geometry_rows(s.r[self.i[1]], s.r[self.i[2]], box[0], box[1])):
+            self.f[k] = row
 
     @property
     def w(self):
@@ -195,32 +207,44 @@ class PairConstants:
         C._index(s, offsets)
         return C
 
-    def set_bonds(self, s, state, d_eq):
-        """Bond-dependent constants (bonds never change during the measurement).
+    def set_bonds(self, s, state, d_eq, fill=None):
+        """Set every constant of the candidates from their states (bonds never change during the measurement).
 
-        Sets the per-candidate constants of the central law (contact distance, cap, linear and
-        divergent coefficients, eq. S1-5a/b, S1-6), of the tensile law of bonds, the permanent
-        ratios and the viscosities, the tangential constants and the Coulomb bound offset
-        (``inf`` for bonds).
+        The rows of :data:`FLOAT_ROWS` are :func:`pair_rows` of each candidate (the geometry, and the
+        constants of the central law, eq. S1-5a/b, S1-6, of the tensile law of bonds, the permanent
+        ratios and the viscosities, the tangential constants and the Coulomb bound offset, ``inf``
+        for bonds, seen by the visit from i), the flags ``perm``, ``trans`` follow from ``state``:
+        :func:`pair_rows` on the arrays, one row at a time, or ``fill``.
 
         Parameters
         ----------
         s : BatchState
-            The batch whose per-replica constants (``k, nu, k_t, nu_t, mu, c, prc, prt, keep``)
+            The batch whose radii, boxes and per-replica constants (``k, nu, k_t, nu_t, mu`` and
+            ``c, prc, prt, keep``, or the spheres' own :attr:`~particleShear.engine.state.BatchState.visit`)
             are gathered to the candidates.
         state : ndarray of int8 (P,)
             State of each candidate; 2 (:data:`~particleShear.engine.state.PERMANENT`) marks a bond.
         d_eq : ndarray (P,)
             Equilibrium distance of each candidate (µm; used for bonds only).
+        fill : callable, optional
+            ``fill(f, b, i, s, state, d_eq)`` writes the blocks :attr:`f` and :attr:`b` in one pass
+            from the same :func:`pair_rows` (the compiled backend's
+            :func:`~particleShear.engine.numba_step.constant_rows`); default NumPy's rows.
         """
+        if fill is not None:
+            fill(self.f, self.b, self.i, s, state, d_eq)
+            self.__dict__["perm_code"] = self.perm.view(np.int8) * np.int8(2)
+            return
         perm = state == 2
         self.perm = perm
         self.trans = ~perm
-        K = self._visit(s, self.ai, d_eq, rows=True)        # the visit from i
-        self.k = K.k
-        self.c = K.c
-        for name in self.TERM_ROWS:
-            setattr(self, name, getattr(K, name))
+        rep = spread(s.xp.stack((s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)), self.rep, s.B)
+        # the visiting sphere's own values; where a replica's spheres share them, its values directly
+        own = s.per_replica_parameters(self.rep) if s.visit is None else s.visit[:, self.ai]
+        rows = pair_rows(s.r[self.ai], s.r[self.aj], rep[0], rep[1], perm, d_eq, rep[2], own[0], rep[3], rep[4], rep[5],
+                         rep[6], own[1], own[2], own[3])
+        for n, row in enumerate(rows):
+            self.f[n] = row
 
     def _visit(self, s, spheres, d_eq, rows=False):
         """The :class:`~particleShear.engine.terms.TermConstants` of the candidates as seen from the sphere
@@ -271,6 +295,11 @@ class PairConstants:
         self.Kj = None if s.visit is None else VisitConstants(self._visit(s, self.aj, self.d_eq), self)
 
 
+# (pair_rows returns the rows in this order)
+assert PairConstants.FLOAT_ROWS[:11] == ("ri", "rj", "d0", "w_i", "w_j", "Lx", "Ly", "hy", "hx", "k", "c")
+assert PairConstants.FLOAT_ROWS[11:] == TERM_ROWS
+
+
 class VisitConstants(TermConstants):
     """The :class:`~particleShear.engine.terms.TermConstants` of one visit of a batch's candidates,
     with what the laws of a force phase read besides them (:func:`~particleShear.engine.phase_laws.force_phase_laws`):
@@ -287,6 +316,52 @@ class VisitConstants(TermConstants):
     def __init__(self, K, C):
         TermConstants.__init__(self, **{name: getattr(K, name) for name in TermConstants.__slots__})
         self.perm, self.rep, self.ri, self.rj = C.perm, C.rep, C.ri, C.rj
+
+
+def geometry_rows(ri, rj, Lx, Ly):
+    """The geometric constants of candidates, the first rows of :data:`PairConstants.FLOAT_ROWS` (pure:
+    arrays or numbers): radii, contact distance ``d0 = r_i + r_j``, lever fractions ``r/d0`` (eq.
+    S1-3), box and half box.
+
+    Parameters
+    ----------
+    ri, rj : ndarray or float
+        Radii (µm).
+    Lx, Ly : ndarray or float
+        Box of the candidate's replica (µm).
+
+    Returns
+    -------
+    tuple
+        ``(r_i, r_j, d0, w_i, w_j, Lx, Ly, hy, hx)`` (µm but the fractions).
+    """
+    d0 = ri + rj
+    return ri, rj, d0, ri / d0, rj / d0, Lx, Ly, Ly / 2, Lx / 2
+
+
+def pair_rows(ri, rj, Lx, Ly, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep):
+    """Every constant of candidates as seen by the visit from i, in the order of
+    :data:`PairConstants.FLOAT_ROWS` (pure: arrays or numbers): :func:`geometry_rows`, ``k``, ``c``
+    and :func:`~particleShear.engine.terms.term_rows` at ``d0 = r_i + r_j``.
+
+    Parameters
+    ----------
+    ri, rj, Lx, Ly : ndarray or float
+        As :func:`geometry_rows` (µm).
+    perm : ndarray of bool or bool
+        Which candidates are bonds.
+    d_eq : ndarray or float
+        Equilibrium distance of a bond (µm).
+    k, c, nu, k_t, nu_t, mu, prc, prt, keep : ndarray or float
+        The model parameters the visit sees (:func:`~particleShear.engine.terms.term_constants`).
+
+    Returns
+    -------
+    tuple
+        The 23 values of :data:`PairConstants.FLOAT_ROWS`.
+    """
+    geometry = geometry_rows(ri, rj, Lx, Ly)
+    return geometry + (k, c) + term_rows(geometry[2], perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
 
 
 def splice_arrays(old, new, segments):

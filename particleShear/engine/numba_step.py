@@ -17,9 +17,10 @@ formula is a pure function of the NumPy engine called here on numbers
 :func:`~.guard.verdict_code`, :func:`~.guard.transient_ratio`, :func:`~.neighbours.verlet_bound`
 and the laws), in the NumPy engine's order of operations, so the trajectories are the same bits.
 
-What stays in Python: the rebuild of a candidate list when one is due
-(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; its search runs compiled,
-:func:`search`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
+What stays in Python: the bookkeeping of a rebuild of the candidate lists when one is due
+(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; per replica the search and the history
+merge run compiled, :func:`rebuild`, and the new candidates' constants in one compiled pass,
+:func:`constant_rows`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
 replica's generator, as :func:`~.forces.normals` draws them; the step then goes on compiled), and
 the protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
@@ -34,22 +35,24 @@ import warnings
 
 import numpy as np
 
-from . import box, forces, guard, integrate, neighbours, numba_driver, state, stress, terms
+from . import box, forces, guard, integrate, laws, neighbours, numba_driver, state, stress, terms
 from .box import MAX_PASSES, folded, period_count
-from .forces import pair_roles, shear_from_sums, shear_rows
+from .forces import pair_roles, pair_rows, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
 from .laws import get_law
 from .integrate import damped, flow_shifted, half_velocity_change, plate_velocity, velocity_change, xi_rates
-from .neighbours import _INT32_MAX, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
+from .neighbours import _INT32_MAX, build_candidates, cell_grid, cell_index, near_pairs, verlet_bound, within_reach
 from .numba_driver import pair_term
 from .phase_laws import force_phase_laws, run_law
+from .state import PERMANENT, carried_fields, carried_rows
 from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, otsuki_entries, outer_entries,
                      spin_entry, tensors_from_sums, unbalanced_entries)
 from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_kernels", "run_step", "run_force_phase", "run_move", "run_block",
-           "search", "carried", "tensor_sums", "NOT_RUN"]
+           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels", "run_step",
+           "run_force_phase", "run_move", "run_block", "search", "carried", "rebuild", "constant_rows", "tensor_sums",
+           "NOT_RUN"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -72,7 +75,13 @@ KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"),
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the compiled block (:func:`run_block`) and of the search (:func:`search`) besides the step's
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (sys.modules[__name__], "_block_kernel"))
-SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_search_kernel"))
+SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pairs"),
+                    (sys.modules[__name__], "_cell_pairs"),
+                    (sys.modules[__name__], "_search_kernel"))
+#: the constants of a rebuild's candidates (:func:`constant_rows`)
+CONSTANT_FUNCTIONS = ((laws, "central_constants"), (terms, "term_rows"), (forces, "geometry_rows"),
+                      (forces, "pair_rows"), (sys.modules[__name__], "_constants_kernel"))
+assert len(forces.PairConstants.FLOAT_ROWS) == 23      # (the rows _constants_kernel writes)
 #: the compiled rows and sums of every tensor of a force phase's inputs (:func:`tensor_sums`)
 TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
@@ -634,18 +643,24 @@ def compile_step_kernel(cache=True, say=None):
                     lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
 
 
-def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False):
+def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
     ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
-    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``)."""
+    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``);
+    with ``linear`` the history merge's positions by one pass (:func:`_positions_linear`, in place of
+    :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache)."""
     if cache and key in _kernels:
         return _kernels[key]
     import numba
 
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
-    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE,
-                                     **({"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {}))[name]
+    options = {"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {}
+    if linear:
+        merged = numba_driver.jit_laws(cache, ((sys.modules[__name__], "_positions_linear"),))["_positions_linear"]
+        options = {"extra": {"_positions": merged},
+                   "rename": {n: n + "__linear" for _, n in MERGE_FUNCTIONS if n != "_positions"}}
+    compiled = numba_driver.jit_laws(cache, functions, inline=INLINE, **options)[name]
     if say is not None and not numba_driver.on_disk(compiled):
         say(message())
     compiled.compile(signature())          # (or loaded from the cache): before any timing
@@ -658,7 +673,7 @@ def _search_signature():
     """The Numba signature of :func:`_search_kernel`."""
     from numba import types
     f1, i1, f, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.float64, types.int64
-    return i(f1, f1, f1, f, f, f, f, i, i, i1)
+    return i1(f1, f1, f1, f, f, f, f, i, i, i)
 
 
 def _block_signature():
@@ -761,6 +776,8 @@ def compile_kernels(say=None, law=None):
     compile_block_kernel(parallel=parallel)
     compile_search_kernel()
     compile_carried_kernel()
+    compile_constants_kernel()
+    compile_carry_kernel()
     _compile_tensor_kernel()
     if law is None:
         return
@@ -802,8 +819,8 @@ class _Workspace:
         self.ktot = np.empty((3, B * N if self.keep else 0))
         self.verdict = np.zeros((4, B))
         self.need = np.zeros(B, dtype=np.bool_)
-        per_sphere = lambda a: np.array(np.broadcast_to(a, (B * N,)), dtype=float)       # (writable copies)
-        per_replica = lambda a: np.array(np.broadcast_to(a, (B,)), dtype=float)
+        per_sphere = lambda a: _copy_of(a, B * N)       # (writable copies)
+        per_replica = lambda a: _copy_of(a, B)
         self.Ly_s = per_sphere(engine.Ly_s)
         self.rep_s = np.array(s.rep, dtype=np.int64)
         self.V, self.Lx, self.Ly, self.kk = (per_replica(a) for a in (engine.V, s.Lx, s.Ly, s.k))
@@ -851,6 +868,15 @@ class _Workspace:
             self.tp = np.empty((9, self.C.P))
             self.ts = np.empty((10, len(self.mob)))
         return self.tp, self.ts
+
+
+def _copy_of(a, n):
+    """A new float64 array (n,) of ``a``: a number repeated, or a copy of the array (a writable
+    buffer of the workspace; ``numpy.broadcast_to`` costs several times a copy on short arrays)."""
+    if np.ndim(a) == 0:
+        return np.full(n, float(a))
+    out = np.array(a, dtype=np.float64)
+    return out if out.shape == (n,) else np.array(np.broadcast_to(out, (n,)))
 
 
 def _key(engine):
@@ -1305,67 +1331,106 @@ _NO_ROWS = np.zeros((9, 0)), np.zeros((10, 0))
 _NO_SUMS = np.zeros((0, 0, 0))
 
 
-def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, out):
-    """The pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled): the minimum image of
-    :func:`_min_image_pair` and the criterion :func:`~particleShear.engine.neighbours.within_reach`
-    on the candidates of an ``nx × ny`` cell list (the grid, binning and half neighbourhood of
+def _search_kernel(x, y, r, Lx, Ly, shift, skin, nx, ny, scale):
+    """The keys ``i·scale + j`` of the pairs ``i < j`` within ``r_i + r_j + skin`` of one replica (compiled).
+
+    The minimum image of :func:`_min_image_pair` and the criterion
+    :func:`~particleShear.engine.neighbours.within_reach` on the candidates of an ``nx × ny`` cell
+    list (:func:`_cell_pairs`), or on every pair when ``nx`` or ``ny`` is below 3
+    (:func:`_all_pairs`).  The keys are found into a buffer of ``8·N`` (once more, into one of the
+    size found, where a dense replica has more); unsorted (NumPy's sort of them is the faster:
+    :func:`search` sorts them).
+
+    Returns
+    -------
+    ndarray of int64
+        The keys, in the order found (a view of the buffer).
+    """
+    N = x.shape[0]
+    key = np.empty(8 * N + 16, np.int64)
+    for _ in range(2):
+        n = (_cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, scale, key) if nx >= 3 and ny >= 3
+             else _all_pairs(x, y, r, Lx, Ly, shift, skin, scale, key))
+        if n <= key.shape[0]:
+            break
+        key = np.empty(n, np.int64)      # (a dense replica: room for every pair found)
+    return key[:n]
+
+
+def _all_pairs(x, y, r, Lx, Ly, shift, skin, scale, key):
+    """The keys ``i·scale + j`` of every pair ``i < j`` within reach into ``key`` while they fit; returns
+    how many there are (compiled; the grid of fewer than 3 cells per side)."""
+    N, cap, n = x.shape[0], key.shape[0], 0
+    for i in range(N):
+        for j in range(i + 1, N):
+            reach = r[i] + r[j] + skin
+            ady = abs(y[j] - y[i])
+            if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
+                continue
+            dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
+            if within_reach(dx, dy, reach):
+                if n < cap:
+                    key[n] = i * scale + j
+                n += 1
+    return n
+
+
+def _cell_pairs(x, y, r, Lx, Ly, shift, skin, nx, ny, scale, key):
+    """The keys ``i·scale + j`` of the pairs ``i < j`` within reach by an ``nx × ny`` cell list, into
+    ``key`` (unordered) while they fit; returns how many there are (compiled).
+
+    The grid, binning and half neighbourhood of
     :func:`~particleShear.engine.neighbours.near_pairs_cells`: the same cell, the cell to the right,
     the three cells of the row above, the row above the top row being the bottom row at
-    ``x − shift``), or on every pair when ``nx`` or ``ny`` is below 3.  Writes the keys
-    ``i·N + j`` into ``out`` while they fit (unsorted: NumPy's sort is the faster); returns their
-    count (more than ``len(out)``: the caller gives room for that many and calls again)."""
-    N = x.shape[0]
-    cap = out.shape[0]
-    n = 0
-    if nx < 3 or ny < 3:
-        for i in range(N):
-            for j in range(i + 1, N):
-                reach = r[i] + r[j] + skin
-                ady = abs(y[j] - y[i])
-                if min(ady, Ly - ady) > reach * (1 + 1e-9):      # (out of reach in y through any image: a safe skip)
-                    continue
-                dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-                if within_reach(dx, dy, reach):
-                    if n < cap:
-                        out[n] = i * N + j
-                    n += 1
-    else:
-        cw, ch = Lx / nx, Ly / ny
-        cx, cy, cu = np.empty(N, np.int64), np.empty(N, np.int64), np.empty(N, np.int64)
-        start = np.zeros(nx * ny + 1, np.int64)
-        for a in range(N):       # bin: fold into the cell (a y period moves x by the offset)
-            ky = np.floor(y[a] / Ly)
-            xf = x[a] - shift * ky
-            cy[a] = int(cell_index(y[a] - Ly * ky, ch, ny))
-            cx[a] = int(cell_index(np.mod(xf, Lx), cw, nx))
-            # the column of the row above (the bottom row at x − shift above the top row)
-            cu[a] = int(cell_index(np.mod(xf - shift, Lx), cw, nx)) if cy[a] + 1 >= ny else cx[a]
-            start[cy[a] * nx + cx[a] + 1] += 1
-        for c in range(nx * ny):
-            start[c + 1] += start[c]
-        fill = start[:-1].copy()
-        order = np.empty(N, np.int64)
-        for a in range(N):       # (spheres of a cell in increasing order)
-            c = cy[a] * nx + cx[a]
-            order[fill[c]] = a
-            fill[c] += 1
-        for a in range(N):
-            up = (cy[a] + 1) % ny
-            for q in range(5):
-                if q < 2:
-                    cell = cy[a] * nx + (cx[a] + q) % nx
-                else:
-                    cell = up * nx + (cu[a] + q - 3) % nx
-                for m in range(start[cell], start[cell + 1]):
-                    b = order[m]
-                    if q == 0 and b <= a:
-                        continue
-                    i, j = min(a, b), max(a, b)     # (the pair vector as the all-pairs search takes it)
-                    dx, dy, _, _ = _min_image_pair(x[j] - x[i], y[j] - y[i], Lx, Ly, shift)
-                    if within_reach(dx, dy, r[i] + r[j] + skin):
-                        if n < cap:
-                            out[n] = i * N + j
-                        n += 1
+    ``x − shift``.  The spheres' coordinates are copied in cell order first, so that each cell's
+    spheres are read from consecutive memory, and the cells are visited in order, each computing
+    its neighbours once.  Every pair within reach lies in neighbouring cells, so the pairs found do
+    not depend on the order of the visit; each is tested on ``j − i`` (``±1`` times ``b − a``,
+    exactly), as the all-pairs search tests it.
+    """
+    N, cap, n = x.shape[0], key.shape[0], 0
+    cw, ch = Lx / nx, Ly / ny
+    cell, cu = np.empty(N, np.int64), np.empty(N, np.int64)
+    start = np.zeros(nx * ny + 1, np.int64)
+    for a in range(N):       # bin: fold into the cell (a y period moves x by the offset)
+        ky = np.floor(y[a] / Ly)
+        xf = x[a] - shift * ky
+        cy = int(cell_index(y[a] - Ly * ky, ch, ny))
+        cx = int(cell_index(np.mod(xf, Lx), cw, nx))
+        # the column of the row above (the bottom row at x − shift above the top row)
+        cu[a] = int(cell_index(np.mod(xf - shift, Lx), cw, nx)) if cy + 1 >= ny else cx
+        cell[a] = cy * nx + cx
+        start[cell[a] + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    order = np.empty(N, np.int64)
+    for a in range(N):       # (spheres of a cell in increasing order)
+        order[fill[cell[a]]] = a
+        fill[cell[a]] += 1
+    xs, ys, rs, us = np.empty(N), np.empty(N), np.empty(N), np.empty(N, np.int64)
+    for m in range(N):       # (the coordinates in cell order: each cell's spheres side by side)
+        a = order[m]
+        xs[m], ys[m], rs[m], us[m] = x[a], y[a], r[a], cu[a]
+    for cy in range(ny):
+        up = (cy + 1 if cy + 1 < ny else 0) * nx
+        for cx in range(nx):
+            c = cy * nx + cx
+            right = c + 1 if cx + 1 < nx else c + 1 - nx
+            for m in range(start[c], start[c + 1]):
+                a, xa, ya, ra = order[m], xs[m], ys[m], rs[m]
+                u = us[m]
+                left_up, right_up = (u - 1 if u > 0 else nx - 1), (u + 1 if u + 1 < nx else 0)
+                for q in range(5):
+                    other = c if q == 0 else right if q == 1 else up + (left_up if q == 2 else u if q == 3 else right_up)
+                    for m2 in range(m + 1 if q == 0 else start[other], start[other + 1]):
+                        b = order[m2]
+                        sign = 1.0 if a < b else -1.0
+                        dx, dy, _, _ = _min_image_pair(sign * (xs[m2] - xa), sign * (ys[m2] - ya), Lx, Ly, shift)
+                        if within_reach(dx, dy, ra + rs[m2] + skin):
+                            if n < cap:
+                                key[n] = min(a, b) * scale + max(a, b)
+                            n += 1
     return n
 
 
@@ -1393,23 +1458,188 @@ def search(x, y, r, Lx, Ly, shift, skin):
         return near_pairs(x, y, r, Lx, Ly, shift, skin)
     kernel = _kernels.get("search") or compile_search_kernel()
     nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
-    args = (np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-            np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny)
-    out = np.empty(min(16 * N, N * (N - 1) // 2), dtype=np.int64)
-    n = kernel(*args, out)
-    if n > len(out):       # (a dense replica: room for every pair found, once)
-        out = np.empty(n, dtype=np.int64)
-        kernel(*args, out)
-    key = np.sort(out[:n].astype(np.int32) if N * N <= _INT32_MAX else out[:n])   # (as near_pairs_cells sorts)
+    key = kernel(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+                 np.ascontiguousarray(r, dtype=float), float(Lx), float(Ly), float(shift), float(skin), nx, ny, N)
+    key = np.sort(key.astype(np.int32) if N * N <= _INT32_MAX else key)   # (as near_pairs_cells sorts)
     return (key // N).astype(np.intp), (key % N).astype(np.intp)
 
 
+def _constants_kernel(f, flags, idx, r, Lx, Ly, k, nu, k_t, nu_t, mu, c, prc, prt, keep, by_sphere, state, d_eq):
+    """Every constant of the candidates in one pass (compiled): column p of the float block ``f`` is
+    :func:`~particleShear.engine.forces.pair_rows` of candidate p (replica ``idx[0, p]``, sphere rows
+    ``idx[1, p]``, ``idx[2, p]``; ``Lx … mu`` per replica; ``c, prc, prt, keep`` per sphere row where
+    ``by_sphere``, else per replica), and ``flags`` rows 0, 1 are ``perm``, ``trans``."""
+    for p in range(f.shape[1]):
+        b, ai, aj = idx[0, p], idx[1, p], idx[2, p]
+        o = ai if by_sphere else b
+        perm = state[p] == PERMANENT
+        rows = pair_rows(r[ai], r[aj], Lx[b], Ly[b], perm, d_eq[p], k[b], c[o], nu[b], k_t[b], nu_t[b], mu[b], prc[o],
+                         prt[o], keep[o])
+        # (each row by its literal index: a tuple read at a variable index costs twice the whole pass)
+        (f[0, p], f[1, p], f[2, p], f[3, p], f[4, p], f[5, p], f[6, p], f[7, p], f[8, p], f[9, p], f[10, p], f[11, p],
+         f[12, p], f[13, p], f[14, p], f[15, p], f[16, p], f[17, p], f[18, p], f[19, p], f[20, p], f[21, p],
+         f[22, p]) = rows
+        flags[0, p], flags[1, p] = perm, not perm
+    return 0
+
+
+def constant_rows(f, flags, idx, s, state, d_eq):
+    """:meth:`~particleShear.engine.forces.PairConstants.set_bonds` of the compiled backend: its
+    blocks ``f`` (float, rows :data:`~particleShear.engine.forces.PairConstants.FLOAT_ROWS`) and
+    ``flags`` (``perm``, ``trans``) written in one compiled pass (:func:`_constants_kernel`) from the
+    same function, :func:`~particleShear.engine.forces.pair_rows`, that the NumPy engine calls on
+    arrays (≈ 20 array calls and a gather per parameter there).
+
+    Parameters
+    ----------
+    f, flags : ndarray (23, P), (2, P)
+        The blocks, written in place.
+    idx : ndarray of int (3, P)
+        Replica and sphere rows i, j of each candidate.
+    s : BatchState
+        The batch (radii, boxes, per-replica constants, ``visit``).
+    state : ndarray of int8 (P,)
+        State of each candidate (2: a bond).
+    d_eq : ndarray (P,)
+        Equilibrium distance of each candidate (µm).
+    """
+    kernel = _kernels.get("constants") or compile_constants_kernel()
+    own = s.visit if s.visit is not None else (s.c, s.prc, s.prt, s.keep)
+    kernel(f, flags, _int64(idx), _float(s.r), *(_float(a) for a in (s.Lx, s.Ly, s.k, s.nu, s.k_t, s.nu_t, s.mu)),
+           *(_float(a) for a in own), s.visit is not None, np.ascontiguousarray(state, dtype=np.int8), _float(d_eq))
+
+
+def _float(a):
+    """``a`` as a C-contiguous float64 array (itself when it is one)."""
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _int64(a):
+    """``a`` as a C-contiguous int64 array (itself when it is one)."""
+    return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def compile_constants_kernel(cache=True):
+    """The compiled constants of a rebuild (:func:`constant_rows`), compiled once per process (or
+    loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    return _compile("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
+
+
+def _constants_signature():
+    """The Numba signature of :func:`_constants_kernel`."""
+    from numba import types
+    f2, b2, i2 = (types.Array(t, 2, "C") for t in (types.float64, types.boolean, types.int64))
+    f1, i1 = types.Array(types.float64, 1, "C"), types.Array(types.int8, 1, "C")
+    return types.int64(f2, b2, i2, *(f1,) * 12, types.boolean, i1, f1)
+
+
+#: key scale of the pair table (``i << 32 | j``, :class:`~particleShear.engine.state.PairTable`)
+_TABLE_SCALE = 1 << 32
+
+
+def _carry_kernel(old_key, k, state, d_eq, active, birth, xi, merge_min):
+    """The history merge of a rebuild in one compiled call: the bonds of the old table kept,
+    :func:`~particleShear.engine.state.carried_rows` and :func:`~particleShear.engine.state.carried_fields`
+    (the functions :meth:`~particleShear.engine.state.PairTable.replace` calls with
+    ``keep_relations=False``, compiled).  Returns the new keys and fields
+    (:meth:`~particleShear.engine.state.PairTable.adopt`)."""
+    key, src = carried_rows(old_key, old_key[state == PERMANENT], k, merge_min)
+    s, d, a, b, z = carried_fields(src, state, d_eq, active, birth, xi)
+    return key, s, d, a, b, z
+
+
+def rebuild(x, y, r, Lx, Ly, shift, skin, table):
+    """:func:`~particleShear.engine.neighbours.build_candidates` of the compiled backend (the same
+    table) in three calls: the search (:func:`_search_kernel`, the pairs as the table's keys
+    ``i << 32 | j``), NumPy's sort of the keys, and the history merge with its gathers
+    (:func:`_carry_kernel`): ≈ 40 NumPy calls of :meth:`~particleShear.engine.state.PairTable.replace`
+    and :func:`search` fewer, and no key taken apart and put together again.
+
+    Parameters
+    ----------
+    x, y, r : ndarray (N,)
+        Positions and radii of the replica's spheres (µm).
+    Lx, Ly, shift : float
+        Box and Lees-Edwards offset ``Ly·γ`` (µm).
+    skin : float
+        Verlet skin (µm, ≥ 0).
+    table : PairTable
+        The replica's pair list, changed in place.
+
+    Returns
+    -------
+    PairTable
+        ``table``.
+    """
+    N = len(x)
+    if not math.isfinite(float(shift)) or N < 2:     # (an infinite offset: no pair is near, as NumPy's)
+        return build_candidates(x, y, r, Lx, Ly, shift, skin, table)
+    find = _kernels.get("search") or compile_search_kernel()
+    carry = _kernels.get("carry") or compile_carry_kernel()
+    nx, ny = cell_grid(float(Lx), float(Ly), 2 * float(np.max(r)) + float(skin), N)
+    key = np.sort(find(_float(x), _float(y), _float(r), float(Lx), float(Ly), float(shift), float(skin), nx, ny,
+                       _TABLE_SCALE))
+    table.adopt(*carry(_int64(table.key), key, *table.fields(), state._MERGE_MIN))
+    return table
+
+
+def compile_carry_kernel(cache=True):
+    """The compiled history merge of a rebuild (:func:`rebuild`), compiled once per process (or
+    loaded from the cache).
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    return _compile("carry", "_carry_kernel", MERGE_FUNCTIONS + ((state, "carried_fields"),
+                                                                (sys.modules[__name__], "_carry_kernel")),
+                    _carry_signature, cache, linear=True)
+
+
+def _carry_signature():
+    """The Numba signature of :func:`_carry_kernel`."""
+    from numba import types
+    f1, i1, i = types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"), types.int64
+    s1, b1, f2 = types.Array(types.int8, 1, "C"), types.Array(types.boolean, 1, "C"), types.Array(types.float64, 2, "C")
+    return types.Tuple((i1, s1, f1, b1, i1, f2))(i1, i1, s1, f1, b1, i1, f2, i)
+
+
+def _positions_linear(a, v, merge_min):
+    """``numpy.searchsorted(a, v)`` (left side) of the sorted array ``v`` in the sorted array ``a`` by
+    one linear pass (compiled): what :func:`~particleShear.engine.state._positions` returns, in
+    O(n + m) where compiled code has no run-adaptive sort to merge with and binary searches cost
+    O(m log n) (the compiled history merge, :func:`carried`, takes it in place of that function;
+    ``merge_min`` is not read)."""
+    out = np.empty(len(v), np.int64)
+    i, n = 0, len(a)
+    for m in range(len(v)):
+        while i < n and a[i] < v[m]:
+            i += 1
+        out[m] = i
+    return out
+
+
 def carried(old_key, kept, k):
-    """:func:`~particleShear.engine.state.carried_rows` compiled (the same function object) below
-    :data:`~particleShear.engine.state._MERGE_MIN` keys, where its binary searches run: the keys of a
-    rebuilt candidate list and the old row each carries, without NumPy's call overhead (≈ 20 array
-    calls per rebuilt replica: 54 → 38 µs at N = 150).  From there on NumPy's (its merge by a radix
-    sort is faster than a compiled one: 1.3 against 1.6 ms at N = 10,000).
+    """:func:`~particleShear.engine.state.carried_rows` compiled (the same function, its positions found
+    by :func:`_positions_linear`): the keys of a rebuilt candidate list and the old row each carries,
+    in O(n) and without NumPy's call overhead (``rows=`` of
+    :meth:`~particleShear.engine.state.PairTable.replace`; :func:`rebuild` merges with its gathers
+    in :func:`_carry_kernel`).
 
     Parameters
     ----------
@@ -1420,8 +1650,6 @@ def carried(old_key, kept, k):
     -------
     key, src : ndarray of int64
     """
-    if len(old_key) + len(k) >= state._MERGE_MIN:     # (NumPy's merge by its radix sort is the faster there)
-        return state.carried_rows(old_key, kept, k)
     kernel = _kernels.get("carried") or compile_carried_kernel()
     return kernel(*(np.ascontiguousarray(a, dtype=np.int64) for a in (old_key, kept, k)), state._MERGE_MIN)
 
@@ -1438,7 +1666,7 @@ def compile_carried_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache)
+    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
 
 
 def _carried_signature():

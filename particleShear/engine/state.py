@@ -159,6 +159,34 @@ def carried_rows(old_key, kept, k, merge_min=_MERGE_MIN):
     return k, np.where(had, pos_c, n).astype(np.int64)
 
 
+def carried_fields(src, state, d_eq, active, birth, xi):
+    """The history of a new candidate set: each field's old row ``src`` (:func:`carried_rows`), the
+    zeros of a pair new to the table (``src = len(state)``: inactive, sticking, ξ = 0, no number).
+    Written in the array operations Numba compiles as they stand (one gather per field, after one
+    zero appended; :func:`~particleShear.engine.numba_step.rebuild` runs it compiled).
+
+    Parameters
+    ----------
+    src : ndarray of int64 (C,)
+        The old row of each new candidate.
+    state, d_eq, active, birth : ndarray (n,) of int8, float, bool, int64
+        The old table's fields.
+    xi : ndarray (2, n)
+        The old table's ξ (µm).
+
+    Returns
+    -------
+    tuple of ndarray
+        ``state, d_eq, active, birth, xi`` of the new candidates (new arrays).
+    """
+    xi_new = np.empty((2, len(src)))        # (C-contiguous, as the engine's ξ must be: row by row)
+    for row in range(2):
+        xi_new[row] = np.concatenate((xi[row], np.zeros(1)))[src]
+    return (np.concatenate((state, np.zeros(1, np.int8)))[src], np.concatenate((d_eq, np.zeros(1)))[src],
+            np.concatenate((active, np.zeros(1, np.bool_)))[src], np.concatenate((birth, np.zeros(1, np.int64)))[src],
+            xi_new)
+
+
 class PairTable:
     """Candidate pairs of one ensemble (one replica): sphere indices ``i < j`` in canonical ``(i, j)``
     order and their history, as a structure of arrays.
@@ -381,12 +409,34 @@ class PairTable:
         bond = self.state == PERMANENT
         kept = old_key if keep_existing else old_key[np.flatnonzero((self.active | bond) if keep_relations else bond)]
         k, src = (rows or carried_rows)(old_key, kept, k)
-        self.i = (k >> 32).astype(np.intp)
-        self.j = (k & 0xFFFFFFFF).astype(np.intp)
-        for name, dtype in (("state", np.int8), ("d_eq", float), ("active", bool), ("birth", np.int64)):
-            setattr(self, name, np.concatenate((getattr(self, name), np.zeros(1, dtype))).astype(dtype, copy=False)[src])
-        self.xi = np.concatenate((self.xi, np.zeros((2, 1))), axis=1).astype(float, copy=False).take(src, axis=1)
-        self.key = k
+        self.adopt(k, *carried_fields(src, *self.fields()))
+
+    def fields(self):
+        """The history of the candidates as :func:`carried_fields` takes it: ``state`` (int8), ``d_eq``
+        (float), ``active`` (bool), ``birth`` (int64), ``xi`` (2, C), C-contiguous.
+
+        Returns
+        -------
+        tuple of ndarray
+        """
+        return (np.ascontiguousarray(self.state, dtype=np.int8), np.ascontiguousarray(self.d_eq, dtype=float),
+                np.ascontiguousarray(self.active, dtype=np.bool_), np.ascontiguousarray(self.birth, dtype=np.int64),
+                np.ascontiguousarray(np.asarray(self.xi, dtype=float).reshape(2, -1)))
+
+    def adopt(self, key, state, d_eq, active, birth, xi):
+        """Make the sorted unique keys ``key`` (``i << 32 | j``) the candidates, with the history given
+        (:func:`carried_fields`); the version advances.
+
+        Parameters
+        ----------
+        key : ndarray of int64 (C,)
+        state, d_eq, active, birth, xi : ndarray
+            One value (``xi``: one column) per key.
+        """
+        self.i = (key >> 32).astype(np.intp)
+        self.j = (key & 0xFFFFFFFF).astype(np.intp)
+        self.state, self.d_eq, self.active, self.birth, self.xi = state, d_eq, active, birth, xi
+        self.key = key
         self.version += 1
 
     def ensure(self, i, j):

@@ -319,12 +319,11 @@ class BatchEngine:
         # the images' offset the force phase sees: Ly·γ, 0 for a plain periodic replica (lees_edwards)
         shift = to_host(self._image_shift(), "rebuild")
         r, Lx, Ly, skin = self.host_consts
-        # (compiled: the same pairs from the same grid, the same history merge)
-        search, merge = (numba_step.search, numba_step.carried) if be.compiled else (None, None)
+        # (compiled: the same pairs from the same grid, the same history merge, numba_step.rebuild)
+        build = numba_step.rebuild if be.compiled else build_candidates
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
-            s.pairs[b] = build_candidates(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b],
-                                          s.pairs[b], search, merge)
+            s.pairs[b] = build(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b], s.pairs[b])
             self.rebuilds[b] += 1
         due = be.asarray(need)
         self.bound = xp.where(due, 0.0, self.bound)
@@ -334,12 +333,14 @@ class BatchEngine:
         self.need = np.zeros(s.B, bool)
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
         fresh = [s.pairs[b] for b in changed]
-        new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed)
         state_p = be.asarray(np.concatenate([p.state for p in fresh]))
         xi = be.asarray(np.concatenate([p.xi for p in fresh], axis=1))
         active = be.asarray(np.concatenate([p.active for p in fresh]))
         birth = be.asarray(np.concatenate([p.birth for p in fresh]))
-        new.set_bonds(s, state_p, be.asarray(np.concatenate([p.d_eq for p in fresh])))
+        # (every constant of the rebuilt replicas' candidates at once, from their states and d_eq)
+        new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed,
+                            state=state_p, d_eq=be.asarray(np.concatenate([p.d_eq for p in fresh])),
+                            fill=numba_step.constant_rows if be.compiled else None)
         if self.C is None or len(changed) == s.B:
             self.C, self.state_p, self.xi, self.active, self.birth = new, state_p, xi, active, birth
             self.C.set_visits(s)

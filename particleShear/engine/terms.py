@@ -30,13 +30,13 @@ repulsion), k in mg·s⁻² and ν in mg·s⁻¹ per m depth.
 __docformat__ = "numpy"
 
 import math
-import numbers
 
 from . import laws
+from .laws import central_constants
 from .tangential import tangential_two_pass
-from .xp import array_namespace, select
+from .xp import select
 
-__all__ = ["relative_velocity", "normal_speed", "slip_speed", "TermConstants", "term_constants", "elastic_term", "viscous_term", "viscous_force", "central_term", "tangential_term",
+__all__ = ["relative_velocity", "normal_speed", "slip_speed", "TermConstants", "term_constants", "term_rows", "TERM_ROWS", "elastic_term", "viscous_term", "viscous_force", "central_term", "tangential_term",
            "pair_forces"]
 
 
@@ -182,25 +182,46 @@ def term_constants(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc=1.0, prt=1.0, ke
         d_cap, a_lin, a_div = laws.central_constants(d0, k, c)
         return TermConstants(k=k, c=c, d_law=d0, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c), d_eq=None,
                              a_tens=None, ratio_c=1.0, nu=nu, k_t=k_t, nu_t=nu_t, mu=mu, fc_inf=0.0)
-    xp = array_namespace(d0, d_eq)
+    rows = term_rows(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep)
+    return TermConstants(k=k, c=c, form=laws.central_form(c), **dict(zip(TERM_ROWS, rows)))
 
-    def on_bonds(mask, ratio):
-        """``ratio`` on the pairs of ``mask``, 1 elsewhere (the number 1 when the ratio is the number 1)."""
-        if mask is None or (isinstance(ratio, numbers.Real) and ratio == 1):
-            return 1.0
-        return xp.where(mask, ratio, 1.0)
 
-    d_law = xp.where(perm, d_eq, d0)
-    d_cap, a_lin, a_div = laws.central_constants(d_law, k, c)
-    # bonds whose viscosities take the permanent ratios (None: none does)
-    if isinstance(keep, numbers.Real):
-        loose = perm if keep == 0 else None
-    else:
-        loose = perm & (keep == 0)
-    return TermConstants(k=k, c=c, d_law=d_law, d_cap=d_cap, a_lin=a_lin, a_div=a_div, form=laws.central_form(c),
-                         d_eq=xp.where(perm, d_eq, 0.0), a_tens=-xp.where(perm, k, 0.0), ratio_c=on_bonds(perm, prc),
-                         nu=nu * on_bonds(loose, prc), k_t=k_t * on_bonds(perm, prt), nu_t=nu_t * on_bonds(loose, prt),
-                         mu=mu, fc_inf=xp.where(perm, math.inf, 0.0))
+#: the constants :func:`term_rows` returns, in its order (the attributes of a :class:`TermConstants`
+#: but ``k``, ``c`` and ``form``; the rows of the engine's float block from ``d_law`` on)
+TERM_ROWS = ("d_law", "d_cap", "a_lin", "a_div", "d_eq", "a_tens", "ratio_c", "nu", "k_t", "nu_t", "mu", "fc_inf")
+
+
+def term_rows(d0, perm, d_eq, k, c, nu, k_t, nu_t, mu, prc, prt, keep):
+    """The constants of the force terms of pairs some of which may be bonds (:data:`TERM_ROWS`), a pure
+    expression: :func:`term_constants` calls it on arrays, the compiled backend's rebuild on the
+    numbers of each candidate (:func:`~particleShear.engine.forces.pair_rows`).
+
+    Contacts: the compressive law at ``d0`` (eqs. S1-5a/b, S1-6), ``ν``, ``k_t``, ``ν_t``, ``μ`` as
+    given, no Coulomb offset.  Bonds: the compressive law at ``d_eq`` and the tensile law
+    ``−k (d_eq − d)`` (``a_tens = −k``; ``−0`` on contacts, so that ``−0·(0 − d) = +0``), the factor
+    ``prc`` on the elastic law, ``k_t·prt``, the viscosities times ``prc``, ``prt`` where ``keep`` is 0,
+    and ``fc_inf = inf`` (no bound).  A factor 1 where it does not apply (``x·1.0`` is ``x``).
+
+    Parameters
+    ----------
+    d0, d_eq : ndarray or float
+        Contact distance ``r_i + r_j`` and equilibrium distance of a bond (µm).
+    perm : ndarray of bool or bool
+        Which pairs are bonds.
+    k, c, nu, k_t, nu_t, mu, prc, prt, keep : ndarray or float
+        As :func:`term_constants`.
+
+    Returns
+    -------
+    tuple
+        The values of :data:`TERM_ROWS` (arrays, or numbers on numbers).
+    """
+    d_law = select(perm, d_eq, d0)
+    d_cap, a_lin, a_div = central_constants(d_law, k, c)
+    loose = perm & (keep == 0)          # (bonds whose viscosities take the permanent ratios)
+    return (d_law, d_cap, a_lin, a_div, select(perm, d_eq, 0.0), -select(perm, k, 0.0), select(perm, prc, 1.0),
+            nu * select(loose, prc, 1.0), k_t * select(perm, prt, 1.0), nu_t * select(loose, prt, 1.0), mu,
+            select(perm, math.inf, 0.0))
 
 
 def elastic_term(K, d, central=None, tensile=None):
