@@ -50,10 +50,10 @@ def _block_end(engine, i, n_steps, after_step, observers):
     """Where a compiled block of steps from step ``i`` ends (``i``: none), for the compiled backend.
 
     A block holds steps whose rate does not depend on the steps before (no controller
-    ``after_step``), and ends at the latest after the first step an observer is due after, and
-    after :data:`BLOCK` steps (the first block is the first step alone, so that the progress is
-    reported after it, as the pre-equilibration reports its first step) (its steps that sample every tensor sum their rows in the compiled
-    step, :func:`~particleShear.engine.numba_step.run_block`)."""
+    ``after_step``); its steps that sample every tensor sum their rows in the compiled step
+    (:func:`~particleShear.engine.numba_step.run_block`).  It ends at the latest after the first
+    step an observer is due after, and after :data:`BLOCK` steps; the first block is the first step
+    alone, so that the progress is reported after it, as the pre-equilibration reports its first step."""
     if not engine.backend.compiled or after_step is not None:
         return i
     j = min(n_steps, i + BLOCK if i else 1)      # (step 1 alone: the phase's first progress call)
