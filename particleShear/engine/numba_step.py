@@ -841,7 +841,8 @@ class _Workspace:
         self.Tj = np.zeros((len(forces.PairConstants.TERM_ROWS), 1)) if Kj is None else np.ascontiguousarray(
             [np.broadcast_to(np.asarray(getattr(Kj, n), dtype=float), (C.P,)) for n in forces.PairConstants.TERM_ROWS])
         self.offsets = np.array(C.offsets, dtype=np.int64)
-        # the run's law (run_law): its function and its arguments per candidate, rows of law_rows
+        # the phase's law (_phase_law: the run's law or a registered callback): its function and its
+        # arguments per candidate, rows of law_rows
         got = _phase_law(s, C) if self.why is None else None
         got = None if got is None else got[1:]
         if got is not None and len(got[1]) > numba_driver.LAW_SLOTS:
