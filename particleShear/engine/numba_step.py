@@ -967,6 +967,8 @@ def _launch(engine, cool, dt, sample, forces_only=False):
         return None
     kernel, B = _kernels_of(ws)[0], engine.s.B
     check = ws.guarded and not engine.step_count % engine.check_interval
+    if forces_only:
+        _fresh(ws)
     args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
                             forces_only=forces_only)
     status = kernel(0, 0, B, *args)
@@ -976,7 +978,7 @@ def _launch(engine, cool, dt, sample, forces_only=False):
         status = kernel(3, 0, B, *args)
     _adopt(engine, ws, held)
     if ws.keep:
-        engine.terms = _terms(engine, ws)
+        engine.terms = _terms(engine, ws, own_buffers=forces_only)
     if status == _GUARD:
         _report(engine, ws)
     return ws, kernel, args, held, status
@@ -1009,9 +1011,8 @@ def run_force_phase(engine, sample=False):
     if got is None:
         return NOT_RUN
     ws = got[0]
-    w = ws.work
-    fields = (w[0].copy(), w[1].copy(), w[5].copy(), w[6].copy(), w[7].copy(), engine.active.copy(), ws.yc.copy(),
-              ws.mob.copy())
+    w = ws.work        # (this phase's own buffer, _fresh)
+    fields = (w[0], w[1], w[5], w[6], w[7], engine.active.copy(), ws.yc.copy(), ws.mob.copy())
     return fields, _samples(ws, sample)
 
 
@@ -1037,11 +1038,12 @@ def run_move(engine, dt, g):
     -------
     None or NOT_RUN
     """
-    ws = _prepared(engine)
-    if ws is None or ws.C is not engine.C or g.verdict is not None:
+    ws = engine.__dict__.get("_compiled_workspace")       # (the force phase's: its candidates, its laws)
+    if ws is None or ws.why is not None or ws.C is not engine.C or g.verdict is not None:
         return NOT_RUN
     w = ws.work
-    w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
+    if g.dx.base is not w:        # (a record of this workspace's phase holds its rows already)
+        w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
     ws.yc[:] = g.yc
     B = engine.s.B
     kernel = _kernels_of(ws)[0]
@@ -1079,23 +1081,21 @@ def tensor_sums(q):
     ndarray (19, B)
     """
     C, B = q.C, q.B
-    n = len(q.x)
-    N = n // B if B else 0
-    def f(a, k=n):        # (a contiguous float64 array of k: the array itself when it is one)
-        if type(a) is np.ndarray and a.dtype == np.float64 and a.shape == (k,) and a.flags.c_contiguous:
-            return a
-        return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (k,)))
-
-    i = lambda a: np.ascontiguousarray(a, dtype=np.int64)                                          # noqa: E731
+    n, P = len(q.x), len(q.dx)
     own = q.fx_j is not None
-    P = len(q.dx)
     tsum = np.zeros((_SUMS, B))
-    _compile_tensor_kernel()(B, N, i(C.ai), i(C.aj), i(C.rep), i(C.offsets), i(q.rep), own, f(q.x), f(q.y), f(q.vx),
-                             f(q.vy), f(q.omega), f(q.m), f(q.inertia), f(q.Lx, B), f(q.Ly, B), f(q.rate, B),
-                             np.ascontiguousarray(q.mob, dtype=np.bool_), np.ascontiguousarray(q.active, dtype=np.bool_),
-                             f(q.shifted, P), f(q.dx, P), f(q.dy, P), f(q.fx_i, P), f(q.fy_i, P),
-                             f(q.fx_j if own else q.fx_i, P), f(q.fy_j if own else q.fy_i, P), f(q.dF, P), f(q.fx),
-                             f(q.fy), f(q.torque), np.empty((9, P)), np.empty((10, n)), tsum)
+    arrays = [C.ai, C.aj, C.rep, C.offsets, q.rep, q.x, q.y, q.vx, q.vy, q.omega, q.m, q.inertia, q.Lx, q.Ly, q.rate,
+              q.mob, q.active, q.shifted, q.dx, q.dy, q.fx_i, q.fy_i, q.fx_j if own else q.fx_i,
+              q.fy_j if own else q.fy_i, q.dF, q.fx, q.fy, q.torque]
+    kernel = _compile_tensor_kernel()
+    try:            # (the inputs as they are: the arrays of a force phase have the kernel's types)
+        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
+    except TypeError:
+        sizes = [None] * 5 + [n] * 7 + [B] * 3 + [None, None] + [P] * 8 + [n] * 3
+        kinds = [np.int64] * 5 + [float] * 10 + [np.bool_] * 3 + [float] * 10
+        arrays = [np.ascontiguousarray(np.asarray(a, dtype=t) if k is None else
+                                       np.broadcast_to(np.asarray(a, dtype=t), (k,))) for a, k, t in zip(arrays, sizes, kinds)]
+        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
     return tsum
 
 
@@ -1107,8 +1107,8 @@ def _compile_tensor_kernel(cache=True):
     f1, i1, f2 = (types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"),
                   types.Array(types.float64, 2, "C"))
     b1 = types.Array(types.boolean, 1, "C")
-    signature = types.int64(types.int64, types.int64, i1, i1, i1, i1, i1, types.boolean, *(f1,) * 10, b1, b1,
-                            *(f1,) * 11, f2, f2, f2)
+    signature = types.int64(types.int64, types.int64, i1, i1, i1, i1, i1, types.boolean, *(f1,) * 10, b1, b1, b1,
+                            *(f1,) * 10, f2, f2, f2)
     return _compile("tensors", "_tensor_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + TENSOR_FUNCTIONS,
                     lambda: signature, cache)
 
@@ -1177,19 +1177,28 @@ def _adopt(engine, ws, held, stepped=False, kicked=True):
         engine.need = ws.need.copy()
 
 
-def _terms(engine, ws):
+def _terms(engine, ws, own_buffers=False):
     """The terms of the last force phase as the NumPy force phase keeps them for a force register
-    (:attr:`~particleShear.engine.step.BatchEngine.terms`): copies of the rows the step kept
-    (``keep``) and of its geometry; the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy
-    phase's expressions on them."""
+    (:attr:`~particleShear.engine.step.BatchEngine.terms`): the rows the step kept (``keep``) and its
+    geometry, copies (``own_buffers``: the rows themselves, of buffers made for this phase alone,
+    :func:`_fresh`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's
+    expressions on them."""
     C, w, kt, own = engine.C, ws.work, ws.kt, ws.visit_j
-    d, dF = w[4].copy(), w[10].copy()
-    return dict(C=C, parts=([kt[0].copy(), kt[1].copy()], [kt[6].copy(), kt[7].copy()] if own else []),
-                F=kt[2:4].copy(), dx=w[0].copy(), dy=w[1].copy(), nx=w[5].copy(), ny=w[6].copy(), d=d,
-                touching=d < C.d0, active=engine.active.copy(), shifted=(w[2] != 0) | (w[3] != 0),
-                mob=ws.mob.copy(), fx_i=kt[4].copy(), fy_i=kt[5].copy(), fx_j=kt[8].copy() if own else None,
-                fy_j=kt[9].copy() if own else None, dF=dF, tq=dF * C.w, birth=engine.birth.copy(),
-                totals=ws.ktot.copy())
+    if not own_buffers:
+        w, kt = w[:11].copy(), kt.copy()
+    d, dF = w[4], w[10]
+    return dict(C=C, parts=([kt[0], kt[1]], [kt[6], kt[7]] if own else []), F=kt[2:4], dx=w[0], dy=w[1], nx=w[5],
+                ny=w[6], d=d, touching=d < C.d0, active=engine.active.copy(), shifted=(w[2] != 0) | (w[3] != 0),
+                mob=ws.mob.copy(), fx_i=kt[4], fy_i=kt[5], fx_j=kt[8] if own else None, fy_j=kt[9] if own else None,
+                dF=dF, tq=dF * C.w, birth=engine.birth.copy(), totals=ws.ktot if own_buffers else ws.ktot.copy())
+
+
+def _fresh(ws):
+    """New buffers for the rows a force phase alone hands over (the geometry, the kept terms), so that
+    its record and terms are those rows themselves and the next phase writes other ones."""
+    ws.work = np.empty_like(ws.work)
+    if ws.keep:
+        ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
 
 
 def _report(engine, ws):
