@@ -29,6 +29,7 @@ one-line note per engine and reason.
 """
 __docformat__ = "numpy"
 
+import logging
 import math
 import sys
 import warnings
@@ -855,7 +856,7 @@ class _Workspace:
                 self.law_rows[k] = np.broadcast_to(np.asarray(a, dtype=float), (C.P,))
             self.law = (got[0], len(got[1]))
             try:
-                _law_kernels(*self.law)
+                _law_kernels(*self.law, say=logging.getLogger(__name__).info)   # (a first compile, announced)
             except Exception as exc:          # (a law Numba cannot compile: NumPy runs it)
                 self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
