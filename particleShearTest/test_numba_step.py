@@ -196,6 +196,31 @@ class TestCompiledStepBits(unittest.TestCase):
                     self.assertTrue(np.any(terms[1]["F"] != 0.0))
                     same(terms[0], terms[1], f"own={own} B={B} {last}")
 
+    def test_a_force_phase_keeps_its_record_and_terms(self):
+        """The record and the kept terms of a compiled force phase alone are rows of its own buffers:
+        its movement, later steps (whole, in blocks) and later force phases leave them as they were."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        ens = constituted(63, **FRICTIONAL_BONDS)[1]
+        eng = BatchEngine(state_from_ensembles([ens], backend="numba"), keep_terms=True)
+        eng.s.applying_shear = True
+        eng.set_rate(np.array([400.0]))
+        g = eng.force_phase()[0]
+        terms = eng.terms
+        arrays = lambda: [np.array(a) for a in (*g[:8], *terms["parts"][0], terms["F"], terms["dx"], terms["fx_i"],  # noqa: E731
+                                                terms["totals"])]
+        before = arrays()
+        eng.accelerate(0.999, ens.dt, g)
+        eng.move(ens.dt, g)
+        eng.step(0.999, ens.dt, sample=True)
+        eng.steps(5, 0.999, ens.dt)
+        eng.force_phase()
+        for a, b in zip(before, arrays()):
+            np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a, _bits(b) if b.dtype.kind == "f" else b)
+        self.assertIsNot(eng.terms, terms)
+
     def test_documented_experiment_runs_compiled(self):
         """The documented experiment's own pre-equilibration and protocol
         (``OscillatoryShearExperiment.oscillatory_shear_experiment``, an engine on the ensemble's

@@ -814,6 +814,7 @@ class _Workspace:
         self.tau = np.zeros((2, B))
         self.tsum = np.zeros((_SUMS, B))
         self.tp = self.ts = None          # (the rows of every tensor: made at the first step that samples them)
+        self.lent = False                 # (work, kt, ktot handed over by a force phase alone: _fresh)
         # the terms a step keeps for a force register (engine.keep_terms)
         self.keep = bool(engine.keep_terms)
         self.kt = np.empty((len(_KEPT), C.P if self.keep else 0))
@@ -968,8 +969,9 @@ def _launch(engine, cool, dt, sample, forces_only=False):
         return None
     kernel, B = _kernels_of(ws)[0], engine.s.B
     check = ws.guarded and not engine.step_count % engine.check_interval
-    if forces_only:
+    if forces_only or ws.lent:
         _fresh(ws)
+    ws.lent = forces_only
     args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
                             forces_only=forces_only)
     status = kernel(0, 0, B, *args)
@@ -1196,7 +1198,9 @@ def _terms(engine, ws, own_buffers=False):
 
 def _fresh(ws):
     """New buffers for the rows a force phase alone hands over (the geometry, the kept terms), so that
-    its record and terms are those rows themselves and the next phase writes other ones."""
+    its record and terms are those rows themselves and the next phase writes other ones (``ws.lent``:
+    the present ones were handed over; only the movement of that phase writes into them, rows it
+    does not hand over)."""
     ws.work = np.empty_like(ws.work)
     if ws.keep:
         ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
@@ -1304,6 +1308,9 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                 raise RuntimeError("run_block: the step stopped running compiled within a block")
             return 0
         starts[~going] = _SKIP
+        if ws.lent:
+            _fresh(ws)
+            ws.lent = False
         args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any())
         _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
                            scheduled, want, sums, *args)
