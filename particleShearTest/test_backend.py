@@ -675,6 +675,31 @@ class TestBadBackend(unittest.TestCase):
             self.assertIn("backend='nonsense' (--backend) is out of range", err.getvalue())
 
 
+class TestDocumentedClassesStayOnTheHost(unittest.TestCase):
+    def test_a_device_default_leaves_the_documented_classes_on_the_host(self):
+        """With a device as the default backend (``PARTICLESHEAR_BACKEND``), the documented classes,
+        whose engine steps the ensemble's own host rows (``state_of_ensemble(backend="auto")``), run
+        on NumPy: the same spheres as with ``PARTICLESHEAR_BACKEND=numpy``, no error."""
+        import math
+        import os
+        from unittest import mock
+
+        from particleShearTest.test_engine import constituted
+
+        runs = {}
+        for default in ("numpy", STANDIN):
+            with standin_registered(), mock.patch.dict(os.environ, {"PARTICLESHEAR_BACKEND": default}):
+                ens = constituted(97, theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1)[1]
+                ens.applyingShear = True
+                for k in range(10):
+                    ens.setShearRate(300.0 * math.cos(0.05 * k))
+                    ens.mechanical_simulation_step_calculate_forces()
+                    ens.mechanical_simulation_step_calculate_acceleration(0.999, ens.dt)
+                    ens.mechanical_simulation_step_calculate_movement(ens.dt)
+                runs[default] = np.array([(q.x, q.y, q.xspeed, q.yspeed) for q in ens.sphereList])
+        np.testing.assert_array_equal(runs["numpy"], runs[STANDIN])     # (NumPy's bits: not the device's)
+
+
 class TestNoCuPyAtImport(unittest.TestCase):
     def test_importing_the_package_does_not_import_cupy(self):
         # CuPy initialises CUDA when imported: a NumPy user must never pay for it, nor a forked worker break

@@ -180,7 +180,8 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
         As :func:`state_from_ensembles`.
     backend : {"numpy", "numba", "auto"} or Backend, default "numpy"
         A backend whose arrays are the host's (the rows stay the ensembles' own); ``"numba"``
-        runs the engine's steps in the compiled step (:mod:`particleShear.engine.numba_step`).
+        runs the engine's steps in the compiled step (:mod:`particleShear.engine.numba_step`);
+        ``"auto"`` is the default backend when that is a host one, else ``"numpy"``.
 
     Returns
     -------
@@ -196,6 +197,8 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     if len({id(e) for e in ensembles}) != len(ensembles):
         raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
     target = get_backend(backend)
+    if not target.host and backend == "auto":
+        target = get_backend("numpy")   # ("auto" on a device's default: the ensembles' rows stay on the host)
     if not target.host:
         raise ValueError(f"backend={target.name!r} is not allowed here: the ensembles' own rows are host "
                          "arrays (numpy, numba or auto)")
