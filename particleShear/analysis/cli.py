@@ -57,7 +57,7 @@ from .sweep import CHARACTERISTICS, DEFAULT_SEED, FLAGS, MIN_POINT_AMPLITUDES, N
 from ..experiment.measured import main as measured_main
 from ..plot_tools import ESTIMATORS, _float, _has_matplotlib, is_flagged, ok_moduli, read_sweep_table
 from ..run.rheometer import PROTOCOL_DEFAULTS
-from ..signals import sigterm_raises
+from ..signals import sigterm_raises, signals_held
 from ..simulation.provenance import IDENTITY_EXCLUDED
 from ..sweep.locks import FolderBusyError
 from ..sweep.spec import sweep_parameter_defaults
@@ -489,6 +489,7 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
     """
     import os
     import shutil
+    import signal
 
 
     if max_figure_panels is None:
@@ -517,8 +518,12 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
         notes.append("the flow curve with its fit is drawn by: particleShear plot DIR (flow_curve.png)")
     generation = f"{os.getpid()}-{np.random.default_rng().integers(1 << 62):x}"
     settings = {"estimator": estimator, "n_boot": n_boot, "confidence": confidence, "bootstrap_seed": seed}
-    staging = make_staging(folder)
+    staging = None
     try:
+        with signals_held() as got:     # (the staging folder is made and named at once: the finally removes it)
+            staging = make_staging(folder)
+        for signum in got[:1]:          # a signal that came while it was made, acted on now
+            signal.raise_signal(signum)
         out_rows, panels, names = [], [], []
         for g in groups:
             # each group its own stream, from the seed and the group's parameters: a group's intervals do not
@@ -560,7 +565,8 @@ def analyse_folder(folder, estimator="surface", n_boot=2000, confidence=0.95, se
                 notes.append('no figure: matplotlib is not installed (pip install "particleShear[plot]")')
         removed = publish(folder, staging, names, SET_NAMES)
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     if removed:
         notes.append("removed " + ", ".join(os.path.basename(p) for p in removed) + " of an earlier analysis "
                      "(not part of this one)")
