@@ -33,6 +33,9 @@ import os
 
 for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
+#: the NumPy engine's figures (docs/performance.md: the documented classes' engine is made on the
+#: default backend); PARTICLESHEAR_BACKEND=numba times the compiled one
+os.environ.setdefault("PARTICLESHEAR_BACKEND", "numpy")
 
 import argparse  # noqa: E402
 import math  # noqa: E402
