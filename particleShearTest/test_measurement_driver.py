@@ -80,3 +80,57 @@ class TestOneDriver(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class _Tripwire:
+    """Stands for an ensemble after its hand-over: any read fails the test (a write is let through,
+    e.g. ``_close_windows`` clearing a renderer)."""
+
+    def __getattr__(self, name):
+        raise AssertionError(f"the measurement read the ensemble's {name!r} after the hand-over")
+
+
+#: a small batch of two protocols' kinds of replica (frictional only; crosslinked and cut)
+_QUICK = dict(N=20, relative_frequency=0.2, pre_periods=0.5, periods=1, post_periods=0.5, doDrawing=False,
+              plotStress=False, verbose=False)
+_BATCH = [dict(_QUICK, seed=1, theAmplitude=0.2, theMu=0.01, do_permanent_links=False, cut_lines=0),
+          dict(_QUICK, seed=2, theAmplitude=0.3, theMu=0.05, do_permanent_links=True, cut_lines=2)]
+
+
+class TestMeasurementReadsNoEnsemble(unittest.TestCase):
+    """Issue 46 item 1: after the hand-over (``RunSession.hand_over``) the measurement works on the
+    sessions' states; the ensemble is replaced by a tripwire there, and every replica's moduli and
+    stress series must be the same numbers as those of the run that kept its ensemble (the state
+    holds everything a measurement needs, generator included)."""
+
+    @staticmethod
+    def _tripped(original):
+        def hand_over(run):
+            original(run)
+            run.sim.theEnsemble = _Tripwire()
+            if run.exp is not None:
+                run.exp.theEnsemble = _Tripwire()
+        return hand_over
+
+    def _both(self, call):
+        from particleShear.simulation.oscillatory import RunSession
+        kept = call()
+        with mock.patch.object(RunSession, "hand_over", self._tripped(RunSession.hand_over)):
+            tripped = call()
+        return kept, tripped
+
+    def test_oscillatory_batch(self):
+        from particleShear import run_batch
+        kept, tripped = self._both(lambda: run_batch(_BATCH))
+        for a, b in zip(kept, tripped):
+            self.assertEqual((a.G_surface, a.G_internal, a.removed_fraction), (b.G_surface, b.G_internal, b.removed_fraction))
+            self.assertEqual(a.series["stress_surface"].tolist(), b.series["stress_surface"].tolist())
+
+    def test_recording_protocol(self):
+        from particleShear import doParticleShearSimulation
+        kw = dict(_BATCH[1], protocol="relaxation", ramp_time=2.0, hold_time=5.0, return_result=True)
+        kept, tripped = self._both(lambda: doParticleShearSimulation(**kw))
+        self.assertEqual(kept.summary, tripped.summary)
+        self.assertEqual(sorted(kept.series), sorted(tripped.series))
+        for name in kept.series:
+            self.assertEqual(kept.series[name].tolist(), tripped.series[name].tolist(), name)

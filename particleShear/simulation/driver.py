@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..base.engine_adapter import relax_ensembles, state_from_ensembles
+from ..base.engine_adapter import relax_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
 from ..engine.numba_step import compile_kernels
@@ -147,6 +147,8 @@ def measure_sessions(sessions, constituted=False, conclusion=None):
         if not constituted:
             _constitute(sessions)
         plan = part.plan()
+        for run in sessions:        # the one read of the ensembles: each becomes its session's state
+            run.hand_over()
         for key in dict.fromkeys(k for k, _ in plan):
             members = [b for b, (k, _) in enumerate(plan) if k == key]
             engine, order = pre_equilibrated(sessions, members, [plan[b][1] for b in members], part.dt(key),
@@ -368,7 +370,7 @@ class Oscillation:
                 spawn_key=sim.spawn_key, timings=info["timings"], output_path=info["output_path"],
                 image_folder=info["image_folder"], n_images=info["n_images"], dt=info["dt"], f=info["f"],
                 N_steps=info["N_steps"], damping_factor=info["damping_factor"],
-                removed_fraction=getattr(sim.theEnsemble, "removed_fraction", 0.0),
+                removed_fraction=run.removed_fraction,
                 series=run.exp.plotter.arrays(), run_id=sim.run_id, write_error=info.get("write_error"),
                 microstructure=getattr(run, "microstructure", None)))
         return results
@@ -682,7 +684,8 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     Parameters
     ----------
     sessions : list of RunSession
-        All sessions of the batch (constituted).
+        All sessions of the batch, handed over (their :attr:`~particleShear.simulation.oscillatory.RunSession.state`,
+        which this function takes: no ensemble is read).
     members : list of int
         The sessions measured together (one protocol schedule).
     pre : list of tuple
@@ -714,16 +717,17 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     for key in dict.fromkeys(pre):
         group = [b for b, k in zip(members, pre) if k == key]
         t0 = time.perf_counter()
-        st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
-                                       laws=[sims[b].contact_law for b in group])
+        host = BatchState.concat([sessions[b].state for b in group])     # (the sessions' states: no ensemble)
+        for b in group:
+            sessions[b].state = None            # handed to the engine
+        st = host.to_backend(backend)
         for b in group:           # the backend used ("auto" resolved), as the result records it
             sims[b].backend_used = st.backend.name
         say, report = _console(sims, group, "pre-equilibration", where)
         if st.backend.compiled:       # compiled (or loaded from the cache) here, not counted in the timings
             tc = time.perf_counter()
             if not _compiled({backend}, say, st.law):       # ("auto" without a usable Numba: NumPy)
-                st = state_from_ensembles([sims[b].theEnsemble for b in group], backend=backend,
-                                          laws=[sims[b].contact_law for b in group])
+                st = host.to_backend(backend)
                 for b in group:
                     sims[b].backend_used = st.backend.name
             t0 += time.perf_counter() - tc

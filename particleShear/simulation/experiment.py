@@ -466,8 +466,7 @@ class OscillatoryShearExperiment:
         list of float
             ``[G′_surface, G″_surface]`` in Pa.
         """
-        self.cool_factor = cool_factor
-        self.description_text = experiment_description_text(self, reference_header=self.reference_header)
+        self.describe(cool_factor)
         if self.output_file:
             self.write_experiment_description_information_to_file()
         record, timings = self.measure_in_engine(cool_factor, N_pre_equilibration_fixed_boundaries)
@@ -615,8 +614,8 @@ class OscillatoryShearExperiment:
         list of float
             ``[G′_surface, G″_surface]`` in Pa.
         """
-        self.cool_factor = cool_factor
-        self.description_text = experiment_description_text(self, reference_header=self.reference_header)
+        if self.description_text is None or self.cool_factor != cool_factor:
+            self.describe(cool_factor)
         self._record(record)
         self.timings.update(timings or {})
         t0 = time.perf_counter()
@@ -624,6 +623,25 @@ class OscillatoryShearExperiment:
         G_int = self.demodulation(record["t"], record["stress_internal"])
         G_surf = self.demodulation(record["t"], record["stress_surface"])
         return self._conclude(G_int, G_surf, t0)
+
+    def describe(self, cool_factor):
+        """What the recording takes from the ensemble, read before a measurement at ``cool_factor``:
+        block 2 of the file (:attr:`description_text`: model, ensemble and protocol parameters) and
+        the evaluator of the tensors (:attr:`theEvaluator`, of the ensemble's cell).
+
+        Called by :meth:`oscillatory_shear_experiment` and by the driver's hand-over
+        (:meth:`~particleShear.simulation.oscillatory.RunSession.hand_over`), after which a
+        measurement and :meth:`adopt_measurement` read nothing of the ensemble.
+
+        Parameters
+        ----------
+        cool_factor : float
+            The per-step damping factor of the measurement (written in block 2).
+        """
+        self.cool_factor = cool_factor
+        self.description_text = experiment_description_text(self, reference_header=self.reference_header)
+        if self.theEvaluator is None:
+            self.theEvaluator = StressTensorEvaluation(self.theEnsemble.size_x, self.theEnsemble.size_y)
 
     def _record(self, record):
         """The recording of a replica's record: :attr:`plotter` (series, tensor history when kept,

@@ -20,6 +20,7 @@ import sys
 import time
 from collections import namedtuple
 
+from ..base.engine_adapter import state_from_ensembles
 from ..linkable.builders import relax_constitution
 from ..base.stability import StabilityGuard
 from .drawing import make_renderer, open_stress_plot
@@ -126,6 +127,9 @@ class RunSession:
         self.exp = None
         self.schedule = None
         self.t_start = time.perf_counter()
+        self.state = None                 # the measurement's state (hand_over)
+        self.scene_configuration = None   # the ensemble's drawing configuration (hand_over)
+        self.removed_fraction = 0.0
 
     def constitution(self):
         """The constitution as a generator of its relaxations (docs/engine.md, "Runs").
@@ -188,6 +192,24 @@ class RunSession:
             if sim.saveData:
                 _log.info("Writing output to file " + fileName)
         return exp
+
+    def hand_over(self):
+        """The constituted ensemble as the measurement's state, copied once (after :meth:`prepare`).
+
+        The one point where a measurement reads the documented ensemble: its spheres, box, clock,
+        constants, pair list with its history and generator become :attr:`state` (one replica, on
+        the host; :func:`~particleShear.base.engine_adapter.state_from_ensembles`), with the two
+        facts a result reports from it, :attr:`scene_configuration` and :attr:`removed_fraction`.
+        It runs after :meth:`prepare`, so whatever the experiment set on the ensemble is handed over
+        too; from here on the driver (:func:`~particleShear.simulation.driver.measure_sessions`)
+        reads this state and never the ensemble."""
+        sim = self.sim
+        ens = sim.theEnsemble
+        self.state = state_from_ensembles([ens], backend="numpy", laws=[sim.contact_law])
+        self.scene_configuration = getattr(ens, "graphical_output_configuration", None)
+        self.removed_fraction = float(getattr(ens, "removed_fraction", 0.0))
+        if self.exp is not None:          # block 2 of the file and the evaluator, from the ensemble
+            self.exp.describe(self.schedule.cool)
 
     def finish(self):
         """After the measurement: snapshot folder and output file into place, ``result_info``; G.
