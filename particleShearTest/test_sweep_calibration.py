@@ -221,3 +221,40 @@ class TestCli(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestStaticModelFollowsTheBackend(unittest.TestCase):
+    """The static projection (``--no-calibrate``) of a run is that of the backend the run would use:
+    ``"auto"`` resolved by the one rule of backend selection, a backend without figures at NumPy's;
+    the compiled backend's projection is the smaller at every size (it is faster per step and per
+    constitution at N = 150, 1,000 and 10,000, docs/sweeps.md)."""
+
+    def test_auto_is_the_resolved_backend(self):
+        from particleShear.sweep import cost
+        from particleShear.engine import xp
+        for name in ("numpy", "numba"):
+            with mock.patch.dict(os.environ, {xp.BACKEND_ENV: name}):
+                self.assertEqual(cost.cost_backend(dict(BASE, backend="auto")), name)
+                self.assertEqual(cost.run_seconds(dict(BASE, backend="auto")),
+                                 cost.run_seconds(dict(BASE, backend=name)))
+
+    def test_device_is_projected_at_numpy(self):
+        from particleShear.sweep import cost
+        self.assertEqual(cost.cost_backend(dict(BASE, backend="cupy")), "numpy")
+        self.assertEqual(cost.run_seconds(dict(BASE, backend="cupy")), cost.run_seconds(dict(BASE, backend="numpy")))
+
+    def test_compiled_projects_less_at_every_size(self):
+        from particleShear.sweep import cost
+        for N in (20, 150, 1000, 5000, 10000, 40000):
+            with self.subTest(N=N):
+                self.assertLess(cost.run_seconds(dict(BASE, N=N, backend="numba")),
+                                cost.run_seconds(dict(BASE, N=N, backend="numpy")))
+
+    def test_calibrated_shape_uses_the_points_backend(self):
+        cal = _cal(N=30)
+        at = {be: C.project_cost([dict(BASE, N=1000, backend=be)], [1], cal, cores=1)["cpu_s"]
+              for be in ("numpy", "numba")}
+        # the same measured costs at N = 30 scaled to N = 1,000 by each backend's shapes: the compiled
+        # backend's costs grow faster with N than NumPy's (NumPy's per-call overhead dominates at small
+        # N, so its cost per step grows sublinearly), so the same calibration projects more for it
+        self.assertGreater(at["numba"], at["numpy"])

@@ -253,9 +253,7 @@ class Oscillation:
             plan.append(((sc.dt, sc.f, sc.cool, run.exp.baseline_pre_periods, run.exp.periods,
                           run.exp.baseline_post_periods), (sc.dt_max, sc.N_pre)))
         self.cools = [key[2] for key, _ in plan]
-        self.scenes = [ReplicaScene(getattr(run.sim.theEnsemble, "graphical_output_configuration", None))
-                       for run in self.sessions]
-        self.watch = [run.exp.observers(sc, sc.samples) for run, sc in zip(self.sessions, self.scenes)]
+        self.scenes = self.watch = None       # (made at the first observers(): after the hand-over)
         return plan
 
     @staticmethod
@@ -304,6 +302,9 @@ class Oscillation:
         list
             The observers of every member.
         """
+        if self.scenes is None:    # each replica's scene, of the configuration its session handed over
+            self.scenes = [ReplicaScene(run.scene_configuration) for run in self.sessions]
+            self.watch = [run.exp.observers(sc, sc.samples) for run, sc in zip(self.sessions, self.scenes)]
         for col, b in enumerate(members):
             self.scenes[b].bind(engine, col)
         return [ob for b in members for ob in self.watch[b]]

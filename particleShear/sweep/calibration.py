@@ -22,7 +22,7 @@ import warnings
 
 from .._version import __version__
 from ..protocols import PROTOCOLS
-from .cost import _human_s, _step_seconds, run_seconds, run_steps
+from .cost import _constitution_seconds, _human_s, _step_seconds, cost_backend, run_seconds, run_steps
 from ..analysis.measures import MeasurementWarning
 from ..run.api import doParticleShearSimulation
 from ..run.batch import run_batch, schedule_key
@@ -410,9 +410,9 @@ def _batch_fraction(cal, b):
 def project_cost(points, counts, cal, workers=1, batch_size=None, cores=None, schedule=None):
     """Projected CPU and wall time of ``counts[i]`` runs of each point, from a calibration ``cal``.
 
-    A run of point p costs ``fixed·(N_p/N_c)^0.7 + steps_p·per_step·s(N_p)/s(N_c)`` (``N_c`` the
-    calibrated N, ``s`` the shape of the documented per-step cost, ``steps_p`` its protocol
-    steps).  With ``batch_size`` the runs of one step schedule go in batches of up to
+    A run of point p costs ``fixed·c(N_p)/c(N_c) + steps_p·per_step·s(N_p)/s(N_c)`` (``N_c`` the
+    calibrated N, ``c`` and ``s`` the shapes in N of the documented constitution and per-step
+    costs of the point's backend, :mod:`~particleShear.sweep.cost`; ``steps_p`` its protocol steps).  With ``batch_size`` the runs of one step schedule go in batches of up to
     ``batch_size``; a batch of b runs costs ``b·(c0/b + c1)`` single runs, with ``c0 + c1 = 1``
     fitted to the calibration batch.  Wall time is CPU / min(workers, cores, tasks), at least
     the longest task.
@@ -458,9 +458,9 @@ def project_cost(points, counts, cal, workers=1, batch_size=None, cores=None, sc
         cpu = longest = 0.0
         tasks = 0
         for members in groups.values():
-            cost = sum(n * (fixed * (float(p["N"]) / n_c) ** 0.7
-                            + run_steps(p) * per_step * _step_seconds(float(p["N"])) / _step_seconds(n_c))
-                       for p, n in members)
+            cost = sum(n * (fixed * _constitution_seconds(float(p["N"]), be) / _constitution_seconds(n_c, be)
+                            + run_steps(p) * per_step * _step_seconds(float(p["N"]), be) / _step_seconds(n_c, be))
+                       for p, n in members for be in (cost_backend(p),))
             runs = sum(n for _, n in members)
             if batch_size:
                 n_batches = math.ceil(runs / batch_size)

@@ -2,9 +2,13 @@
 
 The number of protocol steps of a run is exact (the rule of ``time_steps_from_model`` and
 ``protocol_steps``: ``τ`` cancels, so no ensemble is built).  Wall times use static per-step costs
-measured by ``benchmarks/bench_step.py`` on a quiet 2-core CI-class machine: 285 µs per step at
-N = 150, 645 µs at N = 1,000, 5.6 ms at N = 10,000 (log-log interpolation, extrapolated with the
-nearest slope), plus constitution 0.53 s · (N/150)^0.7; a loaded machine measures up to 2× more
+of the run's backend (``backend``, ``"auto"`` resolved as a run resolves it), measured on a quiet
+2-core CI-class machine: NumPy (``benchmarks/bench_step.py``) 285 µs per step at N = 150, 645 µs at
+N = 1,000, 5.6 ms at N = 10,000, constitution 0.53 s · (N/150)^0.7; Numba 35 µs, 165 µs, 1.9 ms,
+constitution 0.085 s · (N/150)^0.93 (NumPy's figures over the ratios of the two backends measured
+in one run of whole runs at each N: protocol 8.1×, 3.9×, 2.9×; constitution 6.5×, 3.4×, 2.5×).
+Steps are interpolated log-log, extrapolated with the nearest slope; a backend without figures
+(a device) is projected at NumPy's.  A loaded machine measures up to 2× more
 (docs/performance.md), which is why ``--dry-run`` calibrates on the machine at hand.  Disk: the text format writes about
 723 bytes per step with the tensor table and a ≈ 4 kB header (measured, docs/sweeps.md); the file of another
 protocol about 110 bytes per step.  Every protocol counts its own steps (:func:`run_steps`).
@@ -12,15 +16,19 @@ protocol about 110 bytes per step.  Every protocol counts its own steps (:func:`
 __docformat__ = "numpy"
 import math
 
+from ..engine.xp import resolve_backend
 from ..linkable.builders import time_steps_from_model
 from ..simulation.experiment import protocol_steps
 from ..run.api import doParticleShearSimulation
 from ..run.rheometer import PROTOCOL_DEFAULTS, normalize_protocol, protocol_steps as steps_of
 
-__all__ = ["run_steps", "run_seconds", "run_bytes", "estimate_cost", "estimate_point_cost", "format_cost"]
+__all__ = ["cost_backend", "run_steps", "run_seconds", "run_bytes", "estimate_cost", "estimate_point_cost", "format_cost"]
 
-_STEP_COST = ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3))   # (N, s per step), bench_step.py, quiet
-_CONSTITUTION_S = 0.53                                            # s at N = 150
+#: (N, s per protocol step) of each backend (module docstring)
+_STEP_COST = {"numpy": ((150, 285e-6), (1000, 645e-6), (10000, 5.6e-3)),
+              "numba": ((150, 35e-6), (1000, 165e-6), (10000, 1.9e-3))}
+#: (s at N = 150, exponent of N/150) of a constitution on each backend
+_CONSTITUTION = {"numpy": (0.53, 0.7), "numba": (0.085, 0.93)}
 _BYTES_PER_STEP = 723
 _HEADER_BYTES = 4000
 _PROTOCOL_BYTES_PER_STEP = 110   # another protocol's text file: 103 B per row (creep), 105 (steady, N1), measured
@@ -56,8 +64,32 @@ def run_steps(p):
     return protocol_steps(p["periods"], p["pre_periods"], p["post_periods"], p["relative_frequency"], dt)
 
 
-def _step_seconds(N):
-    pts = _STEP_COST
+def cost_backend(p):
+    """The backend whose static costs project a run with parameters ``p``: its ``backend``
+    (``"auto"`` resolved as the run resolves it, :func:`~particleShear.engine.xp.resolve_backend`),
+    NumPy's for a backend without figures.
+
+    Parameters
+    ----------
+    p : dict
+        Parameters of ``doParticleShearSimulation`` (``backend`` optional, default ``"auto"``).
+
+    Returns
+    -------
+    str
+        A key of :data:`_STEP_COST`.
+    """
+    name = resolve_backend(p.get("backend") or "auto")
+    return name if name in _STEP_COST else "numpy"
+
+
+def _constitution_seconds(N, backend="numpy"):
+    t0, power = _CONSTITUTION[backend]
+    return t0 * (N / 150) ** power
+
+
+def _step_seconds(N, backend="numpy"):
+    pts = _STEP_COST[backend]
     if N <= pts[1][0]:
         (n0, t0), (n1, t1) = pts[0], pts[1]
     else:
@@ -78,10 +110,11 @@ def run_seconds(p):
     Returns
     -------
     float
-        Seconds on the reference machine of docs/performance.md.
+        Seconds on the reference machine of docs/performance.md, on the run's backend
+        (:func:`cost_backend`).
     """
-    N = float(p["N"])
-    return _CONSTITUTION_S * (N / 150) ** 0.7 + run_steps(p) * _step_seconds(N)
+    N, backend = float(p["N"]), cost_backend(p)
+    return _constitution_seconds(N, backend) + run_steps(p) * _step_seconds(N, backend)
 
 
 def run_bytes(p):
