@@ -22,7 +22,7 @@ import numpy as np
 
 import particleShear.engine.forces as forces
 import particleShear.run.validation as validation
-import particleShear.simulation.driver as driver
+import particleShear.simulation.oscillatory as oscillatory
 import particleShear.simulation.fragmentation as fragmentation
 from particleShear.linkable.builders import EnsembleRecipe
 from particleShear.run.api import doParticleShearSimulation, doParticleShearSimulationSeries
@@ -227,10 +227,10 @@ class TestMuReachesTheKernel(unittest.TestCase):
     """A changed ``theMu`` reaches ``BatchState.mu`` and the pair constants unchanged."""
 
     def test_mu_in_batch_state_and_pair_constants(self):
-        """The measurement's BatchState.mu and every candidate's constant μ (the row ``mu`` of the
+        """The measurement's BatchState.mu (made at the session's hand-over) and every candidate's constant μ (the row ``mu`` of the
         pair constants, written by ``PairConstants.set_bonds`` on every backend) equal theMu."""
         states, pair_mu = [], []
-        state_from_ensembles, set_bonds = driver.state_from_ensembles, forces.PairConstants.set_bonds
+        state_from_ensembles, set_bonds = oscillatory.state_from_ensembles, forces.PairConstants.set_bonds
 
         def capture_state(*args, **kwargs):
             st = state_from_ensembles(*args, **kwargs)
@@ -242,7 +242,7 @@ class TestMuReachesTheKernel(unittest.TestCase):
             if states:      # the measurement's pair constants (the constitution's relaxations may run at μ = 0)
                 pair_mu.append(np.asarray(C.mu).copy())
 
-        with mock.patch.object(driver, "state_from_ensembles", capture_state), \
+        with mock.patch.object(oscillatory, "state_from_ensembles", capture_state), \
                 mock.patch.object(forces.PairConstants, "set_bonds", capture_constants), self.assertWarns(Warning):
             result = doParticleShearSimulation(theMu=MU, return_result=True, **SMALL)
         self.assertEqual(result.parameters["theMu"], MU)
