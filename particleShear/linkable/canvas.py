@@ -1,13 +1,8 @@
 """Ensembles with permanent links (bonds, rows of the pair table): making, listing and cutting them."""
 __docformat__ = "numpy"
-import math
-
-import numpy as np
-
 from ..base.canvas import CanvasPointsFrictionElasticityLeesEdwards
-from ..engine.box import inside_half_cell, min_image
-from ..base.neighbours import PERMANENT, SLIP
 from ..objects.ensembles import RandomBimodalSpheres
+from . import bonds
 from .spheres import LinkableRelationView, SphereLinkable
 
 
@@ -31,38 +26,34 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
                                                            k_t, nu_t, mu)
         self._relation_view_class = LinkableRelationView
 
-    def _link_pairs(self, i, j):
-        """Make pairs (i, j) permanent: ``d_eq = r_i + r_j``, ξ = 0; creates missing relations."""
-        i = np.atleast_1d(np.asarray(i, dtype=np.intp))
-        j = np.atleast_1d(np.asarray(j, dtype=np.intp))
-        if (i == j).any():
-            k = int(np.flatnonzero(i == j)[0])
-            raise ValueError(f"cannot link sphere {int(i[k])} to itself")
-        if not len(i):
-            return
-        pt = self._pairs
-        slots = pt.ensure(i, j)
-        r = self._a["r"]
-        pt.open_relations(slots)
-        self._set_bonds(slots, PERMANENT, r[pt.i[slots]] + r[pt.j[slots]])
-
-    def _set_bonds(self, slots, state, d_eq):
-        """Pairs ``slots`` to ``state`` with ``d_eq`` and ξ = 0; drops the cached bond constants and grid."""
-        pt = self._pairs
-        pt.state[slots] = state
-        pt.d_eq[slots] = d_eq
-        pt.xi_ij[slots] = 0.0
-        pt.xi_ji[slots] = 0.0
+    def _bonds_edited(self):
+        """The bookkeeping after the table's bonds were edited: cached bond constants and grid dropped."""
         self._links_changed()
         self._g = None
 
+    def _rows(self):
+        """``(x, y, r)`` of the spheres (µm): the rows the algorithms of :mod:`.bonds` read."""
+        a = self._a
+        return a["x"], a["y"], a["r"]
+
+    def _link_pairs(self, i, j):
+        """Make pairs (i, j) permanent: ``d_eq = r_i + r_j``, ξ = 0; creates missing relations."""
+        bonds.link_pairs(self._pairs, self._a["r"], i, j)
+        self._bonds_edited()
+
+    def _set_bonds(self, slots, state, d_eq):
+        """Pairs ``slots`` to ``state`` with ``d_eq`` and ξ = 0; drops the cached bond constants and grid."""
+        bonds.set_bonds(self._pairs, slots, state, d_eq)
+        self._bonds_edited()
+
     def _cut_slots(self, slots):
-        self._set_bonds(slots[self._pairs.state[slots] == PERMANENT], SLIP, 0.0)
+        bonds.cut_slots(self._pairs, slots)
+        self._bonds_edited()
 
     def _cut_pairs(self, i, j):
         """Cut bonds (i, j): state slip, ξ = 0, ``d_eq`` = 0; the contact stays while touching."""
-        slots = self._pairs.find(np.atleast_1d(i), np.atleast_1d(j))
-        self._cut_slots(slots[slots >= 0])
+        bonds.cut_pairs(self._pairs, i, j)
+        self._bonds_edited()
 
     def permanent_pairs(self, physical_neighbors_only=False):
         """Sphere indices ``(i, j)``, i < j, of the bonds (two integer arrays, copies).
@@ -72,26 +63,21 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         physical_neighbors_only : bool, optional
             Only bonds not wrapping through the periodic boundary (raw differences below half the cell).
         """
-        pt = self._pairs
-        m = pt.state == PERMANENT
-        i, j = pt.i[m], pt.j[m]
-        if physical_neighbors_only:
-            keep = self._physical(i, j)
-            i, j = i[keep], j[keep]
-        return i.copy(), j.copy()
+        x, y, _ = self._rows()
+        return bonds.permanent_pairs(self._pairs, x, y, self.size_x, self.size_y, physical_neighbors_only)
 
     def _physical(self, i, j):
         """Bonds that do not cross the periodic boundary (raw coordinate differences below L/2)."""
-        a = self._a
-        return inside_half_cell(a["x"][i] - a["x"][j], a["y"][i] - a["y"][j], self.size_x, self.size_y)
+        x, y, _ = self._rows()
+        return bonds.physical(x, y, self.size_x, self.size_y, i, j)
 
     def makeAllLinksPermanent(self):
         """Bond every current relation (updating the neighbours if none exists): ``d_eq = r_i + r_j``, ξ = 0."""
         pt = self._pairs
         if self._g is None and not pt.active.any():
             self.test_neighbor_relation()
-        m = np.flatnonzero(pt.active)
-        self._link_pairs(pt.i[m], pt.j[m])
+        bonds.link_relations(self._pairs, self._a["r"])
+        self._bonds_edited()
 
     def cutLine(self, point, angle):
         """Cut (to slipping contacts) every bond crossed by the infinite, non-periodic line.
@@ -106,34 +92,19 @@ class CanvasPointsLinkable(CanvasPointsFrictionElasticityLeesEdwards):
         angle : float
             Angle of the line's normal to the x axis (rad).
         """
-        pt = self._pairs
-        slots = np.flatnonzero(pt.state == PERMANENT)
-        if not len(slots):
-            return
-        a = self._a
-        i, j = pt.i[slots], pt.j[slots]
-        nu = (math.cos(angle), math.sin(angle))
-        b = nu[0] * point[0] + nu[1] * point[1]
-        xi, yi, xj, yj = a["x"][i], a["y"][i], a["x"][j], a["y"][j]
-        shift = self._le_shift()
-        dx, dy = min_image(xj - xi, yj - yi, self.size_x, self.size_y, shift)[:2]
-        ex, ey = min_image(xi - xj, yi - yj, self.size_x, self.size_y, shift)[:2]
-        si = nu[0] * xi + nu[1] * yi - b
-        sj = nu[0] * xj + nu[1] * yj - b
-        cut = (si * (nu[0] * (xi + dx) + nu[1] * (yi + dy) - b) <= 0) | \
-              (sj * (nu[0] * (xj + ex) + nu[1] * (yj + ey) - b) <= 0)
-        self._cut_slots(slots[cut])
+        x, y, _ = self._rows()
+        bonds.cut_line(self._pairs, x, y, self.size_x, self.size_y, self._le_shift(), point, angle)
+        self._bonds_edited()
 
     def cutRandomLine(self):
         """Cut along a line through a random integer point, uniform random normal angle (draws x, y, angle)."""
-        rng = self._rng
-        point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
-        self.cutLine(point, 2 * math.pi * rng.random())
+        self.cutLine(*bonds.random_line(self._rng, self.size_x, self.size_y))
 
     def cutTopBottomEdge(self):
         """Cut every bond crossing y = 0 or y = size_y (wall slip, ``cut_top_bottom`` of the builders)."""
-        self.cutLine((0, 0), math.pi / 2)
-        self.cutLine((0, self.size_y), math.pi / 2)
+        x, y, _ = self._rows()
+        bonds.cut_top_bottom_edge(self._pairs, x, y, self.size_x, self.size_y, self._le_shift())
+        self._bonds_edited()
 
     @property
     def active_terms(self):

@@ -4,17 +4,15 @@
 boundary.  ``particles`` is, as in 1.0.2, a list of lists of spheres.
 """
 __docformat__ = "numpy"
-import math
 
 import numpy as np
 
 from ..base.canvas_base import check_non_negative
 from ..base.engine_adapter import relax_ensembles
 from ..checks import in_range
-from ..engine.box import min_image
-from ..engine.graph import adjacency, component_labels, connected_without_edge
-from ..base.neighbours import PERMANENT
+from ..engine.graph import adjacency, component_labels
 from ..objects.ensembles import RandomBimodalSpheres
+from . import bonds
 from .canvas import CanvasPointsLinkable, EnsembleLinkable
 from .spheres import SphereLinkableAdjustableInterfaceStrength
 
@@ -104,8 +102,8 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         relax_ensembles([self], N)
 
     def _labels(self, physical_neighbors_only=True):
-        i, j = self.permanent_pairs(physical_neighbors_only)
-        return component_labels(self._n, i, j)
+        x, y, _ = self._rows()
+        return bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y, physical_neighbors_only)
 
     def _particles_from_labels(self, lab):
         order = np.argsort(lab, kind="stable")
@@ -124,13 +122,8 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         return self.particles
 
     def _particle_heights(self, lab):
-        a = self._a
-        top = np.full(self._n, -np.inf)
-        bottom = np.full(self._n, np.inf)
-        np.maximum.at(top, lab, a["y"] + a["r"])
-        np.minimum.at(bottom, lab, a["y"] - a["r"])
-        roots = np.flatnonzero(lab == np.arange(self._n))
-        return top[roots] - bottom[roots]
+        _, y, r = self._rows()
+        return bonds.particle_heights(lab, y, r)
 
     def maximal_particle_height(self):
         """Height ``max(y + r) − min(y − r)`` of the tallest particle (µm; 0 if empty); sets ``particles``."""
@@ -228,31 +221,13 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
             Consecutive failed trials after which the removal stops.
         """
         check_non_negative("max_fraction_to_remove", max_fraction_to_remove)
-        i, j = self.permanent_pairs(physical_neighbors_only)
-        n_links = len(i)
-        if n_links == 0:
-            self.removed_fraction = 0
-            return 0
-        adj = adjacency(self._n, i, j)
-        rng = self._rng
-        failures = successes = 0
-        target = max_fraction_to_remove * n_links
-        while failures < max_trials and successes < target:
-            failures += 1
-            p = int(rng.integers(0, self._n))
-            cand = adj[p]
-            if not cand:
-                continue
-            q = sorted(cand)[int(rng.integers(0, len(cand)))]
-            if connected_without_edge(adj, p, q):
-                adj[p].discard(q)
-                adj[q].discard(p)
-                self._cut_pairs([p], [q])
-                successes += 1
-                failures = 0
-            else:  # the reference cuts and re-establishes: d_eq = r_i + r_j, ξ = 0
-                self._link_pairs([p], [q])
-        self.removed_fraction = successes / n_links
+        x, y, r = self._rows()
+        try:
+            self.removed_fraction = bonds.remove_non_essential_links(
+                self._pairs, x, y, r, self.size_x, self.size_y, max_fraction_to_remove, self._rng,
+                physical_neighbors_only, max_trials)
+        finally:
+            self._bonds_edited()
         return self.removed_fraction
 
     def join_isolated_spheres(self, physical_neighbors_only=True):
@@ -262,23 +237,12 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         ----------
         physical_neighbors_only : bool, optional
         """
-        pt = self._pairs
-        i, j = self.permanent_pairs(physical_neighbors_only)
-        bonded = np.zeros(self._n, bool)
-        bonded[i] = True
-        bonded[j] = True
-        rng = self._rng
-        for p in np.flatnonzero(~bonded):
-            if bonded[p]:
-                continue
-            slots = pt.relations_of(p, bonds=False)          # relation-list order
-            if not len(slots):
-                continue
-            s = slots[int(rng.integers(0, len(slots)))]
-            q = int(pt.j[s] if pt.i[s] == p else pt.i[s])
-            self._link_pairs([p], [q])
-            if not physical_neighbors_only or self._physical(np.array([p]), np.array([q]))[0]:
-                bonded[p] = bonded[q] = True
+        x, y, r = self._rows()
+        try:
+            bonds.join_isolated_spheres(self._pairs, x, y, r, self.size_x, self.size_y, self._rng,
+                                        physical_neighbors_only)
+        finally:
+            self._bonds_edited()
 
     def cutByTriangulationPoints(self, triangulation_points, edge_fuzziness=0):
         """Periodic Voronoi cut: cut every bond between spheres with different nearest seeds.
@@ -298,15 +262,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.doCutByTriangulation = True
         if not len(pts) or not self._n:
             return
-        a = self._a
-        dx, dy = min_image(pts[None, :, 0] - a["x"][:, None], pts[None, :, 1] - a["y"][:, None],
-                           self.size_x, self.size_y, self._le_shift())[:2]
-        dist = np.sqrt(dx * dx + dy * dy)
-        dist = dist + edge_fuzziness * self._rng.random(dist.shape) * self.r_max  # drawn even at 0
-        seed = np.argmin(dist, axis=1)
-        pt = self._pairs
-        slots = np.flatnonzero(pt.state == PERMANENT)
-        self._cut_slots(slots[seed[pt.i[slots]] != seed[pt.j[slots]]])
+        x, y, _ = self._rows()
+        seed = bonds.nearest_seeds(x, y, self.size_x, self.size_y, self._le_shift(), pts, edge_fuzziness,
+                                   self.r_max, self._rng)
+        bonds.cut_between_seeds(self._pairs, seed)
+        self._bonds_edited()
         self.sphere_seed = seed
 
     def cutByTriangulation(self, n_points=5, edge_fuzziness=0):
@@ -318,8 +278,7 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         edge_fuzziness : float, optional
             As for :meth:`cutByTriangulationPoints`.
         """
-        n_points = int(n_points)
-        pts = self._rng.random((max(n_points, 0), 2)) * np.array([self.size_x, self.size_y])
+        pts = bonds.seed_points(self._rng, n_points, self.size_x, self.size_y)
         self.triangulation_points = pts
         self.cutByTriangulationPoints(pts, edge_fuzziness)
 
@@ -331,21 +290,11 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         angle : float
             Angle of the cut line's normal to the x axis (rad), in [0, 2π).
         """
-        a = self.avoid_horizontal_angle_degree
-        if not a > 0:
-            return True
-        w = a / 180 * math.pi
-        return not ((math.pi / 2 - w <= angle <= math.pi / 2 + w)
-                    or (3 * math.pi / 2 - w <= angle <= 3 * math.pi / 2 + w))
+        return bonds.angle_ok(angle, self.avoid_horizontal_angle_degree)
 
     def cutRandomLine(self):
         """Cut along a line through a random integer point, redrawing angles :meth:`angle_OK` rejects."""
-        rng = self._rng
-        point = (int(rng.integers(0, int(self.size_x) + 1)), int(rng.integers(0, int(self.size_y) + 1)))
-        angle = 2 * math.pi * rng.random()
-        while not self.angle_OK(angle):
-            angle = 2 * math.pi * rng.random()
-        self.cutLine(point, angle)
+        self.cutLine(*bonds.random_line(self._rng, self.size_x, self.size_y, self.avoid_horizontal_angle_degree))
 
 
 class EnsembleCompactParticlesAdjustableInterfaceStrength(EnsembleCompactParticles):

@@ -5,7 +5,7 @@ import math
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                            CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
 from ..checks import integer, positive as _check_positive
-from .model import adjust_m, r_estimate
+from .placement import bimodal_placement
 from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
 
 __all__ = ["Ensemble", "EnsembleFriction", "EnsembleLeesEdwards", "EnsembleFrictionLeesEdwards",
@@ -37,19 +37,11 @@ class RandomBimodalSpheres:
 
     def _create_spheres(self, N, m):
         """Draw and append N spheres; one block of draws per quantity, in index order."""
-        if N == 0:
-            return
-        r_b = r_estimate(self.size_x, self.size_y, self.packing_fraction, N, self.bimodal_upper,
-                         self.bimodal_lower)
-        rng = self._rng
-        large = rng.integers(0, 2, N)
-        xs = rng.integers(0, int(self.size_x), N) if self.size_x >= 1 else rng.random(N) * self.size_x
-        ys = rng.integers(0, int(self.size_y), N) if self.size_y >= 1 else rng.random(N) * self.size_y
+        x, y, r, mass = bimodal_placement(self._rng, N, self.size_x, self.size_y, self.packing_fraction,
+                                          self.bimodal_lower, self.bimodal_upper, m)
         for p in range(N):
-            r = r_b * (self.bimodal_lower + (self.bimodal_upper - self.bimodal_lower) * int(large[p]))
-            self.r_max = max(self.r_max, r)
-            s = self._new_sphere(float(xs[p]), float(ys[p]), r, adjust_m(m, r, r_b), p)
-            self.sphereList.append(s)
+            self.r_max = max(self.r_max, float(r[p]))
+            self.sphereList.append(self._new_sphere(float(x[p]), float(y[p]), float(r[p]), float(mass[p]), p))
 
     def particle_info(self):
         """Description of the spheres (radii ``r1``, ``r2`` in µm) for the header of the output file."""
