@@ -35,7 +35,7 @@ from .callbacks import callback_phase_laws
 from .fields import ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
-           "untouched_on_failure", "relax_ensembles"]
+           "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws"]
 
 
 def uniform_parameters(ensemble):
@@ -90,11 +90,7 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
         any copy).
     """
     target = get_backend(backend)
-    laws = [None] * len(ensembles) if laws is None else list(laws)
-    names = {None if law is None else law[0] for law in laws}
-    if len(laws) != len(ensembles) or len(names) > 1:
-        raise ValueError(f"laws={laws!r} is invalid: one law per ensemble, the same law for every one "
-                         "(its parameters may differ)")
+    laws = _checked_laws(laws, len(ensembles))
     Ns = {len(e.sphereList) for e in ensembles}
     if len(Ns) != 1:
         raise ValueError(f"ensembles have N = {sorted(Ns)}: a batch needs one N")
@@ -127,11 +123,44 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
     if any(own):
         shared = np.repeat(np.logical_not(own), N)
         s.visit[:, shared] = s.per_replica_parameters()[:, shared]
-    s.law = names.pop() if names else None
-    s.callback_laws = callback_phase_laws      # the classes' law callbacks, read at every force phase
-    if s.law is not None:
-        s.law_params = np.array([law[1] for law in laws], dtype=float).reshape(B, -1).T.copy()
+    set_laws(s, laws)
     return s.to_backend(target)
+
+
+def _checked_laws(laws, B):
+    """``laws`` as a list of B entries (None: B times None); ValueError unless they are one law."""
+    laws = [None] * B if laws is None else list(laws)
+    if len(laws) != B or len({None if law is None else law[0] for law in laws}) > 1:
+        raise ValueError(f"laws={laws!r} is invalid: one law per ensemble, the same law for every one "
+                         "(its parameters may differ)")
+    return laws
+
+
+def set_laws(state, laws=None):
+    """Give a host state the central law of each replica and the classes' law callbacks.
+
+    What :func:`state_from_ensembles` sets: :attr:`~particleShear.engine.state.BatchState.law`,
+    ``law_params`` and ``callback_laws`` (:func:`~particleShear.base.callbacks.callback_phase_laws`,
+    read at every force phase).
+
+    Parameters
+    ----------
+    state : BatchState
+        On the host, changed in place.
+    laws : sequence, optional
+        One entry per replica, as :func:`state_from_ensembles` takes them (default: None for every one).
+
+    Raises
+    ------
+    ValueError
+        If the laws are not one law (their parameters may differ) or not one per replica.
+    """
+    laws = _checked_laws(laws, state.B)
+    names = {None if law is None else law[0] for law in laws}
+    state.law = names.pop() if names else None
+    state.callback_laws = callback_phase_laws      # the classes' law callbacks, read at every force phase
+    if state.law is not None:
+        state.law_params = np.array([law[1] for law in laws], dtype=float).reshape(state.B, -1).T.copy()
 
 def state_of_ensemble(ensemble, laws=None, backend="numpy"):
     """:func:`state_of_ensembles` of one ensemble (the ensemble keeps its own block).
@@ -368,10 +397,47 @@ def relax_ensembles(ensembles, N, skin_factor=RELAX_SKIN, laws=None, backend="nu
             stack.enter_context(untouched_on_failure(e))
         # the engine steps the ensembles' own sphere rows and pair tables (nothing of them to copy back)
         state = state_of_ensembles(ensembles, laws=laws, backend=backend)
-        engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrators.pop(), check_interval=interval,
-                             guard=[g is not None for g in guards], min_distance_ratio=ratio,
-                             max_kinetic_energy=ke, phase="constitution", numbers_relations=True)
-        steps = free_relaxation(engine, N, dt, dt_max, state.mu.copy())
+        engine, steps = relax_state(state, N, dt, dt_max, skin_factor=skin_factor, integrator=integrators.pop(),
+                                    guard=[g is not None for g in guards], check_interval=interval,
+                                    min_distance_ratio=ratio, max_kinetic_energy=ke)
     for b, e in enumerate(ensembles):
         write_back(engine, b, e, steps)
     return steps
+
+
+def relax_state(state, N, dt, dt_max, skin_factor=RELAX_SKIN, integrator="euler", guard=False, check_interval=4,
+                min_distance_ratio=0.05, max_kinetic_energy=None):
+    """``free_pre_equilibration(N)`` of every replica of ``state``, in a new engine on it.
+
+    The relaxation of :func:`relax_ensembles` (which runs it on the ensembles' own rows) and of
+    :func:`particleShear.linkable.builders.constituted_state` (on an engine state): an engine of
+    phase ``"constitution"`` that numbers the relations as they form, then
+    :func:`~particleShear.engine.relax.free_relaxation` with each replica's μ (``state.mu``) for
+    the last block.  The state holds the clock, strain, μ, spheres and pair lists afterwards.
+
+    Parameters
+    ----------
+    state : BatchState
+        The batch (shear rate 0, as in a constitution); advanced in place.
+    N : int
+        Steps per level and per final block (>= 0).
+    dt, dt_max : float
+        Final and coarsest step (s).
+    skin_factor : float, optional
+        Verlet skin in units of each replica's largest radius (the result does not depend on it).
+    integrator : {"euler", "verlet"}, optional
+    guard : bool or sequence of bool, optional
+        Stability guard per replica (the builders' ensembles have none), with its ``check_interval``,
+        ``min_distance_ratio`` and ``max_kinetic_energy`` (as :class:`~particleShear.engine.step.BatchEngine`).
+
+    Returns
+    -------
+    engine : BatchEngine
+        The engine after the relaxation (its Verlet half kick, for a write-back).
+    steps : int
+        Steps run per replica.
+    """
+    engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrator, check_interval=check_interval,
+                         guard=guard, min_distance_ratio=min_distance_ratio, max_kinetic_energy=max_kinetic_energy,
+                         phase="constitution", numbers_relations=True)
+    return engine, free_relaxation(engine, N, dt, dt_max, state.mu.copy())

@@ -8,14 +8,22 @@ import logging
 
 import numpy as np
 
-from ..base.engine_adapter import relax_ensembles
+from ..base.engine_adapter import relax_ensembles, relax_state, set_laws
+from ..base.fields import FIELDS
+from ..base.pair_canvas import CanvasPointsNeighbors
 from ..checks import finite, in_range, integer, non_negative, positive
+from ..engine.state import PERMANENT, BatchState, PairTable
+from ..engine.step import BatchEngine
+from ..engine.xp import get_backend
 from ..objects.model import particle_shear_model_parameters
+from ..objects.placement import bimodal_factors, bimodal_placement
+from . import bonds
 from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustableInterfaceStrength
 
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
-           "adjustable_interface_constitution", "constitution", "EnsembleRecipe", "Relaxation", "relax_constitution",
+           "adjustable_interface_constitution", "constitution", "constituted_state", "ConstitutedState",
+           "EnsembleRecipe", "Relaxation", "relax_constitution",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
 
 #: attempts at cutting without a height-spanning particle before giving up (the reference loops forever)
@@ -346,48 +354,78 @@ def constitution(recipe, *, legacy=False, doDrawing=False, do_debug=False, rng=N
     EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
         The constituted ensemble (``StopIteration.value``).
     """
+    c = _Constants(recipe, legacy, do_debug, verbose)
     r = recipe
-    N, cut_lines = int(r.N), int(r.cut_lines)
-    R = 10 if do_debug else 1
-    irc, irt = r.interface_reenforcement_central, r.interface_reenforcement_tangential
-    rv, rts, A, bf = r.relative_viscosity, r.relative_transversal_link_strength, r.anticipated_amplitude, r.bimodal_factor
-    prc = 1 / irc
-    prt = 1 / irt
-    avoid = r.avoid_height_spanning_particles
-    if avoid and cut_lines <= (1 if r.doCutByTriangulation else 0):   # no separate particles: no height to check
-        if verbose:
-            logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines="
-                                             + str(cut_lines) + " the gel is not cut into separate particles")
-        avoid = False
-
-    model = particle_shear_model_parameters(r.size_x, r.size_y, N, r.packing_fraction, r.Young_modulus_spheres,
-                                            r.density, bimodal_factor=1)
-    tau, k = model.time_constant, model.k
-    dt, dt_max = time_steps_from_model(tau, bf, r.mu, rts, A, rv)
-    k_ens = k * irc
-    k_t_ens = k * rts * irt
-    nu_ens = rv * k * tau
-    nu_t_ens = rv * k * tau * rts
-    if not r.keep_viscosity_coefficients_constant:
-        nu_ens = nu_ens * irc
-        nu_t_ens = nu_t_ens * irt
     cls, extra = ((EnsembleCompactParticles, {}) if legacy else (
         EnsembleCompactParticlesAdjustableInterfaceStrength,
-        dict(permanent_ratio_central=prc, permanent_ratio_tangential=prt,
+        dict(permanent_ratio_central=c.prc, permanent_ratio_tangential=c.prt,
              keep_viscosity_coefficients_constant=r.keep_viscosity_coefficients_constant)))
-    ens = cls(r.size_x, r.size_y, N, packing_fraction=r.packing_fraction, theCanvas=False, doDrawing=doDrawing,
-              k=k_ens, nu=nu_ens, m=model.m, bimodal_factor=bf, k_t=k_t_ens, nu_t=nu_t_ens, dt=dt, dt_max=dt_max,
-              theTkSimulation=False, avoid_horizontal_angle_degree=r.avoid_horizontal_angle_degree,
+    ens = cls(r.size_x, r.size_y, c.N, packing_fraction=r.packing_fraction, theCanvas=False, doDrawing=doDrawing,
+              k=c.k, nu=c.nu, m=c.model.m, bimodal_factor=r.bimodal_factor, k_t=c.k_t, nu_t=c.nu_t, dt=c.dt,
+              dt_max=c.dt_max, theTkSimulation=False, avoid_horizontal_angle_degree=r.avoid_horizontal_angle_degree,
               rng=np.random.default_rng(rng), **extra)
     ens.mu = r.mu        # the constitution's to set, as in its μ = 0 blocks (_free_mu0)
     ens.set_central_repulsion_coefficient(r.central_repulsion_coefficient)
-    ens.avoid_height_spanning_particles = avoid
-    ens.model = model
+    ens.avoid_height_spanning_particles = c.avoid
+    ens.model = c.model
     ens.edge_fuzziness = r.edge_fuzziness
+    return (yield from _schedule(ens, r, c, legacy, verbose))
 
+
+class _Constants:
+    """What a constitution derives from its recipe before any sphere exists (both paths read it).
+
+    ``N``, ``cut_lines`` (int); ``R`` (10 with ``do_debug``: shorter relaxations, else 1); the
+    permanent ratios ``prc = 1/irc``, ``prt = 1/irt``; ``avoid`` (the height check, off when the
+    gel is not cut into separate particles); ``model``
+    (:class:`~particleShear.objects.model.particle_shear_model_parameters`, ``bimodal_factor=1``);
+    ``tau`` (s); ``dt``, ``dt_max`` (s, :func:`time_steps_from_model`); the ensemble's ``k, k_t``
+    (mg·s⁻² per m depth) and ``nu, nu_t`` (mg·s⁻¹ per m depth), eq. S1-8, S1-9.
+    """
+
+    def __init__(self, r, legacy, do_debug, verbose):
+        self.N, self.cut_lines = int(r.N), int(r.cut_lines)
+        self.R = 10 if do_debug else 1
+        irc, irt = r.interface_reenforcement_central, r.interface_reenforcement_tangential
+        rv, rts, bf = r.relative_viscosity, r.relative_transversal_link_strength, r.bimodal_factor
+        self.prc = 1 / irc
+        self.prt = 1 / irt
+        avoid = r.avoid_height_spanning_particles
+        if avoid and self.cut_lines <= (1 if r.doCutByTriangulation else 0):   # not cut into separate particles
+            if verbose:
+                logging.getLogger(__name__).info("avoid_height_spanning_particles ignored: with cut_lines="
+                                                 + str(self.cut_lines)
+                                                 + " the gel is not cut into separate particles")
+            avoid = False
+        self.avoid = avoid
+        model = self.model = particle_shear_model_parameters(r.size_x, r.size_y, self.N, r.packing_fraction,
+                                                             r.Young_modulus_spheres, r.density, bimodal_factor=1)
+        tau, k = model.time_constant, model.k
+        self.tau = tau
+        self.dt, self.dt_max = time_steps_from_model(tau, bf, r.mu, rts, r.anticipated_amplitude, rv)
+        self.k = k * irc
+        self.k_t = k * rts * irt
+        self.nu = rv * k * tau
+        self.nu_t = rv * k * tau * rts
+        if not r.keep_viscosity_coefficients_constant:
+            self.nu = self.nu * irc
+            self.nu_t = self.nu_t * irt
+
+
+def _schedule(ens, r, c, legacy, verbose):
+    """The relaxations, crosslinking and cuts of a constitution on ``ens`` (generator of its relaxations).
+
+    ``ens`` is a documented ensemble (:func:`constitution`) or the state's target
+    (:class:`_StateTarget`, :func:`constituted_state`): the schedule reads and sets its ``dt``,
+    ``dt_max``, ``mu``, ``particles``, ``cut_top_bottom`` and calls its crosslinking and cutting
+    methods; every relaxation is yielded as a :class:`Relaxation` of ``ens``.  Returns ``ens``.
+    """
+    R, A, rts, bf = c.R, r.anticipated_amplitude, r.relative_transversal_link_strength, r.bimodal_factor
+    irc, irt = r.interface_reenforcement_central, r.interface_reenforcement_tangential
+    prc, tau, dt, dt_max = c.prc, c.tau, c.dt, c.dt_max
     if r.do_pre_equilibration:
         ens.dt = dt
-        ens.dt_max = 0.2 * tau / bf if rv <= 0.1 else 0.25 * tau / bf
+        ens.dt_max = 0.2 * tau / bf if r.relative_viscosity <= 0.1 else 0.25 * tau / bf
         if r.packing_fraction > 2 and not legacy:
             ens.dt_max = ens.dt_max / 2
         n1 = int(300 / R) if prc == 1 else int(100 / R)
@@ -402,7 +440,8 @@ def constitution(recipe, *, legacy=False, doDrawing=False, do_debug=False, rng=N
                 yield Relaxation(ens, int(200 / R))
 
     if r.do_permanent_links:
-        _crosslink_and_cut(ens, cut_lines, r.doCutByTriangulation, r.edge_fuzziness, r.cut_top_bottom, avoid, verbose)
+        _crosslink_and_cut(ens, c.cut_lines, r.doCutByTriangulation, r.edge_fuzziness, r.cut_top_bottom, c.avoid,
+                           verbose)
         if r.cut_top_bottom and not legacy:
             ens.cut_top_bottom = True
         if r.remove_link_fraction > 0:
@@ -435,6 +474,204 @@ def constitution(recipe, *, legacy=False, doDrawing=False, do_debug=False, rng=N
             yield from _free_mu0(ens, n, r.mu)
             yield Relaxation(ens, n)
     return ens
+
+
+@dataclasses.dataclass(frozen=True)
+class ConstitutedState:
+    """A constituted gel as the engine's state, with the facts a result or file reports of it.
+
+    Attributes
+    ----------
+    state : BatchState
+        One replica on the requested backend: spheres, box, strain, rate, clock, constants, the
+        pair list (bonds and relations with their history) and the generator (``rng[0]``, at the
+        position the constitution left it).
+    dt, dt_max : float
+        The steps to use (s), as the builders leave them on their ensemble.
+    model : particle_shear_model_parameters
+        The model constants (``ensemble.model``).
+    removed_fraction : float
+        Fraction of the non-essential links removed (0 without ``remove_link_fraction``).
+    triangulation_points : ndarray (n, 2) or None
+        The Voronoi seeds of the last cut (µm), None without a Voronoi cut.
+    r_max : float
+        The largest radius (µm).
+    """
+    state: object
+    dt: float
+    dt_max: float
+    model: object
+    removed_fraction: float
+    triangulation_points: object
+    r_max: float
+
+
+class _StateTarget:
+    """What :func:`_schedule` reads and calls of an ensemble, on an engine state of one replica.
+
+    Its methods are the documented classes' (same names) on the state's rows and pair table,
+    through :mod:`.bonds`; a relaxation runs the engine on the state
+    (:func:`~particleShear.base.engine_adapter.relax_state`, the settings of
+    :func:`~particleShear.base.engine_adapter.relax_ensembles` for an ensemble without a guard).
+    """
+
+    def __init__(self, r, c, legacy, rng):
+        g = np.random.default_rng(rng)
+        lower, upper = bimodal_factors(r.bimodal_factor)
+        x, y, radius, mass = bimodal_placement(g, c.N, r.size_x, r.size_y, r.packing_fraction, lower, upper,
+                                               c.model.m)
+        s = self.state = BatchState(1, c.N, backend="numpy")
+        s.x[:], s.y[:], s.r[:], s.m[:] = x, y, radius, mass
+        s.phi[:] = FIELDS["phi"]
+        s.inertia[:] = mass * radius * radius / 2          # as the spheres' m r²/2
+        s.Lx[0], s.Ly[0] = float(r.size_x), float(r.size_y)
+        s.k[0], s.nu[0], s.k_t[0], s.nu_t[0] = c.k, c.nu, c.k_t, c.nu_t
+        s.c[0] = r.central_repulsion_coefficient
+        if not legacy:
+            s.prc[0], s.prt[0], s.keep[0] = c.prc, c.prt, float(bool(r.keep_viscosity_coefficients_constant))
+        else:
+            s.prc[0], s.prt[0], s.keep[0] = (FIELDS[name] for name in (
+                "permanent_ratio_central", "permanent_ratio_tangential", "keep_viscosity_coefficients_constant"))
+        s.pairs[0] = PairTable()
+        s.rng[0] = g
+        s.applying_shear = False
+        set_laws(s)          # the relaxations' laws: the classes' callbacks, as for an ensemble
+        self.size_x, self.size_y = r.size_x, r.size_y
+        self.avoid_horizontal_angle_degree = r.avoid_horizontal_angle_degree
+        self.r_max = 0
+        for p in range(c.N):
+            self.r_max = max(self.r_max, float(radius[p]))
+        self.mu = r.mu
+        self.dt, self.dt_max = c.dt, c.dt_max
+        self.removed_fraction = 0
+        self.triangulation_points = None
+        self.particles = []
+        self.cut_top_bottom = False
+
+    # -- the state's rows, as the algorithms of .bonds take them
+    def _rows(self):
+        s = self.state
+        return s.x, s.y, s.r
+
+    def _shift(self):
+        s = self.state
+        return float(s.Ly[0] * s.gamma[0])     # the ensemble's size_y·shear
+
+    @property
+    def _pairs(self):
+        return self.state.pairs[0]
+
+    def free_pre_equilibration(self, N):
+        self.state.mu[0] = float(self.mu)
+        relax_state(self.state, N, float(self.dt), float(self.dt_max))
+
+    def makeAllLinksPermanent(self):
+        if not self._pairs.active.any():       # the ensemble's neighbour update (test_neighbor_relation)
+            s = self.state
+            s.mu[0] = float(self.mu)
+            engine = BatchEngine(s, skin_factor=CanvasPointsNeighbors.neighbour_skin, guard=False, keep_terms=True,
+                                 numbers_relations=True)
+            engine.relations()
+            engine.flush()
+        bonds.link_relations(self._pairs, self.state.r)
+
+    def cutTopBottomEdge(self):
+        x, y, _ = self._rows()
+        bonds.cut_top_bottom_edge(self._pairs, x, y, self.size_x, self.size_y, self._shift())
+
+    def cutByTriangulation(self, n_points, edge_fuzziness=0):
+        pts = self.triangulation_points = bonds.seed_points(self.state.rng[0], n_points, self.size_x, self.size_y)
+        if len(pts) and self.state.N:
+            x, y, _ = self._rows()
+            seed = bonds.nearest_seeds(x, y, self.size_x, self.size_y, self._shift(), pts, edge_fuzziness,
+                                       self.r_max, self.state.rng[0])
+            bonds.cut_between_seeds(self._pairs, seed)
+
+    def cutRandomLine(self):
+        x, y, _ = self._rows()
+        point, angle = bonds.random_line(self.state.rng[0], self.size_x, self.size_y,
+                                         self.avoid_horizontal_angle_degree)
+        bonds.cut_line(self._pairs, x, y, self.size_x, self.size_y, self._shift(), point, angle)
+
+    def maximal_particle_height(self):
+        x, y, r = self._rows()
+        labels = bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y, True)
+        return float(bonds.particle_heights(labels, y, r).max()) if len(x) else 0
+
+    def remove_non_essential_links(self, fraction, physical_only=True):
+        x, y, r = self._rows()
+        self.removed_fraction = bonds.remove_non_essential_links(self._pairs, x, y, r, self.size_x, self.size_y,
+                                                                 fraction, self.state.rng[0], physical_only)
+
+    def join_isolated_spheres(self):
+        x, y, r = self._rows()
+        bonds.join_isolated_spheres(self._pairs, x, y, r, self.size_x, self.size_y, self.state.rng[0])
+
+
+def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="numpy", do_debug=False, verbose=False):
+    """The constitution of ``recipe`` made on the engine's state, without a documented ensemble.
+
+    The same placement, relaxations, crosslinking, cuts, link removal and joining as
+    :func:`constitution` (one schedule, one implementation of each step: :mod:`.bonds`,
+    :mod:`particleShear.objects.placement`), run on a one-replica
+    :class:`~particleShear.engine.state.BatchState` with the random draws in the same order from
+    the same generator: the state is bit-identical to
+    ``state_from_ensembles([ensemble], backend, laws=[law])`` of the ensemble :func:`constitution`
+    builds from the same recipe and seed (docs/engine.md, "Runs").
+
+    Parameters
+    ----------
+    recipe : EnsembleRecipe
+        The checked parameters of the gel.
+    legacy : bool, optional
+        The legacy builder's constitution (:func:`EnsembleCompactParticlesFromModelParameters`).
+    rng : numpy.random.Generator, int or None, optional
+        Generator or seed of every random choice (None: fresh entropy); a generator is used, not copied.
+    law : tuple or None, optional
+        The central law of the measurement, ``(name, values)`` as
+        :func:`~particleShear.base.engine_adapter.state_from_ensembles` takes it (None: the classes'
+        callback); the relaxations use the callbacks, as the builders do.
+    backend : str or Backend, optional
+        Where the returned state lives (the constitution runs on the host, NumPy).
+    do_debug, verbose : bool, optional
+        Ten times shorter relaxations; log the builders' messages.
+
+    Returns
+    -------
+    ConstitutedState
+
+    Raises
+    ------
+    RuntimeError
+        If no cut without a height-spanning particle is found in :data:`MAX_CUT_ATTEMPTS` attempts.
+    ValueError
+        For an unusable backend or law (before any work).
+    """
+    target_backend = get_backend(backend)
+    set_laws(BatchState(1, 0, backend="numpy"), [law])      # checks the law before any work
+    c = _Constants(recipe, legacy, do_debug, verbose)
+    target = _StateTarget(recipe, c, legacy, rng)
+    steps = _schedule(target, recipe, c, legacy, verbose)
+    try:
+        request = next(steps)
+        for _ in range(MAX_RELAXATIONS):
+            request.ensemble.free_pre_equilibration(request.N)
+            request = next(steps)
+        raise RuntimeError(f"a constitution yielded more than {MAX_RELAXATIONS} relaxations")
+    except StopIteration:
+        pass
+    w = target.state
+    s = BatchState(1, w.N, backend="numpy")       # the hand-over's copy (state_from_ensembles)
+    for name in BatchState.SPHERE_ARRAYS + BatchState.REPLICA_ARRAYS:
+        getattr(s, name)[...] = getattr(w, name)
+
+    pt = w.pairs[0]
+    s.pairs[0] = pt.copy(pt.active | (pt.state == PERMANENT))
+    s.rng[0] = w.rng[0]
+    set_laws(s, [law])
+    return ConstitutedState(state=s.to_backend(target_backend), dt=float(target.dt), dt_max=float(target.dt_max),
+                            model=c.model, removed_fraction=float(target.removed_fraction),
+                            triangulation_points=target.triangulation_points, r_max=float(target.r_max))
 
 
 def _parameters_section(doc):

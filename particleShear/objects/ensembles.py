@@ -1,11 +1,10 @@
 """Concrete non-crosslinkable ensembles of random bimodal spheres (lengths µm, masses mg per m depth)."""
 __docformat__ = "numpy"
-import math
 
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                            CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
 from ..checks import integer, positive as _check_positive
-from .placement import bimodal_placement
+from .placement import bimodal_factors, bimodal_placement
 from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
 
 __all__ = ["Ensemble", "EnsembleFriction", "EnsembleLeesEdwards", "EnsembleFrictionLeesEdwards",
@@ -23,7 +22,7 @@ class RandomBimodalSpheres:
         integer("N", N, 0)
         _check_positive("packing_fraction", packing_fraction)
         _check_positive("bimodal_factor", bimodal_factor)
-        self.bimodal_upper, self.bimodal_lower = math.sqrt(bimodal_factor), math.sqrt(1 / bimodal_factor)
+        self.bimodal_lower, self.bimodal_upper = bimodal_factors(bimodal_factor)
         self.N, self.packing_fraction, self.r_max = N, packing_fraction, 0
 
     def random_radius_bimodal(self, r):

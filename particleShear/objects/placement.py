@@ -6,11 +6,18 @@ spheres from it, and :func:`particleShear.linkable.builders.constituted_state` a
 """
 __docformat__ = "numpy"
 
+import math
+
 import numpy as np
 
 from .model import adjust_m, r_estimate
 
-__all__ = ["bimodal_placement"]
+__all__ = ["bimodal_factors", "bimodal_placement"]
+
+
+def bimodal_factors(bimodal_factor):
+    """``(1/√bf, √bf)``: the small and large radius in units of ``r_b`` (bf > 0, the radius ratio)."""
+    return math.sqrt(1 / bimodal_factor), math.sqrt(bimodal_factor)
 
 
 def bimodal_placement(rng, N, Lx, Ly, packing_fraction, lower, upper, m):
