@@ -645,10 +645,9 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     RuntimeError
         If no cut without a height-spanning particle is found in :data:`MAX_CUT_ATTEMPTS` attempts.
     ValueError
-        For an unusable backend or law (before any work).
+        For an unusable backend (before any work).
     """
     target_backend = get_backend(backend)
-    set_laws(BatchState(1, 0, backend="numpy"), [law])      # checks the law before any work
     c = _Constants(recipe, legacy, do_debug, verbose)
     target = _StateTarget(recipe, c, legacy, rng)
     steps = _schedule(target, recipe, c, legacy, verbose)
