@@ -427,8 +427,9 @@ def relax_state(state, N, dt, dt_max, skin_factor=RELAX_SKIN, integrator="euler"
         Verlet skin in units of each replica's largest radius (the result does not depend on it).
     integrator : {"euler", "verlet"}, optional
     guard : bool or sequence of bool, optional
-        Stability guard per replica (the builders' ensembles have none), with its ``check_interval``,
-        ``min_distance_ratio`` and ``max_kinetic_energy`` (as :class:`~particleShear.engine.step.BatchEngine`).
+        Stability guard per replica (the builders' ensembles have none).
+    check_interval, min_distance_ratio, max_kinetic_energy : optional
+        The guard's settings, as :class:`~particleShear.engine.step.BatchEngine` takes them.
 
     Returns
     -------

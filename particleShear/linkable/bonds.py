@@ -196,7 +196,16 @@ def cut_line(pairs, x, y, Lx, Ly, shift, point, angle):
 
 
 def cut_top_bottom_edge(pairs, x, y, Lx, Ly, shift):
-    """Cut every bond crossing y = 0 or y = Ly (:func:`cut_line` twice; arguments as there)."""
+    """Cut every bond crossing y = 0 or y = Ly (:func:`cut_line` along both).
+
+    Parameters
+    ----------
+    pairs : PairTable
+    x, y : ndarray (N,)
+        Positions (µm).
+    Lx, Ly, shift : float
+        Cell and Lees-Edwards offset (µm).
+    """
     cut_line(pairs, x, y, Lx, Ly, shift, (0, 0), math.pi / 2)
     cut_line(pairs, x, y, Lx, Ly, shift, (0, Ly), math.pi / 2)
 
@@ -250,7 +259,21 @@ def random_line(rng, Lx, Ly, avoid_degree=0):
 
 
 def seed_points(rng, n, Lx, Ly):
-    """``n`` uniform random points of the cell (µm), shape (max(n, 0), 2): the Voronoi seeds."""
+    """``n`` uniform random points of the cell: the Voronoi seeds (one block of draws).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    n : int
+        Number of points (none for n <= 0).
+    Lx, Ly : float
+        Cell (µm).
+
+    Returns
+    -------
+    ndarray (max(n, 0), 2)
+        The points (µm).
+    """
     return rng.random((max(int(n), 0), 2)) * np.array([Lx, Ly])
 
 

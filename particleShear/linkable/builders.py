@@ -480,7 +480,7 @@ def _schedule(ens, r, c, legacy, verbose):
 class ConstitutedState:
     """A constituted gel as the engine's state, with the facts a result or file reports of it.
 
-    Attributes
+    Parameters
     ----------
     state : BatchState
         One replica on the requested backend: spheres, box, strain, rate, clock, constants, the

@@ -16,7 +16,17 @@ __all__ = ["bimodal_factors", "bimodal_placement"]
 
 
 def bimodal_factors(bimodal_factor):
-    """``(1/√bf, √bf)``: the small and large radius in units of ``r_b`` (bf > 0, the radius ratio)."""
+    """``(1/√bf, √bf)``: the small and large radius in units of ``r_b``.
+
+    Parameters
+    ----------
+    bimodal_factor : float
+        bf, the large/small radius ratio (> 0).
+
+    Returns
+    -------
+    lower, upper : float
+    """
     return math.sqrt(1 / bimodal_factor), math.sqrt(bimodal_factor)
 
 
