@@ -140,3 +140,33 @@ def test_angles_and_a_bounded_redraw():
         assert 0 <= px <= 100 and 0 <= py <= 50 and bonds.angle_ok(angle, 80)
     with pytest.raises(RuntimeError):
         bonds.random_line(g, 100, 50, 90.0001)          # (the recipe forbids it: every angle rejected)
+
+
+def driver_style(recipe, seed, law, backend):
+    """The ensemble as a run's driver constitutes it: each relaxation with the run's law and backend
+    (``simulation.driver``'s ``relax_ensembles`` call, for a batch of one)."""
+    from particleShear.base.engine_adapter import relax_ensembles
+    from particleShear.simulation.driver import ENGINE_SKIN_FACTOR
+    steps = constitution(recipe, do_debug=True, rng=seed)
+    try:
+        while True:
+            request = next(steps)
+            relax_ensembles([request.ensemble], request.N, skin_factor=ENGINE_SKIN_FACTOR, laws=[law], backend=backend)
+    except StopIteration as done:
+        return done.value
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_relaxations_with_the_runs_law_and_backend(backend):
+    """With the relaxations' law and backend of a run's driver, the state is the driver's hand-over state."""
+    if backend == "numba":
+        pytest.importorskip("numba")
+    from particleShear.simulation.driver import ENGINE_SKIN_FACTOR
+    recipe = EnsembleRecipe(**{**SMALL, "N": 20})
+    law = ("plateau", (0.3, 0.8, 0.1))
+    ens = driver_style(recipe, 41, law, backend)
+    got = constituted_state(recipe, rng=41, do_debug=True, law=law, relaxation_law=law, relaxation_backend=backend,
+                            skin_factor=ENGINE_SKIN_FACTOR)
+    assert differences(state_from_ensembles([ens], backend="numpy", laws=[law]), got.state) == []
+    plain = constituted_state(recipe, rng=41, do_debug=True, law=law)      # (the builders' relaxations: callbacks)
+    assert differences(plain.state, got.state) != []

@@ -35,7 +35,7 @@ from .callbacks import callback_phase_laws
 from .fields import ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
-           "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws"]
+           "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws", "host_backend"]
 
 
 def uniform_parameters(ensemble):
@@ -225,12 +225,7 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     ensembles = list(ensembles)
     if len({id(e) for e in ensembles}) != len(ensembles):
         raise ValueError("ensembles: an ensemble is given twice; each replica needs state of its own")
-    target = get_backend(backend)
-    if not target.host and backend == "auto":
-        target = get_backend("numpy")   # ("auto" on a device's default: the ensembles' rows stay on the host)
-    if not target.host:
-        raise ValueError(f"backend={target.name!r} is not allowed here: the ensembles' own rows are host "
-                         "arrays (numpy, numba or auto)")
+    target = host_backend(backend)
     s = state_from_ensembles(ensembles, backend="numpy", laws=laws)   # views of the ensembles' NumPy rows
     N = s.N
     if len(ensembles) == 1:
@@ -249,6 +244,32 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     s.ensembles = ensembles
     s.backend = target         # (the same host arrays)
     return s
+
+
+def host_backend(backend):
+    """The host backend a state on host arrays runs on: ``backend``, or NumPy for ``"auto"`` on a device.
+
+    Parameters
+    ----------
+    backend : {"numpy", "numba", "auto"} or Backend
+        ``"auto"`` is the default backend when that is a host one, else ``"numpy"``.
+
+    Returns
+    -------
+    Backend
+
+    Raises
+    ------
+    ValueError
+        For a device backend named explicitly (or an unknown one).
+    """
+    target = get_backend(backend)
+    if not target.host and backend == "auto":
+        target = get_backend("numpy")   # ("auto" on a device's default: the rows stay on the host)
+    if not target.host:
+        raise ValueError(f"backend={target.name!r} is not allowed here: the ensembles' own rows are host "
+                         "arrays (numpy, numba or auto)")
+    return target
 
 
 def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):

@@ -8,10 +8,11 @@ import logging
 
 import numpy as np
 
-from ..base.engine_adapter import relax_ensembles, relax_state, set_laws
+from ..base.engine_adapter import host_backend, relax_ensembles, relax_state, set_laws
 from ..base.fields import FIELDS
 from ..base.pair_canvas import CanvasPointsNeighbors
 from ..checks import finite, in_range, integer, non_negative, positive
+from ..engine.relax import RELAX_SKIN
 from ..engine.state import PERMANENT, BatchState, PairTable
 from ..engine.step import BatchEngine
 from ..engine.xp import get_backend
@@ -512,10 +513,11 @@ class _StateTarget:
     Its methods are the documented classes' (same names) on the state's rows and pair table,
     through :mod:`.bonds`; a relaxation runs the engine on the state
     (:func:`~particleShear.base.engine_adapter.relax_state`, the settings of
-    :func:`~particleShear.base.engine_adapter.relax_ensembles` for an ensemble without a guard).
+    :func:`~particleShear.base.engine_adapter.relax_ensembles` for an ensemble without a guard:
+    the relaxations' central law ``law``, host backend ``backend`` and Verlet skin ``skin_factor``).
     """
 
-    def __init__(self, r, c, legacy, rng):
+    def __init__(self, r, c, legacy, rng, law=None, backend="numpy", skin_factor=RELAX_SKIN):
         g = np.random.default_rng(rng)
         lower, upper = bimodal_factors(r.bimodal_factor)
         x, y, radius, mass = bimodal_placement(g, c.N, r.size_x, r.size_y, r.packing_fraction, lower, upper,
@@ -535,7 +537,9 @@ class _StateTarget:
         s.pairs[0] = PairTable()
         s.rng[0] = g
         s.applying_shear = False
-        set_laws(s)          # the relaxations' laws: the classes' callbacks, as for an ensemble
+        set_laws(s, [law])        # the relaxations' law (None: the classes' callbacks)
+        s.backend = host_backend(backend)       # (the same host arrays)
+        self.skin_factor = skin_factor
         self.size_x, self.size_y = r.size_x, r.size_y
         self.avoid_horizontal_angle_degree = r.avoid_horizontal_angle_degree
         self.r_max = 0
@@ -563,16 +567,20 @@ class _StateTarget:
 
     def free_pre_equilibration(self, N):
         self.state.mu[0] = float(self.mu)
-        relax_state(self.state, N, float(self.dt), float(self.dt_max))
+        relax_state(self.state, N, float(self.dt), float(self.dt_max), skin_factor=self.skin_factor)
 
     def makeAllLinksPermanent(self):
         if not self._pairs.active.any():       # the ensemble's neighbour update (test_neighbor_relation)
             s = self.state
             s.mu[0] = float(self.mu)
-            engine = BatchEngine(s, skin_factor=CanvasPointsNeighbors.neighbour_skin, guard=False, keep_terms=True,
-                                 numbers_relations=True)
-            engine.relations()
-            engine.flush()
+            backend, s.backend = s.backend, host_backend("auto")      # (the ensemble's own engine's)
+            try:
+                engine = BatchEngine(s, skin_factor=CanvasPointsNeighbors.neighbour_skin, guard=False,
+                                     keep_terms=True, numbers_relations=True)
+                engine.relations()
+                engine.flush()
+            finally:
+                s.backend = backend
         bonds.link_relations(self._pairs, self.state.r)
 
     def cutTopBottomEdge(self):
@@ -608,7 +616,8 @@ class _StateTarget:
         bonds.join_isolated_spheres(self._pairs, x, y, r, self.size_x, self.size_y, self.state.rng[0])
 
 
-def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="numpy", do_debug=False, verbose=False):
+def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="numpy", relaxation_law=None,
+                      relaxation_backend="numpy", skin_factor=RELAX_SKIN, do_debug=False, verbose=False):
     """The constitution of ``recipe`` made on the engine's state, without a documented ensemble.
 
     The same placement, relaxations, crosslinking, cuts, link removal and joining as
@@ -632,7 +641,12 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
         :func:`~particleShear.base.engine_adapter.state_from_ensembles` takes it (None: the classes'
         callback); the relaxations use the callbacks, as the builders do.
     backend : str or Backend, optional
-        Where the returned state lives (the constitution runs on the host, NumPy).
+        Where the returned state lives (the constitution runs on the host).
+    relaxation_law, relaxation_backend, skin_factor : optional
+        The central law, host backend (``"numpy"``, ``"numba"`` or ``"auto"``) and Verlet skin of
+        the relaxations, as :func:`~particleShear.base.engine_adapter.relax_ensembles` takes them
+        (defaults: the builders' — the classes' callbacks, NumPy, ``RELAX_SKIN``; a run's driver
+        relaxes with its run's law and backend, ``simulation.driver``).
     do_debug, verbose : bool, optional
         Ten times shorter relaxations; log the builders' messages.
 
@@ -645,11 +659,12 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     RuntimeError
         If no cut without a height-spanning particle is found in :data:`MAX_CUT_ATTEMPTS` attempts.
     ValueError
-        For an unusable backend (before any work).
+        For an unusable backend or relaxation backend (before any work).
     """
     target_backend = get_backend(backend)
+    host_backend(relaxation_backend)
     c = _Constants(recipe, legacy, do_debug, verbose)
-    target = _StateTarget(recipe, c, legacy, rng)
+    target = _StateTarget(recipe, c, legacy, rng, relaxation_law, relaxation_backend, skin_factor)
     steps = _schedule(target, recipe, c, legacy, verbose)
     try:
         request = next(steps)
