@@ -39,6 +39,8 @@ CASES = [
     ("fuzzy", False, dict(edge_fuzziness=0.7), (14,)),
     ("open-top-bottom", False, dict(cut_top_bottom=False, N=20), (15,)),
     ("unrelaxed", False, dict(do_pre_equilibration=False), (16,)),
+    ("spheres-only", True, dict(do_pre_equilibration=False, do_permanent_links=False, N=2), (19,)),
+    ("uncut", False, dict(cut_lines=0, packing_fraction=3, relative_transversal_link_strength=6), (20,)),
     ("small-amplitude", False, dict(anticipated_amplitude=0.001, interface_reenforcement_central=2,
                                     interface_reenforcement_tangential=3,
                                     keep_viscosity_coefficients_constant=False), (17,)),

@@ -528,6 +528,7 @@ class _StateTarget:
         s.inertia[:] = mass * radius * radius / 2          # as the spheres' m r²/2
         s.Lx[0], s.Ly[0] = float(r.size_x), float(r.size_y)
         s.k[0], s.nu[0], s.k_t[0], s.nu_t[0] = c.k, c.nu, c.k_t, c.nu_t
+        s.mu[0] = r.mu
         s.c[0] = r.central_repulsion_coefficient
         if not legacy:
             s.prc[0], s.prt[0], s.keep[0] = c.prc, c.prt, float(bool(r.keep_viscosity_coefficients_constant))
@@ -678,6 +679,7 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     s = BatchState(1, w.N, backend="numpy")       # the hand-over's copy (state_from_ensembles)
     for name in BatchState.SPHERE_ARRAYS + BatchState.REPLICA_ARRAYS:
         getattr(s, name)[...] = getattr(w, name)
+    s.mu[0] = float(target.mu)      # the ensemble's μ (also where no relaxation ran)
 
     pt = w.pairs[0]
     s.pairs[0] = pt.copy(pt.active | (pt.state == PERMANENT))
