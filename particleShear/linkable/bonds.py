@@ -27,7 +27,8 @@ from ..engine.state import PERMANENT, SLIP
 
 __all__ = ["set_bonds", "link_pairs", "cut_slots", "cut_pairs", "physical", "permanent_pairs",
            "link_relations", "cut_line", "cut_top_bottom_edge", "angle_ok", "random_line", "seed_points",
-           "nearest_seeds", "cut_between_seeds", "particle_labels", "particle_heights", "remove_non_essential_links",
+           "nearest_seeds", "cut_between_seeds", "voronoi_cut", "particle_labels", "particle_heights",
+           "maximal_particle_height", "remove_non_essential_links",
            "join_isolated_spheres", "MAX_ANGLE_DRAWS"]
 
 #: draws of a cut line's angle before :func:`random_line` gives up (a band < 180° is left: ~never reached)
@@ -319,6 +320,36 @@ def cut_between_seeds(pairs, seed):
     cut_slots(pairs, slots[seed[pairs.i[slots]] != seed[pairs.j[slots]]])
 
 
+def voronoi_cut(pairs, x, y, Lx, Ly, shift, points, edge_fuzziness, r_max, rng):
+    """Periodic Voronoi cut around ``points``: :func:`nearest_seeds`, then :func:`cut_between_seeds`.
+
+    Nothing is drawn or cut without points or spheres.
+
+    Parameters
+    ----------
+    pairs : PairTable
+    x, y : ndarray (N,)
+        Positions (µm).
+    Lx, Ly, shift : float
+        Cell and Lees-Edwards offset (µm).
+    points : ndarray (n, 2)
+        Seed points (µm).
+    edge_fuzziness, r_max : float
+        As for :func:`nearest_seeds`.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray of int (N,) or None
+        The seed of each sphere, None where nothing was cut.
+    """
+    if not len(points) or not len(x):
+        return None
+    seed = nearest_seeds(x, y, Lx, Ly, shift, points, edge_fuzziness, r_max, rng)
+    cut_between_seeds(pairs, seed)
+    return seed
+
+
 def particle_labels(pairs, x, y, Lx, Ly, physical_only=True):
     """The particle of each sphere: the lowest index of its connected component of the bond graph.
 
@@ -446,3 +477,20 @@ def join_isolated_spheres(pairs, x, y, r, Lx, Ly, rng, physical_only=True):
         link_pairs(pairs, r, [p], [q])
         if not physical_only or physical(x, y, Lx, Ly, np.array([p]), np.array([q]))[0]:
             bonded[p] = bonded[q] = True
+
+
+def maximal_particle_height(labels, y, r):
+    """Height of the tallest particle (µm; 0 without spheres): the largest of :func:`particle_heights`.
+
+    Parameters
+    ----------
+    labels : ndarray of int (N,)
+        :func:`particle_labels`.
+    y, r : ndarray (N,)
+        Heights and radii (µm).
+
+    Returns
+    -------
+    float
+    """
+    return float(particle_heights(labels, y, r).max()) if len(labels) else 0

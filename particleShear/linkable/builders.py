@@ -590,11 +590,9 @@ class _StateTarget:
 
     def cutByTriangulation(self, n_points, edge_fuzziness=0):
         pts = self.triangulation_points = bonds.seed_points(self.state.rng[0], n_points, self.size_x, self.size_y)
-        if len(pts) and self.state.N:
-            x, y, _ = self._rows()
-            seed = bonds.nearest_seeds(x, y, self.size_x, self.size_y, self._shift(), pts, edge_fuzziness,
-                                       self.r_max, self.state.rng[0])
-            bonds.cut_between_seeds(self._pairs, seed)
+        x, y, _ = self._rows()
+        bonds.voronoi_cut(self._pairs, x, y, self.size_x, self.size_y, self._shift(), pts, edge_fuzziness, self.r_max,
+                          self.state.rng[0])
 
     def cutRandomLine(self):
         x, y, _ = self._rows()
@@ -604,8 +602,7 @@ class _StateTarget:
 
     def maximal_particle_height(self):
         x, y, r = self._rows()
-        labels = bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y, True)
-        return float(bonds.particle_heights(labels, y, r).max()) if len(x) else 0
+        return bonds.maximal_particle_height(bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y), y, r)
 
     def remove_non_essential_links(self, fraction, physical_only=True):
         x, y, r = self._rows()

@@ -121,17 +121,12 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         self.particles = self._particles_from_labels(self._labels(physical_neighbors_only))
         return self.particles
 
-    def _particle_heights(self, lab):
-        _, y, r = self._rows()
-        return bonds.particle_heights(lab, y, r)
-
     def maximal_particle_height(self):
         """Height ``max(y + r) − min(y − r)`` of the tallest particle (µm; 0 if empty); sets ``particles``."""
         lab = self._labels(True)
         self.particles = self._particles_from_labels(lab)
-        if not self._n:
-            return 0
-        return float(self._particle_heights(lab).max())
+        _, y, r = self._rows()
+        return bonds.maximal_particle_height(lab, y, r)
 
     def _index_of(self, theSphere):
         d = theSphere.__dict__
@@ -260,14 +255,12 @@ class EnsembleCompactParticles(RandomBimodalSpheres, CanvasPointsLinkable):
         check_non_negative("edge_fuzziness", edge_fuzziness)
         pts = np.asarray(triangulation_points, dtype=float).reshape(-1, 2)
         self.doCutByTriangulation = True
-        if not len(pts) or not self._n:
-            return
         x, y, _ = self._rows()
-        seed = bonds.nearest_seeds(x, y, self.size_x, self.size_y, self._le_shift(), pts, edge_fuzziness,
-                                   self.r_max, self._rng)
-        bonds.cut_between_seeds(self._pairs, seed)
-        self._bonds_edited()
-        self.sphere_seed = seed
+        seed = bonds.voronoi_cut(self._pairs, x, y, self.size_x, self.size_y, self._le_shift(), pts, edge_fuzziness,
+                                 self.r_max, self._rng)
+        if seed is not None:
+            self._bonds_edited()
+            self.sphere_seed = seed
 
     def cutByTriangulation(self, n_points=5, edge_fuzziness=0):
         """Periodic Voronoi cut around ``n_points`` random seeds (kept in ``triangulation_points``; <= 1: none).
