@@ -637,7 +637,7 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     law : tuple or None, optional
         The central law of the measurement, ``(name, values)`` as
         :func:`~particleShear.base.engine_adapter.state_from_ensembles` takes it (None: the classes'
-        callback); the relaxations use the callbacks, as the builders do.
+        callback), given to the returned state; the relaxations use ``relaxation_law``.
     backend : str or Backend, optional
         Where the returned state lives (the constitution runs on the host).
     relaxation_law, relaxation_backend, skin_factor : optional
