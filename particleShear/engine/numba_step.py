@@ -92,7 +92,8 @@ CARRY_FUNCTIONS = MERGE_FUNCTIONS + ((state, "carried_fields"), (sys.modules[__n
 #: search, the history merge and the constants of the rebuild outside a block (:func:`_rebuild_replica`)
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (state, "synced_history"), (neighbours, "cell_grid")) + \
     SEARCH_FUNCTIONS + CONSTANT_FUNCTIONS + CARRY_FUNCTIONS + \
-    ((sys.modules[__name__], "_rebuild_replica"), (sys.modules[__name__], "_block_kernel"))
+    ((sys.modules[__name__], "_sorted_keys"), (sys.modules[__name__], "_rebuild_replica"),
+     (sys.modules[__name__], "_block_kernel"))
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
 #: ``i1``: int8; ``[:]``, ``[:, :]``: C-contiguous arrays), compiled once before any timing
@@ -700,8 +701,9 @@ def _block_signature():
     f2, i1, i = types.Array(types.float64, 2, "C"), types.Array(types.int64, 1, "C"), types.int64
     b1, f3 = types.Array(types.boolean, 1, "C"), types.Array(types.float64, 3, "C")
     f1 = types.Array(types.float64, 1, "C")
-    return i(i1, i, i1, i1, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean, b1, f3, types.boolean, i1, f1,
-             f2, i1, *_signature().args[3:])
+    i2, b2, s1 = types.Array(types.int64, 2, "C"), types.Array(types.boolean, 2, "C"), types.Array(types.int8, 1, "C")
+    return i(i1, i, i1, i1, f2, f2, f2, f2, f2, f2, i, i, i, types.boolean, types.boolean, b1, f3, types.boolean, i1, i1,
+             f2, i1, f1, f2, i2, b2, s1, f2, b1, i1, f1, *_signature().args[3:])
 
 
 def _signature():
@@ -1158,16 +1160,16 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
     phase alone; ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
     ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
     (``half`` is then the one handed back); default a new array per step, handed back itself (as
-    ``half_kick`` gives); ``slots``: a block's :class:`_Slots`, whose candidates, history and
-    buffers the kernel reads and writes instead of the engine's (not handed back: :func:`_settle`)."""
+    ``half_kick`` gives); ``slots``: a block's :class:`_Slots`, whose ranges of each replica's
+    candidates and buffers the kernel takes (a rebuilt replica's candidates are its slot's,
+    handed back by :func:`_settle`)."""
     s, C = engine.s, engine.C
     gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
     next_birth, u, u_max, strain, bound, rate_max = (
         _array(a) for a in (engine.next_birth, engine.u, engine.u_max, engine.strain, engine.bound, engine.rate_max))
-    at = ws if slots is None else slots       # (the candidates' columns and the buffers over them)
-    Cf, Ci, Cb = (C.f, C.i, C.b) if slots is None else (slots.f, slots.i, slots.b)
-    state_p, xi, active, birth = ((_array(a) for a in (engine.state_p, engine.xi, engine.active, engine.birth))
-                                  if slots is None else (slots.state_p, slots.xi, slots.active, slots.birth))
+    at = ws if slots is None else slots       # (each replica's columns and the buffers over them)
+    Cf, Ci, Cb = C.f, C.i, C.b
+    state_p, xi, active, birth = (_array(a) for a in (engine.state_p, engine.xi, engine.active, engine.birth))
     free = engine.free_p
     free_mode, free = (0, at.zero) if free is None else (1, at.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
@@ -1191,13 +1193,12 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
     return args, held
 
 
-def _adopt(engine, ws, held, stepped=False, kicked=True, pairs=True):
+def _adopt(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the engine: after the force phase the relations and
     the guard's record; after a whole step (``stepped``) also the displacement bookkeeping, the
     strain, the clock, the lists due and, when a step of this call reached its kick (``kicked``),
-    the Verlet half kick.  ``pairs`` False: the relations are a block's :class:`_Slots` (handed back
-    by :func:`_settle`)."""
-    for name in ("state_p", "xi", "active", "birth")[:4 if pairs else 0] + ("next_birth", "rate_max"):
+    the Verlet half kick."""
+    for name in ("state_p", "xi", "active", "birth", "next_birth", "rate_max"):
         setattr(engine, name, held[name])
     engine.s.rate = held["rate"]
     if stepped:
@@ -1331,12 +1332,14 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                 break
             if not drawn:     # rebuild the lists due of the replicas still going, and start them anew
                 due = engine.need.copy()
-                if slots is not None and (due & going).any():     # (a list the block left: its candidates back first)
-                    slots, left = None, slots
-                    _settle(engine, left)
-                engine.need = due & going
-                engine.neighbours()
-                engine.need = due & ~going
+                left = slots is not None and bool((due & going).any())      # (a list the block could not rebuild)
+                if left:          # (the block's candidates back first)
+                    slots, held_slots = None, slots
+                    _settle(engine, held_slots)
+                if left or engine.C is None or not _slotted(engine, _workspace(engine)):
+                    engine.need = due & going
+                    engine.neighbours()
+                    engine.need = due & ~going
                 starts[going & (starts == _SKIP)] = 0
             ws = _prepared(engine)
             if ws is not None and ws.keep and B > 1 and not ks.any():
@@ -1356,7 +1359,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                                     slots=slots)
             _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
                                scheduled, want, sums, *(_NO_SLOTS if slots is None else slots.arguments()), *args)
-            _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()), pairs=slots is None)
+            _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
             drawn = False
             for b in np.flatnonzero(going):
                 st = status[b]
@@ -1393,7 +1396,9 @@ _NO_RECORD = np.zeros((0, 0))
 _NO_ROWS = np.zeros((9, 0)), np.zeros((10, 0))
 _NO_SUMS = np.zeros((0, 0, 0))
 #: the slot arguments of :func:`_block_kernel` that rebuild nothing inside (:meth:`_Slots.arguments`)
-_NO_SLOTS = (False, np.zeros(0, np.int64), np.zeros(0), np.zeros((11, 0)), np.zeros(0, np.int64))
+_NO_SLOTS = (False, np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((11, 0)), np.zeros(0, np.int64), np.zeros(0),
+             np.zeros((23, 0)), np.zeros((3, 0), np.int64), np.zeros((2, 0), np.bool_), np.zeros(0, np.int8),
+             np.zeros((2, 0)), np.zeros(0, np.bool_), np.zeros(0, np.int64), np.zeros(0))
 
 #: run_block rebuilds the lists due inside its compiled call (:class:`_Slots`); False: every rebuild
 #: between calls, by :meth:`~particleShear.engine.step.BatchEngine.neighbours` (the same numbers; a
@@ -1409,21 +1414,23 @@ def _slotted(engine, ws):
     candidates' constants are those of :func:`constant_rows` alone (no visit from j with its own
     constants, no run law's arguments per candidate, no mixed frictionless replicas, no kept terms)."""
     free = engine.free_p
-    return REBUILD_IN_BLOCK and engine.C is not None and not (ws.keep or ws.visit_j or ws.custom) and \
-        (free is None or free is True)
+    return REBUILD_IN_BLOCK and engine.C is not None and ws.why is None and \
+        not (ws.keep or ws.visit_j or ws.custom) and (free is None or free is True)
 
 
 class _Slots:
-    """A block's candidates with room after each replica's own, for its rebuilds inside the compiled
-    block (:func:`_rebuild_replica`).
+    """The room of a block's rebuilds inside the compiled block (:func:`_rebuild_replica`): a slot per
+    replica, and each replica's present columns.
 
-    Replica b's candidates are the columns ``offsets[b] … ends[b] − 1`` of the blocks ``f``, ``i``,
-    ``b`` (the engine's :class:`~particleShear.engine.forces.PairConstants` blocks) and of the
-    history ``state_p``, ``xi``, ``active``, ``birth`` and ``d_eq`` (the tables' equilibrium
-    distances), with free columns up to ``cap[b]`` (:data:`SLACK`): a rebuild writes its new list
-    there and touches no other replica's columns, so no rebuild copies the batch.  The engine's
-    arrays are copied in once per block and back once (:func:`_settle`); ``work``, ``zero`` and
-    the tensors' pair rows are the kernel's buffers over these columns.
+    Replica b's candidates are the columns ``offsets[b] … ends[b] − 1`` of the engine's
+    :class:`~particleShear.engine.forces.PairConstants` blocks and history until the block rebuilds
+    its list, then of the slot arrays ``f``, ``i``, ``b``, ``state_p``, ``xi``, ``active``,
+    ``birth`` and ``d_eq`` (the equilibrium distances; ``d_eq_c``: the engine candidates', from the
+    pair tables): its slot is their columns ``base[b] … cap[b] − 1`` (its candidates and
+    :data:`SLACK` more), after the engine's P columns, so that every replica's columns, and those
+    of the buffers ``work``, ``zero`` and the tensors' pair rows, are its own.  A rebuild writes only
+    its replica's slot: nothing is copied in, and the engine's arrays are written in place until
+    :func:`_settle` hands the rebuilt replicas' candidates back.
 
     Parameters
     ----------
@@ -1433,21 +1440,19 @@ class _Slots:
 
     def __init__(self, engine):
         s, C = engine.s, engine.C
-        lo, hi = np.asarray(C.offsets[:-1], np.int64), np.asarray(C.offsets[1:], np.int64)
-        count = hi - lo
+        P = C.P
+        self.offsets, self.ends = np.array(C.offsets[:-1], np.int64), np.array(C.offsets[1:], np.int64)
+        count = self.ends - self.offsets
         room = count + (count * SLACK[0]).astype(np.int64) + SLACK[1]
-        self.cap = np.cumsum(room)
-        self.offsets = self.cap - room
-        self.ends = self.offsets + count
-        Q = int(self.cap[-1]) if len(room) else 0
-        self.f, self.i, self.b = np.empty((C.f.shape[0], Q)), np.zeros((3, Q), np.int64), np.zeros((2, Q), np.bool_)
-        self.state_p, self.xi = np.zeros(Q, np.int8), np.zeros((2, Q))
-        self.active, self.birth, self.d_eq = np.zeros(Q, np.bool_), np.zeros(Q, np.int64), np.zeros(Q)
-        d_eq = np.concatenate([np.asarray(p.d_eq, dtype=float) for p in s.pairs])
-        for src, dst in ((C.f, self.f), (C.i, self.i), (C.b, self.b), (engine.state_p, self.state_p),
-                         (engine.xi, self.xi), (engine.active, self.active), (engine.birth, self.birth),
-                         (d_eq, self.d_eq)):
-            _move(src, lo, hi, dst, self.offsets)
+        self.cap = P + np.cumsum(room)
+        self.base = self.cap - room
+        Q = int(self.cap[-1]) if len(room) else P
+        self.f, self.i, self.b = np.empty((C.f.shape[0], Q)), np.empty((3, Q), np.int64), np.empty((2, Q), np.bool_)
+        self.state_p, self.xi = np.empty(Q, np.int8), np.empty((2, Q))
+        self.active, self.birth, self.d_eq = np.empty(Q, np.bool_), np.empty(Q, np.int64), np.empty(Q)
+        self.d_eq_c = np.ascontiguousarray(np.concatenate([np.asarray(p.d_eq, dtype=float) for p in s.pairs]))
+        if len(self.d_eq_c) != P:
+            raise RuntimeError("run_block: the pair tables are not the engine's candidates")
         self.work, self.zero = np.empty((16, Q)), np.zeros(Q, np.bool_)
         self.tp = self.ts = None
         self.spheres = s.B * s.N
@@ -1458,8 +1463,9 @@ class _Slots:
                                                   s.keep)]))
 
     def arguments(self):
-        """The slot arguments of :func:`_block_kernel` (``here, cap, d_eq_p, pc, rebuilt``)."""
-        return True, self.cap, self.d_eq, self.pc, self.rebuilt
+        """The slot arguments of :func:`_block_kernel` (``here … s_deq``)."""
+        return (True, self.base, self.cap, self.pc, self.rebuilt, self.d_eq_c, self.f, self.i, self.b, self.state_p,
+                self.xi, self.active, self.birth, self.d_eq)
 
     def tensor_rows(self, tensors):
         """As :meth:`_Workspace.tensor_rows`, over these columns."""
@@ -1471,31 +1477,32 @@ class _Slots:
 
 
 def _settle(engine, slots):
-    """Hand a block's candidates back to the engine (:class:`_Slots`): the history in place where no
-    list was rebuilt; otherwise the candidates side by side again as the engine's constants
+    """Hand a block's rebuilt lists back to the engine (:class:`_Slots`), what
+    :meth:`~particleShear.engine.step.BatchEngine.neighbours` leaves after the same rebuilds: the
+    candidates side by side again (the rebuilt replicas' from their slots, the others' from the
+    engine's arrays) as the engine's constants
     (:meth:`~particleShear.engine.forces.PairConstants.from_blocks`) and history, each rebuilt
     replica's pair table made its new list (its history written as
-    :meth:`~particleShear.engine.step.BatchEngine._sync_down` writes it), what
-    :meth:`~particleShear.engine.step.BatchEngine.neighbours` leaves after the same rebuilds."""
-    s, C = engine.s, engine.C
+    :meth:`~particleShear.engine.step.BatchEngine._sync_down` writes it).  Nothing where no list
+    was rebuilt (the kernel wrote the engine's history in place)."""
     rebuilt = np.flatnonzero(slots.rebuilt)
-    names = ("state_p", "xi", "active", "birth")
     if not len(rebuilt):
-        lo = np.asarray(C.offsets[:-1], np.int64)
-        for name in names:
-            dst = _array(getattr(engine, name))
-            _move(getattr(slots, name), slots.offsets, slots.ends, dst, lo)
-            setattr(engine, name, dst)
         return
+    s, C = engine.s, engine.C
+    kept = np.flatnonzero(slots.rebuilt == 0)
     offsets = np.zeros(s.B + 1, np.int64)
     np.cumsum(slots.ends - slots.offsets, out=offsets[1:])
     P = int(offsets[-1])
     f, i, b = np.empty((slots.f.shape[0], P)), np.empty((3, P), np.intp), np.empty((2, P), np.bool_)
     history = np.empty(P, np.int8), np.empty((2, P)), np.empty(P, np.bool_), np.empty(P, np.int64)
     d_eq = np.empty(P)
-    for src, dst in zip((slots.f, slots.i, slots.b) + tuple(getattr(slots, n) for n in names) + (slots.d_eq,),
-                        (f, i, b) + history + (d_eq,)):
-        _move(src, slots.offsets, slots.ends, dst, offsets[:-1])
+    names = ("state_p", "xi", "active", "birth")
+    for own, slot, dst in zip((C.f, C.i, C.b) + tuple(getattr(engine, n) for n in names) + (slots.d_eq_c,),
+                              (slots.f, slots.i, slots.b) + tuple(getattr(slots, n) for n in names) + (slots.d_eq,),
+                              (f, i, b) + history + (d_eq,)):
+        for src, which in ((own, kept), (slot, rebuilt)):
+            if len(which):
+                _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
     for name, a in zip(names, history):
         setattr(engine, name, a)
     engine.C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
@@ -1888,27 +1895,57 @@ def compile_search_kernel(cache=True):
                     cache)
 
 
-def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, Cb, offsets, ends, cap, state_p, xi,
-                     active, birth, d_eq, u, u_max, strain, bound):
-    """Rebuild replica b's candidate list in its own columns (compiled; :func:`_block_kernel`): what
+def _sorted_keys(key, N):
+    """``numpy.sort`` of the keys ``i·2³² + j`` (``0 ≤ i < N``) of a search, compiled: a counting sort
+    on i, then each i's few keys in order by insertion.  The same array (a sorted array of numbers is
+    one), in O(P + N): Numba's own sort is a quicksort about ten times slower than NumPy's on these
+    (2 ms against 0.18 ms at 36,000 keys), which made it a third of a rebuild inside a block."""
+    start = np.zeros(N + 1, np.int64)
+    for q in range(key.shape[0]):
+        start[key[q] // _TABLE_SCALE + 1] += 1
+    for i in range(N):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    out = np.empty_like(key)
+    for q in range(key.shape[0]):
+        i = key[q] // _TABLE_SCALE
+        out[fill[i]] = key[q]
+        fill[i] += 1
+    for i in range(N):
+        for a in range(start[i] + 1, start[i + 1]):
+            v, c = out[a], a - 1
+            while c >= start[i] and out[c] > v:
+                out[c + 1] = out[c]
+                c -= 1
+            out[c + 1] = v
+    return out
+
+
+def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, state_p, xi, active, birth, d_eq,
+                     Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, offsets, ends, base, cap, u, u_max, strain,
+                     bound):
+    """Rebuild replica b's candidate list into its own slot (compiled; :func:`_block_kernel`): what
     :meth:`~particleShear.engine.step.BatchEngine.neighbours` does for it, from the same functions.
 
-    The history of its candidates ``offsets[b] … ends[b] − 1`` as the pair table keeps it
+    The history of its candidates, the columns ``offsets[b] … ends[b] − 1`` of ``Cf, Ci, state_p, xi,
+    active, birth, d_eq`` (the engine's, or its slot's), as the pair table keeps it
     (:func:`~particleShear.engine.state.synced_history`, what the engine writes back before a
-    rebuild), the search (:func:`_search_kernel` on the grid of
-    :func:`~particleShear.engine.neighbours.cell_grid`, the keys sorted), the history merge
-    (:func:`_carry_kernel`), the new candidates with their history and constants
+    rebuild); the search (:func:`_search_kernel` on the grid of
+    :func:`~particleShear.engine.neighbours.cell_grid`, the keys sorted); the history merge
+    (:func:`_carry_kernel`); the new candidates with their history and constants
     (:func:`_constants_kernel`; ``pc`` rows ``Lx, Ly, k, nu, k_t, nu_t, mu, c, prc, prt, keep`` per
-    replica) written from ``offsets[b]`` on, ``ends[b]`` moved, and the displacement bookkeeping
-    reset.  Returns False, having changed nothing, where the new list would pass ``cap[b]`` or the
-    image offset is not finite (the caller rebuilds it, :func:`rebuild`)."""
+    replica) written into the slot's columns ``base[b] …`` of ``Sf, Si, Sb, s_state, s_xi,
+    s_active, s_birth, s_deq`` (the old columns are read first, so the slot may be the source), and
+    ``offsets[b], ends[b]`` made the new ones; the displacement bookkeeping reset.  Returns False,
+    having changed nothing, where the new list would pass ``cap[b]`` or the image offset is not
+    finite (the caller rebuilds it, :func:`rebuild`)."""
     shift = Ly[b] * gamma[b] * le[b]            # (BatchEngine._image_shift)
     if not math.isfinite(shift) or N < 2:
         return False
     n0, lo, hi = b * N, offsets[b], ends[b]
     nx, ny = cell_grid(Lx[b], Ly[b], 2 * r_max[b] + skin[b], N)
-    key = np.sort(_search_kernel(pos[0, n0:n0 + N].copy(), pos[1, n0:n0 + N].copy(), r[n0:n0 + N].copy(), Lx[b], Ly[b],
-                                 shift, skin[b], nx, ny, _TABLE_SCALE))
+    key = _sorted_keys(_search_kernel(pos[0, n0:n0 + N].copy(), pos[1, n0:n0 + N].copy(), r[n0:n0 + N].copy(), Lx[b],
+                                      Ly[b], shift, skin[b], nx, ny, _TABLE_SCALE), N)
     m = hi - lo
     old_key, st, act, num = np.empty(m, np.int64), np.empty(m, np.int8), np.empty(m, np.bool_), np.empty(m, np.int64)
     z, de = np.empty((2, m)), np.empty(m)
@@ -1919,17 +1956,17 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, C
         z[1, q] = synced_history(state_p[p], xi[1, p], active[p], birth[p])[1]
         act[q], de[q] = active[p], d_eq[p]
     key, s_new, d_new, a_new, b_new, z_new = _carry_kernel(old_key, key, st, de, act, num, z, _MERGE_MIN)
-    n = key.shape[0]
+    n, lo = key.shape[0], base[b]
     if lo + n > cap[b]:
         return False
     for q in range(n):
         p = lo + q
-        Ci[0, p], Ci[1, p], Ci[2, p] = b, key[q] // _TABLE_SCALE + n0, key[q] % _TABLE_SCALE + n0
-        state_p[p], xi[0, p], xi[1, p], active[p], birth[p], d_eq[p] = (s_new[q], z_new[0, q], z_new[1, q], a_new[q],
-                                                                        b_new[q], d_new[q])
-    _constants_kernel(Cf[:, lo:lo + n], Cb[:, lo:lo + n], Ci[:, lo:lo + n], r, pc[0], pc[1], pc[2], pc[3], pc[4],
-                      pc[5], pc[6], pc[7], pc[8], pc[9], pc[10], False, state_p[lo:lo + n], d_eq[lo:lo + n])
-    ends[b] = lo + n
+        Si[0, p], Si[1, p], Si[2, p] = b, key[q] // _TABLE_SCALE + n0, key[q] % _TABLE_SCALE + n0
+        s_state[p], s_xi[0, p], s_xi[1, p], s_active[p], s_birth[p], s_deq[p] = (s_new[q], z_new[0, q], z_new[1, q],
+                                                                                a_new[q], b_new[q], d_new[q])
+    _constants_kernel(Sf[:, lo:lo + n], Sb[:, lo:lo + n], Si[:, lo:lo + n], r, pc[0], pc[1], pc[2], pc[3], pc[4],
+                      pc[5], pc[6], pc[7], pc[8], pc[9], pc[10], False, s_state[lo:lo + n], s_deq[lo:lo + n])
+    offsets[b], ends[b] = lo, lo + n
     for k in range(n0, n0 + N):
         u[0, k] = 0.0
         u[1, k] = 0.0
@@ -1938,8 +1975,8 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, C
 
 
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
-                  interval, guarded, scheduled, want, rec_sums, here, cap, d_eq_p, pc, rebuilt, N, cool, dt, sample,
-                  check, applying, numbers, form,
+                  interval, guarded, scheduled, want, rec_sums, here, base, cap, pc, rebuilt, d_eq_c, Sf, Si, Sb,
+                  s_state, s_xi, s_active, s_birth, s_deq, N, cool, dt, sample, check, applying, numbers, form,
                   custom, A,
                   visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi, mmi, r, Ly_s,
                   rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p, xi, active, birth,
@@ -1958,12 +1995,15 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     step ``step0 + k``.  Writes the next step of each replica into ``ks`` and its status into
     ``status`` (:data:`_DONE`, :data:`_NEED` or a status of :func:`_step_kernel`).
 
-    With ``here`` a replica whose candidate list is due before its next step of the block rebuilds
-    it here (:func:`_rebuild_replica`: the search, the history merge and the new candidates'
-    constants, into its own columns ``offsets[b] … cap[b] − 1``; ``d_eq_p`` the candidates'
-    equilibrium distances, ``pc`` the constants of :func:`constant_rows` per replica, ``rebuilt[b]``
-    counts them) and goes on; a list that does not fit its columns, or one the compiled search does
-    not take, is left to the caller (:data:`_NEED`).
+    With ``here`` a replica whose candidate list is due before a step of the block (the lists the
+    steps before marked, ``need``) rebuilds it here (:func:`_rebuild_replica`: the search, the
+    history merge and the new candidates' constants, into its slot: the columns ``base[b] … cap[b] − 1``
+    of ``Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq``, whose column indices follow the
+    engine's, :class:`_Slots`; ``d_eq_c`` the equilibrium distances of the engine's candidates,
+    ``pc`` the constants of :func:`constant_rows` per replica, ``rebuilt[b]`` counts the rebuilds)
+    and goes on, its candidates from then on the slot's columns ``offsets[b] … ends[b] − 1``; a
+    list that does not fit its slot, or one the compiled search does not take, is left to the
+    caller (:data:`_NEED`).
 
     The replicas share nothing (each reads and writes its own spheres, candidates and records),
     so each runs to its own next rebuild: a batch's block is as long as its replicas' own,
@@ -1973,6 +2013,18 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     for b in prange(B):
         k, start, st = ks[b], starts[b], _DONE
         while start != _SKIP and k < n:
+            if here and need[b] and start == 0:       # (the list due before this step, rebuilt here)
+                if rebuilt[b] > 0:        # (its present candidates: its slot's, or the engine's)
+                    F, I, S, X, Ac, Bi, D = Sf, Si, s_state, s_xi, s_active, s_birth, s_deq
+                else:
+                    F, I, S, X, Ac, Bi, D = Cf, Ci, state_p, xi, active, birth, d_eq_c
+                if not _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, F, I, S, X, Ac, Bi, D, Sf,
+                                        Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, offsets, ends, base, cap, u,
+                                        u_max, strain, bound):
+                    st = _NEED
+                    break
+                need[b] = False
+                rebuilt[b] += 1
             if scheduled and start == 0:      # (a resumed step has its rate and records)
                 for q in range(b * N, (b + 1) * N):
                     vel[0, q], vel[2, q] = flow_shifted(vel[0, q], vel[2, q], pos[1, q] - Ly_s[q] / 2,
@@ -1984,10 +2036,14 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
             due_check = guarded and (step0 + k) % interval == 0
             tensors = scheduled and want[k]
             code = 2 if tensors else 1 if scheduled else 0
+            if here and rebuilt[b] > 0:    # (its candidates are its slot's since its first rebuild here)
+                F, I, Bf, S, X, Ac, Bi = Sf, Si, Sb, s_state, s_xi, s_active, s_birth
+            else:
+                F, I, Bf, S, X, Ac, Bi = Cf, Ci, Cb, state_p, xi, active, birth
             st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
                               applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
-                              mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p,
-                              xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
+                              mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, F, I, Bf, offsets, ends, S,
+                              X, Ac, Bi, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
                               max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot,
                               False)
             start = 0
@@ -2004,13 +2060,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                     half[0, q], half[1, q], half[2, q] = half_out[0, q], half_out[1, q], half_out[2, q]
                 pred[b] = True
             k += 1
-            if need[b]:
-                if here and k < n and _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, Cb,
-                                                       offsets, ends, cap, state_p, xi, active, birth, d_eq_p, u,
-                                                       u_max, strain, bound):
-                    need[b] = False
-                    rebuilt[b] += 1
-                    continue
+            if need[b] and not here:
                 st = _NEED
                 break
         ks[b], status[b] = k, st
