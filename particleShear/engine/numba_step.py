@@ -1333,10 +1333,12 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
             if not drawn:     # rebuild the lists due of the replicas still going, and start them anew
                 due = engine.need.copy()
                 left = slots is not None and bool((due & going).any())      # (a list the block could not rebuild)
-                if left:          # (the block's candidates back first)
+                if left:          # (the block's rebuilt candidates back first; the lists due rebuilt here)
                     slots, held_slots = None, slots
                     _settle(engine, held_slots)
-                if left or engine.C is None or not _slotted(engine, _workspace(engine)):
+                elif slots is None and engine.C is not None and _slotted(engine, _workspace(engine)):
+                    slots = _Slots.of(engine)      # (the lists due are rebuilt inside the block)
+                if slots is None:
                     engine.need = due & going
                     engine.neighbours()
                     engine.need = due & ~going
@@ -1353,7 +1355,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                 _fresh(ws)
                 ws.lent = False
             if slots is None and _slotted(engine, ws):
-                slots = _Slots(engine)
+                slots = _Slots.of(engine)
             at = ws if slots is None else slots
             args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any(),
                                     slots=slots)
@@ -1438,6 +1440,15 @@ class _Slots:
         The engine (its candidates built, :func:`_slotted`).
     """
 
+    @classmethod
+    def of(cls, engine):
+        """The slots of a block of ``engine``, or None where its pair tables are not its candidates
+        (a table edited since the engine's last rebuild: the engine rebuilds from it)."""
+        C = engine.C
+        if any(len(p.d_eq) != n for p, n in zip(engine.s.pairs, np.diff(C.offsets))):
+            return None
+        return cls(engine)
+
     def __init__(self, engine):
         s, C = engine.s, engine.C
         P = C.P
@@ -1451,8 +1462,6 @@ class _Slots:
         self.state_p, self.xi = np.empty(Q, np.int8), np.empty((2, Q))
         self.active, self.birth, self.d_eq = np.empty(Q, np.bool_), np.empty(Q, np.int64), np.empty(Q)
         self.d_eq_c = np.ascontiguousarray(np.concatenate([np.asarray(p.d_eq, dtype=float) for p in s.pairs]))
-        if len(self.d_eq_c) != P:
-            raise RuntimeError("run_block: the pair tables are not the engine's candidates")
         self.work, self.zero = np.empty((16, Q)), np.zeros(Q, np.bool_)
         self.tp = self.ts = None
         self.spheres = s.B * s.N
