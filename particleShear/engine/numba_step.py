@@ -17,12 +17,16 @@ formula is a pure function of the NumPy engine called here on numbers
 :func:`~.guard.verdict_code`, :func:`~.guard.transient_ratio`, :func:`~.neighbours.verlet_bound`
 and the laws), in the NumPy engine's order of operations, so the trajectories are the same bits.
 
-What stays in Python: the bookkeeping of a rebuild of the candidate lists when one is due
-(:meth:`~particleShear.engine.step.BatchEngine.neighbours`; per replica the search and the history
-merge run compiled, :func:`rebuild`, and the new candidates' constants in one compiled pass,
-:func:`constant_rows`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from each
-replica's generator, as :func:`~.forces.normals` draws them; the step then goes on compiled), and
-the protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
+A block of steps (:func:`run_block`, the protocols' schedules and the relaxations) also rebuilds the
+candidate lists due inside its compiled call, replica by replica (:func:`_rebuild_replica`: the
+search, the history merge and the new candidates' constants from the same compiled functions, into
+the replica's own slot of columns, :class:`_Slots`); the engine's candidates are handed back once
+per block (:func:`_settle`).  What stays in Python: a rebuild outside a block, or one a block
+leaves (:meth:`~particleShear.engine.step.BatchEngine.neighbours`; per replica the search and the
+history merge run compiled, :func:`rebuild`, and the new candidates' constants in one compiled
+pass, :func:`constant_rows`), the draws of the random directions at ``d = 0`` and ``|R| = 0`` (from
+each replica's generator, as :func:`~.forces.normals` draws them; the step then goes on compiled),
+and the protocol's schedule and observers.  The sums NumPy takes per replica (the shear sums of
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
 _pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
@@ -1458,12 +1462,20 @@ class _Slots:
         self.cap = P + np.cumsum(room)
         self.base = self.cap - room
         Q = int(self.cap[-1]) if len(room) else P
-        self.f, self.i, self.b = np.empty((C.f.shape[0], Q)), np.empty((3, Q), np.int64), np.empty((2, Q), np.bool_)
-        self.state_p, self.xi = np.empty(Q, np.int8), np.empty((2, Q))
-        self.active, self.birth, self.d_eq = np.empty(Q, np.bool_), np.empty(Q, np.int64), np.empty(Q)
+        # (the buffers of the engine's last block where they are wide enough: its slots are scratch, and
+        # fresh arrays of this size cost page faults at every block; a quarter more room otherwise)
+        kept = engine.__dict__.get("_slot_buffers")
+        if kept is None or kept["f"].shape != (C.f.shape[0], kept["f"].shape[1]) or kept["f"].shape[1] < Q:
+            W = Q + Q // 4
+            kept = engine.__dict__["_slot_buffers"] = dict(
+                f=np.empty((C.f.shape[0], W)), i=np.empty((3, W), np.int64), b=np.empty((2, W), np.bool_),
+                state_p=np.empty(W, np.int8), xi=np.empty((2, W)), active=np.empty(W, np.bool_),
+                birth=np.empty(W, np.int64), d_eq=np.empty(W), work=np.empty((16, W)), zero=np.zeros(W, np.bool_),
+                tp=None)
+        self._kept = kept
+        for name in ("f", "i", "b", "state_p", "xi", "active", "birth", "d_eq", "work", "zero"):
+            setattr(self, name, kept[name])
         self.d_eq_c = np.ascontiguousarray(np.concatenate([np.asarray(p.d_eq, dtype=float) for p in s.pairs]))
-        self.work, self.zero = np.empty((16, Q)), np.zeros(Q, np.bool_)
-        self.tp = self.ts = None
         self.spheres = s.B * s.N
         self.rebuilt = np.zeros(s.B, np.int64)
         # (the per-replica constants of constant_rows, in the order _constants_kernel takes them)
@@ -1480,9 +1492,10 @@ class _Slots:
         """As :meth:`_Workspace.tensor_rows`, over these columns."""
         if not tensors:
             return _NO_ROWS
-        if self.tp is None:
-            self.tp, self.ts = np.empty((9, self.f.shape[1])), np.empty((10, self.spheres))
-        return self.tp, self.ts
+        rows = self._kept["tp"]
+        if rows is None or rows[0].shape[1] != self.f.shape[1] or rows[1].shape[1] != self.spheres:
+            rows = self._kept["tp"] = np.empty((9, self.f.shape[1])), np.empty((10, self.spheres))
+        return rows
 
 
 def _settle(engine, slots):
