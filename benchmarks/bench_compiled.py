@@ -136,7 +136,7 @@ def main():
     rows = [(150, 1, 100 if q else 400, 3 if q else 7, "µs/step"),
             (150, 32, 10 if q else 40, 3 if q else 5, "µs/replica-step"),
             (10_000, 1, 3 if q else 10, 3 if q else 5, "ns/particle-step")]
-    extra = (" | Numba, blocks, rebuilds between calls | between / inside", "|---|---|") if between else ("", "")
+    extra = (" | Numba, blocks, rebuilds between calls | between / inside", "---|---|") if between else ("", "")
     print("| N | B | NumPy | Numba, a call per step | Numba, compiled blocks | NumPy / Numba per step | "
           f"NumPy / Numba blocks{extra[0]} | unit |\n|---|---|---|---|---|---|---|{extra[1]}---|", flush=True)
     for N, B, steps, blocks, unit in rows:
