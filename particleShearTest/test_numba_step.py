@@ -7,8 +7,10 @@ included), not merely close.  Scenes: crosslinked particles with cut bonds, fric
 frictionless spheres (the shortcut), a batch mixing frictionless and frictional replicas, the
 velocity Verlet integrator, the Hertz and the plateau law of the laws folder, plates off (the constitution's relaxation), a run's whole
 constitution and measurement, a diverging replica (the same guard verdict, also in blocks), a pair at
-distance 0 (the compiled step draws its random normal from the replica's generator), and a block's
-replicas on two threads.  Skipped without Numba.
+distance 0 (the compiled step draws its random normal from the replica's generator), a block's
+replicas on two threads, and the lists rebuilt inside the compiled blocks (against the rebuilds
+between calls and NumPy; a list outgrowing its slot; a pair at d = 0 after such a rebuild).
+Skipped without Numba.
 """
 import unittest
 import warnings
@@ -922,3 +924,27 @@ class TestRebuildsInBlock(unittest.TestCase):
             two = _measure(self.SCENES, "numba")
         self.assertGreater(sum(counts), 0)
         self.assert_same(two, _measure(self.SCENES, "numba"))
+
+    def test_distance_zero_after_a_rebuild_inside(self):
+        """A pair at d = 0 in the first step after a list rebuilt inside the block (the replica's
+        candidates in its slot's columns): its normal is drawn there from the replica's generator,
+        and the step goes on; the same bits as NumPy, Euler and Verlet."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        for integrator in ("euler", "verlet"):
+            engines, counts = [], None
+            for backend in ("numpy", "numba"):
+                ens = [constituted(s, **FRICTIONAL)[1] for s in (42, 43)]
+                eng = BatchEngine(state_from_ensembles(ens, backend=backend), guard=False, integrator=integrator)
+                eng.steps(3, 0.999, ens[0].dt)
+                N = eng.s.N
+                eng.s.pos[:, N + 1] = eng.s.pos[:, N]        # (replica 1: spheres 0 and 1 on one place)
+                eng.need[:] = True
+                counts, patch = self.counted()
+                with patch:
+                    eng.steps(8, 0.999, ens[0].dt)
+                engines.append(eng)
+            self.assertGreater(sum(counts), 0)
+            TestCompiledStepBits.assert_same_engines(self, *engines)
