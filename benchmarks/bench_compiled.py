@@ -10,14 +10,18 @@ compiled call from the NumPy engine's own functions (engine/numba_step.py, docs/
 candidate search and the Python of the loop around the step are the same on both.
 
 "Numba, compiled blocks": the same steps through ``numba_step.run_block`` (many steps per compiled
-call, the rate update and the records inside, as the protocols' recording loop runs them).  Then
+call, the rate update, the records and the rebuilds of the candidate lists inside, as the
+protocols' recording loop runs them).  ``--rebuilds-between`` adds, in the same alternation, the
+compiled blocks with every rebuild between calls (``numba_step.REBUILD_IN_BLOCK = False``: the
+rebuild of a replica's list by ``BatchEngine.neighbours``, a block call per list due; the same
+bits) and its ratio to the rebuilds inside.  Then
 the documented step loop of the README (what 1.0.2's scripts run, every tensor at every step) on
 the N = 150 scene, its engine made on each backend, in alternating blocks.  Last rows: the default
 run ``doParticleShearSimulation(seed=1)`` (no drawing), whole call with a warm
 compile cache, per backend, without files and saving its files (``saveData=True`` into a temporary
 folder: the per-step table of every stress tensor, so every step samples every tensor).
 
-Usage: python benchmarks/bench_compiled.py [--quick]
+Usage: python benchmarks/bench_compiled.py [--quick] [--rebuilds-between]
 """
 import os
 
@@ -43,6 +47,8 @@ from particleShear.engine.step import BatchEngine  # noqa: E402
 from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 
 BACKENDS = ("numpy", "numba", "numba blocks")
+#: the compiled blocks with every rebuild between calls (``--rebuilds-between``)
+BETWEEN = "numba blocks between"
 
 
 def engine(ensembles, backend):
@@ -66,19 +72,24 @@ def engine(ensembles, backend):
         rates = np.repeat((amp * w * np.cos(w * (start + dt * np.arange(n))))[:, None], B, axis=1)
         record = {name: np.empty((n, B)) for name in ("t", "strain", "strain_rate", "stress_internal",
                                                       "stress_surface")}
-        numba_step.run_block(eng, rates, cool, dt, record, 0)
+        inside = numba_step.REBUILD_IN_BLOCK
+        numba_step.REBUILD_IN_BLOCK = backend != BETWEEN
+        try:
+            numba_step.run_block(eng, rates, cool, dt, record, 0)
+        finally:
+            numba_step.REBUILD_IN_BLOCK = inside
         return time.perf_counter() - t0
-    return compiled_block if backend == "numba blocks" else block
+    return compiled_block if backend.startswith("numba blocks") else block
 
 
-def row(N, B, steps, blocks):
+def row(N, B, steps, blocks, backends=BACKENDS):
     ensembles = [bench_step.build(N, seed=1 + b) for b in range(B)]
-    run = {be: engine(ensembles, be) for be in BACKENDS}
-    for be in BACKENDS:
+    run = {be: engine(ensembles, be) for be in backends}
+    for be in backends:
         run[be](5)                       # warm-up: the compile (or the cache load) is not timed
-    samples = {be: [] for be in BACKENDS}
+    samples = {be: [] for be in backends}
     for _ in range(blocks):
-        for be in BACKENDS:
+        for be in backends:
             samples[be].append(run[be](steps) / (steps * B))
     return {be: statistics.median(v) for be, v in samples.items()}
 
@@ -118,18 +129,22 @@ def default_run(backend, save=False):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer steps and blocks")
+    ap.add_argument("--rebuilds-between", action="store_true",
+                    help="also the compiled blocks with every list rebuild between calls (REBUILD_IN_BLOCK = False)")
     args = ap.parse_args()
-    q = args.quick
+    q, between = args.quick, args.rebuilds_between
     rows = [(150, 1, 100 if q else 400, 3 if q else 7, "µs/step"),
             (150, 32, 10 if q else 40, 3 if q else 5, "µs/replica-step"),
             (10_000, 1, 3 if q else 10, 3 if q else 5, "ns/particle-step")]
+    extra = (" | Numba, blocks, rebuilds between calls | between / inside", "---|---|") if between else ("", "")
     print("| N | B | NumPy | Numba, a call per step | Numba, compiled blocks | NumPy / Numba per step | "
-          "NumPy / Numba blocks | unit |\n|---|---|---|---|---|---|---|---|", flush=True)
+          f"NumPy / Numba blocks{extra[0]} | unit |\n|---|---|---|---|---|---|---|{extra[1]}---|", flush=True)
     for N, B, steps, blocks, unit in rows:
-        m = row(N, B, steps, blocks)
+        m = row(N, B, steps, blocks, BACKENDS + ((BETWEEN,) if between else ()))
         scale = 1e9 / N if unit.startswith("ns") else 1e6
+        more = f" | {m[BETWEEN] * scale:.1f} | {m[BETWEEN] / m['numba blocks']:.2f}×" if between else ""
         print(f"| {N:,} | {B} | {m['numpy'] * scale:.1f} | {m['numba'] * scale:.1f} | {m['numba blocks'] * scale:.1f} | "
-              f"{m['numpy'] / m['numba']:.2f}× | {m['numpy'] / m['numba blocks']:.2f}× | {unit} |", flush=True)
+              f"{m['numpy'] / m['numba']:.2f}× | {m['numpy'] / m['numba blocks']:.2f}×{more} | {unit} |", flush=True)
     loops = {be: documented(be) for be in ("numpy", "numba")}
     samples = {be: [] for be in loops}
     for _ in range(3 if q else 7):

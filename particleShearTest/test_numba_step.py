@@ -7,8 +7,10 @@ included), not merely close.  Scenes: crosslinked particles with cut bonds, fric
 frictionless spheres (the shortcut), a batch mixing frictionless and frictional replicas, the
 velocity Verlet integrator, the Hertz and the plateau law of the laws folder, plates off (the constitution's relaxation), a run's whole
 constitution and measurement, a diverging replica (the same guard verdict, also in blocks), a pair at
-distance 0 (the compiled step draws its random normal from the replica's generator), and a block's
-replicas on two threads.  Skipped without Numba.
+distance 0 (the compiled step draws its random normal from the replica's generator), a block's
+replicas on two threads, and the lists rebuilt inside the compiled blocks (against the rebuilds
+between calls and NumPy; a list outgrowing its slot; a pair at d = 0 after such a rebuild).
+Skipped without Numba.
 """
 import unittest
 import warnings
@@ -860,3 +862,89 @@ class TestThreads(unittest.TestCase):
             with mock.patch.dict("os.environ", {numba_step.THREADS_VARIABLE: text}):
                 with self.assertRaisesRegex(ValueError, "PARTICLESHEAR_THREADS=.*whole number of threads >= 1"):
                     numba_step.threads()
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestRebuildsInBlock(unittest.TestCase):
+    """The lists due rebuilt inside the compiled block (numba_step._Slots, _rebuild_replica): the same
+    bits as the rebuilds between calls (``REBUILD_IN_BLOCK = False``) and as NumPy, the pair tables
+    included; a list that outgrows its slot is left to the rebuild between calls; on two threads."""
+
+    SCENES = [(0, FRICTIONAL_BONDS), (1, FRICTIONAL), (3, FRICTIONAL_BONDS)]
+
+    @staticmethod
+    def counted():
+        """A patch of ``_settle`` that counts the lists rebuilt inside each block, and the counts."""
+        from unittest import mock
+        counts, real = [], numba_step._settle
+
+        def settle(engine, slots):
+            counts.append(int(slots.rebuilt.sum()))
+            return real(engine, slots)
+        return counts, mock.patch.object(numba_step, "_settle", settle)
+
+    def assert_same(self, a, b):
+        TestCompiledStepBits.assert_same_engines(self, a[0], b[0])
+        TestCompiledStepBits.assert_same_records(self, a[1], b[1])
+        for r in range(a[0].s.B):
+            np.testing.assert_array_equal(_bits(a[0].pairs_of(r).d_eq), _bits(b[0].pairs_of(r).d_eq))
+            self.assertEqual(a[0].pairs_of(r)._births, b[0].pairs_of(r)._births)
+
+    def test_same_bits_as_between_calls_and_numpy(self):
+        from unittest import mock
+        for integrator in ("euler", "verlet"):
+            with self.subTest(integrator=integrator):
+                counts, patch = self.counted()
+                with patch:
+                    inside = _measure(self.SCENES, "numba", integrator)
+                self.assertGreater(sum(counts), 0)
+                with mock.patch.object(numba_step, "REBUILD_IN_BLOCK", False):
+                    counts, patch = self.counted()
+                    with patch:
+                        between = _measure(self.SCENES, "numba", integrator)
+                    self.assertEqual(counts, [])
+                self.assert_same(inside, between)
+                self.assert_same(inside, _measure(self.SCENES, "numpy", integrator))
+
+    def test_list_outgrowing_its_slot(self):
+        """No room after the candidates: a list that grows is rebuilt between calls, one that does not
+        inside; the same bits."""
+        from unittest import mock
+        counts, patch = self.counted()
+        with patch, mock.patch.object(numba_step, "SLACK", (0.0, 0)):
+            tight = _measure(self.SCENES, "numba")
+        self.assertGreater(sum(counts), 0)
+        self.assertGreater(int(tight[0].rebuilds.sum()), sum(counts))
+        self.assert_same(tight, _measure(self.SCENES, "numpy"))
+
+    def test_two_threads(self):
+        from unittest import mock
+        counts, patch = self.counted()
+        with patch, mock.patch.dict("os.environ", {numba_step.THREADS_VARIABLE: "2"}):
+            two = _measure(self.SCENES, "numba")
+        self.assertGreater(sum(counts), 0)
+        self.assert_same(two, _measure(self.SCENES, "numba"))
+
+    def test_distance_zero_after_a_rebuild_inside(self):
+        """A pair at d = 0 in the first step after a list rebuilt inside the block (the replica's
+        candidates in its slot's columns): its normal is drawn there from the replica's generator,
+        and the step goes on; the same bits as NumPy, Euler and Verlet."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        for integrator in ("euler", "verlet"):
+            engines, counts = [], None
+            for backend in ("numpy", "numba"):
+                ens = [constituted(s, **FRICTIONAL)[1] for s in (42, 43)]
+                eng = BatchEngine(state_from_ensembles(ens, backend=backend), guard=False, integrator=integrator)
+                eng.steps(3, 0.999, ens[0].dt)
+                N = eng.s.N
+                eng.s.pos[:, N + 1] = eng.s.pos[:, N]        # (replica 1: spheres 0 and 1 on one place)
+                eng.need[:] = True
+                counts, patch = self.counted()
+                with patch:
+                    eng.steps(8, 0.999, ens[0].dt)
+                engines.append(eng)
+            self.assertGreater(sum(counts), 0)
+            TestCompiledStepBits.assert_same_engines(self, *engines)

@@ -207,6 +207,31 @@ class PairConstants:
         C._index(s, offsets)
         return C
 
+    @classmethod
+    def from_blocks(cls, s, f, i, b, offsets):
+        """The constants of a batch from blocks already written: the compiled backend's block, whose
+        rebuilds write each replica's new candidates and their constants in its own columns
+        (:func:`~particleShear.engine.numba_step.run_block`), hands them back this way.
+
+        Parameters
+        ----------
+        s : BatchState
+            The batch (on a host backend).
+        f, i, b : ndarray
+            The blocks (rows :data:`FLOAT_ROWS`, :data:`INT_ROWS`, :data:`BOOL_ROWS`; P columns), taken as they are.
+        offsets : ndarray of int (B + 1,)
+            Segments of the replicas.
+
+        Returns
+        -------
+        PairConstants
+        """
+        C = cls.__new__(cls)
+        C.backend = s.backend
+        C._set_blocks(f, i, b, i)
+        C._index(s, offsets)
+        return C
+
     def set_bonds(self, s, state, d_eq, fill=None):
         """Set every constant of the candidates from their states (bonds never change during the measurement).
 

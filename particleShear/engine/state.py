@@ -15,9 +15,9 @@ __docformat__ = "numpy"
 
 import numpy as np
 
-from .xp import get_backend, to_host
+from .xp import get_backend, select, to_host
 
-__all__ = ["STICK", "SLIP", "PERMANENT", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
+__all__ = ["STICK", "SLIP", "PERMANENT", "synced_history", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
            "PER_REPLICA_PARAMETERS", "spread"]
 
 STICK, SLIP, PERMANENT = 0, 1, 2
@@ -185,6 +185,35 @@ def carried_fields(src, state, d_eq, active, birth, xi):
     return (np.concatenate((state, np.zeros(1, np.int8)))[src], np.concatenate((d_eq, np.zeros(1)))[src],
             np.concatenate((active, np.zeros(1, np.bool_)))[src], np.concatenate((birth, np.zeros(1, np.int64)))[src],
             xi_new)
+
+
+def synced_history(state, xi, active, birth):
+    """The history a candidate list keeps of the engine's flat rows: what the pair table holds of a
+    candidate (pure: arrays or numbers).
+
+    A candidate that is no relation (not ``active``) keeps no ξ and no number and sticks, unless it
+    is a bond, which keeps its state.  The engine writes its flat history back this way
+    (:meth:`~particleShear.engine.step.BatchEngine._sync_down`, on arrays) and the compiled backend's
+    rebuild inside a block reads it this way before the history merge (on the numbers of each
+    candidate, :mod:`particleShear.engine.numba_step`), so both merge the same history.
+
+    Parameters
+    ----------
+    state : ndarray of int8 or int
+        The candidate's state (:data:`STICK`, :data:`SLIP`, :data:`PERMANENT`).
+    xi : ndarray (…, P) or float
+        A component of ξ, or both (µm).
+    active : ndarray of bool or bool
+        Whether the candidate is a relation.
+    birth : ndarray of int64 or int
+        The relation's number.
+
+    Returns
+    -------
+    tuple
+        ``state, xi, birth`` as the table keeps them (``active`` is kept as it is).
+    """
+    return select(active | (state == PERMANENT), state, STICK), select(active, xi, 0.0), select(active, birth, 0)
 
 
 class PairTable:

@@ -40,7 +40,7 @@ from .terms import (central_term, elastic_term, normal_speed, pair_forces, relat
 from .config import INTEGRATORS, EngineConfig
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .state import PERMANENT, SLIP, STICK, spread
+from .state import PERMANENT, SLIP, STICK, spread, synced_history
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 from . import numba_driver, numba_step
@@ -292,10 +292,9 @@ class BatchEngine:
             p = s.pairs[b]
             a = active[lo:hi].copy()
             # the classes' table: a candidate that is no relation sticks, without history or number
-            p.state = np.where(a | (state_p[lo:hi] == PERMANENT), state_p[lo:hi], STICK).astype(np.int8)
-            p.xi = np.where(a, xi[:, lo:hi], 0.0)
+            kept, p.xi, p.birth = synced_history(state_p[lo:hi], xi[:, lo:hi], a, birth[lo:hi])
+            p.state = kept.astype(np.int8)
             p.active = a
-            p.birth = np.where(a, birth[lo:hi], 0)
             p._births = int(counters[b])
             p.version += 1
 
