@@ -888,7 +888,7 @@ class TestRebuildsInBlock(unittest.TestCase):
         TestCompiledStepBits.assert_same_records(self, a[1], b[1])
         for r in range(a[0].s.B):
             np.testing.assert_array_equal(_bits(a[0].pairs_of(r).d_eq), _bits(b[0].pairs_of(r).d_eq))
-            self.assertEqual(a[0].pairs_of(r)._births, b[0].pairs_of(r)._births)
+            self.assertEqual(a[0].pairs_of(r).birth_count, b[0].pairs_of(r).birth_count)
 
     def test_same_bits_as_between_calls_and_numpy(self):
         from unittest import mock
@@ -948,3 +948,26 @@ class TestRebuildsInBlock(unittest.TestCase):
                 engines.append(eng)
             self.assertGreater(sum(counts), 0)
             TestCompiledStepBits.assert_same_engines(self, *engines)
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestWhatTheModuleKeeps(unittest.TestCase):
+    """What the compiled backend keeps for an engine (its workspace, the block slots' buffers) is
+    held beside the engine (``numba_step._HELD``), not in its attributes, and goes with it: after
+    a whole compiled run and a collection nothing is left (a value that referred to its engine
+    would keep it alive for ever)."""
+
+    def test_nothing_is_left_after_a_run(self):
+        import gc
+        from particleShear import doParticleShearSimulation
+        from particleShear.engine import numba_step
+        from unittest import mock
+        with warnings.catch_warnings(), mock.patch.object(numba_step, "_held", wraps=numba_step._held) as held:
+            warnings.simplefilter("ignore")
+            doParticleShearSimulation(N=20, seed=1, periods=1, pre_periods=0.5, post_periods=0.5,
+                                      relative_frequency=0.2, doDrawing=False, plotStress=False, verbose=False,
+                                      backend="numba")
+        self.assertTrue(held.called)          # (the run's engines were stepped compiled)
+        held.reset_mock()                     # (the spy's record of its calls held the engines)
+        gc.collect()
+        self.assertEqual(len(numba_step._HELD), 0)

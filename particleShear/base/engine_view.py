@@ -115,7 +115,7 @@ class EngineStep:
             s.pairs[0] = pairs
             eng.C = None
             eng.need[:] = True
-            eng.next_birth[...] = pairs._births
+            eng.next_birth[...] = pairs.birth_count
         elif eng.C is not None:
             self._share_history(eng)
 

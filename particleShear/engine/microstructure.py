@@ -375,7 +375,7 @@ class Stroboscope:
         pos = to_host(s.pos, "microstructure")
         r = to_host(s.r, "microstructure")
         Lx, Ly, gamma = (to_host(a, "microstructure") for a in (s.Lx, s.Ly, s.gamma))
-        shift = to_host(engine._image_shift(), "microstructure")
+        shift = to_host(engine.image_shift(), "microstructure")
         mob = to_host(engine.mobile(), "microstructure")
         C = engine.C
         ai, aj, rep = C.ai_host, C.aj_host, C.rep_host

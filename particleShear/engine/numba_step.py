@@ -37,6 +37,7 @@ import logging
 import math
 import sys
 import warnings
+import weakref
 
 import numpy as np
 
@@ -928,12 +929,25 @@ def _laws_key(engine):
     return None if key is None else key()
 
 
+#: what this module keeps for each engine (its :class:`_Workspace` under "workspace", the block
+#: slots' buffers under "slot_buffers"), dropped with the engine: the engine's own attributes stay its own
+_HELD = weakref.WeakKeyDictionary()
+
+
+def _held(engine):
+    """The dictionary of what this module keeps for ``engine`` (:data:`_HELD`)."""
+    held = _HELD.get(engine)
+    if held is None:
+        held = _HELD[engine] = {}
+    return held
+
+
 def _workspace(engine):
     """The engine's :class:`_Workspace`, rebuilt at a rebuild of the lists (new ``C``) or when its key changed."""
-    ws = engine.__dict__.get("_compiled_workspace")
+    ws = _held(engine).get("workspace")
     key, laws = _key(engine), _laws_key(engine)
     if ws is None or ws.C is not engine.C or any(a is not b for a, b in zip(ws.key, key)) or ws.laws != laws:
-        ws = engine.__dict__["_compiled_workspace"] = _Workspace(engine, key)
+        ws = _held(engine)["workspace"] = _Workspace(engine, key)
         ws.laws = laws
     return ws
 
@@ -1071,7 +1085,7 @@ def run_move(engine, dt, g):
     -------
     None or NOT_RUN
     """
-    ws = engine.__dict__.get("_compiled_workspace")       # (the force phase's: its candidates, its laws)
+    ws = _held(engine).get("workspace")       # (the force phase's: its candidates, its laws)
     if ws is None or ws.why is not None or ws.C is not engine.C or g.verdict is not None:
         return NOT_RUN
     w = ws.work
@@ -1147,13 +1161,16 @@ def _compile_tensor_kernel(cache=True):
 
 
 def _prepared(engine):
-    """The engine's workspace when its step runs compiled, else None (with the note, once per reason)."""
+    """The engine's workspace when its step runs compiled, else None, with the note: once per engine
+    and reason, shown once per process and reason by Python's default filter (the warning is issued
+    from this line, so the several engines of one run, the constitution's, the pre-equilibration's
+    and the protocol's, print it once)."""
     ws = _workspace(engine)
     if ws.why is None:
         return ws
     if ws.why not in engine.notes:
         engine.notes.add(ws.why)
-        warnings.warn(f"backend='numba': this step runs on NumPy ({ws.why})", RuntimeWarning, stacklevel=4)
+        warnings.warn(f"backend='numba': this step runs on NumPy ({ws.why})", RuntimeWarning, stacklevel=1)
     return None
 
 
@@ -1243,7 +1260,7 @@ def _fresh(ws):
 def _report(engine, ws):
     """Raise the guard's EngineInstability of the verdict the kernel wrote."""
     v = ws.verdict
-    engine._report((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
+    engine.report_verdict((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
 
 
 def _draw(engine, ws, b, mask, row):
@@ -1393,7 +1410,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         first = int(failed[failed >= 0].min())
         code = np.where(failed == first, verdicts[0], 0).astype(np.int64)
         engine.step_count = step0 + first
-        engine._report((code, verdicts[1], verdicts[2], verdicts[3]), engine.step_count)
+        engine.report_verdict((code, verdicts[1], verdicts[2], verdicts[3]), engine.step_count)
     engine.step_count = step0 + n
     return n
 
@@ -1437,7 +1454,7 @@ class _Slots:
     of the buffers ``work``, ``zero`` and the tensors' pair rows, are its own.  A rebuild writes only
     its replica's slot: nothing is copied in, and the engine's arrays are written in place until
     :func:`_settle` hands the rebuilt replicas' candidates back.  The slot arrays and buffers are
-    scratch between blocks, kept by the engine (``_slot_buffers``) while they are wide enough: new
+    scratch between blocks, kept for the engine (``_HELD``) while they are wide enough: new
     ones of this size cost page faults at every block (N = 10,000: blocks 10–40 % slower).
 
     Parameters
@@ -1466,10 +1483,10 @@ class _Slots:
         Q = int(self.cap[-1]) if len(room) else P
         # (the buffers of the engine's last block where they are wide enough: its slots are scratch, and
         # fresh arrays of this size cost page faults at every block; a quarter more room otherwise)
-        kept = engine.__dict__.get("_slot_buffers")
+        kept = _held(engine).get("slot_buffers")
         if kept is None or kept["f"].shape != (C.f.shape[0], kept["f"].shape[1]) or kept["f"].shape[1] < Q:
             W = Q + Q // 4
-            kept = engine.__dict__["_slot_buffers"] = dict(
+            kept = _held(engine)["slot_buffers"] = dict(
                 f=np.empty((C.f.shape[0], W)), i=np.empty((3, W), np.int64), b=np.empty((2, W), np.bool_),
                 state_p=np.empty(W, np.int8), xi=np.empty((2, W)), active=np.empty(W, np.bool_),
                 birth=np.empty(W, np.int64), d_eq=np.empty(W), work=np.empty((16, W)), zero=np.zeros(W, np.bool_),
@@ -1962,7 +1979,7 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, s
     ``offsets[b], ends[b]`` made the new ones; the displacement bookkeeping reset.  Returns False,
     having changed nothing, where the new list would pass ``cap[b]`` or the image offset is not
     finite (the caller rebuilds it, :func:`rebuild`)."""
-    shift = Ly[b] * gamma[b] * le[b]            # (BatchEngine._image_shift)
+    shift = Ly[b] * gamma[b] * le[b]            # (BatchEngine.image_shift)
     if not math.isfinite(shift) or N < 2:
         return False
     n0, lo, hi = b * N, offsets[b], ends[b]

@@ -308,9 +308,21 @@ class PairTable:
     def birth_count(self):
         """How many creation numbers were handed out (int): the number the next relation gets.
 
-        Read-only; :meth:`next_births` and :meth:`open_relations` advance it.
+        :meth:`next_births` and :meth:`open_relations` advance it; an engine that numbered this
+        table's relations in its own counter hands it back with :meth:`resume_births`.
         """
         return self._births
+
+    def resume_births(self, n):
+        """Go on numbering relations from ``n``: the counter an engine kept for this table while
+        its steps numbered the relations that formed (the next relation gets ``n``).
+
+        Parameters
+        ----------
+        n : int
+            The next creation number.
+        """
+        self._births = int(n)
 
     @property
     def xi_ij(self):

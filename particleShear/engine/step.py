@@ -224,7 +224,7 @@ class BatchEngine:
         self.rate_max = xp.zeros(B)
         self.step_count = 0
         #: ``next_birth``: the number the next relation of each replica gets (:attr:`numbers_relations`)
-        self.next_birth = self.backend.asarray(np.array([p._births for p in s.pairs], dtype=np.int64))
+        self.next_birth = self.backend.asarray(np.array([p.birth_count for p in s.pairs], dtype=np.int64))
         self.phase = phase        # (run state, not configuration: begin_phase sets it as the loops run)
         #: the record of the running protocol (rows written so far; None outside one): what observers read
         self.record = None
@@ -295,7 +295,7 @@ class BatchEngine:
             kept, p.xi, p.birth = synced_history(state_p[lo:hi], xi[:, lo:hi], a, birth[lo:hi])
             p.state = kept.astype(np.int8)
             p.active = a
-            p._births = int(counters[b])
+            p.resume_births(counters[b])
             p.version += 1
 
     def neighbours(self):
@@ -316,7 +316,7 @@ class BatchEngine:
         rows = np.concatenate([np.arange(b * s.N, (b + 1) * s.N) for b in changed])
         pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
         # the images' offset the force phase sees: Ly·γ, 0 for a plain periodic replica (lees_edwards)
-        shift = to_host(self._image_shift(), "rebuild")
+        shift = to_host(self.image_shift(), "rebuild")
         r, Lx, Ly, skin = self.host_consts
         # (compiled: the same pairs from the same grid, the same history merge, numba_step.rebuild)
         build = numba_step.rebuild if be.compiled else build_candidates
@@ -363,7 +363,7 @@ class BatchEngine:
         self.C.set_visits(s)
         self._frictionless()
 
-    def _image_shift(self):
+    def image_shift(self):
         """The Lees-Edwards offset ``Ly·γ`` of the images of each replica (B,), 0 for a plain periodic
         replica (:attr:`lees_edwards`)."""
         s = self.s
@@ -622,7 +622,7 @@ class BatchEngine:
         if not self.step_count % self.check_interval and self.guard.any():
             verdict = self._check(d, active)
             if self.backend.host:     # NumPy: report at once (a device reports with the flags at the end)
-                self._report(verdict, self.step_count)
+                self.report_verdict(verdict, self.step_count)
                 verdict = None
         return ForceRecord(dx, dy, nx, ny, dvx, active, yc, mob, verdict), out
 
@@ -637,7 +637,7 @@ class BatchEngine:
             ``(yc, dx, dy, ky, kx, d, touching, active, image_rate)``: the heights ``y − Ly/2`` of
             the spheres (µm), per candidate the pair vector (µm, j's nearest image minus i), its
             image periods, distance, contact and relation flags, and the rate the images move
-            with per replica (1/s; :meth:`_image_shift`, :meth:`_image_rate`).
+            with per replica (1/s; :meth:`image_shift`, :meth:`_image_rate`).
         """
         s, xp = self.s, self.xp
         self.neighbours()          # (positions at the start of the step)
@@ -645,7 +645,7 @@ class BatchEngine:
         yc = s.y - self.hy_s                            # height above the cell's centre line
         raw = s.pos.take(C.aj, axis=1)
         raw -= s.pos.take(C.ai, axis=1)
-        shift, image_rate = self._image_shift(), self._image_rate()
+        shift, image_rate = self.image_shift(), self._image_rate()
         dx, dy, ky, kx = self._images(raw[0], raw[1], spread(shift, C.rep, s.B))
         d = xp.sqrt(dx * dx + dy * dy)
         touching = d < C.d0
@@ -849,7 +849,7 @@ class BatchEngine:
         s, xp = self.s, self.xp
         rate_s = spread(self._image_rate(), s.rep, s.B)
         s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
-        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, spread(self._image_shift(), s.rep, s.B), rate_s)
+        wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, spread(self.image_shift(), s.rep, s.B), rate_s)
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = None if g is None else g.verdict
@@ -857,7 +857,7 @@ class BatchEngine:
         flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
         self.need = flags[:s.B]
         if verdict is not None and flags[s.B:].any():
-            self._report(verdict, self.step_count)
+            self.report_verdict(verdict, self.step_count)
         self.step_count += 1
 
     def _check(self, d, active):
@@ -873,8 +873,23 @@ class BatchEngine:
                                         self.max_kinetic_energy)
         return code * self.guard_dev, ke, bound, closest
 
-    def _report(self, verdict, step):
-        """Raise :class:`EngineInstability` for the first guarded replica whose verdict is not sound."""
+    def report_verdict(self, verdict, step):
+        """Raise :class:`EngineInstability` for the first guarded replica whose verdict is not sound
+        (the step-by-step loop's check, and the compiled blocks' report of theirs).
+
+        Parameters
+        ----------
+        verdict : tuple of array
+            ``(code, kinetic energy, its bound, closest contact ratio)`` per replica
+            (:func:`~particleShear.engine.guard.verdict_code`; code 0: sound).
+        step : int
+            The step the verdict is of (reported in the exception).
+
+        Raises
+        ------
+        EngineInstability
+            For the first replica whose code is not 0.
+        """
         code = to_host(verdict[0], "guard")
         bad = np.flatnonzero(code)
         if not len(bad):
