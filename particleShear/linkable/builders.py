@@ -543,9 +543,7 @@ class _StateTarget:
         self.skin_factor = skin_factor
         self.size_x, self.size_y = r.size_x, r.size_y
         self.avoid_horizontal_angle_degree = r.avoid_horizontal_angle_degree
-        self.r_max = 0
-        for p in range(c.N):
-            self.r_max = max(self.r_max, float(radius[p]))
+        self.r_max = float(radius.max()) if c.N else 0
         self.mu = r.mu
         self.dt, self.dt_max = c.dt, c.dt_max
         self.removed_fraction = 0

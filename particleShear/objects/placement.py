@@ -62,6 +62,6 @@ def bimodal_placement(rng, N, Lx, Ly, packing_fraction, lower, upper, m):
     large = rng.integers(0, 2, N)
     xs = rng.integers(0, int(Lx), N) if Lx >= 1 else rng.random(N) * Lx
     ys = rng.integers(0, int(Ly), N) if Ly >= 1 else rng.random(N) * Ly
-    r = np.array([r_b * (lower + (upper - lower) * int(large[p])) for p in range(N)])
-    mass = np.array([adjust_m(m, float(r[p]), r_b) for p in range(N)])
+    r = r_b * (lower + (upper - lower) * large)      # (element by element: the reference's scalar arithmetic)
+    mass = adjust_m(m, r, r_b)
     return xs.astype(float), ys.astype(float), r, mass
