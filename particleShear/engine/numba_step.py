@@ -1523,9 +1523,9 @@ def _settle(engine, slots):
     candidates side by side again (the rebuilt replicas' from their slots, the others' from the
     engine's arrays) as the engine's constants
     (:meth:`~particleShear.engine.forces.PairConstants.from_blocks`) and history, each rebuilt
-    replica's pair table made its new list (its history written as
-    :meth:`~particleShear.engine.step.BatchEngine._sync_down` writes it).  Nothing where no list
-    was rebuilt (the kernel wrote the engine's history in place)."""
+    replica's pair table made its new list, all taken by
+    :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`.  Nothing where no list was
+    rebuilt (the kernel wrote the engine's history in place)."""
     rebuilt = np.flatnonzero(slots.rebuilt)
     if not len(rebuilt):
         return
@@ -1544,19 +1544,14 @@ def _settle(engine, slots):
         for src, which in ((own, kept), (slot, rebuilt)):
             if len(which):
                 _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
-    for name, a in zip(names, history):
-        setattr(engine, name, a)
-    engine.C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
-    engine.C.set_visits(s)
+    C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
     N = s.N
     for r in rebuilt:
         lo, hi = offsets[r], offsets[r + 1]
         key = (i[1, lo:hi] - r * N).astype(np.int64) << 32 | (i[2, lo:hi] - r * N)
         s.pairs[r].adopt(key, history[0][lo:hi], d_eq[lo:hi].copy(), history[2][lo:hi], history[3][lo:hi],
                          history[1][:, lo:hi])
-    engine._sync_down(rebuilt)       # (the tables' history: what the engine writes back)
-    engine.rebuilds += slots.rebuilt
-    engine._frictionless()
+    engine.adopt_candidates(C, history, slots.rebuilt)
 
 
 def _columns(src, lo, hi, dst, at):

@@ -397,6 +397,29 @@ class BatchEngine:
             C.images = (C.Ly * ky, ky, C.Lx * kx, kx) if one else None
         return dx, dy, ky, kx
 
+    def adopt_candidates(self, C, history, counts):
+        """Take candidate lists rebuilt elsewhere (a compiled block's, :func:`~particleShear.engine.numba_step._settle`)
+        as what :meth:`neighbours` leaves after the same rebuilds: the constants ``C`` and the flat
+        history of every replica, the rebuilt replicas' pair tables written as :meth:`flush` writes
+        them, their rebuild counts, the frictionless replicas anew.
+
+        Parameters
+        ----------
+        C : PairConstants
+            The candidates of every replica, side by side.
+        history : tuple of ndarray
+            ``(state_p, xi, active, birth)`` of those candidates.
+        counts : ndarray of int (B,)
+            How many times each replica's list was rebuilt (the rebuilt ones' pair tables hold
+            their new lists already).
+        """
+        self.state_p, self.xi, self.active, self.birth = history
+        self.C = C
+        C.set_visits(self.s)
+        self._sync_down(np.flatnonzero(counts))
+        self.rebuilds += counts
+        self._frictionless()
+
     def flush(self):
         """Write the flat pair history back into ``state.pairs`` (after a phase)."""
         if self.C is not None:
