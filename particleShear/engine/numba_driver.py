@@ -95,10 +95,46 @@ def cache_dir():
     return folder
 
 
+#: the start of the symbols of this package's compiled engine functions (Numba's mangled names:
+#: ``_ZN`` and the lengths and names of ``particleShear.engine``)
+OWN_SYMBOLS = "_ZN13particleShear6engine"
+
+
+def _indices_as_given():
+    """Index arrays in this package's compiled engine functions without the wrap of negative indices.
+
+    Numba treats a signed integer index as Python does (``a[-1]`` is the last element): every
+    ``a[i]`` with a signed ``i`` tests ``i < 0`` and adds the length, a few instructions on each of the
+    compiled step's many gathers (``pos[0, Ci[1, p]]``, ``Cf[_ILX, p]``, …), about a sixth of its
+    time.  The engine's compiled functions (those whose symbol starts with :data:`OWN_SYMBOLS`)
+    never index with a negative number, so their indices are taken as they are (what Numba does for
+    an unsigned index); every other function Numba compiles (a user's law, Numba's own library)
+    keeps the wrap.  The same addresses, so the same bits; once per process, before any compile
+    (it changes how the code is generated, not what it computes for the engine's indices).  Where
+    Numba's ``numba.np.arrayobj.fix_integer_index`` is not there (another Numba), nothing changes.
+    """
+    try:
+        from numba.core import types
+        from numba.np import arrayobj
+    except ImportError:          # pragma: no cover
+        return
+    given = getattr(arrayobj, "fix_integer_index", None)
+    if given is None or getattr(given, "own_symbols", None) == OWN_SYMBOLS:
+        return
+
+    def fix_integer_index(context, builder, idxty, idx, size):
+        if idxty.signed and builder.function.name.startswith(OWN_SYMBOLS):
+            return context.cast(builder, idx, idxty, types.uintp)
+        return given(context, builder, idxty, idx, size)
+
+    fix_integer_index.own_symbols = OWN_SYMBOLS
+    arrayobj.fix_integer_index = fix_integer_index
+
+
 def register_helpers():
     """Register :func:`~particleShear.engine.xp.select`, :func:`~particleShear.engine.xp.maximum` and
     :func:`~particleShear.engine.xp.minimum` with Numba for numbers (``a if cond else b``, ``max``,
-    ``min``); once per process.
+    ``min``), and take the engine's array indices as given (:func:`_indices_as_given`); once per process.
 
     Raises
     ------
@@ -107,6 +143,7 @@ def register_helpers():
     """
     from numba.extending import overload
 
+    _indices_as_given()
     if id(xp.select) not in _registered:
         @overload(xp.select)
         def _select(cond, a, b):
