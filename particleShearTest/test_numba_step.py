@@ -959,6 +959,7 @@ class TestWhatTheModuleKeeps(unittest.TestCase):
 
     def test_nothing_is_left_after_a_run(self):
         import gc
+        import weakref
         from particleShear import doParticleShearSimulation
         from particleShear.engine import numba_step
         from unittest import mock
@@ -967,7 +968,30 @@ class TestWhatTheModuleKeeps(unittest.TestCase):
             doParticleShearSimulation(N=20, seed=1, periods=1, pre_periods=0.5, post_periods=0.5,
                                       relative_frequency=0.2, doDrawing=False, plotStress=False, verbose=False,
                                       backend="numba")
-        self.assertTrue(held.called)          # (the run's engines were stepped compiled)
+        engines = [weakref.ref(c.args[0]) for c in held.call_args_list]
+        self.assertTrue(engines)              # (the run's engines were stepped compiled)
         held.reset_mock()                     # (the spy's record of its calls held the engines)
         gc.collect()
-        self.assertEqual(len(numba_step._HELD), 0)
+        # this run's engines are gone, and nothing is kept for them (other tests' live engines may be)
+        self.assertEqual([r for r in engines if r() is not None], [])
+        self.assertFalse(any(e in numba_step._HELD for e in (r() for r in engines) if e is not None))
+
+
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestIndicesAsGiven(unittest.TestCase):
+    """``numba_driver._indices_as_given`` takes signed indices as given only in the package's own
+    compiled engine functions: a function compiled elsewhere (a user's law, a script) still reads
+    ``a[-1]`` as the last element, as Python does."""
+
+    def test_negative_index_elsewhere_wraps(self):
+        import numba
+        from particleShear.engine import numba_driver
+        numba_driver.register_helpers()
+
+        @numba.njit(cache=False)
+        def last(a, k):
+            return a[k]
+
+        a = np.arange(5.0)
+        self.assertEqual(last(a, -1), 4.0)
+        self.assertEqual(last(a, -5), 0.0)

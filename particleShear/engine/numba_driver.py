@@ -24,6 +24,7 @@ __docformat__ = "numpy"
 
 import hashlib
 import importlib
+import inspect
 import os
 import sys
 import tempfile
@@ -111,7 +112,8 @@ def _indices_as_given():
     an unsigned index); every other function Numba compiles (a user's law, Numba's own library)
     keeps the wrap.  The same addresses, so the same bits; once per process, before any compile
     (it changes how the code is generated, not what it computes for the engine's indices).  Where
-    Numba's ``numba.np.arrayobj.fix_integer_index`` is not there (another Numba), nothing changes.
+    Numba's ``numba.np.arrayobj.fix_integer_index`` is not there or has another signature (another
+    Numba), nothing changes.
     """
     try:
         from numba.core import types
@@ -120,6 +122,11 @@ def _indices_as_given():
         return
     given = getattr(arrayobj, "fix_integer_index", None)
     if given is None or getattr(given, "own_symbols", None) == OWN_SYMBOLS:
+        return
+    try:        # (only the function this was written against: another signature, another Numba)
+        if list(inspect.signature(given).parameters) != ["context", "builder", "idxty", "idx", "size"]:
+            return
+    except (TypeError, ValueError):          # pragma: no cover
         return
 
     def fix_integer_index(context, builder, idxty, idx, size):
