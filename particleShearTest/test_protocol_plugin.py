@@ -115,7 +115,10 @@ class TestOneFileProtocol(unittest.TestCase):
         assert not cls.protocol_file.exists(), "the package ships no ramp protocol"
         cls.protocol_file.write_text(design_block(), encoding="utf-8")      # the one step
         cls.copy = copy
-        env = dict(os.environ, PYTHONPATH=str(copy), PYTHONDONTWRITEBYTECODE="1")
+        # NumPy in the copy: Numba keys its cache by the source files' folder, so the copy's compiled
+        # loops would be compiled anew (≈ 50 s of the suite); what is added by one file does not
+        # depend on the backend, and the compiled backend is tested on the package itself
+        env = dict(os.environ, PYTHONPATH=str(copy), PYTHONDONTWRITEBYTECODE="1", PARTICLESHEAR_BACKEND="numpy")
         proc = subprocess.run([sys.executable, "-c", CHECK, str(copy), str(cls.tmp)], capture_output=True,
                               text=True, env=env, cwd=str(cls.tmp), timeout=900)
         cls.proc = proc
