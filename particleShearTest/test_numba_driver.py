@@ -120,6 +120,19 @@ def _python_only_law(d, d0, k, c):
     return -k * (d0 - d) * _SCALE["linear"]
 
 
+def _stiffening_law(d, d0, k, c):
+    """A user's law: the linear law stiffening with the relative overlap δ/d0 and its square root
+    (arithmetic and sqrt only)."""
+    x = (d0 - d) / d0
+    return -k * (d0 - d) * (1.0 + 0.5 * x + 0.1 * np.sqrt(np.abs(x)))
+
+
+def _three_halves_law(d, d0, k, c):
+    """A user's law: a Hertz-like force ``−k·d0·(δ/d0)^{3/2}`` written with ``**``."""
+    x = np.abs(d0 - d) / d0
+    return -k * d0 * x ** 1.5
+
+
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestNumbaBackendRuns(unittest.TestCase):
     """backend="numba" steps the engine in the compiled step: the whole measurement (pre-equilibration
@@ -175,17 +188,87 @@ class TestNumbaBackendRuns(unittest.TestCase):
             self.assert_same(single, both, (0, n))
 
     def test_fallback_is_announced(self):
-        """A user's contact law (not among the laws compiled bit for bit) runs on NumPy, with a note,
-        and gives NumPy's numbers."""
+        """A user's contact law Numba cannot compile (it reads a dict) runs on NumPy, with a note
+        naming why, and gives NumPy's numbers."""
         from particleShear.engine.laws import register_law, unregister_law
         register_law("python_only", _python_only_law)
         try:
             scenes = [(0, dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))]
-            with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*python_only.*not among the laws compiled"):
+            with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*Numba cannot compile"):
                 _, got = self.measure(scenes, "numba", law=("python_only", ()))
             self.assert_same(self.measure(scenes, "numpy", law=("python_only", ()))[1], got)
         finally:
             unregister_law("python_only")
+
+    SCENE = [(0, dict(theMu=0.3, do_permanent_links=False, cut_lines=0, theAmplitude=0.1))]
+
+    def test_user_law_of_rounded_operations_runs_compiled(self):
+        """A user's law of arithmetic and sqrt (each operation correctly rounded by IEEE 754, so the
+        same bits in NumPy's loops and in Numba's scalar code) runs compiled — no note — and its
+        measurement equals NumPy's bit for bit; it changes the forces (not the built-in law)."""
+        from particleShear.engine.laws import register_law, unregister_law
+        register_law("stiffening", _stiffening_law)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", RuntimeWarning)        # compiled: no fallback note
+                e_nb, got = self.measure(self.SCENE, "numba", law=("stiffening", ()))
+            e_np, want = self.measure(self.SCENE, "numpy", law=("stiffening", ()))
+            self.assert_same(want, got)
+            np.testing.assert_array_equal(_bits(e_np.s.pos), _bits(e_nb.s.pos))
+            _, linear = self.measure(self.SCENE, "numpy")
+            self.assertFalse(np.array_equal(linear["stress_surface"], want["stress_surface"]))
+        finally:
+            unregister_law("stiffening")
+
+    def test_user_law_with_a_transcendental_function(self):
+        """A user's law with ``**`` of a fractional exponent: where the check finds its compiled bits
+        differ from NumPy's on this machine it runs on NumPy with a note saying so; either way the
+        measurement on ``"numba"`` equals NumPy's bit for bit."""
+        from particleShear.engine import law_check
+        from particleShear.engine.laws import register_law, unregister_law
+        register_law("three_halves", _three_halves_law)
+        try:
+            d0 = np.array([50.0, 61.3])
+            rows = np.array([[50.0, 61.3], [3.1e9, 2.2e9], [0.3, 0.3]])
+            verdict = law_check.law_bits("three_halves", _three_halves_law, rows, d0)
+            with warnings.catch_warnings(record=True) as seen:
+                warnings.simplefilter("always", RuntimeWarning)
+                _, got = self.measure(self.SCENE, "numba", law=("three_halves", ()))
+            notes = [str(w.message) for w in seen if "three_halves" in str(w.message)]
+            if verdict is None:
+                self.assertEqual(notes, [])
+            else:
+                self.assertRegex(verdict, r"differs from NumPy in the last bit for [1-9]\d* of 512 ")
+                self.assertTrue(notes and "runs on NumPy" in notes[0], notes)
+            self.assert_same(self.measure(self.SCENE, "numpy", law=("three_halves", ()))[1], got)
+        finally:
+            unregister_law("three_halves")
+
+    def test_a_law_whose_bits_differ_runs_on_numpy(self):
+        """Fault injection: a check that sees the compiled law one ulp away from NumPy's values sends
+        the step to NumPy with the note, and the measurement stays NumPy's."""
+        from unittest import mock
+
+        from particleShear.engine import law_check
+        from particleShear.engine.laws import register_law, unregister_law
+        register_law("stiffening_off", _stiffening_law)
+        real = law_check._probe
+
+        def one_ulp_away(function, m):
+            kernel = real(function, m)
+
+            def probe(d, A, out):
+                kernel(d, A, out)
+                out[:] = np.nextafter(out, np.inf)
+            return probe
+
+        try:
+            with mock.patch.object(law_check, "_probe", one_ulp_away):
+                with self.assertWarnsRegex(RuntimeWarning, "runs on NumPy .*stiffening_off.* differs from NumPy"):
+                    _, got = self.measure(self.SCENE, "numba", law=("stiffening_off", ()))
+            self.assert_same(self.measure(self.SCENE, "numpy", law=("stiffening_off", ()))[1], got)
+        finally:
+            unregister_law("stiffening_off")
 
 
 class TestNumbaStaysOptional(unittest.TestCase):

@@ -41,7 +41,7 @@ import weakref
 
 import numpy as np
 
-from . import box, forces, guard, integrate, laws, neighbours, numba_driver, state, stress, terms
+from . import box, forces, guard, integrate, law_check, laws, neighbours, numba_driver, state, stress, terms
 from .box import MAX_PASSES, folded, period_count
 from .forces import pair_roles, pair_rows, shear_from_sums, shear_rows
 from .guard import energy_bound, kinetic_term, transient_ratio, verdict_code
@@ -202,11 +202,7 @@ def reason(engine):
     got = _phase_law(s, C)
     if got is None:
         return "a law callback of the documented classes that is a function of its own"
-    if got[0] not in COMPILED_LAWS:
-        return (f"contact_law={got[0]!r} is not among the laws compiled bit for bit ({', '.join(COMPILED_LAWS)}): "
-                "compiled code may round its functions (e.g. ** with a fractional exponent) in the last bit "
-                "otherwise than NumPy")
-    return None
+    return None    # (a law outside COMPILED_LAWS is checked bit for bit by the workspace: law_check.law_bits)
 
 
 def _phase_law(s, C):
@@ -766,11 +762,7 @@ def _law_kernels(function, m, say=None, parallel=False):
     except (OSError, TypeError):
         h.update(function.__code__.co_code)
     suffix = "__" + h.hexdigest()[:12]
-    law = numba_driver.jit_deep(function)
-    source = "def _central_law(d, a):\n    return LAW(d" + "".join(f", a[{i}]" for i in range(m)) + ")\n"
-    namespace = {"LAW": law}
-    exec(source, namespace)           # (an adapter of m arguments; numbers only, so no reference counts)
-    adapter = numba.njit(namespace["_central_law"], inline="always")
+    adapter = law_check.law_adapter(function, m)
     names = ("pair_term", "_step_kernel", "_block_kernel")
     extra, rename = _linear()
     L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
@@ -813,17 +805,21 @@ def compile_kernels(say=None, law=None):
     if law is None:
         return
     found = get_law(law)
-    if found.name not in COMPILED_LAWS:
+    if found.name == "linear" and not found.parameters:     # (the built-in law: no variant, phase_laws.run_law)
         return
+    values = tuple(float(v) for v in found.parameters.values())
+    pair = ((2.0, 1.0, 1.0) if found.radii else (2.0,)) + (1.0, 0.5) + values   # (d0, [r_i, r_j,] k, c, parameters)
     if found.prepared is None:
-        function, m = found.function, (5 if found.radii else 3) + len(found.parameters)
+        function, arguments = found.function, pair
     else:      # (as many constants as the law prepares: its constants of one pair, at its defaults)
         constants, function = found.prepared
-        values = tuple(float(v) for v in found.parameters.values())
-        m = len(constants(*((2.0, 1.0, 1.0) if found.radii else (2.0,)), 1.0, 0.5, *values))
+        arguments = tuple(constants(*pair))
+    m = len(arguments)
     if m <= numba_driver.LAW_SLOTS:
-        try:
-            _law_kernels(function, m, say, parallel)
+        try:     # (a law outside COMPILED_LAWS is compiled where its bits are NumPy's at these arguments)
+            rows = np.array(arguments, dtype=float).reshape(m, 1)
+            if found.name in COMPILED_LAWS or law_check.law_bits(found.name, function, rows, np.array([2.0])) is None:
+                _law_kernels(function, m, say, parallel)
         except Exception:      # (the step notes it and runs on NumPy)
             pass
 
@@ -877,7 +873,7 @@ class _Workspace:
         # the phase's law (_phase_law: the run's law or a registered callback): its function and its
         # arguments per candidate, rows of law_rows
         got = _phase_law(s, C) if self.why is None else None
-        got = None if got is None else got[1:]
+        name, got = (None, None) if got is None else (got[0], got[1:])
         if got is not None and len(got[1]) > numba_driver.LAW_SLOTS:
             self.why, got = f"a contact law of more than {numba_driver.LAW_SLOTS} arguments after d", None
         self.custom = got is not None
@@ -887,8 +883,11 @@ class _Workspace:
             for k, a in enumerate(got[1]):
                 self.law_rows[k] = np.broadcast_to(np.asarray(a, dtype=float), (C.P,))
             self.law = (got[0], len(got[1]))
-            try:
-                _law_kernels(*self.law, say=logging.getLogger(__name__).info)   # (a first compile, announced)
+            try:      # (a law outside COMPILED_LAWS runs compiled only where its bits are NumPy's)
+                if name not in COMPILED_LAWS:
+                    self.why = law_check.law_bits(name, got[0], self.law_rows[:len(got[1])], C.f[_ID0])
+                if self.why is None:
+                    _law_kernels(*self.law, say=logging.getLogger(__name__).info)   # (a first compile, announced)
             except Exception as exc:          # (a law Numba cannot compile: NumPy runs it)
                 self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
