@@ -181,6 +181,7 @@ ENGINE_MODULES = [
     "particleShear.engine.memory",
     "particleShear.engine.neighbours",
     "particleShear.engine.numba_driver",
+    "particleShear.engine.law_check",
     "particleShear.engine.numba_step",
     "particleShear.engine.observers",
     "particleShear.engine.microstructure",
