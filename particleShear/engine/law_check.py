@@ -27,7 +27,7 @@ import numpy as np
 
 from . import numba_driver
 
-__all__ = ["PROBE_FACTORS", "MAX_PROBED_CANDIDATES", "law_adapter", "law_bits"]
+__all__ = ["PROBE_FACTORS", "MAX_PROBED_CANDIDATES", "MAX_PARAMETER_VALUES", "law_adapter", "law_bits"]
 
 #: the centre distances of the check in units of each candidate's contact distance ``d0``: 256
 #: values between 0.5·d0 (a deep overlap) and 1.05·d0 (just apart), spread by the golden ratio so that
@@ -36,6 +36,10 @@ PROBE_FACTORS = 1.05 - 0.55 * ((np.arange(256) * 0.6180339887498949) % 1.0)
 
 #: the most candidates whose arguments the check takes (evenly spaced; 256 values each)
 MAX_PROBED_CANDIDATES = 64
+
+#: a row of a law's arguments with at most this many distinct values is a parameter (k, c, the law's
+#: own) whose values key the kept verdict; one with more is geometry (d0, radii) and does not
+MAX_PARAMETER_VALUES = 64
 
 _kept = {}
 
@@ -112,6 +116,8 @@ def law_bits(name, function, rows, d0):
     str or None
         None where every probed value has the same bits both ways (NaN matching NaN); else why
         the law runs on NumPy (how many of how many values differ), a text for the step's note.
+        Kept per process for the law and the values of its parameter rows
+        (:data:`MAX_PARAMETER_VALUES`): the candidates of later rebuilds reuse it.
 
     Raises
     ------
@@ -122,6 +128,19 @@ def law_bits(name, function, rows, d0):
     m, P = rows.shape
     if P == 0:
         return None
+    # the verdict is kept per law and per values of its parameter-like rows (those with few distinct
+    # values: k, c, the law's own parameters), not of its geometric rows (d0, radii: new at every
+    # rebuild of the candidate lists), so a run checks its law once, not at every rebuild
+    distinct = [np.unique(row) for row in rows]
+    key = ("verdict", function, m) + tuple(u.tobytes() for u in distinct if len(u) <= MAX_PARAMETER_VALUES)
+    if key not in _kept:
+        _kept[key] = _verdict(name, function, rows, d0)
+    return _kept[key]
+
+
+def _verdict(name, function, rows, d0):
+    """:func:`law_bits` evaluated (not kept)."""
+    m, P = rows.shape
     take = np.unique(np.linspace(0, P - 1, min(P, MAX_PROBED_CANDIDATES)).round().astype(np.int64))
     K = len(PROBE_FACTORS)
     d = (np.asarray(d0, dtype=float)[take][None, :] * PROBE_FACTORS[:, None]).ravel()
