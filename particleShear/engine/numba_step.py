@@ -112,9 +112,10 @@ _ARGUMENTS = ("i i i i f f i b b b i b f[:,:] b i f[:,:] i b[:] b b[:] f[:,:] f[
               "b f[:,:] f[:,:] b").split()                                  # keep, kt, ktot, forces_only
 
 #: the contact laws of the laws folder whose compiled form is checked bit for bit against NumPy's
-#: (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and min.  The
-#: compiled step runs another law on NumPy (a law's ``**`` or ``exp`` may round otherwise in the
-#: last bit in compiled code, which would break "the same bits on every backend")
+#: by the tests (particleShearTest/test_numba_step.py): pure expressions of arithmetic, sqrt, max and
+#: min.  Another law runs compiled where :func:`~.law_check.law_bits` finds NumPy's bits on the
+#: run's candidates (a law's ``**`` or ``exp`` may round otherwise in the last bit in compiled
+#: code), else on NumPy with a note
 COMPILED_LAWS = ("hertz", "plateau")
 
 #: what :func:`run_step` returns when the step was not run (the NumPy step runs it)
@@ -175,7 +176,8 @@ def reason(engine):
     strains advancing or held (:attr:`~particleShear.engine.step.BatchEngine.strain_advances`), replicas with
     and without friction and bonds, spheres with parameters of their own under the linear law (the
     visit from j with its own constants, ``C.Kj``), the linear law
-    from the prepared constants or a run's contact law of :data:`COMPILED_LAWS`, the tensile law
+    from the prepared constants or a run's contact law (those of :data:`COMPILED_LAWS`; any other where
+    Numba compiles it with NumPy's bits, checked by the workspace: :func:`~.law_check.law_bits`), the tensile law
     of bonds, no force register, samples of the two shear stresses and of every tensor of
     :data:`~.stress.TENSORS` (their rows summed per replica in NumPy's order, :func:`~.stress.tensors_from_sums`).
 
