@@ -119,6 +119,14 @@ class BatchEngine:
     whose fields the engine also shows as read-only properties (``engine.integrator``,
     ``engine.keep_terms`` …); an engine configured otherwise is a new engine.
 
+    What the steps change is the state's: the spheres, boxes, strain, rate and clock, and the
+    contacts ``state.contacts`` (:class:`~particleShear.engine.contacts.Contacts`: the candidates
+    with their constants and relation history, the bookkeeping of the Verlet lists), which the
+    engine starts anew at its construction (every list built at the first step from
+    ``state.pairs``).  The engine keeps of the run only the Verlet predictor :attr:`half`, the
+    guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s), the step count
+    ``step_count``, the ``phase``, the protocol's ``record`` and the register's ``terms``.
+
     Parameters
     ----------
     state : BatchState
