@@ -110,15 +110,15 @@ def compare(n, steps, block, scene):
     eng = BatchEngine(state_from_ensembles([ens]), skin_factor=ENGINE_SKIN_FACTOR)   # as a run's engine
     run_engine(eng, 5)                 # warm-up (the first list build is not timed)
     run_classes(5)
-    rebuilds0 = int(eng.rebuilds[0])
+    rebuilds0 = int(eng.s.contacts.rebuilds[0])
     te, tc = [], []
     for _ in range(max(1, steps // block)):
         te.append(run_engine(eng, block) / block)
         tc.append(run_classes(block) / block)
     e_us, c_us = statistics.median(te) * 1e6, statistics.median(tc) * 1e6
-    pairs = len(eng.C.ai)
+    pairs = len(eng.s.contacts.C.ai)
     print(f"{scene} N = {n:7d}: engine {e_us:10.1f} µs/step = {1e3 * e_us / n:6.0f} ns/particle-step "
-          f"({int(eng.rebuilds[0]) - rebuilds0} rebuilds in {len(te) * block} steps, {pairs} candidates); "
+          f"({int(eng.s.contacts.rebuilds[0]) - rebuilds0} rebuilds in {len(te) * block} steps, {pairs} candidates); "
           f"classes {c_us:10.1f} µs/step = {1e3 * c_us / n:6.0f} ns/particle-step; "
           f"engine/classes = {e_us / c_us:.2f}  [L = {ens.size_x:.0f} µm, build {t_build:.1f} s]", flush=True)
     return e_us / n, c_us / n

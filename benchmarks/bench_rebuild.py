@@ -47,7 +47,7 @@ def main():
                     t0 = time.process_time()
                     for q in range(K):
                         if forced:
-                            e.need[(blk * K + q) * 7 % 32] = True
+                            e.s.contacts.need[(blk * K + q) * 7 % 32] = True
                         e.set_rate(A * np.cos(w * float(s.t[0])) * w)
                         e.step(cool, dt, sample=True)
                     us = 1e6 * (time.process_time() - t0) / K

@@ -171,6 +171,7 @@ ENGINE_MODULES = [
     "particleShear.engine",
     "particleShear.engine.box",
     "particleShear.engine.config",
+    "particleShear.engine.contacts",
     "particleShear.engine.forces",
     "particleShear.engine.graph",
     "particleShear.engine.guard",

@@ -264,7 +264,7 @@ class TestFrictionlessReplicaDrawsNothingForXi(unittest.TestCase):
         for _ in range(6 + 1):
             expected.random()
         self.assertEqual(batch.rng[0].random(), expected.random())
-        self.assertTrue(np.any(runs[2].xi[:, 1] != 0.0))        # the frictional pair sticks and integrates ξ
+        self.assertTrue(np.any(runs[2].s.contacts.xi[:, 1] != 0.0))        # the frictional pair sticks and integrates ξ
 
 
 class TestStressRegistry(unittest.TestCase):
@@ -318,7 +318,7 @@ class TestStressRegistry(unittest.TestCase):
             batch = BatchEngine(state_from_ensembles([scene(seed)[0] for seed in (3, 4)]), guard=False)
             dt = scene(3)[1]["dt"]
             runs[sample] = [[e.step(0.999, dt, sample=sample) for _ in range(20)] for e in engines + [batch]]
-            self.assertIsNotNone(batch.C.Kj)
+            self.assertIsNotNone(batch.s.contacts.C.Kj)
         for k in range(20):
             for b in range(2):
                 for r in range(2):      # τ_internal, τ_surface: single run, with or without tensors, batch
@@ -450,10 +450,10 @@ class TestVerletListKeepsEveryContact(unittest.TestCase):
             dx, dy, _, _ = min_image(s.x[j] - s.x[i], s.y[j] - s.y[i], Lx, Ly, Ly * s.gamma[0])
             touching = set(zip(i[np.hypot(dx, dy) < s.r[i] + s.r[j]].tolist(),
                                j[np.hypot(dx, dy) < s.r[i] + s.r[j]].tolist()))
-            cand = set(zip((eng.C.ai).tolist(), (eng.C.aj).tolist()))
+            cand = set(zip((eng.s.contacts.C.ai).tolist(), (eng.s.contacts.C.aj).tolist()))
             self.assertLessEqual(touching, cand, f"step {step}")
             eng.step(1.0, sc["dt"])
-        self.assertGreater(int(eng.rebuilds[0]), 3)
+        self.assertGreater(int(eng.s.contacts.rebuilds[0]), 3)
         self.assertGreater(abs(s.gamma[0]), 0.01)
 
 

@@ -192,7 +192,7 @@ class TestEngineWithTheCellList(unittest.TestCase):
                     eng.step(1.0, dt)
                 eng.flush()
                 runs.append((s.pos.copy(), s.vel.copy(), [(p.i.copy(), p.j.copy()) for p in s.pairs],
-                             int(eng.rebuilds[0])))
+                             int(eng.s.contacts.rebuilds[0])))
         (pos_c, vel_c, pairs_c, nb_c), (pos_a, vel_a, pairs_a, nb_a) = runs
         self.assertGreater(nb_c, 3)
         self.assertEqual(nb_c, nb_a)

@@ -107,10 +107,13 @@ class TestSplicedConstants(unittest.TestCase):
         for changed in ([1], [0, 3], [3], [0]):
             with self.subTest(changed=changed):
                 s.x[:] = (s.x + 3.0) % s.Lx[s.rep]            # moved: the rebuilt lists differ
-                engine.bound[:] = 0.0
-                engine.bound[changed] = np.inf
+                contacts = s.contacts
+                contacts.need[:] = False
+                contacts.need[changed] = True
+                before = contacts.rebuilds.copy()
                 engine.neighbours()
-                C = engine.C
+                np.testing.assert_array_equal(contacts.rebuilds - before, np.isin(np.arange(s.B), changed))
+                C = contacts.C
                 engine.flush()                                 # every replica's list with its history
                 offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
                 full = PairConstants(s, offsets)

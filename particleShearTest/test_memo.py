@@ -118,7 +118,7 @@ class TestCanvasMemo(unittest.TestCase):
     def _constants(self):
         """The per-candidate constants of the last force phase and the table rows they describe."""
         ens = self.ens
-        C = ens._engine.C
+        C = ens._engine.s.contacts.C
         pt = ens.pair_table
         return C, pt.find(C.ai, C.aj)
 
@@ -231,10 +231,10 @@ class TestCanvasMemo(unittest.TestCase):
 
     def test_edited_relations_renew_the_constants(self):
         ens = self.ens
-        C = ens._engine.C
+        C = ens._engine.s.contacts.C
         ens._relations_edited()
         ens.mechanical_simulation_step_calculate_forces()
-        self.assertIsNot(ens._engine.C, C)
+        self.assertIsNot(ens._engine.s.contacts.C, C)
 
 
 if __name__ == "__main__":

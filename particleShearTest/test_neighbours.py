@@ -156,7 +156,7 @@ class TestEnsembleRelationsDuringShear(unittest.TestCase):
         ens.setShearRate(0.25)  # 0.025 strain per step: the offset passes Lx/Ly·γ = 1 during the run
         ens.test_neighbor_relation()
         engine = ens._engine                      # the ensemble's step (kept while nothing is edited)
-        rebuilds = int(engine.rebuilds[0])
+        rebuilds = int(engine.s.contacts.rebuilds[0])
         boundary_pairs = 0
         stretched_links = 0
         dt = 0.1
@@ -187,7 +187,7 @@ class TestEnsembleRelationsDuringShear(unittest.TestCase):
         self.assertGreater(stretched_links, 0)
         # the Verlet list was rebuilt several times (and not at every step) during the run
         self.assertIs(ens._engine, engine)
-        calls = int(engine.rebuilds[0]) - rebuilds
+        calls = int(engine.s.contacts.rebuilds[0]) - rebuilds
         self.assertGreater(calls, 3)
         self.assertLess(calls, 120)
 

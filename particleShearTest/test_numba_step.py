@@ -57,7 +57,7 @@ class TestCompiledStepBits(unittest.TestCase):
                 np.testing.assert_array_equal(getattr(p, key), getattr(q, key), err_msg=key)
             np.testing.assert_array_equal(_bits(p.xi), _bits(q.xi), err_msg="xi")
         self.assertEqual(a.step_count, b.step_count)
-        np.testing.assert_array_equal(a.rebuilds, b.rebuilds)
+        np.testing.assert_array_equal(a.s.contacts.rebuilds, b.s.contacts.rebuilds)
 
     def assert_same_records(self, a, b):
         for key in ("t", "strain", "strain_rate", "stress_internal", "stress_surface"):
@@ -394,7 +394,7 @@ class TestCompiledStepBits(unittest.TestCase):
                 samples.append([eng.step(0.999, ens[0].dt, sample=True) for _ in range(5)]
                                + [eng.step(0.999, ens[0].dt, sample="tensors") for _ in range(3)])
             engines.append(eng)
-        self.assertIsNotNone(engines[1].C.Kj)
+        self.assertIsNotNone(engines[1].s.contacts.C.Kj)
         self.assert_same_engines(*engines)
         for a, b in zip(*samples):
             self.assertEqual(len(a), len(b))
@@ -914,7 +914,7 @@ class TestRebuildsInBlock(unittest.TestCase):
         with patch, mock.patch.object(numba_step, "SLACK", (0.0, 0)):
             tight = _measure(self.SCENES, "numba")
         self.assertGreater(sum(counts), 0)
-        self.assertGreater(int(tight[0].rebuilds.sum()), sum(counts))
+        self.assertGreater(int(tight[0].s.contacts.rebuilds.sum()), sum(counts))
         self.assert_same(tight, _measure(self.SCENES, "numpy"))
 
     def test_two_threads(self):
@@ -941,7 +941,7 @@ class TestRebuildsInBlock(unittest.TestCase):
                 eng.steps(3, 0.999, ens[0].dt)
                 N = eng.s.N
                 eng.s.pos[:, N + 1] = eng.s.pos[:, N]        # (replica 1: spheres 0 and 1 on one place)
-                eng.need[:] = True
+                eng.s.contacts.need[:] = True
                 counts, patch = self.counted()
                 with patch:
                     eng.steps(8, 0.999, ens[0].dt)

@@ -103,7 +103,7 @@ class EngineStep:
         gamma = getattr(self, "shear", 0.0)
         if s.gamma[0] != gamma:      # a strain set from outside moves the boundary images by Ly·Δγ
             s.gamma[0] = gamma
-            eng.need[:] = True
+            s.contacts.need[:] = True
         s.rate[0] = getattr(self, "shear_rate", 0.0)
         s.applying_shear = bool(getattr(self, "applyingShear", False))
         mu = float(getattr(self, "mu", 0.0))
@@ -113,16 +113,14 @@ class EngineStep:
         if self._engine_pairs != (pairs, pairs.version) or s.pairs[0] is not pairs:
             # edited since the engine's last write-back: candidates and constants anew from the table
             s.pairs[0] = pairs
-            eng.C = None
-            eng.need[:] = True
-            eng.next_birth[...] = pairs.birth_count
-        elif eng.C is not None:
+            s.contacts.reload(s)
+        elif s.contacts.C is not None:
             self._share_history(eng)
 
     def _share_history(self, eng):
         """Make the engine's relation history the pair table's own arrays (a batch of one has one segment)."""
         pairs = self._pairs
-        eng.state_p, eng.xi, eng.active, eng.birth = pairs.state, pairs.xi, pairs.active, pairs.birth
+        eng.s.contacts.use_history(pairs.state, pairs.xi, pairs.active, pairs.birth)
 
     def _engine_force_phase(self):
         """Force phase on the engine: neighbours, terms, scatter, the register."""
@@ -172,18 +170,19 @@ class EngineStep:
             eng = self._step_engine()
             self._hand_to_engine(eng)
         eng.move_spheres(dt, self._force_record)
-        eng.need[:] = True
+        eng.s.contacts.need[:] = True
         self._pos_version += 1
 
     def _closest_contact(self):
         """``(ratio, i, j)``: the smallest ``d/(r_i + r_j)`` of a transient contact of the last force phase
         (:func:`~particleShear.engine.guard.transient_ratios`, inf without one), or None without candidates."""
         eng, g = self._engine, self._force_record
-        if eng is None or g is None or not eng.C.P:
+        if eng is None or g is None or not eng.s.contacts.C.P:
             return None
-        ratio = transient_ratios(eng.C, np.sqrt(g.dx * g.dx + g.dy * g.dy), g.active)
+        C = eng.s.contacts.C
+        ratio = transient_ratios(C, np.sqrt(g.dx * g.dx + g.dy * g.dy), g.active)
         k = int(np.argmin(ratio))
-        return float(ratio[k]), int(eng.C.ai[k]), int(eng.C.aj[k])
+        return float(ratio[k]), int(C.ai[k]), int(C.aj[k])
 
 
 class ForcePhaseGeometry:
@@ -212,7 +211,7 @@ class ForcePhaseGeometry:
         if name not in self.NAMES:
             raise AttributeError(name)
         eng = self._engine
-        g, C = self._record, eng.C
+        g, C = self._record, eng.s.contacts.C
         m = np.asarray(g.active, dtype=bool)
         dx, dy = g.dx[m], g.dy[m]
         ai, aj = C.ai[m], C.aj[m]

@@ -377,7 +377,7 @@ class Stroboscope:
         Lx, Ly, gamma = (to_host(a, "microstructure") for a in (s.Lx, s.Ly, s.gamma))
         shift = to_host(engine.image_shift(), "microstructure")
         mob = to_host(engine.mobile(), "microstructure")
-        C = engine.C
+        C = engine.s.contacts.C
         ai, aj, rep = C.ai_host, C.aj_host, C.rep_host
         # contacts and their normal forces over the engine's candidates (the Verlet list holds every
         # pair within contact distance), at the positions of now

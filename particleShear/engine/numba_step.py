@@ -190,7 +190,7 @@ def reason(engine):
     -------
     str or None
     """
-    C, s = engine.C, engine.s
+    C, s = engine.s.contacts.C, engine.s
     for a in (s.pos, s.vel, s.frc, s.phi, s.r, engine.mmi, C.f, C.i, C.b):
         if not (type(a) is np.ndarray and a.flags.c_contiguous and a.flags.writeable):
             return "state arrays that are not writable C-contiguous NumPy arrays"
@@ -831,7 +831,8 @@ class _Workspace:
     the reason the step is not compiled (None: it is), under the key of what that depends on."""
 
     def __init__(self, engine, key):
-        s, C = engine.s, engine.C
+        s = engine.s
+        C = s.contacts.C
         B, N = s.B, s.N
         self.C, self.key, self.why = C, key, reason(engine)
         self.work = np.empty((16, C.P))
@@ -918,7 +919,7 @@ def _key(engine):
     """What :func:`reason` and the workspace depend on besides the candidates and the law callbacks
     (:func:`_laws_key`), compared by identity: the engine's configuration and the run's law."""
     s = engine.s
-    return (engine.integrator, engine.keep_terms, engine.lees_edwards, engine.strain_advances, engine.free_p,
+    return (engine.integrator, engine.keep_terms, engine.lees_edwards, engine.strain_advances, engine.s.contacts.free_p,
             s.law, s.law_params, engine.guard, engine.max_kinetic_energy)
 
 
@@ -947,7 +948,7 @@ def _workspace(engine):
     """The engine's :class:`_Workspace`, rebuilt at a rebuild of the lists (new ``C``) or when its key changed."""
     ws = _held(engine).get("workspace")
     key, laws = _key(engine), _laws_key(engine)
-    if ws is None or ws.C is not engine.C or any(a is not b for a, b in zip(ws.key, key)) or ws.laws != laws:
+    if ws is None or ws.C is not engine.s.contacts.C or any(a is not b for a, b in zip(ws.key, key)) or ws.laws != laws:
         ws = _held(engine)["workspace"] = _Workspace(engine, key)
         ws.laws = laws
     return ws
@@ -1060,7 +1061,7 @@ def run_force_phase(engine, sample=False):
         return NOT_RUN
     ws = got[0]
     w = ws.work        # (this phase's own buffer, _fresh)
-    fields = (w[0], w[1], w[5], w[6], w[7], engine.active.copy(), ws.yc.copy(), ws.mob.copy())
+    fields = (w[0], w[1], w[5], w[6], w[7], engine.s.contacts.active.copy(), ws.yc.copy(), ws.mob.copy())
     return fields, _samples(ws, sample)
 
 
@@ -1087,7 +1088,7 @@ def run_move(engine, dt, g):
     None or NOT_RUN
     """
     ws = _held(engine).get("workspace")       # (the force phase's: its candidates, its laws)
-    if ws is None or ws.why is not None or ws.C is not engine.C or g.verdict is not None:
+    if ws is None or ws.why is not None or ws.C is not engine.s.contacts.C or g.verdict is not None:
         return NOT_RUN
     w = ws.work
     if g.dx.base is not w:        # (a record of this workspace's phase holds its rows already)
@@ -1185,20 +1186,22 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
     ``half_kick`` gives); ``slots``: a block's :class:`_Slots`, whose ranges of each replica's
     candidates and buffers the kernel takes (a rebuilt replica's candidates are its slot's,
     handed back by :func:`_settle`)."""
-    s, C = engine.s, engine.C
+    s = engine.s
+    c = s.contacts
+    C = c.C
     gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
     next_birth, u, u_max, strain, bound, rate_max = (
-        _array(a) for a in (engine.next_birth, engine.u, engine.u_max, engine.strain, engine.bound, engine.rate_max))
+        _array(a) for a in (c.next_birth, c.u, c.u_max, c.strain, c.bound, engine.rate_max))
     at = ws if slots is None else slots       # (each replica's columns and the buffers over them)
     Cf, Ci, Cb = C.f, C.i, C.b
-    state_p, xi, active, birth = (_array(a) for a in (engine.state_p, engine.xi, engine.active, engine.birth))
-    free = engine.free_p
+    state_p, xi, active, birth = (_array(a) for a in c.history)
+    free = c.free_p
     free_mode, free = (0, at.zero) if free is None else (1, at.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
     half = np.array(engine.half, dtype=float) if engine.half is not None else np.empty((3, s.B * s.N)) if verlet \
         else ws.no_half
     new_half = ws.no_half if not verlet else np.empty((3, s.B * s.N)) if half_out is None else half_out
-    ws.need[:] = engine.need        # (a replica a block skips keeps its flag)
+    ws.need[:] = c.need             # (a replica a block skips keeps its flag)
     code = 2 if sample == "tensors" else int(bool(sample))
     args = (s.N, float(cool), float(dt), code, bool(check), bool(s.applying_shear), engine.numbers_relations,
             ws.form, ws.custom, ws.law_rows, ws.visit_j, ws.form_j, ws.Tj, free_mode, free, verlet, pred, half,
@@ -1216,20 +1219,23 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
 
 
 def _adopt(engine, ws, held, stepped=False, kicked=True):
-    """Hand the arrays the kernel wrote back to the engine: after the force phase the relations and
-    the guard's record; after a whole step (``stepped``) also the displacement bookkeeping, the
-    strain, the clock, the lists due and, when a step of this call reached its kick (``kicked``),
-    the Verlet half kick."""
-    for name in ("state_p", "xi", "active", "birth", "next_birth", "rate_max"):
-        setattr(engine, name, held[name])
-    engine.s.rate = held["rate"]
+    """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
+    copies): after the force phase the relations and their history (``state.contacts``), the rate
+    and the guard's record; after a whole step (``stepped``) also the lists' bookkeeping
+    (displacement, strain since the build, bound, the lists due), the strain, the clock and, when
+    a step of this call reached its kick (``kicked``), the Verlet half kick."""
+    s = engine.s
+    c = s.contacts
+    c.state_p, c.xi, c.active, c.birth, c.next_birth = (held["state_p"], held["xi"], held["active"], held["birth"],
+                                                        held["next_birth"])
+    engine.rate_max = held["rate_max"]
+    s.rate = held["rate"]
     if stepped:
-        for name in ("u", "u_max", "strain", "bound"):
-            setattr(engine, name, held[name])
+        c.u, c.u_max, c.strain, c.bound = held["u"], held["u_max"], held["strain"], held["bound"]
         if held["half"] is not None and kicked:
             engine.half = held["half"]
-        engine.s.gamma, engine.s.t = held["gamma"], held["t"]
-        engine.need = ws.need.copy()
+        s.gamma, s.t = held["gamma"], held["t"]
+        c.need = ws.need.copy()
 
 
 def _terms(engine, ws, own_buffers=False):
@@ -1238,14 +1244,15 @@ def _terms(engine, ws, own_buffers=False):
     geometry, copies (``own_buffers``: the rows themselves, of buffers made for this phase alone,
     :func:`_fresh`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's
     expressions on them."""
-    C, w, kt, own = engine.C, ws.work, ws.kt, ws.visit_j
+    c = engine.s.contacts
+    C, w, kt, own = c.C, ws.work, ws.kt, ws.visit_j
     if not own_buffers:
         w, kt = w[:11].copy(), kt.copy()
     d, dF = w[4], w[10]
     return dict(C=C, parts=([kt[0], kt[1]], [kt[6], kt[7]] if own else []), F=kt[2:4], dx=w[0], dy=w[1], nx=w[5],
-                ny=w[6], d=d, touching=d < C.d0, active=engine.active.copy(), shifted=(w[2] != 0) | (w[3] != 0),
+                ny=w[6], d=d, touching=d < C.d0, active=c.active.copy(), shifted=(w[2] != 0) | (w[3] != 0),
                 mob=ws.mob.copy(), fx_i=kt[4], fy_i=kt[5], fx_j=kt[8] if own else None, fy_j=kt[9] if own else None,
-                dF=dF, tq=dF * C.w, birth=engine.birth.copy(), totals=ws.ktot if own_buffers else ws.ktot.copy())
+                dF=dF, tq=dF * C.w, birth=c.birth.copy(), totals=ws.ktot if own_buffers else ws.ktot.copy())
 
 
 def _fresh(ws):
@@ -1336,6 +1343,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         rates = _NO_RECORD
         rec = (_NO_RECORD,) * 5
     B, step0 = engine.s.B, engine.step_count
+    contacts = engine.s.contacts
     want = np.zeros(n, dtype=np.bool_)          # (read at every scheduled step)
     if tensors is not None and scheduled:
         want[:] = tensors
@@ -1353,17 +1361,17 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
             if not going.any():
                 break
             if not drawn:     # rebuild the lists due of the replicas still going, and start them anew
-                due = engine.need.copy()
+                due = contacts.need.copy()
                 left = slots is not None and bool((due & going).any())      # (a list the block could not rebuild)
                 if left:          # (the block's rebuilt candidates back first; the lists due rebuilt here)
                     slots, held_slots = None, slots
                     _settle(engine, held_slots)
-                elif slots is None and engine.C is not None and _slotted(engine, _workspace(engine)):
+                elif slots is None and contacts.C is not None and _slotted(engine, _workspace(engine)):
                     slots = _Slots.of(engine)      # (the lists due are rebuilt inside the block)
                 if slots is None:
-                    engine.need = due & going
+                    contacts.need = due & going
                     engine.neighbours()
-                    engine.need = due & ~going
+                    contacts.need = due & ~going
                 starts[going & (starts == _SKIP)] = 0
             ws = _prepared(engine)
             if ws is not None and ws.keep and B > 1 and not ks.any():
@@ -1437,8 +1445,8 @@ def _slotted(engine, ws):
     """Whether :func:`run_block` rebuilds the lists inside its compiled call (:class:`_Slots`): the
     candidates' constants are those of :func:`constant_rows` alone (no visit from j with its own
     constants, no run law's arguments per candidate, no mixed frictionless replicas, no kept terms)."""
-    free = engine.free_p
-    return REBUILD_IN_BLOCK and engine.C is not None and ws.why is None and \
+    C, free = engine.s.contacts.C, engine.s.contacts.free_p
+    return REBUILD_IN_BLOCK and C is not None and ws.why is None and \
         not (ws.keep or ws.visit_j or ws.custom) and (free is None or free is True)
 
 
@@ -1468,13 +1476,14 @@ class _Slots:
     def of(cls, engine):
         """The slots of a block of ``engine``, or None where its pair tables are not its candidates
         (a table edited since the engine's last rebuild: the engine rebuilds from it)."""
-        C = engine.C
+        C = engine.s.contacts.C
         if any(len(p.d_eq) != n for p, n in zip(engine.s.pairs, np.diff(C.offsets))):
             return None
         return cls(engine)
 
     def __init__(self, engine):
-        s, C = engine.s, engine.C
+        s = engine.s
+        C = s.contacts.C
         P = C.P
         self.offsets, self.ends = np.array(C.offsets[:-1], np.int64), np.array(C.offsets[1:], np.int64)
         count = self.ends - self.offsets
@@ -1522,15 +1531,16 @@ def _settle(engine, slots):
     """Hand a block's rebuilt lists back to the engine (:class:`_Slots`), what
     :meth:`~particleShear.engine.step.BatchEngine.neighbours` leaves after the same rebuilds: the
     candidates side by side again (the rebuilt replicas' from their slots, the others' from the
-    engine's arrays) as the engine's constants
+    state's contacts) as the candidates' constants
     (:meth:`~particleShear.engine.forces.PairConstants.from_blocks`) and history, each rebuilt
     replica's pair table made its new list, all taken by
     :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`.  Nothing where no list was
-    rebuilt (the kernel wrote the engine's history in place)."""
+    rebuilt (the kernel wrote the history of ``state.contacts`` in place)."""
     rebuilt = np.flatnonzero(slots.rebuilt)
     if not len(rebuilt):
         return
-    s, C = engine.s, engine.C
+    s = engine.s
+    C = s.contacts.C
     kept = np.flatnonzero(slots.rebuilt == 0)
     offsets = np.zeros(s.B + 1, np.int64)
     np.cumsum(slots.ends - slots.offsets, out=offsets[1:])
@@ -1539,7 +1549,7 @@ def _settle(engine, slots):
     history = np.empty(P, np.int8), np.empty((2, P)), np.empty(P, np.bool_), np.empty(P, np.int64)
     d_eq = np.empty(P)
     names = ("state_p", "xi", "active", "birth")
-    for own, slot, dst in zip((C.f, C.i, C.b) + tuple(getattr(engine, n) for n in names) + (slots.d_eq_c,),
+    for own, slot, dst in zip((C.f, C.i, C.b) + s.contacts.history + (slots.d_eq_c,),
                               (slots.f, slots.i, slots.b) + tuple(getattr(slots, n) for n in names) + (slots.d_eq,),
                               (f, i, b) + history + (d_eq,)):
         for src, which in ((own, kept), (slot, rebuilt)):

@@ -193,7 +193,7 @@ def synced_history(state, xi, active, birth):
 
     A candidate that is no relation (not ``active``) keeps no ξ and no number and sticks, unless it
     is a bond, which keeps its state.  The engine writes its flat history back this way
-    (:meth:`~particleShear.engine.step.BatchEngine._sync_down`, on arrays) and the compiled backend's
+    (:meth:`~particleShear.engine.contacts.Contacts.sync_down`, on arrays) and the compiled backend's
     rebuild inside a block reads it this way before the history merge (on the numbers of each
     candidate, :mod:`particleShear.engine.numba_step`), so both merge the same history.
 
@@ -523,7 +523,13 @@ class BatchState:
         Ensemble constants of each replica (the values a step of its ensemble uses).
     pairs : list of PairTable
         Candidate pairs of each replica (NumPy arrays, on the host), each with its counter of
-        creation numbers.
+        creation numbers: the host view of :attr:`contacts`, as its last write-back left it
+        (:meth:`~particleShear.engine.contacts.Contacts.sync_down`).
+    contacts : Contacts or None
+        The candidates of every replica side by side with their relation history and the
+        bookkeeping of their lists (:class:`~particleShear.engine.contacts.Contacts`), on the
+        state's backend: started anew by each engine built on the state; None before (and in a
+        state made by :meth:`concat`, :meth:`to_backend` or unpickling, whose tables carry the history).
     rng : list of numpy.random.Generator
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
@@ -578,6 +584,10 @@ class BatchState:
     #: engine on such a state numbers the relations as they form
     #: (:attr:`~particleShear.engine.step.BatchEngine.numbers_relations`).
     ensembles = None
+    #: the flat candidate list and its history (:class:`~particleShear.engine.contacts.Contacts`),
+    #: made by the engine built on this state; None until then (a class default: a state pickled
+    #: without it loads with None)
+    contacts = None
 
     @property
     def ensemble(self):
@@ -610,11 +620,15 @@ class BatchState:
         self.visit = None
 
     def __getstate__(self):
-        """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load."""
+        """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load.
+
+        The contacts are left out (the copy has None): its pair tables carry the history as the
+        last write-back left it (an engine's ``flush``), and an engine built on the copy starts anew."""
         state = dict(self.__dict__)
         state["backend"] = self.backend.name
         del state["xp"]
         state.pop("ensembles", None)      # a copy is no longer the ensembles' rows
+        state.pop("contacts", None)       # (engine bookkeeping; the tables are the carried view)
         return state
 
     def __setstate__(self, state):
@@ -662,7 +676,8 @@ class BatchState:
     def to_backend(self, backend):
         """This state with its arrays copied to ``backend`` (the same object if it is there already).
 
-        Pair lists and generators are shared (they stay on the host).
+        Pair lists and generators are shared (they stay on the host); the copy has no contacts
+        (None: an engine built on it starts them from the tables).
 
         Parameters
         ----------
@@ -680,6 +695,7 @@ class BatchState:
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
         out.ensembles = None        # copies, no longer the ensembles' rows
+        out.contacts = None         # (the flat list lives on the source's backend; the tables are shared)
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
@@ -695,7 +711,8 @@ class BatchState:
         ----------
         states : sequence of BatchState
             States with the same N; their arrays and pair lists are copied, their generators
-            shared.
+            shared; the result has no contacts (None), so the states' engines must have written
+            their history into the tables first (``flush``).
 
         Returns
         -------

@@ -8,8 +8,10 @@ argument, so the engine holds no record of a phase between calls.
 The measurement's loops, :func:`~.loops.pre_equilibrate` and :func:`~.loops.protocol`, are in
 :mod:`.loops` (and importable from here).
 
-The only cache is :attr:`BatchEngine.C` (the per-candidate constants); it is rebuilt in one
-place, :meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
+The candidates, their relation history and the bookkeeping of their lists are the state's
+(``state.contacts``, a :class:`~particleShear.engine.contacts.Contacts`, started anew by each
+engine); the only cache is its ``C`` (the per-candidate constants), rebuilt in one place,
+:meth:`BatchEngine.neighbours`, whenever a replica's candidate list is rebuilt.
 
 The arrays live on the state's backend (NumPy or CuPy, :mod:`.xp`).  A step reads device values
 on the host only through :func:`~particleShear.engine.xp.to_host`, for named reasons: once at its
@@ -26,7 +28,6 @@ in Pa (docs/parameters.md, docs/output.md).
 __docformat__ = "numpy"
 
 import collections
-import math
 
 import numpy as np
 
@@ -38,9 +39,10 @@ from .phase_laws import force_phase_laws
 from .terms import (central_term, elastic_term, normal_speed, pair_forces, relative_velocity, slip_speed,
                     tangential_term, viscous_term)
 from .config import INTEGRATORS, EngineConfig
+from .contacts import Contacts
 from .memory import tune_allocator
 from .neighbours import build_candidates, verlet_bound
-from .state import PERMANENT, SLIP, STICK, spread, synced_history
+from .state import SLIP, STICK, spread
 from .stress import EXTERNAL, OVERALL, StressInputs, evaluate_all
 from .xp import to_host
 from . import numba_driver, numba_step
@@ -116,6 +118,14 @@ class BatchEngine:
     construction: it is :attr:`config`, a frozen :class:`~particleShear.engine.config.EngineConfig`,
     whose fields the engine also shows as read-only properties (``engine.integrator``,
     ``engine.keep_terms`` …); an engine configured otherwise is a new engine.
+
+    What the steps change is the state's: the spheres, boxes, strain, rate and clock, and the
+    contacts ``state.contacts`` (:class:`~particleShear.engine.contacts.Contacts`: the candidates
+    with their constants and relation history, the bookkeeping of the Verlet lists), which the
+    engine starts anew at its construction (every list built at the first step from
+    ``state.pairs``).  The engine keeps of the run only the Verlet predictor :attr:`half`, the
+    guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s), the step count
+    ``step_count``, the ``phase``, the protocol's ``record`` and the register's ``terms``.
 
     Parameters
     ----------
@@ -193,7 +203,6 @@ class BatchEngine:
         #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
         #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
         self.terms = None
-        self.free_p = None        # replicas without tangential force, per candidate (see _frictionless)
         xp = self.xp = s.xp
         self.backend = s.backend
         self.notes = set()        # why the compiled backend fell back to NumPy (each reason once)
@@ -208,12 +217,8 @@ class BatchEngine:
                              guard_dev=self.backend.asarray(guard_mask),
                              lees_edwards=None if config.lees_edwards else xp.zeros(B),
                              held=xp.zeros(B) if config.strain_only_while_shearing else None)
-        self.bound = xp.full(B, math.inf)      # Verlet bound of each replica (see verlet_bound)
-        self.need = np.ones(B, bool)           # host: list rebuild due (the first step builds every list)
-        self.u = xp.zeros((2, B * N))          # peculiar displacement of each sphere since its list was built
-        self.u_max = xp.zeros(B)               # running maximum of |u| per replica
-        self.strain = xp.zeros(B)              # Σ |γ̇| dt per replica since its list was built
-        self.C = None
+        # the candidates, their history and the lists' bookkeeping start anew (every list due at the first step)
+        s.contacts = Contacts(s)
         self.Lx_s = s.Lx[s.rep]
         self.Ly_s = s.Ly[s.rep]
         self.hy_s = self.Ly_s / 2
@@ -221,14 +226,11 @@ class BatchEngine:
         self.mmi = xp.stack((s.m, s.m, s.inertia))        # kick weights of (vx, vy, ω)
         # what the candidate search (on the host) needs besides the positions: radii, boxes, skins
         self.host_consts = [to_host(a, "state") for a in (s.r, s.Lx, s.Ly, self.skin)]
-        self.rate_max = xp.zeros(B)
+        self.rate_max = xp.zeros(B)       # the guard's largest |γ̇| of each replica since this engine started (1/s)
         self.step_count = 0
-        #: ``next_birth``: the number the next relation of each replica gets (:attr:`numbers_relations`)
-        self.next_birth = self.backend.asarray(np.array([p.birth_count for p in s.pairs], dtype=np.int64))
         self.phase = phase        # (run state, not configuration: begin_phase sets it as the loops run)
         #: the record of the running protocol (rows written so far; None outside one): what observers read
         self.record = None
-        self.rebuilds = np.zeros(B, dtype=np.int64)
 
     # -- the configuration, read-only -------------------------------------------------------------
     @property
@@ -272,47 +274,24 @@ class BatchEngine:
         state does not apply shear; the same object at every read)."""
         return None if self._fixed.held is None or self.s.applying_shear else self._fixed.held
 
-    # -- the one cache ---------------------------------------------------------------------------
-    def _sync_down(self, replicas=None):
-        """Write the flat pair history back into the per-replica lists (of ``replicas``; all by default).
-
-        On a device the rows of those replicas are gathered there and read on the host at once."""
-        C, be, s = self.C, self.backend, self.s
-        which = list(range(s.B)) if replicas is None else list(replicas)
-        spans = [(C.offsets[b], C.offsets[b + 1]) for b in which]
-        state_p, xi, active, birth = self.state_p, self.xi, self.active, self.birth
-        if not be.host and which:
-            sel = be.asarray(np.concatenate([np.arange(lo, hi) for lo, hi in spans]))
-            state_p, xi, active, birth = (to_host(a, "pair history")
-                                          for a in (state_p[sel], xi[:, sel], active[sel], birth[sel]))
-            ends = np.cumsum([hi - lo for lo, hi in spans])
-            spans = list(zip(ends - [hi - lo for lo, hi in spans], ends))
-        counters = to_host(self.next_birth, "pair history")
-        for b, (lo, hi) in zip(which, spans):
-            p = s.pairs[b]
-            a = active[lo:hi].copy()
-            # the classes' table: a candidate that is no relation sticks, without history or number
-            kept, p.xi, p.birth = synced_history(state_p[lo:hi], xi[:, lo:hi], a, birth[lo:hi])
-            p.state = kept.astype(np.int8)
-            p.active = a
-            p.resume_births(counters[b])
-            p.version += 1
-
+    # -- the candidates (the state's contacts) ---------------------------------------------------
     def neighbours(self):
         """Rebuild the candidate lists of the replicas whose Verlet bound reached the skin, and the
         per-candidate constants with them (the one invalidation point).
 
         Only the rebuilt replicas' constants are computed; the other replicas' segments are copied
         from the previous constants (:meth:`~particleShear.engine.forces.PairConstants.splice`).
-        Which replicas are due was read at the end of the previous step (:attr:`need`, on the
-        host); the candidate search runs on the host, on the positions of those replicas."""
-        need = self.need
+        Which replicas are due was read at the end of the previous step (``state.contacts.need``, on
+        the host); the candidate search runs on the host, on the positions of those replicas.  The
+        rebuilt lists carry the history written back into their tables first, and their
+        bookkeeping starts from 0 (:meth:`~particleShear.engine.contacts.Contacts.restart`)."""
+        c = self.s.contacts
+        need = c.need
         if not need.any():
             return
-        s, xp, be = self.s, self.xp, self.backend
+        s, be = self.s, self.backend
         changed = np.flatnonzero(need)
-        if self.C is not None:
-            self._sync_down(changed)     # the history the rebuilt lists carry over
+        c.sync_down(s, changed)          # the history the rebuilt lists carry over
         rows = np.concatenate([np.arange(b * s.N, (b + 1) * s.N) for b in changed])
         pos = to_host(s.pos[:, rows] if be.host else s.pos[:, be.asarray(rows)], "rebuild")
         # the images' offset the force phase sees: Ly·γ, 0 for a plain periodic replica (lees_edwards)
@@ -323,13 +302,8 @@ class BatchEngine:
         for k, b in enumerate(changed):
             mine, own = slice(k * s.N, (k + 1) * s.N), s.replica(b)
             s.pairs[b] = build(pos[0, mine], pos[1, mine], r[own], Lx[b], Ly[b], shift[b], skin[b], s.pairs[b])
-            self.rebuilds[b] += 1
-        due = be.asarray(need)
-        self.bound = xp.where(due, 0.0, self.bound)
-        self.u = xp.where(due[s.rep], 0.0, self.u)
-        self.u_max = xp.where(due, 0.0, self.u_max)
-        self.strain = xp.where(due, 0.0, self.strain)
-        self.need = np.zeros(s.B, bool)
+            c.rebuilds[b] += 1
+        c.restart(be.asarray(need), s)
         offsets = np.concatenate(([0], np.cumsum([len(p.i) for p in s.pairs])))
         fresh = [s.pairs[b] for b in changed]
         state_p = be.asarray(np.concatenate([p.state for p in fresh]))
@@ -340,13 +314,13 @@ class BatchEngine:
         new = PairConstants(s, np.concatenate(([0], np.cumsum([len(p.i) for p in fresh]))), replicas=changed,
                             state=state_p, d_eq=be.asarray(np.concatenate([p.d_eq for p in fresh])),
                             fill=numba_step.constant_rows if be.compiled else None)
-        if self.C is None or len(changed) == s.B:
-            self.C, self.state_p, self.xi, self.active, self.birth = new, state_p, xi, active, birth
-            self.C.set_visits(s)
-            self._frictionless()
+        if c.C is None or len(changed) == s.B:
+            c.take(new, (state_p, xi, active, birth))
+            new.set_visits(s)
+            c.refresh_free(s)
             return
         # the batch's arrays: the unchanged replicas' segments from the old arrays, in replica order
-        old_off, segments, k = self.C.offsets, [], 0
+        old_off, segments, k = c.C.offsets, [], 0
         for b in range(s.B):
             if k < len(changed) and changed[k] == b:
                 segments.append((True, new.offsets[k], new.offsets[k + 1]))
@@ -355,13 +329,11 @@ class BatchEngine:
                 segments[-1] = (False, segments[-1][1], old_off[b + 1])     # extend a run of unchanged replicas
             else:
                 segments.append((False, old_off[b], old_off[b + 1]))
-        self.state_p = splice_arrays(self.state_p, state_p, segments)
-        self.xi = splice_arrays(self.xi, xi, segments)
-        self.active = splice_arrays(self.active, active, segments)
-        self.birth = splice_arrays(self.birth, birth, segments)
-        self.C = PairConstants.splice(s, self.C, new, segments, offsets)
-        self.C.set_visits(s)
-        self._frictionless()
+        history = tuple(splice_arrays(old, fresh_rows, segments)
+                        for old, fresh_rows in zip(c.history, (state_p, xi, active, birth)))
+        c.take(PairConstants.splice(s, c.C, new, segments, offsets), history)
+        c.C.set_visits(s)
+        c.refresh_free(s)
 
     def image_shift(self):
         """The Lees-Edwards offset ``Ly·γ`` of the images of each replica (B,), 0 for a plain periodic
@@ -382,7 +354,7 @@ class BatchEngine:
         The counts are kept with the candidates' constants (``C.images``), so they are dropped at the
         one invalidation point, a rebuild.  On NumPy only (deciding the reuse reads the arrays); it
         saves ≈ 14 % of a step of one replica and nothing measurable at B = 32 (docs/performance.md)."""
-        C = self.C
+        C = self.s.contacts.C
         img = C.images
         if img is not None:
             Lyky, ky, Lxkx, kx = img
@@ -413,17 +385,18 @@ class BatchEngine:
             How many times each replica's list was rebuilt (the rebuilt ones' pair tables hold
             their new lists already).
         """
-        self.state_p, self.xi, self.active, self.birth = history
-        self.C = C
-        C.set_visits(self.s)
-        self._sync_down(np.flatnonzero(counts))
-        self.rebuilds += counts
-        self._frictionless()
+        s = self.s
+        c = s.contacts
+        c.take(C, history)
+        C.set_visits(s)
+        c.sync_down(s, np.flatnonzero(counts))
+        c.rebuilds += counts
+        c.refresh_free(s)
 
     def flush(self):
-        """Write the flat pair history back into ``state.pairs`` (after a phase)."""
-        if self.C is not None:
-            self._sync_down()
+        """Write the flat pair history of ``state.contacts`` back into ``state.pairs`` (after a phase;
+        :meth:`~particleShear.engine.contacts.Contacts.sync_down`)."""
+        self.s.contacts.sync_down(self.s)
 
     def pairs_of(self, b):
         """Current candidate list of replica ``b`` (a copy, with the flat history written in).
@@ -440,8 +413,7 @@ class BatchEngine:
             creation numbers (those formed in this engine are numbered only with
             :attr:`numbers_relations`; else 0).
         """
-        if self.C is not None:
-            self._sync_down()
+        self.s.contacts.sync_down(self.s)
         return self.s.pairs[b].copy()
 
     def mobile(self):
@@ -494,7 +466,8 @@ class BatchEngine:
     def set_mu(self, mu):
         """Change the Coulomb friction coefficient μ of each replica (the constitution's μ = 0 blocks).
 
-        The per-candidate μ of :attr:`C` is refreshed with it; nothing else depends on μ.
+        The per-candidate μ of the candidates' constants (``state.contacts.C``) is refreshed with it
+        and the frictionless replicas found anew; nothing else depends on μ.
 
         Parameters
         ----------
@@ -503,11 +476,13 @@ class BatchEngine:
         """
         s = self.s
         s.mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
-        if self.C is not None:
-            self.C.mu = s.mu[self.C.rep]
-            if self.C.Kj is not None:
-                self.C.Kj.mu = self.C.mu
-        self._frictionless()
+        c = s.contacts
+        C = c.C
+        if C is not None:
+            C.mu = s.mu[C.rep]
+            if C.Kj is not None:
+                C.Kj.mu = C.mu
+        c.refresh_free(s)
 
     def step(self, cool, dt, sample=False):
         """One step of every replica: :meth:`force_phase`, :meth:`accelerate`, :meth:`move`.
@@ -595,9 +570,10 @@ class BatchEngine:
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         yc, dx, dy, ky, kx, d, touching, active, image_rate = self.relations()
-        C = self.C
+        c = s.contacts
+        C = c.C
         ai, aj = C.ai, C.aj
-        xi = self.xi
+        xi = c.xi
         nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
         # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
         dvx = -(C.Ly * spread(image_rate, C.rep, s.B)) * ky
@@ -607,7 +583,7 @@ class BatchEngine:
         rv = relative_velocity(Vi, Vj, dvx)
         vn = normal_speed(rv, nx, ny)
         # the slip speed only where a replica has a tangential force (see _tangential)
-        vt = None if self.free_p is True else slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
+        vt = None if c.free_p is True else slip_speed(rv, nx, ny, C.ri, C.rj, Vi[2], Vj[2])
         # forces: central (elastic + viscous), tangential (two visits), scatter
         parts = ([], [])          # the central terms of each visit, kept for the register (keep_terms)
         if self.backend.compiled and self._compiled_terms(C):   # the same laws in one compiled loop (bit-identical)
@@ -615,7 +591,7 @@ class BatchEngine:
         else:
             fn, law = self._central(C, d, vn, active, parts[0])
             F, slip = self._tangential(C, vt, touching, xi, law, active)
-        self.state_p = slip.view(np.int8) + C.perm_code
+        c.state_p = slip.view(np.int8) + C.perm_code
         ft = (F[0] + F[1]) * 0.5
         fx_i, fy_i, dF, tq = pair_forces(fn, ft, nx, ny, d, C.w)
         fx_j = fy_j = None
@@ -629,7 +605,7 @@ class BatchEngine:
         if self.keep_terms:
             self.terms = dict(C=C, parts=parts, F=self.xp.stack(F), dx=dx, dy=dy, nx=nx, ny=ny, d=d, touching=touching,
                               active=active, shifted=shifted, mob=mob, fx_i=fx_i, fy_i=fy_i, fx_j=fx_j, fy_j=fy_j, dF=dF,
-                              tq=tq, birth=self.birth, totals=s.frc.copy())   # (the kick resets s.frc)
+                              tq=tq, birth=c.birth, totals=s.frc.copy())   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(
                 C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,
@@ -664,7 +640,8 @@ class BatchEngine:
         """
         s, xp = self.s, self.xp
         self.neighbours()          # (positions at the start of the step)
-        C = self.C
+        c = s.contacts
+        C = c.C
         yc = s.y - self.hy_s                            # height above the cell's centre line
         raw = s.pos.take(C.aj, axis=1)
         raw -= s.pos.take(C.ai, axis=1)
@@ -673,12 +650,12 @@ class BatchEngine:
         d = xp.sqrt(dx * dx + dy * dy)
         touching = d < C.d0
         active = C.perm | touching
-        new = active & ~self.active
-        xp.copyto(self.state_p, STICK, where=new)       # a new relation starts sticking
+        new = active & ~c.active
+        xp.copyto(c.state_p, STICK, where=new)          # a new relation starts sticking
         if self.numbers_relations:
             self._number(new)
-        self.xi = xp.where(active, self.xi, 0.0)        # an opened contact loses its history
-        self.active = active
+        c.xi = xp.where(active, c.xi, 0.0)              # an opened contact loses its history
+        c.active = active
         return yc, dx, dy, ky, kx, d, touching, active, image_rate
 
     def _compiled_terms(self, C):
@@ -690,7 +667,7 @@ class BatchEngine:
         tensile law of bonds, from prepared constants) of frictional replicas or bonds when the
         terms are not kept for a register; otherwise the NumPy terms run (the same bits).
         """
-        return not self.keep_terms and self.free_p is None and force_phase_laws(self.s, C) == (None, None)
+        return not self.keep_terms and self.s.contacts.free_p is None and force_phase_laws(self.s, C) == (None, None)
 
     def _central(self, K, d, vn, active, parts):
         """The central term of one visit (:func:`~particleShear.engine.terms.central_term`); with
@@ -707,19 +684,20 @@ class BatchEngine:
         """Give the relations formed in this step (``new``, per candidate) their creation numbers.
 
         As the classes number them (``PairTable.birth``, the order of ``sphere.neighbors``): the
-        newly touching pairs of a replica take the next numbers of its counter (:attr:`next_birth`)
+        newly touching pairs of a replica take the next numbers of its counter (``state.contacts.next_birth``)
         in ``(i, j)`` order, which is the order of its contiguous segment of candidates.  Only
         when :attr:`numbers_relations` (a write-back into ensembles needs the numbers); on NumPy a
         step without new relations returns at once (then ≈ 2 % of a step of one replica, N = 150,
         median of 15 paired blocks of 200 steps)."""
-        xp, C = self.xp, self.C
+        xp, c = self.xp, self.s.contacts
+        C = c.C
         if self.backend.host and not new.any():
             return
         count = xp.cumsum(new)
         upto = xp.concatenate((xp.zeros(1, count.dtype), count))[self.backend.asarray(C.offsets)]
         before = upto[:-1]
-        self.birth = xp.where(new, self.next_birth[C.rep] + (count - 1 - before[C.rep]), self.birth)
-        self.next_birth = self.next_birth + (upto[1:] - before)
+        c.birth = xp.where(new, c.next_birth[C.rep] + (count - 1 - before[C.rep]), c.birth)
+        c.next_birth = c.next_birth + (upto[1:] - before)
 
     def _tangential(self, C, vt, touching, xi, law, active):
         """The tangential term, left out for the replicas without friction and bonds.
@@ -731,7 +709,7 @@ class BatchEngine:
 
         Returns ``(F, slip)`` as :func:`~particleShear.engine.terms.tangential_term`.
         """
-        free = self.free_p
+        free = self.s.contacts.free_p
         if free is None:
             return tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         if free is True:
@@ -740,23 +718,6 @@ class BatchEngine:
         F, slip = tangential_term(C, vt, touching.astype(float), xi, law, C.Kj)
         self.xp.copyto(xi, 0.0, where=free)
         return F, slip | (free & active)
-
-    def _frictionless(self):
-        """Which replicas have no tangential force (μ = 0 and no bond): sets :attr:`free_p`, per
-        candidate (None when no replica is such, True when all are); after a rebuild and a change of μ."""
-        s = self.s
-        if self.C is None:
-            return
-        mu = to_host(s.mu, "state") if not isinstance(s.mu, np.ndarray) else s.mu
-        free = mu == 0
-        for b in np.flatnonzero(free):          # (only the replicas without friction are looked at)
-            free[b] = not (s.pairs[b].state == PERMANENT).any()
-        if not free.any():
-            self.free_p = None
-        elif free.all():
-            self.free_p = True
-        else:
-            self.free_p = self.backend.asarray(free)[self.C.rep]
 
     def accelerate(self, cool, dt, g=None):
         """Kick (plates follow), rotational kick and damping of every replica (eqs. S1-10, S1-11).
@@ -823,11 +784,13 @@ class BatchEngine:
             The record of the step's force phase (:meth:`force_phase`): the relations, pair
             vectors, normals and image velocity the ξ rule reads, the heights; None: no ξ rule.
         """
-        s, xp, C = self.s, self.xp, self.C
+        s, xp = self.s, self.xp
+        c = s.contacts
+        C = c.C
         vx, vy = s.vx, s.vy
-        free = self.free_p
+        free = c.free_p
         if free is not True and g is not None:   # without friction and bonds no ξ (nor without a force phase)
-            kd = xp.where(g.active & (self.state_p != SLIP), dt, 0.0)
+            kd = xp.where(g.active & (c.state_p != SLIP), dt, 0.0)
             Vi = s.vel.take(C.ai, axis=1)
 
             def unit(Rx, Ry):
@@ -837,19 +800,19 @@ class BatchEngine:
 
             inc_ij, inc_ji = xi_increments(Vi, s.vel.take(C.aj, axis=1), g.dvx, g.nx, g.ny, C.ri, C.rj,
                                            Vi[0] * dt - g.dx, Vi[1] * dt - g.dy, unit)
-            xi = self.xi
+            xi = c.xi
             xi[0] += inc_ij * kd
             xi[1] += inc_ji * kd
         # drift, strain, wrap, clock (the displacement relative to the flow the images follow)
         image_rate = self._image_rate()
         rate_s = spread(image_rate, s.rep, s.B)
-        u = self.u
+        u = c.u
         u[0] += (vx - (s.y - self.hy_s if g is None else g.yc) * rate_s) * dt
         u[1] += vy * dt
         # (the largest length is the root of the largest square: the root is monotonic and correctly rounded)
-        self.u_max = xp.maximum(self.u_max, xp.sqrt((u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1)))
-        self.strain += abs(image_rate) * dt
-        self.bound = verlet_bound(self.u_max, self.strain, self.r_max)
+        c.u_max = xp.maximum(c.u_max, xp.sqrt((u[0] * u[0] + u[1] * u[1]).reshape(s.B, s.N).max(axis=1)))
+        c.strain += abs(image_rate) * dt
+        c.bound = verlet_bound(c.u_max, c.strain, self.r_max)
         drift(s.pos, s.phi, s.vel, dt)
 
     def advance_cells(self, dt, g=None):
@@ -876,9 +839,10 @@ class BatchEngine:
         s.t = s.t + dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = None if g is None else g.verdict
-        due = self.bound >= self.skin
+        c = s.contacts
+        due = c.bound >= self.skin
         flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
-        self.need = flags[:s.B]
+        c.need = flags[:s.B]
         if verdict is not None and flags[s.B:].any():
             self.report_verdict(verdict, self.step_count)
         self.step_count += 1
@@ -890,7 +854,7 @@ class BatchEngine:
         replica, 1 non-finite state, 2 kinetic energy above its bound, 3 interpenetration."""
         s, xp = self.s, self.xp
         self.rate_max = xp.maximum(self.rate_max, abs(s.rate))
-        closest = closest_transient(self.C, d, active)
+        closest = closest_transient(s.contacts.C, d, active)
         code, ke, bound = guard_verdict(s.B, s.x, s.y - self.hy_s, s.vx, s.vy, s.omega, s.rate[s.rep], s.m, s.inertia,
                                         s.r, s.k, s.Ly, self.rate_max, closest, self.min_distance_ratio,
                                         self.max_kinetic_energy)

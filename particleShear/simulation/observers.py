@@ -86,12 +86,12 @@ class ReplicaView:
         cur = self._current()
         if "_pairs" not in cur:
             e, b = self.engine, self.b
-            p = e.s.pairs[b]
-            if e.C is None:           # before the first step: the lists as constituted
+            p, c = e.s.pairs[b], e.s.contacts
+            if c.C is None:           # before the first step: the lists as constituted
                 state, active = p.state, p.active
             else:                     # the flat history of the running phase, replica b's segment
-                lo, hi = int(e.C.offsets[b]), int(e.C.offsets[b + 1])
-                state, active = (to_host(a[lo:hi], "state") for a in (e.state_p, e.active))
+                lo, hi = int(c.C.offsets[b]), int(c.C.offsets[b + 1])
+                state, active = (to_host(a[lo:hi], "state") for a in (c.state_p, c.active))
             cur["_pairs"] = _Pairs(np.array(p.i), np.array(p.j), np.array(state), np.array(active))
         return cur["_pairs"]
 
