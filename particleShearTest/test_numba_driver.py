@@ -133,6 +133,26 @@ def _three_halves_law(d, d0, k, c):
     return -k * d0 * x ** 1.5
 
 
+def _small_exp_law(d, d0, k, c):
+    """A user's law: the linear law with a small exponential correction (1 % of e^{δ/d0})."""
+    return -k * (d0 - d) * (1.0 + 1e-2 * np.exp((d0 - d) / d0))
+
+
+def _scaled_law(scale):
+    """A closure factory: the linear law times ``scale``."""
+    def scaled(d, d0, k, c):
+        return -scale * k * (d0 - d)
+    return scaled
+
+
+_GLOBAL_SCALE = 1.0
+
+
+def _global_scaled_law(d, d0, k, c):
+    """A user's law reading a global number."""
+    return -_GLOBAL_SCALE * k * (d0 - d)
+
+
 @unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
 class TestNumbaBackendRuns(unittest.TestCase):
     """backend="numba" steps the engine in the compiled step: the whole measurement (pre-equilibration
@@ -221,28 +241,60 @@ class TestNumbaBackendRuns(unittest.TestCase):
             unregister_law("stiffening")
 
     def test_user_law_with_a_transcendental_function(self):
-        """A user's law with ``**`` of a fractional exponent: where the check finds its compiled bits
-        differ from NumPy's on this machine it runs on NumPy with a note saying so; either way the
-        measurement on ``"numba"`` equals NumPy's bit for bit."""
-        from particleShear.engine import law_check
+        """A user's law with ``**`` of a fractional exponent, and one whose transcendental part is a
+        small correction (too rare a difference for a sample to find): their compiled code calls
+        ``pow`` / ``exp``, so they run on NumPy with a note naming the call, and the measurement on
+        ``"numba"`` equals NumPy's bit for bit."""
         from particleShear.engine.laws import register_law, unregister_law
-        register_law("three_halves", _three_halves_law)
+        for name, law, call in (("three_halves", _three_halves_law, "pow"), ("small_exp", _small_exp_law, "exp")):
+            with self.subTest(law=name):
+                register_law(name, law)
+                try:
+                    with self.assertWarnsRegex(RuntimeWarning, f"runs on NumPy .*{name}.* calls .*{call}"):
+                        _, got = self.measure(self.SCENE, "numba", law=(name, ()))
+                    self.assert_same(self.measure(self.SCENE, "numpy", law=(name, ()))[1], got)
+                finally:
+                    unregister_law(name)
+
+    def test_law_is_compiled_from_its_values(self):
+        """Two laws of one closure factory with other values (and so one code object and name) are
+        checked and compiled each with its own values: each measurement equals NumPy's bit for bit,
+        no note, and the two differ (a stale compiled law would give the first one's forces)."""
+        from particleShear.engine.laws import register_law, unregister_law
+        runs = []
+        for scale in (1.0, 2.5):
+            register_law("scaled", _scaled_law(scale), replace=True)
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", RuntimeWarning)
+                    _, got = self.measure(self.SCENE, "numba", law=("scaled", ()))
+                self.assert_same(self.measure(self.SCENE, "numpy", law=("scaled", ()))[1], got)
+                runs.append(got["stress_surface"])
+            finally:
+                unregister_law("scaled")
+        self.assertFalse(np.array_equal(runs[0], runs[1]))
+
+    def test_what_the_check_reads(self):
+        """The check reads the compiled code: a law of arithmetic and sqrt calls nothing outside the
+        exact operations; ``exp`` and ``**`` of a variable exponent are calls it names; the
+        fingerprint follows a closure's values and a global's value."""
+        from particleShear.engine import law_check
+        for law, calls in ((_stiffening_law, []), (_small_exp_law, ["exp"]), (_three_halves_law, ["pow"])):
+            adapter = law_check.law_adapter(law, 3)
+            adapter(50.0, (49.0, 3.1e9, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0))
+            found = law_check.outside_calls(adapter.law_functions)
+            self.assertEqual(len(found), len(calls), found)
+            for name, want in zip(found, calls):
+                self.assertIn(want, name)
+        self.assertNotEqual(law_check.law_fingerprint(_scaled_law(1.0)), law_check.law_fingerprint(_scaled_law(2.0)))
+        self.assertEqual(law_check.law_fingerprint(_scaled_law(1.0)), law_check.law_fingerprint(_scaled_law(1.0)))
+        before = law_check.law_fingerprint(_global_scaled_law)
+        global _GLOBAL_SCALE
+        _GLOBAL_SCALE, old = 3.0, _GLOBAL_SCALE
         try:
-            d0 = np.array([50.0, 61.3])
-            rows = np.array([[50.0, 61.3], [3.1e9, 2.2e9], [0.3, 0.3]])
-            verdict = law_check.law_bits("three_halves", _three_halves_law, rows, d0)
-            with warnings.catch_warnings(record=True) as seen:
-                warnings.simplefilter("always", RuntimeWarning)
-                _, got = self.measure(self.SCENE, "numba", law=("three_halves", ()))
-            notes = [str(w.message) for w in seen if "three_halves" in str(w.message)]
-            if verdict is None:
-                self.assertEqual(notes, [])
-            else:
-                self.assertRegex(verdict, r"differs from NumPy in the last bit for [1-9]\d* of 512 ")
-                self.assertTrue(notes and "runs on NumPy" in notes[0], notes)
-            self.assert_same(self.measure(self.SCENE, "numpy", law=("three_halves", ()))[1], got)
+            self.assertNotEqual(law_check.law_fingerprint(_global_scaled_law), before)
         finally:
-            unregister_law("three_halves")
+            _GLOBAL_SCALE = old
 
     def test_a_law_whose_bits_differ_runs_on_numpy(self):
         """Fault injection: a check that sees the compiled law one ulp away from NumPy's values sends
@@ -251,13 +303,11 @@ class TestNumbaBackendRuns(unittest.TestCase):
 
         from particleShear.engine import law_check
         from particleShear.engine.laws import register_law, unregister_law
-        import types
-        law = types.FunctionType(_stiffening_law.__code__, _stiffening_law.__globals__, "stiffening_off")
-        register_law("stiffening_off", law)      # (a function object of its own: no verdict kept for it yet)
+        register_law("stiffening_off", _scaled_law(7.25))   # (values of its own: no verdict kept for it yet)
         real = law_check._probe
 
-        def one_ulp_away(function, m):
-            kernel = real(function, m)
+        def one_ulp_away(adapter):
+            kernel = real(adapter)
 
             def probe(d, A, out):
                 kernel(d, A, out)

@@ -251,7 +251,7 @@ def jit_deep(f, done=None):
     if f in done:
         return done[f]
     copy = _copy(f)
-    done[f] = compiled = numba.njit(copy)
+    done[f] = compiled = numba.njit(copy, error_model="numpy")     # (x/0 is inf as on NumPy, no exception)
     for name in f.__code__.co_names:
         v = f.__globals__.get(name)
         if isinstance(v, types.FunctionType) and v not in (xp.select, xp.maximum, xp.minimum):

@@ -729,16 +729,18 @@ def _kernels_of(ws):
     if ws.law is None:
         step = _kernels.get(True) or compile_step_kernel()
         return step, _kernels.get(("block", n > 1)) or compile_block_kernel(parallel=n > 1)
-    return _law_kernels(*ws.law, parallel=n > 1)
+    function, m, fingerprint = ws.law
+    return _law_kernels(function, m, parallel=n > 1, fingerprint=fingerprint)
 
 
-def _law_kernels(function, m, say=None, parallel=False):
+def _law_kernels(function, m, say=None, parallel=False, fingerprint=None):
     """The compiled step and block for a run's law ``function(d, a0 … a{m−1})`` (:func:`~.phase_laws.run_law`).
 
     The law (and every function it calls) is compiled, an adapter ``_central_law(d, a)`` passes it
     the first m numbers of ``a``, and the step's functions are compiled with that adapter under their
-    own names (``…__<hash>``: the law's module source, name and m), so that Numba's cache keeps one
-    entry per law and an edited law gets a new one.
+    own names (``…__<hash>``: the law's name, m and :func:`~.law_check.law_fingerprint` — its code,
+    its helpers', its closure's and its globals' values), so that Numba's cache keeps one entry per
+    law and an edited law, a closure with other values or a global set anew gets a new one.
 
     With ``parallel`` the block is the variant over several threads (:func:`threads`).
 
@@ -748,23 +750,19 @@ def _law_kernels(function, m, say=None, parallel=False):
         ``(step, block)``: the dispatchers of :func:`_step_kernel` and :func:`_block_kernel`.
     """
     import hashlib
-    import inspect
 
     import numba
 
-    key = ("law", function, m, parallel)
+    fingerprint = fingerprint or law_check.law_fingerprint(function)
+    key = ("law", fingerprint, m, parallel)
     if key in _kernels:
         return _kernels[key]
     numba_driver.register_helpers()
     numba.config.CACHE_DIR = numba_driver.cache_dir()
     h = hashlib.sha1(f"{function.__module__}.{function.__qualname__}/{m}{'/parallel' if parallel else ''}".encode())
-    try:
-        with open(inspect.getsourcefile(function), "rb") as fh:
-            h.update(fh.read())
-    except (OSError, TypeError):
-        h.update(function.__code__.co_code)
+    h.update(fingerprint.encode())     # (the law's code, helpers, closure and globals: law_check.law_fingerprint)
     suffix = "__" + h.hexdigest()[:12]
-    adapter = law_check.law_adapter(function, m)
+    adapter = law_check.law_adapter(function, m, fingerprint)
     names = ("pair_term", "_step_kernel", "_block_kernel")
     extra, rename = _linear()
     L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
@@ -818,7 +816,7 @@ def compile_kernels(say=None, law=None):
         arguments = tuple(constants(*pair))
     m = len(arguments)
     if m <= numba_driver.LAW_SLOTS:
-        try:     # (a law outside COMPILED_LAWS is compiled where its bits are NumPy's at these arguments)
+        try:     # (a law outside COMPILED_LAWS is compiled where its bits are NumPy's: law_check.law_bits)
             rows = np.array(arguments, dtype=float).reshape(m, 1)
             if found.name in COMPILED_LAWS or law_check.law_bits(found.name, function, rows, np.array([2.0])) is None:
                 _law_kernels(function, m, say, parallel)
@@ -885,12 +883,14 @@ class _Workspace:
         if self.custom:
             for k, a in enumerate(got[1]):
                 self.law_rows[k] = np.broadcast_to(np.asarray(a, dtype=float), (C.P,))
-            self.law = (got[0], len(got[1]))
+            fingerprint = law_check.law_fingerprint(got[0])
+            self.law = (got[0], len(got[1]), fingerprint)
             try:      # (a law outside COMPILED_LAWS runs compiled only where its bits are NumPy's)
                 if name not in COMPILED_LAWS:
-                    self.why = law_check.law_bits(name, got[0], self.law_rows[:len(got[1])], C.f[_ID0])
+                    self.why = law_check.law_bits(name, got[0], self.law_rows[:len(got[1])], C.f[_ID0], fingerprint)
                 if self.why is None:
-                    _law_kernels(*self.law, say=logging.getLogger(__name__).info)   # (a first compile, announced)
+                    _law_kernels(got[0], len(got[1]), say=logging.getLogger(__name__).info,
+                                 fingerprint=fingerprint)   # (a first compile, announced)
             except Exception as exc:          # (a law Numba cannot compile: NumPy runs it)
                 self.why = f"a contact law Numba cannot compile ({type(exc).__name__})"
         self.no_half = np.zeros((3, 0))
