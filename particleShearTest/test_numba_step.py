@@ -677,6 +677,48 @@ class TestCompiledSearch(unittest.TestCase):
                 self.assertFalse(np.isin(want[0][~carried], old).any())  # and only new keys read none
 
 
+    def test_merged_history_is_the_carry(self):
+        """The one-pass history merge of a rebuild inside a block (``_merged_history``) writes the keys
+        and fields of ``_carry_kernel`` (``carried_rows`` of the bonds kept, ``carried_fields``): random
+        tables of 0 … 3,000 sorted unique keys with bonds and relations, new keys sorted (with repeats
+        or unique) that hold or miss them; its count alone (``at < 0``) is the same number."""
+        from particleShear.engine import numba_driver as nd
+        from particleShear.engine import state
+        f = nd.jit_laws(True, ((numba_step, "_merged_history"),))
+        merged = f["_merged_history"]
+        rng = np.random.default_rng(5)
+        S = numba_step._TABLE_SCALE
+        for t in range(200):
+            m = int(rng.integers(0, 3000))
+            old = np.unique(rng.integers(0, 120, m) * S + rng.integers(0, 120, m)).astype(np.int64)
+            m = len(old)
+            st = rng.choice(np.array([state.STICK, state.SLIP, state.PERMANENT], np.int8), m)
+            de, act, num = rng.random(m), rng.random(m) < 0.5, rng.integers(0, 99, m).astype(np.int64)
+            z = rng.random((2, m))
+            c = int(rng.integers(0, 3000))
+            k = np.sort(rng.integers(0, 120, c) * S + rng.integers(0, 120, c)).astype(np.int64)
+            if t % 2:
+                k = np.unique(k)
+            key, src = state.carried_rows(old, old[st == state.PERMANENT], k)
+            want = state.carried_fields(src, st, de, act, num, z)
+            b, n0, at = 3, 7, 5
+            W = at + len(key) + 2
+            Si, s_state, s_xi = np.zeros((3, W), np.int64), np.zeros(W, np.int8), np.zeros((2, W))
+            s_active, s_birth, s_deq = np.zeros(W, np.bool_), np.zeros(W, np.int64), np.zeros(W)
+            with self.subTest(t=t):
+                self.assertEqual(merged(old, k, st, de, act, num, z, -1, b, n0, Si, s_state, s_xi, s_active, s_birth,
+                                        s_deq), len(key))
+                self.assertFalse(Si.any())
+                n = merged(old, k, st, de, act, num, z, at, b, n0, Si, s_state, s_xi, s_active, s_birth, s_deq)
+                self.assertEqual(n, len(key))
+                cols = slice(at, at + n)
+                np.testing.assert_array_equal(Si[0, cols], b)
+                np.testing.assert_array_equal(Si[1, cols], key // S + n0)
+                np.testing.assert_array_equal(Si[2, cols], key % S + n0)
+                for got, expected in zip((s_state, s_deq, s_active, s_birth), want[:4]):
+                    np.testing.assert_array_equal(got[cols], expected)
+                np.testing.assert_array_equal(_bits(s_xi[:, cols]), _bits(want[4]))
+
     def test_linear_positions_are_searchsorted(self):
         """``_positions_linear`` (the compiled merge's positions) is ``numpy.searchsorted`` (left) of a
         sorted array in a sorted array: repeats in either, empty arrays, values below and above all."""

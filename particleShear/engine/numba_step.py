@@ -94,10 +94,12 @@ MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merg
 #: the functions of the compiled history merge of a rebuild (:func:`rebuild`)
 CARRY_FUNCTIONS = MERGE_FUNCTIONS + ((state, "carried_fields"), (sys.modules[__name__], "_carry_kernel"))
 #: the functions of the compiled block (:func:`run_block`) besides the step's: its rebuilds run the
-#: search, the history merge and the constants of the rebuild outside a block (:func:`_rebuild_replica`)
+#: search and the constants of the rebuild outside a block, and the history merge in one pass
+#: (:func:`_rebuild_replica`, :func:`_merged_history`)
 BLOCK_FUNCTIONS = ((integrate, "flow_shifted"), (state, "synced_history"), (neighbours, "cell_grid")) + \
-    SEARCH_FUNCTIONS + CONSTANT_FUNCTIONS + CARRY_FUNCTIONS + \
-    ((sys.modules[__name__], "_sorted_keys"), (sys.modules[__name__], "_rebuild_replica"),
+    SEARCH_FUNCTIONS + CONSTANT_FUNCTIONS + \
+    ((sys.modules[__name__], "_sorted_keys"), (sys.modules[__name__], "_merged_history"),
+     (sys.modules[__name__], "_rebuild_replica"),
      (sys.modules[__name__], "_block_kernel"))
 
 #: the types of :func:`_step_kernel`'s arguments, in order (``f``: float64, ``i``: int64, ``b``: bool,
@@ -380,7 +382,8 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     step is the same numbers whatever else the batch holds or in which order its replicas step.
     ``start`` 0 runs the whole step; 3 runs it with the random normals of the pairs at ``d = 0``
     given (``work`` rows 5, 6, drawn by the caller after :data:`_D_ZERO`); 1 resumes at the ξ rule
-    once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9).  ``pred[b]``:
+    once the caller gave the random directions at ``|R| = 0`` (``work`` rows 8, 9), from the first
+    such pair on (the pairs before it had theirs in the call that stopped there).  ``pred[b]``:
     replica b's velocity terms see the velocities half a kick ahead (``half``; velocity Verlet after
     its first step).  ``sample``: 0 no stresses, 1 the two shear stresses (``tau``), 2 also the sums of
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
@@ -559,9 +562,12 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                 vel[2, k] *= cool
         if free_mode == 1:            # no ξ without friction and bonds
             start = 2
-        # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller)
+        # the unit vectors of R = v_i dt − D (a random one at |R| = 0, drawn by the caller), and the ξ
+        # rule of each pair in the same pass until the first |R| = 0 (each pair's ξ reads only its own
+        # numbers and velocities nothing here changes, so the order of the pairs' updates is free)
         units = False
-        for p in range(P0, P1 if start != 2 else P0):
+        last = P1 if start != 2 else P0
+        for p in range(P0, last):
             i = Ci[1, p]
             Rx = vel[0, i] * dt - dxs[p]
             Ry = vel[1, i] * dt - dys[p]
@@ -572,11 +578,25 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
             if zero[p]:
                 units = True
             else:
-                mxs[p], mys[p] = Rx / dR, Ry / dR
+                mx, my = Rx / dR, Ry / dR
+                mxs[p], mys[p] = mx, my
+                if not units:      # (the ξ rule below, written out: as an inlined helper of the
+                    j = Ci[2, p]       # arrays the compiled step took 2.5× as long)
+                    kd = dt if active[p] and state_p[p] != 1 else 0.0
+                    rvx = vel[0, j] - vel[0, i] + dvxs[p]
+                    spin = Cf[_IRI, p] * vel[2, i] + Cf[_IRJ, p] * vel[2, j]
+                    inc_ij, inc_ji = xi_rates(rvx, vel[1, j] - vel[1, i], nxs[p], nys[p], mx, my, spin, rvx)
+                    xi[0, p] += inc_ij * kd
+                    xi[1, p] += inc_ji * kd
         if units:
             return _UNITS
+        xi_from = last
+    else:       # (the resumption: the ξ rule from the first |R| = 0 on, the pairs before had theirs)
+        xi_from = P0
+        while xi_from < P1 and not zero[xi_from]:
+            xi_from += 1
     # -- the sequential ξ rule (velocities after the kick and damping, geometry of the force phase)
-    for p in range(P0, P1 if start != 2 else P0):
+    for p in range(xi_from, P1 if start != 2 else P0):
         i, j = Ci[1, p], Ci[2, p]
         kd = dt if active[p] and state_p[p] != 1 else 0.0
         rvx = vel[0, j] - vel[0, i] + dvxs[p]
@@ -1967,6 +1987,58 @@ def _sorted_keys(key, N):
     return out
 
 
+def _merged_history(old_key, key, state, d_eq, active, birth, xi, at, b, n0, Si, s_state, s_xi, s_active, s_birth,
+                     s_deq):
+    """The history merge of a rebuild in one pass (compiled; :func:`_rebuild_replica`): what
+    :func:`_carry_kernel` returns (:func:`~particleShear.engine.state.carried_rows` and
+    :func:`~particleShear.engine.state.carried_fields` of the bonds kept), written straight into
+    the slot's columns ``at …``; with ``at < 0`` nothing is written, only the count.
+
+    ``old_key`` (the old candidates' keys ``i·2³² + j``, sorted and unique, as a pair table keeps
+    them) and ``key`` (the search's, sorted) are walked side by side: a new key takes its old row
+    where the old list has it and the zeros of a new pair otherwise (inactive, sticking, ξ = 0, no
+    number, ``d_eq`` 0); an old key the search missed stays where it is a bond; a repeated new key
+    is taken once (``numpy.unique``).  The same keys and fields, copied, as the two functions'
+    sorted union and gathers, without their ≈ 25 temporary arrays and passes (about half of a
+    rebuild inside a block at N = 150).  The row ``Si`` of a column is ``b`` and the key's sphere
+    rows ``i + n0``, ``j + n0``.
+
+    Returns
+    -------
+    int
+        The number of candidates of the new list.
+    """
+    m, c = old_key.shape[0], key.shape[0]
+    q, a, n = 0, 0, 0
+    last = -1
+    while q < c or a < m:
+        if q < c and key[q] == last:        # (a repeated new key)
+            q += 1
+            continue
+        if q < c and (a >= m or key[q] <= old_key[a]):
+            k = key[q]
+            src = a if a < m and old_key[a] == k else -1
+            q += 1
+            last = k
+        else:
+            k, src = old_key[a], a
+            if state[a] != PERMANENT:      # (an old key the search missed: kept only as a bond)
+                a += 1
+                continue
+        if src >= 0:
+            a += 1
+        if at >= 0:
+            p = at + n
+            Si[0, p], Si[1, p], Si[2, p] = b, k // _TABLE_SCALE + n0, k % _TABLE_SCALE + n0
+            if src >= 0:
+                s_state[p], s_xi[0, p], s_xi[1, p] = state[src], xi[0, src], xi[1, src]
+                s_active[p], s_birth[p], s_deq[p] = active[src], birth[src], d_eq[src]
+            else:
+                s_state[p], s_xi[0, p], s_xi[1, p], s_active[p], s_birth[p], s_deq[p] = 0, 0.0, 0.0, False, 0, 0.0
+        n += 1
+    return n
+
+
 def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, state_p, xi, active, birth, d_eq,
                      Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, offsets, ends, base, cap, u, u_max, strain,
                      bound):
@@ -1992,6 +2064,8 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, s
     nx, ny = cell_grid(Lx[b], Ly[b], 2 * r_max[b] + skin[b], N)
     key = _sorted_keys(_search_kernel(pos[0, n0:n0 + N].copy(), pos[1, n0:n0 + N].copy(), r[n0:n0 + N].copy(), Lx[b],
                                       Ly[b], shift, skin[b], nx, ny, _TABLE_SCALE), N)
+    # the old candidates' keys and history as the pair table keeps it (read before the slot is written:
+    # it may be their source), then the history merge straight into the slot's columns
     m = hi - lo
     old_key, st, act, num = np.empty(m, np.int64), np.empty(m, np.int8), np.empty(m, np.bool_), np.empty(m, np.int64)
     z, de = np.empty((2, m)), np.empty(m)
@@ -2001,15 +2075,11 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, s
         st[q], z[0, q], num[q] = synced_history(state_p[p], xi[0, p], active[p], birth[p])
         z[1, q] = synced_history(state_p[p], xi[1, p], active[p], birth[p])[1]
         act[q], de[q] = active[p], d_eq[p]
-    key, s_new, d_new, a_new, b_new, z_new = _carry_kernel(old_key, key, st, de, act, num, z, _MERGE_MIN)
-    n, lo = key.shape[0], base[b]
+    lo = base[b]
+    n = _merged_history(old_key, key, st, de, act, num, z, -1, b, n0, Si, s_state, s_xi, s_active, s_birth, s_deq)
     if lo + n > cap[b]:
         return False
-    for q in range(n):
-        p = lo + q
-        Si[0, p], Si[1, p], Si[2, p] = b, key[q] // _TABLE_SCALE + n0, key[q] % _TABLE_SCALE + n0
-        s_state[p], s_xi[0, p], s_xi[1, p], s_active[p], s_birth[p], s_deq[p] = (s_new[q], z_new[0, q], z_new[1, q],
-                                                                                a_new[q], b_new[q], d_new[q])
+    _merged_history(old_key, key, st, de, act, num, z, lo, b, n0, Si, s_state, s_xi, s_active, s_birth, s_deq)
     _constants_kernel(Sf[:, lo:lo + n], Sb[:, lo:lo + n], Si[:, lo:lo + n], r, pc[0], pc[1], pc[2], pc[3], pc[4],
                       pc[5], pc[6], pc[7], pc[8], pc[9], pc[10], False, s_state[lo:lo + n], s_deq[lo:lo + n])
     offsets[b], ends[b] = lo, lo + n
@@ -2130,4 +2200,4 @@ def compile_block_kernel(cache=True, parallel=False):
     numba.core.registry.CPUDispatcher
     """
     return _compile(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
-                    _block_signature, cache, parallel=bool(parallel), linear=True)
+                    _block_signature, cache, parallel=bool(parallel))
