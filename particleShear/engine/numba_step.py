@@ -1553,9 +1553,11 @@ def _settle(engine, slots):
     candidates side by side again (the rebuilt replicas' from their slots, the others' from the
     state's contacts) as the candidates' constants
     (:meth:`~particleShear.engine.forces.PairConstants.from_blocks`) and history, each rebuilt
-    replica's pair table made its new list, all taken by
-    :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`.  Nothing where no list was
-    rebuilt (the kernel wrote the history of ``state.contacts`` in place)."""
+    replica's pair table made its new list with its history as
+    :meth:`~particleShear.engine.contacts.Contacts.sync_down` writes it (written once here, so
+    :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`, which takes the rest, does
+    not write these tables again).  Nothing where no list was rebuilt (the kernel wrote the
+    history of ``state.contacts`` in place)."""
     rebuilt = np.flatnonzero(slots.rebuilt)
     if not len(rebuilt):
         return
@@ -1577,12 +1579,14 @@ def _settle(engine, slots):
                 _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
     C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
     N = s.N
-    for r in rebuilt:
+    for r in rebuilt:      # (each table written once, as sync_down writes it: its own copies, the kept history)
         lo, hi = offsets[r], offsets[r + 1]
-        key = (i[1, lo:hi] - r * N).astype(np.int64) << 32 | (i[2, lo:hi] - r * N)
-        s.pairs[r].adopt(key, history[0][lo:hi], d_eq[lo:hi].copy(), history[2][lo:hi], history[3][lo:hi],
-                         history[1][:, lo:hi])
-    engine.adopt_candidates(C, history, slots.rebuilt)
+        pi, pj = i[1, lo:hi] - r * N, i[2, lo:hi] - r * N
+        kept, xi, birth = state.synced_history(history[0][lo:hi], history[1][:, lo:hi], history[2][lo:hi],
+                                               history[3][lo:hi])
+        s.pairs[r].adopt(np.left_shift(pi, 32, dtype=np.int64) | pj, kept.astype(np.int8), d_eq[lo:hi].copy(),
+                         history[2][lo:hi].copy(), birth, xi, i=pi, j=pj)
+    engine.adopt_candidates(C, history, slots.rebuilt, written=True)
 
 
 def _columns(src, lo, hi, dst, at):
