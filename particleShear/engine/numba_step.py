@@ -1579,14 +1579,40 @@ def _settle(engine, slots):
                 _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
     C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
     N = s.N
-    for r in rebuilt:      # (each table written once, as sync_down writes it: its own copies, the kept history)
-        lo, hi = offsets[r], offsets[r + 1]
-        pi, pj = i[1, lo:hi] - r * N, i[2, lo:hi] - r * N
-        kept, xi, birth = state.synced_history(history[0][lo:hi], history[1][:, lo:hi], history[2][lo:hi],
-                                               history[3][lo:hi])
-        s.pairs[r].adopt(np.left_shift(pi, 32, dtype=np.int64) | pj, kept.astype(np.int8), d_eq[lo:hi].copy(),
-                         history[2][lo:hi].copy(), birth, xi, i=pi, j=pj)
+    table = _kernels.get("table")
+    if table is None:
+        table = _kernels["table"] = numba_driver.jit_laws(
+            True, ((state, "synced_history"), (sys.modules[__name__], "_table_columns")))["_table_columns"]
+    for r in rebuilt:      # (each table written once, as sync_down writes it: its own arrays, the kept history)
+        key, st, de, act, num, z, pi, pj = table(i, *history, d_eq, offsets[r], offsets[r + 1], r * N)
+        s.pairs[r].adopt(key, st, de, act, num, z, i=pi, j=pj)
     engine.adopt_candidates(C, history, slots.rebuilt, written=True)
+
+
+def _table_columns(i, state_p, xi, active, birth, d_eq, lo, hi, first):
+    """A rebuilt replica's pair table from the columns ``lo … hi − 1`` of the handed-back blocks, in
+    one pass (compiled; :func:`_settle`): the keys ``i << 32 | j`` and sphere indices (rows less
+    ``first``, the replica's first sphere row), and the history as
+    :meth:`~particleShear.engine.contacts.Contacts.sync_down` writes it
+    (:func:`~particleShear.engine.state.synced_history`), each a new array.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``key, state, d_eq, active, birth, xi, i, j`` (:meth:`~particleShear.engine.state.PairTable.adopt`).
+    """
+    n = hi - lo
+    key, pi, pj = np.empty(n, np.int64), np.empty(n, np.intp), np.empty(n, np.intp)
+    st, de, act, num, z = np.empty(n, np.int8), np.empty(n), np.empty(n, np.bool_), np.empty(n, np.int64), \
+        np.empty((2, n))
+    for q in range(n):
+        p = lo + q
+        a, c = i[1, p] - first, i[2, p] - first
+        pi[q], pj[q], key[q] = a, c, (a << 32) | c
+        st[q], z[0, q], num[q] = synced_history(state_p[p], xi[0, p], active[p], birth[p])
+        z[1, q] = synced_history(state_p[p], xi[1, p], active[p], birth[p])[1]
+        act[q], de[q] = active[p], d_eq[p]
+    return key, st, de, act, num, z, pi, pj
 
 
 def _columns(src, lo, hi, dst, at):
