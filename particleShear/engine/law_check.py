@@ -14,7 +14,8 @@ to a large linear one differs for fewer, too few for any sample to find reliably
 
 So the check reads the code, not a sample (:func:`law_bits`): the law and every helper it calls are
 compiled for numbers and their LLVM code is read; every function that code may call must be one of
-the correctly rounded intrinsics of :data:`EXACT_INTRINSICS`, Python's and Numba's runtime (the
+the correctly rounded intrinsics of :data:`EXACT_INTRINSICS` or C functions of :data:`EXACT_LIBRARY`,
+Python's and Numba's runtime (the
 wrapper that converts the arguments, the raising of an error) or another compiled helper of the law
 that passes the same reading.  A law that calls anything else (``llvm.pow``, ``llvm.exp``, ``fmod``,
 a function of a library) runs on NumPy, and the note names what it calls.  A law that passes is
@@ -40,7 +41,7 @@ import numpy as np
 
 from . import numba_driver
 
-__all__ = ["EXACT_INTRINSICS", "PROBE_FACTORS", "MAX_PROBED_CANDIDATES", "law_fingerprint", "law_adapter",
+__all__ = ["EXACT_INTRINSICS", "EXACT_LIBRARY", "PROBE_FACTORS", "MAX_PROBED_CANDIDATES", "law_fingerprint", "law_adapter",
            "outside_calls", "law_bits"]
 
 #: the LLVM intrinsics a law's compiled code may call (prefixes of their names): correctly rounded
@@ -53,6 +54,11 @@ EXACT_INTRINSICS = ("llvm.fabs.", "llvm.sqrt.", "llvm.copysign.", "llvm.floor.",
                     "llvm.abs.", "llvm.smax.", "llvm.smin.", "llvm.umax.", "llvm.umin.",
                     "llvm.lifetime.", "llvm.assume", "llvm.expect.", "llvm.dbg.", "llvm.memcpy.", "llvm.memset.",
                     "llvm.memmove.")
+
+#: the C library's functions a law's compiled code may call (whole names): IEEE 754 requires them
+#: correctly rounded or exact (square root, absolute value, sign transfer, rounding to an integer)
+EXACT_LIBRARY = frozenset(n + t for n in ("sqrt", "fabs", "copysign", "floor", "ceil", "trunc", "rint", "nearbyint",
+                                            "round", "roundeven") for t in ("", "f"))
 
 #: the runtime a compiled function's wrapper and error handling call (prefixes): no arithmetic
 _RUNTIME = ("Py", "_Py", "NRT_", "numba_do_raise", "numba_gil_ensure", "numba_gil_release",
@@ -197,8 +203,8 @@ _DEFINE = re.compile(r'^define\b[^@]*@"?([^"(\s]+)"?\(', re.MULTILINE)
 
 def outside_calls(dispatchers):
     """The functions the compiled code of ``dispatchers`` may call that are not known to round
-    as NumPy does: what is neither an intrinsic of :data:`EXACT_INTRINSICS`, the runtime, nor a
-    function defined in the code read.
+    as NumPy does: what is neither an intrinsic of :data:`EXACT_INTRINSICS`, a function of
+    :data:`EXACT_LIBRARY`, the runtime, nor a function defined in the code read.
 
     Parameters
     ----------
@@ -215,7 +221,7 @@ def outside_calls(dispatchers):
     out = set()
     for t in texts:
         for name in _DECLARE.findall(t):
-            if name in defined or name.startswith(_RUNTIME):
+            if name in defined or name in EXACT_LIBRARY or name.startswith(_RUNTIME):
                 continue
             if name.startswith("llvm.") and name.startswith(EXACT_INTRINSICS):
                 continue
