@@ -17,6 +17,8 @@ candidate set are built on the host from the per-replica lists and copied to the
 __docformat__ = "numpy"
 
 
+import functools
+
 import numpy as np
 
 from .state import spread
@@ -159,7 +161,7 @@ class PairConstants:
         self.B = len(offsets) - 1
         self.seg_rep = np.flatnonzero(offsets[1:] > offsets[:-1])
         self.seg_starts = offsets[:-1][self.seg_rep]
-        # (the scatter of the pair forces, read by the array step only, is built on its first use: _scatter)
+        # (the scatter of the pair forces, read by the array step only, is built on its first read: scatter)
         self.spheres = s.B * s.N
         self.replica_sum = None       # pair rows → replica sums on a device without ordered reduceat
         if be.ordered_reductions:
@@ -167,32 +169,27 @@ class PairConstants:
         elif self.B == s.B:           # the whole batch (not the rebuilt replicas alone)
             self.replica_sum = SegmentSum(self.rep_host, s.B, be)
 
-    #: the attributes :meth:`_scatter` builds on their first read
-    _DEFERRED = frozenset(("scatter_idx", "scatter"))
-
-    def __getattr__(self, name):
-        """The scatter of the pair forces (:attr:`scatter_idx`, :attr:`scatter`) on its first read.
+    @functools.cached_property
+    def scatter_idx(self):
+        """The rows ``(ai, aj, ai + nb, aj + nb, ai + 2nb, aj + 2nb)`` of the three components (F_x,
+        F_y, torque) of the pair forces, ``nb`` = B·N spheres; built on its first read and kept
+        with these constants (dropped with them at the one invalidation point, a rebuild).
 
         Only the array step reads it (:func:`scatter_forces`); the compiled backend sums its pair
         forces inside its kernels, so building it with every set of candidates (each hand-back of a
-        compiled block) cost that backend ≈ 0.3 ms per set at N = 10,000 for nothing.  Deferred
-        construction of the same arrays from the same index rows, kept with these constants (built
-        once per set, dropped with it at the one invalidation point, a rebuild)."""
-        if name in PairConstants._DEFERRED and "spheres" in self.__dict__:
-            self._scatter()
-            return self.__dict__[name]
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
-    def _scatter(self):
-        """Build :attr:`scatter_idx` and :attr:`scatter` from ``ai``, ``aj`` (:meth:`__getattr__`)."""
-        be, nb = self.backend, self.spheres
+        compiled block) cost that backend ≈ 0.3 ms per set at N = 10,000 for nothing."""
         pair_rows = self.i_host[1:3]          # (ai, aj)
-        # (ai, aj, ai + nb, aj + nb, ai + 2nb, aj + 2nb): the rows of the three components (F_x, F_y, torque)
-        self.scatter_idx = (pair_rows + (nb * np.arange(3))[:, None, None]).reshape(-1)
-        #: pair forces → sphere totals: one bincount over the three components on NumPy; on CuPy a
-        #: padded gather over (ai, aj), applied to each component's row (a third of the layout to build)
-        self.scatter = SegmentSum(self.scatter_idx if be.ordered_reductions else pair_rows.reshape(-1),
-                                  3 * nb if be.ordered_reductions else nb, be)
+        return (pair_rows + (self.spheres * np.arange(3))[:, None, None]).reshape(-1)
+
+    @functools.cached_property
+    def scatter(self):
+        """Pair forces → sphere totals (:attr:`scatter_idx`): one bincount over the three components
+        on NumPy; on CuPy a padded gather over (ai, aj), applied to each component's row (a third of
+        the layout to build).  Built on its first read, as :attr:`scatter_idx`."""
+        be, nb = self.backend, self.spheres
+        if be.ordered_reductions:
+            return SegmentSum(self.scatter_idx, 3 * nb, be)
+        return SegmentSum(self.i_host[1:3].reshape(-1), nb, be)
 
     @classmethod
     def splice(cls, s, old, new, segments, offsets):
