@@ -147,11 +147,12 @@ def rebuild_parts(eng, repeats):
         return 0
 
     ws, slots = numba_step._workspace(eng), numba_step._Slots.of(eng)
-    s, C, b = eng.s, eng.C, 0
+    s, c, b = eng.s, eng.s.contacts, 0
+    C = c.C
     args = (s.N, s.pos, s.r, ws.Lx, ws.Ly, s.gamma.astype(float), ws.le, ws.skin, ws.r_max, slots.pc, C.f, C.i,
-            eng.state_p, eng.xi, eng.active, eng.birth, slots.d_eq_c, slots.f, slots.i, slots.b, slots.state_p,
+            c.state_p, c.xi, c.active, c.birth, slots.d_eq_c, slots.f, slots.i, slots.b, slots.state_p,
             slots.xi, slots.active, slots.birth, slots.d_eq, slots.offsets, slots.ends, slots.base, slots.cap,
-            eng.u.copy(), eng.u_max.copy(), eng.strain.copy(), eng.bound.copy())
+            c.u.copy(), c.u_max.copy(), c.strain.copy(), c.bound.copy())
     grid_args = (b, s.N, s.pos, s.r, float(ws.Lx[b]), float(ws.Ly[b]), float(ws.Ly[b] * s.gamma[b] * ws.le[b]),
                  float(ws.skin[b]), float(ws.r_max[b]))
     lo, n = int(slots.base[b]), int(loop_rebuild(1, b, args))     # (the rebuilt list, in the slot)

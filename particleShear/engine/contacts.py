@@ -182,7 +182,7 @@ class Contacts:
         else:
             self.free_p = state.backend.asarray(free)[self.C.rep]
 
-    def sync_down(self, state, replicas=None):
+    def sync_down(self, state, replicas=None, written=False):
         """Write the history of the candidates back into the state's pair tables (of ``replicas``;
         all by default), with each replica's creation counter; each table's version advances.
 
@@ -197,11 +197,22 @@ class Contacts:
             The batch these contacts belong to.
         replicas : iterable of int, optional
             The replicas whose tables are written.
+        written : bool, default False
+            Their tables hold this history already (written by the caller as this method writes
+            it, e.g. a compiled block's hand-back, :func:`~particleShear.engine.numba_step._settle`):
+            only the creation counters and versions are brought up to date.
         """
         C, be = self.C, state.backend
         if C is None:
             return
         which = list(range(state.B)) if replicas is None else list(replicas)
+        if written:
+            counters = to_host(self.next_birth, "pair history")
+            for b in which:
+                p = state.pairs[b]
+                p.resume_births(counters[b])
+                p.version += 1
+            return
         spans = [(C.offsets[b], C.offsets[b + 1]) for b in which]
         state_p, xi, active, birth = self.history
         if not be.host and which:

@@ -1554,9 +1554,11 @@ def _settle(engine, slots):
     candidates side by side again (the rebuilt replicas' from their slots, the others' from the
     state's contacts) as the candidates' constants
     (:meth:`~particleShear.engine.forces.PairConstants.from_blocks`) and history, each rebuilt
-    replica's pair table made its new list, all taken by
-    :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`.  Nothing where no list was
-    rebuilt (the kernel wrote the history of ``state.contacts`` in place)."""
+    replica's pair table made its new list with its history as
+    :meth:`~particleShear.engine.contacts.Contacts.sync_down` writes it (written once here, so
+    :meth:`~particleShear.engine.step.BatchEngine.adopt_candidates`, which takes the rest, does
+    not write these tables again).  Nothing where no list was rebuilt (the kernel wrote the
+    history of ``state.contacts`` in place)."""
     rebuilt = np.flatnonzero(slots.rebuilt)
     if not len(rebuilt):
         return
@@ -1578,12 +1580,40 @@ def _settle(engine, slots):
                 _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
     C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
     N = s.N
-    for r in rebuilt:
-        lo, hi = offsets[r], offsets[r + 1]
-        key = (i[1, lo:hi] - r * N).astype(np.int64) << 32 | (i[2, lo:hi] - r * N)
-        s.pairs[r].adopt(key, history[0][lo:hi], d_eq[lo:hi].copy(), history[2][lo:hi], history[3][lo:hi],
-                         history[1][:, lo:hi])
-    engine.adopt_candidates(C, history, slots.rebuilt)
+    table = _kernels.get("table")
+    if table is None:
+        table = _kernels["table"] = numba_driver.jit_laws(
+            True, ((state, "synced_history"), (sys.modules[__name__], "_table_columns")))["_table_columns"]
+    for r in rebuilt:      # (each table written once, as sync_down writes it: its own arrays, the kept history)
+        key, st, de, act, num, z, pi, pj = table(i, *history, d_eq, offsets[r], offsets[r + 1], r * N)
+        s.pairs[r].adopt(key, st, de, act, num, z, i=pi, j=pj)
+    engine.adopt_candidates(C, history, slots.rebuilt, written=True)
+
+
+def _table_columns(i, state_p, xi, active, birth, d_eq, lo, hi, first):
+    """A rebuilt replica's pair table from the columns ``lo … hi − 1`` of the handed-back blocks, in
+    one pass (compiled; :func:`_settle`): the keys ``i << 32 | j`` and sphere indices (rows less
+    ``first``, the replica's first sphere row), and the history as
+    :meth:`~particleShear.engine.contacts.Contacts.sync_down` writes it
+    (:func:`~particleShear.engine.state.synced_history`), each a new array.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``key, state, d_eq, active, birth, xi, i, j`` (:meth:`~particleShear.engine.state.PairTable.adopt`).
+    """
+    n = hi - lo
+    key, pi, pj = np.empty(n, np.int64), np.empty(n, np.intp), np.empty(n, np.intp)
+    st, de, act, num, z = np.empty(n, np.int8), np.empty(n), np.empty(n, np.bool_), np.empty(n, np.int64), \
+        np.empty((2, n))
+    for q in range(n):
+        p = lo + q
+        a, c = i[1, p] - first, i[2, p] - first
+        pi[q], pj[q], key[q] = a, c, (a << 32) | c
+        st[q], z[0, q], num[q] = synced_history(state_p[p], xi[0, p], active[p], birth[p])
+        z[1, q] = synced_history(state_p[p], xi[1, p], active[p], birth[p])[1]
+        act[q], de[q] = active[p], d_eq[p]
+    return key, st, de, act, num, z, pi, pj
 
 
 def _columns(src, lo, hi, dst, at):

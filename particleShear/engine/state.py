@@ -464,7 +464,7 @@ class PairTable:
                 np.ascontiguousarray(self.active, dtype=np.bool_), np.ascontiguousarray(self.birth, dtype=np.int64),
                 np.ascontiguousarray(np.asarray(self.xi, dtype=float).reshape(2, -1)))
 
-    def adopt(self, key, state, d_eq, active, birth, xi):
+    def adopt(self, key, state, d_eq, active, birth, xi, i=None, j=None):
         """Make the sorted unique keys ``key`` (``i << 32 | j``) the candidates, with the history given
         (:func:`carried_fields`); the version advances.
 
@@ -473,9 +473,12 @@ class PairTable:
         key : ndarray of int64 (C,)
         state, d_eq, active, birth, xi : ndarray
             One value (``xi``: one column) per key.
+        i, j : ndarray of intp (C,), optional
+            The sphere indices of the keys where the caller has them already (taken as they are,
+            not copied); default: read from ``key``.
         """
-        self.i = (key >> 32).astype(np.intp)
-        self.j = (key & 0xFFFFFFFF).astype(np.intp)
+        self.i = (key >> 32).astype(np.intp) if i is None else i
+        self.j = (key & 0xFFFFFFFF).astype(np.intp) if j is None else j
         self.state, self.d_eq, self.active, self.birth, self.xi = state, d_eq, active, birth, xi
         self.key = key
         self.version += 1

@@ -369,7 +369,7 @@ class BatchEngine:
             C.images = (C.Ly * ky, ky, C.Lx * kx, kx) if one else None
         return dx, dy, ky, kx
 
-    def adopt_candidates(self, C, history, counts):
+    def adopt_candidates(self, C, history, counts, written=False):
         """Take candidate lists rebuilt elsewhere (a compiled block's, :func:`~particleShear.engine.numba_step._settle`)
         as what :meth:`neighbours` leaves after the same rebuilds: the constants ``C`` and the flat
         history of every replica, the rebuilt replicas' pair tables written as :meth:`flush` writes
@@ -384,12 +384,16 @@ class BatchEngine:
         counts : ndarray of int (B,)
             How many times each replica's list was rebuilt (the rebuilt ones' pair tables hold
             their new lists already).
+        written : bool, default False
+            The rebuilt replicas' tables hold their history too, as
+            :meth:`~particleShear.engine.contacts.Contacts.sync_down` writes it: only their
+            creation counters and versions are brought up to date (no second write of the tables).
         """
         s = self.s
         c = s.contacts
         c.take(C, history)
         C.set_visits(s)
-        c.sync_down(s, np.flatnonzero(counts))
+        c.sync_down(s, np.flatnonzero(counts), written=written)
         c.rebuilds += counts
         c.refresh_free(s)
 
