@@ -56,9 +56,10 @@ from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, ot
 from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels", "run_step",
-           "run_force_phase", "run_move", "run_block", "search", "carried", "rebuild", "constant_rows", "tensor_sums",
-           "NOT_RUN", "REBUILD_IN_BLOCK", "SLACK"]
+           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels",
+           "compile_tensor_kernel", "run_step", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
+           "step_samples", "draw_directions", "kernels_of", "last_workspace", "run_block", "search", "carried",
+           "rebuild", "constant_rows", "NOT_RUN", "UNITS", "MOVE_ONLY", "TENSOR_SUMS", "REBUILD_IN_BLOCK", "SLACK"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -87,7 +88,7 @@ SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pa
 CONSTANT_FUNCTIONS = ((laws, "central_constants"), (terms, "term_rows"), (forces, "geometry_rows"),
                       (forces, "pair_rows"), (sys.modules[__name__], "_constants_kernel"))
 assert len(forces.PairConstants.FLOAT_ROWS) == 23      # (the rows _constants_kernel writes)
-#: the compiled rows and sums of every tensor of a force phase's inputs (:func:`tensor_sums`)
+#: the compiled rows and sums of every tensor of a force phase's inputs (:func:`compile_tensor_kernel`)
 TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
@@ -125,9 +126,14 @@ NOT_RUN = object()
 
 # the kernel's return codes, and the start of a replica a block skips
 _DONE, _D_ZERO, _GUARD, _UNITS, _NEED = 0, 1, 2, 3, 4
+#: the kernel's status where it stopped for the random directions at ``|R| = 0`` (:func:`resume_at_units`)
+UNITS = _UNITS
+#: the kernel's start of the movement alone after a force phase and a kick of its own (the ξ rule,
+#: displacement, drift, strain, wrap and clock; the phase's geometry in ``work`` rows 0, 1, 5–7 and ``yc``)
+MOVE_ONLY = 5
 _SKIP = -1
 #: the sums of every tensor's rows a sampling step makes (:data:`~.stress.SUMMED_ROWS`)
-_SUMS = sum(n for _, n in stress.SUMMED_ROWS)
+TENSOR_SUMS = sum(n for _, n in stress.SUMMED_ROWS)
 
 _kernels = {}
 
@@ -229,7 +235,7 @@ _ILX, _ILY, _IRI, _IRJ, _ID0, _IWI, _IWJ = (forces.PairConstants.FLOAT_ROWS.inde
 _T0 = numba_driver._TERM_START
 # the rows of the permanent ratio and the viscosity in the term block (the register's elastic and viscous parts)
 _TRC, _TNU = (forces.PairConstants.TERM_ROWS.index(n) for n in ("ratio_c", "nu"))
-#: the rows of the terms a step keeps for a force register (``keep``; :func:`_terms`)
+#: the rows of the terms a step keeps for a force register (``keep``; :func:`kept_terms`)
 _KEPT = ("el_i", "v_i", "F_i", "F_j", "fx_i", "fy_i", "el_j", "v_j", "fx_j", "fy_j")
 
 
@@ -355,7 +361,7 @@ def _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
 
 def _tensor_kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly, rate, mob,
                    active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum):
-    """Every tensor's row sums of one force phase's inputs (compiled; :func:`tensor_sums`)."""
+    """Every tensor's row sums of one force phase's inputs (compiled; :func:`compile_tensor_kernel`)."""
     _pair_rows(offsets[0], offsets[B], ai, aj, rep_p, own_j, x, y, Lx, Ly, mob, active, shifted, shifted, dx, dy,
                fx_i, fy_i, fx_j, fy_j, dF, tp)
     _sphere_rows(0, B * N, rep_s, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts)
@@ -389,9 +395,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
     rows in ``ts``, summed per replica as NumPy sums them).  ``keep``: the step keeps the terms of
     its force phase for a force register (the rows :data:`_KEPT` of ``kt``, the sphere totals in
-    ``ktot``; :func:`_terms`).  ``forces_only``: the force phase alone (:func:`run_force_phase`),
+    ``ktot``; :func:`kept_terms`).  ``forces_only``: the force phase alone (:func:`launch`),
     the forces and torques left in ``frc`` and its geometry in ``work``; ``start`` 5: the movement
-    alone (:func:`run_move`: the ξ rule, displacement, drift, strain, wrap and clock after a force
+    alone (:data:`MOVE_ONLY`: the ξ rule, displacement, drift, strain, wrap and clock after a force
     phase and a kick of their own, its geometry in ``work`` and ``yc``).  The other arguments are
     the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
@@ -740,7 +746,7 @@ def _signature():
     return types.int64(*out)
 
 
-def _kernels_of(ws):
+def kernels_of(ws):
     """The compiled step and block of a workspace: the built-in laws', or its run law's variant."""
     n = threads()
     if n > 1:
@@ -818,7 +824,7 @@ def compile_kernels(say=None, law=None):
     compile_carried_kernel()
     compile_constants_kernel()
     compile_carry_kernel()
-    _compile_tensor_kernel()
+    compile_tensor_kernel()
     for kind in (np.float64, np.int64, np.bool_, np.int8):     # (the copies of a block's candidates, _move)
         _move(np.zeros((1, 1), kind), np.zeros(1, np.int64), np.ones(1, np.int64), np.zeros((1, 1), kind),
               np.zeros(1, np.int64))
@@ -859,9 +865,8 @@ class _Workspace:
         self.yc = np.empty(B * N)
         self.y0 = np.empty(B * N)
         self.tau = np.zeros((2, B))
-        self.tsum = np.zeros((_SUMS, B))
+        self.tsum = np.zeros((TENSOR_SUMS, B))
         self.tp = self.ts = None          # (the rows of every tensor: made at the first step that samples them)
-        self.lent = False                 # (work, kt, ktot handed over by a force phase alone: _fresh)
         # the terms a step keeps for a force register (engine.keep_terms)
         self.keep = bool(engine.keep_terms)
         self.kt = np.empty((len(_KEPT), C.P if self.keep else 0))
@@ -1010,124 +1015,100 @@ def run_step(engine, cool, dt, sample):
     EngineInstability
         When the guard finds a guarded replica unstable (after the force phase, as NumPy).
     """
-    got = _launch(engine, cool, dt, sample)
+    got = launch(engine, cool, dt, sample)
     if got is None:
         return NOT_RUN
     ws, kernel, args, held, status = got
-    if status == _UNITS:
-        for b in range(engine.s.B):
-            _draw(engine, ws, b, ws.zero, 8)
-        kernel(1, 0, engine.s.B, *args)
-    _adopt(engine, ws, held, stepped=True)
+    resume_at_units(engine, ws, kernel, args, status)
+    hand_back(engine, ws, held, stepped=True)
     engine.step_count += 1
-    return _samples(ws, sample)
+    return step_samples(ws, sample)
 
 
-def _launch(engine, cool, dt, sample, forces_only=False):
+def launch(engine, cool, dt, sample, forces_only=False):
     """The start of a compiled step (or of its force phase alone): the lists rebuilt when due, the
     kernel run from the start (the normals at ``d = 0`` drawn and the step run with them), the
     relations, the terms when kept and the guard's record handed back, an unsound verdict reported.
-
-    Returns ``(workspace, kernel, arguments, held arrays, status)``, or None when the compiled code
-    does not cover the engine's step."""
-    engine.neighbours()
-    ws = _prepared(engine)
-    if ws is None:
-        return None
-    kernel, B = _kernels_of(ws)[0], engine.s.B
-    check = ws.guarded and not engine.step_count % engine.check_interval
-    if forces_only or ws.lent:
-        _fresh(ws)
-    ws.lent = forces_only
-    args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
-                            forces_only=forces_only)
-    status = kernel(0, 0, B, *args)
-    if status == _D_ZERO:
-        for b in range(B):
-            _draw(engine, ws, b, ws.work[4] == 0.0, 5)
-        status = kernel(3, 0, B, *args)
-    _adopt(engine, ws, held)
-    if ws.keep:
-        engine.terms = _terms(engine, ws, own_buffers=forces_only)
-    if status == _GUARD:
-        _report(engine, ws)
-    return ws, kernel, args, held, status
-
-
-def run_force_phase(engine, sample=False):
-    """The force phase of ``engine`` in the compiled code (the first part of :func:`run_step`), or
-    :data:`NOT_RUN` when it does not cover it.
-
-    What :meth:`~particleShear.engine.step.BatchEngine.force_phase` does, with the same numbers: the
-    forces and torques in the state, the relations and their history, the guard when due, the
-    terms when kept; the acceleration and movement phases (on NumPy) then read the record.
 
     Parameters
     ----------
     engine : BatchEngine
         The engine (backend ``"numba"``).
+    cool, dt : float
+        Damping factor and time step (s).
     sample : bool or str
-        As :meth:`~particleShear.engine.step.BatchEngine.force_phase`.
+        As :meth:`~particleShear.engine.step.BatchEngine.step`.
+    forces_only : bool, default False
+        The force phase alone (the kernel stops after it, the forces and torques left in the
+        state's ``frc`` and the phase's geometry in the workspace's ``work``).  The kept terms
+        (:func:`kept_terms`) are then the rows of the workspace's buffers themselves, not copies:
+        a caller that keeps them past the next compiled call gives the workspace new buffers first.
 
     Returns
     -------
-    tuple or NOT_RUN
-        ``(fields, stresses)``: the fields of the phase's
-        :class:`~particleShear.engine.step.ForceRecord` but the verdict (``dx, dy, nx, ny, dvx,
-        active, yc, mob``: copies) and the stresses as
-        :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them.
+    tuple or None
+        ``(workspace, kernel, arguments, held arrays, status)`` (the kernel's arguments after
+        ``start, b0, b1``, :func:`step_arguments`; the status of :func:`_step_kernel`), or None
+        when the compiled code does not cover the engine's step.
+
+    Raises
+    ------
+    EngineInstability
+        When the guard finds a guarded replica unstable.
     """
-    got = _launch(engine, 1.0, 0.0, sample, forces_only=True)
-    if got is None:
-        return NOT_RUN
-    ws = got[0]
-    w = ws.work        # (this phase's own buffer, _fresh)
-    fields = (w[0], w[1], w[5], w[6], w[7], engine.s.contacts.active.copy(), ws.yc.copy(), ws.mob.copy())
-    return fields, _samples(ws, sample)
+    engine.neighbours()
+    ws = _prepared(engine)
+    if ws is None:
+        return None
+    kernel, B = kernels_of(ws)[0], engine.s.B
+    check = ws.guarded and not engine.step_count % engine.check_interval
+    args, held = step_arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
+                            forces_only=forces_only)
+    status = kernel(0, 0, B, *args)
+    if status == _D_ZERO:
+        for b in range(B):
+            draw_directions(engine, ws, b, ws.work[4] == 0.0, 5)
+        status = kernel(3, 0, B, *args)
+    hand_back(engine, ws, held)
+    if ws.keep:
+        engine.terms = kept_terms(engine, ws, own_buffers=forces_only)
+    if status == _GUARD:
+        _report(engine, ws)
+    return ws, kernel, args, held, status
 
 
-def run_move(engine, dt, g):
-    """The movement of ``engine`` after its force phase ``g`` and its kick, in the compiled code (the
-    tail of :func:`run_step`), or :data:`NOT_RUN` when it does not cover it.
-
-    What :meth:`~particleShear.engine.step.BatchEngine.move` does, with the same numbers: the
-    sequential ξ rule (a random direction at ``|R| = 0`` drawn here, as in :func:`run_step`), the
-    displacement since the lists were built, the drift, the strain, the wrap, the clock and the
-    lists due.
+def resume_at_units(engine, ws, kernel, args, status):
+    """The rest of a step the kernel stopped at the ξ rule (``status`` :data:`UNITS`): the random
+    directions at ``|R| = 0`` drawn (:func:`draw_directions`, rows 8, 9 of ``work``) and the kernel
+    resumed from there (its start 1); nothing for another status.
 
     Parameters
     ----------
     engine : BatchEngine
-        The engine (backend ``"numba"``), its candidates those of the force phase.
-    dt : float
-        Time step (s).
-    g : ForceRecord
-        The record of the step's force phase (its pair vectors, normals, image velocity, heights).
-
-    Returns
-    -------
-    None or NOT_RUN
+        The engine the kernel stepped (all its replicas).
+    ws : _Workspace
+        Its workspace (:func:`last_workspace`).
+    kernel : numba.core.registry.CPUDispatcher
+        The compiled step (:func:`kernels_of`).
+    args : tuple
+        The kernel's arguments after ``start, b0, b1`` (:func:`step_arguments`).
+    status : int
+        What the kernel returned.
     """
-    ws = _held(engine).get("workspace")       # (the force phase's: its candidates, its laws)
-    if ws is None or ws.why is not None or ws.C is not engine.s.contacts.C or g.verdict is not None:
-        return NOT_RUN
-    w = ws.work
-    if g.dx.base is not w:        # (a record of this workspace's phase holds its rows already)
-        w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
-    ws.yc[:] = g.yc
-    B = engine.s.B
-    kernel = _kernels_of(ws)[0]
-    args, held = _arguments(engine, ws, 1.0, dt, False, False, np.zeros(B, dtype=np.bool_))
-    if kernel(5, 0, B, *args) == _UNITS:
-        for b in range(B):
-            _draw(engine, ws, b, ws.zero, 8)
-        kernel(1, 0, B, *args)
-    _adopt(engine, ws, held, stepped=True, kicked=False)
-    engine.step_count += 1
-    return None
+    if status == UNITS:
+        for b in range(engine.s.B):
+            draw_directions(engine, ws, b, ws.zero, 8)
+        kernel(1, 0, engine.s.B, *args)
 
 
-def _samples(ws, sample):
+def last_workspace(engine):
+    """The workspace of the engine's last compiled call (:class:`_Workspace`: its buffers, its
+    candidates ``C``, ``why`` not None where the step is not compiled), or None before one; unlike
+    :func:`_workspace` it makes none (the workspace of a force phase, for its movement)."""
+    return _held(engine).get("workspace")
+
+
+def step_samples(ws, sample):
     """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`)."""
     if sample == "tensors":       # (the xy entries are the shear stresses, as the NumPy step returns them)
         T = tensors_from_sums(ws.tsum.copy(), ws.V)
@@ -1135,42 +1116,26 @@ def _samples(ws, sample):
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
 
 
-def tensor_sums(q):
-    """The per-replica sums of every tensor's rows (:data:`~.stress.SUMMED_ROWS`) of one force phase's
-    inputs, in the compiled code: what :meth:`~.stress.StressInputs.reduce` sums on NumPy, the same
-    bits (the rows from the same entry functions, the sums in NumPy's order); the tensors are then
-    :func:`~.stress.tensors_from_sums` of them.
+def compile_tensor_kernel(cache=True):
+    """The compiled :func:`_tensor_kernel`, compiled once per process (or loaded from the cache).
+
+    The per-replica sums of every tensor's rows (:data:`~.stress.SUMMED_ROWS`, :data:`TENSOR_SUMS`
+    of them) of one force phase's inputs, from the step's own row functions (:func:`_pair_rows`,
+    :func:`_sphere_rows`, :func:`_row_sums`): the sums of :meth:`~.stress.StressInputs.reduce`,
+    the same bits.  Its call is
+    ``kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly,
+    rate, mob, active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum)``
+    (``tp`` (9, P) and ``ts`` (10, B·N) scratch, ``tsum`` (:data:`TENSOR_SUMS`, B) written).
 
     Parameters
     ----------
-    q : StressInputs
-        Every input of the rows (one force phase of a batch whose spheres are ``B·N`` rows; host arrays).
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
 
     Returns
     -------
-    ndarray (19, B)
+    numba.core.registry.CPUDispatcher
     """
-    C, B = q.C, q.B
-    n, P = len(q.x), len(q.dx)
-    own = q.fx_j is not None
-    tsum = np.zeros((_SUMS, B))
-    arrays = [C.ai, C.aj, C.rep, C.offsets, q.rep, q.x, q.y, q.vx, q.vy, q.omega, q.m, q.inertia, q.Lx, q.Ly, q.rate,
-              q.mob, q.active, q.shifted, q.dx, q.dy, q.fx_i, q.fy_i, q.fx_j if own else q.fx_i,
-              q.fy_j if own else q.fy_i, q.dF, q.fx, q.fy, q.torque]
-    kernel = _compile_tensor_kernel()
-    try:            # (the inputs as they are: the arrays of a force phase have the kernel's types)
-        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
-    except TypeError:
-        sizes = [None] * 5 + [n] * 7 + [B] * 3 + [None, None] + [P] * 8 + [n] * 3
-        kinds = [np.int64] * 5 + [float] * 10 + [np.bool_] * 3 + [float] * 10
-        arrays = [np.ascontiguousarray(np.asarray(a, dtype=t) if k is None else
-                                       np.broadcast_to(np.asarray(a, dtype=t), (k,))) for a, k, t in zip(arrays, sizes, kinds)]
-        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
-    return tsum
-
-
-def _compile_tensor_kernel(cache=True):
-    """The compiled :func:`_tensor_kernel`, compiled once per process (or loaded from the cache)."""
     if cache and "tensors" in _kernels:
         return _kernels["tensors"]
     from numba import types
@@ -1197,9 +1162,9 @@ def _prepared(engine):
     return None
 
 
-def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False, slots=None):
+def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False, slots=None):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
-    (:func:`_adopt`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
+    (:func:`hand_back`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
     (``tensors``: a block samples every tensor at some of its steps); ``forces_only``: the force
     phase alone; ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
     ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
@@ -1239,7 +1204,7 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
     return args, held
 
 
-def _adopt(engine, ws, held, stepped=False, kicked=True):
+def hand_back(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
     copies): after the force phase the relations and their history (``state.contacts``), the rate
     and the guard's record; after a whole step (``stepped``) also the lists' bookkeeping
@@ -1259,12 +1224,12 @@ def _adopt(engine, ws, held, stepped=False, kicked=True):
         c.need = ws.need.copy()
 
 
-def _terms(engine, ws, own_buffers=False):
+def kept_terms(engine, ws, own_buffers=False):
     """The terms of the last force phase as the NumPy force phase keeps them for a force register
     (:attr:`~particleShear.engine.step.BatchEngine.terms`): the rows the step kept (``keep``) and its
-    geometry, copies (``own_buffers``: the rows themselves, of buffers made for this phase alone,
-    :func:`_fresh`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's
-    expressions on them."""
+    geometry, copies (``own_buffers``: the rows themselves, for a force phase alone whose caller
+    takes the buffers, :func:`launch`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy
+    phase's expressions on them."""
     c = engine.s.contacts
     C, w, kt, own = c.C, ws.work, ws.kt, ws.visit_j
     if not own_buffers:
@@ -1276,23 +1241,13 @@ def _terms(engine, ws, own_buffers=False):
                 dF=dF, tq=dF * C.w, birth=c.birth.copy(), totals=ws.ktot if own_buffers else ws.ktot.copy())
 
 
-def _fresh(ws):
-    """New buffers for the rows a force phase alone hands over (the geometry, the kept terms), so that
-    its record and terms are those rows themselves and the next phase writes other ones (``ws.lent``:
-    the present ones were handed over; only the movement of that phase writes into them, rows it
-    does not hand over)."""
-    ws.work = np.empty_like(ws.work)
-    if ws.keep:
-        ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
-
-
 def _report(engine, ws):
     """Raise the guard's EngineInstability of the verdict the kernel wrote."""
     v = ws.verdict
     engine.report_verdict((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
 
 
-def _draw(engine, ws, b, mask, row):
+def draw_directions(engine, ws, b, mask, row):
     """Random unit vectors ``(cos 2πu, sin 2πu)`` into ``work`` rows ``row``, ``row + 1`` for replica
     b's candidates where ``mask`` holds: in pair order, from the replica's own generator, as
     :func:`~particleShear.engine.forces.normals` draws them (rows 5, 6: the normals at ``d = 0``;
@@ -1368,7 +1323,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
     want = np.zeros(n, dtype=np.bool_)          # (read at every scheduled step)
     if tensors is not None and scheduled:
         want[:] = tensors
-    sums = np.zeros((n, _SUMS, B)) if want.any() else _NO_SUMS
+    sums = np.zeros((n, TENSOR_SUMS, B)) if want.any() else _NO_SUMS
     ks, starts, status = np.zeros(B, np.int64), np.zeros(B, np.int64), np.zeros(B, np.int64)
     pred = np.full(B, engine.half is not None)
     # (one buffer of new half kicks for the block: a step resumed in the next call kicked into it)
@@ -1402,26 +1357,23 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                     raise RuntimeError("run_block: the step stopped running compiled within a block")
                 return 0
             starts[~going] = _SKIP
-            if ws.lent:
-                _fresh(ws)
-                ws.lent = False
             if slots is None and _slotted(engine, ws):
                 slots = _Slots.of(engine)
             at = ws if slots is None else slots
-            args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any(),
+            args, held = step_arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any(),
                                     slots=slots)
-            _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
+            kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
                                scheduled, want, sums, *(_NO_SLOTS if slots is None else slots.arguments()), *args)
-            _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
+            hand_back(engine, ws, held, stepped=True, kicked=bool(pred.any()))
             drawn = False
             for b in np.flatnonzero(going):
                 st = status[b]
                 starts[b] = _SKIP
                 if st == _D_ZERO:        # (nothing of the step changed: its normals at d = 0, then the step)
-                    _draw(engine, at, b, at.work[4] == 0.0, 5)
+                    draw_directions(engine, at, b, at.work[4] == 0.0, 5)
                     starts[b], drawn = 3, True
                 elif st == _UNITS:       # (the rest of the step, from the ξ rule)
-                    _draw(engine, at, b, at.zero, 8)
+                    draw_directions(engine, at, b, at.zero, 8)
                     starts[b], drawn = 1, True
                 elif st == _GUARD:       # (the other replicas run to this step at least: the first failure is reported)
                     failed[b], verdicts[:, b] = ks[b], ws.verdict[:, b]
@@ -1430,10 +1382,10 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         if slots is not None:
             _settle(engine, slots)
     if ws.keep:        # (the terms of the last step: a batch of one, whose last call stepped it)
-        engine.terms = _terms(engine, ws)
+        engine.terms = kept_terms(engine, ws)
     if want.any():     # (the tensors of the sampled steps at once: each column is one replica's step)
         k = np.flatnonzero(want)
-        S = sums[k].transpose(1, 0, 2).reshape(_SUMS, -1)
+        S = sums[k].transpose(1, 0, 2).reshape(TENSOR_SUMS, -1)
         V = np.broadcast_to(np.asarray(engine.V, dtype=float), (B,))
         tensor_out[k] = tensors_from_sums(S, np.tile(V, len(k))).reshape(len(k), B, *tensor_out.shape[2:])
     if (failed >= 0).any():
