@@ -30,6 +30,12 @@ and the protocol's schedule and observers.  The sums NumPy takes per replica (th
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
 _pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
+
+The pieces of a step are public (:func:`launch`, :func:`step_arguments`, :func:`resume_at_units`,
+:func:`hand_back`, :func:`kept_terms`, :func:`step_samples`, :data:`MOVE_ONLY`,
+:func:`compile_tensor_kernel`): the documented classes, which step an ensemble in three calls,
+run the kernel's force phase alone and its movement alone through them, beside those classes
+(:mod:`particleShear.base.compiled_phases`).
 """
 __docformat__ = "numpy"
 
