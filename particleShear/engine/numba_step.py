@@ -32,9 +32,10 @@ _pairwise order, so the sampled stresses are the same bits too.  A step the comp
 one-line note per engine and reason.
 
 The pieces of a step are public (:func:`launch`, :func:`step_arguments`, :func:`resume_at_units`,
-:func:`hand_back`, :func:`kept_terms`, :func:`step_samples`, :data:`MOVE_ONLY`,
-:func:`compile_tensor_kernel`): the documented classes, which step an ensemble in three calls,
-run the kernel's force phase alone and its movement alone through them, beside those classes
+:func:`hand_back`, :func:`kept_terms`, :func:`step_samples`, :data:`MOVE_ONLY`, :func:`compile_kernel`
+and the tensors' rows :func:`pair_tensor_rows`, :func:`sphere_tensor_rows`, :func:`tensor_row_sums`):
+the documented classes, which step an ensemble in three calls, run the kernel's force phase alone,
+its movement alone and their tensor sums through them, beside those classes
 (:mod:`particleShear.base.compiled_phases`).
 """
 __docformat__ = "numpy"
@@ -63,7 +64,8 @@ from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
            "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels",
-           "compile_tensor_kernel", "run_step", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
+           "compile_kernel", "pair_tensor_rows", "sphere_tensor_rows", "tensor_row_sums",
+           "run_step", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
            "step_samples", "draw_directions", "kernels_of", "last_workspace", "run_block", "search", "carried",
            "rebuild", "constant_rows", "NOT_RUN", "UNITS", "MOVE_ONLY", "TENSOR_SUMS", "REBUILD_IN_BLOCK", "SLACK"]
 
@@ -82,8 +84,8 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
-                    (sys.modules[__name__], "_pair_rows"),
-                    (sys.modules[__name__], "_sphere_rows"), (sys.modules[__name__], "_row_sums"),
+                    (sys.modules[__name__], "pair_tensor_rows"),
+                    (sys.modules[__name__], "sphere_tensor_rows"), (sys.modules[__name__], "tensor_row_sums"),
                     (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the search (:func:`search`) besides the step's
@@ -94,8 +96,6 @@ SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pa
 CONSTANT_FUNCTIONS = ((laws, "central_constants"), (terms, "term_rows"), (forces, "geometry_rows"),
                       (forces, "pair_rows"), (sys.modules[__name__], "_constants_kernel"))
 assert len(forces.PairConstants.FLOAT_ROWS) == 23      # (the rows _constants_kernel writes)
-#: the compiled rows and sums of every tensor of a force phase's inputs (:func:`compile_tensor_kernel`)
-TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
 #: the functions of the compiled history merge of a rebuild (:func:`rebuild`)
@@ -323,7 +323,8 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
-def _pair_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, tp):
+def pair_tensor_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF,
+                     tp):
     """The pair rows of every tensor (:mod:`~.stress`: Love-Weber, external, internal torque) of the
     candidates ``P0 … P1 − 1`` into ``tp`` (9, P); ``ky, kx`` nonzero where the pair acts through a
     periodic boundary; ``fx_j, fy_j`` read only with ``own_j`` (compiled)."""
@@ -341,7 +342,7 @@ def _pair_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx
         tp[8, p] = dF[p] * internal
 
 
-def _sphere_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
+def sphere_tensor_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
     """The sphere rows of every tensor (:mod:`~.stress`: unbalanced forces, torques, spin, Otsuki) of
     the spheres ``n0 … n1 − 1`` into ``ts`` (10, B·N) (compiled)."""
     for k in range(n0, n1):
@@ -353,7 +354,7 @@ def _sphere_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, m
         ts[6, k], ts[7, k], ts[8, k], ts[9, k] = otsuki_entries(m[k], vx[k], vy[k], rate[b], yc, mob[k])
 
 
-def _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
+def tensor_row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
     """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` (its candidates the columns
     ``offsets[b] … ends[b] − 1``) into ``tsum`` (19, B), in
     the order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
@@ -363,16 +364,6 @@ def _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
             tsum[q, b] = _segment_sum(tp[q], offsets[b], ends[b])
         for q in range(10):
             tsum[9 + q, b] = _segment_sum(ts[q], b * N, (b + 1) * N)
-
-
-def _tensor_kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly, rate, mob,
-                   active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum):
-    """Every tensor's row sums of one force phase's inputs (compiled; :func:`compile_tensor_kernel`)."""
-    _pair_rows(offsets[0], offsets[B], ai, aj, rep_p, own_j, x, y, Lx, Ly, mob, active, shifted, shifted, dx, dy,
-               fx_i, fy_i, fx_j, fy_j, dF, tp)
-    _sphere_rows(0, B * N, rep_s, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts)
-    _row_sums(0, B, N, offsets, offsets[1:], tp, ts, tsum)
-    return 0
 
 
 def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, visit_j, form_j, Tj,
@@ -529,11 +520,11 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                     tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
                                                            _segment_sum(work[13], lo, hi), V[b])
             if sample == 2:     # every tensor's rows (the totals of the scatter), summed per replica
-                _pair_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs, dys,
-                           work[14], work[15], mxs, mys, dFs, tp)
-                _sphere_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0], frc[1],
-                             frc[2], mob, rate, Lx, Ly, ts)
-                _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum)
+                pair_tensor_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs,
+                                 dys, work[14], work[15], mxs, mys, dFs, tp)
+                sphere_tensor_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0],
+                                   frc[1], frc[2], mob, rate, Lx, Ly, ts)
+                tensor_row_sums(b0, b1, N, offsets, ends, tp, ts, tsum)
             if check:
                 bad = False
                 for b in range(b0, b1):
@@ -685,16 +676,40 @@ def compile_step_kernel(cache=True, say=None):
     numba.core.registry.CPUDispatcher
     """
     import numba
-    return _compile(True, "_step_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS, _signature, cache, say,
+    return compile_kernel(True, "_step_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS, _signature, cache, say,
                     lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
 
 
-def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
+def compile_kernel(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
-    ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
-    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``);
-    with ``linear`` the history merge's positions by one pass (:func:`_positions_linear`, in place of
-    :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache)."""
+    ``signature()`` now (or loaded from Numba's cache) and kept per process under ``key``: the one
+    compile of every kernel of the step (the engine's, and the documented classes' tensor sums,
+    :mod:`particleShear.base.compiled_phases`).
+
+    Parameters
+    ----------
+    key : hashable
+        The kernel's key in this process's table (a second call with it returns the first's).
+    name : str
+        The function compiled, one of ``functions``.
+    functions : sequence of (module, name)
+        Every function it calls, compiled with it (:data:`STEP_FUNCTIONS`, :data:`KERNEL_FUNCTIONS` …).
+    signature : callable
+        ``signature()``: its Numba signature.
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+    say, message : callable, optional
+        ``say(message())`` before a compile (not before a load from the cache).
+    parallel : bool, default False
+        Its variant over several threads (``name__parallel``).
+    linear : bool, default False
+        The history merge's positions by one pass (:func:`_positions_linear`, in place of
+        :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache).
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
     if cache and key in _kernels:
         return _kernels[key]
     import numba
@@ -830,7 +845,6 @@ def compile_kernels(say=None, law=None):
     compile_carried_kernel()
     compile_constants_kernel()
     compile_carry_kernel()
-    compile_tensor_kernel()
     for kind in (np.float64, np.int64, np.bool_, np.int8):     # (the copies of a block's candidates, _move)
         _move(np.zeros((1, 1), kind), np.zeros(1, np.int64), np.ones(1, np.int64), np.zeros((1, 1), kind),
               np.zeros(1, np.int64))
@@ -1120,38 +1134,6 @@ def step_samples(ws, sample):
         T = tensors_from_sums(ws.tsum.copy(), ws.V)
         return -T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
-
-
-def compile_tensor_kernel(cache=True):
-    """The compiled :func:`_tensor_kernel`, compiled once per process (or loaded from the cache).
-
-    The per-replica sums of every tensor's rows (:data:`~.stress.SUMMED_ROWS`, :data:`TENSOR_SUMS`
-    of them) of one force phase's inputs, from the step's own row functions (:func:`_pair_rows`,
-    :func:`_sphere_rows`, :func:`_row_sums`): the sums of :meth:`~.stress.StressInputs.reduce`,
-    the same bits.  Its call is
-    ``kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly,
-    rate, mob, active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum)``
-    (``tp`` (9, P) and ``ts`` (10, B·N) scratch, ``tsum`` (:data:`TENSOR_SUMS`, B) written).
-
-    Parameters
-    ----------
-    cache : bool, default True
-        As :func:`compile_step_kernel`.
-
-    Returns
-    -------
-    numba.core.registry.CPUDispatcher
-    """
-    if cache and "tensors" in _kernels:
-        return _kernels["tensors"]
-    from numba import types
-    f1, i1, f2 = (types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"),
-                  types.Array(types.float64, 2, "C"))
-    b1 = types.Array(types.boolean, 1, "C")
-    signature = types.int64(types.int64, types.int64, i1, i1, i1, i1, i1, types.boolean, *(f1,) * 10, b1, b1, b1,
-                            *(f1,) * 10, f2, f2, f2)
-    return _compile("tensors", "_tensor_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + TENSOR_FUNCTIONS,
-                    lambda: signature, cache)
 
 
 def _prepared(engine):
@@ -1792,7 +1774,7 @@ def compile_constants_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
+    return compile_kernel("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
 
 
 def _constants_signature():
@@ -1866,7 +1848,7 @@ def compile_carry_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carry", "_carry_kernel", CARRY_FUNCTIONS, _carry_signature, cache, linear=True)
+    return compile_kernel("carry", "_carry_kernel", CARRY_FUNCTIONS, _carry_signature, cache, linear=True)
 
 
 def _carry_signature():
@@ -1924,7 +1906,7 @@ def compile_carried_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
+    return compile_kernel("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
 
 
 def _carried_signature():
@@ -1946,8 +1928,8 @@ def compile_search_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("search", "_search_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS, _search_signature,
-                    cache)
+    return compile_kernel("search", "_search_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS,
+                          _search_signature, cache)
 
 
 def _sorted_keys(key, N):
@@ -2188,5 +2170,5 @@ def compile_block_kernel(cache=True, parallel=False):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
+    return compile_kernel(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
                     _block_signature, cache, parallel=bool(parallel))
