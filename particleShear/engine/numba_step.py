@@ -326,8 +326,36 @@ def _segment_sum(a, lo, hi):
 def pair_tensor_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF,
                      tp):
     """The pair rows of every tensor (:mod:`~.stress`: Love-Weber, external, internal torque) of the
-    candidates ``P0 … P1 − 1`` into ``tp`` (9, P); ``ky, kx`` nonzero where the pair acts through a
-    periodic boundary; ``fx_j, fy_j`` read only with ``own_j`` (compiled)."""
+    candidates ``P0 … P1 − 1`` into ``tp`` (compiled; the step's sampling steps and the documented
+    classes' tensor sums).
+
+    Parameters
+    ----------
+    P0, P1 : int
+        The candidates' range.
+    ai, aj, rep : ndarray of int (P,)
+        The candidates' sphere rows and replicas.
+    own_j : bool
+        Spheres with parameters of their own: j receives ``fx_j, fy_j`` (else ``fx_i, fy_i`` are read).
+    x, y : ndarray (B·N,)
+        Positions (µm).
+    Lx, Ly : ndarray (B,)
+        Cell sizes (µm).
+    mob : ndarray of bool (B·N,)
+        The mobility mask.
+    active : ndarray of bool (P,)
+        The relations.
+    ky, kx : ndarray (P,)
+        Nonzero where the pair acts through a periodic boundary.
+    dx, dy : ndarray (P,)
+        The pair vectors (µm).
+    fx_i, fy_i, fx_j, fy_j : ndarray (P,)
+        The forces on i (and on j, read only with ``own_j``).
+    dF : ndarray (P,)
+        The tangential torque factors.
+    tp : ndarray (9, P)
+        Written: the rows.
+    """
     for p in range(P0, P1):
         i, j, b = ai[p], aj[p], rep[p]
         internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (ky[p] != 0.0) or (kx[p] != 0.0))
@@ -344,7 +372,29 @@ def pair_tensor_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, 
 
 def sphere_tensor_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
     """The sphere rows of every tensor (:mod:`~.stress`: unbalanced forces, torques, spin, Otsuki) of
-    the spheres ``n0 … n1 − 1`` into ``ts`` (10, B·N) (compiled)."""
+    the spheres ``n0 … n1 − 1`` into ``ts`` (compiled).
+
+    Parameters
+    ----------
+    n0, n1 : int
+        The spheres' range.
+    rep : ndarray of int (B·N,)
+        Each sphere's replica.
+    x, y, vx, vy, omega : ndarray (B·N,)
+        Positions (µm), velocities (µm/s), spins (1/s).
+    m, inertia : ndarray (B·N,)
+        Masses and moments of inertia.
+    fx, fy, torque : ndarray (B·N,)
+        The totals of the force phase.
+    mob : ndarray of bool (B·N,)
+        The mobility mask.
+    rate : ndarray (B,)
+        Shear rates (1/s).
+    Lx, Ly : ndarray (B,)
+        Cell sizes (µm).
+    ts : ndarray (10, B·N)
+        Written: the rows.
+    """
     for k in range(n0, n1):
         b = rep[k]
         xc, yc = x[k] - Lx[b] / 2, y[k] - Ly[b] / 2
@@ -355,10 +405,23 @@ def sphere_tensor_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, tor
 
 
 def tensor_row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
-    """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` (its candidates the columns
-    ``offsets[b] … ends[b] − 1``) into ``tsum`` (19, B), in
-    the order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
-    ``StressInputs.per_replica``: ``numpy.add.reduceat`` over each replica's segment) (compiled)."""
+    """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` into ``tsum``, in the
+    order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
+    ``StressInputs.per_replica``: ``numpy.add.reduceat`` over each replica's segment) (compiled).
+
+    Parameters
+    ----------
+    b0, b1 : int
+        The replicas' range.
+    N : int
+        Spheres per replica.
+    offsets, ends : ndarray of int (B,)
+        Replica b's candidates are the columns ``offsets[b] … ends[b] − 1``.
+    tp, ts : ndarray (9, P), (10, B·N)
+        The pair and sphere rows (:func:`pair_tensor_rows`, :func:`sphere_tensor_rows`).
+    tsum : ndarray (19, B)
+        Written: the sums.
+    """
     for b in range(b0, b1):
         for q in range(9):
             tsum[q, b] = _segment_sum(tp[q], offsets[b], ends[b])
@@ -768,7 +831,18 @@ def _signature():
 
 
 def kernels_of(ws):
-    """The compiled step and block of a workspace: the built-in laws', or its run law's variant."""
+    """The compiled step and block of a workspace: the built-in laws', or its run law's variant.
+
+    Parameters
+    ----------
+    ws : _Workspace
+        The workspace (its law, ``ws.law``).
+
+    Returns
+    -------
+    tuple of numba.core.registry.CPUDispatcher
+        ``(step, block)``: :func:`_step_kernel` and :func:`_block_kernel` compiled (or loaded).
+    """
     n = threads()
     if n > 1:
         import numba
@@ -1122,14 +1196,38 @@ def resume_at_units(engine, ws, kernel, args, status):
 
 
 def last_workspace(engine):
-    """The workspace of the engine's last compiled call (:class:`_Workspace`: its buffers, its
-    candidates ``C``, ``why`` not None where the step is not compiled), or None before one; unlike
-    :func:`_workspace` it makes none (the workspace of a force phase, for its movement)."""
+    """The workspace of the engine's last compiled call, or None before one; unlike
+    :func:`_workspace` it makes none (the workspace of a force phase, for its movement).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine.
+
+    Returns
+    -------
+    _Workspace or None
+        Its buffers, its candidates ``C``, ``why`` (not None where the step is not compiled).
+    """
     return _held(engine).get("workspace")
 
 
 def step_samples(ws, sample):
-    """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`)."""
+    """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`).
+
+    Parameters
+    ----------
+    ws : _Workspace
+        The workspace the kernel sampled into (``tau``, ``tsum``).
+    sample : bool or str
+        As the step took it.
+
+    Returns
+    -------
+    None or tuple
+        None unless ``sample``; else ``(tau_internal, tau_surface)`` and, for ``"tensors"``, the
+        (B, 9, 2, 2) tensors (copies).
+    """
     if sample == "tensors":       # (the xy entries are the shear stresses, as the NumPy step returns them)
         T = tensors_from_sums(ws.tsum.copy(), ws.V)
         return -T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T
@@ -1150,16 +1248,44 @@ def _prepared(engine):
     return None
 
 
-def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False, slots=None):
+def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False,
+                   slots=None):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
-    (:func:`hand_back`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
-    (``tensors``: a block samples every tensor at some of its steps); ``forces_only``: the force
-    phase alone; ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
-    ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
-    (``half`` is then the one handed back); default a new array per step, handed back itself (as
-    ``half_kick`` gives); ``slots``: a block's :class:`_Slots`, whose ranges of each replica's
-    candidates and buffers the kernel takes (a rebuilt replica's candidates are its slot's,
-    handed back by :func:`_settle`)."""
+    (:func:`hand_back`).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine stepped.
+    ws : _Workspace
+        Its workspace (:func:`last_workspace`).
+    cool, dt : float
+        Damping factor and time step (s).
+    sample : bool or str
+        As :meth:`~particleShear.engine.step.BatchEngine.step` takes it.
+    check : bool
+        Whether the guard checks this step.
+    pred : ndarray of bool (B,)
+        Which replicas' force phase sees the Verlet half kick.
+    half_out : ndarray (3, B·N), optional
+        A block's buffer of the new half kicks, copied into ``half`` replica by replica (``half``
+        is then the one handed back); default a new array per step, handed back itself (as
+        ``half_kick`` gives).
+    tensors : bool, default False
+        A block samples every tensor at some of its steps.
+    forces_only : bool, default False
+        The force phase alone (:func:`launch`).
+    slots : _Slots, optional
+        A block's slots, whose ranges of each replica's candidates and buffers the kernel takes (a
+        rebuilt replica's candidates are its slot's, handed back by :func:`_settle`).
+
+    Returns
+    -------
+    args : tuple
+        The kernel's arguments after ``start, b0, b1``.
+    held : dict
+        The arrays the kernel writes that :func:`hand_back` gives to the state and the engine.
+    """
     s = engine.s
     c = s.contacts
     C = c.C
@@ -1195,9 +1321,22 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
 def hand_back(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
     copies): after the force phase the relations and their history (``state.contacts``), the rate
-    and the guard's record; after a whole step (``stepped``) also the lists' bookkeeping
-    (displacement, strain since the build, bound, the lists due), the strain, the clock and, when
-    a step of this call reached its kick (``kicked``), the Verlet half kick."""
+    and the guard's record; after a whole step also the lists' bookkeeping and the clock.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine the kernel stepped.
+    ws : _Workspace
+        Its workspace (the lists due, ``need``).
+    held : dict
+        The arrays of :func:`step_arguments`.
+    stepped : bool, default False
+        The kernel ran the movement too: also the displacement, strain since the build, bound,
+        the lists due, the strain and the clock.
+    kicked : bool, default True
+        With ``stepped``: a step of this call reached its kick, so the Verlet half kick too.
+    """
     s = engine.s
     c = s.contacts
     c.state_p, c.xi, c.active, c.birth, c.next_birth = (held["state_p"], held["xi"], held["active"], held["birth"],
@@ -1215,9 +1354,23 @@ def hand_back(engine, ws, held, stepped=False, kicked=True):
 def kept_terms(engine, ws, own_buffers=False):
     """The terms of the last force phase as the NumPy force phase keeps them for a force register
     (:attr:`~particleShear.engine.step.BatchEngine.terms`): the rows the step kept (``keep``) and its
-    geometry, copies (``own_buffers``: the rows themselves, for a force phase alone whose caller
-    takes the buffers, :func:`launch`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy
-    phase's expressions on them."""
+    geometry; the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's expressions on them.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine after its compiled force phase.
+    ws : _Workspace
+        Its workspace (the rows ``kt``, ``ktot`` and the geometry ``work``).
+    own_buffers : bool, default False
+        The rows themselves rather than copies (a force phase alone whose caller takes the
+        buffers, :func:`launch`).
+
+    Returns
+    -------
+    dict
+        The arrays by name, as :attr:`~particleShear.engine.step.BatchEngine.terms`.
+    """
     c = engine.s.contacts
     C, w, kt, own = c.C, ws.work, ws.kt, ws.visit_j
     if not own_buffers:
@@ -1238,9 +1391,21 @@ def _report(engine, ws):
 def draw_directions(engine, ws, b, mask, row):
     """Random unit vectors ``(cos 2πu, sin 2πu)`` into ``work`` rows ``row``, ``row + 1`` for replica
     b's candidates where ``mask`` holds: in pair order, from the replica's own generator, as
-    :func:`~particleShear.engine.forces.normals` draws them (rows 5, 6: the normals at ``d = 0``;
-    rows 8, 9: the directions at ``|R| = 0``).  ``ws``: the workspace, or a block's :class:`_Slots`
-    (the columns and buffers the kernel read)."""
+    :func:`~particleShear.engine.forces.normals` draws them.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (its replicas' generators).
+    ws : _Workspace or _Slots
+        The workspace, or a block's slots (the columns and buffers the kernel read).
+    b : int
+        The replica.
+    mask : ndarray of bool (P,)
+        The candidates that get a direction.
+    row : int
+        5: the normals at ``d = 0`` (rows 5, 6); 8: the directions at ``|R| = 0`` (rows 8, 9).
+    """
     lo, hi = ws.offsets[b], ws.ends[b]
     rng = engine.s.rng[b]
     for p in np.flatnonzero(mask[lo:hi]) + lo:
