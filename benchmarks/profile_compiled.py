@@ -43,11 +43,11 @@ from particleShear.run.batch import ENGINE_SKIN_FACTOR  # noqa: E402
 COOL = 0.99969060716623
 
 _counts = {"kernel": 0.0, "settle": 0.0, "rebuilds": 0}
-_kernels_of, _settle = numba_step._kernels_of, numba_step._settle
+_kernels_of, _settle = numba_step.kernels_of, numba_step._settle
 
 
 def _timed_kernels_of(ws):
-    """``numba_step._kernels_of`` whose block kernel adds its time to ``_counts``."""
+    """``numba_step.kernels_of`` whose block kernel adds its time to ``_counts``."""
     step, block = _kernels_of(ws)
 
     def timed(*args):
@@ -85,7 +85,7 @@ def _stats(values, scale):
 
 def blocks(eng, steps, repeats, scale):
     """Part 1: the blocks, the compiled call, the hand-back; returns the rebuilds per replica-step."""
-    numba_step._kernels_of, numba_step._settle = _timed_kernels_of, _timed_settle
+    numba_step.kernels_of, numba_step._settle = _timed_kernels_of, _timed_settle
     try:
         block(eng, 5)
         got = {"block": [], "kernel": [], "settle": []}
@@ -98,7 +98,7 @@ def blocks(eng, steps, repeats, scale):
             got["settle"].append(_counts["settle"])
             rebuilds += _counts["rebuilds"]
     finally:
-        numba_step._kernels_of, numba_step._settle = _kernels_of, _settle
+        numba_step.kernels_of, numba_step._settle = _kernels_of, _settle
     n = steps * eng.s.B
     print("  blocks of %d steps: whole %s, compiled call %s, hand-back %s; rebuilds per replica-step %.3f"
           % (steps, *(_stats([v / n for v in got[k]], scale) for k in ("block", "kernel", "settle")),
@@ -178,13 +178,13 @@ def rebuild_parts(eng, repeats):
 def step_parts(eng, repeats, scale):
     """Part 3: one compiled step of the batch, its force phase alone, without and with samples."""
     ws = numba_step._prepared(eng)
-    kernel, B = numba_step._kernels_of(ws)[0], eng.s.B
+    kernel, B = numba_step.kernels_of(ws)[0], eng.s.B
     pred = np.full(B, eng.half is not None)
     K = max(3, int(300_000 / (eng.s.N * B)))
     got = {}
     for name, sample, forces_only, b1 in (("empty call", False, False, 0), ("force phase", False, True, B),
                                           ("step", False, False, B), ("step sampled", True, False, B)):
-        args, _ = numba_step._arguments(eng, ws, COOL, bench_step.DT, sample, False, pred, forces_only=forces_only)
+        args, _ = numba_step.step_arguments(eng, ws, COOL, bench_step.DT, sample, False, pred, forces_only=forces_only)
         kernel(0, 0, b1, *args)
         got[name] = []
         for _ in range(repeats):

@@ -18,6 +18,8 @@ def warm_compiled_backend():
     if numba_driver.available():
         for law in (None, "hertz", "plateau"):
             numba_step.compile_kernels(law=law)
+        from particleShear.base.compiled_phases import compile_tensor_kernel
+        compile_tensor_kernel()
 
 
 def load_tests(loader, tests, pattern):

@@ -144,6 +144,7 @@ ENGINE_MODULES = [
     "particleShear.base.elastic_canvas",
     "particleShear.base.engine_adapter",
     "particleShear.base.engine_view",
+    "particleShear.base.compiled_phases",
     "particleShear.base.fields",
     "particleShear.base.graphics",
     "particleShear.base.laws",

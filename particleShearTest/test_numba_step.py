@@ -201,6 +201,7 @@ class TestCompiledStepBits(unittest.TestCase):
     def test_a_force_phase_keeps_its_record_and_terms(self):
         """The record and the kept terms of a compiled force phase alone are rows of its own buffers:
         its movement, later steps (whole, in blocks) and later force phases leave them as they were."""
+        from particleShear.base import compiled_phases
         from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
@@ -209,16 +210,17 @@ class TestCompiledStepBits(unittest.TestCase):
         eng = BatchEngine(state_from_ensembles([ens], backend="numba"), keep_terms=True)
         eng.s.applying_shear = True
         eng.set_rate(np.array([400.0]))
-        g = eng.force_phase()[0]
+        g = compiled_phases.force_phase(eng)[0]
+        self.assertIsNot(g.dx.base, None)       # (the compiled phase's own rows)
         terms = eng.terms
         arrays = lambda: [np.array(a) for a in (*g[:8], *terms["parts"][0], terms["F"], terms["dx"], terms["fx_i"],  # noqa: E731
                                                 terms["totals"])]
         before = arrays()
         eng.accelerate(0.999, ens.dt, g)
-        eng.move(ens.dt, g)
+        compiled_phases.move(eng, ens.dt, g)
         eng.step(0.999, ens.dt, sample=True)
         eng.steps(5, 0.999, ens.dt)
-        eng.force_phase()
+        compiled_phases.force_phase(eng)
         for a, b in zip(before, arrays()):
             np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a, _bits(b) if b.dtype.kind == "f" else b)
         self.assertIsNot(eng.terms, terms)

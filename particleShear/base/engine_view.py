@@ -15,6 +15,7 @@ import numpy as np
 
 from ..engine.guard import transient_ratios
 from ..engine.step import BatchEngine
+from . import compiled_phases
 from .engine_adapter import state_of_ensemble
 
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
@@ -127,7 +128,7 @@ class EngineStep:
         eng = self._step_engine()
         self._hand_to_engine(eng)
         extra = self._frc.copy() if self._frc.any() else None     # forces put on before the phase add up
-        g = self._force_record = eng.force_phase()[0]
+        g = self._force_record = compiled_phases.force_phase(eng)[0]     # (compiled on the Numba backend)
         if extra is not None:
             self._frc += extra
         self.force_register.set_from_engine(self, eng, current=True)
@@ -156,7 +157,7 @@ class EngineStep:
             self._hand_to_engine(eng)
         # where the drift takes the spheres: non-finite or far outside the cell stops the run (before the wrap)
         self._check_positions(self._pos + self._vel[:2] * dt)
-        eng.move(dt, self._force_record)
+        compiled_phases.move(eng, dt, self._force_record)
         self._force_record = None       # (the step's record ends with its movement, as in BatchEngine.step)
         s = eng.s
         self.t = float(s.t[0])

@@ -15,10 +15,11 @@ from operator import attrgetter
 import numpy as np
 
 from ..checks import positive
-from ..engine import numba_step, stress as _es
+from ..engine import stress as _es
 from ..engine.forces import pair_roles, shear_stresses as _engine_shear_stresses
 from ..engine.stress import TENSORS, StressInputs
 from ..engine.xp import get_backend
+from .compiled_phases import tensor_sums
 from .register import SphereSelection
 
 __all__ = ["StressTensorEvaluation", "TENSOR_NAMES"]
@@ -473,7 +474,7 @@ class StressTensorEvaluation:
             q = ForcePhase(self._pair_inputs(reg), self._total_inputs(reg),
                            self._sphere_inputs(theSphereList, shear_rate))
         elif type(q) is StressInputs and q.C.backend.compiled:    # the rows summed in compiled code (same bits)
-            self._t[...] = _es.tensors_from_sums(numba_step.tensor_sums(q), q.V)[0]
+            self._t[...] = _es.tensors_from_sums(tensor_sums(q), q.V)[0]
             return
         self._t[...] = _es.evaluate_all(q)[0]
 

@@ -30,6 +30,13 @@ and the protocol's schedule and observers.  The sums NumPy takes per replica (th
 ``numpy.add.reduceat``, the guard's kinetic energy of ``numpy.sum``) are taken in NumPy's
 _pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
+
+The pieces of a step are public (:func:`launch`, :func:`step_arguments`, :func:`resume_at_units`,
+:func:`hand_back`, :func:`kept_terms`, :func:`step_samples`, :data:`MOVE_ONLY`, :func:`compile_kernel`
+and the tensors' rows :func:`pair_tensor_rows`, :func:`sphere_tensor_rows`, :func:`tensor_row_sums`):
+the documented classes, which step an ensemble in three calls, run the kernel's force phase alone,
+its movement alone and their tensor sums through them, beside those classes
+(:mod:`particleShear.base.compiled_phases`).
 """
 __docformat__ = "numpy"
 
@@ -56,9 +63,11 @@ from .stress import (EXTERNAL, OVERALL, external_entries, love_weber_entries, ot
 from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
-           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels", "run_step",
-           "run_force_phase", "run_move", "run_block", "search", "carried", "rebuild", "constant_rows", "tensor_sums",
-           "NOT_RUN", "REBUILD_IN_BLOCK", "SLACK"]
+           "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels",
+           "compile_kernel", "pair_tensor_rows", "sphere_tensor_rows", "tensor_row_sums",
+           "run_step", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
+           "step_samples", "draw_directions", "kernels_of", "last_workspace", "run_block", "search", "carried",
+           "rebuild", "constant_rows", "NOT_RUN", "UNITS", "MOVE_ONLY", "TENSOR_SUMS", "REBUILD_IN_BLOCK", "SLACK"]
 
 #: the pure functions the compiled step calls besides the laws: ``(module, name)``
 STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
@@ -75,8 +84,8 @@ STEP_FUNCTIONS = numba_driver.LAW_FUNCTIONS + (
 KERNEL_FUNCTIONS = ((numba_driver, "_central_law"), (numba_driver, "pair_term"), (sys.modules[__name__], "_min_image_pair"),
                     (sys.modules[__name__], "_pairwise"), (sys.modules[__name__], "_segment_sum"),
                     (sys.modules[__name__], "_nan_max"), (sys.modules[__name__], "_nan_min"),
-                    (sys.modules[__name__], "_pair_rows"),
-                    (sys.modules[__name__], "_sphere_rows"), (sys.modules[__name__], "_row_sums"),
+                    (sys.modules[__name__], "pair_tensor_rows"),
+                    (sys.modules[__name__], "sphere_tensor_rows"), (sys.modules[__name__], "tensor_row_sums"),
                     (sys.modules[__name__], "_step_kernel"))
 INLINE = ("pair_term", "_min_image_pair", "_segment_sum", "_nan_max", "_nan_min")
 #: the functions of the search (:func:`search`) besides the step's
@@ -87,8 +96,6 @@ SEARCH_FUNCTIONS = ((neighbours, "cell_index"), (sys.modules[__name__], "_all_pa
 CONSTANT_FUNCTIONS = ((laws, "central_constants"), (terms, "term_rows"), (forces, "geometry_rows"),
                       (forces, "pair_rows"), (sys.modules[__name__], "_constants_kernel"))
 assert len(forces.PairConstants.FLOAT_ROWS) == 23      # (the rows _constants_kernel writes)
-#: the compiled rows and sums of every tensor of a force phase's inputs (:func:`tensor_sums`)
-TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
 #: the history merge of a rebuild (:func:`carried`): the pair table's own functions
 MERGE_FUNCTIONS = ((state, "_increasing"), (state, "_positions"), (state, "_merge"), (state, "carried_rows"))
 #: the functions of the compiled history merge of a rebuild (:func:`rebuild`)
@@ -125,9 +132,14 @@ NOT_RUN = object()
 
 # the kernel's return codes, and the start of a replica a block skips
 _DONE, _D_ZERO, _GUARD, _UNITS, _NEED = 0, 1, 2, 3, 4
+#: the kernel's status where it stopped for the random directions at ``|R| = 0`` (:func:`resume_at_units`)
+UNITS = _UNITS
+#: the kernel's start of the movement alone after a force phase and a kick of its own (the ξ rule,
+#: displacement, drift, strain, wrap and clock; the phase's geometry in ``work`` rows 0, 1, 5–7 and ``yc``)
+MOVE_ONLY = 5
 _SKIP = -1
 #: the sums of every tensor's rows a sampling step makes (:data:`~.stress.SUMMED_ROWS`)
-_SUMS = sum(n for _, n in stress.SUMMED_ROWS)
+TENSOR_SUMS = sum(n for _, n in stress.SUMMED_ROWS)
 
 _kernels = {}
 
@@ -229,7 +241,7 @@ _ILX, _ILY, _IRI, _IRJ, _ID0, _IWI, _IWJ = (forces.PairConstants.FLOAT_ROWS.inde
 _T0 = numba_driver._TERM_START
 # the rows of the permanent ratio and the viscosity in the term block (the register's elastic and viscous parts)
 _TRC, _TNU = (forces.PairConstants.TERM_ROWS.index(n) for n in ("ratio_c", "nu"))
-#: the rows of the terms a step keeps for a force register (``keep``; :func:`_terms`)
+#: the rows of the terms a step keeps for a force register (``keep``; :func:`kept_terms`)
 _KEPT = ("el_i", "v_i", "F_i", "F_j", "fx_i", "fy_i", "el_j", "v_j", "fx_j", "fy_j")
 
 
@@ -311,10 +323,39 @@ def _segment_sum(a, lo, hi):
     return a[lo] + _pairwise(a, lo + 1, hi - lo - 1) if hi > lo else 0.0
 
 
-def _pair_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, tp):
+def pair_tensor_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx, dy, fx_i, fy_i, fx_j, fy_j, dF,
+                     tp):
     """The pair rows of every tensor (:mod:`~.stress`: Love-Weber, external, internal torque) of the
-    candidates ``P0 … P1 − 1`` into ``tp`` (9, P); ``ky, kx`` nonzero where the pair acts through a
-    periodic boundary; ``fx_j, fy_j`` read only with ``own_j`` (compiled)."""
+    candidates ``P0 … P1 − 1`` into ``tp`` (compiled; the step's sampling steps and the documented
+    classes' tensor sums).
+
+    Parameters
+    ----------
+    P0, P1 : int
+        The candidates' range.
+    ai, aj, rep : ndarray of int (P,)
+        The candidates' sphere rows and replicas.
+    own_j : bool
+        Spheres with parameters of their own: j receives ``fx_j, fy_j`` (else ``fx_i, fy_i`` are read).
+    x, y : ndarray (B·N,)
+        Positions (µm).
+    Lx, Ly : ndarray (B,)
+        Cell sizes (µm).
+    mob : ndarray of bool (B·N,)
+        The mobility mask.
+    active : ndarray of bool (P,)
+        The relations.
+    ky, kx : ndarray (P,)
+        Nonzero where the pair acts through a periodic boundary.
+    dx, dy : ndarray (P,)
+        The pair vectors (µm).
+    fx_i, fy_i, fx_j, fy_j : ndarray (P,)
+        The forces on i (and on j, read only with ``own_j``).
+    dF : ndarray (P,)
+        The tangential torque factors.
+    tp : ndarray (9, P)
+        Written: the rows.
+    """
     for p in range(P0, P1):
         i, j, b = ai[p], aj[p], rep[p]
         internal, ext_i, ext_j = pair_roles(mob[i], mob[j], (ky[p] != 0.0) or (kx[p] != 0.0))
@@ -329,9 +370,31 @@ def _pair_rows(P0, P1, ai, aj, rep, own_j, x, y, Lx, Ly, mob, active, ky, kx, dx
         tp[8, p] = dF[p] * internal
 
 
-def _sphere_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
+def sphere_tensor_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts):
     """The sphere rows of every tensor (:mod:`~.stress`: unbalanced forces, torques, spin, Otsuki) of
-    the spheres ``n0 … n1 − 1`` into ``ts`` (10, B·N) (compiled)."""
+    the spheres ``n0 … n1 − 1`` into ``ts`` (compiled).
+
+    Parameters
+    ----------
+    n0, n1 : int
+        The spheres' range.
+    rep : ndarray of int (B·N,)
+        Each sphere's replica.
+    x, y, vx, vy, omega : ndarray (B·N,)
+        Positions (µm), velocities (µm/s), spins (1/s).
+    m, inertia : ndarray (B·N,)
+        Masses and moments of inertia.
+    fx, fy, torque : ndarray (B·N,)
+        The totals of the force phase.
+    mob : ndarray of bool (B·N,)
+        The mobility mask.
+    rate : ndarray (B,)
+        Shear rates (1/s).
+    Lx, Ly : ndarray (B,)
+        Cell sizes (µm).
+    ts : ndarray (10, B·N)
+        Written: the rows.
+    """
     for k in range(n0, n1):
         b = rep[k]
         xc, yc = x[k] - Lx[b] / 2, y[k] - Ly[b] / 2
@@ -341,26 +404,29 @@ def _sphere_rows(n0, n1, rep, x, y, vx, vy, omega, m, inertia, fx, fy, torque, m
         ts[6, k], ts[7, k], ts[8, k], ts[9, k] = otsuki_entries(m[k], vx[k], vy[k], rate[b], yc, mob[k])
 
 
-def _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
-    """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` (its candidates the columns
-    ``offsets[b] … ends[b] − 1``) into ``tsum`` (19, B), in
-    the order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
-    ``StressInputs.per_replica``: ``numpy.add.reduceat`` over each replica's segment) (compiled)."""
+def tensor_row_sums(b0, b1, N, offsets, ends, tp, ts, tsum):
+    """The sums of the rows of ``tp`` and ``ts`` per replica ``b0 … b1 − 1`` into ``tsum``, in the
+    order of :data:`~.stress.SUMMED_ROWS` and NumPy's (``forces.replica_sums`` and
+    ``StressInputs.per_replica``: ``numpy.add.reduceat`` over each replica's segment) (compiled).
+
+    Parameters
+    ----------
+    b0, b1 : int
+        The replicas' range.
+    N : int
+        Spheres per replica.
+    offsets, ends : ndarray of int (B,)
+        Replica b's candidates are the columns ``offsets[b] … ends[b] − 1``.
+    tp, ts : ndarray (9, P), (10, B·N)
+        The pair and sphere rows (:func:`pair_tensor_rows`, :func:`sphere_tensor_rows`).
+    tsum : ndarray (19, B)
+        Written: the sums.
+    """
     for b in range(b0, b1):
         for q in range(9):
             tsum[q, b] = _segment_sum(tp[q], offsets[b], ends[b])
         for q in range(10):
             tsum[9 + q, b] = _segment_sum(ts[q], b * N, (b + 1) * N)
-
-
-def _tensor_kernel(B, N, ai, aj, rep_p, offsets, rep_s, own_j, x, y, vx, vy, omega, m, inertia, Lx, Ly, rate, mob,
-                   active, shifted, dx, dy, fx_i, fy_i, fx_j, fy_j, dF, fx, fy, torque, tp, ts, tsum):
-    """Every tensor's row sums of one force phase's inputs (compiled; :func:`tensor_sums`)."""
-    _pair_rows(offsets[0], offsets[B], ai, aj, rep_p, own_j, x, y, Lx, Ly, mob, active, shifted, shifted, dx, dy,
-               fx_i, fy_i, fx_j, fy_j, dF, tp)
-    _sphere_rows(0, B * N, rep_s, x, y, vx, vy, omega, m, inertia, fx, fy, torque, mob, rate, Lx, Ly, ts)
-    _row_sums(0, B, N, offsets, offsets[1:], tp, ts, tsum)
-    return 0
 
 
 def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, form, custom, A, visit_j, form_j, Tj,
@@ -389,9 +455,9 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
     every tensor's rows (``tsum``, :data:`~.stress.SUMMED_ROWS`: the pair rows in ``tp``, the sphere
     rows in ``ts``, summed per replica as NumPy sums them).  ``keep``: the step keeps the terms of
     its force phase for a force register (the rows :data:`_KEPT` of ``kt``, the sphere totals in
-    ``ktot``; :func:`_terms`).  ``forces_only``: the force phase alone (:func:`run_force_phase`),
+    ``ktot``; :func:`kept_terms`).  ``forces_only``: the force phase alone (:func:`launch`),
     the forces and torques left in ``frc`` and its geometry in ``work``; ``start`` 5: the movement
-    alone (:func:`run_move`: the ξ rule, displacement, drift, strain, wrap and clock after a force
+    alone (:data:`MOVE_ONLY`: the ξ rule, displacement, drift, strain, wrap and clock after a force
     phase and a kick of their own, its geometry in ``work`` and ``yc``).  The other arguments are
     the engine's (the flags of the step, the state's
     sphere rows, the per-replica box, strain, rate and clock, the candidates' blocks and history,
@@ -517,11 +583,11 @@ def _step_kernel(start, b0, b1, N, cool, dt, sample, check, applying, numbers, f
                     tau[0, b], tau[1, b] = shear_from_sums(_segment_sum(work[11], lo, hi), _segment_sum(work[12], lo, hi),
                                                            _segment_sum(work[13], lo, hi), V[b])
             if sample == 2:     # every tensor's rows (the totals of the scatter), summed per replica
-                _pair_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs, dys,
-                           work[14], work[15], mxs, mys, dFs, tp)
-                _sphere_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0], frc[1],
-                             frc[2], mob, rate, Lx, Ly, ts)
-                _row_sums(b0, b1, N, offsets, ends, tp, ts, tsum)
+                pair_tensor_rows(P0, P1, Ci[1], Ci[2], Ci[0], visit_j, pos[0], pos[1], Lx, Ly, mob, active, kys, kxs, dxs,
+                                 dys, work[14], work[15], mxs, mys, dFs, tp)
+                sphere_tensor_rows(n0, n1, rep_s, pos[0], pos[1], vel[0], vel[1], vel[2], mmi[0], mmi[2], frc[0],
+                                   frc[1], frc[2], mob, rate, Lx, Ly, ts)
+                tensor_row_sums(b0, b1, N, offsets, ends, tp, ts, tsum)
             if check:
                 bad = False
                 for b in range(b0, b1):
@@ -673,16 +739,40 @@ def compile_step_kernel(cache=True, say=None):
     numba.core.registry.CPUDispatcher
     """
     import numba
-    return _compile(True, "_step_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS, _signature, cache, say,
+    return compile_kernel(True, "_step_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS, _signature, cache, say,
                     lambda: f"backend 'numba': compiling the step (first use; kept in {numba.config.CACHE_DIR})")
 
 
-def _compile(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
+def compile_kernel(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
-    ``signature()`` now (or loaded from Numba's cache), kept per process under ``key``; ``say(message())``
-    before a compile (not before a load); with ``parallel`` its variant over several threads (``name__parallel``);
-    with ``linear`` the history merge's positions by one pass (:func:`_positions_linear`, in place of
-    :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache)."""
+    ``signature()`` now (or loaded from Numba's cache) and kept per process under ``key``: the one
+    compile of every kernel of the step (the engine's, and the documented classes' tensor sums,
+    :mod:`particleShear.base.compiled_phases`).
+
+    Parameters
+    ----------
+    key : hashable
+        The kernel's key in this process's table (a second call with it returns the first's).
+    name : str
+        The function compiled, one of ``functions``.
+    functions : sequence of (module, name)
+        Every function it calls, compiled with it (:data:`STEP_FUNCTIONS`, :data:`KERNEL_FUNCTIONS` …).
+    signature : callable
+        ``signature()``: its Numba signature.
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+    say, message : callable, optional
+        ``say(message())`` before a compile (not before a load from the cache).
+    parallel : bool, default False
+        Its variant over several threads (``name__parallel``).
+    linear : bool, default False
+        The history merge's positions by one pass (:func:`_positions_linear`, in place of
+        :func:`~particleShear.engine.state._positions`; its functions under their own names in the cache).
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
     if cache and key in _kernels:
         return _kernels[key]
     import numba
@@ -740,8 +830,19 @@ def _signature():
     return types.int64(*out)
 
 
-def _kernels_of(ws):
-    """The compiled step and block of a workspace: the built-in laws', or its run law's variant."""
+def kernels_of(ws):
+    """The compiled step and block of a workspace: the built-in laws', or its run law's variant.
+
+    Parameters
+    ----------
+    ws : _Workspace
+        The workspace (its law, ``ws.law``).
+
+    Returns
+    -------
+    tuple of numba.core.registry.CPUDispatcher
+        ``(step, block)``: :func:`_step_kernel` and :func:`_block_kernel` compiled (or loaded).
+    """
     n = threads()
     if n > 1:
         import numba
@@ -818,7 +919,6 @@ def compile_kernels(say=None, law=None):
     compile_carried_kernel()
     compile_constants_kernel()
     compile_carry_kernel()
-    _compile_tensor_kernel()
     for kind in (np.float64, np.int64, np.bool_, np.int8):     # (the copies of a block's candidates, _move)
         _move(np.zeros((1, 1), kind), np.zeros(1, np.int64), np.ones(1, np.int64), np.zeros((1, 1), kind),
               np.zeros(1, np.int64))
@@ -859,9 +959,8 @@ class _Workspace:
         self.yc = np.empty(B * N)
         self.y0 = np.empty(B * N)
         self.tau = np.zeros((2, B))
-        self.tsum = np.zeros((_SUMS, B))
+        self.tsum = np.zeros((TENSOR_SUMS, B))
         self.tp = self.ts = None          # (the rows of every tensor: made at the first step that samples them)
-        self.lent = False                 # (work, kt, ktot handed over by a force phase alone: _fresh)
         # the terms a step keeps for a force register (engine.keep_terms)
         self.keep = bool(engine.keep_terms)
         self.kt = np.empty((len(_KEPT), C.P if self.keep else 0))
@@ -1010,177 +1109,129 @@ def run_step(engine, cool, dt, sample):
     EngineInstability
         When the guard finds a guarded replica unstable (after the force phase, as NumPy).
     """
-    got = _launch(engine, cool, dt, sample)
+    got = launch(engine, cool, dt, sample)
     if got is None:
         return NOT_RUN
     ws, kernel, args, held, status = got
-    if status == _UNITS:
-        for b in range(engine.s.B):
-            _draw(engine, ws, b, ws.zero, 8)
-        kernel(1, 0, engine.s.B, *args)
-    _adopt(engine, ws, held, stepped=True)
+    resume_at_units(engine, ws, kernel, args, status)
+    hand_back(engine, ws, held, stepped=True)
     engine.step_count += 1
-    return _samples(ws, sample)
+    return step_samples(ws, sample)
 
 
-def _launch(engine, cool, dt, sample, forces_only=False):
+def launch(engine, cool, dt, sample, forces_only=False):
     """The start of a compiled step (or of its force phase alone): the lists rebuilt when due, the
     kernel run from the start (the normals at ``d = 0`` drawn and the step run with them), the
     relations, the terms when kept and the guard's record handed back, an unsound verdict reported.
-
-    Returns ``(workspace, kernel, arguments, held arrays, status)``, or None when the compiled code
-    does not cover the engine's step."""
-    engine.neighbours()
-    ws = _prepared(engine)
-    if ws is None:
-        return None
-    kernel, B = _kernels_of(ws)[0], engine.s.B
-    check = ws.guarded and not engine.step_count % engine.check_interval
-    if forces_only or ws.lent:
-        _fresh(ws)
-    ws.lent = forces_only
-    args, held = _arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
-                            forces_only=forces_only)
-    status = kernel(0, 0, B, *args)
-    if status == _D_ZERO:
-        for b in range(B):
-            _draw(engine, ws, b, ws.work[4] == 0.0, 5)
-        status = kernel(3, 0, B, *args)
-    _adopt(engine, ws, held)
-    if ws.keep:
-        engine.terms = _terms(engine, ws, own_buffers=forces_only)
-    if status == _GUARD:
-        _report(engine, ws)
-    return ws, kernel, args, held, status
-
-
-def run_force_phase(engine, sample=False):
-    """The force phase of ``engine`` in the compiled code (the first part of :func:`run_step`), or
-    :data:`NOT_RUN` when it does not cover it.
-
-    What :meth:`~particleShear.engine.step.BatchEngine.force_phase` does, with the same numbers: the
-    forces and torques in the state, the relations and their history, the guard when due, the
-    terms when kept; the acceleration and movement phases (on NumPy) then read the record.
 
     Parameters
     ----------
     engine : BatchEngine
         The engine (backend ``"numba"``).
+    cool, dt : float
+        Damping factor and time step (s).
     sample : bool or str
-        As :meth:`~particleShear.engine.step.BatchEngine.force_phase`.
+        As :meth:`~particleShear.engine.step.BatchEngine.step`.
+    forces_only : bool, default False
+        The force phase alone (the kernel stops after it, the forces and torques left in the
+        state's ``frc`` and the phase's geometry in the workspace's ``work``).  The kept terms
+        (:func:`kept_terms`) are then the rows of the workspace's buffers themselves, not copies:
+        a caller that keeps them past the next compiled call gives the workspace new buffers first.
 
     Returns
     -------
-    tuple or NOT_RUN
-        ``(fields, stresses)``: the fields of the phase's
-        :class:`~particleShear.engine.step.ForceRecord` but the verdict (``dx, dy, nx, ny, dvx,
-        active, yc, mob``: copies) and the stresses as
-        :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them.
+    tuple or None
+        ``(workspace, kernel, arguments, held arrays, status)`` (the kernel's arguments after
+        ``start, b0, b1``, :func:`step_arguments`; the status of :func:`_step_kernel`), or None
+        when the compiled code does not cover the engine's step.
+
+    Raises
+    ------
+    EngineInstability
+        When the guard finds a guarded replica unstable.
     """
-    got = _launch(engine, 1.0, 0.0, sample, forces_only=True)
-    if got is None:
-        return NOT_RUN
-    ws = got[0]
-    w = ws.work        # (this phase's own buffer, _fresh)
-    fields = (w[0], w[1], w[5], w[6], w[7], engine.s.contacts.active.copy(), ws.yc.copy(), ws.mob.copy())
-    return fields, _samples(ws, sample)
+    engine.neighbours()
+    ws = _prepared(engine)
+    if ws is None:
+        return None
+    kernel, B = kernels_of(ws)[0], engine.s.B
+    check = ws.guarded and not engine.step_count % engine.check_interval
+    args, held = step_arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
+                            forces_only=forces_only)
+    status = kernel(0, 0, B, *args)
+    if status == _D_ZERO:
+        for b in range(B):
+            draw_directions(engine, ws, b, ws.work[4] == 0.0, 5)
+        status = kernel(3, 0, B, *args)
+    hand_back(engine, ws, held)
+    if ws.keep:
+        engine.terms = kept_terms(engine, ws, own_buffers=forces_only)
+    if status == _GUARD:
+        _report(engine, ws)
+    return ws, kernel, args, held, status
 
 
-def run_move(engine, dt, g):
-    """The movement of ``engine`` after its force phase ``g`` and its kick, in the compiled code (the
-    tail of :func:`run_step`), or :data:`NOT_RUN` when it does not cover it.
-
-    What :meth:`~particleShear.engine.step.BatchEngine.move` does, with the same numbers: the
-    sequential ξ rule (a random direction at ``|R| = 0`` drawn here, as in :func:`run_step`), the
-    displacement since the lists were built, the drift, the strain, the wrap, the clock and the
-    lists due.
+def resume_at_units(engine, ws, kernel, args, status):
+    """The rest of a step the kernel stopped at the ξ rule (``status`` :data:`UNITS`): the random
+    directions at ``|R| = 0`` drawn (:func:`draw_directions`, rows 8, 9 of ``work``) and the kernel
+    resumed from there (its start 1); nothing for another status.
 
     Parameters
     ----------
     engine : BatchEngine
-        The engine (backend ``"numba"``), its candidates those of the force phase.
-    dt : float
-        Time step (s).
-    g : ForceRecord
-        The record of the step's force phase (its pair vectors, normals, image velocity, heights).
+        The engine the kernel stepped (all its replicas).
+    ws : _Workspace
+        Its workspace (:func:`last_workspace`).
+    kernel : numba.core.registry.CPUDispatcher
+        The compiled step (:func:`kernels_of`).
+    args : tuple
+        The kernel's arguments after ``start, b0, b1`` (:func:`step_arguments`).
+    status : int
+        What the kernel returned.
+    """
+    if status == UNITS:
+        for b in range(engine.s.B):
+            draw_directions(engine, ws, b, ws.zero, 8)
+        kernel(1, 0, engine.s.B, *args)
+
+
+def last_workspace(engine):
+    """The workspace of the engine's last compiled call, or None before one; unlike
+    :func:`_workspace` it makes none (the workspace of a force phase, for its movement).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine.
 
     Returns
     -------
-    None or NOT_RUN
+    _Workspace or None
+        Its buffers, its candidates ``C``, ``why`` (not None where the step is not compiled).
     """
-    ws = _held(engine).get("workspace")       # (the force phase's: its candidates, its laws)
-    if ws is None or ws.why is not None or ws.C is not engine.s.contacts.C or g.verdict is not None:
-        return NOT_RUN
-    w = ws.work
-    if g.dx.base is not w:        # (a record of this workspace's phase holds its rows already)
-        w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
-    ws.yc[:] = g.yc
-    B = engine.s.B
-    kernel = _kernels_of(ws)[0]
-    args, held = _arguments(engine, ws, 1.0, dt, False, False, np.zeros(B, dtype=np.bool_))
-    if kernel(5, 0, B, *args) == _UNITS:
-        for b in range(B):
-            _draw(engine, ws, b, ws.zero, 8)
-        kernel(1, 0, B, *args)
-    _adopt(engine, ws, held, stepped=True, kicked=False)
-    engine.step_count += 1
-    return None
+    return _held(engine).get("workspace")
 
 
-def _samples(ws, sample):
-    """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`)."""
+def step_samples(ws, sample):
+    """What a step or force phase returns of its samples (:meth:`~particleShear.engine.step.BatchEngine.step`).
+
+    Parameters
+    ----------
+    ws : _Workspace
+        The workspace the kernel sampled into (``tau``, ``tsum``).
+    sample : bool or str
+        As the step took it.
+
+    Returns
+    -------
+    None or tuple
+        None unless ``sample``; else ``(tau_internal, tau_surface)`` and, for ``"tensors"``, the
+        (B, 9, 2, 2) tensors (copies).
+    """
     if sample == "tensors":       # (the xy entries are the shear stresses, as the NumPy step returns them)
         T = tensors_from_sums(ws.tsum.copy(), ws.V)
         return -T[:, OVERALL, 0, 1], -T[:, EXTERNAL, 0, 1], T
     return (ws.tau[0].copy(), ws.tau[1].copy()) if sample else None
-
-
-def tensor_sums(q):
-    """The per-replica sums of every tensor's rows (:data:`~.stress.SUMMED_ROWS`) of one force phase's
-    inputs, in the compiled code: what :meth:`~.stress.StressInputs.reduce` sums on NumPy, the same
-    bits (the rows from the same entry functions, the sums in NumPy's order); the tensors are then
-    :func:`~.stress.tensors_from_sums` of them.
-
-    Parameters
-    ----------
-    q : StressInputs
-        Every input of the rows (one force phase of a batch whose spheres are ``B·N`` rows; host arrays).
-
-    Returns
-    -------
-    ndarray (19, B)
-    """
-    C, B = q.C, q.B
-    n, P = len(q.x), len(q.dx)
-    own = q.fx_j is not None
-    tsum = np.zeros((_SUMS, B))
-    arrays = [C.ai, C.aj, C.rep, C.offsets, q.rep, q.x, q.y, q.vx, q.vy, q.omega, q.m, q.inertia, q.Lx, q.Ly, q.rate,
-              q.mob, q.active, q.shifted, q.dx, q.dy, q.fx_i, q.fy_i, q.fx_j if own else q.fx_i,
-              q.fy_j if own else q.fy_i, q.dF, q.fx, q.fy, q.torque]
-    kernel = _compile_tensor_kernel()
-    try:            # (the inputs as they are: the arrays of a force phase have the kernel's types)
-        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
-    except TypeError:
-        sizes = [None] * 5 + [n] * 7 + [B] * 3 + [None, None] + [P] * 8 + [n] * 3
-        kinds = [np.int64] * 5 + [float] * 10 + [np.bool_] * 3 + [float] * 10
-        arrays = [np.ascontiguousarray(np.asarray(a, dtype=t) if k is None else
-                                       np.broadcast_to(np.asarray(a, dtype=t), (k,))) for a, k, t in zip(arrays, sizes, kinds)]
-        kernel(B, n // B if B else 0, *arrays[:5], own, *arrays[5:], np.empty((9, P)), np.empty((10, n)), tsum)
-    return tsum
-
-
-def _compile_tensor_kernel(cache=True):
-    """The compiled :func:`_tensor_kernel`, compiled once per process (or loaded from the cache)."""
-    if cache and "tensors" in _kernels:
-        return _kernels["tensors"]
-    from numba import types
-    f1, i1, f2 = (types.Array(types.float64, 1, "C"), types.Array(types.int64, 1, "C"),
-                  types.Array(types.float64, 2, "C"))
-    b1 = types.Array(types.boolean, 1, "C")
-    signature = types.int64(types.int64, types.int64, i1, i1, i1, i1, i1, types.boolean, *(f1,) * 10, b1, b1, b1,
-                            *(f1,) * 10, f2, f2, f2)
-    return _compile("tensors", "_tensor_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + TENSOR_FUNCTIONS,
-                    lambda: signature, cache)
 
 
 def _prepared(engine):
@@ -1197,16 +1248,44 @@ def _prepared(engine):
     return None
 
 
-def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False, slots=None):
+def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors=False, forces_only=False,
+                   slots=None):
     """The arguments of :func:`_step_kernel` after ``start, b0, b1``, and the arrays to hand back
-    (:func:`_adopt`); ``sample`` as :meth:`~particleShear.engine.step.BatchEngine.step` takes it
-    (``tensors``: a block samples every tensor at some of its steps); ``forces_only``: the force
-    phase alone; ``pred`` (B,): which replicas' force phase sees the Verlet half kick;
-    ``half_out``: a block's buffer of the new half kicks, copied into ``half`` replica by replica
-    (``half`` is then the one handed back); default a new array per step, handed back itself (as
-    ``half_kick`` gives); ``slots``: a block's :class:`_Slots`, whose ranges of each replica's
-    candidates and buffers the kernel takes (a rebuilt replica's candidates are its slot's,
-    handed back by :func:`_settle`)."""
+    (:func:`hand_back`).
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine stepped.
+    ws : _Workspace
+        Its workspace (:func:`last_workspace`).
+    cool, dt : float
+        Damping factor and time step (s).
+    sample : bool or str
+        As :meth:`~particleShear.engine.step.BatchEngine.step` takes it.
+    check : bool
+        Whether the guard checks this step.
+    pred : ndarray of bool (B,)
+        Which replicas' force phase sees the Verlet half kick.
+    half_out : ndarray (3, B·N), optional
+        A block's buffer of the new half kicks, copied into ``half`` replica by replica (``half``
+        is then the one handed back); default a new array per step, handed back itself (as
+        ``half_kick`` gives).
+    tensors : bool, default False
+        A block samples every tensor at some of its steps.
+    forces_only : bool, default False
+        The force phase alone (:func:`launch`).
+    slots : _Slots, optional
+        A block's slots, whose ranges of each replica's candidates and buffers the kernel takes (a
+        rebuilt replica's candidates are its slot's, handed back by :func:`_settle`).
+
+    Returns
+    -------
+    args : tuple
+        The kernel's arguments after ``start, b0, b1``.
+    held : dict
+        The arrays the kernel writes that :func:`hand_back` gives to the state and the engine.
+    """
     s = engine.s
     c = s.contacts
     C = c.C
@@ -1239,12 +1318,25 @@ def _arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, tensors
     return args, held
 
 
-def _adopt(engine, ws, held, stepped=False, kicked=True):
+def hand_back(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
     copies): after the force phase the relations and their history (``state.contacts``), the rate
-    and the guard's record; after a whole step (``stepped``) also the lists' bookkeeping
-    (displacement, strain since the build, bound, the lists due), the strain, the clock and, when
-    a step of this call reached its kick (``kicked``), the Verlet half kick."""
+    and the guard's record; after a whole step also the lists' bookkeeping and the clock.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine the kernel stepped.
+    ws : _Workspace
+        Its workspace (the lists due, ``need``).
+    held : dict
+        The arrays of :func:`step_arguments`.
+    stepped : bool, default False
+        The kernel ran the movement too: also the displacement, strain since the build, bound,
+        the lists due, the strain and the clock.
+    kicked : bool, default True
+        With ``stepped``: a step of this call reached its kick, so the Verlet half kick too.
+    """
     s = engine.s
     c = s.contacts
     c.state_p, c.xi, c.active, c.birth, c.next_birth = (held["state_p"], held["xi"], held["active"], held["birth"],
@@ -1259,12 +1351,26 @@ def _adopt(engine, ws, held, stepped=False, kicked=True):
         c.need = ws.need.copy()
 
 
-def _terms(engine, ws, own_buffers=False):
+def kept_terms(engine, ws, own_buffers=False):
     """The terms of the last force phase as the NumPy force phase keeps them for a force register
     (:attr:`~particleShear.engine.step.BatchEngine.terms`): the rows the step kept (``keep``) and its
-    geometry, copies (``own_buffers``: the rows themselves, of buffers made for this phase alone,
-    :func:`_fresh`); the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's
-    expressions on them."""
+    geometry; the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's expressions on them.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine after its compiled force phase.
+    ws : _Workspace
+        Its workspace (the rows ``kt``, ``ktot`` and the geometry ``work``).
+    own_buffers : bool, default False
+        The rows themselves rather than copies (a force phase alone whose caller takes the
+        buffers, :func:`launch`).
+
+    Returns
+    -------
+    dict
+        The arrays by name, as :attr:`~particleShear.engine.step.BatchEngine.terms`.
+    """
     c = engine.s.contacts
     C, w, kt, own = c.C, ws.work, ws.kt, ws.visit_j
     if not own_buffers:
@@ -1276,28 +1382,30 @@ def _terms(engine, ws, own_buffers=False):
                 dF=dF, tq=dF * C.w, birth=c.birth.copy(), totals=ws.ktot if own_buffers else ws.ktot.copy())
 
 
-def _fresh(ws):
-    """New buffers for the rows a force phase alone hands over (the geometry, the kept terms), so that
-    its record and terms are those rows themselves and the next phase writes other ones (``ws.lent``:
-    the present ones were handed over; only the movement of that phase writes into them, rows it
-    does not hand over)."""
-    ws.work = np.empty_like(ws.work)
-    if ws.keep:
-        ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
-
-
 def _report(engine, ws):
     """Raise the guard's EngineInstability of the verdict the kernel wrote."""
     v = ws.verdict
     engine.report_verdict((v[0].astype(np.int64), v[1].copy(), v[2].copy(), v[3].copy()), engine.step_count)
 
 
-def _draw(engine, ws, b, mask, row):
+def draw_directions(engine, ws, b, mask, row):
     """Random unit vectors ``(cos 2πu, sin 2πu)`` into ``work`` rows ``row``, ``row + 1`` for replica
     b's candidates where ``mask`` holds: in pair order, from the replica's own generator, as
-    :func:`~particleShear.engine.forces.normals` draws them (rows 5, 6: the normals at ``d = 0``;
-    rows 8, 9: the directions at ``|R| = 0``).  ``ws``: the workspace, or a block's :class:`_Slots`
-    (the columns and buffers the kernel read)."""
+    :func:`~particleShear.engine.forces.normals` draws them.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (its replicas' generators).
+    ws : _Workspace or _Slots
+        The workspace, or a block's slots (the columns and buffers the kernel read).
+    b : int
+        The replica.
+    mask : ndarray of bool (P,)
+        The candidates that get a direction.
+    row : int
+        5: the normals at ``d = 0`` (rows 5, 6); 8: the directions at ``|R| = 0`` (rows 8, 9).
+    """
     lo, hi = ws.offsets[b], ws.ends[b]
     rng = engine.s.rng[b]
     for p in np.flatnonzero(mask[lo:hi]) + lo:
@@ -1368,7 +1476,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
     want = np.zeros(n, dtype=np.bool_)          # (read at every scheduled step)
     if tensors is not None and scheduled:
         want[:] = tensors
-    sums = np.zeros((n, _SUMS, B)) if want.any() else _NO_SUMS
+    sums = np.zeros((n, TENSOR_SUMS, B)) if want.any() else _NO_SUMS
     ks, starts, status = np.zeros(B, np.int64), np.zeros(B, np.int64), np.zeros(B, np.int64)
     pred = np.full(B, engine.half is not None)
     # (one buffer of new half kicks for the block: a step resumed in the next call kicked into it)
@@ -1402,26 +1510,23 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
                     raise RuntimeError("run_block: the step stopped running compiled within a block")
                 return 0
             starts[~going] = _SKIP
-            if ws.lent:
-                _fresh(ws)
-                ws.lent = False
             if slots is None and _slotted(engine, ws):
                 slots = _Slots.of(engine)
             at = ws if slots is None else slots
-            args, held = _arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any(),
+            args, held = step_arguments(engine, ws, cool, dt, scheduled, False, pred, half_out, tensors=want.any(),
                                     slots=slots)
-            _kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
+            kernels_of(ws)[1](ks, end, starts, status, rates, *rec, row, step0, engine.check_interval, ws.guarded,
                                scheduled, want, sums, *(_NO_SLOTS if slots is None else slots.arguments()), *args)
-            _adopt(engine, ws, held, stepped=True, kicked=bool(pred.any()))
+            hand_back(engine, ws, held, stepped=True, kicked=bool(pred.any()))
             drawn = False
             for b in np.flatnonzero(going):
                 st = status[b]
                 starts[b] = _SKIP
                 if st == _D_ZERO:        # (nothing of the step changed: its normals at d = 0, then the step)
-                    _draw(engine, at, b, at.work[4] == 0.0, 5)
+                    draw_directions(engine, at, b, at.work[4] == 0.0, 5)
                     starts[b], drawn = 3, True
                 elif st == _UNITS:       # (the rest of the step, from the ξ rule)
-                    _draw(engine, at, b, at.zero, 8)
+                    draw_directions(engine, at, b, at.zero, 8)
                     starts[b], drawn = 1, True
                 elif st == _GUARD:       # (the other replicas run to this step at least: the first failure is reported)
                     failed[b], verdicts[:, b] = ks[b], ws.verdict[:, b]
@@ -1430,10 +1535,10 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         if slots is not None:
             _settle(engine, slots)
     if ws.keep:        # (the terms of the last step: a batch of one, whose last call stepped it)
-        engine.terms = _terms(engine, ws)
+        engine.terms = kept_terms(engine, ws)
     if want.any():     # (the tensors of the sampled steps at once: each column is one replica's step)
         k = np.flatnonzero(want)
-        S = sums[k].transpose(1, 0, 2).reshape(_SUMS, -1)
+        S = sums[k].transpose(1, 0, 2).reshape(TENSOR_SUMS, -1)
         V = np.broadcast_to(np.asarray(engine.V, dtype=float), (B,))
         tensor_out[k] = tensors_from_sums(S, np.tile(V, len(k))).reshape(len(k), B, *tensor_out.shape[2:])
     if (failed >= 0).any():
@@ -1834,7 +1939,7 @@ def compile_constants_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
+    return compile_kernel("constants", "_constants_kernel", CONSTANT_FUNCTIONS, _constants_signature, cache)
 
 
 def _constants_signature():
@@ -1908,7 +2013,7 @@ def compile_carry_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carry", "_carry_kernel", CARRY_FUNCTIONS, _carry_signature, cache, linear=True)
+    return compile_kernel("carry", "_carry_kernel", CARRY_FUNCTIONS, _carry_signature, cache, linear=True)
 
 
 def _carry_signature():
@@ -1966,7 +2071,7 @@ def compile_carried_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
+    return compile_kernel("carried", "carried_rows", MERGE_FUNCTIONS, _carried_signature, cache, linear=True)
 
 
 def _carried_signature():
@@ -1988,8 +2093,8 @@ def compile_search_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile("search", "_search_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS, _search_signature,
-                    cache)
+    return compile_kernel("search", "_search_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + SEARCH_FUNCTIONS,
+                          _search_signature, cache)
 
 
 def _sorted_keys(key, N):
@@ -2230,5 +2335,5 @@ def compile_block_kernel(cache=True, parallel=False):
     -------
     numba.core.registry.CPUDispatcher
     """
-    return _compile(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
+    return compile_kernel(("block", bool(parallel)), "_block_kernel", STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS,
                     _block_signature, cache, parallel=bool(parallel))

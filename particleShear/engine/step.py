@@ -553,7 +553,10 @@ class BatchEngine:
         is its arguments).  With :attr:`keep_terms` the per-term arrays are kept in :attr:`terms`
         for the force register.  With the velocity Verlet integrator (:attr:`integrator`) the
         velocity-dependent terms see the velocities moved half a kick ahead (the half kick of the
-        previous step).
+        previous step).  This is the phase of the NumPy step, which the compiled step runs in one
+        call instead (:meth:`step`); the force phase alone in the compiled code is
+        :func:`~particleShear.engine.numba_step.launch` with ``forces_only`` (the documented
+        classes' phase, :func:`particleShear.base.compiled_phases.force_phase`).
 
         Parameters
         ----------
@@ -567,10 +570,6 @@ class BatchEngine:
         stresses : None or tuple
             As :meth:`step` returns.
         """
-        if self.backend.compiled:       # the same phase in one compiled call
-            got = numba_step.run_force_phase(self, sample)
-            if got is not numba_step.NOT_RUN:
-                return ForceRecord(*got[0], None), got[1]
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         yc, dx, dy, ky, kx, d, touching, active, image_rate = self.relations()
@@ -755,7 +754,10 @@ class BatchEngine:
         """ξ of sticking contacts and bonds (sequential rule, Appendix B.2), drift, strain, wrap, clock.
 
         Ends with the step's one read of per-replica flags on the host: the lists due for a
-        rebuild (and, on a device, the stability guard's verdict).
+        rebuild (and, on a device, the stability guard's verdict).  The movement of the NumPy step
+        (the compiled step runs it in its one call; the movement alone in the compiled code is the
+        step kernel from :data:`~particleShear.engine.numba_step.MOVE_ONLY`, the documented
+        classes' movement, :func:`particleShear.base.compiled_phases.move`).
 
         Parameters
         ----------
@@ -770,8 +772,6 @@ class BatchEngine:
         EngineInstability
             On a device, if the force phase's guard verdict is not sound.
         """
-        if self.backend.compiled and g is not None and numba_step.run_move(self, dt, g) is not numba_step.NOT_RUN:
-            return          # (the same movement in one compiled call)
         self.move_spheres(dt, g)
         self.advance_cells(dt, g)
 

@@ -19,6 +19,7 @@ import time
 
 import numpy as np
 
+from ..base.compiled_phases import compile_tensor_kernel
 from ..base.engine_adapter import relax_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
@@ -752,13 +753,15 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
 
 
 def _compiled(requested, say, law):
-    """Compile (or load) the compiled backend's loops before the timings (:func:`~particleShear.engine.numba_step.compile_kernels`).
+    """Compile (or load) the compiled backend's loops before the timings (:func:`~particleShear.engine.numba_step.compile_kernels`,
+    and the documented classes' tensor sums, :func:`~particleShear.base.compiled_phases.compile_tensor_kernel`).
 
     Returns False when the compile failed for runs that asked for ``"auto"`` (which then stands for
     NumPy in this process: :func:`~particleShear.engine.xp.auto_without_numba`); a run that asked
     for ``"numba"`` gets the error."""
     try:
         compile_kernels(say=say, law=law)
+        compile_tensor_kernel()
         return True
     except Exception as exc:
         if not requested <= {"auto", None}:
