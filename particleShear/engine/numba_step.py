@@ -2156,6 +2156,10 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     The replicas share nothing (each reads and writes its own spheres, candidates, slot and
     records), so each runs through the block with its own rebuilds, in any order or on any thread,
     instead of the block ending at the first list due in any replica.
+
+    The arrays are taken as views that own no reference (:func:`~.numba_driver.borrowed`; the
+    caller holds them for the call): the ≈ 100 arrays of each replica's call of the step cost no
+    atomic reference counts (≈ 6 % of a block at B = 32 before).
     """
     # (views that own no reference: the ~100 arrays of each step's call, not counted per call, numba_driver.borrowed)
     (ks, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, want, rec_sums, base, cap, pc,
