@@ -327,6 +327,37 @@ class TestNumbaBackendRuns(unittest.TestCase):
             unregister_law("stiffening_off")
 
 
+@unittest.skipUnless(HAVE_NUMBA, "Numba is not installed (pip install particleShear[fast])")
+class TestBorrowedViews(unittest.TestCase):
+    def test_views_share_memory_and_own_nothing(self):
+        """numba_driver.borrowed: in Python the tuple itself; compiled, views of the same memory
+        (a write through a view, or a row of it, is the array's) that leave the arrays' reference
+        counts as they were, and the other elements as they are."""
+        import numba
+
+        numba_driver.register_helpers()
+        a, b = np.zeros((2, 5)), np.arange(4, dtype=np.int64)
+        args = (a, b, 3.5)
+        self.assertIs(numba_driver.borrowed(args), args)
+        borrowed = numba_driver.borrowed
+
+        @numba.njit
+        def write(a, b, x):
+            a, b, x = borrowed((a, b, x))
+            row = a[1]
+            row[2] = x
+            b[3] += 1
+            return a.shape[1] + b.shape[0]
+
+        counts = sys.getrefcount(a), sys.getrefcount(b)
+        for _ in range(3):
+            self.assertEqual(write(a, b, 3.5), 9)
+        self.assertEqual((sys.getrefcount(a), sys.getrefcount(b)), counts)
+        self.assertEqual(a[1, 2], 3.5)
+        self.assertEqual(a.sum(), 3.5)
+        self.assertEqual(b.tolist(), [0, 1, 2, 6])
+
+
 class TestNumbaStaysOptional(unittest.TestCase):
     def test_import_without_numba(self):
         """Importing the package (and the compiled driver's module) imports no Numba, and with Numba

@@ -138,10 +138,71 @@ def _indices_as_given():
     arrayobj.fix_integer_index = fix_integer_index
 
 
+def borrowed(arrays):
+    """The arrays of the tuple ``arrays`` as they are (in Python; compiled: views that own no reference).
+
+    Numba counts the references of every array it passes to a compiled function or binds to a
+    name (``NRT_incref`` and ``NRT_decref``, an atomic add each, a call of its runtime): a compiled
+    block (:func:`~.numba_step._block_kernel`) calls its step once per replica and step with ~100
+    arrays, about 6 % of its time in those counts.  In compiled code each array of the tuple is
+    given back as a view of the same memory, shape and strides without its owner (a null
+    ``meminfo``, as a view of foreign memory has): the counts of such a view are a test of a null
+    pointer, and every view taken from it (a row, a slice) owns nothing either.  The same
+    addresses, so the same numbers; only for a function that holds the arrays themselves for the
+    whole life of the views (the block's arguments, held by its caller for the call): a view
+    outliving them would point to freed memory.  Other elements of the tuple are given back as they are.
+
+    Parameters
+    ----------
+    arrays : tuple
+        Arrays (and other values).
+
+    Returns
+    -------
+    tuple
+        The same values (compiled: the arrays as views owning no reference).
+    """
+    return arrays
+
+
+def _borrowed_views():
+    """The compiled form of :func:`borrowed` (an intrinsic of Numba's code generation), registered once."""
+    from numba.core import cgutils, types
+    from numba.extending import intrinsic, overload
+
+    @intrinsic
+    def _views(typingctx, arrays):
+        if not isinstance(arrays, types.BaseTuple):
+            return None
+
+        def codegen(context, builder, sig, args):
+            out = []
+            for k, ty in enumerate(sig.args[0]):
+                value = builder.extract_value(args[0], k)
+                if isinstance(ty, types.Array):
+                    a = context.make_array(ty)(context, builder, value=value)
+                    view = context.make_array(ty)(context, builder)
+                    for field in ("data", "shape", "strides", "itemsize", "nitems"):
+                        setattr(view, field, getattr(a, field))
+                    view.meminfo = cgutils.get_null_value(view.meminfo.type)
+                    view.parent = cgutils.get_null_value(view.parent.type)
+                    out.append(view._getvalue())
+                else:
+                    context.nrt.incref(builder, ty, value)
+                    out.append(value)
+            return context.make_tuple(builder, sig.return_type, out)
+        return arrays(arrays), codegen
+
+    @overload(borrowed)
+    def _borrowed(arrays):
+        return lambda arrays: _views(arrays)
+
+
 def register_helpers():
     """Register :func:`~particleShear.engine.xp.select`, :func:`~particleShear.engine.xp.maximum` and
     :func:`~particleShear.engine.xp.minimum` with Numba for numbers (``a if cond else b``, ``max``,
-    ``min``), and take the engine's array indices as given (:func:`_indices_as_given`); once per process.
+    ``min``) and :func:`borrowed`, and take the engine's array indices as given
+    (:func:`_indices_as_given`); once per process.
 
     Raises
     ------
@@ -164,6 +225,7 @@ def register_helpers():
         def _minimum(a, b):
             return lambda a, b: min(a, b)
 
+        _borrowed_views()
         _registered.add(id(xp.select))
 
 
