@@ -357,6 +357,37 @@ class TestBorrowedViews(unittest.TestCase):
         self.assertEqual(a.sum(), 3.5)
         self.assertEqual(b.tolist(), [0, 1, 2, 6])
 
+    def test_a_parallel_kernel_keeps_its_stores(self):
+        """A kernel of the shape of the block (its arguments rebound by ``borrowed``, a ``prange``
+        over replicas writing ``a[b]`` of arrays not read after the loop), compiled on several
+        threads through the one compile of the step's kernels (``numba_step.compile_kernel``,
+        ``parallel=True``, which turns ``BORROWED_VIEWS`` off): every store reaches the caller's
+        arrays.  (With ``borrowed``'s views there, or any call's tuple unpacked, Numba's parfor
+        passes removed them as dead: the arrays stayed zero.)"""
+        from particleShear.engine import numba_step
+        ks, rate, rates = np.zeros(8, np.int64), np.zeros(8), np.arange(1.0, 9.0)
+        kernel = numba_step.compile_kernel(None, "_stores", ((sys.modules[__name__], "_stores"),),
+                                           lambda: "int64(int64[:], float64[:], float64[:], int64)",
+                                           cache=False, parallel=True)
+        self.assertEqual(kernel(ks, rate, rates, 7), 0)
+        self.assertEqual(ks.tolist(), [7] * 8)
+        self.assertEqual(rate.tolist(), rates.tolist())
+
+
+prange = range      # (numba.prange in the parallel variant, numba_driver.jit_laws)
+borrowed = numba_driver.borrowed
+BORROWED_VIEWS = True     # (as numba_step's: False in the variant on several threads)
+
+
+def _stores(ks, rate, rates, n):
+    """Replica b's rate and step written in a loop over replicas (test_a_parallel_kernel_keeps_its_stores)."""
+    if BORROWED_VIEWS:
+        ks, rate, rates = borrowed((ks, rate, rates))
+    for b in prange(ks.shape[0]):
+        rate[b] = rates[b]
+        ks[b] = n
+    return 0
+
 
 class TestNumbaStaysOptional(unittest.TestCase):
     def test_import_without_numba(self):

@@ -151,6 +151,10 @@ def borrowed(arrays):
     addresses, so the same numbers; only for a function that holds the arrays themselves for the
     whole life of the views (the block's arguments, held by its caller for the call): a view
     outliving them would point to freed memory.  Other elements of the tuple are given back as they are.
+    Never in a function compiled with ``parallel=True``: Numba's parfor passes cannot see that the
+    views alias the arguments and remove stores through them in a ``prange`` loop as dead (a small
+    kernel lost every write), and a parfor's threads take their arrays as views owning no
+    reference already (:data:`~.numba_step.BORROWED_VIEWS`).
 
     Parameters
     ----------

@@ -780,9 +780,11 @@ def compile_kernel(key, name, functions, signature, cache=True, say=None, messag
     if cache:
         numba.config.CACHE_DIR = numba_driver.cache_dir()
     options = {"rename": {name: name + "__parallel"}, "parallel": (name,)} if parallel else {"rename": {}}
+    if parallel:
+        options["extra"] = {"BORROWED_VIEWS": False}     # (see BORROWED_VIEWS)
     if linear:
         extra, rename = _linear(cache)
-        options["extra"] = extra
+        options["extra"] = {**options.get("extra", {}), **extra}
         options["rename"].update(rename)
     compiled = numba_driver.jit_laws(cache, functions, inline=INLINE, **options)[name]
     if say is not None and not numba_driver.on_disk(compiled):
@@ -919,6 +921,7 @@ def compile_kernels(say=None, law=None):
     compile_carried_kernel()
     compile_constants_kernel()
     compile_carry_kernel()
+    compile_table_kernel()
     for kind in (np.float64, np.int64, np.bool_, np.int8):     # (the copies of a block's candidates, _move)
         _move(np.zeros((1, 1), kind), np.zeros(1, np.int64), np.ones(1, np.int64), np.zeros((1, 1), kind),
               np.zeros(1, np.int64))
@@ -1685,10 +1688,7 @@ def _settle(engine, slots):
                 _move(src, slots.offsets[which], slots.ends[which], dst, offsets[which])
     C = forces.PairConstants.from_blocks(s, f, i, b, offsets)
     N = s.N
-    table = _kernels.get("table")
-    if table is None:
-        table = _kernels["table"] = numba_driver.jit_laws(
-            True, ((state, "synced_history"), (sys.modules[__name__], "_table_columns")))["_table_columns"]
+    table = compile_table_kernel()
     for r in rebuilt:      # (each table written once, as sync_down writes it: its own arrays, the kept history)
         key, st, de, act, num, z, pi, pj = table(i, *history, d_eq, offsets[r], offsets[r + 1], r * N)
         s.pairs[r].adopt(key, st, de, act, num, z, i=pi, j=pj)
@@ -1719,6 +1719,31 @@ def _table_columns(i, state_p, xi, active, birth, d_eq, lo, hi, first):
         z[1, q] = synced_history(state_p[p], xi[1, p], active[p], birth[p])[1]
         act[q], de[q] = active[p], d_eq[p]
     return key, st, de, act, num, z, pi, pj
+
+
+def compile_table_kernel(cache=True):
+    """:func:`_table_columns` compiled once per process (or loaded from the cache) for the types
+    :func:`_settle` passes; :func:`compile_kernels` calls it before a run's timings.
+
+    Parameters
+    ----------
+    cache : bool, default True
+        As :func:`compile_step_kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+    """
+    if cache and "table" in _kernels:
+        return _kernels["table"]
+    table = numba_driver.jit_laws(cache, ((state, "synced_history"),
+                                          (sys.modules[__name__], "_table_columns")))["_table_columns"]
+    one = np.int64(1)
+    table(np.zeros((3, 1), np.intp), np.zeros(1, np.int8), np.zeros((2, 1)), np.zeros(1, np.bool_),
+          np.zeros(1, np.int64), np.zeros(1), np.int64(0), one, np.int64(0))       # (the compile, or the load)
+    if cache:
+        _kernels["table"] = table
+    return table
 
 
 def _columns(src, lo, hi, dst, at):
@@ -2226,6 +2251,14 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, s
     return True
 
 
+#: the compiled block rebinds its arguments as views owning no reference (numba_driver.borrowed);
+#: False in its variant on several threads (compile_kernel, parallel=True): there Numba's parfor
+#: passes, which cannot see that the views alias the arguments, may remove stores through them as
+#: dead, and a parfor's threads take views owning no reference anyway (a global constant, so the
+#: branch is removed at compile time)
+BORROWED_VIEWS = True
+
+
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
                   interval, guarded, scheduled, want, rec_sums, here, base, cap, pc, rebuilt, d_eq_c, Sf, Si, Sb,
                   s_state, s_xi, s_active, s_birth, s_deq, N, cool, dt, sample, check, applying, numbers, form,
@@ -2264,19 +2297,21 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
 
     The arrays are taken as views that own no reference (:func:`~.numba_driver.borrowed`; the
     caller holds them for the call): the ≈ 100 arrays of each replica's call of the step cost no
-    atomic reference counts (≈ 6 % of a block at B = 32 before).
+    atomic reference counts (≈ 6 % of a block at B = 32 before).  Not in the variant on several
+    threads (:data:`BORROWED_VIEWS` is False there).
     """
     # (views that own no reference: the ~100 arrays of each step's call, not counted per call, numba_driver.borrowed)
-    (ks, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, want, rec_sums, base, cap, pc,
-     rebuilt, d_eq_c, Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, A, Tj, free, pred, half, half_out, pos, vel,
-     frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p, xi, active,
-     birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, work, mob, yc, y0,
-     zero, tau, verdict, need, tp, ts, tsum, kt, ktot) = borrowed(
-        (ks, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, want, rec_sums, base, cap,
-         pc, rebuilt, d_eq_c, Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, A, Tj, free, pred, half, half_out,
-         pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p,
-         xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum,
-         work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, kt, ktot))
+    if BORROWED_VIEWS:
+        (ks, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, want, rec_sums, base, cap, pc,
+         rebuilt, d_eq_c, Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, A, Tj, free, pred, half, half_out, pos, vel,
+         frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p, xi, active,
+         birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, work, mob, yc, y0,
+         zero, tau, verdict, need, tp, ts, tsum, kt, ktot) = borrowed(
+            (ks, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, want, rec_sums, base, cap,
+             pc, rebuilt, d_eq_c, Sf, Si, Sb, s_state, s_xi, s_active, s_birth, s_deq, A, Tj, free, pred, half, half_out,
+             pos, vel, frc, phi, mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, Cf, Ci, Cb, offsets, ends, state_p,
+             xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum,
+             work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, kt, ktot))
     B = rate.shape[0]
     for b in prange(B):
         k, start, st = ks[b], starts[b], _DONE
