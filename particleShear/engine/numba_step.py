@@ -1734,16 +1734,16 @@ def compile_table_kernel(cache=True):
     -------
     numba.core.registry.CPUDispatcher
     """
-    if cache and "table" in _kernels:
-        return _kernels["table"]
-    table = numba_driver.jit_laws(cache, ((state, "synced_history"),
-                                          (sys.modules[__name__], "_table_columns")))["_table_columns"]
-    one = np.int64(1)
-    table(np.zeros((3, 1), np.intp), np.zeros(1, np.int8), np.zeros((2, 1)), np.zeros(1, np.bool_),
-          np.zeros(1, np.int64), np.zeros(1), np.int64(0), one, np.int64(0))       # (the compile, or the load)
-    if cache:
-        _kernels["table"] = table
-    return table
+    return compile_kernel("table", "_table_columns", ((state, "synced_history"), (sys.modules[__name__], "_table_columns")),
+                          _table_signature, cache)
+
+
+def _table_signature():
+    """The Numba argument types of :func:`_table_columns` (as :func:`_settle` passes them)."""
+    from numba import types
+    C = lambda t, d: types.Array(t, d, "C")
+    return (C(types.intp, 2), C(types.int8, 1), C(types.float64, 2), C(types.boolean, 1), C(types.int64, 1),
+            C(types.float64, 1), types.int64, types.int64, types.int64)
 
 
 def _columns(src, lo, hi, dst, at):
