@@ -206,13 +206,18 @@ class Contacts:
         if C is None:
             return
         which = list(range(state.B)) if replicas is None else list(replicas)
-        if written:
-            counters = to_host(self.next_birth, "pair history")
-            for b in which:
-                p = state.pairs[b]
-                p.resume_births(counters[b])
-                p.version += 1
-            return
+        if not written:
+            self._write_history(state, which)
+        counters = to_host(self.next_birth, "pair history")
+        for b in which:      # (each table's creation counter and version, written or not here)
+            p = state.pairs[b]
+            p.resume_births(counters[b])
+            p.version += 1
+
+    def _write_history(self, state, which):
+        """Write the history of the candidates of the replicas ``which`` into their pair tables
+        (:meth:`sync_down`, the table's fields as :func:`~particleShear.engine.state.synced_history` gives them)."""
+        C, be = self.C, state.backend
         spans = [(C.offsets[b], C.offsets[b + 1]) for b in which]
         state_p, xi, active, birth = self.history
         if not be.host and which:
@@ -221,7 +226,6 @@ class Contacts:
                                           for a in (state_p[sel], xi[:, sel], active[sel], birth[sel]))
             ends = np.cumsum([hi - lo for lo, hi in spans])
             spans = list(zip(ends - [hi - lo for lo, hi in spans], ends))
-        counters = to_host(self.next_birth, "pair history")
         for b, (lo, hi) in zip(which, spans):
             p = state.pairs[b]
             a = active[lo:hi].copy()
@@ -229,5 +233,3 @@ class Contacts:
             kept, p.xi, p.birth = synced_history(state_p[lo:hi], xi[:, lo:hi], a, birth[lo:hi])
             p.state = kept.astype(np.int8)
             p.active = a
-            p.resume_births(counters[b])
-            p.version += 1
