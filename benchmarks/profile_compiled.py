@@ -179,7 +179,7 @@ def step_parts(eng, repeats, scale):
     """Part 3: one compiled step of the batch, its force phase alone, without and with samples."""
     ws = numba_step._prepared(eng)
     kernel, B = numba_step.kernels_of(ws)[0], eng.s.B
-    pred = np.full(B, eng.half is not None)
+    pred = np.full(B, eng.s.predictor.half is not None)
     K = max(3, int(300_000 / (eng.s.N * B)))
     got = {}
     for name, sample, forces_only, b1 in (("empty call", False, False, 0), ("force phase", False, True, B),

@@ -173,6 +173,7 @@ ENGINE_MODULES = [
     "particleShear.engine.box",
     "particleShear.engine.config",
     "particleShear.engine.contacts",
+    "particleShear.engine.predictor",
     "particleShear.engine.forces",
     "particleShear.engine.graph",
     "particleShear.engine.guard",

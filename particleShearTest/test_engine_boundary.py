@@ -58,7 +58,7 @@ class TestEngineBoundary(unittest.TestCase):
     def test_the_scan_sees_the_classes_private_members(self):
         # the scan must see what the adapter uses, else the next test could not fail
         self.assertLessEqual({"_a", "_pairs", "_rng", "_block", "_st", "_invalidate_neighbours", "_links_changed",
-                              "_relations_edited", "_half_kick", "_last_dt"}, self.documented)
+                              "_relations_edited", "_predictor", "_last_dt"}, self.documented)
 
     def test_engine_reads_no_private_member_of_the_documented_classes(self):
         found = []

@@ -587,7 +587,7 @@ class TestCompiledStepBits(unittest.TestCase):
             eng.steps(6, 0.999, e.dt)
             engines.append(eng)
         self.assert_same_engines(*engines)
-        np.testing.assert_array_equal(_bits(engines[0].half), _bits(engines[1].half))
+        np.testing.assert_array_equal(_bits(engines[0].s.predictor.half), _bits(engines[1].s.predictor.half))
 
     def test_zero_R_draws_from_the_replica_generator(self):
         """``R = v_i dt − D = 0`` exactly (sphere i moves onto j's place in one step): the ξ rule's

@@ -55,7 +55,7 @@ class CanvasPointsBasicElasticity(CanvasPointsShear):
         if integrator not in self.INTEGRATORS:
             raise ValueError(f"integrator must be one of {self.INTEGRATORS}, got {integrator!r}")
         self.integrator = integrator
-        self._half_kick = None
+        self._predictor.drop()
 
     def set_central_repulsion_coefficient(self, central_repulsion_coefficient=0):
         """Set the law's repulsion coefficient c (0 linear, eq. S1-5a; 1 divergent, eq. S1-5b) on every sphere.

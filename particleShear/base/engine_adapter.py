@@ -8,7 +8,7 @@ of plain arrays and knows nothing of the documented classes.  This module is the
 * :func:`state_of_ensembles` (:func:`state_of_ensemble` for one) makes a batch state whose
   per-sphere arrays are the ensembles' own state rows and whose pair lists are their pair tables,
   so that what the engine's steps write the ensembles hold;
-* :func:`write_back` hands an ensemble its clock, strain, plates, μ, relations and half kick after
+* :func:`write_back` hands an ensemble its clock, strain, plates, μ, relations and Verlet predictor after
   such an engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as
   it was when a run on its own state fails;
 * :func:`relax_ensembles` is ``free_pre_equilibration`` of a list of ensembles in one engine
@@ -28,9 +28,10 @@ import numpy as np
 from ..checks import integer
 from ..engine.loops import relaxation_levels
 from ..engine.relax import RELAX_SKIN, free_relaxation
+from ..engine.predictor import Predictor
 from ..engine.state import PER_REPLICA_PARAMETERS, PER_SPHERE_PARAMETERS, PERMANENT, BatchState
 from ..engine.step import BatchEngine
-from ..engine.xp import get_backend, to_host
+from ..engine.xp import get_backend
 from .callbacks import callback_phase_laws
 from .fields import ROW
 
@@ -192,7 +193,9 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     then holds its columns as a view (an ensemble that later gains a sphere copies its block
     out again).
     Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
-    block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the box, strain,
+    block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the Verlet predictor
+    (:mod:`particleShear.engine.predictor`) is a single ensemble's own, the predictors of several
+    joined (:meth:`~particleShear.engine.predictor.Predictor.joined`); the box, strain,
     rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
     by :func:`state_from_ensembles`, the plates (``applying_shear``) from the first ensemble's
     ``applyingShear``.  An engine on this state numbers the relations as they form, and
@@ -240,6 +243,9 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     s.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
                *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
     s.pairs = [e._pairs for e in ensembles]
+    # the Verlet predictor: a batch of one holds the ensemble's own (successive engines continue it)
+    s.predictor = ensembles[0]._predictor if s.B == 1 else Predictor.joined(
+        [e._predictor for e in ensembles], [N] * s.B, np)
     s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
     s.ensembles = ensembles
     s.backend = target         # (the same host arrays)
@@ -278,8 +284,9 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     The spheres and the pair table are the ensemble's own already
     (:func:`state_of_ensembles`): what is handed back is the
     clock, the strain, the plates, μ, the relations of the last step (written into the table,
-    with the creation numbers the engine gave them as they formed: the order of ``neighbors``), a
-    Verlet engine's half kick, and the bookkeeping: the ensemble's neighbour list and caches are
+    with the creation numbers the engine gave them as they formed: the order of ``neighbors``), the
+    Verlet predictor (its rows of a batch of several; a batch of one holds the ensemble's own), and
+    the bookkeeping: the ensemble's neighbour list and caches are
     invalidated, its ``step_count`` and ``n_constitution_steps`` advance by ``steps``.
 
     Parameters
@@ -295,7 +302,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     constitution : bool, default True
         The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
         ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
-        the shear rate of its last step; a Verlet engine's half kick becomes the ensemble's).
+        the shear rate of its last step).
     dt : float, optional
         The time step of the last step (default: the ensemble's ``dt``).
 
@@ -325,9 +332,8 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
 
     ensemble.invalidate_caches()
     ensemble._last_dt = float(ensemble.dt if dt is None else dt)
-    if engine.half is not None and hasattr(ensemble, "_half_kick"):
-        h = to_host(engine.half[:, rows], "state")
-        ensemble._half_kick = (h[0].copy(), h[1].copy(), h[2].copy())
+    if s.predictor is not ensemble._predictor:      # (a batch of several: its rows)
+        ensemble._predictor.half = s.predictor.rows_of(rows)
     ensemble.step_count += int(steps)
     if constitution and hasattr(ensemble, "n_constitution_steps"):
         ensemble.n_constitution_steps += int(steps)
@@ -349,11 +355,13 @@ def untouched_on_failure(ensemble):
     """
     n = len(ensemble.sphereList)
     block, pairs = ensemble._block[:, :n].copy(), ensemble._pairs.copy()
+    half = ensemble._predictor.half         # (replaced by the steps, never written into)
     try:
         yield
     except BaseException:
         ensemble._block[:, :n] = block
         ensemble._pairs.assign(pairs)
+        ensemble._predictor.half = half
         ensemble.invalidate_caches()
         raise
 
@@ -455,10 +463,12 @@ def relax_state(state, N, dt, dt_max, skin_factor=RELAX_SKIN, integrator="euler"
     Returns
     -------
     engine : BatchEngine
-        The engine after the relaxation (its Verlet half kick, for a write-back).
+        The engine after the relaxation (for a write-back; the state's Verlet predictor is started
+        afresh, :meth:`~particleShear.engine.predictor.Predictor.drop`).
     steps : int
         Steps run per replica.
     """
+    state.predictor.drop()       # (a relaxation starts the Verlet predictor afresh: none carried into a constitution)
     engine = BatchEngine(state, skin_factor=skin_factor, integrator=integrator, check_interval=check_interval,
                          guard=guard, min_distance_ratio=min_distance_ratio, max_kinetic_energy=max_kinetic_energy,
                          phase="constitution", numbers_relations=True)

@@ -31,7 +31,6 @@ class EngineStep:
     """
 
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
-    _engine_half = None     # the Verlet half kick while no engine is kept
     #: the record of the last force phase of the kept engine (ForceRecord), for the acceleration and
     #: movement phases of its step; None before one, after the step's movement and with the engine dropped
     _force_record = None
@@ -60,42 +59,22 @@ class EngineStep:
         return self._memo.get("engine", self._engine_view_key(), self._new_engine)
 
     def _new_engine(self):
-        """A new engine on the ensemble's state (the half kick of the one it replaces carried over)."""
-        half = self._half_kick
+        """A new engine on the ensemble's state (which holds the ensemble's Verlet predictor: the
+        new engine continues the one it replaces, :mod:`particleShear.engine.predictor`)."""
         self._drop_engine()
-        integrator = getattr(self, "integrator", "euler")
-        carried = (np.array([h if h is not None else np.zeros(self._n) for h in half])
-                   if integrator == "verlet" and half is not None and len(half[0]) == self._n else None)
         eng = BatchEngine(state_of_ensemble(self, backend="auto"), skin_factor=self.neighbour_skin, guard=False,
-                          integrator=integrator, keep_terms=True, half=carried,   # keep_terms: the force register
+                          integrator=getattr(self, "integrator", "euler"), keep_terms=True,   # (the force register)
                           lees_edwards=self._lees_edwards(),
                           strain_only_while_shearing=self._strain_only_while_shearing)
         self._engine_pairs = (self._pairs, self._pairs.version)
         return eng
 
     def _drop_engine(self):
-        """Forget the engine (the one invalidation point; its Verlet half kick is kept)."""
+        """Forget the engine (the one invalidation point; the Verlet predictor is the ensemble's own, kept)."""
         eng = self._memo.drop("engine")
         self._force_record = None       # (the record is the dropped engine's)
         if eng is not None:
-            self._engine_half = None if eng.half is None else tuple(np.array(h) for h in eng.half)
             self._engine_pairs = None
-
-    @property
-    def _half_kick(self):
-        """Velocity Verlet: the half kick ``F·dt/(2m)`` of the last step, rows (vx, vy, ω), or None."""
-        eng = self._engine
-        if eng is not None:
-            return None if eng.half is None else tuple(eng.half)
-        return self._engine_half
-
-    @_half_kick.setter
-    def _half_kick(self, value):
-        self._engine_half = value
-        eng = self._engine
-        if eng is not None:
-            eng.half = None if value is None else np.array([h if h is not None else np.zeros(self._n)
-                                                            for h in value])
 
     def _hand_to_engine(self, eng):
         """What a step reads of the ensemble, into the engine's state (before a force phase)."""

@@ -3,6 +3,7 @@ __docformat__ = "numpy"
 import numpy as np
 from ..engine import box as _box
 from ..engine.integrate import kick, mobile_mask, plates_follow
+from ..engine.predictor import Predictor
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
 
@@ -28,6 +29,7 @@ class CanvasPointsNeighbors(EngineStep, CanvasPointsMass):
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsMass.__init__(self, size_x, size_y, theCanvas, doDrawing, m)
         self._pairs = PairTable()
+        self._predictor = Predictor()     # the Verlet predictor its engines continue (state_of_ensembles)
         self._g = None
         self._relation_view_class = _BaseRelationView
 

@@ -9,8 +9,9 @@ replica's numbers do not depend on the other replicas of its batch.
 
 Modules, bottom-up: :mod:`.box` (Lees-Edwards geometry), :mod:`.laws` (central laws),
 :mod:`.tangential` (the two-visit tangential rule, shared with the canvas classes),
-:mod:`.state` (the batch state), :mod:`.neighbours` (Verlet candidates per replica from a cell
-list; also the classes' neighbour search), :mod:`.relax` (the constitution's free relaxation of a
+:mod:`.state` (the batch state; its contacts, :mod:`.contacts`, and its Verlet predictor,
+:mod:`.predictor`), :mod:`.neighbours` (Verlet candidates per replica from a cell list; also the
+classes' neighbour search), :mod:`.relax` (the constitution's free relaxation of a
 batch),
 :mod:`.terms` (the force terms of a pair, each written once: kinematics, term constants, elastic,
 viscous and tangential terms, force vectors and torque split; shared with the canvas classes),

@@ -1159,7 +1159,7 @@ def launch(engine, cool, dt, sample, forces_only=False):
         return None
     kernel, B = kernels_of(ws)[0], engine.s.B
     check = ws.guarded and not engine.step_count % engine.check_interval
-    args, held = step_arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.half is not None),
+    args, held = step_arguments(engine, ws, cool, dt, sample, check, np.full(B, engine.s.predictor.half is not None),
                             forces_only=forces_only)
     status = kernel(0, 0, B, *args)
     if status == _D_ZERO:
@@ -1271,9 +1271,9 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
     pred : ndarray of bool (B,)
         Which replicas' force phase sees the Verlet half kick.
     half_out : ndarray (3, B·N), optional
-        A block's buffer of the new half kicks, copied into ``half`` replica by replica (``half``
-        is then the one handed back); default a new array per step, handed back itself (as
-        ``half_kick`` gives).
+        A block's buffer of the new half kicks, copied into ``half`` (a copy of the state's
+        predictor) replica by replica (``half`` is then the one handed back); default a new array
+        per step, handed back itself (as ``half_kick`` gives).
     tensors : bool, default False
         A block samples every tensor at some of its steps.
     forces_only : bool, default False
@@ -1301,7 +1301,8 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
     free = c.free_p
     free_mode, free = (0, at.zero) if free is None else (1, at.zero) if free is True else (2, _array(free))
     verlet = engine.integrator == "verlet"
-    half = np.array(engine.half, dtype=float) if engine.half is not None else np.empty((3, s.B * s.N)) if verlet \
+    carried = s.predictor.half
+    half = np.array(carried, dtype=float) if carried is not None else np.empty((3, s.B * s.N)) if verlet \
         else ws.no_half
     new_half = ws.no_half if not verlet else np.empty((3, s.B * s.N)) if half_out is None else half_out
     ws.need[:] = c.need             # (a replica a block skips keeps its flag)
@@ -1324,7 +1325,8 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
 def hand_back(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
     copies): after the force phase the relations and their history (``state.contacts``), the rate
-    and the guard's record; after a whole step also the lists' bookkeeping and the clock.
+    and the guard's record; after a whole step also the lists' bookkeeping, the clock and the
+    Verlet predictor (``state.predictor``).
 
     Parameters
     ----------
@@ -1338,7 +1340,7 @@ def hand_back(engine, ws, held, stepped=False, kicked=True):
         The kernel ran the movement too: also the displacement, strain since the build, bound,
         the lists due, the strain and the clock.
     kicked : bool, default True
-        With ``stepped``: a step of this call reached its kick, so the Verlet half kick too.
+        With ``stepped``: a step of this call reached its kick, so the Verlet predictor too.
     """
     s = engine.s
     c = s.contacts
@@ -1349,7 +1351,7 @@ def hand_back(engine, ws, held, stepped=False, kicked=True):
     if stepped:
         c.u, c.u_max, c.strain, c.bound = held["u"], held["u_max"], held["strain"], held["bound"]
         if held["half"] is not None and kicked:
-            engine.half = held["half"]
+            s.predictor.half = held["half"]
         s.gamma, s.t = held["gamma"], held["t"]
         c.need = ws.need.copy()
 
@@ -1481,7 +1483,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         want[:] = tensors
     sums = np.zeros((n, TENSOR_SUMS, B)) if want.any() else _NO_SUMS
     ks, starts, status = np.zeros(B, np.int64), np.zeros(B, np.int64), np.zeros(B, np.int64)
-    pred = np.full(B, engine.half is not None)
+    pred = np.full(B, engine.s.predictor.half is not None)
     # (one buffer of new half kicks for the block: a step resumed in the next call kicked into it)
     half_out = np.empty((3, B * engine.s.N)) if engine.integrator == "verlet" else None
     failed, verdicts = np.full(B, -1, np.int64), np.zeros((4, B))

@@ -15,6 +15,7 @@ __docformat__ = "numpy"
 
 import numpy as np
 
+from .predictor import Predictor
 from .xp import get_backend, select, to_host
 
 __all__ = ["STICK", "SLIP", "PERMANENT", "synced_history", "PairTable", "ReplicaPairs", "BatchState", "PER_SPHERE_PARAMETERS",
@@ -533,6 +534,11 @@ class BatchState:
         bookkeeping of their lists (:class:`~particleShear.engine.contacts.Contacts`), on the
         state's backend: started anew by each engine built on the state; None before (and in a
         state made by :meth:`concat`, :meth:`to_backend` or unpickling, whose tables carry the history).
+    predictor : Predictor
+        The velocity Verlet predictor, the half kick of the last step
+        (:class:`~particleShear.engine.predictor.Predictor`; its ``half`` None before a Verlet
+        step): continued by an engine built on the state, kept by :meth:`to_backend` and
+        pickling, joined by :meth:`concat` (the rules: :mod:`particleShear.engine.predictor`).
     rng : list of numpy.random.Generator
         Each replica's own generator (random normals at ``d = 0``).
     applying_shear : bool
@@ -621,12 +627,14 @@ class BatchState:
         self.law_params = xp.zeros((0, self.B))
         self.callback_laws = None
         self.visit = None
+        self.predictor = Predictor()
 
     def __getstate__(self):
         """Pickle and copy by backend name (a module is not picklable); the row views are rebound on load.
 
         The contacts are left out (the copy has None): its pair tables carry the history as the
-        last write-back left it (an engine's ``flush``), and an engine built on the copy starts anew."""
+        last write-back left it (an engine's ``flush``), and an engine built on the copy starts anew.
+        The predictor is kept (an engine built on the copy continues it)."""
         state = dict(self.__dict__)
         state["backend"] = self.backend.name
         del state["xp"]
@@ -680,7 +688,7 @@ class BatchState:
         """This state with its arrays copied to ``backend`` (the same object if it is there already).
 
         Pair lists and generators are shared (they stay on the host); the copy has no contacts
-        (None: an engine built on it starts them from the tables).
+        (None: an engine built on it starts them from the tables) and a copy of the predictor.
 
         Parameters
         ----------
@@ -699,6 +707,7 @@ class BatchState:
         out.backend, out.xp = target, target.xp
         out.ensembles = None        # copies, no longer the ensembles' rows
         out.contacts = None         # (the flat list lives on the source's backend; the tables are shared)
+        out.predictor = self.predictor.on(target)
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
             out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
         if self.visit is not None:
@@ -715,7 +724,8 @@ class BatchState:
         states : sequence of BatchState
             States with the same N; their arrays and pair lists are copied, their generators
             shared; the result has no contacts (None), so the states' engines must have written
-            their history into the tables first (``flush``).
+            their history into the tables first (``flush``); their predictors are joined
+            (:meth:`~particleShear.engine.predictor.Predictor.joined`).
 
         Returns
         -------
@@ -751,6 +761,7 @@ class BatchState:
         out.law_params = xp.concatenate([st.law_params for st in states], axis=1)
         if any(st.visit is not None for st in states):
             out.visit = xp.concatenate([st.visit_rows() for st in states], axis=1)
+        out.predictor = Predictor.joined([st.predictor for st in states], [st.B * st.N for st in states], xp)
         return out
 
     def per_replica_parameters(self, rep=None):

@@ -123,9 +123,11 @@ class BatchEngine:
     contacts ``state.contacts`` (:class:`~particleShear.engine.contacts.Contacts`: the candidates
     with their constants and relation history, the bookkeeping of the Verlet lists), which the
     engine starts anew at its construction (every list built at the first step from
-    ``state.pairs``).  The engine keeps of the run only the Verlet predictor :attr:`half`, the
-    guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s), the step count
-    ``step_count``, the ``phase``, the protocol's ``record`` and the register's ``terms``.
+    ``state.pairs``), and the Verlet predictor ``state.predictor``
+    (:class:`~particleShear.engine.predictor.Predictor`), which the engine continues (an Euler
+    engine drops it; :meth:`~particleShear.engine.predictor.Predictor.start`).  The engine keeps of
+    the run only the guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s),
+    the step count ``step_count``, the ``phase``, the protocol's ``record`` and the register's ``terms``.
 
     Parameters
     ----------
@@ -156,8 +158,9 @@ class BatchEngine:
         The guard's bound of the kinetic energy relative to the flow (mg·µm²/s² per m depth);
         None: the bound above.
     half : ndarray (3, B·N) or None, keyword-only
-        Verlet: the half kick F·dt/(2m) of (vx, vy, ω) of the step before (a predictor carried on
-        from an earlier engine); None: no step yet.
+        Verlet: the half kick F·dt/(2m) of (vx, vy, ω) of the step before, set as the state's
+        predictor (``state.predictor.half``); None: the predictor the state carries, continued
+        (dropped where :meth:`~particleShear.engine.predictor.Predictor.start` says).
     phase : str, keyword-only
         The phase its steps belong to, for messages (the loops set it as they run).
     numbers_relations : bool or None, keyword-only
@@ -199,7 +202,6 @@ class BatchEngine:
         if config.numbers_relations is None:     # (on from the start for a state that is an ensemble's own)
             config = config.replace(numbers_relations=s.ensembles is not None)
         self._config = config     # (read-only: the property config)
-        self.half = half          # Verlet: the half kick F·dt/(2m) of the last step (None before the first)
         #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
         #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
         self.terms = None
@@ -219,6 +221,7 @@ class BatchEngine:
                              held=xp.zeros(B) if config.strain_only_while_shearing else None)
         # the candidates, their history and the lists' bookkeeping start anew (every list due at the first step)
         s.contacts = Contacts(s)
+        s.predictor.start(config.integrator, B * N, half)       # (the state's, continued or dropped)
         self.Lx_s = s.Lx[s.rep]
         self.Ly_s = s.Ly[s.rep]
         self.hy_s = self.Ly_s / 2
@@ -580,7 +583,8 @@ class BatchEngine:
         nx, ny = normals(dx, dy, d, C.rep_host, s.rng)
         # relative velocities (image velocity −Ly·γ̇ per period above); Verlet: half a kick ahead
         dvx = -(C.Ly * spread(image_rate, C.rep, s.B)) * ky
-        vel = s.vel if self.half is None else s.vel + self.half
+        half = s.predictor.half
+        vel = s.vel if half is None else s.vel + half
         Vi = vel.take(ai, axis=1)
         Vj = vel.take(aj, axis=1)
         rv = relative_velocity(Vi, Vj, dvx)
@@ -725,8 +729,8 @@ class BatchEngine:
     def accelerate(self, cool, dt, g=None):
         """Kick (plates follow), rotational kick and damping of every replica (eqs. S1-10, S1-11).
 
-        With velocity Verlet the half kick ``F·dt/(2m)`` of the mobile spheres is kept for the
-        next force phase (:func:`~particleShear.engine.integrate.half_kick`).
+        With velocity Verlet the half kick ``F·dt/(2m)`` of the mobile spheres becomes the state's
+        predictor, which the next force phase sees (:func:`~particleShear.engine.integrate.half_kick`).
 
         Parameters
         ----------
@@ -743,7 +747,7 @@ class BatchEngine:
         # the force phase's mobility and heights (a kick without a force phase: those of now)
         mob, yc = (self.mobile(), s.y - self.hy_s) if g is None else (g.mob, g.yc)
         if self.integrator == "verlet":
-            self.half = half_kick(s.frc, self.mmi, dt, mob)
+            s.predictor.half = half_kick(s.frc, self.mmi, dt, mob)
         rate_s = spread(s.rate, s.rep, s.B)
         kick(s.vel, s.frc, self.mmi, dt)                    # (F_x/m, F_y/m, T/I)·dt
         if s.applying_shear:        # (without the plates every sphere is mobile)

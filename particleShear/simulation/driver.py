@@ -715,7 +715,7 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
     backend = (sims[members[0]].parameters or {}).get("backend", "auto")   # one backend per batch
     guard_of = [bool(run.sim.stability_guard) for run in sessions]
     integrator = sims[members[0]].integrator        # part of the schedule key
-    states, halves, order = [], [], []
+    states, order = [], []
     for key in dict.fromkeys(pre):
         group = [b for b, k in zip(members, pre) if k == key]
         t0 = time.perf_counter()
@@ -736,19 +736,13 @@ def pre_equilibrated(sessions, members, pre, dt, cool, where, observers, timings
         engine = BatchEngine(st, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in group],
                              integrator=integrator)
         _guarded(pre_equilibrate, engine, key[1], dt, key[0], cool, say, report, observers(engine, group), dt=dt)
-        halves.append(engine.half)
         for b in group:
             timings[b]["pre_equilibration"] = (time.perf_counter() - t0) / len(group)
         states.append(st)
         order += group
-    state = BatchState.concat(states)
-    half = None
-    if integrator == "verlet":
-        # the predictor carries on from the pre-equilibration, as in one ensemble (no step yet: none)
-        half = state.xp.concatenate([state.xp.zeros((3, st.B * st.N)) if h is None else h
-                                     for h, st in zip(halves, states)], axis=1)
-    engine = BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in order],
-                         integrator=integrator, half=half)
+    # (the joined state carries the groups' Verlet predictors on, as in one ensemble: BatchState.concat)
+    engine = BatchEngine(BatchState.concat(states), skin_factor=ENGINE_SKIN_FACTOR, guard=[guard_of[b] for b in order],
+                         integrator=integrator)
     return engine, order
 
 

@@ -520,9 +520,10 @@ class OscillatoryShearExperiment:
         Parameters
         ----------
         carry_predictor : bool, default True
-            With velocity Verlet, carry on the ensemble's half kick (the protocol after a
-            pre-equilibration); False starts the predictor afresh, as every measurement does at its
-            pre-equilibration (the half kick of a constitution predates its crosslinking).
+            With velocity Verlet, continue the ensemble's predictor, which its state holds (the
+            protocol after a pre-equilibration; :mod:`particleShear.engine.predictor`); False drops
+            it first, as every measurement does at its pre-equilibration (the half kick of a
+            constitution predates its crosslinking).
 
         Returns
         -------
@@ -530,19 +531,16 @@ class OscillatoryShearExperiment:
         """
         ens = self.theEnsemble
         guard = getattr(ens, "stability_guard", None)
-        integrator = getattr(ens, "integrator", "euler")
-        half = getattr(ens, "_half_kick", None) if carry_predictor else None
-        carried = None
-        if integrator == "verlet" and half is not None and len(half[0]) == len(ens.sphereList):
-            # the predictor carries on from the ensemble's last step (no spin half kick: none)
-            carried = np.array([h if h is not None else np.zeros(len(half[0])) for h in half])
+        state = state_of_ensemble(ens, backend="auto")      # (holds the ensemble's Verlet predictor)
+        if not carry_predictor:
+            state.predictor.drop()
         thresholds = ({} if guard is None else     # the thresholds of the ensemble's guard
                       dict(min_distance_ratio=guard.min_distance_ratio, max_kinetic_energy=guard.max_kinetic_energy))
         # keep_terms: the last step's terms, for the ensemble's force register; "auto": compiled where
         # Numba is installed (the same numbers, terms included)
-        return BatchEngine(state_of_ensemble(ens, backend="auto"), skin_factor=ENGINE_SKIN_FACTOR,
-                           guard=guard is not None, check_interval=getattr(guard, "interval", 4), integrator=integrator, keep_terms=True,
-                           half=carried, **thresholds)
+        return BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
+                           check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"),
+                           keep_terms=True, **thresholds)
 
     def _scene(self, engine):
         scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
