@@ -7,11 +7,14 @@
   engine dropped halfway (``invalidate_caches``) gives the bits of its step without the drop.
 * Where it is dropped: an Euler engine, rows that are not the state's (an ensemble that gained
   spheres), a relaxation (``relax_state``); ``half=`` sets it.
+* A measurement that fails after dropping it (at its pre-equilibration) leaves the ensemble's
+  predictor as it was (``untouched_on_failure``).
 * Copies keep it (``to_backend``, pickling); ``concat`` joins the replicas' rows, zeros where a
   state had none, none when no state had one.
 """
 import pickle
 import unittest
+from unittest import mock
 
 import numpy as np
 
@@ -75,6 +78,20 @@ class TestPredictor(unittest.TestCase):
             runs.append(e._st[:, :len(e.sphereList)].copy())
         np.testing.assert_array_equal(_bits(runs[1]), _bits(runs[0]))
         self.assertFalse(np.array_equal(_bits(runs[2]), _bits(runs[0])))
+
+    def test_a_failed_measurement_keeps_the_ensemble_s_predictor(self):
+        # a measurement drops the predictor at its pre-equilibration; a run that fails there leaves the
+        # ensemble as it was (untouched_on_failure), its predictor included
+        sim, e, sc = constituted(22, **FRICTION)
+        exp = sim.createExperiment(False, 1, False)
+        e.set_integrator("verlet")
+        for _ in range(5):
+            e.mechanical_simulation_step(sc["cool"], sc["dt"])
+        half = _bits(e._predictor.half)
+        with mock.patch.object(type(exp), "_pre_equilibrate_in", side_effect=RuntimeError("injected")):
+            with self.assertRaisesRegex(RuntimeError, "injected"):
+                exp.pre_equilibrate(5, sc["cool"])
+        np.testing.assert_array_equal(_bits(e._predictor.half), half)
 
     def test_where_it_is_dropped_or_set(self):
         s = stepped("numpy", 0)

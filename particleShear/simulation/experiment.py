@@ -248,9 +248,9 @@ class OscillatoryShearExperiment:
         SimulationInstabilityError
             If the ensemble's stability guard finds the run unstable.
         """
-        engine = self.engine_of_ensemble(carry_predictor=False)
-        observers = self.observers(self._scene(engine), None, protocol=False)
-        with untouched_on_failure(self.theEnsemble):
+        with untouched_on_failure(self.theEnsemble):     # (also the predictor the engine drops)
+            engine = self.engine_of_ensemble(carry_predictor=False)
+            observers = self.observers(self._scene(engine), None, protocol=False)
             steps = self._pre_equilibrate_in(engine, N, cool_factor, observers)
         self._write_back(engine, steps)
 
@@ -499,11 +499,11 @@ class OscillatoryShearExperiment:
         timings : dict
             Wall times of "pre_equilibration" and "protocol" (s).
         """
-        engine = self.engine_of_ensemble(carry_predictor=False)
-        scene = self._scene(engine)
-        observers = self.observers(scene, scene.samples)
         self.timings["pre_equilibration"] = 0.0
-        with untouched_on_failure(self.theEnsemble):
+        with untouched_on_failure(self.theEnsemble):     # (also the predictor the engine drops)
+            engine = self.engine_of_ensemble(carry_predictor=False)
+            scene = self._scene(engine)
+            observers = self.observers(scene, scene.samples)
             if self.do_preequilibration_with_fixed_boundaries:
                 self._pre_equilibrate_in(engine, N_pre, cool_factor, observers)
             record = self._protocol_in(engine, cool_factor, observers)
