@@ -308,9 +308,10 @@ class TestMuReachesTheKernel(unittest.TestCase):
         simulation = ["Simulation_interlocking_rheology.__init__", "Simulation_dermal_filler_rheology.__init__",
                       "OscillatorySimulationFragmentation.__init__"]
         # the call, then (in RunParameters, not an argument) the recipe (dataclass __init__) and the ensemble's
-        # μ (the NonNegative descriptor of the canvas), read into BatchState.mu by state_from_ensembles
+        # μ (the ReplicaValue descriptor of the canvas: its replica cell), read into BatchState.mu by
+        # state_from_ensembles
         self.assertEqual(sorted(passed), sorted(["doParticleShearSimulation", *simulation, "__init__",
-                                                 "NonNegative.__set__"]))
+                                                 "ReplicaValue.__set__"]))
 
 
 if __name__ == "__main__":

@@ -6,8 +6,8 @@ changes, friction and spin (:mod:`.elastic_canvas`).  This module gathers them (
 imports the module of its base class, never this one).
 """
 __docformat__ = "numpy"
-from .canvas_base import (MAX_CELLS_OUTSIDE, CanvasPoints, CanvasPointsMass, NonNegative, SphereList,  # noqa: F401
-                          check_non_negative, check_time_step)
+from .canvas_base import (MAX_CELLS_OUTSIDE, CanvasPoints, CanvasPointsMass, NonNegative, ReplicaValue,  # noqa: F401
+                          SphereList, check_non_negative, check_time_step)
 from .pair_canvas import CanvasPointsNeighbors, CanvasPointsShear
 from .elastic_canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
                              CanvasPointsFrictionElasticityLeesEdwards)

@@ -11,7 +11,7 @@ from operator import attrgetter
 
 import numpy as np
 
-from .fields import FIELDS, ROW
+from .fields import FIELDS, REPLICA_FIELDS, REPLICA_ROW, ROW
 from .graphics import Graphical_output_configuration
 from ..engine.box import flow_velocity, inside_cell, wrap
 from ..engine.forces import pair_roles
@@ -24,7 +24,7 @@ from .stability import StabilityGuard
 from .neighbours import STATE_CODES
 
 
-__all__ = ["CanvasPoints", "CanvasPointsMass", "SphereList", "check_non_negative", "check_time_step"]
+__all__ = ["CanvasPoints", "CanvasPointsMass", "ReplicaValue", "SphereList", "check_non_negative", "check_time_step"]
 
 #: a sphere farther than this many cell lengths outside the cell has diverged (or was misplaced)
 MAX_CELLS_OUTSIDE = 1000
@@ -45,7 +45,8 @@ def check_time_step(dt, step=None):
 
 
 class NonNegative:
-    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t, mu); only assignment is checked."""
+    """Ensemble constant that must stay a finite number ≥ 0 (k, nu, k_t, nu_t; μ is a :class:`ReplicaValue`
+    with the same check); only assignment is checked."""
 
     def __set_name__(self, owner, name):
         self.name = name
@@ -53,6 +54,38 @@ class NonNegative:
     def __set__(self, obj, value):
         check_non_negative(self.name, value)
         obj.__dict__[self.name] = value
+
+
+class ReplicaValue:
+    """Ensemble value held in its cell of the ensemble's replica cells (``t``, ``shear``, ``shear_rate``,
+    ``mu``: :data:`~particleShear.base.fields.REPLICA_FIELDS`): a float in, a float out.
+
+    The cells are the engine's memory (:func:`~particleShear.base.engine_adapter.state_of_ensembles`
+    makes them element b of the batch's ``t``, ``gamma``, ``rate`` and ``mu``), so what a step
+    advances the ensemble reads, and what is set here the engine's next step reads.
+
+    Parameters
+    ----------
+    check : callable, optional
+        ``check(name, value)`` raising ValueError for a value out of range (μ: ≥ 0), called on
+        assignment before the cell is written.
+    """
+
+    def __init__(self, check=None):
+        self.check = check
+
+    def __set_name__(self, owner, name):
+        self.name, self.row = name, REPLICA_ROW[name]
+
+    def __get__(self, obj, objtype=None):
+        if obj is None:
+            return self
+        return obj._replica.item(self.row)
+
+    def __set__(self, obj, value):
+        if self.check is not None:
+            self.check(self.name, value)
+        obj._replica[self.row] = value
 
 
 class SphereList(list):
@@ -135,6 +168,7 @@ class CanvasPoints:
         self.doDrawing = doDrawing
         self._n = 0
         self._set_capacity(0)
+        self._replica = np.zeros(len(REPLICA_FIELDS))   # the cells of ReplicaValue (0 where a class has none)
         self._sphereList = SphereList(self)
         self._m_given = []   # masses as given to the spheres (an int stays int) for the evaluation handler
         self._rng = np.random.default_rng()
@@ -229,6 +263,30 @@ class CanvasPoints:
         self._block, self._cap = block, self._n
         self._views()
         self._invalidate_neighbours()
+
+    def adopt_replica_cells(self, cells):
+        """Hold the replica values (clock, strain, rate, μ) in ``cells`` from now on (column b of a
+        batch's joint cells, as :meth:`adopt_state_block` the sphere block).
+
+        The values are the caller's to have copied there
+        (:func:`~particleShear.base.engine_adapter.state_of_ensembles`); what was kept on the old
+        cells (the step's engine) is dropped.
+
+        Parameters
+        ----------
+        cells : numpy.ndarray (len(REPLICA_FIELDS),) of float
+            One cell per value of :data:`~particleShear.base.fields.REPLICA_FIELDS`, in that order.
+
+        Raises
+        ------
+        ValueError
+            If ``cells`` is not such an array.
+        """
+        if np.shape(cells) != (len(REPLICA_FIELDS),) or np.asarray(cells).dtype != np.float64:
+            raise ValueError(f"cells have shape {np.shape(cells)}: they must be float cells of shape "
+                             f"({len(REPLICA_FIELDS)},) (one per replica value)")
+        self._replica = cells
+        self._block_version += 1      # (the step's engine is made on the cells too)
 
     def _views(self):
         """Per-field views ``_a[name]`` and the grouped rows ``_pos``, ``_vel``, ``_frc``."""
@@ -486,6 +544,9 @@ class CanvasPointsMass(CanvasPoints):
     m : float
         Default sphere mass (mg per m depth); each sphere carries its own.
     """
+
+    #: the clock (s)
+    t = ReplicaValue()
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPoints.__init__(self, size_x, size_y, theCanvas, doDrawing)

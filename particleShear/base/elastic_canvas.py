@@ -8,7 +8,7 @@ from ..engine.integrate import kick, shift_flow
 from ..engine.step import BatchEngine
 from ..checks import finite as _check_finite
 
-from .canvas_base import NonNegative, check_time_step
+from .canvas_base import NonNegative, ReplicaValue, check_non_negative, check_time_step
 from .pair_canvas import CanvasPointsShear
 
 __all__ = ["CanvasPointsBasicElasticity", "CanvasPointsBasicElasticityLeesEdwards", "CanvasPointsFrictionElasticityLeesEdwards"]
@@ -235,7 +235,7 @@ class CanvasPointsFrictionElasticityLeesEdwards(CanvasPointsBasicElasticityLeesE
 
     k_t = NonNegative()
     nu_t = NonNegative()
-    mu = NonNegative()
+    mu = ReplicaValue(check_non_negative)
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, k=1, nu=0.01, m=1, k_t=1,
                  nu_t=0.01, mu=0.1):

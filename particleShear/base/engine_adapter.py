@@ -6,11 +6,12 @@ of plain arrays and knows nothing of the documented classes.  This module is the
 
 * :func:`state_from_ensembles` copies B ensembles into a new batch state (a measurement's batch);
 * :func:`state_of_ensembles` (:func:`state_of_ensemble` for one) makes a batch state whose
-  per-sphere arrays are the ensembles' own state rows and whose pair lists are their pair tables,
-  so that what the engine's steps write the ensembles hold;
-* :func:`write_back` hands an ensemble its clock, strain, plates, μ, relations and Verlet predictor after
-  such an engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as
-  it was when a run on its own state fails;
+  per-sphere arrays are the ensembles' own state rows, whose clock, strain, rate and μ are their
+  replica cells and whose pair lists are their pair tables, so that what the engine's steps write
+  the ensembles hold;
+* :func:`write_back` hands an ensemble its plates, relations and Verlet predictor after such an
+  engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as it was
+  when a run on its own state fails;
 * :func:`relax_ensembles` is ``free_pre_equilibration`` of a list of ensembles in one engine
   (:func:`~particleShear.engine.relax.free_relaxation`), written back.
 
@@ -33,7 +34,7 @@ from ..engine.state import PER_REPLICA_PARAMETERS, PER_SPHERE_PARAMETERS, PERMAN
 from ..engine.step import BatchEngine
 from ..engine.xp import get_backend
 from .callbacks import callback_phase_laws
-from .fields import ROW
+from .fields import REPLICA_FIELDS, ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
            "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws", "host_backend"]
@@ -183,25 +184,28 @@ def state_of_ensemble(ensemble, laws=None, backend="numpy"):
     return state_of_ensembles([ensemble], laws=laws, backend=backend)
 
 def state_of_ensembles(ensembles, laws=None, backend="numpy"):
-    """B ensembles of equal N as one batch whose per-sphere arrays are the ensembles' own rows:
-    what the engine's steps write, the ensembles hold (nothing to copy back).
+    """B ensembles of equal N as one batch whose per-sphere arrays, clocks, strains, rates and μ are
+    the ensembles' own memory: what the engine's steps write, the ensembles hold (nothing to copy back).
 
     The sphere rows of replica b are columns ``b·N … b·N + N − 1`` of one state block laid out as
     the ensembles' (:data:`FIELDS` × spheres); a single ensemble keeps its own block, fitted to
     its spheres (so the engine's rows of positions, velocities and forces are contiguous: ≈ 4 %
     of a documented step at N = 150), several move theirs into the joint block, of which each
     then holds its columns as a view (an ensemble that later gains a sphere copies its block
-    out again).
+    out again).  Likewise the replica cells (:data:`REPLICA_FIELDS`: clock ``t``, strain
+    ``shear``, rate ``shear_rate``, ``mu``): element b of the state's ``t``, ``gamma``, ``rate``
+    and ``mu`` is ``ensembles[b]``'s cell, a single ensemble's own, several ensembles' columns of
+    one joint array (:meth:`~particleShear.base.canvas_base.CanvasPoints.adopt_replica_cells`).
     Positions, φ, velocities, forces, radii, masses and moments of inertia are views of that
     block, and replica b's pair list is ``ensembles[b]``'s pair table itself; the Verlet predictor
     (:mod:`particleShear.engine.predictor`) is a single ensemble's own, the predictors of several
-    joined (:meth:`~particleShear.engine.predictor.Predictor.joined`); the box, strain,
-    rate, clock, constants and per-sphere parameters (which a step only reads) are copied as
-    by :func:`state_from_ensembles`, the plates (``applying_shear``) from the first ensemble's
-    ``applyingShear``.  An engine on this state numbers the relations as they form, and
-    :func:`write_back` afterwards gives each ensemble its clock,
-    strain and relations and drops its caches (and
-    :func:`untouched_on_failure` puts one back after a failed run).
+    joined (:meth:`~particleShear.engine.predictor.Predictor.joined`); the box, constants
+    and per-sphere parameters (which a step only reads) are copied as by
+    :func:`state_from_ensembles`, the plates (``applying_shear``, one flag per batch) from the
+    first ensemble's ``applyingShear``.  An engine on this state numbers the relations as they
+    form, and :func:`write_back` afterwards gives each ensemble its plates, relations and
+    predictor rows and drops its caches (and :func:`untouched_on_failure` puts one back after a
+    failed run).
 
     Parameters
     ----------
@@ -233,15 +237,17 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     N = s.N
     if len(ensembles) == 1:
         ensembles[0]._fit_block()      # no spare columns: the (2|3, N) rows below are contiguous
-        block = ensembles[0]._st
+        block, cells = ensembles[0]._st, ensembles[0]._replica[:, None]
     else:
-        block = np.empty((ensembles[0]._st.shape[0], s.B * N))
+        block, cells = np.empty((ensembles[0]._st.shape[0], s.B * N)), np.empty((len(REPLICA_FIELDS), s.B))
         for b, e in enumerate(ensembles):
-            block[:, b * N:(b + 1) * N] = e._st
+            block[:, b * N:(b + 1) * N], cells[:, b] = e._st, e._replica
             e.adopt_state_block(block[:, b * N:(b + 1) * N])   # (its caches of the old block dropped)
+            e.adopt_replica_cells(cells[:, b])
     x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
     s.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
                *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
+    s.use_replica_rows(**{name: row for name, row in zip(REPLICA_FIELDS.values(), cells)})
     s.pairs = [e._pairs for e in ensembles]
     # the Verlet predictor: a batch of one holds the ensemble's own (successive engines continue it)
     s.predictor = ensembles[0]._predictor if s.B == 1 else Predictor.joined(
@@ -281,13 +287,13 @@ def host_backend(backend):
 def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     """Hand replica ``b`` of a relaxed (or measured) engine on the ensembles' state back to its ensemble.
 
-    The spheres and the pair table are the ensemble's own already
-    (:func:`state_of_ensembles`): what is handed back is the
-    clock, the strain, the plates, μ, the relations of the last step (written into the table,
-    with the creation numbers the engine gave them as they formed: the order of ``neighbors``), the
-    Verlet predictor (its rows of a batch of several; a batch of one holds the ensemble's own), and
-    the bookkeeping: the ensemble's neighbour list and caches are
-    invalidated, its ``step_count`` and ``n_constitution_steps`` advance by ``steps``.
+    The spheres, the clock, strain, rate, μ and the pair table are the ensemble's own already
+    (:func:`state_of_ensembles`): what is handed back is the plates (one flag per batch), the
+    relations of the last step (written into the table, with the creation numbers the engine
+    gave them as they formed: the order of ``neighbors``), the Verlet predictor (its rows of a
+    batch of several; a batch of one holds the ensemble's own), and the bookkeeping: the
+    ensemble's neighbour list and caches are invalidated, its ``step_count`` and
+    ``n_constitution_steps`` advance by ``steps``.
 
     Parameters
     ----------
@@ -301,8 +307,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
         Steps the replica was advanced (bookkeeping of the classes).
     constitution : bool, default True
         The steps were a relaxation of the constitution (plates off afterwards, the ensemble's
-        ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them,
-        the shear rate of its last step).
+        ``n_constitution_steps`` advances); False: a measurement (plates as the engine had them).
     dt : float, optional
         The time step of the last step (default: the ensemble's ``dt``).
 
@@ -320,13 +325,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
         raise ValueError("write_back needs an engine with numbers_relations = True from its first step "
                          "(the creation numbers of the relations order the ensemble's neighbors)")
     rows = s.replica(b)
-    ensemble.t = float(s.t[b])
-    ensemble.shear = float(s.gamma[b])
     ensemble.applyingShear = bool(s.applying_shear) and not constitution
-    if not constitution:
-        ensemble.shear_rate = float(s.rate[b])
-    if hasattr(ensemble, "mu"):        # a frictionless ensemble of particleShear.objects has none
-        ensemble.mu = float(s.mu[b])
 
     engine.flush()
 
@@ -344,9 +343,10 @@ def untouched_on_failure(ensemble):
     """Leave ``ensemble`` as it was when the block raises (an instability, an interrupt).
 
     An engine on the ensemble's own state (:func:`state_of_ensemble`)
-    steps its spheres and pair table in place; a run that fails before its write-back would leave
-    them half-advanced, out of step with the ensemble's clock and caches.  This keeps a copy of
-    both and puts it back (and drops the ensemble's caches) on any exception, which is re-raised.
+    steps its spheres, replica cells (clock, strain, rate, μ), pair table and Verlet predictor in
+    place; a run that fails before its write-back would leave them half-advanced, out of step with
+    the ensemble's caches.  This keeps a copy of the four and puts it back (and drops the
+    ensemble's caches) on any exception, which is re-raised.
 
     Parameters
     ----------
@@ -354,12 +354,13 @@ def untouched_on_failure(ensemble):
         A documented ensemble.
     """
     n = len(ensemble.sphereList)
-    block, pairs = ensemble._block[:, :n].copy(), ensemble._pairs.copy()
+    block, cells, pairs = ensemble._block[:, :n].copy(), ensemble._replica.copy(), ensemble._pairs.copy()
     half = ensemble._predictor.half         # (replaced by the steps, never written into)
     try:
         yield
     except BaseException:
         ensemble._block[:, :n] = block
+        ensemble._replica[:] = cells
         ensemble._pairs.assign(pairs)
         ensemble._predictor.half = half
         ensemble.invalidate_caches()

@@ -2,9 +2,10 @@
 
 A canvas keeps one :class:`~particleShear.engine.step.BatchEngine` on a batch of one
 (:func:`~particleShear.base.engine_adapter.state_of_ensemble`) whose sphere arrays are the ensemble's
-rows and whose pairs are its pair table.  What a step reads (clock, strain, rate, μ, plates) is
-handed to the engine before each force phase; clock, strain and relations come back after each
-movement.  The engine is kept under one key and dropped at :meth:`EngineStep._drop_engine`.
+rows, whose clock, strain, rate and μ are the ensemble's replica cells and whose pairs are its pair
+table.  Before each force phase the engine is told what changed from outside (a strain or μ set on
+the ensemble, an edited pair table) and given the plates' flag; the relations come back after each
+phase.  The engine is kept under one key and dropped at :meth:`EngineStep._drop_engine`.
 
 The documented step's three phases are three calls of the canvas, so the record a force phase
 returns (:class:`~particleShear.engine.step.ForceRecord`) is kept here, on the canvas, until its
@@ -31,6 +32,9 @@ class EngineStep:
     """
 
     _engine_pairs = None    # (table, version) after the last write-back of the engine's relations
+    #: the strain γ and μ as the kept engine last had them (its own strain after a movement): a value
+    #: set on the ensemble from outside differs
+    _engine_strain = _engine_mu = None
     #: the record of the last force phase of the kept engine (ForceRecord), for the acceleration and
     #: movement phases of its step; None before one, after the step's movement and with the engine dropped
     _force_record = None
@@ -67,6 +71,7 @@ class EngineStep:
                           lees_edwards=self._lees_edwards(),
                           strain_only_while_shearing=self._strain_only_while_shearing)
         self._engine_pairs = (self._pairs, self._pairs.version)
+        self._engine_strain, self._engine_mu = eng.s.gamma.item(0), eng.s.mu.item(0)
         return eng
 
     def _drop_engine(self):
@@ -77,18 +82,23 @@ class EngineStep:
             self._engine_pairs = None
 
     def _hand_to_engine(self, eng):
-        """What a step reads of the ensemble, into the engine's state (before a force phase)."""
+        """Bring the engine up to what was changed on the ensemble from outside (before a force phase).
+
+        Clock, strain, rate and μ are the engine's own cells; what follows from a change of them
+        is done here, found against the values the engine last had: a strain set from outside moves
+        the boundary images by ``Ly·Δγ`` (the lists are rebuilt), a μ set from outside renews the
+        candidates' constants (:meth:`~particleShear.engine.step.BatchEngine.set_mu`).  The plates'
+        flag ``applyingShear`` is copied (the state has one for its whole batch), and an edited pair
+        table gives the engine its candidates anew.
+        """
         s = eng.s
-        s.t[0] = getattr(self, "t", 0.0)
-        gamma = getattr(self, "shear", 0.0)
-        if s.gamma[0] != gamma:      # a strain set from outside moves the boundary images by Ly·Δγ
-            s.gamma[0] = gamma
-            s.contacts.need[:] = True
-        s.rate[0] = getattr(self, "shear_rate", 0.0)
         s.applying_shear = bool(getattr(self, "applyingShear", False))
-        mu = float(getattr(self, "mu", 0.0))
-        if s.mu[0] != mu:
+        gamma, mu = s.gamma.item(0), s.mu.item(0)
+        if gamma != self._engine_strain:
+            s.contacts.need[:] = True
+        if mu != self._engine_mu:
             eng.set_mu(mu)
+        self._engine_strain, self._engine_mu = gamma, mu
         pairs = self._pairs
         if self._engine_pairs != (pairs, pairs.version) or s.pairs[0] is not pairs:
             # edited since the engine's last write-back: candidates and constants anew from the table
@@ -129,7 +139,7 @@ class EngineStep:
         eng.accelerate(cool, dt, self._force_record)
 
     def _engine_move(self, dt):
-        """Movement on the engine, then the clock and strain and the relations back into the ensemble."""
+        """Movement on the engine (the ensemble's clock and strain advance in their cells)."""
         eng = self._engine
         if eng is None:
             eng = self._step_engine()
@@ -138,9 +148,7 @@ class EngineStep:
         self._check_positions(self._pos + self._vel[:2] * dt)
         compiled_phases.move(eng, dt, self._force_record)
         self._force_record = None       # (the step's record ends with its movement, as in BatchEngine.step)
-        s = eng.s
-        self.t = float(s.t[0])
-        self.shear = float(s.gamma[0])
+        self._engine_strain = eng.s.gamma.item(0)      # (the engine's own advance)
         self._pos_version += 1
 
     def _engine_move_spheres(self, dt):

@@ -7,7 +7,7 @@ from ..engine.predictor import Predictor
 from .neighbours import PERMANENT, STICK, PairTable
 from .relations import _BaseRelationView
 
-from .canvas_base import CanvasPointsMass
+from .canvas_base import CanvasPointsMass, ReplicaValue
 from .engine_view import EngineStep
 from .point_base import PointLeesEdwards
 
@@ -128,6 +128,9 @@ class CanvasPointsShear(CanvasPointsNeighbors):
     """
 
     use_lees_edwards = True
+    #: the strain γ and its rate γ̇ (1/s)
+    shear = ReplicaValue()
+    shear_rate = ReplicaValue()
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False, m=1):
         CanvasPointsNeighbors.__init__(self, size_x, size_y, theCanvas, doDrawing, m)

@@ -154,7 +154,7 @@ def pre_equilibrate(engine, N, dt, dt_max, cool, say=_quiet, report=_quiet, obse
         run(n, cf, level_dt)
     say("  Setting final dt= " + str(dt))
     run(2 * int(N), 0.98, dt)
-    s.rate = s.xp.zeros(s.B)       # direct assignment, no velocity adjustment (γ̇ is 0 here; no step changes it)
+    s.rate[...] = 0.0       # direct assignment, no velocity adjustment (γ̇ is 0 here; no step changes it)
     run(int(N), cool, dt)
     engine.flush()
     return step

@@ -1292,7 +1292,7 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
     s = engine.s
     c = s.contacts
     C = c.C
-    gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (the state's are replaced)
+    gamma, t, rate = s.gamma.astype(float), s.t.astype(float), s.rate.astype(float)   # (copied back by hand_back)
     next_birth, u, u_max, strain, bound, rate_max = (
         _array(a) for a in (c.next_birth, c.u, c.u_max, c.strain, c.bound, engine.rate_max))
     at = ws if slots is None else slots       # (each replica's columns and the buffers over them)
@@ -1324,9 +1324,10 @@ def step_arguments(engine, ws, cool, dt, sample, check, pred, half_out=None, ten
 
 def hand_back(engine, ws, held, stepped=False, kicked=True):
     """Hand the arrays the kernel wrote back to the state and the engine (the arrays themselves, no
-    copies): after the force phase the relations and their history (``state.contacts``), the rate
-    and the guard's record; after a whole step also the lists' bookkeeping, the clock and the
-    Verlet predictor (``state.predictor``).
+    copies, except the rate, strain and clock, which go into the state's own arrays: they may be the
+    ensembles' cells): after the force phase the relations and their history (``state.contacts``),
+    the rate and the guard's record; after a whole step also the lists' bookkeeping, the clock and
+    the Verlet predictor (``state.predictor``).
 
     Parameters
     ----------
@@ -1347,12 +1348,12 @@ def hand_back(engine, ws, held, stepped=False, kicked=True):
     c.state_p, c.xi, c.active, c.birth, c.next_birth = (held["state_p"], held["xi"], held["active"], held["birth"],
                                                         held["next_birth"])
     engine.rate_max = held["rate_max"]
-    s.rate = held["rate"]
+    s.rate[...] = held["rate"]      # (into the state's arrays: they may be the ensembles' cells)
     if stepped:
         c.u, c.u_max, c.strain, c.bound = held["u"], held["u_max"], held["strain"], held["bound"]
         if held["half"] is not None and kicked:
             s.predictor.half = held["half"]
-        s.gamma, s.t = held["gamma"], held["t"]
+        s.gamma[...], s.t[...] = held["gamma"], held["t"]
         c.need = ws.need.copy()
 
 

@@ -133,7 +133,7 @@ def shear_record(engine, dt, cool, n_steps, rate_of, tensors_every=0, say=_quiet
     check_observers(observers)
     s, xp = engine.s, engine.xp
     s.applying_shear = True
-    s.t = xp.zeros(s.B)
+    s.t[...] = 0.0
     names = ["t", "strain", "strain_rate", "stress_internal", "stress_surface"] + (["N1"] if tensors_every else [])
     rec = {name: xp.empty((n_steps, s.B)) for name in names}
     if tensors_every:

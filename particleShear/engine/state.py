@@ -522,7 +522,9 @@ class BatchState:
         Sphere state (µm, µm/s, 1/s, rad, µm, mg/m, mg·µm²/m); ``x, y`` are the rows of ``pos``
         (2, B·N) and ``vx, vy, omega`` those of ``vel`` (3, B·N).
     Lx, Ly, gamma, rate, t : ndarray (B,)
-        Box (µm), strain γ, strain rate γ̇ (1/s) and clock (s) of each replica.
+        Box (µm), strain γ, strain rate γ̇ (1/s) and clock (s) of each replica; the engine writes
+        ``gamma``, ``rate``, ``t`` and ``mu`` in place (they may be the documented ensembles'
+        cells, :meth:`use_replica_rows`).
     k, nu, k_t, nu_t, mu, c, prc, prt, keep : ndarray (B,)
         Ensemble constants of each replica (the values a step of its ensemble uses).
     pairs : list of PairTable
@@ -587,7 +589,8 @@ class BatchState:
 
     #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
     visit = None
-    #: the objects whose memory this state's per-sphere arrays and pair lists are, one per replica
+    #: the objects whose memory this state's per-sphere arrays, ``t``, ``gamma``, ``rate``, ``mu`` and pair
+    #: lists are, one per replica
     #: (set by :func:`particleShear.base.engine_adapter.state_of_ensembles`: the documented
     #: ensembles), else None; a copy (:meth:`to_backend`, pickling) owns its arrays and has None.  An
     #: engine on such a state numbers the relations as they form
@@ -683,6 +686,27 @@ class BatchState:
         self.pos, self.vel, self.frc = pos, vel, frc
         self.phi, self.r, self.m, self.inertia = phi, r, m, inertia
         self._bind_views()
+
+    def use_replica_rows(self, **rows):
+        """Make the given arrays the state's per-replica arrays of those names (views of memory the
+        caller keeps, e.g. the documented ensembles' replica cells): what a step writes there (the
+        clock, the strain, a rate or μ set through the engine), the caller's arrays hold.
+
+        Parameters
+        ----------
+        **rows : ndarray (B,)
+            By name of :attr:`REPLICA_ARRAYS` (e.g. ``t``, ``gamma``, ``rate``, ``mu``), float.
+
+        Raises
+        ------
+        ValueError
+            For another name or a shape other than (B,).
+        """
+        for name, a in rows.items():
+            if name not in self.REPLICA_ARRAYS or tuple(a.shape) != (self.B,):
+                raise ValueError(f"{name} of shape {tuple(a.shape)} is not a per-replica array: allowed the "
+                                 f"names {self.REPLICA_ARRAYS}, shape ({self.B},)")
+        self.__dict__.update(rows)
 
     def to_backend(self, backend):
         """This state with its arrays copied to ``backend`` (the same object if it is there already).

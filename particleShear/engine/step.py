@@ -468,7 +468,7 @@ class BatchEngine:
         """
         s = self.s
         shift_flow(s.vx, s.omega, s.y - self.hy_s, spread(rate - s.rate, s.rep, s.B))
-        s.rate = self.xp.array(rate, dtype=float)
+        s.rate[...] = self.xp.asarray(rate, dtype=float)     # (in place: the arrays may be ensembles' cells)
 
     def set_mu(self, mu):
         """Change the Coulomb friction coefficient μ of each replica (the constitution's μ = 0 blocks).
@@ -482,7 +482,7 @@ class BatchEngine:
             New μ of each replica (≥ 0).
         """
         s = self.s
-        s.mu = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (s.B,)))
+        s.mu[...] = self.xp.asarray(mu, dtype=float)     # (in place, as the rate)
         c = s.contacts
         C = c.C
         if C is not None:
@@ -842,9 +842,9 @@ class BatchEngine:
         """
         s, xp = self.s, self.xp
         rate_s = spread(self._image_rate(), s.rep, s.B)
-        s.gamma = s.gamma + (s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances)
+        s.gamma += s.rate * dt if self.strain_advances is None else s.rate * dt * self.strain_advances
         wrap(s.x, s.y, s.vx, self.Lx_s, self.Ly_s, spread(self.image_shift(), s.rep, s.B), rate_s)
-        s.t = s.t + dt
+        s.t += dt
         # the step's one read of per-replica flags: lists due for a rebuild (and the guard's verdict)
         verdict = None if g is None else g.verdict
         c = s.contacts

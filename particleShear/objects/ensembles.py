@@ -2,7 +2,8 @@
 __docformat__ = "numpy"
 
 from ..base.canvas import (CanvasPointsBasicElasticity, CanvasPointsBasicElasticityLeesEdwards,
-                           CanvasPointsFrictionElasticityLeesEdwards, NonNegative)
+                           CanvasPointsFrictionElasticityLeesEdwards, NonNegative, ReplicaValue,
+                           check_non_negative)
 from ..checks import integer, positive as _check_positive
 from .placement import bimodal_factors, bimodal_placement
 from .spheres import SphereFriction, SphereFrictionLeesEdwards, SphereLeesEdwards
@@ -86,7 +87,7 @@ class EnsembleFriction(Ensemble):
 
     k_t = NonNegative()
     nu_t = NonNegative()
-    mu = NonNegative()
+    mu = ReplicaValue(check_non_negative)
 
     def __init__(self, size_x, size_y, N, packing_fraction=0.8, theCanvas=False, doDrawing=False, k=1,
                  nu=0.01, m=1, bimodal_factor=1.4, k_t=1, nu_t=0.01, mu=0.1):
