@@ -7,7 +7,7 @@
 * The documented step loop advances the ensemble's clock and strain through those cells and gives
   the bits of the engine's own steps on a copy, also after a strain and a μ set from outside between
   steps (the lists rebuilt, the candidates' μ renewed: what ``_hand_to_engine`` keeps of the old
-  copying).
+  copying), also for a strain set between a step's force phase and its movement.
 * ``untouched_on_failure`` puts the cells back with the spheres.
 """
 import copy
@@ -162,6 +162,25 @@ class DocumentedLoopTest(unittest.TestCase):
         self.assert_same_bits(e, eng)
         self.assertFalse(e._engine.s.contacts.C.mu.any())
 
+    def test_a_strain_set_inside_a_step_reaches_the_next_force_phase(self):
+        # a strain set between a step's force phase and its movement: the movement starts from it,
+        # and the next force phase must see the images moved by Ly·Δγ (the lists rebuilt), as the
+        # engine's own phases on a copy do when told so
+        e = ensemble()
+        eng = engine_on_copy(e)
+        self.steps(e, eng, 5)
+        e.mechanical_simulation_step_calculate_forces()
+        e.record_total_particle_forces()
+        g = eng.force_phase()[0]
+        e.setShear(e.shear + 0.3)
+        eng.s.gamma[0] += 0.3
+        e.mechanical_simulation_step_calculate_acceleration(COOL, DT)
+        eng.accelerate(COOL, DT, g)
+        e.mechanical_simulation_step_calculate_movement(DT)
+        eng.move(DT, g)
+        eng.s.contacts.need[:] = True
+        self.steps(e, eng, 5)
+        self.assert_same_bits(e, eng)
 
 if __name__ == "__main__":
     unittest.main()

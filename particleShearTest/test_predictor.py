@@ -9,8 +9,10 @@
   spheres), a relaxation (``relax_state``); ``half=`` sets it.
 * A measurement that fails after dropping it (at its pre-equilibration) leaves the ensemble's
   predictor as it was (``untouched_on_failure``).
-* Copies keep it (``to_backend``, pickling); ``concat`` joins the replicas' rows, zeros where a
-  state had none, none when no state had one.
+* Copies keep it (``to_backend``, pickling) and are copies (stepping one on the host leaves the
+  source as it was); a state pickled before the predictor was the state's loads without one;
+  ``concat`` joins the replicas' rows, zeros where a state had none (or rows not its own), none
+  when no state had one.
 """
 import pickle
 import unittest
@@ -119,6 +121,18 @@ class TestPredictor(unittest.TestCase):
                 continue
             self.assertIsNot(copied.predictor, s.predictor)
             np.testing.assert_array_equal(_bits(copied.predictor.half), half)
+            # a copy, also on the host: stepping it (in place) leaves the source as it was
+            t, x = s.t.copy(), s.x.copy()
+            BatchEngine(copied, guard=False, integrator="verlet").steps(3, 0.9, 1e-9)
+            np.testing.assert_array_equal(s.t, t)
+            np.testing.assert_array_equal(s.x, x)
+        # a state pickled before the predictor was the state's loads without one
+        old = dict(s.__getstate__())
+        old.pop("predictor")
+        loaded = object.__new__(BatchState)
+        loaded.__setstate__(old)
+        self.assertIsNone(loaded.predictor.half)
+        BatchEngine(loaded, guard=False, integrator="verlet").steps(1, 0.9, 1e-9)
 
     def test_concat_joins_each_replica_s_rows(self):
         s = stepped("numpy", 0)
@@ -130,6 +144,9 @@ class TestPredictor(unittest.TestCase):
         np.testing.assert_array_equal(_bits(joined.predictor.half[:, :n]), _bits(s.predictor.half))
         np.testing.assert_array_equal(joined.predictor.half[:, n:], 0.0)
         self.assertIsNone(BatchState.concat([other, other]).predictor.half)
+        # a predictor whose rows are not its state's (spheres gained since) is zeros, as none
+        s.predictor.half = np.ones((3, n + 1))
+        np.testing.assert_array_equal(BatchState.concat([s, other]).predictor.half[:, :n], 0.0)
 
 
 if __name__ == "__main__":

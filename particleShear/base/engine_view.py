@@ -146,8 +146,11 @@ class EngineStep:
             self._hand_to_engine(eng)
         # where the drift takes the spheres: non-finite or far outside the cell stops the run (before the wrap)
         self._check_positions(self._pos + self._vel[:2] * dt)
+        outside = eng.s.gamma.item(0) != self._engine_strain     # a strain set since the force phase
         compiled_phases.move(eng, dt, self._force_record)
         self._force_record = None       # (the step's record ends with its movement, as in BatchEngine.step)
+        if outside:             # the boundary images moved by Ly·Δγ: the lists anew at the next force phase
+            eng.s.contacts.need[:] = True
         self._engine_strain = eng.s.gamma.item(0)      # (the engine's own advance)
         self._pos_version += 1
 

@@ -95,7 +95,8 @@ class Predictor:
     @classmethod
     def joined(cls, predictors, rows, xp):
         """The predictors of several states side by side, in their order: each one's rows, zeros
-        where a state has none (a replica that took no step yet sees its velocities, as with none).
+        where a state has none or one whose rows are not its state's (a replica that took no step
+        yet sees its velocities, as with none; :meth:`start` drops such a predictor likewise).
 
         Parameters
         ----------
@@ -113,7 +114,7 @@ class Predictor:
         """
         if all(p.half is None for p in predictors):
             return cls()
-        return cls(xp.concatenate([xp.zeros((3, n)) if p.half is None else p.half
+        return cls(xp.concatenate([p.half if p.half is not None and p.half.shape[-1] == n else xp.zeros((3, n))
                                    for p, n in zip(predictors, rows)], axis=1))
 
     def rows_of(self, rows):

@@ -53,6 +53,12 @@ def spread(values, rep, B):
     return values if B == 1 else values[..., rep]
 
 
+def _copied(a, target):
+    """``a`` (an array of any backend) copied onto ``target``: a copy also where both are the host's."""
+    host = to_host(a, "state")
+    return target.asarray(np.array(host, copy=True) if host is a else host)
+
+
 def _key(i, j):
     return (np.asarray(i, dtype=np.int64) << 32) | np.asarray(j, dtype=np.int64)
 
@@ -647,6 +653,8 @@ class BatchState:
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        if "predictor" not in state:        # (a state pickled before the predictor was the state's)
+            self.predictor = Predictor()
         self.backend = get_backend(state["backend"])
         self.xp = self.backend.xp
         self._bind_views()
@@ -733,9 +741,9 @@ class BatchState:
         out.contacts = None         # (the flat list lives on the source's backend; the tables are shared)
         out.predictor = self.predictor.on(target)
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:
-            out.__dict__[name] = target.asarray(to_host(getattr(self, name), "state"))
+            out.__dict__[name] = _copied(getattr(self, name), target)
         if self.visit is not None:
-            out.visit = target.asarray(to_host(self.visit, "state"))
+            out.visit = _copied(self.visit, target)
         out._bind_views()
         return out
 

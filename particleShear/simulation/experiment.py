@@ -557,9 +557,10 @@ class OscillatoryShearExperiment:
         return report
 
     def _write_back(self, engine, steps):
-        """The engine's clock, strain, rate, relations (and Verlet predictor) into the ensemble, and
-        its last force phase into the ensemble's force register (the six lists, the totals), as the
-        documented step loop leaves them."""
+        """The engine's plates and relations into the ensemble (its clock, strain, rate, μ and Verlet
+        predictor are the ensemble's own already: :func:`~particleShear.base.engine_adapter.write_back`),
+        and its last force phase into the ensemble's force register (the six lists, the totals), as
+        the documented step loop leaves them."""
         ens = self.theEnsemble
         if engine.phase == "protocol":
             ens.step_count = 0        # the protocol's steps, as the documented loop counts them
