@@ -534,7 +534,8 @@ class ConstitutedState:
         The particle of each sphere at the last height check (``avoid_height_spanning_particles``:
         the builders' ensemble's ``particles``), None without a check.
     cut_top_bottom : bool, optional
-        Bonds through the y boundary are cut in every step (the ensemble's ``cut_top_bottom``).
+        The builders' ensemble's flag ``cut_top_bottom``: the constitution cut the bonds through
+        the y boundary (never set by the legacy one).
     """
     state: object
     dt: float
