@@ -9,6 +9,9 @@ of plain arrays and knows nothing of the documented classes.  This module is the
   per-sphere arrays are the ensembles' own state rows, whose clock, strain, rate and μ are their
   replica cells and whose pair lists are their pair tables, so that what the engine's steps write
   the ensembles hold;
+* :func:`adopt_state` is the inverse: an ensemble of a one-replica state's spheres (made by the
+  builders, ``particleShear.linkable.builders.ensemble_of_state``) then holds them in the state's
+  memory, as if the state had been made by :func:`state_of_ensemble`;
 * :func:`write_back` hands an ensemble its plates, relations and Verlet predictor after such an
   engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as it was
   when a run on its own state fails;
@@ -36,8 +39,13 @@ from ..engine.xp import get_backend
 from .callbacks import callback_phase_laws
 from .fields import REPLICA_FIELDS, ROW
 
-__all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "write_back",
-           "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws", "host_backend"]
+__all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "adopt_state",
+           "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws", "host_backend"]
+
+#: each per-sphere array of a :class:`BatchState` and the field of the ensembles' state block it holds
+SPHERE_ROWS = (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"), ("phi", "phi"),
+               ("r", "r"), ("m", "m"), ("inertia", "inertia"), ("fx", "xforce"), ("fy", "yforce"),
+               ("torque", "torque"))
 
 
 def uniform_parameters(ensemble):
@@ -104,9 +112,7 @@ def state_from_ensembles(ensembles, backend="auto", laws=None):
     for b, e in enumerate(ensembles):
         a = e._a
         rows = slice(b * N, (b + 1) * N)
-        for name, src in (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"),
-                          ("phi", "phi"), ("r", "r"), ("m", "m"), ("inertia", "inertia"),
-                          ("fx", "xforce"), ("fy", "yforce"), ("torque", "torque")):
+        for name, src in SPHERE_ROWS:
             getattr(s, name)[rows] = a[src][:N]
         s.Lx[b], s.Ly[b] = float(e.size_x), float(e.size_y)
         s.gamma[b], s.rate[b], s.t[b] = (float(getattr(e, name, 0.0)) for name in ("shear", "shear_rate", "t"))
@@ -244,10 +250,7 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
             block[:, b * N:(b + 1) * N], cells[:, b] = e._st, e._replica
             e.adopt_state_block(block[:, b * N:(b + 1) * N])   # (its caches of the old block dropped)
             e.adopt_replica_cells(cells[:, b])
-    x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
-    s.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
-               *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
-    s.use_replica_rows(**{name: row for name, row in zip(REPLICA_FIELDS.values(), cells)})
+    _use_block(s, block, cells)
     s.pairs = [e._pairs for e in ensembles]
     # the Verlet predictor: a batch of one holds the ensemble's own (successive engines continue it)
     s.predictor = ensembles[0]._predictor if s.B == 1 else Predictor.joined(
@@ -256,6 +259,60 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     s.ensembles = ensembles
     s.backend = target         # (the same host arrays)
     return s
+
+
+def _use_block(state, block, cells):
+    """Make the rows of a state block (fields × B·N) and of replica cells (values × B) the state's arrays."""
+    x, vx, fx = ROW["x"], ROW["xspeed"], ROW["xforce"]
+    state.use_rows(block[x:x + 2], block[vx:vx + 3], block[fx:fx + 3],
+                   *(block[ROW[name]] for name in ("phi", "r", "m", "inertia")))
+    state.use_replica_rows(**{name: row for name, row in zip(REPLICA_FIELDS.values(), cells)})
+
+
+def adopt_state(ensemble, state):
+    """Make ``ensemble`` a view of the one-replica host ``state``: the inverse of :func:`state_of_ensemble`.
+
+    The state's per-sphere arrays are laid out as one state block (:data:`FIELDS` × N, the
+    per-sphere parameters from :meth:`~particleShear.engine.state.BatchState.visit_rows`), its
+    clock, strain, rate and μ as replica cells; the ensemble adopts both
+    (:meth:`~particleShear.base.canvas_base.CanvasPoints.adopt_state_block`,
+    :meth:`~particleShear.base.canvas_base.CanvasPoints.adopt_replica_cells`) and the state
+    takes views of them (:meth:`~particleShear.engine.state.BatchState.use_rows`,
+    :meth:`~particleShear.engine.state.BatchState.use_replica_rows`), so that what either
+    writes the other reads, as after :func:`state_of_ensemble`.  The ensemble's pair table is
+    the state's ``pairs[0]``, its Verlet predictor the state's, its generator ``rng[0]``; its
+    caches are dropped.  The box, constants and plates (which an ensemble holds as attributes,
+    the state as copies) are left to the caller.  Arrays of the state read before the call are
+    no longer its own afterwards: read them again.
+
+    Parameters
+    ----------
+    ensemble : ensemble of ``particleShear.linkable``
+        An ensemble of the state's N spheres (their values are replaced by the state's).
+    state : BatchState
+        One replica on a host backend.
+
+    Raises
+    ------
+    ValueError
+        If the state has more than one replica, lives on a device or has another N.
+    """
+    if state.B != 1 or not state.backend.host or state.N != len(ensemble.sphereList):
+        raise ValueError(f"state of B = {state.B}, N = {state.N} on {state.backend.name!r}: adopt_state needs one "
+                         f"replica of the ensemble's N = {len(ensemble.sphereList)} spheres on a host backend")
+    ensemble._fit_block()
+    block = ensemble._block
+    for name, field in SPHERE_ROWS:
+        block[ROW[field]] = getattr(state, name)
+    block[[ROW[name] for name in PER_SPHERE_PARAMETERS]] = state.visit_rows()
+    cells = np.array([getattr(state, name)[0] for name in REPLICA_FIELDS.values()], dtype=float)
+    _use_block(state, block, cells[:, None])
+    ensemble.adopt_state_block(block)
+    ensemble.adopt_replica_cells(cells)
+    ensemble._pairs, ensemble._predictor = state.pairs[0], state.predictor
+    ensemble.set_random_generator(state.rng[0])
+    ensemble.invalidate_caches()
+    state.ensembles = [ensemble]
 
 
 def host_backend(backend):

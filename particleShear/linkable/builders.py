@@ -8,7 +8,7 @@ import logging
 
 import numpy as np
 
-from ..base.engine_adapter import host_backend, relax_ensembles, relax_state, set_laws
+from ..base.engine_adapter import adopt_state, host_backend, relax_ensembles, relax_state, set_laws
 from ..base.fields import FIELDS
 from ..base.pair_canvas import CanvasPointsNeighbors
 from ..checks import finite, in_range, integer, non_negative, positive
@@ -24,6 +24,7 @@ from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustabl
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
            "adjustable_interface_constitution", "constitution", "constituted_state", "ConstitutedState",
+           "ensemble_of_state",
            "EnsembleRecipe", "Relaxation", "relax_constitution",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
 
@@ -356,21 +357,49 @@ def constitution(recipe, *, legacy=False, doDrawing=False, do_debug=False, rng=N
         The constituted ensemble (``StopIteration.value``).
     """
     c = _Constants(recipe, legacy, do_debug, verbose)
-    r = recipe
+    ens = _documented_ensemble(recipe, c, legacy, doDrawing, np.random.default_rng(rng))
+    return (yield from _schedule(ens, recipe, c, legacy, verbose))
+
+
+def _documented_ensemble(r, c, legacy, doDrawing, rng, placement=None):
+    """The documented ensemble of a constitution before its schedule: class, constants, spheres, μ, model.
+
+    The one construction of :func:`constitution` (which lets the class draw its placement from
+    ``rng``) and :func:`ensemble_of_state` (which gives the placement: nothing is drawn).
+
+    Parameters
+    ----------
+    r : EnsembleRecipe
+    c : _Constants
+    legacy : bool
+        :class:`~.compact.EnsembleCompactParticles` (else the adjustable interface's class).
+    doDrawing : bool
+    rng : numpy.random.Generator
+        The ensemble's generator (used, not copied).
+    placement : tuple of ndarray (N,) or None, optional
+        ``(x, y, r, mass)`` of the spheres (µm, mg per m depth); None: drawn by the class.
+
+    Returns
+    -------
+    EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
+    """
     cls, extra = ((EnsembleCompactParticles, {}) if legacy else (
         EnsembleCompactParticlesAdjustableInterfaceStrength,
         dict(permanent_ratio_central=c.prc, permanent_ratio_tangential=c.prt,
              keep_viscosity_coefficients_constant=r.keep_viscosity_coefficients_constant)))
-    ens = cls(r.size_x, r.size_y, c.N, packing_fraction=r.packing_fraction, theCanvas=False, doDrawing=doDrawing,
-              k=c.k, nu=c.nu, m=c.model.m, bimodal_factor=r.bimodal_factor, k_t=c.k_t, nu_t=c.nu_t, dt=c.dt,
-              dt_max=c.dt_max, theTkSimulation=False, avoid_horizontal_angle_degree=r.avoid_horizontal_angle_degree,
-              rng=np.random.default_rng(rng), **extra)
+    ens = cls(r.size_x, r.size_y, c.N if placement is None else 0, packing_fraction=r.packing_fraction,
+              theCanvas=False, doDrawing=doDrawing, k=c.k, nu=c.nu, m=c.model.m, bimodal_factor=r.bimodal_factor,
+              k_t=c.k_t, nu_t=c.nu_t, dt=c.dt, dt_max=c.dt_max, theTkSimulation=False,
+              avoid_horizontal_angle_degree=r.avoid_horizontal_angle_degree, rng=rng, **extra)
+    if placement is not None:
+        ens.N = c.N
+        ens._append_spheres(*placement)
     ens.mu = r.mu        # the constitution's to set, as in its μ = 0 blocks (_free_mu0)
     ens.set_central_repulsion_coefficient(r.central_repulsion_coefficient)
     ens.avoid_height_spanning_particles = c.avoid
     ens.model = c.model
     ens.edge_fuzziness = r.edge_fuzziness
-    return (yield from _schedule(ens, r, c, legacy, verbose))
+    return ens
 
 
 class _Constants:
@@ -497,6 +526,16 @@ class ConstitutedState:
         The Voronoi seeds of the last cut (µm), None without a Voronoi cut.
     r_max : float
         The largest radius (µm).
+    steps : int, optional
+        Relaxation steps run (the builders' ensemble's ``step_count`` and ``n_constitution_steps``).
+    sphere_seed : ndarray (N,) of int or None, optional
+        The Voronoi seed of each sphere at the last cut, None where nothing was cut.
+    particle_labels : ndarray (N,) of int or None, optional
+        The particle of each sphere at the last height check (``avoid_height_spanning_particles``:
+        the builders' ensemble's ``particles``), None without a check.
+    cut_top_bottom : bool, optional
+        The builders' ensemble's flag ``cut_top_bottom``: the constitution cut the bonds through
+        the y boundary (never set by the legacy one).
     """
     state: object
     dt: float
@@ -505,6 +544,10 @@ class ConstitutedState:
     removed_fraction: float
     triangulation_points: object
     r_max: float
+    steps: int = 0
+    sphere_seed: object = None
+    particle_labels: object = None
+    cut_top_bottom: bool = False
 
 
 class _StateTarget:
@@ -547,9 +590,10 @@ class _StateTarget:
         self.mu = r.mu
         self.dt, self.dt_max = c.dt, c.dt_max
         self.removed_fraction = 0
-        self.triangulation_points = None
+        self.triangulation_points = self.sphere_seed = self.particle_labels = None
         self.particles = []
         self.cut_top_bottom = False
+        self.steps = 0
 
     # -- the state's rows, as the algorithms of .bonds take them
     def _rows(self):
@@ -566,7 +610,8 @@ class _StateTarget:
 
     def free_pre_equilibration(self, N):
         self.state.mu[0] = float(self.mu)
-        relax_state(self.state, N, float(self.dt), float(self.dt_max), skin_factor=self.skin_factor)
+        _, steps = relax_state(self.state, N, float(self.dt), float(self.dt_max), skin_factor=self.skin_factor)
+        self.steps += steps
 
     def makeAllLinksPermanent(self):
         if not self._pairs.active.any():       # the ensemble's neighbour update (test_neighbor_relation)
@@ -589,8 +634,10 @@ class _StateTarget:
     def cutByTriangulation(self, n_points, edge_fuzziness=0):
         pts = self.triangulation_points = bonds.seed_points(self.state.rng[0], n_points, self.size_x, self.size_y)
         x, y, _ = self._rows()
-        bonds.voronoi_cut(self._pairs, x, y, self.size_x, self.size_y, self._shift(), pts, edge_fuzziness, self.r_max,
-                          self.state.rng[0])
+        seed = bonds.voronoi_cut(self._pairs, x, y, self.size_x, self.size_y, self._shift(), pts, edge_fuzziness,
+                                 self.r_max, self.state.rng[0])
+        if seed is not None:
+            self.sphere_seed = seed
 
     def cutRandomLine(self):
         x, y, _ = self._rows()
@@ -600,7 +647,8 @@ class _StateTarget:
 
     def maximal_particle_height(self):
         x, y, r = self._rows()
-        return bonds.maximal_particle_height(bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y), y, r)
+        self.particle_labels = bonds.particle_labels(self._pairs, x, y, self.size_x, self.size_y)
+        return bonds.maximal_particle_height(self.particle_labels, y, r)
 
     def remove_non_essential_links(self, fraction, physical_only=True):
         x, y, r = self._rows()
@@ -682,7 +730,78 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     set_laws(s, [law])
     return ConstitutedState(state=s.to_backend(target_backend), dt=float(target.dt), dt_max=float(target.dt_max),
                             model=c.model, removed_fraction=float(target.removed_fraction),
-                            triangulation_points=target.triangulation_points, r_max=float(target.r_max))
+                            triangulation_points=target.triangulation_points, r_max=float(target.r_max),
+                            steps=target.steps, sphere_seed=target.sphere_seed, particle_labels=target.particle_labels,
+                            cut_top_bottom=target.cut_top_bottom)
+
+
+def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):
+    """The documented ensemble of a constituted state, as a view of the state: nothing drawn or relaxed.
+
+    The ensemble :func:`constitution` and :func:`relax_constitution` make from the same recipe
+    and seed (same class, constants, spheres, pair table, generator position, clock, strain, μ,
+    steps, step counts and facts of the cut), made from ``constituted``
+    (:func:`constituted_state`, ``legacy`` as given there) instead: the class's construction of
+    a constitution (:func:`_documented_ensemble`) with the state's placement, then
+    :func:`~particleShear.base.engine_adapter.adopt_state`, after which the ensemble's state
+    block, replica cells, pair table, Verlet predictor and generator are the state's own
+    memory (a step of either is the other's); the facts the state does not hold (``dt``,
+    ``dt_max``, ``removed_fraction``, ``triangulation_points``, ``sphere_seed``, ``particles``,
+    ``cut_top_bottom``, the step counts) are set from ``constituted``.  Its plates are off, as
+    after a constitution; the state's flag is left as it is.
+
+    Parameters
+    ----------
+    constituted : ConstitutedState
+        A constitution of ``recipe`` on a host backend (its state's arrays are replaced by views:
+        read them again).
+    recipe : EnsembleRecipe
+        The recipe ``constituted`` was made of (the ensemble's constants and class parameters).
+    legacy : bool, optional
+        :class:`~.compact.EnsembleCompactParticles`, the legacy builder's (as for :func:`constituted_state`).
+    doDrawing : bool, optional
+        Draw the spheres (no window), as :func:`constitution` takes it.
+
+    Returns
+    -------
+    EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
+
+    Raises
+    ------
+    ValueError
+        If the state is not one replica on the host, or its N, box or constants are not the recipe's.
+    """
+    s = constituted.state
+    c = _Constants(recipe, legacy, False, False)
+    given = (s.B, s.N, s.Lx[0], s.Ly[0], s.k[0], s.nu[0], s.k_t[0], s.nu_t[0])
+    if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t):
+        raise ValueError(f"the state (B, N, Lx, Ly, k, nu, k_t, nu_t) = {given} is not a constitution of the recipe")
+    ens = _documented_ensemble(recipe, c, legacy, doDrawing, s.rng[0], (s.x, s.y, s.r, s.m))
+    adopt_state(ens, s)
+    _set_constitution_facts(ens, constituted)
+    return ens
+
+
+def _set_constitution_facts(ens, constituted):
+    """Set on ``ens`` what its constitution left on a documented ensemble besides the state's memory.
+
+    The steps, the cut's facts where a cut made them (:meth:`~.compact.EnsembleCompactParticles.cutByTriangulation`,
+    :meth:`~.compact.EnsembleCompactParticles.maximal_particle_height`) and the bookkeeping of
+    :func:`~particleShear.base.engine_adapter.write_back` after its relaxations.
+    """
+    ens.dt, ens.dt_max = constituted.dt, constituted.dt_max
+    ens.removed_fraction = constituted.removed_fraction
+    if constituted.triangulation_points is not None:
+        ens.triangulation_points, ens.doCutByTriangulation = constituted.triangulation_points, True
+    if constituted.sphere_seed is not None:
+        ens.sphere_seed = constituted.sphere_seed
+    if constituted.particle_labels is not None:
+        ens.particles = ens._particles_from_labels(constituted.particle_labels)
+    if constituted.cut_top_bottom:
+        ens.cut_top_bottom = True
+    ens.step_count = ens.n_constitution_steps = constituted.steps
+    if constituted.steps:
+        ens._last_dt = float(constituted.dt)
 
 
 def _parameters_section(doc):

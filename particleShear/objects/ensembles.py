@@ -37,11 +37,23 @@ class RandomBimodalSpheres:
 
     def _create_spheres(self, N, m):
         """Draw and append N spheres; one block of draws per quantity, in index order."""
-        x, y, r, mass = bimodal_placement(self._rng, N, self.size_x, self.size_y, self.packing_fraction,
-                                          self.bimodal_lower, self.bimodal_upper, m)
-        for p in range(N):
+        self._append_spheres(*bimodal_placement(self._rng, N, self.size_x, self.size_y, self.packing_fraction,
+                                                self.bimodal_lower, self.bimodal_upper, m))
+
+    def _append_spheres(self, x, y, r, mass):
+        """Append a sphere of the class (``_new_sphere``) per element of the given placement, in index order,
+        growing ``r_max``; no draw (a placement made elsewhere: ``linkable.builders.ensemble_of_state``).
+
+        Parameters
+        ----------
+        x, y, r, mass : array_like of float (n,)
+            Positions and radii (µm), masses (mg per m depth).
+        """
+        first = len(self.sphereList)
+        for p in range(len(r)):
             self.r_max = max(self.r_max, float(r[p]))
-            self.sphereList.append(self._new_sphere(float(x[p]), float(y[p]), float(r[p]), float(mass[p]), p))
+            self.sphereList.append(self._new_sphere(float(x[p]), float(y[p]), float(r[p]), float(mass[p]),
+                                                    first + p))
 
     def particle_info(self):
         """Description of the spheres (radii ``r1``, ``r2`` in µm) for the header of the output file."""
