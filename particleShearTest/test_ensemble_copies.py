@@ -1,13 +1,15 @@
-"""Copies and pickles of the documented ensembles (docs/classes.md, "Copies and pickles").
+"""Copies and pickles of the documented ensembles (docs/classes.md, "The documented classes", the item
+"Copies and pickles").
 
 * Every documented ensemble class, with and without spheres, bonds, steps or the Verlet
   integrator, is deep-copied and pickled: the copy holds its own state block (its field views are
   views of it again), replica cells, pair table, predictor, generator and spheres (each pointing at
   the copy); the caches (memo and its engine, the force phase's records, the force register) and
   the window handles are not carried.
-* A copy continues bit for bit as the original: the state block, the pair table, clock and strain
-  after the same steps, the same generator draws; stepped alternately with another protocol the
-  two do not interfere; a copy between two Verlet steps continues the predictor.
+* A copy continues bit for bit as the original: the state block, the pair table's relations, clock
+  and strain after the same steps, the same generator draws; stepped alternately with another
+  protocol the two do not interfere; a copy between two Verlet steps continues the predictor (the
+  table's other candidate rows follow each engine's own neighbour-list rebuilds: :func:`bits`).
 The steps are the documented ones, on the engine the documented step makes (``backend="auto"``:
 ``PARTICLESHEAR_BACKEND`` or the default backend).
 """
@@ -173,6 +175,7 @@ class CopiesTest(unittest.TestCase):
             with self.subTest(copy=how):
                 e, dt = gel()
                 c = make(e)
+                self.assertTrue(all(s.__dict__["_ens"] is c for particle in c.particles for s in particle))
                 before = bits(e), table(e)
                 c.sphereList[0].x += 1.0
                 c.t, c.shear, c.mu = 1.0, 0.5, 0.0
