@@ -12,7 +12,7 @@ from operator import attrgetter
 import numpy as np
 
 from .fields import FIELDS, REPLICA_FIELDS, REPLICA_ROW, ROW
-from .graphics import Graphical_output_configuration
+from .graphics import Graphical_output_configuration, headless
 from ..engine.box import flow_velocity, inside_cell, wrap
 from ..engine.forces import pair_roles
 from ..engine.integrate import damp, drift, kick, remove_mean_velocity
@@ -137,6 +137,18 @@ class SphereList(list):
 
     insert = remove = pop = clear = sort = reverse = __setitem__ = __delitem__ = _forbidden
 
+    def __reduce__(self):
+        """Copy and pickle as the list of the same spheres of the ensemble's copy, made without
+        :meth:`append`: each sphere's state is in the copied state block already, at its index."""
+        return _sphere_list, (self._canvas, list(self))
+
+
+def _sphere_list(canvas, spheres):
+    """The :class:`SphereList` of ``canvas`` holding ``spheres``, which are in its state block already."""
+    out = SphereList(canvas)
+    list.extend(out, spheres)
+    return out
+
 
 # ufunc reductions without the Python wrappers of ndarray.max/min (hot path)
 _max_reduce = np.maximum.reduce
@@ -158,6 +170,12 @@ class CanvasPoints:
 
     use_lees_edwards = False
 
+    #: what a copy or a pickle of the ensemble leaves out: the memo (with the step's engine), the
+    #: step's records of that engine (:class:`~particleShear.base.engine_view.EngineStep`) and the
+    #: views of the state block (made anew on the copy's own block)
+    _NOT_COPIED = ("_memo", "_st", "_a", "_pos", "_vel", "_frc", "_g", "_force_record", "_engine_pairs",
+                   "_engine_strain", "_engine_mu")
+
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False):
         _check_positive("size_x", size_x)
         _check_positive("size_y", size_y)
@@ -177,6 +195,28 @@ class CanvasPoints:
         self._pos_version = 0
         self._params_version = 0
         self.graphical_output_configuration = Graphical_output_configuration()
+
+    # -- copies and pickles -------------------------------------------------------------------------
+    def __getstate__(self):
+        """The state a copy (``copy.deepcopy``) or a pickle carries: every attribute but the caches
+        (:attr:`_NOT_COPIED`), without window handles (:func:`~particleShear.base.graphics.headless`).
+
+        The state block, the replica cells, the pair table, the Verlet predictor and the random
+        generator are carried as values, so the copy is independent of the original and continues
+        as it would (the generator's next draws included); the caches are made anew when needed.
+        """
+        return {name: value for name, value in headless(self.__dict__).items() if name not in self._NOT_COPIED}
+
+    def __setstate__(self, state):
+        """Take ``state`` (of :meth:`__getstate__`), with an empty memo and the views of its own block.
+
+        Parameters
+        ----------
+        state : dict
+        """
+        self.__dict__.update(state)
+        self._memo = Memo()
+        self._views()
 
     # -- sphere list and state arrays ----------------------------------------------------------
     @property

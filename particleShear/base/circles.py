@@ -10,7 +10,7 @@ from .register import Force_register
 from .relations import neighbor_relation
 
 from .point_base import ArrayField, PointLeesEdwards, _check_positive, _one, _pair_query
-from .graphics import Graphical_output_configuration
+from .graphics import Graphical_output_configuration, headless
 
 __all__ = ["Circle", "CircleMass", "CircleMassNeighbors"]
 
@@ -46,6 +46,11 @@ class Circle(PointLeesEdwards):
         self.r = diameter / 2
         self.doDrawing, self.shape, self.color = doDrawing, None, color
         self.graphical_output_configuration = Graphical_output_configuration()
+
+    def __getstate__(self):
+        """The sphere's attributes for a copy or a pickle, without the window handle ``theCanvas``
+        (:func:`~particleShear.base.graphics.headless`); a sphere of an ensemble goes with its ensemble."""
+        return headless(self.__dict__)
 
     def set_graphical_output_configuration(self, graphical_output_configuration):
         """Use these drawing options for the sphere and its contacts.

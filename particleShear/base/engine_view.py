@@ -38,6 +38,8 @@ class EngineStep:
     #: the record of the last force phase of the kept engine (ForceRecord), for the acceleration and
     #: movement phases of its step; None before one, after the step's movement and with the engine dropped
     _force_record = None
+    #: the relations of the last force phase (:class:`ForcePhaseGeometry`); None before one
+    _g = None
 
     #: the strain advances only while the plates shear (``applyingShear``; the frictionless canvases)
     _strain_only_while_shearing = True

@@ -1,7 +1,30 @@
 """Drawing options shared by an ensemble and its spheres (see docs/output.md for the images)."""
 __docformat__ = "numpy"
 
-__all__ = ["Graphical_output_configuration"]
+__all__ = ["Graphical_output_configuration", "HANDLES", "headless"]
+
+#: the attributes of an ensemble or a sphere that hold a live window's handles (the Tk canvas of 1.0.2's
+#: scripts, the Tk root, the renderer), each with its value when there is no window
+HANDLES = {"theCanvas": False, "theTkSimulation": False, "_renderer": None}
+
+
+def headless(state):
+    """``state``, an object's attribute dict, with its window handles (:data:`HANDLES`) set to no window.
+
+    A handle belongs to the process and the window that made it: it can be neither copied nor
+    pickled, and a copy of an ensemble or a sphere draws nowhere (it is headless).
+
+    Parameters
+    ----------
+    state : dict
+        The attributes (left unchanged).
+
+    Returns
+    -------
+    dict
+        A new dict: ``state`` with the handles it has replaced.
+    """
+    return {**state, **{name: value for name, value in HANDLES.items() if name in state}}
 
 
 class Graphical_output_configuration:

@@ -276,6 +276,11 @@ class Force_register:
     def __init__(self):
         self.reset_force_register()
 
+    def __reduce__(self):
+        """Copy and pickle as an empty register (as at the start of a force phase): what it holds is
+        the record of a force phase of the original's engine, which a copy does not have."""
+        return Force_register, ()
+
     def reset_force_register(self):
         """Clear everything (start of each force phase)."""
         self._ens = None
