@@ -17,12 +17,8 @@ from particleShear.base.engine_adapter import state_of_ensemble
 from particleShear.engine.state import PERMANENT, BatchState, PairTable
 from particleShear.linkable.builders import (EnsembleRecipe, constituted_state, constitution, ensemble_of_state,
                                              relax_constitution)
+from particleShearTest.test_constituted_state import SMALL      # the small gel of the constitution's tests
 
-#: a small gel (the builders' defaults but N)
-SMALL = dict(N=30, packing_fraction=1, mu=1, Young_modulus_spheres=10000, density=50, bimodal_factor=1.4,
-             cut_lines=5, do_permanent_links=True, relative_viscosity=0.01, central_repulsion_coefficient=0,
-             anticipated_amplitude=0.1, relative_transversal_link_strength=1, avoid_horizontal_angle_degree=0,
-             avoid_height_spanning_particles=False, doCutByTriangulation=True)
 
 #: (id, legacy, recipe fields over SMALL, seeds): crosslinked and cut, legacy, frictional spheres only, ...
 CASES = [
