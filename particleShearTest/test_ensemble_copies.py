@@ -253,6 +253,24 @@ class CopiesContinueTest(unittest.TestCase):
                 stepped(c, 20, GEL_RATE, dt)
                 self.assertEqual(bits(c), bits(e))
 
+    def test_a_copy_inside_a_step_finishes_it_as_after_invalidate_caches(self):
+        # a copy keeps no record of a force phase: made between a step's force phase and its
+        # movement, it finishes the step as the original does with its caches dropped there (a
+        # kick and a movement without the phase's record: no ξ rule), and steps on (its lists are
+        # due until its first force phase builds them)
+        for how, make in COPIES.items():
+            with self.subTest(copy=how):
+                e, dt = gel()
+                e.setShearRate(500)
+                e.mechanical_simulation_step_calculate_forces()
+                c = make(e)
+                e.invalidate_caches()
+                for x in (c, e):
+                    x.mechanical_simulation_step_calculate_acceleration(COOL, dt)
+                    x.mechanical_simulation_step_calculate_movement(dt)
+                    stepped(x, 5, GEL_RATE, dt)
+                self.assertEqual(bits(c), bits(e))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -141,6 +141,9 @@ def test_the_recipe_must_be_the_states():
     for other in (dict(N=31), dict(Young_modulus_spheres=20000), dict(size_x=400)):
         with pytest.raises(ValueError, match="not a constitution of the recipe"):
             ensemble_of_state(got, EnsembleRecipe(**{**SMALL, **other}))
+    ensemble_of_state(got, recipe)
+    with pytest.raises(ValueError, match="already the memory of an ensemble"):    # one view per state
+        ensemble_of_state(got, recipe)
 
 
 @pytest.mark.parametrize("legacy, fields, seed, integrator",

@@ -40,7 +40,8 @@ from .callbacks import callback_phase_laws
 from .fields import REPLICA_FIELDS, ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "adopt_state",
-           "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws", "host_backend"]
+           "check_adoptable", "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws",
+           "host_backend"]
 
 #: each per-sphere array of a :class:`BatchState` and the field of the ensembles' state block it holds
 SPHERE_ROWS = (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"), ("phi", "phi"),
@@ -295,11 +296,9 @@ def adopt_state(ensemble, state):
     Raises
     ------
     ValueError
-        If the state has more than one replica, lives on a device or has another N.
+        As :func:`check_adoptable`.
     """
-    if state.B != 1 or not state.backend.host or state.N != len(ensemble.sphereList):
-        raise ValueError(f"state of B = {state.B}, N = {state.N} on {state.backend.name!r}: adopt_state needs one "
-                         f"replica of the ensemble's N = {len(ensemble.sphereList)} spheres on a host backend")
+    check_adoptable(state, len(ensemble.sphereList))
     ensemble._fit_block()
     block = ensemble._block
     for name, field in SPHERE_ROWS:
@@ -313,6 +312,29 @@ def adopt_state(ensemble, state):
     ensemble.set_random_generator(state.rng[0])
     ensemble.invalidate_caches()
     state.ensembles = [ensemble]
+
+
+def check_adoptable(state, n):
+    """Raise unless ``state`` can become the memory of an ensemble of ``n`` spheres (:func:`adopt_state`).
+
+    Parameters
+    ----------
+    state : BatchState
+    n : int
+        The ensemble's number of spheres.
+
+    Raises
+    ------
+    ValueError
+        If the state has more than one replica, lives on a device, has another N, or is already
+        an ensemble's memory (one ensemble per state: ``copy.deepcopy`` that one for another).
+    """
+    if state.B != 1 or not state.backend.host or state.N != n:
+        raise ValueError(f"state of B = {state.B}, N = {state.N} on {state.backend.name!r}: adopt_state needs one "
+                         f"replica of the ensemble's N = {n} spheres on a host backend")
+    if state.ensembles is not None:
+        raise ValueError("the state is already the memory of an ensemble (state.ensembles): one ensemble per state; "
+                         "copy.deepcopy that ensemble for another")
 
 
 def host_backend(backend):

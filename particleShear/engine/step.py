@@ -850,7 +850,7 @@ class BatchEngine:
         c = s.contacts
         due = c.bound >= self.skin
         flags = to_host(due if verdict is None else xp.concatenate((due, verdict[0] != 0)), "flags")
-        c.need = flags[:s.B]
+        c.need = c.need | flags[:s.B]      # (a list due and not rebuilt since, e.g. none before a first force phase, stays due)
         if verdict is not None and flags[s.B:].any():
             self.report_verdict(verdict, self.step_count)
         self.step_count += 1

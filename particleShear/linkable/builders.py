@@ -8,7 +8,7 @@ import logging
 
 import numpy as np
 
-from ..base.engine_adapter import adopt_state, host_backend, relax_ensembles, relax_state, set_laws
+from ..base.engine_adapter import adopt_state, check_adoptable, host_backend, relax_ensembles, relax_state, set_laws
 from ..base.fields import FIELDS
 from ..base.pair_canvas import CanvasPointsNeighbors
 from ..checks import finite, in_range, integer, non_negative, positive
@@ -769,13 +769,16 @@ def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):
     Raises
     ------
     ValueError
-        If the state is not one replica on the host, or its N, box or constants are not the recipe's.
+        If the state is not one replica on the host or is an ensemble's already
+        (:func:`~particleShear.base.engine_adapter.check_adoptable`), or its N, box or constants
+        are not the recipe's.
     """
     s = constituted.state
     c = _Constants(recipe, legacy, False, False)
     given = (s.B, s.N, s.Lx[0], s.Ly[0], s.k[0], s.nu[0], s.k_t[0], s.nu_t[0])
     if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t):
         raise ValueError(f"the state (B, N, Lx, Ly, k, nu, k_t, nu_t) = {given} is not a constitution of the recipe")
+    check_adoptable(s, c.N)           # (before any work)
     ens = _documented_ensemble(recipe, c, legacy, doDrawing, s.rng[0], (s.x, s.y, s.r, s.m))
     adopt_state(ens, s)
     _set_constitution_facts(ens, constituted)
