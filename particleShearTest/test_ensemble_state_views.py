@@ -86,18 +86,45 @@ class StateCellsTest(unittest.TestCase):
             getattr(s, row)[0] = 7.0
         self.assertEqual([e.t, e.shear, e.shear_rate, e.mu], [0.25, 0.01, 0.5, 0.3])
 
-    def test_values_are_floats_checked_and_copied_with_the_ensemble(self):
+    def test_values_are_checked_and_copied_with_the_ensemble(self):
         e = CanvasPointsFrictionElasticityLeesEdwards(100, 100, mu=0)
         e.t = 0
         e.shear += 1
         self.assertEqual((e.t, e.shear, e.mu), (0.0, 1.0, 0.0))
-        self.assertIs(type(e.mu), float)
         with self.assertRaisesRegex(ValueError, "mu=-1 is out of range"):
             e.mu = -1
         twin = copy.deepcopy(e)
         twin.t = 3
         self.assertEqual((e.t, twin.t, twin.shear), (0.0, 3.0, 1.0))
         self.assertFalse(hasattr(EnsembleLeesEdwards(100, 100, 0), "mu"))     # frictionless: no μ
+
+    def test_an_integer_reads_back_as_given_until_the_cell_changes(self):
+        # 1.0.2's values were plain attributes: an int assigned stayed an int; a step's value is a float
+        e = CanvasPointsFrictionElasticityLeesEdwards(100, 100, mu=0)
+        s = state_of_ensemble(e)
+        for name, row in VALUES:
+            with self.subTest(value=name):
+                setattr(e, name, 2)
+                self.assertIs(type(getattr(e, name)), int)
+                self.assertEqual(getattr(e, name), 2)
+                getattr(s, row)[0] = 2.5                     # the engine's write: the cell's float
+                self.assertIs(type(getattr(e, name)), float)
+                self.assertEqual(getattr(e, name), 2.5)
+                setattr(e, name, 1.0)                        # a float assigned stays a float
+                self.assertIs(type(getattr(e, name)), float)
+        self.assertIs(type(CanvasPointsFrictionElasticityLeesEdwards(100, 100, mu=0).mu), int)
+
+    def test_a_shallow_copy_has_its_own_values_and_the_originals_spheres(self):
+        # as 1.0.2's copy.copy: the sphere objects shared, the clock, strain, rate and μ the copy's own
+        e = ensemble()
+        twin = copy.copy(e)
+        self.assertEqual([getattr(twin, n) for n, _ in VALUES], [getattr(e, n) for n, _ in VALUES])
+        before = [getattr(e, n) for n, _ in VALUES]
+        for k, (name, _) in enumerate(VALUES):
+            setattr(twin, name, 9.0 + k)
+        self.assertEqual([getattr(e, n) for n, _ in VALUES], before)
+        twin.sphereList[0].x = 3.25          # a sphere of the copy is the original's
+        self.assertEqual(e.sphereList[0].x, 3.25)
 
     def test_a_failed_run_puts_the_cells_back(self):
         e = ensemble()

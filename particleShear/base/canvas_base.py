@@ -7,6 +7,7 @@ The pair canvases of :mod:`.pair_canvas` and the force canvases of :mod:`.elasti
 __docformat__ = "numpy"
 
 import math
+import numbers
 from operator import attrgetter
 
 import numpy as np
@@ -58,7 +59,11 @@ class NonNegative:
 
 class ReplicaValue:
     """Ensemble value held in its cell of the ensemble's replica cells (``t``, ``shear``, ``shear_rate``,
-    ``mu``: :data:`~particleShear.base.fields.REPLICA_FIELDS`): a float in, a float out.
+    ``mu``: :data:`~particleShear.base.fields.REPLICA_FIELDS`).
+
+    The cell is a float; an integer assigned reads back as that integer (``ens.t = 0`` gives
+    ``0``, as an attribute of 1.0.2 would) until the cell holds another value, after which it reads
+    as a float (a step's clock, strain or rate).
 
     The cells are the engine's memory (:func:`~particleShear.base.engine_adapter.state_of_ensembles`
     makes them element b of the batch's ``t``, ``gamma``, ``rate`` and ``mu``), so what a step
@@ -80,12 +85,19 @@ class ReplicaValue:
     def __get__(self, obj, objtype=None):
         if obj is None:
             return self
-        return obj._replica.item(self.row)
+        v = obj._replica.item(self.row)
+        i = obj.__dict__.get("_replica_ints", {}).get(self.name)
+        return i if i is not None and i == v else v
 
     def __set__(self, obj, value):
         if self.check is not None:
             self.check(self.name, value)
         obj._replica[self.row] = value
+        ints = obj.__dict__.setdefault("_replica_ints", {})
+        if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+            ints[self.name] = value       # (read back while the cell still holds it)
+        else:
+            ints.pop(self.name, None)
 
 
 class SphereList(list):
@@ -217,6 +229,22 @@ class CanvasPoints:
         self.__dict__.update(state)
         self._memo = Memo()
         self._views()
+
+    def __copy__(self):
+        """A shallow copy (``copy.copy``), as of 1.0.2's ensembles: the spheres are the original's,
+        the clock, strain, rate and μ are the copy's own values.
+
+        The state block, the sphere list, the pair table, the Verlet predictor and the generator
+        are shared with the original (as 1.0.2's shallow copy shared its sphere objects); the
+        replica cells (``t``, ``shear``, ``shear_rate``, ``mu``, attributes of their own in
+        1.0.2) are copied, and the caches (:attr:`_NOT_COPIED`) are made anew.  Use
+        ``copy.deepcopy`` for an independent ensemble (:meth:`__getstate__`).
+        """
+        new = type(self).__new__(type(self))
+        new.__setstate__(self.__getstate__())
+        new._replica = self._replica.copy()
+        new._replica_ints = dict(getattr(self, "_replica_ints", {}))
+        return new
 
     # -- sphere list and state arrays ----------------------------------------------------------
     @property
