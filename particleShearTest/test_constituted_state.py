@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from particleShear.base.engine_adapter import state_from_ensembles
+from particleShear.base.engine_adapter import ensembles_of, state_from_ensembles
 from particleShear.engine.state import BatchState, PairTable
 from particleShear.linkable import bonds
 from particleShear.linkable.builders import (ConstitutedState, EnsembleRecipe, constituted_state, constitution,
@@ -122,7 +122,7 @@ def test_no_documented_ensemble_is_made(monkeypatch):
         with pytest.raises(AssertionError):
             relax_constitution(constitution(recipe, legacy=legacy, do_debug=True, rng=31))
     got = constituted_state(recipe, rng=31, do_debug=True)
-    assert got.state.ensembles is None
+    assert ensembles_of(got.state) is None
     assert differences(ref, got.state) == []
 
 

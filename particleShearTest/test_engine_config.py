@@ -50,9 +50,12 @@ class TestEngineConfig(unittest.TestCase):
         np.testing.assert_array_equal(eng.skin, 0.3 * 20.0)
         np.testing.assert_array_equal(eng.lees_edwards, [0.0])
 
-    def test_defaults_and_the_decided_numbering(self):
+    def test_defaults_do_not_depend_on_whose_memory_the_state_is(self):
+        # the configuration is what is given: an ensemble's own state decides nothing in the engine
         own = BatchEngine(state_of_ensemble(ensemble()))
-        self.assertEqual(own.config, EngineConfig(numbers_relations=True))   # an ensemble's own state: numbered
+        self.assertEqual(own.config, EngineConfig())
+        self.assertFalse(own.numbers_relations)
+        self.assertTrue(BatchEngine(state_of_ensemble(ensemble()), numbers_relations=True).numbers_relations)
         copy = BatchEngine(state_from_ensembles([ensemble()]))
         self.assertEqual(copy.config, EngineConfig(numbers_relations=False))
         self.assertIsNone(copy.lees_edwards)

@@ -13,7 +13,7 @@
 import numpy as np
 import pytest
 
-from particleShear.base.engine_adapter import state_of_ensemble
+from particleShear.base.engine_adapter import ensembles_of, state_of_ensemble
 from particleShear.engine.state import PERMANENT, BatchState, PairTable
 from particleShear.linkable.builders import (EnsembleRecipe, constituted_state, constitution, ensemble_of_state,
                                              relax_constitution)
@@ -122,7 +122,7 @@ def test_it_is_a_view_of_the_state():
     for name in ("t", "gamma", "rate", "mu"):
         assert np.shares_memory(view._replica, getattr(s, name)), name
     assert view._pairs is s.pairs[0] and view._predictor is s.predictor and view._rng is s.rng[0]
-    assert s.ensembles == [view]
+    assert ensembles_of(s) == [view]
     sphere = view.sphereList[7]
     sphere.x = 123.5                                   # the ensemble's writes, the state's values
     view.shear, view.mu = 0.25, 0.5

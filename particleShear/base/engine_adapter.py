@@ -12,6 +12,7 @@ of plain arrays and knows nothing of the documented classes.  This module is the
 * :func:`adopt_state` is the inverse: an ensemble of a one-replica state's spheres (made by the
   builders, ``particleShear.linkable.builders.ensemble_of_state``) then holds them in the state's
   memory, as if the state had been made by :func:`state_of_ensemble`;
+* :func:`ensembles_of` tells whose memory a state is;
 * :func:`write_back` hands an ensemble its plates, relations and Verlet predictor after such an
   engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as it was
   when a run on its own state fails;
@@ -26,6 +27,7 @@ Units: µm, s, mg per m depth (docs/parameters.md).
 __docformat__ = "numpy"
 
 import contextlib
+import weakref
 
 import numpy as np
 
@@ -40,7 +42,7 @@ from .callbacks import callback_phase_laws
 from .fields import REPLICA_FIELDS, ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "adopt_state",
-           "check_adoptable", "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws",
+           "ensembles_of", "check_adoptable", "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws",
            "host_backend"]
 
 #: each per-sphere array of a :class:`BatchState` and the field of the ensembles' state block it holds
@@ -186,7 +188,7 @@ def state_of_ensemble(ensemble, laws=None, backend="numpy"):
     Returns
     -------
     BatchState
-        B = 1 on the host, with :attr:`ensemble` set to ``ensemble``.
+        B = 1 on the host, the memory of ``ensemble`` (:func:`ensembles_of`).
     """
     return state_of_ensembles([ensemble], laws=laws, backend=backend)
 
@@ -209,8 +211,8 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     joined (:meth:`~particleShear.engine.predictor.Predictor.joined`); the box, constants
     and per-sphere parameters (which a step only reads) are copied as by
     :func:`state_from_ensembles`, the plates (``applying_shear``, one flag per batch) from the
-    first ensemble's ``applyingShear``.  An engine on this state numbers the relations as they
-    form, and :func:`write_back` afterwards gives each ensemble its plates, relations and
+    first ensemble's ``applyingShear``.  An engine on this state built with
+    ``numbers_relations=True`` numbers the relations as they form, and :func:`write_back` afterwards gives each ensemble its plates, relations and
     predictor rows and drops its caches (and :func:`untouched_on_failure` puts one back after a
     failed run).
 
@@ -229,7 +231,7 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     Returns
     -------
     BatchState
-        On the host, with :attr:`ensembles` set (and :attr:`ensemble` for B = 1).
+        On the host, the memory of ``ensembles`` (:func:`ensembles_of`).
 
     Raises
     ------
@@ -257,9 +259,36 @@ def state_of_ensembles(ensembles, laws=None, backend="numpy"):
     s.predictor = ensembles[0]._predictor if s.B == 1 else Predictor.joined(
         [e._predictor for e in ensembles], [N] * s.B, np)
     s.applying_shear = bool(getattr(ensembles[0], "applyingShear", True))
-    s.ensembles = ensembles
+    _remember(s, ensembles)
     s.backend = target         # (the same host arrays)
     return s
+
+
+#: state → weak references to the ensembles whose memory it is, one per replica (set by
+#: :func:`state_of_ensembles` and :func:`adopt_state`); a copy of a state is a new object, not in it
+_MEMORY_OF = weakref.WeakKeyDictionary()
+
+
+def ensembles_of(state):
+    """The documented ensembles whose memory ``state`` is, one per replica; None for a state of its own.
+
+    Parameters
+    ----------
+    state : BatchState
+
+    Returns
+    -------
+    list of ensemble or None
+        Set by :func:`state_of_ensembles` and :func:`adopt_state` (a copy of the state,
+        ``to_backend`` or a pickle, owns its arrays and gives None).
+    """
+    refs = _MEMORY_OF.get(state)
+    return None if refs is None else [ref() for ref in refs]
+
+
+def _remember(state, ensembles):
+    """Record that ``state`` is the memory of ``ensembles`` (:func:`ensembles_of`)."""
+    _MEMORY_OF[state] = [weakref.ref(e) for e in ensembles]
 
 
 def _use_block(state, block, cells):
@@ -311,7 +340,7 @@ def adopt_state(ensemble, state):
     ensemble._pairs, ensemble._predictor = state.pairs[0], state.predictor
     ensemble.set_random_generator(state.rng[0])
     ensemble.invalidate_caches()
-    state.ensembles = [ensemble]
+    _remember(state, [ensemble])
 
 
 def check_adoptable(state, n):
@@ -332,8 +361,8 @@ def check_adoptable(state, n):
     if state.B != 1 or not state.backend.host or state.N != n:
         raise ValueError(f"state of B = {state.B}, N = {state.N} on {state.backend.name!r}: adopt_state needs one "
                          f"replica of the ensemble's N = {n} spheres on a host backend")
-    if state.ensembles is not None:
-        raise ValueError("the state is already the memory of an ensemble (state.ensembles): one ensemble per state; "
+    if ensembles_of(state) is not None:
+        raise ValueError("the state is already the memory of an ensemble (ensembles_of): one ensemble per state; "
                          "copy.deepcopy that ensemble for another")
 
 
@@ -381,7 +410,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     b : int
         Replica index (0 … B−1).
     ensemble : ensemble of ``particleShear.linkable``
-        The ensemble that is replica ``b`` of the engine's state (``state.ensembles[b]``).
+        The ensemble that is replica ``b`` of the engine's state (``ensembles_of(state)[b]``).
     steps : int, optional
         Steps the replica was advanced (bookkeeping of the classes).
     constitution : bool, default True
@@ -397,7 +426,8 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
         engine does not number its relations (``numbers_relations`` False).
     """
     s = engine.s
-    if s.ensembles is None or s.ensembles[b] is not ensemble:
+    members = ensembles_of(s)
+    if members is None or members[b] is not ensemble:
         raise ValueError("write_back needs an engine on the ensemble's own state "
                          "(state_of_ensembles, of which replica b is the ensemble)")
     if not engine.numbers_relations:

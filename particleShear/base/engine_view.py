@@ -70,6 +70,7 @@ class EngineStep:
         self._drop_engine()
         eng = BatchEngine(state_of_ensemble(self, backend="auto"), skin_factor=self.neighbour_skin, guard=False,
                           integrator=getattr(self, "integrator", "euler"), keep_terms=True,   # (the force register)
+                          numbers_relations=True,          # (the creation numbers order the neighbours)
                           lees_edwards=self._lees_edwards(),
                           strain_only_while_shearing=self._strain_only_while_shearing)
         self._engine_pairs = (self._pairs, self._pairs.version)

@@ -43,11 +43,9 @@ class EngineConfig:
         None: the engine's default bound.
     keep_terms : bool
         Keep the per-term arrays of each force phase for the force register.
-    numbers_relations : bool or None
-        Number the relations as they form, for a write-back into ensembles; None: decided by the
-        engine from its state (on for a state that is an ensemble's own).  The engine's own
-        configuration (:attr:`BatchEngine.config <particleShear.engine.step.BatchEngine.config>`)
-        holds the decision, a bool.
+    numbers_relations : bool
+        Number the relations as they form (their creation numbers order a documented ensemble's
+        neighbours; the adapters build an engine on an ensemble's memory with True).
     lees_edwards : bool
         True: every replica is a Lees-Edwards cell (images offset by ``Ly·γ``, moving with
         ``Ly·γ̇``); False: plain periodic cells (the documented ``use_lees_edwards = False``
@@ -69,7 +67,7 @@ class EngineConfig:
     min_distance_ratio: float = 0.05
     max_kinetic_energy: object = None
     keep_terms: bool = False
-    numbers_relations: object = None
+    numbers_relations: bool = False
     lees_edwards: bool = True
     strain_only_while_shearing: bool = False
 
@@ -83,7 +81,7 @@ class EngineConfig:
         guard = np.asarray(self.guard, dtype=bool)
         fixed = dict(check_interval=int(self.check_interval), keep_terms=bool(self.keep_terms),
                      guard=bool(guard) if guard.ndim == 0 else tuple(bool(g) for g in guard.ravel()),
-                     numbers_relations=None if self.numbers_relations is None else bool(self.numbers_relations),
+                     numbers_relations=bool(self.numbers_relations),
                      lees_edwards=bool(self.lees_edwards),
                      strain_only_while_shearing=bool(self.strain_only_while_shearing))
         for name, value in fixed.items():      # (a frozen dataclass sets its own fields this way)

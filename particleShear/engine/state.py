@@ -595,23 +595,10 @@ class BatchState:
 
     #: per-sphere parameters (see above); a class default, so a state pickled without it loads as shared
     visit = None
-    #: the objects whose memory this state's per-sphere arrays, ``t``, ``gamma``, ``rate``, ``mu`` and pair
-    #: lists are, one per replica
-    #: (set by :func:`particleShear.base.engine_adapter.state_of_ensembles`: the documented
-    #: ensembles), else None; a copy (:meth:`to_backend`, pickling) owns its arrays and has None.  An
-    #: engine on such a state numbers the relations as they form
-    #: (:attr:`~particleShear.engine.step.BatchEngine.numbers_relations`).
-    ensembles = None
     #: the flat candidate list and its history (:class:`~particleShear.engine.contacts.Contacts`),
     #: made by the engine built on this state; None until then (a class default: a state pickled
     #: without it loads with None)
     contacts = None
-
-    @property
-    def ensemble(self):
-        """The one entry of :attr:`ensembles` of a batch of one, else None."""
-        e = self.ensembles
-        return e[0] if e is not None and len(e) == 1 else None
 
     def __init__(self, B, N, backend="auto"):
         self.backend = get_backend(backend)
@@ -647,7 +634,6 @@ class BatchState:
         state = dict(self.__dict__)
         state["backend"] = self.backend.name
         del state["xp"]
-        state.pop("ensembles", None)      # a copy is no longer the ensembles' rows
         state.pop("contacts", None)       # (engine bookkeeping; the tables are the carried view)
         return state
 
@@ -737,7 +723,6 @@ class BatchState:
         out = object.__new__(type(self))
         out.__dict__.update(self.__dict__)
         out.backend, out.xp = target, target.xp
-        out.ensembles = None        # copies, no longer the ensembles' rows
         out.contacts = None         # (the flat list lives on the source's backend; the tables are shared)
         out.predictor = self.predictor.on(target)
         for name in ("pos", "vel", "frc", "phi", "r", "m", "inertia", "rep", "law_params") + self.REPLICA_ARRAYS:

@@ -163,9 +163,9 @@ class BatchEngine:
         (dropped where :meth:`~particleShear.engine.predictor.Predictor.start` says).
     phase : str, keyword-only
         The phase its steps belong to, for messages (the loops set it as they run).
-    numbers_relations : bool or None, keyword-only
-        Number the relations as they form, for a write-back into ensembles; None: for a state
-        that is an ensemble's own (``state.ensembles``).
+    numbers_relations : bool, keyword-only
+        Number the relations as they form (their creation numbers order a documented ensemble's
+        neighbours: an engine on an ensemble's memory is built with True by the adapters).
     lees_edwards : bool, keyword-only
         False: plain periodic cells (no Lees-Edwards images; the documented ``use_lees_edwards =
         False`` ensembles).
@@ -187,7 +187,7 @@ class BatchEngine:
 
     def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler", *,
                  keep_terms=False, min_distance_ratio=0.05, max_kinetic_energy=None, half=None,
-                 phase="pre-equilibration", numbers_relations=None, lees_edwards=True,
+                 phase="pre-equilibration", numbers_relations=False, lees_edwards=True,
                  strain_only_while_shearing=False, config=None):
         given = EngineConfig(integrator=integrator, skin_factor=skin_factor, check_interval=check_interval,
                              guard=guard, min_distance_ratio=min_distance_ratio,
@@ -199,8 +199,6 @@ class BatchEngine:
         elif given != EngineConfig():
             raise ValueError("give the engine's configuration either as config or as keyword arguments, not both")
         s = self.s = state
-        if config.numbers_relations is None:     # (on from the start for a state that is an ensemble's own)
-            config = config.replace(numbers_relations=s.ensembles is not None)
         self._config = config     # (read-only: the property config)
         #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
         #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
@@ -239,7 +237,7 @@ class BatchEngine:
     @property
     def config(self):
         """The engine's configuration (:class:`~particleShear.engine.config.EngineConfig`), fixed at
-        construction (its ``numbers_relations`` decided, a bool); its fields are also read-only
+        construction; its fields are also read-only
         properties of the engine of the same names."""
         return self._config
 

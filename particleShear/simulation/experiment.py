@@ -540,7 +540,7 @@ class OscillatoryShearExperiment:
         # Numba is installed (the same numbers, terms included)
         return BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                            check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"),
-                           keep_terms=True, **thresholds)
+                           keep_terms=True, numbers_relations=True, **thresholds)
 
     def _scene(self, engine):
         scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
