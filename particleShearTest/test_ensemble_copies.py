@@ -24,6 +24,7 @@ from particleShear.base.canvas import (CanvasPoints, CanvasPointsBasicElasticity
                                        CanvasPointsFrictionElasticityLeesEdwards, CanvasPointsMass,
                                        CanvasPointsNeighbors, CanvasPointsShear)
 from particleShear.base.canvas_base import SphereList
+from particleShear.base.engine_adapter import state_of_ensemble
 from particleShear.base.register import Force_register
 from particleShear.linkable import (CanvasPointsLinkable, EnsembleCompactParticles,
                                     EnsembleCompactParticlesAdjustableInterfaceStrength, EnsembleLinkable,
@@ -111,8 +112,8 @@ def bits(e):
     a candidate that is no relation are exact zeros, which leave the sums' bits as they are.
     """
     out = {"block": e._st.tobytes(), "replica": e._replica.tobytes()}
-    if hasattr(e, "_pairs"):
-        pt = e._pairs
+    if hasattr(e, "pair_table"):
+        pt = e.pair_table
         out.update({"pairs." + name: getattr(pt, name)[..., pt.active].tobytes() for name in pt.ARRAYS})
         out["births"] = pt.birth_count
         out["half"] = None if e._predictor.half is None else e._predictor.half.tobytes()
@@ -121,14 +122,16 @@ def bits(e):
 
 def table(e):
     """The bytes of every array of the pair table of ``e``."""
-    return [getattr(e._pairs, name).tobytes() for name in e._pairs.ARRAYS]
+    pt = e.pair_table
+    return [getattr(pt, name).tobytes() for name in pt.ARRAYS]
 
 
 def arrays(e):
     """The arrays of ``e`` a copy must not share: the state block, the replica cells, the pair table, the predictor."""
-    out = [e._block, e._replica]
-    if hasattr(e, "_pairs"):
-        out += [getattr(e._pairs, name) for name in e._pairs.ARRAYS]
+    pt = state_of_ensemble(e).pairs[0] if hasattr(e, "pair_table") else None   # (the ensemble's own table)
+    out = [e._block, e._replica]      # (read after state_of_ensemble, which may fit the block)
+    if pt is not None:
+        out += [getattr(pt, name) for name in pt.ARRAYS]
         out += [] if e._predictor.half is None else [e._predictor.half]
     return out
 
@@ -146,7 +149,7 @@ class CopiesTest(unittest.TestCase):
             self.assertIs(t.__dict__["_ens"], c)
             self.assertEqual((t.__dict__["_idx"], t.x, t.r), (k, s.x, s.r))
         self.assertEqual(bits(c), bits(e))
-        for name, row in list(c._a.items()) + [("_st", c._st), ("_pos", c._pos), ("_vel", c._vel), ("_frc", c._frc)]:
+        for name, row in list(c.sphere_arrays.items()) + [("_st", c._st), ("_pos", c._pos), ("_vel", c._vel), ("_frc", c._frc)]:
             self.assertTrue(row.size == 0 or np.shares_memory(row, c._block), name)    # views of its own block
         for mine in arrays(c):
             self.assertFalse(any(np.shares_memory(mine, theirs) for theirs in arrays(e)))
@@ -179,7 +182,7 @@ class CopiesTest(unittest.TestCase):
                 before = bits(e), table(e)
                 c.sphereList[0].x += 1.0
                 c.t, c.shear, c.mu = 1.0, 0.5, 0.0
-                c._pairs.xi[:] = 1.0
+                state_of_ensemble(c).pairs[0].xi[:] = 1.0       # (the copy's own table)
                 c.makeAllLinksPermanent()
                 c.sphereList.append(SphereLinkable("grey", 10, 10, 20))
                 stepped(c, 3, dt=dt)

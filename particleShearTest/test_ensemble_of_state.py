@@ -95,9 +95,9 @@ def test_the_builders_ensemble_bit_for_bit(legacy, fields, seed):
     assert attribute_differences(ens, view, PRIVATE + MEMORY) == []
     assert np.array_equal(bits(view._st), bits(ens._st))
     assert [view.t, view.shear, view.shear_rate, view.mu] == [ens.t, ens.shear, ens.shear_rate, ens.mu]
-    assert pair_differences(kept(ens._pairs), view._pairs) == []
+    assert pair_differences(kept(ens.pair_table), view.pair_table) == []
     if recipe.do_permanent_links:
-        assert view._pairs.n_permanent > 0               # a gel: the comparison has bonds
+        assert view.pair_table.n_permanent > 0               # a gel: the comparison has bonds
     assert ens.step_count > 0 or not recipe.do_pre_equilibration
     assert vars(view.model) == vars(ens.model)
     assert vars(view.graphical_output_configuration) == vars(ens.graphical_output_configuration)
@@ -121,7 +121,7 @@ def test_it_is_a_view_of_the_state():
         assert np.shares_memory(block, getattr(s, name)), name
     for name in ("t", "gamma", "rate", "mu"):
         assert np.shares_memory(view._replica, getattr(s, name)), name
-    assert view._pairs is s.pairs[0] and view._predictor is s.predictor and view._rng is s.rng[0]
+    assert view._predictor is s.predictor and view._rng is s.rng[0]
     assert ensembles_of(s) == [view]
     sphere = view.sphereList[7]
     sphere.x = 123.5                                   # the ensemble's writes, the state's values
@@ -162,5 +162,5 @@ def test_the_documented_steps_of_the_view_are_the_builders(legacy, fields, seed,
     assert not np.array_equal(view._st, relax_constitution(constitution(recipe, legacy=legacy, do_debug=True,
                                                                         rng=seed))._st)     # (they moved)
     assert (view.t, view.shear, view.step_count) == (ens.t, ens.shear, ens.step_count)
-    assert pair_differences(kept(ens._pairs), kept(view._pairs)) == []
+    assert pair_differences(kept(ens.pair_table), kept(view.pair_table)) == []
     assert np.array_equal(bits(s.vel), bits(ens._vel)) and s.t[0] == ens.t          # the state holds the steps
