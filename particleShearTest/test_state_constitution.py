@@ -17,6 +17,7 @@ import pytest
 
 from particleShear.base.engine_adapter import relax_states, state_from_ensembles
 from particleShear.engine.state import BatchState, PairTable
+from particleShear.linkable import builders
 from particleShear.linkable.builders import EnsembleRecipe, Relaxation, constituted_state, state_constitution
 from particleShear.run.measurement import CONCLUSION
 from particleShear.run.sessions import build_sessions
@@ -159,19 +160,27 @@ def run_sessions(kws, constituted=None):
     return measure_sessions(sessions, constituted=constituted is not None, conclusion=CONCLUSION), sims
 
 
-def test_a_runs_ensemble_is_a_view_of_the_builders_gel_and_gives_its_results():
+def test_a_runs_ensemble_is_a_view_of_the_builders_gel_and_gives_its_results(monkeypatch):
     # (a law other than the callbacks': the relaxations' law shows in the gel)
     kws = [dict(QUICK, seed=s, contact_law="plateau", **more) for s, more in
            ((1, dict(theMu=0.05, cut_lines=2)), (2, dict(theMu=0.05, cut_lines=2)),
             (3, dict(theMu=0.0, do_permanent_links=False)))]
+    sizes = []
+
+    def counted(states, *args, **kwargs):
+        sizes.append(len(states))
+        return relax_states(states, *args, **kwargs)
+    monkeypatch.setattr(builders, "relax_states", counted)
     results, sims = run_sessions(kws)
+    monkeypatch.undo()
+    assert max(sizes) == len(kws)           # the driver relaxed the sessions' states together
     assert sims[0].contact_law[0] == "plateau"
-    builders = []
+    theirs = []
     for kw, sim in zip(kws, sims):
         recipe = sim.ensemble_recipe()
         generator = validated_run(dict(kw, return_result=True)).generator      # the run's seed, afresh
         ens = driver_style(recipe, generator, sim.contact_law, sim.parameters["backend"], do_debug=False)
-        builders.append(ens)
+        theirs.append(ens)
         view, s = sim.theEnsemble, sim.constituted.state
         assert s.ensembles == [view] and view._pairs is s.pairs[0] and view._rng is s.rng[0]
         assert np.shares_memory(view._block, s.x)
@@ -182,10 +191,9 @@ def test_a_runs_ensemble_is_a_view_of_the_builders_gel_and_gives_its_results():
         assert pair_differences(kept(ens._pairs), view._pairs) == []
         # (the run's experiment set its guard on the ensemble)
         assert attribute_differences(ens, view, PRIVATE + MEMORY + ("stability_guard",)) == []
-        assert differences(state_from_ensembles([ens], backend="numpy"), state_from_ensembles([view], backend="numpy")) \
-            == []
+        assert differences(*(state_from_ensembles([e], backend="numpy") for e in (ens, view))) == []
     # the builders' gels measured by the same driver: the same results bit for bit
-    again, _ = run_sessions(kws, constituted=builders)
+    again, _ = run_sessions(kws, constituted=theirs)
     for a, b in zip(results, again, strict=True):
         assert_same_result(_Asserter(), a, b)
 

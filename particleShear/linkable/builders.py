@@ -665,7 +665,9 @@ class _StateTarget:
 
     @staticmethod
     def relax(targets, N):
-        """``free_pre_equilibration(N)`` of every target in one engine (:func:`~particleShear.base.engine_adapter.relax_states`).
+        """``free_pre_equilibration(N)`` of every target, all in one engine.
+
+        :func:`~particleShear.base.engine_adapter.relax_states` of the targets' states.
 
         Each target's μ is set on its state first; the targets share ``dt``, ``dt_max`` and the
         skin (ValueError otherwise, before any step); each one's step count advances.

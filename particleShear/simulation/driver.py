@@ -176,8 +176,9 @@ def _constitute(sessions):
     :func:`particleShear.base.engine_adapter.relax_states`; a subclass's ensembles by
     :func:`~particleShear.base.engine_adapter.relax_ensembles`), the key of the first waiting
     replica first, until every constitution is done.  A replica's gel does not depend on its
-    companions (each has its own generator, and the engine's relaxation is per replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
-    the relaxations it took part in."""
+    companions (each has its own generator, and the engine's relaxation is per replica).  Each
+    replica's ``constitution`` timing is its own bookkeeping plus its share of the relaxations it
+    took part in."""
 
     # the backend of each replica's relaxations: its run's, where that keeps the host's arrays (the
     # compiled step is compiled, or loaded from the cache, here: not counted in the timings)

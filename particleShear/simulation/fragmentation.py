@@ -319,7 +319,8 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     """The simulation created by ``doParticleShearSimulation``: adjustable interface strength.
 
     Builds the ensemble of ``EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters``
-    on the engine's state (:meth:`constitution_steps`; the ensemble a view of it).  The class defaults are the reference's and differ from those of ``doParticleShearSimulation``
+    on the engine's state (:meth:`constitution_steps`; the ensemble a view of it).  The class
+    defaults are the reference's and differ from those of ``doParticleShearSimulation``
     (docs/parameters.md), which passes every argument.
 
     Parameters
