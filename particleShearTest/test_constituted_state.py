@@ -144,12 +144,12 @@ def test_angles_and_a_bounded_redraw():
         bonds.random_line(g, 100, 50, 90.0001)          # (the recipe forbids it: every angle rejected)
 
 
-def driver_style(recipe, seed, law, backend):
-    """The ensemble as a run's driver constitutes it: each relaxation with the run's law and backend
-    (``simulation.driver``'s ``relax_ensembles`` call, for a batch of one)."""
+def driver_style(recipe, seed, law, backend, do_debug=True):
+    """The builders' ensemble with each relaxation as a run's driver relaxes it: the run's law and
+    backend and the driver's skin (``relax_ensembles``, a batch of one)."""
     from particleShear.base.engine_adapter import relax_ensembles
     from particleShear.simulation.driver import ENGINE_SKIN_FACTOR
-    steps = constitution(recipe, do_debug=True, rng=seed)
+    steps = constitution(recipe, do_debug=do_debug, rng=seed)
     try:
         while True:
             request = next(steps)

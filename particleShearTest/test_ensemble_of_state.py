@@ -74,7 +74,7 @@ def attribute_differences(a, b, skip=()):
         if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
             same = np.shape(x) == np.shape(y) and np.array_equal(bits(x), bits(y))
         elif isinstance(x, SCALARS) or isinstance(x, list) and all(isinstance(v, SCALARS) for v in x):
-            same = x == y
+            same = x == y and type(x) is type(y)      # (a file writes 0 and 0.0 differently)
         else:
             same = type(x) is type(y)
         if not same:

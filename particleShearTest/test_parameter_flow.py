@@ -256,16 +256,17 @@ class TestMuReachesTheKernel(unittest.TestCase):
 
     def test_mu_travels_as_one_object_in_two_records(self):
         """The hops of μ: the call's value is, as the very object, ``RunParameters["theMu"]``, then the field
-        ``mu`` of the run's :class:`EnsembleRecipe`, which the constitution sets as the ensemble's μ (read into
-        ``BatchState.mu``, above): no builder or constructor argument, no dict repacked on the way."""
+        ``mu`` of the run's :class:`EnsembleRecipe`, which the constitution (on the engine's state, a run's)
+        sets as the state's μ (read into ``BatchState.mu``, above): no builder or constructor argument, no
+        dict repacked on the way."""
         mu = float("0.37")                  # an object of its own, followed by identity
-        recipes, constitution = [], fragmentation.constitution
+        recipes, constitution = [], fragmentation.state_constitution
 
         def capture(recipe, **kw):
             recipes.append(recipe)
             return constitution(recipe, **kw)
 
-        with mock.patch.object(fragmentation, "constitution", capture), self.assertWarns(Warning):
+        with mock.patch.object(fragmentation, "state_constitution", capture), self.assertWarns(Warning):
             result = doParticleShearSimulation(theMu=mu, return_result=True, **SMALL)
         self.assertEqual(len(recipes), 1)
         self.assertIsInstance(recipes[0], EnsembleRecipe)

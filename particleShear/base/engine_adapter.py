@@ -17,7 +17,8 @@ of plain arrays and knows nothing of the documented classes.  This module is the
   engine ran, and drops its caches; :func:`untouched_on_failure` puts an ensemble back as it was
   when a run on its own state fails;
 * :func:`relax_ensembles` is ``free_pre_equilibration`` of a list of ensembles in one engine
-  (:func:`~particleShear.engine.relax.free_relaxation`), written back.
+  (:func:`~particleShear.engine.relax.free_relaxation`), written back; :func:`relax_state` the
+  same relaxation of a state, :func:`relax_states` of several one-replica states in one engine.
 
 This module and the classes themselves are the only code that reads the classes' state blocks,
 pair tables and generators and drops their caches (through the classes' package-private members).
@@ -42,8 +43,8 @@ from .callbacks import callback_phase_laws
 from .fields import REPLICA_FIELDS, ROW
 
 __all__ = ["uniform_parameters", "state_from_ensembles", "state_of_ensemble", "state_of_ensembles", "adopt_state",
-           "ensembles_of", "check_adoptable", "write_back", "untouched_on_failure", "relax_ensembles", "relax_state", "set_laws",
-           "host_backend"]
+           "ensembles_of", "check_adoptable", "write_back", "untouched_on_failure", "relax_ensembles", "relax_state",
+           "relax_states", "set_laws", "host_backend"]
 
 #: each per-sphere array of a :class:`BatchState` and the field of the ensembles' state block it holds
 SPHERE_ROWS = (("x", "x"), ("y", "y"), ("vx", "xspeed"), ("vy", "yspeed"), ("omega", "omega"), ("phi", "phi"),
@@ -583,3 +584,60 @@ def relax_state(state, N, dt, dt_max, skin_factor=RELAX_SKIN, integrator="euler"
                          guard=guard, min_distance_ratio=min_distance_ratio, max_kinetic_energy=max_kinetic_energy,
                          phase="constitution", numbers_relations=True)
     return engine, free_relaxation(engine, N, dt, dt_max, state.mu.copy())
+
+
+def relax_states(states, N, dt, dt_max, skin_factor=RELAX_SKIN):
+    """:func:`relax_state` of several one-replica states, all in one engine, each handed its replica back.
+
+    The batch of a run's driver on the engine's states, as :func:`relax_ensembles` is on the
+    documented ensembles: the states are joined (:meth:`~particleShear.engine.state.BatchState.concat`,
+    their rows, clocks, strains, μ and constants copied, their generators shared), relaxed once, and
+    each state gets its rows, replica values and pair table back (the joint state's table
+    itself: the engine's rebuilds replace a replica's table, its history is flushed into it) and
+    the rows of the Verlet predictor; a state's contacts are dropped (an engine built on it
+    starts them from its table).  Each replica is relaxed as it would be alone, bit for bit: the
+    relaxation is per replica, and each has its own generator (docs/engine.md, "Runs").  A single
+    state is relaxed in place, without a copy.
+
+    Parameters
+    ----------
+    states : sequence of BatchState
+        One-replica host states of equal N, backend, law and law callbacks (shear rate 0), each once.
+    N : int
+        Steps per level and per final block (>= 0).
+    dt, dt_max : float
+        Final and coarsest step (s), the same for every state.
+    skin_factor : float, optional
+        Verlet skin in units of each replica's largest radius (the result does not depend on it).
+
+    Returns
+    -------
+    int
+        Steps run per state.
+
+    Raises
+    ------
+    ValueError
+        If a state is given twice, has more than one replica or lives on a device, or the states
+        differ in N, backend, law or law callbacks (before any step).
+    """
+    states = list(states)
+    if len({id(st) for st in states}) != len(states):
+        raise ValueError("states: a state is given twice; each replica needs state of its own")
+    if any(st.B != 1 or not st.backend.host for st in states):
+        raise ValueError("relax_states needs one-replica states on a host backend: "
+                         f"(B, backend) = {[(st.B, st.backend.name) for st in states]}")
+    if len(states) == 1:
+        return relax_state(states[0], N, dt, dt_max, skin_factor=skin_factor)[1]
+    joint = BatchState.concat(states)           # (checks N, backend, law and callbacks before any step)
+    _, steps = relax_state(joint, N, dt, dt_max, skin_factor=skin_factor)
+    for b, st in enumerate(states):
+        rows = joint.replica(b)
+        for name in BatchState.SPHERE_ARRAYS:
+            getattr(st, name)[...] = getattr(joint, name)[rows]
+        for name in BatchState.REPLICA_ARRAYS:
+            getattr(st, name)[0] = getattr(joint, name)[b]
+        st.pairs[0] = joint.pairs[b]
+        st.predictor.half = joint.predictor.rows_of(rows)
+        st.contacts = None
+    return steps

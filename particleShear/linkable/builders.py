@@ -8,7 +8,7 @@ import logging
 
 import numpy as np
 
-from ..base.engine_adapter import adopt_state, check_adoptable, host_backend, relax_ensembles, relax_state, set_laws
+from ..base.engine_adapter import adopt_state, check_adoptable, host_backend, relax_ensembles, relax_states, set_laws
 from ..base.fields import FIELDS
 from ..base.pair_canvas import CanvasPointsNeighbors
 from ..checks import finite, in_range, integer, non_negative, positive
@@ -24,6 +24,7 @@ from .compact import EnsembleCompactParticles, EnsembleCompactParticlesAdjustabl
 __all__ = ["EnsembleCompactParticlesFromModelParameters",
            "EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters",
            "adjustable_interface_constitution", "constitution", "constituted_state", "ConstitutedState",
+           "state_constitution",
            "ensemble_of_state",
            "EnsembleRecipe", "Relaxation", "relax_constitution",
            "time_steps_from_model", "MAX_CUT_ATTEMPTS"]
@@ -184,11 +185,15 @@ def _crosslink_and_cut(ens, cut_lines, doCutByTriangulation, edge_fuzziness, cut
 class Relaxation:
     """Request to run ``ensemble.free_pre_equilibration(N)`` in the engine, yielded by a constitution.
 
-    Run by :meth:`run` or by a batch's driver; ``dt``, ``dt_max``, ``mu`` are read then (docs/engine.md, "Runs").
+    The target is a documented ensemble (:func:`constitution`) or the engine state of a
+    constitution on the state (:func:`state_constitution`); it is run by :meth:`run` or, with
+    the waiting requests of other constitutions, by :meth:`run_together` (a batch's driver);
+    ``dt``, ``dt_max``, ``mu`` are read then (docs/engine.md, "Runs").
 
     Parameters
     ----------
-    ensemble : EnsembleCompactParticles
+    ensemble : EnsembleCompactParticles or the state's target
+        What is relaxed (attribute ``ensemble`` for either).
     N : int
         Steps per level and per final block, >= 0.
     """
@@ -204,9 +209,55 @@ class Relaxation:
         e = self.ensemble
         return (self.N, float(e.dt), float(e.dt_max))
 
+    @property
+    def batch_key(self):
+        """:attr:`key` and what else one engine needs to be common: requests of equal batch keys can run together.
+
+        For a state's request also its backend, law and Verlet skin (:func:`state_constitution`);
+        an ensemble's takes them from :meth:`run_together`'s arguments.
+        """
+        e = self.ensemble
+        if not isinstance(e, _StateTarget):
+            return self.key + ("ensemble",)
+        s = e.state
+        return self.key + ("state", s.backend.name, s.law, float(e.skin_factor))
+
     def run(self):
-        """Relax this ensemble alone in the engine (:func:`particleShear.base.engine_adapter.relax_ensembles`)."""
-        relax_ensembles([self.ensemble], self.N)
+        """Relax this target alone in the engine (the target's ``free_pre_equilibration``)."""
+        self.ensemble.free_pre_equilibration(self.N)
+
+    @staticmethod
+    def run_together(requests, skin_factor=RELAX_SKIN, laws=None, backend="numpy"):
+        """Run requests of one :attr:`batch_key` in one engine, each target as if alone (bit for bit).
+
+        States' by :func:`~particleShear.base.engine_adapter.relax_states` (with their own law,
+        backend and skin), ensembles' by :func:`~particleShear.base.engine_adapter.relax_ensembles`
+        (with the settings given here).
+
+        Parameters
+        ----------
+        requests : sequence of Relaxation
+            Of equal :attr:`batch_key`, each target once.
+        skin_factor, laws, backend : optional
+            The Verlet skin, central law of each target and host backend of an ensembles' engine,
+            as :func:`~particleShear.base.engine_adapter.relax_ensembles` takes them (unused for states).
+
+        Raises
+        ------
+        ValueError
+            If the requests' batch keys differ (before any step), or as the relaxation raises.
+        """
+        requests = list(requests)
+        keys = {r.batch_key for r in requests}
+        if len(keys) > 1:
+            raise ValueError(f"requests of the batch keys {sorted(keys, key=str)}: one engine relaxes one kind")
+        if not requests:
+            return
+        targets = [r.ensemble for r in requests]
+        if isinstance(targets[0], _StateTarget):
+            _StateTarget.relax(targets, requests[0].N)
+        else:
+            relax_ensembles(targets, requests[0].N, skin_factor=skin_factor, laws=laws, backend=backend)
 
     def __repr__(self):
         N, dt, dt_max = self.key
@@ -520,8 +571,9 @@ class ConstitutedState:
         The steps to use (s), as the builders leave them on their ensemble.
     model : particle_shear_model_parameters
         The model constants (``ensemble.model``).
-    removed_fraction : float
-        Fraction of the non-essential links removed (0 without ``remove_link_fraction``).
+    removed_fraction : float or int
+        Fraction of the non-essential links removed: the value the builders' ensemble holds (the
+        int 0 without ``remove_link_fraction``, which a file's header writes as ``0``).
     triangulation_points : ndarray (n, 2) or None
         The Voronoi seeds of the last cut (µm), None without a Voronoi cut.
     r_max : float
@@ -554,8 +606,8 @@ class _StateTarget:
     """What :func:`_schedule` reads and calls of an ensemble, on an engine state of one replica.
 
     Its methods are the documented classes' (same names) on the state's rows and pair table,
-    through :mod:`.bonds`; a relaxation runs the engine on the state
-    (:func:`~particleShear.base.engine_adapter.relax_state`, the settings of
+    through :mod:`.bonds`; a relaxation runs the engine on the state, alone or joined with other
+    targets' (:meth:`relax`, :func:`~particleShear.base.engine_adapter.relax_states`, the settings of
     :func:`~particleShear.base.engine_adapter.relax_ensembles` for an ensemble without a guard:
     the relaxations' central law ``law``, host backend ``backend`` and Verlet skin ``skin_factor``).
     """
@@ -609,9 +661,27 @@ class _StateTarget:
         return self.state.pairs[0]
 
     def free_pre_equilibration(self, N):
-        self.state.mu[0] = float(self.mu)
-        _, steps = relax_state(self.state, N, float(self.dt), float(self.dt_max), skin_factor=self.skin_factor)
-        self.steps += steps
+        _StateTarget.relax([self], N)
+
+    @staticmethod
+    def relax(targets, N):
+        """``free_pre_equilibration(N)`` of every target, all in one engine.
+
+        :func:`~particleShear.base.engine_adapter.relax_states` of the targets' states.
+
+        Each target's μ is set on its state first; the targets share ``dt``, ``dt_max`` and the
+        skin (ValueError otherwise, before any step); each one's step count advances.
+        """
+        settings = {(float(t.dt), float(t.dt_max), float(t.skin_factor)) for t in targets}
+        if len(settings) != 1:
+            raise ValueError(f"targets have (dt, dt_max, skin_factor) = {sorted(settings)}: one engine relaxes "
+                             "one schedule")
+        (dt, dt_max, skin_factor), = settings
+        for t in targets:
+            t.state.mu[0] = float(t.mu)
+        steps = relax_states([t.state for t in targets], N, dt, dt_max, skin_factor=skin_factor)
+        for t in targets:
+            t.steps += steps
 
     def makeAllLinksPermanent(self):
         if not self._pairs.active.any():       # the ensemble's neighbour update (test_neighbor_relation)
@@ -660,6 +730,54 @@ class _StateTarget:
         bonds.join_isolated_spheres(self._pairs, x, y, r, self.size_x, self.size_y, self.state.rng[0])
 
 
+def state_constitution(recipe, *, legacy=False, rng=None, law=None, backend="numpy", relaxation_law=None,
+                       relaxation_backend="numpy", skin_factor=RELAX_SKIN, do_debug=False, verbose=False):
+    """The constitution of ``recipe`` on the engine's state as a generator of its relaxations.
+
+    :func:`constituted_state` with each relaxation yielded as a :class:`Relaxation` of the
+    state's target (its ``dt``, ``dt_max`` and ``mu`` set for it) for the caller to run:
+    alone (:meth:`Relaxation.run`, :func:`relax_constitution`) or with the waiting requests of
+    other constitutions in one engine (:meth:`Relaxation.run_together`, a run's driver,
+    ``simulation.driver``); the result does not depend on which (docs/engine.md, "Runs").
+    Invalid backends raise on the first ``next()``, before any work.
+
+    Parameters
+    ----------
+    recipe, legacy, rng, law, backend, relaxation_law, relaxation_backend, skin_factor, do_debug, verbose
+        As for :func:`constituted_state`.
+
+    Yields
+    ------
+    Relaxation
+        The next block.
+
+    Returns
+    -------
+    ConstitutedState
+        The constituted gel (``StopIteration.value``).
+    """
+    target_backend = get_backend(backend)
+    host_backend(relaxation_backend)
+    c = _Constants(recipe, legacy, do_debug, verbose)
+    target = _StateTarget(recipe, c, legacy, rng, relaxation_law, relaxation_backend, skin_factor)
+    yield from _schedule(target, recipe, c, legacy, verbose)
+    w = target.state
+    s = BatchState(1, w.N, backend="numpy")       # the hand-over's copy (state_from_ensembles)
+    for name in BatchState.SPHERE_ARRAYS + BatchState.REPLICA_ARRAYS:
+        getattr(s, name)[...] = getattr(w, name)
+    s.mu[0] = float(target.mu)      # the ensemble's μ (also where no relaxation ran)
+
+    pt = w.pairs[0]
+    s.pairs[0] = pt.copy(pt.active | (pt.state == PERMANENT))
+    s.rng[0] = w.rng[0]
+    set_laws(s, [law])
+    return ConstitutedState(state=s.to_backend(target_backend), dt=float(target.dt), dt_max=float(target.dt_max),
+                            model=c.model, removed_fraction=target.removed_fraction,
+                            triangulation_points=target.triangulation_points, r_max=float(target.r_max),
+                            steps=target.steps, sphere_seed=target.sphere_seed, particle_labels=target.particle_labels,
+                            cut_top_bottom=target.cut_top_bottom)
+
+
 def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="numpy", relaxation_law=None,
                       relaxation_backend="numpy", skin_factor=RELAX_SKIN, do_debug=False, verbose=False):
     """The constitution of ``recipe`` made on the engine's state, without a documented ensemble.
@@ -670,7 +788,8 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     :class:`~particleShear.engine.state.BatchState` with the random draws in the same order from
     the same generator: the state is bit-identical to
     ``state_from_ensembles([ensemble], backend, laws=[law])`` of the ensemble :func:`constitution`
-    builds from the same recipe and seed (docs/engine.md, "Runs").
+    builds from the same recipe and seed (docs/engine.md, "Runs").  Its relaxations are those of
+    :func:`state_constitution`, run one by one (:func:`relax_constitution`).
 
     Parameters
     ----------
@@ -705,34 +824,9 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
     ValueError
         For an unusable backend or relaxation backend (before any work).
     """
-    target_backend = get_backend(backend)
-    host_backend(relaxation_backend)
-    c = _Constants(recipe, legacy, do_debug, verbose)
-    target = _StateTarget(recipe, c, legacy, rng, relaxation_law, relaxation_backend, skin_factor)
-    steps = _schedule(target, recipe, c, legacy, verbose)
-    try:
-        request = next(steps)
-        for _ in range(MAX_RELAXATIONS):
-            request.ensemble.free_pre_equilibration(request.N)
-            request = next(steps)
-        raise RuntimeError(f"a constitution yielded more than {MAX_RELAXATIONS} relaxations")
-    except StopIteration:
-        pass
-    w = target.state
-    s = BatchState(1, w.N, backend="numpy")       # the hand-over's copy (state_from_ensembles)
-    for name in BatchState.SPHERE_ARRAYS + BatchState.REPLICA_ARRAYS:
-        getattr(s, name)[...] = getattr(w, name)
-    s.mu[0] = float(target.mu)      # the ensemble's μ (also where no relaxation ran)
-
-    pt = w.pairs[0]
-    s.pairs[0] = pt.copy(pt.active | (pt.state == PERMANENT))
-    s.rng[0] = w.rng[0]
-    set_laws(s, [law])
-    return ConstitutedState(state=s.to_backend(target_backend), dt=float(target.dt), dt_max=float(target.dt_max),
-                            model=c.model, removed_fraction=float(target.removed_fraction),
-                            triangulation_points=target.triangulation_points, r_max=float(target.r_max),
-                            steps=target.steps, sphere_seed=target.sphere_seed, particle_labels=target.particle_labels,
-                            cut_top_bottom=target.cut_top_bottom)
+    return relax_constitution(state_constitution(
+        recipe, legacy=legacy, rng=rng, law=law, backend=backend, relaxation_law=relaxation_law,
+        relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=verbose))
 
 
 def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):

@@ -20,7 +20,6 @@ import time
 import numpy as np
 
 from ..base.compiled_phases import compile_tensor_kernel
-from ..base.engine_adapter import relax_ensembles
 from ..base.stability import SimulationInstabilityError
 from ..engine.microstructure import Stroboscope
 from ..engine.numba_step import compile_kernels
@@ -28,7 +27,7 @@ from ..engine.rheometer import shear_record
 from ..engine.state import BatchState
 from ..engine.step import BatchEngine, EngineInstability, pre_equilibrate, protocol
 from ..engine.xp import auto_without_numba, get_backend
-from ..linkable.builders import MAX_RELAXATIONS, time_steps_from_model
+from ..linkable.builders import MAX_RELAXATIONS, Relaxation, time_steps_from_model
 from ..protocols import PROTOCOLS
 from .observers import ReplicaScene
 
@@ -168,13 +167,18 @@ def measure_sessions(sessions, constituted=False, conclusion=None):
 def _constitute(sessions):
     """Constitute every replica: bookkeeping per replica through the classes, relaxations in the engine.
 
-    Each session's constitution (:meth:`~particleShear.simulation.oscillatory.RunSession.constitution`)
-    yields its relaxation requests; the pending requests of equal key (steps, ``dt``, ``dt_max``)
-    run together in one engine (:func:`particleShear.base.engine_adapter.relax_ensembles`), the key of
-    the first waiting replica first, until every constitution is done.  A replica's ensemble does
-    not depend on its companions (each has its own generator, and the engine's relaxation is per
-    replica).  Each replica's ``constitution`` timing is its own bookkeeping plus its share of
-    the relaxations it took part in."""
+    Each session's constitution (:meth:`~particleShear.simulation.oscillatory.RunSession.constitution`:
+    the documented simulation's on the engine's state, with the run's law, its host backend and
+    :data:`ENGINE_SKIN_FACTOR`) yields its relaxation requests; the pending requests of equal
+    batch key (steps, ``dt``, ``dt_max``, and for states their backend, law and skin:
+    :attr:`~particleShear.linkable.builders.Relaxation.batch_key`) run together in one engine
+    (:meth:`~particleShear.linkable.builders.Relaxation.run_together`: the states joined,
+    :func:`particleShear.base.engine_adapter.relax_states`; a subclass's ensembles by
+    :func:`~particleShear.base.engine_adapter.relax_ensembles`), the key of the first waiting
+    replica first, until every constitution is done.  A replica's gel does not depend on its
+    companions (each has its own generator, and the engine's relaxation is per replica).  Each
+    replica's ``constitution`` timing is its own bookkeeping plus its share of the relaxations it
+    took part in."""
 
     # the backend of each replica's relaxations: its run's, where that keeps the host's arrays (the
     # compiled step is compiled, or loaded from the cache, here: not counted in the timings)
@@ -185,7 +189,8 @@ def _constitute(sessions):
         requested = {(sessions[b].sim.parameters or {}).get("backend", "auto") for b in compiled}
         if not all(_compiled(requested, say, law) for law in {(run.sim.contact_law or (None,))[0] for run in sessions}):
             backends = [_host_backend(run) for run in sessions]        # ("auto": NumPy now)
-    steps = [run.constitution() for run in sessions]
+    steps = [run.constitution(relaxation_law=run.sim.contact_law, relaxation_backend=backends[b],
+                              skin_factor=ENGINE_SKIN_FACTOR) for b, run in enumerate(sessions)]
     pending = {}            # replica -> its waiting Relaxation
     since = {}              # replica -> when it was suspended
 
@@ -203,11 +208,11 @@ def _constitute(sessions):
     for _ in range(MAX_RELAXATIONS * max(len(sessions), 1)):   # each round serves at least one request
         if not pending:
             return
-        key = pending[min(pending)].key
-        group = [b for b in sorted(pending) if pending[b].key == key]
+        key = pending[min(pending)].batch_key
+        group = [b for b in sorted(pending) if pending[b].batch_key == key]
         t0 = time.perf_counter()
-        relax_ensembles([pending[b].ensemble for b in group], key[0], skin_factor=ENGINE_SKIN_FACTOR,
-                        laws=[sessions[b].sim.contact_law for b in group], backend=backends[group[0]])
+        Relaxation.run_together([pending[b] for b in group], skin_factor=ENGINE_SKIN_FACTOR,
+                                laws=[sessions[b].sim.contact_law for b in group], backend=backends[group[0]])
         share = (time.perf_counter() - t0) / len(group)
         for b in group:
             advance(b, share)

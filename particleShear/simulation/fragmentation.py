@@ -10,8 +10,9 @@ __docformat__ = "numpy"
 import math
 import os
 
+from ..engine.relax import RELAX_SKIN
 from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, EnsembleRecipe, constitution,
-                                 relax_constitution)
+                                 ensemble_of_state, relax_constitution, state_constitution)
 from .provenance import header_number, positional_numbers_in_call, provenance_lines
 from .oscillatory import OscillatorySimulation, _log, _writes, call_string
 
@@ -317,8 +318,9 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
 class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     """The simulation created by ``doParticleShearSimulation``: adjustable interface strength.
 
-    Builds the ensemble with ``EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters``.
-    The class defaults are the reference's and differ from those of ``doParticleShearSimulation``
+    Builds the ensemble of ``EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters``
+    on the engine's state (:meth:`constitution_steps`; the ensemble a view of it).  The class
+    defaults are the reference's and differ from those of ``doParticleShearSimulation``
     (docs/parameters.md), which passes every argument.
 
     Parameters
@@ -419,8 +421,15 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
                     cut_top_bottom=self.cut_top_bottom, remove_link_fraction=self.remove_link_fraction,
                     edge_fuzziness=self.edge_fuzziness)
 
+    #: the constitution of the last :meth:`initEnsemble` or :meth:`constitution_steps` on the engine's
+    #: state (``linkable.builders.ConstitutedState``), whose state ``theEnsemble`` is a view of; None before
+    constituted = None
+
     def initEnsemble(self, do_debug=False):
-        """Build ``theEnsemble`` with the adjustable-interface builder (``anticipated_amplitude = amplitude``).
+        """Build ``theEnsemble`` as the adjustable-interface builder does (``anticipated_amplitude = amplitude``).
+
+        The requests of :meth:`constitution_steps` run one by one: the builder's ensemble bit for
+        bit, as a view of the state ``constituted``.
 
         Parameters
         ----------
@@ -434,19 +443,28 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         """
         return relax_constitution(self.constitution_steps(do_debug))
 
-    def constitution_steps(self, do_debug=False):
-        """:meth:`initEnsemble` as a generator of the builder's relaxations.
+    def constitution_steps(self, do_debug=False, relaxation_law=None, relaxation_backend="numpy",
+                           skin_factor=RELAX_SKIN):
+        """:meth:`initEnsemble` as a generator of the relaxations of a constitution on the engine's state.
 
-        Runs :func:`~particleShear.linkable.builders.constitution` of this simulation's
-        :meth:`ensemble_recipe`, yielding each of its
-        :class:`~particleShear.linkable.builders.Relaxation` requests, and sets ``theEnsemble``,
-        ``model``, ``dt`` and ``dt_max`` at the end, as :meth:`initEnsemble` does (which runs
-        the requests with the classes).
+        Runs :func:`~particleShear.linkable.builders.state_constitution` of this simulation's
+        :meth:`ensemble_recipe` (the builders' schedule on a one-replica engine state), yielding
+        each of its :class:`~particleShear.linkable.builders.Relaxation` requests, then keeps the
+        :class:`~particleShear.linkable.builders.ConstitutedState` as ``constituted`` and sets
+        ``theEnsemble`` to its documented ensemble, a view of its state
+        (:func:`~particleShear.linkable.builders.ensemble_of_state`: bit for bit the builder's
+        ensemble of the same recipe and seed), and ``model``, ``dt`` and ``dt_max``, as
+        :meth:`initEnsemble` does (which runs the requests one by one).  A run's driver runs the
+        requests of its sessions together (``simulation.driver``) with the run's law and backend.
 
         Parameters
         ----------
         do_debug : bool, optional
             Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+        relaxation_law, relaxation_backend, skin_factor : optional
+            The central law, host backend and Verlet skin of the relaxations, as
+            :func:`~particleShear.linkable.builders.constituted_state` takes them (defaults: the
+            builders').
 
         Yields
         ------
@@ -458,8 +476,11 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
         EnsembleCompactParticlesAdjustableInterfaceStrength
             The constituted ensemble (also ``self.theEnsemble``).
         """
-        self.theEnsemble = yield from constitution(self.ensemble_recipe(), do_debug=do_debug, rng=self.rng,
-                                                   verbose=self.verbose)
+        recipe = self.ensemble_recipe()
+        self.constituted = yield from state_constitution(
+            recipe, rng=self.rng, law=self.contact_law, relaxation_law=relaxation_law,
+            relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=self.verbose)
+        self.theEnsemble = ensemble_of_state(self.constituted, recipe)
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max

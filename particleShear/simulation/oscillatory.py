@@ -23,6 +23,7 @@ from collections import namedtuple
 from ..base.engine_adapter import state_from_ensembles
 from ..linkable.builders import relax_constitution
 from ..base.stability import StabilityGuard
+from ..engine.relax import RELAX_SKIN
 from .drawing import make_renderer, open_stress_plot
 from .driver import measure_sessions
 from .experiment import OscillatoryShearExperiment
@@ -131,17 +132,24 @@ class RunSession:
         self.scene_configuration = None   # the ensemble's drawing configuration (hand_over)
         self.removed_fraction = 0.0
 
-    def constitution(self):
+    def constitution(self, relaxation_law=None, relaxation_backend="numpy", skin_factor=RELAX_SKIN):
         """The constitution as a generator of its relaxations (docs/engine.md, "Runs").
 
-        Yields each :class:`~particleShear.linkable.builders.Relaxation` of the builder (the
+        Yields each :class:`~particleShear.linkable.builders.Relaxation` of the constitution (the
         caller runs it in the engine, alone or with a batch's, and resumes) when the
         simulation's ``initEnsemble`` is that of the class which also gives it as a generator,
-        ``constitution_steps`` (the documented one:
+        ``constitution_steps`` (the documented one, on the engine's state:
         :class:`~particleShear.simulation.fragmentation.Simulation_interlocking_rheology`); any other
         ``initEnsemble`` (a subclass's own) is called as it is, with nothing yielded.  It reports ``progress("constitution", …)`` at its start and end; the ``constitution``
         timing is the wall time since the start less :attr:`waited` (time the caller spent on
         other runs while this one was suspended).
+
+        Parameters
+        ----------
+        relaxation_law, relaxation_backend, skin_factor : optional
+            The central law, host backend and Verlet skin of the relaxations, passed to
+            ``constitution_steps`` (defaults: the builders'; the driver gives the run's law and
+            backend and its skin).
 
         Yields
         ------
@@ -157,7 +165,8 @@ class RunSession:
             sim.progress("constitution", 0, 0, 0.0)
         owner = next((c for c in type(sim).__mro__ if "constitution_steps" in vars(c)), None)
         if owner is not None and type(sim).initEnsemble is vars(owner).get("initEnsemble"):
-            yield from sim.constitution_steps()
+            yield from sim.constitution_steps(relaxation_law=relaxation_law, relaxation_backend=relaxation_backend,
+                                              skin_factor=skin_factor)
         else:
             sim.initEnsemble()
         sim.timings["constitution"] = time.perf_counter() - self.t_start - self.waited
@@ -202,7 +211,9 @@ class RunSession:
         facts a result reports from it, :attr:`scene_configuration` and :attr:`removed_fraction`.
         It runs after :meth:`prepare`, so whatever the experiment set on the ensemble is handed over
         too; from here on the driver (:func:`~particleShear.simulation.driver.measure_sessions`)
-        reads this state and never the ensemble."""
+        reads this state and never the ensemble.  A copy, also where the ensemble is a view of a
+        constituted state (``sim.constituted``): the measurement does not step that state, and
+        ``theEnsemble`` stays the constituted gel after the run."""
         sim = self.sim
         ens = sim.theEnsemble
         self.state = state_from_ensembles([ens], backend="numpy", laws=[sim.contact_law])
