@@ -208,15 +208,44 @@ class _Asserter:
         assert x, msg
 
 
-def test_init_ensemble_is_the_builders_ensemble_as_a_view():
-    """``initEnsemble`` (not a generator) runs the same constitution's requests itself: the builders' gel."""
+def _legacy_factory(sim, **kw):
+    """The legacy builder called with the simulation's parameters (not its recipe)."""
+    from particleShear.linkable.builders import EnsembleCompactParticlesFromModelParameters
+    return EnsembleCompactParticlesFromModelParameters(
+        size_x=500, size_y=500, N=sim.N, packing_fraction=sim.packing_fraction, mu=sim.mu,
+        Young_modulus_spheres=sim.Young_modulus_spheres, cut_lines=sim.cut_lines,
+        do_permanent_links=sim.do_permanent_links, anticipated_amplitude=sim.amplitude, doDrawing=False, **kw)
+
+
+def _interlocking(sim):
     from particleShear.linkable.builders import constitution, relax_constitution
-    from particleShear.simulation.fragmentation import Simulation_interlocking_rheology
-    sim = Simulation_interlocking_rheology("", N=20, cut_lines=2, do_permanent_links=True, mu=0.05, amplitude=0.2,
-                                           doDrawing=False)
+    return relax_constitution(constitution(sim.ensemble_recipe(), do_debug=True, rng=7))
+
+
+def _dermal(sim):
+    return _legacy_factory(sim, density=sim.density, bimodal_factor=sim.bimodal_factor,
+                           relative_viscosity=sim.relative_viscosity,
+                           relative_transversal_link_strength=sim.relative_transversal_link_strength,
+                           central_repulsion_coefficient=sim.central_repulsion_coefficient,
+                           avoid_horizontal_angle_degree=sim.avoid_horizontal_angle_degree,
+                           avoid_height_spanning_particles=sim.avoid_height_spanning_particles,
+                           doCutByTriangulation=sim.doCutByTriangulation, do_debug=True, rng=7)
+
+
+@pytest.mark.parametrize("cls, builder", [("Simulation_interlocking_rheology", _interlocking),
+                                          ("Simulation_dermal_filler_rheology", _dermal),
+                                          ("OscillatorySimulationFragmentation",
+                                           lambda sim: _legacy_factory(sim, do_debug=True, rng=7))])
+def test_init_ensemble_is_the_builders_ensemble_as_a_view(cls, builder):
+    """``initEnsemble`` (not a generator) runs the same constitution's requests itself: each class's
+    builder's gel (the legacy classes': the legacy builder called with the class's parameters)."""
+    from particleShear.simulation import fragmentation
+    sim = getattr(fragmentation, cls)("", N=20, cut_lines=2, do_permanent_links=True, mu=0.05, amplitude=0.2,
+                                      doDrawing=False)
     sim.rng = 7
     got = sim.initEnsemble(do_debug=True)
-    ens = relax_constitution(constitution(sim.ensemble_recipe(), do_debug=True, rng=7))
+    ens = builder(sim)
+    assert type(got) is type(ens)
     assert got is sim.theEnsemble and ensembles_of(sim.constituted.state) == [got]
     assert np.array_equal(bits(got._st), bits(ens._st)) and got.t == ens.t > 0
     assert pair_differences(kept(ens.pair_table), got.pair_table) == [] and got.pair_table.n_permanent > 0

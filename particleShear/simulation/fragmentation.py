@@ -3,27 +3,36 @@
 :class:`OscillatorySimulationFragmentation` (the legacy builder with fixed material constants),
 :class:`Simulation_dermal_filler_rheology` (full material parameters, legacy builder) and
 :class:`Simulation_interlocking_rheology` (the adjustable interface strength builder: the scene of
-``doParticleShearSimulation``).  Each builds its ensemble in ``initEnsemble`` and writes its file
+``doParticleShearSimulation``).  Each constitutes its gel on the engine's state
+(:meth:`OscillatorySimulationFragmentation.constitution_steps`, the builders' schedule of its
+recipe; ``theEnsemble`` is the documented ensemble as a view of that state) and writes its file
 header; the run itself is :class:`~particleShear.simulation.oscillatory.OscillatorySimulation`'s.
 """
 __docformat__ = "numpy"
+import inspect
 import math
 import os
 
 from ..engine.relax import RELAX_SKIN
-from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, EnsembleRecipe, constitution,
+from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, EnsembleRecipe,
                                  ensemble_of_state, relax_constitution, state_constitution)
 from .provenance import header_number, positional_numbers_in_call, provenance_lines
 from .oscillatory import OscillatorySimulation, _log, _writes, call_string
 
 __all__ = ["OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology", "Simulation_interlocking_rheology"]
 
+#: the legacy builder's defaults, by parameter name: the recipe of
+#: :class:`OscillatorySimulationFragmentation` is that builder called with the class's parameters
+_LEGACY_DEFAULTS = {name: p.default for name, p in
+                    inspect.signature(EnsembleCompactParticlesFromModelParameters).parameters.items()}
+
 
 class OscillatorySimulationFragmentation(OscillatorySimulation):
     """Crosslinked ensembles cut into particles ("fragmentation"); file naming and header of docs/output.md.
 
-    Builds the ensemble with the legacy builder ``EnsembleCompactParticlesFromModelParameters``
-    (fixed material constants apart from those given here).
+    Builds the ensemble of the legacy builder ``EnsembleCompactParticlesFromModelParameters``
+    (fixed material constants apart from those given here) on the engine's state
+    (:meth:`constitution_steps`; the ensemble a view of it).
 
     Parameters
     ----------
@@ -83,8 +92,33 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
                 + " central=" + str(getattr(self, "interface_reenforcement_central", 1))
                 + " A=" + str(self.amplitude) + " mu=" + str(self.mu))
 
+    #: the builders' constitution of the class: the legacy builder's (``linkable.builders``,
+    #: ``legacy=True``); :class:`Simulation_interlocking_rheology` has the adjustable interface's
+    legacy_builder = True
+    #: the constitution of the last :meth:`initEnsemble` or :meth:`constitution_steps` on the engine's
+    #: state (``linkable.builders.ConstitutedState``), whose state ``theEnsemble`` is a view of; None before
+    constituted = None
+
+    def ensemble_recipe(self):
+        """The :class:`~particleShear.linkable.builders.EnsembleRecipe` of this simulation's ensemble:
+        the legacy builder ``EnsembleCompactParticlesFromModelParameters`` called with this class's
+        parameters (its own defaults for the rest; the cell of 500 × 500 µm, the anticipated
+        amplitude ``amplitude``).
+
+        Returns
+        -------
+        EnsembleRecipe
+        """
+        return EnsembleRecipe.of(_LEGACY_DEFAULTS, size_x=500, size_y=500, N=self.N,
+                                 packing_fraction=self.packing_fraction, mu=self.mu,
+                                 Young_modulus_spheres=self.Young_modulus_spheres, cut_lines=self.cut_lines,
+                                 do_permanent_links=self.do_permanent_links, anticipated_amplitude=self.amplitude)
+
     def initEnsemble(self, do_debug=False):
-        """Build ``theEnsemble`` with the legacy builder and this class's parameters.
+        """Build ``theEnsemble``: the requests of :meth:`constitution_steps` run one by one.
+
+        The builder's ensemble of :meth:`ensemble_recipe` bit for bit (the legacy builder's, or the
+        adjustable interface's: :attr:`legacy_builder`), as a view of the state :attr:`constituted`.
 
         Parameters
         ----------
@@ -93,14 +127,50 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
 
         Returns
         -------
-        EnsembleCompactParticlesFromModelParameters
+        EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
             The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
         """
-        self.theEnsemble = EnsembleCompactParticlesFromModelParameters(
-            size_x=500, size_y=500, N=self.N, packing_fraction=self.packing_fraction, mu=self.mu,
-            Young_modulus_spheres=self.Young_modulus_spheres, cut_lines=self.cut_lines,
-            do_permanent_links=self.do_permanent_links, anticipated_amplitude=self.amplitude, doDrawing=False,
-            do_debug=do_debug, rng=self.rng, verbose=self.verbose)
+        return relax_constitution(self.constitution_steps(do_debug))
+
+    def constitution_steps(self, do_debug=False, relaxation_law=None, relaxation_backend="numpy",
+                           skin_factor=RELAX_SKIN):
+        """:meth:`initEnsemble` as a generator of the relaxations of a constitution on the engine's state.
+
+        Runs :func:`~particleShear.linkable.builders.state_constitution` of this simulation's
+        :meth:`ensemble_recipe` (the builders' schedule, ``legacy`` = :attr:`legacy_builder`, on a
+        one-replica engine state), yielding each of its
+        :class:`~particleShear.linkable.builders.Relaxation` requests, then keeps the
+        :class:`~particleShear.linkable.builders.ConstitutedState` as :attr:`constituted` and sets
+        ``theEnsemble`` to its documented ensemble, a view of its state
+        (:func:`~particleShear.linkable.builders.ensemble_of_state`: bit for bit the builder's
+        ensemble of the same recipe and seed), and ``model``, ``dt`` and ``dt_max``, as
+        :meth:`initEnsemble` does (which runs the requests one by one).  A run's driver runs the
+        requests of its sessions together (``simulation.driver``) with the run's law and backend.
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+        relaxation_law, relaxation_backend, skin_factor : optional
+            The central law, host backend and Verlet skin of the relaxations, as
+            :func:`~particleShear.linkable.builders.constituted_state` takes them (defaults: the
+            builders').
+
+        Yields
+        ------
+        Relaxation
+            The next relaxation block.
+
+        Returns
+        -------
+        EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
+            The constituted ensemble (also ``self.theEnsemble``).
+        """
+        recipe = self.ensemble_recipe()
+        self.constituted = yield from state_constitution(
+            recipe, legacy=self.legacy_builder, rng=self.rng, law=self.contact_law, relaxation_law=relaxation_law,
+            relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=self.verbose)
+        self.theEnsemble = ensemble_of_state(self.constituted, recipe, legacy=self.legacy_builder)
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max
@@ -294,26 +364,6 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             avoid_height_spanning_particles=self.avoid_height_spanning_particles,
             doCutByTriangulation=self.doCutByTriangulation)
 
-    def initEnsemble(self, do_debug=False):
-        """Build ``theEnsemble`` with the legacy builder and every material parameter.
-
-        Parameters
-        ----------
-        do_debug : bool, optional
-            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
-
-        Returns
-        -------
-        EnsembleCompactParticlesFromModelParameters
-            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
-        """
-        self.theEnsemble = relax_constitution(constitution(self.ensemble_recipe(), legacy=True, do_debug=do_debug,
-                                                           rng=self.rng, verbose=self.verbose))
-        self.model = self.theEnsemble.model
-        self.dt = self.theEnsemble.dt
-        self.dt_max = self.theEnsemble.dt_max
-        return self.theEnsemble
-
 
 class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     """The simulation created by ``doParticleShearSimulation``: adjustable interface strength.
@@ -421,67 +471,6 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
                     cut_top_bottom=self.cut_top_bottom, remove_link_fraction=self.remove_link_fraction,
                     edge_fuzziness=self.edge_fuzziness)
 
-    #: the constitution of the last :meth:`initEnsemble` or :meth:`constitution_steps` on the engine's
-    #: state (``linkable.builders.ConstitutedState``), whose state ``theEnsemble`` is a view of; None before
-    constituted = None
+    #: the adjustable interface's constitution (``linkable.builders``, ``legacy=False``)
+    legacy_builder = False
 
-    def initEnsemble(self, do_debug=False):
-        """Build ``theEnsemble`` as the adjustable-interface builder does (``anticipated_amplitude = amplitude``).
-
-        The requests of :meth:`constitution_steps` run one by one: the builder's ensemble bit for
-        bit, as a view of the state ``constituted``.
-
-        Parameters
-        ----------
-        do_debug : bool, optional
-            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
-
-        Returns
-        -------
-        EnsembleCompactParticlesAdjustableInterfaceStrengthFromModelParameters
-            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
-        """
-        return relax_constitution(self.constitution_steps(do_debug))
-
-    def constitution_steps(self, do_debug=False, relaxation_law=None, relaxation_backend="numpy",
-                           skin_factor=RELAX_SKIN):
-        """:meth:`initEnsemble` as a generator of the relaxations of a constitution on the engine's state.
-
-        Runs :func:`~particleShear.linkable.builders.state_constitution` of this simulation's
-        :meth:`ensemble_recipe` (the builders' schedule on a one-replica engine state), yielding
-        each of its :class:`~particleShear.linkable.builders.Relaxation` requests, then keeps the
-        :class:`~particleShear.linkable.builders.ConstitutedState` as ``constituted`` and sets
-        ``theEnsemble`` to its documented ensemble, a view of its state
-        (:func:`~particleShear.linkable.builders.ensemble_of_state`: bit for bit the builder's
-        ensemble of the same recipe and seed), and ``model``, ``dt`` and ``dt_max``, as
-        :meth:`initEnsemble` does (which runs the requests one by one).  A run's driver runs the
-        requests of its sessions together (``simulation.driver``) with the run's law and backend.
-
-        Parameters
-        ----------
-        do_debug : bool, optional
-            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
-        relaxation_law, relaxation_backend, skin_factor : optional
-            The central law, host backend and Verlet skin of the relaxations, as
-            :func:`~particleShear.linkable.builders.constituted_state` takes them (defaults: the
-            builders').
-
-        Yields
-        ------
-        Relaxation
-            The next relaxation block.
-
-        Returns
-        -------
-        EnsembleCompactParticlesAdjustableInterfaceStrength
-            The constituted ensemble (also ``self.theEnsemble``).
-        """
-        recipe = self.ensemble_recipe()
-        self.constituted = yield from state_constitution(
-            recipe, rng=self.rng, law=self.contact_law, relaxation_law=relaxation_law,
-            relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=self.verbose)
-        self.theEnsemble = ensemble_of_state(self.constituted, recipe)
-        self.model = self.theEnsemble.model
-        self.dt = self.theEnsemble.dt
-        self.dt_max = self.theEnsemble.dt_max
-        return self.theEnsemble
