@@ -138,9 +138,11 @@ def test_it_is_a_view_of_the_state():
 def test_the_recipe_must_be_the_states():
     recipe = EnsembleRecipe(**SMALL)
     got = constituted_state(recipe, rng=5, do_debug=True)
-    for other in (dict(N=31), dict(Young_modulus_spheres=20000), dict(size_x=400)):
+    for other in (dict(N=31), dict(Young_modulus_spheres=20000), dict(size_x=400), dict(mu=SMALL["mu"] + 0.25)):
         with pytest.raises(ValueError, match="not a constitution of the recipe"):
             ensemble_of_state(got, EnsembleRecipe(**{**SMALL, **other}))
+    with pytest.raises(ValueError, match="legacy=True, but the state is a constitution with legacy=False"):
+        ensemble_of_state(got, recipe, legacy=True)      # (the legacy builder's class on another constitution)
     ensemble_of_state(got, recipe)
     with pytest.raises(ValueError, match="already the memory of an ensemble"):    # one view per state
         ensemble_of_state(got, recipe)

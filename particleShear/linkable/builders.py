@@ -588,6 +588,9 @@ class ConstitutedState:
     cut_top_bottom : bool, optional
         The builders' ensemble's flag ``cut_top_bottom``: the constitution cut the bonds through
         the y boundary (never set by the legacy one).
+    legacy : bool, optional
+        The legacy builder's constitution (``constituted_state(legacy=True)``): the class of its
+        documented ensemble (:func:`ensemble_of_state`).
     """
     state: object
     dt: float
@@ -600,6 +603,7 @@ class ConstitutedState:
     sphere_seed: object = None
     particle_labels: object = None
     cut_top_bottom: bool = False
+    legacy: bool = False
 
 
 class _StateTarget:
@@ -775,7 +779,7 @@ def state_constitution(recipe, *, legacy=False, rng=None, law=None, backend="num
                             model=c.model, removed_fraction=target.removed_fraction,
                             triangulation_points=target.triangulation_points, r_max=float(target.r_max),
                             steps=target.steps, sphere_seed=target.sphere_seed, particle_labels=target.particle_labels,
-                            cut_top_bottom=target.cut_top_bottom)
+                            cut_top_bottom=target.cut_top_bottom, legacy=bool(legacy))
 
 
 def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="numpy", relaxation_law=None,
@@ -829,7 +833,7 @@ def constituted_state(recipe, *, legacy=False, rng=None, law=None, backend="nump
         relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=verbose))
 
 
-def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):
+def ensemble_of_state(constituted, recipe, *, legacy=None, doDrawing=False):
     """The documented ensemble of a constituted state, as a view of the state: nothing drawn or relaxed.
 
     The ensemble :func:`constitution` and :func:`relax_constitution` make from the same recipe
@@ -851,8 +855,9 @@ def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):
         read them again).
     recipe : EnsembleRecipe
         The recipe ``constituted`` was made of (the ensemble's constants and class parameters).
-    legacy : bool, optional
-        :class:`~.compact.EnsembleCompactParticles`, the legacy builder's (as for :func:`constituted_state`).
+    legacy : bool or None, optional
+        :class:`~.compact.EnsembleCompactParticles`, the legacy builder's; None (default): as
+        ``constituted`` was made (``constituted.legacy``), which a value given must equal.
     doDrawing : bool, optional
         Draw the spheres (no window), as :func:`constitution` takes it.
 
@@ -864,14 +869,21 @@ def ensemble_of_state(constituted, recipe, *, legacy=False, doDrawing=False):
     ------
     ValueError
         If the state is not one replica on the host or is an ensemble's already
-        (:func:`~particleShear.base.engine_adapter.check_adoptable`), or its N, box or constants
-        are not the recipe's.
+        (:func:`~particleShear.base.engine_adapter.check_adoptable`), its N, box, constants or μ
+        are not the recipe's, or ``legacy`` is not the constitution's.
     """
     s = constituted.state
+    made = bool(getattr(constituted, "legacy", False))
+    if legacy is None:
+        legacy = made
+    elif bool(legacy) != made:
+        raise ValueError(f"legacy={legacy!r}, but the state is a constitution with legacy={made!r} "
+                         "(the builder's class follows it: leave legacy out)")
     c = _Constants(recipe, legacy, False, False)
-    given = (s.B, s.N, s.Lx[0], s.Ly[0], s.k[0], s.nu[0], s.k_t[0], s.nu_t[0])
-    if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t):
-        raise ValueError(f"the state (B, N, Lx, Ly, k, nu, k_t, nu_t) = {given} is not a constitution of the recipe")
+    given = (s.B, s.N, s.Lx[0], s.Ly[0], s.k[0], s.nu[0], s.k_t[0], s.nu_t[0], s.mu[0])
+    if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t, recipe.mu):
+        raise ValueError(f"the state (B, N, Lx, Ly, k, nu, k_t, nu_t, mu) = {given} is not a constitution of the "
+                         "recipe")
     check_adoptable(s, c.N)           # (before any work)
     ens = _documented_ensemble(recipe, c, legacy, doDrawing, s.rng[0], (s.x, s.y, s.r, s.m))
     adopt_state(ens, s)
