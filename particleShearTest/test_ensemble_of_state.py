@@ -166,3 +166,17 @@ def test_the_documented_steps_of_the_view_are_the_builders(legacy, fields, seed,
     assert (view.t, view.shear, view.step_count) == (ens.t, ens.shear, ens.step_count)
     assert pair_differences(kept(ens.pair_table), kept(view.pair_table)) == []
     assert np.array_equal(bits(s.vel), bits(ens._vel)) and s.t[0] == ens.t          # the state holds the steps
+
+
+def test_a_state_whose_ensemble_is_gone_is_free_again():
+    # the adapter's record of whose memory a state is holds the ensembles weakly
+    import gc
+    recipe = EnsembleRecipe(**SMALL)
+    got = constituted_state(recipe, rng=5, do_debug=True)
+    view = ensemble_of_state(got, recipe)
+    assert ensembles_of(got.state) == [view]
+    del view
+    gc.collect()
+    assert ensembles_of(got.state) is None
+    again = ensemble_of_state(got, recipe)
+    assert ensembles_of(got.state) == [again]

@@ -60,7 +60,7 @@ def verdicts(ens):
         by_class = None
     except SimulationInstabilityError as exc:
         by_class = exc.reason
-    engine = BatchEngine(state_of_ensemble(ens), guard=True, check_interval=1)
+    engine = BatchEngine(state_of_ensemble(ens), guard=True, check_interval=1, numbers_relations=True)
     engine.rate_max[...] = RATE
     try:
         engine.force_phase()

@@ -271,7 +271,7 @@ class ForceRegisterOrderTest(unittest.TestCase):
             with self.subTest(scene=name):
                 ens = two_sphere_scene(**spec)
                 want = reference_force_phase(ens)
-                eng = BatchEngine(state_of_ensemble(ens), guard=False, keep_terms=True)
+                eng = BatchEngine(state_of_ensemble(ens), guard=False, keep_terms=True, numbers_relations=True)
                 eng.force_phase()
                 eng.flush()                    # the states of the relations into the ensemble's table
                 self.assertTrue(ens.force_register.set_from_engine(ens, eng, current=True))

@@ -280,11 +280,19 @@ def ensembles_of(state):
     Returns
     -------
     list of ensemble or None
-        Set by :func:`state_of_ensembles` and :func:`adopt_state` (a copy of the state,
-        ``to_backend`` or a pickle, owns its arrays and gives None).
+        Set by :func:`state_of_ensembles` and :func:`adopt_state` (a copy of the state, a pickle
+        or ``to_backend`` to another backend, owns its arrays and gives None).  An entry is None
+        where that ensemble no longer exists; a state whose ensembles are all gone is its own
+        again (None).
     """
     refs = _MEMORY_OF.get(state)
-    return None if refs is None else [ref() for ref in refs]
+    if refs is None:
+        return None
+    members = [ref() for ref in refs]
+    if all(e is None for e in members):
+        del _MEMORY_OF[state]
+        return None
+    return members
 
 
 def _remember(state, ensembles):
@@ -428,7 +436,7 @@ def write_back(engine, b, ensemble, steps=0, constitution=True, dt=None):
     """
     s = engine.s
     members = ensembles_of(s)
-    if members is None or members[b] is not ensemble:
+    if members is None or ensemble is None or members[b] is not ensemble:
         raise ValueError("write_back needs an engine on the ensemble's own state "
                          "(state_of_ensembles, of which replica b is the ensemble)")
     if not engine.numbers_relations:
@@ -594,10 +602,10 @@ def relax_states(states, N, dt, dt_max, skin_factor=RELAX_SKIN):
     their rows, clocks, strains, μ and constants copied, their generators shared), relaxed once, and
     each state gets its rows, replica values and pair table back (the joint state's table
     itself: the engine's rebuilds replace a replica's table, its history is flushed into it) and
-    the rows of the Verlet predictor; a state's contacts are dropped (an engine built on it
-    starts them from its table).  Each replica is relaxed as it would be alone, bit for bit: the
-    relaxation is per replica, and each has its own generator (docs/engine.md, "Runs").  A single
-    state is relaxed in place, without a copy.
+    the rows of the Verlet predictor; its contacts are dropped (an engine built on it starts them
+    from its table).  Each replica is relaxed as it would be alone, bit for bit: the relaxation is
+    per replica, and each has its own generator (docs/engine.md, "Runs").  A single state is
+    relaxed in place, without a copy (its contacts are the relaxing engine's).
 
     Parameters
     ----------

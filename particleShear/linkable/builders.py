@@ -837,8 +837,9 @@ def ensemble_of_state(constituted, recipe, *, legacy=None, doDrawing=False):
     """The documented ensemble of a constituted state, as a view of the state: nothing drawn or relaxed.
 
     The ensemble :func:`constitution` and :func:`relax_constitution` make from the same recipe
-    and seed (same class, constants, spheres, pair table, generator position, clock, strain, μ,
-    steps, step counts and facts of the cut), made from ``constituted``
+    and seed (same class, constants, spheres, relations and bonds with their history, generator
+    position, clock, strain, μ, steps, step counts and facts of the cut; the builders' pair table
+    also keeps rows of relations that ended, which a step reads as exact zeros), made from ``constituted``
     (:func:`constituted_state`, ``legacy`` as given there) instead: the class's construction of
     a constitution (:func:`_documented_ensemble`) with the state's placement, then
     :func:`~particleShear.base.engine_adapter.adopt_state`, after which the ensemble's state

@@ -118,7 +118,8 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         """Build ``theEnsemble``: the requests of :meth:`constitution_steps` run one by one.
 
         The builder's ensemble of :meth:`ensemble_recipe` bit for bit (the legacy builder's, or the
-        adjustable interface's: :attr:`legacy_builder`), as a view of the state :attr:`constituted`.
+        adjustable interface's: :attr:`legacy_builder`; :meth:`constitution_steps`), as a view of
+        the state :attr:`constituted`.
 
         Parameters
         ----------
@@ -143,7 +144,8 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         :class:`~particleShear.linkable.builders.ConstitutedState` as :attr:`constituted` and sets
         ``theEnsemble`` to its documented ensemble, a view of its state
         (:func:`~particleShear.linkable.builders.ensemble_of_state`: bit for bit the builder's
-        ensemble of the same recipe and seed), and ``model``, ``dt`` and ``dt_max``, as
+        ensemble of the same recipe and seed, but for the rows of ended relations the builder's
+        pair table keeps), and ``model``, ``dt`` and ``dt_max``, as
         :meth:`initEnsemble` does (which runs the requests one by one).  A run's driver runs the
         requests of its sessions together (``simulation.driver``) with the run's law and backend.
 
