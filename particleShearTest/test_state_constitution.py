@@ -252,3 +252,30 @@ def test_init_ensemble_is_the_builders_ensemble_as_a_view(cls, builder):
     assert attribute_differences(ens, got, PRIVATE + MEMORY) == []
     assert (sim.dt, sim.dt_max, vars(sim.model)) == (ens.dt, ens.dt_max, vars(ens.model))
     assert np.array_equal(got._rng.random(4), ens._rng.random(4))
+
+
+def test_a_fractional_mu_constitutes():
+    # a μ given as any real number (validated as such) is stored as a float: its view is accepted
+    from fractions import Fraction
+    recipe = EnsembleRecipe(**{**SMALL, "mu": Fraction(1, 3)})
+    got = constituted_state(recipe, rng=2, do_debug=True)
+    view = builders.ensemble_of_state(got, recipe)
+    assert view.mu == float(Fraction(1, 3)) == got.state.mu[0]
+
+
+@pytest.mark.parametrize("cls, named, builder", [
+    ("Simulation_dermal_filler_rheology", "OscillatorySimulationFragmentation", "fragmentation"),
+    ("Simulation_interlocking_rheology", "Simulation_dermal_filler_rheology", "dermal")])
+def test_a_classes_init_ensemble_named_from_a_subclass_builds_that_classes_gel(cls, named, builder):
+    # as in 1.0.2: `Base.initEnsemble(self)` in a subclass's own initEnsemble builds Base's builder's gel
+    from particleShear.simulation import fragmentation
+    parent = getattr(fragmentation, named)
+    sub = type("Sub", (getattr(fragmentation, cls),), {"initEnsemble": lambda self: parent.initEnsemble(self, True)})
+    sim = sub("", N=20, cut_lines=2, do_permanent_links=True, mu=0.05, amplitude=0.2, doDrawing=False)
+    sim.rng = 7
+    assert fragmentation.builder_of(sub) is None                  # (its own initEnsemble: called as it is)
+    got = sim.initEnsemble()
+    ens = {"fragmentation": lambda: _legacy_factory(sim, do_debug=True, rng=7), "dermal": lambda: _dermal(sim)}[builder]()
+    assert type(got) is type(ens)
+    assert np.array_equal(bits(got._st), bits(ens._st))
+    assert pair_differences(kept(ens.pair_table), got.pair_table) == []

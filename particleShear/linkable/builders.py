@@ -882,7 +882,7 @@ def ensemble_of_state(constituted, recipe, *, legacy=None, doDrawing=False):
                          "(the builder's class follows it: leave legacy out)")
     c = _Constants(recipe, legacy, False, False)
     given = (s.B, s.N, s.Lx[0], s.Ly[0], s.k[0], s.nu[0], s.k_t[0], s.nu_t[0], s.mu[0])
-    if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t, recipe.mu):
+    if given != (1, c.N, recipe.size_x, recipe.size_y, c.k, c.nu, c.k_t, c.nu_t, float(recipe.mu)):   # (μ as stored)
         raise ValueError(f"the state (B, N, Lx, Ly, k, nu, k_t, nu_t, mu) = {given} is not a constitution of the "
                          "recipe")
     check_adoptable(s, c.N)           # (before any work)

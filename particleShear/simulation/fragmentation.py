@@ -19,7 +19,8 @@ from ..linkable.builders import (EnsembleCompactParticlesFromModelParameters, En
 from .provenance import header_number, positional_numbers_in_call, provenance_lines
 from .oscillatory import OscillatorySimulation, _log, _writes, call_string
 
-__all__ = ["OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology", "Simulation_interlocking_rheology"]
+__all__ = ["OscillatorySimulationFragmentation", "Simulation_dermal_filler_rheology", "Simulation_interlocking_rheology",
+           "builder_of"]
 
 #: the legacy builder's defaults, by parameter name: the recipe of
 #: :class:`OscillatorySimulationFragmentation` is that builder called with the class's parameters
@@ -95,31 +96,39 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
     #: the builders' constitution of the class: the legacy builder's (``linkable.builders``,
     #: ``legacy=True``); :class:`Simulation_interlocking_rheology` has the adjustable interface's
     legacy_builder = True
+    #: the method giving the recipe of the class's builder: this class's own legacy call (which
+    #: its 1.0.2 ``initEnsemble`` made whatever the subclass), the others' :meth:`ensemble_recipe`
+    recipe_method = "_legacy_call_recipe"
     #: the constitution of the last :meth:`initEnsemble` or :meth:`constitution_steps` on the engine's
     #: state (``linkable.builders.ConstitutedState``), whose state ``theEnsemble`` is a view of; None before
     constituted = None
 
     def ensemble_recipe(self):
-        """The :class:`~particleShear.linkable.builders.EnsembleRecipe` of this simulation's ensemble:
-        the legacy builder ``EnsembleCompactParticlesFromModelParameters`` called with this class's
-        parameters (its own defaults for the rest; the cell of 500 × 500 µm, the anticipated
-        amplitude ``amplitude``).
+        """The :class:`~particleShear.linkable.builders.EnsembleRecipe` of this simulation's ensemble
+        (here :meth:`_legacy_call_recipe`).
 
         Returns
         -------
         EnsembleRecipe
         """
+        return self._legacy_call_recipe()
+
+    def _legacy_call_recipe(self):
+        """The recipe of the legacy builder ``EnsembleCompactParticlesFromModelParameters`` called with
+        this class's parameters (its own defaults for the rest; the cell of 500 × 500 µm, the
+        anticipated amplitude ``amplitude``)."""
         return EnsembleRecipe.of(_LEGACY_DEFAULTS, size_x=500, size_y=500, N=self.N,
                                  packing_fraction=self.packing_fraction, mu=self.mu,
                                  Young_modulus_spheres=self.Young_modulus_spheres, cut_lines=self.cut_lines,
                                  do_permanent_links=self.do_permanent_links, anticipated_amplitude=self.amplitude)
 
     def initEnsemble(self, do_debug=False):
-        """Build ``theEnsemble``: the requests of :meth:`constitution_steps` run one by one.
+        """Build ``theEnsemble``: the requests of :meth:`constitution_steps` of this class's builder
+        run one by one.
 
-        The builder's ensemble of :meth:`ensemble_recipe` bit for bit (the legacy builder's, or the
-        adjustable interface's: :attr:`legacy_builder`; :meth:`constitution_steps`), as a view of
-        the state :attr:`constituted`.
+        The builder's ensemble bit for bit (here the legacy builder called with this class's
+        parameters, also on a subclass's instance, as in 1.0.2; the subclasses' ``initEnsemble``
+        their builders'), as a view of the state :attr:`constituted`.
 
         Parameters
         ----------
@@ -131,15 +140,20 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
             The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
         """
-        return relax_constitution(self.constitution_steps(do_debug))
+        return relax_constitution(self.constitution_steps(do_debug, builder=OscillatorySimulationFragmentation))
+
+    def constitution_builder(self):
+        """The documented class whose ``initEnsemble`` this simulation's class has (:func:`builder_of`),
+        None where it has its own."""
+        return builder_of(type(self))
 
     def constitution_steps(self, do_debug=False, relaxation_law=None, relaxation_backend="numpy",
-                           skin_factor=RELAX_SKIN):
+                           skin_factor=RELAX_SKIN, builder=None):
         """:meth:`initEnsemble` as a generator of the relaxations of a constitution on the engine's state.
 
-        Runs :func:`~particleShear.linkable.builders.state_constitution` of this simulation's
-        :meth:`ensemble_recipe` (the builders' schedule, ``legacy`` = :attr:`legacy_builder`, on a
-        one-replica engine state), yielding each of its
+        Runs :func:`~particleShear.linkable.builders.state_constitution` of the recipe of
+        ``builder`` (its :attr:`recipe_method`; the builders' schedule, ``legacy`` =
+        ``builder.legacy_builder``, on a one-replica engine state), yielding each of its
         :class:`~particleShear.linkable.builders.Relaxation` requests, then keeps the
         :class:`~particleShear.linkable.builders.ConstitutedState` as :attr:`constituted` and sets
         ``theEnsemble`` to its documented ensemble, a view of its state
@@ -157,6 +171,9 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
             The central law, host backend and Verlet skin of the relaxations, as
             :func:`~particleShear.linkable.builders.constituted_state` takes them (defaults: the
             builders').
+        builder : type, optional
+            The documented class whose builder constitutes (:func:`builder_of`; default: the one
+            whose ``initEnsemble`` this simulation's class has, else the nearest in its MRO).
 
         Yields
         ------
@@ -168,11 +185,13 @@ class OscillatorySimulationFragmentation(OscillatorySimulation):
         EnsembleCompactParticles or EnsembleCompactParticlesAdjustableInterfaceStrength
             The constituted ensemble (also ``self.theEnsemble``).
         """
-        recipe = self.ensemble_recipe()
+        if builder is None:
+            builder = builder_of(type(self)) or next(c for c in type(self).__mro__ if c in _DOCUMENTED)
+        recipe, legacy = getattr(self, builder.recipe_method)(), builder.legacy_builder
         self.constituted = yield from state_constitution(
-            recipe, legacy=self.legacy_builder, rng=self.rng, law=self.contact_law, relaxation_law=relaxation_law,
+            recipe, legacy=legacy, rng=self.rng, law=self.contact_law, relaxation_law=relaxation_law,
             relaxation_backend=relaxation_backend, skin_factor=skin_factor, do_debug=do_debug, verbose=self.verbose)
-        self.theEnsemble = ensemble_of_state(self.constituted, recipe, legacy=self.legacy_builder)
+        self.theEnsemble = ensemble_of_state(self.constituted, recipe, legacy=legacy)
         self.model = self.theEnsemble.model
         self.dt = self.theEnsemble.dt
         self.dt_max = self.theEnsemble.dt_max
@@ -366,6 +385,26 @@ class Simulation_dermal_filler_rheology(OscillatorySimulationFragmentation):
             avoid_height_spanning_particles=self.avoid_height_spanning_particles,
             doCutByTriangulation=self.doCutByTriangulation)
 
+    #: the recipe of this class's builder: :meth:`ensemble_recipe` (which a subclass may override)
+    recipe_method = "ensemble_recipe"
+
+    def initEnsemble(self, do_debug=False):
+        """Build ``theEnsemble`` with the legacy builder and every material parameter
+        (:meth:`ensemble_recipe`): the requests of :meth:`constitution_steps` run one by one, the
+        builder's ensemble bit for bit as a view of the state :attr:`constituted`.
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Returns
+        -------
+        EnsembleCompactParticles
+            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
+        """
+        return relax_constitution(self.constitution_steps(do_debug, builder=Simulation_dermal_filler_rheology))
+
 
 class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
     """The simulation created by ``doParticleShearSimulation``: adjustable interface strength.
@@ -475,4 +514,44 @@ class Simulation_interlocking_rheology(Simulation_dermal_filler_rheology):
 
     #: the adjustable interface's constitution (``linkable.builders``, ``legacy=False``)
     legacy_builder = False
+
+    def initEnsemble(self, do_debug=False):
+        """Build ``theEnsemble`` with the adjustable interface's builder (``anticipated_amplitude =
+        amplitude``): the requests of :meth:`constitution_steps` run one by one, the builder's
+        ensemble bit for bit as a view of the state :attr:`constituted`.
+
+        Parameters
+        ----------
+        do_debug : bool, optional
+            Passed to the builder: a tenth of the relaxation steps, for quick tests (default False).
+
+        Returns
+        -------
+        EnsembleCompactParticlesAdjustableInterfaceStrength
+            The relaxed, crosslinked and cut ensemble (also ``self.theEnsemble``).
+        """
+        return relax_constitution(self.constitution_steps(do_debug, builder=Simulation_interlocking_rheology))
+
+
+#: the documented simulation classes, each with the ``initEnsemble`` of its own builder
+_DOCUMENTED = (OscillatorySimulationFragmentation, Simulation_dermal_filler_rheology, Simulation_interlocking_rheology)
+
+
+def builder_of(cls):
+    """The documented class whose ``initEnsemble`` the simulation class ``cls`` has, or None for its own.
+
+    A run constitutes on the engine's state, batched, exactly when this is not None
+    (``RunSession.constitution`` through ``constitution_builder``: ``constitution_steps`` with that
+    builder).
+
+    Parameters
+    ----------
+    cls : type
+
+    Returns
+    -------
+    type or None
+    """
+    init = getattr(cls, "initEnsemble", None)
+    return next((c for c in _DOCUMENTED if vars(c).get("initEnsemble") is init), None)
 

@@ -137,10 +137,10 @@ class RunSession:
 
         Yields each :class:`~particleShear.linkable.builders.Relaxation` of the constitution (the
         caller runs it in the engine, alone or with a batch's, and resumes) when the
-        simulation's ``initEnsemble`` is that of the class which also gives it as a generator,
-        ``constitution_steps`` (the documented one, on the engine's state:
-        :class:`~particleShear.simulation.fragmentation.Simulation_interlocking_rheology`); any other
-        ``initEnsemble`` (a subclass's own) is called as it is, with nothing yielded.  It reports ``progress("constitution", …)`` at its start and end; the ``constitution``
+        simulation's ``initEnsemble`` is one of the documented simulation classes'
+        (:meth:`OscillatorySimulation.constitution_builder`), as ``constitution_steps``
+        with that class's builder, on the engine's state; any other ``initEnsemble`` (a
+        subclass's own) is called as it is, with nothing yielded.  It reports ``progress("constitution", …)`` at its start and end; the ``constitution``
         timing is the wall time since the start less :attr:`waited` (time the caller spent on
         other runs while this one was suspended).
 
@@ -163,10 +163,10 @@ class RunSession:
         self.waited = 0.0
         if sim.progress is not None:
             sim.progress("constitution", 0, 0, 0.0)
-        owner = next((c for c in type(sim).__mro__ if "constitution_steps" in vars(c)), None)
-        if owner is not None and type(sim).initEnsemble is vars(owner).get("initEnsemble"):
+        builder = sim.constitution_builder()
+        if builder is not None:
             yield from sim.constitution_steps(relaxation_law=relaxation_law, relaxation_backend=relaxation_backend,
-                                              skin_factor=skin_factor)
+                                              skin_factor=skin_factor, builder=builder)
         else:
             sim.initEnsemble()
         sim.timings["constitution"] = time.perf_counter() - self.t_start - self.waited
@@ -389,6 +389,12 @@ class OscillatorySimulation:
     # -- ensemble --------------------------------------------------------------------------------
     def initEnsemble(self):
         """Base class: nothing to build (subclasses create ``theEnsemble``)."""
+        return None
+
+    def constitution_builder(self):
+        """The documented class whose builder constitutes this simulation on the engine's state
+        (with ``constitution_steps``, batched by a run's driver), or None: ``initEnsemble`` is
+        called as it is (here; the documented simulation classes say which, ``simulation.fragmentation``)."""
         return None
 
     def _attach_renderer(self):
