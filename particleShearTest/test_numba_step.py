@@ -9,7 +9,8 @@ velocity Verlet integrator, the Hertz and the plateau law of the laws folder, pl
 constitution and measurement, a diverging replica (the same guard verdict, also in blocks), a pair at
 distance 0 (the compiled step draws its random normal from the replica's generator), a block's
 replicas on two threads, and the lists rebuilt inside the compiled blocks (against the rebuilds
-between calls and NumPy; a list outgrowing its slot; a pair at d = 0 after such a rebuild).
+between calls and NumPy; a list outgrowing its slot; a pair at d = 0 after such a rebuild), and the
+engine's force phase and movement called alone (the kernel's phases, NumPy's bits and guard report).
 Skipped without Numba.
 """
 import unittest
@@ -63,6 +64,25 @@ class TestCompiledStepBits(unittest.TestCase):
         for key in ("t", "strain", "strain_rate", "stress_internal", "stress_surface"):
             np.testing.assert_array_equal(_bits(a[key]), _bits(b[key]), err_msg=key)
 
+    def assert_same_tree(self, a, b, path):
+        """The same dicts (but their candidates ``C``), sequences, Nones and arrays' bits, nested."""
+        if isinstance(a, dict):
+            self.assertEqual(a.keys(), b.keys(), path)
+            for k in a:
+                if k != "C":
+                    self.assert_same_tree(a[k], b[k], f"{path}.{k}")
+        elif isinstance(a, (list, tuple)):
+            self.assertEqual(len(a), len(b), path)
+            for k, (x, y) in enumerate(zip(a, b)):
+                self.assert_same_tree(x, y, f"{path}[{k}]")
+        elif a is None:
+            self.assertIsNone(b, path)
+        else:
+            a, b = np.asarray(a), np.asarray(b)
+            self.assertEqual((a.dtype, a.shape), (b.dtype, b.shape), path)
+            np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a,
+                                          _bits(b) if b.dtype.kind == "f" else b, err_msg=path)
+
     def test_scenes_bit_identical(self):
         """Every scene: the engine's state after pre-equilibration and protocol and the recorded
         series equal NumPy's bit for bit; no step of these scenes falls back (no note)."""
@@ -94,14 +114,14 @@ class TestCompiledStepBits(unittest.TestCase):
 
         from particleShear.engine.step import BatchEngine
         phases = []
-        original = BatchEngine.force_phase
+        original = BatchEngine._force_phase
 
         def numpy_phase(engine, sample=False):
             if engine.backend.compiled:          # (the ensembles' constitution runs on NumPy engines)
                 phases.append(sample)
             return original(engine, sample)
 
-        with mock.patch.object(BatchEngine, "force_phase", numpy_phase):
+        with mock.patch.object(BatchEngine, "_force_phase", numpy_phase):
             eng, _ = _measure([(0, FRICTIONAL_BONDS)], "numba")
         self.assertEqual(phases, [])
         self.assertGreater(eng.step_count, 250)
@@ -128,7 +148,7 @@ class TestCompiledStepBits(unittest.TestCase):
                 eng = BatchEngine(state_from_ensembles(ens, backend=backend), integrator=integrator)
                 eng.s.applying_shear = True
                 rate_of = lambda i: np.array([300.0, -200.0]) * np.cos(0.01 * i)        # noqa: E731
-                numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+                numpy_phase = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("ran on NumPy"))
                 with numpy_phase if backend == "numba" else contextlib.nullcontext():
                     rec = shear_record(eng, ens[0].dt, 0.999, 90, rate_of, keep_tensors=True, end_tensors=True)
                     rec_n1 = shear_record(eng, ens[0].dt, 0.999, 30, rate_of, tensors_every=7)
@@ -159,23 +179,6 @@ class TestCompiledStepBits(unittest.TestCase):
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
 
-        def same(a, b, path):
-            if isinstance(a, dict):
-                self.assertEqual(a.keys(), b.keys())
-                for k in a:
-                    if k != "C":
-                        same(a[k], b[k], f"{path}.{k}")
-            elif isinstance(a, (list, tuple)):
-                self.assertEqual(len(a), len(b), path)
-                for k, (x, y) in enumerate(zip(a, b)):
-                    same(x, y, f"{path}[{k}]")
-            elif a is None:
-                self.assertIsNone(b, path)
-            else:
-                self.assertEqual((a.dtype, a.shape), (b.dtype, b.shape), path)
-                np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a,
-                                              _bits(b) if b.dtype.kind == "f" else b, err_msg=path)
-
         for own in (False, True):
             for B in (1, 2):
                 for last in ("block", "step"):
@@ -188,7 +191,7 @@ class TestCompiledStepBits(unittest.TestCase):
                         eng = BatchEngine(state_from_ensembles(ens, backend=backend), keep_terms=True)
                         eng.s.applying_shear = True
                         eng.set_rate(np.array([400.0, -300.0][:B]))
-                        patch = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("NumPy"))
+                        patch = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("NumPy"))
                         with patch if backend == "numba" else contextlib.nullcontext():
                             eng.steps(30, 0.999, ens[0].dt)
                             if last == "step":
@@ -196,12 +199,11 @@ class TestCompiledStepBits(unittest.TestCase):
                         terms.append(eng.terms)
                     self.assertEqual(terms[1]["fx_j"] is not None, own)
                     self.assertTrue(np.any(terms[1]["F"] != 0.0))
-                    same(terms[0], terms[1], f"own={own} B={B} {last}")
+                    self.assert_same_tree(terms[0], terms[1], f"own={own} B={B} {last}")
 
     def test_a_force_phase_keeps_its_record_and_terms(self):
-        """The record and the kept terms of a compiled force phase alone are rows of its own buffers:
-        its movement, later steps (whole, in blocks) and later force phases leave them as they were."""
-        from particleShear.base import compiled_phases
+        """The record and the kept terms of the engine's compiled force phase alone are rows of its own
+        buffers: its movement, later steps (whole, in blocks) and later force phases leave them as they were."""
         from particleShear.base.engine_adapter import state_from_ensembles
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
@@ -210,20 +212,89 @@ class TestCompiledStepBits(unittest.TestCase):
         eng = BatchEngine(state_from_ensembles([ens], backend="numba"), keep_terms=True)
         eng.s.applying_shear = True
         eng.set_rate(np.array([400.0]))
-        g = compiled_phases.force_phase(eng)[0]
+        g = eng.force_phase()[0]
         self.assertIsNot(g.dx.base, None)       # (the compiled phase's own rows)
         terms = eng.terms
         arrays = lambda: [np.array(a) for a in (*g[:8], *terms["parts"][0], terms["F"], terms["dx"], terms["fx_i"],  # noqa: E731
                                                 terms["totals"])]
         before = arrays()
         eng.accelerate(0.999, ens.dt, g)
-        compiled_phases.move(eng, ens.dt, g)
+        eng.move(ens.dt, g)
         eng.step(0.999, ens.dt, sample=True)
         eng.steps(5, 0.999, ens.dt)
-        compiled_phases.force_phase(eng)
+        eng.force_phase()
         for a, b in zip(before, arrays()):
             np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a, _bits(b) if b.dtype.kind == "f" else b)
         self.assertIsNot(eng.terms, terms)
+
+    def test_engine_phases_run_compiled(self):
+        """``BatchEngine.force_phase``, ``accelerate`` and ``move`` called by an engine's user on the
+        ``"numba"`` backend run the compiled step kernel's phases (the NumPy phases never run, the
+        compiled workspace covers the engine) and give the NumPy engine's phases' bits over 100
+        steps: positions, velocities, relations and their history, clock and strain, every field
+        of each force phase's record, the sampled stresses and tensors and the kept terms, with
+        both integrators and two replicas."""
+        import contextlib
+        from unittest import mock
+
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine
+        from particleShearTest.test_engine import constituted
+
+        for integrator, keep in (("euler", False), ("verlet", True)):
+            engines, seen = [], []
+            for backend in ("numpy", "numba"):
+                ens = [constituted(65, **FRICTIONAL_BONDS)[1], constituted(66, **FRICTIONAL)[1]]
+                eng = BatchEngine(state_from_ensembles(ens, backend=backend), integrator=integrator, keep_terms=keep)
+                eng.s.applying_shear = True
+                numpy_phases = (mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("NumPy")),
+                                mock.patch.object(BatchEngine, "_move", side_effect=AssertionError("NumPy move")))
+                records = []
+                with contextlib.ExitStack() as stack:
+                    if backend == "numba":
+                        for p in numpy_phases:
+                            stack.enter_context(p)
+                    for k in range(100):
+                        eng.set_rate(np.array([400.0, -300.0]) * np.cos(0.03 * k))
+                        sample = "tensors" if k % 25 == 0 else bool(k % 7 == 0)
+                        g, out = eng.force_phase(sample)
+                        records.append((tuple(g), out, eng.terms if keep else None))
+                        eng.accelerate(0.999, ens[0].dt, g)
+                        eng.move(ens[0].dt, g)
+                        if backend == "numba":
+                            ws = numba_step.last_workspace(eng)
+                            self.assertIsNotNone(ws)
+                            self.assertIsNone(ws.why)
+                engines.append(eng)
+                seen.append(records)
+            self.assertEqual(engines[1].step_count, 100)
+            self.assertEqual(engines[1].notes, set())
+            self.assert_same_engines(*engines)
+            np.testing.assert_array_equal(engines[0].s.contacts.rebuilds, engines[1].s.contacts.rebuilds)
+            self.assertTrue(np.any(engines[1].pairs_of(0).xi != 0.0))      # (the ξ rule really ran)
+            self.assert_same_tree(seen[0], seen[1], integrator)
+
+    def test_engine_force_phase_reports_at_once(self):
+        """An unsound guard verdict in ``BatchEngine.force_phase``: raised by the phase itself, at once,
+        with the same EngineInstability (replica, step, phase, message) and the same forces written,
+        on NumPy and on the compiled phase."""
+        from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.engine.step import BatchEngine, EngineInstability
+        from particleShearTest.test_engine import constituted
+
+        got = []
+        for backend in ("numpy", "numba"):
+            ens = [constituted(31 + k, **FRICTIONAL)[1] for k in range(2)]
+            eng = BatchEngine(state_from_ensembles(ens, backend=backend), check_interval=1)
+            eng.s.vel[:, eng.s.N:] *= 1e6
+            with self.assertRaises(EngineInstability) as ctx:
+                eng.force_phase()
+            e = ctx.exception
+            got.append((str(e), e.replica, e.step, e.phase, eng.s.frc.copy(), eng.step_count))
+        self.assertEqual(got[0][:4], got[1][:4])
+        self.assertEqual(got[0][1], 1)
+        np.testing.assert_array_equal(_bits(got[0][4]), _bits(got[1][4]))
+        self.assertEqual(got[0][5], got[1][5])
 
     def test_documented_experiment_runs_compiled(self):
         """The documented experiment's own pre-equilibration and protocol
@@ -246,14 +317,14 @@ class TestCompiledStepBits(unittest.TestCase):
             exp = s.createExperiment(False, 1, False)
             sched = s.measurement_schedule(0.5)
             phases = []
-            original = BatchEngine.force_phase
+            original = BatchEngine._force_phase
 
             def counted(engine, sample=False):
                 phases.append(sample)
                 return original(engine, sample)
 
             with mock.patch.dict(os.environ, {"PARTICLESHEAR_BACKEND": backend}), \
-                    mock.patch.object(BatchEngine, "force_phase", counted):
+                    mock.patch.object(BatchEngine, "_force_phase", counted):
                 G = exp.oscillatory_shear_experiment(cool_factor=sched.cool,
                                                      N_pre_equilibration_fixed_boundaries=sched.N_pre)
             results[backend] = (G, len(phases))
@@ -389,7 +460,7 @@ class TestCompiledStepBits(unittest.TestCase):
             s = state_from_ensembles(ens, backend=backend)
             self.assertIsNotNone(s.visit)
             eng = BatchEngine(s)
-            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            numpy_phase = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("ran on NumPy"))
             with numpy_phase if backend == "numba" else contextlib.nullcontext():
                 eng.set_rate(np.array([400.0, -300.0]))
                 eng.steps(40, 0.999, ens[0].dt)
@@ -419,7 +490,7 @@ class TestCompiledStepBits(unittest.TestCase):
             ens = [constituted(51 + k, **FRICTIONAL)[1] for k in range(2)]
             eng = BatchEngine(state_from_ensembles(ens, backend=backend), lees_edwards=False,
                               strain_only_while_shearing=True)
-            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            numpy_phase = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("ran on NumPy"))
             with numpy_phase if backend == "numba" else contextlib.nullcontext():
                 for applying in (False, True):
                     eng.s.applying_shear = applying
@@ -509,7 +580,7 @@ class TestCompiledStepBits(unittest.TestCase):
             s = state_from_ensembles([e], backend=backend)
             s.pos[:, 1] = s.pos[:, 0]
             eng = BatchEngine(s, guard=False)        # (the guard would stop the interpenetration)
-            numpy_phase = mock.patch.object(BatchEngine, "force_phase", side_effect=AssertionError("ran on NumPy"))
+            numpy_phase = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("ran on NumPy"))
             with numpy_phase if backend == "numba" else contextlib.nullcontext():
                 for _ in range(5):
                     eng.step(0.999, e.dt)

@@ -1,24 +1,20 @@
-"""The documented classes' force phase, movement and tensor sums in the compiled step (Numba, optional).
+"""The documented classes' tensor sums in the compiled code (Numba, optional).
 
 1.0.2's API steps an ensemble in three calls (``mechanical_simulation_step_calculate_forces``,
 ``…_acceleration``, ``…_movement``) with the force register and ``StressTensorEvaluation`` read in
 between, so the canvas's engine (:class:`~particleShear.base.engine_view.EngineStep`) runs its step
-as phases rather than as :meth:`~particleShear.engine.step.BatchEngine.step`.  On the ``"numba"``
-backend those phases run here in the engine's compiled step kernel, the same code as the engine's
-own steps, through the public names of :mod:`particleShear.engine.numba_step`:
+as the engine's phases, :meth:`~particleShear.engine.step.BatchEngine.force_phase`,
+:meth:`~particleShear.engine.step.BatchEngine.accelerate` and
+:meth:`~particleShear.engine.step.BatchEngine.move` (on the ``"numba"`` backend the force phase and
+the movement run in the engine's compiled step kernel, alone). What is left here is the sums of
+``StressTensorEvaluation``:
 
-* :func:`force_phase`: the kernel's force phase alone (:func:`~particleShear.engine.numba_step.launch`
-  with ``forces_only``);
-* :func:`move`: the kernel from its movement alone (:data:`~particleShear.engine.numba_step.MOVE_ONLY`:
-  the ξ rule, displacement, drift, strain, wrap, clock) after the phase and the NumPy kick;
 * :func:`tensor_sums`: every tensor's row sums of a force register's phase (:func:`compile_tensor_kernel`,
-  the step kernel's own row functions).
+  the step kernel's own row functions, through the public names of :mod:`particleShear.engine.numba_step`).
 
-Each gives the NumPy phase's numbers bit for bit, and falls back to it
-(:meth:`~particleShear.engine.step.BatchEngine.force_phase`, :meth:`~particleShear.engine.step.BatchEngine.move`,
-:meth:`~particleShear.engine.stress.StressInputs.reduce`) where the compiled step does not cover the
-engine (:func:`~particleShear.engine.numba_step.reason`) or the backend is NumPy.  Kept here, beside
-the classes they serve: the engine's own runs step whole steps and blocks (docs/design.md).
+It gives NumPy's numbers bit for bit (:meth:`~particleShear.engine.stress.StressInputs.reduce`).
+Kept here, beside the classes it serves: the engine's own runs sample whole steps and blocks
+(docs/design.md).
 """
 __docformat__ = "numpy"
 
@@ -28,106 +24,11 @@ import numpy as np
 
 from ..engine import numba_step
 from ..engine.numba_step import pair_tensor_rows, sphere_tensor_rows, tensor_row_sums
-from ..engine.step import ForceRecord
 
-__all__ = ["force_phase", "move", "tensor_sums", "compile_tensor_kernel", "TENSOR_FUNCTIONS"]
+__all__ = ["tensor_sums", "compile_tensor_kernel", "TENSOR_FUNCTIONS"]
 
 #: the functions of the compiled tensor sums (:func:`compile_tensor_kernel`) besides the step's
 TENSOR_FUNCTIONS = ((sys.modules[__name__], "_tensor_kernel"),)
-
-
-def force_phase(engine, sample=False):
-    """The force phase of ``engine``: compiled on the ``"numba"`` backend where the step kernel covers
-    it, else :meth:`~particleShear.engine.step.BatchEngine.force_phase` (the same numbers).
-
-    Compiled: the first part of the compiled step (neighbours when due, relations and their
-    history, terms, forces and torques into the state, the guard when due, the terms when kept),
-    the acceleration and movement phases then reading the record.  The record's rows and the kept
-    terms are the phase's own buffers (no copies): the engine's workspace is given new ones, so
-    the engine's later steps and phases leave them as they are.
-
-    Parameters
-    ----------
-    engine : BatchEngine
-        The engine (a documented canvas's; any engine).
-    sample : bool or str
-        As :meth:`~particleShear.engine.step.BatchEngine.force_phase`.
-
-    Returns
-    -------
-    record : ForceRecord
-        What the acceleration and the movement of the step read (``verdict`` None: the compiled
-        phase reports an unsound verdict at once).
-    stresses : None or tuple
-        As :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them.
-
-    Raises
-    ------
-    EngineInstability
-        When the guard finds a guarded replica unstable.
-    """
-    if not engine.backend.compiled:
-        return engine.force_phase(sample)
-    try:
-        got = numba_step.launch(engine, 1.0, 0.0, sample, forces_only=True)
-    except BaseException:      # (the terms kept before the guard's report are the workspace's rows)
-        _take_buffers(numba_step.last_workspace(engine))
-        raise
-    if got is None:
-        return engine.force_phase(sample)
-    ws = got[0]
-    w = ws.work
-    record = ForceRecord(w[0], w[1], w[5], w[6], w[7], engine.s.contacts.active.copy(), ws.yc.copy(), ws.mob.copy(),
-                         None)
-    stresses = numba_step.step_samples(ws, sample)
-    _take_buffers(ws)
-    return record, stresses
-
-
-def _take_buffers(ws):
-    """Give the workspace ``ws`` (or nothing, None) new buffers for the rows a force phase alone hands
-    to its caller (its geometry ``work``, the kept terms ``kt`` and totals ``ktot``): those of the
-    phase are then the caller's record and terms, which no later compiled call writes into."""
-    if ws is None:
-        return
-    ws.work = np.empty_like(ws.work)
-    if ws.keep:
-        ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
-
-
-def move(engine, dt, g):
-    """The movement of ``engine`` after its force phase ``g`` and its kick: compiled on the ``"numba"``
-    backend where ``g`` is the record of a compiled phase (:func:`force_phase`) of the engine's
-    present candidates, else :meth:`~particleShear.engine.step.BatchEngine.move` (the same numbers).
-
-    Compiled: the tail of the compiled step from :data:`~particleShear.engine.numba_step.MOVE_ONLY`,
-    the sequential ξ rule (a random direction at ``|R| = 0`` drawn from the replica's generator,
-    :func:`~particleShear.engine.numba_step.resume_at_units`), the displacement since the lists were
-    built, the drift, the strain, the wrap, the clock and the lists due.
-
-    Parameters
-    ----------
-    engine : BatchEngine
-        The engine, its candidates those of the force phase.
-    dt : float
-        Time step (s).
-    g : ForceRecord or None
-        The record of the step's force phase (its pair vectors, normals, image velocity, heights);
-        None: a movement without a force phase (:meth:`~particleShear.engine.step.BatchEngine.move`).
-    """
-    ws = numba_step.last_workspace(engine) if engine.backend.compiled and g is not None else None
-    if ws is None or ws.why is not None or ws.C is not engine.s.contacts.C or g.verdict is not None:
-        engine.move(dt, g)
-        return
-    w = ws.work        # (the phase's geometry: its rows are the record's, the workspace has new ones)
-    w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
-    ws.yc[:] = g.yc
-    B = engine.s.B
-    kernel = numba_step.kernels_of(ws)[0]
-    args, held = numba_step.step_arguments(engine, ws, 1.0, dt, False, False, np.zeros(B, dtype=np.bool_))
-    numba_step.resume_at_units(engine, ws, kernel, args, kernel(numba_step.MOVE_ONLY, 0, B, *args))
-    numba_step.hand_back(engine, ws, held, stepped=True, kicked=False)
-    engine.step_count += 1
 
 
 def tensor_sums(q):

@@ -16,7 +16,6 @@ import numpy as np
 
 from ..engine.guard import transient_ratios
 from ..engine.step import BatchEngine
-from . import compiled_phases
 from .engine_adapter import state_of_ensemble
 
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
@@ -120,7 +119,7 @@ class EngineStep:
         eng = self._step_engine()
         self._hand_to_engine(eng)
         extra = self._frc.copy() if self._frc.any() else None     # forces put on before the phase add up
-        g = self._force_record = compiled_phases.force_phase(eng)[0]     # (compiled on the Numba backend)
+        g = self._force_record = eng.force_phase()[0]     # (compiled on the Numba backend)
         if extra is not None:
             self._frc += extra
         self.force_register.set_from_engine(self, eng, current=True)
@@ -150,7 +149,7 @@ class EngineStep:
         # where the drift takes the spheres: non-finite or far outside the cell stops the run (before the wrap)
         self._check_positions(self._pos + self._vel[:2] * dt)
         outside = eng.s.gamma.item(0) != self._engine_strain     # a strain set since the force phase
-        compiled_phases.move(eng, dt, self._force_record)
+        eng.move(dt, self._force_record)      # (compiled after a compiled force phase)
         self._force_record = None       # (the step's record ends with its movement, as in BatchEngine.step)
         if outside:             # the boundary images moved by Ly·Δγ: the lists anew at the next force phase
             eng.s.contacts.need[:] = True

@@ -31,11 +31,15 @@ and the protocol's schedule and observers.  The sums NumPy takes per replica (th
 _pairwise order, so the sampled stresses are the same bits too.  A step the compiled code does not cover (see :func:`reason`) runs on NumPy, with a
 one-line note per engine and reason.
 
-The pieces of a step are public (:func:`launch`, :func:`step_arguments`, :func:`resume_at_units`,
-:func:`hand_back`, :func:`kept_terms`, :func:`step_samples`, :data:`MOVE_ONLY`, :func:`compile_kernel`
-and the tensors' rows :func:`pair_tensor_rows`, :func:`sphere_tensor_rows`, :func:`tensor_row_sums`):
-the documented classes, which step an ensemble in three calls, run the kernel's force phase alone,
-its movement alone and their tensor sums through them, beside those classes
+The engine's phases run here alone too: :func:`force_phase` (the kernel's force phase,
+:func:`launch` with ``forces_only``) and :func:`move` (the kernel from its movement,
+:data:`MOVE_ONLY`) are :meth:`~particleShear.engine.step.BatchEngine.force_phase` and
+:meth:`~particleShear.engine.step.BatchEngine.move` on the ``"numba"`` backend (the documented
+classes step an ensemble in these phases, three calls).  The pieces of a step are public
+(:func:`launch`, :func:`step_arguments`, :func:`resume_at_units`, :func:`hand_back`,
+:func:`kept_terms`, :func:`step_samples`, :func:`compile_kernel` and the tensors' rows
+:func:`pair_tensor_rows`, :func:`sphere_tensor_rows`, :func:`tensor_row_sums`): the documented
+classes' tensor sums run through them, beside those classes
 (:mod:`particleShear.base.compiled_phases`).
 """
 __docformat__ = "numpy"
@@ -65,7 +69,7 @@ from .terms import normal_speed, pair_forces, slip_speed, viscous_force
 __all__ = ["STEP_FUNCTIONS", "reason", "compile_step_kernel", "compile_block_kernel", "compile_search_kernel",
            "compile_carried_kernel", "compile_constants_kernel", "compile_carry_kernel", "compile_kernels",
            "compile_kernel", "pair_tensor_rows", "sphere_tensor_rows", "tensor_row_sums",
-           "run_step", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
+           "run_step", "force_phase", "move", "launch", "resume_at_units", "step_arguments", "hand_back", "kept_terms",
            "step_samples", "draw_directions", "kernels_of", "last_workspace", "run_block", "search", "carried",
            "rebuild", "constant_rows", "NOT_RUN", "UNITS", "MOVE_ONLY", "TENSOR_SUMS", "REBUILD_IN_BLOCK", "SLACK"]
 
@@ -746,8 +750,8 @@ def compile_step_kernel(cache=True, say=None):
 def compile_kernel(key, name, functions, signature, cache=True, say=None, message=None, parallel=False, linear=False):
     """The compiled function ``name`` of ``functions`` (:func:`~.numba_driver.jit_laws`), compiled for
     ``signature()`` now (or loaded from Numba's cache) and kept per process under ``key``: the one
-    compile of every kernel of the step (the engine's, and the documented classes' tensor sums,
-    :mod:`particleShear.base.compiled_phases`).
+    compile of every kernel of the step (the engine's steps, blocks and phases, and the documented
+    classes' tensor sums, :func:`particleShear.base.compiled_phases.compile_tensor_kernel`).
 
     Parameters
     ----------
@@ -1139,7 +1143,8 @@ def launch(engine, cool, dt, sample, forces_only=False):
         The force phase alone (the kernel stops after it, the forces and torques left in the
         state's ``frc`` and the phase's geometry in the workspace's ``work``).  The kept terms
         (:func:`kept_terms`) are then the rows of the workspace's buffers themselves, not copies:
-        a caller that keeps them past the next compiled call gives the workspace new buffers first.
+        a caller that keeps them past the next compiled call gives the workspace new buffers first
+        (:func:`force_phase`).
 
     Returns
     -------
@@ -1172,6 +1177,108 @@ def launch(engine, cool, dt, sample, forces_only=False):
     if status == _GUARD:
         _report(engine, ws)
     return ws, kernel, args, held, status
+
+
+def force_phase(engine, sample=False):
+    """The force phase of ``engine`` alone in the compiled step
+    (:meth:`~particleShear.engine.step.BatchEngine.force_phase` on the ``"numba"`` backend), or None
+    where the compiled code does not cover the engine's step (:func:`reason`; the engine then runs
+    its NumPy phase, the same numbers).
+
+    The first part of the compiled step (:func:`launch` with ``forces_only``: neighbours when due,
+    relations and their history, terms, forces and torques into the state, the guard when due, the
+    terms when kept), the acceleration and movement phases then reading the record.  The record's
+    rows and the kept terms are the phase's own buffers (no copies): the engine's workspace is
+    given new ones (:func:`_take_buffers`), so the engine's later steps and phases leave them as
+    they are.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``).
+    sample : bool or str
+        As :meth:`~particleShear.engine.step.BatchEngine.force_phase`.
+
+    Returns
+    -------
+    tuple or None
+        ``(rows, stresses)``: the record's fields but its verdict, in the order of
+        :class:`~particleShear.engine.step.ForceRecord` (``dx, dy, nx, ny, dvx, active, yc, mob``;
+        the record's ``verdict`` is None: an unsound verdict is reported at once, as on NumPy), and
+        the stresses as :meth:`~particleShear.engine.step.BatchEngine.force_phase` returns them;
+        or None when the compiled code does not cover the engine's step.
+
+    Raises
+    ------
+    EngineInstability
+        When the guard finds a guarded replica unstable (at once, as the NumPy phase on the host).
+    """
+    try:
+        got = launch(engine, 1.0, 0.0, sample, forces_only=True)
+    except BaseException:      # (the terms kept before the guard's report are the workspace's rows)
+        _take_buffers(last_workspace(engine))
+        raise
+    if got is None:
+        return None
+    ws = got[0]
+    w = ws.work
+    rows = (w[0], w[1], w[5], w[6], w[7], engine.s.contacts.active.copy(), ws.yc.copy(), ws.mob.copy())
+    stresses = step_samples(ws, sample)
+    _take_buffers(ws)
+    return rows, stresses
+
+
+def _take_buffers(ws):
+    """Give the workspace ``ws`` (or nothing, None) new buffers for the rows a force phase alone hands
+    to its caller (its geometry ``work``, the kept terms ``kt`` and totals ``ktot``): those of the
+    phase are then the caller's record and terms, which no later compiled call writes into."""
+    if ws is None:
+        return
+    ws.work = np.empty_like(ws.work)
+    if ws.keep:
+        ws.kt, ws.ktot = np.empty_like(ws.kt), np.empty_like(ws.ktot)
+
+
+def move(engine, dt, g):
+    """The movement of ``engine`` after its force phase ``g`` and its kick in the compiled step
+    (:meth:`~particleShear.engine.step.BatchEngine.move` on the ``"numba"`` backend), where ``g`` is
+    the record of a compiled force phase (:func:`force_phase`) of the engine's present candidates
+    with no verdict left to read; else nothing (the engine then runs its NumPy movement, the same
+    numbers).
+
+    The tail of the compiled step from :data:`MOVE_ONLY`: the sequential ξ rule (a random direction
+    at ``|R| = 0`` drawn from the replica's generator, :func:`resume_at_units`), the displacement
+    since the lists were built, the drift, the strain, the wrap, the clock, the lists due and the
+    step count.
+
+    Parameters
+    ----------
+    engine : BatchEngine
+        The engine (backend ``"numba"``), its candidates those of the force phase.
+    dt : float
+        Time step (s).
+    g : ForceRecord or None
+        The record of the step's force phase (its pair vectors, normals, image velocity, heights);
+        None: a movement without a force phase (not run here).
+
+    Returns
+    -------
+    bool
+        Whether the movement ran here.
+    """
+    ws = last_workspace(engine) if g is not None else None
+    if ws is None or ws.why is not None or ws.C is not engine.s.contacts.C or g.verdict is not None:
+        return False
+    w = ws.work        # (the phase's geometry: its rows are the record's, the workspace has new ones)
+    w[0], w[1], w[5], w[6], w[7] = g.dx, g.dy, g.nx, g.ny, g.dvx
+    ws.yc[:] = g.yc
+    B = engine.s.B
+    kernel = kernels_of(ws)[0]
+    args, held = step_arguments(engine, ws, 1.0, dt, False, False, np.zeros(B, dtype=np.bool_))
+    resume_at_units(engine, ws, kernel, args, kernel(MOVE_ONLY, 0, B, *args))
+    hand_back(engine, ws, held, stepped=True, kicked=False)
+    engine.step_count += 1
+    return True
 
 
 def resume_at_units(engine, ws, kernel, args, status):

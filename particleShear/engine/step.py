@@ -523,9 +523,9 @@ class BatchEngine:
             out = numba_step.run_step(self, cool, dt, sample)
             if out is not numba_step.NOT_RUN:
                 return out
-        g, out = self.force_phase(sample)       # (g, the phase's record, is freed with this call)
+        g, out = self._force_phase(sample)       # (g, the phase's record, is freed with this call)
         self.accelerate(cool, dt, g)
-        self.move(dt, g)
+        self._move(dt, g)
         return out
 
     def steps(self, n, cool, dt):
@@ -554,10 +554,12 @@ class BatchEngine:
         is its arguments).  With :attr:`keep_terms` the per-term arrays are kept in :attr:`terms`
         for the force register.  With the velocity Verlet integrator (:attr:`integrator`) the
         velocity-dependent terms see the velocities moved half a kick ahead (the half kick of the
-        previous step).  This is the phase of the NumPy step, which the compiled step runs in one
-        call instead (:meth:`step`); the force phase alone in the compiled code is
-        :func:`~particleShear.engine.numba_step.launch` with ``forces_only`` (the documented
-        classes' phase, :func:`particleShear.base.compiled_phases.force_phase`).
+        previous step).  On the compiled backend the phase runs in the compiled step kernel, alone
+        (:func:`~particleShear.engine.numba_step.force_phase`: the kernel's force phase, the same
+        bits; the record's rows and the kept terms are then the phase's own buffers, which later
+        steps and phases leave as they are), where the compiled step covers the engine
+        (:func:`~particleShear.engine.numba_step.reason`); else it is the NumPy step's phase, the
+        one :meth:`step` runs on NumPy (the compiled step runs its force phase in its one call).
 
         Parameters
         ----------
@@ -567,10 +569,28 @@ class BatchEngine:
         Returns
         -------
         record : ForceRecord
-            What :meth:`accelerate` and :meth:`move` of the step read.
+            What :meth:`accelerate` and :meth:`move` of the step read.  Its ``verdict`` is None on
+            the host backends (NumPy and compiled), where an unsound guard verdict is reported at
+            once (raised here); a device's verdict is read with the flags by :meth:`move`.
         stresses : None or tuple
             As :meth:`step` returns.
+
+        Raises
+        ------
+        EngineInstability
+            On the host backends, when the stability guard (checked every ``check_interval`` steps)
+            finds a guarded replica unstable; the forces and the kept terms of the phase are then
+            written.
         """
+        if self.backend.compiled:
+            got = numba_step.force_phase(self, sample)
+            if got is not None:       # (the compiled phase has reported an unsound verdict at once)
+                return ForceRecord(*got[0], None), got[1]
+        return self._force_phase(sample)
+
+    def _force_phase(self, sample=False):
+        """The NumPy step's force phase (:meth:`force_phase` where it does not run compiled, and the
+        phase of :meth:`step` on NumPy); the parameters and results of :meth:`force_phase`."""
         s = self.s
         x, y, vx, vy, om = s.x, s.y, s.vx, s.vy, s.omega
         yc, dx, dy, ky, kx, d, touching, active, image_rate = self.relations()
@@ -666,11 +686,11 @@ class BatchEngine:
     def _compiled_terms(self, C):
         """Whether the force terms of a NumPy force phase run in the compiled pair loop of :mod:`.numba_driver`.
 
-        A NumPy force phase on the compiled backend is a step the compiled step leaves to NumPy (a
-        scene :func:`.numba_step.reason` names, with its note there, or the documented classes'
-        own force phase).  Its terms run compiled for the default laws (the linear law and the
-        tensile law of bonds, from prepared constants) of frictional replicas or bonds when the
-        terms are not kept for a register; otherwise the NumPy terms run (the same bits).
+        A NumPy force phase on the compiled backend is a step or phase the compiled step leaves to
+        NumPy (a scene :func:`.numba_step.reason` names, with its note there).  Its terms run
+        compiled for the default laws (the linear law and the tensile law of bonds, from prepared
+        constants) of frictional replicas or bonds when the terms are not kept for a register;
+        otherwise the NumPy terms run (the same bits).
         """
         return not self.keep_terms and self.s.contacts.free_p is None and force_phase_laws(self.s, C) == (None, None)
 
@@ -756,10 +776,13 @@ class BatchEngine:
         """ξ of sticking contacts and bonds (sequential rule, Appendix B.2), drift, strain, wrap, clock.
 
         Ends with the step's one read of per-replica flags on the host: the lists due for a
-        rebuild (and, on a device, the stability guard's verdict).  The movement of the NumPy step
-        (the compiled step runs it in its one call; the movement alone in the compiled code is the
-        step kernel from :data:`~particleShear.engine.numba_step.MOVE_ONLY`, the documented
-        classes' movement, :func:`particleShear.base.compiled_phases.move`).
+        rebuild (and, on a device, the stability guard's verdict), and the step count.  On the
+        compiled backend, after a compiled :meth:`force_phase` of the present candidates, the
+        movement runs in the compiled step kernel, alone
+        (:func:`~particleShear.engine.numba_step.move`: the kernel from
+        :data:`~particleShear.engine.numba_step.MOVE_ONLY`, the same bits); else it is the NumPy
+        step's movement (:meth:`move_spheres`, :meth:`advance_cells`), the one :meth:`step` runs
+        on NumPy.
 
         Parameters
         ----------
@@ -774,6 +797,12 @@ class BatchEngine:
         EngineInstability
             On a device, if the force phase's guard verdict is not sound.
         """
+        if not (self.backend.compiled and numba_step.move(self, dt, g)):
+            self._move(dt, g)
+
+    def _move(self, dt, g=None):
+        """The NumPy step's movement (:meth:`move` where it does not run compiled, and the movement
+        of :meth:`step` on NumPy): :meth:`move_spheres`, then :meth:`advance_cells`."""
         self.move_spheres(dt, g)
         self.advance_cells(dt, g)
 
