@@ -12,6 +12,7 @@ import numpy as np
 
 from particleShear import EnsembleLinkable, SphereLinkable
 from particleShear.base.engine_adapter import state_from_ensembles, state_of_ensemble
+from particleShear.base.register import KeptTerms
 from particleShear.engine.config import EngineConfig
 from particleShear.engine.step import BatchEngine
 
@@ -19,7 +20,7 @@ CONFIG_FIELDS = ("integrator", "skin_factor", "check_interval", "guard", "min_di
                  "max_kinetic_energy", "keep_terms", "numbers_relations", "lees_edwards",
                  "strain_only_while_shearing")
 #: the engine's read-only properties of its configuration
-READ_ONLY = ("config", "integrator", "keep_terms", "check_interval", "min_distance_ratio", "max_kinetic_energy",
+READ_ONLY = ("config", "integrator", "keep_terms", "terms_to", "check_interval", "min_distance_ratio", "max_kinetic_energy",
              "numbers_relations", "skin", "guard", "guard_dev", "lees_edwards", "strain_advances")
 
 
@@ -40,7 +41,7 @@ class TestEngineConfig(unittest.TestCase):
         given = dict(integrator="verlet", skin_factor=0.3, check_interval=7, guard=False, min_distance_ratio=0.02,
                      max_kinetic_energy=12.5, keep_terms=True, numbers_relations=False, lees_edwards=False,
                      strain_only_while_shearing=True)
-        eng = BatchEngine(state_from_ensembles([ensemble()]), **given)
+        eng = BatchEngine(state_from_ensembles([ensemble()]), **given, terms_to=KeptTerms())
         self.assertEqual(dataclasses.asdict(eng.config), given)
         self.assertEqual(eng.config, EngineConfig(**given))
         for name, value in given.items():        # (the engine's properties of the same names)
@@ -77,7 +78,8 @@ class TestEngineConfig(unittest.TestCase):
                 BatchEngine(state_from_ensembles([ensemble()]), **bad)
 
     def test_configuration_cannot_be_changed_after_construction(self):
-        eng = BatchEngine(state_from_ensembles([ensemble()]), keep_terms=True, check_interval=3)
+        kept = KeptTerms()
+        eng = BatchEngine(state_from_ensembles([ensemble()]), keep_terms=True, terms_to=kept, check_interval=3)
         cfg = eng.config
         for name in CONFIG_FIELDS:
             with self.subTest(field=name), self.assertRaises(dataclasses.FrozenInstanceError):
@@ -89,6 +91,45 @@ class TestEngineConfig(unittest.TestCase):
             eng.guard[0] = False
         self.assertIs(eng.config, cfg)
         self.assertEqual((eng.keep_terms, eng.check_interval), (True, 3))
+        self.assertIs(eng.terms_to, kept)
+
+    def test_kept_terms_need_their_receiver(self):
+        # keep_terms and terms_to come together (the terms are handed out, the engine keeps none)
+        for bad in (dict(keep_terms=True), dict(terms_to=KeptTerms()), dict(keep_terms=True, terms_to="register"),
+                    dict(config=EngineConfig(keep_terms=True))):
+            with self.subTest(bad=bad), self.assertRaisesRegex(ValueError, "keep_terms=.*terms_to="):
+                BatchEngine(state_from_ensembles([ensemble()]), **bad)
+        self.assertIsNotNone(BatchEngine(state_from_ensembles([ensemble()]), config=EngineConfig(keep_terms=True),
+                                         terms_to=KeptTerms()))
+
+    def test_the_engine_keeps_no_terms_of_its_phases(self):
+        """Each NumPy force phase hands its terms to ``terms_to`` as a new value (the forces of the
+        phase's totals are the forces it wrote), also the phase of an unsound guard verdict, before
+        it raises; the engine holds no attribute of them."""
+        from particleShear.engine.step import EngineInstability
+        from particleShearTest.test_engine import constituted
+
+        got = []
+        ens = constituted(31)[1]
+        eng = BatchEngine(state_from_ensembles([ens], backend="numpy"), keep_terms=True, terms_to=got.append,
+                          check_interval=1)
+        eng.set_rate(np.array([300.0]))
+        for k in range(3):
+            g, _ = eng.force_phase()
+            self.assertEqual(len(got), k + 1)
+            np.testing.assert_array_equal(got[-1]["totals"], eng.s.frc)
+            np.testing.assert_array_equal(got[-1]["dx"], g.dx)
+            eng.accelerate(0.999, ens.dt, g)
+            eng.move(ens.dt, g)
+        eng.step(0.999, ens.dt)
+        self.assertEqual(len(got), 4)
+        self.assertEqual(len({id(t) for t in got}), 4)
+        self.assertFalse(any("terms" == name for name in vars(eng)))
+        eng.s.vel *= 1e6            # an unsound state: the guard raises after the terms are handed out
+        with self.assertRaises(EngineInstability):
+            eng.force_phase()
+        self.assertEqual(len(got), 5)
+        np.testing.assert_array_equal(got[-1]["totals"], eng.s.frc)
 
     def test_configuration_is_the_same_objects_at_every_read(self):
         # numba_step._key compares the configuration by identity, step after step

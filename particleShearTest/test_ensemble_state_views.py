@@ -23,6 +23,7 @@ from particleShear.base.engine_adapter import (state_from_ensembles, state_of_en
 from particleShear.engine import numba_driver
 from particleShear.engine.step import BatchEngine
 from particleShear.engine.xp import BACKEND_ENV
+from particleShear.base.register import KeptTerms
 from particleShear.objects.ensembles import EnsembleFrictionLeesEdwards, EnsembleLeesEdwards
 
 #: the ensemble's attribute and the state's array of each replica value
@@ -46,7 +47,8 @@ def engine_on_copy(ens):
     s = state_from_ensembles([ens], backend="numpy")
     s.applying_shear = bool(ens.applyingShear)
     s.rng = [copy.deepcopy(g) for g in s.rng]
-    return BatchEngine(s, skin_factor=ens.neighbour_skin, guard=False, keep_terms=True, lees_edwards=True,
+    return BatchEngine(s, skin_factor=ens.neighbour_skin, guard=False, keep_terms=True, terms_to=KeptTerms(),
+                       lees_edwards=True,
                        strain_only_while_shearing=False)
 
 

@@ -266,15 +266,18 @@ class ForceRegisterOrderTest(unittest.TestCase):
         # the engine's force phase on the ensemble's own state, its terms given to the register
         # (Force_register.set_from_engine): the same entries, in the same order
         from particleShear.base.engine_adapter import state_of_ensemble
+        from particleShear.base.register import KeptTerms
         from particleShear.engine.step import BatchEngine
         for name, spec in SCENES.items():
             with self.subTest(scene=name):
                 ens = two_sphere_scene(**spec)
                 want = reference_force_phase(ens)
-                eng = BatchEngine(state_of_ensemble(ens), guard=False, keep_terms=True, numbers_relations=True)
+                kept = KeptTerms()
+                eng = BatchEngine(state_of_ensemble(ens), guard=False, keep_terms=True, terms_to=kept,
+                                  numbers_relations=True)
                 eng.force_phase()
                 eng.flush()                    # the states of the relations into the ensemble's table
-                self.assertTrue(ens.force_register.set_from_engine(ens, eng, current=True))
+                self.assertTrue(ens.force_register.set_from_engine(ens, eng, kept.last, current=True))
                 self._compare(name, ens, want)
 
     def test_scenes_exercise_every_list(self):

@@ -168,14 +168,15 @@ class TestCompiledStepBits(unittest.TestCase):
 
     def test_terms_kept_for_a_force_register(self):
         """An engine that keeps its terms for a force register (the documented experiment's) runs
-        compiled, in blocks and step by step, and keeps the terms of its last force phase with
-        NumPy's bits: every array of :attr:`BatchEngine.terms` (the elastic and viscous parts of
+        compiled, in blocks and step by step, and hands the terms of its last force phase to its
+        ``terms_to`` with NumPy's bits: every array of them (the elastic and viscous parts of
         each visit, the tangential visits, the forces on i and j, geometry, roles, totals), with
         spheres sharing their parameters and with spheres of their own, at B = 1 and 2."""
         import contextlib
         from unittest import mock
 
         from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.base.register import KeptTerms
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
 
@@ -188,7 +189,8 @@ class TestCompiledStepBits(unittest.TestCase):
                         for k, sphere in enumerate(ens[0].sphereList[:9] if own else ()):
                             sphere.central_repulsion_coefficient = 0.5 + 0.05 * k
                             sphere.permanent_ratio_central = 1.0 + 0.2 * k
-                        eng = BatchEngine(state_from_ensembles(ens, backend=backend), keep_terms=True)
+                        kept = KeptTerms()
+                        eng = BatchEngine(state_from_ensembles(ens, backend=backend), keep_terms=True, terms_to=kept)
                         eng.s.applying_shear = True
                         eng.set_rate(np.array([400.0, -300.0][:B]))
                         patch = mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("NumPy"))
@@ -196,7 +198,7 @@ class TestCompiledStepBits(unittest.TestCase):
                             eng.steps(30, 0.999, ens[0].dt)
                             if last == "step":
                                 eng.step(0.999, ens[0].dt, sample=True)
-                        terms.append(eng.terms)
+                        terms.append(kept.last)
                     self.assertEqual(terms[1]["fx_j"] is not None, own)
                     self.assertTrue(np.any(terms[1]["F"] != 0.0))
                     self.assert_same_tree(terms[0], terms[1], f"own={own} B={B} {last}")
@@ -205,16 +207,18 @@ class TestCompiledStepBits(unittest.TestCase):
         """The record and the kept terms of the engine's compiled force phase alone are rows of its own
         buffers: its movement, later steps (whole, in blocks) and later force phases leave them as they were."""
         from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.base.register import KeptTerms
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
 
         ens = constituted(63, **FRICTIONAL_BONDS)[1]
-        eng = BatchEngine(state_from_ensembles([ens], backend="numba"), keep_terms=True)
+        kept = KeptTerms()
+        eng = BatchEngine(state_from_ensembles([ens], backend="numba"), keep_terms=True, terms_to=kept)
         eng.s.applying_shear = True
         eng.set_rate(np.array([400.0]))
         g = eng.force_phase()[0]
         self.assertIsNot(g.dx.base, None)       # (the compiled phase's own rows)
-        terms = eng.terms
+        terms = kept.last
         arrays = lambda: [np.array(a) for a in (*g[:8], *terms["parts"][0], terms["F"], terms["dx"], terms["fx_i"],  # noqa: E731
                                                 terms["totals"])]
         before = arrays()
@@ -225,7 +229,7 @@ class TestCompiledStepBits(unittest.TestCase):
         eng.force_phase()
         for a, b in zip(before, arrays()):
             np.testing.assert_array_equal(_bits(a) if a.dtype.kind == "f" else a, _bits(b) if b.dtype.kind == "f" else b)
-        self.assertIsNot(eng.terms, terms)
+        self.assertIsNot(kept.last, terms)
 
     def test_engine_phases_run_compiled(self):
         """``BatchEngine.force_phase``, ``accelerate`` and ``move`` called by an engine's user on the
@@ -238,6 +242,7 @@ class TestCompiledStepBits(unittest.TestCase):
         from unittest import mock
 
         from particleShear.base.engine_adapter import state_from_ensembles
+        from particleShear.base.register import KeptTerms
         from particleShear.engine.step import BatchEngine
         from particleShearTest.test_engine import constituted
 
@@ -245,7 +250,9 @@ class TestCompiledStepBits(unittest.TestCase):
             engines, seen = [], []
             for backend in ("numpy", "numba"):
                 ens = [constituted(65, **FRICTIONAL_BONDS)[1], constituted(66, **FRICTIONAL)[1]]
-                eng = BatchEngine(state_from_ensembles(ens, backend=backend), integrator=integrator, keep_terms=keep)
+                kept = KeptTerms() if keep else None
+                eng = BatchEngine(state_from_ensembles(ens, backend=backend), integrator=integrator, keep_terms=keep,
+                                  terms_to=kept)
                 eng.s.applying_shear = True
                 numpy_phases = (mock.patch.object(BatchEngine, "_force_phase", side_effect=AssertionError("NumPy")),
                                 mock.patch.object(BatchEngine, "_move", side_effect=AssertionError("NumPy move")))
@@ -258,7 +265,7 @@ class TestCompiledStepBits(unittest.TestCase):
                         eng.set_rate(np.array([400.0, -300.0]) * np.cos(0.03 * k))
                         sample = "tensors" if k % 25 == 0 else bool(k % 7 == 0)
                         g, out = eng.force_phase(sample)
-                        records.append((tuple(g), out, eng.terms if keep else None))
+                        records.append((tuple(g), out, kept.last if keep else None))
                         eng.accelerate(0.999, ens[0].dt, g)
                         eng.move(ens[0].dt, g)
                         if backend == "numba":

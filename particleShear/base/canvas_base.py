@@ -185,7 +185,7 @@ class CanvasPoints:
     #: what a copy or a pickle of the ensemble leaves out: the memo (with the step's engine), the
     #: step's records of that engine (:class:`~particleShear.base.engine_view.EngineStep`) and the
     #: views of the state block (made anew on the copy's own block)
-    _NOT_COPIED = ("_memo", "_st", "_a", "_pos", "_vel", "_frc", "_g", "_force_record", "_engine_pairs",
+    _NOT_COPIED = ("_memo", "_st", "_a", "_pos", "_vel", "_frc", "_g", "_force_record", "_kept_terms", "_engine_pairs",
                    "_engine_strain", "_engine_mu")
 
     def __init__(self, size_x, size_y, theCanvas=False, doDrawing=False):

@@ -17,6 +17,7 @@ import numpy as np
 from ..engine.guard import transient_ratios
 from ..engine.step import BatchEngine
 from .engine_adapter import state_of_ensemble
+from .register import KeptTerms
 
 __all__ = ["EngineStep", "ForcePhaseGeometry"]
 
@@ -67,8 +68,9 @@ class EngineStep:
         """A new engine on the ensemble's state (which holds the ensemble's Verlet predictor: the
         new engine continues the one it replaces, :mod:`particleShear.engine.predictor`)."""
         self._drop_engine()
+        self._kept_terms = KeptTerms()        # (what the force phases hand out, for the force register)
         eng = BatchEngine(state_of_ensemble(self, backend="auto"), skin_factor=self.neighbour_skin, guard=False,
-                          integrator=getattr(self, "integrator", "euler"), keep_terms=True,   # (the force register)
+                          integrator=getattr(self, "integrator", "euler"), keep_terms=True, terms_to=self._kept_terms,
                           numbers_relations=True,          # (the creation numbers order the neighbours)
                           lees_edwards=self._lees_edwards(),
                           strain_only_while_shearing=self._strain_only_while_shearing)
@@ -122,7 +124,7 @@ class EngineStep:
         g = self._force_record = eng.force_phase()[0]     # (compiled on the Numba backend)
         if extra is not None:
             self._frc += extra
-        self.force_register.set_from_engine(self, eng, current=True)
+        self.force_register.set_from_engine(self, eng, self._kept_terms.last, current=True)
         self._g = ForcePhaseGeometry(eng, g)
         self._take_relations(eng)
         return eng

@@ -14,18 +14,18 @@ from ..engine.forces import pair_roles
 from ..engine.terms import pair_forces
 from ..engine.xp import to_host
 
-__all__ = ["Force_register", "SphereSelection", "TermRecord", "register_block"]
+__all__ = ["Force_register", "KeptTerms", "SphereSelection", "TermRecord", "register_block"]
 
 
 class TermRecord(collections.namedtuple("TermRecord", "C parts F dx dy nx ny d touching active shifted mob fx_i fy_i "
                                                       "fx_j fy_j dF tq birth totals")):
     """The per-candidate terms of an engine's last force phase, as the force register reads them.
 
-    Made from :attr:`~particleShear.engine.step.BatchEngine.terms` (a dict of the same names, kept
-    with :attr:`~particleShear.engine.step.BatchEngine.keep_terms`) by :meth:`Force_register.set_from_engine`.
-    The record type lives here, beside its only reader, rather than in the engine: the engine
-    keeps the arrays as plain values and knows nothing of the register's layout (the layers go
-    engine → base, never back).
+    Made from the terms an engine with :attr:`~particleShear.engine.step.BatchEngine.keep_terms`
+    hands to its :attr:`~particleShear.engine.step.BatchEngine.terms_to` (a dict of the same names,
+    held by :class:`KeptTerms`) by :meth:`Force_register.set_from_engine`.  The record type lives
+    here, beside its only reader, rather than in the engine: the engine hands the arrays out as
+    plain values and knows nothing of the register's layout (the layers go engine → base, never back).
 
     Attributes
     ----------
@@ -58,7 +58,7 @@ class TermRecord(collections.namedtuple("TermRecord", "C parts F dx dy nx ny d t
 
 def register_block(t, N, b, tangential=True):
     """The force register's block of replica ``b`` of a force phase whose terms an engine kept
-    (:attr:`~particleShear.engine.step.BatchEngine.terms` with
+    (what :attr:`~particleShear.engine.step.BatchEngine.terms_to` received with
     :attr:`~particleShear.engine.step.BatchEngine.keep_terms` on), in the layout the
     documented classes' register (:class:`Force_register`) reads.
 
@@ -71,8 +71,7 @@ def register_block(t, N, b, tangential=True):
     Parameters
     ----------
     t : TermRecord or None
-        The record of the force phase (:class:`TermRecord` of the engine's
-        :attr:`~particleShear.engine.step.BatchEngine.terms`).
+        The record of the force phase (:class:`TermRecord` of the terms the engine handed out).
     N : int
         Spheres per replica.
     b : int
@@ -124,6 +123,28 @@ class PairBlock(dict):
         raise KeyError(key)
 
 
+class KeptTerms:
+    """The receiver of an engine's kept terms: ``BatchEngine(..., keep_terms=True, terms_to=KeptTerms())``.
+
+    The engine hands the per-term arrays of its force phases to it as they end (a value, as
+    HOOMD-blue's writers take theirs; the engine keeps none); it holds the last, for a documented
+    ensemble's force register (:meth:`Force_register.set_from_engine`).
+
+    Attributes
+    ----------
+    last : dict or None
+        The terms of the last force phase handed over (None before the first).
+    """
+    __slots__ = ("last",)
+
+    def __init__(self):
+        self.last = None
+
+    def __call__(self, terms):
+        """Hold ``terms`` (a dict of arrays by name), the last force phase's."""
+        self.last = terms
+
+
 class EngineForcePhase:
     """Force phase of replica ``b`` of an engine, held by a register (which does not keep the engine alive).
 
@@ -132,7 +153,7 @@ class EngineForcePhase:
     Parameters
     ----------
     terms : TermRecord
-        The engine's :attr:`~particleShear.engine.step.BatchEngine.terms` of the phase.
+        The terms the engine handed out for the phase (:class:`KeptTerms`).
     N, b, pos_version : int
         Spheres per replica; the replica; the ensemble's position version of the phase (−1: moved since).
     tangential, one_host_replica : bool
@@ -316,15 +337,18 @@ class Force_register:
         self._tot = (mobile, fx, fy)
         self._mom = torque
 
-    def set_from_engine(self, ensemble, engine, b=0, current=False):
-        """Hold the last force phase (pairs, totals) of replica ``b``; return False, changing nothing, if none.
+    def set_from_engine(self, ensemble, engine, terms, b=0, current=False):
+        """Hold a force phase (pairs, totals) of replica ``b``; return False, changing nothing, if none.
 
         Parameters
         ----------
         ensemble : ensemble
             The ensemble of the replica (its spheres are the lists' entries).
         engine : BatchEngine
-            An engine after a force phase with ``keep_terms`` on.
+            The engine of the phase (its batch's N and B, its backend).
+        terms : dict or None
+            The terms the engine handed to its ``terms_to`` for the phase (:class:`KeptTerms`
+            ``.last``; None: no phase).
         b : int, default 0
             The replica.
         current : bool, default False
@@ -333,10 +357,9 @@ class Force_register:
             (after whole steps of the engine, whose last movement followed the phase): they are
             evaluated anew.  The caller says it, since the engine keeps no record of its phases.
         """
-        t = engine.terms
-        if t is None:
+        if terms is None:
             return False
-        t = TermRecord(**t)
+        t = TermRecord(**terms)
         spin = ensemble._torque_total() is not None
         N = engine.s.N
         mobile = to_host(t.mob, "register")[b * N:(b + 1) * N]

@@ -1173,7 +1173,7 @@ def launch(engine, cool, dt, sample, forces_only=False):
         status = kernel(3, 0, B, *args)
     hand_back(engine, ws, held)
     if ws.keep:
-        engine.terms = kept_terms(engine, ws, own_buffers=forces_only)
+        engine.terms_to(kept_terms(engine, ws, own_buffers=forces_only))
     if status == _GUARD:
         _report(engine, ws)
     return ws, kernel, args, held, status
@@ -1466,7 +1466,7 @@ def hand_back(engine, ws, held, stepped=False, kicked=True):
 
 def kept_terms(engine, ws, own_buffers=False):
     """The terms of the last force phase as the NumPy force phase keeps them for a force register
-    (:attr:`~particleShear.engine.step.BatchEngine.terms`): the rows the step kept (``keep``) and its
+    (what :attr:`~particleShear.engine.step.BatchEngine.terms_to` receives): the rows the step kept (``keep``) and its
     geometry; the torques ``dF·w`` and the contacts ``d < d0`` are the NumPy phase's expressions on them.
 
     Parameters
@@ -1482,7 +1482,8 @@ def kept_terms(engine, ws, own_buffers=False):
     Returns
     -------
     dict
-        The arrays by name, as :attr:`~particleShear.engine.step.BatchEngine.terms`.
+        The arrays by name, as the NumPy force phase hands them to
+        :attr:`~particleShear.engine.step.BatchEngine.terms_to`.
     """
     c = engine.s.contacts
     C, w, kt, own = c.C, ws.work, ws.kt, ws.visit_j
@@ -1648,7 +1649,7 @@ def run_block(engine, rates, cool, dt, record=None, row=0, n=None, tensors=None,
         if slots is not None:
             _settle(engine, slots)
     if ws.keep:        # (the terms of the last step: a batch of one, whose last call stepped it)
-        engine.terms = kept_terms(engine, ws)
+        engine.terms_to(kept_terms(engine, ws))
     if want.any():     # (the tensors of the sampled steps at once: each column is one replica's step)
         k = np.flatnonzero(want)
         S = sums[k].transpose(1, 0, 2).reshape(TENSOR_SUMS, -1)

@@ -127,7 +127,8 @@ class BatchEngine:
     (:class:`~particleShear.engine.predictor.Predictor`), which the engine continues (an Euler
     engine drops it; :meth:`~particleShear.engine.predictor.Predictor.start`).  The engine keeps of
     the run only the guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s),
-    the step count ``step_count``, the ``phase``, the protocol's ``record`` and the register's ``terms``.
+    the step count ``step_count``, the ``phase`` and the protocol's ``record``; the terms a force
+    phase keeps (``keep_terms``) go to the caller's ``terms_to``, as a value.
 
     Parameters
     ----------
@@ -150,7 +151,7 @@ class BatchEngine:
         ``set_integrator("verlet")``).
     keep_terms : bool, keyword-only
         Keep the per-term arrays of each force phase for the force register of a script's
-        ensemble (:func:`particleShear.base.register.register_block`).
+        ensemble (:func:`particleShear.base.register.register_block`): they go to ``terms_to``.
     min_distance_ratio : float, keyword-only
         The guard's smallest d/(r_i + r_j) of a transient contact (the attribute of a
         :class:`~particleShear.base.stability.StabilityGuard`).
@@ -174,13 +175,22 @@ class BatchEngine:
         frictionless canvases).
     config : EngineConfig or None, keyword-only
         The whole configuration at once (:class:`~particleShear.engine.config.EngineConfig`),
-        instead of the keyword arguments above (``state``, ``half`` and ``phase`` aside).
+        instead of the keyword arguments above (``state``, ``half``, ``phase`` and ``terms_to`` aside).
+    terms_to : callable or None, keyword-only
+        With ``keep_terms`` (and only then): ``terms_to(terms)`` receives the per-term arrays of a
+        force phase by name (a plain dict; the register reads it as a
+        :class:`particleShear.base.register.TermRecord`) when the phase ends, before an unsound
+        guard verdict is raised: every force phase of :meth:`force_phase` and of NumPy's
+        :meth:`step`, the last of each compiled step or block (the compiled backend keeps only
+        that one).  A value handed out, as HOOMD-blue's writers take theirs: the engine keeps
+        none (:class:`particleShear.base.register.KeptTerms` holds the last one).
 
     Raises
     ------
     ValueError
-        If ``skin_factor`` is not > 0, ``integrator`` is unknown, ``check_interval`` < 1, or
-        ``config`` is given with configuration keywords.
+        If ``skin_factor`` is not > 0, ``integrator`` is unknown, ``check_interval`` < 1,
+        ``config`` is given with configuration keywords, or ``keep_terms`` and ``terms_to`` are
+        not given together (``terms_to`` callable).
     """
 
     INTEGRATORS = INTEGRATORS
@@ -188,7 +198,7 @@ class BatchEngine:
     def __init__(self, state, skin_factor=0.5, check_interval=4, guard=True, integrator="euler", *,
                  keep_terms=False, min_distance_ratio=0.05, max_kinetic_energy=None, half=None,
                  phase="pre-equilibration", numbers_relations=False, lees_edwards=True,
-                 strain_only_while_shearing=False, config=None):
+                 strain_only_while_shearing=False, config=None, terms_to=None):
         given = EngineConfig(integrator=integrator, skin_factor=skin_factor, check_interval=check_interval,
                              guard=guard, min_distance_ratio=min_distance_ratio,
                              max_kinetic_energy=max_kinetic_energy, keep_terms=keep_terms,
@@ -198,11 +208,12 @@ class BatchEngine:
             config = given
         elif given != EngineConfig():
             raise ValueError("give the engine's configuration either as config or as keyword arguments, not both")
+        if config.keep_terms != (terms_to is not None) or not (terms_to is None or callable(terms_to)):
+            raise ValueError(f"keep_terms={config.keep_terms!r}, terms_to={terms_to!r}: the kept terms need "
+                             "terms_to, a callable that receives them, and terms_to needs keep_terms=True")
         s = self.s = state
         self._config = config     # (read-only: the property config)
-        #: with :attr:`keep_terms`, the per-term arrays of the last force phase by name (a plain dict;
-        #: the record type that reads them is the register's, :class:`particleShear.base.register.TermRecord`)
-        self.terms = None
+        self._terms_to = terms_to     # (read-only: the property terms_to)
         xp = self.xp = s.xp
         self.backend = s.backend
         self.notes = set()        # why the compiled backend fell back to NumPy (each reason once)
@@ -245,7 +256,10 @@ class BatchEngine:
                           doc="The integrator, ``\"euler\"`` or ``\"verlet\"`` (:attr:`config`).")
     keep_terms = property(lambda self: self.config.keep_terms,
                           doc="Keep the per-term arrays of each force phase for the force register "
-                              "(``base.register``; :attr:`config`).")
+                              "(``base.register``; :attr:`config`), handed to :attr:`terms_to`.")
+    terms_to = property(lambda self: self._terms_to,
+                        doc="The callable that receives the kept terms of the force phases (None without "
+                            ":attr:`keep_terms`); fixed at construction.")
     check_interval = property(lambda self: self.config.check_interval,
                               doc="Steps between the checks of the stability guard (:attr:`config`).")
     min_distance_ratio = property(lambda self: self.config.min_distance_ratio,
@@ -551,7 +565,7 @@ class BatchEngine:
         ``nx, ny``, image velocity ``dvx``, relations ``active``, the heights ``y − Ly/2``, the
         mobility mask, a device's guard verdict), which the caller hands to :meth:`accelerate` and
         :meth:`move` and then drops (the engine keeps no record of the phase: what a phase reads
-        is its arguments).  With :attr:`keep_terms` the per-term arrays are kept in :attr:`terms`
+        is its arguments).  With :attr:`keep_terms` the per-term arrays go to :attr:`terms_to`
         for the force register.  With the velocity Verlet integrator (:attr:`integrator`) the
         velocity-dependent terms see the velocities moved half a kick ahead (the half kick of the
         previous step).  On the compiled backend the phase runs in the compiled step kernel, alone
@@ -579,8 +593,8 @@ class BatchEngine:
         ------
         EngineInstability
             On the host backends, when the stability guard (checked every ``check_interval`` steps)
-            finds a guarded replica unstable; the forces and the kept terms of the phase are then
-            written.
+            finds a guarded replica unstable; the forces of the phase are then written and its
+            kept terms handed to :attr:`terms_to`.
         """
         if self.backend.compiled:
             got = numba_step.force_phase(self, sample)
@@ -628,9 +642,9 @@ class BatchEngine:
         out = None
         shifted = (ky != 0) | (kx != 0) if sample or self.keep_terms else None
         if self.keep_terms:
-            self.terms = dict(C=C, parts=parts, F=self.xp.stack(F), dx=dx, dy=dy, nx=nx, ny=ny, d=d, touching=touching,
+            self._terms_to(dict(C=C, parts=parts, F=self.xp.stack(F), dx=dx, dy=dy, nx=nx, ny=ny, d=d, touching=touching,
                               active=active, shifted=shifted, mob=mob, fx_i=fx_i, fy_i=fy_i, fx_j=fx_j, fy_j=fy_j, dF=dF,
-                              tq=tq, birth=c.birth, totals=s.frc.copy())   # (the kick resets s.frc)
+                                tq=tq, birth=c.birth, totals=s.frc.copy()))   # (the kick resets s.frc)
         if sample:
             q = None if sample != "tensors" else StressInputs(
                 C=C, B=s.B, rep=s.rep, x=x, y=y, vx=vx, vy=vy, omega=om, m=s.m, inertia=s.inertia, Lx=s.Lx, Ly=s.Ly,

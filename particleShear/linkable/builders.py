@@ -694,7 +694,7 @@ class _StateTarget:
             backend, s.backend = s.backend, host_backend("auto")      # (the ensemble's own engine's)
             try:
                 engine = BatchEngine(s, skin_factor=CanvasPointsNeighbors.neighbour_skin, guard=False,
-                                     keep_terms=True, numbers_relations=True)
+                                     numbers_relations=True)
                 engine.relations()
                 engine.flush()
             finally:

@@ -20,6 +20,7 @@ import numpy as np
 from ..base.stress import StressTensorEvaluation
 from ..engine.loops import relaxation_levels
 from ..base.engine_adapter import state_of_ensemble, untouched_on_failure, write_back
+from ..base.register import KeptTerms
 from .evaluation import EvaluationHandlerPlotter, demodulation
 from .output import NO_TENSOR_DATA_TEXT, experiment_description_text, iter_table_text, output_summary_text
 from .drawing import IMAGE_EXTENSIONS
@@ -528,6 +529,8 @@ class OscillatoryShearExperiment:
         Returns
         -------
         BatchEngine
+            Its ``terms_to`` is a :class:`~particleShear.base.register.KeptTerms`: the terms of its
+            last force phase, for the ensemble's force register.
         """
         ens = self.theEnsemble
         guard = getattr(ens, "stability_guard", None)
@@ -536,11 +539,11 @@ class OscillatoryShearExperiment:
             state.predictor.drop()
         thresholds = ({} if guard is None else     # the thresholds of the ensemble's guard
                       dict(min_distance_ratio=guard.min_distance_ratio, max_kinetic_energy=guard.max_kinetic_energy))
-        # keep_terms: the last step's terms, for the ensemble's force register; "auto": compiled where
-        # Numba is installed (the same numbers, terms included)
+        # keep_terms: the last step's terms, handed to a KeptTerms for the ensemble's force register;
+        # "auto": compiled where Numba is installed (the same numbers, terms included)
         return BatchEngine(state, skin_factor=ENGINE_SKIN_FACTOR, guard=guard is not None,
                            check_interval=getattr(guard, "interval", 4), integrator=getattr(ens, "integrator", "euler"),
-                           keep_terms=True, numbers_relations=True, **thresholds)
+                           keep_terms=True, terms_to=KeptTerms(), numbers_relations=True, **thresholds)
 
     def _scene(self, engine):
         scene = ReplicaScene(getattr(self.theEnsemble, "graphical_output_configuration", None))
@@ -566,7 +569,7 @@ class OscillatoryShearExperiment:
             ens.step_count = 0        # the protocol's steps, as the documented loop counts them
         write_back(engine, 0, ens, steps, constitution=False, dt=self.dt)
         ens.phase = engine.phase
-        ens.force_register.set_from_engine(ens, engine)
+        ens.force_register.set_from_engine(ens, engine, engine.terms_to.last)
 
     def _conclude(self, G_int, G_surf, t0):
         """Keep the demodulations, say them (verbose), write block 3 to ``output_file``; return G_surface."""
