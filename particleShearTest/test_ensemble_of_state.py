@@ -34,7 +34,7 @@ PARAMS = [pytest.param(legacy, fields, seed, id=f"{name}-{seed}") for name, lega
 
 #: what differs by construction, not by content: the private counters of what depends on the block and
 #: the step's engine's caches (the builders' ensemble made one for its neighbour update)
-PRIVATE = ("_block_version", "_pos_version", "_params_version", "_engine_mu", "_engine_strain")
+PRIVATE = ("_block_version", "_pos_version", "_params_version", "_engine_mu", "_engine_strain", "_kept_terms")
 #: the state's memory, compared separately (shared objects or their own checks below)
 MEMORY = ("_block", "_st", "_a", "_pos", "_vel", "_frc", "_replica", "_pairs", "_predictor", "_rng", "_sphereList",
           "particles", "model", "graphical_output_configuration", "force_register", "_memo")
