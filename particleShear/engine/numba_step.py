@@ -2424,6 +2424,10 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
              xi, active, birth, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum,
              work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, kt, ktot))
     B = rate.shape[0]
+    # a run without a law of its own, spheres' own constants or a force register (the protocols' runs) steps
+    # through the step compiled with those three flags as the constant False (Numba compiles a call with a
+    # literal argument for that value): their branches leave the pair loop, ≈ 4 % of a block (docs/performance.md)
+    plain = not (custom or visit_j or keep)
     for b in prange(B):
         k, start, st = ks[b], starts[b], _DONE
         while start != _SKIP and k < n:
@@ -2454,12 +2458,22 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                 F, I, Bf, S, X, Ac, Bi = Sf, Si, Sb, s_state, s_xi, s_active, s_birth
             else:
                 F, I, Bf, S, X, Ac, Bi = Cf, Ci, Cb, state_p, xi, active, birth
-            st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
-                              applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half, half_out, pos, vel, frc, phi,
-                              mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, F, I, Bf, offsets, ends, S,
-                              X, Ac, Bi, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean, m_sum, min_ratio,
-                              max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep, kt, ktot,
-                              False)
+            if plain:     # (custom, visit_j and keep as the constant False: the step compiled without them)
+                st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
+                                  applying, numbers, form, False, A, False, form_j, Tj, free_mode, free, verlet, pred, half,
+                                  half_out, pos, vel, frc, phi,
+                                  mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, F, I, Bf, offsets, ends, S,
+                                  X, Ac, Bi, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean,
+                                  m_sum, min_ratio, max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, False,
+                                  kt, ktot, False)
+            else:
+                st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
+                                  applying, numbers, form, custom, A, visit_j, form_j, Tj, free_mode, free, verlet, pred, half,
+                                  half_out, pos, vel, frc, phi,
+                                  mmi, r, Ly_s, rep_s, rate, gamma, t, Lx, Ly, V, le, adv, F, I, Bf, offsets, ends, S,
+                                  X, Ac, Bi, next_birth, u, u_max, strain, bound, r_max, skin, guard_on, rate_max, kk, r_mean,
+                                  m_sum, min_ratio, max_ke, work, mob, yc, y0, zero, tau, verdict, need, tp, ts, tsum, keep,
+                                  kt, ktot, False)
             start = 0
             if st != _DONE:
                 break
