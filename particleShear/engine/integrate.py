@@ -1,10 +1,17 @@
 """Integration of one Euler step: kick, plates, damping, the sequential ξ rule, drift (eqs. S1-10 … S1-12).
 
-Small pure functions over arrays that the batch engine's step (:meth:`~particleShear.engine.step.BatchEngine.step`)
-and the documented canvas classes (``mechanical_simulation_step_calculate_acceleration`` and
-``…_calculate_movement``) both call, so each of these operations is written once.  They work in place
-on the rows they are given (a sphere block of B·N columns, or of the N spheres of one ensemble), in
-the array namespace of their inputs (NumPy or CuPy).
+Two kinds of function, each operation written once:
+
+- **pure expressions** (:func:`velocity_change`, :func:`half_velocity_change`, :func:`plate_velocity`,
+  :func:`damped`, :func:`flow_shifted`, :func:`xi_rates`): values in, values out, on arrays or on
+  numbers, evaluated by the NumPy step and by the compiled step (:mod:`particleShear.engine.numba_step`)
+  alike (docs/backends.md, "One law, two drivers");
+- **the NumPy step's array operations** built from them (:func:`kick`, :func:`plates_follow`,
+  :func:`damp`, :func:`shift_flow`, :func:`xi_increments`, :func:`drift` …), which update in place
+  the rows they are given (a sphere block of B·N columns, or of the N spheres of one ensemble: the
+  batch engine's :meth:`~particleShear.engine.step.BatchEngine.step` and the documented canvases'
+  ``mechanical_simulation_step_calculate_acceleration`` and ``…_calculate_movement`` call them), in
+  the array namespace of their inputs (NumPy or CuPy): the state's arrays are updated, never replaced.
 
 The order of a step (docs/engine.md, "One step"): forces → :func:`kick` → :func:`plates_follow`
 → :func:`damp` → :func:`xi_increments` (velocities after the kick and damping, positions of the force
