@@ -153,7 +153,8 @@ class EngineForcePhase:
     Parameters
     ----------
     terms : TermRecord
-        The terms the engine handed out for the phase (:class:`KeptTerms`).
+        The record of the terms the engine handed out for the phase (made from what a
+        :class:`KeptTerms` holds).
     N, b, pos_version : int
         Spheres per replica; the replica; the ensemble's position version of the phase (−1: moved since).
     tangential, one_host_replica : bool

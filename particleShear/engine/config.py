@@ -42,7 +42,8 @@ class EngineConfig:
         The guard's bound of the kinetic energy relative to the flow (mg·µm²/s² per m depth);
         None: the engine's default bound.
     keep_terms : bool
-        Keep the per-term arrays of each force phase for the force register.
+        Keep the per-term arrays of each force phase for the force register; an engine so
+        configured needs the receiver of those arrays, ``BatchEngine(..., terms_to=f)``.
     numbers_relations : bool
         Number the relations as they form (their creation numbers order a documented ensemble's
         neighbours; the adapters build an engine on an ensemble's memory with True).

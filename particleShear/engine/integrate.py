@@ -6,12 +6,14 @@ Two kinds of function, each operation written once:
   :func:`damped`, :func:`flow_shifted`, :func:`xi_rates`): values in, values out, on arrays or on
   numbers, evaluated by the NumPy step and by the compiled step (:mod:`particleShear.engine.numba_step`)
   alike (docs/backends.md, "One law, two drivers");
-- **the NumPy step's array operations** built from them (:func:`kick`, :func:`plates_follow`,
-  :func:`damp`, :func:`shift_flow`, :func:`xi_increments`, :func:`drift` …), which update in place
-  the rows they are given (a sphere block of B·N columns, or of the N spheres of one ensemble: the
-  batch engine's :meth:`~particleShear.engine.step.BatchEngine.step` and the documented canvases'
-  ``mechanical_simulation_step_calculate_acceleration`` and ``…_calculate_movement`` call them), in
-  the array namespace of their inputs (NumPy or CuPy): the state's arrays are updated, never replaced.
+- **the NumPy step's array operations** built from them, in the array namespace of their inputs
+  (NumPy or CuPy), on the rows they are given (a sphere block of B·N columns, or the N spheres of
+  one ensemble: the batch engine's :meth:`~particleShear.engine.step.BatchEngine.step` and the
+  documented canvases' ``mechanical_simulation_step_calculate_acceleration`` and
+  ``…_calculate_movement`` call them).  :func:`kick`, :func:`plates_follow`, :func:`damp`,
+  :func:`shift_flow`, :func:`remove_mean_velocity` and :func:`drift` update those rows in place
+  (the state's arrays are updated, never replaced); :func:`half_kick`, :func:`mobile_mask` and
+  :func:`xi_increments` return new arrays (the caller adds the ξ increments to ξ).
 
 The order of a step (docs/engine.md, "One step"): forces → :func:`kick` → :func:`plates_follow`
 → :func:`damp` → :func:`xi_increments` (velocities after the kick and damping, positions of the force

@@ -893,7 +893,8 @@ def _law_kernels(function, m, say=None, parallel=False, fingerprint=None):
     names = ("pair_term", "_step_kernel", "_block_kernel")
     extra, rename = _linear()
     L = numba_driver.jit_laws(True, STEP_FUNCTIONS + KERNEL_FUNCTIONS + BLOCK_FUNCTIONS, inline=INLINE,
-                              extra={"_central_law": adapter, **extra}, rename={**rename, **{n: n + suffix for n in names}},
+                              extra={"_central_law": adapter, "PLAIN_STEP": False, **extra},
+                              rename={**rename, **{n: n + suffix for n in names}},
                               parallel=("_block_kernel",) if parallel else ())
     step, block = L["_step_kernel"], L["_block_kernel"]
     if say is not None and not numba_driver.on_disk(step):
@@ -2369,6 +2370,12 @@ def _rebuild_replica(b, N, pos, r, Lx, Ly, gamma, le, skin, r_max, pc, Cf, Ci, s
 #: branch is removed at compile time)
 BORROWED_VIEWS = True
 
+#: :func:`_block_kernel` steps a run without a law of its own, spheres' constants of their own or a force
+#: register through a second compile of the step without those flags (≈ 4 % of a block); False in the
+#: blocks of a run's law (:func:`_law_kernels`), whose runs always have one: Numba prunes the branch on
+#: this constant, so those blocks compile no step they would never call
+PLAIN_STEP = True
+
 
 def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec_internal, rec_surface, row, step0,
                   interval, guarded, scheduled, want, rec_sums, here, base, cap, pc, rebuilt, d_eq_c, Sf, Si, Sb,
@@ -2426,7 +2433,8 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
     B = rate.shape[0]
     # a run without a law of its own, spheres' own constants or a force register (the protocols' runs) steps
     # through the step compiled with those three flags as the constant False (Numba compiles a call with a
-    # literal argument for that value): their branches leave the pair loop, ≈ 4 % of a block (docs/performance.md)
+    # literal argument for that value): their branches leave the pair loop, ≈ 4 % of a block (docs/performance.md);
+    # a run law's block (PLAIN_STEP False, _law_kernels) compiles no such step
     plain = not (custom or visit_j or keep)
     for b in prange(B):
         k, start, st = ks[b], starts[b], _DONE
@@ -2460,7 +2468,7 @@ def _block_kernel(ks, n, starts, status, rates, rec_t, rec_strain, rec_rate, rec
                 F, I, Bf, S, X, Ac, Bi = Cf, Ci, Cb, state_p, xi, active, birth
             # (two calls on purpose: the literal False arguments of the first are what makes Numba compile the
             # step without those flags; one call with the shared arguments packed as *args took 1.05× as long)
-            if plain:     # (custom, visit_j and keep as the constant False: the step compiled without them)
+            if PLAIN_STEP and plain:     # (custom, visit_j, keep the constant False: the step compiled without them)
                 st = _step_kernel(start, b, b + 1, N, cool, dt, code, due_check,
                                   applying, numbers, form, False, A, False, form_j, Tj, free_mode, free, verlet, pred, half,
                                   half_out, pos, vel, frc, phi,

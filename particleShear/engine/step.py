@@ -127,8 +127,9 @@ class BatchEngine:
     (:class:`~particleShear.engine.predictor.Predictor`), which the engine continues (an Euler
     engine drops it; :meth:`~particleShear.engine.predictor.Predictor.start`).  The engine keeps of
     the run only the guard's ``rate_max`` (the largest |γ̇| of each replica since it started, 1/s),
-    the step count ``step_count``, the ``phase`` and the protocol's ``record``; the terms a force
-    phase keeps (``keep_terms``) go to the caller's ``terms_to``, as a value.
+    the step count ``step_count``, the ``phase``, the protocol's ``record`` and the ``notes`` of why
+    the compiled backend fell back to NumPy; the terms a force phase keeps (``keep_terms``) go to
+    the caller's ``terms_to``, as a value.
 
     Parameters
     ----------
